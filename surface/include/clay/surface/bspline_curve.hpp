@@ -1,0 +1,44 @@
+#pragma once
+/// BSplineCurve — a (rational) B-spline curve as plain data.
+///
+/// C(t) = sum_i N_{i,p}(t) w_i P_i / sum_i N_{i,p}(t) w_i. Weights are all 1 for a polynomial curve;
+/// one type serves both so that no algorithm exists twice.
+#include <clay/surface/basis.hpp>
+
+#include <Eigen/Core>
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace clay::surface {
+
+/// Control points, one row per point (x, y, z in millimetres), row-major so each point is contiguous.
+using Points3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+/// A B-spline curve: basis, control points (basis.count() rows) and weights (basis.count() entries,
+/// positive, all 1 when polynomial).
+struct BSplineCurve {
+  BSplineBasis basis;
+  Points3 points;
+  Eigen::VectorXd weights;
+
+  /// True when some weight differs from 1.
+  bool is_rational() const noexcept;
+};
+
+/// Builds and validates a curve; `weights` empty means polynomial (all 1).
+/// Throws clay::Error(InvalidGeometry) naming every broken invariant.
+BSplineCurve make_curve(int degree, std::vector<double> knots, Points3 points,
+                        Eigen::VectorXd weights = {});
+
+/// Every invariant the curve breaks, in words, each naming `name`. Empty when valid.
+std::vector<std::string> problems(const BSplineCurve& curve, std::string_view name = "curve");
+
+/// Throws clay::Error(InvalidGeometry) listing problems(curve, name) when there are any.
+void validate(const BSplineCurve& curve, std::string_view name = "curve");
+
+/// True when degree, knots, control points and weights are equal bit for bit.
+bool identical(const BSplineCurve& a, const BSplineCurve& b) noexcept;
+
+}  // namespace clay::surface

@@ -1,0 +1,73 @@
+#pragma once
+/// STEP, IGES and glTF exchange of B-spline surfaces (through OpenCASCADE, kept out of this header).
+///
+/// Writing is lossless: control points, weights and knots are written with 17 significant digits,
+/// so reading a file back gives bit-identical data. Each surface becomes one face bounded by its
+/// exact iso-parameter edges. Files are written to a temporary file in the target folder and
+/// renamed on success: a failed write leaves no file behind. All exchange calls are serialized
+/// internally (OpenCASCADE 7.6's translators are not thread-safe), so they may be called from
+/// several threads.
+#include <clay/surface/bspline_surface.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace clay::surface {
+
+/// Largest degree OpenCASCADE (and so our STEP/IGES export) accepts.
+inline constexpr int max_exchange_degree = 25;
+
+/// STEP application protocol written.
+enum class StepSchema { AP214, AP242 };
+
+/// Settings of write_step.
+struct StepWriteOptions {
+  StepSchema schema = StepSchema::AP214;  ///< AP214 (automotive design) by default
+  std::string product_name = "clayform";  ///< product name written in the file header
+};
+
+/// Settings of write_gltf.
+struct GltfWriteOptions {
+  double linear_deflection = 0.05;   ///< mesher chord tolerance in millimetres, > 0
+  double angular_deflection = 0.35;  ///< mesher angle tolerance in radians, in (0, pi)
+};
+
+/// What was written (or checked): size figures and OpenCASCADE's BRepCheck verdict.
+struct ExchangeReport {
+  int faces = 0;              ///< faces written
+  int max_degree = 0;         ///< largest degree over both directions of every surface
+  long control_points = 0;    ///< control points over all surfaces
+  bool valid = false;         ///< every face passes BRepCheck_Analyzer at `tolerance`
+  double tolerance = 1e-7;    ///< tolerance of the faces' edges and vertices (mm)
+  std::vector<std::string> problems;  ///< BRepCheck findings, in words, per face
+};
+
+/// Writes `surfaces` as faces to a STEP file (millimetres). Throws clay::Error: InvalidGeometry for
+/// an invalid surface, DegreeLimit above max_exchange_degree, Exchange when OpenCASCADE refuses the
+/// model, Io when the file cannot be written. Returns the face count and BRepCheck verdict.
+ExchangeReport write_step(const std::vector<BSplineSurface>& surfaces,
+                          const std::filesystem::path& file, const StepWriteOptions& options = {});
+
+/// Writes `surfaces` as faces to an IGES file (trimmed surfaces, entity 144, over rational B-spline
+/// surfaces, entity 128; millimetres). Throws as write_step.
+ExchangeReport write_iges(const std::vector<BSplineSurface>& surfaces,
+                          const std::filesystem::path& file);
+
+/// Reads every B-spline surface of a STEP file (other analytic surfaces are converted to B-splines
+/// exactly by OpenCASCADE). Throws clay::Error(Io) when the file is missing or unreadable,
+/// Exchange when it holds no surface.
+std::vector<BSplineSurface> read_step(const std::filesystem::path& file);
+
+/// Reads every B-spline surface of an IGES file. Throws as read_step.
+std::vector<BSplineSurface> read_iges(const std::filesystem::path& file);
+
+/// Builds the faces that write_step/write_iges write and runs BRepCheck_Analyzer on them.
+ExchangeReport check_faces(const std::vector<BSplineSurface>& surfaces);
+
+/// Meshes the surfaces and writes a binary glTF (.glb) preview. glTF's units are metres and its
+/// up axis is Y; the writer converts. Throws as write_step, and InvalidArgument for bad options.
+void write_gltf(const std::vector<BSplineSurface>& surfaces, const std::filesystem::path& file,
+                const GltfWriteOptions& options = {});
+
+}  // namespace clay::surface

@@ -1,0 +1,38 @@
+#pragma once
+// OpenCASCADE as an independent reference, behind an OCCT-free interface (internal; used by tests
+// and benchmarks only, not installed). Each function converts through the adapter in convert.hpp.
+#include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <memory>
+#include <span>
+
+namespace clay::surface::occt_reference {
+
+/// Point and derivatives up to order 2 from Geom_BSplineSurface::D2 (du, dv, duu, duv, dvv).
+SurfaceDerivatives surface_d2(const BSplineSurface& surface, double u, double v);
+
+/// Point and derivatives up to order 2 from Geom_BSplineCurve::D2.
+CurveDerivatives curve_d2(const BSplineCurve& curve, double t);
+
+/// Ours -> Geom_BSplineSurface -> ours (checks the adapter is bit-exact both ways).
+BSplineSurface round_trip(const BSplineSurface& surface);
+/// Ours -> Geom_BSplineCurve -> ours.
+BSplineCurve round_trip(const BSplineCurve& curve);
+
+/// Holds one Geom_BSplineSurface and evaluates grids with its D0 (the benchmark's baseline).
+class GridEvaluator {
+ public:
+  explicit GridEvaluator(const BSplineSurface& surface);
+  ~GridEvaluator();
+  GridEvaluator(const GridEvaluator&) = delete;
+  GridEvaluator& operator=(const GridEvaluator&) = delete;
+  /// Same layout as clay::surface::evaluate_grid.
+  Points3 evaluate_grid(std::span<const double> us, std::span<const double> vs) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace clay::surface::occt_reference
