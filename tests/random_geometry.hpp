@@ -84,3 +84,34 @@ inline surface::BSplineCurve random_curve(std::mt19937& rng, int degree, int cou
 }
 
 }  // namespace clay::test
+
+#include <clay/surface/evaluate.hpp>
+
+namespace clay::test {
+
+/// Largest distance between two surfaces over an n x n grid of their common domain, divided by
+/// the size of the first one's control box (a relative deviation).
+inline double relative_deviation(const surface::BSplineSurface& a, const surface::BSplineSurface& b,
+                                 int n = 41) {
+  const auto [ua, ub] = a.u.domain();
+  const auto [va, vb] = a.v.domain();
+  const auto us = surface::linspace(ua, ub, n);
+  const auto vs = surface::linspace(va, vb, n);
+  double worst = 0;
+  for (double u : us)
+    for (double v : vs) worst = std::max(worst, (surface::evaluate(a, u, v) - surface::evaluate(b, u, v)).norm());
+  const auto [lo, hi] = surface::control_box(a);
+  return worst / (hi - lo).norm();
+}
+
+/// Same for curves, on n samples.
+inline double relative_deviation(const surface::BSplineCurve& a, const surface::BSplineCurve& b, int n = 201) {
+  const auto [ta, tb] = a.basis.domain();
+  double worst = 0;
+  for (double t : surface::linspace(ta, tb, n))
+    worst = std::max(worst, (surface::evaluate(a, t) - surface::evaluate(b, t)).norm());
+  const Eigen::Vector3d lo = a.points.colwise().minCoeff(), hi = a.points.colwise().maxCoeff();
+  return worst / (hi - lo).norm();
+}
+
+}  // namespace clay::test

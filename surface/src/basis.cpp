@@ -116,7 +116,8 @@ int find_span(const BSplineBasis& basis, double t) {
   const auto& k = basis.knots;
   const double a = k[static_cast<size_t>(p)];
   const double b = k[static_cast<size_t>(n)];
-  if (!(t >= a && t <= b)) {
+  // isfinite first: an ordered comparison with NaN would raise FE_INVALID where traps are on.
+  if (!std::isfinite(t) || t < a || t > b) {
     std::ostringstream m;
     m.precision(17);
     m << "parameter " << t << " is outside the domain [" << a << ", " << b

@@ -1,0 +1,53 @@
+#pragma once
+/// Knot insertion (Boehm), knot refinement and Bézier extraction. None of these change the shape:
+/// the new representation describes the same curve or surface (exactly, up to rounding).
+///
+/// Every function validates its input and throws clay::Error: InvalidGeometry for an invalid
+/// object, OutOfDomain for a knot outside the parameter domain, InvalidArgument for a request that
+/// would raise a knot's multiplicity above the degree (above degree + 1 at the domain ends of an
+/// unclamped vector's outermost value).
+#include <clay/surface/bspline_surface.hpp>
+
+#include <span>
+#include <vector>
+
+namespace clay::surface {
+
+/// Inserts knot t `times` times (Boehm's algorithm, The NURBS Book A5.1).
+BSplineCurve insert_knot(const BSplineCurve& curve, double t, int times = 1);
+/// Inserts knot u `times` times in the u direction of the surface.
+BSplineSurface insert_knot_u(const BSplineSurface& surface, double u, int times = 1);
+/// Inserts knot v `times` times in the v direction of the surface.
+BSplineSurface insert_knot_v(const BSplineSurface& surface, double v, int times = 1);
+
+/// Inserts all of `knots` (sorted or not, repeats allowed) at once (The NURBS Book A5.4).
+BSplineCurve refine_knots(const BSplineCurve& curve, std::span<const double> knots);
+/// Knot refinement in the u direction of the surface.
+BSplineSurface refine_knots_u(const BSplineSurface& surface, std::span<const double> knots);
+/// Knot refinement in the v direction of the surface.
+BSplineSurface refine_knots_v(const BSplineSurface& surface, std::span<const double> knots);
+
+/// Splits the curve into its Bézier segments, one per non-empty knot span of the domain, each a
+/// clamped curve of the same degree on its own span [t_k, t_k+1] (parameters are kept, not
+/// normalized), so segment k evaluates like the curve on that span.
+std::vector<BSplineCurve> extract_bezier(const BSplineCurve& curve);
+
+/// The Bézier patches of a surface, one per pair of non-empty knot spans.
+struct BezierPatches {
+  std::vector<double> breaks_u;          ///< distinct knot values of the u domain, ends included
+  std::vector<double> breaks_v;          ///< same in v
+  std::vector<BSplineSurface> patches;   ///< patch (i, j) at i * count_v() + j
+
+  int count_u() const noexcept { return static_cast<int>(breaks_u.size()) - 1; }
+  int count_v() const noexcept { return static_cast<int>(breaks_v.size()) - 1; }
+  /// Patch over [breaks_u[i], breaks_u[i+1]] x [breaks_v[j], breaks_v[j+1]].
+  const BSplineSurface& patch(int i, int j) const {
+    return patches[static_cast<size_t>(i * count_v() + j)];
+  }
+};
+
+/// Splits the surface into its Bézier patches (The NURBS Book A5.7 by way of refinement); each
+/// patch keeps the surface's parameters on its span, so it evaluates like the surface there.
+BezierPatches extract_bezier(const BSplineSurface& surface);
+
+}  // namespace clay::surface

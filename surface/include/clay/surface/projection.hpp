@@ -1,0 +1,48 @@
+#pragma once
+/// Projection of a point onto a surface: the local foot point from a start (normal projection)
+/// and the global closest point.
+///
+/// Both minimize |S(u,v) - P|^2 over the parameter domain by Newton's method on the gradient
+/// (S_u.r, S_v.r) with the full Hessian (S_u.S_u + S_uu.r, ...), a backtracking line search and
+/// bound constraints, so a foot point on a domain edge is found as such (a Karush–Kuhn–Tucker
+/// point), not by silently clamping the answer.
+#include <clay/summary.hpp>
+#include <clay/surface/bspline_surface.hpp>
+
+#include <Eigen/Core>
+
+namespace clay::surface {
+
+/// Settings of project_normal and closest_point.
+struct ProjectionOptions {
+  int max_iterations = 50;            ///< Newton iterations per start, >= 1
+  double parametric_tolerance = 1e-14;///< step size below which Newton stops (relative to domain)
+  double cosine_tolerance = 1e-12;    ///< |cos| between S_u or S_v and S - P that counts as normal
+  int samples_per_span = 4;           ///< closest_point: start grid density per knot span, >= 1
+  int starts = 4;                     ///< closest_point: Newton runs from the best grid samples, >= 1
+
+  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  void validate() const;
+};
+
+/// A projected point: its parameters, the surface point, the distance and how Newton ended.
+struct SurfaceProjection {
+  double u = 0, v = 0;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double distance = 0;
+  bool on_boundary = false;  ///< the foot point lies on the domain edge (gradient points outside)
+  Summary summary;
+};
+
+/// The foot point of `point` reached by Newton from (u0, v0): a point where S - P is normal to the
+/// surface (or a constrained minimum on the domain edge). Throws clay::Error: OutOfDomain for a
+/// start outside the domain, InvalidGeometry for an invalid surface or a non-finite point.
+SurfaceProjection project_normal(const BSplineSurface& surface, const Eigen::Vector3d& point,
+                                 double u0, double v0, const ProjectionOptions& options = {});
+
+/// The closest point of the surface to `point`: Newton from the best samples of a grid of
+/// samples_per_span points per knot span, the nearest result kept. Throws as project_normal.
+SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vector3d& point,
+                                const ProjectionOptions& options = {});
+
+}  // namespace clay::surface

@@ -1,0 +1,203 @@
+#include <clay/surface/projection.hpp>
+
+#include <clay/error.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+namespace clay::surface {
+
+void ProjectionOptions::validate() const {
+  auto bad = [](const std::string& field, const std::string& rule) {
+    throw Error(ErrorCategory::InvalidArgument, "ProjectionOptions::" + field + " " + rule);
+  };
+  if (max_iterations < 1) bad("max_iterations", "= " + std::to_string(max_iterations) + " must be >= 1");
+  if (!(parametric_tolerance > 0.0 && parametric_tolerance < 1.0))
+    bad("parametric_tolerance", "= " + std::to_string(parametric_tolerance) + " must be in (0, 1)");
+  if (!(cosine_tolerance > 0.0 && cosine_tolerance < 1.0))
+    bad("cosine_tolerance", "= " + std::to_string(cosine_tolerance) + " must be in (0, 1)");
+  if (samples_per_span < 1) bad("samples_per_span", "= " + std::to_string(samples_per_span) + " must be >= 1");
+  if (starts < 1) bad("starts", "= " + std::to_string(starts) + " must be >= 1");
+}
+
+namespace {
+
+void check_point(const Eigen::Vector3d& p) {
+  if (!p.allFinite())
+    throw Error(ErrorCategory::InvalidGeometry,
+                "projection: the point to project has a non-finite coordinate; give a finite point");
+}
+
+/// Newton from (u0, v0) on a valid surface (checked by the callers).
+SurfaceProjection newton(const BSplineSurface& s, const Eigen::Vector3d& target, double u0, double v0,
+                         const ProjectionOptions& o) {
+  const auto [ua, ub] = s.u.domain();
+  const auto [va, vb] = s.v.domain();
+  const double lo[2] = {ua, va}, hi[2] = {ub, vb};
+  const double step_tol[2] = {o.parametric_tolerance * (ub - ua), o.parametric_tolerance * (vb - va)};
+  double x[2] = {u0, v0};
+  SurfaceProjection out;
+  SurfaceDerivatives d = derivatives(s, x[0], x[1], 2);
+  double f = (d.point - target).squaredNorm();
+  out.summary.initial_residual = std::sqrt(f);
+  const double scale = (s.points.colwise().maxCoeff() - s.points.colwise().minCoeff()).norm() + target.norm();
+  out.summary.termination = Termination::NotConverged;
+  out.summary.message = "iteration limit reached";
+  int it = 0;
+  bool active[2] = {false, false};
+  for (; it < o.max_iterations; ++it) {
+    const Eigen::Vector3d r = d.point - target;
+    const Eigen::Vector3d su = d.du, sv = d.dv;
+    const Eigen::Vector2d g(su.dot(r), sv.dot(r));
+    Eigen::Matrix2d H;
+    H << su.dot(su) + d.duu.dot(r), su.dot(sv) + d.duv.dot(r), su.dot(sv) + d.duv.dot(r),
+        sv.dot(sv) + d.dvv.dot(r);
+    // Active bounds: at a domain edge with the descent direction pointing outside.
+    for (int k = 0; k < 2; ++k) active[k] = (x[k] <= lo[k] && g[k] > 0.0) || (x[k] >= hi[k] && g[k] < 0.0);
+    // Stationary for every free coordinate: S - P is normal to S_u (resp. S_v), or P is on S.
+    const double rn = r.norm();
+    bool stationary = rn <= 1e-15 * scale;
+    if (!stationary) {
+      stationary = true;
+      const Eigen::Vector3d* tangents[2] = {&su, &sv};
+      for (int k = 0; k < 2; ++k) {
+        if (active[k]) continue;
+        const double tn = tangents[k]->norm();
+        if (tn == 0.0) continue;  // degenerate direction (a pole): nothing to move
+        if (std::abs(g[k]) > o.cosine_tolerance * tn * rn) stationary = false;
+      }
+    }
+    if (stationary) {
+      out.summary.termination = Termination::Converged;
+      out.summary.message = "foot point found";
+      break;
+    }
+    // Newton step on the free coordinates; Gauss–Newton matrix when the Hessian is not positive.
+    Eigen::Vector2d step = Eigen::Vector2d::Zero();
+    Eigen::Matrix2d G;
+    G << su.dot(su), su.dot(sv), su.dot(sv), sv.dot(sv);
+    auto solve_free = [&](const Eigen::Matrix2d& M) -> bool {
+      if (!active[0] && !active[1]) {
+        if (!(M(0, 0) > 0.0 && M.determinant() > 0.0)) return false;
+        step = -M.ldlt().solve(g);
+        return step.allFinite();
+      }
+      for (int k = 0; k < 2; ++k) {
+        if (active[k]) continue;
+        if (!(M(k, k) > 0.0)) return false;
+        step[k] = -g[k] / M(k, k);
+      }
+      return true;
+    };
+    step.setZero();
+    if (!solve_free(H)) {
+      step.setZero();
+      if (!solve_free(G)) {
+        out.summary.termination = Termination::Failed;
+        out.summary.message = "degenerate surface derivatives at the current point";
+        break;
+      }
+    }
+    // Backtracking line search within the domain box.
+    double t = 1.0, xn[2] = {x[0], x[1]};
+    double fn = f;
+    SurfaceDerivatives dn;
+    bool accepted = false;
+    for (int ls = 0; ls < 40; ++ls) {
+      for (int k = 0; k < 2; ++k) xn[k] = std::clamp(x[k] + t * step[k], lo[k], hi[k]);
+      dn = derivatives(s, xn[0], xn[1], 2);
+      fn = (dn.point - target).squaredNorm();
+      // Near the foot point f changes at rounding level: accept that noise, or Newton stalls.
+      if (fn <= f * (1.0 + 1e-13)) {
+        accepted = true;
+        break;
+      }
+      t *= 0.5;
+    }
+    const bool tiny = std::abs(xn[0] - x[0]) <= step_tol[0] && std::abs(xn[1] - x[1]) <= step_tol[1];
+    if (!accepted || tiny) {
+      if (accepted) {
+        x[0] = xn[0];
+        x[1] = xn[1];
+        d = dn;
+        f = fn;
+      }
+      out.summary.termination = Termination::Converged;
+      out.summary.message = "parameter step below tolerance";
+      ++it;
+      break;
+    }
+    x[0] = xn[0];
+    x[1] = xn[1];
+    d = dn;
+    f = fn;
+  }
+  out.u = x[0];
+  out.v = x[1];
+  out.point = d.point;
+  out.distance = std::sqrt(f);
+  out.on_boundary = active[0] || active[1];
+  out.summary.iterations = it;
+  out.summary.final_residual = out.distance;
+  return out;
+}
+
+}  // namespace
+
+SurfaceProjection project_normal(const BSplineSurface& surface, const Eigen::Vector3d& point,
+                                 double u0, double v0, const ProjectionOptions& options) {
+  options.validate();
+  validate(surface);
+  check_point(point);
+  find_span(surface.u, u0);  // throws OutOfDomain with the value and the domain
+  find_span(surface.v, v0);
+  return newton(surface, point, u0, v0, options);
+}
+
+namespace {
+std::vector<double> sample_parameters(const BSplineBasis& basis, int per_span) {
+  const auto breaks = breakpoints(basis);
+  std::vector<double> out;
+  for (size_t k = 0; k + 1 < breaks.size(); ++k)
+    for (int i = 0; i < per_span; ++i)
+      out.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * i / per_span);
+  out.push_back(breaks.back());
+  return out;
+}
+}  // namespace
+
+SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vector3d& point,
+                                const ProjectionOptions& options) {
+  options.validate();
+  validate(surface);
+  check_point(point);
+  const auto us = sample_parameters(surface.u, options.samples_per_span);
+  const auto vs = sample_parameters(surface.v, options.samples_per_span);
+  const Points3 grid = evaluate_grid(surface, us, vs);
+  std::vector<Eigen::Index> order(static_cast<size_t>(grid.rows()));
+  std::iota(order.begin(), order.end(), Eigen::Index{0});
+  Eigen::VectorXd dist2 = (grid.rowwise() - point.transpose()).rowwise().squaredNorm();
+  const size_t starts = std::min(order.size(), static_cast<size_t>(options.starts));
+  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(starts), order.end(),
+                    [&](Eigen::Index a, Eigen::Index b) { return dist2[a] < dist2[b]; });
+  SurfaceProjection best;
+  bool have = false;
+  for (size_t k = 0; k < starts; ++k) {
+    const Eigen::Index r = order[k];
+    const double u0 = us[static_cast<size_t>(r) / vs.size()];
+    const double v0 = vs[static_cast<size_t>(r) % vs.size()];
+    SurfaceProjection candidate = newton(surface, point, u0, v0, options);
+    if (!have || candidate.distance < best.distance) {
+      best = std::move(candidate);
+      have = true;
+    }
+  }
+  return best;
+}
+
+}  // namespace clay::surface

@@ -1,0 +1,138 @@
+#include <catch2/catch.hpp>
+
+#include <clay/error.hpp>
+#include <clay/surface/evaluate.hpp>
+#include <clay/surface/knots.hpp>
+
+#include <random>
+
+#include "random_geometry.hpp"
+
+using namespace clay::surface;
+using clay::test::relative_deviation;
+
+TEST_CASE("knot insertion keeps curves unchanged", "[knots]") {
+  std::mt19937 rng(31);
+  for (int p = 1; p <= 7; ++p) {
+    for (bool clamped : {true, false}) {
+      const BSplineCurve c = clay::test::random_curve(rng, p, p + 5, true, clamped, p);
+      const auto [a, b] = c.basis.domain();
+      const double t = a + 0.37 * (b - a);
+      const BSplineCurve once = insert_knot(c, t);
+      CHECK(once.basis.count() == c.basis.count() + 1);
+      CHECK(multiplicity(once.basis, t) == 1 + multiplicity(c.basis, t));
+      CHECK(relative_deviation(c, once) < 1e-12);
+      const BSplineCurve full = insert_knot(c, t, p);
+      CHECK(multiplicity(full.basis, t) == p);
+      CHECK(relative_deviation(c, full) < 1e-12);
+      // At an existing knot and at the domain ends.
+      const double k = c.basis.knots[static_cast<size_t>(p + 1)];
+      if (k < b && multiplicity(c.basis, k) < p) CHECK(relative_deviation(c, insert_knot(c, k)) < 1e-12);
+      if (!clamped && p > 1) {  // unclamped ends are simple knots: room for p - 1 more
+        CHECK(relative_deviation(c, insert_knot(c, a)) < 1e-12);
+        CHECK(relative_deviation(c, insert_knot(c, b, p - 1)) < 1e-12);
+      }
+    }
+  }
+}
+
+TEST_CASE("knot insertion in u and v keeps surfaces unchanged", "[knots]") {
+  std::mt19937 rng(32);
+  for (int p = 1; p <= 5; ++p) {
+    const BSplineSurface s = clay::test::random_surface(rng, p, 6 - p, p + 3, 9 - p, true, p != 3, 2);
+    const BSplineSurface su = insert_knot_u(s, 0.41, 2 > p ? p : 2);
+    const BSplineSurface sv = insert_knot_v(s, 0.77);
+    CHECK(su.count_u() == s.count_u() + (2 > p ? p : 2));
+    CHECK(sv.count_v() == s.count_v() + 1);
+    CHECK(relative_deviation(s, su) < 1e-12);
+    CHECK(relative_deviation(s, sv) < 1e-12);
+  }
+}
+
+TEST_CASE("refinement equals repeated insertion and keeps the shape", "[knots]") {
+  std::mt19937 rng(33);
+  for (int p = 1; p <= 6; ++p) {
+    for (bool clamped : {true, false}) {
+      const BSplineCurve c = clay::test::random_curve(rng, p, p + 6, true, clamped);
+      const auto [a, b] = c.basis.domain();
+      std::vector<double> x = {a + 0.9 * (b - a), a + 0.1 * (b - a), a + 0.5 * (b - a)};
+      if (p > 1) x.push_back(a + 0.5 * (b - a));  // a double knot
+      if (!clamped && p > 1) {
+        x.push_back(a);
+        x.push_back(b);
+      }
+      const BSplineCurve r = refine_knots(c, x);
+      BSplineCurve seq = c;
+      for (double t : x) seq = insert_knot(seq, t);
+      REQUIRE(r.basis.knots == seq.basis.knots);
+      CHECK((r.points - seq.points).cwiseAbs().maxCoeff() < 1e-10);
+      CHECK((r.weights - seq.weights).cwiseAbs().maxCoeff() < 1e-12);
+      CHECK(relative_deviation(c, r) < 1e-12);
+    }
+  }
+  std::mt19937 rng2(34);
+  const BSplineSurface s = clay::test::random_surface(rng2, 3, 4, 7, 8, true);
+  const std::vector<double> ku = {0.2, 0.2, 0.6, 0.95}, kv = {-0.5, 0.0, 1.5};
+  CHECK(relative_deviation(s, refine_knots_u(s, ku)) < 1e-12);
+  CHECK(relative_deviation(s, refine_knots_v(s, kv)) < 1e-12);
+}
+
+TEST_CASE("Bézier extraction: patches evaluate like the surface on their spans", "[knots]") {
+  std::mt19937 rng(35);
+  for (bool clamped : {true, false}) {
+    const BSplineSurface s = clay::test::random_surface(rng, 3, 2, 7, 6, true, clamped, 2);
+    const BezierPatches bez = extract_bezier(s);
+    REQUIRE(bez.count_u() == static_cast<int>(breakpoints(s.u).size()) - 1);
+    REQUIRE(bez.patches.size() == static_cast<size_t>(bez.count_u() * bez.count_v()));
+    const auto [lo, hi] = control_box(s);
+    const double size = (hi - lo).norm();
+    double worst = 0;
+    for (int i = 0; i < bez.count_u(); ++i)
+      for (int j = 0; j < bez.count_v(); ++j) {
+        const BSplineSurface& patch = bez.patch(i, j);
+        CHECK(patch.count_u() == 4);
+        CHECK(patch.count_v() == 3);
+        CHECK(is_clamped(patch.u));
+        for (double u : linspace(bez.breaks_u[static_cast<size_t>(i)], bez.breaks_u[static_cast<size_t>(i + 1)], 7))
+          for (double v : linspace(bez.breaks_v[static_cast<size_t>(j)], bez.breaks_v[static_cast<size_t>(j + 1)], 7))
+            worst = std::max(worst, (evaluate(patch, u, v) - evaluate(s, u, v)).norm());
+      }
+    CHECK(worst / size < 1e-12);
+  }
+  std::mt19937 rng2(36);
+  const BSplineCurve c = clay::test::random_curve(rng2, 4, 9, true, false);
+  const auto segments = extract_bezier(c);
+  const auto breaks = breakpoints(c.basis);
+  REQUIRE(segments.size() == breaks.size() - 1);
+  double worst = 0;
+  for (size_t k = 0; k < segments.size(); ++k)
+    for (double t : linspace(breaks[k], breaks[k + 1], 11))
+      worst = std::max(worst, (evaluate(segments[k], t) - evaluate(c, t)).norm());
+  CHECK(worst < 1e-10);
+}
+
+TEST_CASE("knot operations refuse bad requests", "[knots][errors]") {
+  std::mt19937 rng(37);
+  const BSplineCurve c = clay::test::random_curve(rng, 3, 6, false);
+  try {
+    insert_knot(c, 1.5);
+    FAIL("no throw");
+  } catch (const clay::Error& e) {
+    CHECK(e.category() == clay::ErrorCategory::OutOfDomain);
+    CHECK_THAT(e.what(), Catch::Contains("1.5") && Catch::Contains("insert_knot"));
+  }
+  try {
+    insert_knot(c, 0.5, 4);
+    FAIL("no throw");
+  } catch (const clay::Error& e) {
+    CHECK(e.category() == clay::ErrorCategory::InvalidArgument);
+    CHECK_THAT(e.what(), Catch::Contains("multiplicity 4") && Catch::Contains("at most 3"));
+  }
+  CHECK_THROWS_AS(insert_knot(c, 0.0), clay::Error);  // clamped end already at degree + 1
+  CHECK_THROWS_AS(insert_knot(c, 0.5, -1), clay::Error);
+  const std::vector<double> bad = {0.5, 2.0};
+  CHECK_THROWS_AS(refine_knots(c, bad), clay::Error);
+  BSplineCurve broken = c;
+  broken.points(2, 2) = std::nan("");
+  CHECK_THROWS_AS(extract_bezier(broken), clay::Error);
+}

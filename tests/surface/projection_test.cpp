@@ -1,0 +1,104 @@
+#include <catch2/catch.hpp>
+
+#include <clay/error.hpp>
+#include <clay/surface/evaluate.hpp>
+#include <clay/surface/projection.hpp>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <random>
+
+#include "random_geometry.hpp"
+
+using namespace clay::surface;
+using Catch::Matchers::WithinAbs;
+
+namespace {
+
+/// A quarter cylinder of radius r and height h about the z axis: exact rational quadratic in u.
+BSplineSurface quarter_cylinder(double r, double h) {
+  const double w = std::sqrt(0.5);
+  Points3 p(6, 3);  // (i, j) = i * 2 + j, j along z
+  p << r, 0, 0, r, 0, h, r, r, 0, r, r, h, 0, r, 0, 0, r, h;
+  Eigen::VectorXd wt(6);
+  wt << 1, 1, w, w, 1, 1;
+  return make_surface(BSplineBasis{2, {0, 0, 0, 1, 1, 1}}, clamped_uniform_basis(1, 2), p, wt);
+}
+
+}  // namespace
+
+TEST_CASE("closest point on an exact cylinder: distance |rho - r| and the radial foot", "[projection]") {
+  const double r = 50.0, h = 80.0;
+  const BSplineSurface s = quarter_cylinder(r, h);
+  std::mt19937 rng(51);
+  std::uniform_real_distribution<double> angle(0.05, 1.52), rho(5.0, 120.0), z(1.0, 79.0);
+  for (int k = 0; k < 100; ++k) {
+    const double a = angle(rng), q = rho(rng), zz = z(rng);
+    const Eigen::Vector3d p(q * std::cos(a), q * std::sin(a), zz);
+    const SurfaceProjection proj = closest_point(s, p);
+    REQUIRE(proj.summary.converged());
+    CHECK_THAT(proj.distance, WithinAbs(std::abs(q - r), 1e-9));
+    const Eigen::Vector3d foot(r * std::cos(a), r * std::sin(a), zz);
+    CHECK((proj.point - foot).norm() < 1e-9);
+    CHECK_FALSE(proj.on_boundary);
+  }
+}
+
+TEST_CASE("closest point beyond the domain edge lands on the edge", "[projection]") {
+  const BSplineSurface s = quarter_cylinder(50.0, 80.0);
+  const SurfaceProjection above = closest_point(s, Eigen::Vector3d(30.0, 30.0, 120.0));
+  CHECK(above.on_boundary);
+  CHECK_THAT(above.v, WithinAbs(1.0, 0.0));
+  CHECK_THAT(above.distance, WithinAbs(std::hypot(40.0, 50.0 - std::hypot(30.0, 30.0)), 1e-9));
+}
+
+TEST_CASE("normal projection recovers the foot point of offset points on random surfaces", "[projection]") {
+  std::mt19937 rng(52);
+  for (int p = 2; p <= 4; ++p) {
+    // Mild surfaces (small z relief over a regular xy grid) so that the offset foot point is unique.
+    BSplineSurface s = clay::test::random_surface(rng, p, p, p + 3, p + 3, true, true, 1, 10.0);
+    for (int i = 0; i < s.count_u(); ++i)
+      for (int j = 0; j < s.count_v(); ++j) {
+        s.points(s.index(i, j), 0) = 100.0 * i;
+        s.points(s.index(i, j), 1) = 100.0 * j;
+      }
+    const auto [ua, ub] = s.u.domain();
+    const auto [va, vb] = s.v.domain();
+    for (int k = 1; k < 10; ++k) {
+      const double u = ua + (ub - ua) * k / 10.0, v = va + (vb - va) * (10 - k) / 10.0;
+      const Eigen::Vector3d foot = evaluate(s, u, v);
+      const Eigen::Vector3d p_off = foot + 3.0 * unit_normal(s, u, v);
+      const SurfaceProjection proj = project_normal(s, p_off, std::min(ub, u + 0.03 * (ub - ua)), v);
+      REQUIRE(proj.summary.converged());
+      CHECK_THAT(proj.distance, WithinAbs(3.0, 1e-9));
+      CHECK((proj.point - foot).norm() < 1e-8);
+      // Independent check of the foot condition: S - P orthogonal to both tangents.
+      const SurfaceDerivatives d = derivatives(s, proj.u, proj.v, 1);
+      const Eigen::Vector3d rr = proj.point - p_off;
+      CHECK(std::abs(d.du.dot(rr)) < 1e-9 * d.du.norm() * rr.norm());
+      CHECK(std::abs(d.dv.dot(rr)) < 1e-9 * d.dv.norm() * rr.norm());
+      const SurfaceProjection global = closest_point(s, p_off);
+      CHECK(global.distance <= proj.distance + 1e-9);
+    }
+  }
+}
+
+TEST_CASE("projection refuses bad input", "[projection][errors]") {
+  const BSplineSurface s = quarter_cylinder(10.0, 10.0);
+  CHECK_THROWS_AS(closest_point(s, Eigen::Vector3d(std::nan(""), 0, 0)), clay::Error);
+  try {
+    project_normal(s, Eigen::Vector3d(1, 2, 3), 2.0, 0.5);
+    FAIL("no throw");
+  } catch (const clay::Error& e) {
+    CHECK(e.category() == clay::ErrorCategory::OutOfDomain);
+  }
+  ProjectionOptions bad;
+  bad.samples_per_span = 0;
+  try {
+    closest_point(s, Eigen::Vector3d(1, 2, 3), bad);
+    FAIL("no throw");
+  } catch (const clay::Error& e) {
+    CHECK_THAT(e.what(), Catch::Contains("samples_per_span"));
+  }
+}
