@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Builds and runs the benchmarks; JSON results go to build/bench/results.json.
+source "$(dirname "${BASH_SOURCE[0]}")/../scripts/common.sh"
+clay_ensure_packages
+clay_build --target bench_evaluate
+"$CLAY_BUILD/bench/bench_evaluate" --benchmark_out="$CLAY_BUILD/bench/results.json" \
+  --benchmark_out_format=json "$@"
+echo "results: $CLAY_BUILD/bench/results.json"

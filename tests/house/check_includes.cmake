@@ -1,0 +1,25 @@
+# House rule (STYLE.md 11): OpenCASCADE headers only in surface/src/occt/, Ceres headers only in
+# .cpp files. An include counts as OCCT when the file exists in OCCT's include folder.
+# -DSOURCE_DIR=<tree to scan> -DOCCT_INCLUDE_DIR=<OCCT headers>
+set(violations "")
+file(GLOB_RECURSE files RELATIVE ${SOURCE_DIR}
+  ${SOURCE_DIR}/*.hpp ${SOURCE_DIR}/*.h ${SOURCE_DIR}/*.cpp ${SOURCE_DIR}/*.cc ${SOURCE_DIR}/*.hxx)
+list(FILTER files EXCLUDE REGEX "^(build|out|\\.git)/|/fixtures/")
+foreach(f ${files})
+  file(STRINGS ${SOURCE_DIR}/${f} includes REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]")
+  foreach(line ${includes})
+    string(REGEX REPLACE "^[ \t]*#[ \t]*include[ \t]*[<\"]([^>\"]+)[>\"].*" "\\1" header "${line}")
+    if(header MATCHES "^ceres/" AND NOT f MATCHES "\\.(cpp|cc)$")
+      list(APPEND violations "${f}: Ceres header <${header}> outside a .cpp file")
+    endif()
+    if(EXISTS ${OCCT_INCLUDE_DIR}/${header} AND NOT f MATCHES "^surface/src/occt/")
+      list(APPEND violations "${f}: OpenCASCADE header <${header}> outside surface/src/occt/")
+    endif()
+  endforeach()
+endforeach()
+list(LENGTH files scanned)
+if(violations)
+  list(JOIN violations "\n  " text)
+  message(FATAL_ERROR "include rules broken (${scanned} files scanned):\n  ${text}")
+endif()
+message(STATUS "include rules hold in ${scanned} files")

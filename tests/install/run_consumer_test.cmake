@@ -1,0 +1,31 @@
+# Installs the built project into a scratch prefix, then configures, builds and runs a consumer
+# project that only knows find_package(Clayform) and links Clayform::deform.
+file(REMOVE_RECURSE ${WORK_DIR})
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
+  endif()
+  set(last_output "${out}" PARENT_SCOPE)
+endfunction()
+run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
+foreach(f include/clay/surface/bspline_surface.hpp include/clay/deform.hpp
+          lib/cmake/Clayform/ClayformConfig.cmake lib/cmake/Clayform/ClayformConfigVersion.cmake
+          bin/clayform)
+  if(NOT EXISTS ${WORK_DIR}/prefix/${f})
+    message(FATAL_ERROR "install is missing ${f}")
+  endif()
+endforeach()
+file(GLOB_RECURSE leaked ${WORK_DIR}/prefix/include/*occt* ${WORK_DIR}/prefix/include/*reference*)
+if(leaked)
+  message(FATAL_ERROR "internal headers were installed: ${leaked}")
+endif()
+run(${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/build -G ${GENERATOR}
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
+run(${WORK_DIR}/build/consumer ${WORK_DIR}/consumer.step)
+if(NOT last_output MATCHES "consumer ok")
+  message(FATAL_ERROR "consumer printed: ${last_output}")
+endif()
+run(${WORK_DIR}/prefix/bin/clayform info ${WORK_DIR}/consumer.step)
+message(STATUS "${last_output}")
