@@ -3,6 +3,7 @@
 #include <clay/error.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <sstream>
@@ -168,7 +169,8 @@ void basis_derivatives(const BSplineBasis& basis, int span, double t, int order,
   assert(static_cast<int>(derivs.size()) >= (order + 1) * w);
   const double* U = basis.knots.data();
   // ndu: (p+1) x (p+1), lower triangle knot differences, upper triangle basis values (A2.3).
-  std::vector<double> ndu(static_cast<size_t>(w * w));
+  // Stack storage (32 KiB at the kernel's degree limit): this runs once per evaluated point.
+  std::array<double, (max_kernel_degree + 1) * (max_kernel_degree + 1)> ndu;
   auto NDU = [&](int r, int c) -> double& { return ndu[static_cast<size_t>(r * w + c)]; };
   double left[max_kernel_degree + 1], right[max_kernel_degree + 1];
   NDU(0, 0) = 1.0;
@@ -186,7 +188,7 @@ void basis_derivatives(const BSplineBasis& basis, int span, double t, int order,
   }
   auto D = [&](int k, int j) -> double& { return derivs[static_cast<size_t>(k * w + j)]; };
   for (int j = 0; j <= p; ++j) D(0, j) = NDU(j, p);
-  std::vector<double> a(static_cast<size_t>(2 * w));
+  std::array<double, 2 * (max_kernel_degree + 1)> a;
   auto A = [&](int s, int j) -> double& { return a[static_cast<size_t>(s * w + j)]; };
   for (int r = 0; r <= p; ++r) {
     int s1 = 0, s2 = 1;

@@ -47,7 +47,10 @@ CurveDerivatives derivatives(const BSplineCurve& curve, double t, int order) {
   const int p = curve.basis.degree;
   const int span = find_span(curve.basis, t);
   std::array<double, 3 * max_width> nd;
-  basis_derivatives(curve.basis, span, t, order, nd);
+  if (order == 0)
+    basis_functions(curve.basis, span, t, nd);
+  else
+    basis_derivatives(curve.basis, span, t, order, nd);
   // Homogeneous derivatives A^(k) (x w, y w, z w, w).
   Eigen::Vector4d a[3] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
   for (int j = 0; j <= p; ++j) {
@@ -74,8 +77,13 @@ SurfaceDerivatives derivatives(const BSplineSurface& surface, double u, double v
   const int su = find_span(surface.u, u);
   const int sv = find_span(surface.v, v);
   std::array<double, 3 * max_width> nu, nv;
-  basis_derivatives(surface.u, su, u, order, nu);
-  basis_derivatives(surface.v, sv, v, order, nv);
+  if (order == 0) {  // the plain basis functions are cheaper than A2.3
+    basis_functions(surface.u, su, u, nu);
+    basis_functions(surface.v, sv, v, nv);
+  } else {
+    basis_derivatives(surface.u, su, u, order, nu);
+    basis_derivatives(surface.v, sv, v, order, nv);
+  }
   auto NU = [&](int k, int i) { return nu[static_cast<size_t>(k * (p + 1) + i)]; };
   auto NV = [&](int l, int j) { return nv[static_cast<size_t>(l * (q + 1) + j)]; };
   // Homogeneous derivatives A(k, l), k + l <= order (The NURBS Book A3.6).

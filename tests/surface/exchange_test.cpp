@@ -1,1 +1,400 @@
+// STEP / IGES / glTF exchange (clay/surface/exchange.hpp): lossless round trips, face validity,
+// file headers, atomic writes and error paths, concurrent use.
+#include <catch2/catch.hpp>
 
+#include <clay/error.hpp>
+#include <clay/surface/exchange.hpp>
+
+#include <random_geometry.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+#include <fstream>
+#include <iterator>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace clay;
+using namespace clay::surface;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A fresh, empty folder under the test output folder.
+fs::path fresh_folder(const std::string& name) {
+  const fs::path folder = fs::path(CLAY_TEST_OUTPUT_DIR) / "exchange" / name;
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+std::vector<std::string> names_in(const fs::path& folder) {
+  std::vector<std::string> out;
+  for (const auto& entry : fs::directory_iterator(folder)) out.push_back(entry.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// Surfaces for the round trips: polynomial and rational, clamped and unclamped, interior knots
+/// of multiplicity > 1, degrees up to 25 in both directions. The degree-25 ones have many knot
+/// spans, where OpenCASCADE's own evaluation is accurate (see the "Bezier-like" test below).
+std::vector<BSplineSurface> mixed_surfaces(std::mt19937& rng) {
+  std::vector<BSplineSurface> out;
+  out.push_back(test::random_surface(rng, 3, 3, 6, 7, false));
+  out.push_back(test::random_surface(rng, 2, 3, 5, 6, true, true, 2));
+  out.push_back(test::random_surface(rng, 5, 4, 11, 9, true, true, 4));   // C0 knots
+  out.push_back(test::random_surface(rng, 4, 6, 8, 9, true, false));       // unclamped
+  out.push_back(test::random_surface(rng, 25, 25, 30, 30, true, false));   // degree (25, 25)
+  out.push_back(test::random_surface(rng, 25, 3, 29, 8, false, false, 2)); // degree (25, 3)
+  out.push_back(test::random_surface(rng, 1, 1, 2, 2, false));             // bilinear
+  return out;
+}
+
+void require_identical(const std::vector<BSplineSurface>& read,
+                       const std::vector<BSplineSurface>& written) {
+  REQUIRE(read.size() == written.size());
+  for (size_t k = 0; k < read.size(); ++k) {
+    INFO("surface #" << k << " degree (" << written[k].u.degree << ", " << written[k].v.degree
+                     << ")");
+    REQUIRE(identical(read[k], written[k]));
+  }
+}
+
+void require_report(const ExchangeReport& report, const std::vector<BSplineSurface>& surfaces) {
+  long points = 0;
+  int degree = 0;
+  for (const auto& s : surfaces) {
+    points += static_cast<long>(s.points.rows());
+    degree = std::max({degree, s.u.degree, s.v.degree});
+  }
+  std::string found;
+  for (const auto& p : report.problems) found += p + "\n";
+  INFO(found);
+  REQUIRE(report.faces == static_cast<int>(surfaces.size()));
+  REQUIRE(report.control_points == points);
+  REQUIRE(report.max_degree == degree);
+  REQUIRE(report.tolerance == 1e-7);
+  REQUIRE(report.valid);
+  REQUIRE(report.problems.empty());
+  REQUIRE(report.evaluation_error == 0.0);
+}
+
+ErrorCategory category_of(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    return e.category();
+  }
+  FAIL("no clay::Error thrown");
+  return ErrorCategory::Internal;
+}
+
+}  // namespace
+
+TEST_CASE("STEP AP214 round trip is bit-identical and faces are valid at 1e-7", "[exchange][step]") {
+  std::mt19937 rng(214);
+  const auto surfaces = mixed_surfaces(rng);
+  const fs::path file = fresh_folder("step214") / "surfaces.step";
+  const ExchangeReport report = write_step(surfaces, file);
+  require_report(report, surfaces);
+  REQUIRE(report.max_degree == 25);
+  require_identical(read_step(file), surfaces);
+
+  const std::string text = read_text(file);
+  REQUIRE_THAT(text, Catch::Matchers::StartsWith("ISO-10303-21;"));
+  REQUIRE_THAT(text, Catch::Matchers::Contains("FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214"));
+  REQUIRE_THAT(text, Catch::Matchers::Contains("LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.)"));
+  REQUIRE_THAT(text, Catch::Matchers::Contains("PRODUCT('clayform','clayform'"));
+  REQUIRE_THAT(text, Catch::Matchers::Contains("RATIONAL_B_SPLINE_SURFACE"));
+  REQUIRE(names_in(file.parent_path()) == std::vector<std::string>{"surfaces.step"});
+}
+
+TEST_CASE("STEP AP242 round trip is bit-identical", "[exchange][step]") {
+  std::mt19937 rng(242);
+  auto surfaces = mixed_surfaces(rng);
+  std::reverse(surfaces.begin(), surfaces.end());  // order is kept, whatever it is
+  const fs::path file = fresh_folder("step242") / "surfaces.stp";
+  StepWriteOptions options;
+  options.schema = StepSchema::AP242;
+  options.product_name = "hood panel";
+  require_report(write_step(surfaces, file, options), surfaces);
+  require_identical(read_step(file), surfaces);
+
+  const std::string text = read_text(file);
+  REQUIRE_THAT(text, Catch::Matchers::Contains("AP242_MANAGED_MODEL_BASED_3D_ENGINEERING_MIM_LF"));
+  REQUIRE_THAT(text, !Catch::Matchers::Contains("AUTOMOTIVE_DESIGN"));
+  REQUIRE_THAT(text, Catch::Matchers::Contains("SI_UNIT(.MILLI.,.METRE.)"));
+  REQUIRE_THAT(text, Catch::Matchers::Contains("PRODUCT('hood panel','hood panel'"));
+
+  // The schema is a per-call setting, not a sticky global: the next default write is AP214.
+  const fs::path again = file.parent_path() / "again.step";
+  write_step({surfaces.front()}, again);
+  REQUIRE_THAT(read_text(again), Catch::Matchers::Contains("AUTOMOTIVE_DESIGN"));
+}
+
+TEST_CASE("IGES round trip is bit-identical", "[exchange][iges]") {
+  std::mt19937 rng(128);
+  const auto surfaces = mixed_surfaces(rng);
+  const fs::path file = fresh_folder("iges") / "surfaces.igs";
+  require_report(write_iges(surfaces, file), surfaces);
+  require_identical(read_iges(file), surfaces);
+
+  // Global section: unit flag 2 = millimetres, unit name "MM"; directory entries of types 144
+  // (trimmed surface) and 128 (rational B-spline surface), one each per surface.
+  const std::string text = read_text(file);
+  REQUIRE_THAT(text, Catch::Matchers::Contains(",2,2HMM,"));
+  std::istringstream lines(text);
+  std::string line;
+  int trimmed = 0, bsplines = 0, directory_line = 0;
+  while (std::getline(lines, line)) {
+    if (line.size() < 73 || line[72] != 'D') continue;
+    if (directory_line++ % 2 != 0) continue;  // two lines per directory entry
+    const int type = std::stoi(line.substr(0, 8));
+    trimmed += type == 144;
+    bsplines += type == 128;
+  }
+  REQUIRE(trimmed == static_cast<int>(surfaces.size()));
+  REQUIRE(bsplines == static_cast<int>(surfaces.size()));
+}
+
+TEST_CASE("Closed surfaces come back as written although the readers make them periodic",
+          "[exchange][step][iges]") {
+  std::mt19937 rng(9);
+  BSplineSurface closed_u = test::random_surface(rng, 3, 3, 7, 6, true);
+  for (int j = 0; j < 6; ++j) {  // last row = first row: closed in u (a tube)
+    closed_u.points.row(closed_u.index(6, j)) = closed_u.points.row(closed_u.index(0, j));
+    closed_u.weights[closed_u.index(6, j)] = closed_u.weights[closed_u.index(0, j)];
+  }
+  BSplineSurface closed_both = test::random_surface(rng, 4, 2, 8, 5, false);
+  for (int j = 0; j < 5; ++j)
+    closed_both.points.row(closed_both.index(7, j)) = closed_both.points.row(closed_both.index(0, j));
+  for (int i = 0; i < 8; ++i)
+    closed_both.points.row(closed_both.index(i, 4)) = closed_both.points.row(closed_both.index(i, 0));
+  BSplineSurface pole = test::random_surface(rng, 3, 3, 6, 6, true);  // degenerate side
+  for (int i = 0; i < 6; ++i) pole.points.row(pole.index(i, 0)) = pole.points.row(pole.index(0, 0));
+  const std::vector<BSplineSurface> surfaces{closed_u, closed_both, pole};
+
+  const fs::path folder = fresh_folder("closed");
+  require_report(write_step(surfaces, folder / "closed.step"), surfaces);
+  require_identical(read_step(folder / "closed.step"), surfaces);
+  require_report(write_iges(surfaces, folder / "closed.igs"), surfaces);
+  require_identical(read_iges(folder / "closed.igs"), surfaces);
+}
+
+TEST_CASE("Bezier-like degree-25 patches: exact file, honest BRepCheck verdict",
+          "[exchange][step][validity]") {
+  // One span of degree 25 with a random net: OpenCASCADE's cached power-basis evaluation (what
+  // BRepCheck uses) is off by far more than 1e-7 mm, although the edges are exact iso-curves.
+  // The report must say so instead of claiming validity, and the file must still be exact.
+  std::mt19937 rng(2525);
+  const std::vector<BSplineSurface> surfaces{test::random_surface(rng, 25, 25, 26, 26, true)};
+  const ExchangeReport report = check_faces(surfaces);
+  REQUIRE(report.faces == 1);
+  REQUIRE_FALSE(report.valid);
+  REQUIRE(report.evaluation_error > 1e-7);
+  REQUIRE(report.problems.size() == 1);
+  REQUIRE_THAT(report.problems[0], Catch::Matchers::StartsWith("surface #0: BRepCheck") &&
+                                       Catch::Matchers::Contains("exact iso-curves") &&
+                                       Catch::Matchers::Contains("cached power-basis"));
+  const fs::path file = fresh_folder("bezier25") / "patch.igs";
+  const ExchangeReport written = write_iges(surfaces, file);
+  REQUIRE_FALSE(written.valid);
+  require_identical(read_iges(file), surfaces);
+}
+
+TEST_CASE("check_faces reports sizes and validity without writing", "[exchange][validity]") {
+  std::mt19937 rng(3);
+  const std::vector<BSplineSurface> surfaces{
+      test::random_surface(rng, 20, 22, 40, 41, true, false),
+      test::random_surface(rng, 24, 2, 45, 3, false, false),
+      test::random_surface(rng, 3, 3, 4, 4, true)};
+  require_report(check_faces(surfaces), surfaces);
+}
+
+TEST_CASE("Failed writes throw clay::Error and leave no file behind", "[exchange][errors]") {
+  std::mt19937 rng(404);
+  const std::vector<BSplineSurface> good{test::random_surface(rng, 3, 3, 5, 5, true)};
+  const fs::path folder = fresh_folder("failures");
+
+  SECTION("missing output folder") {
+    const fs::path file = folder / "no-such-folder" / "out.step";
+    try {
+      write_step(good, file);
+      FAIL("no exception");
+    } catch (const Error& e) {
+      REQUIRE(e.category() == ErrorCategory::Io);
+      REQUIRE_THAT(e.message(), Catch::Matchers::Contains("no-such-folder"));
+    }
+    REQUIRE(category_of([&] { write_iges(good, file); }) == ErrorCategory::Io);
+    REQUIRE(category_of([&] { write_gltf(good, folder / "missing" / "x.glb"); }) ==
+            ErrorCategory::Io);
+    REQUIRE_FALSE(fs::exists(folder / "no-such-folder"));
+  }
+  SECTION("NaN control point") {
+    std::vector<BSplineSurface> bad = good;
+    bad.push_back(good[0]);
+    bad[1].points(3, 2) = std::numeric_limits<double>::quiet_NaN();
+    try {
+      write_step(bad, folder / "nan.step");
+      FAIL("no exception");
+    } catch (const Error& e) {
+      REQUIRE(e.category() == ErrorCategory::InvalidGeometry);
+      REQUIRE_THAT(e.message(), Catch::Matchers::Contains("surface #1"));
+    }
+    REQUIRE(category_of([&] { write_iges(bad, folder / "nan.igs"); }) ==
+            ErrorCategory::InvalidGeometry);
+    REQUIRE(category_of([&] { write_gltf(bad, folder / "nan.glb"); }) ==
+            ErrorCategory::InvalidGeometry);
+  }
+  SECTION("degree above 25") {
+    const std::vector<BSplineSurface> high{good[0], test::random_surface(rng, 3, 26, 4, 27, false)};
+    try {
+      write_iges(high, folder / "high.igs");
+      FAIL("no exception");
+    } catch (const Error& e) {
+      REQUIRE(e.category() == ErrorCategory::DegreeLimit);
+      REQUIRE_THAT(e.message(), Catch::Matchers::Contains("surface #1") &&
+                                    Catch::Matchers::Contains("26"));
+    }
+    REQUIRE(category_of([&] { write_step(high, folder / "high.step"); }) ==
+            ErrorCategory::DegreeLimit);
+    REQUIRE(category_of([&] { (void)check_faces(high); }) == ErrorCategory::DegreeLimit);
+  }
+  SECTION("empty list and bad options") {
+    REQUIRE(category_of([&] { write_step({}, folder / "empty.step"); }) ==
+            ErrorCategory::InvalidArgument);
+    REQUIRE(category_of([&] { write_iges({}, folder / "empty.igs"); }) ==
+            ErrorCategory::InvalidArgument);
+    REQUIRE(category_of([&] { (void)check_faces({}); }) == ErrorCategory::InvalidArgument);
+    StepWriteOptions unnamed;
+    unnamed.product_name.clear();
+    REQUIRE(category_of([&] { write_step(good, folder / "unnamed.step", unnamed); }) ==
+            ErrorCategory::InvalidArgument);
+    struct BadOptions {
+      double linear, angular;
+      const char* field;
+    };
+    for (const BadOptions& bad :
+         {BadOptions{0.0, 0.3, "linear_deflection"}, BadOptions{-1.0, 0.3, "linear_deflection"},
+          BadOptions{std::numeric_limits<double>::quiet_NaN(), 0.3, "linear_deflection"},
+          BadOptions{0.1, 0.0, "angular_deflection"}, BadOptions{0.1, 3.2, "angular_deflection"}}) {
+      GltfWriteOptions options;
+      options.linear_deflection = bad.linear;
+      options.angular_deflection = bad.angular;
+      try {
+        write_gltf(good, folder / "bad.glb", options);
+        FAIL("no exception");
+      } catch (const Error& e) {
+        REQUIRE(e.category() == ErrorCategory::InvalidArgument);
+        REQUIRE_THAT(e.message(), Catch::Matchers::Contains(bad.field));
+      }
+    }
+  }
+  SECTION("target is an existing folder: the rename fails, the temporary file is removed") {
+    fs::create_directories(folder / "taken.step");
+    REQUIRE(category_of([&] { write_step(good, folder / "taken.step"); }) == ErrorCategory::Io);
+    REQUIRE(category_of([&] { write_iges(good, folder / "taken.step"); }) == ErrorCategory::Io);
+    REQUIRE(category_of([&] { write_gltf(good, folder / "taken.step"); }) == ErrorCategory::Io);
+    REQUIRE(names_in(folder) == std::vector<std::string>{"taken.step"});
+    REQUIRE(fs::is_empty(folder / "taken.step"));
+    fs::remove(folder / "taken.step");
+  }
+  // Whatever failed: neither the target nor a temporary file is left.
+  REQUIRE(names_in(folder).empty());
+}
+
+TEST_CASE("Reading missing, unparsable or empty files throws", "[exchange][errors]") {
+  const fs::path folder = fresh_folder("reading");
+  REQUIRE(category_of([&] { (void)read_step(folder / "missing.step"); }) == ErrorCategory::Io);
+  REQUIRE(category_of([&] { (void)read_iges(folder / "missing.igs"); }) == ErrorCategory::Io);
+  REQUIRE(category_of([&] { (void)read_step(folder); }) == ErrorCategory::Io);
+
+  std::ofstream(folder / "garbage.step") << "this is not a STEP file\n";
+  REQUIRE(category_of([&] { (void)read_step(folder / "garbage.step"); }) ==
+          ErrorCategory::Exchange);
+
+  // A well-formed STEP file without any geometry.
+  std::ofstream(folder / "empty.step")
+      << "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('empty'),'2;1');\n"
+         "FILE_NAME('empty.step','2024-01-01T00:00:00',(''),(''),'','','');\n"
+         "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n"
+         "#1 = CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;\nEND-ISO-10303-21;\n";
+  try {
+    (void)read_step(folder / "empty.step");
+    FAIL("no exception");
+  } catch (const Error& e) {
+    REQUIRE(e.category() == ErrorCategory::Exchange);
+    REQUIRE_THAT(e.message(), Catch::Matchers::Contains("empty.step"));
+  }
+}
+
+TEST_CASE("Concurrent STEP and IGES round trips from 4 threads", "[exchange][threads]") {
+  const fs::path folder = fresh_folder("threads");
+  constexpr int threads = 4, rounds = 3;
+  std::vector<std::vector<std::vector<BSplineSurface>>> written(threads);
+  std::vector<std::vector<std::vector<BSplineSurface>>> read_back(threads);
+  std::vector<std::string> failures(threads);
+  std::vector<std::thread> workers;
+  for (int t = 0; t < threads; ++t)
+    workers.emplace_back([&, t] {
+      try {
+        std::mt19937 rng(1000 + static_cast<unsigned>(t));
+        for (int r = 0; r < rounds; ++r) {
+          std::vector<BSplineSurface> surfaces{
+              test::random_surface(rng, 3 + r, 2 + t, 6 + r, 5 + t, (r + t) % 2 == 0, r != 1, 2),
+              test::random_surface(rng, 12 + t, 5, 30, 9, true, false)};
+          const fs::path stem = folder / ("t" + std::to_string(t) + "r" + std::to_string(r));
+          write_step(surfaces, stem.string() + ".step");
+          written[t].push_back(surfaces);
+          read_back[t].push_back(read_step(stem.string() + ".step"));
+          write_iges(surfaces, stem.string() + ".igs");
+          written[t].push_back(surfaces);
+          read_back[t].push_back(read_iges(stem.string() + ".igs"));
+        }
+      } catch (const std::exception& e) {
+        failures[t] = e.what();
+      }
+    });
+  for (auto& w : workers) w.join();
+  for (int t = 0; t < threads; ++t) {
+    INFO("thread " << t);
+    REQUIRE(failures[t].empty());
+    REQUIRE(read_back[t].size() == 2 * rounds);
+    for (size_t r = 0; r < read_back[t].size(); ++r) require_identical(read_back[t][r], written[t][r]);
+  }
+  REQUIRE(names_in(folder).size() == 2 * threads * rounds);
+}
+
+TEST_CASE("glTF preview is a binary glTF file", "[exchange][gltf]") {
+  std::mt19937 rng(77);
+  const std::vector<BSplineSurface> surfaces{test::random_surface(rng, 3, 3, 5, 5, true),
+                                             test::random_surface(rng, 2, 4, 4, 6, false)};
+  const fs::path folder = fresh_folder("gltf");
+  const fs::path file = folder / "preview.glb";
+  GltfWriteOptions options;
+  options.linear_deflection = 0.5;
+  write_gltf(surfaces, file, options);
+  const std::string bytes = read_text(file);
+  REQUIRE(bytes.size() > 100);
+  REQUIRE(bytes.substr(0, 4) == "glTF");
+  // Binary glTF header: version 2, then the total length, little-endian.
+  auto u32 = [&](size_t at) {
+    return static_cast<unsigned>(static_cast<unsigned char>(bytes[at])) |
+           static_cast<unsigned>(static_cast<unsigned char>(bytes[at + 1])) << 8 |
+           static_cast<unsigned>(static_cast<unsigned char>(bytes[at + 2])) << 16 |
+           static_cast<unsigned>(static_cast<unsigned char>(bytes[at + 3])) << 24;
+  };
+  REQUIRE(u32(4) == 2u);
+  REQUIRE(u32(8) == bytes.size());
+  REQUIRE(names_in(folder) == std::vector<std::string>{"preview.glb"});
+}

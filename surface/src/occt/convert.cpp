@@ -49,6 +49,59 @@ std::vector<double> flat_knots(const TColStd_Array1OfReal& knots,
   return flat;
 }
 
+/// Flat knots of one direction and, for each of our control points, the 0-based index of the
+/// OCCT pole it copies.
+struct DirectionPlan {
+  std::vector<double> knots;
+  std::vector<int> source;
+};
+
+DirectionPlan keep_all(const TColStd_Array1OfReal& knots, const TColStd_Array1OfInteger& mults,
+                       int poles) {
+  DirectionPlan plan{flat_knots(knots, mults), {}};
+  for (int i = 0; i < poles; ++i) plan.source.push_back(i);
+  return plan;
+}
+
+/// A periodic direction whose end knots have multiplicity p (what OCCT's SetUPeriodic makes of a
+/// closed clamped direction, and what the STEP and IGES readers do to every closed surface):
+/// its clamped form repeats the end knots p + 1 times and closes the poles with the first one.
+/// Only copies, so a closed clamped surface comes back exactly as written. (OCCT's own
+/// SetNotPeriodic goes through homogeneous coordinates and changes rational poles in the last
+/// bit.)
+DirectionPlan unperiodize_exact(const TColStd_Array1OfReal& knots,
+                                const TColStd_Array1OfInteger& mults, int p, int poles) {
+  DirectionPlan plan;
+  plan.knots.assign(static_cast<size_t>(p + 1), knots.First());
+  for (int k = knots.Lower() + 1; k < knots.Upper(); ++k)
+    plan.knots.insert(plan.knots.end(), static_cast<size_t>(mults(k)), knots(k));
+  plan.knots.insert(plan.knots.end(), static_cast<size_t>(p + 1), knots.Last());
+  for (int i = 0; i < poles; ++i) plan.source.push_back(i);
+  plan.source.push_back(0);
+  return plan;
+}
+
+/// Clamps a direction made non-periodic by SetNotPeriodic whose domain ends [K[p], K[n]] have
+/// multiplicity >= p (raised by knot insertion first): inserting an end knot once more at a
+/// p-fold knot only duplicates a pole (Boehm's rule with s = p blends nothing), and the poles
+/// whose basis functions vanish on the domain are dropped.
+DirectionPlan clamp_ends(const TColStd_Array1OfReal& knots, const TColStd_Array1OfInteger& mults,
+                         int p) {
+  const std::vector<double> k = flat_knots(knots, mults);
+  const int n = static_cast<int>(k.size()) - p - 1;
+  const double a = k[static_cast<size_t>(p)], b = k[static_cast<size_t>(n)];
+  int e = p;  // last index of the run of a
+  while (k[static_cast<size_t>(e + 1)] == a) ++e;
+  int s2 = n;  // first index of the run of b
+  while (k[static_cast<size_t>(s2 - 1)] == b) --s2;
+  DirectionPlan plan;
+  plan.knots.assign(static_cast<size_t>(p + 1), a);
+  plan.knots.insert(plan.knots.end(), k.begin() + e + 1, k.begin() + s2);
+  plan.knots.insert(plan.knots.end(), static_cast<size_t>(p + 1), b);
+  for (int i = e - p; i <= s2 - 1; ++i) plan.source.push_back(i);
+  return plan;
+}
+
 std::string occt_message(const Standard_Failure& failure) {
   const char* text = failure.GetMessageString();
   std::string out = failure.DynamicType()->Name();
@@ -106,23 +159,32 @@ BSplineCurve from_occt(const Handle(Geom_BSplineCurve)& input, std::string_view 
   BSplineCurve curve;
   try {
     Handle(Geom_BSplineCurve) c = input;
-    if (c->IsPeriodic()) {
+    const int p = c->Degree();
+    DirectionPlan plan;
+    if (c->IsPeriodic() && c->Multiplicity(1) < p) {
+      // No exact clamped form: unperiodize and raise the end multiplicities with OCCT.
       c = Handle(Geom_BSplineCurve)::DownCast(input->Copy());
       c->SetNotPeriodic();
+      c->InsertKnot(c->Knot(c->FirstUKnotIndex()), p, 0.0, false);
+      c->InsertKnot(c->Knot(c->LastUKnotIndex()), p, 0.0, false);
+      plan = clamp_ends(c->Knots(), c->Multiplicities(), p);
+    } else if (c->IsPeriodic()) {
+      plan = unperiodize_exact(c->Knots(), c->Multiplicities(), p, c->NbPoles());
+    } else {
+      plan = keep_all(c->Knots(), c->Multiplicities(), c->NbPoles());
     }
-    const int n = c->NbPoles();
-    curve.basis.degree = c->Degree();
-    curve.basis.knots = flat_knots(c->Knots(), c->Multiplicities());
+    const int n = static_cast<int>(plan.source.size());
+    curve.basis.degree = p;
+    curve.basis.knots = std::move(plan.knots);
     curve.points.resize(n, 3);
     curve.weights = Eigen::VectorXd::Ones(n);
     const TColgp_Array1OfPnt& poles = c->Poles();
+    const TColStd_Array1OfReal* weights = c->IsRational() ? c->Weights() : nullptr;
     for (int i = 0; i < n; ++i) {
-      const gp_Pnt& p = poles.Value(poles.Lower() + i);
-      curve.points.row(i) << p.X(), p.Y(), p.Z();
-    }
-    if (c->IsRational()) {
-      const TColStd_Array1OfReal* weights = c->Weights();
-      for (int i = 0; i < n; ++i) curve.weights[i] = weights->Value(weights->Lower() + i);
+      const int from = plan.source[static_cast<size_t>(i)];
+      const gp_Pnt& pt = poles.Value(poles.Lower() + from);
+      curve.points.row(i) << pt.X(), pt.Y(), pt.Z();
+      if (weights != nullptr) curve.weights[i] = weights->Value(weights->Lower() + from);
     }
   } catch (const Standard_Failure& failure) {
     refused(name, failure);
@@ -165,32 +227,52 @@ BSplineSurface from_occt(const Handle(Geom_BSplineSurface)& input, std::string_v
   BSplineSurface surface;
   try {
     Handle(Geom_BSplineSurface) s = input;
-    if (s->IsUPeriodic() || s->IsVPeriodic()) {
+    const int p = s->UDegree(), q = s->VDegree();
+    // Periodic directions without an exact clamped form: unperiodize and raise the end
+    // multiplicities with OCCT on a copy (see the curve overload).
+    const bool u_inexact = s->IsUPeriodic() && s->UMultiplicity(1) < p;
+    const bool v_inexact = s->IsVPeriodic() && s->VMultiplicity(1) < q;
+    if (u_inexact || v_inexact) {
       s = Handle(Geom_BSplineSurface)::DownCast(input->Copy());
-      if (s->IsUPeriodic()) s->SetUNotPeriodic();
-      if (s->IsVPeriodic()) s->SetVNotPeriodic();
+      if (u_inexact) {
+        s->SetUNotPeriodic();
+        s->InsertUKnot(s->UKnot(s->FirstUKnotIndex()), p, 0.0, false);
+        s->InsertUKnot(s->UKnot(s->LastUKnotIndex()), p, 0.0, false);
+      }
+      if (v_inexact) {
+        s->SetVNotPeriodic();
+        s->InsertVKnot(s->VKnot(s->FirstVKnotIndex()), q, 0.0, false);
+        s->InsertVKnot(s->VKnot(s->LastVKnotIndex()), q, 0.0, false);
+      }
     }
-    const int nu = s->NbUPoles(), nv = s->NbVPoles();
-    surface.u.degree = s->UDegree();
-    surface.v.degree = s->VDegree();
-    surface.u.knots = flat_knots(s->UKnots(), s->UMultiplicities());
-    surface.v.knots = flat_knots(s->VKnots(), s->VMultiplicities());
+    const DirectionPlan pu =
+        u_inexact ? clamp_ends(s->UKnots(), s->UMultiplicities(), p)
+        : s->IsUPeriodic() ? unperiodize_exact(s->UKnots(), s->UMultiplicities(), p, s->NbUPoles())
+                           : keep_all(s->UKnots(), s->UMultiplicities(), s->NbUPoles());
+    const DirectionPlan pv =
+        v_inexact ? clamp_ends(s->VKnots(), s->VMultiplicities(), q)
+        : s->IsVPeriodic() ? unperiodize_exact(s->VKnots(), s->VMultiplicities(), q, s->NbVPoles())
+                           : keep_all(s->VKnots(), s->VMultiplicities(), s->NbVPoles());
+    const int nu = static_cast<int>(pu.source.size()), nv = static_cast<int>(pv.source.size());
+    surface.u.degree = p;
+    surface.v.degree = q;
+    surface.u.knots = pu.knots;
+    surface.v.knots = pv.knots;
     surface.points.resize(static_cast<Eigen::Index>(nu) * nv, 3);
     surface.weights = Eigen::VectorXd::Ones(surface.points.rows());
     const TColgp_Array2OfPnt& poles = s->Poles();
+    // IsURational() says whether weights vary along V (and the reverse): test both.
+    const TColStd_Array2OfReal* weights =
+        (s->IsURational() || s->IsVRational()) ? s->Weights() : nullptr;
     for (int i = 0; i < nu; ++i)
       for (int j = 0; j < nv; ++j) {
-        const gp_Pnt& p = poles.Value(poles.LowerRow() + i, poles.LowerCol() + j);
-        surface.points.row(surface.index(i, j)) << p.X(), p.Y(), p.Z();
-      }
-    // IsURational() says whether weights vary along V (and the reverse): test both.
-    if (s->IsURational() || s->IsVRational()) {
-      const TColStd_Array2OfReal* weights = s->Weights();
-      for (int i = 0; i < nu; ++i)
-        for (int j = 0; j < nv; ++j)
+        const int ui = pu.source[static_cast<size_t>(i)], vj = pv.source[static_cast<size_t>(j)];
+        const gp_Pnt& pt = poles.Value(poles.LowerRow() + ui, poles.LowerCol() + vj);
+        surface.points.row(surface.index(i, j)) << pt.X(), pt.Y(), pt.Z();
+        if (weights != nullptr)
           surface.weights[surface.index(i, j)] =
-              weights->Value(weights->LowerRow() + i, weights->LowerCol() + j);
-    }
+              weights->Value(weights->LowerRow() + ui, weights->LowerCol() + vj);
+      }
   } catch (const Standard_Failure& failure) {
     refused(name, failure);
   }

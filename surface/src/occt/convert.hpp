@@ -26,7 +26,10 @@ namespace clay::surface::occt {
 /// (e.g. two knots one unit in the last place apart). `name` names the object in messages.
 Handle(Geom_BSplineCurve) to_occt(const BSplineCurve& curve, std::string_view name = "curve");
 
-/// Reads an OCCT curve (a periodic one is converted to its non-periodic form on a copy first).
+/// Reads an OCCT curve. A periodic one is made non-periodic on a copy (SetNotPeriodic) and then
+/// clamped to its domain: exactly (control points copied) when its end knots have multiplicity
+/// >= degree, which is the case for a closed clamped curve that OCCT made periodic, so such a
+/// curve comes back as it was written; otherwise after OCCT knot insertion (not bit-exact).
 /// Throws clay::Error(Exchange) for a null handle; the result is validated (InvalidGeometry).
 BSplineCurve from_occt(const Handle(Geom_BSplineCurve)& curve, std::string_view name = "curve");
 
@@ -35,8 +38,10 @@ BSplineCurve from_occt(const Handle(Geom_BSplineCurve)& curve, std::string_view 
 Handle(Geom_BSplineSurface) to_occt(const BSplineSurface& surface,
                                     std::string_view name = "surface");
 
-/// Reads an OCCT surface (periodic directions made non-periodic on a copy first; weights read when
-/// IsURational() || IsVRational(), else all 1). Throws as the curve overload.
+/// Reads an OCCT surface: periodic directions are made non-periodic and clamped as for curves
+/// (the STEP and IGES readers make every closed clamped surface periodic; this undoes it
+/// exactly); weights are read when IsURational() || IsVRational(), else all 1. Throws as the
+/// curve overload.
 BSplineSurface from_occt(const Handle(Geom_BSplineSurface)& surface,
                          std::string_view name = "surface");
 
