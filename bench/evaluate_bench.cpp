@@ -51,15 +51,30 @@ void grid_occt_d0(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(us.size() * vs.size()));
 }
 
-void point_clayform(benchmark::State& state) {
-  // Scattered single-point evaluation (no grid reuse): the per-point cost of evaluate().
-  const BSplineSurface s = bicubic_20x20(state.range(0) != 0);
+/// 4096 scattered parameter pairs (no grid reuse possible).
+std::pair<std::vector<double>, std::vector<double>> scattered() {
   std::mt19937 rng(2);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<double> us(4096), vs(4096);
   for (size_t k = 0; k < us.size(); ++k) us[k] = unit(rng), vs[k] = unit(rng);
+  return {us, vs};
+}
+
+void point_clayform(benchmark::State& state) {
+  const BSplineSurface s = bicubic_20x20(state.range(0) != 0);
+  const auto [us, vs] = scattered();
   for (auto _ : state) {
     for (size_t k = 0; k < us.size(); ++k) benchmark::DoNotOptimize(evaluate(s, us[k], vs[k]));
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(us.size()));
+}
+
+void point_occt_d0(benchmark::State& state) {
+  const BSplineSurface s = bicubic_20x20(state.range(0) != 0);
+  const occt_reference::GridEvaluator occt(s);
+  const auto [us, vs] = scattered();
+  for (auto _ : state) {
+    for (size_t k = 0; k < us.size(); ++k) benchmark::DoNotOptimize(occt.evaluate(us[k], vs[k]));
   }
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(us.size()));
 }
@@ -70,5 +85,6 @@ void point_clayform(benchmark::State& state) {
 BENCHMARK(grid_clayform)->Args({201, 0})->Args({201, 1})->Args({1001, 0})->Args({1001, 1});
 BENCHMARK(grid_occt_d0)->Args({201, 0})->Args({201, 1})->Args({1001, 0})->Args({1001, 1});
 BENCHMARK(point_clayform)->Arg(0)->Arg(1);
+BENCHMARK(point_occt_d0)->Arg(0)->Arg(1);
 
 BENCHMARK_MAIN();

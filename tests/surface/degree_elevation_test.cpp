@@ -67,3 +67,20 @@ TEST_CASE("degree elevation refuses bad requests", "[elevate][errors]") {
   }
   CHECK(identical(elevate_degree(c, 0), c));
 }
+
+TEST_CASE("clamp makes an unclamped curve clamped on the same domain", "[elevate]") {
+  std::mt19937 rng(45);
+  for (int p = 1; p <= 6; ++p) {
+    const BSplineCurve c = clay::test::random_curve(rng, p, p + 4, true, false);
+    REQUIRE_FALSE(is_clamped(c.basis));
+    const BSplineCurve k = clamp(c);
+    CHECK(is_clamped(k.basis));
+    CHECK(k.basis.domain() == c.basis.domain());
+    CHECK(relative_deviation(c, k) < 1e-12);
+    // A clamped curve's end points are its end control points.
+    const auto [a, b] = k.basis.domain();
+    CHECK((evaluate(c, a) - k.points.row(0).transpose()).norm() < 1e-10);
+    CHECK((evaluate(c, b) - k.points.row(k.points.rows() - 1).transpose()).norm() < 1e-10);
+    CHECK(identical(clamp(k), k));
+  }
+}

@@ -130,3 +130,15 @@ TEST_CASE("evaluation errors: parameter outside the domain, bad order, degenerat
   broken.points(0, 0) = std::nan("");
   CHECK_THROWS_AS(evaluate_grid(broken, linspace(0, 1, 3), linspace(-1, 2, 3)), clay::Error);
 }
+
+TEST_CASE("evaluate_many equals pointwise evaluation of a curve", "[evaluate]") {
+  std::mt19937 rng(12);
+  const BSplineCurve c = clay::test::random_curve(rng, 4, 9, true, false);
+  const auto [a, b] = c.basis.domain();
+  const auto ts = linspace(a, b, 33);
+  const Points3 pts = evaluate_many(c, ts);
+  REQUIRE(pts.rows() == 33);
+  for (size_t k = 0; k < ts.size(); ++k)
+    CHECK((pts.row(static_cast<Eigen::Index>(k)).transpose() - evaluate(c, ts[k])).norm() == 0.0);
+  CHECK_THROWS_AS(evaluate_many(c, std::vector<double>{a, b + 1.0}), clay::Error);
+}

@@ -69,4 +69,10 @@ Points3 GridEvaluator::evaluate_grid(std::span<const double> us, std::span<const
   return out;
 }
 
+Eigen::Vector3d GridEvaluator::evaluate(double u, double v) const {
+  gp_Pnt p;
+  impl_->surface->D0(u, v, p);
+  return {p.X(), p.Y(), p.Z()};
+}
+
 }  // namespace clay::surface::occt_reference

@@ -29,6 +29,8 @@ class GridEvaluator {
   GridEvaluator& operator=(const GridEvaluator&) = delete;
   /// Same layout as clay::surface::evaluate_grid.
   Points3 evaluate_grid(std::span<const double> us, std::span<const double> vs) const;
+  /// One point by Geom_BSplineSurface::D0.
+  Eigen::Vector3d evaluate(double u, double v) const;
 
  private:
   struct Impl;

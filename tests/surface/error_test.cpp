@@ -1,0 +1,28 @@
+#include <catch2/catch.hpp>
+
+#include <clay/error.hpp>
+#include <clay/summary.hpp>
+
+TEST_CASE("clay::Error carries category and message", "[error]") {
+  const clay::Error e(clay::ErrorCategory::DegreeLimit, "surface 'hood': degree 30 exceeds 25");
+  CHECK(e.category() == clay::ErrorCategory::DegreeLimit);
+  CHECK(e.message() == "surface 'hood': degree 30 exceeds 25");
+  CHECK(std::string(e.what()) == "degree limit: surface 'hood': degree 30 exceeds 25");
+  CHECK(clay::to_string(clay::ErrorCategory::InvalidGeometry) == "invalid geometry");
+  CHECK(clay::to_string(clay::ErrorCategory::Io) == "i/o");
+}
+
+TEST_CASE("Summary::brief states the outcome in one line", "[error]") {
+  clay::Summary s;
+  s.termination = clay::Termination::Converged;
+  s.iterations = 4;
+  s.initial_residual = 0.11;
+  s.final_residual = 3.2e-13;
+  s.message = "foot point found";
+  CHECK(s.converged());
+  CHECK(s.brief() == "converged in 4 iterations, residual 3.2e-13 (from 0.11): foot point found");
+  s.termination = clay::Termination::NotConverged;
+  s.message.clear();
+  CHECK_FALSE(s.converged());
+  CHECK(s.brief() == "not converged in 4 iterations, residual 3.2e-13 (from 0.11)");
+}
