@@ -102,17 +102,10 @@ DirectionPlan clamp_ends(const TColStd_Array1OfReal& knots, const TColStd_Array1
   return plan;
 }
 
-std::string occt_message(const Standard_Failure& failure) {
-  const char* text = failure.GetMessageString();
-  std::string out = failure.DynamicType()->Name();
-  if (text != nullptr && *text != '\0') out += std::string(" (") + text + ")";
-  return out;
-}
-
 [[noreturn]] void refused(std::string_view name, const Standard_Failure& failure) {
   throw Error(ErrorCategory::Exchange,
               std::string(name) + ": OpenCASCADE refused the B-spline data: " +
-                  occt_message(failure) +
+                  describe(failure) +
                   "; check for knots closer than one unit in the last place or weights near 0");
 }
 
@@ -131,6 +124,13 @@ void check_degree(std::string_view name, int degree_u, int degree_v, bool surfac
 }
 
 }  // namespace
+
+std::string describe(const Standard_Failure& failure) {
+  const char* text = failure.GetMessageString();
+  std::string out = failure.DynamicType()->Name();
+  if (text != nullptr && *text != '\0') out += std::string(" (") + text + ")";
+  return out;
+}
 
 Handle(Geom_BSplineCurve) to_occt(const BSplineCurve& curve, std::string_view name) {
   validate(curve, name);

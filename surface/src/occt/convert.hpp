@@ -17,9 +17,14 @@
 
 #include <Geom_BSplineCurve.hxx>
 #include <Geom_BSplineSurface.hxx>
+#include <Standard_Failure.hxx>
 #include <Standard_Handle.hxx>
+#include <string>
 
 namespace clay::surface::occt {
+
+/// An OpenCASCADE exception in words: its type and, when it has one, its message.
+std::string describe(const Standard_Failure& failure);
 
 /// Builds the OCCT curve. Throws clay::Error: InvalidGeometry when validate(curve, name) fails,
 /// DegreeLimit above Geom_BSplineCurve::MaxDegree() (25), Exchange when OCCT refuses the data

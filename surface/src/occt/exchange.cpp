@@ -141,13 +141,6 @@ struct ExchangeSession {
   NonStopFloatingPoint floating_point;
 };
 
-std::string occt_message(const Standard_Failure& failure) {
-  const char* text = failure.GetMessageString();
-  std::string out = failure.DynamicType()->Name();
-  if (text != nullptr && *text != '\0') out += std::string(" (") + text + ")";
-  return out;
-}
-
 std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
 
 std::string surface_name(size_t k) { return "surface #" + std::to_string(k); }
@@ -186,7 +179,7 @@ TopoDS_Face make_face(const Handle(Geom_BSplineSurface)& surface, const std::str
     return maker.Face();
   } catch (const Standard_Failure& failure) {
     throw Error(ErrorCategory::Exchange,
-                name + ": OpenCASCADE failed to build its face: " + occt_message(failure));
+                name + ": OpenCASCADE failed to build its face: " + occt::describe(failure));
   }
 }
 
@@ -314,7 +307,7 @@ BuiltFaces build_faces(const std::vector<BSplineSurface>& input, std::string_vie
       report.problems.push_back(text);
     } catch (const Standard_Failure& failure) {
       report.valid = false;
-      report.problems.push_back(name + ": BRepCheck_Analyzer failed: " + occt_message(failure));
+      report.problems.push_back(name + ": BRepCheck_Analyzer failed: " + occt::describe(failure));
     }
   }
   return built;
@@ -485,7 +478,7 @@ auto guarded(std::string_view caller, Body&& body) -> decltype(body()) {
     return body();
   } catch (const Standard_Failure& failure) {
     throw Error(ErrorCategory::Exchange,
-                std::string(caller) + ": OpenCASCADE failed: " + occt_message(failure));
+                std::string(caller) + ": OpenCASCADE failed: " + occt::describe(failure));
   }
 }
 
