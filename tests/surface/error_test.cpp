@@ -26,3 +26,19 @@ TEST_CASE("Summary::brief states the outcome in one line", "[error]") {
   CHECK_FALSE(s.converged());
   CHECK(s.brief() == "not converged in 4 iterations, residual 3.2e-13 (from 0.11)");
 }
+
+#include <clay/surface/build_report.hpp>
+
+TEST_CASE("BuildReport describes a surface in one line", "[error]") {
+  using namespace clay::surface;
+  Points3 p(4, 3);
+  p << 0, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0;
+  const BSplineSurface s = make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
+  BuildReport r = describe(s, "bilinear");
+  r.exact = true;
+  r.max_deviation = 0.0;
+  r.samples = 9;
+  CHECK(r.count_u == 2);
+  CHECK_FALSE(r.rational);
+  CHECK(r.brief() == "bilinear: degree (1, 1), 2 x 2 control points, polynomial, exact (max deviation 0 mm on 9 samples)");
+}
