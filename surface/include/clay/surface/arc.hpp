@@ -1,0 +1,18 @@
+#pragma once
+/// Exact circular arcs as rational quadratic B-spline curves (The NURBS Book A7.1).
+#include <clay/surface/bspline_curve.hpp>
+
+#include <Eigen/Core>
+
+namespace clay::surface {
+
+/// The arc C(t) = center + radius (cos a x_axis + sin a y_axis), a from `start` to `end` (radians,
+/// 0 < end - start <= 2 pi), as a rational quadratic curve on [0, 1] with one Bézier segment per
+/// 90 degrees or less (weights 1 and cos(half segment angle)). A full circle closes exactly: its
+/// last control point is a bit-for-bit copy of its first. `x_axis` and `y_axis` must be
+/// orthonormal; radius >= 0 (0 gives a curve collapsed to `center`). Throws
+/// clay::Error(InvalidArgument) naming the bad value.
+BSplineCurve circular_arc(const Eigen::Vector3d& center, const Eigen::Vector3d& x_axis,
+                          const Eigen::Vector3d& y_axis, double radius, double start, double end);
+
+}  // namespace clay::surface
