@@ -134,7 +134,7 @@ TEST_CASE("revolve refuses an axis of zero length", "[revolve][errors]") {
   }
 }
 
-TEST_CASE("revolve refuses angles outside (0, 360]", "[revolve][errors]") {
+TEST_CASE("revolve refuses angles outside 0 to 360 degrees", "[revolve][errors]") {
   std::mt19937 rng(74);
   const BSplineCurve profile = wiggly_profile(rng, false);
   for (double bad : {0.0, -10.0, 360.5, std::nan("")})
