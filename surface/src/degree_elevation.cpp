@@ -207,6 +207,7 @@ BSplineSurface elevate_degree_v(const BSplineSurface& surface, int times) {
 
 BSplineCurve clamp(const BSplineCurve& curve) {
   validate(curve);
+  if (is_clamped(curve.basis)) return curve;  // bit for bit (no trip through x w / w)
   detail::Strip strip = detail::curve_strip(curve);
   detail::clamp(strip);
   return detail::curve_from_strip(std::move(strip));
@@ -214,9 +215,12 @@ BSplineCurve clamp(const BSplineCurve& curve) {
 
 BSplineSurface clamp(const BSplineSurface& surface) {
   validate(surface);
-  BSplineSurface out = detail::apply_in_direction(surface, detail::Direction::U,
-                                                  [](detail::Strip& s) { detail::clamp(s); });
-  return detail::apply_in_direction(out, detail::Direction::V, [](detail::Strip& s) { detail::clamp(s); });
+  BSplineSurface out = surface;  // directions already clamped are kept bit for bit
+  if (!is_clamped(out.u))
+    out = detail::apply_in_direction(out, detail::Direction::U, [](detail::Strip& s) { detail::clamp(s); });
+  if (!is_clamped(out.v))
+    out = detail::apply_in_direction(out, detail::Direction::V, [](detail::Strip& s) { detail::clamp(s); });
+  return out;
 }
 
 }  // namespace clay::surface

@@ -166,6 +166,7 @@ std::vector<detail::Strip> bezier_strips(const detail::Strip& refined) {
     seg.basis.knots.assign(static_cast<size_t>(p + 1), breaks[s]);
     seg.basis.knots.insert(seg.basis.knots.end(), static_cast<size_t>(p + 1), breaks[s + 1]);
     seg.rows = refined.rows.middleRows(k - p, p + 1);
+    seg.polynomial = refined.polynomial;
     out.push_back(std::move(seg));
   }
   return out;

@@ -17,15 +17,19 @@ using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMaj
 struct Strip {
   BSplineBasis basis;
   Rows rows;
+  /// Every weight is exactly 1: the result's weights are set back to exactly 1, since sums like
+  /// a + (1 - a) need not round to 1 and a polynomial object must stay polynomial.
+  bool polynomial = false;
 };
 
 inline Strip curve_strip(const BSplineCurve& c) {
-  return {c.basis, Rows(to_homogeneous(c.points, c.weights))};
+  return {c.basis, Rows(to_homogeneous(c.points, c.weights)), !c.is_rational()};
 }
 
 inline BSplineCurve curve_from_strip(Strip strip) {
   BSplineCurve c;
   c.basis = std::move(strip.basis);
+  if (strip.polynomial) strip.rows.col(3).setOnes();
   from_homogeneous(Homogeneous(strip.rows), c.points, c.weights);
   return c;
 }
@@ -40,12 +44,12 @@ inline Strip surface_strip(const BSplineSurface& s, Direction d) {
     Rows rows(nu, 4 * nv);
     for (int i = 0; i < nu; ++i)
       for (int j = 0; j < nv; ++j) rows.block<1, 4>(i, 4 * j) = h.row(s.index(i, j));
-    return {s.u, std::move(rows)};
+    return {s.u, std::move(rows), !s.is_rational()};
   }
   Rows rows(nv, 4 * nu);
   for (int j = 0; j < nv; ++j)
     for (int i = 0; i < nu; ++i) rows.block<1, 4>(j, 4 * i) = h.row(s.index(i, j));
-  return {s.v, std::move(rows)};
+  return {s.v, std::move(rows), !s.is_rational()};
 }
 
 /// Inverse of surface_strip: `other` is the basis of the untouched direction.
@@ -64,6 +68,7 @@ inline BSplineSurface surface_from_strip(Strip strip, const BSplineBasis& other,
     for (int j = 0; j < nv; ++j)
       h.row(s.index(i, j)) = d == Direction::U ? strip.rows.block<1, 4>(i, 4 * j)
                                                : strip.rows.block<1, 4>(j, 4 * i);
+  if (strip.polynomial) h.col(3).setOnes();
   from_homogeneous(h, s.points, s.weights);
   return s;
 }

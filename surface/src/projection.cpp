@@ -81,18 +81,24 @@ SurfaceProjection newton(const BSplineSurface& s, const Eigen::Vector3d& target,
     Eigen::Vector2d step = Eigen::Vector2d::Zero();
     Eigen::Matrix2d G;
     G << su.dot(su), su.dot(sv), su.dot(sv), sv.dot(sv);
+    // A direction whose tangent vanishes (a collapsed edge, a pole) cannot move the point at first
+    // order: it is held for this step and Newton runs on the other one.
+    const double tangent_floor = 1e-24 * (G(0, 0) + G(1, 1));
+    const bool held[2] = {active[0] || !(G(0, 0) > tangent_floor), active[1] || !(G(1, 1) > tangent_floor)};
     auto solve_free = [&](const Eigen::Matrix2d& M) -> bool {
-      if (!active[0] && !active[1]) {
+      if (!held[0] && !held[1]) {
         if (!(M(0, 0) > 0.0 && M.determinant() > 0.0)) return false;
         step = -M.ldlt().solve(g);
         return step.allFinite();
       }
+      bool moved = false;
       for (int k = 0; k < 2; ++k) {
-        if (active[k]) continue;
+        if (held[k]) continue;
         if (!(M(k, k) > 0.0)) return false;
         step[k] = -g[k] / M(k, k);
+        moved = true;
       }
-      return true;
+      return moved;
     };
     step.setZero();
     if (!solve_free(H)) {

@@ -84,3 +84,19 @@ TEST_CASE("clamp makes an unclamped curve clamped on the same domain", "[elevate
     CHECK(identical(clamp(k), k));
   }
 }
+
+TEST_CASE("polynomial objects stay polynomial through knot and degree operations", "[elevate][knots]") {
+  std::mt19937 rng(46);
+  for (int p = 1; p <= 6; ++p) {
+    const BSplineCurve c = clay::test::random_curve(rng, p, p + 5, false, p % 2 == 0);
+    CHECK_FALSE(elevate_degree(c, 3).is_rational());
+    CHECK_FALSE(clamp(c).is_rational());
+    CHECK_FALSE(insert_knot(c, 0.3).is_rational());
+    for (const auto& seg : extract_bezier(c)) CHECK_FALSE(seg.is_rational());
+    const BSplineSurface s = clay::test::random_surface(rng, p, 3, p + 4, 6, false, p % 2 == 1);
+    CHECK_FALSE(elevate_degree_u(s, 2).is_rational());
+    CHECK_FALSE(elevate_degree_v(s, 1).is_rational());
+    for (const auto& patch : extract_bezier(s).patches) CHECK_FALSE(patch.is_rational());
+    CHECK((elevate_degree_u(s, 2).weights.array() == 1.0).all());
+  }
+}

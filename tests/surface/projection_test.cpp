@@ -102,3 +102,23 @@ TEST_CASE("projection refuses bad input", "[projection][errors]") {
     CHECK_THAT(e.what(), Catch::Contains("samples_per_span"));
   }
 }
+
+TEST_CASE("closest point near a collapsed edge (a triangular patch)", "[projection]") {
+  // Bicubic patch whose row i = 0 collapses to the apex (0, 0, 0): S_v vanishes along u = 0.
+  Points3 p(16, 3);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const double r = 30.0 * i, a = 0.5 * j;  // a fan from the apex
+      p.row(i * 4 + j) << r * std::cos(a), r * std::sin(a), 0.0;
+    }
+  const BSplineSurface s = make_surface(clamped_uniform_basis(3, 4), clamped_uniform_basis(3, 4), p);
+  // Points of the surface near and at the apex project onto themselves.
+  for (double u : {0.0, 1e-6, 0.01, 0.2})
+    for (double v : {0.0, 0.4, 1.0}) {
+      const Eigen::Vector3d x = evaluate(s, u, v) + Eigen::Vector3d(0, 0, 2.0);  // 2 mm above the plane
+      const SurfaceProjection proj = closest_point(s, x);
+      INFO("u " << u << ", v " << v << ": " << proj.summary.brief());
+      CHECK(proj.summary.termination != clay::Termination::Failed);
+      CHECK_THAT(proj.distance, WithinAbs(2.0, 1e-9));
+    }
+}

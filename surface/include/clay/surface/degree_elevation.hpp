@@ -16,9 +16,11 @@ BSplineSurface elevate_degree_u(const BSplineSurface& surface, int times = 1);
 /// The surface with its v degree raised by `times`.
 BSplineSurface elevate_degree_v(const BSplineSurface& surface, int times = 1);
 
-/// The curve with a clamped knot vector on the same domain (unchanged if already clamped).
+/// The curve with a clamped knot vector on the same domain (returned bit for bit if already
+/// clamped).
 BSplineCurve clamp(const BSplineCurve& curve);
-/// The surface with clamped knot vectors in both directions on the same domain.
+/// The surface with clamped knot vectors in both directions on the same domain (a direction
+/// already clamped is kept bit for bit).
 BSplineSurface clamp(const BSplineSurface& surface);
 
 }  // namespace clay::surface

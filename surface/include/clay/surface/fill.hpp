@@ -1,0 +1,92 @@
+#pragma once
+/// Filling: a surface spanned by boundary curves. fill() is exact for 2, 3 or 4 curves
+/// (OpenCASCADE's GeomFill_BSplineCurves: the boundary curves are the surface's edges);
+/// fill_n_sided() approximates a plate through any number of boundary curves and optional interior
+/// curves (OpenCASCADE's BRepOffsetAPI_MakeFilling), reporting how far each curve is from it.
+#include <clay/surface/build_report.hpp>
+
+#include <vector>
+
+namespace clay::surface {
+
+/// How fill() blends the boundary curves into the interior (OpenCASCADE's GeomFill styles).
+enum class FillStyle {
+  Stretch,  ///< the flattest patch
+  Coons,    ///< a rounded patch (Coons construction with cubic blending on the control points)
+  Curved,   ///< the most rounded patch
+};
+
+/// Settings of fill().
+struct FillOptions {
+  FillStyle style = FillStyle::Coons;  ///< interior blend
+  double gap_tolerance = 1e-7;  ///< mm, > 0 and finite: ends of consecutive boundary curves must
+                                ///< meet within this; they are then joined at their midpoint
+
+  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  void validate() const;
+};
+
+/// The surface bounded by 2, 3 or 4 B-spline curves, exact (GeomFill_BSplineCurves). Curves may
+/// come in any order and direction: from curve #0 each next curve is the one whose end is nearest,
+/// reversed when needed, until the loop closes; corners within options.gap_tolerance are joined at
+/// their midpoint. Curves are clamped and reparametrized to [0, 1], opposite sides made compatible
+/// (degree elevation and knot refinement), and, for Coons, sides with fewer than 4 control points
+/// raised to degree 3 (OpenCASCADE refuses Coons below 4). 4 curves: u runs along the first curve
+/// of the loop (v = 0), v along the second (u = 1); 3 curves: the side u = 0 collapses to the corner
+/// where the loop closes; 2 curves: Stretch and Coons give the ruled surface between them (the
+/// second curve turned to run like the first; no loop needed), Curved the patch spanned by two
+/// curves that share a corner. The report is exact; its max_deviation is the largest distance
+/// between each input curve and the surface edge it became, on dense samples (rounding, plus at
+/// most half a joined gap), and its method lists what was reversed, raised or joined. Throws
+/// clay::Error: InvalidArgument for a count outside [2, 4] or bad options; InvalidGeometry for an
+/// invalid or degenerate curve (named "curve #k", 0-based) and for curves that do not close,
+/// naming each gap, e.g. "curve #1 end and curve #2 start are 0.25 mm apart (tolerance 1e-07 mm)";
+/// InvalidGeometry with OpenCASCADE's message if it still fails.
+BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& options = {});
+
+/// Settings of fill_n_sided(): BRepOffsetAPI_MakeFilling's parameters. Defaults are OpenCASCADE's
+/// except degree (5, not 3), tolerance_3d (1e-5, not 1e-4) and max_segments (20, not 9): on a
+/// 5-sided sphere cap and a cubic dome (~200 mm) they bring the measured curve-to-surface distance
+/// from 6e-4 and 1.7e-3 mm down to 3.4e-6 and 1.2e-6 mm, at the same cost (20-40 ms).
+struct NSidedFillOptions {
+  int degree = 5;              ///< order of the plate's energy criterion, 2..14 (OCCT "Degree")
+  int points_on_curve = 15;    ///< constraint points per curve, 2..1000 (OCCT "NbPtsOnCur")
+  int iterations = 2;          ///< plate iterations, 1..50 (OCCT "NbIter")
+  bool anisotropy = false;     ///< favour the longer parametric direction (OCCT "Anisotropie")
+  double tolerance_2d = 1e-5;  ///< parametric tolerance, > 0 (OCCT "Tol2d")
+  double tolerance_3d = 1e-5;  ///< mm, > 0: distance the plate may leave the curves by (OCCT
+                               ///< "Tol3d"); the measured distance can be larger, see the report
+  double angular_tolerance = 1e-2;  ///< radians, > 0 (OCCT "TolAng"; used for G1 constraints)
+  double curvature_tolerance = 0.1; ///< > 0 (OCCT "TolCurv"; used for G2 constraints)
+  int max_degree = 8;          ///< degree of the B-spline approximating the plate, 3..25 (OCCT "MaxDeg")
+  int max_segments = 20;       ///< knot spans per direction of that B-spline, 1..1000 (OCCT "MaxSegments")
+  double gap_tolerance = 1e-7; ///< mm, > 0: boundary corners must meet within this (joined at
+                               ///< their midpoint)
+  int samples_per_curve = 64;  ///< points per curve where the deviation is measured, >= 2
+
+  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  void validate() const;
+};
+
+/// What fill_n_sided() built and how far each curve is from it.
+struct NSidedFill {
+  BuiltSurface built;                  ///< the plate as one B-spline surface (report not exact)
+  std::vector<double> curve_deviations;  ///< mm: boundary curves in input order, then interior
+                                         ///< curves; each the largest closest-point distance of
+                                         ///< its samples to the surface
+};
+
+/// A smooth surface through 3 or more boundary curves (any order and direction, chained as in
+/// fill()) and optional interior curves it must pass through: OpenCASCADE's plate
+/// (BRepOffsetAPI_MakeFilling, GeomPlate: a thin-plate energy minimized under point constraints,
+/// then approximated by a B-spline), returned as that B-spline surface, untrimmed: it covers the
+/// N-sided region and extends beyond it (the boundary curves trim it). Not exact: max_deviation is
+/// the largest of curve_deviations, measured with closest_point() on options.samples_per_curve
+/// points of every curve. Throws clay::Error: InvalidArgument for fewer than 3 boundary curves or
+/// bad options; InvalidGeometry for invalid or degenerate curves, a boundary that does not close
+/// (naming each gap as fill() does), or when OpenCASCADE fails (its message included).
+NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
+                        const std::vector<BSplineCurve>& interior = {},
+                        const NSidedFillOptions& options = {});
+
+}  // namespace clay::surface

@@ -1,0 +1,96 @@
+#pragma once
+/// Skinning: a surface through section curves (loft) and a profile moved along a path (sweep).
+///
+/// Both are our own code on the value types (no OpenCASCADE). The surface's u direction runs along
+/// the sections (the profile), its v direction across them (along the path).
+#include <clay/surface/build_report.hpp>
+
+#include <vector>
+
+namespace clay::surface {
+
+/// How loft() places the sections across the surface (their v parameters).
+enum class LoftParametrization {
+  ChordLength,  ///< v steps proportional to the distance between sections (The NURBS Book eq. 9.5)
+  Centripetal,  ///< proportional to its square root (eq. 9.6); steadier for uneven spacing
+  Uniform,      ///< equal steps
+};
+
+/// Settings of loft().
+struct LoftOptions {
+  int degree = 3;  ///< degree across the sections (v), 1..max_kernel_degree; the loft uses
+                   ///< min(degree, sections - 1), so the surface is C^(degree-1) across sections
+  LoftParametrization parametrization = LoftParametrization::ChordLength;  ///< v spacing
+  bool auto_orient = true;  ///< reverse a section that runs against its predecessor (else reject)
+  double tolerance = 1e-7;  ///< relative to the model size (diagonal of the sections' control
+                            ///< points): consecutive sections closer than this coincide, a section
+                            ///< whose control polygon is shorter is degenerate; in (0, 1e-2]
+
+  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  void validate() const;
+};
+
+/// The curves written compatibly: every one clamped, reparametrized linearly to [0, 1], raised to
+/// the highest degree (degree elevation, The NURBS Book A5.9) and refined to the union of all knot
+/// vectors (A5.4; knots within 1e-12 of each other are merged). Same shapes, so curve k at t equals
+/// input k at a_k + t (b_k - a_k) for its domain [a_k, b_k] (up to rounding). Every result has the
+/// same degree and knot vector. Throws clay::Error(InvalidGeometry) for an invalid curve (named
+/// "curve #k", 0-based) or when the degree would exceed max_kernel_degree; InvalidArgument for an
+/// empty list.
+std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves);
+
+/// The v parameter at which loft(sections, options) interpolates each section (0 first, 1 last):
+/// the chord-length (or centripetal, or uniform) parameters of the compatible sections' control
+/// points averaged over the control point columns (The NURBS Book §10.3, eq. 10.8). Throws as loft.
+std::vector<double> loft_parameters(const std::vector<BSplineCurve>& sections,
+                                    const LoftOptions& options = {});
+
+/// A surface through 2 or more section curves (skinning, The NURBS Book §10.3): the sections are
+/// made compatible (make_compatible), then each column of their control points (homogeneous, so
+/// rational sections work) is interpolated across the sections with degree
+/// min(options.degree, sections - 1), the averaged parameters of loft_parameters and knots by
+/// averaging (eq. 9.8). Exact: S(u, v_k) equals section k at its normalized parameter u in [0, 1];
+/// the report's max_deviation measures exactly that on a dense sample (rounding, ~1e-15 of size).
+/// A section running against its predecessor is reversed when options.auto_orient (the report's
+/// method says which). Throws clay::Error: InvalidArgument for fewer than 2 sections or bad
+/// options; InvalidGeometry naming the section index (0-based) for an invalid or degenerate
+/// section (control polygon ~0 long, e.g. a point), two consecutive coincident sections, a
+/// reversed section when auto_orient is false, or rational sections whose interpolated weights
+/// are not positive.
+BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& options = {});
+
+/// Settings of sweep().
+struct SweepOptions {
+  double twist_degrees = 0;  ///< total rotation of the profile about the path tangent from start to
+                             ///< end, spread in proportion to arc length; finite
+  int sections = 0;          ///< profile copies placed along the path: 0 = adaptive (refined until
+                             ///< the deviation is within tolerance), else a fixed count >= 2
+  double tolerance = 1e-6;   ///< relative to the model size (diagonal of the profile's and path's
+                             ///< control points): the deviation the adaptive sweep must reach, and
+                             ///< the largest tangent turn (radians) at a path knot; in (0, 1e-1]
+  int max_sections = 1025;   ///< adaptive refinement stops here, >= 2
+
+  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  void validate() const;
+};
+
+/// The profile moved along the path without twisting: rotation-minimizing frames by the double
+/// reflection method (Wang, Jüttler, Zheng, Liu 2008, "Computation of rotation minimizing frames",
+/// Algorithm 1) on a fine table of the path, plus options.twist_degrees about the tangent. The
+/// profile is given in world coordinates at the path start, where the frame maps it to itself;
+/// at path parameter t a profile point X goes to C(t) + M(t) (X - C(t0)), M(t) the rotation from
+/// the start frame to the frame at t. The surface interpolates exact copies of the profile placed
+/// at equal arc-length steps (cubic across them, v = arc-length fraction, u = the profile's own
+/// clamped parameter), doubling their number until the largest distance between S(u, v) and the
+/// exactly moved profile at 1/4, 1/2, 3/4 of every interval is within tolerance (report: exact =
+/// false, max_deviation, the sections used in the method; "tolerance not reached" when
+/// max_sections stopped it). At path knots where the curvature (or its derivative) jumps, a copy
+/// sits on the knot and v gets a triple (double) knot, matching the sweep's own C0 (C1) continuity
+/// there. A straight path without twist gives the exact extrusion (degree 1 across, exact = true). Throws clay::Error(InvalidGeometry) naming "profile" or "path" for an invalid or
+/// degenerate curve (control polygon ~0 long), a path with a zero tangent or a corner (tangent
+/// turning by more than tolerance radians at a knot: split the path there); InvalidArgument for
+/// bad options.
+BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
+                   const SweepOptions& options = {});
+
+}  // namespace clay::surface

@@ -1,0 +1,832 @@
+// Loft (skinning) and sweep: our own code on the value types (The NURBS Book §10.3; Wang et al.
+// 2008 for the rotation-minimizing frames).
+#include <clay/surface/skin.hpp>
+
+#include <clay/error.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/degree_elevation.hpp>
+#include <clay/surface/evaluate.hpp>
+#include <clay/surface/knots.hpp>
+#include <clay/tolerance.hpp>
+
+#include <Eigen/Geometry>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "builder_tools.hpp"
+
+namespace clay::surface {
+namespace {
+
+using detail::model_size;
+using detail::normalized;
+using detail::polygon_length;
+using detail::reversed;
+
+std::string num(double x) { return detail::short_number(x); }
+
+std::string name(const char* what, size_t k) { return std::string(what) + " #" + std::to_string(k); }
+
+// ---- Interpolation of compatible sections across v (The NURBS Book §10.3) ----
+
+/// Knots by averaging (The NURBS Book eq. 9.8) for parameters v (v.front() = 0, v.back() = 1).
+BSplineBasis averaged_basis(const std::vector<double>& v, int q) {
+  const int count = static_cast<int>(v.size());
+  BSplineBasis basis;
+  basis.degree = q;
+  basis.knots.assign(static_cast<size_t>(q + 1), 0.0);
+  for (int j = 1; j <= count - q - 1; ++j) {
+    double sum = 0;
+    for (int i = j; i <= j + q - 1; ++i) sum += v[static_cast<size_t>(i)];
+    basis.knots.push_back(sum / q);
+  }
+  basis.knots.insert(basis.knots.end(), static_cast<size_t>(q + 1), 1.0);
+  return basis;
+}
+
+/// The surface whose iso-curve v = v[k] is sections[k] (all compatible: same basis), degree q in
+/// v. Rational sections are interpolated in homogeneous coordinates; polynomial ones in Cartesian
+/// coordinates so the weights stay exactly 1.
+BSplineSurface interpolate_sections(const std::vector<BSplineCurve>& sections,
+                                    const std::vector<double>& v, const BSplineBasis& basis_v) {
+  const int count = static_cast<int>(sections.size());
+  const int n = sections.front().basis.count();
+  const int q = basis_v.degree;
+  if (basis_v.count() != count)
+    throw Error(ErrorCategory::Internal,
+                "loft: " + std::to_string(basis_v.count()) + " basis functions across " +
+                    std::to_string(count) + " sections (please report this input)");
+  const bool rational = std::any_of(sections.begin(), sections.end(),
+                                    [](const BSplineCurve& c) { return c.is_rational(); });
+
+  // Collocation matrix N_j(v_k): banded and totally positive (de Boor), sparse LU solves it.
+  Eigen::SparseMatrix<double> A(count, count);
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<double> values(static_cast<size_t>(q + 1));
+  for (int k = 0; k < count; ++k) {
+    const int span = find_span(basis_v, v[static_cast<size_t>(k)]);
+    basis_functions(basis_v, span, v[static_cast<size_t>(k)], values);
+    for (int j = 0; j <= q; ++j)
+      if (values[static_cast<size_t>(j)] != 0.0)
+        entries.emplace_back(k, span - q + j, values[static_cast<size_t>(j)]);
+  }
+  A.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+  lu.compute(A);
+  if (lu.info() != Eigen::Success)
+    throw Error(ErrorCategory::Internal,
+                "loft: the interpolation matrix across the sections is singular; the section "
+                "parameters are not increasing (please report this input)");
+
+  const int width = rational ? 4 : 3;
+  Eigen::MatrixXd rhs(count, width * n);
+  for (int k = 0; k < count; ++k) {
+    const BSplineCurve& c = sections[static_cast<size_t>(k)];
+    for (int i = 0; i < n; ++i) {
+      const double w = c.weights[i];
+      for (int d = 0; d < 3; ++d) rhs(k, width * i + d) = rational ? w * c.points(i, d) : c.points(i, d);
+      if (rational) rhs(k, width * i + 3) = w;
+    }
+  }
+  const Eigen::MatrixXd x = lu.solve(rhs);
+
+  BSplineSurface s;
+  s.u = sections.front().basis;
+  s.v = basis_v;
+  s.points.resize(static_cast<Eigen::Index>(n) * count, 3);
+  s.weights = Eigen::VectorXd::Ones(s.points.rows());
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < count; ++j) {
+      const Eigen::Index r = s.index(i, j);
+      if (rational) {
+        const double w = x(j, width * i + 3);
+        if (!(w > 0.0))
+          throw Error(ErrorCategory::InvalidGeometry,
+                      "loft: the weights interpolated across the rational sections are not "
+                      "positive at control point (" + std::to_string(i) + ", " + std::to_string(j) +
+                      ") (weight " + num(w) + "); give sections with similar weights or lower the "
+                      "loft degree");
+        s.weights[r] = w;
+        for (int d = 0; d < 3; ++d) s.points(r, d) = x(j, width * i + d) / w;
+      } else {
+        for (int d = 0; d < 3; ++d) s.points(r, d) = x(j, width * i + d);
+      }
+    }
+  return s;
+}
+
+/// Same with knots by averaging (The NURBS Book eq. 9.8) for degree q.
+BSplineSurface interpolate_sections(const std::vector<BSplineCurve>& sections,
+                                    const std::vector<double>& v, int q) {
+  return interpolate_sections(sections, v, averaged_basis(v, q));
+}
+
+// ---- Loft ----
+
+struct PreparedLoft {
+  std::vector<BSplineCurve> compatible;  // oriented, compatible, on [0, 1]
+  std::vector<bool> reversed;
+  std::vector<double> v;
+  int degree = 1;
+};
+
+std::vector<double> section_parameters(const std::vector<BSplineCurve>& c,
+                                       LoftParametrization kind) {
+  const size_t count = c.size();
+  std::vector<double> v(count, 0.0);
+  v.back() = 1.0;
+  if (kind == LoftParametrization::Uniform) {
+    for (size_t k = 1; k + 1 < count; ++k) v[k] = static_cast<double>(k) / static_cast<double>(count - 1);
+    return v;
+  }
+  // Per column i of control points: cumulative (chord or centripetal) length across the sections,
+  // normalized; then averaged over the columns (The NURBS Book eq. 10.8). Columns that do not move
+  // (e.g. a shared apex) carry no information and are skipped.
+  const Eigen::Index n = c.front().points.rows();
+  std::vector<double> sum(count, 0.0);
+  int used = 0;
+  std::vector<double> step(count, 0.0);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double total = 0;
+    for (size_t k = 1; k < count; ++k) {
+      const double d = (c[k].points.row(i) - c[k - 1].points.row(i)).norm();
+      step[k] = kind == LoftParametrization::Centripetal ? std::sqrt(d) : d;
+      total += step[k];
+    }
+    if (!(total > 0.0)) continue;
+    ++used;
+    double run = 0;
+    for (size_t k = 1; k + 1 < count; ++k) {
+      run += step[k];
+      sum[k] += run / total;
+    }
+  }
+  for (size_t k = 1; k + 1 < count; ++k) v[k] = sum[k] / used;
+  return v;
+}
+
+PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftOptions& options) {
+  options.validate();
+  if (sections.size() < 2)
+    throw Error(ErrorCategory::InvalidArgument,
+                "loft: needs at least 2 sections, got " + std::to_string(sections.size()) +
+                    "; give two or more section curves");
+  std::vector<const BSplineCurve*> all;
+  for (size_t k = 0; k < sections.size(); ++k) {
+    validate(sections[k], name("loft section", k));
+    all.push_back(&sections[k]);
+  }
+  const double size = model_size(all);
+  const double tol = options.tolerance * size;
+  for (size_t k = 0; k < sections.size(); ++k) {
+    const double length = polygon_length(sections[k]);
+    if (!(length > tol))
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "loft: section #" + std::to_string(k) + " is degenerate: its control polygon is " +
+                      num(length) + " mm long (tolerance " + num(tol) +
+                      " mm); a loft needs curves, not points: remove it or give a curve");
+  }
+
+  PreparedLoft out;
+  std::vector<BSplineCurve> oriented;
+  for (const BSplineCurve& s : sections) oriented.push_back(normalized(s));
+  out.reversed.assign(sections.size(), false);
+  const std::vector<double> ts = linspace(0.0, 1.0, 65);
+  for (size_t k = 1; k < oriented.size(); ++k) {
+    double same = 0, against = 0, largest = 0;
+    for (double t : ts) {
+      const Eigen::Vector3d a = evaluate(oriented[k], t);
+      const double d = (a - evaluate(oriented[k - 1], t)).norm();
+      same += d * d;
+      largest = std::max(largest, d);
+      against += (a - evaluate(oriented[k - 1], 1.0 - t)).squaredNorm();
+    }
+    if (against < same) {
+      if (!options.auto_orient)
+        throw Error(ErrorCategory::InvalidGeometry,
+                    "loft: section #" + std::to_string(k) + " runs against section #" +
+                        std::to_string(k - 1) +
+                        " (it lies nearer to that section run backwards); reverse it or set "
+                        "LoftOptions::auto_orient");
+      oriented[k] = reversed(oriented[k]);
+      out.reversed[k] = true;
+      largest = 0;
+      for (double t : ts)
+        largest = std::max(largest, (evaluate(oriented[k], t) - evaluate(oriented[k - 1], t)).norm());
+    }
+    if (!(largest > tol))
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "loft: sections #" + std::to_string(k - 1) + " and #" + std::to_string(k) +
+                      " coincide (largest distance " + num(largest) + " mm, tolerance " + num(tol) +
+                      " mm); remove one of them");
+  }
+  out.compatible = make_compatible(oriented);
+  out.v = section_parameters(out.compatible, options.parametrization);
+  for (size_t k = 1; k < out.v.size(); ++k)
+    if (!(out.v[k] > out.v[k - 1]))
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "loft: sections #" + std::to_string(k - 1) + " and #" + std::to_string(k) +
+                      " get the same parameter (their control points coincide); remove one of them");
+  out.degree = std::min(options.degree, static_cast<int>(sections.size()) - 1);
+  return out;
+}
+
+// ---- Sweep: rotation-minimizing frames on a fine table of the path ----
+
+// 8-point Gauss–Legendre nodes and weights on [-1, 1].
+constexpr std::array<double, 8> gauss_x = {-0.9602898564975363, -0.7966664774136267,
+                                           -0.5255324099163290, -0.1834346424956498,
+                                           0.1834346424956498,  0.5255324099163290,
+                                           0.7966664774136267,  0.9602898564975363};
+constexpr std::array<double, 8> gauss_w = {0.1012285362903763, 0.2223810344533745,
+                                           0.3137066458778873, 0.3626837833783620,
+                                           0.3626837833783620, 0.3137066458778873,
+                                           0.2223810344533745, 0.1012285362903763};
+
+/// The path sampled finely: points, unit tangents, rotation-minimizing normals r (double
+/// reflection, Wang et al. 2008, Algorithm 1) and cumulative arc length. Frames and arc lengths
+/// between entries come from one more reflection / quadrature step from the entry before.
+class PathTable {
+ public:
+  PathTable(const BSplineCurve& path, double size) : path_(path) {
+    const std::vector<double> bp = breakpoints(path.basis);
+    const int spans = static_cast<int>(bp.size()) - 1;
+    const int steps = std::max(8, (512 + spans - 1) / spans);
+    for (int k = 0; k < spans; ++k) {
+      const std::vector<double> ts = linspace(bp[static_cast<size_t>(k)], bp[static_cast<size_t>(k + 1)], steps + 1);
+      for (size_t i = k == 0 ? 0 : 1; i < ts.size(); ++i) t_.push_back(ts[i]);
+    }
+    const double domain = bp.back() - bp.front();
+    for (double t : t_) {
+      const CurveDerivatives d = derivatives(path, t, 1);
+      const double speed = d.d1.norm();
+      if (!(speed * domain > 1e-12 * size))
+        throw Error(ErrorCategory::InvalidGeometry,
+                    "sweep: path has a zero tangent at t = " + num(t) +
+                        " (a cusp or a collapsed span); remove the repeated control points there");
+      x_.push_back(d.point);
+      tangent_.push_back(d.d1 / speed);
+    }
+    // Any unit vector normal to the first tangent: the sweep does not depend on the choice.
+    const Eigen::Vector3d& t0 = tangent_.front();
+    Eigen::Index axis;
+    t0.cwiseAbs().minCoeff(&axis);
+    r_.push_back(t0.cross(Eigen::Vector3d::Unit(axis)).normalized());
+    s_.push_back(0.0);
+    for (size_t j = 1; j < t_.size(); ++j) {
+      r_.push_back(reflect(x_[j - 1], tangent_[j - 1], r_[j - 1], x_[j], tangent_[j]));
+      s_.push_back(s_[j - 1] + arc(t_[j - 1], t_[j]));
+    }
+  }
+
+  double length() const { return s_.back(); }
+  double first() const { return t_.front(); }
+  double last() const { return t_.back(); }
+
+  /// Arc length from the path start to t.
+  double arc_length(double t) const {
+    const size_t j = entry(t);
+    return s_[j] + arc(t_[j], t);
+  }
+
+  /// The parameter t at arc length s in [0, length()] (Newton with bisection safeguard).
+  double parameter(double s) const {
+    if (s <= 0.0) return t_.front();
+    if (s >= s_.back()) return t_.back();
+    const size_t j = static_cast<size_t>(std::upper_bound(s_.begin(), s_.end(), s) - s_.begin()) - 1;
+    double lo = t_[j], hi = t_[j + 1];
+    double t = lo + (hi - lo) * (s - s_[j]) / (s_[j + 1] - s_[j]);
+    for (int it = 0; it < 60; ++it) {
+      const double f = s_[j] + arc(t_[j], t) - s;
+      if (std::abs(f) <= 1e-15 * s_.back()) break;
+      if (f > 0) hi = t; else lo = t;
+      double next = t - f / derivatives(path_, t, 1).d1.norm();
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (next == t) break;
+      t = next;
+    }
+    return t;
+  }
+
+  /// Position, unit tangent and rotation-minimizing normal at t.
+  void frame(double t, Eigen::Vector3d& x, Eigen::Vector3d& tangent, Eigen::Vector3d& r) const {
+    const size_t j = entry(t);
+    if (t == t_[j]) {
+      x = x_[j];
+      tangent = tangent_[j];
+      r = r_[j];
+      return;
+    }
+    const CurveDerivatives d = derivatives(path_, t, 1);
+    x = d.point;
+    tangent = d.d1.normalized();
+    r = reflect(x_[j], tangent_[j], r_[j], x, tangent);
+  }
+
+ private:
+  /// Double reflection (Wang et al. 2008, Algorithm 1): the normal at (x1, t1) from (x0, t0, r0).
+  static Eigen::Vector3d reflect(const Eigen::Vector3d& x0, const Eigen::Vector3d& t0,
+                                 const Eigen::Vector3d& r0, const Eigen::Vector3d& x1,
+                                 const Eigen::Vector3d& t1) {
+    Eigen::Vector3d rl = r0, tl = t0;
+    const Eigen::Vector3d v1 = x1 - x0;
+    const double c1 = v1.squaredNorm();
+    if (c1 > 0) {
+      rl = r0 - (2.0 / c1) * v1.dot(r0) * v1;
+      tl = t0 - (2.0 / c1) * v1.dot(t0) * v1;
+    }
+    const Eigen::Vector3d v2 = t1 - tl;
+    const double c2 = v2.squaredNorm();
+    Eigen::Vector3d r1 = c2 > 0 ? Eigen::Vector3d(rl - (2.0 / c2) * v2.dot(rl) * v2) : rl;
+    // Keep r exactly normal to the tangent and of unit length (rounding only).
+    r1 -= r1.dot(t1) * t1;
+    return r1.normalized();
+  }
+
+  size_t entry(double t) const {
+    const auto it = std::upper_bound(t_.begin(), t_.end(), t);
+    if (it == t_.begin()) return 0;
+    return std::min(static_cast<size_t>(it - t_.begin()) - 1, t_.size() - 1);
+  }
+
+  double arc(double a, double b) const {
+    if (b <= a) return 0.0;
+    double sum = 0;
+    for (size_t g = 0; g < gauss_x.size(); ++g) {
+      const double t = 0.5 * (a + b) + 0.5 * (b - a) * gauss_x[g];
+      sum += gauss_w[g] * derivatives(path_, t, 1).d1.norm();
+    }
+    return 0.5 * (b - a) * sum;
+  }
+
+  const BSplineCurve& path_;
+  std::vector<double> t_, s_;
+  std::vector<Eigen::Vector3d> x_, tangent_, r_;
+};
+
+/// The rigid motions of the sweep: start frame to frame at t, with the twist.
+class SweepMotion {
+ public:
+  SweepMotion(const PathTable& table, double twist_radians)
+      : table_(table), twist_(twist_radians) {
+    Eigen::Vector3d t0, r0;
+    table_.frame(table_.first(), x0_, t0, r0);
+    f0_ = frame_matrix(t0, r0, 0.0);
+  }
+
+  /// The profile moved to path parameter t (control points moved, weights kept: exact).
+  BSplineCurve moved(const BSplineCurve& profile, double t) const {
+    Eigen::Vector3d x;
+    const Eigen::Matrix3d m = rotation(t, x);
+    BSplineCurve c = profile;
+    for (Eigen::Index i = 0; i < c.points.rows(); ++i)
+      c.points.row(i) = (x + m * (profile.points.row(i).transpose() - x0_)).transpose();
+    return c;
+  }
+
+  /// Points moved to path parameter t.
+  Points3 moved(const Points3& points, double t) const {
+    Eigen::Vector3d x;
+    const Eigen::Matrix3d m = rotation(t, x);
+    Points3 out(points.rows(), 3);
+    for (Eigen::Index i = 0; i < points.rows(); ++i)
+      out.row(i) = (x + m * (points.row(i).transpose() - x0_)).transpose();
+    return out;
+  }
+
+ private:
+  static Eigen::Matrix3d frame_matrix(const Eigen::Vector3d& t, const Eigen::Vector3d& r,
+                                      double angle) {
+    const Eigen::Vector3d s = t.cross(r);
+    const Eigen::Vector3d rt = std::cos(angle) * r + std::sin(angle) * s;
+    Eigen::Matrix3d f;
+    f.col(0) = t;
+    f.col(1) = rt;
+    f.col(2) = t.cross(rt);
+    return f;
+  }
+
+  Eigen::Matrix3d rotation(double t, Eigen::Vector3d& x) const {
+    Eigen::Vector3d tangent, r;
+    table_.frame(t, x, tangent, r);
+    const double angle = twist_ == 0.0 ? 0.0 : twist_ * table_.arc_length(t) / table_.length();
+    return frame_matrix(tangent, r, angle) * f0_.transpose();
+  }
+
+  const PathTable& table_;
+  double twist_;
+  Eigen::Vector3d x0_;
+  Eigen::Matrix3d f0_;
+};
+
+/// True when every control point of the path lies on the chord from its first to its last one and
+/// they advance monotonically along it: the path is a straight segment traversed once.
+bool is_straight(const BSplineCurve& path, double size) {
+  const Eigen::Vector3d a = path.points.row(0).transpose();
+  const Eigen::Vector3d d = path.points.row(path.points.rows() - 1).transpose() - a;
+  const double length = d.norm();
+  if (!(length > 0)) return false;
+  const Eigen::Vector3d e = d / length;
+  double along = 0;
+  for (Eigen::Index i = 0; i < path.points.rows(); ++i) {
+    const Eigen::Vector3d p = path.points.row(i).transpose() - a;
+    if ((p - p.dot(e) * e).norm() > 1e-13 * size) return false;
+    if (p.dot(e) < along) return false;
+    along = p.dot(e);
+  }
+  return true;
+}
+
+void check_corners(const BSplineCurve& path, double tolerance) {
+  const std::vector<BSplineCurve> segments = extract_bezier(path);
+  for (size_t k = 0; k + 1 < segments.size(); ++k) {
+    const double t = segments[k].basis.domain().second;
+    const Eigen::Vector3d a = derivatives(segments[k], t, 1).d1;
+    const Eigen::Vector3d b = derivatives(segments[k + 1], segments[k + 1].basis.domain().first, 1).d1;
+    if (!(a.norm() > 0 && b.norm() > 0))
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "sweep: path has a zero tangent at its knot t = " + num(t) +
+                      "; remove the repeated control points there");
+    const double angle = std::atan2(a.cross(b).norm(), a.dot(b));
+    if (angle > tolerance)
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "sweep: path has a corner at t = " + num(t) + " (its tangent turns by " +
+                      num(angle * 180.0 / std::numbers::pi) +
+                      " degrees); split the path there and sweep each part");
+  }
+}
+
+/// A path knot where the sweep is less smooth than a cubic across the sections: the moved profile
+/// is C^0 in arc length where the path's curvature jumps (multiplicity 3 in v) and C^1 where only
+/// its derivative does (multiplicity 2), as at the knots of a C2 cubic path.
+struct Join {
+  double t = 0;
+  int multiplicity = 3;
+};
+
+/// Curvature vector dT/ds of a segment at t, and its arc-length derivative by a one-sided
+/// second-order difference into the segment (direction +1 or -1).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> curvature(const BSplineCurve& segment, double t, double direction) {
+  auto k = [&](double x) {
+    const CurveDerivatives d = derivatives(segment, x, 2);
+    const double speed = d.d1.norm();
+    const Eigen::Vector3d tangent = d.d1 / speed;
+    return Eigen::Vector3d((d.d2 - d.d2.dot(tangent) * tangent) / (speed * speed));
+  };
+  const auto [a, b] = segment.basis.domain();
+  const double h = 1e-3 * (b - a) * direction;
+  const Eigen::Vector3d k0 = k(t), k1 = k(t + h), k2 = k(t + 2 * h);
+  const double speed = derivatives(segment, t, 1).d1.norm();
+  return {k0, (-3.0 * k0 + 4.0 * k1 - k2) / (2.0 * h * speed)};
+}
+
+std::vector<Join> sweep_joins(const BSplineCurve& path, double size) {
+  std::vector<Join> joins;
+  const std::vector<BSplineCurve> segments = extract_bezier(path);
+  for (size_t k = 0; k + 1 < segments.size(); ++k) {
+    const double t = segments[k].basis.domain().second;
+    const auto [kl, dkl] = curvature(segments[k], t, -1.0);
+    const auto [kr, dkr] = curvature(segments[k + 1], t, +1.0);
+    if ((kl - kr).norm() * size > 1e-9)
+      joins.push_back({t, 3});
+    else if ((dkl - dkr).norm() * size * size > 1e-4)
+      joins.push_back({t, 2});
+  }
+  return joins;
+}
+
+/// `total` section intervals spread over the pieces in proportion to their arc length, at least 3
+/// each when there is room (else all in the first entry: the caller then ignores the joins).
+void distribute_intervals(int total, const std::vector<double>& sigma, std::vector<int>& intervals) {
+  const size_t pieces = intervals.size();
+  if (total < 3 * static_cast<int>(pieces)) {
+    std::fill(intervals.begin(), intervals.end(), 0);
+    intervals[0] = total;
+    return;
+  }
+  int used = 0;
+  for (size_t k = 0; k < pieces; ++k) {
+    intervals[k] = std::max(3, static_cast<int>(std::floor(total * (sigma[k + 1] - sigma[k]))));
+    used += intervals[k];
+  }
+  // Take or give the difference where the pieces are largest.
+  while (used != total) {
+    size_t pick = 0;
+    for (size_t k = 1; k < pieces; ++k)
+      if ((used > total) ? intervals[k] > intervals[pick] : (sigma[k + 1] - sigma[k]) / intervals[k] >
+                                                              (sigma[pick + 1] - sigma[pick]) / intervals[pick])
+        pick = k;
+    intervals[pick] += used > total ? -1 : 1;
+    used += used > total ? -1 : 1;
+  }
+}
+
+/// Cubic knots for sections at sites v split into pieces (piece k starts at site piece_start[k]):
+/// knots by averaging inside each piece, and at a join the site repeated `multiplicity` times
+/// (3: C0, 2: C1 plus one extra knot at the next site to keep one basis function per section).
+BSplineBasis joined_basis(const std::vector<double>& v, const std::vector<int>& piece_start,
+                          const std::vector<int>& multiplicity) {
+  BSplineBasis basis;
+  basis.degree = 3;
+  basis.knots.assign(4, 0.0);
+  const size_t pieces = piece_start.size();
+  for (size_t k = 0; k < pieces; ++k) {
+    const int first = piece_start[k];
+    const int last = k + 1 < pieces ? piece_start[k + 1] : static_cast<int>(v.size()) - 1;
+    if (k > 0) {
+      const double at = v[static_cast<size_t>(first)];
+      basis.knots.insert(basis.knots.end(), 2, at);
+      basis.knots.push_back(multiplicity[k] == 3 ? at : v[static_cast<size_t>(first + 1)]);
+    }
+    for (int i = first + 1; i + 2 <= last - 1; ++i)
+      basis.knots.push_back((v[static_cast<size_t>(i)] + v[static_cast<size_t>(i + 1)] + v[static_cast<size_t>(i + 2)]) / 3.0);
+  }
+  basis.knots.insert(basis.knots.end(), 4, 1.0);
+  return basis;
+}
+
+}  // namespace
+
+void LoftOptions::validate() const {
+  if (degree < 1 || degree > max_kernel_degree)
+    throw Error(ErrorCategory::InvalidArgument,
+                "LoftOptions::degree is " + std::to_string(degree) + "; it must be in [1, " +
+                    std::to_string(max_kernel_degree) + "]");
+  if (!(tolerance > 0.0 && tolerance <= 1e-2))
+    throw Error(ErrorCategory::InvalidArgument,
+                "LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
+}
+
+void SweepOptions::validate() const {
+  if (!std::isfinite(twist_degrees))
+    throw Error(ErrorCategory::InvalidArgument,
+                "SweepOptions::twist_degrees is " + num(twist_degrees) + "; it must be finite");
+  if (sections != 0 && sections < 2)
+    throw Error(ErrorCategory::InvalidArgument,
+                "SweepOptions::sections is " + std::to_string(sections) +
+                    "; it must be 0 (adaptive) or >= 2");
+  if (!(tolerance > 0.0 && tolerance <= 1e-1))
+    throw Error(ErrorCategory::InvalidArgument,
+                "SweepOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-1]");
+  if (max_sections < 2)
+    throw Error(ErrorCategory::InvalidArgument,
+                "SweepOptions::max_sections is " + std::to_string(max_sections) + "; it must be >= 2");
+}
+
+std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves) {
+  if (curves.empty())
+    throw Error(ErrorCategory::InvalidArgument, "make_compatible: no curves given; give at least one");
+  std::vector<BSplineCurve> out;
+  int degree = 1;
+  for (size_t k = 0; k < curves.size(); ++k) {
+    validate(curves[k], name("curve", k));
+    out.push_back(normalized(curves[k]));
+    degree = std::max(degree, curves[k].basis.degree);
+  }
+  for (size_t k = 0; k < out.size(); ++k) {
+    BSplineCurve& c = out[k];
+    if (c.basis.degree < degree) c = elevate_degree(c, degree - c.basis.degree);
+  }
+
+  // Interior knots of every curve, clustered: values within 1e-12 (of the domain [0, 1]) are one.
+  struct Knot {
+    double value;
+    size_t curve;
+  };
+  std::vector<Knot> all;
+  for (size_t k = 0; k < out.size(); ++k)
+    for (double t : out[k].basis.knots)
+      if (t > 0.0 && t < 1.0) all.push_back({t, k});
+  std::sort(all.begin(), all.end(), [](const Knot& a, const Knot& b) { return a.value < b.value; });
+  std::vector<std::vector<double>> snapped(out.size());
+  std::vector<std::vector<double>> missing(out.size());
+  for (size_t i = 0; i < all.size();) {
+    const double representative = all[i].value;
+    size_t e = i;
+    std::vector<int> mult(out.size(), 0);
+    while (e < all.size() && all[e].value - representative <= tolerance::knot_relative) {
+      ++mult[all[e].curve];
+      ++e;
+    }
+    const int target = *std::max_element(mult.begin(), mult.end());
+    for (size_t k = 0; k < out.size(); ++k)
+      for (int r = mult[k]; r < target; ++r) missing[k].push_back(representative);
+    for (size_t j = i; j < e; ++j) snapped[all[j].curve].push_back(representative);
+    i = e;
+  }
+  for (size_t k = 0; k < out.size(); ++k) {
+    // Snap this curve's interior knots to their cluster's value (a change of at most 1e-12).
+    size_t next = 0;
+    for (double& t : out[k].basis.knots)
+      if (t > 0.0 && t < 1.0) t = snapped[k][next++];
+    validate(out[k], name("curve", k));
+    if (!missing[k].empty()) out[k] = refine_knots(out[k], missing[k]);
+    if (!curves[k].is_rational()) out[k].weights.setOnes();
+  }
+  for (size_t k = 1; k < out.size(); ++k)
+    if (out[k].basis.knots != out[0].basis.knots)
+      throw Error(ErrorCategory::Internal,
+                  "make_compatible: curve #" + std::to_string(k) +
+                      " did not reach the common knot vector (please report this input)");
+  return out;
+}
+
+std::vector<double> loft_parameters(const std::vector<BSplineCurve>& sections,
+                                    const LoftOptions& options) {
+  return prepare_loft(sections, options).v;
+}
+
+BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& options) {
+  const PreparedLoft prepared = prepare_loft(sections, options);
+  BuiltSurface built;
+  built.surface = interpolate_sections(prepared.compatible, prepared.v, prepared.degree);
+
+  // Exactness check: S(u, v_k) against the input section k at the same (normalized) parameter.
+  const int spans = static_cast<int>(breakpoints(built.surface.u).size()) - 1;
+  const std::vector<double> us = linspace(0.0, 1.0, std::max(65, 8 * spans + 1));
+  const Points3 grid = evaluate_grid(built.surface, us, prepared.v);
+  const size_t count = sections.size();
+  double worst = 0;
+  for (size_t k = 0; k < count; ++k) {
+    const auto [a, b] = sections[k].basis.domain();
+    for (size_t i = 0; i < us.size(); ++i) {
+      const double t = prepared.reversed[k] ? b - us[i] * (b - a) : a + us[i] * (b - a);
+      const Eigen::Vector3d expected = evaluate(sections[k], std::clamp(t, a, b));
+      worst = std::max(worst, (grid.row(static_cast<Eigen::Index>(i * count + k)).transpose() - expected).norm());
+    }
+  }
+  std::string method = "loft of " + std::to_string(count) + " sections";
+  std::string turned;
+  for (size_t k = 0; k < count; ++k)
+    if (prepared.reversed[k]) turned += (turned.empty() ? "" : ", #") + std::to_string(k);
+  if (!turned.empty()) method += " (reversed: #" + turned + ")";
+  built.report = describe(built.surface, method);
+  built.report.exact = true;
+  built.report.max_deviation = worst;
+  built.report.samples = static_cast<int>(us.size() * count);
+  return built;
+}
+
+BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const SweepOptions& options) {
+  options.validate();
+  validate(profile, "sweep profile");
+  validate(path, "sweep path");
+  const double size = model_size({&profile, &path});
+  const double exact_tol = tolerance::exact_relative * size;
+  if (!(polygon_length(profile) > exact_tol))
+    throw Error(ErrorCategory::InvalidGeometry,
+                "sweep: profile is degenerate: its control polygon is " + num(polygon_length(profile)) +
+                    " mm long (tolerance " + num(exact_tol) + " mm); give a curve, not a point");
+  if (!(polygon_length(path) > exact_tol))
+    throw Error(ErrorCategory::InvalidGeometry,
+                "sweep: path has zero length (its control polygon is " + num(polygon_length(path)) +
+                    " mm long, tolerance " + num(exact_tol) + " mm); give a path that moves");
+  const BSplineCurve shape = clamp(profile);
+  const BSplineCurve track = clamp(path);
+  check_corners(track, options.tolerance);
+  const PathTable table(track, size);
+  if (!(table.length() > exact_tol))
+    throw Error(ErrorCategory::InvalidGeometry,
+                "sweep: path has zero length (" + num(table.length()) + " mm); give a path that moves");
+  const double twist = options.twist_degrees * std::numbers::pi / 180.0;
+  const SweepMotion motion(table, twist);
+
+  // Samples of the profile for the deviation check.
+  const int profile_spans = static_cast<int>(breakpoints(shape.basis).size()) - 1;
+  const auto [ua, ub] = shape.basis.domain();
+  const std::vector<double> us = linspace(ua, ub, std::max(17, 4 * profile_spans + 1));
+  const Points3 profile_samples = evaluate_many(shape, us);
+
+  // Largest distance between S(u, v) and the moved profile at 1/4, 1/2, 3/4 of every interval
+  // between sites; `per_interval` gets the largest of each interval.
+  std::vector<double> per_interval;
+  auto deviation = [&](const BSplineSurface& s, const std::vector<double>& sites, int& samples) {
+    std::vector<double> vs;
+    for (size_t k = 0; k + 1 < sites.size(); ++k)
+      for (double f : {0.25, 0.5, 0.75}) vs.push_back(sites[k] + f * (sites[k + 1] - sites[k]));
+    const Points3 grid = evaluate_grid(s, us, vs);
+    per_interval.assign(sites.size() - 1, 0.0);
+    for (size_t j = 0; j < vs.size(); ++j) {
+      const Points3 expected = motion.moved(profile_samples, table.parameter(vs[j] * table.length()));
+      double& worst = per_interval[j / 3];
+      for (size_t i = 0; i < us.size(); ++i)
+        worst = std::max(worst, (grid.row(static_cast<Eigen::Index>(i * vs.size() + j)) -
+                                 expected.row(static_cast<Eigen::Index>(i))).norm());
+    }
+    samples = static_cast<int>(vs.size() * us.size());
+    return *std::max_element(per_interval.begin(), per_interval.end());
+  };
+
+  BuiltSurface built;
+  if (twist == 0.0 && is_straight(track, size)) {
+    // The exact extrusion: the profile and its copy translated to the path end, degree 1 across.
+    BSplineCurve end = shape;
+    const Eigen::RowVector3d d = track.points.row(track.points.rows() - 1) - track.points.row(0);
+    end.points.rowwise() += d;
+    built.surface = interpolate_sections({shape, end}, {0.0, 1.0}, 1);
+    int samples = 0;
+    const double worst = deviation(built.surface, linspace(0.0, 1.0, 9), samples);
+    built.report = describe(built.surface, "sweep along a straight path (exact extrusion)");
+    built.report.exact = true;
+    built.report.max_deviation = worst;
+    built.report.samples = samples;
+    return built;
+  }
+
+  // Pieces of the path between joins (path knots where the sweep is less smooth than the cubic
+  // across the sections would be), each with its number of section intervals.
+  const std::vector<Join> joins = sweep_joins(track, size);
+  std::vector<double> piece_t = {table.first()}, piece_sigma = {0.0};
+  std::vector<int> piece_mult = {0};
+  for (const Join& j : joins) {
+    piece_t.push_back(j.t);
+    piece_sigma.push_back(table.arc_length(j.t) / table.length());
+    piece_mult.push_back(j.multiplicity);
+  }
+  piece_t.push_back(table.last());
+  piece_sigma.push_back(1.0);
+  const size_t pieces = piece_t.size() - 1;
+  const std::vector<double> path_breaks = breakpoints(track.basis);
+  std::vector<int> intervals(pieces);
+  if (options.sections > 0) {
+    distribute_intervals(options.sections - 1, piece_sigma, intervals);
+  } else {
+    for (size_t k = 0; k < pieces; ++k) {
+      // 4 per path knot span inside the piece, at least 4.
+      int spans = 0;
+      for (size_t b = 0; b + 1 < path_breaks.size(); ++b) {
+        const double mid = 0.5 * (path_breaks[b] + path_breaks[b + 1]);
+        if (mid > piece_t[k] && mid < piece_t[k + 1]) ++spans;
+      }
+      intervals[k] = 4 * std::max(1, spans);
+    }
+  }
+  int initial = 0;
+  for (int m : intervals) initial += m;
+  if (initial + 1 > options.max_sections)
+    distribute_intervals(options.max_sections - 1, piece_sigma, intervals);
+  const double target = options.tolerance * size;
+  double worst = 0;
+  int samples = 0;
+  int count = 0;
+  while (true) {
+    int total = 0;
+    for (int m : intervals) total += m;
+    const bool use_joins = pieces > 1 && *std::min_element(intervals.begin(), intervals.end()) >= 3;
+    // Without joins: one piece over the whole path.
+    const std::vector<double> pt = use_joins ? piece_t : std::vector<double>{table.first(), table.last()};
+    const std::vector<double> ps = use_joins ? piece_sigma : std::vector<double>{0.0, 1.0};
+    const std::vector<int> pm = use_joins ? intervals : std::vector<int>{total};
+    std::vector<BSplineCurve> copies;
+    std::vector<double> v;
+    std::vector<int> piece_start;  // index in v of each piece's first site
+    for (size_t k = 0; k + 1 < pt.size(); ++k) {
+      piece_start.push_back(static_cast<int>(v.size()));
+      for (int i = 0; i < pm[k]; ++i) {
+        const double sigma = ps[k] + (ps[k + 1] - ps[k]) * i / pm[k];
+        v.push_back(sigma);
+        if (k == 0 && i == 0)
+          copies.push_back(shape);  // the start frame maps the profile to itself, exactly
+        else
+          copies.push_back(motion.moved(shape, i == 0 ? pt[k] : table.parameter(sigma * table.length())));
+      }
+    }
+    v.push_back(1.0);
+    copies.push_back(motion.moved(shape, table.last()));
+    count = static_cast<int>(v.size());
+    const BSplineBasis basis_v = use_joins ? joined_basis(v, piece_start, piece_mult)
+                                           : averaged_basis(v, std::min(3, count - 1));
+    built.surface = interpolate_sections(copies, v, basis_v);
+    worst = deviation(built.surface, v, samples);
+    if (options.sections > 0 || worst <= target || count >= options.max_sections) break;
+    // Double the intervals of the pieces that miss the tolerance (all of them without joins).
+    int grown = 0;
+    for (size_t k = 0; k < pieces; ++k) {
+      bool miss = !use_joins;
+      for (int i = 0; use_joins && i < intervals[k]; ++i)
+        miss = miss || per_interval[static_cast<size_t>(piece_start[k] + i)] > target;
+      if (miss) intervals[k] *= 2;
+      grown += intervals[k];
+    }
+    if (grown + 1 > options.max_sections)
+      distribute_intervals(options.max_sections - 1, piece_sigma, intervals);
+  }
+  std::string method = "sweep with rotation-minimizing frames, " + std::to_string(count) + " sections";
+  if (options.sections == 0 && worst > target)
+    method += " (tolerance " + num(target) + " mm not reached at max_sections)";
+  built.report = describe(built.surface, method);
+  built.report.exact = false;
+  built.report.max_deviation = worst;
+  built.report.samples = samples;
+  return built;
+}
+
+}  // namespace clay::surface
