@@ -50,4 +50,15 @@ bool identical(const BSplineCurve& a, const BSplineCurve& b) noexcept {
          a.points == b.points && a.weights == b.weights;
 }
 
+BSplineCurve reversed(const BSplineCurve& curve) {
+  validate(curve);
+  BSplineCurve c = curve;
+  const auto [a, b] = curve.basis.domain();
+  const size_t m = curve.basis.knots.size();
+  for (size_t i = 0; i < m; ++i) c.basis.knots[i] = a + b - curve.basis.knots[m - 1 - i];
+  c.points = curve.points.colwise().reverse();
+  c.weights = curve.weights.reverse();
+  return c;
+}
+
 }  // namespace clay::surface

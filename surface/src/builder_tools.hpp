@@ -47,15 +47,4 @@ inline BSplineCurve normalized(const BSplineCurve& curve) {
   return c;
 }
 
-/// The same curve run backwards on the same domain: C'(t) = C(a + b - t).
-inline BSplineCurve reversed(const BSplineCurve& curve) {
-  BSplineCurve c = curve;
-  const auto [a, b] = curve.basis.domain();
-  const size_t m = curve.basis.knots.size();
-  for (size_t i = 0; i < m; ++i) c.basis.knots[i] = a + b - curve.basis.knots[m - 1 - i];
-  c.points = curve.points.colwise().reverse();
-  c.weights = curve.weights.reverse();
-  return c;
-}
-
 }  // namespace clay::surface::detail

@@ -29,7 +29,6 @@ namespace {
 using detail::model_size;
 using detail::normalized;
 using detail::polygon_length;
-using detail::reversed;
 
 std::string num(double x) { return detail::short_number(x); }
 

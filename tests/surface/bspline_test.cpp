@@ -2,6 +2,7 @@
 
 #include <clay/error.hpp>
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/evaluate.hpp>
 
 #include <cmath>
 #include <random>
@@ -111,4 +112,21 @@ TEST_CASE("identical compares bit for bit", "[bspline]") {
   CHECK_FALSE(identical(a, b));
   const auto [lo, hi] = control_box(a);
   CHECK((lo.array() <= hi.array()).all());
+}
+
+TEST_CASE("reversed runs a curve backwards on the same domain", "[bspline]") {
+  std::mt19937 rng(5);
+  for (bool clamped : {true, false}) {
+    const BSplineCurve c = clay::test::random_curve(rng, 3, 8, true, clamped, 2);
+    const BSplineCurve r = reversed(c);
+    const auto [a, b] = c.basis.domain();
+    CHECK(r.basis.domain() == c.basis.domain());
+    for (double t : linspace(a, b, 41)) CHECK((evaluate(r, a + b - t) - evaluate(c, t)).norm() < 1e-12);
+    // Twice reversed: the same control net bit for bit; knots a + b - (a + b - k) up to rounding.
+    const BSplineCurve rr = reversed(r);
+    CHECK(rr.points == c.points);
+    CHECK(rr.weights == c.weights);
+    for (size_t k = 0; k < c.basis.knots.size(); ++k)
+      CHECK(std::abs(rr.basis.knots[k] - c.basis.knots[k]) <= 4e-16 * (std::abs(a) + std::abs(b)));
+  }
 }

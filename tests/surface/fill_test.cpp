@@ -11,22 +11,14 @@
 #include <functional>
 #include <random>
 
+#include "error_of.hpp"
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
+using clay::test::error_of;
 using Catch::Matchers::WithinAbs;
 
 namespace {
-
-std::pair<clay::ErrorCategory, std::string> error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const clay::Error& e) {
-    return {e.category(), e.what()};
-  }
-  FAIL("no clay::Error was thrown");
-  return {};
-}
 
 double curves_size(const std::vector<BSplineCurve>& curves) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -35,16 +27,6 @@ double curves_size(const std::vector<BSplineCurve>& curves) {
     hi = hi.cwiseMax(c.points.colwise().maxCoeff().transpose());
   }
   return (hi - lo).norm();
-}
-
-BSplineCurve reversed_copy(const BSplineCurve& c) {
-  BSplineCurve r = c;
-  const auto [a, b] = c.basis.domain();
-  const size_t m = c.basis.knots.size();
-  for (size_t i = 0; i < m; ++i) r.basis.knots[i] = a + b - c.basis.knots[m - 1 - i];
-  r.points = c.points.colwise().reverse();
-  r.weights = c.weights.reverse();
-  return r;
 }
 
 /// A random curve of the given degree and count from `from` to `to` (clamped, so the ends are
@@ -135,7 +117,7 @@ TEST_CASE("fill of 4 curves interpolates them exactly in every style", "[fill]")
 TEST_CASE("fill of 4 curves in shuffled order and directions", "[fill]") {
   std::mt19937 rng(402);
   const std::vector<BSplineCurve> quad = quad_boundary(rng);
-  const std::vector<BSplineCurve> shuffled = {reversed_copy(quad[2]), quad[0], reversed_copy(quad[3]), quad[1]};
+  const std::vector<BSplineCurve> shuffled = {reversed(quad[2]), quad[0], reversed(quad[3]), quad[1]};
   for (FillStyle style : all_styles) check_fill(shuffled, style);
   const BuiltSurface built = fill(shuffled);
   CHECK_THAT(built.report.method, Catch::Contains("reversed"));
@@ -163,7 +145,7 @@ TEST_CASE("fill of 3 curves collapses one side to the corner", "[fill]") {
   std::mt19937 rng(404);
   const Eigen::Vector3d p0(0, 0, 0), p1(100, 0, 10), p2(40, 90, -5);
   const std::vector<BSplineCurve> tri = {curve_between(rng, 3, 5, p0, p1, 8.0),
-                                         reversed_copy(curve_between(rng, 2, 5, p1, p2, 8.0)),
+                                         reversed(curve_between(rng, 2, 5, p1, p2, 8.0)),
                                          curve_between(rng, 3, 4, p2, p0, 8.0)};
   for (FillStyle style : all_styles) check_fill(tri, style);
 }
@@ -173,17 +155,17 @@ TEST_CASE("fill of 2 curves: ruled surface (Stretch, Coons) and corner patch (Cu
   const BSplineCurve a = curve_between(rng, 3, 6, {0, 0, 0}, {100, 0, 0}, 10.0);
   const BSplineCurve b = curve_between(rng, 2, 5, {0, 80, 20}, {100, 80, 0}, 10.0);
   for (FillStyle style : {FillStyle::Stretch, FillStyle::Coons}) {
-    check_fill({a, reversed_copy(b)}, style);
+    check_fill({a, reversed(b)}, style);
     FillOptions o;
     o.style = style;
-    const BuiltSurface ruled = fill({a, reversed_copy(b)}, o);
+    const BuiltSurface ruled = fill({a, reversed(b)}, o);
     CHECK(ruled.surface.v.degree == 1);
     // The ruled surface pairs the ends by distance: S(0, 0) = a start, S(0, 1) = b start.
     CHECK((evaluate(ruled.surface, 0.0, 1.0) - evaluate(b, 0.0)).norm() < 1e-12);
   }
   // Curved: two curves sharing a corner.
   const BSplineCurve c = curve_between(rng, 3, 5, {0, 0, 0}, {10, 90, 30}, 10.0);
-  check_fill({a, reversed_copy(c)}, FillStyle::Curved);
+  check_fill({a, reversed(c)}, FillStyle::Curved);
 }
 
 TEST_CASE("Coons fill of straight sides raises them to degree 3", "[fill]") {
@@ -232,7 +214,7 @@ TEST_CASE("fill rejects a boundary with a gap, naming the curves and the gap", "
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
   CHECK_THAT(message, Catch::Contains("curve #1 end and curve #2 start are 0.25 mm apart (tolerance 1e-07 mm)"));
   // Reversed curve: its start becomes the trailing end.
-  quad[1] = reversed_copy(quad[1]);
+  quad[1] = reversed(quad[1]);
   CHECK_THAT(error_of([&] { fill(quad); }).second,
              Catch::Contains("curve #1 start and curve #2 start are 0.25 mm apart"));
 }
@@ -331,7 +313,7 @@ TEST_CASE("n-sided fill of a 5-sided dome with an interior curve reports a measu
   std::vector<BSplineCurve> sides = pentagon_on_dome();
   // Shuffle and reverse some: the loop is found regardless.
   std::swap(sides[1], sides[3]);
-  sides[2] = reversed_copy(sides[2]);
+  sides[2] = reversed(sides[2]);
   const std::vector<BSplineCurve> interior = {lifted({-30, -10}, {30, 15})};
   const NSidedFill result = fill_n_sided(sides, interior);
   std::vector<BSplineCurve> all = sides;

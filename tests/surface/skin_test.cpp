@@ -11,23 +11,14 @@
 #include <numbers>
 #include <random>
 
+#include "error_of.hpp"
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
+using clay::test::error_of;
 using Catch::Matchers::WithinAbs;
 
 namespace {
-
-/// Message and category of the clay::Error thrown by f (fails the test when nothing is thrown).
-std::pair<clay::ErrorCategory, std::string> error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const clay::Error& e) {
-    return {e.category(), e.what()};
-  }
-  FAIL("no clay::Error was thrown");
-  return {};
-}
 
 double box_size(const BSplineSurface& s) {
   const auto [lo, hi] = control_box(s);
@@ -39,16 +30,6 @@ BSplineCurve on_domain(BSplineCurve c, double a, double b) {
   const auto [c0, c1] = c.basis.domain();
   for (double& t : c.basis.knots) t = a + (t - c0) * (b - a) / (c1 - c0);
   return c;
-}
-
-BSplineCurve reversed_copy(const BSplineCurve& c) {
-  BSplineCurve r = c;
-  const auto [a, b] = c.basis.domain();
-  const size_t m = c.basis.knots.size();
-  for (size_t i = 0; i < m; ++i) r.basis.knots[i] = a + b - c.basis.knots[m - 1 - i];
-  r.points = c.points.colwise().reverse();
-  r.weights = c.weights.reverse();
-  return r;
 }
 
 BSplineCurve translated(BSplineCurve c, const Eigen::Vector3d& d) {
@@ -180,7 +161,7 @@ TEST_CASE("loft parameters: chord length, centripetal and uniform spacing", "[sk
 TEST_CASE("loft turns a section that runs against its neighbour", "[skin][loft]") {
   std::mt19937 rng(306);
   std::vector<BSplineCurve> sections = random_sections(rng, false);
-  sections[2] = reversed_copy(sections[2]);
+  sections[2] = reversed(sections[2]);
   const BuiltSurface built = loft(sections);
   CHECK_THAT(built.report.method, Catch::Contains("reversed: #2"));
   const double err = section_error(built.surface, sections, loft_parameters(sections),

@@ -44,7 +44,6 @@ namespace clay::surface {
 namespace {
 
 using detail::normalized;
-using detail::reversed;
 
 std::string num(double x) { return detail::short_number(x); }
 std::string curve_name(size_t k) { return "curve #" + std::to_string(k); }

@@ -41,4 +41,8 @@ void validate(const BSplineCurve& curve, std::string_view name = "curve");
 /// True when degree, knots, control points and weights are equal bit for bit.
 bool identical(const BSplineCurve& a, const BSplineCurve& b) noexcept;
 
+/// The same curve run backwards on the same domain [a, b]: reversed(c)(t) = c(a + b - t). Knots
+/// are mirrored, control points and weights reversed (exact up to the rounding of a + b - t).
+BSplineCurve reversed(const BSplineCurve& curve);
+
 }  // namespace clay::surface
