@@ -111,6 +111,18 @@ std::vector<double> breakpoints(const BSplineBasis& basis) {
   return out;
 }
 
+std::vector<double> span_samples(const BSplineBasis& basis, int per_span) {
+  if (per_span < 1)
+    throw Error(ErrorCategory::InvalidArgument,
+                "span_samples: per_span = " + std::to_string(per_span) + " must be >= 1");
+  const auto breaks = breakpoints(basis);
+  std::vector<double> out;
+  for (size_t k = 0; k + 1 < breaks.size(); ++k)
+    for (int i = 0; i < per_span; ++i) out.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * i / per_span);
+  out.push_back(breaks.back());
+  return out;
+}
+
 int find_span(const BSplineBasis& basis, double t) {
   const int p = basis.degree;
   const int n = basis.count();

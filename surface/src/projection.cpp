@@ -165,25 +165,13 @@ SurfaceProjection project_normal(const BSplineSurface& surface, const Eigen::Vec
   return newton(surface, point, u0, v0, options);
 }
 
-namespace {
-std::vector<double> sample_parameters(const BSplineBasis& basis, int per_span) {
-  const auto breaks = breakpoints(basis);
-  std::vector<double> out;
-  for (size_t k = 0; k + 1 < breaks.size(); ++k)
-    for (int i = 0; i < per_span; ++i)
-      out.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * i / per_span);
-  out.push_back(breaks.back());
-  return out;
-}
-}  // namespace
-
 SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vector3d& point,
                                 const ProjectionOptions& options) {
   options.validate();
   validate(surface);
   check_point(point);
-  const auto us = sample_parameters(surface.u, options.samples_per_span);
-  const auto vs = sample_parameters(surface.v, options.samples_per_span);
+  const auto us = span_samples(surface.u, options.samples_per_span);
+  const auto vs = span_samples(surface.v, options.samples_per_span);
   const Points3 grid = evaluate_grid(surface, us, vs);
   std::vector<Eigen::Index> order(static_cast<size_t>(grid.rows()));
   std::iota(order.begin(), order.end(), Eigen::Index{0});

@@ -15,17 +15,6 @@
 namespace clay::surface {
 namespace {
 
-/// Parameters of `basis` with `per_span` samples in every non-empty span, ends included.
-std::vector<double> span_samples(const BSplineBasis& basis, int per_span) {
-  const auto breaks = breakpoints(basis);
-  std::vector<double> out;
-  for (size_t k = 0; k + 1 < breaks.size(); ++k)
-    for (int i = 0; i < per_span; ++i)
-      out.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * i / per_span);
-  out.push_back(breaks.back());
-  return out;
-}
-
 std::string number(double x) {
   std::ostringstream s;
   s.precision(6);

@@ -117,3 +117,10 @@ TEST_CASE("clamped_uniform_basis, breakpoints, multiplicity", "[basis]") {
   CHECK_THROWS_AS(clamped_uniform_basis(3, 3), clay::Error);
   CHECK_THROWS_AS(clamped_uniform_basis(2, 5, 1.0, 1.0), clay::Error);
 }
+
+TEST_CASE("span_samples follows the knot spans", "[basis]") {
+  const BSplineBasis b{2, {0, 0, 0, 1, 1, 3, 3, 3}};  // spans [0, 1], [1, 3]
+  CHECK(span_samples(b, 2) == std::vector<double>{0, 0.5, 1, 2, 3});
+  CHECK(span_samples(b, 1) == std::vector<double>{0, 1, 3});
+  CHECK_THROWS_AS(span_samples(b, 0), clay::Error);
+}

@@ -51,6 +51,10 @@ int multiplicity(const BSplineBasis& basis, double t) noexcept;
 /// Distinct knot values inside the domain, ends included, in increasing order.
 std::vector<double> breakpoints(const BSplineBasis& basis);
 
+/// Parameters `per_span` (>= 1) evenly spaced in every non-empty knot span, the domain end added:
+/// a sample that follows the knots. Throws clay::Error(InvalidArgument) for per_span < 1.
+std::vector<double> span_samples(const BSplineBasis& basis, int per_span);
+
 /// Index k of the knot span [knots[k], knots[k+1]) holding t, with degree <= k < count(); the domain
 /// end maps to the last non-empty span. Throws clay::Error(OutOfDomain) when t is outside the domain
 /// or not finite. (The NURBS Book A2.1.)
