@@ -10,10 +10,12 @@
 // One documented loss: OCCT itself decides a curve or surface is polynomial when its weights are
 // all equal (to within one unit in the last place between neighbours), and then drops them. Such an
 // object is polynomial in disguise; from_occt returns it with weights 1 (the same geometry).
+#include <clay/error.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
 #include <string_view>
+#include <utility>
 
 #include <Geom_BSplineCurve.hxx>
 #include <Geom_BSplineSurface.hxx>
@@ -25,6 +27,16 @@ namespace clay::surface::occt {
 
 /// An OpenCASCADE exception in words: its type and, when it has one, its message.
 std::string describe(const Standard_Failure& failure);
+
+/// Runs `body`, turning an OpenCASCADE exception into clay::Error(category) that names `what`.
+template <class Body>
+auto guarded(ErrorCategory category, std::string_view what, Body&& body) -> decltype(body()) {
+  try {
+    return body();
+  } catch (const Standard_Failure& failure) {
+    throw Error(category, std::string(what) + ": OpenCASCADE failed: " + describe(failure));
+  }
+}
 
 /// Builds the OCCT curve. Throws clay::Error: InvalidGeometry when validate(curve, name) fails,
 /// DegreeLimit above Geom_BSplineCurve::MaxDegree() (25), Exchange when OCCT refuses the data

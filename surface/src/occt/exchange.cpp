@@ -471,15 +471,10 @@ std::vector<BSplineSurface> surfaces_of_shape(const TopoDS_Shape& shape, const f
   return out;
 }
 
-/// Runs `body` and turns OpenCASCADE exceptions into clay::Error(Exchange).
+/// Runs `body`, turning OpenCASCADE exceptions into clay::Error(Exchange).
 template <class Body>
 auto guarded(std::string_view caller, Body&& body) -> decltype(body()) {
-  try {
-    return body();
-  } catch (const Standard_Failure& failure) {
-    throw Error(ErrorCategory::Exchange,
-                std::string(caller) + ": OpenCASCADE failed: " + occt::describe(failure));
-  }
+  return occt::guarded(ErrorCategory::Exchange, caller, std::forward<Body>(body));
 }
 
 }  // namespace

@@ -295,12 +295,7 @@ BSplineCurve point_curve(const BSplineCurve& like, const Eigen::Vector3d& p) {
 
 template <class F>
 auto with_occt(const char* what, F f) {
-  try {
-    return f();
-  } catch (const Standard_Failure& failure) {
-    throw Error(ErrorCategory::InvalidGeometry,
-                std::string(what) + ": OpenCASCADE failed: " + occt::describe(failure));
-  }
+  return occt::guarded(ErrorCategory::InvalidGeometry, what, std::move(f));
 }
 
 }  // namespace
