@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# Builds and runs the benchmarks; JSON results go to build/bench/results.json.
+# Builds and runs the benchmarks; JSON results go to build/bench/results.json (evaluation) and
+# build/bench/constraints.json (constraint solve + diagnosis). Extra arguments go to both.
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/common.sh"
 clay_ensure_packages
-clay_build --target bench_evaluate
+clay_build --target bench_evaluate bench_constraints
 "$CLAY_BUILD/bench/bench_evaluate" --benchmark_out="$CLAY_BUILD/bench/results.json" \
   --benchmark_out_format=json "$@"
-echo "results: $CLAY_BUILD/bench/results.json"
+"$CLAY_BUILD/bench/bench_constraints" --benchmark_out="$CLAY_BUILD/bench/constraints.json" \
+  --benchmark_out_format=json "$@"
+echo "results: $CLAY_BUILD/bench/results.json $CLAY_BUILD/bench/constraints.json"

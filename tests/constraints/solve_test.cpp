@@ -1,0 +1,368 @@
+#include <catch2/catch.hpp>
+
+#include <clay/constraints.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "error_of.hpp"
+
+using namespace clay::constraints;
+using clay::ErrorCategory;
+using clay::sketch::Sketch;
+using clay::test::error_of;
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinAbs;
+
+namespace {
+
+constexpr double pi = std::numbers::pi;
+
+Eigen::Vector3d at(const Sketch& s, PointId p) { return clay::sketch::position(s, p); }
+
+double deg(double radians) { return radians * 180 / pi; }
+
+/// Angle (degrees, counterclockwise in the xy plane) turning direction a into direction b.
+double turn(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return deg(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)));
+}
+
+struct Rectangle {
+  Sketch sketch;
+  std::vector<PointId> corners;  // 8 points: each side owns its two ends
+  std::vector<EntityId> sides;   // bottom, right, top, left (counterclockwise)
+  std::vector<Constraint> constraints;
+};
+
+/// A rectangle drawn crookedly: separate end points per side, joined by coincident constraints,
+/// with horizontal/vertical sides, width 40, height 25 and the first corner fixed.
+Rectangle crooked_rectangle(double width = 40, double height = 25, bool fix = true) {
+  Rectangle r;
+  const PlaneId plane = r.sketch.add_plane({});
+  const std::vector<Eigen::Vector2d> drawn = {{0.3, -0.2}, {41.0, 0.8},  {39.5, 0.4},  {40.6, 26.1},
+                                              {40.2, 24.3}, {-0.7, 25.9}, {0.5, 24.6}, {-0.4, 0.6}};
+  for (const Eigen::Vector2d& p : drawn) r.corners.push_back(r.sketch.add_point(plane, p));
+  for (int k = 0; k < 4; ++k)
+    r.sides.push_back(r.sketch.add_line(r.corners[static_cast<size_t>(2 * k)], r.corners[static_cast<size_t>(2 * k + 1)]));
+  for (int k = 0; k < 4; ++k)
+    r.constraints.push_back(coincident(r.corners[static_cast<size_t>(2 * k + 1)], r.corners[static_cast<size_t>((2 * k + 2) % 8)]));
+  r.constraints.push_back(horizontal(r.sides[0]));
+  r.constraints.push_back(vertical(r.sides[1]));
+  r.constraints.push_back(horizontal(r.sides[2]));
+  r.constraints.push_back(vertical(r.sides[3]));
+  r.constraints.push_back(distance(r.corners[0], r.corners[1], width));
+  r.constraints.push_back(distance(r.corners[2], r.corners[3], height));
+  if (fix) r.constraints.push_back(fixed(r.corners[0]));
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("a rectangle with horizontal, vertical and distance constraints has 0 DOF and exact sizes", "[constraints]") {
+  const Rectangle r = crooked_rectangle();
+  const SolveResult result = solve(r.sketch, r.constraints);
+  const SolveReport& rep = result.report;
+  INFO(rep.summary.brief());
+  REQUIRE(rep.summary.converged());
+  CHECK(rep.degrees_of_freedom == 0);
+  CHECK(rep.redundant.empty());
+  CHECK(rep.conflicting.empty());
+  CHECK(rep.max_residual <= 1e-10);
+  const Sketch& s = result.sketch;
+  // Independent checks: corners from the solved positions.
+  const Eigen::Vector3d a = at(s, r.corners[0]), b = at(s, r.corners[1]);
+  const Eigen::Vector3d c = at(s, r.corners[3]), d = at(s, r.corners[5]);
+  CHECK_THAT((a - Eigen::Vector3d(0.3, -0.2, 0)).norm(), WithinAbs(0, 1e-12));  // fixed
+  CHECK_THAT((b - a).norm(), WithinAbs(40, 1e-10));
+  CHECK_THAT((c - b).norm(), WithinAbs(25, 1e-10));
+  CHECK_THAT(std::abs((b - a).y()), WithinAbs(0, 1e-12));
+  CHECK_THAT(std::abs((c - b).x()), WithinAbs(0, 1e-12));
+  CHECK_THAT(std::abs((d - c).y()), WithinAbs(0, 1e-12));
+  for (int k = 0; k < 4; ++k)  // joints coincide exactly (substituted)
+    CHECK((at(s, r.corners[static_cast<size_t>(2 * k + 1)]) - at(s, r.corners[static_cast<size_t>((2 * k + 2) % 8)])).norm() == 0);
+  CHECK(rep.substituted > 0);
+  CHECK(rep.components == 1);
+}
+
+TEST_CASE("degrees of freedom count what is left to move", "[constraints]") {
+  Rectangle r = crooked_rectangle(40, 25, false);  // not fixed: it can slide in x and y
+  CHECK(solve(r.sketch, r.constraints).report.degrees_of_freedom == 2);
+  r.constraints.pop_back();  // no height: 3
+  CHECK(solve(r.sketch, r.constraints).report.degrees_of_freedom == 3);
+  Sketch free_line;
+  const PlaneId plane = free_line.add_plane({});
+  const EntityId l = free_line.add_line(free_line.add_point(plane, {0, 0}), free_line.add_point(plane, {3, 1}));
+  CHECK(solve(free_line, {}).report.degrees_of_freedom == 4);
+  CHECK(solve(free_line, {horizontal(l)}).report.degrees_of_freedom == 3);
+  Sketch space;  // free 3D points: 3 unknowns each
+  const PointId p = space.add_point({0, 0, 0}), q = space.add_point({1, 2, 3});
+  CHECK(solve(space, {distance(p, q, 5)}).report.degrees_of_freedom == 5);
+}
+
+TEST_CASE("a triangle whose three angles do not sum to 180 degrees is conflicting, naming them", "[constraints]") {
+  Sketch s;
+  const PlaneId plane = s.add_plane({});
+  const PointId a = s.add_point(plane, {0, 0}), b = s.add_point(plane, {10, 0}), c = s.add_point(plane, {4, 7});
+  const EntityId ab = s.add_line(a, b), bc = s.add_line(b, c), ca = s.add_line(c, a);
+  std::vector<Constraint> cs = {fixed(a), distance(a, b, 10), horizontal(ab), angle(ab, bc, 120),
+                                angle(bc, ca, 130), angle(ca, ab, 120)};  // turns sum to 370, not 360
+  const SolveResult result = solve(s, cs);
+  const SolveReport& rep = result.report;
+  INFO(rep.summary.brief());
+  CHECK(rep.summary.termination == clay::Termination::Failed);
+  REQUIRE(rep.conflicting.size() == 1);
+  CHECK(rep.conflicting[0].constraints == std::vector<int>{3, 4, 5});
+  CHECK_THAT(rep.conflicting[0].message, Contains("angle 120 degrees from line #0 to line #1"));
+  CHECK(rep.redundant.empty());
+
+  // The same triangle with consistent angles (exterior turns 120 + 130 + 110 = 360): solved,
+  // and the third angle is named redundant.
+  cs[5] = angle(ca, ab, 110);
+  const SolveResult ok = solve(s, cs);
+  INFO(ok.report.summary.brief());
+  REQUIRE(ok.report.summary.converged());
+  REQUIRE(ok.report.redundant.size() == 1);
+  CHECK(ok.report.redundant[0].constraints == std::vector<int>{3, 4, 5});
+  CHECK(ok.report.degrees_of_freedom == 0);
+  const Sketch& t = ok.sketch;
+  CHECK_THAT(turn(at(t, b) - at(t, a), at(t, c) - at(t, b)), WithinAbs(120, 1e-8));
+  CHECK_THAT(turn(at(t, c) - at(t, b), at(t, a) - at(t, c)), WithinAbs(130, 1e-8));
+}
+
+TEST_CASE("a redundant dimension is named redundant, a contradicting one conflicting", "[constraints]") {
+  Rectangle r = crooked_rectangle();
+  r.constraints.push_back(distance(r.corners[4], r.corners[5], 40));  // top width again: consistent
+  SolveResult result = solve(r.sketch, r.constraints);
+  INFO(result.report.summary.brief());
+  REQUIRE(result.report.summary.converged());
+  REQUIRE(result.report.redundant.size() == 1);
+  const std::vector<int>& set = result.report.redundant[0].constraints;
+  CHECK(std::count(set.begin(), set.end(), 8) == 1);   // the bottom width
+  CHECK(std::count(set.begin(), set.end(), 11) == 1);  // the top width
+  CHECK(result.report.degrees_of_freedom == 0);
+
+  r.constraints.back() = distance(r.corners[4], r.corners[5], 41);  // contradicts the bottom
+  result = solve(r.sketch, r.constraints);
+  CHECK(!result.report.summary.converged());
+  REQUIRE(result.report.conflicting.size() == 1);
+  const std::vector<int>& clash = result.report.conflicting[0].constraints;
+  CHECK(std::count(clash.begin(), clash.end(), 8) == 1);
+  CHECK(std::count(clash.begin(), clash.end(), 11) == 1);
+
+  // Substituted equalities are diagnosed too: two fixes of one coincident pair at two places.
+  Sketch s;
+  const PlaneId plane = s.add_plane({});
+  const PointId p = s.add_point(plane, {0, 0}), q = s.add_point(plane, {1, 0});
+  const SolveResult twice = solve(s, {fixed(p), fixed(q), coincident(p, q)});
+  REQUIRE(twice.report.conflicting.size() == 1);
+  CHECK(twice.report.conflicting[0].constraints == std::vector<int>{0, 1, 2});
+}
+
+TEST_CASE("G1 and G2 joints between B-spline curves hold to 1e-9", "[constraints]") {
+  using clay::surface::derivatives;
+  Sketch s;
+  clay::surface::Points3 p1(4, 3), p2(5, 3);
+  p1 << 0, 0, 0, 10, 5, 2, 20, 6, -1, 30, 2, 3;
+  p2 << 31, 1, 4, 38, -4, 6, 45, -2, 2, 52, 3, 0, 60, 1, 1;
+  const EntityId c1 = s.add_curve(clay::surface::make_curve(3, {0, 0, 0, 0, 1, 1, 1, 1}, p1));
+  const EntityId c2 = s.add_curve(clay::surface::make_curve(3, {0, 0, 0, 0, 0.5, 1, 1, 1, 1}, p2));
+  const auto& cp1 = std::get<clay::sketch::Curve>(s.entities[0]).control_points;
+  const auto& cp2 = std::get<clay::sketch::Curve>(s.entities[1]).control_points;
+  for (int joint = 1; joint <= 2; ++joint) {
+    std::vector<Constraint> cs = {fixed(cp1[0]), fixed(cp1[1]), fixed(cp2.back())};
+    cs.push_back(joint == 1 ? tangent(end_of(c1), start_of(c2)) : curvature(end_of(c1), start_of(c2)));
+    const SolveResult result = solve(s, cs);
+    INFO(result.report.summary.brief());
+    REQUIRE(result.report.summary.converged());
+    CHECK(result.report.flipped.empty());
+    const auto a = derivatives(clay::sketch::curve_of(result.sketch, c1), 1.0, 2);
+    const auto b = derivatives(clay::sketch::curve_of(result.sketch, c2), 0.0, 2);
+    CHECK((a.point - b.point).norm() <= 1e-12);
+    const double angle_between = std::atan2(a.d1.cross(b.d1).norm(), a.d1.dot(b.d1));
+    CHECK(angle_between <= 1e-9);
+    if (joint == 2) {  // curvature vectors k = (C' x C'') x C' / |C'|^4
+      auto kappa = [](const Eigen::Vector3d& d1, const Eigen::Vector3d& d2) -> Eigen::Vector3d {
+        return d1.cross(d2).cross(d1) / std::pow(d1.norm(), 4);
+      };
+      const Eigen::Vector3d ka = kappa(a.d1, a.d2), kb = kappa(b.d1, b.d2);
+      INFO("curvature " << ka.transpose() << " vs " << kb.transpose());
+      CHECK((ka - kb).norm() <= 1e-9 * std::max(1.0, ka.norm()));
+      CHECK(ka.norm() > 1e-4);  // a real curvature was matched, not zero against zero
+    }
+  }
+}
+
+TEST_CASE("a line tangent to an arc, an arc of given radius and a curve end along a direction", "[constraints]") {
+  Sketch s;
+  const PlaneId plane = s.add_plane({});
+  const PointId center = s.add_point(plane, {0, 0});
+  const PointId a0 = s.add_point(plane, {5, 0}), a1 = s.add_point(plane, {0, 5});
+  const EntityId arc = s.add_arc(center, a0, a1, plane);
+  const PointId l0 = s.add_point(plane, {0.3, 5.2}), l1 = s.add_point(plane, {-10, 6});
+  const EntityId line = s.add_line(l0, l1);
+  const SolveResult result =
+      solve(s, {fixed(center), fixed(a0), tangent(end_of(arc), start_of(line)), distance(l0, l1, 10)});
+  INFO(result.report.summary.brief());
+  REQUIRE(result.report.summary.converged());
+  CHECK(result.report.redundant.empty());
+  const Sketch& t = result.sketch;
+  const Eigen::Vector3d c = at(t, center), e = at(t, a1), q = at(t, l1);
+  CHECK_THAT((e - c).norm(), WithinAbs(5, 1e-10));
+  CHECK_THAT(std::abs((e - c).dot(q - e)) / (q - e).norm(), WithinAbs(0, 1e-10));  // radius ⟂ line
+  CHECK_THAT((q - e).norm(), WithinAbs(10, 1e-10));
+  // the line leaves the arc in the arc's direction of travel (counterclockwise)
+  CHECK(Eigen::Vector3d::UnitZ().cross(e - c).dot(q - e) > 0);
+  CHECK(result.report.degrees_of_freedom == 1);  // the arc's end can still slide round
+
+  Sketch sp;
+  clay::surface::Points3 p(4, 3);
+  p << 0, 0, 0, 3, 1, 0, 6, -1, 2, 9, 0, 1;
+  const EntityId curve = sp.add_curve(clay::surface::make_curve(3, {0, 0, 0, 0, 1, 1, 1, 1}, p));
+  const auto& cps = std::get<clay::sketch::Curve>(sp.entities[0]).control_points;
+  const Eigen::Vector3d dir(1, 2, 2);
+  const SolveResult r2 = solve(sp, {fixed(cps[0]), fixed(cps[2]), fixed(cps[3]), end_tangent(start_of(curve), dir)});
+  REQUIRE(r2.report.summary.converged());
+  const auto d = clay::surface::derivatives(clay::sketch::curve_of(r2.sketch, curve), 0.0, 1);
+  CHECK(d.d1.normalized().dot(dir.normalized()) >= 1 - 1e-15);
+}
+
+TEST_CASE("each planar constraint holds in an independent measurement", "[constraints]") {
+  Sketch s;
+  const PlaneId plane = s.add_plane(clay::sketch::make_plane({1, 2, 3}, {0, 1, 1}));
+  auto pt = [&](double x, double y) { return s.add_point(plane, {x, y}); };
+  const PointId a = pt(0, 0), b = pt(10, 1), c = pt(1, 5), d = pt(9, 9), m = pt(4, 1), p = pt(3, -4),
+                q = pt(6, 7), on = pt(12, 3);
+  const EntityId ab = s.add_line(a, b), cd = s.add_line(c, d);
+  const PointId e = pt(2, 8), f = pt(2.5, 14);
+  const EntityId ef = s.add_line(e, f);
+  const PointId cc = pt(20, 0);
+  const EntityId circle = s.add_circle(cc, 3, plane);
+  const PointId oc = pt(24, 1);
+  const PointId ac = pt(-10, 0), as = pt(-5, 0), ae = pt(-10, 5);
+  const EntityId arc = s.add_arc(ac, as, ae, plane);
+  const std::vector<Constraint> cs = {
+      fixed(a), fixed(b), parallel(ab, cd), distance(c, ab, 6), equal_length(ab, cd),
+      perpendicular(ab, ef), midpoint(m, ab), symmetric(p, q, ab), point_on(on, ab),
+      fixed(cc), radius(circle, 4), point_on(oc, circle), distance(e, c, 2),
+      fixed(ac), radius(arc, 7)};
+  const SolveResult result = solve(s, cs);
+  INFO(result.report.summary.brief());
+  REQUIRE(result.report.summary.converged());
+  const Sketch& t = result.sketch;
+  const clay::sketch::SketchPlane& pl = t.planes[0];
+  auto uv = [&](PointId id) {
+    const Eigen::Vector2d x = pl.to_plane(at(t, id));
+    return Eigen::Vector3d(x.x(), x.y(), 0);
+  };
+  for (size_t i = 0; i < t.points.size(); ++i) CHECK(std::abs(pl.distance(t.points[i].position)) < 1e-12);
+  const Eigen::Vector3d u = uv(b) - uv(a), v = uv(d) - uv(c), w = uv(f) - uv(e);
+  CHECK(std::abs(u.cross(v).z()) / (u.norm() * v.norm()) < 1e-10);
+  CHECK(u.dot(v) > 0);  // kept its sense
+  CHECK_THAT(u.cross(uv(c) - uv(a)).z() / u.norm(), WithinAbs(6, 1e-10));  // on the side it started
+  CHECK_THAT(u.norm() - v.norm(), WithinAbs(0, 1e-10));
+  CHECK(std::abs(u.dot(w)) / (u.norm() * w.norm()) < 1e-10);
+  CHECK((uv(m) - (uv(a) + uv(b)) / 2).norm() < 1e-10);
+  const Eigen::Vector3d mid = (uv(p) + uv(q)) / 2;
+  CHECK(std::abs(u.cross(mid - uv(a)).z()) / u.norm() < 1e-10);
+  CHECK(std::abs(u.dot(uv(q) - uv(p))) / u.norm() < 1e-10);
+  CHECK(std::abs(u.cross(uv(on) - uv(a)).z()) / u.norm() < 1e-10);
+  CHECK_THAT(std::get<clay::sketch::Circle>(t.entities[3]).radius, WithinAbs(4, 1e-10));
+  CHECK_THAT((at(t, oc) - at(t, cc)).norm(), WithinAbs(4, 1e-10));
+  CHECK_THAT((at(t, e) - at(t, c)).norm(), WithinAbs(2, 1e-10));
+  CHECK_THAT((at(t, as) - at(t, ac)).norm(), WithinAbs(7, 1e-10));
+  CHECK_THAT((at(t, ae) - at(t, ac)).norm(), WithinAbs(7, 1e-10));  // the arc's implicit equation
+}
+
+TEST_CASE("drag moves the dragged point and keeps the constraints", "[constraints]") {
+  const Rectangle r = crooked_rectangle(40, 25, false);
+  SolveOptions options;
+  options.drag = {{r.corners[0], {5, 7, 0}}};
+  const SolveResult result = solve(r.sketch, r.constraints, options);
+  INFO(result.report.summary.brief());
+  REQUIRE(result.report.summary.converged());
+  const Sketch& s = result.sketch;
+  CHECK((at(s, r.corners[0]) - Eigen::Vector3d(5, 7, 0)).norm() < 1e-6);
+  CHECK_THAT((at(s, r.corners[1]) - at(s, r.corners[0])).norm(), WithinAbs(40, 1e-10));
+  CHECK_THAT((at(s, r.corners[3]) - at(s, r.corners[2])).norm(), WithinAbs(25, 1e-10));
+  // A dragged point held by a fixed constraint stays; the rest follows as little as possible.
+  const Rectangle fixed_rect = crooked_rectangle();
+  const SolveResult held = solve(fixed_rect.sketch, fixed_rect.constraints, options);
+  REQUIRE(held.report.summary.converged());
+  CHECK((at(held.sketch, fixed_rect.corners[0]) - Eigen::Vector3d(0.3, -0.2, 0)).norm() < 1e-12);
+}
+
+TEST_CASE("a solution that turns a joint into a cusp is reported as flipped", "[constraints]") {
+  Sketch s;
+  const PlaneId plane = s.add_plane({});
+  const PointId a = s.add_point(plane, {0, 0}), b = s.add_point(plane, {10, 0});
+  const PointId c = s.add_point(plane, {10, 0.5}), d = s.add_point(plane, {5, 1});
+  const EntityId first = s.add_line(a, b), second = s.add_line(c, d);
+  // The second line starts drawn back over the first: the nearest G1 solution points backwards.
+  const SolveResult result = solve(s, {fixed(a), fixed(b), tangent(end_of(first), start_of(second)), distance(c, d, 5)});
+  INFO(result.report.summary.brief());
+  REQUIRE(result.report.summary.converged());  // the equations hold ...
+  CHECK((at(result.sketch, d) - Eigen::Vector3d(5, 0, 0)).norm() < 1e-9);  // ... as a cusp
+  CHECK(result.report.flipped == std::vector<int>{2});
+  CHECK_THAT(result.report.summary.message, Contains("orientation flipped for constraint #2"));
+}
+
+TEST_CASE("independent rectangles are separate components", "[constraints]") {
+  Sketch s;
+  const PlaneId plane = s.add_plane({});
+  std::vector<Constraint> cs;
+  for (int k = 0; k < 5; ++k) {
+    const Rectangle r = crooked_rectangle();
+    const int offset = static_cast<int>(s.points.size());
+    const int eoffset = static_cast<int>(s.entities.size());
+    for (const auto& p : r.sketch.points) s.add_point(plane, {p.position.x() + 50 * k, p.position.y()});
+    for (const auto& e : r.sketch.entities) {
+      const auto& l = std::get<clay::sketch::Line>(e);
+      s.add_line({l.start.index + offset}, {l.end.index + offset});
+    }
+    for (Constraint c : r.constraints) {
+      for (PointId& p : c.points) p.index += offset;
+      for (EntityId& e : c.entities) e.index += eoffset;
+      if (c.kind == ConstraintKind::Fixed) continue;
+      cs.push_back(c);
+    }
+  }
+  const SolveResult result = solve(s, cs);
+  REQUIRE(result.report.summary.converged());
+  CHECK(result.report.components == 5);
+  CHECK(result.report.degrees_of_freedom == 10);
+}
+
+TEST_CASE("bad constraints raise clay::Error naming the constraint", "[constraints]") {
+  Sketch s;
+  const PlaneId plane = s.add_plane({});
+  const PointId a = s.add_point(plane, {0, 0}), b = s.add_point(plane, {1, 0});
+  const PointId free_point = s.add_point({0, 0, 5});
+  const EntityId l = s.add_line(a, b);
+  const EntityId circle = s.add_circle(a, 2, plane);
+  const EntityId slanted = s.add_line(b, free_point);
+  auto category_and = [&](const std::vector<Constraint>& cs, const std::string& text) {
+    const auto [category, message] = error_of([&] { (void)solve(s, cs); });
+    CHECK(category == ErrorCategory::InvalidArgument);
+    CHECK_THAT(message, Contains(text));
+  };
+  category_and({fixed(a), distance(a, PointId{9}, 1)}, "constraint #1: refers to point #9, which does not exist");
+  category_and({horizontal(EntityId{7})}, "constraint #0: refers to entity #7, which does not exist");
+  category_and({horizontal(circle)}, "circle #1 is not a line");
+  category_and({horizontal(slanted)}, "needs its points in one sketch plane");
+  category_and({distance(a, b, 0)}, "must be positive; use coincident");
+  category_and({distance(a, b, NAN)}, "not finite");
+  category_and({angle(l, l, 30)}, "two different lines");
+  category_and({coincident(a, a)}, "coincident with itself");
+  category_and({radius(l, 3)}, "is not a circle or an arc");
+  category_and({tangent(end_of(circle), start_of(l))}, "has no ends");
+  category_and({end_tangent(end_of(l), Eigen::Vector3d::Zero())}, "zero vector");
+  SolveOptions bad;
+  bad.tolerance = 0;
+  const auto [category, message] = error_of([&] { (void)solve(s, {}, bad); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("SolveOptions::tolerance"));
+}
