@@ -290,6 +290,9 @@ void run_ceres(CeresSystem& sys, const Model& m, const SolveOptions& options, bo
   o.logging_type = ceres::SILENT;
   o.minimizer_progress_to_stdout = false;
   o.num_threads = 1;
+  // Start nearly as Gauss–Newton (most sketches are close to a solution); LM damps when a step
+  // fails. Measured on the zigzag chain of 1,000 segments: 15 iterations instead of 29.
+  o.initial_trust_region_radius = 1e12;
   StopWhenSolved stop(0.5 * std::pow(1e-3 * options.tolerance, 2));
   if (stop_early) o.callbacks.push_back(&stop);
   (void)m;

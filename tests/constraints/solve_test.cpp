@@ -366,3 +366,69 @@ TEST_CASE("bad constraints raise clay::Error naming the constraint", "[constrain
   CHECK(category == ErrorCategory::InvalidArgument);
   CHECK_THAT(message, Contains("SolveOptions::tolerance"));
 }
+
+TEST_CASE("points on curves and arcs, equal radii, and joints across planes and 3D", "[constraints]") {
+  Sketch s;
+  const PlaneId xy = s.add_plane({});
+  const PlaneId tilted = s.add_plane(clay::sketch::make_plane({0, 0, 10}, {1, 0, 1}));
+  // A free 3D cubic and a point that must lie on it.
+  clay::surface::Points3 cp(5, 3);
+  cp << 0, 0, 0, 5, 8, 2, 12, -3, 4, 18, 6, -2, 25, 0, 1;
+  const EntityId curve = s.add_curve(clay::surface::make_curve(3, {0, 0, 0, 0, 0.4, 1, 1, 1, 1}, cp));
+  const std::vector<PointId> cps = std::get<clay::sketch::Curve>(s.entities[0]).control_points;
+  const PointId near = s.add_point({11, 3, 5});
+  // A circle and an arc of equal radius in the xy plane, a point on the arc's circle.
+  const PointId cc = s.add_point(xy, {40, 0});
+  const EntityId circle = s.add_circle(cc, 3, xy);
+  const PointId ac = s.add_point(xy, {60, 0}), as = s.add_point(xy, {65, 0}), ae = s.add_point(xy, {60, 5});
+  const EntityId arc = s.add_arc(ac, as, ae, xy);
+  const PointId on_arc = s.add_point(xy, {57, -3});
+  // A point of the tilted plane made coincident with a free point (a world-frame equation).
+  const Eigen::Vector3d spot = s.planes[1].to_world({3, -1});
+  const PointId in_plane = s.add_point(tilted, {1, 1}), loose = s.add_point(spot + Eigen::Vector3d(0.5, 0.2, -0.3));
+  // A line of the tilted plane joined G1 to the 3D curve's end.
+  const PointId l0 = s.add_point(tilted, {2, 2}), l1 = s.add_point(tilted, {8, 3});
+  const EntityId line = s.add_line(l0, l1);
+  std::vector<Constraint> cs = {fixed(cps[0]), fixed(cps[1]), fixed(cps[2]),
+                                point_on(near, curve), fixed(cc), fixed(ac), radius(circle, 4),
+                                equal_radius(circle, arc), point_on(on_arc, arc),
+                                coincident(in_plane, loose), distance(loose, l0, 3),
+                                tangent(end_of(line), end_of(curve)), distance(l0, l1, 6)};
+  const SolveResult result = solve(s, cs);
+  INFO(result.report.summary.brief());
+  REQUIRE(result.report.summary.converged());
+  CHECK(result.report.conflicting.empty());
+  CHECK(result.report.redundant.empty());
+  const Sketch& t = result.sketch;
+  // The point lies on the curve: its distance to a fine sample, refined by bisection, is ~0.
+  const auto c = clay::sketch::curve_of(t, curve);
+  double best = INFINITY, t_best = 0;
+  for (int i = 0; i <= 20000; ++i) {
+    const double u = i / 20000.0;
+    const double d = (clay::surface::evaluate(c, u) - at(t, near)).norm();
+    if (d < best) best = d, t_best = u;
+  }
+  for (int iter = 0; iter < 60; ++iter) {  // golden-free refinement: ternary search near the sample
+    const double h = 1.0 / 20000.0 / (1 << std::min(iter, 30));
+    for (double u : {t_best - h, t_best + h}) {
+      const double d = (clay::surface::evaluate(c, std::clamp(u, 0.0, 1.0)) - at(t, near)).norm();
+      if (d < best) best = d, t_best = std::clamp(u, 0.0, 1.0);
+    }
+  }
+  CHECK(best < 1e-9);
+  CHECK_THAT(std::get<clay::sketch::Circle>(t.entities[1]).radius, WithinAbs(4, 1e-10));
+  CHECK_THAT((at(t, as) - at(t, ac)).norm(), WithinAbs(4, 1e-10));
+  CHECK_THAT((at(t, ae) - at(t, ac)).norm(), WithinAbs(4, 1e-10));
+  CHECK_THAT((at(t, on_arc) - at(t, ac)).norm(), WithinAbs(4, 1e-10));
+  CHECK((at(t, in_plane) - at(t, loose)).norm() < 1e-10);  // a world-frame coincidence
+  CHECK_THAT((at(t, loose) - at(t, l0)).norm(), WithinAbs(3, 1e-10));
+  const auto d_line = clay::surface::derivatives(clay::sketch::curve_of(t, line), 1.0, 1);
+  const auto d_curve = clay::surface::derivatives(c, 1.0, 1);
+  CHECK((d_line.point - d_curve.point).norm() < 1e-10);
+  // line ends where the curve ends, so the G1 joint has the line arriving against the curve's
+  // direction: the curve's end tangent points back along the line.
+  CHECK(std::atan2(d_line.d1.cross(-d_curve.d1).norm(), d_line.d1.dot(-d_curve.d1)) < 1e-9);
+  for (size_t i = 0; i < t.points.size(); ++i)
+    if (!t.points[i].plane.free())
+      CHECK(std::abs(t.planes[static_cast<size_t>(t.points[i].plane.index)].distance(t.points[i].position)) < 1e-12);
+}
