@@ -335,12 +335,12 @@ Eigen::SparseMatrix<double> normalised(Eigen::SparseMatrix<double> J) {
 template <class Ordering>
 int dependent_rows(const Eigen::SparseMatrix<double>& J, double threshold, bool circuits,
                    std::vector<std::vector<int>>* out) {
-  const Eigen::SparseMatrix<double> A = normalised(J).transpose();
-  if (A.cols() == 0) return 0;
-  if (A.rows() == 0) {
-    for (Eigen::Index c = 0; c < A.cols(); ++c) out->push_back({static_cast<int>(c)});
+  if (J.rows() == 0) return 0;  // no equations: nothing depends, rank 0
+  if (J.cols() == 0) {          // no unknowns: every equation is dependent (constant)
+    for (Eigen::Index r = 0; r < J.rows(); ++r) out->push_back({static_cast<int>(r)});
     return 0;
   }
+  const Eigen::SparseMatrix<double> A = normalised(J).transpose();
   Eigen::SparseQR<Eigen::SparseMatrix<double>, Ordering> qr;
   qr.setPivotThreshold(threshold);
   qr.compute(A);
