@@ -14,7 +14,6 @@
 #include <Eigen/SparseLU>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -22,6 +21,7 @@
 #include <vector>
 
 #include "builder_tools.hpp"
+#include "quadrature.hpp"
 
 namespace clay::surface {
 namespace {
@@ -240,16 +240,6 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
 
 // ---- Sweep: rotation-minimizing frames on a fine table of the path ----
 
-// 8-point Gauss–Legendre nodes and weights on [-1, 1].
-constexpr std::array<double, 8> gauss_x = {-0.9602898564975363, -0.7966664774136267,
-                                           -0.5255324099163290, -0.1834346424956498,
-                                           0.1834346424956498,  0.5255324099163290,
-                                           0.7966664774136267,  0.9602898564975363};
-constexpr std::array<double, 8> gauss_w = {0.1012285362903763, 0.2223810344533745,
-                                           0.3137066458778873, 0.3626837833783620,
-                                           0.3626837833783620, 0.3137066458778873,
-                                           0.2223810344533745, 0.1012285362903763};
-
 /// The path sampled finely: points, unit tangents, rotation-minimizing normals r (double
 /// reflection, Wang et al. 2008, Algorithm 1) and cumulative arc length. Frames and arc lengths
 /// between entries come from one more reflection / quadrature step from the entry before.
@@ -358,12 +348,7 @@ class PathTable {
 
   double arc(double a, double b) const {
     if (b <= a) return 0.0;
-    double sum = 0;
-    for (size_t g = 0; g < gauss_x.size(); ++g) {
-      const double t = 0.5 * (a + b) + 0.5 * (b - a) * gauss_x[g];
-      sum += gauss_w[g] * derivatives(path_, t, 1).d1.norm();
-    }
-    return 0.5 * (b - a) * sum;
+    return detail::gauss_legendre_8(a, b, [&](double t) { return derivatives(path_, t, 1).d1.norm(); });
   }
 
   const BSplineCurve& path_;
