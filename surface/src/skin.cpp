@@ -193,6 +193,11 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
                       num(length) + " mm long (tolerance " + num(tol) +
                       " mm); a loft needs curves, not points: remove it or give a curve");
   }
+  for (size_t k = 0; k < sections.size(); ++k)
+    detail::reject_self_intersection(
+        sections[k], tol, "loft: section #" + std::to_string(k),
+        "the lofted surface would intersect itself there: move the section's control points so "
+        "that it does not cross or touch itself");
 
   PreparedLoft out;
   std::vector<BSplineCurve> oriented;
@@ -673,6 +678,12 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
     throw Error(ErrorCategory::InvalidGeometry,
                 "sweep: path has zero length (its control polygon is " + num(polygon_length(path)) +
                     " mm long, tolerance " + num(exact_tol) + " mm); give a path that moves");
+  detail::reject_self_intersection(profile, exact_tol, "sweep: profile",
+                                   "the swept surface would intersect itself: give a profile that "
+                                   "does not cross or touch itself");
+  detail::reject_self_intersection(path, exact_tol, "sweep: path",
+                                   "the swept surface would intersect itself: move the path apart "
+                                   "there, or split it and sweep each part");
   const BSplineCurve shape = clamp(profile);
   const BSplineCurve track = clamp(path);
   check_corners(track, options.tolerance);
