@@ -260,7 +260,7 @@ class PathTable {
     }
     const double domain = bp.back() - bp.front();
     for (double t : t_) {
-      const CurveDerivatives d = derivatives(path, t, 1);
+      const CurveDerivatives d = derivatives(path, t, 2);
       const double speed = d.d1.norm();
       if (!(speed * domain > 1e-12 * size))
         throw Error(ErrorCategory::InvalidGeometry,
@@ -268,6 +268,8 @@ class PathTable {
                         " (a cusp or a collapsed span); remove the repeated control points there");
       x_.push_back(d.point);
       tangent_.push_back(d.d1 / speed);
+      // dT/ds = kappa n: the part of C'' normal to the tangent over the squared speed.
+      curvature_.push_back((d.d2 - d.d2.dot(tangent_.back()) * tangent_.back()) / (speed * speed));
     }
     // Any unit vector normal to the first tangent: the sweep does not depend on the choice.
     const Eigen::Vector3d& t0 = tangent_.front();
@@ -284,6 +286,12 @@ class PathTable {
   double length() const { return s_.back(); }
   double first() const { return t_.front(); }
   double last() const { return t_.back(); }
+
+  /// Entries of the table: parameter, point and curvature vector kappa n (right-sided at knots).
+  size_t entries() const { return t_.size(); }
+  double parameter_of(size_t j) const { return t_[j]; }
+  const Eigen::Vector3d& point_of(size_t j) const { return x_[j]; }
+  const Eigen::Vector3d& curvature_of(size_t j) const { return curvature_[j]; }
 
   /// Arc length from the path start to t.
   double arc_length(double t) const {
@@ -358,7 +366,7 @@ class PathTable {
 
   const BSplineCurve& path_;
   std::vector<double> t_, s_;
-  std::vector<Eigen::Vector3d> x_, tangent_, r_;
+  std::vector<Eigen::Vector3d> x_, tangent_, r_, curvature_;
 };
 
 /// The rigid motions of the sweep: start frame to frame at t, with the twist.
@@ -415,6 +423,36 @@ class SweepMotion {
   Eigen::Vector3d x0_;
   Eigen::Matrix3d f0_;
 };
+
+/// Where the sweep folds through itself. With rotation-minimizing frames, a profile point at
+/// offset q from the path point moves with dS/ds = T (1 - kappa n . q) + (terms normal to T): where
+/// kappa n . q reaches 1 the profile stretches to the path's centre of curvature and beyond it the
+/// surface runs backwards, through itself. Throws when the largest kappa n . q over the path
+/// table and dense profile samples reaches 1 - 1e-3 (the sampling's margin), naming the path
+/// parameter, the radius of curvature and how far the profile reaches toward the centre.
+void check_fold(const PathTable& table, const SweepMotion& motion, const BSplineCurve& profile) {
+  const Points3 samples = evaluate_many(profile, span_samples(profile.basis, 16));
+  double worst = 0;
+  size_t worst_entry = 0;
+  for (size_t j = 0; j < table.entries(); ++j) {
+    const Eigen::Vector3d& k = table.curvature_of(j);
+    if (k.squaredNorm() == 0.0) continue;
+    const Points3 moved = motion.moved(samples, table.parameter_of(j));
+    for (Eigen::Index i = 0; i < moved.rows(); ++i) {
+      const double reach = k.dot(moved.row(i).transpose() - table.point_of(j));
+      if (reach > worst) worst = reach, worst_entry = j;
+    }
+  }
+  if (worst < 1.0 - 1e-3) return;
+  const double kappa = table.curvature_of(worst_entry).norm();
+  throw Error(ErrorCategory::InvalidGeometry,
+              "sweep: the swept surface would fold through itself near path t = " +
+                  num(table.parameter_of(worst_entry)) + ": the path's radius of curvature there is " +
+                  num(1.0 / kappa) + " mm but the profile reaches " + num(worst / kappa) +
+                  " mm from the path toward the centre of curvature; use a smaller profile (reaching "
+                  "less than " + num(1.0 / kappa) + " mm toward the centre) or a gentler path (radius of "
+                  "curvature above " + num(worst / kappa) + " mm there)");
+}
 
 /// True when every control point of the path lies on the chord from its first to its last one and
 /// they advance monotonically along it: the path is a straight segment traversed once.
@@ -693,6 +731,7 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
                 "sweep: path has zero length (" + num(table.length()) + " mm); give a path that moves");
   const double twist = options.twist_degrees * std::numbers::pi / 180.0;
   const SweepMotion motion(table, twist);
+  check_fold(table, motion, shape);
 
   // Samples of the profile for the deviation check.
   const int profile_spans = static_cast<int>(breakpoints(shape.basis).size()) - 1;

@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/skin.hpp>
 
@@ -610,6 +611,37 @@ TEST_CASE("sweep rejects a path that crosses itself", "[skin][sweep][errors]") {
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
   CHECK_THAT(message, Catch::Contains("sweep: path crosses itself at t = -1 and t = 1 (point (0, 0, 0)") &&
                           Catch::Contains("tangents 90 degrees apart"));
+}
+
+namespace {
+
+/// A circle of radius `r` about the start (R, 0, 0) of quarter_circle(R, 0), in the plane y = 0
+/// normal to the path there: the sweep is a torus.
+BSplineCurve tube_profile(double big_r, double r) {
+  return circular_arc({big_r, 0, 0}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(), r, 0.0, 2 * std::numbers::pi);
+}
+
+}  // namespace
+
+TEST_CASE("sweep rejects a profile reaching past the path's centre of curvature (the surface would fold)", "[skin][sweep][errors]") {
+  // Profile radius 10 along an arc of radius 5: it reaches 10 mm toward the centre, 5 mm away.
+  const auto [category, message] = error_of([&] { sweep(tube_profile(5, 10), quarter_circle(5, 0)); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Catch::Contains("fold through itself") && Catch::Contains("radius of curvature there is 5 mm") &&
+                          Catch::Contains("the profile reaches 10 mm"));
+  // Just past the centre (reach / radius 1.05) is refused, just short of it (0.95) is not.
+  CHECK_THAT(error_of([&] { sweep(tube_profile(9.5, 10), quarter_circle(9.5, 0)); }).second,
+             Catch::Contains("fold through itself"));
+  CHECK_NOTHROW(sweep(tube_profile(10.5, 10), quarter_circle(10.5, 0)));
+  // Along an arc of radius 20 the tube is a torus (R 20, r 10).
+  const BuiltSurface built = sweep(tube_profile(20, 10), quarter_circle(20, 0));
+  double worst = 0;
+  for (double u : linspace(0, 1, 41))
+    for (double v : linspace(0, 1, 41)) {
+      const Eigen::Vector3d x = evaluate(built.surface, u, v);
+      worst = std::max(worst, std::abs(std::hypot(std::hypot(x.x(), x.y()) - 20.0, x.z()) - 10.0));
+    }
+  CHECK(worst <= 1e-6 * box_size(built.surface));
 }
 
 TEST_CASE("sweep rejects an invalid path, naming it", "[skin][sweep][errors]") {
