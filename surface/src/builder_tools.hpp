@@ -42,19 +42,22 @@ inline std::string point_text(const Eigen::Vector3d& p, double zero = 0.0) {
 /// between the two points when it is not 0 up to rounding.
 inline std::string describe(const CurveSelfIntersection& x, double tolerance) {
   const double a = x.angle_degrees;
-  std::string text = a <= 10.0 ? "touches itself" : a >= 170.0 ? "doubles back onto itself" : "crosses itself";
+  std::string text = a <= 10.0    ? "touches itself"
+                     : a >= 170.0 ? "doubles back onto itself"
+                                  : "crosses itself";
   text += " at t = " + parameter_text(x.t0) + " and t = " + parameter_text(x.t1) + " (point " +
           point_text(x.point, 1e-3 * tolerance);
   if (a > 10.0 && a < 170.0) text += ", tangents " + parameter_text(a) + " degrees apart";
   if (x.distance > 1e-3 * tolerance)
-    text += ", " + short_number(x.distance) + " mm apart, tolerance " + short_number(tolerance) + " mm";
+    text +=
+        ", " + short_number(x.distance) + " mm apart, tolerance " + short_number(tolerance) + " mm";
   return text + ")";
 }
 
 /// Throws clay::Error(InvalidGeometry) "<who> <describe(...)>; <fix>" when `curve` meets itself
 /// within `tolerance` (find_self_intersection).
-inline void reject_self_intersection(const BSplineCurve& curve, double tolerance, const std::string& who,
-                                     const std::string& fix) {
+inline void reject_self_intersection(const BSplineCurve& curve, double tolerance,
+                                     const std::string& who, const std::string& fix) {
   if (const auto x = find_self_intersection(curve, tolerance))
     throw Error(ErrorCategory::InvalidGeometry, who + " " + describe(*x, tolerance) + "; " + fix);
 }

@@ -79,7 +79,8 @@ BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle
   const Eigen::Vector3d lo = profile.points.colwise().minCoeff(), hi = profile.points.colwise().maxCoeff();
   const double size = (hi - lo).norm() + (0.5 * (hi + lo) - axis.point).norm();
   check_profile_against_axis(profile, axis.point, a, size);
-  detail::reject_self_intersection(profile, tolerance::exact_relative * size, "revolve: the profile",
+  detail::reject_self_intersection(profile, tolerance::exact_relative * size,
+                                   "revolve: the profile",
                                    "the revolved surface would intersect itself: give a profile "
                                    "that does not cross or touch itself");
 

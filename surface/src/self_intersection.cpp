@@ -58,7 +58,8 @@ Cone merge(const Cone& a, const Cone& b) {
   const double norm = sum.norm();
   if (!(norm > 1e-9)) return out;
   out.axis = sum / norm;
-  out.half = std::max(angle_between(out.axis, a.axis) + a.half, angle_between(out.axis, b.axis) + b.half);
+  out.half =
+      std::max(angle_between(out.axis, a.axis) + a.half, angle_between(out.axis, b.axis) + b.half);
   return out;
 }
 
@@ -77,7 +78,7 @@ struct Piece {
   double chord = 0;
   double arc = 0;  // arc length estimate (2 chord + (p - 1) polygon) / (p + 1) (Gravesen 1997)
   Cone cone;
-  Homogeneous h;     // its control points, for further subdivision
+  Homogeneous h;       // its control points, for further subdivision
   size_t segment = 0;  // index of the Bézier segment it comes from
 };
 
@@ -87,7 +88,8 @@ Points3 cartesian(const Homogeneous& h) {
   return p;
 }
 
-double distance_to_segment(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+double distance_to_segment(const Eigen::Vector3d& x, const Eigen::Vector3d& a,
+                           const Eigen::Vector3d& b) {
   const Eigen::Vector3d d = b - a;
   const double dd = d.squaredNorm();
   const double f = dd > 0 ? std::clamp((x - a).dot(d) / dd, 0.0, 1.0) : 0.0;
@@ -144,7 +146,8 @@ void split(const Homogeneous& h, Homogeneous& left, Homogeneous& right) {
   left.row(0) = work.row(0);
   right.row(n - 1) = work.row(n - 1);
   for (Eigen::Index level = 1; level < n; ++level) {
-    for (Eigen::Index i = 0; i < n - level; ++i) work.row(i) = 0.5 * (work.row(i) + work.row(i + 1));
+    for (Eigen::Index i = 0; i < n - level; ++i)
+      work.row(i) = 0.5 * (work.row(i) + work.row(i + 1));
     left.row(level) = work.row(0);
     right.row(n - 1 - level) = work.row(n - 1 - level);
   }
@@ -185,8 +188,9 @@ struct ChordMinimum {
   bool on_band = false;  // the minimum lies on the edge of the arc-length band
 };
 
-ChordMinimum chord_minimum(const Eigen::Vector3d& w, const Eigen::Vector3d& u, const Eigen::Vector3d& v,
-                           double k0, double ka, double kb, double lo, double hi) {
+ChordMinimum chord_minimum(const Eigen::Vector3d& w, const Eigen::Vector3d& u,
+                           const Eigen::Vector3d& v, double k0, double ka, double kb, double lo,
+                           double hi) {
   // Constraints n . (a, b) <= c, each row normalized.
   struct Row {
     Eigen::Vector2d n;
@@ -196,8 +200,10 @@ ChordMinimum chord_minimum(const Eigen::Vector3d& w, const Eigen::Vector3d& u, c
   size_t count = 4;
   auto add = [&](Eigen::Vector2d n, double c) {
     const double norm = n.norm();
-    if (norm > 0) rows[count++] = {n / norm, c / norm};
-    else if (c < 0) rows[count++] = {{0, 0}, -1};  // infeasible
+    if (norm > 0)
+      rows[count++] = {n / norm, c / norm};
+    else if (c < 0)
+      rows[count++] = {{0, 0}, -1};  // infeasible
   };
   add({ka, -kb}, k0 - lo);  // k0 + kb b - ka a >= lo
   if (std::isfinite(hi)) add({-ka, kb}, hi - k0);
@@ -215,7 +221,8 @@ ChordMinimum chord_minimum(const Eigen::Vector3d& w, const Eigen::Vector3d& u, c
   const double uu = u.dot(u), vv = v.dot(v), uv = u.dot(v);
   const double det = uu * vv - uv * uv;
   if (det > 1e-12 * uu * vv && det > 0) {
-    const Eigen::Vector2d x((uv * w.dot(v) - vv * w.dot(u)) / det, (uu * w.dot(v) - uv * w.dot(u)) / det);
+    const Eigen::Vector2d x((uv * w.dot(v) - vv * w.dot(u)) / det,
+                            (uu * w.dot(v) - uv * w.dot(u)) / det);
     if (feasible(x)) consider(x, false);
   }
   for (size_t i = 0; i < count; ++i) {
@@ -249,16 +256,19 @@ ChordMinimum chord_minimum(const Eigen::Vector3d& w, const Eigen::Vector3d& u, c
 /// another crossing), with a backtracking line search (Levenberg damping where the Hessian is not
 /// positive definite). A and B are the pieces' Bézier segments, so that derivatives at a piece's
 /// end are its own even where the curve has a corner there.
-void refine(const BSplineCurve& ca, const BSplineCurve& cb, double s0, double s1, double t0, double t1,
-            double& s, double& t) {
-  auto f = [&](double x, double y) { return 0.5 * (evaluate(ca, x) - evaluate(cb, y)).squaredNorm(); };
+void refine(const BSplineCurve& ca, const BSplineCurve& cb, double s0, double s1, double t0,
+            double t1, double& s, double& t) {
+  auto f = [&](double x, double y) {
+    return 0.5 * (evaluate(ca, x) - evaluate(cb, y)).squaredNorm();
+  };
   double value = f(s, t);
   for (int iteration = 0; iteration < 50 && value > 0; ++iteration) {
     const CurveDerivatives ds = derivatives(ca, s, 2), dt = derivatives(cb, t, 2);
     const Eigen::Vector3d r = ds.point - dt.point;
     Eigen::Vector2d g(r.dot(ds.d1), -r.dot(dt.d1));
     Eigen::Matrix2d H;
-    H << ds.d1.dot(ds.d1) + r.dot(ds.d2), -ds.d1.dot(dt.d1), -ds.d1.dot(dt.d1), dt.d1.dot(dt.d1) - r.dot(dt.d2);
+    H << ds.d1.dot(ds.d1) + r.dot(ds.d2), -ds.d1.dot(dt.d1), -ds.d1.dot(dt.d1),
+        dt.d1.dot(dt.d1) - r.dot(dt.d2);
     // Variables at a bound with the gradient pushing outwards stay there.
     const bool fix_s = (s <= s0 && g[0] > 0) || (s >= s1 && g[0] < 0);
     const bool fix_t = (t <= t0 && g[1] > 0) || (t >= t1 && g[1] < 0);
@@ -281,7 +291,8 @@ void refine(const BSplineCurve& ca, const BSplineCurve& cb, double s0, double s1
     }
     bool improved = false;
     for (double alpha = 1.0; alpha > 1e-12; alpha *= 0.5) {
-      const double ns = std::clamp(s + alpha * step[0], s0, s1), nt = std::clamp(t + alpha * step[1], t0, t1);
+      const double ns = std::clamp(s + alpha * step[0], s0, s1),
+                   nt = std::clamp(t + alpha * step[1], t0, t1);
       const double next = f(ns, nt);
       if (next < value) {
         const bool small = std::abs(ns - s) + std::abs(nt - t) <= 1e-15 * (s1 - s0 + t1 - t0);
@@ -302,7 +313,8 @@ class Search {
     for (size_t k = 0; k < segments_.size(); ++k) {
       const BSplineCurve& segment = segments_[k];
       const auto [t0, t1] = segment.basis.domain();
-      subdivide(detail::to_homogeneous(segment.points, segment.weights), t0, t1, k, 0.5 * min_arc_, 0, pieces_);
+      subdivide(detail::to_homogeneous(segment.points, segment.weights), t0, t1, k, 0.5 * min_arc_,
+                0, pieces_);
     }
     const size_t n = pieces_.size();
     polygon_.assign(n + 1, 0.0);
@@ -357,7 +369,8 @@ class Search {
   void self(int index) {
     const Node& n = nodes_[static_cast<size_t>(index)];
     if (n.leaf() || monotone(n.cone) || polygon_length(n) < min_arc_) return;
-    // Earlier pieces first, so that the first intersection found has a small t0 and prunes the rest.
+    // Earlier pieces first, so that the first intersection found has a small t0 and prunes the
+    // rest.
     self(n.left);
     pair(n.left, n.right);
     self(n.right);
@@ -373,7 +386,8 @@ class Search {
     if (((A.lo - B.hi).array() > tol_).any() || ((B.lo - A.hi).array() > tol_).any()) return;
     // Every pair of points nearer than min_arc along the curve (the shorter way when closed).
     const double total = polygon_.back();
-    double farthest = polygon_[static_cast<size_t>(B.last)] - polygon_[static_cast<size_t>(A.first)];
+    double farthest =
+        polygon_[static_cast<size_t>(B.last)] - polygon_[static_cast<size_t>(A.first)];
     if (closed_)
       farthest = std::min(farthest, total - polygon_[static_cast<size_t>(B.first)] +
                                         polygon_[static_cast<size_t>(A.last)]);
@@ -403,10 +417,11 @@ class Search {
                                      [](double x, const Piece& p) { return x < p.t0; });
     const size_t k = it == pieces_.begin() ? 0 : static_cast<size_t>(it - pieces_.begin()) - 1;
     const Piece& p = pieces_[k];
-    const double along = p.chord > 0 ? std::clamp((point - p.p0).dot(p.p1 - p.p0) / (p.chord * p.chord), 0.0, 1.0) : 0.0;
+    const double along =
+        p.chord > 0 ? std::clamp((point - p.p0).dot(p.p1 - p.p0) / (p.chord * p.chord), 0.0, 1.0)
+                    : 0.0;
     return arc_[k] + along * p.arc;
   }
-
 
   void candidate(int ka, int kb) {
     budget_ = 4096;
@@ -417,7 +432,8 @@ class Search {
   /// Piece A, at arc lengths [a0, a1] from the curve start, against the later piece B at [b0, b1].
   /// (The arc positions of a piece's halves split its own interval, so that the ends of pieces
   /// keep one position at every level and the band test stays exact where two pieces meet.)
-  void narrow(const Piece& A, double a0, double a1, const Piece& B, double b0, double b1, int depth) {
+  void narrow(const Piece& A, double a0, double a1, const Piece& B, double b0, double b1,
+              int depth) {
     if (best_ && A.t0 > best_->t0) return;
     if (((A.lo - B.hi).array() > tol_).any() || ((B.lo - A.hi).array() > tol_).any()) return;
     // Chord points a, b in [0, 1]; the arc between them, ~ b0 + b (b1 - b0) - a0 - a (a1 - a0),
@@ -477,16 +493,18 @@ class Search {
     for (size_t k = it == pieces_.begin() ? 0 : static_cast<size_t>(it - pieces_.begin()) - 1;
          k < pieces_.size() && pieces_[k].t0 < t; ++k) {
       const double a = std::max(s, pieces_[k].t0), b = std::min(t, pieces_[k].t1);
-      if (b > a) sum += detail::gauss_legendre_8(a, b, [&](double x) {
-        return derivatives(segments_[pieces_[k].segment], x, 1).d1.norm();
-      });
+      if (b > a)
+        sum += detail::gauss_legendre_8(a, b, [&](double x) {
+          return derivatives(segments_[pieces_[k].segment], x, 1).d1.norm();
+        });
     }
     return sum;
   }
 
   /// Arc length between s < t (the shorter way round on a closed curve): estimated from the
   /// pieces, integrated where the estimate is near the threshold.
-  double separation(double s, const Eigen::Vector3d& ps, double t, const Eigen::Vector3d& pt) const {
+  double separation(double s, const Eigen::Vector3d& ps, double t,
+                    const Eigen::Vector3d& pt) const {
     const double d = arc_at(t, pt) - arc_at(s, ps);
     const bool around = closed_ && arc_.back() - d < d;
     const double estimate = around ? arc_.back() - d : d;
@@ -529,11 +547,12 @@ class Search {
 
 }  // namespace
 
-std::optional<CurveSelfIntersection> find_self_intersection(const BSplineCurve& curve, double tolerance) {
+std::optional<CurveSelfIntersection> find_self_intersection(const BSplineCurve& curve,
+                                                            double tolerance) {
   if (!(tolerance > 0.0 && std::isfinite(tolerance)))
-    throw Error(ErrorCategory::InvalidArgument,
-                "find_self_intersection: tolerance is " + detail::short_number(tolerance) +
-                    " mm; it must be positive and finite");
+    throw Error(ErrorCategory::InvalidArgument, "find_self_intersection: tolerance is " +
+                                                    detail::short_number(tolerance) +
+                                                    " mm; it must be positive and finite");
   validate(curve, "curve");
   return Search(curve, tolerance).run();
 }

@@ -361,7 +361,8 @@ class PathTable {
 
   double arc(double a, double b) const {
     if (b <= a) return 0.0;
-    return detail::gauss_legendre_8(a, b, [&](double t) { return derivatives(path_, t, 1).d1.norm(); });
+    return detail::gauss_legendre_8(a, b,
+                                    [&](double t) { return derivatives(path_, t, 1).d1.norm(); });
   }
 
   const BSplineCurve& path_;
@@ -445,13 +446,15 @@ void check_fold(const PathTable& table, const SweepMotion& motion, const BSpline
   }
   if (worst < 1.0 - 1e-3) return;
   const double kappa = table.curvature_of(worst_entry).norm();
+  const std::string radius = num(1.0 / kappa), reach = num(worst / kappa);
   throw Error(ErrorCategory::InvalidGeometry,
               "sweep: the swept surface would fold through itself near path t = " +
-                  num(table.parameter_of(worst_entry)) + ": the path's radius of curvature there is " +
-                  num(1.0 / kappa) + " mm but the profile reaches " + num(worst / kappa) +
-                  " mm from the path toward the centre of curvature; use a smaller profile (reaching "
-                  "less than " + num(1.0 / kappa) + " mm toward the centre) or a gentler path (radius of "
-                  "curvature above " + num(worst / kappa) + " mm there)");
+                  num(table.parameter_of(worst_entry)) +
+                  ": the path's radius of curvature there is " + radius +
+                  " mm but the profile reaches " + reach +
+                  " mm from the path toward the centre of curvature; use a smaller profile "
+                  "(reaching less than " + radius + " mm toward the centre) or a gentler path "
+                  "(radius of curvature above " + reach + " mm there)");
 }
 
 /// True when every control point of the path lies on the chord from its first to its last one and

@@ -18,21 +18,23 @@
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
-using clay::test::error_of;
 using Catch::Matchers::WithinAbs;
+using clay::test::error_of;
 
 namespace {
 
 /// Homogeneous (w x, w y, w z, w) polynomial of degree `degree` on [a, b] written as a Bézier
 /// segment: its Bernstein coefficients, found by collocation at degree + 1 parameters (exact for a
 /// polynomial of that degree, up to rounding).
-Eigen::MatrixXd bernstein(const std::function<Eigen::Vector4d(double)>& f, int degree, double a, double b) {
+Eigen::MatrixXd bernstein(const std::function<Eigen::Vector4d(double)>& f, int degree, double a,
+                          double b) {
   const int n = degree + 1;
   Eigen::MatrixXd m(n, n), rhs(n, 4);
   for (int k = 0; k < n; ++k) {
     const double s = double(k) / degree;
     for (int i = 0; i < n; ++i)
-      m(k, i) = std::tgamma(n) / (std::tgamma(i + 1) * std::tgamma(n - i)) * std::pow(s, i) * std::pow(1 - s, degree - i);
+      m(k, i) = std::tgamma(n) / (std::tgamma(i + 1) * std::tgamma(n - i)) * std::pow(s, i) *
+                std::pow(1 - s, degree - i);
     rhs.row(k) = f(a + s * (b - a)).transpose();
   }
   return m.fullPivLu().solve(rhs);
@@ -40,13 +42,15 @@ Eigen::MatrixXd bernstein(const std::function<Eigen::Vector4d(double)>& f, int d
 
 /// A C0 curve made of Bézier segments of one degree over the breaks (interior knots repeated
 /// `degree` times), each the homogeneous polynomial f on its span.
-BSplineCurve piecewise(const std::function<Eigen::Vector4d(double)>& f, int degree, const std::vector<double>& breaks) {
+BSplineCurve piecewise(const std::function<Eigen::Vector4d(double)>& f, int degree,
+                       const std::vector<double>& breaks) {
   std::vector<double> knots(static_cast<size_t>(degree + 1), breaks.front());
   std::vector<Eigen::Vector4d> rows;
   for (size_t k = 0; k + 1 < breaks.size(); ++k) {
     const Eigen::MatrixXd c = bernstein(f, degree, breaks[k], breaks[k + 1]);
     for (int i = k == 0 ? 0 : 1; i <= degree; ++i) rows.push_back(c.row(i).transpose());
-    knots.insert(knots.end(), static_cast<size_t>(k + 2 < breaks.size() ? degree : degree + 1), breaks[k + 1]);
+    knots.insert(knots.end(), static_cast<size_t>(k + 2 < breaks.size() ? degree : degree + 1),
+                 breaks[k + 1]);
   }
   Points3 p(static_cast<Eigen::Index>(rows.size()), 3);
   Eigen::VectorXd w(p.rows());
@@ -62,7 +66,8 @@ Eigen::Vector4d polynomial_point(double x, double y, double z) { return {x, y, z
 /// The nodal cubic (t^2 - 1, t^3 - t, c t) on [-1.5, 1.5]: a loop closing at t = -1 and t = 1
 /// when c = 0; lifted by c its strands pass each other at a distance computed below.
 BSplineCurve nodal_cubic(double c) {
-  return piecewise([c](double t) { return polynomial_point(t * t - 1, t * t * t - t, c * t); }, 3, {-1.5, 1.5});
+  return piecewise([c](double t) { return polynomial_point(t * t - 1, t * t * t - t, c * t); }, 3,
+                   {-1.5, 1.5});
 }
 
 /// Closest approach of the lifted nodal cubic's strands. The objective is symmetric under
@@ -90,7 +95,8 @@ BSplineCurve polyline(const std::vector<Eigen::Vector3d>& points) {
 BSplineCurve hairpin(double r, double length) {
   const double w = std::sqrt(0.5);
   Points3 p(9, 3);
-  p << length, -r, 0, length / 2, -r, 0, 0, -r, 0, -r, -r, 0, -r, 0, 0, -r, r, 0, 0, r, 0, length / 2, r, 0, length, r, 0;
+  p << length, -r, 0, length / 2, -r, 0, 0, -r, 0, -r, -r, 0, -r, 0, 0, -r, r, 0, 0, r, 0,
+      length / 2, r, 0, length, r, 0;
   Eigen::VectorXd wt(9);
   wt << 1, 1, 1, w, 1, w, 1, 1, 1;
   return make_curve(2, {0, 0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 4}, p, wt);
@@ -98,7 +104,8 @@ BSplineCurve hairpin(double r, double length) {
 
 }  // namespace
 
-TEST_CASE("self-intersection: the nodal cubic's loop closes at t = -1 and t = 1", "[self_intersection]") {
+TEST_CASE("self-intersection: the nodal cubic's loop closes at t = -1 and t = 1",
+          "[self_intersection]") {
   const std::optional<CurveSelfIntersection> x = find_self_intersection(nodal_cubic(0.0), 1e-7);
   REQUIRE(x);
   CHECK_THAT(x->t0, WithinAbs(-1.0, 1e-12));
@@ -118,13 +125,15 @@ TEST_CASE("self-intersection: the nodal cubic's loop closes at t = -1 and t = 1"
   CHECK_THAT(x->arc_length, WithinAbs(arc, 1e-3 * arc));
 }
 
-TEST_CASE("self-intersection: a rational figure-8 crosses at its analytic parameters", "[self_intersection]") {
+TEST_CASE("self-intersection: a rational figure-8 crosses at its analytic parameters",
+          "[self_intersection]") {
   // Lemniscate of Gerono (cos θ, sin θ cos θ) with u = tan(θ/2): homogeneous ((1 - u^4),
   // 2 u (1 - u^2), 0, (1 + u^2)^2), a rational quartic; it passes the origin at θ = ±90°, u = ±1.
   const auto gerono = [](double u) {
     return Eigen::Vector4d(1 - u * u * u * u, 2 * u * (1 - u * u), 0, (1 + u * u) * (1 + u * u));
   };
-  const BSplineCurve eight = piecewise(gerono, 4, {-2.0, -0.5, 0.5, 2.0});  // weights > 0 on each span
+  const BSplineCurve eight =
+      piecewise(gerono, 4, {-2.0, -0.5, 0.5, 2.0});  // weights > 0 on each span
   REQUIRE(eight.is_rational());
   const std::optional<CurveSelfIntersection> x = find_self_intersection(eight, 1e-9);
   REQUIRE(x);
@@ -135,7 +144,8 @@ TEST_CASE("self-intersection: a rational figure-8 crosses at its analytic parame
   CHECK_THAT(x->angle_degrees, WithinAbs(90.0, 1e-8));
 }
 
-TEST_CASE("self-intersection: a 3D curve passing itself just inside or outside the tolerance", "[self_intersection]") {
+TEST_CASE("self-intersection: a 3D curve passing itself just inside or outside the tolerance",
+          "[self_intersection]") {
   SECTION("smooth: the lifted nodal cubic") {
     const double c = 1e-4;
     double t_star = 0;
@@ -150,12 +160,13 @@ TEST_CASE("self-intersection: a 3D curve passing itself just inside or outside t
   }
   SECTION("polyline: a strand along x at z = 0 and one along -y at z = d, crossing over x = 5") {
     const double d = 1e-3;
-    const BSplineCurve curve = polyline({{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {5, 10, d}, {5, -10, d}});
+    const BSplineCurve curve =
+        polyline({{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {5, 10, d}, {5, -10, d}});
     const std::optional<CurveSelfIntersection> inside = find_self_intersection(curve, 1.01 * d);
     REQUIRE(inside);
     CHECK_THAT(inside->distance, WithinAbs(d, 1e-12));
-    CHECK_THAT(inside->t0, WithinAbs(0.5, 1e-12));   // (5, 0, 0) on the first segment
-    CHECK_THAT(inside->t1, WithinAbs(3.5, 1e-12));   // (5, 0, d) halfway down the last one
+    CHECK_THAT(inside->t0, WithinAbs(0.5, 1e-12));  // (5, 0, 0) on the first segment
+    CHECK_THAT(inside->t1, WithinAbs(3.5, 1e-12));  // (5, 0, d) halfway down the last one
     CHECK_THAT(inside->angle_degrees, WithinAbs(90.0, 1e-9));
     CHECK_FALSE(find_self_intersection(curve, 0.99 * d));
   }
@@ -179,7 +190,8 @@ TEST_CASE("self-intersection: a curve running back over itself", "[self_intersec
   }
   SECTION("a hairpin whose legs lie closer than the tolerance") {
     const double tol = 1e-4;
-    const std::optional<CurveSelfIntersection> x = find_self_intersection(hairpin(0.3 * tol, 10.0), tol);
+    const std::optional<CurveSelfIntersection> x =
+        find_self_intersection(hairpin(0.3 * tol, 10.0), tol);
     REQUIRE(x);
     CHECK_THAT(x->distance, WithinAbs(0.6 * tol, 1e-9));
     CHECK_THAT(x->angle_degrees, WithinAbs(180.0, 1e-6));
@@ -196,8 +208,11 @@ TEST_CASE("self-intersection: a curve running back over itself", "[self_intersec
   }
 }
 
-TEST_CASE("self-intersection: a closed curve meets itself only where it crosses, not at its seam", "[self_intersection]") {
-  const BSplineCurve circle = circular_arc(Eigen::Vector3d(1, 2, 3), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 50.0, 0.0, 2 * std::numbers::pi);
+TEST_CASE("self-intersection: a closed curve meets itself only where it crosses, not at its seam",
+          "[self_intersection]") {
+  const BSplineCurve circle =
+      circular_arc(Eigen::Vector3d(1, 2, 3), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                   50.0, 0.0, 2 * std::numbers::pi);
   CHECK_FALSE(find_self_intersection(circle, 1e-5));
   // A closed bow tie: (0,0) -> (10,10) -> (10,0) -> (0,10) -> (0,0) crosses at (5, 5).
   const BSplineCurve bow = polyline({{0, 0, 0}, {10, 10, 0}, {10, 0, 0}, {0, 10, 0}, {0, 0, 0}});
@@ -207,10 +222,12 @@ TEST_CASE("self-intersection: a closed curve meets itself only where it crosses,
   CHECK_THAT(x->t1, WithinAbs(2.5, 1e-12));
   CHECK((x->point - Eigen::Vector3d(5, 5, 0)).norm() < 1e-12);
   // A closed square: four corners, no crossing.
-  CHECK_FALSE(find_self_intersection(polyline({{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {0, 10, 0}, {0, 0, 0}}), 1e-6));
+  CHECK_FALSE(find_self_intersection(
+      polyline({{0, 0, 0}, {10, 0, 0}, {10, 10, 0}, {0, 10, 0}, {0, 0, 0}}), 1e-6));
 }
 
-TEST_CASE("self-intersection: bends, corners and helices are not self-intersections", "[self_intersection]") {
+TEST_CASE("self-intersection: bends, corners and helices are not self-intersections",
+          "[self_intersection]") {
   const double tol = 1e-4;
   // A hairpin of radius 50 tolerances: its legs stay 100 tolerances apart.
   CHECK_FALSE(find_self_intersection(hairpin(50 * tol, 10.0), tol));
@@ -228,13 +245,17 @@ TEST_CASE("self-intersection: bends, corners and helices are not self-intersecti
   CHECK_FALSE(find_self_intersection(helix, 1e-5));
   // The pitch squeezed to 1e-3: the turns now lie within a tolerance of 1e-2 of each other.
   for (int i = 0; i < count; ++i) p(i, 2) = 1e-3 * i / 12;
-  const std::optional<CurveSelfIntersection> tight = find_self_intersection(make_curve(3, clamped_uniform_basis(3, count).knots, p), 1e-2);
+  const std::optional<CurveSelfIntersection> tight =
+      find_self_intersection(make_curve(3, clamped_uniform_basis(3, count).knots, p), 1e-2);
   REQUIRE(tight);
   CHECK(tight->distance <= 1e-2);
   CHECK(tight->angle_degrees < 30.0);  // the turns run the same way
 }
 
-TEST_CASE("self-intersection: the first crossing of random planar curves matches a brute-force polyline search", "[self_intersection]") {
+TEST_CASE(
+    "self-intersection: the first crossing of random planar curves matches a brute-force polyline "
+    "search",
+    "[self_intersection]") {
   std::mt19937 rng(91);
   int crossing = 0, simple = 0;
   for (int trial = 0; trial < 12; ++trial) {
@@ -255,10 +276,12 @@ TEST_CASE("self-intersection: the first crossing of random planar curves matches
         const Eigen::Vector2d q1 = pts.row(static_cast<Eigen::Index>(j + 1)).head<2>().transpose();
         Eigen::Matrix2d m;
         m << p1 - p0, q0 - q1;
-        if (std::abs(m.determinant()) < 1e-9 * (p1 - p0).norm() * (q1 - q0).norm()) continue;  // parallel
+        if (std::abs(m.determinant()) < 1e-9 * (p1 - p0).norm() * (q1 - q0).norm())
+          continue;  // parallel
         const Eigen::Vector2d x = m.inverse() * (q0 - p0);
         const double s = ts[i] + x[0] * (ts[i + 1] - ts[i]), t = ts[j] + x[1] * (ts[j + 1] - ts[j]);
-        if (x[0] >= 0 && x[0] < 1 && x[1] >= 0 && x[1] < 1 && (!first || s < first->first)) first = std::pair{s, t};
+        if (x[0] >= 0 && x[0] < 1 && x[1] >= 0 && x[1] < 1 && (!first || s < first->first))
+          first = std::pair{s, t};
       }
     const std::optional<CurveSelfIntersection> found = find_self_intersection(c, 1e-6);
     INFO("trial " << trial);
@@ -276,7 +299,8 @@ TEST_CASE("self-intersection: the first crossing of random planar curves matches
   CHECK(simple >= 1);
 }
 
-TEST_CASE("self-intersection: bad tolerance and invalid curves are refused", "[self_intersection][errors]") {
+TEST_CASE("self-intersection: bad tolerance and invalid curves are refused",
+          "[self_intersection][errors]") {
   const BSplineCurve c = nodal_cubic(0.0);
   for (double bad : {0.0, -1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
     const auto [category, message] = error_of([&] { find_self_intersection(c, bad); });
@@ -285,5 +309,6 @@ TEST_CASE("self-intersection: bad tolerance and invalid curves are refused", "[s
   }
   BSplineCurve broken = c;
   broken.points(1, 0) = std::nan("");
-  CHECK(error_of([&] { find_self_intersection(broken, 1e-7); }).first == clay::ErrorCategory::InvalidGeometry);
+  CHECK(error_of([&] { find_self_intersection(broken, 1e-7); }).first ==
+        clay::ErrorCategory::InvalidGeometry);
 }

@@ -162,7 +162,8 @@ BSplineCurve joined(const std::vector<LoopCurve>& loop) {
     const size_t m = c.basis.knots.size();
     for (size_t i = static_cast<size_t>(p + 1); i + static_cast<size_t>(p + 1) < m; ++i)
       knots.push_back(static_cast<double>(k) + c.basis.knots[i]);
-    knots.insert(knots.end(), static_cast<size_t>(k + 1 < loop.size() ? p : p + 1), static_cast<double>(k + 1));
+    knots.insert(knots.end(), static_cast<size_t>(k + 1 < loop.size() ? p : p + 1),
+                 static_cast<double>(k + 1));
     const double scale = k == 0 ? 1.0 : weights.back() / c.weights[0];
     for (Eigen::Index i = k == 0 ? 0 : 1; i < c.points.rows(); ++i) {
       points.push_back(c.points.row(i));
@@ -182,8 +183,9 @@ BSplineCurve joined(const std::vector<LoopCurve>& loop) {
 /// `tolerance` (find_self_intersection on the joined loop): within one curve ("curve #1 crosses
 /// itself at t = ...") or between two ("curve #0 at t = 0.4 and curve #2 at t = 0.6 meet ..."),
 /// parameters in the input curves' own domains.
-void reject_crossing_loop(const std::vector<BSplineCurve>& curves, const std::vector<LoopCurve>& loop,
-                          double tolerance, const char* builder) {
+void reject_crossing_loop(const std::vector<BSplineCurve>& curves,
+                          const std::vector<LoopCurve>& loop, double tolerance,
+                          const char* builder) {
   const std::optional<CurveSelfIntersection> x = find_self_intersection(joined(loop), tolerance);
   if (!x) return;
   // Loop parameter T -> (input curve, its own parameter).
@@ -200,7 +202,8 @@ void reject_crossing_loop(const std::vector<BSplineCurve>& curves, const std::ve
     own.t0 = std::min(t0, t1);
     own.t1 = std::max(t0, t1);
     throw Error(ErrorCategory::InvalidGeometry,
-                std::string(builder) + ": " + curve_name(c0) + " " + detail::describe(own, tolerance) +
+                std::string(builder) + ": " + curve_name(c0) + " " +
+                    detail::describe(own, tolerance) +
                     "; a boundary curve must not cross or touch itself: move its control points "
                     "apart there");
   }
@@ -209,9 +212,9 @@ void reject_crossing_loop(const std::vector<BSplineCurve>& curves, const std::ve
   if (x->distance > 1e-3 * tolerance)
     how += ", " + num(x->distance) + " mm apart, tolerance " + num(tolerance) + " mm";
   throw Error(ErrorCategory::InvalidGeometry,
-              std::string(builder) + ": the boundary crosses itself: " + curve_name(c0) + " at t = " +
-                  detail::parameter_text(t0) + " and " + curve_name(c1) + " at t = " +
-                  detail::parameter_text(t1) + " meet " + how +
+              std::string(builder) + ": the boundary crosses itself: " + curve_name(c0) +
+                  " at t = " + detail::parameter_text(t0) + " and " + curve_name(c1) +
+                  " at t = " + detail::parameter_text(t1) + " meet " + how +
                   "; the boundary curves must form a simple loop: move them apart there");
 }
 
@@ -391,7 +394,8 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
   const double size = size_of(boundary);
   check_curves(boundary, "curve", size);
   // Points closer than this are one point: the gap tolerance, at least the kernel's relative one.
-  const double crossing_tolerance = std::max(options.gap_tolerance, tolerance::exact_relative * size);
+  const double crossing_tolerance =
+      std::max(options.gap_tolerance, tolerance::exact_relative * size);
   if (n == 2)
     for (size_t k = 0; k < n; ++k)
       detail::reject_self_intersection(boundary[k], crossing_tolerance, "fill: " + curve_name(k),
@@ -570,7 +574,8 @@ NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
   const std::vector<LoopCurve> loop =
       closed_loop(boundary, options.gap_tolerance, "fill_n_sided", joined);
   reject_crossing_loop(boundary, loop,
-                       std::max(options.gap_tolerance, tolerance::exact_relative * size), "fill_n_sided");
+                       std::max(options.gap_tolerance, tolerance::exact_relative * size),
+                       "fill_n_sided");
 
   double occt_g0 = 0;
   const Handle(Geom_BSplineSurface) plate = with_occt("fill_n_sided", [&] {

@@ -16,7 +16,7 @@ namespace clay::surface {
 struct CurveSelfIntersection {
   double t0 = 0;        ///< first parameter, in the curve's own domain
   double t1 = 0;        ///< second parameter, t0 < t1
-  double distance = 0;  ///< |C(t0) - C(t1)| in mm, <= the tolerance (0 up to rounding at a crossing)
+  double distance = 0;  ///< |C(t0) - C(t1)| in mm, <= the tolerance (~0 at a crossing)
   Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< midpoint of C(t0) and C(t1), mm
   double angle_degrees = 0;  ///< angle between the tangents C'(t0) and C'(t1), in [0, 180]: near
                              ///< 0 where the curve touches itself running the same way, near 180
