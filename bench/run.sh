@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Builds and runs the benchmarks; JSON results go to build/bench/results.json (evaluation) and
-# build/bench/constraints.json (constraint solve + diagnosis). Extra arguments go to both.
+# Builds and runs every benchmark; each writes build/bench/<name>.json (Google Benchmark JSON).
+# Extra arguments go to every benchmark (e.g. --benchmark_filter=...).
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/common.sh"
 clay_ensure_packages
-clay_build --target bench_evaluate bench_constraints
-"$CLAY_BUILD/bench/bench_evaluate" --benchmark_out="$CLAY_BUILD/bench/results.json" \
-  --benchmark_out_format=json "$@"
-"$CLAY_BUILD/bench/bench_constraints" --benchmark_out="$CLAY_BUILD/bench/constraints.json" \
-  --benchmark_out_format=json "$@"
-echo "results: $CLAY_BUILD/bench/results.json $CLAY_BUILD/bench/constraints.json"
+benches=(evaluate constraints self_intersection)
+clay_build --target "${benches[@]/#/bench_}"
+for name in "${benches[@]}"; do
+  "$CLAY_BUILD/bench/bench_$name" --benchmark_out="$CLAY_BUILD/bench/$name.json" \
+    --benchmark_out_format=json "$@"
+  echo "results: $CLAY_BUILD/bench/$name.json"
+done

@@ -1,7 +1,10 @@
 #pragma once
-// Small curve helpers shared by the surface builders (skin.cpp, occt/fill.cpp); internal.
+// Small curve helpers shared by the surface builders (skin.cpp, revolve.cpp, occt/fill.cpp) and
+// the self-intersection search; internal.
+#include <clay/error.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/degree_elevation.hpp>
+#include <clay/surface/self_intersection.hpp>
 
 #include <Eigen/Core>
 
@@ -17,6 +20,46 @@ inline std::string short_number(double x) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.3g", x);
   return buffer;
+}
+
+/// A parameter or coordinate for messages: 4 significant digits ("0.3125", "-12.5").
+inline std::string parameter_text(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.4g", x);
+  return buffer;
+}
+
+/// "(x, y, z)" with 4 significant digits; coordinates within `zero` of 0 (rounding noise below
+/// the tolerance of the result) are written as 0.
+inline std::string point_text(const Eigen::Vector3d& p, double zero = 0.0) {
+  auto c = [zero](double x) { return parameter_text(std::abs(x) <= zero ? 0.0 : x); };
+  return "(" + c(p.x()) + ", " + c(p.y()) + ", " + c(p.z()) + ")";
+}
+
+/// What a self-intersection is, in words: "crosses itself at t = 0.31 and t = 0.74 (point (1, 2,
+/// 3), tangents 62 degrees apart)", "touches itself at ..." (tangents within 10 degrees) or
+/// "doubles back onto itself at ..." (tangents within 10 degrees of opposite), with the distance
+/// between the two points when it is not 0 up to rounding.
+inline std::string describe(const CurveSelfIntersection& x, double tolerance) {
+  const double a = x.angle_degrees;
+  std::string text = a <= 10.0    ? "touches itself"
+                     : a >= 170.0 ? "doubles back onto itself"
+                                  : "crosses itself";
+  text += " at t = " + parameter_text(x.t0) + " and t = " + parameter_text(x.t1) + " (point " +
+          point_text(x.point, 1e-3 * tolerance);
+  if (a > 10.0 && a < 170.0) text += ", tangents " + parameter_text(a) + " degrees apart";
+  if (x.distance > 1e-3 * tolerance)
+    text +=
+        ", " + short_number(x.distance) + " mm apart, tolerance " + short_number(tolerance) + " mm";
+  return text + ")";
+}
+
+/// Throws clay::Error(InvalidGeometry) "<who> <describe(...)>; <fix>" when `curve` meets itself
+/// within `tolerance` (find_self_intersection).
+inline void reject_self_intersection(const BSplineCurve& curve, double tolerance,
+                                     const std::string& who, const std::string& fix) {
+  if (const auto x = find_self_intersection(curve, tolerance))
+    throw Error(ErrorCategory::InvalidGeometry, who + " " + describe(*x, tolerance) + "; " + fix);
 }
 
 /// Diagonal of the box around every control point of `curves` (the model size of a builder).

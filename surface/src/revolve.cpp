@@ -12,6 +12,8 @@
 #include <sstream>
 #include <string>
 
+#include "builder_tools.hpp"
+
 namespace clay::surface {
 namespace {
 
@@ -77,6 +79,10 @@ BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle
   const Eigen::Vector3d lo = profile.points.colwise().minCoeff(), hi = profile.points.colwise().maxCoeff();
   const double size = (hi - lo).norm() + (0.5 * (hi + lo) - axis.point).norm();
   check_profile_against_axis(profile, axis.point, a, size);
+  detail::reject_self_intersection(profile, tolerance::exact_relative * size,
+                                   "revolve: the profile",
+                                   "the revolved surface would intersect itself: give a profile "
+                                   "that does not cross or touch itself");
 
   const double sweep = angle_degrees == 360.0 ? 2.0 * std::numbers::pi : angle_degrees * std::numbers::pi / 180.0;
   const int nv = profile.basis.count();

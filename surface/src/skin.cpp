@@ -14,7 +14,6 @@
 #include <Eigen/SparseLU>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -22,6 +21,7 @@
 #include <vector>
 
 #include "builder_tools.hpp"
+#include "quadrature.hpp"
 
 namespace clay::surface {
 namespace {
@@ -193,6 +193,11 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
                       num(length) + " mm long (tolerance " + num(tol) +
                       " mm); a loft needs curves, not points: remove it or give a curve");
   }
+  for (size_t k = 0; k < sections.size(); ++k)
+    detail::reject_self_intersection(
+        sections[k], tol, "loft: section #" + std::to_string(k),
+        "the lofted surface would intersect itself there: move the section's control points so "
+        "that it does not cross or touch itself");
 
   PreparedLoft out;
   std::vector<BSplineCurve> oriented;
@@ -240,16 +245,6 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
 
 // ---- Sweep: rotation-minimizing frames on a fine table of the path ----
 
-// 8-point Gauss–Legendre nodes and weights on [-1, 1].
-constexpr std::array<double, 8> gauss_x = {-0.9602898564975363, -0.7966664774136267,
-                                           -0.5255324099163290, -0.1834346424956498,
-                                           0.1834346424956498,  0.5255324099163290,
-                                           0.7966664774136267,  0.9602898564975363};
-constexpr std::array<double, 8> gauss_w = {0.1012285362903763, 0.2223810344533745,
-                                           0.3137066458778873, 0.3626837833783620,
-                                           0.3626837833783620, 0.3137066458778873,
-                                           0.2223810344533745, 0.1012285362903763};
-
 /// The path sampled finely: points, unit tangents, rotation-minimizing normals r (double
 /// reflection, Wang et al. 2008, Algorithm 1) and cumulative arc length. Frames and arc lengths
 /// between entries come from one more reflection / quadrature step from the entry before.
@@ -265,7 +260,7 @@ class PathTable {
     }
     const double domain = bp.back() - bp.front();
     for (double t : t_) {
-      const CurveDerivatives d = derivatives(path, t, 1);
+      const CurveDerivatives d = derivatives(path, t, 2);
       const double speed = d.d1.norm();
       if (!(speed * domain > 1e-12 * size))
         throw Error(ErrorCategory::InvalidGeometry,
@@ -273,6 +268,8 @@ class PathTable {
                         " (a cusp or a collapsed span); remove the repeated control points there");
       x_.push_back(d.point);
       tangent_.push_back(d.d1 / speed);
+      // dT/ds = kappa n: the part of C'' normal to the tangent over the squared speed.
+      curvature_.push_back((d.d2 - d.d2.dot(tangent_.back()) * tangent_.back()) / (speed * speed));
     }
     // Any unit vector normal to the first tangent: the sweep does not depend on the choice.
     const Eigen::Vector3d& t0 = tangent_.front();
@@ -289,6 +286,12 @@ class PathTable {
   double length() const { return s_.back(); }
   double first() const { return t_.front(); }
   double last() const { return t_.back(); }
+
+  /// Entries of the table: parameter, point and curvature vector kappa n (right-sided at knots).
+  size_t entries() const { return t_.size(); }
+  double parameter_of(size_t j) const { return t_[j]; }
+  const Eigen::Vector3d& point_of(size_t j) const { return x_[j]; }
+  const Eigen::Vector3d& curvature_of(size_t j) const { return curvature_[j]; }
 
   /// Arc length from the path start to t.
   double arc_length(double t) const {
@@ -358,17 +361,13 @@ class PathTable {
 
   double arc(double a, double b) const {
     if (b <= a) return 0.0;
-    double sum = 0;
-    for (size_t g = 0; g < gauss_x.size(); ++g) {
-      const double t = 0.5 * (a + b) + 0.5 * (b - a) * gauss_x[g];
-      sum += gauss_w[g] * derivatives(path_, t, 1).d1.norm();
-    }
-    return 0.5 * (b - a) * sum;
+    return detail::gauss_legendre_8(a, b,
+                                    [&](double t) { return derivatives(path_, t, 1).d1.norm(); });
   }
 
   const BSplineCurve& path_;
   std::vector<double> t_, s_;
-  std::vector<Eigen::Vector3d> x_, tangent_, r_;
+  std::vector<Eigen::Vector3d> x_, tangent_, r_, curvature_;
 };
 
 /// The rigid motions of the sweep: start frame to frame at t, with the twist.
@@ -425,6 +424,38 @@ class SweepMotion {
   Eigen::Vector3d x0_;
   Eigen::Matrix3d f0_;
 };
+
+/// Where the sweep folds through itself. With rotation-minimizing frames, a profile point at
+/// offset q from the path point moves with dS/ds = T (1 - kappa n . q) + (terms normal to T): where
+/// kappa n . q reaches 1 the profile stretches to the path's centre of curvature and beyond it the
+/// surface runs backwards, through itself. Throws when the largest kappa n . q over the path
+/// table and dense profile samples reaches 1 - 1e-3 (the sampling's margin), naming the path
+/// parameter, the radius of curvature and how far the profile reaches toward the centre.
+void check_fold(const PathTable& table, const SweepMotion& motion, const BSplineCurve& profile) {
+  const Points3 samples = evaluate_many(profile, span_samples(profile.basis, 16));
+  double worst = 0;
+  size_t worst_entry = 0;
+  for (size_t j = 0; j < table.entries(); ++j) {
+    const Eigen::Vector3d& k = table.curvature_of(j);
+    if (k.squaredNorm() == 0.0) continue;
+    const Points3 moved = motion.moved(samples, table.parameter_of(j));
+    for (Eigen::Index i = 0; i < moved.rows(); ++i) {
+      const double reach = k.dot(moved.row(i).transpose() - table.point_of(j));
+      if (reach > worst) worst = reach, worst_entry = j;
+    }
+  }
+  if (worst < 1.0 - 1e-3) return;
+  const double kappa = table.curvature_of(worst_entry).norm();
+  const std::string radius = num(1.0 / kappa), reach = num(worst / kappa);
+  throw Error(ErrorCategory::InvalidGeometry,
+              "sweep: the swept surface would fold through itself near path t = " +
+                  num(table.parameter_of(worst_entry)) +
+                  ": the path's radius of curvature there is " + radius +
+                  " mm but the profile reaches " + reach +
+                  " mm from the path toward the centre of curvature; use a smaller profile "
+                  "(reaching less than " + radius + " mm toward the centre) or a gentler path "
+                  "(radius of curvature above " + reach + " mm there)");
+}
 
 /// True when every control point of the path lies on the chord from its first to its last one and
 /// they advance monotonically along it: the path is a straight segment traversed once.
@@ -688,6 +719,12 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
     throw Error(ErrorCategory::InvalidGeometry,
                 "sweep: path has zero length (its control polygon is " + num(polygon_length(path)) +
                     " mm long, tolerance " + num(exact_tol) + " mm); give a path that moves");
+  detail::reject_self_intersection(profile, exact_tol, "sweep: profile",
+                                   "the swept surface would intersect itself: give a profile that "
+                                   "does not cross or touch itself");
+  detail::reject_self_intersection(path, exact_tol, "sweep: path",
+                                   "the swept surface would intersect itself: move the path apart "
+                                   "there, or split it and sweep each part");
   const BSplineCurve shape = clamp(profile);
   const BSplineCurve track = clamp(path);
   check_corners(track, options.tolerance);
@@ -697,6 +734,7 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
                 "sweep: path has zero length (" + num(table.length()) + " mm); give a path that moves");
   const double twist = options.twist_degrees * std::numbers::pi / 180.0;
   const SweepMotion motion(table, twist);
+  check_fold(table, motion, shape);
 
   // Samples of the profile for the deviation check.
   const int profile_spans = static_cast<int>(breakpoints(shape.basis).size()) - 1;

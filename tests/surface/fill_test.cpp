@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <random>
 
@@ -248,6 +249,52 @@ TEST_CASE("fill rejects an invalid curve, naming it", "[fill][errors]") {
   CHECK_THAT(message, Catch::Contains("curve #1"));
 }
 
+namespace {
+
+/// Degree-1 curve through the points, knots 0, 1, 2, ...
+BSplineCurve polyline(const std::vector<Eigen::Vector3d>& points) {
+  const int n = static_cast<int>(points.size());
+  std::vector<double> knots = {0.0};
+  for (int i = 0; i < n; ++i) knots.push_back(i);
+  knots.push_back(n - 1);
+  Points3 p(n, 3);
+  for (int i = 0; i < n; ++i) p.row(i) = points[static_cast<size_t>(i)].transpose();
+  return make_curve(1, knots, p);
+}
+
+}  // namespace
+
+TEST_CASE("fill rejects a boundary curve that crosses itself", "[fill][errors]") {
+  std::mt19937 rng(412);
+  std::vector<BSplineCurve> quad = quad_boundary(rng);
+  // Curve #2 from its start p2 to its end p3 by way of p3 + d and p2 + d: its first and last
+  // segments cross at (p2 + p3 + d) / 2, at t = 0.5 and t = 2.5.
+  const Eigen::Vector3d p2(110, 90, -5), p3(-5, 100, 20), d(0, -20, 0);
+  quad[2] = polyline({p2, p3 + d, p2 + d, p3});
+  const auto [category, message] = error_of([&] { fill(quad); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Catch::Contains("fill: curve #2 crosses itself at t = 0.5 and t = 2.5 (point (52.5, 85, 7.5)") &&
+                          Catch::Contains("must not cross or touch itself"));
+  // The same curve reversed and given first: its parameters are still its own.
+  std::vector<BSplineCurve> turned = {reversed(quad[2]), quad[0], quad[1], quad[3]};
+  CHECK_THAT(error_of([&] { fill(turned); }).second, Catch::Contains("curve #0 crosses itself at t = 0.5 and t = 2.5"));
+  // Two curves of a ruled fill: each is checked on its own.
+  const BSplineCurve zee = polyline({{0, 0, 0}, {100, 30, 0}, {100, 0, 0}, {0, 30, 0}});
+  const BSplineCurve far = curve_between(rng, 3, 5, {0, 80, 20}, {100, 80, 0}, 5.0);
+  CHECK_THAT(error_of([&] { fill({far, zee}); }).second,
+             Catch::Contains("fill: curve #1 crosses itself at t = 0.5 and t = 2.5 (point (50, 15, 0)"));
+}
+
+TEST_CASE("fill rejects boundary curves that cross each other", "[fill][errors]") {
+  // A bow tie: (0,0) -> (100,0) -> (0,100) -> (100,100) -> (0,0); curves #1 and #3 cross at (50, 50).
+  auto line = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return polyline({a, b}); };
+  const Eigen::Vector3d p0(0, 0, 0), p1(100, 0, 0), p2(0, 100, 0), p3(100, 100, 0);
+  const auto [category, message] = error_of([&] { fill({line(p0, p1), line(p1, p2), line(p2, p3), line(p3, p0)}); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Catch::Contains("fill: the boundary crosses itself: curve #1 at t = 0.5 and curve #3 at t = 0.5 meet at point (50, 50, 0)") &&
+                          Catch::Contains("must form a simple loop"));
+}
+
 TEST_CASE("curved fill of 2 curves needs a shared corner", "[fill][errors]") {
   std::mt19937 rng(411);
   const BSplineCurve a = curve_between(rng, 3, 6, {0, 0, 0}, {100, 0, 0}, 10.0);
@@ -363,4 +410,34 @@ TEST_CASE("n-sided fill rejects a degenerate interior curve", "[fill][nsided][er
   const auto [category, message] = error_of([&] { fill_n_sided(pentagon_on_dome(), {point}); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
   CHECK_THAT(message, Catch::Contains("interior curve #0 is degenerate"));
+}
+
+TEST_CASE("n-sided fill rejects a star-shaped (self-crossing) boundary", "[fill][nsided][errors]") {
+  // The pentagon's corners joined every second one: a pentagram, whose sides cross each other (on
+  // the dome, so in 3D too). Independently: the first crossing along side #0 in the plane.
+  std::vector<Eigen::Vector2d> corners;
+  for (int k = 0; k < 5; ++k) {
+    const double a = M_PI / 2 + 2 * M_PI * k / 5;
+    corners.emplace_back(80 * std::cos(a), 80 * std::sin(a));
+  }
+  std::vector<BSplineCurve> star;
+  for (int k = 0; k < 5; ++k) star.push_back(lifted(corners[(2 * k) % 5], corners[(2 * k + 2) % 5]));
+  double first = 2, other_t = 0;
+  int other = -1;
+  const Eigen::Vector2d a0 = corners[0], a1 = corners[2];
+  for (int k = 1; k < 5; ++k) {
+    const Eigen::Vector2d b0 = corners[(2 * k) % 5], b1 = corners[(2 * k + 2) % 5];
+    Eigen::Matrix2d m;
+    m << a1 - a0, b0 - b1;
+    if (std::abs(m.determinant()) < 1e-9) continue;
+    const Eigen::Vector2d x = m.inverse() * (b0 - a0);
+    if (x[0] > 1e-9 && x[0] < 1 - 1e-9 && x[1] > 1e-9 && x[1] < 1 - 1e-9 && x[0] < first)
+      first = x[0], other = k, other_t = x[1];
+  }
+  REQUIRE(other > 0);
+  char expected[160];
+  std::snprintf(expected, sizeof expected, "curve #0 at t = %.4g and curve #%d at t = %.4g meet", first, other, other_t);
+  const auto [category, message] = error_of([&] { fill_n_sided(star); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Catch::Contains("fill_n_sided: the boundary crosses itself") && Catch::Contains(expected));
 }

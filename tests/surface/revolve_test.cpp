@@ -161,3 +161,18 @@ TEST_CASE("revolve refuses a profile lying on the axis", "[revolve][errors]") {
   const BSplineCurve on_axis = make_curve(1, {0, 0, 1, 1}, (Points3(2, 3) << 0, 0, 0, 0, 0, 30).finished());
   CHECK_THROWS_WITH(revolve(on_axis, Axis{}, 90.0), Catch::Contains("lies on the axis"));
 }
+
+TEST_CASE("revolve refuses a profile that crosses itself", "[revolve][errors]") {
+  // A "Z" in the x-z plane, 20 to 40 mm from the axis: its first and last segments cross at
+  // (30, 0, 15), at t = 0.5 and t = 2.5.
+  const BSplineCurve zee = make_curve(1, {0, 0, 1, 2, 3, 3},
+                                      (Points3(4, 3) << 20, 0, 0, 40, 0, 30, 40, 0, 0, 20, 0, 30).finished());
+  try {
+    revolve(zee, Axis{}, 360.0);
+    FAIL("no throw");
+  } catch (const clay::Error& e) {
+    CHECK(e.category() == clay::ErrorCategory::InvalidGeometry);
+    CHECK_THAT(e.what(), Catch::Contains("revolve: the profile crosses itself at t = 0.5 and t = 2.5 (point (30, 0, 15)") &&
+                             Catch::Contains("the revolved surface would intersect itself"));
+  }
+}

@@ -1,10 +1,12 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/skin.hpp>
 
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 
 #include <cmath>
 #include <functional>
@@ -79,6 +81,37 @@ BSplineCurve quarter_circle(double r, double z) {
   Eigen::VectorXd w(3);
   w << 1, std::sqrt(0.5), 1;
   return make_curve(2, {0, 0, 0, 1, 1, 1}, p, w);
+}
+
+/// Degree-1 curve through the points, knots 0, 1, 2, ... (a polyline).
+BSplineCurve polyline(const std::vector<Eigen::Vector3d>& points) {
+  const int n = static_cast<int>(points.size());
+  std::vector<double> knots = {0.0};
+  for (int i = 0; i < n; ++i) knots.push_back(i);
+  knots.push_back(n - 1);
+  Points3 p(n, 3);
+  for (int i = 0; i < n; ++i) p.row(i) = points[static_cast<size_t>(i)].transpose();
+  return make_curve(1, knots, p);
+}
+
+/// A "Z" at height z: (x0, y0) -> (x1, y1) -> (x1, y0) -> (x0, y1), whose first and last segments
+/// cross at the centre, at t = 0.5 and t = 2.5.
+BSplineCurve z_shape(double x0, double y0, double x1, double y1, double z) {
+  return polyline({{x0, y0, z}, {x1, y1, z}, {x1, y0, z}, {x0, y1, z}});
+}
+
+/// The cubic polynomial curve f on [a, b] as one Bézier segment (Bernstein coefficients by
+/// collocation at a, (2a + b) / 3, (a + 2b) / 3, b: exact for a cubic up to rounding).
+BSplineCurve cubic_curve(const std::function<Eigen::Vector3d(double)>& f, double a, double b) {
+  Eigen::Matrix4d bernstein;
+  Eigen::Matrix<double, 4, 3> values;
+  for (int k = 0; k < 4; ++k) {
+    const double s = k / 3.0;
+    bernstein.row(k) << std::pow(1 - s, 3), 3 * s * std::pow(1 - s, 2), 3 * s * s * (1 - s), std::pow(s, 3);
+    values.row(k) = f(a + s * (b - a)).transpose();
+  }
+  const Points3 p = bernstein.fullPivLu().solve(values);
+  return make_curve(3, {a, a, a, a, b, b, b, b}, p);
 }
 
 }  // namespace
@@ -220,6 +253,19 @@ TEST_CASE("loft rejects rational sections whose interpolated weights turn negati
   CHECK_THAT(message, Catch::Contains("weights interpolated across the rational sections are not positive"));
 }
 
+TEST_CASE("loft rejects a section that crosses itself, naming it, the parameters and the point", "[skin][loft][errors]") {
+  std::mt19937 rng(312);
+  std::vector<BSplineCurve> sections = random_sections(rng, false);
+  sections[2] = z_shape(0, 0, 40, 30, 200);  // crosses at (20, 15, 200), t = 0.5 and 2.5
+  const auto [category, message] = error_of([&] { loft(sections); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Catch::Contains("loft: section #2 crosses itself at t = 0.5 and t = 2.5 (point (20, 15, 200)") &&
+                          Catch::Contains("move the section's control points"));
+  // The same section running back over itself instead.
+  sections[2] = polyline({{0, 0, 200}, {40, 0, 200}, {10, 0, 200}});
+  CHECK_THAT(error_of([&] { loft(sections); }).second, Catch::Contains("section #2 doubles back onto itself"));
+}
+
 TEST_CASE("loft options are validated", "[skin][loft][errors]") {
   LoftOptions o;
   o.degree = 0;
@@ -262,6 +308,8 @@ TEST_CASE("sweep along a straight path is the exact extrusion", "[skin][sweep]")
   std::mt19937 rng(311);
   BSplineCurve profile = clay::test::random_curve(rng, 3, 7, true, true, 1, 50.0);
   profile.points.col(2).setZero();
+  // Control points advancing along x: the profile cannot cross itself (a sweep would refuse it).
+  for (Eigen::Index i = 0; i < profile.points.rows(); ++i) profile.points(i, 0) = -50.0 + 100.0 * i / 6.0;
   // Straight path along z, unevenly parametrized (control points 0, 10, 60, 100).
   Points3 p(4, 3);
   p << 0, 0, 0, 0, 0, 10, 0, 0, 60, 0, 0, 100;
@@ -545,6 +593,55 @@ TEST_CASE("sweep rejects a path with a corner", "[skin][sweep][errors]") {
   const auto [category, message] = error_of([&] { sweep(upright_profile(), make_curve(1, {0, 0, 0.5, 1, 1}, p)); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
   CHECK_THAT(message, Catch::Contains("path has a corner at t = 0.5") && Catch::Contains("90 degrees"));
+}
+
+TEST_CASE("sweep rejects a profile that crosses itself", "[skin][sweep][errors]") {
+  // A "Z" in the plane y = 0 at the quarter circle's start, crossing at (100, 0, 0).
+  const BSplineCurve profile = polyline({{90, 0, -10}, {110, 0, 10}, {110, 0, -10}, {90, 0, 10}});
+  const auto [category, message] = error_of([&] { sweep(profile, quarter_circle(100, 0)); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Catch::Contains("sweep: profile crosses itself at t = 0.5 and t = 2.5 (point (100, 0, 0)"));
+}
+
+TEST_CASE("sweep rejects a path that crosses itself", "[skin][sweep][errors]") {
+  // The nodal cubic 50 (t^2 - 1, t^3 - t, 0) on [-1.5, 1.5]: its loop closes at the origin, t = -1
+  // and t = 1.
+  const BSplineCurve path = cubic_curve([](double t) { return Eigen::Vector3d(50 * (t * t - 1), 50 * (t * t * t - t), 0); }, -1.5, 1.5);
+  const auto [category, message] = error_of([&] { sweep(upright_profile(), path); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Catch::Contains("sweep: path crosses itself at t = -1 and t = 1 (point (0, 0, 0)") &&
+                          Catch::Contains("tangents 90 degrees apart"));
+}
+
+namespace {
+
+/// A circle of radius `r` about the start (R, 0, 0) of quarter_circle(R, 0), in the plane y = 0
+/// normal to the path there: the sweep is a torus.
+BSplineCurve tube_profile(double big_r, double r) {
+  return circular_arc({big_r, 0, 0}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(), r, 0.0, 2 * std::numbers::pi);
+}
+
+}  // namespace
+
+TEST_CASE("sweep rejects a profile reaching past the path's centre of curvature (the surface would fold)", "[skin][sweep][errors]") {
+  // Profile radius 10 along an arc of radius 5: it reaches 10 mm toward the centre, 5 mm away.
+  const auto [category, message] = error_of([&] { sweep(tube_profile(5, 10), quarter_circle(5, 0)); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Catch::Contains("fold through itself") && Catch::Contains("radius of curvature there is 5 mm") &&
+                          Catch::Contains("the profile reaches 10 mm"));
+  // Just past the centre (reach / radius 1.05) is refused, just short of it (0.95) is not.
+  CHECK_THAT(error_of([&] { sweep(tube_profile(9.5, 10), quarter_circle(9.5, 0)); }).second,
+             Catch::Contains("fold through itself"));
+  CHECK_NOTHROW(sweep(tube_profile(10.5, 10), quarter_circle(10.5, 0)));
+  // Along an arc of radius 20 the tube is a torus (R 20, r 10).
+  const BuiltSurface built = sweep(tube_profile(20, 10), quarter_circle(20, 0));
+  double worst = 0;
+  for (double u : linspace(0, 1, 41))
+    for (double v : linspace(0, 1, 41)) {
+      const Eigen::Vector3d x = evaluate(built.surface, u, v);
+      worst = std::max(worst, std::abs(std::hypot(std::hypot(x.x(), x.y()) - 20.0, x.z()) - 10.0));
+    }
+  CHECK(worst <= 1e-6 * box_size(built.surface));
 }
 
 TEST_CASE("sweep rejects an invalid path, naming it", "[skin][sweep][errors]") {

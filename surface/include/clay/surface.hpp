@@ -1,7 +1,7 @@
 #pragma once
 /// Umbrella header of the surface module: NURBS value types, evaluation, knot operations, degree
-/// elevation, projection, parent-surface builders (fill, loft, sweep, revolve, primitives) and
-/// STEP/IGES/glTF exchange.
+/// elevation, projection, self-intersection of curves, parent-surface builders (fill, loft, sweep,
+/// revolve, primitives) and STEP/IGES/glTF exchange.
 #include <clay/error.hpp>
 #include <clay/summary.hpp>
 #include <clay/tolerance.hpp>
@@ -18,4 +18,5 @@
 #include <clay/surface/primitives.hpp>
 #include <clay/surface/projection.hpp>
 #include <clay/surface/revolve.hpp>
+#include <clay/surface/self_intersection.hpp>
 #include <clay/surface/skin.hpp>

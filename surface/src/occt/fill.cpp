@@ -8,10 +8,13 @@
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
+#include <clay/surface/self_intersection.hpp>
 #include <clay/surface/skin.hpp>
+#include <clay/tolerance.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -142,6 +145,77 @@ std::vector<LoopCurve> closed_loop(const std::vector<BSplineCurve>& curves, doub
     b.points.row(0) = corner.transpose();
   }
   return loop;
+}
+
+/// The loop as one closed curve on [0, n]: loop curve k (degree raised to the loop's highest) on
+/// [k, k + 1], C0 joins (knots repeated degree times), each curve's weights scaled so that it
+/// starts with the weight its predecessor ends with (same shapes).
+BSplineCurve joined(const std::vector<LoopCurve>& loop) {
+  int p = 1;
+  for (const LoopCurve& c : loop) p = std::max(p, c.curve.basis.degree);
+  std::vector<double> knots(static_cast<size_t>(p + 1), 0.0);
+  std::vector<Eigen::RowVector3d> points;
+  std::vector<double> weights;
+  for (size_t k = 0; k < loop.size(); ++k) {
+    BSplineCurve c = loop[k].curve;
+    if (c.basis.degree < p) c = elevate_degree(c, p - c.basis.degree);
+    const size_t m = c.basis.knots.size();
+    for (size_t i = static_cast<size_t>(p + 1); i + static_cast<size_t>(p + 1) < m; ++i)
+      knots.push_back(static_cast<double>(k) + c.basis.knots[i]);
+    knots.insert(knots.end(), static_cast<size_t>(k + 1 < loop.size() ? p : p + 1),
+                 static_cast<double>(k + 1));
+    const double scale = k == 0 ? 1.0 : weights.back() / c.weights[0];
+    for (Eigen::Index i = k == 0 ? 0 : 1; i < c.points.rows(); ++i) {
+      points.push_back(c.points.row(i));
+      weights.push_back(scale * c.weights[i]);
+    }
+  }
+  Points3 net(static_cast<Eigen::Index>(points.size()), 3);
+  Eigen::VectorXd w(net.rows());
+  for (size_t i = 0; i < points.size(); ++i) {
+    net.row(static_cast<Eigen::Index>(i)) = points[i];
+    w[static_cast<Eigen::Index>(i)] = weights[i];
+  }
+  return make_curve(p, std::move(knots), std::move(net), std::move(w));
+}
+
+/// Throws InvalidGeometry when the closed loop crosses, touches or doubles back onto itself within
+/// `tolerance` (find_self_intersection on the joined loop): within one curve ("curve #1 crosses
+/// itself at t = ...") or between two ("curve #0 at t = 0.4 and curve #2 at t = 0.6 meet ..."),
+/// parameters in the input curves' own domains.
+void reject_crossing_loop(const std::vector<BSplineCurve>& curves,
+                          const std::vector<LoopCurve>& loop, double tolerance,
+                          const char* builder) {
+  const std::optional<CurveSelfIntersection> x = find_self_intersection(joined(loop), tolerance);
+  if (!x) return;
+  // Loop parameter T -> (input curve, its own parameter).
+  auto input = [&](double T) {
+    const size_t k = std::min(static_cast<size_t>(std::max(0.0, std::floor(T))), loop.size() - 1);
+    const double u = T - static_cast<double>(k);
+    const auto [a, b] = curves[loop[k].input].basis.domain();
+    return std::pair{loop[k].input, loop[k].reversed ? b - u * (b - a) : a + u * (b - a)};
+  };
+  auto [c0, t0] = input(x->t0);
+  auto [c1, t1] = input(x->t1);
+  if (c0 == c1) {
+    CurveSelfIntersection own = *x;
+    own.t0 = std::min(t0, t1);
+    own.t1 = std::max(t0, t1);
+    throw Error(ErrorCategory::InvalidGeometry,
+                std::string(builder) + ": " + curve_name(c0) + " " +
+                    detail::describe(own, tolerance) +
+                    "; a boundary curve must not cross or touch itself: move its control points "
+                    "apart there");
+  }
+  if (c1 < c0) std::swap(c0, c1), std::swap(t0, t1);
+  std::string how = "at point " + detail::point_text(x->point, 1e-3 * tolerance);
+  if (x->distance > 1e-3 * tolerance)
+    how += ", " + num(x->distance) + " mm apart, tolerance " + num(tolerance) + " mm";
+  throw Error(ErrorCategory::InvalidGeometry,
+              std::string(builder) + ": the boundary crosses itself: " + curve_name(c0) +
+                  " at t = " + detail::parameter_text(t0) + " and " + curve_name(c1) +
+                  " at t = " + detail::parameter_text(t1) + " meet " + how +
+                  "; the boundary curves must form a simple loop: move them apart there");
 }
 
 /// One edge of a filled surface and the input curve it must reproduce.
@@ -319,6 +393,14 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
                     (n > 4 ? "; use fill_n_sided for more" : "; give 2 to 4 curves"));
   const double size = size_of(boundary);
   check_curves(boundary, "curve", size);
+  // Points closer than this are one point: the gap tolerance, at least the kernel's relative one.
+  const double crossing_tolerance =
+      std::max(options.gap_tolerance, tolerance::exact_relative * size);
+  if (n == 2)
+    for (size_t k = 0; k < n; ++k)
+      detail::reject_self_intersection(boundary[k], crossing_tolerance, "fill: " + curve_name(k),
+                                       "a boundary curve must not cross or touch itself: move its "
+                                       "control points apart there");
   const bool coons = options.style == FillStyle::Coons;
   const GeomFill_FillingStyle style = occt_style(options.style);
   std::string note;
@@ -382,6 +464,7 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
   } else {
     double joined = 0;
     std::vector<LoopCurve> loop = closed_loop(boundary, options.gap_tolerance, "fill", joined);
+    reject_crossing_loop(boundary, loop, crossing_tolerance, "fill");
     bool rational = false;
     for (LoopCurve& c : loop) {
       rational = rational || c.curve.is_rational();
@@ -490,6 +573,9 @@ NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
   double joined = 0;
   const std::vector<LoopCurve> loop =
       closed_loop(boundary, options.gap_tolerance, "fill_n_sided", joined);
+  reject_crossing_loop(boundary, loop,
+                       std::max(options.gap_tolerance, tolerance::exact_relative * size),
+                       "fill_n_sided");
 
   double occt_g0 = 0;
   const Handle(Geom_BSplineSurface) plate = with_occt("fill_n_sided", [&] {

@@ -39,9 +39,13 @@ struct FillOptions {
 /// between each input curve and the surface edge it became, on dense samples (rounding, plus at
 /// most half a joined gap), and its method lists what was reversed, raised or joined. Throws
 /// clay::Error: InvalidArgument for a count outside [2, 4] or bad options; InvalidGeometry for an
-/// invalid or degenerate curve (named "curve #k", 0-based) and for curves that do not close,
-/// naming each gap, e.g. "curve #1 end and curve #2 start are 0.25 mm apart (tolerance 1e-07 mm)";
-/// InvalidGeometry with OpenCASCADE's message if it still fails.
+/// invalid or degenerate curve (named "curve #k", 0-based), for curves that do not close,
+/// naming each gap, e.g. "curve #1 end and curve #2 start are 0.25 mm apart (tolerance 1e-07 mm)",
+/// and for a boundary that crosses, touches or doubles back onto itself within the larger of
+/// gap_tolerance and 1e-7 × size (find_self_intersection on the closed loop, so two curves
+/// crossing each other count too: "curve #1 at t = 0.5 and curve #3 at t = 0.5 meet at point
+/// ..."; with 2 curves each is checked on its own); InvalidGeometry with OpenCASCADE's message if
+/// it still fails.
 BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& options = {});
 
 /// Settings of fill_n_sided(): BRepOffsetAPI_MakeFilling's parameters. Defaults are OpenCASCADE's
@@ -84,7 +88,8 @@ struct NSidedFill {
 /// the largest of curve_deviations, measured with closest_point() on options.samples_per_curve
 /// points of every curve. Throws clay::Error: InvalidArgument for fewer than 3 boundary curves or
 /// bad options; InvalidGeometry for invalid or degenerate curves, a boundary that does not close
-/// (naming each gap as fill() does), or when OpenCASCADE fails (its message included).
+/// (naming each gap as fill() does), a boundary loop that crosses, touches or doubles back onto
+/// itself (as fill() checks it), or when OpenCASCADE fails (its message included).
 NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
                         const std::vector<BSplineCurve>& interior = {},
                         const NSidedFillOptions& options = {});

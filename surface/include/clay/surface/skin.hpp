@@ -54,9 +54,10 @@ std::vector<double> loft_parameters(const std::vector<BSplineCurve>& sections,
 /// A section running against its predecessor is reversed when options.auto_orient (the report's
 /// method says which). Throws clay::Error: InvalidArgument for fewer than 2 sections or bad
 /// options; InvalidGeometry naming the section index (0-based) for an invalid or degenerate
-/// section (control polygon ~0 long, e.g. a point), two consecutive coincident sections, a
-/// reversed section when auto_orient is false, or rational sections whose interpolated weights
-/// are not positive.
+/// section (control polygon ~0 long, e.g. a point), a section that crosses, touches or doubles
+/// back onto itself within options.tolerance × size (find_self_intersection; the message gives
+/// both parameters and the point), two consecutive coincident sections, a reversed section when
+/// auto_orient is false, or rational sections whose interpolated weights are not positive.
 BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& options = {});
 
 /// Settings of sweep().
@@ -86,10 +87,15 @@ struct SweepOptions {
 /// false, max_deviation, the sections used in the method; "tolerance not reached" when
 /// max_sections stopped it). At path knots where the curvature (or its derivative) jumps, a copy
 /// sits on the knot and v gets a triple (double) knot, matching the sweep's own C0 (C1) continuity
-/// there. A straight path without twist gives the exact extrusion (degree 1 across, exact = true). Throws clay::Error(InvalidGeometry) naming "profile" or "path" for an invalid or
-/// degenerate curve (control polygon ~0 long), a path with a zero tangent or a corner (tangent
-/// turning by more than tolerance radians at a knot: split the path there); InvalidArgument for
-/// bad options.
+/// there. A straight path without twist gives the exact extrusion (degree 1 across, exact = true).
+/// Throws clay::Error(InvalidGeometry) naming "profile" or "path" for an invalid or degenerate
+/// curve (control polygon ~0 long), a profile or path that crosses, touches or doubles back onto
+/// itself within 1e-7 × size (find_self_intersection), a path with a zero tangent or a corner
+/// (tangent turning by more than tolerance radians at a knot: split the path there), and a
+/// profile that reaches as far toward the path's centre of curvature as its radius of curvature
+/// (kappa n . q >= 1 - 1e-3 for a profile offset q in the moving frame, on the path table: the
+/// surface would fold through itself; the message gives the path parameter, the radius and the
+/// reach); InvalidArgument for bad options.
 BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
                    const SweepOptions& options = {});
 
