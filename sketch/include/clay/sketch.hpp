@@ -1,4 +1,6 @@
 #pragma once
-/// Umbrella header of the sketch module (strokes, stroke fitting, sketch entities).
-/// The module builds on clay/surface; its own topic headers arrive with issue #3.
+/// Umbrella header of the sketch module: sketch planes and strokes.
+/// The module builds on clay/surface.
 #include <clay/surface.hpp>
+#include <clay/sketch/plane.hpp>
+#include <clay/sketch/stroke.hpp>
