@@ -87,7 +87,7 @@ struct FittedCurve {
 /// The curves fitted to one stroke, in drawing order; consecutive curves share their joint point
 /// exactly (corners).
 struct StrokeFit {
-  std::vector<FittedCurve> curves;
+  std::vector<FittedCurve> curves;    ///< in drawing order
   std::vector<Eigen::Index> corners;  ///< stroke index of each corner (the last point before it)
   bool closed = false;                ///< the chain closes (one closed curve, or corners all round)
   double max_deviation = 0;           ///< mm, largest of the curves' max_deviation
