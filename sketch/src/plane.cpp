@@ -7,7 +7,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "finite.hpp"
+#include "checks.hpp"
 
 namespace clay::sketch {
 
@@ -41,11 +41,7 @@ std::vector<std::string> problems(const SketchPlane& plane, std::string_view nam
 }
 
 void validate(const SketchPlane& plane, std::string_view name) {
-  const auto found = problems(plane, name);
-  if (found.empty()) return;
-  std::string text;
-  for (const auto& f : found) text += (text.empty() ? "" : "; ") + f;
-  throw Error(ErrorCategory::InvalidGeometry, text);
+  detail::throw_if(problems(plane, name));
 }
 
 SketchPlane make_plane(const Eigen::Vector3d& origin, const Eigen::Vector3d& normal,

@@ -8,7 +8,7 @@
 
 #include "stroke_points.hpp"
 
-#include "finite.hpp"
+#include "checks.hpp"
 
 namespace clay::sketch {
 namespace detail {
@@ -89,11 +89,7 @@ std::vector<std::string> problems(const Stroke& stroke, std::string_view name,
 }
 
 void validate(const Stroke& stroke, std::string_view name, bool allow_duplicates) {
-  const auto found = problems(stroke, name, allow_duplicates);
-  if (found.empty()) return;
-  std::string text;
-  for (const auto& f : found) text += (text.empty() ? "" : "; ") + f;
-  throw Error(ErrorCategory::InvalidGeometry, text);
+  detail::throw_if(problems(stroke, name, allow_duplicates));
 }
 
 double length(const Stroke& stroke) {

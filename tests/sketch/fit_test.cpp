@@ -31,36 +31,40 @@ BSplineCurve true_curve() {
 
 /// Largest distance from the stroke's points to a dense polyline of the curve (independent of the
 /// fitter's own foot points).
-double stroke_deviation(const Points3& pts, const BSplineCurve& c, Eigen::Index first = 0,
-                        Eigen::Index last = -1) {
+double stroke_deviation(const Points3& pts, const BSplineCurve& c) {
   const Points3 poly = clay::test::polyline(clay::test::analytic(c), 4000);
-  if (last < 0) last = pts.rows() - 1;
   double worst = 0;
-  for (Eigen::Index i = first; i <= last; ++i)
+  for (Eigen::Index i = 0; i < pts.rows(); ++i)
     worst = std::max(worst, clay::test::distance_to_polyline(pts.row(i).transpose(), poly));
   return worst;
 }
 
-struct Quality {
-  int control_points;
-  double to_truth, energy_ratio;
+constexpr double noise_sigma = 0.15;  // mm per coordinate
+
+/// 300 points of true_curve() with Gaussian noise, fitted at a tolerance of 3 sigma, and how the
+/// fit compares with the truth.
+struct NoisyCase {
+  Stroke stroke;
+  StrokeFit fit;
+  double to_truth = 0;      ///< mm, both ways on dense samples
+  double energy_ratio = 0;  ///< int kappa^2 ds of the fit / of the truth (Simpson)
 };
 
-Quality fit_noisy(unsigned seed) {
+NoisyCase noisy_case(unsigned seed) {
   const BSplineCurve truth = true_curve();
   const auto exact = clay::test::analytic(truth);
   clay::test::Gaussian g(seed);
-  const double sigma = 0.15;
-  const Stroke stroke{clay::test::noisy_samples(exact, 300, sigma, g), std::nullopt};
+  NoisyCase out;
+  out.stroke.points = clay::test::noisy_samples(exact, 300, noise_sigma, g);
   FitOptions o;
-  o.tolerance = 3 * sigma;
-  const StrokeFit fit = fit_stroke(stroke, o);
-  REQUIRE(fit.curves.size() == 1);
-  const FittedCurve& c = fit.curves[0];
-  const auto fitted = clay::test::analytic(c.curve);
-  const double e_fit = clay::test::bending_energy(fitted, clay::test::unit_breaks(c.curve));
-  const double e_true = clay::test::bending_energy(exact, clay::test::unit_breaks(truth));
-  return {c.control_points, clay::test::curve_distance(fitted, exact), e_fit / e_true};
+  o.tolerance = 3 * noise_sigma;
+  out.fit = fit_stroke(out.stroke, o);
+  REQUIRE(out.fit.curves.size() == 1);
+  const auto fitted = clay::test::analytic(out.fit.curves[0].curve);
+  out.to_truth = clay::test::curve_distance(fitted, exact);
+  out.energy_ratio = clay::test::bending_energy(fitted, clay::test::unit_breaks(out.fit.curves[0].curve)) /
+                     clay::test::bending_energy(exact, clay::test::unit_breaks(truth));
+  return out;
 }
 
 }  // namespace
@@ -68,51 +72,39 @@ Quality fit_noisy(unsigned seed) {
 // OCCT's default fitter (GeomAPI_PointsToBSpline with its default settings) interpolates the
 // noise of this kind of stroke: 302 control points for 300 points. Ours looks through it.
 TEST_CASE("noisy 3D stroke: few control points, within 0.2 mm of the true curve, as fair", "[fit]") {
-  const BSplineCurve truth = true_curve();
-  const auto exact = clay::test::analytic(truth);
-  clay::test::Gaussian g(2024);
-  const double sigma = 0.15;
-  const Stroke stroke{clay::test::noisy_samples(exact, 300, sigma, g), std::nullopt};
-  FitOptions o;
-  o.tolerance = 3 * sigma;
-  const StrokeFit fit = fit_stroke(stroke, o);
-  REQUIRE(fit.curves.size() == 1);
-  CHECK_FALSE(fit.closed);
-  CHECK(fit.corners.empty());
-  const FittedCurve& c = fit.curves[0];
+  const NoisyCase n = noisy_case(2024);
+  CHECK_FALSE(n.fit.closed);
+  CHECK(n.fit.corners.empty());
+  const FittedCurve& c = n.fit.curves[0];
   INFO(c.summary.brief());
   CHECK(c.summary.converged());
   CHECK(c.control_points <= 20);
   CHECK(c.curve.basis.degree == 3);
   CHECK(clay::surface::is_clamped(c.curve.basis));
-  // Against the true curve, both ways, on dense samples.
-  const auto fitted = clay::test::analytic(c.curve);
-  CHECK(clay::test::curve_distance(fitted, exact) <= 0.2);
-  // Bending energy int kappa^2 ds by Simpson's rule, against the true curve's.
-  const double e_fit = clay::test::bending_energy(fitted, clay::test::unit_breaks(c.curve));
-  const double e_true = clay::test::bending_energy(exact, clay::test::unit_breaks(truth));
-  CHECK(e_fit <= 1.5 * e_true);
-  CHECK(e_fit >= e_true / 1.5);
+  CHECK(n.to_truth <= 0.2);
+  CHECK(n.energy_ratio <= 1.5);
+  CHECK(n.energy_ratio >= 1 / 1.5);
   // The reported deviation is the stroke's distance to the curve (checked on a dense polyline).
-  CHECK_THAT(c.max_deviation, WithinAbs(stroke_deviation(stroke.points, c.curve), 1e-4));
+  CHECK_THAT(c.max_deviation, WithinAbs(stroke_deviation(n.stroke.points, c.curve), 1e-4));
   CHECK(c.rms_deviation < c.max_deviation);
   CHECK(c.first_point == 0);
   CHECK(c.last_point == 299);
   // The noise is the only thing left: the rms residual is about sqrt(2) sigma (two normal
   // components), and the noise estimate is near sigma.
-  CHECK_THAT(c.rms_deviation, WithinAbs(std::sqrt(2.0) * sigma, 0.03));
-  CHECK_THAT(c.noise, WithinAbs(sigma, 0.03));
+  CHECK_THAT(c.rms_deviation, WithinAbs(std::sqrt(2.0) * noise_sigma, 0.03));
+  CHECK_THAT(c.noise, WithinAbs(noise_sigma, 0.03));
 }
 
 TEST_CASE("noisy 3D strokes, other seeds: the same quality", "[fit]") {
   for (unsigned seed = 1; seed <= 6; ++seed) {
-    const Quality q = fit_noisy(seed);
-    INFO("seed " << seed << ": " << q.control_points << " control points, " << q.to_truth
-                 << " mm from the truth, energy ratio " << q.energy_ratio);
-    CHECK(q.control_points <= 20);
-    CHECK(q.to_truth <= 0.25);  // the stroke's ends carry the most uncertainty
-    CHECK(q.energy_ratio <= 1.5);
-    CHECK(q.energy_ratio >= 1 / 1.5);
+    const NoisyCase n = noisy_case(seed);
+    const int control_points = n.fit.curves[0].control_points;
+    INFO("seed " << seed << ": " << control_points << " control points, " << n.to_truth
+                 << " mm from the truth, energy ratio " << n.energy_ratio);
+    CHECK(control_points <= 20);
+    CHECK(n.to_truth <= 0.25);  // the stroke's ends carry the most uncertainty
+    CHECK(n.energy_ratio <= 1.5);
+    CHECK(n.energy_ratio >= 1 / 1.5);
   }
 }
 
