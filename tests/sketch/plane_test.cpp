@@ -1,9 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
-#include <clay/sketch/plane.hpp>
-
-#include <Eigen/Geometry>
+#include <clay/sketch/plane.hpp>  // alone: normal() must compile from it
 
 #include <cmath>
 #include <limits>

@@ -5,6 +5,7 @@
 /// (x_axis, y_axis, normal) is right-handed. Strokes, sketch entities and the constraint solver
 /// share this one type.
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross() in normal()
 
 #include <optional>
 #include <string>
