@@ -157,7 +157,6 @@ Line fit_line(const Points3& pts, const std::vector<Eigen::Index>& idx) {
   return line;
 }
 
-
 }  // namespace
 
 std::vector<Corner> find_corners(const Points3& pts, bool closed, double angle_degrees,
@@ -265,6 +264,10 @@ std::vector<Corner> find_corners(const Points3& pts, bool closed, double angle_d
   }
   std::sort(corners.begin(), corners.end(),
             [](const Corner& a, const Corner& b) { return a.split < b.split; });
+  // Every curve keeps at least one point: refined splits must stay distinct.
+  corners.erase(std::unique(corners.begin(), corners.end(),
+                            [](const Corner& a, const Corner& b) { return a.split == b.split; }),
+                corners.end());
   return corners;
 }
 
@@ -383,7 +386,6 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
       const Corner& to = corners[(j + 1) % k];
       out.curves.push_back(fit_open(from.anchor, range((from.split + 1) % n, to.split), to.anchor));
     }
-    // Start the chain after the first corner, in drawing order.
     out.closed = true;
   } else {
     // The ends move at most three noise deviations (and the tolerance) from the drawn points.
