@@ -260,7 +260,7 @@ std::optional<Points3> solve_ends(const Normal& h, const BSplineBasis& basis, bo
   const int ve = constrained(e.condition) ? alpha_variable(map, n - 2) : -1;
   // A control leg is about (domain / spans / p) x |C'|; |C'| is about the data's size.
   const double size = count > 1 ? (pr.data.colwise().maxCoeff() - pr.data.colwise().minCoeff()).norm() : 1.0;
-  const double floor = 1e-3 * std::max(size, 1e-9) / (p * std::max(1, n - p));
+  const double floor = 0.1 * std::max(size, 1e-9) / (p * std::max(1, n - p));
   bool again = false;
   auto settle = [&](EndSetup& end, int variable) {
     if (variable < 0) return;
