@@ -538,7 +538,7 @@ Model build_model(const sketch::Sketch& sketch, const std::vector<Constraint>& c
       for (int i = 0; i < 3; ++i) m.scalars.push_back({p.position[i]});
     } else {
       r.dim = 2;
-      const Eigen::Vector2d ab = sketch.planes[static_cast<size_t>(p.plane.index)].to_plane(p.position);
+      const Eigen::Vector2d ab = sketch::to_plane(sketch.planes[static_cast<size_t>(p.plane.index)], p.position);
       m.scalars.push_back({ab.x()});
       m.scalars.push_back({ab.y()});
     }

@@ -441,7 +441,7 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
       eq.plane = v.plane;
       Eigen::Vector3d target = d.target;
       if (eq.planar) {
-        const Eigen::Vector2d ab = m.planes[static_cast<size_t>(v.plane)].to_plane(d.target);
+        const Eigen::Vector2d ab = clay::sketch::to_plane(m.planes[static_cast<size_t>(v.plane)], d.target);
         target = {ab.x(), ab.y(), 0};
       }
       eq.data = {target.x(), target.y(), target.z()};
@@ -622,7 +622,7 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
     const double* p = x.data() + v.offset;
     result.sketch.points[i].position =
         v.dim == 3 ? Eigen::Vector3d(p[0], p[1], p[2])
-                   : m.planes[static_cast<size_t>(v.plane)].to_world(Eigen::Vector2d(p[0], p[1]));
+                   : clay::sketch::to_world(m.planes[static_cast<size_t>(v.plane)], Eigen::Vector2d(p[0], p[1]));
   }
   for (size_t k = 0; k < sketch.entities.size(); ++k)
     if (m.radius_var[k] >= 0)

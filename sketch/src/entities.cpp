@@ -36,43 +36,6 @@ double model_size(const Sketch& sketch) {
 
 }  // namespace
 
-SketchPlane make_plane(const Eigen::Vector3d& origin, const Eigen::Vector3d& normal,
-                       const Eigen::Vector3d& x_direction) {
-  if (!finite(origin) || !finite(normal) || !finite(x_direction))
-    fail(ErrorCategory::InvalidGeometry, "make_plane: origin, normal and x direction must be finite");
-  const double length = normal.norm();
-  if (!(length > 0))
-    fail(ErrorCategory::InvalidGeometry, "make_plane: the normal is the zero vector; give a direction");
-  const Eigen::Vector3d n = normal / length;
-  Eigen::Vector3d x = x_direction;
-  if (x.squaredNorm() == 0) {
-    Eigen::Index axis;
-    n.cwiseAbs().minCoeff(&axis);
-    x = Eigen::Vector3d::Unit(axis);
-  }
-  x -= x.dot(n) * n;
-  if (!(x.norm() > 1e-12 * std::max(1.0, x_direction.norm())))
-    fail(ErrorCategory::InvalidGeometry,
-         "make_plane: the x direction is parallel to the normal; give one that is not");
-  SketchPlane plane;
-  plane.origin = origin;
-  plane.x_axis = x.normalized();
-  plane.y_axis = n.cross(plane.x_axis);
-  return plane;
-}
-
-void validate(const SketchPlane& plane, std::string_view name) {
-  const std::string who(name);
-  if (!finite(plane.origin) || !finite(plane.x_axis) || !finite(plane.y_axis))
-    fail(ErrorCategory::InvalidGeometry, who + ": origin and axes must be finite");
-  if (std::abs(plane.x_axis.norm() - 1) > 1e-12 || std::abs(plane.y_axis.norm() - 1) > 1e-12 ||
-      std::abs(plane.x_axis.dot(plane.y_axis)) > 1e-12)
-    fail(ErrorCategory::InvalidGeometry,
-         who + ": x_axis and y_axis must be orthonormal (lengths " + num(plane.x_axis.norm()) +
-             " and " + num(plane.y_axis.norm()) + ", dot " + num(plane.x_axis.dot(plane.y_axis)) +
-             "); build it with make_plane");
-}
-
 PlaneId Sketch::add_plane(const SketchPlane& plane) {
   validate(plane, "plane #" + std::to_string(planes.size()));
   planes.push_back(plane);
@@ -95,7 +58,7 @@ PointId Sketch::add_point(PlaneId plane, const Eigen::Vector2d& ab) {
   if (!ab.allFinite())
     fail(ErrorCategory::InvalidGeometry,
          "add_point: " + point_name(static_cast<int>(points.size())) + " has a non-finite coordinate");
-  points.push_back({planes[static_cast<size_t>(plane.index)].to_world(ab), plane});
+  points.push_back({to_world(planes[static_cast<size_t>(plane.index)], ab), plane});
   return {static_cast<int>(points.size()) - 1};
 }
 
@@ -206,7 +169,7 @@ EntityId Sketch::add_curve(const surface::BSplineCurve& curve, PlaneId plane) {
     check_plane(*this, plane, who);
     const SketchPlane& pl = planes[static_cast<size_t>(plane.index)];
     for (Eigen::Index i = 0; i < curve.points.rows(); ++i) {
-      const double d = std::abs(pl.distance(curve.points.row(i).transpose()));
+      const double d = std::abs(signed_distance(pl, curve.points.row(i).transpose()));
       if (d > 1e-9 * size)
         fail(ErrorCategory::InvalidGeometry,
              who + ": control point " + std::to_string(i) + " is " + num(d) + " mm off plane #" +
@@ -221,7 +184,7 @@ EntityId Sketch::add_curve(const surface::BSplineCurve& curve, PlaneId plane) {
     const Eigen::Vector3d p = curve.points.row(i).transpose();
     c.control_points.push_back(plane.free()
                                    ? add_point(p)
-                                   : add_point(plane, planes[static_cast<size_t>(plane.index)].to_plane(p)));
+                                   : add_point(plane, to_plane(planes[static_cast<size_t>(plane.index)], p)));
   }
   return push(*this, std::move(c));
 }
@@ -262,9 +225,9 @@ surface::BSplineCurve curve_of(const Sketch& sketch, EntityId entity) {
   }
   const Arc& a = std::get<Arc>(e);
   const SketchPlane& pl = sketch.planes[static_cast<size_t>(a.plane.index)];
-  const Eigen::Vector2d c = pl.to_plane(position(sketch, a.center));
-  const Eigen::Vector2d s = pl.to_plane(position(sketch, a.start)) - c;
-  const Eigen::Vector2d t = pl.to_plane(position(sketch, a.end)) - c;
+  const Eigen::Vector2d c = to_plane(pl, position(sketch, a.center));
+  const Eigen::Vector2d s = to_plane(pl, position(sketch, a.start)) - c;
+  const Eigen::Vector2d t = to_plane(pl, position(sketch, a.end)) - c;
   const double start = std::atan2(s.y(), s.x());
   double end = std::atan2(t.y(), t.x());
   while (end <= start) end += 2 * std::numbers::pi;
@@ -291,7 +254,7 @@ std::vector<std::string> problems(const Sketch& sketch) {
       out.push_back(point_name(i) + " refers to plane #" + std::to_string(p.plane.index) +
                     ", which does not exist");
     else if (!p.plane.free()) {
-      const double d = std::abs(sketch.planes[static_cast<size_t>(p.plane.index)].distance(p.position));
+      const double d = std::abs(signed_distance(sketch.planes[static_cast<size_t>(p.plane.index)], p.position));
       if (d > 1e-9 * size)
         out.push_back(point_name(i) + " is " + num(d) + " mm off its plane #" +
                       std::to_string(p.plane.index));

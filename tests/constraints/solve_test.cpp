@@ -255,10 +255,10 @@ TEST_CASE("each planar constraint holds in an independent measurement", "[constr
   const Sketch& t = result.sketch;
   const clay::sketch::SketchPlane& pl = t.planes[0];
   auto uv = [&](PointId id) {
-    const Eigen::Vector2d x = pl.to_plane(at(t, id));
+    const Eigen::Vector2d x = clay::sketch::to_plane(pl, at(t, id));
     return Eigen::Vector3d(x.x(), x.y(), 0);
   };
-  for (size_t i = 0; i < t.points.size(); ++i) CHECK(std::abs(pl.distance(t.points[i].position)) < 1e-12);
+  for (size_t i = 0; i < t.points.size(); ++i) CHECK(std::abs(clay::sketch::signed_distance(pl, t.points[i].position)) < 1e-12);
   const Eigen::Vector3d u = uv(b) - uv(a), v = uv(d) - uv(c), w = uv(f) - uv(e);
   CHECK(std::abs(u.cross(v).z()) / (u.norm() * v.norm()) < 1e-10);
   CHECK(u.dot(v) > 0);  // kept its sense
@@ -384,7 +384,7 @@ TEST_CASE("points on curves and arcs, equal radii, and joints across planes and 
   const EntityId arc = s.add_arc(ac, as, ae, xy);
   const PointId on_arc = s.add_point(xy, {57, -3});
   // A point of the tilted plane made coincident with a free point (a world-frame equation).
-  const Eigen::Vector3d spot = s.planes[1].to_world({3, -1});
+  const Eigen::Vector3d spot = clay::sketch::to_world(s.planes[1], {3, -1});
   const PointId in_plane = s.add_point(tilted, {1, 1}), loose = s.add_point(spot + Eigen::Vector3d(0.5, 0.2, -0.3));
   // A line of the tilted plane joined G1 to the 3D curve's end.
   const PointId l0 = s.add_point(tilted, {2, 2}), l1 = s.add_point(tilted, {8, 3});
@@ -430,5 +430,5 @@ TEST_CASE("points on curves and arcs, equal radii, and joints across planes and 
   CHECK(std::atan2(d_line.d1.cross(-d_curve.d1).norm(), d_line.d1.dot(-d_curve.d1)) < 1e-9);
   for (size_t i = 0; i < t.points.size(); ++i)
     if (!t.points[i].plane.free())
-      CHECK(std::abs(t.planes[static_cast<size_t>(t.points[i].plane.index)].distance(t.points[i].position)) < 1e-12);
+      CHECK(std::abs(clay::sketch::signed_distance(t.planes[static_cast<size_t>(t.points[i].plane.index)], t.points[i].position)) < 1e-12);
 }

@@ -14,30 +14,6 @@ using clay::test::error_of;
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
 
-TEST_CASE("make_plane builds an orthonormal frame and maps points both ways", "[sketch]") {
-  const SketchPlane p = make_plane({1, 2, 3}, {0, 0, 2}, {1, 1, 5});
-  CHECK_THAT(p.x_axis.norm(), WithinAbs(1, 1e-15));
-  CHECK_THAT(p.y_axis.norm(), WithinAbs(1, 1e-15));
-  CHECK_THAT(p.x_axis.dot(p.y_axis), WithinAbs(0, 1e-15));
-  CHECK((p.normal() - Eigen::Vector3d::UnitZ()).norm() < 1e-15);
-  CHECK((p.x_axis - Eigen::Vector3d(1, 1, 0).normalized()).norm() < 1e-15);  // x direction kept
-  const Eigen::Vector3d w = p.to_world({4, -2});
-  CHECK((p.to_plane(w) - Eigen::Vector2d(4, -2)).norm() < 1e-14);
-  CHECK_THAT(p.distance(w + 3 * p.normal()), WithinAbs(3, 1e-14));
-  CHECK_THAT((p.to_world({3, 4}) - p.origin).norm(), WithinAbs(5, 1e-14));
-  const SketchPlane tilted = make_plane({0, 0, 0}, {1, 1, 1});  // default x direction
-  CHECK_THAT(tilted.x_axis.dot(tilted.normal()), WithinAbs(0, 1e-15));
-  validate(tilted);
-
-  CHECK(error_of([] { (void)make_plane({0, 0, 0}, {0, 0, 0}); }).second.find("zero vector") != std::string::npos);
-  CHECK(error_of([] { (void)make_plane({0, 0, 0}, {0, 0, 1}, {0, 0, 3}); }).second.find("parallel") != std::string::npos);
-  SketchPlane skew;
-  skew.y_axis = {0.1, 1, 0};
-  const auto [category, message] = error_of([&] { validate(skew, "plane P"); });
-  CHECK(category == ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Contains("plane P: x_axis and y_axis must be orthonormal"));
-}
-
 TEST_CASE("entities read back as exact B-spline curves", "[sketch]") {
   Sketch s;
   const PlaneId plane = s.add_plane(make_plane({0, 0, 1}, {0, 0, 1}));
