@@ -13,10 +13,12 @@
 #include <random>
 
 #include "error_of.hpp"
+#include "polyline.hpp"
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
 using clay::test::error_of;
+using clay::test::polyline;
 using Catch::Matchers::WithinAbs;
 
 namespace {
@@ -249,20 +251,6 @@ TEST_CASE("fill rejects an invalid curve, naming it", "[fill][errors]") {
   CHECK_THAT(message, Catch::Contains("curve #1"));
 }
 
-namespace {
-
-/// Degree-1 curve through the points, knots 0, 1, 2, ...
-BSplineCurve polyline(const std::vector<Eigen::Vector3d>& points) {
-  const int n = static_cast<int>(points.size());
-  std::vector<double> knots = {0.0};
-  for (int i = 0; i < n; ++i) knots.push_back(i);
-  knots.push_back(n - 1);
-  Points3 p(n, 3);
-  for (int i = 0; i < n; ++i) p.row(i) = points[static_cast<size_t>(i)].transpose();
-  return make_curve(1, knots, p);
-}
-
-}  // namespace
 
 TEST_CASE("fill rejects a boundary curve that crosses itself", "[fill][errors]") {
   std::mt19937 rng(412);

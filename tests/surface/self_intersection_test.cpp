@@ -15,11 +15,13 @@
 #include <random>
 
 #include "error_of.hpp"
+#include "polyline.hpp"
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
 using Catch::Matchers::WithinAbs;
 using clay::test::error_of;
+using clay::test::polyline;
 
 namespace {
 
@@ -79,16 +81,6 @@ double nodal_gap(double c, double* t_star = nullptr) {
   return 2.0 * t * std::sqrt((t * t - 1) * (t * t - 1) + c * c);
 }
 
-/// Degree-1 curve through the points, uniform knots 0, 1, 2, ...
-BSplineCurve polyline(const std::vector<Eigen::Vector3d>& points) {
-  const int n = static_cast<int>(points.size());
-  std::vector<double> knots = {0.0};
-  for (int i = 0; i < n; ++i) knots.push_back(i);
-  knots.push_back(n - 1);
-  Points3 p(n, 3);
-  for (int i = 0; i < n; ++i) p.row(i) = points[static_cast<size_t>(i)].transpose();
-  return make_curve(1, knots, p);
-}
 
 /// A hairpin: a straight leg along y = -r, a semicircle of radius r about the origin on the left,
 /// and a leg back along y = +r (exact rational quadratic, legs `length` long).

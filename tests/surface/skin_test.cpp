@@ -14,10 +14,12 @@
 #include <random>
 
 #include "error_of.hpp"
+#include "polyline.hpp"
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
 using clay::test::error_of;
+using clay::test::polyline;
 using Catch::Matchers::WithinAbs;
 
 namespace {
@@ -83,16 +85,6 @@ BSplineCurve quarter_circle(double r, double z) {
   return make_curve(2, {0, 0, 0, 1, 1, 1}, p, w);
 }
 
-/// Degree-1 curve through the points, knots 0, 1, 2, ... (a polyline).
-BSplineCurve polyline(const std::vector<Eigen::Vector3d>& points) {
-  const int n = static_cast<int>(points.size());
-  std::vector<double> knots = {0.0};
-  for (int i = 0; i < n; ++i) knots.push_back(i);
-  knots.push_back(n - 1);
-  Points3 p(n, 3);
-  for (int i = 0; i < n; ++i) p.row(i) = points[static_cast<size_t>(i)].transpose();
-  return make_curve(1, knots, p);
-}
 
 /// A "Z" at height z: (x0, y0) -> (x1, y1) -> (x1, y0) -> (x0, y1), whose first and last segments
 /// cross at the centre, at t = 0.5 and t = 2.5.
