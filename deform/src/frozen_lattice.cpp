@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <thread>
 #include <vector>
@@ -28,7 +29,7 @@ namespace clay::deform {
 namespace {
 
 constexpr int W = 8;                      // points per block (one AVX-512 register of doubles)
-constexpr std::size_t chunk_points = 8192;  // B-spline lattices: points sorted by cell at a time
+constexpr std::size_t chunk_points = 16384;  // B-spline lattices: points sorted by cell at a time
 constexpr std::size_t min_points_per_thread = 16384;
 
 /// Everything the kernels read, as plain pointers and numbers.
@@ -54,44 +55,112 @@ struct Io {
 
 /// Per-thread scratch of the B-spline path (allocated once per call, never per point).
 struct Scratch {
-  std::vector<double> s, t, u;
-  std::vector<std::int32_t> cell, order, count;
+  std::vector<double> s, t, u, rx, ry, rz;
+  std::vector<std::int32_t> cell, order, position, count;
 };
 
 // ---- block kernels (always inlined into the cloned drivers below) ---------------------------
+//
+// A block is W = 8 points held in GCC vector-extension values (one zmm register under AVX-512,
+// two ymm under AVX2, four xmm otherwise); scalars in arithmetic with them are broadcast. Vectors
+// are passed by reference only (no vector in a function's ABI).
+
+using vd = double __attribute__((vector_size(W * sizeof(double))));
+using vi = long long __attribute__((vector_size(W * sizeof(long long))));
+using vi32 = std::int32_t __attribute__((vector_size(W * sizeof(std::int32_t))));
+
+[[gnu::always_inline]] inline void load(vd& v, const double* p) { std::memcpy(&v, p, sizeof v); }
+
+[[gnu::always_inline]] inline void store(double* p, const vd& v) { std::memcpy(p, &v, sizeof v); }
+
+/// x, y, z of 8 consecutive points from 24 doubles stored x0 y0 z0 x1 y1 z1 ... (row-major N x 3).
+[[gnu::always_inline]] inline void load_rows(const double* p, vd& x, vd& y, vd& z) {
+  vd a, b, c;
+  load(a, p);
+  load(b, p + W);
+  load(c, p + 2 * W);
+  x = __builtin_shuffle(__builtin_shuffle(a, b, vi{0, 3, 6, 9, 12, 15, 0, 0}), c, vi{0, 1, 2, 3, 4, 5, 10, 13});
+  y = __builtin_shuffle(__builtin_shuffle(a, b, vi{1, 4, 7, 10, 13, 0, 0, 0}), c, vi{0, 1, 2, 3, 4, 8, 11, 14});
+  z = __builtin_shuffle(__builtin_shuffle(a, b, vi{2, 5, 8, 11, 14, 0, 0, 0}), c, vi{0, 1, 2, 3, 4, 9, 12, 15});
+}
+
+/// The inverse of load_rows.
+[[gnu::always_inline]] inline void store_rows(double* p, const vd& x, const vd& y, const vd& z) {
+  // a = x0 y0 z0 x1 y1 z1 x2 y2, b = z2 x3 y3 z3 x4 y4 z4 x5, c = y5 z5 x6 y6 z6 x7 y7 z7
+  const vd xy = __builtin_shuffle(x, y, vi{0, 8, 0, 1, 9, 0, 2, 10});
+  const vd a = __builtin_shuffle(xy, z, vi{0, 1, 8, 3, 4, 9, 6, 7});
+  const vd zx = __builtin_shuffle(z, x, vi{2, 11, 0, 3, 12, 0, 4, 13});
+  const vd b = __builtin_shuffle(zx, y, vi{0, 1, 11, 3, 4, 12, 6, 7});
+  const vd yz = __builtin_shuffle(y, z, vi{5, 13, 0, 6, 14, 0, 7, 15});
+  const vd c = __builtin_shuffle(yz, x, vi{0, 1, 14, 3, 4, 15, 6, 7});
+  store(p, a);
+  store(p + W, b);
+  store(p + 2 * W, c);
+}
+
+/// Points ahead of the block being computed whose input is prefetched (hardware prefetchers
+/// lag behind on six streams).
+constexpr std::size_t prefetch_distance = 64;
 
 template <int Stride>
-[[gnu::always_inline]] inline void load_block(const Io& io, std::size_t first, double* x, double* y,
-                                              double* z) {
-  for (int q = 0; q < W; ++q) {
-    x[q] = io.in[0][(first + q) * Stride];
-    y[q] = io.in[1][(first + q) * Stride];
-    z[q] = io.in[2][(first + q) * Stride];
+[[gnu::always_inline]] inline void prefetch_block(const Io& io, std::size_t first) {
+  if constexpr (Stride == 3) {
+    __builtin_prefetch(io.in[0] + first * 3);
+    __builtin_prefetch(io.in[0] + first * 3 + W);
+    __builtin_prefetch(io.in[0] + first * 3 + 2 * W);
+  } else {
+    __builtin_prefetch(io.in[0] + first);
+    __builtin_prefetch(io.in[1] + first);
+    __builtin_prefetch(io.in[2] + first);
   }
 }
 
-/// Local coordinates (eq. (1) through the dual vectors), clamped to [0, 1]; inside flags.
-[[gnu::always_inline]] inline void local_block(const Kernel& K, const double* x, const double* y,
-                                               const double* z, double* s, double* t, double* u,
-                                               int* in) {
-  constexpr double lo = -face_tolerance, hi = 1 + face_tolerance;
-  for (int q = 0; q < W; ++q) {
-    const double dx = x[q] - K.origin[0], dy = y[q] - K.origin[1], dz = z[q] - K.origin[2];
-    const double ls = K.dual[0][0] * dx + K.dual[0][1] * dy + K.dual[0][2] * dz;
-    const double lt = K.dual[1][0] * dx + K.dual[1][1] * dy + K.dual[1][2] * dz;
-    const double lu = K.dual[2][0] * dx + K.dual[2][1] * dy + K.dual[2][2] * dz;
-    in[q] = (ls >= lo) & (ls <= hi) & (lt >= lo) & (lt <= hi) & (lu >= lo) & (lu <= hi);
-    s[q] = ls < 0 ? 0.0 : (ls > 1 ? 1.0 : ls);
-    t[q] = lt < 0 ? 0.0 : (lt > 1 ? 1.0 : lt);
-    u[q] = lu < 0 ? 0.0 : (lu > 1 ? 1.0 : lu);
+/// Loads block [first, first + 8) (Stride 3: rows, 1: columns).
+template <int Stride>
+[[gnu::always_inline]] inline void load_block(const Io& io, std::size_t first, vd& x, vd& y, vd& z) {
+  if constexpr (Stride == 3) {
+    load_rows(io.in[0] + first * 3, x, y, z);
+  } else {
+    load(x, io.in[0] + first);
+    load(y, io.in[1] + first);
+    load(z, io.in[2] + first);
   }
 }
 
-/// Nested Horner in u, t, s of the three coordinate polynomials of one cell; r[c * W + q].
+template <int Stride>
+[[gnu::always_inline]] inline void store_block(const Io& io, std::size_t first, const vd& x,
+                                               const vd& y, const vd& z) {
+  if constexpr (Stride == 3) {
+    store_rows(io.out[0] + first * 3, x, y, z);
+  } else {
+    store(io.out[0] + first, x);
+    store(io.out[1] + first, y);
+    store(io.out[2] + first, z);
+  }
+}
+
+/// Local coordinates (eq. (1) through the dual vectors), clamped to [0, 1], and how far outside
+/// the unit cube the point is (|ls − s| + |lt − t| + |lu − u|: inside when <= face_tolerance,
+/// outside also when NaN). One comparison per block instead of six keeps GCC on mask registers.
+[[gnu::always_inline]] inline void local_block(const Kernel& K, const vd& x, const vd& y, const vd& z,
+                                               vd& s, vd& t, vd& u, vd& outside) {
+  const vd zero = {}, one = zero + 1.0;
+  const vd dx = x - K.origin[0], dy = y - K.origin[1], dz = z - K.origin[2];
+  const vd ls = K.dual[0][0] * dx + K.dual[0][1] * dy + K.dual[0][2] * dz;
+  const vd lt = K.dual[1][0] * dx + K.dual[1][1] * dy + K.dual[1][2] * dz;
+  const vd lu = K.dual[2][0] * dx + K.dual[2][1] * dy + K.dual[2][2] * dz;
+  s = ls < zero ? zero : (ls > one ? one : ls);
+  t = lt < zero ? zero : (lt > one ? one : lt);
+  u = lu < zero ? zero : (lu > one ? one : lu);
+  const vd ds = ls - s, dt = lt - t, du = lu - u;
+  outside = (ds < zero ? -ds : ds) + (dt < zero ? -dt : dt) + (du < zero ? -du : du);
+}
+
+/// Nested Horner in u, t, s of the three coordinate polynomials of one cell, plus the center.
 /// L, M, N >= 0 fix the degrees at compile time (fully unrolled); -1 reads them from K.
 template <int L, int M, int N>
-[[gnu::always_inline]] inline void horner_block(const Kernel& K, const double* coef, const double* s,
-                                                const double* t, const double* u, double* r) {
+[[gnu::always_inline]] inline void horner_block(const Kernel& K, const double* coef, const vd& s,
+                                                const vd& t, const vd& u, vd* r) {
   const int l = L >= 0 ? L : K.deg[0];
   const int m = M >= 0 ? M : K.deg[1];
   const int n = N >= 0 ? N : K.deg[2];
@@ -99,22 +168,18 @@ template <int L, int M, int N>
   const int per_coordinate = (l + 1) * Q * R;
   for (int c = 0; c < 3; ++c) {
     const double* a = coef + c * per_coordinate;
-    double as[W];
-    for (int q = 0; q < W; ++q) as[q] = 0;
+    vd as = {};
     for (int i = l; i >= 0; --i) {
-      double at[W];
-      for (int q = 0; q < W; ++q) at[q] = 0;
+      vd at = {};
       for (int j = m; j >= 0; --j) {
         const double* ak = a + (i * Q + j) * R;
-        double au[W];
-        for (int q = 0; q < W; ++q) au[q] = ak[n];
-        for (int k = n - 1; k >= 0; --k)
-          for (int q = 0; q < W; ++q) au[q] = au[q] * u[q] + ak[k];
-        for (int q = 0; q < W; ++q) at[q] = at[q] * t[q] + au[q];
+        vd au = u * ak[n] + ak[n - 1];
+        for (int k = n - 2; k >= 0; --k) au = au * u + ak[k];
+        at = j == m ? au : at * t + au;
       }
-      for (int q = 0; q < W; ++q) as[q] = as[q] * s[q] + at[q];
+      as = i == l ? at : as * s + at;
     }
-    for (int q = 0; q < W; ++q) r[c * W + q] = as[q] + K.center[c];
+    r[c] = as + K.center[c];
   }
 }
 
@@ -123,41 +188,38 @@ template <int L, int M, int N>
 template <int L, int M, int N, int Stride>
 [[gnu::always_inline]] inline void bezier_range(const Kernel& K, const Io& io, std::size_t begin,
                                                 std::size_t end) {
-  alignas(64) double x[W], y[W], z[W], s[W], t[W], u[W], r[3 * W];
-  alignas(64) int in[W];
-  for (std::size_t b = begin; b < end; b += W) {
-    const std::size_t count = std::min<std::size_t>(W, end - b);
-    if (count == W) {
-      load_block<Stride>(io, b, x, y, z);
-    } else {  // tail: pad with the last point (valid data, results discarded)
-      for (int q = 0; q < W; ++q) {
-        const std::size_t i = b + std::min<std::size_t>(static_cast<std::size_t>(q), count - 1);
-        x[q] = io.in[0][i * Stride];
-        y[q] = io.in[1][i * Stride];
-        z[q] = io.in[2][i * Stride];
-      }
-    }
-    local_block(K, x, y, z, s, t, u, in);
+  vd x, y, z, s, t, u, r[3], out;
+  std::size_t b = begin;
+  for (; b + W <= end; b += W) {
+    prefetch_block<Stride>(io, b + prefetch_distance);
+    load_block<Stride>(io, b, x, y, z);
+    local_block(K, x, y, z, s, t, u, out);
     horner_block<L, M, N>(K, K.coef, s, t, u, r);
-    if (count == W) {
-      for (int q = 0; q < W; ++q) {
-        io.out[0][(b + q) * Stride] = in[q] ? r[q] : x[q];
-        io.out[1][(b + q) * Stride] = in[q] ? r[W + q] : y[q];
-        io.out[2][(b + q) * Stride] = in[q] ? r[2 * W + q] : z[q];
-      }
-    } else {
-      for (std::size_t q = 0; q < count; ++q) {
-        io.out[0][(b + q) * Stride] = in[q] ? r[q] : x[q];
-        io.out[1][(b + q) * Stride] = in[q] ? r[W + q] : y[q];
-        io.out[2][(b + q) * Stride] = in[q] ? r[2 * W + q] : z[q];
-      }
+    const vd tol = vd{} + face_tolerance;
+    store_block<Stride>(io, b, out <= tol ? r[0] : x, out <= tol ? r[1] : y, out <= tol ? r[2] : z);
+  }
+  if (b < end) {  // tail: pad with the last point (valid data, results discarded)
+    const std::size_t count = end - b;
+    for (std::size_t q = 0; q < W; ++q) {
+      const std::size_t i = b + std::min(q, count - 1);
+      x[q] = io.in[0][i * Stride];
+      y[q] = io.in[1][i * Stride];
+      z[q] = io.in[2][i * Stride];
+    }
+    local_block(K, x, y, z, s, t, u, out);
+    horner_block<L, M, N>(K, K.coef, s, t, u, r);
+    for (std::size_t q = 0; q < count; ++q) {
+      const bool in = out[q] <= face_tolerance;
+      io.out[0][(b + q) * Stride] = in ? r[0][q] : x[q];
+      io.out[1][(b + q) * Stride] = in ? r[1][q] : y[q];
+      io.out[2][(b + q) * Stride] = in ? r[2][q] : z[q];
     }
   }
 }
 
 // ---- B-spline lattice: per chunk, a counting sort by cell, then blocks of one cell -----------
 
-/// Cell index along direction d and the local coordinate inside the cell.
+/// Cell index along direction d and the local coordinate inside the cell (one point).
 [[gnu::always_inline]] inline int cell_of(const Kernel& K, int d, double v, double& local) {
   const int n = K.cells[d];
   int c;
@@ -173,74 +235,138 @@ template <int L, int M, int N, int Stride>
   return c;
 }
 
+/// Cells and in-cell coordinates of a block: vectorized when every direction has uniform breaks
+/// (cell = floor(v n) by truncation, v >= 0), one point at a time otherwise. Points outside the
+/// lattice get cell K.cell_count.
+[[gnu::always_inline]] inline void cells_block(const Kernel& K, vd& s, vd& t, vd& u, const vd& out,
+                                               vi& cell) {
+  const vd tol = vd{} + face_tolerance;
+  if (K.uniform[0] && K.uniform[1] && K.uniform[2]) {
+    const vd fs = s * K.cells[0], ft = t * K.cells[1], fu = u * K.cells[2];
+    vi a = __builtin_convertvector(fs, vi), b = __builtin_convertvector(ft, vi),
+       c = __builtin_convertvector(fu, vi);
+    const vi la = vi{} + (K.cells[0] - 1), lb = vi{} + (K.cells[1] - 1), lc = vi{} + (K.cells[2] - 1);
+    a = a > la ? la : a;
+    b = b > lb ? lb : b;
+    c = c > lc ? lc : c;
+    s = fs - __builtin_convertvector(a, vd);
+    t = ft - __builtin_convertvector(b, vd);
+    u = fu - __builtin_convertvector(c, vd);
+    const vi id = (a * K.cells[1] + b) * K.cells[2] + c;
+    cell = out <= tol ? id : vi{} + K.cell_count;
+    return;
+  }
+  for (int q = 0; q < W; ++q) {
+    double ls, lt, lu;
+    const int a = cell_of(K, 0, s[q], ls);
+    const int b = cell_of(K, 1, t[q], lt);
+    const int c = cell_of(K, 2, u[q], lu);
+    s[q] = ls;
+    t[q] = lt;
+    u[q] = lu;
+    cell[q] = out[q] <= face_tolerance ? (a * K.cells[1] + b) * K.cells[2] + c : K.cell_count;
+  }
+}
+
 template <int L, int M, int N, int Stride>
 [[gnu::always_inline]] inline void bspline_range(const Kernel& K, const Io& io, std::size_t begin,
                                                  std::size_t end, Scratch& sc) {
-  alignas(64) double x[W], y[W], z[W], s[W], t[W], u[W], r[3 * W];
-  alignas(64) int in[W];
+  vd x, y, z, s, t, u, r[3], out;
+  vi cl;
+  // In-cell coordinates in input order, results in sorted order (W spare entries: the last
+  // partial block of a cell spills over), cells, sorted order and sorted position of each point.
   double* S = sc.s.data();
   double* T = sc.t.data();
   double* U = sc.u.data();
+  double* RX = sc.rx.data();
+  double* RY = sc.ry.data();
+  double* RZ = sc.rz.data();
   std::int32_t* cell = sc.cell.data();
   std::int32_t* order = sc.order.data();
+  std::int32_t* position = sc.position.data();
   std::int32_t* count = sc.count.data();  // cell_count + 2 entries
   const int outside = K.cell_count;
   for (std::size_t c0 = begin; c0 < end; c0 += chunk_points) {
     const std::size_t n = std::min(chunk_points, end - c0);
-    // 1. Local coordinates (vectorized) and cells.
+    // 1. Local coordinates and cells, a block at a time.
     for (std::size_t b = 0; b < n; b += W) {
       const std::size_t cnt = std::min<std::size_t>(W, n - b);
-      for (int q = 0; q < W; ++q) {
-        const std::size_t i = c0 + b + std::min<std::size_t>(static_cast<std::size_t>(q), cnt - 1);
-        x[q] = io.in[0][i * Stride];
-        y[q] = io.in[1][i * Stride];
-        z[q] = io.in[2][i * Stride];
+      if (cnt == W) {
+        prefetch_block<Stride>(io, c0 + b + prefetch_distance);
+        load_block<Stride>(io, c0 + b, x, y, z);
+      } else {
+        for (std::size_t q = 0; q < W; ++q) {
+          const std::size_t i = c0 + b + std::min(q, cnt - 1);
+          x[q] = io.in[0][i * Stride];
+          y[q] = io.in[1][i * Stride];
+          z[q] = io.in[2][i * Stride];
+        }
       }
-      local_block(K, x, y, z, s, t, u, in);
-      for (std::size_t q = 0; q < cnt; ++q) {
-        double ls, lt, lu;
-        const int a = cell_of(K, 0, s[q], ls);
-        const int bb = cell_of(K, 1, t[q], lt);
-        const int cc = cell_of(K, 2, u[q], lu);
-        S[b + q] = ls;
-        T[b + q] = lt;
-        U[b + q] = lu;
-        cell[b + q] = in[q] ? (a * K.cells[1] + bb) * K.cells[2] + cc : outside;
-      }
+      local_block(K, x, y, z, s, t, u, out);
+      cells_block(K, s, t, u, out, cl);
+      store(S + b, s);
+      store(T + b, t);
+      store(U + b, u);
+      const auto narrow = __builtin_convertvector(cl, vi32);
+      std::memcpy(cell + b, &narrow, sizeof narrow);
     }
-    // 2. Counting sort of the chunk's points by cell.
+    // 2. Counting sort by cell (indices only: one store per point into an L1-sized array).
     std::fill(count, count + outside + 2, 0);
     for (std::size_t i = 0; i < n; ++i) ++count[cell[i] + 1];
     for (int c = 0; c <= outside; ++c) count[c + 1] += count[c];  // count[c] = start of cell c
-    for (std::size_t i = 0; i < n; ++i) order[count[cell[i]]++] = static_cast<std::int32_t>(i);
-    // Now count[c] = end of cell c = start of cell c + 1.
-    // 3. Blocks of one cell: coefficients broadcast, coordinates gathered, results scattered.
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::int32_t p = count[cell[i]]++;
+      order[p] = static_cast<std::int32_t>(i);
+      position[i] = p;
+    }
+    for (std::size_t p = n; p < n + W; ++p) order[p] = order[n - 1];  // spill-over lanes
+    // Now count[c] = end of cell c. 3. Blocks within one cell, coefficients broadcast; a last
+    // partial block spills into the next cell's slots, which that cell then overwrites.
     int start = 0;
     for (int c = 0; c < outside; ++c) {
       const int stop = count[c];
       const double* coef = K.coef + static_cast<std::size_t>(c) * K.cell_size;
       for (int b = start; b < stop; b += W) {
-        const int cnt = std::min(W, stop - b);
         for (int q = 0; q < W; ++q) {
-          const std::int32_t i = order[b + std::min(q, cnt - 1)];
+          const std::int32_t i = order[b + q];
           s[q] = S[i];
           t[q] = T[i];
           u[q] = U[i];
         }
         horner_block<L, M, N>(K, coef, s, t, u, r);
-        for (int q = 0; q < cnt; ++q) {
-          const std::size_t i = c0 + static_cast<std::size_t>(order[b + q]);
-          io.out[0][i * Stride] = r[q];
-          io.out[1][i * Stride] = r[W + q];
-          io.out[2][i * Stride] = r[2 * W + q];
-        }
+        store(RX + b, r[0]);
+        store(RY + b, r[1]);
+        store(RZ + b, r[2]);
       }
       start = stop;
     }
-    // 4. Points outside the lattice are copied unchanged.
-    for (int b = start; b < count[outside]; ++b) {
-      const std::size_t i = c0 + static_cast<std::size_t>(order[b]);
-      for (int d = 0; d < 3; ++d) io.out[d][i * Stride] = io.in[d][i * Stride];
+    // 4. Back to the input order; points outside are copied unchanged.
+    for (std::size_t b = 0; b < n; b += W) {
+      const std::size_t cnt = std::min<std::size_t>(W, n - b);
+      for (std::size_t q = 0; q < W; ++q) {
+        const std::int32_t p = position[b + std::min(q, cnt - 1)];
+        x[q] = RX[p];
+        y[q] = RY[p];
+        z[q] = RZ[p];
+      }
+      if (start < count[outside]) {  // some points of the chunk are outside
+        for (std::size_t q = 0; q < cnt; ++q)
+          if (cell[b + q] == outside) {
+            const std::size_t i = c0 + b + q;
+            x[q] = io.in[0][i * Stride];
+            y[q] = io.in[1][i * Stride];
+            z[q] = io.in[2][i * Stride];
+          }
+      }
+      if (cnt == W) {
+        store_block<Stride>(io, c0 + b, x, y, z);
+      } else {
+        for (std::size_t q = 0; q < cnt; ++q) {
+          io.out[0][(c0 + b + q) * Stride] = x[q];
+          io.out[1][(c0 + b + q) * Stride] = y[q];
+          io.out[2][(c0 + b + q) * Stride] = z[q];
+        }
+      }
     }
   }
 }
@@ -379,12 +505,10 @@ void run(const FrozenLattice& lattice, const Io& io, std::size_t n, bool rows,
   threads = std::max<std::size_t>(1, std::min(threads, n / min_points_per_thread));
   std::vector<Scratch> scratch(bezier ? 0 : threads);
   for (auto& sc : scratch) {
-    const std::size_t c = std::min(chunk_points, n);
-    sc.s.resize(c);
-    sc.t.resize(c);
-    sc.u.resize(c);
-    sc.cell.resize(c);
-    sc.order.resize(c);
+    // Whole blocks plus W spare entries (the last partial block of a cell spills over).
+    const std::size_t c = (std::min(chunk_points, n) + W - 1) / W * W + W;
+    for (auto* v : {&sc.s, &sc.t, &sc.u, &sc.rx, &sc.ry, &sc.rz}) v->resize(c);
+    for (auto* v : {&sc.cell, &sc.order, &sc.position}) v->resize(c);
     sc.count.resize(static_cast<std::size_t>(K.cell_count) + 2);
   }
   auto work = [&](std::size_t part) {
@@ -420,11 +544,17 @@ Eigen::Vector3d deform_point(const FrozenLattice& lattice, const Eigen::Vector3d
 Points3 deform_points(const FrozenLattice& lattice, const Points3& points,
                       const DeformOptions& options) {
   Points3 out(points.rows(), 3);
+  deform_points(lattice, points, out, options);
+  return out;
+}
+
+void deform_points(const FrozenLattice& lattice, const Points3& points, Points3& out,
+                   const DeformOptions& options) {
+  if (&out != &points && out.rows() != points.rows()) out.resize(points.rows(), 3);
   const double* in = points.data();
   double* o = out.data();
   run(lattice, Io{{in, in + 1, in + 2}, {o, o + 1, o + 2}}, static_cast<std::size_t>(points.rows()),
       true, options);
-  return out;
 }
 
 void deform_points(const FrozenLattice& lattice, PointColumns in, MutablePointColumns out,

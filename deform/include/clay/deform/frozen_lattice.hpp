@@ -60,6 +60,11 @@ Eigen::Vector3d deform_point(const FrozenLattice& lattice, const Eigen::Vector3d
 Points3 deform_points(const FrozenLattice& lattice, const Points3& points,
                       const DeformOptions& options = {});
 
+/// Same into `out` (resized to points.rows() x 3 when needed, so a reused buffer costs no
+/// allocation). `out` may be `points` itself.
+void deform_points(const FrozenLattice& lattice, const Points3& points, Points3& out,
+                   const DeformOptions& options = {});
+
 /// Structure-of-arrays form: writes the deformed in[i] to out[i]. `out` may be `in` itself.
 /// Throws clay::Error(InvalidArgument) for columns of different sizes or bad options.
 void deform_points(const FrozenLattice& lattice, PointColumns in, MutablePointColumns out,
