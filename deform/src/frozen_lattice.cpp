@@ -252,8 +252,10 @@ template <int L, int M, int N, int Stride>
     s = fs - __builtin_convertvector(a, vd);
     t = ft - __builtin_convertvector(b, vd);
     u = fu - __builtin_convertvector(c, vd);
-    const vi id = (a * K.cells[1] + b) * K.cells[2] + c;
-    cell = out <= tol ? id : vi{} + K.cell_count;
+    // The cell number in doubles (exact: small integers), then one conversion.
+    const vd id = (__builtin_convertvector(a, vd) * K.cells[1] + __builtin_convertvector(b, vd)) * K.cells[2] +
+                  __builtin_convertvector(c, vd);
+    cell = __builtin_convertvector(out <= tol ? id : vd{} + K.cell_count, vi);
     return;
   }
   for (int q = 0; q < W; ++q) {
@@ -288,6 +290,7 @@ template <int L, int M, int N, int Stride>
   const int outside = K.cell_count;
   for (std::size_t c0 = begin; c0 < end; c0 += chunk_points) {
     const std::size_t n = std::min(chunk_points, end - c0);
+    std::fill(count, count + outside + 2, 0);
     // 1. Local coordinates and cells, a block at a time.
     for (std::size_t b = 0; b < n; b += W) {
       const std::size_t cnt = std::min<std::size_t>(W, n - b);
@@ -309,10 +312,9 @@ template <int L, int M, int N, int Stride>
       store(U + b, u);
       const auto narrow = __builtin_convertvector(cl, vi32);
       std::memcpy(cell + b, &narrow, sizeof narrow);
+      for (std::size_t q = 0; q < cnt; ++q) ++count[narrow[q] + 1];  // histogram
     }
     // 2. Counting sort by cell (indices only: one store per point into an L1-sized array).
-    std::fill(count, count + outside + 2, 0);
-    for (std::size_t i = 0; i < n; ++i) ++count[cell[i] + 1];
     for (int c = 0; c <= outside; ++c) count[c + 1] += count[c];  // count[c] = start of cell c
     for (std::size_t i = 0; i < n; ++i) {
       const std::int32_t p = count[cell[i]]++;
