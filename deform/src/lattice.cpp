@@ -29,6 +29,15 @@ std::string format(double v) {
   return m.str();
 }
 
+/// std::isfinite on every coordinate (Eigen's allFinite computes x − x, which raises FE_INVALID
+/// on an infinity where floating-point traps are on).
+template <class V>
+bool finite(const V& v) {
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (!std::isfinite(v(i))) return false;
+  return true;
+}
+
 [[noreturn]] void throw_problems(ErrorCategory category, const std::vector<std::string>& list) {
   std::string text;
   for (size_t k = 0; k < list.size(); ++k) text += (k ? "; " : "") + list[k];
@@ -58,7 +67,7 @@ void point_problems(const Points3& points, std::array<int, 3> counts, std::strin
     return;
   }
   for (Eigen::Index r = 0; r < points.rows(); ++r)
-    if (!points.row(r).allFinite()) {
+    if (!finite(points.row(r))) {
       const int k = static_cast<int>(r % counts[2]);
       const int j = static_cast<int>((r / counts[2]) % counts[1]);
       const int i = static_cast<int>(r / (static_cast<Eigen::Index>(counts[1]) * counts[2]));
@@ -107,7 +116,7 @@ std::vector<std::string> problems(const Frame& frame, std::string_view name) {
   const std::pair<const char*, const Eigen::Vector3d*> vectors[4] = {
       {"origin X0", &frame.origin}, {"edge S", &frame.s}, {"edge T", &frame.t}, {"edge U", &frame.u}};
   for (const auto& [what, v] : vectors)
-    if (!v->allFinite())
+    if (!finite(*v))
       out.push_back(n + ": " + what + " " + format(*v) + " is not finite; give finite coordinates");
   if (!out.empty()) return out;
   for (int d = 1; d < 4; ++d)
@@ -139,8 +148,9 @@ Eigen::Vector3d local_coordinates(const Frame& frame, const Eigen::Vector3d& x) 
 }
 
 bool inside(const Eigen::Vector3d& local) noexcept {
-  for (int d = 0; d < 3; ++d)
-    if (!(local[d] >= -face_tolerance && local[d] <= 1 + face_tolerance)) return false;
+  for (int d = 0; d < 3; ++d)  // isfinite first: no ordered comparison with NaN
+    if (!std::isfinite(local[d]) || local[d] < -face_tolerance || local[d] > 1 + face_tolerance)
+      return false;
   return true;
 }
 
