@@ -55,8 +55,8 @@ struct Io {
 
 /// Per-thread scratch of the B-spline path (allocated once per call, never per point).
 struct Scratch {
-  std::vector<double> s, t, u, rx, ry, rz;
-  std::vector<std::int32_t> cell, order, position, count;
+  std::vector<double> s, t, u;
+  std::vector<std::int32_t> cell, order, count;
 };
 
 // ---- block kernels (always inlined into the cloned drivers below) ---------------------------
@@ -112,6 +112,20 @@ template <int Stride>
     __builtin_prefetch(io.in[0] + first);
     __builtin_prefetch(io.in[1] + first);
     __builtin_prefetch(io.in[2] + first);
+  }
+}
+
+/// Output of a block ahead, fetched for writing (the stores then do not wait for the lines).
+template <int Stride>
+[[gnu::always_inline]] inline void prefetch_output(const Io& io, std::size_t first) {
+  if constexpr (Stride == 3) {
+    __builtin_prefetch(io.out[0] + first * 3, 1);
+    __builtin_prefetch(io.out[0] + first * 3 + W, 1);
+    __builtin_prefetch(io.out[0] + first * 3 + 2 * W, 1);
+  } else {
+    __builtin_prefetch(io.out[0] + first, 1);
+    __builtin_prefetch(io.out[1] + first, 1);
+    __builtin_prefetch(io.out[2] + first, 1);
   }
 }
 
@@ -192,6 +206,7 @@ template <int L, int M, int N, int Stride>
   std::size_t b = begin;
   for (; b + W <= end; b += W) {
     prefetch_block<Stride>(io, b + prefetch_distance);
+    prefetch_output<Stride>(io, b + prefetch_distance);
     load_block<Stride>(io, b, x, y, z);
     local_block(K, x, y, z, s, t, u, out);
     horner_block<L, M, N>(K, K.coef, s, t, u, r);
@@ -275,23 +290,19 @@ template <int L, int M, int N, int Stride>
                                                  std::size_t end, Scratch& sc) {
   vd x, y, z, s, t, u, r[3], out;
   vi cl;
-  // In-cell coordinates in input order, results in sorted order (W spare entries: the last
-  // partial block of a cell spills over), cells, sorted order and sorted position of each point.
+  // In-cell coordinates of the chunk in input order, overwritten by each point's result; cells;
+  // the order sorted by cell (W spare entries for the last cell's partial block).
   double* S = sc.s.data();
   double* T = sc.t.data();
   double* U = sc.u.data();
-  double* RX = sc.rx.data();
-  double* RY = sc.ry.data();
-  double* RZ = sc.rz.data();
   std::int32_t* cell = sc.cell.data();
   std::int32_t* order = sc.order.data();
-  std::int32_t* position = sc.position.data();
   std::int32_t* count = sc.count.data();  // cell_count + 2 entries
   const int outside = K.cell_count;
   for (std::size_t c0 = begin; c0 < end; c0 += chunk_points) {
     const std::size_t n = std::min(chunk_points, end - c0);
     std::fill(count, count + outside + 2, 0);
-    // 1. Local coordinates and cells, a block at a time.
+    // 1. Local coordinates and cells, a block at a time, and the histogram of cells.
     for (std::size_t b = 0; b < n; b += W) {
       const std::size_t cnt = std::min<std::size_t>(W, n - b);
       if (cnt == W) {
@@ -312,18 +323,14 @@ template <int L, int M, int N, int Stride>
       store(U + b, u);
       const auto narrow = __builtin_convertvector(cl, vi32);
       std::memcpy(cell + b, &narrow, sizeof narrow);
-      for (std::size_t q = 0; q < cnt; ++q) ++count[narrow[q] + 1];  // histogram
+      for (std::size_t q = 0; q < cnt; ++q) ++count[narrow[q] + 1];
     }
-    // 2. Counting sort by cell (indices only: one store per point into an L1-sized array).
+    // 2. Counting sort by cell (indices only: one store per point into a small array).
     for (int c = 0; c <= outside; ++c) count[c + 1] += count[c];  // count[c] = start of cell c
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::int32_t p = count[cell[i]]++;
-      order[p] = static_cast<std::int32_t>(i);
-      position[i] = p;
-    }
-    for (std::size_t p = n; p < n + W; ++p) order[p] = order[n - 1];  // spill-over lanes
+    for (std::size_t i = 0; i < n; ++i) order[count[cell[i]]++] = static_cast<std::int32_t>(i);
+    for (std::size_t p = n; p < n + W; ++p) order[p] = order[n - 1];  // spare lanes
     // Now count[c] = end of cell c. 3. Blocks within one cell, coefficients broadcast; a last
-    // partial block spills into the next cell's slots, which that cell then overwrites.
+    // partial block reads (but does not write) points of the next cell, not yet evaluated.
     int start = 0;
     for (int c = 0; c < outside; ++c) {
       const int stop = count[c];
@@ -336,22 +343,24 @@ template <int L, int M, int N, int Stride>
           u[q] = U[i];
         }
         horner_block<L, M, N>(K, coef, s, t, u, r);
-        store(RX + b, r[0]);
-        store(RY + b, r[1]);
-        store(RZ + b, r[2]);
+        const int cnt = std::min(W, stop - b);
+        for (int q = 0; q < cnt; ++q) {  // the result replaces the point's coordinates
+          const std::int32_t i = order[b + q];
+          S[i] = r[0][q];
+          T[i] = r[1][q];
+          U[i] = r[2][q];
+        }
       }
       start = stop;
     }
-    // 4. Back to the input order; points outside are copied unchanged.
+    // 4. Results in input order; points outside are copied unchanged.
+    const bool any_outside = start < count[outside];
     for (std::size_t b = 0; b < n; b += W) {
       const std::size_t cnt = std::min<std::size_t>(W, n - b);
-      for (std::size_t q = 0; q < W; ++q) {
-        const std::int32_t p = position[b + std::min(q, cnt - 1)];
-        x[q] = RX[p];
-        y[q] = RY[p];
-        z[q] = RZ[p];
-      }
-      if (start < count[outside]) {  // some points of the chunk are outside
+      load(x, S + b);
+      load(y, T + b);
+      load(z, U + b);
+      if (any_outside) {
         for (std::size_t q = 0; q < cnt; ++q)
           if (cell[b + q] == outside) {
             const std::size_t i = c0 + b + q;
@@ -361,6 +370,7 @@ template <int L, int M, int N, int Stride>
           }
       }
       if (cnt == W) {
+        prefetch_output<Stride>(io, c0 + b + prefetch_distance);
         store_block<Stride>(io, c0 + b, x, y, z);
       } else {
         for (std::size_t q = 0; q < cnt; ++q) {
@@ -509,8 +519,8 @@ void run(const FrozenLattice& lattice, const Io& io, std::size_t n, bool rows,
   for (auto& sc : scratch) {
     // Whole blocks plus W spare entries (the last partial block of a cell spills over).
     const std::size_t c = (std::min(chunk_points, n) + W - 1) / W * W + W;
-    for (auto* v : {&sc.s, &sc.t, &sc.u, &sc.rx, &sc.ry, &sc.rz}) v->resize(c);
-    for (auto* v : {&sc.cell, &sc.order, &sc.position}) v->resize(c);
+    for (auto* v : {&sc.s, &sc.t, &sc.u}) v->resize(c);
+    for (auto* v : {&sc.cell, &sc.order}) v->resize(c);
     sc.count.resize(static_cast<std::size_t>(K.cell_count) + 2);
   }
   auto work = [&](std::size_t part) {
