@@ -17,7 +17,7 @@ enum class Face { s_min, s_max, t_min, t_max, u_min, u_max };
 
 /// C^order continuity with the undeformed space across one face.
 struct FaceContinuity {
-  Face face = Face::s_min;
+  Face face = Face::s_min;  ///< the face across which the continuity holds
   int order = 1;  ///< k of C^k, 0 <= k <= degree in the face's normal direction
 };
 

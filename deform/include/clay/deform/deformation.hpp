@@ -23,13 +23,13 @@ struct DeformOptions {
 
 /// Read-only structure-of-arrays points: x[i], y[i], z[i] (mm), three spans of equal size.
 struct PointColumns {
-  std::span<const double> x, y, z;
+  std::span<const double> x, y, z;  ///< coordinates (mm), same size
 };
 
 /// Writable structure-of-arrays points, three spans of equal size. May be the very same buffers
 /// as the input of deform_points (in-place), but must not overlap them otherwise.
 struct MutablePointColumns {
-  std::span<double> x, y, z;
+  std::span<double> x, y, z;  ///< coordinates (mm), same size
 };
 
 /// A deformation of space: one point at a time and many at once.

@@ -18,8 +18,8 @@ namespace clay::deform {
 /// A scalar trivariate Bernstein polynomial on the unit cube: degrees (a, b, c) and coefficient
 /// c_ijk at (i (b+1) + j)(c+1) + k of `coefficients` (the lattice's s-major order).
 struct BernsteinVolume {
-  std::array<int, 3> degrees{0, 0, 0};
-  Eigen::VectorXd coefficients;
+  std::array<int, 3> degrees{0, 0, 0};  ///< degrees along s, t, u (>= 0)
+  Eigen::VectorXd coefficients;         ///< (a+1)(b+1)(c+1) Bernstein coefficients, s-major
 };
 
 /// Value at local coordinates (s, t, u) in [0, 1]^3 by de Casteljau's algorithm.

@@ -68,7 +68,7 @@ bool inside(const Eigen::Vector3d& local) noexcept;
 /// A trivariate Bernstein FFD: degrees (l, m, n) and (l+1)(m+1)(n+1) control points P_ijk,
 /// row (i (m+1) + j)(n+1) + k of `points` (mm). Deforms a point by Sederberg–Parry eq. (2).
 struct BezierLattice {
-  Frame frame;
+  Frame frame;                          ///< the parallelepiped (local coordinates, eq. (1))
   std::array<int, 3> degrees{1, 1, 1};  ///< l, m, n (along S, T, U), each >= 1
   Points3 points;                       ///< P_ijk, s-major as above
 
@@ -124,7 +124,7 @@ enum class LatticeKnots {
 /// B-spline parameters), and bases[0].count() * bases[1].count() * bases[2].count() control
 /// points, row (i * count_t + j) * count_u + k (mm).
 struct BSplineLattice {
-  Frame frame;
+  Frame frame;                                 ///< the parallelepiped (local coordinates, eq. (1))
   std::array<surface::BSplineBasis, 3> bases;  ///< along S, T, U; domains exactly [0, 1]
   Points3 points;                              ///< P_ijk, s-major as above
 
