@@ -1,0 +1,43 @@
+#pragma once
+/// What every deformation of space offers, so that lattices, and later extended lattices,
+/// regular deformations and deformation stacks, can be used alike: a one-off
+/// `deform_point(d, x)` and a bulk `deform_points(d, points, options)` on an N x 3 row-major
+/// matrix (and on structure-of-arrays columns). The PointDeformation concept checks both.
+#include <clay/surface/bspline_curve.hpp>
+
+#include <Eigen/Core>
+
+#include <concepts>
+#include <span>
+
+namespace clay::deform {
+
+/// Settings of deform_points().
+struct DeformOptions {
+  int threads = 0;  ///< worker threads, >= 0; 0 = std::thread::hardware_concurrency(). Fewer are
+                    ///< used when there are few points (at least 16,384 points per thread).
+
+  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  void validate() const;
+};
+
+/// Read-only structure-of-arrays points: x[i], y[i], z[i] (mm), three spans of equal size.
+struct PointColumns {
+  std::span<const double> x, y, z;  ///< coordinates (mm), same size
+};
+
+/// Writable structure-of-arrays points, three spans of equal size. May be the very same buffers
+/// as the input of deform_points (in-place), but must not overlap them otherwise.
+struct MutablePointColumns {
+  std::span<double> x, y, z;  ///< coordinates (mm), same size
+};
+
+/// A deformation of space: one point at a time and many at once.
+template <class D>
+concept PointDeformation = requires(const D& d, const Eigen::Vector3d& x,
+                                    const surface::Points3& points, const DeformOptions& options) {
+  { deform_point(d, x) } -> std::convertible_to<Eigen::Vector3d>;
+  { deform_points(d, points, options) } -> std::convertible_to<surface::Points3>;
+};
+
+}  // namespace clay::deform

@@ -1,0 +1,79 @@
+// Every bad input raises clay::Error naming the culprit and the fix.
+#include <catch2/catch.hpp>
+
+#include <clay/deform.hpp>
+
+#include <limits>
+#include <vector>
+
+#include "error_of.hpp"
+
+using namespace clay::deform;
+using clay::ErrorCategory;
+using clay::test::error_of;
+using Catch::Matchers::Contains;
+
+TEST_CASE("a zero-volume frame is rejected", "[deform]") {
+  Frame f;
+  f.u = f.s + 2 * f.t;  // coplanar with S and T
+  const auto [category, what] = error_of([&] { make_bezier_lattice(f, {2, 2, 2}); });
+  CHECK(category == ErrorCategory::InvalidGeometry);
+  CHECK_THAT(what, Contains("coplanar") && Contains("zero volume") && Contains("independent edge"));
+  CHECK(error_of([&] { make_bspline_lattice(f, {3, 3, 3}, {2, 2, 2}); }).first == ErrorCategory::InvalidGeometry);
+}
+
+TEST_CASE("a degree below one is rejected", "[deform]") {
+  const auto [category, what] = error_of([] { make_bezier_lattice(Frame{}, {3, 0, 3}); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(what, Contains("degree along t = 0") && Contains("1 <= degree"));
+  BezierLattice L = make_bezier_lattice(Frame{}, {2, 2, 2});
+  L.degrees[2] = 0;
+  CHECK_THAT(error_of([&] { validate(L); }).second, Contains("degree along u = 0"));
+}
+
+TEST_CASE("a wrong control point count is rejected", "[deform]") {
+  BSplineLattice S = make_bspline_lattice(Frame{}, {3, 3, 3}, {2, 2, 2});
+  S.points.conservativeResize(S.points.rows() - 1, 3);
+  const auto [category, what] = error_of([&] { FrozenLattice{S}; });
+  CHECK(category == ErrorCategory::InvalidGeometry);
+  CHECK_THAT(what, Contains("124 control points") && Contains("5 x 5 x 5 = 125"));
+}
+
+TEST_CASE("non-finite values are rejected naming the control point or the frame vector", "[deform]") {
+  BezierLattice L = make_bezier_lattice(Frame{}, {2, 3, 1});
+  L.points(L.index(1, 2, 0), 1) = std::numeric_limits<double>::quiet_NaN();
+  const auto [category, what] = error_of([&] { jacobian_bounds(L); });
+  CHECK(category == ErrorCategory::InvalidGeometry);
+  CHECK_THAT(what, Contains("P_1,2,0") && Contains("not finite"));
+  Frame f;
+  f.origin.x() = std::numeric_limits<double>::infinity();
+  CHECK_THAT(error_of([&] { make_bezier_lattice(f, {1, 1, 1}); }).second, Contains("origin X0"));
+}
+
+TEST_CASE("bad options and arguments are rejected naming the field", "[deform]") {
+  const BezierLattice L = make_bezier_lattice(Frame{}, {1, 1, 1});
+  const Points3 p = Points3::Zero(4, 3);
+  const auto [category, what] = error_of([&] { deform_points(L, p, DeformOptions{-1}); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(what, Contains("DeformOptions::threads = -1") && Contains("0 <= threads"));
+  CHECK_THAT(error_of([] { make_bspline_lattice(Frame{}, {3, 3, 3}, {2, 0, 2}); }).second,
+             Contains("cells along t = 0"));
+  const FaceContinuity too_smooth[] = {{Face::t_min, 4}};
+  CHECK_THAT(error_of([&] { locked_control_points(L, too_smooth); }).second,
+             Contains("FaceContinuity{t_min}.order = 4") && Contains("0 <= order <= 1"));
+  std::vector<double> a(3), b(2);
+  CHECK_THAT(error_of([&] {
+               deform_points(FrozenLattice(L), PointColumns{a, a, a}, MutablePointColumns{a, a, b});
+             }).second,
+             Contains("same size"));
+}
+
+TEST_CASE("a B-spline basis whose domain is not the unit interval is rejected", "[deform]") {
+  auto basis = clay::surface::clamped_uniform_basis(2, 4, 0.0, 2.0);
+  const auto [category, what] = error_of([&] {
+    make_bspline_lattice(Frame{}, {clay::surface::clamped_uniform_basis(2, 4), basis,
+                                   clay::surface::clamped_uniform_basis(2, 4)});
+  });
+  CHECK(category == ErrorCategory::InvalidGeometry);
+  CHECK_THAT(what, Contains("t basis") && Contains("is not [0, 1]"));
+}
