@@ -15,6 +15,23 @@ using clay::test::random_frame;
 using clay::test::sample_points;
 using clay::test::size_of;
 
+namespace {
+
+/// Largest |f(x) - g(x)| / size over the rows of `points`.
+template <class F, class G>
+double worst_difference(const clay::surface::Points3& points, double size, F f, G g) {
+  double worst = 0;
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    const Eigen::Vector3d x = points.row(r).transpose();
+    worst = std::max(worst, (f(x) - g(x)).norm() / size);
+  }
+  return worst;
+}
+
+Eigen::Vector3d same(const Eigen::Vector3d& x) { return x; }
+
+}  // namespace
+
 TEST_CASE("local coordinates invert X = X0 + sS + tT + uU (Sederberg-Parry eq. 1)", "[deform]") {
   std::mt19937 rng(1);
   for (bool left : {false, true}) {
@@ -50,11 +67,7 @@ TEST_CASE("undisplaced Bezier lattices are the identity", "[deform]") {
       const BezierLattice L = make_bezier_lattice(random_frame(rng, left), degrees);
       const double size = size_of(L.points);
       const auto points = sample_points(L.frame, rng, 200);
-      double worst = 0;
-      for (Eigen::Index r = 0; r < points.rows(); ++r) {
-        const Eigen::Vector3d x = points.row(r).transpose();
-        worst = std::max(worst, (deform_point(L, x) - x).norm() / size);
-      }
+      const double worst = worst_difference(points, size, [&](const Eigen::Vector3d& x) { return deform_point(L, x); }, same);
       INFO("degrees " << degrees[0] << degrees[1] << degrees[2] << " relative error " << worst);
       CHECK(worst < 1e-12);
     }
@@ -73,11 +86,7 @@ TEST_CASE("undisplaced B-spline lattices are the identity, clamped, uniform and 
       const BSplineLattice L = make_bspline_lattice(random_frame(rng), c.degrees, c.cells, knots);
       const double size = size_of(L.points);
       const auto points = sample_points(L.frame, rng, 200);
-      double worst = 0;
-      for (Eigen::Index r = 0; r < points.rows(); ++r) {
-        const Eigen::Vector3d x = points.row(r).transpose();
-        worst = std::max(worst, (deform_point(L, x) - x).norm() / size);
-      }
+      const double worst = worst_difference(points, size, [&](const Eigen::Vector3d& x) { return deform_point(L, x); }, same);
       INFO("relative error " << worst);
       CHECK(worst < 1e-12);
     }
@@ -125,11 +134,8 @@ TEST_CASE("a Bezier lattice equals the one-cell clamped B-spline lattice", "[def
     S.points = B.points;  // same storage order, same control points
     const double size = size_of(B.points);
     const auto points = sample_points(f, rng, 300);
-    double worst = 0;
-    for (Eigen::Index r = 0; r < points.rows(); ++r) {
-      const Eigen::Vector3d x = points.row(r).transpose();
-      worst = std::max(worst, (deform_point(B, x) - deform_point(S, x)).norm() / size);
-    }
+    const double worst = worst_difference(points, size, [&](const Eigen::Vector3d& x) { return deform_point(B, x); },
+                                          [&](const Eigen::Vector3d& x) { return deform_point(S, x); });
     INFO("relative difference " << worst);
     CHECK(worst < 1e-12);
   }
