@@ -9,3 +9,4 @@
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/lattice.hpp>
+#include <clay/deform/style.hpp>
