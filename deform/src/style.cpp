@@ -37,8 +37,10 @@ void StyleOptions::validate() const {
   };
   if (!(lambda >= 0 && lambda <= 1))
     fail("lambda = " + std::to_string(lambda) + " must lie in [0, 1] (Han et al. eq. 9)");
-  if (curve_samples < 8)
-    fail("curve_samples = " + std::to_string(curve_samples) + " must be >= 8");
+  if (curve_samples != 0 && curve_samples < 8)
+    fail("curve_samples = " + std::to_string(curve_samples) + " must be 0 (automatic) or >= 8");
+  if (bound_samples < 8)
+    fail("bound_samples = " + std::to_string(bound_samples) + " must be >= 8");
   if (key_points_per_row < 1)
     fail("key_points_per_row = " + std::to_string(key_points_per_row) + " must be >= 1");
   if (boundary_rows < 0 || boundary_rows > 4)
@@ -56,21 +58,25 @@ int InfluenceRegion::inside_count() const noexcept {
 
 namespace detail {
 
-std::vector<TraceSample> trace_on_surface(const BSplineSurface& surface, const BSplineCurve& curve,
-                                          int count, const surface::ProjectionOptions& options) {
+std::vector<TraceSample> trace_on_surface(const surface::SurfaceProjector& projector,
+                                          const BSplineCurve& curve, int count,
+                                          const std::vector<Eigen::Vector2d>* warm) {
   const auto [a, b] = curve.basis.domain();
   const auto ts = surface::linspace(a, b, count);
   std::vector<TraceSample> out(ts.size());
+  const bool have_warm = warm && warm->size() == ts.size();
   for (size_t k = 0; k < ts.size(); ++k) {
     TraceSample& s = out[k];
     s.t = ts[k];
     s.point = surface::evaluate(curve, s.t);
     surface::SurfaceProjection p;
-    if (k == 0) {
-      p = surface::closest_point(surface, s.point, options);
+    if (k == 0 && !have_warm) {
+      p = projector.closest_point(s.point);
     } else {
-      p = surface::project_normal(surface, s.point, out[k - 1].u, out[k - 1].v, options);
-      if (!p.summary.converged()) p = surface::closest_point(surface, s.point, options);
+      // Newton from the previous sample, or from the same sample of the previous drag position.
+      const Eigen::Vector2d start = have_warm ? (*warm)[k] : Eigen::Vector2d(out[k - 1].u, out[k - 1].v);
+      p = projector.project_normal(s.point, start.x(), start.y());
+      if (!p.summary.converged()) p = projector.closest_point(s.point);
     }
     s.u = p.u;
     s.v = p.v;
@@ -78,18 +84,53 @@ std::vector<TraceSample> trace_on_surface(const BSplineSurface& surface, const B
   return out;
 }
 
-bool inside_polygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p,
-                    double on_edge_tolerance) {
-  int winding = 0;
+PolygonLocator::PolygonLocator(const std::vector<Eigen::Vector2d>& polygon, double on_edge_tolerance)
+    : polygon_(&polygon), tolerance_(on_edge_tolerance) {
+  if (polygon.empty()) return;
+  y_lo_ = 1e300;
+  double y_hi = -1e300;
+  for (const auto& p : polygon) {
+    y_lo_ = std::min(y_lo_, p.y());
+    y_hi = std::max(y_hi, p.y());
+  }
+  y_lo_ -= tolerance_;
+  y_hi += tolerance_;
+  const int bins = std::max(1, static_cast<int>(polygon.size() / 4));
+  inverse_height_ = bins / std::max(y_hi - y_lo_, 1e-300);
+  bins_.resize(static_cast<size_t>(bins));
   const size_t n = polygon.size();
   for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector2d& a = polygon[i];
-    const Eigen::Vector2d& b = polygon[(i + 1) % n];
-    const Eigen::Vector2d ab = b - a;
-    const double len2 = ab.squaredNorm();
-    const double s = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-    if ((a + s * ab - p).norm() <= on_edge_tolerance) return true;
-    const double side = ab.x() * (p.y() - a.y()) - ab.y() * (p.x() - a.x());
+    const double a = polygon[i].y(), b = polygon[(i + 1) % n].y();
+    const int first = bin_of(std::min(a, b) - tolerance_), last = bin_of(std::max(a, b) + tolerance_);
+    for (int k = first; k <= last; ++k) bins_[static_cast<size_t>(k)].push_back(static_cast<int>(i));
+  }
+}
+
+int PolygonLocator::bin_of(double y) const noexcept {
+  const double f = (y - y_lo_) * inverse_height_;
+  const int last = static_cast<int>(bins_.size()) - 1;
+  if (!(f > 0)) return 0;
+  return f >= last ? last : static_cast<int>(f);
+}
+
+bool PolygonLocator::inside(const Eigen::Vector2d& p) const {
+  if (bins_.empty() || p.y() < y_lo_ || p.y() > y_lo_ + static_cast<double>(bins_.size()) / inverse_height_)
+    return false;
+  // Winding number: only edges whose y-range holds p.y can cross the ray, and those are in p's
+  // bin; so are the edges p can lie on.
+  const auto& poly = *polygon_;
+  const size_t n = poly.size();
+  int winding = 0;
+  for (int i : bins_[static_cast<size_t>(bin_of(p.y()))]) {
+    const Eigen::Vector2d& a = poly[static_cast<size_t>(i)];
+    const Eigen::Vector2d& b = poly[(static_cast<size_t>(i) + 1) % n];
+    if (p.x() >= std::min(a.x(), b.x()) - tolerance_ && p.x() <= std::max(a.x(), b.x()) + tolerance_) {
+      const Eigen::Vector2d ab = b - a;
+      const double len2 = ab.squaredNorm();
+      const double s = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+      if ((a + s * ab - p).norm() <= tolerance_) return true;
+    }
+    const double side = (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
     if (a.y() <= p.y()) {
       if (b.y() > p.y() && side > 0) ++winding;
     } else if (b.y() <= p.y() && side < 0) {
@@ -97,6 +138,18 @@ bool inside_polygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Ve
     }
   }
   return winding != 0;
+}
+
+int target_samples(const BSplineCurve& target, const StyleOptions& options) {
+  if (options.curve_samples > 0) return options.curve_samples;
+  const int spans = static_cast<int>(surface::breakpoints(target.basis).size()) - 1;
+  return std::clamp(16 * spans, 32, 4096);
+}
+
+double parameter_tolerance(const BSplineSurface& s) {
+  const auto [u0, u1] = s.u.domain();
+  const auto [v0, v1] = s.v.domain();
+  return 1e-12 * std::max(u1 - u0, v1 - v0);
 }
 
 std::vector<std::uint8_t> region_factors(const BSplineSurface& surface,
@@ -109,13 +162,11 @@ std::vector<std::uint8_t> region_factors(const BSplineSurface& surface,
     // Han et al. eq. 2: E = 1 where φ(u_j, v_j) <= 0, at the Greville point of the vertex.
     const auto xu = surface::greville_abscissae(surface.u);
     const auto xv = surface::greville_abscissae(surface.v);
-    const auto [u0, u1] = surface.u.domain();
-    const auto [v0, v1] = surface.v.domain();
-    const double tol = 1e-12 * std::max(u1 - u0, v1 - v0);
+    const PolygonLocator locator(polygon, parameter_tolerance(surface));
     for (int i = 0; i < nu; ++i)
       for (int j = 0; j < nv; ++j)
         e[static_cast<size_t>(surface.index(i, j))] =
-            inside_polygon(polygon, {xu[static_cast<size_t>(i)], xv[static_cast<size_t>(j)]}, tol) ? 1 : 0;
+            locator.inside({xu[static_cast<size_t>(i)], xv[static_cast<size_t>(j)]}) ? 1 : 0;
     return e;
   }
   // §5: the vertices whose basis functions support a point of the projected target, widened by
@@ -163,20 +214,33 @@ surface::SurfaceProjection project_from(const BSplineSurface& s, const Eigen::Ve
   return p;
 }
 
-// Whether the sample lies in the region: inside the bound polygon, or anywhere when the region
-// was made from the target itself.
-bool sample_inside(const InfluenceRegion& region, const BSplineSurface& s, double u, double v) {
-  if (region.polygon.empty()) return true;
-  const auto [u0, u1] = s.u.domain();
-  const auto [v0, v1] = s.v.domain();
-  return inside_polygon(region.polygon, {u, v}, 1e-12 * std::max(u1 - u0, v1 - v0));
+// Same with a prepared projector.
+surface::SurfaceProjection project_from(const surface::SurfaceProjector& projector,
+                                        const Eigen::Vector3d& x, double u, double v) {
+  auto p = projector.project_normal(x, u, v);
+  if (!p.summary.converged()) p = projector.closest_point(x);
+  return p;
 }
+
+// Whether a sample lies in the region: inside the bound polygon, or anywhere when the region was
+// made from the target itself.
+class RegionTest {
+ public:
+  RegionTest(const InfluenceRegion& region, const BSplineSurface& s)
+      : bounded_(!region.polygon.empty()), locator_(region.polygon, parameter_tolerance(s)) {}
+  bool operator()(double u, double v) const { return !bounded_ || locator_.inside({u, v}); }
+
+ private:
+  bool bounded_;
+  PolygonLocator locator_;
+};
 
 }  // namespace
 
-KeyPoints find_key_points(const BSplineSurface& s, const InfluenceRegion& region,
+KeyPoints find_key_points(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
                           const BSplineCurve& target, const std::vector<TraceSample>& trace,
-                          int per_row, const StyleOptions& options) {
+                          int per_row) {
+  const BSplineSurface& s = projector.surface();
   KeyPoints out;
   const auto xu = surface::greville_abscissae(s.u);
   const auto xv = surface::greville_abscissae(s.v);
@@ -184,13 +248,14 @@ KeyPoints find_key_points(const BSplineSurface& s, const InfluenceRegion& region
   // Han et al. eq. 8: the direction is the one in which the target covers more rows of the net.
   double gu_lo = 1e300, gu_hi = -1e300, gv_lo = 1e300, gv_hi = -1e300;
   int inside = 0;
+  const RegionTest sample_inside(region, s);
   for (const TraceSample& t : trace) {
     const double gu = continuous_index(xu, t.u), gv = continuous_index(xv, t.v);
     gu_lo = std::min(gu_lo, gu);
     gu_hi = std::max(gu_hi, gu);
     gv_lo = std::min(gv_lo, gv);
     gv_hi = std::max(gv_hi, gv);
-    inside += sample_inside(region, s, t.u, t.v) ? 1 : 0;
+    inside += sample_inside(t.u, t.v) ? 1 : 0;
   }
   out.direction = (gu_hi - gu_lo >= gv_hi - gv_lo) ? KeyDirection::u : KeyDirection::v;
   out.constraint_class = inside == 0 ? ConstraintClass::over_constrained
@@ -256,7 +321,7 @@ KeyPoints find_key_points(const BSplineSurface& s, const InfluenceRegion& region
     int side = 0;
     for (int it = 0; it < 100; ++it) {
       t = (fa * tb - fb * ta) / (fa - fb);
-      const auto p = project_from(s, surface::evaluate(target, t), u, v, options.projection);
+      const auto p = project_from(projector, surface::evaluate(target, t), u, v);
       u = p.u;
       v = p.v;
       const double f = coord(u, v) - c;
@@ -311,9 +376,14 @@ void measure(const BSplineSurface& parent, const BSplineSurface& result,
     report.target_deviation = std::max(report.target_deviation, p.distance);
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  report.target_curve_deviation = nan;
+  report.boundary_position_jump = nan;
+  report.boundary_tangent_angle = nan;
+  if (!options.report_curves) return;
   report.target_curve_deviation = samples.empty() ? nan : 0.0;
+  const RegionTest sample_inside(region, parent);
   for (const TraceSample& t : samples) {
-    if (!sample_inside(region, parent, t.u, t.v)) continue;
+    if (!sample_inside(t.u, t.v)) continue;
     const auto p = project_from(result, t.point, t.u, t.v, options.projection);
     report.target_curve_deviation = std::max(report.target_curve_deviation, p.distance);
   }
@@ -412,7 +482,8 @@ InfluenceRegion influence_factors(const BSplineSurface& parent, const BSplineCur
         << " mm apart; a bound curve must be closed (make its last point equal its first)";
     throw Error(ErrorCategory::InvalidGeometry, msg.str());
   }
-  const auto trace = detail::trace_on_surface(parent, bound, options.curve_samples, options.projection);
+  const surface::SurfaceProjector projector(parent, options.projection);
+  const auto trace = detail::trace_on_surface(projector, bound, options.bound_samples, nullptr);
   InfluenceRegion region;
   region.count_u = parent.count_u();
   region.count_v = parent.count_v();
@@ -435,7 +506,8 @@ InfluenceRegion influence_factors(const BSplineSurface& parent, const BSplineCur
 InfluenceRegion influence_from_target(const BSplineSurface& parent, const BSplineCurve& target,
                                       const StyleOptions& options) {
   check_inputs(parent, target, "target curve", options);
-  const auto trace = detail::trace_on_surface(parent, target, options.curve_samples, options.projection);
+  const surface::SurfaceProjector projector(parent, options.projection);
+  const auto trace = detail::trace_on_surface(projector, target, detail::target_samples(target, options), nullptr);
   std::vector<Eigen::Vector2d> uv;
   uv.reserve(trace.size());
   for (const auto& t : trace) uv.emplace_back(t.u, t.v);
@@ -452,18 +524,36 @@ KeyPoints key_points(const BSplineSurface& parent, const InfluenceRegion& region
                      const BSplineCurve& target, const StyleOptions& options) {
   check_inputs(parent, target, "target curve", options);
   check_region(parent, region);
-  const auto trace = detail::trace_on_surface(parent, target, options.curve_samples, options.projection);
-  return detail::find_key_points(parent, region, target, trace, 1, options);
+  const surface::SurfaceProjector projector(parent, options.projection);
+  const auto trace = detail::trace_on_surface(projector, target, detail::target_samples(target, options), nullptr);
+  return detail::find_key_points(projector, region, target, trace, 1);
 }
 
-StyleResult style_deform(const BSplineSurface& parent, const InfluenceRegion& region,
-                         const BSplineCurve& target, const StyleOptions& options) {
-  check_inputs(parent, target, "target curve", options);
-  check_region(parent, region);
-  if (options.mode == StyleMode::exact) return detail::style_exact(parent, region, target, options);
+StyleEditor::StyleEditor(BSplineSurface parent, InfluenceRegion region, const StyleOptions& options)
+    : projector_((options.validate(), std::move(parent)), options.projection),
+      region_(std::move(region)),
+      options_(options) {
+  check_region(projector_.surface(), region_);
+}
 
-  const auto trace = detail::trace_on_surface(parent, target, options.curve_samples, options.projection);
-  KeyPoints keys = detail::find_key_points(parent, region, target, trace, 1, options);
+StyleResult StyleEditor::update(const BSplineCurve& target) {
+  surface::validate(target, "target curve");
+  const auto trace = detail::trace_on_surface(projector_, target, detail::target_samples(target, options_), &warm_);
+  StyleResult out = options_.mode == StyleMode::exact
+                        ? detail::style_exact(projector_, region_, target, trace, options_, exact_)
+                        : detail::style_paper(projector_, region_, target, trace, options_);
+  warm_.resize(trace.size());
+  for (size_t k = 0; k < trace.size(); ++k) warm_[k] = {trace[k].u, trace[k].v};
+  return out;
+}
+
+namespace detail {
+
+StyleResult style_paper(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
+                        const BSplineCurve& target, const std::vector<TraceSample>& trace,
+                        const StyleOptions& options) {
+  const BSplineSurface& parent = projector.surface();
+  KeyPoints keys = find_key_points(projector, region, target, trace, 1);
   StyleResult out{parent, parent, {}};
   StyleReport& report = out.report;
   report.mode = StyleMode::paper;
@@ -560,6 +650,14 @@ StyleResult style_deform(const BSplineSurface& parent, const InfluenceRegion& re
       << report.influenced_vertices << " influenced vertices moved";
   report.message = msg.str();
   return out;
+}
+
+}  // namespace detail
+
+StyleResult style_deform(const BSplineSurface& parent, const InfluenceRegion& region,
+                         const BSplineCurve& target, const StyleOptions& options) {
+  check_inputs(parent, target, "target curve", options);
+  return StyleEditor(parent, region, options).update(target);
 }
 
 StyleResult style_deform(const BSplineSurface& parent, const BSplineCurve& bound,

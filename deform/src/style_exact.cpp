@@ -99,9 +99,74 @@ std::vector<double> halving_knots(const surface::BSplineBasis& basis, const std:
 
 }  // namespace
 
-StyleResult style_exact(const BSplineSurface& parent, const InfluenceRegion& region,
-                        const BSplineCurve& target, const StyleOptions& options) {
-  const auto trace = trace_on_surface(parent, target, options.curve_samples, options.projection);
+// The fairness factorization of one net (knot vectors) and its free vertices.
+struct ExactCache {
+  std::vector<double> knots_u, knots_v;     // the net it was built for
+  std::vector<Eigen::Index> free_index;     // per vertex: its unknown, or -1 when fixed
+  std::vector<Eigen::Index> free_rows;      // per unknown: its vertex
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  // of H = L^T L + ridge
+};
+
+namespace {
+
+// Free vertices of `s` (influenced, more than boundary_rows layers inside the region's edge) and
+// the factorized thin-plate fairness of their displacements (fixed vertices have d = 0).
+std::shared_ptr<const ExactCache> build_cache(const BSplineSurface& s, const std::vector<std::uint8_t>& factors,
+                                              int boundary_rows) {
+  auto cache = std::make_shared<ExactCache>();
+  cache->knots_u = s.u.knots;
+  cache->knots_v = s.v.knots;
+  const auto dist = distance_to_outside(s, factors);
+  cache->free_index.assign(factors.size(), -1);
+  for (size_t r = 0; r < factors.size(); ++r)
+    if (factors[r] != 0 && dist[r] > boundary_rows) {
+      cache->free_index[r] = static_cast<Eigen::Index>(cache->free_rows.size());
+      cache->free_rows.push_back(static_cast<Eigen::Index>(r));
+    }
+  const Eigen::Index nf = static_cast<Eigen::Index>(cache->free_rows.size());
+  if (nf == 0) return cache;
+
+  std::vector<Eigen::Triplet<double>> stencil;
+  Eigen::Index stencil_rows = 0;
+  const int nu = s.count_u(), nv = s.count_v();
+  const auto& free_index = cache->free_index;
+  auto add_stencil = [&](std::initializer_list<std::tuple<int, int, double>> terms) {
+    bool any = false;
+    for (const auto& [i, j, c] : terms) any = any || free_index[static_cast<size_t>(s.index(i, j))] >= 0;
+    if (!any) return;
+    for (const auto& [i, j, c] : terms) {
+      const Eigen::Index f = free_index[static_cast<size_t>(s.index(i, j))];
+      if (f >= 0) stencil.emplace_back(stencil_rows, f, c);
+    }
+    ++stencil_rows;
+  };
+  const double twist = std::sqrt(2.0);
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      if (i > 0 && i + 1 < nu) add_stencil({{i - 1, j, 1.0}, {i, j, -2.0}, {i + 1, j, 1.0}});
+      if (j > 0 && j + 1 < nv) add_stencil({{i, j - 1, 1.0}, {i, j, -2.0}, {i, j + 1, 1.0}});
+      if (i + 1 < nu && j + 1 < nv)
+        add_stencil({{i, j, twist}, {i + 1, j, -twist}, {i, j + 1, -twist}, {i + 1, j + 1, twist}});
+    }
+  Eigen::SparseMatrix<double> L(stencil_rows, nf);
+  L.setFromTriplets(stencil.begin(), stencil.end());
+  Eigen::SparseMatrix<double> H = L.transpose() * L;
+  double max_diag = 0;
+  for (Eigen::Index c = 0; c < nf; ++c) max_diag = std::max(max_diag, H.coeff(c, c));
+  // A tiny ridge keeps H definite where the free vertices reach the border of the net.
+  for (Eigen::Index c = 0; c < nf; ++c) H.coeffRef(c, c) += 1e-12 * std::max(max_diag, 1.0);
+  cache->ldlt.compute(H);
+  if (cache->ldlt.info() != Eigen::Success)
+    throw Error(ErrorCategory::Internal, "style deformation: the fairness matrix is not positive definite");
+  return cache;
+}
+
+}  // namespace
+
+StyleResult style_exact(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
+                        const BSplineCurve& target, const std::vector<TraceSample>& trace,
+                        const StyleOptions& options, std::shared_ptr<const ExactCache>& cache) {
+  const BSplineSurface& parent = projector.surface();
   const double size = model_size(parent);
   const double tol = options.tolerance * size;
 
@@ -112,7 +177,7 @@ StyleResult style_exact(const BSplineSurface& parent, const InfluenceRegion& reg
   report.mode = StyleMode::exact;
 
   // The key points are those of the parent's net (eq. 8): refinement adds freedom, not constraints.
-  const KeyPoints keys = find_key_points(parent, region, target, trace, options.key_points_per_row, options);
+  const KeyPoints keys = find_key_points(projector, region, target, trace, options.key_points_per_row);
   report.constraint_class = keys.constraint_class;
   report.direction = keys.direction;
   report.m = static_cast<int>(keys.points.size());
@@ -124,37 +189,30 @@ StyleResult style_exact(const BSplineSurface& parent, const InfluenceRegion& reg
     measure(parent, parent, region.factors, region, trace, options, report);
     return out;
   }
+  std::vector<const KeyPoint*> active;
+  std::vector<int> active_index;  // index in keys.points
+  for (size_t k = 0; k < keys.points.size(); ++k)
+    if (keys.points[k].influenced) {
+      active.push_back(&keys.points[k]);
+      active_index.push_back(static_cast<int>(k));
+    }
+  const Eigen::Index nk = static_cast<Eigen::Index>(active.size());
+  Eigen::MatrixXd rhs(nk, 3);
+  for (Eigen::Index k = 0; k < nk; ++k)
+    rhs.row(k) = options.lambda * (active[static_cast<size_t>(k)]->point - active[static_cast<size_t>(k)]->foot).transpose();
 
   for (int round = 0;; ++round) {
-
-    // Free vertices: influenced and more than boundary_rows layers inside the region's edge.
-    const auto dist = distance_to_outside(s, reg.factors);
-    std::vector<Eigen::Index> free_index(reg.factors.size(), -1);
-    std::vector<Eigen::Index> free_rows;
-    for (size_t r = 0; r < reg.factors.size(); ++r)
-      if (reg.factors[r] != 0 && dist[r] > options.boundary_rows) {
-        free_index[r] = static_cast<Eigen::Index>(free_rows.size());
-        free_rows.push_back(static_cast<Eigen::Index>(r));
-      }
+    if (!cache || cache->knots_u != s.u.knots || cache->knots_v != s.v.knots)
+      cache = build_cache(s, reg.factors, options.boundary_rows);
+    const auto& free_index = cache->free_index;
+    const auto& free_rows = cache->free_rows;
     const Eigen::Index nf = static_cast<Eigen::Index>(free_rows.size());
 
     // Key-point rows: sum_free R_ij(u_k, v_k) d_ij = λ (K_k - P_k).
-    std::vector<const KeyPoint*> active;
-    std::vector<int> active_index;  // index in keys.points
-    for (size_t k = 0; k < keys.points.size(); ++k)
-      if (keys.points[k].influenced) {
-        active.push_back(&keys.points[k]);
-        active_index.push_back(static_cast<int>(k));
-      }
-    const Eigen::Index nk = static_cast<Eigen::Index>(active.size());
     Eigen::MatrixXd B = Eigen::MatrixXd::Zero(nk, nf);
-    Eigen::MatrixXd rhs(nk, 3);
-    for (Eigen::Index k = 0; k < nk; ++k) {
+    for (Eigen::Index k = 0; k < nk; ++k)
       for (const auto& [r, value] : basis_at(s, active[static_cast<size_t>(k)]->u, active[static_cast<size_t>(k)]->v))
         if (free_index[static_cast<size_t>(r)] >= 0) B(k, free_index[static_cast<size_t>(r)]) = value;
-      rhs.row(k) = options.lambda *
-                   (active[static_cast<size_t>(k)]->point - active[static_cast<size_t>(k)]->foot).transpose();
-    }
     int rank = 0;
     if (nk > 0 && nf > 0) {
       Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(B.transpose());
@@ -178,41 +236,9 @@ StyleResult style_exact(const BSplineSurface& parent, const InfluenceRegion& reg
       continue;
     }
 
-    // Thin-plate fairness of the displacement net (fixed vertices have zero displacement).
-    std::vector<Eigen::Triplet<double>> stencil;
-    Eigen::Index stencil_rows = 0;
-    const int nu = s.count_u(), nv = s.count_v();
-    auto add_stencil = [&](std::initializer_list<std::tuple<int, int, double>> terms) {
-      bool any = false;
-      for (const auto& [i, j, c] : terms) any = any || free_index[static_cast<size_t>(s.index(i, j))] >= 0;
-      if (!any) return;
-      for (const auto& [i, j, c] : terms) {
-        const Eigen::Index f = free_index[static_cast<size_t>(s.index(i, j))];
-        if (f >= 0) stencil.emplace_back(stencil_rows, f, c);
-      }
-      ++stencil_rows;
-    };
-    const double twist = std::sqrt(2.0);
-    for (int i = 0; i < nu; ++i)
-      for (int j = 0; j < nv; ++j) {
-        if (i > 0 && i + 1 < nu) add_stencil({{i - 1, j, 1.0}, {i, j, -2.0}, {i + 1, j, 1.0}});
-        if (j > 0 && j + 1 < nv) add_stencil({{i, j - 1, 1.0}, {i, j, -2.0}, {i, j + 1, 1.0}});
-        if (i + 1 < nu && j + 1 < nv)
-          add_stencil({{i, j, twist}, {i + 1, j, -twist}, {i, j + 1, -twist}, {i + 1, j + 1, twist}});
-      }
-    Eigen::SparseMatrix<double> L(stencil_rows, nf);
-    L.setFromTriplets(stencil.begin(), stencil.end());
-    Eigen::SparseMatrix<double> H = L.transpose() * L;
-    double max_diag = 0;
-    for (Eigen::Index c = 0; c < nf; ++c) max_diag = std::max(max_diag, H.coeff(c, c));
-    for (Eigen::Index c = 0; c < nf; ++c) H.coeffRef(c, c) += 1e-12 * std::max(max_diag, 1.0);
-
     Eigen::MatrixXd d = Eigen::MatrixXd::Zero(nf, 3);
     if (nk > 0 && nf > 0) {
-      Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(H);
-      if (ldlt.info() != Eigen::Success)
-        throw Error(ErrorCategory::Internal, "style deformation: the fairness matrix is not positive definite");
-      const Eigen::MatrixXd Y = ldlt.solve(Eigen::MatrixXd(B.transpose()));  // H^-1 B^T
+      const Eigen::MatrixXd Y = cache->ldlt.solve(Eigen::MatrixXd(B.transpose()));  // H^-1 B^T
       const Eigen::MatrixXd M = B * Y;
       Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(M);
       cod.setThreshold(1e-12);

@@ -2,9 +2,11 @@
 // Pieces shared by the paper mode (style.cpp) and the exact mode (style_exact.cpp).
 #include <clay/deform/style.hpp>
 #include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/projection.hpp>
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <vector>
 
 namespace clay::deform::detail {
@@ -17,16 +19,35 @@ struct TraceSample {
 };
 
 /// `count` samples of the curve (uniform in its parameter, ends included) projected onto the
-/// surface: the first by closest_point, the others by Newton continuation from the previous foot
-/// point, falling back to closest_point where Newton does not converge.
-std::vector<TraceSample> trace_on_surface(const surface::BSplineSurface& surface,
+/// surface: by Newton from the same sample of `warm` (the previous position of a dragged curve)
+/// when it has `count` samples, else the first by closest_point and the others by Newton
+/// continuation from the previous foot point; closest_point wherever Newton does not converge.
+std::vector<TraceSample> trace_on_surface(const surface::SurfaceProjector& projector,
                                           const surface::BSplineCurve& curve, int count,
-                                          const surface::ProjectionOptions& options);
+                                          const std::vector<Eigen::Vector2d>* warm);
 
-/// True when (u, v) lies inside or on the closed polygon (winding number; points within 1e-12 of
-/// the domain size from an edge count as inside, like φ <= 0 in Han et al. eq. 2).
-bool inside_polygon(const std::vector<Eigen::Vector2d>& polygon, const Eigen::Vector2d& p,
-                    double on_edge_tolerance);
+/// Point-in-polygon for a closed polygon in parameter space, by winding number over the edges of
+/// one horizontal slab (edges are binned by their y-range once). Points within the tolerance of
+/// an edge count as inside, like φ <= 0 in Han et al. eq. 2. Keeps a pointer to the polygon.
+class PolygonLocator {
+ public:
+  PolygonLocator(const std::vector<Eigen::Vector2d>& polygon, double on_edge_tolerance);
+  /// True when p lies inside or on the polygon (false for an empty polygon).
+  bool inside(const Eigen::Vector2d& p) const;
+
+ private:
+  int bin_of(double y) const noexcept;
+  const std::vector<Eigen::Vector2d>* polygon_;
+  double tolerance_;
+  double y_lo_ = 0, inverse_height_ = 0;
+  std::vector<std::vector<int>> bins_;  // edges i (from vertex i to i + 1) overlapping each slab
+};
+
+/// Samples of the target curve: options.curve_samples, or when 0, 16 per knot span (32 to 4096).
+int target_samples(const surface::BSplineCurve& target, const StyleOptions& options);
+
+/// 1e-12 of the larger parameter domain: the on-edge tolerance of the region tests.
+double parameter_tolerance(const surface::BSplineSurface& s);
 
 /// E(Q_ij) of every vertex of `surface` for the region's polygon or, without one, the target trace
 /// (its support band widened by `margin` vertices). Recomputed on a refined net: knot insertion
@@ -43,12 +64,11 @@ double model_size(const surface::BSplineSurface& surface);
 /// clamped to [0, size - 1].
 double continuous_index(const std::vector<double>& xi, double x);
 
-/// Key points of the traced target on `surface` (whose net `region.factors` describes): Han et
-/// al. eq. 8 with `per_row` key points per control-net row interval crossed (1 in paper mode).
-KeyPoints find_key_points(const surface::BSplineSurface& surface, const InfluenceRegion& region,
+/// Key points of the traced target on the projector's surface (whose net `region.factors`
+/// describes): Han et al. eq. 8 with `per_row` key points per control-net row interval crossed.
+KeyPoints find_key_points(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
                           const surface::BSplineCurve& target,
-                          const std::vector<TraceSample>& trace, int per_row,
-                          const StyleOptions& options);
+                          const std::vector<TraceSample>& trace, int per_row);
 
 /// Fills the quality figures of `report` that compare `result` with `parent` on the region:
 /// locality, boundary jumps, target deviations (key points and, when `samples` is not empty, the
@@ -58,8 +78,14 @@ void measure(const surface::BSplineSurface& parent, const surface::BSplineSurfac
              const std::vector<TraceSample>& samples, const StyleOptions& options,
              StyleReport& report);
 
-/// Exact mode (style_exact.cpp).
-StyleResult style_exact(const surface::BSplineSurface& parent, const InfluenceRegion& region,
-                        const surface::BSplineCurve& target, const StyleOptions& options);
+/// Paper mode on a traced target (style.cpp).
+StyleResult style_paper(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
+                        const surface::BSplineCurve& target, const std::vector<TraceSample>& trace,
+                        const StyleOptions& options);
+
+/// Exact mode on a traced target (style_exact.cpp); reuses and replaces `cache`.
+StyleResult style_exact(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
+                        const surface::BSplineCurve& target, const std::vector<TraceSample>& trace,
+                        const StyleOptions& options, std::shared_ptr<const ExactCache>& cache);
 
 }  // namespace clay::deform::detail

@@ -138,7 +138,7 @@ TEST_CASE("influence factors: Greville points inside the projected bound (Han et
         ++checked;
       }
     CHECK(checked > 200);
-    CHECK(region.polygon.size() == 199u);
+    CHECK(region.polygon.size() == static_cast<size_t>(StyleOptions{}.bound_samples - 1));
   }
 }
 
@@ -447,4 +447,43 @@ TEST_CASE("style deformation errors name the object and the fix", "[style]") {
   auto [c5, m5] = error_of([&] { style_deform(s, hood_bound(), nan_target); });
   CHECK(c5 == ErrorCategory::InvalidGeometry);
   CHECK(m5.find("target curve") != std::string::npos);
+}
+
+TEST_CASE("StyleEditor: drags give the one-off results and reuse the exact factorization", "[style]") {
+  const BSplineSurface s = hood(16, 16);
+  const double size = size_of(s);
+  for (StyleMode mode : {StyleMode::paper, StyleMode::exact}) {
+    StyleOptions options;
+    options.mode = mode;
+    const InfluenceRegion region = influence_factors(s, hood_bound(), options);
+    StyleEditor editor(s, region, options);
+    for (double lift : {0.0, 3.0, 6.0, 9.0, 6.0}) {
+      BSplineCurve target = hood_target();
+      target.points.col(2).array() += lift;
+      const StyleResult dragged = editor.update(target);
+      const StyleResult once = style_deform(s, region, target, options);
+      REQUIRE(dragged.surface.points.rows() == once.surface.points.rows());
+      // Same up to the projection tolerance (the Newton starts differ).
+      CHECK((dragged.surface.points - once.surface.points).cwiseAbs().maxCoeff() <= 1e-9 * size);
+      CHECK(dragged.report.m == once.report.m);
+      CHECK(dragged.report.knots_inserted == once.report.knots_inserted);
+      if (mode == StyleMode::exact) CHECK(dragged.report.target_deviation <= 1e-6 * size);
+    }
+  }
+  CHECK_THROWS_AS(StyleEditor(hood(8, 8), influence_factors(s, hood_bound())), clay::Error);
+}
+
+TEST_CASE("report_curves off leaves the sampled figures unmeasured (NaN), the rest identical", "[style]") {
+  const BSplineSurface s = hood(16, 16);
+  StyleOptions options;
+  const StyleResult full = style_deform(s, hood_bound(), hood_target(), options);
+  options.report_curves = false;
+  const StyleResult quick = style_deform(s, hood_bound(), hood_target(), options);
+  CHECK(clay::surface::identical(full.surface, quick.surface));
+  CHECK(std::isnan(quick.report.target_curve_deviation));
+  CHECK(std::isnan(quick.report.boundary_tangent_angle));
+  CHECK(std::isnan(quick.report.boundary_position_jump));
+  CHECK(quick.report.target_deviation == full.report.target_deviation);
+  CHECK(std::isfinite(full.report.boundary_tangent_angle));
+  CHECK(full.report.target_curve_deviation >= full.report.target_deviation * 0.5);
 }

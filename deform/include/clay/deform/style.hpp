@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,11 +60,16 @@ struct StyleOptions {
   bool smoothing = true;   ///< paper: distribute each force symmetrically along its control-net
                            ///< curve down to the bound (eqs. 12-13); false: only the two
                            ///< neighbouring vertices get it, by area weights (eqs. 4-5)
-  int curve_samples = 200;  ///< samples of the bound and target curves, >= 8
+  int curve_samples = 0;   ///< samples of the target curve (key-point search, class, figures):
+                           ///< 0 = 16 per knot span of the target, at least 32; else >= 8
+  int bound_samples = 256;  ///< samples of the bound curve (its parameter-space polygon), >= 8
   int key_points_per_row = 1;  ///< exact: key points per control-net row crossed, >= 1
   int boundary_rows = 2;   ///< exact: layers of vertices inside the bound edge kept fixed, 0..4
   double tolerance = 1e-9; ///< exact: key-point deviation accepted, relative to the model size
   int max_refinements = 4; ///< exact: rounds of knot insertion allowed, >= 0
+  bool report_curves = true;  ///< measure target_curve_deviation and the boundary figures by
+                              ///< sampling (the cost of ~curve_samples + bound_samples
+                              ///< projections); off for interactive drags: they are then NaN
   surface::ProjectionOptions projection;  ///< projection of the curves onto the surface
 
   /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
@@ -179,6 +185,40 @@ struct StyleResult {
 /// with E = 0 are never written. Throws as key_points.
 StyleResult style_deform(const surface::BSplineSurface& parent, const InfluenceRegion& region,
                          const surface::BSplineCurve& target, const StyleOptions& options = {});
+
+namespace detail {
+struct ExactCache;  // the exact mode's factorization, kept between drags (style_exact.cpp)
+}  // namespace detail
+
+/// A style deformation prepared for dragging the target curve over one region (geometry-central's
+/// "solver class beside the one-off function"): the parent is validated and prepared for
+/// projection once, each update starts the projection of the target from its previous position,
+/// and the exact mode keeps its fairness factorization while the control net stays the same.
+/// update(target) returns what style_deform(parent, region, target, options) returns, up to the
+/// projection tolerance (the Newton starts differ). Copies share the factorization (immutable).
+class StyleEditor {
+ public:
+  /// Throws clay::Error: InvalidGeometry for an invalid parent, InvalidArgument for bad options or
+  /// a region made for another control net.
+  StyleEditor(surface::BSplineSurface parent, InfluenceRegion region, const StyleOptions& options = {});
+
+  /// The deformation toward `target`. Throws clay::Error(InvalidGeometry) for an invalid target.
+  StyleResult update(const surface::BSplineCurve& target);
+
+  /// The parent surface.
+  const surface::BSplineSurface& parent() const noexcept { return projector_.surface(); }
+  /// The influence region.
+  const InfluenceRegion& region() const noexcept { return region_; }
+  /// The options.
+  const StyleOptions& options() const noexcept { return options_; }
+
+ private:
+  surface::SurfaceProjector projector_;  // of the parent
+  InfluenceRegion region_;
+  StyleOptions options_;
+  std::vector<Eigen::Vector2d> warm_;    // the previous target's projected samples (u, v)
+  std::shared_ptr<const detail::ExactCache> exact_;
+};
 
 /// One-off with a bound curve: influence_factors, then style_deform.
 StyleResult style_deform(const surface::BSplineSurface& parent, const surface::BSplineCurve& bound,
