@@ -42,7 +42,7 @@ BSplineCurve bound() {
 
 BSplineCurve target(double lift) {
   Points3 p(4, 3);
-  p << -60, -180, 120 + lift, -40, -60, 150 + lift, -40, 60, 150 + lift, -60, 180, 120 + lift;
+  p << -60, -180, 70 + lift, -40, -60, 150 + lift, -40, 60, 150 + lift, -60, 180, 70 + lift;
   return clay::surface::make_curve(3, {0, 0, 0, 0, 1, 1, 1, 1}, p);
 }
 

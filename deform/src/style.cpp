@@ -49,6 +49,11 @@ void StyleOptions::validate() const {
     fail("tolerance = " + std::to_string(tolerance) + " must lie in (0, 1e-3] (relative to the model size)");
   if (max_refinements < 0)
     fail("max_refinements = " + std::to_string(max_refinements) + " must be >= 0");
+  if (!(curve_tolerance >= 0 && curve_tolerance <= 1e-1))
+    fail("curve_tolerance = " + std::to_string(curve_tolerance) +
+         " must lie in [0, 0.1] (relative to the model size; 0 = key points only)");
+  if (max_key_point_rounds < 0)
+    fail("max_key_point_rounds = " + std::to_string(max_key_point_rounds) + " must be >= 0");
   projection.validate();
 }
 
@@ -146,6 +151,13 @@ int target_samples(const BSplineCurve& target, const StyleOptions& options) {
   return std::clamp(16 * spans, 32, 4096);
 }
 
+surface::SurfaceProjection project_from(const BSplineSurface& s, const Eigen::Vector3d& x, double u,
+                                        double v, const surface::ProjectionOptions& options) {
+  auto p = surface::project_normal(s, x, u, v, options);
+  if (!p.summary.converged()) p = surface::closest_point(s, x, options);
+  return p;
+}
+
 double parameter_tolerance(const BSplineSurface& s) {
   const auto [u0, u1] = s.u.domain();
   const auto [v0, v1] = s.v.domain();
@@ -204,14 +216,6 @@ Eigen::Vector3d normal_or_zero(const BSplineSurface& s, double u, double v) {
   const double len = n.norm();
   if (!(len > 1e-300 * d.du.norm() * d.dv.norm()) || len == 0) return Eigen::Vector3d::Zero();
   return n / len;
-}
-
-// Projection of `x` onto `s` by Newton from (u, v), the global closest point where Newton fails.
-surface::SurfaceProjection project_from(const BSplineSurface& s, const Eigen::Vector3d& x, double u,
-                                        double v, const surface::ProjectionOptions& options) {
-  auto p = surface::project_normal(s, x, u, v, options);
-  if (!p.summary.converged()) p = surface::closest_point(s, x, options);
-  return p;
 }
 
 // Same with a prepared projector.

@@ -17,11 +17,11 @@
 #include <clay/surface/knots.hpp>
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <Eigen/Sparse>
 
 #include <algorithm>
 #include <deque>
-#include <set>
 #include <sstream>
 
 namespace clay::deform::detail {
@@ -80,40 +80,51 @@ std::vector<std::pair<Eigen::Index, double>> basis_at(const BSplineSurface& s, d
   return out;
 }
 
-// Midpoints of the knot spans of `basis` that hold one of `params` (each span once); a parameter
-// on a knot (within 1e-12 of the domain) counts for the spans on both sides, so mirror-symmetric
-// key points refine mirror-symmetrically.
-std::vector<double> halving_knots(const surface::BSplineBasis& basis, const std::vector<double>& params) {
-  const auto [a, b] = basis.domain();
-  const double eps = 1e-12 * (b - a);
-  std::set<int> spans;
-  for (double t : params) {
-    spans.insert(surface::find_span(basis, std::max(a, t - eps)));
-    spans.insert(surface::find_span(basis, std::min(b, t + eps)));
-  }
+// Midpoints of the non-empty knot spans of `basis` that overlap [lo, hi].
+std::vector<double> halving_knots(const surface::BSplineBasis& basis, double lo, double hi) {
   std::vector<double> knots;
-  for (int k : spans)
-    knots.push_back(0.5 * (basis.knots[static_cast<size_t>(k)] + basis.knots[static_cast<size_t>(k + 1)]));
+  const auto breaks = surface::breakpoints(basis);
+  for (size_t k = 0; k + 1 < breaks.size(); ++k)
+    if (breaks[k + 1] > lo && breaks[k] < hi) knots.push_back(0.5 * (breaks[k] + breaks[k + 1]));
   return knots;
+}
+
+// The parameter box of the region: the bound polygon's, else that of the influenced vertices'
+// Greville points widened by one Greville interval.
+Eigen::AlignedBox2d region_box(const BSplineSurface& s, const InfluenceRegion& reg) {
+  Eigen::AlignedBox2d box;
+  if (!reg.polygon.empty()) {
+    for (const auto& p : reg.polygon) box.extend(p);
+    return box;
+  }
+  const auto xu = surface::greville_abscissae(s.u), xv = surface::greville_abscissae(s.v);
+  for (int i = 0; i < s.count_u(); ++i)
+    for (int j = 0; j < s.count_v(); ++j)
+      if (reg.inside(i, j)) {
+        const size_t a = static_cast<size_t>(i), b = static_cast<size_t>(j);
+        box.extend(Eigen::Vector2d(xu[a > 0 ? a - 1 : a], xv[b > 0 ? b - 1 : b]));
+        box.extend(Eigen::Vector2d(xu[std::min(a + 1, xu.size() - 1)], xv[std::min(b + 1, xv.size() - 1)]));
+      }
+  return box;
 }
 
 }  // namespace
 
-// The fairness factorization of one net (knot vectors) and its free vertices.
-struct ExactCache {
+// The free vertices of one net (knot vectors) and the fairness matrix over them.
+struct NetCache {
   std::vector<double> knots_u, knots_v;     // the net it was built for
   std::vector<Eigen::Index> free_index;     // per vertex: its unknown, or -1 when fixed
   std::vector<Eigen::Index> free_rows;      // per unknown: its vertex
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;  // of H = L^T L + ridge
+  Eigen::SparseMatrix<double> H;            // thin-plate energy L^T L + ridge, free vertices
 };
 
 namespace {
 
 // Free vertices of `s` (influenced, more than boundary_rows layers inside the region's edge) and
 // the factorized thin-plate fairness of their displacements (fixed vertices have d = 0).
-std::shared_ptr<const ExactCache> build_cache(const BSplineSurface& s, const std::vector<std::uint8_t>& factors,
-                                              int boundary_rows) {
-  auto cache = std::make_shared<ExactCache>();
+std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s, const std::vector<std::uint8_t>& factors,
+                                            int boundary_rows) {
+  auto cache = std::make_shared<NetCache>();
   cache->knots_u = s.u.knots;
   cache->knots_v = s.v.knots;
   const auto dist = distance_to_outside(s, factors);
@@ -155,13 +166,37 @@ std::shared_ptr<const ExactCache> build_cache(const BSplineSurface& s, const std
   for (Eigen::Index c = 0; c < nf; ++c) max_diag = std::max(max_diag, H.coeff(c, c));
   // A tiny ridge keeps H definite where the free vertices reach the border of the net.
   for (Eigen::Index c = 0; c < nf; ++c) H.coeffRef(c, c) += 1e-12 * std::max(max_diag, 1.0);
-  cache->ldlt.compute(H);
-  if (cache->ldlt.info() != Eigen::Success)
-    throw Error(ErrorCategory::Internal, "style deformation: the fairness matrix is not positive definite");
+  cache->H = std::move(H);
   return cache;
 }
 
+// A key point at a target sample (its projection onto the parent already known).
+KeyPoint key_point_at(const BSplineSurface& s, const InfluenceRegion& reg, const TraceSample& t,
+                      KeyDirection direction) {
+  KeyPoint k;
+  k.point = t.point;
+  k.curve_parameter = t.t;
+  k.u = t.u;
+  k.v = t.v;
+  const auto d = surface::derivatives(s, t.u, t.v, 1);
+  k.foot = d.point;
+  const Eigen::Vector3d n = d.du.cross(d.dv);
+  k.normal = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
+  k.distance = (k.point - k.foot).dot(k.normal);
+  const double gu = continuous_index(surface::greville_abscissae(s.u), t.u);
+  const double gv = continuous_index(surface::greville_abscissae(s.v), t.v);
+  k.row = static_cast<int>(std::lround(direction == KeyDirection::u ? gu : gv));
+  k.influenced = reg.inside(static_cast<int>(std::lround(gu)), static_cast<int>(std::lround(gv)));
+  return k;
+}
+
 }  // namespace
+
+// What the exact mode keeps between drags: one NetCache per net it has solved on (the parent's
+// and its refinements), never modified once shared.
+struct ExactCache {
+  std::vector<std::shared_ptr<const NetCache>> nets;
+};
 
 StyleResult style_exact(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
                         const BSplineCurve& target, const std::vector<TraceSample>& trace,
@@ -176,7 +211,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   StyleReport& report = out.report;
   report.mode = StyleMode::exact;
 
-  // The key points are those of the parent's net (eq. 8): refinement adds freedom, not constraints.
+  // The key points are those of the parent's net (eq. 8): refinement adds freedom, not
+  // constraints. Key points are added where the result still misses the target curve.
   const KeyPoints keys = find_key_points(projector, region, target, trace, options.key_points_per_row);
   report.constraint_class = keys.constraint_class;
   report.direction = keys.direction;
@@ -189,76 +225,180 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     measure(parent, parent, region.factors, region, trace, options, report);
     return out;
   }
-  std::vector<const KeyPoint*> active;
-  std::vector<int> active_index;  // index in keys.points
-  for (size_t k = 0; k < keys.points.size(); ++k)
-    if (keys.points[k].influenced) {
-      active.push_back(&keys.points[k]);
-      active_index.push_back(static_cast<int>(k));
-    }
-  const Eigen::Index nk = static_cast<Eigen::Index>(active.size());
-  Eigen::MatrixXd rhs(nk, 3);
-  for (Eigen::Index k = 0; k < nk; ++k)
-    rhs.row(k) = options.lambda * (active[static_cast<size_t>(k)]->point - active[static_cast<size_t>(k)]->foot).transpose();
+  std::vector<KeyPoint> points = keys.points;
+  const PolygonLocator bound(region.polygon, parameter_tolerance(parent));
+  auto in_region = [&](const TraceSample& t) { return region.polygon.empty() || bound.inside({t.u, t.v}); };
+  int refinements = 0, additions = 0;
 
-  for (int round = 0;; ++round) {
-    if (!cache || cache->knots_u != s.u.knots || cache->knots_v != s.v.knots)
-      cache = build_cache(s, reg.factors, options.boundary_rows);
-    const auto& free_index = cache->free_index;
-    const auto& free_rows = cache->free_rows;
+  for (;;) {
+    std::shared_ptr<const NetCache> net;
+    if (cache)
+      for (const auto& n : cache->nets)
+        if (n->knots_u == s.u.knots && n->knots_v == s.v.knots) net = n;
+    if (!net) {
+      net = build_cache(s, reg.factors, options.boundary_rows);
+      auto grown = std::make_shared<ExactCache>();
+      if (cache) grown->nets = cache->nets;
+      if (grown->nets.size() >= 16) grown->nets.erase(grown->nets.begin());  // bounded memory
+      grown->nets.push_back(net);
+      cache = std::move(grown);
+    }
+    const auto& free_index = net->free_index;
+    const auto& free_rows = net->free_rows;
     const Eigen::Index nf = static_cast<Eigen::Index>(free_rows.size());
 
+    std::vector<int> active;  // indices of the influenced key points
+    for (size_t k = 0; k < points.size(); ++k)
+      if (points[k].influenced) active.push_back(static_cast<int>(k));
+    const Eigen::Index nk = static_cast<Eigen::Index>(active.size());
     // Key-point rows: sum_free R_ij(u_k, v_k) d_ij = λ (K_k - P_k).
     Eigen::MatrixXd B = Eigen::MatrixXd::Zero(nk, nf);
-    for (Eigen::Index k = 0; k < nk; ++k)
-      for (const auto& [r, value] : basis_at(s, active[static_cast<size_t>(k)]->u, active[static_cast<size_t>(k)]->v))
+    Eigen::MatrixXd rhs(nk, 3);
+    for (Eigen::Index k = 0; k < nk; ++k) {
+      const KeyPoint& kp = points[static_cast<size_t>(active[static_cast<size_t>(k)])];
+      for (const auto& [r, value] : basis_at(s, kp.u, kp.v))
         if (free_index[static_cast<size_t>(r)] >= 0) B(k, free_index[static_cast<size_t>(r)]) = value;
+      rhs.row(k) = options.lambda * (kp.point - kp.foot).transpose();
+    }
+    // Rank of the key-point system from a rank-revealing QR of B^T = Q R P^T: the last nf - rank
+    // columns of Q span the null space of B, the displacements that leave every key point alone.
     int rank = 0;
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr;
     if (nk > 0 && nf > 0) {
-      Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(B.transpose());
       qr.setThreshold(1e-10);
+      qr.compute(B.transpose());
       rank = static_cast<int>(qr.rank());
     }
-    if (rank < nk && round < options.max_refinements) {
-      // The net is too coarse where the key points are: halve the knot spans that hold them.
-      std::vector<double> us, vs;
-      for (const KeyPoint* k : active) {
-        us.push_back(k->u);
-        vs.push_back(k->v);
-      }
-      const auto ku = halving_knots(s.u, us), kv = halving_knots(s.v, vs);
+    // The net is too coarse in the region for the key points: halve every knot span there (the
+    // fixed edge layers get thinner, the free vertices more numerous). The region's box is
+    // mirror-symmetric when the region is, and so is the refinement.
+    auto refine = [&] {
+      const Eigen::AlignedBox2d box = region_box(s, reg);
+      const auto ku = halving_knots(s.u, box.min().x(), box.max().x());
+      const auto kv = halving_knots(s.v, box.min().y(), box.max().y());
       s = surface::refine_knots_u(s, ku);
       s = surface::refine_knots_v(s, kv);
       report.knots_inserted += static_cast<int>(ku.size() + kv.size());
+      ++refinements;
       reg.count_u = s.count_u();
       reg.count_v = s.count_v();
       reg.factors = region_factors(s, reg.polygon, reg.target_trace, reg.margin);
+    };
+    if (rank < nk && refinements < options.max_refinements) {
+      refine();
       continue;
     }
 
+    // The energy minimum subject to the key points: the KKT system [H B^T; B 0] [d; μ] = [0; r],
+    // sparse LU, when the key points are independent (they are then met to rounding, with no
+    // squaring of the condition number as in a Schur complement B H^-1 B^T). Dependent key points:
+    // d = d0 + Z y with d0 the minimal-norm least-squares solution of B d = r, Z a basis of null(B)
+    // and y minimising the energy — the least-squares compromise of least energy.
     Eigen::MatrixXd d = Eigen::MatrixXd::Zero(nf, 3);
     if (nk > 0 && nf > 0) {
-      const Eigen::MatrixXd Y = cache->ldlt.solve(Eigen::MatrixXd(B.transpose()));  // H^-1 B^T
-      const Eigen::MatrixXd M = B * Y;
-      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(M);
-      cod.setThreshold(1e-12);
-      d = Y * cod.solve(rhs);
+      if (rank == nk) {
+        std::vector<Eigen::Triplet<double>> kkt;
+        for (Eigen::Index c = 0; c < nf; ++c)
+          for (Eigen::SparseMatrix<double>::InnerIterator it(net->H, c); it; ++it)
+            kkt.emplace_back(it.row(), it.col(), it.value());
+        for (Eigen::Index k = 0; k < nk; ++k)
+          for (Eigen::Index c = 0; c < nf; ++c)
+            if (B(k, c) != 0) {
+              kkt.emplace_back(nf + k, c, B(k, c));
+              kkt.emplace_back(c, nf + k, B(k, c));
+            }
+        Eigen::SparseMatrix<double> K(nf + nk, nf + nk);
+        K.setFromTriplets(kkt.begin(), kkt.end());
+        Eigen::MatrixXd b = Eigen::MatrixXd::Zero(nf + nk, 3);
+        b.bottomRows(nk) = rhs;
+        if (nf + nk <= 600) {
+          // Small systems (an interactive region): dense LU beats the sparse ordering analysis.
+          d = Eigen::MatrixXd(Eigen::PartialPivLU<Eigen::MatrixXd>(Eigen::MatrixXd(K)).solve(b)).topRows(nf);
+        } else {
+          Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+          lu.compute(K);
+          if (lu.info() != Eigen::Success)
+            throw Error(ErrorCategory::Internal, "style deformation: the key-point system could not be factorized");
+          d = Eigen::MatrixXd(lu.solve(b)).topRows(nf);
+        }
+      } else {
+        Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(B);
+        cod.setThreshold(1e-10);
+        d = cod.solve(rhs);
+        if (rank < nf) {
+          const Eigen::MatrixXd Q = qr.householderQ();
+          const Eigen::MatrixXd Z = Q.rightCols(nf - rank);
+          const Eigen::MatrixXd HZ = net->H * Z;
+          const Eigen::MatrixXd reduced = Z.transpose() * HZ;
+          d -= Z * reduced.ldlt().solve(HZ.transpose() * d);
+        }
+      }
+    }
+    // Key points independent but so nearly dependent that the solve misses them: a finer net.
+    const Eigen::MatrixXd achieved = B * d - rhs;
+    const bool missed = nk > 0 && achieved.rowwise().norm().maxCoeff() > tol;
+    if (missed && refinements < options.max_refinements) {
+      refine();
+      continue;
     }
     out.surface = s;
     out.refined_parent = s;
     for (Eigen::Index f = 0; f < nf; ++f)
       if (!d.row(f).isZero(0)) out.surface.points.row(free_rows[static_cast<size_t>(f)]) += d.row(f);
 
+    // Where the result still misses the target by more than curve_tolerance, add key points at
+    // the local maxima of the miss along the target's samples and solve again.
+    if (!missed && options.curve_tolerance > 0 && additions < options.max_key_point_rounds) {
+      const double limit = options.curve_tolerance * size;
+      std::vector<double> miss(trace.size(), 0.0);
+      for (size_t k = 0; k < trace.size(); ++k) {
+        if (!in_region(trace[k])) continue;
+        // The distance from the wanted point (λ scales the move as for key points) to the result;
+        // the miss at the sample's own parameters bounds it from above and spares most
+        // projections.
+        const Eigen::Vector3d foot = surface::evaluate(s, trace[k].u, trace[k].v);
+        const Eigen::Vector3d wanted = foot + options.lambda * (trace[k].point - foot);
+        miss[k] = (surface::evaluate(out.surface, trace[k].u, trace[k].v) - wanted).norm();
+        if (miss[k] > limit)
+          miss[k] = project_from(out.surface, wanted, trace[k].u, trace[k].v, options.projection).distance;
+      }
+      size_t added = 0;
+      for (size_t k = 0; k < trace.size(); ++k) {
+        // Local maxima, with a relative slack so that a plateau of two equal misses (a symmetric
+        // target) adds both samples, not whichever rounding favours.
+        const double floor = miss[k] * (1 - 1e-6);
+        const bool peak = miss[k] > limit && (k == 0 || floor >= miss[k - 1]) &&
+                          (k + 1 == trace.size() || floor >= miss[k + 1]);
+        if (!peak) continue;
+        // Not next to a key point already there (nearly equal rows would make the system
+        // ill-conditioned): at least half a sample step away along the curve.
+        const double gap = 0.5 * (trace.back().t - trace.front().t) / static_cast<double>(trace.size() - 1);
+        bool crowded = false;
+        for (const KeyPoint& p : points) crowded = crowded || std::abs(p.curve_parameter - trace[k].t) < gap;
+        if (crowded) continue;
+        points.push_back(key_point_at(s, reg, trace[k], keys.direction));
+        ++added;
+      }
+      if (added > 0) {
+        ++additions;
+        report.added_key_points += static_cast<int>(added);
+        continue;
+      }
+    }
+
+    report.m = static_cast<int>(points.size());
+    report.key_points = points;
     report.rank = rank;
     report.degrees_of_freedom = 3 * (static_cast<int>(nf) - rank);
-    const Eigen::MatrixXd achieved = B * d - rhs;
     for (Eigen::Index k = 0; k < nk; ++k)
-      if (achieved.row(k).norm() > tol) report.conflicting_key_points.push_back(active_index[static_cast<size_t>(k)]);
+      if (achieved.row(k).norm() > tol) report.conflicting_key_points.push_back(active[static_cast<size_t>(k)]);
     measure(s, out.surface, reg.factors, reg, trace, options, report);
     std::ostringstream msg;
     msg << to_string(report.constraint_class) << ", m = " << report.m << " key points ("
-        << nk << " influenced), " << nf << " free vertices, rank " << rank << ", "
-        << report.degrees_of_freedom << " degrees of freedom left";
+        << nk << " influenced";
+    if (report.added_key_points > 0) msg << ", " << report.added_key_points << " added where the target was missed";
+    msg << "), " << nf << " free vertices, rank " << rank << ", " << report.degrees_of_freedom
+        << " degrees of freedom left";
     if (report.knots_inserted > 0) msg << ", " << report.knots_inserted << " knots inserted";
     if (!report.conflicting_key_points.empty())
       msg << "; " << report.conflicting_key_points.size()

@@ -67,6 +67,10 @@ struct StyleOptions {
   int boundary_rows = 2;   ///< exact: layers of vertices inside the bound edge kept fixed, 0..4
   double tolerance = 1e-9; ///< exact: key-point deviation accepted, relative to the model size
   int max_refinements = 4; ///< exact: rounds of knot insertion allowed, >= 0
+  double curve_tolerance = 1e-4;  ///< exact: where the result misses the target curve (at its
+                                  ///< samples) by more than this, relative to the model size,
+                                  ///< key points are added at the worst samples; 0 = key points only
+  int max_key_point_rounds = 6;   ///< exact: rounds of such additions, >= 0
   bool report_curves = true;  ///< measure target_curve_deviation and the boundary figures by
                               ///< sampling (the cost of ~curve_samples + bound_samples
                               ///< projections); off for interactive drags: they are then NaN
@@ -164,6 +168,7 @@ struct StyleReport {
                                       ///< parent's normals along the region edge
   // exact mode only
   int knots_inserted = 0;        ///< knots inserted (u and v together) before deforming
+  int added_key_points = 0;      ///< key points added where the target curve was missed
   int degrees_of_freedom = 0;    ///< 3 (free vertices - rank of the key-point system)
   int rank = 0;                  ///< rank of the key-point system (scalar rows)
   std::vector<int> conflicting_key_points;  ///< key points that cannot all be met (indices)
@@ -187,15 +192,16 @@ StyleResult style_deform(const surface::BSplineSurface& parent, const InfluenceR
                          const surface::BSplineCurve& target, const StyleOptions& options = {});
 
 namespace detail {
-struct ExactCache;  // the exact mode's factorization, kept between drags (style_exact.cpp)
+struct ExactCache;  // the exact mode's free vertices and fairness matrix (style_exact.cpp)
 }  // namespace detail
 
 /// A style deformation prepared for dragging the target curve over one region (geometry-central's
 /// "solver class beside the one-off function"): the parent is validated and prepared for
 /// projection once, each update starts the projection of the target from its previous position,
-/// and the exact mode keeps its fairness factorization while the control net stays the same.
+/// and the exact mode keeps its free vertices and fairness matrix while the net stays the same.
 /// update(target) returns what style_deform(parent, region, target, options) returns, up to the
-/// projection tolerance (the Newton starts differ). Copies share the factorization (immutable).
+/// projection tolerance (the Newton starts differ) — in exact mode, where those differences can
+/// change which key points are added, up to curve_tolerance. Copies share the cache (immutable).
 class StyleEditor {
  public:
   /// Throws clay::Error: InvalidGeometry for an invalid parent, InvalidArgument for bad options or
@@ -217,7 +223,7 @@ class StyleEditor {
   InfluenceRegion region_;
   StyleOptions options_;
   std::vector<Eigen::Vector2d> warm_;    // the previous target's projected samples (u, v)
-  std::shared_ptr<const detail::ExactCache> exact_;
+  std::shared_ptr<const detail::ExactCache> exact_;  // exact mode: free vertices, fairness matrix
 };
 
 /// One-off with a bound curve: influence_factors, then style_deform.
