@@ -513,3 +513,25 @@ TEST_CASE("extended lattice errors name the culprit and the fix", "[deform]") {
   }
   CHECK_THAT(error_of([&] { merge_coincident_points(good, -1); }).second, Contains("tolerance = -1"));
 }
+
+TEST_CASE("the docs snippet pushes the axis of a cylindrical lattice up", "[deform]") {
+  CylinderSpec spec;
+  spec.radius = 30;
+  spec.height = 20;
+  spec.sectors = 12;
+  spec.rings = 2;
+  spec.layers = 1;
+  ExtendedLattice lattice = make_cylindrical_lattice(spec);
+  Points3 points(3, 3);
+  points << 0, 0, 10, 29.9, 0, 0, 40, 0, 10;  // on the axis, at the rim's foot, outside
+  const FrozenPoints frozen = freeze(lattice, points);
+  for (int k = 0; k <= 3; ++k) lattice.points.row(cylindrical_index(spec, 0, 0, k)) += Eigen::RowVector3d(0, 0, 8);
+  const Points3 out = evaluate(lattice, frozen);
+  // The axis moves by 8 (all its control points did: partition of unity in w); the rim's outer
+  // ring of control points did not move and the point outside stays.
+  CHECK((out.row(0) - Eigen::RowVector3d(0, 0, 18)).norm() < 1e-12);
+  CHECK(out.row(2) == points.row(2));
+  // Radius 29.9 lies in ring 1, whose chunks do not use the axis rows: unchanged to rounding.
+  CHECK((out.row(1) - points.row(1)).norm() < 1e-12);
+  CHECK_THAT(frozen.summary.brief(), Contains("2 inside, 1 outside, 0 unresolved"));
+}
