@@ -201,7 +201,8 @@ struct FrozenPoints {
 /// chunks from a uniform grid of chunk bounding boxes, kept when the point is inside a k-DOP of
 /// the chunk's 64 rest control points (13 fixed directions plus the chunk's own three face
 /// normals: it contains their convex hull, hence the chunk, so it never rejects a point inside);
-/// Newton from (0.5, 0.5, 0.5) with the inverse Jacobian, or the Moore–Penrose pseudo-inverse
+/// Newton from (0.5, 0.5, 0.5) until the tolerance, plus one polishing step kept when it lowers
+/// the residual (so the identity holds to rounding), with the inverse Jacobian, or the Moore–Penrose pseudo-inverse
 /// (JacobiSVD) when det J is below pseudo_inverse_threshold (degenerate chunks, Lukács); chunks
 /// where Newton diverges or stalls are split by de Casteljau into eight and Newton restarts from
 /// the centre of each sub-chunk whose k-DOP holds the point, up to max_subdivision_depth. The
