@@ -3,10 +3,14 @@
 // million points spread at random (uniform, random order: no coherence for the cell sort to
 // exploit) in a skewed frame, one and two threads. "rows" is an N x 3 row-major matrix deformed
 // into a reused one, "columns" three structure-of-arrays buffers. Wall time (UseRealTime).
+// Extended lattices (Coquillart): freezing and re-evaluating 100,000 points in a cylindrical
+// lattice of 12 sectors x 2 rings x 2 layers (merged axis), one and two threads.
+#include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/frozen_lattice.hpp>
 
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -89,9 +93,71 @@ void arguments(benchmark::internal::Benchmark* b) {
   b->UseRealTime()->Unit(benchmark::kMillisecond);
 }
 
+CylinderSpec bench_cylinder() {
+  CylinderSpec s;
+  s.origin = Eigen::Vector3d(10.0, -20.0, 5.0);
+  s.axis = Eigen::Vector3d(0.1, 0.2, 1.0);
+  s.radius = 40;
+  s.height = 60;
+  s.sectors = 12;
+  s.rings = 2;
+  s.layers = 2;
+  return s;
+}
+
+/// Points uniform in the cylinder (area-uniform radius), random order.
+Points3 cylinder_points(const CylinderSpec& s, Eigen::Index n) {
+  const Eigen::Vector3d e3 = s.axis.normalized();
+  const Eigen::Vector3d e1 = (s.reference - s.reference.dot(e3) * e3).normalized(), e2 = e3.cross(e1);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Points3 p(n, 3);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const double rho = s.radius * std::sqrt(unit(rng)), a = 6.283185307179586 * unit(rng);
+    p.row(r) = (s.origin + s.height * unit(rng) * e3 + rho * (std::cos(a) * e1 + std::sin(a) * e2)).transpose();
+  }
+  return p;
+}
+
+// Arguments: points, threads.
+void extended_freeze(benchmark::State& state) {
+  const ExtendedLattice lattice = make_cylindrical_lattice(bench_cylinder());
+  const Points3 in = cylinder_points(bench_cylinder(), state.range(0));
+  FreezeOptions options;
+  options.threads = static_cast<int>(state.range(1));
+  for (auto _ : state) {
+    FrozenPoints f = freeze(lattice, in, options);
+    benchmark::DoNotOptimize(f.points.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+  state.SetLabel("cylindrical 12x2x2 chunks");
+}
+
+void extended_evaluate(benchmark::State& state) {
+  ExtendedLattice lattice = make_cylindrical_lattice(bench_cylinder());
+  const Points3 in = cylinder_points(bench_cylinder(), state.range(0));
+  const FrozenPoints f = freeze(lattice, in);
+  lattice.points = displaced(ExtendedLattice{lattice}).points;
+  const DeformOptions options{static_cast<int>(state.range(1))};
+  for (auto _ : state) {
+    Points3 out = evaluate(lattice, f, options);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+  state.SetLabel("cylindrical 12x2x2 chunks");
+}
+
+void extended_arguments(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"points", "threads"});
+  for (int threads : {1, 2}) b->Args({100'000, threads});
+  b->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+
 }  // namespace
 
 BENCHMARK(rows)->Apply(arguments);
 BENCHMARK(columns)->Apply(arguments);
+BENCHMARK(extended_freeze)->Apply(extended_arguments);
+BENCHMARK(extended_evaluate)->Apply(extended_arguments);
 
 BENCHMARK_MAIN();
