@@ -98,8 +98,23 @@ double polynomial_derivative(const std::vector<double>& c, double z) noexcept {
   return v;
 }
 
-/// sin(t) / t, 1 at t = 0.
-double sinc(double t) noexcept { return std::abs(t) < 1e-4 ? 1 - t * t / 6 * (1 - t * t / 20) : std::sin(t) / t; }
+/// The bend angle's sine and cosine and q = sin(θ/2) / k for θ = k h, from one sin/cos pair of
+/// θ/2: cos θ = 1 − 2 sin²(θ/2), sin θ = 2 sin(θ/2) cos(θ/2). Then sin θ / k = 2 cos(θ/2) q and
+/// (1 − cos θ) / k = 2 sin(θ/2) q, with no cancellation for small θ (q = h/2 sinc(θ/2) there).
+struct BendAngle {
+  double c, s, half_sin, half_cos, q;
+};
+BendAngle bend_angle(double k, double h) noexcept {
+  const double half = 0.5 * k * h;
+  BendAngle a;
+  a.half_sin = std::sin(half);
+  a.half_cos = std::cos(half);
+  a.c = 1 - 2 * a.half_sin * a.half_sin;
+  a.s = 2 * a.half_sin * a.half_cos;
+  const double t2 = half * half;
+  a.q = std::abs(half) < 1e-4 ? 0.5 * h * (1 - t2 / 6 * (1 - t2 / 20)) : a.half_sin / k;
+  return a;
+}
 
 // ---- the three maps in local coordinates --------------------------------------------------
 
@@ -123,18 +138,14 @@ double clamp_y(const Bend& d, double y) noexcept {
 
 /// §3.1.3: θ = k (ŷ − y0), X = x,
 ///   Y = −Sθ (z − 1/k) + y0 + Cθ (y − ŷ),   Z = Cθ (z − 1/k) + 1/k + Sθ (y − ŷ)
-/// (y − ŷ is 0 inside the region, y − y_min below, y − y_max above). Written without 1/k:
-/// Sθ / k = h sinc(θ) and (1 − Cθ) / k = h sin(θ/2) sinc(θ/2) with h = ŷ − y0.
+/// (y − ŷ is 0 inside the region, y − y_min below, y − y_max above), written without 1/k:
+/// Y = −Sθ z + Sθ/k + y0 + Cθ (y − ŷ), Z = Cθ z + (1 − Cθ)/k + Sθ (y − ŷ) (see bend_angle).
 Eigen::Vector3d bend_local(const Bend& d, const Eigen::Vector3d& l) noexcept {
   const double yh = clamp_y(d, l.y());
-  const double h = yh - d.center;
-  const double theta = d.rate * h;
-  const double c = std::cos(theta), s = std::sin(theta);
+  const BendAngle a = bend_angle(d.rate, yh - d.center);
   const double outside = l.y() - yh;
-  const double sin_over_k = h * sinc(theta);
-  const double one_minus_cos_over_k = h * std::sin(0.5 * theta) * sinc(0.5 * theta);
-  return {l.x(), -s * l.z() + sin_over_k + d.center + c * outside,
-          c * l.z() + one_minus_cos_over_k + s * outside};
+  return {l.x(), -a.s * l.z() + 2 * a.half_cos * a.q + d.center + a.c * outside,
+          a.c * l.z() + 2 * a.half_sin * a.q + a.s * outside};
 }
 
 // ---- Jacobians in local coordinates --------------------------------------------------------
@@ -160,8 +171,8 @@ Eigen::Matrix3d twist_jacobian_local(const Twist& d, const Eigen::Vector3d& l) {
 }
 
 Eigen::Matrix3d bend_jacobian_local(const Bend& d, const Eigen::Vector3d& l) {
-  const double theta = d.rate * (clamp_y(d, l.y()) - d.center);
-  const double c = std::cos(theta), s = std::sin(theta);
+  const BendAngle a = bend_angle(d.rate, clamp_y(d, l.y()) - d.center);
+  const double c = a.c, s = a.s;
   // Inside (and on the ends of) the region dθ/dy = k: ∂Y/∂y = Cθ (1 − k z), ∂Z/∂y = Sθ (1 − k z);
   // outside the parts are rigid: ∂Y/∂y = Cθ, ∂Z/∂y = Sθ.
   const bool inside = l.y() >= d.y_min && l.y() <= d.y_max;

@@ -373,7 +373,15 @@ std::string to_json(const DeformationStack& stack) {
     j["name"] = step.name;
     j["enabled"] = step.enabled;
     std::visit([&](const auto& d) { write_fields(d, j); }, step.deformation);
-    text += (i ? ",\n    " : "\n    ") + j.dump();
+    std::string line;
+    try {
+      line = j.dump();
+    } catch (const Json::type_error&) {  // the only string that can be bad is the name
+      throw Error(ErrorCategory::InvalidArgument,
+                  "to_json: steps[" + std::to_string(i) +
+                      "].name is not valid UTF-8; give the name as UTF-8 text");
+    }
+    text += (i ? ",\n    " : "\n    ") + line;
   }
   text += stack.steps.empty() ? "]\n}\n" : "\n  ]\n}\n";
   return text;

@@ -10,6 +10,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <tuple>
 #include <string>
 
 #include "error_of.hpp"
@@ -278,4 +279,9 @@ TEST_CASE("an invalid stack is rejected naming the step", "[deform][stack]") {
   std::get<BSplineLattice>(stack.steps[2].deformation).points(4, 2) = std::numeric_limits<double>::infinity();
   CHECK_THAT(error_of([&] { validate(stack); }).second, Contains("steps[2] (bspline_lattice 'local')") && Contains("P_0,0,4"));
   CHECK(problems(sample_stack(rng)).empty());
+  stack = sample_stack(rng);
+  stack.steps[1].name = "bad \xff byte";
+  std::tie(category, what) = error_of([&] { to_json(stack); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(what, Contains("steps[1].name is not valid UTF-8"));
 }

@@ -64,7 +64,8 @@ void deform_points(const DeformationStack& stack, const Points3& points, Points3
 
 /// The stack as JSON text (schema "clayform.deformation-stack", version 1, in docs/deform.md):
 /// numbers are written in shortest round-trip form, so stack_from_json(to_json(s)) restores every
-/// double bit for bit. Throws clay::Error(InvalidGeometry) for an invalid stack (JSON has no NaN).
+/// double bit for bit. Throws clay::Error: InvalidGeometry for an invalid stack (JSON has no
+/// NaN), InvalidArgument for a step name that is not valid UTF-8.
 std::string to_json(const DeformationStack& stack);
 
 /// Parses a stack written by to_json (or by hand). Throws clay::Error(Recipe) for malformed
