@@ -267,6 +267,46 @@ TEST_CASE("malformed stack JSON is rejected naming the path and the fix", "[defo
              Contains("the key \"version\" is missing"));
 }
 
+TEST_CASE("every malformed step field is named with its path", "[deform][stack]") {
+  const std::string head = R"({"format": "clayform.deformation-stack", "version": 1, "steps": [)";
+  const std::string axis = R"("frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]})";
+  const std::string cube = R"("frame": {"origin": [0, 0, 0], "s": [1, 0, 0], "t": [0, 1, 0], "u": [0, 0, 1]})";
+  const std::string basis = R"({"degree": 1, "knots": [0, 0, 1, 1]})";
+  const std::pair<std::string, std::string> cases[] = {
+      {"7", "steps[0]: expected a step"},
+      {R"({"kind": 3})", "steps[0].kind: expected a string, found 3"},
+      {R"({"kind": "twist", "name": 5, )" + axis + R"(, "angle": [0]})", "steps[0].name: expected a string, found 5"},
+      {R"({"kind": "twist", "frame": [1, 2, 3], "angle": [0]})", "steps[0].frame: expected an axis frame"},
+      {R"({"kind": "twist", "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1]}, "angle": [0]})",
+       "steps[0].frame: the key \"reference\" is missing"},
+      {R"({"kind": "twist", )" + axis + R"(, "angle": 0.5})", "steps[0].angle: expected an array of numbers, found 0.5"},
+      {R"({"kind": "taper", )" + axis + R"(, "profile": []})", "steps[0] (taper): profile is empty"},
+      {R"({"kind": "bezier_lattice", )" + cube + R"(, "degrees": [1, 1, 1], "points": {}})",
+       "steps[0].points: expected an array of control points"},
+      {R"({"kind": "bezier_lattice", )" + cube + R"(, "degrees": [1, 1, 1e12], "points": []})",
+       "steps[0].degrees[2]: expected an integer, found 1000000000000.0"},
+      {R"({"kind": "bezier_lattice", )" + cube + R"(, "degrees": [1, 1, 10000000000], "points": []})",
+       "steps[0].degrees[2]: the integer 10000000000 is out of range"},
+      {R"({"kind": "bspline_lattice", )" + cube + R"(, "bases": [)" + basis + "," + basis + R"(], "points": []})",
+       "steps[0].bases: expected 3 bases (along S, T, U), found an array of 2"},
+      {R"({"kind": "bspline_lattice", )" + cube + R"(, "bases": [)" + basis + "," + basis + R"(, 4], "points": []})",
+       "steps[0].bases[2]: expected a basis"},
+      {R"({"kind": "bspline_lattice", )" + cube + R"(, "bases": [)" + basis + "," + basis +
+           R"(, {"degree": 1, "knots": [0, 0, 1, 1], "weights": []}], "points": []})",
+       "steps[0].bases[2]: unknown key \"weights\" in a basis"},
+      {R"({"kind": "bspline_lattice", )" + cube + R"(, "bases": [)" + basis + "," + basis +
+           R"(, {"degree": 1, "knots": [0, 0, 2, 2]}], "points": []})",
+       "steps[0] (bspline_lattice)"},
+  };
+  for (const auto& [step, expected] : cases) {
+    const auto [category, what] = error_of([&] { stack_from_json(head + step + "]}"); });
+    CHECK(category == ErrorCategory::Recipe);
+    CHECK_THAT(what, Contains(expected));
+  }
+  CHECK_THAT(error_of([&] { stack_from_json(head + "], \"extra\": 1}"); }).second,
+             Contains("(top level): unknown key \"extra\" in a deformation stack"));
+}
+
 TEST_CASE("an invalid stack is rejected naming the step", "[deform][stack]") {
   std::mt19937 rng(25);
   DeformationStack stack = sample_stack(rng);
