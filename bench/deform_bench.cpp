@@ -5,8 +5,11 @@
 // into a reused one, "columns" three structure-of-arrays buffers. Wall time (UseRealTime).
 // Extended lattices (Coquillart): freezing and re-evaluating 100,000 points in a cylindrical
 // lattice of 12 sectors x 2 rings x 2 layers (merged axis), one and two threads.
+// "regular": Barr's twist (linear angle), bend and taper (quadratic profile) about a tilted axis,
+// 1 million points of the same cloud, rows into a reused matrix.
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/frozen_lattice.hpp>
+#include <clay/deform/regular.hpp>
 
 #include <benchmark/benchmark.h>
 
@@ -150,6 +153,32 @@ void extended_evaluate(benchmark::State& state) {
 void extended_arguments(benchmark::internal::Benchmark* b) {
   b->ArgNames({"points", "threads"});
   for (int threads : {1, 2}) b->Args({100'000, threads});
+// Arguments: points, threads, kind (0 = twist, 1 = bend, 2 = taper).
+void regular(benchmark::State& state) {
+  const AxisFrame frame{Eigen::Vector3d(30.0, 120.0, 50.0), Eigen::Vector3d(0.2, 1.0, 0.1),
+                        Eigen::Vector3d(0.0, 0.0, 1.0)};
+  const Twist twist{frame, {0.1, 0.01}};
+  const Bend bend{frame, -60.0, 80.0, 10.0, 0.01};
+  const Taper taper{frame, {1.0, 2e-3, -1e-5}};
+  const Points3 in = random_points(state.range(0));
+  Points3 out(in.rows(), 3);
+  const DeformOptions options{static_cast<int>(state.range(1))};
+  const auto kind = state.range(2);
+  for (auto _ : state) {
+    if (kind == 0) deform_points(twist, in, out, options);
+    else if (kind == 1) deform_points(bend, in, out, options);
+    else deform_points(taper, in, out, options);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+  state.SetLabel(kind == 0 ? "twist" : (kind == 1 ? "bend" : "taper"));
+}
+
+void regular_arguments(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"points", "threads", "kind"});
+  for (int kind : {0, 1, 2})
+    for (int threads : {1, 2}) b->Args({1'000'000, threads, kind});
   b->UseRealTime()->Unit(benchmark::kMillisecond);
 }
 
@@ -159,5 +188,6 @@ BENCHMARK(rows)->Apply(arguments);
 BENCHMARK(columns)->Apply(arguments);
 BENCHMARK(extended_freeze)->Apply(extended_arguments);
 BENCHMARK(extended_evaluate)->Apply(extended_arguments);
+BENCHMARK(regular)->Apply(regular_arguments);
 
 BENCHMARK_MAIN();
