@@ -3,6 +3,10 @@
 // million points spread at random (uniform, random order: no coherence for the cell sort to
 // exploit) in a skewed frame, one and two threads. "rows" is an N x 3 row-major matrix deformed
 // into a reused one, "columns" three structure-of-arrays buffers. Wall time (UseRealTime).
+// Direct manipulation (Hsu et al. §3) on the same cubic 8 x 8 x 8 B-spline lattice: a one-off
+// manipulate() of 10 / 100 / 400 points (B, factorization, solve, pointwise check), and one drag
+// step (DirectManipulator::move, factorization reused).
+#include <clay/deform/direct_manipulation.hpp>
 #include <clay/deform/frozen_lattice.hpp>
 
 #include <benchmark/benchmark.h>
@@ -89,9 +93,49 @@ void arguments(benchmark::internal::Benchmark* b) {
   b->UseRealTime()->Unit(benchmark::kMillisecond);
 }
 
+/// Points inside the lattice and targets 5 mm away from their images.
+std::vector<PointMove> point_moves(const BSplineLattice& lattice, Eigen::Index n) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(0.05, 0.95), offset(-5.0, 5.0);
+  std::vector<PointMove> moves;
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const Eigen::Vector3d x = lattice.frame.point(unit(rng), unit(rng), unit(rng));
+    moves.push_back({x, deform_point(lattice, x) + Eigen::Vector3d(offset(rng), offset(rng), offset(rng))});
+  }
+  return moves;
+}
+
+void manipulate_once(benchmark::State& state) {
+  const BSplineLattice lattice = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  const auto moves = point_moves(lattice, state.range(0));
+  for (auto _ : state) {
+    auto result = manipulate(lattice, moves);
+    benchmark::DoNotOptimize(result.lattice.points.data());
+  }
+  state.SetLabel("bspline 8x8x8 cells cubic");
+}
+
+void manipulate_drag(benchmark::State& state) {
+  const BSplineLattice lattice = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  const auto moves = point_moves(lattice, state.range(0));
+  Points3 points(state.range(0), 3), targets(state.range(0), 3);
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    points.row(r) = moves[static_cast<size_t>(r)].point.transpose();
+    targets.row(r) = moves[static_cast<size_t>(r)].target.transpose();
+  }
+  const DirectManipulator<BSplineLattice> drag(lattice, points);
+  for (auto _ : state) {
+    auto result = drag.move(targets);
+    benchmark::DoNotOptimize(result.lattice.points.data());
+  }
+  state.SetLabel("bspline 8x8x8 cells cubic");
+}
+
 }  // namespace
 
 BENCHMARK(rows)->Apply(arguments);
 BENCHMARK(columns)->Apply(arguments);
+BENCHMARK(manipulate_once)->ArgName("points")->Arg(10)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
+BENCHMARK(manipulate_drag)->ArgName("points")->Arg(10)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

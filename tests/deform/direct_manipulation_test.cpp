@@ -184,6 +184,13 @@ TEST_CASE("the same point pulled to two targets gets the least-squares compromis
   const PointMove mid{x, (t1 + t2) / 2};
   const auto single = manipulate(lattice, std::span(&mid, 1));
   CHECK((result.lattice.points - single.lattice.points).cwiseAbs().maxCoeff() < 1e-10);
+  // The same request twice is consistent: feasible, rank 1, the one-point move.
+  const PointMove twice[] = {mid, mid};
+  const auto repeated = manipulate(lattice, twice);
+  CHECK(repeated.report.feasible);
+  CHECK(repeated.report.rank == 1);
+  CHECK_THAT(repeated.report.message, Contains("some requests repeat others"));
+  CHECK((repeated.lattice.points - single.lattice.points).cwiseAbs().maxCoeff() < 1e-10);
 }
 
 TEST_CASE("an over-determined request reports the least-squares residual of a dense solve", "[deform]") {
@@ -375,4 +382,28 @@ TEST_CASE("direct manipulation rejects bad requests naming the culprit", "[defor
     CHECK(error_of([&] { influence_matrix(broken, Points3::Constant(1, 3, 0.5)); }).first ==
           ErrorCategory::InvalidGeometry);
   }
+}
+
+TEST_CASE("docs snippet: lift one point and pin another with the bottom kept C1", "[deform]") {
+  Frame frame;
+  frame.origin = {-50, -50, 0};
+  frame.s = {100, 0, 0};
+  frame.t = {10, 100, 0};
+  frame.u = {0, 0, 40};
+  BSplineLattice lattice = make_bspline_lattice(frame, {3, 3, 3}, {8, 8, 8});
+  const FaceContinuity keep[] = {{Face::u_min, 1}};
+  DirectManipulationOptions options;
+  options.locked = locked_control_points(lattice, keep);
+  const PointMove moves[] = {{frame.point(0.5, 0.5, 0.9), frame.point(0.5, 0.5, 0.9) + Eigen::Vector3d(0, 0, 12)},
+                             {frame.point(0.3, 0.7, 0.9), frame.point(0.3, 0.7, 0.9)}};
+  const auto [moved, report] = manipulate(lattice, moves, options);
+  INFO(report.brief());
+  CHECK(report.feasible);
+  CHECK(report.rank == 2);
+  for (const PointMove& m : moves) CHECK((deform_point(moved, m.point) - m.target).norm() < 1e-10);
+  for (size_t r = 0; r < options.locked.size(); ++r)
+    if (options.locked[r])
+      CHECK((moved.points.row(static_cast<Eigen::Index>(r)).array() ==
+             lattice.points.row(static_cast<Eigen::Index>(r)).array()).all());
+  CHECK_THAT(report.brief(), Contains("feasible: 2 points, rank 2"));
 }
