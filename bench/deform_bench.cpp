@@ -7,6 +7,10 @@
 // lattice of 12 sectors x 2 rings x 2 layers (merged axis), one and two threads.
 // "regular": Barr's twist (linear angle), bend and taper (quadratic profile) about a tilted axis,
 // 1 million points of the same cloud, rows into a reused matrix.
+// Direct manipulation (Hsu et al. §3) on the same cubic 8 x 8 x 8 B-spline lattice: a one-off
+// manipulate() of 10 / 100 / 400 points (B, factorization, solve, pointwise check), and one drag
+// step (DirectManipulator::move, factorization reused).
+#include <clay/deform/direct_manipulation.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/regular.hpp>
@@ -180,6 +184,42 @@ void regular_arguments(benchmark::internal::Benchmark* b) {
   for (int kind : {0, 1, 2})
     for (int threads : {1, 2}) b->Args({1'000'000, threads, kind});
   b->UseRealTime()->Unit(benchmark::kMillisecond);
+/// Points inside the lattice and targets 5 mm away from their images.
+std::vector<PointMove> point_moves(const BSplineLattice& lattice, Eigen::Index n) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(0.05, 0.95), offset(-5.0, 5.0);
+  std::vector<PointMove> moves;
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const Eigen::Vector3d x = lattice.frame.point(unit(rng), unit(rng), unit(rng));
+    moves.push_back({x, deform_point(lattice, x) + Eigen::Vector3d(offset(rng), offset(rng), offset(rng))});
+  }
+  return moves;
+}
+
+void manipulate_once(benchmark::State& state) {
+  const BSplineLattice lattice = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  const auto moves = point_moves(lattice, state.range(0));
+  for (auto _ : state) {
+    auto result = manipulate(lattice, moves);
+    benchmark::DoNotOptimize(result.lattice.points.data());
+  }
+  state.SetLabel("bspline 8x8x8 cells cubic");
+}
+
+void manipulate_drag(benchmark::State& state) {
+  const BSplineLattice lattice = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  const auto moves = point_moves(lattice, state.range(0));
+  Points3 points(state.range(0), 3), targets(state.range(0), 3);
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    points.row(r) = moves[static_cast<size_t>(r)].point.transpose();
+    targets.row(r) = moves[static_cast<size_t>(r)].target.transpose();
+  }
+  const DirectManipulator<BSplineLattice> drag(lattice, points);
+  for (auto _ : state) {
+    auto result = drag.move(targets);
+    benchmark::DoNotOptimize(result.lattice.points.data());
+  }
+  state.SetLabel("bspline 8x8x8 cells cubic");
 }
 
 }  // namespace
@@ -189,5 +229,7 @@ BENCHMARK(columns)->Apply(arguments);
 BENCHMARK(extended_freeze)->Apply(extended_arguments);
 BENCHMARK(extended_evaluate)->Apply(extended_arguments);
 BENCHMARK(regular)->Apply(regular_arguments);
+BENCHMARK(manipulate_once)->ArgName("points")->Arg(10)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
+BENCHMARK(manipulate_drag)->ArgName("points")->Arg(10)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

@@ -2,11 +2,13 @@
 /// Umbrella header of the deform module: FFD lattices (Bézier, Sederberg–Parry 1986; B-spline,
 /// Hsu–Hughes–Kaufman 1992), local deformations with continuity, Jacobian bounds and fast
 /// deformation of many points (Güdükbay–Özgüç 1990), extended lattices of tricubic chunks
-/// (Coquillart 1990), Barr's regular deformations (taper, twist, bend) and deformation stacks
-/// with their JSON form. Style deformation and direct manipulation arrive with issues #5-#7.
+/// (Coquillart 1990), direct manipulation (Hsu–Hughes–Kaufman 1992 §3), Barr's regular
+/// deformations (taper, twist, bend) and deformation stacks with their JSON form. Style
+/// deformation arrives with issue #5.
 #include <clay/constraints.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
+#include <clay/deform/direct_manipulation.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/jacobian.hpp>
