@@ -157,6 +157,9 @@ void extended_evaluate(benchmark::State& state) {
 void extended_arguments(benchmark::internal::Benchmark* b) {
   b->ArgNames({"points", "threads"});
   for (int threads : {1, 2}) b->Args({100'000, threads});
+  b->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+
 // Arguments: points, threads, kind (0 = twist, 1 = bend, 2 = taper).
 void regular(benchmark::State& state) {
   const AxisFrame frame{Eigen::Vector3d(30.0, 120.0, 50.0), Eigen::Vector3d(0.2, 1.0, 0.1),

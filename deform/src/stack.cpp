@@ -30,21 +30,44 @@ constexpr int format_version = 1;
 
 std::string_view kind_of(const BezierLattice&) { return "bezier_lattice"; }
 std::string_view kind_of(const BSplineLattice&) { return "bspline_lattice"; }
+std::string_view kind_of(const ExtendedLattice&) { return "extended_lattice"; }
 std::string_view kind_of(const Taper&) { return "taper"; }
 std::string_view kind_of(const Twist&) { return "twist"; }
 std::string_view kind_of(const Bend&) { return "bend"; }
 
 // ---- per kind: in-place bulk deformation ----------------------------------------------------
+// `step` and `report` serve the kinds that iterate (extended lattices): they add their summary.
 
-void apply_in_place(const BezierLattice& d, Points3& p, const DeformOptions& o) {
+void apply_in_place(const BezierLattice& d, Points3& p, const DeformOptions& o, std::size_t,
+                    StackReport&) {
   deform_points(FrozenLattice(d), p, p, o);  // frozen once per call
 }
-void apply_in_place(const BSplineLattice& d, Points3& p, const DeformOptions& o) {
+void apply_in_place(const BSplineLattice& d, Points3& p, const DeformOptions& o, std::size_t,
+                    StackReport&) {
   deform_points(FrozenLattice(d), p, p, o);
 }
-void apply_in_place(const Taper& d, Points3& p, const DeformOptions& o) { deform_points(d, p, p, o); }
-void apply_in_place(const Twist& d, Points3& p, const DeformOptions& o) { deform_points(d, p, p, o); }
-void apply_in_place(const Bend& d, Points3& p, const DeformOptions& o) { deform_points(d, p, p, o); }
+void apply_in_place(const ExtendedLattice& d, Points3& p, const DeformOptions& o,
+                    std::size_t step, StackReport& report) {
+  // deform_points(ExtendedLattice): freeze on the rest shape (Coquillart §3.3), evaluate eq. (1)
+  // on the moved control points (§3.4); unresolved points stay, the summary says so.
+  FreezeOptions f;
+  f.threads = o.threads;
+  const FrozenPoints frozen = freeze(d, p, f);
+  p = evaluate(d, frozen, o);
+  report.freezes.push_back({step, frozen.summary});
+}
+void apply_in_place(const Taper& d, Points3& p, const DeformOptions& o, std::size_t,
+                    StackReport&) {
+  deform_points(d, p, p, o);
+}
+void apply_in_place(const Twist& d, Points3& p, const DeformOptions& o, std::size_t,
+                    StackReport&) {
+  deform_points(d, p, p, o);
+}
+void apply_in_place(const Bend& d, Points3& p, const DeformOptions& o, std::size_t,
+                    StackReport&) {
+  deform_points(d, p, p, o);
+}
 
 std::string step_label(const DeformationStep& step, std::size_t i) {
   std::string label = "steps[" + std::to_string(i) + "] (" + std::string(kind_name(step.deformation));
@@ -96,6 +119,13 @@ void write_fields(const BSplineLattice& d, Json& j) {
   }
   j["bases"] = std::move(bases);
   j["points"] = points_json(d.points);
+}
+void write_fields(const ExtendedLattice& d, Json& j) {
+  j["rest"] = points_json(d.rest);
+  j["points"] = points_json(d.points);
+  Json chunks = Json::array();
+  for (const Chunk& c : d.chunks) chunks.push_back(c);  // 64 indices, entry (i * 4 + j) * 4 + k
+  j["chunks"] = std::move(chunks);
 }
 void write_fields(const Taper& d, Json& j) {
   j["frame"] = frame_json(d.frame);
@@ -239,6 +269,39 @@ void read_fields(BSplineLattice& d, const Json& j, const std::string& path) {
   }
   d.points = points3(member(j, path, "points", "the control points [[x, y, z], ...]"), path + ".points");
 }
+void read_fields(ExtendedLattice& d, const Json& j, const std::string& path) {
+  check_keys(j, path, {"kind", "name", "enabled", "rest", "points", "chunks"},
+             "an extended_lattice step");
+  d.rest = points3(member(j, path, "rest", "the rest control points [[x, y, z], ...]"),
+                   path + ".rest");
+  d.points = points3(member(j, path, "points", "the current control points [[x, y, z], ...]"),
+                     path + ".points");
+  const Eigen::Index rows = d.rest.rows();
+  if (d.points.rows() != rows)
+    fail(path + ".points", "found " + std::to_string(d.points.rows()) +
+                               " control points but rest has " + std::to_string(rows) +
+                               "; give one current position per rest control point");
+  const Json& chunks = member(j, path, "chunks", "the chunks, each 64 row indices");
+  if (!chunks.is_array())
+    fail(path + ".chunks", "expected an array of chunks (64 row indices each), found " + found(chunks));
+  d.chunks.resize(chunks.size());
+  for (std::size_t c = 0; c < chunks.size(); ++c) {
+    const std::string cp = path + ".chunks[" + std::to_string(c) + "]";
+    const Json& chunk = chunks[c];
+    if (!chunk.is_array() || chunk.size() != static_cast<std::size_t>(chunk_control_points))
+      fail(cp, "expected 64 indices (control point (i, j, k) at (i * 4 + j) * 4 + k), found " +
+                   found(chunk));
+    for (std::size_t e = 0; e < chunk.size(); ++e) {
+      const std::string ep = cp + "[" + std::to_string(e) + "]";
+      const int index = integer(chunk[e], ep);
+      if (index < 0 || index >= rows)
+        fail(ep, "index " + std::to_string(index) + " is out of range " +
+                     (rows > 0 ? "(0.." + std::to_string(rows - 1) + ")" : "(rest has no rows)") +
+                     "; give a row of rest / points");
+      d.chunks[c][e] = index;
+    }
+  }
+}
 void read_fields(Taper& d, const Json& j, const std::string& path) {
   check_keys(j, path, {"kind", "name", "enabled", "frame", "profile"}, "a taper step");
   d.frame = axis_frame(member(j, path, "frame", "the axis frame {origin, axis, reference}"), path + ".frame");
@@ -342,14 +405,36 @@ Eigen::Vector3d deform_point(const DeformationStack& stack, const Eigen::Vector3
   return p;
 }
 
+bool StackReport::converged() const noexcept {
+  for (const Freeze& f : freezes)
+    if (!f.summary.summary.converged()) return false;
+  return true;
+}
+
+std::string StackReport::brief() const {
+  if (freezes.empty()) return "no extended lattice step";
+  std::string text;
+  for (const Freeze& f : freezes)
+    text += (text.empty() ? "steps[" : "; steps[") + std::to_string(f.step) + "]: " + f.summary.brief();
+  return text;
+}
+
 void deform_points(const DeformationStack& stack, const Points3& points, Points3& out,
-                   const DeformOptions& options) {
+                   StackReport& report, const DeformOptions& options) {
   validate(stack);
   options.validate();
+  report = StackReport{};
   if (&out != &points) out = points;
-  for (const auto& step : stack.steps)
-    if (step.enabled)
-      std::visit([&](const auto& d) { apply_in_place(d, out, options); }, step.deformation);
+  for (std::size_t i = 0; i < stack.steps.size(); ++i)
+    if (stack.steps[i].enabled)
+      std::visit([&](const auto& d) { apply_in_place(d, out, options, i, report); },
+                 stack.steps[i].deformation);
+}
+
+void deform_points(const DeformationStack& stack, const Points3& points, Points3& out,
+                   const DeformOptions& options) {
+  StackReport report;
+  deform_points(stack, points, out, report, options);
 }
 
 Points3 deform_points(const DeformationStack& stack, const Points3& points,

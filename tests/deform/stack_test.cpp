@@ -81,6 +81,10 @@ bool same_step(const Deformation& a, const Deformation& b) {
       ok = ok && p->bases[d].degree == q.bases[d].degree && same_bits(p->bases[d].knots, q.bases[d].knots);
     return ok;
   }
+  if (auto* p = std::get_if<ExtendedLattice>(&a)) {
+    const auto& q = std::get<ExtendedLattice>(b);
+    return same_bits(p->rest, q.rest) && same_bits(p->points, q.points) && p->chunks == q.chunks;
+  }
   if (auto* p = std::get_if<Taper>(&a)) {
     const auto& q = std::get<Taper>(b);
     return same_bits(p->frame, q.frame) && same_bits(p->profile, q.profile);
@@ -184,6 +188,7 @@ TEST_CASE("JSON round trips every kind bit for bit", "[deform][stack]") {
     CHECK_THAT(text, Contains(std::string("\"kind\":\"") + kind + "\""));
   CHECK(stack_from_json(to_json(DeformationStack{})).steps.empty());
   CHECK(kind_name(Bend{}) == "bend");
+  CHECK(kind_name(ExtendedLattice{}) == "extended_lattice");
 }
 
 TEST_CASE("hand-written JSON may leave out name and enabled and use integers", "[deform][stack]") {
@@ -217,7 +222,7 @@ TEST_CASE("malformed stack JSON is rejected naming the path and the fix", "[defo
              Contains("format: expected \"clayform.deformation-stack\", found the string \"clayform.recipe\""));
   CHECK_THAT(recipe_error(replaced("\"kind\":\"twist\"", "\"kind\":\"wobble\"")),
              Contains("steps[1].kind: unknown kind \"wobble\"") &&
-                 Contains("one of bezier_lattice, bspline_lattice, taper, twist, bend"));
+                 Contains("one of bezier_lattice, bspline_lattice, extended_lattice, taper, twist, bend"));
   CHECK_THAT(recipe_error(replaced("\"rate\":", "\"rat\":1,\"rate\":")),
              Contains("steps[3]: unknown key \"rat\" in a bend step") && Contains("y_min, y_max, center, rate"));
   CHECK_THAT(recipe_error(replaced(",\"y_min\":-20.0", "")),
@@ -324,4 +329,237 @@ TEST_CASE("an invalid stack is rejected naming the step", "[deform][stack]") {
   std::tie(category, what) = error_of([&] { to_json(stack); });
   CHECK(category == ErrorCategory::InvalidArgument);
   CHECK_THAT(what, Contains("steps[1].name is not valid UTF-8"));
+}
+
+// ---- extended lattices in stacks ---------------------------------------------------------------
+
+namespace {
+
+/// A skewed cylinder far from the origin: 8 sectors, 2 rings, 2 layers, merged axis.
+CylinderSpec stack_cylinder() {
+  CylinderSpec s;
+  s.origin = Eigen::Vector3d(40, -25, 60);
+  s.axis = Eigen::Vector3d(0.2, -0.3, 1.0);
+  s.reference = Eigen::Vector3d(1, 0.5, 0);
+  s.radius = 30;
+  s.height = 45;
+  s.sectors = 8;
+  s.rings = 2;
+  s.layers = 2;
+  return s;
+}
+
+/// The cylinder's orthonormal frame, computed here: e1 (angle 0), e2, a (axis).
+struct CylinderAxes {
+  Eigen::Vector3d e1, e2, a;
+  explicit CylinderAxes(const CylinderSpec& s) : a(s.axis.normalized()) {
+    e1 = (s.reference - s.reference.dot(a) * a).normalized();
+    e2 = a.cross(e1);
+  }
+};
+
+/// The cylindrical lattice with every control point moved by up to `amount` mm at random.
+ExtendedLattice displaced_cylinder(const CylinderSpec& s, std::mt19937& rng, double amount) {
+  ExtendedLattice L = make_cylindrical_lattice(s);
+  std::uniform_real_distribution<double> c(-amount, amount);
+  for (Eigen::Index r = 0; r < L.points.rows(); ++r) L.points.row(r) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
+  return L;
+}
+
+/// `n` points in and around the cylinder: radius up to 1.2 R, height from -0.1 H to 1.1 H.
+Points3 around_cylinder(const CylinderSpec& s, std::mt19937& rng, int n) {
+  const CylinderAxes ax(s);
+  std::uniform_real_distribution<double> u(0, 1);
+  Points3 p(n, 3);
+  for (int r = 0; r < n; ++r) {
+    const double rho = 1.2 * s.radius * std::sqrt(u(rng)), phi = 2 * std::numbers::pi * u(rng);
+    const double h = s.height * (1.2 * u(rng) - 0.1);
+    p.row(r) = (s.origin + h * ax.a + rho * (std::cos(phi) * ax.e1 + std::sin(phi) * ax.e2)).transpose();
+  }
+  return p;
+}
+
+/// [a displaced B-spline lattice around the cylinder (global), the displaced cylindrical extended
+/// lattice, a twist about the cylinder's axis].
+DeformationStack extended_stack(std::mt19937& rng) {
+  const CylinderSpec s = stack_cylinder();
+  const CylinderAxes ax(s);
+  Frame g;
+  g.origin = s.origin - 40 * ax.e1 - 40 * ax.e2 - 10 * ax.a;
+  g.s = 80 * ax.e1;
+  g.t = 80 * ax.e2;
+  g.u = 65 * ax.a;
+  const BSplineLattice global = clay::test::displaced(make_bspline_lattice(g, {3, 2, 3}, {2, 3, 2}), rng, 0.03);
+  const Twist twist{{s.origin, s.axis, s.reference}, {0.05, 0.01}};
+  return {{{global, "global", true}, {displaced_cylinder(s, rng, 2.0), "cylinder", true}, {twist, "twist", true}}};
+}
+
+/// A chunk collapsed to the segment from (0, 0, 0) to (0, 0, 9): a point 1e-8 mm off it lies
+/// in the chunk's convex hull test but has no root, so freezing leaves it unresolved.
+ExtendedLattice segment_chunk() {
+  ExtendedLattice L;
+  L.rest.resize(64, 3);
+  L.chunks.resize(1);
+  for (int e = 0; e < 64; ++e) {
+    L.rest.row(e) = Eigen::RowVector3d(0, 0, 3.0 * (e % 4));
+    L.chunks[0][static_cast<std::size_t>(e)] = e;
+  }
+  L.points = L.rest;
+  for (int e = 0; e < 64; ++e) L.points(e, 0) += 2.0;  // the image: the segment moved along x
+  return L;
+}
+
+/// The row of chunks[chunk][entry] in `text` replaced by `value` (JSON written by to_json).
+std::string with_chunk_entry(std::string text, std::size_t chunk, std::size_t entry, const std::string& value) {
+  std::size_t at = text.find("\"chunks\":[");
+  REQUIRE(at != std::string::npos);
+  at += 10;                                                             // the '[' of chunks[0]
+  for (std::size_t c = 0; c < chunk; ++c) at = text.find('[', at + 1);  // of chunks[chunk]
+  std::size_t begin = at + 1;
+  for (std::size_t e = 0; e < entry; ++e) begin = text.find(',', begin) + 1;
+  const std::size_t end = text.find_first_of(",]", begin);
+  return text.replace(begin, end - begin, value);
+}
+
+}  // namespace
+
+TEST_CASE("an extended lattice step is the composition of the steps' own deform_point", "[deform][stack]") {
+  std::mt19937 rng(31);
+  const DeformationStack stack = extended_stack(rng);
+  const auto& global = std::get<BSplineLattice>(stack.steps[0].deformation);
+  const auto& cylinder = std::get<ExtendedLattice>(stack.steps[1].deformation);
+  const auto& twist = std::get<Twist>(stack.steps[2].deformation);
+  const Points3 points = around_cylinder(stack_cylinder(), rng, 200);
+  int moved_by_each = 0;
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    const Eigen::Vector3d x = points.row(r).transpose();
+    const Eigen::Vector3d a = deform_point(global, x), b = deform_point(cylinder, a), c = deform_point(twist, b);
+    CHECK(same_bits(deform_point(stack, x), c));
+    moved_by_each += (a != x) && (b != a) && (c != b);
+  }
+  CHECK(moved_by_each > 100);  // most points lie in the cylinder
+}
+
+TEST_CASE("deform_points on a stack with an extended lattice equals deform_point and reports the freeze",
+          "[deform][stack]") {
+  std::mt19937 rng(32);
+  const DeformationStack stack = extended_stack(rng);
+  const Points3 points = around_cylinder(stack_cylinder(), rng, 3000);  // freezes on two workers
+  Points3 out;
+  StackReport report;
+  deform_points(stack, points, out, report, DeformOptions{2});
+  const double size = clay::test::size_of(points);
+  double worst = 0;
+  for (Eigen::Index r = 0; r < points.rows(); ++r)
+    worst = std::max(worst, (out.row(r).transpose() - deform_point(stack, points.row(r).transpose())).norm());
+  INFO("bulk vs deform_point " << worst / size << " of the size " << size << " mm");
+  CHECK(worst < 1e-13 * size);
+  REQUIRE(report.freezes.size() == 1);
+  CHECK(report.freezes[0].step == 1);
+  const FreezeSummary& f = report.freezes[0].summary;
+  CHECK(report.converged());
+  CHECK(f.inside + f.outside == points.rows());
+  CHECK(f.inside > points.rows() / 2);
+  CHECK(f.outside > 100);
+  CHECK_THAT(report.brief(), Contains("steps[1]: frozen 3000 points: ") && Contains(" 0 unresolved"));
+  // The overloads without a report, in place, give the same bits.
+  CHECK(same_bits(deform_points(stack, points, DeformOptions{2}), out));
+  Points3 in_place = points;
+  deform_points(stack, in_place, in_place, DeformOptions{2});
+  CHECK(same_bits(in_place, out));
+  // A disabled extended step is not frozen; the report is overwritten.
+  DeformationStack skipping = stack;
+  skipping.steps[1].enabled = false;
+  deform_points(skipping, points, out, report);
+  CHECK(report.freezes.empty());
+  CHECK(report.converged());
+  CHECK(report.brief() == "no extended lattice step");
+}
+
+TEST_CASE("points an extended lattice step cannot place are left unchanged and reported", "[deform][stack]") {
+  const Twist twist{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()}, {0, 0.1}};
+  const DeformationStack stack{{{segment_chunk(), "segment", true}, {twist, "twist", true}}};
+  Points3 points(2, 3);
+  points << 0, 0, 4.5,  // on the segment: found, moved by 2 along x
+      1e-8, 0, 4.5;     // off it: unresolved, unchanged by step 0
+  Points3 out;
+  StackReport report;
+  deform_points(stack, points, out, report);
+  REQUIRE(report.freezes.size() == 1);
+  CHECK_FALSE(report.converged());
+  CHECK(report.freezes[0].summary.summary.termination == clay::Termination::NotConverged);
+  CHECK(report.freezes[0].summary.unresolved == 1);
+  CHECK_THAT(report.brief(), Contains("steps[0]: frozen 2 points: 1 inside, 0 outside, 1 unresolved"));
+  const Eigen::Vector3d off = points.row(1).transpose();
+  CHECK(same_bits(Eigen::Vector3d(out.row(1).transpose()), deform_point(twist, off)));
+  CHECK(same_bits(deform_point(stack, off), deform_point(twist, off)));
+  CHECK((out.row(0).transpose() - deform_point(twist, Eigen::Vector3d(2, 0, 4.5))).norm() < 1e-12);
+}
+
+TEST_CASE("JSON round trips a displaced cylindrical lattice bit for bit", "[deform][stack]") {
+  std::mt19937 rng(33);
+  const DeformationStack stack = extended_stack(rng);
+  const std::string text = to_json(stack);
+  CHECK_THAT(text, Contains("\"kind\":\"extended_lattice\",\"name\":\"cylinder\",\"enabled\":true,\"rest\":[["));
+  const DeformationStack back = stack_from_json(text);
+  REQUIRE(back.steps.size() == stack.steps.size());
+  for (std::size_t i = 0; i < stack.steps.size(); ++i) CHECK(same_step(back.steps[i].deformation, stack.steps[i].deformation));
+  CHECK(to_json(back) == text);
+  const Points3 points = around_cylinder(stack_cylinder(), rng, 1500);
+  CHECK(same_bits(deform_points(back, points), deform_points(stack, points)));
+}
+
+TEST_CASE("malformed extended lattice JSON is rejected naming the path", "[deform][stack]") {
+  std::mt19937 rng(34);
+  const DeformationStack stack = extended_stack(rng);
+  const std::string good = to_json(stack);
+  const auto rows = std::get<ExtendedLattice>(stack.steps[1].deformation).rest.rows();
+  const std::string range = "(0.." + std::to_string(rows - 1) + ")";
+  auto recipe_error = [](const std::string& text) {
+    const auto [category, what] = error_of([&] { stack_from_json(text); });
+    CHECK(category == ErrorCategory::Recipe);
+    return what;
+  };
+  CHECK_THAT(recipe_error(with_chunk_entry(good, 3, 17, "5000")),
+             Contains("steps[1].chunks[3][17]: index 5000 is out of range " + range) && Contains("give a row of rest"));
+  CHECK_THAT(recipe_error(with_chunk_entry(good, 0, 63, "-1")),
+             Contains("steps[1].chunks[0][63]: index -1 is out of range " + range));
+  CHECK_THAT(recipe_error(with_chunk_entry(good, 2, 5, "7.5")),
+             Contains("steps[1].chunks[2][5]: expected an integer, found 7.5"));
+  CHECK_THAT(recipe_error(with_chunk_entry(good, 4, 0, "0,0")),
+             Contains("steps[1].chunks[4]: expected 64 indices") && Contains("found an array of 65"));
+
+  const std::string head = R"({"format": "clayform.deformation-stack", "version": 1, "steps": [{"kind": "extended_lattice", )";
+  std::string chunk = "[0";
+  for (int e = 1; e < 64; ++e) chunk += ",0";
+  chunk += "]";
+  const std::string two = R"("rest": [[0, 0, 0], [1, 2, 3]], )";
+  const std::pair<std::string, std::string> cases[] = {
+      {R"("rest": [[0, 0, 0], [1, 2, 3]], "points": [[0, 0, 0]], "chunks": [])",
+       "steps[0].points: found 1 control points but rest has 2; give one current position per rest control point"},
+      {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": [[0, 1, 1]])",
+       "steps[0].chunks[0]: expected 64 indices (control point (i, j, k) at (i * 4 + j) * 4 + k), found an array of 3"},
+      {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": {})", "steps[0].chunks: expected an array of chunks"},
+      {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": [7])", "steps[0].chunks[0]: expected 64 indices"},
+      {two + R"("points": [[0, 0, 0], [1, 2, 3]])", "steps[0]: the key \"chunks\" is missing"},
+      {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": [], "frame": 1)",
+       "steps[0]: unknown key \"frame\" in an extended_lattice step; the keys are kind, name, enabled, rest, points, chunks"},
+      {R"("rest": [], "points": [], "chunks": [[0]])", "steps[0].chunks[0]: expected 64 indices"},
+      {R"("rest": [], "points": [], "chunks": [)" + chunk + "]",
+       "steps[0].chunks[0][0]: index 0 is out of range (rest has no rows)"},
+      {two + R"("points": [[0, 0, 0], [1, 2, null]], "chunks": [])", "steps[0].points[1][2]: expected a number, found null"},
+      // The lattice's own problems(), prefixed with the step.
+      {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": [])", "steps[0] (extended_lattice): no chunks"},
+  };
+  for (const auto& [fields, expected] : cases) {
+    const auto what = recipe_error(head + fields + "}]}");
+    CHECK_THAT(what, Contains(expected));
+  }
+  // A chunk on one repeated row has zero extent: the lattice's own problem, named by step.
+  std::string flat = "[5";
+  for (int e = 1; e < 64; ++e) flat += ",5";
+  flat += "]";
+  std::string t = good;
+  t.insert(t.find("\"chunks\":[") + 10, flat + ",");
+  CHECK_THAT(recipe_error(t), Contains("steps[1] (extended_lattice 'cylinder'): chunk 0 has zero extent"));
 }

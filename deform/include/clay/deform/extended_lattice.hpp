@@ -116,7 +116,8 @@ struct PrismSpec {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();   ///< where 2D point (0, 0) sits (mm)
   Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX();  ///< 2D x direction (normalized)
   Eigen::Vector3d y_axis = Eigen::Vector3d::UnitY();  ///< 2D y direction (made orthogonal to x)
-  Eigen::Vector3d extrusion = Eigen::Vector3d::UnitZ();  ///< the prism's height vector (mm), off the plane
+  /// The prism's height vector (mm), off the plane.
+  Eigen::Vector3d extrusion = Eigen::Vector3d::UnitZ();
   /// Two or more section curves, each a piecewise cubic Bézier curve in the plane (mm): 3 s + 1
   /// control points for s segments (joints shared), every section with the same count. A closed
   /// curve repeats its first point last (the seam is then welded).
@@ -142,8 +143,10 @@ ExtendedLattice make_prismatic_lattice(const PrismSpec& spec);
 
 /// Settings of freeze().
 struct FreezeOptions {
-  double newton_tolerance = 1e-12;   ///< residual |L(u,v,w) − x| / chunk size at convergence, (0, 1e-3]
-  double parameter_tolerance = 1e-9; ///< a root this far outside [0, 1]^3 still counts as inside, [0, 1e-3]
+  /// Residual |L(u,v,w) − x| / chunk size at convergence, (0, 1e-3].
+  double newton_tolerance = 1e-12;
+  /// A root this far outside [0, 1]^3 still counts as inside, [0, 1e-3].
+  double parameter_tolerance = 1e-9;
   double pseudo_inverse_threshold = 1e-12;  ///< below this |det J| / max|column|^3 the
                                             ///< pseudo-inverse replaces the inverse, [0, 1e-3]
   int max_iterations = 50;          ///< Newton iterations per start, 1..1000
@@ -202,13 +205,13 @@ struct FrozenPoints {
 /// the chunk's 64 rest control points (13 fixed directions plus the chunk's own three face
 /// normals: it contains their convex hull, hence the chunk, so it never rejects a point inside);
 /// Newton from (0.5, 0.5, 0.5) until the tolerance, plus one polishing step kept when it lowers
-/// the residual (so the identity holds to rounding), with the inverse Jacobian, or the Moore–Penrose pseudo-inverse
-/// (JacobiSVD) when det J is below pseudo_inverse_threshold (degenerate chunks, Lukács); chunks
-/// where Newton diverges or stalls are split by de Casteljau into eight and Newton restarts from
-/// the centre of each sub-chunk whose k-DOP holds the point, up to max_subdivision_depth. The
-/// first root within parameter_tolerance of [0, 1]^3 wins (on shared faces any chunk gives the
-/// same image). Throws clay::Error: InvalidGeometry for an invalid lattice or non-finite points,
-/// InvalidArgument for bad options.
+/// the residual (so the identity holds to rounding), with the inverse Jacobian, or the
+/// Moore–Penrose pseudo-inverse (JacobiSVD) when det J is below pseudo_inverse_threshold
+/// (degenerate chunks, Lukács); chunks where Newton diverges or stalls are split by de Casteljau
+/// into eight and Newton restarts from the centre of each sub-chunk whose k-DOP holds the point,
+/// up to max_subdivision_depth. The first root within parameter_tolerance of [0, 1]^3 wins (on
+/// shared faces any chunk gives the same image). Throws clay::Error: InvalidGeometry for an
+/// invalid lattice or non-finite points, InvalidArgument for bad options.
 FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points,
                     const FreezeOptions& options = {});
 
