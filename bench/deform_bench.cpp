@@ -187,6 +187,8 @@ void regular_arguments(benchmark::internal::Benchmark* b) {
   for (int kind : {0, 1, 2})
     for (int threads : {1, 2}) b->Args({1'000'000, threads, kind});
   b->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+
 /// Points inside the lattice and targets 5 mm away from their images.
 std::vector<PointMove> point_moves(const BSplineLattice& lattice, Eigen::Index n) {
   std::mt19937 rng(13);
