@@ -3,10 +3,21 @@
 // million points spread at random (uniform, random order: no coherence for the cell sort to
 // exploit) in a skewed frame, one and two threads. "rows" is an N x 3 row-major matrix deformed
 // into a reused one, "columns" three structure-of-arrays buffers. Wall time (UseRealTime).
+// Extended lattices (Coquillart): freezing and re-evaluating 100,000 points in a cylindrical
+// lattice of 12 sectors x 2 rings x 2 layers (merged axis), one and two threads.
+// "regular": Barr's twist (linear angle), bend and taper (quadratic profile) about a tilted axis,
+// 1 million points of the same cloud, rows into a reused matrix.
+// Direct manipulation (Hsu et al. §3) on the same cubic 8 x 8 x 8 B-spline lattice: a one-off
+// manipulate() of 10 / 100 / 400 points (B, factorization, solve, pointwise check), and one drag
+// step (DirectManipulator::move, factorization reused).
+#include <clay/deform/direct_manipulation.hpp>
+#include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/frozen_lattice.hpp>
+#include <clay/deform/regular.hpp>
 
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -89,9 +100,141 @@ void arguments(benchmark::internal::Benchmark* b) {
   b->UseRealTime()->Unit(benchmark::kMillisecond);
 }
 
+CylinderSpec bench_cylinder() {
+  CylinderSpec s;
+  s.origin = Eigen::Vector3d(10.0, -20.0, 5.0);
+  s.axis = Eigen::Vector3d(0.1, 0.2, 1.0);
+  s.radius = 40;
+  s.height = 60;
+  s.sectors = 12;
+  s.rings = 2;
+  s.layers = 2;
+  return s;
+}
+
+/// Points uniform in the cylinder (area-uniform radius), random order.
+Points3 cylinder_points(const CylinderSpec& s, Eigen::Index n) {
+  const Eigen::Vector3d e3 = s.axis.normalized();
+  const Eigen::Vector3d e1 = (s.reference - s.reference.dot(e3) * e3).normalized(), e2 = e3.cross(e1);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  Points3 p(n, 3);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const double rho = s.radius * std::sqrt(unit(rng)), a = 6.283185307179586 * unit(rng);
+    p.row(r) = (s.origin + s.height * unit(rng) * e3 + rho * (std::cos(a) * e1 + std::sin(a) * e2)).transpose();
+  }
+  return p;
+}
+
+// Arguments: points, threads.
+void extended_freeze(benchmark::State& state) {
+  const ExtendedLattice lattice = make_cylindrical_lattice(bench_cylinder());
+  const Points3 in = cylinder_points(bench_cylinder(), state.range(0));
+  FreezeOptions options;
+  options.threads = static_cast<int>(state.range(1));
+  for (auto _ : state) {
+    FrozenPoints f = freeze(lattice, in, options);
+    benchmark::DoNotOptimize(f.points.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+  state.SetLabel("cylindrical 12x2x2 chunks");
+}
+
+void extended_evaluate(benchmark::State& state) {
+  ExtendedLattice lattice = make_cylindrical_lattice(bench_cylinder());
+  const Points3 in = cylinder_points(bench_cylinder(), state.range(0));
+  const FrozenPoints f = freeze(lattice, in);
+  lattice.points = displaced(ExtendedLattice{lattice}).points;
+  const DeformOptions options{static_cast<int>(state.range(1))};
+  for (auto _ : state) {
+    Points3 out = evaluate(lattice, f, options);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+  state.SetLabel("cylindrical 12x2x2 chunks");
+}
+
+void extended_arguments(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"points", "threads"});
+  for (int threads : {1, 2}) b->Args({100'000, threads});
+  b->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+
+// Arguments: points, threads, kind (0 = twist, 1 = bend, 2 = taper).
+void regular(benchmark::State& state) {
+  const AxisFrame frame{Eigen::Vector3d(30.0, 120.0, 50.0), Eigen::Vector3d(0.2, 1.0, 0.1),
+                        Eigen::Vector3d(0.0, 0.0, 1.0)};
+  const Twist twist{frame, {0.1, 0.01}};
+  const Bend bend{frame, -60.0, 80.0, 10.0, 0.01};
+  const Taper taper{frame, {1.0, 2e-3, -1e-5}};
+  const Points3 in = random_points(state.range(0));
+  Points3 out(in.rows(), 3);
+  const DeformOptions options{static_cast<int>(state.range(1))};
+  const auto kind = state.range(2);
+  for (auto _ : state) {
+    if (kind == 0) deform_points(twist, in, out, options);
+    else if (kind == 1) deform_points(bend, in, out, options);
+    else deform_points(taper, in, out, options);
+    benchmark::DoNotOptimize(out.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() * state.range(0));
+  state.SetLabel(kind == 0 ? "twist" : (kind == 1 ? "bend" : "taper"));
+}
+
+void regular_arguments(benchmark::internal::Benchmark* b) {
+  b->ArgNames({"points", "threads", "kind"});
+  for (int kind : {0, 1, 2})
+    for (int threads : {1, 2}) b->Args({1'000'000, threads, kind});
+  b->UseRealTime()->Unit(benchmark::kMillisecond);
+}
+
+/// Points inside the lattice and targets 5 mm away from their images.
+std::vector<PointMove> point_moves(const BSplineLattice& lattice, Eigen::Index n) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(0.05, 0.95), offset(-5.0, 5.0);
+  std::vector<PointMove> moves;
+  for (Eigen::Index r = 0; r < n; ++r) {
+    const Eigen::Vector3d x = lattice.frame.point(unit(rng), unit(rng), unit(rng));
+    moves.push_back({x, deform_point(lattice, x) + Eigen::Vector3d(offset(rng), offset(rng), offset(rng))});
+  }
+  return moves;
+}
+
+void manipulate_once(benchmark::State& state) {
+  const BSplineLattice lattice = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  const auto moves = point_moves(lattice, state.range(0));
+  for (auto _ : state) {
+    auto result = manipulate(lattice, moves);
+    benchmark::DoNotOptimize(result.lattice.points.data());
+  }
+  state.SetLabel("bspline 8x8x8 cells cubic");
+}
+
+void manipulate_drag(benchmark::State& state) {
+  const BSplineLattice lattice = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  const auto moves = point_moves(lattice, state.range(0));
+  Points3 points(state.range(0), 3), targets(state.range(0), 3);
+  for (Eigen::Index r = 0; r < points.rows(); ++r) {
+    points.row(r) = moves[static_cast<size_t>(r)].point.transpose();
+    targets.row(r) = moves[static_cast<size_t>(r)].target.transpose();
+  }
+  const DirectManipulator<BSplineLattice> drag(lattice, points);
+  for (auto _ : state) {
+    auto result = drag.move(targets);
+    benchmark::DoNotOptimize(result.lattice.points.data());
+  }
+  state.SetLabel("bspline 8x8x8 cells cubic");
+}
+
 }  // namespace
 
 BENCHMARK(rows)->Apply(arguments);
 BENCHMARK(columns)->Apply(arguments);
+BENCHMARK(extended_freeze)->Apply(extended_arguments);
+BENCHMARK(extended_evaluate)->Apply(extended_arguments);
+BENCHMARK(regular)->Apply(regular_arguments);
+BENCHMARK(manipulate_once)->ArgName("points")->Arg(10)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
+BENCHMARK(manipulate_drag)->ArgName("points")->Arg(10)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

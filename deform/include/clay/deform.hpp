@@ -1,12 +1,18 @@
 #pragma once
 /// Umbrella header of the deform module: FFD lattices (Bézier, Sederberg–Parry 1986; B-spline,
 /// Hsu–Hughes–Kaufman 1992), local deformations with continuity, Jacobian bounds and fast
-/// deformation of many points (Güdükbay–Özgüç 1990). Style deformation, extended lattices,
-/// direct manipulation, regular deformations and stacks arrive with issues #5-#7.
+/// deformation of many points (Güdükbay–Özgüç 1990), extended lattices of tricubic chunks
+/// (Coquillart 1990), direct manipulation (Hsu–Hughes–Kaufman 1992 §3), Barr's regular
+/// deformations (taper, twist, bend), deformation stacks with their JSON form, and the style
+/// deformation by bound and target curves (Han–De Amicis–Conti 2007).
 #include <clay/constraints.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
+#include <clay/deform/direct_manipulation.hpp>
+#include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/lattice.hpp>
+#include <clay/deform/regular.hpp>
+#include <clay/deform/stack.hpp>
 #include <clay/deform/style.hpp>

@@ -1,6 +1,7 @@
 // A program outside the Clayform tree: builds a surface, evaluates it against a closed form and
 // writes a STEP file through the installed library; solves a small sketch (clay_constraints, which
-// links Ceres privately) and deforms a point with an undisplaced lattice (clay_deform).
+// links Ceres privately), deforms a point with an undisplaced lattice and round-trips a
+// deformation stack through JSON (clay_deform, which links nlohmann-json privately).
 #include <clay/deform.hpp>
 
 #include <cmath>
@@ -26,8 +27,12 @@ int main(int argc, char** argv) {
   const clay::deform::BezierLattice lattice = clay::deform::make_bezier_lattice(
       {Eigen::Vector3d::Zero(), Eigen::Vector3d(10, 0, 0), Eigen::Vector3d(0, 10, 0), Eigen::Vector3d(0, 0, 10)}, {3, 3, 3});
   const double moved = (clay::deform::deform_point(lattice, Eigen::Vector3d(2, 3, 4)) - Eigen::Vector3d(2, 3, 4)).norm();
+  const clay::deform::DeformationStack stack{{{lattice, "global"}, {clay::deform::Twist{{}, {0.0, 0.1}}, "twist"}}};
+  const Eigen::Vector3d x(2, 3, 4);
+  const bool stack_ok = clay::deform::deform_point(clay::deform::stack_from_json(clay::deform::to_json(stack)), x) ==
+                        clay::deform::deform_point(stack, x);
   const bool ok = std::abs(z - 1.25) < 1e-15 && r.valid && read_step(argv[1]).size() == 1 &&
-                  solved.report.summary.converged() && far < 1e-10 && moved < 1e-12;
+                  solved.report.summary.converged() && far < 1e-10 && moved < 1e-12 && stack_ok;
   std::printf("consumer %s (z = %.17g)\n", ok ? "ok" : "FAILED", z);
   return ok ? 0 : 1;
 }
