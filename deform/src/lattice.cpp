@@ -79,18 +79,6 @@ void point_problems(const Points3& points, std::array<int, 3> counts, std::strin
     }
 }
 
-/// Greville abscissae of a basis: xi_i = (k_{i+1} + ... + k_{i+p}) / p.
-std::vector<double> greville(const surface::BSplineBasis& basis) {
-  const int p = basis.degree;
-  std::vector<double> xi(static_cast<size_t>(basis.count()));
-  for (int i = 0; i < basis.count(); ++i) {
-    double sum = 0;
-    for (int r = 1; r <= p; ++r) sum += basis.knots[static_cast<size_t>(i + r)];
-    xi[static_cast<size_t>(i)] = sum / p;
-  }
-  return xi;
-}
-
 Points3 grid_points(const Frame& frame, const std::array<std::vector<double>, 3>& xi) {
   Points3 points(static_cast<Eigen::Index>(xi[0].size() * xi[1].size() * xi[2].size()), 3);
   Eigen::Index r = 0;
@@ -398,8 +386,9 @@ void validate(const BSplineLattice& lattice, std::string_view name) {
 }
 
 Points3 undisplaced_points(const BSplineLattice& lattice) {
-  return grid_points(lattice.frame, {greville(lattice.bases[0]), greville(lattice.bases[1]),
-                                     greville(lattice.bases[2])});
+  return grid_points(lattice.frame, {surface::greville_abscissae(lattice.bases[0]),
+                                     surface::greville_abscissae(lattice.bases[1]),
+                                     surface::greville_abscissae(lattice.bases[2])});
 }
 
 Eigen::Vector3d deform_point(const BSplineLattice& lattice, const Eigen::Vector3d& x) {

@@ -123,6 +123,17 @@ std::vector<double> span_samples(const BSplineBasis& basis, int per_span) {
   return out;
 }
 
+std::vector<double> greville_abscissae(const BSplineBasis& basis) {
+  const int p = basis.degree;
+  std::vector<double> xi(static_cast<size_t>(basis.count()));
+  for (int i = 0; i < basis.count(); ++i) {
+    double sum = 0;
+    for (int r = 1; r <= p; ++r) sum += basis.knots[static_cast<size_t>(i + r)];
+    xi[static_cast<size_t>(i)] = sum / p;
+  }
+  return xi;
+}
+
 int find_span(const BSplineBasis& basis, double t) {
   const int p = basis.degree;
   const int n = basis.count();

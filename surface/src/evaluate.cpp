@@ -9,6 +9,14 @@
 #include <string>
 #include <vector>
 
+// The grid kernel is compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at load time
+// (GCC target_clones), as the FFD kernels of clay_deform are.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define CLAY_SURFACE_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define CLAY_SURFACE_CLONES
+#endif
+
 namespace clay::surface {
 namespace {
 
@@ -149,59 +157,126 @@ Points3 evaluate_many(const BSplineCurve& curve, std::span<const double> ts) {
   return out;
 }
 
+namespace {
+
+/// What one row of evaluate_grid needs: the homogeneous net by coordinate, the v basis by
+/// function and the runs of v parameters sharing a knot span.
+struct GridPlan {
+  int p = 0, q = 0, cv = 0, coords = 3;
+  size_t nvs = 0;
+  const double* net[4] = {nullptr, nullptr, nullptr, nullptr};  // x w, y w, z w, w; row-major net
+  const double* bv = nullptr;                    // bv[j * nvs + k] = N_{span-q+j}(v_k)
+  const std::array<size_t, 3>* runs = nullptr;   // {first, end, span}
+  size_t run_count = 0;
+};
+
+/// a[k] = sum_j N_{span-Q+j}(v_k) col[span-Q+j] over every run, for degree Q in v.
+template <int Q>
+inline void contract_runs(const GridPlan& g, const double* col, double* a) {
+  const size_t nvs = g.nvs;
+  for (size_t r = 0; r < g.run_count; ++r) {
+    const size_t first = g.runs[r][0], end = g.runs[r][1], span = g.runs[r][2];
+    double cj[Q + 1];
+    for (int j = 0; j <= Q; ++j) cj[j] = col[span - Q + static_cast<size_t>(j)];
+    for (size_t k = first; k < end; ++k) {
+      double sum = g.bv[k] * cj[0];
+      for (int j = 1; j <= Q; ++j) sum += g.bv[static_cast<size_t>(j) * nvs + k] * cj[j];
+      a[k] = sum;
+    }
+  }
+}
+
+/// Grid row S(u, v_k) for all k into dst (3 per point): the net contracted in u with the basis
+/// `bu` of span `su`, then in v run by run, each a loop over the parameters that vectorizes.
+CLAY_SURFACE_CLONES
+void grid_row(const GridPlan& g, int su, const double* bu, double* column, double* acc, double* dst) {
+  const size_t nvs = g.nvs;
+  for (int c = 0; c < g.coords; ++c) {
+    double* col = column + static_cast<size_t>(c) * static_cast<size_t>(g.cv);
+    for (int k = 0; k < g.cv; ++k) col[k] = 0.0;
+    for (int i = 0; i <= g.p; ++i) {
+      const double w = bu[i];
+      const double* row = g.net[c] + static_cast<size_t>(su - g.p + i) * static_cast<size_t>(g.cv);
+      for (int k = 0; k < g.cv; ++k) col[k] += w * row[k];
+    }
+    double* a = acc + static_cast<size_t>(c) * nvs;
+    switch (g.q) {  // the usual degrees with the v sum unrolled: one store per point
+      case 1: contract_runs<1>(g, col, a); break;
+      case 2: contract_runs<2>(g, col, a); break;
+      case 3: contract_runs<3>(g, col, a); break;
+      default:
+        for (size_t r = 0; r < g.run_count; ++r) {
+          const size_t first = g.runs[r][0], end = g.runs[r][1], span = g.runs[r][2];
+          for (size_t k = first; k < end; ++k) a[k] = 0.0;
+          for (int j = 0; j <= g.q; ++j) {
+            const double cj = col[span - static_cast<size_t>(g.q) + static_cast<size_t>(j)];
+            const double* bj = g.bv + static_cast<size_t>(j) * nvs;
+            for (size_t k = first; k < end; ++k) a[k] += bj[k] * cj;
+          }
+        }
+    }
+  }
+  const double *x = acc, *y = acc + nvs, *z = acc + 2 * nvs, *w = acc + 3 * nvs;
+  if (g.coords == 4) {
+    for (size_t k = 0; k < nvs; ++k) {
+      const double inv = 1.0 / w[k];
+      dst[3 * k + 0] = x[k] * inv;
+      dst[3 * k + 1] = y[k] * inv;
+      dst[3 * k + 2] = z[k] * inv;
+    }
+  } else {
+    for (size_t k = 0; k < nvs; ++k) {
+      dst[3 * k + 0] = x[k];
+      dst[3 * k + 1] = y[k];
+      dst[3 * k + 2] = z[k];
+    }
+  }
+}
+
+}  // namespace
+
 Points3 evaluate_grid(const BSplineSurface& surface, std::span<const double> us,
                       std::span<const double> vs) {
   validate(surface);
-  const int p = surface.u.degree, q = surface.v.degree;
-  const int cv = surface.count_v();
+  GridPlan g;
+  g.p = surface.u.degree;
+  g.q = surface.v.degree;
+  g.cv = surface.count_v();
+  g.nvs = vs.size();
+  g.coords = surface.is_rational() ? 4 : 3;  // polynomial: no division by sum N w = 1
   const size_t nus = us.size(), nvs = vs.size();
-  // Basis functions of every v parameter, computed once.
-  std::vector<int> span_v(nvs);
-  std::vector<double> basis_v(nvs * static_cast<size_t>(q + 1));
+  // Basis functions of every v parameter, computed once and stored by function, and the runs of
+  // consecutive parameters in the same knot span.
+  std::vector<double> bv(static_cast<size_t>(g.q + 1) * nvs);
+  std::vector<std::array<size_t, 3>> runs;
+  std::array<double, max_width> b;
   for (size_t k = 0; k < nvs; ++k) {
-    span_v[k] = find_span(surface.v, vs[k]);
-    basis_functions(surface.v, span_v[k], vs[k],
-                    std::span<double>(basis_v.data() + k * static_cast<size_t>(q + 1), static_cast<size_t>(q + 1)));
+    const int span = find_span(surface.v, vs[k]);
+    basis_functions(surface.v, span, vs[k], b);
+    for (int j = 0; j <= g.q; ++j) bv[static_cast<size_t>(j) * nvs + k] = b[static_cast<size_t>(j)];
+    if (runs.empty() || runs.back()[2] != static_cast<size_t>(span)) runs.push_back({k, k + 1, static_cast<size_t>(span)});
+    else runs.back()[1] = k + 1;
   }
-  // Homogeneous net, 4 doubles per control point.
+  // Homogeneous net by coordinate: x w, y w, z w, w.
   const Eigen::Index rows = surface.points.rows();
-  std::vector<double> net(static_cast<size_t>(rows) * 4);
+  std::vector<double> net(4 * static_cast<size_t>(rows));
   for (Eigen::Index r = 0; r < rows; ++r) {
     const double w = surface.weights[r];
-    net[static_cast<size_t>(r) * 4 + 0] = surface.points(r, 0) * w;
-    net[static_cast<size_t>(r) * 4 + 1] = surface.points(r, 1) * w;
-    net[static_cast<size_t>(r) * 4 + 2] = surface.points(r, 2) * w;
-    net[static_cast<size_t>(r) * 4 + 3] = w;
+    for (int c = 0; c < 3; ++c) net[static_cast<size_t>(c * rows + r)] = surface.points(r, c) * w;
+    net[static_cast<size_t>(3 * rows + r)] = w;
   }
+  for (int c = 0; c < 4; ++c) g.net[c] = net.data() + static_cast<size_t>(c) * static_cast<size_t>(rows);
+  g.bv = bv.data();
+  g.runs = runs.data();
+  g.run_count = runs.size();
+
   Points3 out(static_cast<Eigen::Index>(nus * nvs), 3);
-  std::vector<double> column(static_cast<size_t>(cv) * 4);  // the net contracted in u at one u
+  std::vector<double> column(4 * static_cast<size_t>(g.cv)), acc(4 * nvs);
   std::array<double, max_width> bu;
   for (size_t iu = 0; iu < nus; ++iu) {
     const int su = find_span(surface.u, us[iu]);
     basis_functions(surface.u, su, us[iu], bu);
-    std::fill(column.begin(), column.end(), 0.0);
-    for (int i = 0; i <= p; ++i) {
-      const double b = bu[static_cast<size_t>(i)];
-      const double* row = net.data() + static_cast<size_t>(su - p + i) * static_cast<size_t>(cv) * 4;
-      for (size_t c = 0; c < column.size(); ++c) column[c] += b * row[c];
-    }
-    for (size_t iv = 0; iv < nvs; ++iv) {
-      const double* bv = basis_v.data() + iv * static_cast<size_t>(q + 1);
-      const double* base = column.data() + static_cast<size_t>(span_v[iv] - q) * 4;
-      double x = 0, y = 0, z = 0, w = 0;
-      for (int j = 0; j <= q; ++j) {
-        const double b = bv[j];
-        x += b * base[4 * j + 0];
-        y += b * base[4 * j + 1];
-        z += b * base[4 * j + 2];
-        w += b * base[4 * j + 3];
-      }
-      const Eigen::Index r = static_cast<Eigen::Index>(iu * nvs + iv);
-      const double inv = 1.0 / w;
-      out(r, 0) = x * inv;
-      out(r, 1) = y * inv;
-      out(r, 2) = z * inv;
-    }
+    grid_row(g, su, bu.data(), column.data(), acc.data(), out.data() + iu * nvs * 3);
   }
   return out;
 }

@@ -33,9 +33,14 @@ void check_point(const Eigen::Vector3d& p) {
                 "projection: the point to project has a non-finite coordinate; give a finite point");
 }
 
-/// Newton from (u0, v0) on a valid surface (checked by the callers).
-SurfaceProjection newton(const BSplineSurface& s, const Eigen::Vector3d& target, double u0, double v0,
-                         const ProjectionOptions& o) {
+/// Diagonal of the control box: the scale of "P is on S" in newton().
+double net_size(const BSplineSurface& s) {
+  return (s.points.colwise().maxCoeff() - s.points.colwise().minCoeff()).norm();
+}
+
+/// Newton from (u0, v0) on a valid surface (checked by the callers); `size` = net_size(s).
+SurfaceProjection newton(const BSplineSurface& s, double size, const Eigen::Vector3d& target,
+                         double u0, double v0, const ProjectionOptions& o) {
   const auto [ua, ub] = s.u.domain();
   const auto [va, vb] = s.v.domain();
   const double lo[2] = {ua, va}, hi[2] = {ub, vb};
@@ -45,7 +50,7 @@ SurfaceProjection newton(const BSplineSurface& s, const Eigen::Vector3d& target,
   SurfaceDerivatives d = derivatives(s, x[0], x[1], 2);
   double f = (d.point - target).squaredNorm();
   out.summary.initial_residual = std::sqrt(f);
-  const double scale = (s.points.colwise().maxCoeff() - s.points.colwise().minCoeff()).norm() + target.norm();
+  const double scale = size + target.norm();
   out.summary.termination = Termination::NotConverged;
   out.summary.message = "iteration limit reached";
   int it = 0;
@@ -162,30 +167,51 @@ SurfaceProjection project_normal(const BSplineSurface& surface, const Eigen::Vec
   check_point(point);
   find_span(surface.u, u0);  // throws OutOfDomain with the value and the domain
   find_span(surface.v, v0);
-  return newton(surface, point, u0, v0, options);
+  return newton(surface, net_size(surface), point, u0, v0, options);
 }
 
 SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vector3d& point,
                                 const ProjectionOptions& options) {
-  options.validate();
-  validate(surface);
+  return SurfaceProjector(surface, options).closest_point(point);
+}
+
+SurfaceProjector::SurfaceProjector(BSplineSurface surface, const ProjectionOptions& options)
+    : surface_(std::move(surface)), options_(options) {
+  options_.validate();
+  validate(surface_);
+  size_ = net_size(surface_);
+  us_ = span_samples(surface_.u, options_.samples_per_span);
+  vs_ = span_samples(surface_.v, options_.samples_per_span);
+  grid_ = evaluate_grid(surface_, us_, vs_);
+}
+
+SurfaceProjection SurfaceProjector::project_normal(const Eigen::Vector3d& point, double u0,
+                                                   double v0) const {
   check_point(point);
-  const auto us = span_samples(surface.u, options.samples_per_span);
-  const auto vs = span_samples(surface.v, options.samples_per_span);
-  const Points3 grid = evaluate_grid(surface, us, vs);
-  std::vector<Eigen::Index> order(static_cast<size_t>(grid.rows()));
-  std::iota(order.begin(), order.end(), Eigen::Index{0});
-  Eigen::VectorXd dist2 = (grid.rowwise() - point.transpose()).rowwise().squaredNorm();
-  const size_t starts = std::min(order.size(), static_cast<size_t>(options.starts));
-  std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(starts), order.end(),
-                    [&](Eigen::Index a, Eigen::Index b) { return dist2[a] < dist2[b]; });
+  find_span(surface_.u, u0);  // throws OutOfDomain with the value and the domain
+  find_span(surface_.v, v0);
+  return newton(surface_, size_, point, u0, v0, options_);
+}
+
+SurfaceProjection SurfaceProjector::closest_point(const Eigen::Vector3d& point) const {
+  check_point(point);
+  // Newton from the `starts` grid samples nearest to the point; the nearest result wins.
+  const size_t starts = std::min(static_cast<size_t>(grid_.rows()), static_cast<size_t>(options_.starts));
+  std::vector<std::pair<double, Eigen::Index>> best_samples;  // (squared distance, row), sorted
+  best_samples.reserve(starts + 1);
+  for (Eigen::Index r = 0; r < grid_.rows(); ++r) {
+    const double d2 = (grid_.row(r) - point.transpose()).squaredNorm();
+    if (best_samples.size() == starts && d2 >= best_samples.back().first) continue;
+    const auto at = std::upper_bound(best_samples.begin(), best_samples.end(), std::make_pair(d2, r));
+    best_samples.insert(at, {d2, r});
+    if (best_samples.size() > starts) best_samples.pop_back();
+  }
   SurfaceProjection best;
   bool have = false;
-  for (size_t k = 0; k < starts; ++k) {
-    const Eigen::Index r = order[k];
-    const double u0 = us[static_cast<size_t>(r) / vs.size()];
-    const double v0 = vs[static_cast<size_t>(r) % vs.size()];
-    SurfaceProjection candidate = newton(surface, point, u0, v0, options);
+  for (const auto& [d2, r] : best_samples) {
+    const double u0 = us_[static_cast<size_t>(r) / vs_.size()];
+    const double v0 = vs_[static_cast<size_t>(r) % vs_.size()];
+    SurfaceProjection candidate = newton(surface_, size_, point, u0, v0, options_);
     if (!have || candidate.distance < best.distance) {
       best = std::move(candidate);
       have = true;

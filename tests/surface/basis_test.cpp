@@ -118,6 +118,27 @@ TEST_CASE("clamped_uniform_basis, breakpoints, multiplicity", "[basis]") {
   CHECK_THROWS_AS(clamped_uniform_basis(2, 5, 1.0, 1.0), clay::Error);
 }
 
+TEST_CASE("greville_abscissae average degree-many knots and reproduce linear functions", "[basis]") {
+  const BSplineBasis b{3, {0, 0, 0, 0, 1, 3, 4, 4, 4, 4}};
+  const auto xi = greville_abscissae(b);
+  REQUIRE(xi.size() == 6);
+  CHECK_THAT(xi[0], WithinAbs(0.0, 1e-15));
+  CHECK_THAT(xi[1], WithinAbs(1.0 / 3, 1e-15));
+  CHECK_THAT(xi[2], WithinAbs(4.0 / 3, 1e-15));
+  CHECK_THAT(xi[3], WithinAbs(8.0 / 3, 1e-15));
+  CHECK_THAT(xi[4], WithinAbs(11.0 / 3, 1e-15));
+  CHECK_THAT(xi[5], WithinAbs(4.0, 1e-15));
+  // Linear precision: sum_i N_i(t) xi_i = t at every parameter.
+  std::vector<double> N(4);
+  for (double t : {0.0, 0.3, 1.0, 2.2, 3.9, 4.0}) {
+    const int k = find_span(b, t);
+    basis_functions(b, k, t, N);
+    double sum = 0;
+    for (int r = 0; r <= 3; ++r) sum += N[static_cast<size_t>(r)] * xi[static_cast<size_t>(k - 3 + r)];
+    CHECK_THAT(sum, WithinAbs(t, 1e-14));
+  }
+}
+
 TEST_CASE("span_samples follows the knot spans", "[basis]") {
   const BSplineBasis b{2, {0, 0, 0, 1, 1, 3, 3, 3}};  // spans [0, 1], [1, 3]
   CHECK(span_samples(b, 2) == std::vector<double>{0, 0.5, 1, 2, 3});

@@ -122,3 +122,33 @@ TEST_CASE("closest point near a collapsed edge (a triangular patch)", "[projecti
       CHECK_THAT(proj.distance, WithinAbs(2.0, 1e-9));
     }
 }
+
+TEST_CASE("SurfaceProjector: the cylinder's closed-form distance, and the free functions' results", "[projection]") {
+  const double r = 50.0, h = 80.0;
+  const BSplineSurface s = quarter_cylinder(r, h);
+  const SurfaceProjector projector(s);
+  std::mt19937 rng(52);
+  std::uniform_real_distribution<double> angle(0.05, 1.52), rho(5.0, 120.0), z(1.0, 79.0);
+  for (int k = 0; k < 50; ++k) {
+    const double a = angle(rng), q = rho(rng), zz = z(rng);
+    const Eigen::Vector3d p(q * std::cos(a), q * std::sin(a), zz);
+    const SurfaceProjection c = projector.closest_point(p);
+    REQUIRE(c.summary.converged());
+    CHECK_THAT(c.distance, WithinAbs(std::abs(q - r), 1e-9));
+    CHECK_THAT(c.point.z(), WithinAbs(zz, 1e-9));
+    const SurfaceProjection free = closest_point(s, p);
+    CHECK(free.u == c.u);
+    CHECK(free.v == c.v);
+    const SurfaceProjection n = projector.project_normal(p, 0.5, 0.5);
+    const SurfaceProjection free_n = project_normal(s, p, 0.5, 0.5);
+    CHECK(n.u == free_n.u);
+    CHECK(n.v == free_n.v);
+    CHECK(n.distance == free_n.distance);
+  }
+  CHECK_THROWS_AS(SurfaceProjector(BSplineSurface{}), clay::Error);
+  CHECK_THROWS_AS(projector.project_normal(Eigen::Vector3d(0, 0, std::nan("")), 0.5, 0.5), clay::Error);
+  CHECK_THROWS_AS(projector.project_normal(Eigen::Vector3d::Zero(), 2.0, 0.5), clay::Error);
+  ProjectionOptions bad;
+  bad.starts = 0;
+  CHECK_THROWS_AS(SurfaceProjector(s, bad), clay::Error);
+}

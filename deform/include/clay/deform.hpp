@@ -3,8 +3,8 @@
 /// Hsu–Hughes–Kaufman 1992), local deformations with continuity, Jacobian bounds and fast
 /// deformation of many points (Güdükbay–Özgüç 1990), extended lattices of tricubic chunks
 /// (Coquillart 1990), direct manipulation (Hsu–Hughes–Kaufman 1992 §3), Barr's regular
-/// deformations (taper, twist, bend) and deformation stacks with their JSON form. Style
-/// deformation arrives with issue #5.
+/// deformations (taper, twist, bend), deformation stacks with their JSON form, and the style
+/// deformation by bound and target curves (Han–De Amicis–Conti 2007).
 #include <clay/constraints.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
@@ -15,3 +15,4 @@
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
 #include <clay/deform/stack.hpp>
+#include <clay/deform/style.hpp>

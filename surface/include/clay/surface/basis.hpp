@@ -55,6 +55,11 @@ std::vector<double> breakpoints(const BSplineBasis& basis);
 /// a sample that follows the knots. Throws clay::Error(InvalidArgument) for per_span < 1.
 std::vector<double> span_samples(const BSplineBasis& basis, int per_span);
 
+/// Greville abscissae xi_i = (k_{i+1} + ... + k_{i+p}) / p, one per control point: the parameters
+/// "under" each control point (a polynomial spline with control points f(xi_i) of a linear f is f
+/// itself). Strictly increasing for a valid basis. Precondition: a valid basis.
+std::vector<double> greville_abscissae(const BSplineBasis& basis);
+
 /// Index k of the knot span [knots[k], knots[k+1]) holding t, with degree <= k < count(); the domain
 /// end maps to the last non-empty span. Throws clay::Error(OutOfDomain) when t is outside the domain
 /// or not finite. (The NURBS Book A2.1.)
