@@ -241,6 +241,23 @@ class RegionTest {
 
 }  // namespace
 
+KeyPoint make_key_point(const BSplineSurface& s, const InfluenceRegion& region, const Eigen::Vector3d& point,
+                        double t, double u, double v, KeyDirection direction) {
+  KeyPoint k;
+  k.curve_parameter = t;
+  k.point = point;
+  k.u = u;
+  k.v = v;
+  k.foot = surface::evaluate(s, u, v);
+  k.normal = normal_or_zero(s, u, v);
+  k.distance = (k.point - k.foot).dot(k.normal);
+  const double gu = continuous_index(surface::greville_abscissae(s.u), u);
+  const double gv = continuous_index(surface::greville_abscissae(s.v), v);
+  k.row = static_cast<int>(std::lround(direction == KeyDirection::u ? gu : gv));
+  k.influenced = region.inside(static_cast<int>(std::lround(gu)), static_cast<int>(std::lround(gv)));
+  return k;
+}
+
 KeyPoints find_key_points(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
                           const BSplineCurve& target, const std::vector<TraceSample>& trace,
                           int per_row) {
@@ -288,18 +305,7 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
   const auto [d0, d1] = along_u ? s.u.domain() : s.v.domain();
   const double ftol = 1e-13 * (d1 - d0);
   auto make_key = [&](double t, double u, double v) {
-    KeyPoint k;
-    k.curve_parameter = t;
-    k.point = surface::evaluate(target, t);
-    k.u = u;
-    k.v = v;
-    k.foot = surface::evaluate(s, u, v);
-    k.normal = normal_or_zero(s, u, v);
-    k.distance = (k.point - k.foot).dot(k.normal);
-    const double gu = continuous_index(xu, u), gv = continuous_index(xv, v);
-    k.row = static_cast<int>(std::lround(along_u ? gu : gv));
-    k.influenced = region.inside(static_cast<int>(std::lround(gu)), static_cast<int>(std::lround(gv)));
-    return k;
+    return make_key_point(s, region, surface::evaluate(target, t), t, u, v, out.direction);
   };
 
   for (double c : values) {

@@ -170,25 +170,6 @@ std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s, const std::
   return cache;
 }
 
-// A key point at a target sample (its projection onto the parent already known).
-KeyPoint key_point_at(const BSplineSurface& s, const InfluenceRegion& reg, const TraceSample& t,
-                      KeyDirection direction) {
-  KeyPoint k;
-  k.point = t.point;
-  k.curve_parameter = t.t;
-  k.u = t.u;
-  k.v = t.v;
-  const auto d = surface::derivatives(s, t.u, t.v, 1);
-  k.foot = d.point;
-  const Eigen::Vector3d n = d.du.cross(d.dv);
-  k.normal = n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero();
-  k.distance = (k.point - k.foot).dot(k.normal);
-  const double gu = continuous_index(surface::greville_abscissae(s.u), t.u);
-  const double gv = continuous_index(surface::greville_abscissae(s.v), t.v);
-  k.row = static_cast<int>(std::lround(direction == KeyDirection::u ? gu : gv));
-  k.influenced = reg.inside(static_cast<int>(std::lround(gu)), static_cast<int>(std::lround(gv)));
-  return k;
-}
 
 }  // namespace
 
@@ -376,7 +357,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
         bool crowded = false;
         for (const KeyPoint& p : points) crowded = crowded || std::abs(p.curve_parameter - trace[k].t) < gap;
         if (crowded) continue;
-        points.push_back(key_point_at(s, reg, trace[k], keys.direction));
+        points.push_back(make_key_point(s, reg, trace[k].point, trace[k].t, trace[k].u, trace[k].v, keys.direction));
         ++added;
       }
       if (added > 0) {

@@ -64,6 +64,12 @@ double model_size(const surface::BSplineSurface& surface);
 /// clamped to [0, size - 1].
 double continuous_index(const std::vector<double>& xi, double x);
 
+/// The key point K = `point` (curve parameter t) whose foot point on `s` is S(u, v): foot, unit
+/// normal (zero at a pole), signed distance D(K) (eq. 3), the row it drives and E of the vertex
+/// nearest to the foot point.
+KeyPoint make_key_point(const surface::BSplineSurface& s, const InfluenceRegion& region,
+                        const Eigen::Vector3d& point, double t, double u, double v, KeyDirection direction);
+
 /// Key points of the traced target on the projector's surface (whose net `region.factors`
 /// describes): Han et al. eq. 8 with `per_row` key points per control-net row interval crossed.
 KeyPoints find_key_points(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
