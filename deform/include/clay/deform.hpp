@@ -4,7 +4,8 @@
 /// deformation of many points (Güdükbay–Özgüç 1990), extended lattices of tricubic chunks
 /// (Coquillart 1990), direct manipulation (Hsu–Hughes–Kaufman 1992 §3), Barr's regular
 /// deformations (taper, twist, bend), deformation stacks with their JSON form, and the style
-/// deformation by bound and target curves (Han–De Amicis–Conti 2007).
+/// deformation by bound and target curves (Han–De Amicis–Conti 2007), and the certified refit of
+/// deformed surfaces that are not polynomial.
 #include <clay/constraints.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
@@ -13,6 +14,7 @@
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/lattice.hpp>
+#include <clay/deform/refit.hpp>
 #include <clay/deform/regular.hpp>
 #include <clay/deform/stack.hpp>
 #include <clay/deform/style.hpp>

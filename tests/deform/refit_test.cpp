@@ -1,0 +1,387 @@
+// Certified refit (issue #7 item 4): every fit is checked at random parameters the refit never
+// sampled, against a deformation computed here independently where a closed form exists (twist as
+// an Eigen rotation, taper as a radial scale); the certified bound must hold there and be within a
+// sensible factor of what the check finds. Knot-plane crossings are found independently by
+// sampling the surface's lattice coordinates.
+#include <catch2/catch.hpp>
+
+#include <clay/deform.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
+#include <clay/surface/skin.hpp>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <set>
+#include <utility>
+
+#include "error_of.hpp"
+#include "fixtures.hpp"
+
+using namespace clay::deform;
+using clay::ErrorCategory;
+using clay::Termination;
+using clay::test::error_of;
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinRel;
+namespace surface = clay::surface;
+
+namespace {
+
+/// A cubic open section: an arc-like curve of 6 control points at height z, scaled by `scale`
+/// and wobbled by `wobble`.
+surface::BSplineCurve section(double z, double scale, double wobble) {
+  surface::Points3 p(6, 3);
+  for (int i = 0; i < 6; ++i) {
+    const double a = 0.6 * i;
+    p.row(i) << scale * 40 * std::cos(a), scale * (25 + wobble * (i % 2)) * std::sin(a), z;
+  }
+  return surface::make_curve(3, {0, 0, 0, 0, 1.0 / 3, 2.0 / 3, 1, 1, 1, 1}, p);
+}
+
+/// A loft through four sections from z = 0 to z = 120 mm.
+surface::BSplineSurface loft_surface() {
+  std::vector<surface::BSplineCurve> sections{section(0, 1.0, 0), section(40, 0.8, 6),
+                                              section(80, 1.1, -4), section(120, 0.9, 3)};
+  return surface::loft(sections).surface;
+}
+
+/// Largest |fit(u, v) − target(S(u, v))| at `n` uniform random parameters.
+template <class Target>
+double random_deviation(const surface::BSplineSurface& original, const surface::BSplineSurface& fit,
+                        Target target, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  const double u0 = original.u.knots[static_cast<std::size_t>(original.u.degree)];
+  const double u1 = original.u.knots[static_cast<std::size_t>(original.u.count())];
+  const double v0 = original.v.knots[static_cast<std::size_t>(original.v.degree)];
+  const double v1 = original.v.knots[static_cast<std::size_t>(original.v.count())];
+  std::uniform_real_distribution<double> du(u0, u1), dv(v0, v1);
+  double worst = 0;
+  for (int k = 0; k < n; ++k) {
+    const double u = du(rng), v = dv(rng);
+    const Eigen::Vector3d want = target(surface::evaluate(original, u, v));
+    worst = std::max(worst, (surface::evaluate(fit, u, v) - want).norm());
+  }
+  return worst;
+}
+
+/// A flat bicubic sheet through the middle of a frame, tilted, local coordinates in [lo, hi].
+surface::BSplineSurface sheet_in(const Frame& f, double lo, double hi, double tilt) {
+  const surface::BSplineBasis b = surface::clamped_uniform_basis(3, 5);
+  surface::Points3 p(25, 3);
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) {
+      const double s = lo + (hi - lo) * i / 4.0, t = lo + (hi - lo) * j / 4.0;
+      p.row(i * 5 + j) = f.point(s, t, 0.5 + tilt * (s - t) + 0.05 * std::sin(3.0 * s)).transpose();
+    }
+  return surface::make_surface(b, b, p);
+}
+
+}  // namespace
+
+TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independently", "[refit]") {
+  const surface::BSplineSurface loft = loft_surface();
+  Twist twist;
+  twist.angle = {0.0, 0.01};  // 1.2 rad over the 120 mm of the loft
+  const RefitResult r = refit_deformed(loft, twist);
+  const RefitReport& rep = r.report;
+  INFO(rep.brief() << " / " << rep.summary.brief());
+  REQUIRE(rep.summary.termination == Termination::Converged);
+  REQUIRE(rep.certified);
+  CHECK(rep.degree_u == 3);
+  CHECK(rep.degree_v == 3);
+  CHECK(r.surface.u.degree == 3);
+  CHECK(rep.sampled_max <= rep.certified_bound);
+  CHECK(rep.certified_bound <= rep.tolerance);
+  CHECK(rep.crossings.empty());
+
+  // the twist computed here: a rotation by 0.01 z about the z axis
+  auto rotate = [](const Eigen::Vector3d& x) -> Eigen::Vector3d {
+    return Eigen::AngleAxisd(0.01 * x.z(), Eigen::Vector3d::UnitZ()) * x;
+  };
+  // size: the deformed surface's box from a dense grid, computed here
+  const auto us = surface::linspace(0, 1, 60), vs = surface::linspace(0, 1, 60);
+  surface::Points3 grid = surface::evaluate_grid(loft, us, vs);
+  for (Eigen::Index k = 0; k < grid.rows(); ++k) grid.row(k) = rotate(grid.row(k).transpose()).transpose();
+  const double size = (grid.colwise().maxCoeff() - grid.colwise().minCoeff()).norm();
+  CHECK_THAT(rep.tolerance, WithinRel(1e-4 * size, 0.02));
+
+  const double check = random_deviation(loft, r.surface, rotate, 4000, 11);
+  INFO("independent check " << check << " mm, bound " << rep.certified_bound << " mm");
+  CHECK(check <= rep.certified_bound);
+  CHECK(check <= 1e-4 * size);
+  CHECK(rep.certified_bound <= 10 * check);  // the bound is not wildly pessimistic
+  CHECK(check <= rep.sampled_max * 1.5);     // the sampled figure is representative
+}
+
+TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor", "[refit]") {
+  std::mt19937 rng(5);
+  const Frame f = clay::test::random_frame(rng);
+  const BezierLattice lattice =
+      clay::test::displaced(make_bezier_lattice(f, {2, 2, 2}), rng, 0.12);
+  const surface::BSplineSurface sheet = sheet_in(f, 0.1, 0.9, 0.2);
+  RefitOptions options;
+  options.tolerance = 1e-5;
+  const RefitResult r = refit_deformed(sheet, lattice, options);
+  INFO(r.report.brief());
+  REQUIRE(r.report.summary.converged());
+  REQUIRE(r.report.certified);
+  CHECK(r.report.crossings.empty());  // inside the lattice
+  const double check = random_deviation(
+      sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, 4000, 3);
+  INFO("independent check " << check);
+  CHECK(check <= r.report.certified_bound);
+  CHECK(r.report.certified_bound <= 10 * check);
+  CHECK(r.report.certified_bound <= r.report.tolerance);
+}
+
+TEST_CASE("B-spline lattice knot planes crossed by the surface are detected and reported",
+          "[refit]") {
+  std::mt19937 rng(8);
+  const Frame f = clay::test::random_frame(rng);
+  const BSplineLattice lattice =
+      clay::test::displaced(make_bspline_lattice(f, {2, 2, 2}, {3, 3, 3}), rng, 0.05);
+  const surface::BSplineSurface sheet = sheet_in(f, 0.05, 0.95, 0.25);
+  RefitOptions options;
+  options.tolerance = 1e-4;
+  const RefitResult r = refit_deformed(sheet, lattice, options);
+  INFO(r.report.brief() << " / " << r.report.summary.message);
+  REQUIRE(r.report.certified);
+  REQUIRE(r.report.summary.converged());
+  REQUIRE_FALSE(r.report.crossings.empty());
+  CHECK_THAT(r.report.summary.message, Contains("crossings"));
+
+  // every interior knot plane the surface crosses (found by sampling its local coordinates) is
+  // among the reported crossings
+  std::set<std::pair<int, double>> reported;
+  for (const KnotPlaneCrossing& c : r.report.crossings) {
+    reported.insert({c.axis, c.plane});
+    CHECK(c.sampled_max <= c.bound);
+    CHECK(c.bound <= r.report.tolerance);
+    CHECK(c.step == 0);
+  }
+  const auto us = surface::linspace(0, 1, 80);
+  const surface::Points3 grid = surface::evaluate_grid(sheet, us, us);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+  for (Eigen::Index k = 0; k < grid.rows(); ++k) {
+    const Eigen::Vector3d l = local_coordinates(f, grid.row(k).transpose());
+    lo = lo.cwiseMin(l), hi = hi.cwiseMax(l);
+  }
+  int crossed = 0;
+  for (int axis = 0; axis < 3; ++axis)
+    for (double plane : {1.0 / 3, 2.0 / 3}) {
+      if (!(lo[axis] < plane && hi[axis] > plane)) continue;
+      ++crossed;
+      bool found = false;
+      for (const auto& [a, value] : reported) found |= a == axis && std::abs(value - plane) < 1e-12;
+      CHECK(found);
+    }
+  CHECK(crossed >= 4);  // s and t planes at least
+
+  const double check = random_deviation(
+      sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, 3000, 4);
+  INFO("independent check " << check);
+  CHECK(check <= r.report.certified_bound);
+}
+
+TEST_CASE("Refit keeps the original's C0 seams and breakpoints", "[refit]") {
+  // a bicubic surface with a C0 knot (multiplicity 3) at u = 0.5
+  surface::BSplineBasis bu;
+  bu.degree = 3;
+  bu.knots = {0, 0, 0, 0, 0.5, 0.5, 0.5, 1, 1, 1, 1};
+  const surface::BSplineBasis bv = surface::clamped_uniform_basis(3, 4);
+  surface::Points3 p(7 * 4, 3);
+  for (int i = 0; i < 7; ++i)
+    for (int j = 0; j < 4; ++j) p.row(i * 4 + j) << 10.0 * i, 10.0 * j, (i == 3 ? 8.0 : 0.0) + j;
+  const surface::BSplineSurface s = surface::make_surface(bu, bv, p);
+  Taper taper;
+  taper.profile = {1.0, 0.004};
+  const RefitResult r = refit_deformed(s, taper);
+  REQUIRE(r.report.summary.converged());
+  REQUIRE(r.report.certified);
+  CHECK(surface::multiplicity(r.surface.u, 0.5) == 3);
+  // the taper computed here: (x, y) scaled by 1 + 0.004 z
+  const double check = random_deviation(
+      s, r.surface,
+      [](const Eigen::Vector3d& x) {
+        const double k = 1 + 0.004 * x.z();
+        return Eigen::Vector3d(k * x.x(), k * x.y(), x.z());
+      },
+      2000, 9);
+  CHECK(check <= r.report.certified_bound);
+  CHECK(r.report.certified_bound <= r.report.tolerance);
+}
+
+TEST_CASE("Refit of a rational surface under a stack is certified", "[refit]") {
+  std::mt19937 rng(21);
+  surface::BSplineSurface s;
+  s.u = surface::clamped_uniform_basis(2, 4);
+  s.v = surface::clamped_uniform_basis(2, 4);
+  s.points.resize(16, 3);
+  s.weights.resize(16);
+  std::uniform_real_distribution<double> c(-1, 1), w(0.5, 2);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      s.points.row(i * 4 + j) << 20.0 * i + 3 * c(rng), 20.0 * j + 3 * c(rng), 10 * c(rng);
+      s.weights(i * 4 + j) = w(rng);
+    }
+  surface::validate(s);
+  DeformationStack stack;
+  Taper taper;
+  taper.profile = {1.0, 0.01};
+  Twist twist;
+  twist.frame.origin = Eigen::Vector3d(30, 30, 0);
+  twist.angle = {0.0, 0.02};
+  stack.steps = {{taper, "taper", true}, {twist, "twist", true}};
+  RefitOptions options;
+  options.tolerance = 1e-3;
+  options.relative = false;  // mm
+  const RefitResult r = refit_deformed(s, stack, options);
+  INFO(r.report.brief());
+  REQUIRE(r.report.certified);
+  REQUIRE(r.report.summary.converged());
+  CHECK_THAT(r.report.tolerance, WithinRel(1e-3, 1e-15));
+  const double check = random_deviation(
+      s, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(stack, x); }, 3000, 2);
+  CHECK(check <= r.report.certified_bound);
+  CHECK(r.report.certified_bound <= 1e-3);
+}
+
+TEST_CASE("A bend region end crossing the surface gets a first-derivative bound", "[refit]") {
+  const surface::BSplineSurface sheet = surface::make_surface(
+      surface::clamped_uniform_basis(3, 4), surface::clamped_uniform_basis(3, 4), [] {
+        surface::Points3 p(16, 3);
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j) p.row(i * 4 + j) << 10.0 * i, 20.0 * j - 30, 2.0 * i;
+        return p;
+      }());
+  Bend bend;
+  bend.y_min = -5;
+  bend.y_max = 5;
+  bend.rate = 0.05;
+  RefitOptions options;
+  options.tolerance = 1e-3;
+  options.max_iterations = 3;
+  const RefitResult r = refit_deformed(sheet, bend, options);
+  INFO(r.report.brief() << " / " << r.report.summary.message);
+  REQUIRE(r.report.certified);
+  CHECK(r.report.lipschitz_cells > 0);
+  CHECK_THAT(r.report.summary.message, Contains("only C0"));
+  const double check = random_deviation(
+      sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(bend, x); }, 3000, 6);
+  CHECK(check <= r.report.certified_bound);
+  CHECK(r.report.sampled_max <= r.report.certified_bound);
+}
+
+TEST_CASE("Point maps and extended lattices are fitted but not certified", "[refit]") {
+  const surface::BSplineSurface loft = loft_surface();
+  const PointMap wave = [](const Eigen::Vector3d& x) {
+    return Eigen::Vector3d(x.x() + 2 * std::sin(x.z() / 30), x.y(), x.z());
+  };
+  const RefitResult r = refit_deformed(loft, wave);
+  CHECK_FALSE(r.report.certified);
+  CHECK(std::isinf(r.report.certified_bound));
+  CHECK(r.report.summary.converged());
+  CHECK(r.report.sampled_max <= r.report.tolerance);
+  CHECK_THAT(r.report.summary.message, Contains("not certified"));
+  CHECK_THAT(r.report.summary.message, Contains("point map"));
+  CHECK_THAT(r.report.brief(), Contains("not certified"));
+  // a sanity check, not a certificate: the 4x-denser sample is representative here
+  CHECK(random_deviation(loft, r.surface, wave, 2000, 5) <= 2 * r.report.tolerance);
+
+  std::mt19937 rng(3);
+  const Frame f = clay::test::random_frame(rng);
+  const BezierLattice b = make_bezier_lattice(f, {3, 3, 3});
+  ExtendedLattice e;
+  e.rest = b.points;
+  e.points = clay::test::displaced(b, rng, 0.05).points;
+  Chunk chunk;
+  for (int k = 0; k < chunk_control_points; ++k) chunk[static_cast<std::size_t>(k)] = k;
+  e.chunks = {chunk};
+  RefitOptions options;
+  options.tolerance = 1e-4;
+  options.max_iterations = 2;
+  const RefitResult x = refit_deformed(sheet_in(f, 0.2, 0.8, 0.1), e, options);
+  CHECK_FALSE(x.report.certified);
+  CHECK_THAT(x.report.summary.message, Contains("Newton-frozen"));
+}
+
+TEST_CASE("Refit limits end in a not-converged report", "[refit]") {
+  const surface::BSplineSurface loft = loft_surface();
+  Twist twist;
+  twist.angle = {0.0, 0.02};
+  RefitOptions options;
+  options.tolerance = 1e-7;
+  options.max_iterations = 1;
+  const RefitResult r = refit_deformed(loft, twist, options);
+  CHECK(r.report.summary.termination == Termination::NotConverged);
+  CHECK(r.report.summary.iterations == 1);
+  CHECK_THAT(r.report.summary.message, Contains("iteration limit 1"));
+  CHECK(r.report.certified_bound > r.report.tolerance);
+
+  options.max_iterations = 10;
+  options.max_control_points = 100;
+  const RefitResult c = refit_deformed(loft, twist, options);
+  CHECK(c.report.summary.termination == Termination::NotConverged);
+  CHECK_THAT(c.report.summary.message, Contains("control point limit 100"));
+  CHECK(c.surface.count_u() * c.surface.count_v() <= 100);
+}
+
+TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]") {
+  const surface::BSplineSurface loft = loft_surface();
+  Twist twist;
+  auto options_error = [&](RefitOptions o, const char* field) {
+    const auto [category, what] = error_of([&] { refit_deformed(loft, twist, o); });
+    CHECK(category == ErrorCategory::InvalidArgument);
+    CHECK_THAT(what, Contains(field));
+  };
+  RefitOptions o;
+  o.degree = 0;
+  options_error(o, "degree = 0");
+  o = {};
+  o.degree = 26;
+  options_error(o, "degree = 26");
+  o = {};
+  o.tolerance = 0;
+  options_error(o, "tolerance = 0");
+  o = {};
+  o.tolerance = std::numeric_limits<double>::quiet_NaN();
+  options_error(o, "tolerance = nan");
+  o = {};
+  o.max_iterations = 0;
+  options_error(o, "max_iterations = 0");
+  o = {};
+  o.max_control_points = 15;
+  options_error(o, "max_control_points = 15");
+  o = {};
+  o.certificate_share = 1;
+  options_error(o, "certificate_share = 1");
+
+  surface::BSplineSurface bad = loft;
+  bad.points(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  auto [c1, w1] = error_of([&] { refit_deformed(bad, twist); });
+  CHECK(c1 == ErrorCategory::InvalidGeometry);
+  CHECK_THAT(w1, Contains("refit_deformed surface"));
+
+  Twist bad_twist;
+  bad_twist.angle = {};
+  auto [c2, w2] = error_of([&] { refit_deformed(loft, bad_twist); });
+  CHECK(c2 == ErrorCategory::InvalidGeometry);
+
+  auto [c3, w3] = error_of([&] { refit_deformed(loft, PointMap{}); });
+  CHECK(c3 == ErrorCategory::InvalidArgument);
+  CHECK_THAT(w3, Contains("empty"));
+
+  const PointMap broken = [](const Eigen::Vector3d& x) {
+    return x.z() > 60 ? Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()) : x;
+  };
+  auto [c4, w4] = error_of([&] { refit_deformed(loft, broken); });
+  CHECK(c4 == ErrorCategory::InvalidArgument);
+  CHECK_THAT(w4, Contains("non-finite"));
+
+  const PointMap collapse = [](const Eigen::Vector3d&) { return Eigen::Vector3d(1, 2, 3); };
+  auto [c5, w5] = error_of([&] { refit_deformed(loft, collapse); });
+  CHECK(c5 == ErrorCategory::InvalidGeometry);
+  CHECK_THAT(w5, Contains("absolute tolerance"));
+}
