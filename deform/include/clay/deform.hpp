@@ -6,6 +6,7 @@
 /// deformations (taper, twist, bend), deformation stacks with their JSON form, and the style
 /// deformation by bound and target curves (Han–De Amicis–Conti 2007).
 #include <clay/constraints.hpp>
+#include <clay/deform/compose.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
 #include <clay/deform/direct_manipulation.hpp>
