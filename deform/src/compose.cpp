@@ -491,7 +491,7 @@ struct Net {
   int pu = 0, pv = 0;
   std::vector<double> ku, kv;
   int nu = 0, nv = 0;  // control point counts
-  Eigen::MatrixXd h;   // nu * nv x 4
+  Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> h;  // nu * nv x 4, rows contiguous
 };
 
 /// The patches (row-major over breaks) elevated to common degrees and joined with interior knots
@@ -515,7 +515,7 @@ Net join(const std::vector<double>& bu, const std::vector<double>& bv, std::vect
   net.kv = knots(bv, net.pv);
   net.nu = cu * net.pu + 1;
   net.nv = cv * net.pv + 1;
-  net.h = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(net.nu) * net.nv, 4);
+  net.h.setZero(static_cast<Eigen::Index>(net.nu) * net.nv, 4);
   Eigen::VectorXd count = Eigen::VectorXd::Zero(net.h.rows());
   for (int a = 0; a < cu; ++a)
     for (int b = 0; b < cv; ++b) {
@@ -579,23 +579,21 @@ double remove_u_knot_once(Net& net, int r, int s, double tol) {
     if (!(gap <= tol)) return -1;
     worst = std::max(worst, gap);
   }
-  // Commit: new points first..last from temp, drop point fout, drop knot r.
-  const int fout = (2 * r - s - p) / 2;
-  Eigen::MatrixXd h(static_cast<Eigen::Index>(net.nu - 1) * net.nv, 4);
+  // Commit: new points first..last from temp, drop point row fout (a block of nv rows), knot r.
   for (int col = 0; col < net.nv; ++col) {
     const Eigen::RowVector4d* t = temp.data() + static_cast<size_t>(col) * static_cast<size_t>(nt);
-    std::vector<Eigen::RowVector4d> pts(static_cast<size_t>(net.nu));
-    for (int i = 0; i < net.nu; ++i) pts[static_cast<size_t>(i)] = P(i, col);
     int i = first, j = last;
     while (j - i > 0) {
-      pts[static_cast<size_t>(i)] = t[i - off];
-      pts[static_cast<size_t>(j)] = t[j - off];
+      net.h.row(static_cast<Eigen::Index>(i) * net.nv + col) = t[i - off];
+      net.h.row(static_cast<Eigen::Index>(j) * net.nv + col) = t[j - off];
       ++i, --j;
     }
-    pts.erase(pts.begin() + fout);
-    for (int k = 0; k < net.nu - 1; ++k) h.row(static_cast<Eigen::Index>(k) * net.nv + col) = pts[static_cast<size_t>(k)];
   }
-  net.h = std::move(h);
+  const int fout = (2 * r - s - p) / 2;
+  double* data = net.h.data();
+  const std::ptrdiff_t row = 4 * static_cast<std::ptrdiff_t>(net.nv);
+  std::copy(data + (fout + 1) * row, data + net.nu * row, data + fout * row);
+  net.h.conservativeResize(static_cast<Eigen::Index>(net.nu - 1) * net.nv, 4);
   net.nu -= 1;
   net.ku.erase(net.ku.begin() + r);
   return worst;
