@@ -18,7 +18,6 @@
 #include <utility>
 #include <vector>
 
-#include "bernstein.hpp"
 
 namespace clay::deform {
 
