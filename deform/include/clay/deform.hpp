@@ -7,6 +7,7 @@
 /// deformation by bound and target curves (Han–De Amicis–Conti 2007), and the certified refit of
 /// deformed surfaces that are not polynomial.
 #include <clay/constraints.hpp>
+#include <clay/deform/compose.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
 #include <clay/deform/direct_manipulation.hpp>

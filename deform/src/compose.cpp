@@ -1,0 +1,1034 @@
+// Exact FFD composition (Sederberg–Parry 1986 §2.1): Bernstein products per Bézier patch of the
+// surface, patches joined into one B-spline surface, exact knot removal (The NURBS Book A5.8).
+#include <clay/deform/compose.hpp>
+
+#include <clay/error.hpp>
+#include <clay/surface/evaluate.hpp>
+#include <clay/surface/exchange.hpp>
+#include <clay/surface/knots.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+
+namespace clay::deform {
+
+namespace {
+
+using surface::BSplineSurface;
+
+std::string format(double v) {
+  std::ostringstream m;
+  m.precision(17);
+  m << v;
+  return m.str();
+}
+
+std::string fmt(double v) {  // short figures for messages
+  std::ostringstream m;
+  m.precision(6);
+  m << v;
+  return m.str();
+}
+
+constexpr const char* coordinate_name[3] = {"s", "t", "u"};
+
+// ---- bivariate Bernstein polynomials --------------------------------------------------------
+
+/// Binomial coefficients up to n = 127 as doubles (exact up to n = 56, to rounding beyond).
+const std::vector<double>& binomial_row(int n) {
+  static const std::vector<std::vector<double>> table = [] {
+    std::vector<std::vector<double>> t(128);
+    for (int r = 0; r < 128; ++r) {
+      t[static_cast<size_t>(r)].assign(static_cast<size_t>(r + 1), 1.0);
+      for (int k = 1; k < r; ++k)
+        t[static_cast<size_t>(r)][static_cast<size_t>(k)] =
+            t[static_cast<size_t>(r - 1)][static_cast<size_t>(k - 1)] +
+            t[static_cast<size_t>(r - 1)][static_cast<size_t>(k)];
+    }
+    return t;
+  }();
+  return table[static_cast<size_t>(n)];
+}
+double binom(int n, int k) {
+  return k < 0 || k > n ? 0.0 : binomial_row(n)[static_cast<size_t>(k)];
+}
+
+/// A bivariate polynomial of degrees (du, dv) in Bernstein form with `dim` values per
+/// coefficient: value d of coefficient (i, j) at ((i * (dv + 1) + j) * dim + d). "Scaled" polys
+/// hold C(du, i) C(dv, j) times the Bernstein coefficients, so that a product is a plain 2D
+/// convolution (exact Bernstein multiplication: B_i^a B_k^b = C(a,i) C(b,k) / C(a+b,i+k) B_{i+k}^{a+b}).
+struct Poly {
+  int du = 0, dv = 0, dim = 1;
+  std::vector<double> c;
+
+  Poly() = default;
+  Poly(int du_, int dv_, int dim_)
+      : du(du_), dv(dv_), dim(dim_), c(static_cast<size_t>((du_ + 1) * (dv_ + 1) * dim_), 0.0) {}
+  double& at(int i, int j, int d = 0) {
+    return c[static_cast<size_t>((i * (dv + 1) + j) * dim + d)];
+  }
+  double at(int i, int j, int d = 0) const {
+    return c[static_cast<size_t>((i * (dv + 1) + j) * dim + d)];
+  }
+};
+
+Poly constant_poly(double value) {
+  Poly p(0, 0, 1);
+  p.c[0] = value;
+  return p;
+}
+
+/// Multiplies (or divides) coefficient (i, j) by C(du, i) C(dv, j).
+void scale(Poly& p, bool divide) {
+  const auto& bu = binomial_row(p.du);
+  const auto& bv = binomial_row(p.dv);
+  for (int i = 0; i <= p.du; ++i)
+    for (int j = 0; j <= p.dv; ++j) {
+      const double f = bu[static_cast<size_t>(i)] * bv[static_cast<size_t>(j)];
+      for (int d = 0; d < p.dim; ++d) {
+        if (divide)
+          p.at(i, j, d) /= f;
+        else
+          p.at(i, j, d) *= f;
+      }
+    }
+}
+
+/// out += a * b for scaled polys (b scalar-valued); out has degrees a + b and a's dim.
+void mul_add(const Poly& a, const Poly& b, Poly& out) {
+  const int arow = (a.dv + 1) * a.dim;
+  const int orow = (out.dv + 1) * out.dim;
+  for (int k = 0; k <= b.du; ++k)
+    for (int l = 0; l <= b.dv; ++l) {
+      const double f = b.at(k, l);
+      if (f == 0) continue;
+      for (int i = 0; i <= a.du; ++i) {
+        const double* src = a.c.data() + i * arow;
+        double* dst = out.c.data() + (i + k) * orow + l * out.dim;
+        for (int x = 0; x < arow; ++x) dst[x] += f * src[x];
+      }
+    }
+}
+
+Poly multiply(const Poly& a, const Poly& b) {
+  Poly out(a.du + b.du, a.dv + b.dv, a.dim);
+  mul_add(a, b, out);
+  return out;
+}
+
+/// The matrix taking Bernstein coefficients of degree p to those of degree e <= p of the
+/// power-basis truncation (a_k = C(p, k) Δ^k b_0 for k <= e, then b'_i = Σ_k C(i,k)/C(e,k) a_k).
+Eigen::MatrixXd reduction_matrix(int p, int e) {
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(e + 1, p + 1);
+  for (int i = 0; i <= e; ++i)
+    for (int k = 0; k <= i; ++k) {
+      const double f = binom(i, k) / binom(e, k) * binom(p, k);
+      for (int r = 0; r <= k; ++r) m(i, r) += f * ((k - r) % 2 ? -1.0 : 1.0) * binom(k, r);
+    }
+  return m;
+}
+
+/// Degree elevation from e to p: b_i = Σ_k C(e,k) C(p−e, i−k) / C(p,i) b'_k.
+Eigen::MatrixXd elevation_matrix(int e, int p) {
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(p + 1, e + 1);
+  for (int i = 0; i <= p; ++i)
+    for (int k = std::max(0, i - (p - e)); k <= std::min(e, i); ++k)
+      m(i, k) = binom(e, k) * binom(p - e, i - k) / binom(p, i);
+  return m;
+}
+
+/// Applies `m` ((new + 1) x (old + 1)) along u (dir 0) or v (dir 1) of unscaled coefficients.
+Poly apply(const Poly& a, const Eigen::MatrixXd& m, int dir) {
+  const int n = static_cast<int>(m.rows()) - 1;
+  Poly out(dir == 0 ? n : a.du, dir == 0 ? a.dv : n, a.dim);
+  for (int i = 0; i <= out.du; ++i)
+    for (int j = 0; j <= out.dv; ++j)
+      for (int d = 0; d < a.dim; ++d) {
+        double s = 0;
+        if (dir == 0)
+          for (int k = 0; k <= a.du; ++k) s += m(i, k) * a.at(k, j, d);
+        else
+          for (int k = 0; k <= a.dv; ++k) s += m(j, k) * a.at(i, k, d);
+        out.at(i, j, d) = s;
+      }
+  return out;
+}
+
+/// The unscaled poly written with degree `e` in direction `dir` (reduced or elevated).
+Poly to_degree(const Poly& a, int e, int dir) {
+  const int p = dir == 0 ? a.du : a.dv;
+  if (e == p) return a;
+  return apply(a, e < p ? reduction_matrix(p, e) : elevation_matrix(p, e), dir);
+}
+
+/// The exact degree in `dir`: the smallest e whose reduced form, elevated back, reproduces every
+/// coefficient to `tol`. With `positive`, also require the reduced coefficients to stay > 0
+/// (weights: products of positive Bernstein coefficients are positive).
+int exact_degree(const Poly& a, int dir, double tol, bool positive) {
+  const int p = dir == 0 ? a.du : a.dv;
+  int best = p;
+  for (int e = p - 1; e >= 0; --e) {
+    const Poly reduced = to_degree(a, e, dir);
+    if (positive && std::any_of(reduced.c.begin(), reduced.c.end(), [](double x) { return !(x > 0); }))
+      break;
+    const Poly back = to_degree(reduced, p, dir);
+    bool same = true;
+    for (size_t k = 0; k < a.c.size() && same; ++k) same = std::abs(back.c[k] - a.c[k]) <= tol;
+    if (!same) break;
+    best = e;
+  }
+  return best;
+}
+
+/// Value at (x, y) in [0, 1]^2 of component d (de Casteljau), for unscaled coefficients.
+double value_at(const Poly& a, double x, double y, int d = 0) {
+  std::vector<double> row(static_cast<size_t>(a.dv + 1)), col(static_cast<size_t>(a.du + 1));
+  for (int i = 0; i <= a.du; ++i) {
+    for (int j = 0; j <= a.dv; ++j) row[static_cast<size_t>(j)] = a.at(i, j, d);
+    for (int l = 1; l <= a.dv; ++l)
+      for (int j = 0; j + l <= a.dv; ++j)
+        row[static_cast<size_t>(j)] =
+            (1 - y) * row[static_cast<size_t>(j)] + y * row[static_cast<size_t>(j + 1)];
+    col[static_cast<size_t>(i)] = row[0];
+  }
+  for (int l = 1; l <= a.du; ++l)
+    for (int i = 0; i + l <= a.du; ++i)
+      col[static_cast<size_t>(i)] =
+          (1 - x) * col[static_cast<size_t>(i)] + x * col[static_cast<size_t>(i + 1)];
+  return col[0];
+}
+
+/// de Casteljau split of unscaled coefficients at 1/2 in `dir`: the halves [0, 1/2], [1/2, 1].
+std::pair<Poly, Poly> halve(const Poly& a, int dir) {
+  Poly lo = a, hi = a;
+  const int p = dir == 0 ? a.du : a.dv;
+  const int other = dir == 0 ? a.dv : a.du;
+  std::vector<double> w(static_cast<size_t>(p + 1));
+  for (int o = 0; o <= other; ++o)
+    for (int d = 0; d < a.dim; ++d) {
+      auto get = [&](const Poly& q, int k) -> double {
+        return dir == 0 ? q.at(k, o, d) : q.at(o, k, d);
+      };
+      auto put = [&](Poly& q, int k, double x) {
+        if (dir == 0)
+          q.at(k, o, d) = x;
+        else
+          q.at(o, k, d) = x;
+      };
+      for (int k = 0; k <= p; ++k) w[static_cast<size_t>(k)] = get(a, k);
+      put(lo, 0, w[0]);
+      put(hi, p, w[static_cast<size_t>(p)]);
+      for (int l = 1; l <= p; ++l) {
+        for (int k = 0; k + l <= p; ++k)
+          w[static_cast<size_t>(k)] = 0.5 * (w[static_cast<size_t>(k)] + w[static_cast<size_t>(k + 1)]);
+        put(lo, l, w[0]);
+        put(hi, p - l, w[static_cast<size_t>(p - l)]);
+      }
+    }
+  return {lo, hi};
+}
+
+// ---- one Bézier patch of the surface in lattice coordinates ---------------------------------
+
+/// Homogeneous coordinate polys of a patch: W and, per coordinate, its numerator C (c = C / W),
+/// with the rounding scale of each (for the exact degree tests).
+struct PatchCoordinates {
+  Poly w;
+  std::array<Poly, 3> c;
+  double w_scale = 1, c_scale = 1;
+};
+
+/// Coordinates c_d = dual_d · (X − origin) of a Bézier patch, homogeneous: C = w dual · (P − X0).
+PatchCoordinates patch_coordinates(const BSplineSurface& patch, const Eigen::Vector3d& origin,
+                                   const std::array<Eigen::Vector3d, 3>& dual) {
+  const int p = patch.u.degree, q = patch.v.degree;
+  PatchCoordinates pc;
+  pc.w = Poly(p, q, 1);
+  double wmax = 0, xmax = 0;
+  for (int d = 0; d < 3; ++d) pc.c[static_cast<size_t>(d)] = Poly(p, q, 1);
+  for (int i = 0; i <= p; ++i)
+    for (int j = 0; j <= q; ++j) {
+      const Eigen::Index r = patch.index(i, j);
+      const double w = patch.weights(r);
+      const Eigen::Vector3d x = patch.points.row(r).transpose() - origin;
+      pc.w.at(i, j) = w;
+      wmax = std::max(wmax, w);
+      xmax = std::max(xmax, x.norm());
+      for (int d = 0; d < 3; ++d) pc.c[static_cast<size_t>(d)].at(i, j) = w * dual[static_cast<size_t>(d)].dot(x);
+    }
+  double dmax = 0;
+  for (const auto& v : dual) dmax = std::max(dmax, v.norm());
+  pc.w_scale = wmax;
+  pc.c_scale = wmax * xmax * dmax;
+  return pc;
+}
+
+/// Dual vectors of a frame: local coordinate d of X is dual[d] · (X − X0) (Sederberg–Parry eq. (1)).
+std::array<Eigen::Vector3d, 3> dual_vectors(const Frame& f) {
+  const Eigen::Vector3d tu = f.t.cross(f.u), su = f.s.cross(f.u), st = f.s.cross(f.t);
+  return {tu / tu.dot(f.s), su / su.dot(f.t), st / st.dot(f.u)};
+}
+
+/// Relative tolerance of the exact degree tests (docs: 1e-14 of the rounding scale).
+constexpr double degree_tolerance = 1e-14;
+
+/// A factor of eq. (2) on a patch: a constant coordinate (S = value, V = 1 − value, degree 0) or
+/// the homogeneous pair (S, V = W − S) at degrees (du, dv), scaled.
+struct Factor {
+  bool constant = false;
+  double value = 0;
+  int du = 0, dv = 0;
+  Poly s, v;  // scaled
+};
+
+/// W's exact degrees (reduced coefficients kept positive).
+std::pair<int, int> weight_degrees(const PatchCoordinates& pc) {
+  const double tol = degree_tolerance * pc.w_scale;
+  return {exact_degree(pc.w, 0, tol, true), exact_degree(pc.w, 1, tol, true)};
+}
+
+/// True when c = C / W is constant on the patch (C = c0 W coefficient by coefficient); sets c0.
+bool constant_coordinate(const Poly& c, const Poly& w, double c_scale, double& c0) {
+  double sum = 0, wsum = 0;
+  for (size_t k = 0; k < c.c.size(); ++k) sum += c.c[k], wsum += w.c[k];
+  c0 = sum / wsum;
+  for (size_t k = 0; k < c.c.size(); ++k)
+    if (std::abs(c.c[k] - c0 * w.c[k]) > degree_tolerance * c_scale) return false;
+  return true;
+}
+
+/// The factor of coordinate numerator `c` with weight `w` (scale `c_scale`), W's exact degrees
+/// `wd`: constant, or the pair at the homogeneous degrees max(deg C, deg W) per direction.
+Factor make_factor(const Poly& c, const Poly& w, double c_scale, std::pair<int, int> wd) {
+  Factor f;
+  double c0 = 0;
+  if (constant_coordinate(c, w, c_scale, c0)) {
+    f.constant = true;
+    f.value = c0;
+    f.s = constant_poly(c0);
+    f.v = constant_poly(1 - c0);
+    return f;
+  }
+  const double tol = degree_tolerance * c_scale;
+  f.du = std::max(exact_degree(c, 0, tol, false), wd.first);
+  f.dv = std::max(exact_degree(c, 1, tol, false), wd.second);
+  f.s = to_degree(to_degree(c, f.du, 0), f.dv, 1);
+  const Poly wr = to_degree(to_degree(w, f.du, 0), f.dv, 1);
+  f.v = wr;
+  for (size_t k = 0; k < f.v.c.size(); ++k) f.v.c[k] -= f.s.c[k];
+  scale(f.s, false);
+  scale(f.v, false);
+  return f;
+}
+
+/// Homogeneous de Casteljau with polynomial parameter: level r point i = V · P_i + S · P_{i+1}
+/// (Sederberg–Parry eq. (2) in one direction), points given scaled; returns the scaled result.
+Poly casteljau(std::vector<Poly> pts, const Factor& f) {
+  for (size_t level = 1; level < pts.size(); ++level)
+    for (size_t i = 0; i + level < pts.size(); ++i) {
+      Poly next(pts[i].du + f.s.du, pts[i].dv + f.s.dv, pts[i].dim);
+      mul_add(pts[i], f.v, next);
+      mul_add(pts[i + 1], f.s, next);
+      pts[i] = std::move(next);
+    }
+  return std::move(pts[0]);
+}
+
+/// A composed patch: unscaled homogeneous coefficients (x w, y w, z w, w), dim 4.
+struct ComposedPatch {
+  int du = 0, dv = 0;
+  Poly h;
+};
+
+/// Degrees of eq. (2) composed on a patch with these factors: Σ_d degree_d · factor degree.
+std::pair<int, int> composed_degrees(const std::array<Factor, 3>& f, std::array<int, 3> degrees) {
+  int du = 0, dv = 0;
+  for (size_t d = 0; d < 3; ++d) {
+    du += degrees[d] * f[d].du;
+    dv += degrees[d] * f[d].dv;
+  }
+  return {du, dv};
+}
+
+/// Sederberg–Parry eq. (2) with the factors' polynomials in place of s, t, u: u (k) innermost,
+/// then t (j), then s (i). `dim` 3 (polynomial: the weight is W^0 = 1) or 4 (the weight
+/// Σ B B B · 1 = W^L rides along).
+ComposedPatch compose_patch(const BezierLattice& cell, const std::array<Factor, 3>& f, bool rational) {
+  const int dim = rational ? 4 : 3;
+  const auto n = cell.counts();
+  std::vector<Poly> along_s;
+  along_s.reserve(static_cast<size_t>(n[0]));
+  for (int i = 0; i < n[0]; ++i) {
+    std::vector<Poly> along_t;
+    along_t.reserve(static_cast<size_t>(n[1]));
+    for (int j = 0; j < n[1]; ++j) {
+      std::vector<Poly> along_u;
+      along_u.reserve(static_cast<size_t>(n[2]));
+      for (int k = 0; k < n[2]; ++k) {
+        Poly p(0, 0, dim);
+        for (int d = 0; d < 3; ++d) p.c[static_cast<size_t>(d)] = cell.points(cell.index(i, j, k), d);
+        if (rational) p.c[3] = 1;
+        along_u.push_back(std::move(p));
+      }
+      along_t.push_back(casteljau(std::move(along_u), f[2]));
+    }
+    along_s.push_back(casteljau(std::move(along_t), f[1]));
+  }
+  ComposedPatch out;
+  out.h = casteljau(std::move(along_s), f[0]);
+  scale(out.h, true);
+  if (!rational) {  // append w = 1
+    Poly h(out.h.du, out.h.dv, 4);
+    for (int i = 0; i <= h.du; ++i)
+      for (int j = 0; j <= h.dv; ++j) {
+        for (int d = 0; d < 3; ++d) h.at(i, j, d) = out.h.at(i, j, d);
+        h.at(i, j, 3) = 1;
+      }
+    out.h = std::move(h);
+  }
+  out.du = out.h.du;
+  out.dv = out.h.dv;
+  return out;
+}
+
+// ---- containment of a patch in a cell -------------------------------------------------------
+
+/// Where c = C / W leaves [lo, hi] (beyond tol) on the patch: the patch-local parameter and value,
+/// `certain` false when subdivision could not decide (the bound crosses, no point does).
+struct Violation {
+  double x = 0, y = 0, value = 0;
+  bool certain = true;
+};
+
+/// Certifies lo − tol <= C / W <= hi + tol on [x0, x1] x [y0, y1] (convex hull of the ratios
+/// C_ij / W_ij: c is a convex combination of them), subdividing where the hull crosses.
+std::optional<Violation> leaves(const Poly& cw, double lo, double hi, double tol, double x0, double x1,
+                                double y0, double y1, int depth) {
+  double mn = std::numeric_limits<double>::infinity(), mx = -mn;
+  for (int i = 0; i <= cw.du; ++i)
+    for (int j = 0; j <= cw.dv; ++j) {
+      const double r = cw.at(i, j, 0) / cw.at(i, j, 1);
+      mn = std::min(mn, r);
+      mx = std::max(mx, r);
+    }
+  if (mn >= lo - tol && mx <= hi + tol) return std::nullopt;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b) {  // the corners are points of the patch
+      const int i = a ? cw.du : 0, j = b ? cw.dv : 0;
+      const double r = cw.at(i, j, 0) / cw.at(i, j, 1);
+      if (r < lo - tol || r > hi + tol) return Violation{a ? x1 : x0, b ? y1 : y0, r, true};
+    }
+  if (depth == 0) return Violation{0.5 * (x0 + x1), 0.5 * (y0 + y1), mn < lo - tol ? mn : mx, false};
+  const double xm = 0.5 * (x0 + x1), ym = 0.5 * (y0 + y1);
+  const auto [left, right] = halve(cw, 0);
+  std::optional<Violation> undecided;
+  const Poly* halves[2] = {&left, &right};
+  for (int a = 0; a < 2; ++a) {
+    const auto [bottom, top] = halve(*halves[a], 1);
+    const Poly* quarters[2] = {&bottom, &top};
+    for (int b = 0; b < 2; ++b) {
+      auto v = leaves(*quarters[b], lo, hi, tol, a ? xm : x0, a ? x1 : xm, b ? ym : y0, b ? y1 : ym,
+                      depth - 1);
+      if (v && v->certain) return v;
+      if (v && !undecided) undecided = v;
+    }
+  }
+  return undecided;
+}
+
+/// C and W of coordinate d as one dim-2 poly.
+Poly ratio_poly(const PatchCoordinates& pc, int d) {
+  Poly cw(pc.w.du, pc.w.dv, 2);
+  for (int i = 0; i <= cw.du; ++i)
+    for (int j = 0; j <= cw.dv; ++j) {
+      cw.at(i, j, 0) = pc.c[static_cast<size_t>(d)].at(i, j);
+      cw.at(i, j, 1) = pc.w.at(i, j);
+    }
+  return cw;
+}
+
+/// Name of a patch and its parameter box, and of a patch-local parameter, for messages.
+std::string patch_name(const surface::BezierPatches& bp, int a, int b) {
+  return "patch (" + std::to_string(a) + ", " + std::to_string(b) + ") over u in [" +
+         fmt(bp.breaks_u[static_cast<size_t>(a)]) + ", " + fmt(bp.breaks_u[static_cast<size_t>(a + 1)]) +
+         "], v in [" + fmt(bp.breaks_v[static_cast<size_t>(b)]) + ", " +
+         fmt(bp.breaks_v[static_cast<size_t>(b + 1)]) + "]";
+}
+std::pair<double, double> global_parameter(const surface::BezierPatches& bp, int a, int b, double x,
+                                           double y) {
+  const double u0 = bp.breaks_u[static_cast<size_t>(a)], u1 = bp.breaks_u[static_cast<size_t>(a + 1)];
+  const double v0 = bp.breaks_v[static_cast<size_t>(b)], v1 = bp.breaks_v[static_cast<size_t>(b + 1)];
+  return {u0 + x * (u1 - u0), v0 + y * (v1 - v0)};
+}
+
+[[noreturn]] void throw_outside(const surface::BezierPatches& bp, int a, int b, int d, const Violation& v,
+                                std::string_view lattice_kind) {
+  const auto [u, w] = global_parameter(bp, a, b, v.x, v.y);
+  throw Error(ErrorCategory::OutOfDomain,
+              "compose_exact: surface " + patch_name(bp, a, b) + " leaves the " + std::string(lattice_kind) +
+                  ": local coordinate " + coordinate_name[d] + " = " + format(v.value) +
+                  (v.certain ? " at" : " (bound; not certified inside) near") + " parameter (" +
+                  format(u) + ", " + format(w) +
+                  ") is outside [0, 1]; the FFD is the identity outside the lattice, so the deformed "
+                  "surface is not one polynomial there: enlarge the lattice frame to contain the "
+                  "whole surface");
+}
+
+// ---- joining patches, knot removal ----------------------------------------------------------
+
+/// Homogeneous control net (rows i * nv + j, columns x w, y w, z w, w) with its knot vectors.
+struct Net {
+  int pu = 0, pv = 0;
+  std::vector<double> ku, kv;
+  int nu = 0, nv = 0;  // control point counts
+  Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> h;  // nu * nv x 4, rows contiguous
+};
+
+/// The patches (row-major over breaks) elevated to common degrees and joined with interior knots
+/// of full multiplicity (C0); shared boundary coefficients are averaged.
+Net join(const std::vector<double>& bu, const std::vector<double>& bv, std::vector<ComposedPatch>& patches) {
+  Net net;
+  for (const auto& p : patches) {
+    net.pu = std::max(net.pu, p.du);
+    net.pv = std::max(net.pv, p.dv);
+  }
+  net.pu = std::max(net.pu, 1);
+  net.pv = std::max(net.pv, 1);
+  const int cu = static_cast<int>(bu.size()) - 1, cv = static_cast<int>(bv.size()) - 1;
+  auto knots = [](const std::vector<double>& b, int p) {
+    std::vector<double> k;
+    for (size_t i = 0; i < b.size(); ++i)
+      k.insert(k.end(), static_cast<size_t>(i == 0 || i + 1 == b.size() ? p + 1 : p), b[i]);
+    return k;
+  };
+  net.ku = knots(bu, net.pu);
+  net.kv = knots(bv, net.pv);
+  net.nu = cu * net.pu + 1;
+  net.nv = cv * net.pv + 1;
+  net.h.setZero(static_cast<Eigen::Index>(net.nu) * net.nv, 4);
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(net.h.rows());
+  for (int a = 0; a < cu; ++a)
+    for (int b = 0; b < cv; ++b) {
+      auto& p = patches[static_cast<size_t>(a * cv + b)];
+      const Poly h = to_degree(to_degree(p.h, net.pu, 0), net.pv, 1);
+      for (int i = 0; i <= net.pu; ++i)
+        for (int j = 0; j <= net.pv; ++j) {
+          const Eigen::Index r = static_cast<Eigen::Index>(a * net.pu + i) * net.nv + (b * net.pv + j);
+          for (int d = 0; d < 4; ++d) net.h(r, d) += h.at(i, j, d);
+          count(r) += 1;
+        }
+    }
+  for (Eigen::Index r = 0; r < net.h.rows(); ++r) net.h.row(r) /= count(r);
+  return net;
+}
+
+/// The net with u and v (and their knots) swapped.
+Net transposed(const Net& n) {
+  Net t;
+  t.pu = n.pv, t.pv = n.pu, t.ku = n.kv, t.kv = n.ku, t.nu = n.nv, t.nv = n.nu;
+  t.h.resize(n.h.rows(), 4);
+  for (int i = 0; i < n.nu; ++i)
+    for (int j = 0; j < n.nv; ++j)
+      t.h.row(static_cast<Eigen::Index>(j) * n.nu + i) = n.h.row(static_cast<Eigen::Index>(i) * n.nv + j);
+  return t;
+}
+
+/// Removes the u knot at index r (its last occurrence, multiplicity s) once from every column,
+/// when every column allows it within `tol` (The NURBS Book A5.8, one removal, homogeneous).
+/// Returns the largest gap (>= 0) when removed, -1 when not.
+double remove_u_knot_once(Net& net, int r, int s, double tol) {
+  const int p = net.pu;
+  const auto& U = net.ku;
+  const double u = U[static_cast<size_t>(r)];
+  const int first = r - p, last = r - s, off = first - 1;
+  const int nt = last - off + 2;
+  std::vector<Eigen::RowVector4d> temp(static_cast<size_t>(nt) * static_cast<size_t>(net.nv));
+  double worst = 0;
+  auto P = [&](int i, int j) { return Eigen::RowVector4d(net.h.row(static_cast<Eigen::Index>(i) * net.nv + j)); };
+  auto alpha = [&](int i) {
+    return (u - U[static_cast<size_t>(i)]) / (U[static_cast<size_t>(i + p + 1)] - U[static_cast<size_t>(i)]);
+  };
+  for (int col = 0; col < net.nv; ++col) {
+    Eigen::RowVector4d* t = temp.data() + static_cast<size_t>(col) * static_cast<size_t>(nt);
+    t[0] = P(off, col);
+    t[last + 1 - off] = P(last + 1, col);
+    int i = first, j = last, ii = 1, jj = last - off;
+    while (j - i > 0) {
+      const double ai = alpha(i), aj = alpha(j);
+      t[ii] = (P(i, col) - (1 - ai) * t[ii - 1]) / ai;
+      t[jj] = (P(j, col) - aj * t[jj + 1]) / (1 - aj);
+      ++i, ++ii, --j, --jj;
+    }
+    double gap;
+    if (j - i < 0) {
+      gap = (t[ii - 1] - t[jj + 1]).norm();
+    } else {
+      const double ai = alpha(i);
+      gap = (P(i, col) - (ai * t[ii + 1] + (1 - ai) * t[ii - 1])).norm();
+    }
+    if (!(gap <= tol)) return -1;
+    worst = std::max(worst, gap);
+  }
+  // Commit: new points first..last from temp, drop point row fout (a block of nv rows), knot r.
+  for (int col = 0; col < net.nv; ++col) {
+    const Eigen::RowVector4d* t = temp.data() + static_cast<size_t>(col) * static_cast<size_t>(nt);
+    int i = first, j = last;
+    while (j - i > 0) {
+      net.h.row(static_cast<Eigen::Index>(i) * net.nv + col) = t[i - off];
+      net.h.row(static_cast<Eigen::Index>(j) * net.nv + col) = t[j - off];
+      ++i, --j;
+    }
+  }
+  const int fout = (2 * r - s - p) / 2;
+  double* data = net.h.data();
+  const std::ptrdiff_t row = 4 * static_cast<std::ptrdiff_t>(net.nv);
+  std::copy(data + (fout + 1) * row, data + net.nu * row, data + fout * row);
+  net.h.conservativeResize(static_cast<Eigen::Index>(net.nu - 1) * net.nv, 4);
+  net.nu -= 1;
+  net.ku.erase(net.ku.begin() + r);
+  return worst;
+}
+
+/// Removes every interior u knot as often as removal is exact; returns the number removed. The
+/// gaps of the removals of one knot value add up to at most `tol` (each removal may move the
+/// surface by about its gap, and repeated removals compound).
+int remove_u_knots(Net& net, double tol) {
+  int removed = 0;
+  const double first = net.ku.front(), last = net.ku.back();
+  std::vector<double> values;
+  for (double k : net.ku)
+    if (k != first && k != last && (values.empty() || values.back() != k)) values.push_back(k);
+  for (double value : values) {
+    double spent = 0;
+    for (;;) {
+      const auto hi = std::upper_bound(net.ku.begin(), net.ku.end(), value);
+      const auto lo = std::lower_bound(net.ku.begin(), net.ku.end(), value);
+      const int s = static_cast<int>(hi - lo);
+      if (s == 0) break;
+      const int r = static_cast<int>(hi - net.ku.begin()) - 1;
+      const double gap = remove_u_knot_once(net, r, s, tol - spent);
+      if (gap < 0) break;
+      spent += gap;
+      ++removed;
+    }
+  }
+  return removed;
+}
+
+BSplineSurface to_surface(const Net& net, bool rational) {
+  BSplineSurface s;
+  s.u = {net.pu, net.ku};
+  s.v = {net.pv, net.kv};
+  s.points.resize(net.h.rows(), 3);
+  s.weights.resize(net.h.rows());
+  const double w0 = net.h(0, 3);
+  const bool all_equal = (net.h.col(3).array() == w0).all();
+  for (Eigen::Index r = 0; r < net.h.rows(); ++r) {
+    const double w = net.h(r, 3);
+    s.points.row(r) = rational ? Eigen::RowVector3d(net.h.row(r).head<3>() / w) : Eigen::RowVector3d(net.h.row(r).head<3>());
+    s.weights(r) = rational && !all_equal ? w : 1.0;
+  }
+  return s;
+}
+
+// ---- the pipeline shared by the entry points ------------------------------------------------
+
+[[noreturn]] void throw_degree(int du, int dv, const std::string& what, const std::string& ways_out) {
+  throw Error(ErrorCategory::DegreeLimit,
+              "compose_exact: the exact composition " + what + " has degree (" + std::to_string(du) +
+                  ", " + std::to_string(dv) + "), above the exchange limit " +
+                  std::to_string(surface::max_exchange_degree) +
+                  " (surface::max_exchange_degree, OpenCASCADE and most CAD systems); " + ways_out);
+}
+
+/// Joins composed patches, removes knots, measures the deviation against `pointwise`.
+ComposeResult finish(const surface::BezierPatches& bp, std::vector<ComposedPatch>& patches, bool rational,
+                     const BSplineSurface& original,
+                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& pointwise, double size,
+                     const ComposeOptions& options, int splits) {
+  Net net = join(bp.breaks_u, bp.breaks_v, patches);
+  ComposeReport report;
+  report.patches = static_cast<int>(patches.size());
+  report.splits = splits;
+  if (options.knot_tolerance > 0) {
+    double hmax = 0;
+    for (Eigen::Index r = 0; r < net.h.rows(); ++r) hmax = std::max(hmax, net.h.row(r).norm());
+    const double tol = options.knot_tolerance * hmax;
+    report.knots_removed += remove_u_knots(net, tol);
+    Net t = transposed(net);
+    report.knots_removed += remove_u_knots(t, tol);
+    net = transposed(t);
+  }
+  ComposeResult result{to_surface(net, rational), {}};
+  report.degree_u = net.pu;
+  report.degree_v = net.pv;
+  report.control_points = static_cast<long>(net.nu) * net.nv;
+  report.size = size;
+  const int n = options.check_samples;
+  for (int a = 0; a + 1 < static_cast<int>(bp.breaks_u.size()); ++a)
+    for (int b = 0; b + 1 < static_cast<int>(bp.breaks_v.size()); ++b)
+      for (int x = 0; x < n; ++x)
+        for (int y = 0; y < n; ++y) {
+          const auto [u, v] = global_parameter(bp, a, b, (x + 0.5) / n, (y + 0.5) / n);
+          const Eigen::Vector3d expected = pointwise(surface::evaluate(original, u, v));
+          const double dev = (surface::evaluate(result.surface, u, v) - expected).norm();
+          report.max_deviation = std::max(report.max_deviation, dev / size);
+        }
+  report.exact = true;
+  result.report = report;
+  return result;
+}
+
+/// Per coordinate d, the factor for composing a patch with a cell whose local coordinate is
+/// (c_d − lo_d) / width_d in the coordinates of `pc`.
+std::array<Factor, 3> cell_factors(const PatchCoordinates& pc, std::array<double, 3> lo,
+                                   std::array<double, 3> width) {
+  const auto wd = weight_degrees(pc);
+  std::array<Factor, 3> f;
+  for (size_t d = 0; d < 3; ++d) {
+    Poly c = pc.c[d];
+    for (size_t k = 0; k < c.c.size(); ++k) c.c[k] = (c.c[k] - lo[d] * pc.w.c[k]) / width[d];
+    f[d] = make_factor(c, pc.w, pc.c_scale / width[d], wd);
+  }
+  return f;
+}
+
+double lattice_size(const Points3& points) {
+  return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
+}
+
+/// Roots in (0, 1) of the univariate Bernstein polynomial `b` (sign changes on a fine sample,
+/// then bisection to rounding).
+std::vector<double> roots(const std::vector<double>& b) {
+  const int p = static_cast<int>(b.size()) - 1;
+  auto value = [&](double x) {
+    std::vector<double> w = b;
+    for (int l = 1; l <= p; ++l)
+      for (int k = 0; k + l <= p; ++k)
+        w[static_cast<size_t>(k)] = (1 - x) * w[static_cast<size_t>(k)] + x * w[static_cast<size_t>(k + 1)];
+    return w[0];
+  };
+  std::vector<double> out;
+  const int n = 32 * std::max(p, 1);
+  double x0 = 0, f0 = value(0);
+  for (int k = 1; k <= n; ++k) {
+    const double x1 = static_cast<double>(k) / n, f1 = value(x1);
+    if (f1 == 0 && k < n) out.push_back(x1);
+    if ((f0 < 0 && f1 > 0) || (f0 > 0 && f1 < 0)) {
+      double a = x0, c = x1, fa = f0;
+      for (int it = 0; it < 200 && c - a > 0; ++it) {
+        const double m = 0.5 * (a + c);
+        if (m <= a || m >= c) break;
+        const double fm = value(m);
+        if (fm == 0) {
+          a = c = m;
+          break;
+        }
+        if ((fa < 0) == (fm < 0))
+          a = m, fa = fm;
+        else
+          c = m;
+      }
+      out.push_back(0.5 * (a + c));
+    }
+    x0 = x1, f0 = f1;
+  }
+  return out;
+}
+
+/// Splits `surface` where a local coordinate that depends on one surface parameter only crosses
+/// an interior knot plane of the lattice (HHK lattices meet the surface along iso-lines there):
+/// knots inserted to full multiplicity. Returns the split surface and the number of knots added.
+std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface, const BSplineLattice& lattice,
+                                               const std::array<std::vector<double>, 3>& breaks) {
+  const auto dual = dual_vectors(lattice.frame);
+  const auto bp = surface::extract_bezier(surface);
+  std::array<std::vector<double>, 2> cuts;
+  for (int a = 0; a < bp.count_u(); ++a)
+    for (int b = 0; b < bp.count_v(); ++b) {
+      const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
+      for (int d = 0; d < 3; ++d) {
+        const Poly& c = pc.c[static_cast<size_t>(d)];
+        for (int dir = 0; dir < 2; ++dir) {
+          // c depends on the parameter `dir` only when C(x, y) W(x, y0) − C(x, y0) W(x, y) ≡ 0
+          // (dir 0; y0 = the patch's first row), i.e. c(x, y) = c(x, y0).
+          const int other = dir == 0 ? c.dv : c.du;
+          const int p = dir == 0 ? c.du : c.dv;
+          auto get = [&](const Poly& q, int k, int o) { return dir == 0 ? q.at(k, o) : q.at(o, k); };
+          Poly c_row(p, 0, 1), w_row(p, 0, 1), c_all(p, other, 1), w_all(p, other, 1);
+          for (int k = 0; k <= p; ++k) {
+            c_row.at(k, 0) = get(c, k, 0);
+            w_row.at(k, 0) = get(pc.w, k, 0);
+            for (int o = 0; o <= other; ++o) c_all.at(k, o) = get(c, k, o), w_all.at(k, o) = get(pc.w, k, o);
+          }
+          scale(c_row, false), scale(w_row, false), scale(c_all, false), scale(w_all, false);
+          Poly g = multiply(c_all, w_row);
+          Poly neg_w = w_all;
+          for (double& x : neg_w.c) x = -x;
+          mul_add(neg_w, c_row, g);
+          scale(g, true);
+          bool one_parameter = true;
+          for (double x : g.c) one_parameter = one_parameter && std::abs(x) <= 1e-13 * pc.c_scale * pc.w_scale;
+          if (!one_parameter) continue;
+          const auto& br = breaks[static_cast<size_t>(d)];
+          const double x0 = dir == 0 ? bp.breaks_u[static_cast<size_t>(a)] : bp.breaks_v[static_cast<size_t>(b)];
+          const double x1 = dir == 0 ? bp.breaks_u[static_cast<size_t>(a + 1)] : bp.breaks_v[static_cast<size_t>(b + 1)];
+          for (size_t plane = 1; plane + 1 < br.size(); ++plane) {
+            std::vector<double> h(static_cast<size_t>(p + 1));
+            for (int k = 0; k <= p; ++k) h[static_cast<size_t>(k)] = get(c, k, 0) - br[plane] * get(pc.w, k, 0);
+            for (double x : roots(h)) {
+              const double t = x0 + x * (x1 - x0);
+              if (t - x0 > 1e-13 * (x1 - x0) && x1 - t > 1e-13 * (x1 - x0))
+                cuts[static_cast<size_t>(dir)].push_back(t);
+            }
+          }
+        }
+      }
+    }
+  BSplineSurface out = surface;
+  int added = 0;
+  for (int dir = 0; dir < 2; ++dir) {
+    auto& c = cuts[static_cast<size_t>(dir)];
+    // The same crossing found from several patches of a row differs by rounding: merge cuts
+    // closer than 1e-12 of the domain, and drop those that close to an existing break.
+    const auto [d0, d1] = (dir == 0 ? surface.u : surface.v).domain();
+    const double merge = 1e-12 * (d1 - d0);
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end(), [&](double x, double y) { return y - x <= merge; }), c.end());
+    const int p = dir == 0 ? out.u.degree : out.v.degree;
+    const auto existing = surface::breakpoints(dir == 0 ? surface.u : surface.v);
+    for (double t : c) {
+      if (std::any_of(existing.begin(), existing.end(), [&](double b) { return std::abs(b - t) <= merge; })) continue;
+      const int have = surface::multiplicity(dir == 0 ? out.u : out.v, t);
+      if (have >= p) continue;
+      out = dir == 0 ? surface::insert_knot_u(out, t, p - have) : surface::insert_knot_v(out, t, p - have);
+      added += p - have;
+    }
+  }
+  return {out, added};
+}
+
+}  // namespace
+
+// ---- public ---------------------------------------------------------------------------------
+
+void ComposeOptions::validate() const {
+  if (!(knot_tolerance >= 0 && knot_tolerance <= 1e-6))
+    throw Error(ErrorCategory::InvalidArgument,
+                "ComposeOptions: knot_tolerance = " + format(knot_tolerance) +
+                    " breaks the rule 0 <= knot_tolerance <= 1e-6 (relative, exact removal only); give "
+                    "e.g. 1e-12, or 0 to keep every patch boundary");
+  if (check_samples < 0 || check_samples > 64)
+    throw Error(ErrorCategory::InvalidArgument,
+                "ComposeOptions: check_samples = " + std::to_string(check_samples) +
+                    " breaks the rule 0 <= check_samples <= 64; give e.g. 4, or 0 to skip the check");
+}
+
+std::string ComposeReport::brief() const {
+  std::ostringstream m;
+  m.precision(3);
+  m << "exact composition: degree " << degree_u << " x " << degree_v << ", " << patches << " patches, "
+    << control_points << " control points, " << knots_removed << " knots removed, " << splits
+    << " split knots, max deviation " << max_deviation << " x " << size << " mm";
+  return m.str();
+}
+
+ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& surface,
+                            const ComposeOptions& options) {
+  options.validate();
+  validate(lattice, "compose_exact: Bézier lattice");
+  surface::validate(surface, "compose_exact: surface");
+  const bool rational = surface.is_rational();
+  const auto bp = surface::extract_bezier(surface);
+  const auto dual = dual_vectors(lattice.frame);
+  const int np = static_cast<int>(bp.patches.size());
+  std::vector<std::array<Factor, 3>> factors(static_cast<size_t>(np));
+  for (int a = 0; a < bp.count_u(); ++a)
+    for (int b = 0; b < bp.count_v(); ++b) {
+      const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
+      for (int d = 0; d < 3; ++d)
+        if (auto v = leaves(ratio_poly(pc, d), 0, 1, face_tolerance, 0, 1, 0, 1, 6))
+          throw_outside(bp, a, b, d, *v, "Bézier lattice");
+      auto& f = factors[static_cast<size_t>(a * bp.count_v() + b)];
+      f = cell_factors(pc, {0, 0, 0}, {1, 1, 1});
+      const auto [du, dv] = composed_degrees(f, lattice.degrees);
+      if (std::max(du, dv) > surface::max_exchange_degree)
+        throw_degree(du, dv,
+                     "of surface " + patch_name(bp, a, b) + " (degree " + std::to_string(surface.u.degree) +
+                         " x " + std::to_string(surface.v.degree) + ") with a Bézier lattice of degrees (" +
+                         std::to_string(lattice.degrees[0]) + ", " + std::to_string(lattice.degrees[1]) +
+                         ", " + std::to_string(lattice.degrees[2]) + ")",
+                     "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
+                     "the deformed surface with a refit tolerance (certified refit)");
+    }
+  std::vector<ComposedPatch> patches(static_cast<size_t>(np));
+  for (size_t k = 0; k < patches.size(); ++k) patches[k] = compose_patch(lattice, factors[k], rational);
+  return finish(bp, patches, rational, surface,
+                [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, lattice_size(lattice.points),
+                options, 0);
+}
+
+ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface& surface,
+                            const ComposeOptions& options) {
+  options.validate();
+  validate(lattice, "compose_exact: B-spline lattice");
+  surface::validate(surface, "compose_exact: surface");
+  const BezierCells cells = bezier_cells(lattice);
+  const auto [split, splits] = split_at_planes(surface, lattice, cells.breaks);
+  const bool rational = split.is_rational();
+  const auto bp = surface::extract_bezier(split);
+  const auto dual = dual_vectors(lattice.frame);
+  const auto counts = cells.counts();
+  std::vector<std::array<Factor, 3>> factors(static_cast<size_t>(bp.patches.size()));
+  std::vector<const BezierLattice*> cell_of(bp.patches.size());
+  for (int a = 0; a < bp.count_u(); ++a)
+    for (int b = 0; b < bp.count_v(); ++b) {
+      const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
+      std::array<int, 3> index{};
+      std::array<double, 3> lo{}, width{};
+      for (int d = 0; d < 3; ++d) {
+        const Poly cw = ratio_poly(pc, d);
+        if (auto v = leaves(cw, 0, 1, face_tolerance, 0, 1, 0, 1, 6)) throw_outside(bp, a, b, d, *v, "B-spline lattice");
+        const auto& br = cells.breaks[static_cast<size_t>(d)];
+        const double centre = value_at(cw, 0.5, 0.5, 0) / value_at(cw, 0.5, 0.5, 1);
+        int cell = static_cast<int>(std::upper_bound(br.begin(), br.end(), centre) - br.begin()) - 1;
+        cell = std::clamp(cell, 0, counts[static_cast<size_t>(d)] - 1);
+        const double c0 = br[static_cast<size_t>(cell)], c1 = br[static_cast<size_t>(cell + 1)];
+        if (auto v = leaves(cw, c0, c1, face_tolerance, 0, 1, 0, 1, 6)) {
+          const double plane = v->value < c0 ? c0 : c1;
+          const auto [u, w] = global_parameter(bp, a, b, v->x, v->y);
+          throw Error(ErrorCategory::InvalidArgument,
+                      "compose_exact: surface " + patch_name(bp, a, b) + " crosses the lattice knot plane " +
+                          coordinate_name[d] + " = " + format(plane) + " (" + coordinate_name[d] + " = " +
+                          format(v->value) + " at parameter (" + format(u) + ", " + format(w) +
+                          ")) other than along an iso-parameter line: no single polynomial patch is "
+                          "exact there; approximate the deformed surface with a refit tolerance "
+                          "(certified refit), or move the knot plane off the surface");
+        }
+        index[static_cast<size_t>(d)] = cell;
+        lo[static_cast<size_t>(d)] = c0;
+        width[static_cast<size_t>(d)] = c1 - c0;
+      }
+      const size_t k = static_cast<size_t>(a * bp.count_v() + b);
+      cell_of[k] = &cells.cell(index[0], index[1], index[2]);
+      factors[k] = cell_factors(pc, lo, width);
+      const auto [du, dv] = composed_degrees(factors[k], cell_of[k]->degrees);
+      if (std::max(du, dv) > surface::max_exchange_degree)
+        throw_degree(du, dv,
+                     "of surface " + patch_name(bp, a, b) + " with a B-spline lattice of degrees (" +
+                         std::to_string(lattice.bases[0].degree) + ", " + std::to_string(lattice.bases[1].degree) +
+                         ", " + std::to_string(lattice.bases[2].degree) + ")",
+                     "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
+                     "the deformed surface with a refit tolerance (certified refit)");
+    }
+  std::vector<ComposedPatch> patches(bp.patches.size());
+  for (size_t k = 0; k < patches.size(); ++k) patches[k] = compose_patch(*cell_of[k], factors[k], rational);
+  return finish(bp, patches, rational, split,
+                [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, lattice_size(lattice.points),
+                options, splits);
+}
+
+ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface, const ComposeOptions& options) {
+  options.validate();
+  validate(taper, "compose_exact: taper");
+  surface::validate(surface, "compose_exact: surface");
+  const bool rational = surface.is_rational();
+  // Barr's local axes (regular.hpp): z = axis, x = reference without its axial part, y = z × x.
+  const Eigen::Vector3d ez = taper.frame.axis.normalized();
+  const Eigen::Vector3d ref = taper.frame.reference - taper.frame.reference.dot(ez) * ez;
+  const Eigen::Vector3d ex = ref.normalized(), ey = ez.cross(ex);
+  std::vector<double> profile = taper.profile;
+  while (profile.size() > 1 && profile.back() == 0) profile.pop_back();
+  const int D = static_cast<int>(profile.size()) - 1;
+  auto r_of = [&](double z) {
+    double v = profile.back();
+    for (size_t i = profile.size() - 1; i-- > 0;) v = v * z + profile[i];
+    return v;
+  };
+  const auto bp = surface::extract_bezier(surface);
+  std::vector<ComposedPatch> patches(bp.patches.size());
+  for (int a = 0; a < bp.count_u(); ++a)
+    for (int b = 0; b < bp.count_v(); ++b) {
+      const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), taper.frame.origin, {ex, ey, ez});
+      const auto wd = weight_degrees(pc);
+      const double tol = degree_tolerance * pc.c_scale;
+      // e: joint exact degrees of (X, Y, Z, W) on the patch.
+      int eu = wd.first, ev = wd.second;
+      for (const auto& c : pc.c) {
+        eu = std::max(eu, exact_degree(c, 0, tol, false));
+        ev = std::max(ev, exact_degree(c, 1, tol, false));
+      }
+      auto at_e = [&](const Poly& q) {
+        Poly r = to_degree(to_degree(q, eu, 0), ev, 1);
+        scale(r, false);
+        return r;
+      };
+      Poly xy(eu, ev, 2), zw(eu, ev, 2);
+      {
+        const Poly X = at_e(pc.c[0]), Y = at_e(pc.c[1]), Z = at_e(pc.c[2]), W = at_e(pc.w);
+        for (size_t k = 0; k < X.c.size(); ++k) {
+          xy.c[2 * k] = X.c[k], xy.c[2 * k + 1] = Y.c[k];
+          zw.c[2 * k] = Z.c[k], zw.c[2 * k + 1] = W.c[k];
+        }
+      }
+      // Taper (Güdükbay–Özgüç §3.1.1) homogeneous: with z = Z / W and r(z) = Σ c_i z^i,
+      // W^(D+1) X' = ex R X + ey R Y + ez W^D Z + o W^D W, R = Σ c_i Z^i W^(D−i).
+      const Factor fz = make_factor(pc.c[2], pc.w, pc.c_scale, wd);
+      Poly R, WD;
+      if (fz.constant || D == 0) {
+        R = constant_poly(r_of(fz.value));
+        if (D == 0) R = constant_poly(profile[0]);
+        WD = constant_poly(1);
+      } else {
+        // fz.s = Z, fz.v = W − Z at d(z) (scaled); W = fz.s + fz.v.
+        Poly Wz = fz.s;
+        for (size_t k = 0; k < Wz.c.size(); ++k) Wz.c[k] += fz.v.c[k];
+        std::vector<Poly> zp{constant_poly(1)}, wp{constant_poly(1)};
+        for (int i = 1; i <= D; ++i) {
+          zp.push_back(multiply(zp.back(), fz.s));
+          wp.push_back(multiply(wp.back(), Wz));
+        }
+        R = Poly(D * fz.du, D * fz.dv, 1);
+        for (int i = 0; i <= D; ++i) {
+          if (profile[static_cast<size_t>(i)] == 0) continue;
+          Poly term = multiply(zp[static_cast<size_t>(i)], wp[static_cast<size_t>(D - i)]);
+          for (size_t k = 0; k < R.c.size(); ++k) R.c[k] += profile[static_cast<size_t>(i)] * term.c[k];
+        }
+        WD = std::move(wp.back());
+      }
+      const int du = R.du + eu, dv = R.dv + ev;
+      if (std::max(du, dv) > surface::max_exchange_degree)
+        throw_degree(du, dv,
+                     "of surface " + patch_name(bp, a, b) + " with a taper profile of degree " + std::to_string(D),
+                     "use a taper profile of lower degree, or approximate the deformed surface with a "
+                     "refit tolerance (certified refit)");
+      Poly rxy = multiply(xy, R), wzw = multiply(zw, WD);
+      scale(rxy, true);
+      scale(wzw, true);
+      ComposedPatch out;
+      out.du = du, out.dv = dv;
+      out.h = Poly(du, dv, 4);
+      for (int i = 0; i <= du; ++i)
+        for (int j = 0; j <= dv; ++j) {
+          const double X = rxy.at(i, j, 0), Y = rxy.at(i, j, 1), Z = wzw.at(i, j, 0), W = wzw.at(i, j, 1);
+          for (int d = 0; d < 3; ++d)
+            out.h.at(i, j, d) = ex[d] * X + ey[d] * Y + ez[d] * Z + taper.frame.origin[d] * W;
+          out.h.at(i, j, 3) = rational ? W : 1.0;
+        }
+      patches[static_cast<size_t>(a * bp.count_v() + b)] = std::move(out);
+    }
+  const auto box = surface::control_box(surface);
+  return finish(bp, patches, rational, surface, [&](const Eigen::Vector3d& x) { return deform_point(taper, x); },
+                (box.second - box.first).norm(), options, 0);
+}
+
+}  // namespace clay::deform
