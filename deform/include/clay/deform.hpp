@@ -3,9 +3,10 @@
 /// Hsu–Hughes–Kaufman 1992), local deformations with continuity, Jacobian bounds and fast
 /// deformation of many points (Güdükbay–Özgüç 1990), extended lattices of tricubic chunks
 /// (Coquillart 1990), direct manipulation (Hsu–Hughes–Kaufman 1992 §3), Barr's regular
-/// deformations (taper, twist, bend), deformation stacks with their JSON form, and the style
-/// deformation by bound and target curves (Han–De Amicis–Conti 2007), and the certified refit of
-/// deformed surfaces that are not polynomial.
+/// deformations (taper, twist, bend), deformation stacks with their JSON form, the style
+/// deformation by bound and target curves (Han–De Amicis–Conti 2007), the exact composition of
+/// lattices and polynomial tapers with NURBS surfaces (Sederberg–Parry §2.1) and the certified
+/// refit of deformed surfaces that are not polynomial.
 #include <clay/constraints.hpp>
 #include <clay/deform/compose.hpp>
 #include <clay/deform/continuity.hpp>
