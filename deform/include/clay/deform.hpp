@@ -20,3 +20,4 @@
 #include <clay/deform/regular.hpp>
 #include <clay/deform/stack.hpp>
 #include <clay/deform/style.hpp>
+#include <clay/deform/surface_deformation.hpp>

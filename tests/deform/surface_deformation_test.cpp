@@ -1,0 +1,179 @@
+// A surface through a deformation stack (issue #7 items 5 and 6): exact steps stay exact, other
+// steps are refitted with a certified bound when allowed and refused with the reason when not.
+// Every result is checked against the pointwise deformation of the original (deform_point of the
+// stack) at random parameters.
+#include <catch2/catch.hpp>
+
+#include <clay/deform/surface_deformation.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <random>
+
+#include "error_of.hpp"
+
+using namespace clay::deform;
+using clay::ErrorCategory;
+using clay::test::error_of;
+using Catch::Matchers::Contains;
+namespace surface = clay::surface;
+
+namespace {
+
+Frame box_frame() {
+  Frame f;
+  f.origin = {-10, -10, -20};
+  f.s = {120, 0, 0};
+  f.t = {0, 120, 0};
+  f.u = {0, 0, 60};
+  return f;
+}
+
+/// A bicubic dome, 100 x 100 mm, inside box_frame().
+surface::BSplineSurface dome() {
+  const auto b = surface::clamped_uniform_basis(3, 6);
+  const auto xi = surface::greville_abscissae(b);
+  surface::Points3 p(36, 3);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) {
+      const double x = 100 * xi[static_cast<size_t>(i)], y = 100 * xi[static_cast<size_t>(j)];
+      p.row(i * 6 + j) << x, y, 20 * std::sin(0.03 * x) * std::sin(0.03 * y);
+    }
+  return surface::make_surface(b, b, p);
+}
+
+BezierLattice bulge() {
+  BezierLattice l = make_bezier_lattice(box_frame(), {2, 2, 1});
+  l.points.row(l.index(1, 1, 1)) += Eigen::RowVector3d(3, -2, 15);
+  return l;
+}
+
+Taper flare() {
+  Taper t;
+  t.frame.origin = {50, 50, 0};
+  t.profile = {1.0, 0.004};  // r(z) = 1 + 0.004 z
+  return t;
+}
+
+Twist spin() {
+  Twist t;
+  t.frame.origin = {50, 50, 0};
+  t.angle = {0.0, 0.004};  // 0.004 rad per mm of height
+  return t;
+}
+
+/// Largest |result(u, v) - deform_point(stack, S(u, v))| at n random parameters.
+double worst_against_pointwise(const DeformationStack& stack, const surface::BSplineSurface& original,
+                               const surface::BSplineSurface& result, int n) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  double worst = 0;
+  for (int k = 0; k < n; ++k) {
+    const double u = unit(rng), v = unit(rng);
+    const Eigen::Vector3d want = deform_point(stack, surface::evaluate(original, u, v));
+    worst = std::max(worst, (surface::evaluate(result, u, v) - want).norm());
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("deform_surface: a stack of exact steps stays an exact NURBS", "[surface_deformation]") {
+  const surface::BSplineSurface s = dome();
+  DeformationStack stack;
+  stack.steps.push_back({bulge(), "bulge", true});
+  stack.steps.push_back({flare(), "flare", true});
+  stack.steps.push_back({spin(), "off", false});  // disabled: skipped
+  const SurfaceDeformationResult r = deform_surface(stack, s);
+  INFO(r.report.brief());
+  REQUIRE(r.report.steps.size() == 3);
+  CHECK(r.report.exact);
+  CHECK(r.report.steps[0].method == StepOutcome::Method::exact);
+  CHECK(r.report.steps[1].method == StepOutcome::Method::exact);
+  CHECK(r.report.steps[2].method == StepOutcome::Method::skipped);
+  // The dome is axis-aligned in the lattice: s is linear in u only, t in v only, u bicubic, so
+  // the bulge gives degree 2 + 0 + 3 = 5 and the linear taper 5 + 5 = 10 in each direction.
+  CHECK(r.surface.u.degree == 10);
+  CHECK(r.surface.v.degree == 10);
+  const double size = box_frame().s.norm();
+  CHECK(worst_against_pointwise(stack, s, r.surface, 2000) <= 1e-12 * size);
+  CHECK(r.report.degree_u == r.surface.u.degree);
+  CHECK(r.report.control_points == r.surface.points.rows());
+}
+
+TEST_CASE("deform_surface: a twist is refitted with a certified bound that holds", "[surface_deformation]") {
+  const surface::BSplineSurface s = dome();
+  DeformationStack stack;
+  stack.steps.push_back({bulge(), "bulge", true});
+  stack.steps.push_back({spin(), "spin", true});
+  SurfaceDeformationOptions options;
+  options.refit = RefitOptions{};
+  options.refit->tolerance = 1e-4;
+  const SurfaceDeformationResult r = deform_surface(stack, s, options);
+  INFO(r.report.brief());
+  CHECK_FALSE(r.report.exact);
+  CHECK(r.report.steps[0].method == StepOutcome::Method::exact);
+  REQUIRE(r.report.steps[1].method == StepOutcome::Method::refit);
+  CHECK_THAT(r.report.steps[1].reason, Contains("not polynomial"));
+  const RefitReport& fit = r.report.steps[1].refit;
+  REQUIRE(fit.certified);
+  CHECK(fit.certified_bound <= fit.tolerance);
+  // The exact first step contributes rounding only: the bound of the refit holds for the stack.
+  CHECK(worst_against_pointwise(stack, s, r.surface, 2000) <= fit.certified_bound + 1e-9);
+  // Without a refit the twist is refused, naming the step and the way out.
+  auto [category, message] = error_of([&] { deform_surface(stack, s); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("steps[1] (twist 'spin')"));
+  CHECK_THAT(message, Contains("refit"));
+}
+
+TEST_CASE("deform_surface: above the degree limit, a refit when allowed, the DegreeLimit error otherwise",
+          "[surface_deformation]") {
+  const surface::BSplineSurface s = dome();
+  // A frame turned against the dome: every local coordinate is bicubic, so the exact result
+  // would have degree 3 x 3 + 3 x 3 + 3 x 3 = 27 > 25 in each direction.
+  const Eigen::Vector3d a(std::cos(0.35), std::sin(0.35), 0.1), b(-std::sin(0.35), std::cos(0.35), 0.1);
+  Frame turned;
+  turned.s = 170 * a;
+  turned.t = 170 * b;
+  turned.u = 90 * a.cross(b).normalized();
+  turned.origin = Eigen::Vector3d(50, 50, 0) - 0.5 * (turned.s + turned.t + turned.u);
+  BezierLattice heavy = make_bezier_lattice(turned, {3, 3, 3});
+  heavy.points.row(heavy.index(1, 2, 3)) += Eigen::RowVector3d(0, 0, 8);
+  const Deformation d = heavy;
+  auto [category, message] = error_of([&] { deform_surface(d, s); });
+  CHECK(category == ErrorCategory::DegreeLimit);
+  CHECK_THAT(message, Contains("steps[0]"));
+  SurfaceDeformationOptions options;
+  options.refit = RefitOptions{};
+  const SurfaceDeformationResult r = deform_surface(d, s, options);
+  INFO(r.report.brief());
+  REQUIRE(r.report.steps[0].method == StepOutcome::Method::refit);
+  CHECK_THAT(r.report.steps[0].reason, Contains("degree"));
+  CHECK(r.surface.u.degree == 3);
+  DeformationStack one;
+  one.steps.push_back({heavy, {}, true});
+  CHECK(worst_against_pointwise(one, s, r.surface, 1000) <= r.report.steps[0].refit.certified_bound + 1e-9);
+}
+
+TEST_CASE("deform_surface: bad input", "[surface_deformation][errors]") {
+  const surface::BSplineSurface s = dome();
+  DeformationStack bad;
+  BezierLattice broken = bulge();
+  broken.points(0, 0) = std::nan("");
+  bad.steps.push_back({broken, "broken", true});
+  CHECK(error_of([&] { deform_surface(bad, s); }).first == ErrorCategory::InvalidGeometry);
+  SurfaceDeformationOptions options;
+  options.compose.check_samples = -1;
+  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, s, options); }).first == ErrorCategory::InvalidArgument);
+  options = {};
+  options.refit = RefitOptions{};
+  options.refit->degree = 0;
+  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, s, options); }).first == ErrorCategory::InvalidArgument);
+  surface::BSplineSurface nan_surface = s;
+  nan_surface.points(3, 1) = std::nan("");
+  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, nan_surface); }).first == ErrorCategory::InvalidGeometry);
+}
