@@ -19,25 +19,17 @@
 #include <vector>
 
 
+#include "messages.hpp"
+
 namespace clay::deform {
 
 namespace {
 
 using surface::BSplineSurface;
 
-std::string format(double v) {
-  std::ostringstream m;
-  m.precision(17);
-  m << v;
-  return m.str();
-}
+using detail::format;
 
-std::string fmt(double v) {  // short figures for messages
-  std::ostringstream m;
-  m.precision(6);
-  m << v;
-  return m.str();
-}
+std::string fmt(double v) { return format(v, 6); }  // short figures for messages
 
 constexpr const char* coordinate_name[3] = {"s", "t", "u"};
 

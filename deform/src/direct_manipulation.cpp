@@ -11,31 +11,14 @@
 #include <utility>
 #include <vector>
 
+#include "messages.hpp"
+
 namespace clay::deform {
 
 namespace {
 
-std::string format(const Eigen::Vector3d& v) {
-  std::ostringstream m;
-  m.precision(17);
-  m << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return m.str();
-}
-
-std::string format(double v, int precision = 17) {
-  std::ostringstream m;
-  m.precision(precision);
-  m << v;
-  return m.str();
-}
-
-/// std::isfinite on every coordinate (no x − x, which traps on infinities).
-template <class V>
-bool finite(const V& v) {
-  for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v(i))) return false;
-  return true;
-}
+using detail::finite;
+using detail::format;
 
 /// All Bernstein polynomials of degree n at t (The NURBS Book A1.3), written to b[0..n].
 void all_bernstein(int n, double t, std::vector<double>& b) {

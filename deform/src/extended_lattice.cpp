@@ -17,6 +17,8 @@
 #include <thread>
 #include <utility>
 
+#include "messages.hpp"
+
 namespace clay::deform {
 
 namespace {
@@ -29,33 +31,10 @@ constexpr std::size_t min_evaluate_points_per_thread = 16384;
 constexpr int max_count = 1024;               // sectors, rings, layers, ...
 constexpr long long max_chunks = 1'000'000;   // per generated lattice
 
-std::string format(const Vec3& v) {
-  std::ostringstream m;
-  m.precision(17);
-  m << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return m.str();
-}
+using detail::finite;
+using detail::format;
+using detail::throw_problems;
 
-std::string format(double v) {
-  std::ostringstream m;
-  m.precision(17);
-  m << v;
-  return m.str();
-}
-
-/// std::isfinite on every coordinate (no x − x, which traps on an infinity).
-template <class V>
-bool finite(const V& v) {
-  for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v(i))) return false;
-  return true;
-}
-
-[[noreturn]] void throw_problems(ErrorCategory category, const std::vector<std::string>& list) {
-  std::string text;
-  for (size_t k = 0; k < list.size(); ++k) text += (k ? "; " : "") + list[k];
-  throw Error(category, text);
-}
 
 [[noreturn]] void bad_argument(const std::string& field, const std::string& value,
                                const std::string& rule) {

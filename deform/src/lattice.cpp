@@ -10,39 +10,16 @@
 #include <utility>
 
 #include "bernstein.hpp"
+#include "messages.hpp"
 
 namespace clay::deform {
 
 namespace {
 
-std::string format(const Eigen::Vector3d& v) {
-  std::ostringstream m;
-  m.precision(17);
-  m << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return m.str();
-}
+using detail::finite;
+using detail::format;
+using detail::throw_problems;
 
-std::string format(double v) {
-  std::ostringstream m;
-  m.precision(17);
-  m << v;
-  return m.str();
-}
-
-/// std::isfinite on every coordinate (Eigen's allFinite computes x − x, which raises FE_INVALID
-/// on an infinity where floating-point traps are on).
-template <class V>
-bool finite(const V& v) {
-  for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v(i))) return false;
-  return true;
-}
-
-[[noreturn]] void throw_problems(ErrorCategory category, const std::vector<std::string>& list) {
-  std::string text;
-  for (size_t k = 0; k < list.size(); ++k) text += (k ? "; " : "") + list[k];
-  throw Error(category, text);
-}
 
 constexpr const char* direction_name[3] = {"s", "t", "u"};
 

@@ -30,6 +30,8 @@
 #include <variant>
 #include <vector>
 
+#include "messages.hpp"
+
 namespace clay::deform {
 
 namespace {
@@ -39,12 +41,7 @@ using surface::BSplineSurface;
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
-std::string format(double v) {
-  std::ostringstream m;
-  m.precision(17);
-  m << v;
-  return m.str();
-}
+using detail::format;
 
 std::string short_format(double v) {
   char buffer[32];

@@ -12,31 +12,18 @@
 #include <sstream>
 #include <string>
 
+#include "messages.hpp"
 #include "parallel.hpp"
 
 namespace clay::deform {
 
 namespace {
 
-std::string format(double v) {
-  std::ostringstream m;
-  m.precision(17);
-  m << v;
-  return m.str();
-}
-
-std::string format(const Eigen::Vector3d& v) {
-  return "(" + format(v.x()) + ", " + format(v.y()) + ", " + format(v.z()) + ")";
-}
-
-bool finite(const Eigen::Vector3d& v) {
-  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
-}
+using detail::finite;
+using detail::format;
 
 [[noreturn]] void throw_problems(const std::vector<std::string>& list) {
-  std::string text;
-  for (std::size_t k = 0; k < list.size(); ++k) text += (k ? "; " : "") + list[k];
-  throw Error(ErrorCategory::InvalidGeometry, text);
+  detail::throw_problems(ErrorCategory::InvalidGeometry, list);
 }
 
 /// Which of Barr's local axes `axis` and `reference` are.

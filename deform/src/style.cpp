@@ -258,6 +258,24 @@ KeyPoint make_key_point(const BSplineSurface& s, const InfluenceRegion& region, 
   return k;
 }
 
+bool begin_report(const KeyPoints& keys, const StyleOptions& options, StyleMode mode,
+                  StyleReport& report) {
+  report.mode = mode;
+  report.constraint_class = keys.constraint_class;
+  report.direction = keys.direction;
+  report.m = static_cast<int>(keys.points.size());
+  report.key_points = keys.points;
+  if (keys.constraint_class == ConstraintClass::over_constrained) {
+    report.message = "over-constrained: the target curve lies outside the bound; the surface is unchanged";
+    return true;
+  }
+  if (options.lambda == 0) {
+    report.message = "lambda = 0: the surface is unchanged";
+    return true;
+  }
+  return false;
+}
+
 KeyPoints find_key_points(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
                           const BSplineCurve& target, const std::vector<TraceSample>& trace,
                           int per_row) {
@@ -566,16 +584,7 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
   KeyPoints keys = find_key_points(projector, region, target, trace, 1);
   StyleResult out{parent, parent, {}};
   StyleReport& report = out.report;
-  report.mode = StyleMode::paper;
-  report.constraint_class = keys.constraint_class;
-  report.direction = keys.direction;
-  report.m = static_cast<int>(keys.points.size());
-  report.key_points = keys.points;
-
-  if (keys.constraint_class == ConstraintClass::over_constrained || options.lambda == 0) {
-    report.message = keys.constraint_class == ConstraintClass::over_constrained
-                         ? "over-constrained: the target curve lies outside the bound; the surface is unchanged"
-                         : "lambda = 0: the surface is unchanged";
+  if (begin_report(keys, options, StyleMode::paper, report)) {
     detail::measure(parent, out.surface, region.factors, region, trace, options, report);
     return out;
   }

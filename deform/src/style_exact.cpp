@@ -190,19 +190,11 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   InfluenceRegion reg = region;
   StyleResult out{parent, parent, {}};
   StyleReport& report = out.report;
-  report.mode = StyleMode::exact;
 
   // The key points are those of the parent's net (eq. 8): refinement adds freedom, not
   // constraints. Key points are added where the result still misses the target curve.
   const KeyPoints keys = find_key_points(projector, region, target, trace, options.key_points_per_row);
-  report.constraint_class = keys.constraint_class;
-  report.direction = keys.direction;
-  report.m = static_cast<int>(keys.points.size());
-  report.key_points = keys.points;
-  if (keys.constraint_class == ConstraintClass::over_constrained || options.lambda == 0) {
-    report.message = keys.constraint_class == ConstraintClass::over_constrained
-                         ? "over-constrained: the target curve lies outside the bound; the surface is unchanged"
-                         : "lambda = 0: the surface is unchanged";
+  if (begin_report(keys, options, StyleMode::exact, report)) {
     measure(parent, parent, region.factors, region, trace, options, report);
     return out;
   }

@@ -70,6 +70,10 @@ double continuous_index(const std::vector<double>& xi, double x);
 KeyPoint make_key_point(const surface::BSplineSurface& s, const InfluenceRegion& region,
                         const Eigen::Vector3d& point, double t, double u, double v, KeyDirection direction);
 
+/// Fills the report's mode, class, direction, m and key points; true (with the message) when the
+/// surface stays as it is: the over-constrained class or λ = 0.
+bool begin_report(const KeyPoints& keys, const StyleOptions& options, StyleMode mode, StyleReport& report);
+
 /// Key points of the traced target on the projector's surface (whose net `region.factors`
 /// describes): Han et al. eq. 8 with `per_row` key points per control-net row interval crossed.
 KeyPoints find_key_points(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
