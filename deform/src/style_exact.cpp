@@ -376,6 +376,10 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     if (!report.conflicting_key_points.empty())
       msg << "; " << report.conflicting_key_points.size()
           << " key points cannot be met (the net is too coarse there: allow more max_refinements)";
+    if (options.curve_tolerance > 0 && report.target_curve_deviation > options.curve_tolerance * size)
+      msg << "; the target curve is still missed by " << report.target_curve_deviation << " mm, more than "
+          << "curve_tolerance x size = " << options.curve_tolerance * size
+          << " mm (allow more max_key_point_rounds or max_refinements)";
     report.message = msg.str();
     return out;
   }

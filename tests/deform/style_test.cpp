@@ -351,6 +351,9 @@ TEST_CASE("exact mode: the hood passes through every key point and joins the par
   CHECK(r.report.target_deviation <= 1e-6 * size);
   CHECK(r.report.conflicting_key_points.empty());
   CHECK(r.report.degrees_of_freedom > 0);
+  // The target curve between key points: followed within curve_tolerance, or the message says not.
+  const bool followed = r.report.target_curve_deviation <= options.curve_tolerance * size;
+  CHECK(followed == (r.report.message.find("still missed") == std::string::npos));
   CHECK(r.report.rank == r.report.m);
   CHECK(normal_jump_along(s, r.surface, hood_bound()) <= 0.5);
   CHECK(r.report.boundary_tangent_angle <= 0.5);
