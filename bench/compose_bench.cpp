@@ -8,20 +8,15 @@
 
 #include <benchmark/benchmark.h>
 
+#include "frames.hpp"
+
 #include <random>
 
 using namespace clay::deform;
 
 namespace {
 
-Frame skewed_frame() {
-  Frame f;
-  f.origin = Eigen::Vector3d(-120.0, 35.0, 10.0);
-  f.s = Eigen::Vector3d(300.0, 20.0, -10.0);
-  f.t = Eigen::Vector3d(40.0, 180.0, 15.0);
-  f.u = Eigen::Vector3d(-10.0, 25.0, 90.0);
-  return f;
-}
+using clay::bench::skewed_frame;
 
 clay::surface::BSplineSurface bicubic_sheet(const Frame& f) {
   std::mt19937 rng(3);

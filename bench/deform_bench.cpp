@@ -21,6 +21,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "frames.hpp"
+
 #include <cmath>
 #include <random>
 #include <vector>
@@ -29,14 +31,7 @@ using namespace clay::deform;
 
 namespace {
 
-Frame skewed_frame() {
-  Frame f;
-  f.origin = Eigen::Vector3d(-120.0, 35.0, 10.0);
-  f.s = Eigen::Vector3d(300.0, 20.0, -10.0);
-  f.t = Eigen::Vector3d(40.0, 180.0, 15.0);
-  f.u = Eigen::Vector3d(-10.0, 25.0, 90.0);
-  return f;
-}
+using clay::bench::skewed_frame;
 
 template <class Lattice>
 Lattice displaced(Lattice lattice) {

@@ -821,46 +821,50 @@ std::string RefitReport::brief() const {
   return line + buffer;
 }
 
+namespace {
+
+// Every deformation kind: validated, then fitted and certified by its certifier.
+template <class D>
+RefitResult refit_validated(const BSplineSurface& surface, const D& deformation, const RefitOptions& options) {
+  validate(deformation);
+  return refit(surface, certifier(deformation), options);
+}
+
+}  // namespace
+
 RefitResult refit_deformed(const BSplineSurface& surface, const Taper& taper,
                            const RefitOptions& options) {
-  validate(taper);
-  return refit(surface, certifier(taper), options);
+  return refit_validated(surface, taper, options);
 }
 
 RefitResult refit_deformed(const BSplineSurface& surface, const Twist& twist,
                            const RefitOptions& options) {
-  validate(twist);
-  return refit(surface, certifier(twist), options);
+  return refit_validated(surface, twist, options);
 }
 
 RefitResult refit_deformed(const BSplineSurface& surface, const Bend& bend,
                            const RefitOptions& options) {
-  validate(bend);
-  return refit(surface, certifier(bend), options);
+  return refit_validated(surface, bend, options);
 }
 
 RefitResult refit_deformed(const BSplineSurface& surface, const BezierLattice& lattice,
                            const RefitOptions& options) {
-  validate(lattice);
-  return refit(surface, certifier(lattice), options);
+  return refit_validated(surface, lattice, options);
 }
 
 RefitResult refit_deformed(const BSplineSurface& surface, const BSplineLattice& lattice,
                            const RefitOptions& options) {
-  validate(lattice);
-  return refit(surface, certifier(lattice), options);
+  return refit_validated(surface, lattice, options);
 }
 
 RefitResult refit_deformed(const BSplineSurface& surface, const ExtendedLattice& lattice,
                            const RefitOptions& options) {
-  validate(lattice);
-  return refit(surface, certifier(lattice), options);
+  return refit_validated(surface, lattice, options);
 }
 
 RefitResult refit_deformed(const BSplineSurface& surface, const DeformationStack& stack,
                            const RefitOptions& options) {
-  validate(stack);
-  return refit(surface, certifier(stack), options);
+  return refit_validated(surface, stack, options);
 }
 
 RefitResult refit_deformed(const BSplineSurface& surface, const PointMap& map,
