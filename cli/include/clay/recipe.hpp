@@ -1,0 +1,130 @@
+#pragma once
+/// Recipes: a styling session recorded as JSON (schema "clayform.recipe", version 1, every field
+/// in docs/recipe.md) — strokes, curves and sketches, parent surfaces, deformation stacks, the
+/// composition mode and the exports — checked with every problem at once, replayed bit for bit,
+/// and applied to other surfaces (Coquillart's recording operator). The `clayform` command is a
+/// shell over these functions.
+#include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/bspline_surface.hpp>
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace clay::recipe {
+
+/// One problem of a recipe: where (a JSON path such as "surfaces.sail.fill.curves[2]", or
+/// "(top level)") and what is wrong, with the fix. Syntax errors carry a 1-based line and column
+/// (0 when not applicable).
+struct Problem {
+  std::string path;     ///< JSON path of the offending value
+  std::string message;  ///< what is wrong and how to fix it
+  int line = 0;         ///< 1-based line of a syntax error, else 0
+  int column = 0;       ///< 1-based column of a syntax error, else 0
+};
+
+/// "path: message" (with "line L, column C: " first for syntax errors).
+std::string to_string(const Problem& problem);
+
+struct RecipeData;  // the checked recipe (recipe_model.hpp, internal)
+
+/// A checked recipe: every reference resolved, every field typed and in range. Cheap to copy
+/// (shared, immutable).
+struct Recipe {
+  std::shared_ptr<const RecipeData> data;
+  /// The recipe's name (its "name", or the file stem when read with load_recipe).
+  const std::string& name() const;
+  /// Names of its deformation stacks, in document order.
+  std::vector<std::string> deformation_names() const;
+};
+
+/// Every problem of the recipe text, all at once, in document order: JSON syntax (with line and
+/// column), wrong format or version, unknown keys, missing or mistyped fields, values out of
+/// range, names that are malformed or defined twice, references to missing or later objects.
+/// Files named by `import` surfaces are resolved against `base_dir` and must exist. Empty when
+/// the recipe can be run. Never throws for bad text.
+std::vector<Problem> check_recipe(std::string_view text, const std::filesystem::path& base_dir = {});
+
+/// The checked recipe. Throws clay::Error(Recipe) listing every problem of check_recipe, one per
+/// line.
+Recipe parse_recipe(std::string_view text, const std::filesystem::path& base_dir = {});
+
+/// Reads and parses a recipe file (imports resolved next to it; the name defaults to the stem).
+/// Throws clay::Error: Io when the file cannot be read, Recipe for its problems.
+Recipe load_recipe(const std::filesystem::path& file);
+
+/// A figure of a step's report: a flag, a count, a measure (mm, degrees, ratio) or a word.
+using Figure = std::variant<bool, long long, double, std::string>;
+
+/// What one step of a run did.
+struct StepReport {
+  std::string path;     ///< "strokes.leech", "surfaces.sail", "surfaces.sail.steps[1]", "exports.sail"
+  std::string kind;     ///< "stroke", "bspline", "fill", "bezier_lattice", "style", "step", ...
+  double seconds = 0;   ///< wall time of the step
+  bool warning = false; ///< produced its result but an outcome fell short (see message)
+  std::string message;  ///< what happened, in words
+  std::vector<std::pair<std::string, Figure>> figures;  ///< in a fixed order per kind
+};
+
+/// Settings of run_recipe / deform_surfaces.
+struct RunOptions {
+  int threads = 0;  ///< worker threads for deformations, 0 = one per hardware thread
+  /// Called after each step (progress lines); may be empty.
+  std::function<void(const StepReport&)> progress;
+};
+
+/// One export: the surfaces written together and what the exchange layer reported.
+struct ExportResult {
+  std::string name;                                ///< the export's name (file stem)
+  std::vector<std::string> surface_names;          ///< in the recipe's order
+  std::vector<surface::BSplineSurface> surfaces;   ///< what is written
+  std::vector<std::string> formats;                ///< "step", "iges", "glb"
+  std::string schema = "AP214";                    ///< STEP schema
+};
+
+/// Everything a run computed, in memory. Nothing is written until write_outputs.
+struct RunResult {
+  std::string recipe;  ///< the recipe's name
+  std::vector<std::pair<std::string, surface::BSplineCurve>> curves;      ///< every named curve
+  std::vector<std::pair<std::string, surface::BSplineSurface>> surfaces;  ///< every named surface
+  std::vector<ExportResult> exports;  ///< in document order
+  std::vector<StepReport> steps;      ///< every step in order of execution
+  double seconds = 0;                 ///< wall time of the whole run
+  /// The named surface. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
+  const surface::BSplineSurface& surface(std::string_view name) const;
+  /// The named curve. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
+  const surface::BSplineCurve& curve(std::string_view name) const;
+};
+
+/// Runs every step of the recipe in memory: strokes, curves, sketches, surfaces (deformed ones
+/// by their stacks, composed per the composition mode), exports prepared. Deterministic: the same
+/// recipe gives bit-identical surfaces whatever `options.threads`. Throws clay::Error with the
+/// failing step's path first ("surfaces.sail.steps[2] (twist): ...") and that step's category.
+RunResult run_recipe(const Recipe& recipe, const RunOptions& options = {});
+
+/// Applies the recipe's deformation stack `deformation` (may be empty when the recipe has
+/// exactly one) to each of `surfaces` with the recipe's composition mode: the "clayform deform"
+/// use. The result's surfaces are named "<stem>-<k>" (k from 0) and one export "<stem>" holds
+/// them all, with the recipe's first export's formats (all three when it has none).
+RunResult deform_surfaces(const Recipe& recipe, const std::vector<surface::BSplineSurface>& surfaces,
+                          std::string_view stem, std::string_view deformation = {},
+                          const RunOptions& options = {});
+
+/// The report of a run as JSON text (schema "clayform.report", version 1, docs/recipe.md):
+/// per step its path, kind, seconds, warning, message and figures; per export its files and
+/// exchange figures (valid is filled in by write_outputs; report_json alone leaves it out).
+std::string report_json(const RunResult& result);
+
+/// Writes every export (NAME.step, NAME.igs, NAME.glb per its formats) and report.json into
+/// `out_dir` (created when missing). The files are first written into a temporary folder next
+/// to `out_dir` and each STEP file is read back and checked (BRepCheck); only when everything
+/// succeeded are they moved into `out_dir`, so a failure leaves no partial files. Returns the
+/// paths written. Throws clay::Error (Io, Exchange) naming the file.
+std::vector<std::filesystem::path> write_outputs(RunResult& result, const std::filesystem::path& out_dir);
+
+}  // namespace clay::recipe
