@@ -1567,8 +1567,18 @@ class RecipeChecker {
 // ---- syntax: line and column, duplicate keys ----------------------------------------------------
 
 std::pair<int, int> line_column(std::string_view text, std::size_t byte) {
-  // nlohmann's byte is the 1-based position of the character where parsing failed.
-  const std::size_t end = std::min(byte > 0 ? byte - 1 : 0, text.size());
+  // nlohmann's byte is the 1-based position of the last character read: the end of the token
+  // that broke the syntax. Report where that token starts (the start of "name" in a missing-comma
+  // error), which is where the eye looks.
+  std::size_t end = std::min(byte > 0 ? byte - 1 : 0, text.size());
+  if (end < text.size() && text[end] == '"' && end > 0) {
+    std::size_t k = end;
+    while (k > 0 && !(text[k - 1] == '"' && (k < 2 || text[k - 2] != '\\'))) --k;
+    if (k > 0) end = k - 1;
+  } else {
+    auto literal = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+'; };
+    while (end > 0 && end <= text.size() && literal(text[end]) && literal(text[end - 1])) --end;
+  }
   int line = 1;
   std::size_t line_start = 0;
   for (std::size_t i = 0; i < end; ++i)
@@ -1655,7 +1665,8 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
 std::string to_string(const Problem& problem) {
   std::string s;
   if (problem.line > 0) s = "line " + std::to_string(problem.line) + ", column " + std::to_string(problem.column) + ": ";
-  return s + problem.path + ": " + problem.message;
+  if (problem.path != "(syntax)") s += problem.path + ": ";
+  return s + problem.message;
 }
 
 std::vector<Problem> check_recipe(std::string_view text, const fs::path& base_dir) {

@@ -28,7 +28,7 @@ struct Problem {
   int column = 0;       ///< 1-based column of a syntax error, else 0
 };
 
-/// "path: message" (with "line L, column C: " first for syntax errors).
+/// "path: message", or "line L, column C: message" for a syntax error.
 std::string to_string(const Problem& problem);
 
 struct RecipeData;  // the checked recipe (recipe_model.hpp, internal)
