@@ -4,6 +4,7 @@
 // lattice built here from the same numbers), closed forms, the exchange read-back.
 #include <catch2/catch.hpp>
 
+#include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
 #include <clay/recipe.hpp>
@@ -458,4 +459,47 @@ TEST_CASE("load_recipe names the file and takes the name from its stem", "[recip
   const auto [category, message] = error_of([&] { load_recipe(dir / "missing.json"); });
   CHECK(category == ErrorCategory::Io);
   CHECK_THAT(message, Contains("missing.json"));
+}
+
+TEST_CASE("a taper composes exactly and a cylindrical extended lattice is refitted", "[recipe]") {
+  const std::string steps = R"("deformations": {
+      "flare": [{"kind": "taper", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": [1, 0.004]}],
+      "dent": [{"kind": "extended_lattice", "name": "dent",
+                "generator": {"cylinder": {"origin": [50, 50, -30], "radius": 60, "height": 60, "sectors": 8}},
+                "moves": [{"index": [1, 2, 2], "by": [0, 0, 12]}]}]})";
+  const std::string text = recipe_with(
+      R"(, "flared": {"deform": {"surface": "dome", "deformation": "flare"}},
+         "dented": {"deform": {"surface": "dome", "deformation": "dent", "composition": {"mode": "refit", "tolerance": 0.2, "relative": false}}})",
+      steps);
+  const auto result = run_recipe(parse_recipe(text));
+  const auto parent = dome();
+
+  deform::Taper taper;
+  taper.frame.origin = {50, 50, 0};
+  taper.profile = {1, 0.004};
+  const auto& flared = result.surface("flared");
+  const auto [lo, hi] = surface::control_box(flared);
+  CHECK(max_gap(flared, [&](double u, double v) {
+          return deform::deform_point(taper, surface::evaluate(parent, u, v));
+        }) <= 1e-12 * (hi - lo).norm());
+
+  deform::CylinderSpec spec;
+  spec.origin = {50, 50, -30};
+  spec.radius = 60;
+  spec.height = 60;
+  spec.sectors = 8;
+  auto lattice = deform::make_cylindrical_lattice(spec);
+  lattice.points.row(deform::cylindrical_index(spec, 1, 2, 2)) += Eigen::RowVector3d(0, 0, 12);
+  const double gap = max_gap(result.surface("dented"), [&](double u, double v) {
+    return deform::deform_point(lattice, surface::evaluate(parent, u, v));
+  }, 100);
+  CHECK(gap <= 0.2);
+  // the dent is there: the lattice moves the surface by about 1 mm (its control point by 12)
+  double moved = 0;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j) {
+      const Eigen::Vector3d x = surface::evaluate(parent, i / 20.0, j / 20.0);
+      moved = std::max(moved, (deform::deform_point(lattice, x) - x).norm());
+    }
+  CHECK(moved > 0.8);
 }
