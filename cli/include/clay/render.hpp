@@ -1,0 +1,78 @@
+#pragma once
+/// Pictures of surfaces: a small software renderer (orthographic camera, z-buffer, Lambert and a
+/// soft specular highlight) and a PNG writer, for README figures and `clayform render`. No GPU,
+/// no window, no OpenCASCADE: the surfaces are tessellated with surface::evaluate_grid.
+#include <clay/surface/bspline_surface.hpp>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace clay::render {
+
+/// An 8-bit colour {red, green, blue}.
+using Rgb = std::array<std::uint8_t, 3>;
+
+/// How a picture is made. Every field is checked by validate().
+struct RenderOptions {
+  int width = 960;   ///< picture width in pixels, in [16, 8192]
+  int height = 640;  ///< picture height in pixels, in [16, 8192]
+  /// Direction from the model towards the eye (any length > 0, finite): the camera sits far along
+  /// it and looks back along -eye_direction. The default looks down on the model from -x, -y, +z.
+  /// World +z is up on the picture (world +y when eye_direction is along z).
+  Eigen::Vector3d eye_direction{-1.0, -1.2, 0.9};
+  /// Tessellation density: parameters per non-empty knot span and direction, in [1, 64]. At most
+  /// 400 triangle rows per direction: fewer per span when a surface has many spans, and evenly
+  /// spaced parameters when it has more than 400 spans.
+  int samples_per_span = 8;
+  double margin = 0.05;         ///< free border on each side, fraction of width/height, in [0, 0.4]
+  bool control_net = false;     ///< draw each control net (lines and points) over the surfaces
+  bool supersample = true;      ///< 2 x 2 samples per pixel, averaged (anti-aliasing)
+  Rgb background{255, 255, 255};
+  Rgb net_colour{40, 40, 40};   ///< colour of the control net
+  /// Base colour of surface k is colours[k % colours.size()]; empty: a palette with a distinct hue
+  /// per surface (golden-angle hue steps from blue).
+  std::vector<Rgb> colours;
+
+  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  void validate() const;
+};
+
+/// An 8-bit RGB picture: pixel (x, y), x to the right and y down from the top-left corner, is
+/// rgb[3 * (y * width + x) + c] for channel c (red, green, blue).
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgb;
+
+  /// Pixel (x, y). Precondition: 0 <= x < width, 0 <= y < height.
+  Rgb pixel(int x, int y) const noexcept;
+};
+
+/// Pictures `surfaces` with an orthographic camera along options.eye_direction, fitted to the
+/// bounding box of the tessellated surfaces (and of the control nets when drawn) so that the
+/// whole model is visible with options.margin free on each side and its centre at the picture's
+/// centre; the scale is uniform (squares stay squares).
+///
+/// Each surface is tessellated on the grid of its knot spans (samples_per_span), split into
+/// triangles and z-buffered. The unit normal at each grid point is S_u x S_v from
+/// surface::derivatives; where that vanishes (a collapsed edge or a pole) it is the average of the
+/// normals of the neighbouring grid cells (cross product of the cell diagonals). Normals are
+/// interpolated across each triangle and shaded per sample (Phong shading): two-sided Lambert
+/// under a key light above-left of the eye (weight 0.6) and a head light (0.25), ambient 0.15,
+/// plus a soft Blinn–Phong highlight of the key light (exponent 50, strength 0.35) so that the
+/// highlight bands show curvature and its breaks.
+///
+/// Throws clay::Error: InvalidArgument for bad options or no surfaces, InvalidGeometry for an
+/// invalid surface (surface::validate).
+Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderOptions& options = {});
+
+/// Writes `image` as an 8-bit RGB PNG (libpng), atomically: into a temporary file next to `file`,
+/// then renamed over it. Throws clay::Error: InvalidArgument when the image's size and pixel count
+/// disagree, Io naming the file when it cannot be written.
+void write_png(const Image& image, const std::filesystem::path& file);
+
+}  // namespace clay::render
