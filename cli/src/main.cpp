@@ -2,11 +2,13 @@
 // outcome, map error categories to exit codes (STYLE.md rule 18).
 #include <clay/deform.hpp>
 #include <clay/recipe.hpp>
+#include <clay/render.hpp>
 
 #include <CLI/CLI.hpp>
 
 #include <cctype>
 #include <charconv>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -148,6 +150,20 @@ int validate(const fs::path& file) {
   return exit_code(clay::ErrorCategory::Recipe);
 }
 
+// ---- clayform render (clay/render.hpp) ----
+
+/// `clayform render FILE --png OUT.png`: a picture of the surfaces of a STEP or IGES file.
+int render_picture(const fs::path& file, const fs::path& png, const clay::render::RenderOptions& options) {
+  const std::vector<BSplineSurface> surfaces = read_surfaces(file, "render");
+  const auto start = std::chrono::steady_clock::now();
+  const clay::render::Image image = clay::render::render(surfaces, options);
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  clay::render::write_png(image, png);
+  std::printf("%s: %zu surface(s) -> %s (%d x %d, %.0f ms)\n", file.string().c_str(), surfaces.size(),
+              png.string().c_str(), image.width, image.height, ms);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -180,6 +196,25 @@ int main(int argc, char** argv) {
   deform_cmd->add_option("--deformation", deformation, "which stack (needed when the recipe has several)");
   deform_cmd->add_flag("--quiet", quiet, "no progress lines");
   deform_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
+  // clayform render
+  std::string png_file;
+  std::vector<double> eye;
+  clay::render::RenderOptions render_options;
+  auto* render_cmd = app.add_subcommand(
+      "render", "Write a PNG picture of the surfaces of a STEP or IGES file: orthographic view fitted "
+                "to the model, one hue per surface, shading with a soft highlight");
+  render_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
+  render_cmd->add_option("--png", png_file, "the picture to write (.png)")->required();
+  render_cmd->add_option("--width", render_options.width, "picture width in pixels [16, 4096]")
+      ->capture_default_str();
+  render_cmd->add_option("--height", render_options.height, "picture height in pixels [16, 4096]")
+      ->capture_default_str();
+  render_cmd->add_option("--eye", eye, "direction from the model towards the eye, X Y Z (default -1 -1.2 0.9)")
+      ->expected(3);
+  render_cmd->add_option("--samples", render_options.samples_per_span,
+                         "tessellation: samples per knot span [1, 64]")
+      ->capture_default_str();
+  render_cmd->add_flag("--net", render_options.control_net, "draw the control nets");
   app.footer(
       "Exit codes: 0 success, 1 usage, 2 invalid argument, 3 invalid geometry or out of domain, "
       "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 70 internal error.");
@@ -190,6 +225,10 @@ int main(int argc, char** argv) {
   }
   try {
     if (*info_cmd) return info(file);
+    if (*render_cmd) {
+      if (!eye.empty()) render_options.eye_direction = {eye[0], eye[1], eye[2]};
+      return render_picture(file, png_file, render_options);
+    }
     const bool show = !quiet && (progress || ::isatty(STDOUT_FILENO));
     if (*validate_cmd) return validate(recipe_file);
     if (*run_cmd) {
