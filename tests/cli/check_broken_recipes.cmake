@@ -14,6 +14,8 @@ foreach(var CLAYFORM DIR WORK)
   endif()
 endforeach()
 
+get_filename_component(DIR "${DIR}" ABSOLUTE)  # relative to the current directory
+get_filename_component(WORK "${WORK}" ABSOLUTE)
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
 
