@@ -4,6 +4,7 @@
 // lattice built here from the same numbers), closed forms, the exchange read-back.
 #include <catch2/catch.hpp>
 
+#include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
 #include <clay/recipe.hpp>
@@ -161,9 +162,9 @@ TEST_CASE("a twist needs the refit mode, and the refit is within its tolerance",
   const std::string twist = R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.01]})";
   const std::string exact = recipe_with(R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin"}})",
                                         R"("deformations": {"spin": [)" + twist + "]}");
-  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(exact)); });
-  CHECK(category == ErrorCategory::InvalidArgument);
-  CHECK_THAT(message, Contains("surfaces.spun.steps[0] (twist)"));
+  // refused by the check already, naming the surface, the step and the fix
+  CHECK(mentions(check_recipe(exact), "surfaces.spun.deform.deformation", "deformations.spin[0] is a twist"));
+  CHECK(mentions(check_recipe(exact), "surfaces.spun.deform.deformation", "\"mode\": \"refit\""));
 
   const std::string refit = recipe_with(
       R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 0.01, "relative": false}}})",
@@ -319,14 +320,11 @@ TEST_CASE("a style step leaves every control vertex outside the bound untouched"
   CHECK(outside_moved == 0);
 }
 
-TEST_CASE("a replay gives bit-identical surfaces, whatever the thread count", "[recipe]") {
+TEST_CASE("a replay gives bit-identical surfaces", "[recipe]") {
   const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
                                        std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
-  RunOptions one, two;
-  one.threads = 1;
-  two.threads = 2;
-  const auto a = run_recipe(parse_recipe(text), one);
-  const auto b = run_recipe(parse_recipe(text), two);
+  const auto a = run_recipe(parse_recipe(text));
+  const auto b = run_recipe(parse_recipe(text));
   CHECK(surface::identical(a.surface("bulged"), b.surface("bulged")));
 }
 
@@ -458,4 +456,58 @@ TEST_CASE("load_recipe names the file and takes the name from its stem", "[recip
   const auto [category, message] = error_of([&] { load_recipe(dir / "missing.json"); });
   CHECK(category == ErrorCategory::Io);
   CHECK_THAT(message, Contains("missing.json"));
+}
+
+TEST_CASE("a taper composes exactly and a cylindrical extended lattice is refitted", "[recipe]") {
+  const std::string steps = R"("deformations": {
+      "flare": [{"kind": "taper", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": [1, 0.004]}],
+      "dent": [{"kind": "extended_lattice", "name": "dent",
+                "generator": {"cylinder": {"origin": [50, 50, -30], "radius": 60, "height": 60, "sectors": 8}},
+                "moves": [{"index": [1, 2, 2], "by": [0, 0, 12]}]}]})";
+  const std::string text = recipe_with(
+      R"(, "flared": {"deform": {"surface": "dome", "deformation": "flare"}},
+         "dented": {"deform": {"surface": "dome", "deformation": "dent", "composition": {"mode": "refit", "tolerance": 0.2, "relative": false}}})",
+      steps);
+  const auto result = run_recipe(parse_recipe(text));
+  const auto parent = dome();
+
+  deform::Taper taper;
+  taper.frame.origin = {50, 50, 0};
+  taper.profile = {1, 0.004};
+  const auto& flared = result.surface("flared");
+  const auto [lo, hi] = surface::control_box(flared);
+  CHECK(max_gap(flared, [&](double u, double v) {
+          return deform::deform_point(taper, surface::evaluate(parent, u, v));
+        }) <= 1e-12 * (hi - lo).norm());
+
+  deform::CylinderSpec spec;
+  spec.origin = {50, 50, -30};
+  spec.radius = 60;
+  spec.height = 60;
+  spec.sectors = 8;
+  auto lattice = deform::make_cylindrical_lattice(spec);
+  lattice.points.row(deform::cylindrical_index(spec, 1, 2, 2)) += Eigen::RowVector3d(0, 0, 12);
+  const double gap = max_gap(result.surface("dented"), [&](double u, double v) {
+    return deform::deform_point(lattice, surface::evaluate(parent, u, v));
+  }, 100);
+  CHECK(gap <= 0.2);
+  // the dent is there: the lattice moves the surface by about 1 mm (its control point by 12)
+  double moved = 0;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j) {
+      const Eigen::Vector3d x = surface::evaluate(parent, i / 20.0, j / 20.0);
+      moved = std::max(moved, (deform::deform_point(lattice, x) - x).norm());
+    }
+  CHECK(moved > 0.8);
+}
+
+TEST_CASE("a step failing at run time is named by its path, with its category", "[recipe]") {
+  // the lattice covers only half of the dome: exact composition refuses a surface leaving it
+  const std::string small = R"({"kind": "bezier_lattice", "frame": {"origin": [-10, -10, -20], "s": [60, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]}, "degrees": [1, 1, 1]})";
+  const std::string text = recipe_with(R"(, "cut": {"deform": {"surface": "dome", "deformation": "half"}})",
+                                       R"("deformations": {"half": [)" + small + "]}");
+  REQUIRE(check_recipe(text).empty());
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
+  CHECK(category == ErrorCategory::OutOfDomain);
+  CHECK_THAT(message, Contains("surfaces.cut.steps[0] (bezier_lattice): "));
 }

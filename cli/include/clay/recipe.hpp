@@ -73,7 +73,6 @@ struct StepReport {
 
 /// Settings of run_recipe / deform_surfaces.
 struct RunOptions {
-  int threads = 0;  ///< worker threads for deformations, 0 = one per hardware thread
   /// Called after each step (progress lines); may be empty.
   std::function<void(const StepReport&)> progress;
 };
@@ -109,7 +108,8 @@ struct RunResult {
 
 /// Runs every step of the recipe in memory: strokes, curves, sketches, surfaces (deformed ones
 /// by their stacks, composed per the composition mode), exports prepared. Deterministic: the same
-/// recipe gives bit-identical surfaces whatever `options.threads`. Throws clay::Error with the
+/// recipe gives bit-identical surfaces (no step's arithmetic depends on timing or on how work is
+/// split between threads). Throws clay::Error with the
 /// failing step's path first ("surfaces.sail.steps[2] (twist): ...") and that step's category.
 RunResult run_recipe(const Recipe& recipe, const RunOptions& options = {});
 
