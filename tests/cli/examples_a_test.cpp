@@ -11,6 +11,7 @@
 #include <clay/deform/style.hpp>
 #include <clay/recipe.hpp>
 #include <clay/surface/basis.hpp>
+#include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
 
@@ -175,6 +176,10 @@ TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow c
   // The billow is there: the middle of the sail moved about 100 mm to leeward.
   const Eigen::Vector3d mid = surface::evaluate(sail, 0.6, 0.5) - surface::evaluate(styled.surface, 0.6, 0.5);
   CHECK(mid.y() > 50.0);
+
+  // A replay gives the same surface bit for bit (the ctest "recipe: sail" also compares the STEP
+  // files of two `clayform run`s byte for byte).
+  CHECK(surface::identical(run_example("sail").surface("sail"), sail));
 }
 
 TEST_CASE("example car hood: skinned hood, crease by bound and target, paper and exact modes", "[examples]") {
