@@ -219,15 +219,16 @@ def car_hood():
 # ---- 3. flat-topped bump -------------------------------------------------------------------------
 
 BUMP_HEIGHT = 40.0
-BUMP_PARAMS = [0.375, 0.4583333333333333, 0.5416666666666666, 0.625]
+BUMP_PARAMS = [0.35, 0.425, 0.5, 0.575, 0.65]  # x, y = -60, -30, 0, 30, 60 mm
 
 
 def bump():
     r = header("bump", (
-        "A flat-topped bump by direct manipulation (Hsu, Hughes & Kaufman 1992, Fig. 1(b)): sixteen "
-        "points of a 400 x 400 mm sheet are pulled to the same height, 40 mm, and the least-squares "
-        "lattice (eq. (5)) puts the control points where a flat top needs them - not in a plane. "
-        "Cubic B-spline lattice, border planes locked (C1 with the sheet around), composed exactly."))
+        "A flat-topped bump by direct manipulation (Hsu, Hughes & Kaufman 1992, Fig. 1(b)): a 5 x 5 "
+        "grid of points of a 400 x 400 mm sheet is pulled to the same height, 40 mm, and the "
+        "least-squares lattice (eq. (5)) puts the control points where a flat top needs them - not "
+        "in a plane; the top is flat over the 120 mm square the points span. Cubic B-spline lattice, "
+        "border planes locked (C1 with the sheet around), composed exactly."))
     r["surfaces"] = {
         "sheet": {"bspline": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
                               "points": [[-200, -200, 0], [-200, 200, 0], [200, -200, 0], [200, 200, 0]]}},
@@ -235,7 +236,7 @@ def bump():
     }
     locked = [[i, j, k] for i in range(9) for j in range(9) for k in range(2)
               if i in (0, 1, 7, 8) or j in (0, 1, 7, 8)]
-    moves = [{"surface_point": [u, v], "to": [-200 + 400 * u, -200 + 400 * v, BUMP_HEIGHT]}
+    moves = [{"surface_point": [u, v], "to": r4([-200 + 400 * u, -200 + 400 * v, BUMP_HEIGHT])}
              for u in BUMP_PARAMS for v in BUMP_PARAMS]
     r["deformations"] = {"flat_top": [{
         "kind": "direct_manipulation", "name": "flat top",
