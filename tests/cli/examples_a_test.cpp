@@ -166,6 +166,16 @@ TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow c
   CHECK(figure<long long>(style_step, "key_points") == styled.report.m);
   for (const auto& k : styled.report.key_points)
     if (k.influenced) CHECK(surface::closest_point(styled.surface, k.point).distance <= 1e-9 * size);
+  // Below and above the bound (an ellipse over z = 500 .. 4100 mm) the style step changed nothing.
+  int away = 0;
+  for (double u : surface::linspace(0, 1, 41))
+    for (double v : surface::linspace(0, 1, 11)) {
+      const Eigen::Vector3d p = surface::evaluate(flat, u, v);
+      if (p.z() > 200 && p.z() < 4400) continue;
+      CHECK((surface::evaluate(styled.surface, u, v) - p).norm() <= 1e-9 * size);
+      ++away;
+    }
+  CHECK(away > 50);
 
   // The luff lies on the lattice face s = 0 whose control points stay: it stays on the mast (x = y = 0).
   for (double u : surface::linspace(0, 1, 21)) {
