@@ -8,7 +8,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 clay_ensure_packages
 clay_build --target clayform
 out=${1:-$CLAY_ROOT/out/demo}
-"$CLAY_BUILD/cli/clayform" run "$CLAY_ROOT/examples/recipes/sail.json" --out "$out"
+"$CLAY_BUILD/cli/clayform" run "$CLAY_ROOT/examples/recipes/sail.json" --out "$out" --progress
 echo
 echo "==> what the files hold (clayform info):"
 "$CLAY_BUILD/cli/clayform" info "$out/sail.step"

@@ -343,8 +343,7 @@ class Runner {
                    {"added_key_points", static_cast<long long>(x.added_key_points)},
                    {"degree_u", static_cast<long long>(r.surface.u.degree)},
                    {"degree_v", static_cast<long long>(r.surface.v.degree)},
-                   {"control_points", static_cast<long long>(r.surface.points.rows())},
-                   {"exact", true}};
+                   {"control_points", static_cast<long long>(r.surface.points.rows())}};
     rep.message += ": " + x.message;
     return r.surface;
   }
