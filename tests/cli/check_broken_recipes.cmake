@@ -2,9 +2,10 @@
 # checks them against DIR/expected.txt (format in its header):
 # - validate: exit 7 (recipe problems) and every expected substring printed (JSON path, or line
 #   and column for syntax errors); a RUNTIME fixture must pass validate (exit 0) instead;
-# - run --out WORK/NN: exit with a clay error code (2..7: never 0, never 70 Internal, never a
-#   signal), exit 7 with the same substrings for recipes validate refuses, the expected substrings
-#   for RUNTIME fixtures, and no partial files: WORK/NN absent or empty, nothing else left in WORK.
+# - run --out WORK/NN: a clay error code (2..7: never 0, never 70 Internal, never a signal or
+#   the 120 s timeout), 7 with the same substrings for recipes validate refuses, the expected
+#   substrings for RUNTIME fixtures, and no partial files: WORK/NN absent or empty, nothing else
+#   left in WORK.
 # Every failure is collected and reported together (as one string: outputs may hold ';'). Usage:
 #   cmake -DCLAYFORM=path/to/clayform -DDIR=tests/cli/recipes/broken -DWORK=scratch -P this.cmake
 cmake_minimum_required(VERSION 3.22)  # IN_LIST, a script run with -P
@@ -80,7 +81,7 @@ foreach(fixture IN LISTS fixtures)
 
   # validate
   execute_process(COMMAND "${CLAYFORM}" validate "${DIR}/${fixture}"
-    OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+    OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc TIMEOUT 120)
   set(text "${out}${err}")
   if(runtime_${fixture})
     if(NOT rc STREQUAL "0")
@@ -98,7 +99,7 @@ foreach(fixture IN LISTS fixtures)
   set(out_dir "${WORK}/${number}")
   file(GLOB before LIST_DIRECTORIES true "${WORK}/*")
   execute_process(COMMAND "${CLAYFORM}" run "${DIR}/${fixture}" --out "${out_dir}"
-    OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+    OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc TIMEOUT 120)
   set(text "${out}${err}")
   if(runtime_${fixture})
     if(NOT rc MATCHES "^[2-7]$")
