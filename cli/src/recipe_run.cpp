@@ -125,7 +125,7 @@ class Runner {
     try {
       f(rep);
     } catch (const Error& e) {
-      throw Error(e.category(), path + " (" + kind + "): " + e.what());
+      throw Error(e.category(), path + " (" + kind + "): " + e.message());
     }
     rep.seconds = seconds_since(t0);
     if (options_.progress) options_.progress(rep);
