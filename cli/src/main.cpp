@@ -1,6 +1,7 @@
 // clayform — the command-line shell over the kernel: parse, call one library function, print the
 // outcome, map error categories to exit codes (STYLE.md rule 18).
 #include <clay/deform.hpp>
+#include <clay/recipe.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -8,8 +9,12 @@
 #include <charconv>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <iostream>
 #include <string>
+#include <unistd.h>
+#include <variant>
 
 namespace {
 
@@ -45,19 +50,20 @@ std::string knots_summary(const BSplineBasis& b) {
   return out;
 }
 
-/// `clayform info FILE`: lists the surfaces of a STEP or IGES file.
-int info(const fs::path& file) {
+/// The surfaces of a STEP or IGES file, chosen by its extension.
+std::vector<BSplineSurface> read_surfaces(const fs::path& file, const char* command) {
   std::string ext = file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  std::vector<BSplineSurface> surfaces;
-  if (ext == ".step" || ext == ".stp")
-    surfaces = read_step(file);
-  else if (ext == ".igs" || ext == ".iges")
-    surfaces = read_iges(file);
-  else
-    throw clay::Error(clay::ErrorCategory::InvalidArgument,
-                      "info: '" + file.string() + "' has extension '" + ext +
-                          "'; give a .step/.stp or .igs/.iges file");
+  if (ext == ".step" || ext == ".stp") return read_step(file);
+  if (ext == ".igs" || ext == ".iges") return read_iges(file);
+  throw clay::Error(clay::ErrorCategory::InvalidArgument,
+                    std::string(command) + ": '" + file.string() + "' has extension '" + ext +
+                        "'; give a .step/.stp or .igs/.iges file");
+}
+
+/// `clayform info FILE`: lists the surfaces of a STEP or IGES file.
+int info(const fs::path& file) {
+  const std::vector<BSplineSurface> surfaces = read_surfaces(file, "info");
   const ExchangeReport check = check_faces(surfaces);
   std::printf("%s: %zu surface(s), BRepCheck %s at %.0e mm\n", file.string().c_str(), surfaces.size(),
               check.valid ? "valid" : "INVALID", check.tolerance);
@@ -74,6 +80,74 @@ int info(const fs::path& file) {
   return check.valid ? 0 : exit_code(clay::ErrorCategory::Exchange);
 }
 
+/// A figure for a progress line: numbers in short form.
+std::string figure_text(const clay::recipe::Figure& f) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, bool>) return x ? "yes" : "no";
+        else if constexpr (std::is_same_v<T, std::string>) return x;
+        else if constexpr (std::is_same_v<T, double>) {
+          char buf[32];
+          std::snprintf(buf, sizeof buf, "%.3g", x);
+          return buf;
+        } else return std::to_string(x);
+      },
+      f);
+}
+
+/// Progress: one line per step, "[3] surfaces.sail (fill) 0.012 s: degree_u 3, ...".
+clay::recipe::RunOptions run_options(bool show) {
+  clay::recipe::RunOptions o;
+  if (!show) return o;
+  o.progress = [count = 0](const clay::recipe::StepReport& r) mutable {
+    std::string figures;
+    int shown = 0;
+    for (const auto& [name, value] : r.figures) {
+      if (shown++ == 6) break;
+      figures += (figures.empty() ? "" : ", ") + name + " " + figure_text(value);
+    }
+    std::printf("[%d] %s (%s) %.3f s%s%s%s\n", ++count, r.path.c_str(), r.kind.c_str(), r.seconds,
+                figures.empty() ? "" : ": ", figures.c_str(), r.warning ? "  WARNING" : "");
+    if (r.warning) std::printf("    %s\n", r.message.c_str());
+    std::fflush(stdout);
+  };
+  return o;
+}
+
+/// Writes the outputs and lists them.
+int finish(clay::recipe::RunResult& result, const fs::path& out) {
+  const auto files = clay::recipe::write_outputs(result, out);
+  bool valid = true;
+  for (const auto& e : result.exports) valid = valid && (!e.checked || e.valid);
+  std::printf("%s: %zu step(s) in %.2f s; outputs in %s:\n", result.recipe.c_str(), result.steps.size(),
+              result.seconds, out.string().c_str());
+  for (const auto& f : files) std::printf("  %s\n", f.string().c_str());
+  for (const auto& e : result.exports)
+    if (e.checked && !e.valid) {
+      std::printf("export %s: read back INVALID (BRepCheck)\n", e.name.c_str());
+      for (const auto& p : e.problems) std::printf("  problem: %s\n", p.c_str());
+    }
+  return valid ? 0 : exit_code(clay::ErrorCategory::Exchange);
+}
+
+/// `clayform validate RECIPE`: every problem, with its location.
+int validate(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw clay::Error(clay::ErrorCategory::Io, "validate: cannot read '" + file.string() + "'; check the path");
+  std::ostringstream text;
+  text << in.rdbuf();
+  const auto problems = clay::recipe::check_recipe(text.str(), file.parent_path());
+  if (problems.empty()) {
+    const auto recipe = clay::recipe::parse_recipe(text.str(), file.parent_path());
+    std::printf("%s: valid recipe\n", file.string().c_str());
+    return 0;
+  }
+  std::printf("%s: %zu problem%s\n", file.string().c_str(), problems.size(), problems.size() == 1 ? "" : "s");
+  for (const auto& p : problems) std::printf("  %s\n", clay::recipe::to_string(p).c_str());
+  return exit_code(clay::ErrorCategory::Recipe);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -84,6 +158,31 @@ int main(int argc, char** argv) {
   auto* info_cmd = app.add_subcommand("info", "List the surfaces of a STEP or IGES file: degrees, "
                                               "control points, knots, rational, box, validity");
   info_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
+  std::string recipe_file, out_dir, deformation;
+  bool quiet = false, progress = false;
+  auto* run_cmd = app.add_subcommand(
+      "run", "Run a recipe: build, deform and export every surface; writes NAME.step/.igs/.glb and "
+             "report.json into --out only when every step succeeded");
+  run_cmd->add_option("RECIPE", recipe_file, "a recipe (.json, docs/recipe.md)")->required();
+  run_cmd->add_option("--out", out_dir, "output folder (created when missing)")->required();
+  run_cmd->add_flag("--quiet", quiet, "no progress lines");
+  run_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
+  auto* validate_cmd = app.add_subcommand(
+      "validate", "Check a recipe without running it: every problem at once, with its JSON path (and "
+                  "line and column for syntax errors)");
+  validate_cmd->add_option("RECIPE", recipe_file, "a recipe (.json)")->required();
+  auto* deform_cmd = app.add_subcommand(
+      "deform", "Apply a recipe's deformation stack to every surface of a STEP or IGES file; writes "
+                "STEM.step/.igs/.glb and report.json into --out");
+  deform_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
+  deform_cmd->add_option("--recipe", recipe_file, "the recipe holding the deformation stack")->required();
+  deform_cmd->add_option("--out", out_dir, "output folder (created when missing)")->required();
+  deform_cmd->add_option("--deformation", deformation, "which stack (needed when the recipe has several)");
+  deform_cmd->add_flag("--quiet", quiet, "no progress lines");
+  deform_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
+  app.footer(
+      "Exit codes: 0 success, 1 usage, 2 invalid argument, 3 invalid geometry or out of domain, "
+      "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 70 internal error.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -91,9 +190,26 @@ int main(int argc, char** argv) {
   }
   try {
     if (*info_cmd) return info(file);
+    const bool show = !quiet && (progress || ::isatty(STDOUT_FILENO));
+    if (*validate_cmd) return validate(recipe_file);
+    if (*run_cmd) {
+      const auto recipe = clay::recipe::load_recipe(recipe_file);
+      auto result = clay::recipe::run_recipe(recipe, run_options(show));
+      return finish(result, out_dir);
+    }
+    if (*deform_cmd) {
+      const auto recipe = clay::recipe::load_recipe(recipe_file);
+      const auto surfaces = read_surfaces(file, "deform");
+      auto result = clay::recipe::deform_surfaces(recipe, surfaces, fs::path(file).stem().string(), deformation,
+                                                  run_options(show));
+      return finish(result, out_dir);
+    }
   } catch (const clay::Error& e) {
     std::fprintf(stderr, "clayform: %s\n", e.what());
     return exit_code(e.category());
+  } catch (const std::exception& e) {  // a bug, never a crash: say so and exit with Internal
+    std::fprintf(stderr, "clayform: internal error: %s; please report it with the input\n", e.what());
+    return exit_code(clay::ErrorCategory::Internal);
   }
   return 0;
 }

@@ -28,7 +28,7 @@ struct Problem {
   int column = 0;       ///< 1-based column of a syntax error, else 0
 };
 
-/// "path: message" (with "line L, column C: " first for syntax errors).
+/// "path: message", or "line L, column C: message" for a syntax error.
 std::string to_string(const Problem& problem);
 
 struct RecipeData;  // the checked recipe (recipe_model.hpp, internal)
@@ -73,7 +73,6 @@ struct StepReport {
 
 /// Settings of run_recipe / deform_surfaces.
 struct RunOptions {
-  int threads = 0;  ///< worker threads for deformations, 0 = one per hardware thread
   /// Called after each step (progress lines); may be empty.
   std::function<void(const StepReport&)> progress;
 };
@@ -85,6 +84,12 @@ struct ExportResult {
   std::vector<surface::BSplineSurface> surfaces;   ///< what is written
   std::vector<std::string> formats;                ///< "step", "iges", "glb"
   std::string schema = "AP214";                    ///< STEP schema
+  // Filled in by write_outputs:
+  std::vector<std::string> files;     ///< file names written (in out_dir)
+  bool checked = false;               ///< the STEP (or IGES) file was read back and checked
+  bool valid = false;                 ///< BRepCheck of the read-back surfaces at 1e-7 mm
+  bool read_back_identical = false;   ///< the read-back surfaces equal the written ones bit for bit
+  std::vector<std::string> problems;  ///< BRepCheck findings
 };
 
 /// Everything a run computed, in memory. Nothing is written until write_outputs.
@@ -103,7 +108,8 @@ struct RunResult {
 
 /// Runs every step of the recipe in memory: strokes, curves, sketches, surfaces (deformed ones
 /// by their stacks, composed per the composition mode), exports prepared. Deterministic: the same
-/// recipe gives bit-identical surfaces whatever `options.threads`. Throws clay::Error with the
+/// recipe gives bit-identical surfaces (no step's arithmetic depends on timing or on how work is
+/// split between threads). Throws clay::Error with the
 /// failing step's path first ("surfaces.sail.steps[2] (twist): ...") and that step's category.
 RunResult run_recipe(const Recipe& recipe, const RunOptions& options = {});
 

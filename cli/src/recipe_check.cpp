@@ -1,0 +1,1715 @@
+// Recipe checking: JSON text → RecipeData, with every problem collected (docs/recipe.md).
+// The JSON is walked once; each reader records a Problem with the value's path and returns a
+// fallback so the walk goes on and everything wrong is reported at once.
+#include "recipe_model.hpp"
+
+#include <clay/constraints/constraint.hpp>
+#include <clay/deform/extended_lattice.hpp>
+#include <clay/deform/lattice.hpp>
+#include <clay/error.hpp>
+#include <clay/sketch/entities.hpp>
+#include <clay/sketch/plane.hpp>
+#include <clay/surface/arc.hpp>
+#include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/exchange.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+namespace clay::recipe {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+namespace fs = std::filesystem;
+using surface::Points3;
+
+constexpr std::string_view format_name = "clayform.recipe";
+constexpr int format_version = 1;
+constexpr double inf = std::numeric_limits<double>::infinity();
+constexpr double degrees_to_radians = std::numbers::pi / 180.0;
+
+std::string shortest(double x) {
+  char buf[32];
+  const auto end = std::to_chars(buf, buf + sizeof buf, x).ptr;
+  return std::string(buf, end);
+}
+
+/// The value in words for messages: "the string \"x\"", "the number 3", "an array of 2", ...
+std::string found(const Json& j) {
+  if (j.is_null()) return "null";
+  if (j.is_boolean()) return j.get<bool>() ? "true" : "false";
+  if (j.is_number()) return "the number " + shortest(j.get<double>());
+  if (j.is_string()) {
+    std::string s = j.get<std::string>();
+    if (s.size() > 40) s = s.substr(0, 37) + "...";
+    return "the string \"" + s + "\"";
+  }
+  if (j.is_array()) return "an array of " + std::to_string(j.size());
+  return "an object";
+}
+
+std::string key_path(const std::string& path, std::string_view key) {
+  return path.empty() ? std::string(key) : path + "." + std::string(key);
+}
+std::string index_path(const std::string& path, std::size_t i) {
+  return path + "[" + std::to_string(i) + "]";
+}
+
+std::string join(const std::vector<std::string>& items, std::string_view sep = ", ") {
+  std::string out;
+  for (std::size_t k = 0; k < items.size(); ++k) out += (k ? std::string(sep) : "") + items[k];
+  return out;
+}
+
+/// An allowed interval for a number, open or closed at each end.
+struct Range {
+  double lo = -inf, hi = inf;
+  bool lo_open = false, hi_open = false;
+  bool contains(double x) const {
+    return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
+  }
+  std::string text() const {
+    if (lo == -inf && hi == inf) return "any finite number";
+    if (hi == inf) return std::string(lo_open ? "> " : ">= ") + shortest(lo);
+    if (lo == -inf) return std::string(hi_open ? "< " : "<= ") + shortest(hi);
+    return std::string(lo_open ? "(" : "[") + shortest(lo) + ", " + shortest(hi) + (hi_open ? ")" : "]");
+  }
+};
+constexpr Range any{};
+constexpr Range positive{0, inf, true, false};
+constexpr Range non_negative{0, inf, false, false};
+
+bool valid_name(std::string_view s) {
+  if (s.empty() || s.size() > 64) return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+           c == '-';
+  });
+}
+
+/// The walk: readers that record problems and return fallbacks.
+class Checker {
+ public:
+  std::vector<Problem> problems;
+
+  void add(std::string path, std::string message) {
+    problems.push_back({path.empty() ? "(top level)" : std::move(path), std::move(message), 0, 0});
+  }
+
+  /// True when j is an object; reports keys outside `allowed`.
+  bool object(const Json& j, const std::string& path, std::initializer_list<std::string_view> allowed,
+              std::string_view what) {
+    if (!j.is_object()) {
+      add(path, "expected " + std::string(what) + " (a JSON object), found " + found(j));
+      return false;
+    }
+    for (const auto& [key, value] : j.items()) {
+      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+      std::vector<std::string> names(allowed.begin(), allowed.end());
+      add(key_path(path, key), "unknown key \"" + key + "\" in " + std::string(what) +
+                                   "; the keys are: " + join(names));
+    }
+    return true;
+  }
+
+  /// The member, or nullptr (reported when required).
+  const Json* member(const Json& obj, const std::string& path, std::string_view key, bool required,
+                     std::string_view hint) {
+    if (!obj.is_object()) return nullptr;
+    const auto it = obj.find(std::string(key));
+    if (it == obj.end()) {
+      if (required) add(key_path(path, key), "missing; give " + std::string(hint));
+      return nullptr;
+    }
+    return &*it;
+  }
+
+  std::optional<double> number(const Json& j, const std::string& path, Range r = any) {
+    if (!j.is_number()) {
+      add(path, "expected a number (" + r.text() + "), found " + found(j));
+      return std::nullopt;
+    }
+    const double x = j.get<double>();
+    if (!std::isfinite(x) || !r.contains(x)) {
+      add(path, shortest(x) + " is out of range; give a number " + r.text());
+      return std::nullopt;
+    }
+    return x;
+  }
+
+  std::optional<int> integer(const Json& j, const std::string& path, int lo, int hi) {
+    if (!j.is_number_integer() || j.get<long long>() < lo || j.get<long long>() > hi) {
+      add(path, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                    "], found " + found(j));
+      return std::nullopt;
+    }
+    return static_cast<int>(j.get<long long>());
+  }
+
+  std::optional<bool> boolean(const Json& j, const std::string& path) {
+    if (!j.is_boolean()) {
+      add(path, "expected true or false, found " + found(j));
+      return std::nullopt;
+    }
+    return j.get<bool>();
+  }
+
+  std::optional<std::string> string(const Json& j, const std::string& path) {
+    if (!j.is_string()) {
+      add(path, "expected a string, found " + found(j));
+      return std::nullopt;
+    }
+    return j.get<std::string>();
+  }
+
+  /// One of `choices` (the index), or nullopt.
+  std::optional<int> choice(const Json& j, const std::string& path,
+                            std::initializer_list<std::string_view> choices) {
+    std::vector<std::string> names(choices.begin(), choices.end());
+    if (j.is_string()) {
+      const auto s = j.get<std::string>();
+      for (std::size_t k = 0; k < names.size(); ++k)
+        if (names[k] == s) return static_cast<int>(k);
+    }
+    add(path, "expected one of " + join(names) + ", found " + found(j));
+    return std::nullopt;
+  }
+
+  std::optional<Eigen::Vector3d> vec3(const Json& j, const std::string& path) {
+    if (!j.is_array() || j.size() != 3) {
+      add(path, "expected [x, y, z] (3 numbers, mm), found " + found(j));
+      return std::nullopt;
+    }
+    Eigen::Vector3d v;
+    bool ok = true;
+    for (int k = 0; k < 3; ++k) {
+      const auto x = number(j[static_cast<std::size_t>(k)], index_path(path, static_cast<std::size_t>(k)));
+      ok = ok && x.has_value();
+      v[k] = x.value_or(0.0);
+    }
+    return ok ? std::optional(v) : std::nullopt;
+  }
+
+  std::optional<Eigen::Vector2d> vec2(const Json& j, const std::string& path) {
+    if (!j.is_array() || j.size() != 2) {
+      add(path, "expected [a, b] (2 numbers, mm in the plane), found " + found(j));
+      return std::nullopt;
+    }
+    const auto a = number(j[0], index_path(path, 0));
+    const auto b = number(j[1], index_path(path, 1));
+    if (!a || !b) return std::nullopt;
+    return Eigen::Vector2d(*a, *b);
+  }
+
+  /// An array of [x, y, z] with at least `min` rows.
+  std::optional<Points3> points(const Json& j, const std::string& path, std::size_t min) {
+    if (!j.is_array() || j.size() < min) {
+      add(path, "expected an array of at least " + std::to_string(min) + " points [x, y, z], found " +
+                    found(j));
+      return std::nullopt;
+    }
+    Points3 p(static_cast<Eigen::Index>(j.size()), 3);
+    bool ok = true;
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      const auto v = vec3(j[i], index_path(path, i));
+      ok = ok && v.has_value();
+      if (v) p.row(static_cast<Eigen::Index>(i)) = v->transpose();
+    }
+    return ok ? std::optional(p) : std::nullopt;
+  }
+
+  std::optional<std::vector<double>> numbers(const Json& j, const std::string& path, std::size_t min) {
+    if (!j.is_array() || j.size() < min) {
+      add(path, "expected an array of at least " + std::to_string(min) + " numbers, found " + found(j));
+      return std::nullopt;
+    }
+    std::vector<double> out;
+    bool ok = true;
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      const auto x = number(j[i], index_path(path, i));
+      ok = ok && x.has_value();
+      out.push_back(x.value_or(0.0));
+    }
+    return ok ? std::optional(out) : std::nullopt;
+  }
+
+  // Optional members with a default: read when present, the default otherwise (or when bad).
+  double number_or(const Json& obj, const std::string& path, std::string_view key, double def,
+                   Range r = any) {
+    const Json* j = member(obj, path, key, false, "");
+    return j ? number(*j, key_path(path, key), r).value_or(def) : def;
+  }
+  int integer_or(const Json& obj, const std::string& path, std::string_view key, int def, int lo, int hi) {
+    const Json* j = member(obj, path, key, false, "");
+    return j ? integer(*j, key_path(path, key), lo, hi).value_or(def) : def;
+  }
+  bool boolean_or(const Json& obj, const std::string& path, std::string_view key, bool def) {
+    const Json* j = member(obj, path, key, false, "");
+    return j ? boolean(*j, key_path(path, key)).value_or(def) : def;
+  }
+
+  /// Runs `build` and turns a clay::Error into a problem at `path`.
+  template <class F>
+  bool attempt(const std::string& path, F&& build) {
+    try {
+      build();
+      return true;
+    } catch (const Error& e) {
+      add(path, e.what());
+      return false;
+    }
+  }
+  void add_all(const std::string& path, const std::vector<std::string>& list) {
+    for (const auto& p : list) add(path, p);
+  }
+};
+
+// ---- names and references ------------------------------------------------------------------------
+
+/// What has been defined so far, and what the whole document declares (to tell "missing" from
+/// "defined later").
+struct Names {
+  std::vector<std::string> curves;            // strokes, curves and sketch entities, in order
+  std::set<std::string> curves_declared;      // everything the document declares as a curve
+  std::vector<std::string> surfaces;
+  std::set<std::string> surfaces_declared;
+  std::vector<std::string> stacks;            // all stacks (may be referenced from anywhere)
+
+  static bool has(const std::vector<std::string>& list, const std::string& name) {
+    return std::find(list.begin(), list.end(), name) != list.end();
+  }
+};
+
+std::string listing(const std::vector<std::string>& names) {
+  if (names.empty()) return "none is defined";
+  if (names.size() <= 12) return "defined: " + join(names);
+  return "defined: " + join(std::vector<std::string>(names.begin(), names.begin() + 12)) + ", ... (" +
+         std::to_string(names.size()) + " in all)";
+}
+
+class RecipeChecker {
+ public:
+  RecipeChecker(Checker& c, fs::path base) : c_(c), base_(std::move(base)) {}
+  RecipeData data;
+
+  void run(const Json& root) {
+    if (!c_.object(root, "", {"format", "version", "name", "description", "units", "composition",
+                              "strokes", "curves", "sketches", "surfaces", "deformations", "exports"},
+                   "a recipe {\"format\": \"clayform.recipe\", \"version\": 1, ...}"))
+      return;
+    const Json* format = c_.member(root, "", "format", true, "\"format\": \"clayform.recipe\"");
+    if (format && (!format->is_string() || format->get<std::string>() != format_name))
+      c_.add("format", "expected \"clayform.recipe\", found " + found(*format) +
+                           "; this is not a Clayform recipe (a deformation stack file is read by "
+                           "deform::stack_from_json)");
+    const Json* version = c_.member(root, "", "version", true, "\"version\": 1");
+    if (version && (!version->is_number_integer() || version->get<long long>() != format_version))
+      c_.add("version", found(*version) + " is not supported: this clayform reads version " +
+                            std::to_string(format_version) + "; write the recipe for version 1");
+    if (const Json* j = c_.member(root, "", "name", false, ""))
+      data.name = c_.string(*j, "name").value_or("");
+    if (const Json* j = c_.member(root, "", "description", false, ""))
+      data.description = c_.string(*j, "description").value_or("");
+    if (const Json* j = c_.member(root, "", "units", false, "")) {
+      const auto u = c_.string(*j, "units");
+      if (u && *u != "mm")
+        c_.add("units", "\"" + *u + "\" is not supported: Clayform models are in millimetres; "
+                        "convert the lengths and write \"units\": \"mm\"");
+    }
+    if (const Json* j = c_.member(root, "", "composition", false, ""))
+      data.composition = composition(*j, "composition", Composition{});
+
+    declare(root);
+    section(root, "strokes", [&](const std::string& n, const Json& j, const std::string& p) { stroke(n, j, p); });
+    section(root, "curves", [&](const std::string& n, const Json& j, const std::string& p) { curve(n, j, p); });
+    section(root, "sketches", [&](const std::string& n, const Json& j, const std::string& p) { sketch(n, j, p); });
+    section(root, "deformations", [&](const std::string& n, const Json& j, const std::string& p) { stack(n, j, p); });
+    section(root, "surfaces", [&](const std::string& n, const Json& j, const std::string& p) { surface(n, j, p); });
+    section(root, "exports", [&](const std::string& n, const Json& j, const std::string& p) { exporting(n, j, p); });
+  }
+
+ private:
+  Checker& c_;
+  fs::path base_;
+  Names names_;
+
+  template <class F>
+  void section(const Json& root, std::string_view key, F&& each) {
+    const Json* j = c_.member(root, "", key, false, "");
+    if (!j) return;
+    if (!j->is_object()) {
+      c_.add(std::string(key), "expected an object of NAME: {...} entries, found " + found(*j));
+      return;
+    }
+    for (const auto& [name, value] : j->items()) each(name, value, key_path(std::string(key), name));
+  }
+
+  /// First pass: every name the document declares (for "defined later" and the stacks, which
+  /// may be referenced before they appear), and malformed or repeated names.
+  void declare(const Json& root) {
+    std::map<std::string, std::string> curve_owner;  // name → path of its definition
+    auto declare_curve = [&](const std::string& name, const std::string& path) {
+      const auto [it, inserted] = curve_owner.emplace(name, path);
+      if (!inserted)
+        c_.add(path, "the curve name \"" + name + "\" is already used by " + it->second +
+                         "; strokes, curves and sketch entities share one namespace: rename one");
+      names_.curves_declared.insert(name);
+    };
+    auto each = [&](std::string_view section_key, auto&& f) {
+      const Json* s = c_.member(root, "", section_key, false, "");
+      if (!s || !s->is_object()) return;
+      for (const auto& [name, value] : s->items()) {
+        const std::string path = key_path(std::string(section_key), name);
+        if (!valid_name(name))
+          c_.add(path, "the name \"" + name + "\" is not allowed; use 1 to 64 of A-Z a-z 0-9 _ -");
+        f(name, value, path);
+      }
+    };
+    each("strokes", [&](const std::string& n, const Json&, const std::string& p) { declare_curve(n, p); });
+    each("curves", [&](const std::string& n, const Json&, const std::string& p) { declare_curve(n, p); });
+    each("sketches", [&](const std::string& n, const Json& v, const std::string& p) {
+      if (!v.is_object()) return;
+      const auto e = v.find("entities");
+      if (e == v.end() || !e->is_object()) return;
+      for (const auto& [entity, ev] : e->items()) {
+        (void)ev;
+        const std::string ep = key_path(key_path(p, "entities"), entity);
+        if (!valid_name(entity))
+          c_.add(ep, "the name \"" + entity + "\" is not allowed; use 1 to 64 of A-Z a-z 0-9 _ -");
+        declare_curve(n + "." + entity, ep);
+      }
+    });
+    each("surfaces", [&](const std::string& n, const Json&, const std::string&) {
+      names_.surfaces_declared.insert(n);
+    });
+    each("deformations", [&](const std::string& n, const Json&, const std::string&) {
+      names_.stacks.push_back(n);
+    });
+    each("exports", [&](const std::string&, const Json&, const std::string&) {});
+  }
+
+  std::optional<std::string> curve_ref(const Json& j, const std::string& path) {
+    const auto name = c_.string(j, path);
+    if (!name) return std::nullopt;
+    if (Names::has(names_.curves, *name)) return name;
+    if (names_.curves_declared.count(*name))
+      c_.add(path, "the curve \"" + *name + "\" is defined later in the recipe; a curve may only use "
+                   "curves defined before it (move its definition up)");
+    else
+      c_.add(path, "no curve named \"" + *name + "\"; " + listing(names_.curves));
+    return std::nullopt;
+  }
+
+  std::optional<std::string> surface_ref(const Json& j, const std::string& path) {
+    const auto name = c_.string(j, path);
+    if (!name) return std::nullopt;
+    if (Names::has(names_.surfaces, *name)) return name;
+    if (names_.surfaces_declared.count(*name))
+      c_.add(path, "the surface \"" + *name + "\" is defined later in \"surfaces\" (or is this one); "
+                   "surfaces are built in document order: move its definition up");
+    else
+      c_.add(path, "no surface named \"" + *name + "\"; " + listing(names_.surfaces));
+    return std::nullopt;
+  }
+
+  std::vector<std::string> curve_refs(const Json& obj, const std::string& path, std::string_view key,
+                                      std::size_t min, std::size_t max) {
+    const Json* j = c_.member(obj, path, key, true, "an array of curve names");
+    if (!j) return {};
+    const std::string p = key_path(path, key);
+    if (!j->is_array() || j->size() < min || j->size() > max) {
+      c_.add(p, "expected an array of " + std::to_string(min) + (max > min ? " to " + std::to_string(max) : "") +
+                    " curve names, found " + found(*j));
+      return {};
+    }
+    std::vector<std::string> out;
+    for (std::size_t i = 0; i < j->size(); ++i)
+      if (const auto n = curve_ref((*j)[i], index_path(p, i))) out.push_back(*n);
+    return out.size() == j->size() ? out : std::vector<std::string>{};
+  }
+
+  // ---- composition ------------------------------------------------------------------------
+
+  Composition composition(const Json& j, const std::string& path, Composition c) {
+    if (!c_.object(j, path, {"mode", "tolerance", "relative", "degree", "check_samples"},
+                   "a composition {\"mode\": \"exact\"|\"refit\", ...}"))
+      return c;
+    if (const Json* m = c_.member(j, path, "mode", false, ""))
+      if (const auto k = c_.choice(*m, key_path(path, "mode"), {"exact", "refit"})) c.refit = *k == 1;
+    c.tolerance = c_.number_or(j, path, "tolerance", c.tolerance, positive);
+    c.relative = c_.boolean_or(j, path, "relative", c.relative);
+    c.degree = c_.integer_or(j, path, "degree", c.degree, 1, 25);
+    c.check_samples = c_.integer_or(j, path, "check_samples", c.check_samples, 2, 64);
+    return c;
+  }
+
+  // ---- strokes, curves, sketches --------------------------------------------------------------
+
+  std::optional<sketch::SketchPlane> plane(const Json& j, const std::string& path) {
+    if (!c_.object(j, path, {"origin", "x_axis", "y_axis"}, "a plane {origin, x_axis, y_axis}"))
+      return std::nullopt;
+    sketch::SketchPlane pl;
+    bool ok = true;
+    for (auto [key, target] : {std::pair{"origin", &pl.origin}, std::pair{"x_axis", &pl.x_axis},
+                               std::pair{"y_axis", &pl.y_axis}}) {
+      const Json* v = c_.member(j, path, key, true, "[x, y, z]");
+      const auto x = v ? c_.vec3(*v, key_path(path, key)) : std::nullopt;
+      ok = ok && x.has_value();
+      if (x) *target = *x;
+    }
+    if (!ok) return std::nullopt;
+    const auto list = sketch::problems(pl, path);
+    if (!list.empty()) {
+      c_.add_all(path, list);
+      return std::nullopt;
+    }
+    return pl;
+  }
+
+  void stroke(const std::string& name, const Json& j, const std::string& path) {
+    names_.curves.push_back(name);  // defined even when broken: one problem, not a cascade
+    if (!c_.object(j, path, {"points", "plane", "tolerance", "degree", "fairness", "closing_ratio"},
+                   "a stroke {points, plane, tolerance, degree, fairness, closing_ratio}"))
+      return;
+    StrokeDef s{name, path, {}, {}};
+    const Json* pts = c_.member(j, path, "points", true, "the drawn points [[x, y, z], ...]");
+    const auto p = pts ? c_.points(*pts, key_path(path, "points"), 2) : std::nullopt;
+    if (const Json* pl = c_.member(j, path, "plane", false, ""))
+      s.stroke.plane = plane(*pl, key_path(path, "plane"));
+    s.fit.tolerance = c_.number_or(j, path, "tolerance", s.fit.tolerance, positive);
+    s.fit.degree = c_.integer_or(j, path, "degree", s.fit.degree, 2, 9);
+    s.fit.fairness = c_.number_or(j, path, "fairness", s.fit.fairness, non_negative);
+    s.fit.closing_ratio = c_.number_or(j, path, "closing_ratio", s.fit.closing_ratio, Range{0, 0.5});
+    s.fit.corner_angle = 180.0;  // one curve per stroke in a recipe (docs/recipe.md)
+    if (!p) return;
+    s.stroke.points = *p;
+    const auto list = sketch::problems(s.stroke, path);
+    if (!list.empty()) return c_.add_all(path, list);
+    if (c_.attempt(path, [&] { s.fit.validate(); })) data.strokes.push_back(std::move(s));
+  }
+
+  std::optional<surface::BSplineCurve> inline_curve(const Json& j, const std::string& path) {
+    if (!c_.object(j, path, {"degree", "knots", "points", "weights"},
+                   "a B-spline curve {degree, knots, points, weights}"))
+      return std::nullopt;
+    const Json* d = c_.member(j, path, "degree", true, "the degree, e.g. 3");
+    const Json* k = c_.member(j, path, "knots", true, "the knot vector (count + degree + 1 numbers)");
+    const Json* p = c_.member(j, path, "points", true, "the control points [[x, y, z], ...]");
+    const auto degree = d ? c_.integer(*d, key_path(path, "degree"), 1, surface::max_kernel_degree) : std::nullopt;
+    const auto knots = k ? c_.numbers(*k, key_path(path, "knots"), 2) : std::nullopt;
+    const auto points = p ? c_.points(*p, key_path(path, "points"), 2) : std::nullopt;
+    std::optional<std::vector<double>> weights;
+    if (const Json* w = c_.member(j, path, "weights", false, ""))
+      if (!(weights = c_.numbers(*w, key_path(path, "weights"), 2))) return std::nullopt;
+    if (!degree || !knots || !points) return std::nullopt;
+    surface::BSplineCurve curve;
+    curve.basis = {*degree, *knots};
+    curve.points = *points;
+    curve.weights = weights ? Eigen::Map<const Eigen::VectorXd>(weights->data(), static_cast<Eigen::Index>(weights->size())).eval()
+                            : Eigen::VectorXd::Ones(points->rows()).eval();
+    const auto list = surface::problems(curve, path);
+    if (!list.empty()) {
+      c_.add_all(path, list);
+      return std::nullopt;
+    }
+    return curve;
+  }
+
+  void curve(const std::string& name, const Json& j, const std::string& path) {
+    CurveDef def{name, path, "", std::nullopt, ""};
+    const bool ok = one_of(j, path, {"bspline", "line", "arc", "polyline", "reversed"}, "a curve", def.kind);
+    const std::string p = key_path(path, def.kind);
+    if (ok) {
+      const Json& v = j.at(def.kind);
+      if (def.kind == "bspline") {
+        def.curve = inline_curve(v, p);
+      } else if (def.kind == "line") {
+        if (c_.object(v, p, {"from", "to"}, "a line {from, to}")) {
+          const Json* a = c_.member(v, p, "from", true, "[x, y, z]");
+          const Json* b = c_.member(v, p, "to", true, "[x, y, z]");
+          const auto from = a ? c_.vec3(*a, key_path(p, "from")) : std::nullopt;
+          const auto to = b ? c_.vec3(*b, key_path(p, "to")) : std::nullopt;
+          if (from && to) {
+            Points3 pts(2, 3);
+            pts.row(0) = from->transpose();
+            pts.row(1) = to->transpose();
+            def.curve = polyline_curve(pts, p);
+          }
+        }
+      } else if (def.kind == "polyline") {
+        if (c_.object(v, p, {"points"}, "a polyline {points}")) {
+          const Json* a = c_.member(v, p, "points", true, "[[x, y, z], ...]");
+          if (const auto pts = a ? c_.points(*a, key_path(p, "points"), 2) : std::nullopt)
+            def.curve = polyline_curve(*pts, p);
+        }
+      } else if (def.kind == "arc") {
+        def.curve = arc(v, p);
+      } else {  // reversed
+        if (const auto n = curve_ref(v, p)) def.reversed_of = *n;
+      }
+    }
+    names_.curves.push_back(name);
+    if (def.curve || !def.reversed_of.empty()) data.curves.push_back(std::move(def));
+  }
+
+  std::optional<surface::BSplineCurve> polyline_curve(const Points3& pts, const std::string& path) {
+    const auto n = pts.rows();
+    for (Eigen::Index i = 1; i < n; ++i)
+      if (pts.row(i) == pts.row(i - 1)) {
+        c_.add(path, "points " + std::to_string(i - 1) + " and " + std::to_string(i) +
+                         " are the same; a polyline needs distinct consecutive points");
+        return std::nullopt;
+      }
+    surface::BSplineCurve c;
+    c.basis.degree = 1;
+    c.basis.knots.resize(static_cast<std::size_t>(n) + 2);
+    c.basis.knots.front() = 0.0;
+    for (Eigen::Index i = 0; i < n; ++i)
+      c.basis.knots[static_cast<std::size_t>(i) + 1] = static_cast<double>(i) / static_cast<double>(n - 1);
+    c.basis.knots.back() = 1.0;
+    c.points = pts;
+    c.weights = Eigen::VectorXd::Ones(n);
+    return c;
+  }
+
+  std::optional<surface::BSplineCurve> arc(const Json& v, const std::string& p) {
+    if (!c_.object(v, p, {"center", "x_axis", "y_axis", "radius", "start", "end"},
+                   "an arc {center, x_axis, y_axis, radius, start, end}"))
+      return std::nullopt;
+    std::array<std::optional<Eigen::Vector3d>, 3> vs;
+    int k = 0;
+    for (const char* key : {"center", "x_axis", "y_axis"}) {
+      const Json* m = c_.member(v, p, key, true, "[x, y, z]");
+      vs[static_cast<std::size_t>(k++)] = m ? c_.vec3(*m, key_path(p, key)) : std::nullopt;
+    }
+    const Json* r = c_.member(v, p, "radius", true, "the radius in mm");
+    const Json* s = c_.member(v, p, "start", true, "the start angle in degrees");
+    const Json* e = c_.member(v, p, "end", true, "the end angle in degrees");
+    const auto radius = r ? c_.number(*r, key_path(p, "radius"), positive) : std::nullopt;
+    const auto start = s ? c_.number(*s, key_path(p, "start")) : std::nullopt;
+    const auto end = e ? c_.number(*e, key_path(p, "end")) : std::nullopt;
+    if (!vs[0] || !vs[1] || !vs[2] || !radius || !start || !end) return std::nullopt;
+    if (!(*end > *start && *end - *start <= 360.0)) {
+      c_.add(p, "end − start = " + shortest(*end - *start) + " degrees; give 0 < end − start <= 360");
+      return std::nullopt;
+    }
+    std::optional<surface::BSplineCurve> out;
+    c_.attempt(p, [&] {
+      out = surface::circular_arc(*vs[0], *vs[1], *vs[2], *radius, *start * degrees_to_radians,
+                                  *end * degrees_to_radians);
+    });
+    return out;
+  }
+
+  /// Exactly one of `kinds` is a key of j: true and `kind` set; else the problem is recorded.
+  bool one_of(const Json& j, const std::string& path, std::initializer_list<std::string_view> kinds,
+              std::string_view what, std::string& kind) {
+    std::vector<std::string> names(kinds.begin(), kinds.end());
+    if (!j.is_object()) {
+      c_.add(path, "expected " + std::string(what) + " as an object with one of " + join(names) +
+                       ", found " + found(j));
+      return false;
+    }
+    std::vector<std::string> present;
+    for (const auto& [key, value] : j.items()) {
+      (void)value;
+      if (std::find(names.begin(), names.end(), key) != names.end())
+        present.push_back(key);
+      else
+        c_.add(key_path(path, key), "unknown key \"" + key + "\" in " + std::string(what) +
+                                        "; give exactly one of " + join(names));
+    }
+    if (present.size() != 1) {
+      if (present.empty())
+        c_.add(path, std::string(what) + " needs exactly one of " + join(names));
+      else
+        c_.add(path, std::string(what) + " has " + join(present) + "; give exactly one");
+      return false;
+    }
+    kind = present.front();
+    return true;
+  }
+
+  void sketch(const std::string& name, const Json& j, const std::string& path) {
+    SketchDef def{name, path, {}, {}, {}, {}};
+    const auto register_entities = [&] {
+      const auto e = j.is_object() ? j.find("entities") : j.end();
+      if (j.is_object() && e != j.end() && e->is_object())
+        for (const auto& [entity, v] : e->items()) {
+          (void)v;
+          names_.curves.push_back(name + "." + entity);
+        }
+    };
+    if (!c_.object(j, path, {"plane", "points", "entities", "constraints", "tolerance"},
+                   "a sketch {plane, points, entities, constraints, tolerance}")) {
+      return;
+    }
+    const std::size_t before = c_.problems.size();
+    sketch::PlaneId plane_id;
+    if (const Json* pl = c_.member(j, path, "plane", false, ""))
+      if (const auto p = plane(*pl, key_path(path, "plane"))) plane_id = def.sketch.add_plane(*p);
+    std::map<std::string, sketch::PointId> points;
+    std::map<std::string, sketch::EntityId> entities;
+    if (const Json* pts = c_.member(j, path, "points", true, "an object of NAME: position")) {
+      const std::string pp = key_path(path, "points");
+      if (pts->is_object()) {
+        for (const auto& [pname, pv] : pts->items()) {
+          const std::string p = key_path(pp, pname);
+          if (!plane_id.free()) {
+            if (const auto ab = c_.vec2(pv, p))
+              c_.attempt(p, [&] { points[pname] = def.sketch.add_point(plane_id, *ab); });
+          } else if (const auto x = c_.vec3(pv, p)) {
+            c_.attempt(p, [&] { points[pname] = def.sketch.add_point(*x); });
+          }
+        }
+      } else {
+        c_.add(pp, "expected an object of NAME: position, found " + found(*pts));
+      }
+    }
+    auto point_ref = [&](const Json& v, const std::string& p) -> std::optional<sketch::PointId> {
+      const auto n = c_.string(v, p);
+      if (!n) return std::nullopt;
+      const auto it = points.find(*n);
+      if (it != points.end()) return it->second;
+      std::vector<std::string> known;
+      for (const auto& [k, id] : points) known.push_back(k);
+      c_.add(p, "no point named \"" + *n + "\" in this sketch; " + listing(known));
+      return std::nullopt;
+    };
+    auto entity_ref = [&](const Json& v, const std::string& p) -> std::optional<sketch::EntityId> {
+      const auto n = c_.string(v, p);
+      if (!n) return std::nullopt;
+      const auto it = entities.find(*n);
+      if (it != entities.end()) return it->second;
+      std::vector<std::string> known;
+      for (const auto& [k, id] : entities) known.push_back(k);
+      c_.add(p, "no entity named \"" + *n + "\" in this sketch; " + listing(known));
+      return std::nullopt;
+    };
+    if (const Json* ents = c_.member(j, path, "entities", true, "an object of NAME: {line|circle|arc}")) {
+      const std::string ep = key_path(path, "entities");
+      if (ents->is_object()) {
+        for (const auto& [ename, ev] : ents->items()) {
+          const std::string p = key_path(ep, ename);
+          std::string kind;
+          if (!one_of(ev, p, {"line", "circle", "arc"}, "a sketch entity", kind)) continue;
+          const Json& v = ev.at(kind);
+          const std::string kp = key_path(p, kind);
+          if (kind == "line") {
+            if (!v.is_array() || v.size() != 2) {
+              c_.add(kp, "expected [\"P\", \"Q\"] (two point names), found " + found(v));
+              continue;
+            }
+            const auto a = point_ref(v[0], index_path(kp, 0));
+            const auto b = point_ref(v[1], index_path(kp, 1));
+            if (a && b) c_.attempt(kp, [&] { entities[ename] = def.sketch.add_line(*a, *b); });
+          } else if (kind == "circle") {
+            if (!c_.object(v, kp, {"center", "radius"}, "a circle {center, radius}")) continue;
+            const Json* cj = c_.member(v, kp, "center", true, "a point name");
+            const Json* rj = c_.member(v, kp, "radius", true, "the radius in mm");
+            const auto center = cj ? point_ref(*cj, key_path(kp, "center")) : std::nullopt;
+            const auto r = rj ? c_.number(*rj, key_path(kp, "radius"), positive) : std::nullopt;
+            if (plane_id.free()) {
+              c_.add(kp, "a circle needs the sketch's plane; give the sketch a \"plane\"");
+              continue;
+            }
+            if (center && r)
+              c_.attempt(kp, [&] { entities[ename] = def.sketch.add_circle(*center, *r, plane_id); });
+          } else {
+            if (!c_.object(v, kp, {"center", "start", "end"}, "an arc {center, start, end}")) continue;
+            std::array<std::optional<sketch::PointId>, 3> ids;
+            int k = 0;
+            for (const char* key : {"center", "start", "end"}) {
+              const Json* m = c_.member(v, kp, key, true, "a point name");
+              ids[static_cast<std::size_t>(k++)] = m ? point_ref(*m, key_path(kp, key)) : std::nullopt;
+            }
+            if (plane_id.free()) {
+              c_.add(kp, "an arc needs the sketch's plane; give the sketch a \"plane\"");
+              continue;
+            }
+            if (ids[0] && ids[1] && ids[2])
+              c_.attempt(kp, [&] { entities[ename] = def.sketch.add_arc(*ids[0], *ids[1], *ids[2], plane_id); });
+          }
+        }
+      } else {
+        c_.add(ep, "expected an object of NAME: {line|circle|arc}, found " + found(*ents));
+      }
+    }
+    if (const Json* cons = c_.member(j, path, "constraints", false, "")) {
+      const std::string cp = key_path(path, "constraints");
+      if (!cons->is_array()) {
+        c_.add(cp, "expected an array of {\"type\": ..., ...}, found " + found(*cons));
+      } else {
+        for (std::size_t i = 0; i < cons->size(); ++i)
+          if (auto con = constraint((*cons)[i], index_path(cp, i), point_ref, entity_ref))
+            def.constraints.push_back(*con);
+      }
+    }
+    def.solve.tolerance = c_.number_or(j, path, "tolerance", def.solve.tolerance, Range{0, 1e-3, true, false});
+    register_entities();
+    if (c_.problems.size() != before) return;
+    for (const auto& [ename, id] : entities) def.entities.emplace_back(name + "." + ename, id);
+    // keep the entities in document order (the map sorted them)
+    const Json& ents = j.at("entities");
+    std::vector<std::pair<std::string, sketch::EntityId>> ordered;
+    for (const auto& [ename, ev] : ents.items()) {
+      (void)ev;
+      ordered.emplace_back(name + "." + ename, entities.at(ename));
+    }
+    def.entities = std::move(ordered);
+    data.sketches.push_back(std::move(def));
+  }
+
+  template <class PointRef, class EntityRef>
+  std::optional<constraints::Constraint> constraint(const Json& j, const std::string& path,
+                                                    PointRef& point_ref, EntityRef& entity_ref) {
+    namespace cs = constraints;
+    if (!j.is_object()) {
+      c_.add(path, "expected a constraint {\"type\": ..., ...}, found " + found(j));
+      return std::nullopt;
+    }
+    const Json* t = c_.member(j, path, "type", true, "the constraint type, e.g. \"coincident\"");
+    if (!t) return std::nullopt;
+    const auto type = c_.choice(*t, key_path(path, "type"),
+                                {"fixed", "coincident", "point_on", "horizontal", "vertical", "parallel",
+                                 "perpendicular", "distance", "angle", "radius", "equal_length",
+                                 "equal_radius", "midpoint", "symmetric", "tangent", "curvature"});
+    if (!type) return std::nullopt;
+    auto point = [&](std::string_view key) -> std::optional<sketch::PointId> {
+      const Json* m = c_.member(j, path, key, true, "a point name");
+      return m ? point_ref(*m, key_path(path, key)) : std::nullopt;
+    };
+    auto entity = [&](std::string_view key) -> std::optional<sketch::EntityId> {
+      const Json* m = c_.member(j, path, key, true, "an entity name");
+      return m ? entity_ref(*m, key_path(path, key)) : std::nullopt;
+    };
+    auto pair_of = [&](std::string_view key, auto&& ref) {
+      using Id = typename std::invoke_result_t<decltype(ref), const Json&, const std::string&>::value_type;
+      std::optional<std::pair<Id, Id>> out;
+      const Json* m = c_.member(j, path, key, true, "two names [\"a\", \"b\"]");
+      if (!m) return out;
+      const std::string p = key_path(path, key);
+      if (!m->is_array() || m->size() != 2) {
+        c_.add(p, "expected two names [\"a\", \"b\"], found " + found(*m));
+        return out;
+      }
+      const auto a = ref((*m)[0], index_path(p, 0));
+      const auto b = ref((*m)[1], index_path(p, 1));
+      if (a && b) out = std::pair<Id, Id>{*a, *b};
+      return out;
+    };
+    auto value = [&](Range r) -> std::optional<double> {
+      const Json* m = c_.member(j, path, "value", true, "the value (mm or degrees)");
+      return m ? c_.number(*m, key_path(path, "value"), r) : std::nullopt;
+    };
+    auto end_ref = [&](const Json& v, const std::string& p) -> std::optional<cs::CurveEnd> {
+      if (!c_.object(v, p, {"entity", "end"}, "a curve end {\"entity\": e, \"end\": \"start\"|\"end\"}"))
+        return std::nullopt;
+      const Json* e = c_.member(v, p, "entity", true, "an entity name");
+      const Json* w = c_.member(v, p, "end", true, "\"start\" or \"end\"");
+      if (!e || !w) return std::nullopt;
+      const auto id = entity_ref(*e, key_path(p, "entity"));
+      const auto which = c_.choice(*w, key_path(p, "end"), {"start", "end"});
+      if (!id.has_value() || !which.has_value()) return std::nullopt;
+      cs::CurveEnd end;
+      end.curve = id.value();
+      end.at_start = which.value() == 0;
+      return end;
+    };
+    std::vector<std::string_view> allowed{"type"};
+    std::optional<cs::Constraint> out;
+    switch (*type) {
+      case 0: allowed.push_back("point"); if (auto p = point("point")) out = cs::fixed(*p); break;
+      case 1: allowed.push_back("points"); if (auto p = pair_of("points", point_ref)) out = cs::coincident(p->first, p->second); break;
+      case 2: allowed.insert(allowed.end(), {"point", "entity"}); { auto p = point("point"); auto e = entity("entity"); if (p && e) out = cs::point_on(*p, *e); } break;
+      case 3: allowed.push_back("entity"); if (auto e = entity("entity")) out = cs::horizontal(*e); break;
+      case 4: allowed.push_back("entity"); if (auto e = entity("entity")) out = cs::vertical(*e); break;
+      case 5: allowed.push_back("entities"); if (auto e = pair_of("entities", entity_ref)) out = cs::parallel(e->first, e->second); break;
+      case 6: allowed.push_back("entities"); if (auto e = pair_of("entities", entity_ref)) out = cs::perpendicular(e->first, e->second); break;
+      case 7: allowed.insert(allowed.end(), {"points", "value"}); { auto p = pair_of("points", point_ref); auto v = value(positive); if (p && v) out = cs::distance(p->first, p->second, *v); } break;
+      case 8: allowed.insert(allowed.end(), {"entities", "value"}); { auto e = pair_of("entities", entity_ref); auto v = value(Range{0, 180, true, false}); if (e && v) out = cs::angle(e->first, e->second, *v); } break;
+      case 9: allowed.insert(allowed.end(), {"entity", "value"}); { auto e = entity("entity"); auto v = value(positive); if (e && v) out = cs::radius(*e, *v); } break;
+      case 10: allowed.push_back("entities"); if (auto e = pair_of("entities", entity_ref)) out = cs::equal_length(e->first, e->second); break;
+      case 11: allowed.push_back("entities"); if (auto e = pair_of("entities", entity_ref)) out = cs::equal_radius(e->first, e->second); break;
+      case 12: allowed.insert(allowed.end(), {"point", "entity"}); { auto p = point("point"); auto e = entity("entity"); if (p && e) out = cs::midpoint(*p, *e); } break;
+      case 13: allowed.insert(allowed.end(), {"points", "entity"}); { auto p = pair_of("points", point_ref); auto e = entity("entity"); if (p && e) out = cs::symmetric(p->first, p->second, *e); } break;
+      default: {
+        allowed.push_back("ends");
+        if (auto e = pair_of("ends", end_ref)) out = *type == 14 ? cs::tangent(e->first, e->second) : cs::curvature(e->first, e->second);
+      }
+    }
+    for (const auto& [key, v] : j.items()) {
+      (void)v;
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
+        c_.add(key_path(path, key), "unknown key \"" + key + "\" for a " + t->get<std::string>() +
+                                        " constraint; its keys are: " +
+                                        join(std::vector<std::string>(allowed.begin(), allowed.end())));
+    }
+    return out;
+  }
+
+  // ---- surfaces ---------------------------------------------------------------------------
+
+  void surface(const std::string& name, const Json& j, const std::string& path) {
+    SurfaceDef def{name, path, "", surface::BSplineSurface{}};
+    const std::size_t before = c_.problems.size();
+    if (one_of(j, path, {"bspline", "fill", "skin", "sweep", "revolve", "superellipsoid", "supertoroid",
+                         "import", "deform"},
+               "a surface", def.kind)) {
+      const Json& v = j.at(def.kind);
+      const std::string p = key_path(path, def.kind);
+      if (def.kind == "bspline") {
+        if (auto s = inline_surface(v, p)) def.build = std::move(*s);
+      } else if (def.kind == "fill") {
+        FillDef f;
+        if (c_.object(v, p, {"curves", "style", "gap_tolerance"}, "a fill {curves, style, gap_tolerance}")) {
+          f.curves = curve_refs(v, p, "curves", 2, 4);
+          if (const Json* s = c_.member(v, p, "style", false, ""))
+            if (const auto k = c_.choice(*s, key_path(p, "style"), {"stretch", "coons", "curved"}))
+              f.options.style = static_cast<surface::FillStyle>(*k);
+          f.options.gap_tolerance = c_.number_or(v, p, "gap_tolerance", f.options.gap_tolerance, positive);
+          c_.attempt(p, [&] { f.options.validate(); });
+        }
+        def.build = std::move(f);
+      } else if (def.kind == "skin") {
+        SkinDef s;
+        if (c_.object(v, p, {"sections", "degree", "parametrization"}, "a skin {sections, degree, parametrization}")) {
+          s.sections = curve_refs(v, p, "sections", 2, 10000);
+          s.options.degree = c_.integer_or(v, p, "degree", s.options.degree, 1, surface::max_exchange_degree);
+          if (const Json* m = c_.member(v, p, "parametrization", false, ""))
+            if (const auto k = c_.choice(*m, key_path(p, "parametrization"), {"chord_length", "centripetal", "uniform"}))
+              s.options.parametrization = static_cast<surface::LoftParametrization>(*k);
+          c_.attempt(p, [&] { s.options.validate(); });
+        }
+        def.build = std::move(s);
+      } else if (def.kind == "sweep") {
+        SweepDef s;
+        if (c_.object(v, p, {"profile", "path", "twist_degrees", "tolerance"}, "a sweep {profile, path, twist_degrees, tolerance}")) {
+          if (const Json* m = c_.member(v, p, "profile", true, "a curve name"))
+            s.profile = curve_ref(*m, key_path(p, "profile")).value_or("");
+          if (const Json* m = c_.member(v, p, "path", true, "a curve name"))
+            s.path = curve_ref(*m, key_path(p, "path")).value_or("");
+          s.options.twist_degrees = c_.number_or(v, p, "twist_degrees", s.options.twist_degrees);
+          s.options.tolerance = c_.number_or(v, p, "tolerance", s.options.tolerance, positive);
+          c_.attempt(p, [&] { s.options.validate(); });
+        }
+        def.build = std::move(s);
+      } else if (def.kind == "revolve") {
+        RevolveDef r;
+        if (c_.object(v, p, {"profile", "axis", "angle"}, "a revolve {profile, axis, angle}")) {
+          if (const Json* m = c_.member(v, p, "profile", true, "a curve name"))
+            r.profile = curve_ref(*m, key_path(p, "profile")).value_or("");
+          if (const Json* a = c_.member(v, p, "axis", true, "{\"point\": [x, y, z], \"direction\": [x, y, z]}")) {
+            const std::string ap = key_path(p, "axis");
+            if (c_.object(*a, ap, {"point", "direction"}, "an axis {point, direction}")) {
+              if (const Json* m = c_.member(*a, ap, "point", true, "[x, y, z]"))
+                r.axis.point = c_.vec3(*m, key_path(ap, "point")).value_or(r.axis.point);
+              if (const Json* m = c_.member(*a, ap, "direction", true, "[x, y, z]"))
+                r.axis.direction = c_.vec3(*m, key_path(ap, "direction")).value_or(r.axis.direction);
+              if (r.axis.direction.norm() == 0.0)
+                c_.add(key_path(ap, "direction"), "the axis direction is zero; give a non-zero vector");
+            }
+          }
+          r.angle = c_.number_or(v, p, "angle", r.angle, Range{0, 360, true, false});
+        }
+        def.build = std::move(r);
+      } else if (def.kind == "superellipsoid" || def.kind == "supertoroid") {
+        const bool toroid = def.kind == "supertoroid";
+        std::initializer_list<std::string_view> keys_e{"radii", "e1", "e2", "tolerance", "degree"};
+        std::initializer_list<std::string_view> keys_t{"radii", "e1", "e2", "tolerance", "degree", "hole"};
+        if (c_.object(v, p, toroid ? keys_t : keys_e, toroid ? "a supertoroid" : "a superellipsoid")) {
+          surface::SuperquadricOptions o;
+          Eigen::Vector3d radii = Eigen::Vector3d::Ones();
+          if (const Json* m = c_.member(v, p, "radii", false, "")) {
+            radii = c_.vec3(*m, key_path(p, "radii")).value_or(radii);
+            if (!(radii.minCoeff() > 0)) c_.add(key_path(p, "radii"), "every radius must be > 0 (mm)");
+          }
+          const double e1 = c_.number_or(v, p, "e1", 1.0, Range{0, 10, true, false});
+          const double e2 = c_.number_or(v, p, "e2", 1.0, Range{0, 10, true, false});
+          o.tolerance = c_.number_or(v, p, "tolerance", o.tolerance, positive);
+          o.degree = c_.integer_or(v, p, "degree", o.degree, 2, 7);
+          if (toroid) {
+            SupertoroidDef d{{radii, 2.0, e1, e2}, o};
+            d.shape.hole = c_.number_or(v, p, "hole", 2.0, Range{1, inf, true, false});
+            def.build = d;
+          } else {
+            def.build = SuperellipsoidDef{{radii, e1, e2}, o};
+          }
+        }
+      } else if (def.kind == "import") {
+        ImportDef d;
+        if (c_.object(v, p, {"file", "index"}, "an import {file, index}")) {
+          if (const Json* f = c_.member(v, p, "file", true, "the path of a .step/.stp/.igs/.iges file"))
+            if (const auto s = c_.string(*f, key_path(p, "file"))) {
+              d.file = fs::path(*s).is_absolute() ? fs::path(*s) : base_ / *s;
+              std::string ext = d.file.extension().string();
+              for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+              if (ext != ".step" && ext != ".stp" && ext != ".igs" && ext != ".iges")
+                c_.add(key_path(p, "file"), "\"" + *s + "\" is not a STEP or IGES file; give a .step, .stp, .igs or .iges file");
+              else if (!fs::is_regular_file(d.file))
+                c_.add(key_path(p, "file"), "no file \"" + d.file.string() + "\" (paths are relative to the recipe's folder)");
+            }
+          d.index = c_.integer_or(v, p, "index", 0, 0, 1000000);
+        }
+        def.build = d;
+      } else {  // deform
+        DeformDef d;
+        d.composition = data.composition;
+        if (c_.object(v, p, {"surface", "deformation", "composition"}, "a deform {surface, deformation, composition}")) {
+          if (const Json* m = c_.member(v, p, "surface", true, "the name of an earlier surface"))
+            d.surface = surface_ref(*m, key_path(p, "surface")).value_or("");
+          if (const Json* m = c_.member(v, p, "deformation", true, "the name of a deformation stack"))
+            if (const auto s = c_.string(*m, key_path(p, "deformation"))) {
+              if (Names::has(names_.stacks, *s))
+                d.deformation = *s;
+              else
+                c_.add(key_path(p, "deformation"), "no deformation stack named \"" + *s + "\"; " + listing(names_.stacks));
+            }
+          if (const Json* m = c_.member(v, p, "composition", false, ""))
+            d.composition = composition(*m, key_path(p, "composition"), d.composition);
+        }
+        def.build = d;
+      }
+    }
+    names_.surfaces.push_back(name);
+    if (c_.problems.size() == before) data.surfaces.push_back(std::move(def));
+  }
+
+  std::optional<surface::BSplineSurface> inline_surface(const Json& j, const std::string& path) {
+    if (!c_.object(j, path, {"degrees", "knots_u", "knots_v", "points", "weights"},
+                   "a B-spline surface {degrees, knots_u, knots_v, points, weights}"))
+      return std::nullopt;
+    const Json* d = c_.member(j, path, "degrees", true, "[p, q]");
+    const Json* ku = c_.member(j, path, "knots_u", true, "the u knot vector");
+    const Json* kv = c_.member(j, path, "knots_v", true, "the v knot vector");
+    const Json* p = c_.member(j, path, "points", true, "count_u x count_v control points, (i, j) at row i * count_v + j");
+    std::optional<std::pair<int, int>> degrees;
+    if (d) {
+      if (!d->is_array() || d->size() != 2) {
+        c_.add(key_path(path, "degrees"), "expected [p, q], found " + found(*d));
+      } else {
+        const auto a = c_.integer((*d)[0], index_path(key_path(path, "degrees"), 0), 1, surface::max_kernel_degree);
+        const auto b = c_.integer((*d)[1], index_path(key_path(path, "degrees"), 1), 1, surface::max_kernel_degree);
+        if (a && b) degrees = std::pair{*a, *b};
+      }
+    }
+    const auto knots_u = ku ? c_.numbers(*ku, key_path(path, "knots_u"), 2) : std::nullopt;
+    const auto knots_v = kv ? c_.numbers(*kv, key_path(path, "knots_v"), 2) : std::nullopt;
+    const auto points = p ? c_.points(*p, key_path(path, "points"), 4) : std::nullopt;
+    std::optional<std::vector<double>> weights;
+    if (const Json* w = c_.member(j, path, "weights", false, ""))
+      if (!(weights = c_.numbers(*w, key_path(path, "weights"), 4))) return std::nullopt;
+    if (!degrees || !knots_u || !knots_v || !points) return std::nullopt;
+    surface::BSplineSurface s;
+    s.u = {degrees->first, *knots_u};
+    s.v = {degrees->second, *knots_v};
+    s.points = *points;
+    s.weights = weights ? Eigen::Map<const Eigen::VectorXd>(weights->data(), static_cast<Eigen::Index>(weights->size())).eval()
+                        : Eigen::VectorXd::Ones(points->rows()).eval();
+    const auto list = surface::problems(s, path);
+    if (!list.empty()) {
+      c_.add_all(path, list);
+      return std::nullopt;
+    }
+    return s;
+  }
+
+  // ---- deformations -----------------------------------------------------------------------
+
+  std::optional<deform::Frame> lattice_frame(const Json& j, const std::string& path) {
+    if (!c_.object(j, path, {"origin", "s", "t", "u"}, "a lattice frame {origin, s, t, u}")) return std::nullopt;
+    deform::Frame f;
+    bool ok = true;
+    for (auto [key, target] : {std::pair{"origin", &f.origin}, std::pair{"s", &f.s}, std::pair{"t", &f.t},
+                               std::pair{"u", &f.u}}) {
+      const Json* v = c_.member(j, path, key, true, "[x, y, z] (mm)");
+      const auto x = v ? c_.vec3(*v, key_path(path, key)) : std::nullopt;
+      ok = ok && x.has_value();
+      if (x) *target = *x;
+    }
+    if (!ok) return std::nullopt;
+    const auto list = deform::problems(f, path);
+    if (!list.empty()) {
+      c_.add_all(path, list);
+      return std::nullopt;
+    }
+    return f;
+  }
+
+  std::optional<std::array<int, 3>> triple(const Json& obj, const std::string& path, std::string_view key,
+                                           int lo, int hi, std::string_view hint) {
+    const Json* j = c_.member(obj, path, key, true, hint);
+    if (!j) return std::nullopt;
+    const std::string p = key_path(path, key);
+    if (!j->is_array() || j->size() != 3) {
+      c_.add(p, "expected 3 integers " + std::string(hint) + ", found " + found(*j));
+      return std::nullopt;
+    }
+    std::array<int, 3> out{};
+    bool ok = true;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto x = c_.integer((*j)[k], index_path(p, k), lo, hi);
+      ok = ok && x.has_value();
+      out[k] = x.value_or(0);
+    }
+    return ok ? std::optional(out) : std::nullopt;
+  }
+
+  /// Applies "moves" to `points` (rows found by `row_of`, which reports its own problems).
+  template <class RowOf>
+  bool apply_moves(const Json& moves, const std::string& path, Points3& points, RowOf&& row_of,
+                   const std::vector<std::string_view>& index_keys) {
+    if (!moves.is_array()) {
+      c_.add(path, "expected an array of {\"index\": ..., \"to\" or \"by\": [x, y, z]}, found " + found(moves));
+      return false;
+    }
+    bool ok = true;
+    std::vector<std::string_view> keys = index_keys;
+    keys.push_back("to");
+    keys.push_back("by");
+    for (std::size_t i = 0; i < moves.size(); ++i) {
+      const std::string p = index_path(path, i);
+      const Json& m = moves[i];
+      if (!m.is_object()) {
+        c_.add(p, "expected {\"index\": ..., \"to\" or \"by\": [x, y, z]}, found " + found(m));
+        ok = false;
+        continue;
+      }
+      for (const auto& [key, v] : m.items()) {
+        (void)v;
+        if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+          c_.add(key_path(p, key), "unknown key \"" + key + "\" in a move; the keys are: " +
+                                       join(std::vector<std::string>(keys.begin(), keys.end())));
+          ok = false;
+        }
+      }
+      const auto row = row_of(m, p);
+      const bool has_to = m.contains("to"), has_by = m.contains("by");
+      if (has_to == has_by) {
+        c_.add(p, "give exactly one of \"to\" (new position) and \"by\" (displacement)");
+        ok = false;
+        continue;
+      }
+      const auto v = c_.vec3(m.at(has_to ? "to" : "by"), key_path(p, has_to ? "to" : "by"));
+      if (!row || !v) {
+        ok = false;
+        continue;
+      }
+      if (has_to)
+        points.row(*row) = v->transpose();
+      else
+        points.row(*row) += v->transpose();
+    }
+    return ok;
+  }
+
+  /// An [i, j, k] index in counts, as a row of an s-major lattice.
+  std::optional<Eigen::Index> lattice_row(const Json& m, const std::string& p, std::array<int, 3> counts) {
+    const Json* idx = c_.member(m, p, "index", true, "[i, j, k]");
+    if (!idx) return std::nullopt;
+    const std::string ip = key_path(p, "index");
+    if (!idx->is_array() || idx->size() != 3) {
+      c_.add(ip, "expected [i, j, k], found " + found(*idx));
+      return std::nullopt;
+    }
+    Eigen::Index row = 0;
+    bool ok = true;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto x = c_.integer((*idx)[k], index_path(ip, k), 0, counts[k] - 1);
+      ok = ok && x.has_value();
+      row = row * counts[k] + x.value_or(0);
+    }
+    return ok ? std::optional(row) : std::nullopt;
+  }
+
+  /// A Bézier or B-spline lattice from recipe fields (points or moves).
+  std::optional<deform::Deformation> lattice(const Json& j, const std::string& path, bool bspline,
+                                             std::initializer_list<std::string_view> extra_keys) {
+    std::vector<std::string_view> keys{"kind", "name", "enabled", "frame", "degrees", "points", "moves"};
+    if (bspline) keys.insert(keys.end(), {"bases", "cells", "knots"});
+    keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
+    for (const auto& [key, v] : j.items()) {
+      (void)v;
+      if (std::find(keys.begin(), keys.end(), key) == keys.end())
+        c_.add(key_path(path, key), "unknown key \"" + key + "\" in a " +
+                                        std::string(bspline ? "bspline_lattice" : "bezier_lattice") +
+                                        " step; the keys are: " + join(std::vector<std::string>(keys.begin(), keys.end())));
+    }
+    const Json* fj = c_.member(j, path, "frame", true, "{\"origin\", \"s\", \"t\", \"u\"}");
+    const auto frame = fj ? lattice_frame(*fj, key_path(path, "frame")) : std::nullopt;
+    std::optional<deform::Deformation> out;
+    if (!bspline) {
+      const auto degrees = triple(j, path, "degrees", 1, surface::max_kernel_degree, "[l, m, n]");
+      if (!frame || !degrees) return std::nullopt;
+      deform::BezierLattice lat = deform::make_bezier_lattice(*frame, *degrees);
+      if (!lattice_points(j, path, lat.points, lat.counts())) return std::nullopt;
+      const auto list = deform::problems(lat, path);
+      if (!list.empty()) return c_.add_all(path, list), std::nullopt;
+      out = std::move(lat);
+    } else {
+      std::optional<deform::BSplineLattice> lat;
+      const bool has_bases = j.contains("bases");
+      if (has_bases == j.contains("cells")) {
+        c_.add(path, "give either \"bases\" (three {degree, knots}) or \"cells\" with \"degrees\" and \"knots\"");
+        return std::nullopt;
+      }
+      if (has_bases) {
+        const Json& b = j.at("bases");
+        const std::string bp = key_path(path, "bases");
+        if (!b.is_array() || b.size() != 3) {
+          c_.add(bp, "expected 3 bases [{degree, knots}, ...] along s, t, u, found " + found(b));
+          return std::nullopt;
+        }
+        std::array<surface::BSplineBasis, 3> bases;
+        bool ok = true;
+        for (std::size_t k = 0; k < 3; ++k) {
+          const std::string p = index_path(bp, k);
+          if (!c_.object(b[k], p, {"degree", "knots"}, "a basis {degree, knots}")) {
+            ok = false;
+            continue;
+          }
+          const Json* d = c_.member(b[k], p, "degree", true, "the degree");
+          const Json* kn = c_.member(b[k], p, "knots", true, "the knot vector on [0, 1]");
+          const auto degree = d ? c_.integer(*d, key_path(p, "degree"), 1, surface::max_kernel_degree) : std::nullopt;
+          const auto knots = kn ? c_.numbers(*kn, key_path(p, "knots"), 2) : std::nullopt;
+          ok = ok && degree && knots;
+          if (degree && knots) bases[k] = {*degree, *knots};
+        }
+        if (!ok || !frame) return std::nullopt;
+        if (!c_.attempt(bp, [&] { lat = deform::make_bspline_lattice(*frame, bases); })) return std::nullopt;
+      } else {
+        const auto cells = triple(j, path, "cells", 1, 1024, "[a, b, c]");
+        const auto degrees = triple(j, path, "degrees", 1, surface::max_kernel_degree, "[p, q, r]");
+        deform::LatticeKnots knots = deform::LatticeKnots::clamped;
+        if (const Json* k = c_.member(j, path, "knots", false, ""))
+          if (const auto c = c_.choice(*k, key_path(path, "knots"), {"clamped", "uniform"}))
+            knots = static_cast<deform::LatticeKnots>(*c);
+        if (!cells || !degrees || !frame) return std::nullopt;
+        if (!c_.attempt(path, [&] { lat = deform::make_bspline_lattice(*frame, *degrees, *cells, knots); }))
+          return std::nullopt;
+      }
+      if (!lattice_points(j, path, lat->points, lat->counts())) return std::nullopt;
+      const auto list = deform::problems(*lat, path);
+      if (!list.empty()) return c_.add_all(path, list), std::nullopt;
+      out = std::move(*lat);
+    }
+    return out;
+  }
+
+  /// "points" (all of them) or "moves" (from the undisplaced points already in `points`).
+  bool lattice_points(const Json& j, const std::string& path, Points3& points, std::array<int, 3> counts) {
+    const bool has_points = j.contains("points"), has_moves = j.contains("moves");
+    if (has_points && has_moves) {
+      c_.add(path, "give either \"points\" (every control point) or \"moves\" (by index), not both");
+      return false;
+    }
+    if (has_points) {
+      const auto p = c_.points(j.at("points"), key_path(path, "points"), 1);
+      if (!p) return false;
+      if (p->rows() != points.rows()) {
+        c_.add(key_path(path, "points"), "found " + std::to_string(p->rows()) + " control points, the lattice has " +
+                                             std::to_string(points.rows()) + " (" + std::to_string(counts[0]) + " x " +
+                                             std::to_string(counts[1]) + " x " + std::to_string(counts[2]) +
+                                             "); give all, s-major, or use \"moves\"");
+        return false;
+      }
+      points = *p;
+      return true;
+    }
+    if (!has_moves) return true;  // undisplaced (an identity step)
+    return apply_moves(j.at("moves"), key_path(path, "moves"), points,
+                       [&](const Json& m, const std::string& p) { return lattice_row(m, p, counts); },
+                       std::vector<std::string_view>{"index"});
+  }
+
+  std::optional<deform::Deformation> extended_from_generator(const Json& j, const std::string& path) {
+    for (const auto& [key, v] : j.items()) {
+      (void)v;
+      if (key != "kind" && key != "name" && key != "enabled" && key != "generator" && key != "moves")
+        c_.add(key_path(path, key), "unknown key \"" + key + "\" in an extended_lattice step with a generator; "
+                                        "the keys are: kind, name, enabled, generator, moves");
+    }
+    const std::string gp = key_path(path, "generator");
+    std::string kind;
+    if (!one_of(j.at("generator"), gp, {"cylinder", "prism"}, "a lattice generator", kind)) return std::nullopt;
+    const Json& g = j.at("generator").at(kind);
+    const std::string p = key_path(gp, kind);
+    deform::ExtendedLattice lat;
+    std::function<std::optional<Eigen::Index>(const Json&, const std::string&)> row_of;
+    std::vector<std::string_view> index_keys{"index"};
+    if (kind == "cylinder") {
+      if (!c_.object(g, p, {"origin", "axis", "reference", "radius", "inner_radius", "height", "sectors", "rings", "layers"},
+                     "a cylinder lattice {origin, axis, reference, radius, inner_radius, height, sectors, rings, layers}"))
+        return std::nullopt;
+      deform::CylinderSpec spec;
+      for (auto [key, target] : {std::pair{"origin", &spec.origin}, std::pair{"axis", &spec.axis},
+                                 std::pair{"reference", &spec.reference}})
+        if (const Json* m = c_.member(g, p, key, false, ""))
+          *target = c_.vec3(*m, key_path(p, key)).value_or(*target);
+      spec.radius = c_.number_or(g, p, "radius", spec.radius, positive);
+      spec.inner_radius = c_.number_or(g, p, "inner_radius", spec.inner_radius, non_negative);
+      spec.height = c_.number_or(g, p, "height", spec.height, positive);
+      spec.sectors = c_.integer_or(g, p, "sectors", spec.sectors, 3, 1024);
+      spec.rings = c_.integer_or(g, p, "rings", spec.rings, 1, 1024);
+      spec.layers = c_.integer_or(g, p, "layers", spec.layers, 1, 1024);
+      if (!c_.attempt(p, [&] { lat = deform::make_cylindrical_lattice(spec); })) return std::nullopt;
+      row_of = [this, spec](const Json& m, const std::string& mp) -> std::optional<Eigen::Index> {
+        const Json* idx = c_.member(m, mp, "index", true, "[radial, angular, axial]");
+        if (!idx) return std::nullopt;
+        const std::string ip = key_path(mp, "index");
+        if (!idx->is_array() || idx->size() != 3) {
+          c_.add(ip, "expected [radial, angular, axial], found " + found(*idx));
+          return std::nullopt;
+        }
+        const auto r = c_.integer((*idx)[0], index_path(ip, 0), 0, 3 * spec.rings);
+        const auto a = c_.integer((*idx)[1], index_path(ip, 1), -3 * 1024 * 1024, 3 * 1024 * 1024);
+        const auto h = c_.integer((*idx)[2], index_path(ip, 2), 0, 3 * spec.layers);
+        if (!r || !a || !h) return std::nullopt;
+        std::optional<Eigen::Index> row;
+        c_.attempt(ip, [&] { row = deform::cylindrical_index(spec, *r, *a, *h); });
+        return row;
+      };
+    } else {
+      if (!c_.object(g, p, {"origin", "x_axis", "y_axis", "extrusion", "sections", "layers"},
+                     "a prism lattice {origin, x_axis, y_axis, extrusion, sections, layers}"))
+        return std::nullopt;
+      deform::PrismSpec spec;
+      for (auto [key, target] : {std::pair{"origin", &spec.origin}, std::pair{"x_axis", &spec.x_axis},
+                                 std::pair{"y_axis", &spec.y_axis}, std::pair{"extrusion", &spec.extrusion}})
+        if (const Json* m = c_.member(g, p, key, false, ""))
+          *target = c_.vec3(*m, key_path(p, key)).value_or(*target);
+      spec.layers = c_.integer_or(g, p, "layers", spec.layers, 1, 1024);
+      const Json* s = c_.member(g, p, "sections", true, "two or more sections [[[a, b], ...], ...]");
+      if (!s) return std::nullopt;
+      const std::string sp = key_path(p, "sections");
+      if (!s->is_array() || s->size() < 2) {
+        c_.add(sp, "expected two or more sections (arrays of [a, b]), found " + found(*s));
+        return std::nullopt;
+      }
+      bool ok = true;
+      for (std::size_t a = 0; a < s->size(); ++a) {
+        const std::string ap = index_path(sp, a);
+        if (!(*s)[a].is_array()) {
+          c_.add(ap, "expected an array of [a, b] points, found " + found((*s)[a]));
+          ok = false;
+          continue;
+        }
+        std::vector<Eigen::Vector2d> section;
+        for (std::size_t b = 0; b < (*s)[a].size(); ++b) {
+          const auto v = c_.vec2((*s)[a][b], index_path(ap, b));
+          ok = ok && v.has_value();
+          if (v) section.push_back(*v);
+        }
+        spec.sections.push_back(std::move(section));
+      }
+      if (!ok || !c_.attempt(p, [&] { lat = deform::make_prismatic_lattice(spec); })) return std::nullopt;
+      const auto rows = lat.rest.rows();
+      row_of = [this, rows](const Json& m, const std::string& mp) -> std::optional<Eigen::Index> {
+        const Json* r = c_.member(m, mp, "row", true, "a control-point row");
+        if (!r) return std::nullopt;
+        const auto x = c_.integer(*r, key_path(mp, "row"), 0, static_cast<int>(rows) - 1);
+        return x ? std::optional<Eigen::Index>(*x) : std::nullopt;
+      };
+      index_keys = {std::string_view("row")};
+    }
+    if (const Json* m = c_.member(j, path, "moves", false, ""))
+      if (!apply_moves(*m, key_path(path, "moves"), lat.points, row_of, index_keys)) return std::nullopt;
+    const auto list = deform::problems(lat, path);
+    if (!list.empty()) return c_.add_all(path, list), std::nullopt;
+    return deform::Deformation(std::move(lat));
+  }
+
+  /// A stack-schema step read by deform::stack_from_json, its errors re-rooted at `path`.
+  std::optional<deform::Deformation> schema_step(const Json& j, const std::string& path) {
+    Json doc = Json::object();
+    doc["format"] = "clayform.deformation-stack";
+    doc["version"] = 1;
+    doc["steps"] = Json::array({j});
+    try {
+      auto stack = deform::stack_from_json(doc.dump());
+      return std::move(stack.steps.front().deformation);
+    } catch (const Error& e) {
+      std::string m = e.what();
+      for (std::string_view prefix : {"deformation stack JSON: "})
+        if (m.rfind(prefix, 0) == 0) m.erase(0, prefix.size());
+      // "steps[0].points[5]: ..." → "<path>.points[5]: ..."; "steps[0] (kind): ..." → "<path> (kind): ..."
+      std::string where = path, what = m;
+      if (m.rfind("steps[0]", 0) == 0) {
+        const auto colon = m.find(": ");
+        if (colon != std::string::npos) {
+          where = path + m.substr(8, colon - 8);
+          what = m.substr(colon + 2);
+        }
+      }
+      c_.add(where, what);
+      return std::nullopt;
+    }
+  }
+
+  void stack(const std::string& name, const Json& j, const std::string& path) {
+    StackDef def{name, path, {}};
+    if (!j.is_array()) {
+      c_.add(path, "expected an array of deformation steps, found " + found(j));
+      return;
+    }
+    const std::size_t before = c_.problems.size();
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      const std::string p = index_path(path, i);
+      const Json& s = j[i];
+      if (!s.is_object()) {
+        c_.add(p, "expected a step {\"kind\": ..., ...}, found " + found(s));
+        continue;
+      }
+      StepDef step{p, "", "", true, deform::Deformation{}};
+      const Json* k = c_.member(s, p, "kind", true, "the step's kind, e.g. \"bezier_lattice\"");
+      if (!k) continue;
+      const auto kind = c_.choice(*k, key_path(p, "kind"),
+                                  {"bezier_lattice", "bspline_lattice", "extended_lattice", "taper", "twist",
+                                   "bend", "style", "direct_manipulation"});
+      if (!kind) continue;
+      step.kind = k->get<std::string>();
+      if (const Json* n = c_.member(s, p, "name", false, "")) step.name = c_.string(*n, key_path(p, "name")).value_or("");
+      step.enabled = c_.boolean_or(s, p, "enabled", true);
+      bool ok = false;
+      if (*kind <= 1) {
+        if (auto d = lattice(s, p, *kind == 1, {})) step.step = std::move(*d), ok = true;
+      } else if (*kind == 2 && s.contains("generator")) {
+        if (auto d = extended_from_generator(s, p)) step.step = std::move(*d), ok = true;
+      } else if (*kind <= 5) {
+        if (auto d = schema_step(s, p)) step.step = std::move(*d), ok = true;
+      } else if (*kind == 6) {
+        if (auto d = style(s, p)) step.step = std::move(*d), ok = true;
+      } else {
+        if (auto d = direct(s, p)) step.step = std::move(*d), ok = true;
+      }
+      if (ok) def.steps.push_back(std::move(step));
+    }
+    if (c_.problems.size() == before) data.stacks.push_back(std::move(def));
+  }
+
+  std::optional<StyleDef> style(const Json& j, const std::string& p) {
+    if (!c_.object(j, p, {"kind", "name", "enabled", "target", "bound", "mode", "lambda", "relaxation", "smoothing",
+                          "key_points_per_row", "boundary_rows", "tolerance", "curve_tolerance"},
+                   "a style step"))
+      return std::nullopt;
+    StyleDef d;
+    const std::size_t before = c_.problems.size();
+    if (const Json* t = c_.member(j, p, "target", true, "the target curve's name"))
+      d.target = curve_ref(*t, key_path(p, "target")).value_or("");
+    if (const Json* b = c_.member(j, p, "bound", false, ""))
+      d.bound = curve_ref(*b, key_path(p, "bound")).value_or("");
+    auto& o = d.options;
+    if (const Json* m = c_.member(j, p, "mode", false, ""))
+      if (const auto k = c_.choice(*m, key_path(p, "mode"), {"paper", "exact"}))
+        o.mode = *k == 0 ? deform::StyleMode::paper : deform::StyleMode::exact;
+    o.lambda = c_.number_or(j, p, "lambda", o.lambda, Range{0, 1});
+    o.relaxation = c_.boolean_or(j, p, "relaxation", o.relaxation);
+    o.smoothing = c_.boolean_or(j, p, "smoothing", o.smoothing);
+    o.key_points_per_row = c_.integer_or(j, p, "key_points_per_row", o.key_points_per_row, 1, 64);
+    o.boundary_rows = c_.integer_or(j, p, "boundary_rows", o.boundary_rows, 0, 4);
+    o.tolerance = c_.number_or(j, p, "tolerance", o.tolerance, positive);
+    o.curve_tolerance = c_.number_or(j, p, "curve_tolerance", o.curve_tolerance, positive);
+    c_.attempt(p, [&] { o.validate(); });
+    if (c_.problems.size() != before) return std::nullopt;
+    return d;
+  }
+
+  std::optional<DirectDef> direct(const Json& j, const std::string& p) {
+    if (!c_.object(j, p, {"kind", "name", "enabled", "lattice", "moves", "locked", "tied", "tolerance"},
+                   "a direct_manipulation step"))
+      return std::nullopt;
+    const std::size_t before = c_.problems.size();
+    DirectDef d{deform::BezierLattice{}, {}, {}};
+    const Json* lj = c_.member(j, p, "lattice", true, "a bezier_lattice or bspline_lattice object with \"kind\"");
+    std::array<int, 3> counts{0, 0, 0};
+    if (lj) {
+      const std::string lp = key_path(p, "lattice");
+      const Json* k = lj->is_object() ? c_.member(*lj, lp, "kind", true, "\"bezier_lattice\" or \"bspline_lattice\"") : nullptr;
+      if (!lj->is_object()) c_.add(lp, "expected a lattice object, found " + found(*lj));
+      const auto kind = k ? c_.choice(*k, key_path(lp, "kind"), {"bezier_lattice", "bspline_lattice"}) : std::nullopt;
+      if (kind) {
+        if (auto lat = lattice(*lj, lp, *kind == 1, {})) {
+          if (auto* b = std::get_if<deform::BezierLattice>(&*lat)) {
+            counts = b->counts();
+            d.lattice = *b;
+          } else {
+            const auto& s = std::get<deform::BSplineLattice>(*lat);
+            counts = s.counts();
+            d.lattice = s;
+          }
+        }
+      }
+    }
+    const Json* mj = c_.member(j, p, "moves", true, "[{\"point\": [x,y,z] | \"surface_point\": [u, v], \"to\": [x,y,z]}]");
+    if (mj) {
+      const std::string mp = key_path(p, "moves");
+      if (!mj->is_array() || mj->empty()) {
+        c_.add(mp, "expected a non-empty array of moves, found " + found(*mj));
+      } else {
+        for (std::size_t i = 0; i < mj->size(); ++i) {
+          const std::string ip = index_path(mp, i);
+          const Json& m = (*mj)[i];
+          if (!c_.object(m, ip, {"point", "surface_point", "to"}, "a move {point | surface_point, to}")) continue;
+          DirectMove move;
+          const bool has_point = m.contains("point"), has_uv = m.contains("surface_point");
+          if (has_point == has_uv) {
+            c_.add(ip, "give exactly one of \"point\" ([x, y, z]) and \"surface_point\" ([u, v])");
+            continue;
+          }
+          if (has_point) {
+            if (const auto v = c_.vec3(m.at("point"), key_path(ip, "point"))) move.point = *v;
+          } else if (const auto uv = c_.vec2(m.at("surface_point"), key_path(ip, "surface_point"))) {
+            move.on_surface = true;
+            move.point = Eigen::Vector3d((*uv)[0], (*uv)[1], 0.0);
+          }
+          if (const Json* t = c_.member(m, ip, "to", true, "the target [x, y, z]"))
+            if (const auto v = c_.vec3(*t, key_path(ip, "to"))) move.to = *v;
+          d.moves.push_back(move);
+        }
+      }
+    }
+    const Eigen::Index rows = static_cast<Eigen::Index>(counts[0]) * counts[1] * counts[2];
+    auto index_row = [&](const Json& v, const std::string& ip) -> std::optional<Eigen::Index> {
+      if (!v.is_array() || v.size() != 3) {
+        c_.add(ip, "expected [i, j, k], found " + found(v));
+        return std::nullopt;
+      }
+      Eigen::Index row = 0;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const auto x = c_.integer(v[k], index_path(ip, k), 0, std::max(counts[k] - 1, 0));
+        if (!x) return std::nullopt;
+        row = row * counts[k] + *x;
+      }
+      return row;
+    };
+    if (const Json* lk = c_.member(j, p, "locked", false, "")) {
+      const std::string lp = key_path(p, "locked");
+      if (!lk->is_array()) {
+        c_.add(lp, "expected an array of [i, j, k], found " + found(*lk));
+      } else if (rows > 0) {
+        d.options.locked.assign(static_cast<std::size_t>(rows), false);
+        for (std::size_t i = 0; i < lk->size(); ++i)
+          if (const auto r = index_row((*lk)[i], index_path(lp, i))) d.options.locked[static_cast<std::size_t>(*r)] = true;
+      }
+    }
+    if (const Json* tj = c_.member(j, p, "tied", false, "")) {
+      const std::string tp = key_path(p, "tied");
+      if (!tj->is_array()) {
+        c_.add(tp, "expected an array of groups [[i, j, k], ...], found " + found(*tj));
+      } else {
+        for (std::size_t g = 0; g < tj->size(); ++g) {
+          const std::string gp = index_path(tp, g);
+          if (!(*tj)[g].is_array() || (*tj)[g].size() < 2) {
+            c_.add(gp, "expected a group of at least 2 indices [i, j, k], found " + found((*tj)[g]));
+            continue;
+          }
+          std::vector<Eigen::Index> group;
+          for (std::size_t i = 0; i < (*tj)[g].size(); ++i)
+            if (const auto r = index_row((*tj)[g][i], index_path(gp, i))) group.push_back(*r);
+          d.options.tied.push_back(std::move(group));
+        }
+      }
+    }
+    d.options.tolerance = c_.number_or(j, p, "tolerance", d.options.tolerance, positive);
+    c_.attempt(p, [&] { d.options.validate(); });
+    if (c_.problems.size() != before) return std::nullopt;
+    return d;
+  }
+
+  // ---- exports ----------------------------------------------------------------------------
+
+  void exporting(const std::string& name, const Json& j, const std::string& path) {
+    if (!c_.object(j, path, {"surfaces", "formats", "schema"}, "an export {surfaces, formats, schema}")) return;
+    const std::size_t before = c_.problems.size();
+    ExportDef def{name, path, {}, {"step", "iges", "glb"}, "AP214"};
+    if (const Json* s = c_.member(j, path, "surfaces", true, "an array of surface names")) {
+      const std::string sp = key_path(path, "surfaces");
+      if (!s->is_array() || s->empty()) {
+        c_.add(sp, "expected a non-empty array of surface names, found " + found(*s));
+      } else {
+        for (std::size_t i = 0; i < s->size(); ++i)
+          if (const auto n = surface_ref((*s)[i], index_path(sp, i))) def.surfaces.push_back(*n);
+      }
+    }
+    if (const Json* f = c_.member(j, path, "formats", false, "")) {
+      const std::string fp = key_path(path, "formats");
+      def.formats.clear();
+      if (!f->is_array() || f->empty()) {
+        c_.add(fp, "expected a non-empty array of \"step\", \"iges\", \"glb\", found " + found(*f));
+      } else {
+        for (std::size_t i = 0; i < f->size(); ++i)
+          if (const auto k = c_.choice((*f)[i], index_path(fp, i), {"step", "iges", "glb"})) {
+            const std::string fmt = (*f)[i].get<std::string>();
+            if (std::find(def.formats.begin(), def.formats.end(), fmt) != def.formats.end())
+              c_.add(index_path(fp, i), "\"" + fmt + "\" is listed twice; list each format once");
+            else
+              def.formats.push_back(fmt);
+          }
+      }
+    }
+    if (const Json* s = c_.member(j, path, "schema", false, ""))
+      if (const auto k = c_.choice(*s, key_path(path, "schema"), {"AP214", "AP242"})) def.schema = *k == 0 ? "AP214" : "AP242";
+    if (c_.problems.size() == before) data.exports.push_back(std::move(def));
+  }
+};
+
+// ---- syntax: line and column, duplicate keys ----------------------------------------------------
+
+std::pair<int, int> line_column(std::string_view text, std::size_t byte) {
+  // nlohmann's byte is the 1-based position of the last character read: the end of the token
+  // that broke the syntax. Report where that token starts (the start of "name" in a missing-comma
+  // error), which is where the eye looks.
+  std::size_t end = std::min(byte > 0 ? byte - 1 : 0, text.size());
+  if (end < text.size() && text[end] == '"' && end > 0) {
+    std::size_t k = end;
+    while (k > 0 && !(text[k - 1] == '"' && (k < 2 || text[k - 2] != '\\'))) --k;
+    if (k > 0) end = k - 1;
+  } else {
+    auto literal = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+'; };
+    while (end > 0 && end <= text.size() && literal(text[end]) && literal(text[end - 1])) --end;
+  }
+  int line = 1;
+  std::size_t line_start = 0;
+  for (std::size_t i = 0; i < end; ++i)
+    if (text[i] == '\n') ++line, line_start = i + 1;
+  return {line, static_cast<int>(end - line_start) + 1};
+}
+
+/// Parses with a callback that reports keys repeated in one object (nlohmann would keep the last
+/// silently: a second curve of the same name would replace the first).
+Json parse_reporting_duplicates(std::string_view text, Checker& c) {
+  struct Level {
+    bool array = false;
+    long index = -1;
+    std::string key;
+    std::set<std::string> keys;
+  };
+  std::vector<Level> levels;
+  auto path = [&] {
+    std::string p;
+    for (std::size_t i = 0; i + 1 < levels.size(); ++i)
+      p = levels[i].array ? index_path(p, static_cast<std::size_t>(levels[i].index)) : key_path(p, levels[i].key);
+    return p;
+  };
+  auto element = [&] {
+    if (!levels.empty() && levels.back().array) ++levels.back().index;
+  };
+  Json::parser_callback_t cb = [&](int, Json::parse_event_t event, Json& parsed) {
+    switch (event) {
+      case Json::parse_event_t::object_start: element(); levels.push_back({false, -1, "", {}}); break;
+      case Json::parse_event_t::array_start: element(); levels.push_back({true, -1, "", {}}); break;
+      case Json::parse_event_t::object_end:
+      case Json::parse_event_t::array_end:
+        if (!levels.empty()) levels.pop_back();
+        break;
+      case Json::parse_event_t::key: {
+        auto& top = levels.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second) {
+          levels.push_back({});  // so path() includes top's key
+          c.add(path(), "the key \"" + top.key + "\" appears twice in this object; only the last would "
+                        "count: remove or rename one");
+          levels.pop_back();
+        }
+        break;
+      }
+      case Json::parse_event_t::value: element(); break;
+    }
+    return true;
+  };
+  return Json::parse(text.begin(), text.end(), cb);
+}
+
+}  // namespace
+
+CheckOutcome check(std::string_view text, const fs::path& base_dir) {
+  Checker c;
+  CheckOutcome out;
+  Json root;
+  try {
+    root = parse_reporting_duplicates(text, c);
+  } catch (const Json::parse_error& e) {
+    const auto [line, column] = line_column(text, e.byte);
+    std::string what = e.what();
+    // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error while
+    // parsing object - unexpected ..." → keep the part after the position.
+    if (const auto k = what.find(": syntax error"); k != std::string::npos) what = what.substr(k + 2);
+    else if (const auto k2 = what.find("] "); k2 != std::string::npos) what = what.substr(k2 + 2);
+    out.problems.push_back({"(syntax)", what + "; fix the JSON syntax (NaN and Infinity are not JSON numbers)",
+                            line, column});
+    return out;
+  } catch (const Json::exception& e) {  // a number beyond the range of a double
+    std::string what = e.what();
+    if (const auto k = what.find("] "); k != std::string::npos) what = what.substr(k + 2);
+    out.problems.push_back({"(syntax)", what + "; give finite numbers within the range of a double", 0, 0});
+    return out;
+  }
+  RecipeChecker rc(c, base_dir);
+  rc.run(root);
+  out.data = std::move(rc.data);
+  out.problems = std::move(c.problems);
+  return out;
+}
+
+std::string to_string(const Problem& problem) {
+  std::string s;
+  if (problem.line > 0) s = "line " + std::to_string(problem.line) + ", column " + std::to_string(problem.column) + ": ";
+  if (problem.path != "(syntax)") s += problem.path + ": ";
+  return s + problem.message;
+}
+
+std::vector<Problem> check_recipe(std::string_view text, const fs::path& base_dir) {
+  return check(text, base_dir).problems;
+}
+
+Recipe parse_recipe(std::string_view text, const fs::path& base_dir) {
+  CheckOutcome out = check(text, base_dir);
+  if (!out.problems.empty()) {
+    std::string m = "the recipe has " + std::to_string(out.problems.size()) + " problem" +
+                    (out.problems.size() == 1 ? "" : "s") + ":";
+    for (const auto& p : out.problems) m += "\n  " + to_string(p);
+    throw Error(ErrorCategory::Recipe, m);
+  }
+  return Recipe{std::make_shared<const RecipeData>(std::move(out.data))};
+}
+
+Recipe load_recipe(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(ErrorCategory::Io, "cannot read the recipe \"" + file.string() + "\"; check the path");
+  std::ostringstream text;
+  text << in.rdbuf();
+  CheckOutcome out = check(text.str(), file.parent_path());
+  if (!out.problems.empty()) {
+    std::string m = file.string() + ": the recipe has " + std::to_string(out.problems.size()) + " problem" +
+                    (out.problems.size() == 1 ? "" : "s") + ":";
+    for (const auto& p : out.problems) m += "\n  " + to_string(p);
+    throw Error(ErrorCategory::Recipe, m);
+  }
+  if (out.data.name.empty()) out.data.name = file.stem().string();
+  return Recipe{std::make_shared<const RecipeData>(std::move(out.data))};
+}
+
+const std::string& Recipe::name() const {
+  static const std::string empty;
+  return data ? data->name : empty;
+}
+
+std::vector<std::string> Recipe::deformation_names() const {
+  std::vector<std::string> out;
+  if (data)
+    for (const auto& s : data->stacks) out.push_back(s.name);
+  return out;
+}
+
+}  // namespace clay::recipe

@@ -1,0 +1,124 @@
+#pragma once
+// The checked recipe (internal): what recipe_check.cpp builds from the JSON and recipe_run.cpp
+// executes. Every inline object is already a validated value; references are names known to
+// exist and to be defined earlier.
+#include <clay/constraints/constraint.hpp>
+#include <clay/constraints/solve.hpp>
+#include <clay/deform/direct_manipulation.hpp>
+#include <clay/deform/stack.hpp>
+#include <clay/deform/style.hpp>
+#include <clay/recipe.hpp>
+#include <clay/sketch/fit.hpp>
+#include <clay/sketch/stroke.hpp>
+#include <clay/surface/fill.hpp>
+#include <clay/surface/primitives.hpp>
+#include <clay/surface/revolve.hpp>
+#include <clay/surface/skin.hpp>
+
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace clay::recipe {
+
+/// The composition mode of deform surfaces.
+struct Composition {
+  bool refit = false;      ///< "refit": steps that cannot be exact are refitted
+  double tolerance = 1e-4;
+  bool relative = true;
+  int degree = 3;
+  int check_samples = 4;
+};
+
+struct StrokeDef {
+  std::string name, path;
+  sketch::Stroke stroke;
+  sketch::FitOptions fit;
+};
+
+/// A curve given inline (already built) or the reverse of another named curve.
+struct CurveDef {
+  std::string name, path, kind;  // kind: bspline, line, arc, polyline, reversed
+  std::optional<surface::BSplineCurve> curve;
+  std::string reversed_of;
+};
+
+struct SketchDef {
+  std::string name, path;
+  sketch::Sketch sketch;
+  std::vector<constraints::Constraint> constraints;
+  constraints::SolveOptions solve;
+  std::vector<std::pair<std::string, sketch::EntityId>> entities;  // curve name "SKETCH.E"
+};
+
+struct FillDef { std::vector<std::string> curves; surface::FillOptions options; };
+struct SkinDef { std::vector<std::string> sections; surface::LoftOptions options; };
+struct SweepDef { std::string profile, path; surface::SweepOptions options; };
+struct RevolveDef { std::string profile; surface::Axis axis; double angle = 360; };
+struct SuperellipsoidDef { surface::Superellipsoid shape; surface::SuperquadricOptions options; };
+struct SupertoroidDef { surface::Supertoroid shape; surface::SuperquadricOptions options; };
+struct ImportDef { std::filesystem::path file; int index = 0; };
+struct DeformDef { std::string surface, deformation; Composition composition; };
+
+struct SurfaceDef {
+  std::string name, path, kind;
+  std::variant<surface::BSplineSurface, FillDef, SkinDef, SweepDef, RevolveDef, SuperellipsoidDef,
+               SupertoroidDef, ImportDef, DeformDef>
+      build;
+};
+
+struct StyleDef {
+  std::string target, bound;  // bound empty: the target's support band (§5)
+  deform::StyleOptions options;
+};
+
+struct DirectMove {
+  bool on_surface = false;     // point holds (u, v, 0) on the deformed step's input surface
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d to = Eigen::Vector3d::Zero();
+};
+
+struct DirectDef {
+  std::variant<deform::BezierLattice, deform::BSplineLattice> lattice;
+  std::vector<DirectMove> moves;
+  deform::DirectManipulationOptions options;
+};
+
+struct StepDef {
+  std::string path, name, kind;
+  bool enabled = true;
+  std::variant<deform::Deformation, StyleDef, DirectDef> step;
+};
+
+struct StackDef {
+  std::string name, path;
+  std::vector<StepDef> steps;
+};
+
+struct ExportDef {
+  std::string name, path;
+  std::vector<std::string> surfaces;
+  std::vector<std::string> formats;
+  std::string schema = "AP214";
+};
+
+struct RecipeData {
+  std::string name, description;
+  Composition composition;
+  std::vector<StrokeDef> strokes;
+  std::vector<CurveDef> curves;
+  std::vector<SketchDef> sketches;
+  std::vector<SurfaceDef> surfaces;
+  std::vector<StackDef> stacks;
+  std::vector<ExportDef> exports;
+};
+
+/// The checked model, or problems (then the model is incomplete and must not be run).
+struct CheckOutcome {
+  RecipeData data;
+  std::vector<Problem> problems;
+};
+CheckOutcome check(std::string_view text, const std::filesystem::path& base_dir);
+
+}  // namespace clay::recipe

@@ -1,0 +1,463 @@
+// Running a checked recipe in memory: every step in order, each timed and reported with the
+// quality figures of DESIGN.md; a failing step is rethrown with its path first.
+#include "recipe_model.hpp"
+
+#include <clay/constraints/solve.hpp>
+#include <clay/deform/jacobian.hpp>
+#include <clay/deform/surface_deformation.hpp>
+#include <clay/error.hpp>
+#include <clay/sketch/entities.hpp>
+#include <clay/surface/evaluate.hpp>
+#include <clay/surface/exchange.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <map>
+
+namespace clay::recipe {
+
+namespace {
+
+namespace fs = std::filesystem;
+using surface::BSplineCurve;
+using surface::BSplineSurface;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::string format(const char* fmt, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, x);
+  return buf;
+}
+
+/// The run's state: named results so far, and the reports.
+class Runner {
+ public:
+  Runner(const RecipeData& d, const RunOptions& o, RunResult& r) : data_(d), options_(o), result_(r) {}
+
+  /// Strokes, curves and sketches: every named curve.
+  void curves() {
+    for (const auto& s : data_.strokes) timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); });
+    for (const auto& c : data_.curves) timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); });
+    for (const auto& s : data_.sketches) timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); });
+  }
+  /// Every named surface, in document order.
+  void surfaces() {
+    for (const auto& s : data_.surfaces) build_surface(s);
+  }
+
+  void exports() {
+    for (const auto& e : data_.exports)
+      timed(e.path, "export", [&](StepReport& rep) {
+        ExportResult x;
+        x.name = e.name;
+        x.surface_names = e.surfaces;
+        x.formats = e.formats;
+        x.schema = e.schema;
+        long points = 0;
+        int degree = 0;
+        for (const auto& n : e.surfaces) {
+          x.surfaces.push_back(surface_of(n));
+          points += x.surfaces.back().points.rows();
+          degree = std::max({degree, x.surfaces.back().u.degree, x.surfaces.back().v.degree});
+        }
+        if (degree > surface::max_exchange_degree &&
+            std::any_of(e.formats.begin(), e.formats.end(), [](const auto& f) { return f != "glb"; }))
+          throw Error(ErrorCategory::DegreeLimit,
+                      "degree " + std::to_string(degree) + " is above the exchange limit " +
+                          std::to_string(surface::max_exchange_degree) +
+                          " of STEP/IGES; lower the lattice degrees or compose with \"mode\": \"refit\"");
+        rep.figures = {{"patches", static_cast<long long>(x.surfaces.size())},
+                       {"control_points", static_cast<long long>(points)},
+                       {"degree", static_cast<long long>(degree)}};
+        rep.message = std::to_string(x.surfaces.size()) + " surface(s) for " + e.name;
+        result_.exports.push_back(std::move(x));
+      });
+  }
+
+  /// One named surface deformed by a stack (the deform command and `deform` surfaces).
+  BSplineSurface deform(const BSplineSurface& parent, const StackDef& stack, const Composition& c,
+                        const std::string& path) {
+    BSplineSurface s = parent;
+    for (std::size_t i = 0; i < stack.steps.size(); ++i) {
+      const StepDef& step = stack.steps[i];
+      const std::string p = path + ".steps[" + std::to_string(i) + "]";
+      timed(p, step.kind, [&](StepReport& rep) {
+        rep.message = step.path + (step.name.empty() ? "" : " '" + step.name + "'");
+        if (!step.enabled) {
+          rep.message += ": disabled, skipped";
+          return;
+        }
+        s = std::visit([&](const auto& d) { return apply(d, s, c, rep); }, step.step);
+      });
+    }
+    return s;
+  }
+
+  const BSplineSurface& surface_of(const std::string& name) const {
+    for (const auto& [n, s] : result_.surfaces)
+      if (n == name) return s;
+    throw Error(ErrorCategory::Internal, "recipe run: surface '" + name + "' missing after checking");
+  }
+  const BSplineCurve& curve_of(const std::string& name) const {
+    const auto it = curve_index_.find(name);
+    if (it == curve_index_.end())
+      throw Error(ErrorCategory::Internal, "recipe run: curve '" + name + "' missing after checking");
+    return result_.curves[it->second].second;
+  }
+
+ private:
+  const RecipeData& data_;
+  const RunOptions& options_;
+  RunResult& result_;
+  std::map<std::string, std::size_t> curve_index_;
+
+  template <class F>
+  void timed(const std::string& path, const std::string& kind, F&& f) {
+    StepReport rep;
+    rep.path = path;
+    rep.kind = kind;
+    const auto t0 = Clock::now();
+    try {
+      f(rep);
+    } catch (const Error& e) {
+      throw Error(e.category(), path + " (" + kind + "): " + e.what());
+    }
+    rep.seconds = seconds_since(t0);
+    if (options_.progress) options_.progress(rep);
+    result_.steps.push_back(std::move(rep));
+  }
+
+  void add_curve(const std::string& name, BSplineCurve c) {
+    curve_index_[name] = result_.curves.size();
+    result_.curves.emplace_back(name, std::move(c));
+  }
+
+  void stroke(const StrokeDef& s, StepReport& rep) {
+    const sketch::StrokeFit fit = sketch::fit_stroke(s.stroke, s.fit);
+    if (fit.curves.size() != 1)
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "the stroke was fitted with " + std::to_string(fit.curves.size()) +
+                      " curves; a recipe stroke must give one curve: draw it as separate strokes");
+    const auto& c = fit.curves.front();
+    rep.figures = {{"control_points", static_cast<long long>(c.control_points)},
+                   {"max_deviation", c.max_deviation},
+                   {"rms_deviation", c.rms_deviation},
+                   {"closed", c.closed}};
+    rep.warning = !fit.summary.converged();
+    rep.message = fit.summary.brief();
+    add_curve(s.name, c.curve);
+  }
+
+  void curve(const CurveDef& c, StepReport& rep) {
+    BSplineCurve out = c.curve ? *c.curve : surface::reversed(curve_of(c.reversed_of));
+    rep.figures = {{"degree", static_cast<long long>(out.basis.degree)},
+                   {"control_points", static_cast<long long>(out.points.rows())},
+                   {"rational", out.is_rational()}};
+    add_curve(c.name, std::move(out));
+  }
+
+  void sketch(const SketchDef& s, StepReport& rep) {
+    const auto solved = constraints::solve(s.sketch, s.constraints, s.solve);
+    const auto& r = solved.report;
+    if (!r.summary.converged()) {
+      std::string m = "the sketch does not solve (" + r.summary.brief() + ")";
+      for (const auto& d : r.conflicting) m += "; " + d.message;
+      throw Error(ErrorCategory::InvalidGeometry, m + "; remove or change a conflicting constraint");
+    }
+    rep.figures = {{"max_residual", r.max_residual},
+                   {"degrees_of_freedom", static_cast<long long>(r.degrees_of_freedom)},
+                   {"redundant_sets", static_cast<long long>(r.redundant.size())},
+                   {"constraints", static_cast<long long>(s.constraints.size())}};
+    rep.message = r.summary.brief();
+    for (const auto& [name, id] : s.entities) add_curve(name, sketch::curve_of(solved.sketch, id));
+  }
+
+  std::vector<BSplineCurve> curves_named(const std::vector<std::string>& names) const {
+    std::vector<BSplineCurve> out;
+    for (const auto& n : names) out.push_back(curve_of(n));
+    return out;
+  }
+
+  static void build_figures(const surface::BuildReport& b, StepReport& rep) {
+    rep.figures = {{"degree_u", static_cast<long long>(b.degree_u)},
+                   {"degree_v", static_cast<long long>(b.degree_v)},
+                   {"control_points", static_cast<long long>(b.count_u) * b.count_v},
+                   {"rational", b.rational},
+                   {"exact", b.exact},
+                   {"max_deviation", b.max_deviation}};
+    rep.message = b.brief();
+  }
+
+  void build_surface(const SurfaceDef& def) {
+    if (const auto* d = std::get_if<DeformDef>(&def.build)) {
+      const StackDef& stack = *std::find_if(data_.stacks.begin(), data_.stacks.end(),
+                                            [&](const StackDef& s) { return s.name == d->deformation; });
+      BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path);
+      result_.surfaces.emplace_back(def.name, std::move(s));
+      return;
+    }
+    timed(def.path, def.kind, [&](StepReport& rep) {
+      BSplineSurface s = std::visit(
+          [&](const auto& b) -> BSplineSurface {
+            using T = std::decay_t<decltype(b)>;
+            if constexpr (std::is_same_v<T, BSplineSurface>) {
+              build_figures(surface::describe(b, "inline B-spline surface"), rep);
+              return b;
+            } else if constexpr (std::is_same_v<T, FillDef>) {
+              auto built = surface::fill(curves_named(b.curves), b.options);
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, SkinDef>) {
+              auto built = surface::loft(curves_named(b.sections), b.options);
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, SweepDef>) {
+              auto built = surface::sweep(curve_of(b.profile), curve_of(b.path), b.options);
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, RevolveDef>) {
+              auto built = surface::revolve(curve_of(b.profile), b.axis, b.angle);
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, SuperellipsoidDef>) {
+              auto built = surface::superellipsoid(b.shape, b.options);
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, SupertoroidDef>) {
+              auto built = surface::supertoroid(b.shape, b.options);
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, ImportDef>) {
+              std::string ext = b.file.extension().string();
+              for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+              auto all = (ext == ".igs" || ext == ".iges") ? surface::read_iges(b.file) : surface::read_step(b.file);
+              if (b.index >= static_cast<int>(all.size()))
+                throw Error(ErrorCategory::InvalidArgument,
+                            "index " + std::to_string(b.index) + " but \"" + b.file.string() + "\" holds " +
+                                std::to_string(all.size()) + " surface(s); give an index below " +
+                                std::to_string(all.size()));
+              build_figures(surface::describe(all[static_cast<std::size_t>(b.index)], "import"), rep);
+              return std::move(all[static_cast<std::size_t>(b.index)]);
+            } else {
+              throw Error(ErrorCategory::Internal, "recipe run: deform handled above");
+            }
+          },
+          def.build);
+      result_.surfaces.emplace_back(def.name, std::move(s));
+    });
+  }
+
+  // ---- deformation steps --------------------------------------------------------------------
+
+  static deform::SurfaceDeformationOptions deformation_options(const Composition& c) {
+    deform::SurfaceDeformationOptions o;
+    o.compose.check_samples = c.check_samples;
+    if (c.refit) {
+      deform::RefitOptions r;
+      r.degree = c.degree;
+      r.tolerance = c.tolerance;
+      r.relative = c.relative;
+      o.refit = r;
+    }
+    return o;
+  }
+
+  static void lattice_figures(const deform::Deformation& d, StepReport& rep) {
+    std::optional<deform::JacobianBounds> j;
+    if (const auto* b = std::get_if<deform::BezierLattice>(&d)) j = deform::jacobian_bounds(*b);
+    if (const auto* b = std::get_if<deform::BSplineLattice>(&d)) j = deform::jacobian_bounds(*b);
+    if (!j) return;
+    rep.figures.emplace_back("fold_free", j->fold_free);
+    rep.figures.emplace_back("volume_ratio_min", j->min);
+    rep.figures.emplace_back("volume_ratio_max", j->max);
+    if (!j->fold_free) {
+      rep.warning = true;
+      rep.message += "; the lattice may fold (Jacobian coefficient " + format("%.3g", j->min) + " <= 0)";
+    }
+  }
+
+  static BSplineSurface compose(const deform::Deformation& d, const BSplineSurface& s, const Composition& c,
+                                StepReport& rep) {
+    const auto r = deform::deform_surface(d, s, deformation_options(c));
+    const auto& o = r.report.steps.front();
+    rep.figures.emplace_back("degree_u", static_cast<long long>(r.surface.u.degree));
+    rep.figures.emplace_back("degree_v", static_cast<long long>(r.surface.v.degree));
+    rep.figures.emplace_back("control_points", static_cast<long long>(r.surface.points.rows()));
+    if (o.method == deform::StepOutcome::Method::exact) {
+      rep.figures.emplace_back("composition", std::string("exact"));
+      rep.figures.emplace_back("exact", true);
+      rep.figures.emplace_back("patches", static_cast<long long>(o.compose.patches));
+      rep.figures.emplace_back("max_deviation", o.compose.max_deviation);  // relative to size
+      rep.figures.emplace_back("max_deviation_mm", o.compose.max_deviation * o.compose.size);
+      rep.figures.emplace_back("size", o.compose.size);
+      rep.message += ": exact, " + o.compose.brief();
+    } else {
+      const auto& f = o.refit;
+      rep.figures.emplace_back("composition", std::string("refit"));
+      rep.figures.emplace_back("exact", false);
+      rep.figures.emplace_back("certified", f.certified);
+      rep.figures.emplace_back("tolerance_mm", f.tolerance);
+      rep.figures.emplace_back("max_deviation_mm", f.certified ? f.certified_bound : f.sampled_max);
+      rep.figures.emplace_back("max_deviation", (f.certified ? f.certified_bound : f.sampled_max) / f.size);
+      rep.figures.emplace_back("sampled_max_mm", f.sampled_max);
+      rep.figures.emplace_back("size", f.size);
+      rep.message += ": refit (" + o.reason + "), " + f.brief();
+      if (!f.summary.converged()) rep.warning = true;
+    }
+    return r.surface;
+  }
+
+  BSplineSurface apply(const deform::Deformation& d, const BSplineSurface& s, const Composition& c,
+                       StepReport& rep) {
+    BSplineSurface out = compose(d, s, c, rep);
+    lattice_figures(d, rep);
+    return out;
+  }
+
+  BSplineSurface apply(const StyleDef& d, const BSplineSurface& s, const Composition&, StepReport& rep) {
+    const auto r = d.bound.empty() ? deform::style_deform(s, curve_of(d.target), d.options)
+                                   : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
+    const auto& x = r.report;
+    rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::exact ? "exact" : "paper")},
+                   {"constraint_class", std::string(deform::to_string(x.constraint_class))},
+                   {"key_points", static_cast<long long>(x.m)},
+                   {"influenced_vertices", static_cast<long long>(x.influenced_vertices)},
+                   {"moved_vertices", static_cast<long long>(x.moved_vertices)},
+                   {"max_displacement", x.max_displacement},
+                   {"target_deviation", x.target_deviation},
+                   {"target_curve_deviation", x.target_curve_deviation},
+                   {"locality", x.locality},
+                   {"boundary_position_jump", x.boundary_position_jump},
+                   {"boundary_tangent_angle", x.boundary_tangent_angle},
+                   {"knots_inserted", static_cast<long long>(x.knots_inserted)},
+                   {"added_key_points", static_cast<long long>(x.added_key_points)},
+                   {"degree_u", static_cast<long long>(r.surface.u.degree)},
+                   {"degree_v", static_cast<long long>(r.surface.v.degree)},
+                   {"control_points", static_cast<long long>(r.surface.points.rows())},
+                   {"exact", true}};
+    rep.message += ": " + x.message;
+    return r.surface;
+  }
+
+  BSplineSurface apply(const DirectDef& d, const BSplineSurface& s, const Composition& c, StepReport& rep) {
+    std::vector<deform::PointMove> moves;
+    for (const auto& m : d.moves) {
+      Eigen::Vector3d x = m.point;
+      if (m.on_surface) {
+        const auto [u0, u1] = s.u.domain();
+        const auto [v0, v1] = s.v.domain();
+        if (m.point.x() < u0 || m.point.x() > u1 || m.point.y() < v0 || m.point.y() > v1)
+          throw Error(ErrorCategory::OutOfDomain,
+                      "surface_point (" + format("%.17g", m.point.x()) + ", " + format("%.17g", m.point.y()) +
+                          ") is outside the surface's domain [" + format("%g", u0) + ", " + format("%g", u1) +
+                          "] x [" + format("%g", v0) + ", " + format("%g", v1) + "]; give parameters inside it");
+        x = surface::evaluate(s, m.point.x(), m.point.y());
+      }
+      moves.push_back({x, m.to});
+    }
+    deform::Deformation lattice;
+    deform::DirectManipulationReport r;
+    std::visit(
+        [&](const auto& lat) {
+          auto solved = deform::manipulate(lat, moves, d.options);
+          r = solved.report;
+          lattice = std::move(solved.lattice);
+        },
+        d.lattice);
+    rep.figures = {{"requested", static_cast<long long>(r.requested)},
+                   {"rank", static_cast<long long>(r.rank)},
+                   {"feasible", r.feasible},
+                   {"residual", r.residual},
+                   {"achieved_max_error", r.achieved_max_error},
+                   {"displacement_norm", r.displacement_norm}};
+    if (!r.feasible) rep.warning = true;
+    rep.message += ": " + r.message;
+    BSplineSurface out = compose(lattice, s, c, rep);
+    lattice_figures(lattice, rep);
+    return out;
+  }
+};
+
+}  // namespace
+
+const BSplineSurface& RunResult::surface(std::string_view name) const {
+  std::string known;
+  for (const auto& [n, s] : surfaces) {
+    if (n == name) return s;
+    known += (known.empty() ? "" : ", ") + n;
+  }
+  throw Error(ErrorCategory::InvalidArgument,
+              "no surface named '" + std::string(name) + "' in the run; its surfaces: " + known);
+}
+
+const BSplineCurve& RunResult::curve(std::string_view name) const {
+  std::string known;
+  for (const auto& [n, c] : curves) {
+    if (n == name) return c;
+    known += (known.empty() ? "" : ", ") + n;
+  }
+  throw Error(ErrorCategory::InvalidArgument,
+              "no curve named '" + std::string(name) + "' in the run; its curves: " + known);
+}
+
+RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
+  if (!recipe.data) throw Error(ErrorCategory::InvalidArgument, "run_recipe: empty recipe; load or parse one first");
+  const auto t0 = Clock::now();
+  RunResult result;
+  result.recipe = recipe.data->name;
+  Runner runner(*recipe.data, options, result);
+  runner.curves();
+  runner.surfaces();
+  runner.exports();
+  result.seconds = seconds_since(t0);
+  return result;
+}
+
+RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface>& surfaces,
+                          std::string_view stem, std::string_view deformation, const RunOptions& options) {
+  if (!recipe.data) throw Error(ErrorCategory::InvalidArgument, "deform_surfaces: empty recipe; load or parse one first");
+  const RecipeData& d = *recipe.data;
+  std::string names;
+  for (const auto& s : d.stacks) names += (names.empty() ? "" : ", ") + s.name;
+  const StackDef* stack = nullptr;
+  if (deformation.empty()) {
+    if (d.stacks.size() != 1)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "the recipe has " + std::to_string(d.stacks.size()) + " deformation stacks (" + names +
+                      "); name one with --deformation");
+    stack = &d.stacks.front();
+  } else {
+    for (const auto& s : d.stacks)
+      if (s.name == deformation) stack = &s;
+    if (!stack)
+      throw Error(ErrorCategory::InvalidArgument, "the recipe has no deformation stack '" + std::string(deformation) +
+                                                      "'; its stacks: " + names);
+  }
+  if (surfaces.empty()) throw Error(ErrorCategory::InvalidArgument, "deform_surfaces: no surfaces given");
+  const auto t0 = Clock::now();
+  RunResult result;
+  result.recipe = d.name;
+  Runner runner(d, options, result);
+  runner.curves();  // the curves its style steps use
+  ExportResult x;
+  x.name = std::string(stem);
+  x.formats = d.exports.empty() ? std::vector<std::string>{"step", "iges", "glb"} : d.exports.front().formats;
+  x.schema = d.exports.empty() ? "AP214" : d.exports.front().schema;
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    const std::string name = std::string(stem) + "-" + std::to_string(k);
+    BSplineSurface s = runner.deform(surfaces[k], *stack, d.composition, "input[" + std::to_string(k) + "]");
+    result.surfaces.emplace_back(name, s);
+    x.surface_names.push_back(name);
+    x.surfaces.push_back(std::move(s));
+  }
+  result.exports.push_back(std::move(x));
+  result.seconds = seconds_since(t0);
+  return result;
+}
+
+}  // namespace clay::recipe

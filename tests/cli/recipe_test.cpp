@@ -1,0 +1,502 @@
+// Recipes (issue #8): the format is read exactly (inline data round-trips bit for bit), every
+// problem is reported at once with its path, and a run's results are checked against independent
+// computations — the deformation applied pointwise to the parent surface (deform_point of a
+// lattice built here from the same numbers), closed forms, the exchange read-back.
+#include <catch2/catch.hpp>
+
+#include <clay/deform/extended_lattice.hpp>
+#include <clay/deform/lattice.hpp>
+#include <clay/deform/regular.hpp>
+#include <clay/recipe.hpp>
+#include <clay/surface/arc.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
+#include <clay/surface/exchange.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include "error_of.hpp"
+
+using namespace clay::recipe;
+using clay::ErrorCategory;
+using clay::test::error_of;
+using Catch::Matchers::Contains;
+namespace surface = clay::surface;
+namespace deform = clay::deform;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string num(double x) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
+std::string points_json(const surface::Points3& p) {
+  std::string s = "[";
+  for (Eigen::Index i = 0; i < p.rows(); ++i)
+    s += std::string(i ? "," : "") + "[" + num(p(i, 0)) + "," + num(p(i, 1)) + "," + num(p(i, 2)) + "]";
+  return s + "]";
+}
+
+std::string numbers_json(const std::vector<double>& v) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? "," : "") + num(v[i]);
+  return s + "]";
+}
+
+/// A bicubic dome, 100 x 100 mm, with uneven knots and full-precision coordinates.
+surface::BSplineSurface dome() {
+  surface::BSplineBasis b{3, {0, 0, 0, 0, 0.3, 0.55, 1, 1, 1, 1}};
+  const auto xi = surface::greville_abscissae(b);
+  surface::Points3 p(36, 3);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) {
+      const double x = 100 * xi[static_cast<size_t>(i)], y = 100 * xi[static_cast<size_t>(j)];
+      p.row(i * 6 + j) << x, y, 20 * std::sin(0.031 * x) * std::sin(0.029 * y) + 1.0 / 3.0;
+    }
+  return surface::make_surface(b, b, p);
+}
+
+std::string surface_json(const surface::BSplineSurface& s) {
+  std::vector<double> w(s.weights.data(), s.weights.data() + s.weights.size());
+  return "{\"bspline\": {\"degrees\": [" + std::to_string(s.u.degree) + ", " + std::to_string(s.v.degree) +
+         "], \"knots_u\": " + numbers_json(s.u.knots) + ", \"knots_v\": " + numbers_json(s.v.knots) +
+         ", \"points\": " + points_json(s.points) + ", \"weights\": " + numbers_json(w) + "}}";
+}
+
+/// A recipe with the dome and the given extra sections (JSON members, comma-separated).
+std::string recipe_with(const std::string& surfaces_extra, const std::string& rest) {
+  return R"({"format": "clayform.recipe", "version": 1, "name": "test",
+    "surfaces": {"dome": )" + surface_json(dome()) + surfaces_extra + "}" + (rest.empty() ? "" : ", " + rest) + "}";
+}
+
+const char* lattice_step = R"({"kind": "bezier_lattice", "name": "bulge",
+   "frame": {"origin": [-10, -10, -20], "s": [120, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
+   "degrees": [2, 2, 1],
+   "moves": [{"index": [1, 1, 1], "by": [3, -2, 15]}, {"index": [2, 0, 0], "to": [111, -9, -21]}]})";
+
+/// The same lattice, built here from the numbers above.
+deform::BezierLattice bulge() {
+  deform::Frame f;
+  f.origin = {-10, -10, -20};
+  f.s = {120, 0, 0};
+  f.t = {0, 120, 0};
+  f.u = {0, 0, 60};
+  auto l = deform::make_bezier_lattice(f, {2, 2, 1});
+  l.points.row(l.index(1, 1, 1)) += Eigen::RowVector3d(3, -2, 15);
+  l.points.row(l.index(2, 0, 0)) = Eigen::RowVector3d(111, -9, -21);
+  return l;
+}
+
+/// Largest |result(u, v) - expected(u, v)| over random parameters of the unit square.
+template <class F>
+double max_gap(const surface::BSplineSurface& result, F&& expected, int samples = 300) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> d(0.0, 1.0);
+  double worst = 0;
+  for (int k = 0; k < samples; ++k) {
+    const double u = d(rng), v = d(rng);
+    worst = std::max(worst, (surface::evaluate(result, u, v) - expected(u, v)).norm());
+  }
+  return worst;
+}
+
+bool mentions(const std::vector<Problem>& problems, const std::string& path, const std::string& words) {
+  for (const auto& p : problems)
+    if (p.path == path && p.message.find(words) != std::string::npos) return true;
+  return false;
+}
+
+std::string dump(const std::vector<Problem>& problems) {
+  std::string s;
+  for (const auto& p : problems) s += to_string(p) + "\n";
+  return s;
+}
+
+fs::path output_dir(const std::string& name) {
+  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("an inline surface is read bit for bit", "[recipe]") {
+  const auto result = run_recipe(parse_recipe(recipe_with("", "")));
+  CHECK(surface::identical(result.surface("dome"), dome()));
+  CHECK(result.steps.size() == 1);
+  CHECK(result.steps[0].path == "surfaces.dome");
+}
+
+TEST_CASE("a Bezier lattice step with moves equals the lattice applied pointwise, exactly", "[recipe]") {
+  const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                                       std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
+  const auto result = run_recipe(parse_recipe(text));
+  const auto parent = dome();
+  const auto lattice = bulge();
+  const double gap = max_gap(result.surface("bulged"), [&](double u, double v) {
+    return deform::deform_point(lattice, surface::evaluate(parent, u, v));
+  });
+  const auto [lo, hi] = surface::control_box(result.surface("bulged"));
+  CHECK(gap <= 1e-12 * (hi - lo).norm());
+  const StepReport& step = result.steps.back();
+  CHECK(step.path == "surfaces.bulged.steps[0]");
+  CHECK(step.kind == "bezier_lattice");
+  bool exact = false, fold_free = false;
+  for (const auto& [name, value] : step.figures) {
+    if (name == "composition") exact = std::get<std::string>(value) == "exact";
+    if (name == "fold_free") fold_free = std::get<bool>(value);
+  }
+  CHECK(exact);
+  CHECK(fold_free);
+}
+
+TEST_CASE("a twist needs the refit mode, and the refit is within its tolerance", "[recipe]") {
+  const std::string twist = R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.01]})";
+  const std::string exact = recipe_with(R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin"}})",
+                                        R"("deformations": {"spin": [)" + twist + "]}");
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(exact)); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("surfaces.spun.steps[0] (twist)"));
+
+  const std::string refit = recipe_with(
+      R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 0.01, "relative": false}}})",
+      R"("deformations": {"spin": [)" + twist + "]}");
+  const auto result = run_recipe(parse_recipe(refit));
+  deform::Twist t;
+  t.frame.origin = {50, 50, 0};
+  t.angle = {0, 0.01};
+  const auto parent = dome();
+  const double gap = max_gap(result.surface("spun"), [&](double u, double v) {
+    return deform::deform_point(t, surface::evaluate(parent, u, v));
+  });
+  CHECK(gap <= 0.01);
+  CHECK(gap > 0);  // a twist is no polynomial in the dome's parameters: the fit is not exact
+}
+
+TEST_CASE("curves: line, polyline, arc and reversed match their closed forms", "[recipe]") {
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "curves": {
+      "l": {"line": {"from": [1, 2, 3], "to": [4, 6, 3]}},
+      "p": {"polyline": {"points": [[0, 0, 0], [10, 0, 0], [10, 5, 0]]}},
+      "a": {"arc": {"center": [1, 1, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0], "radius": 7, "start": 30, "end": 300}},
+      "r": {"reversed": "a"}
+    }})";
+  const auto result = run_recipe(parse_recipe(text));
+  CHECK((surface::evaluate(result.curve("l"), 0.25) - Eigen::Vector3d(1.75, 3, 3)).norm() < 1e-15);
+  CHECK((surface::evaluate(result.curve("p"), 0.5) - Eigen::Vector3d(10, 0, 0)).norm() < 1e-15);
+  for (double t : {0.0, 0.13, 0.5, 0.77, 1.0}) {
+    const Eigen::Vector3d x = surface::evaluate(result.curve("a"), t);
+    CHECK_THAT((x - Eigen::Vector3d(1, 1, 0)).norm(), Catch::Matchers::WithinAbs(7.0, 1e-12));
+    CHECK((surface::evaluate(result.curve("r"), 1.0 - t) - x).norm() < 1e-12);
+  }
+  const double pi = std::acos(-1.0);
+  CHECK((surface::evaluate(result.curve("a"), 0.0) - Eigen::Vector3d(1 + 7 * std::cos(pi / 6), 1 + 7 * std::sin(pi / 6), 0)).norm() < 1e-12);
+}
+
+TEST_CASE("a stroke is fitted within its tolerance", "[recipe]") {
+  std::string pts = "[";
+  for (int i = 0; i <= 60; ++i) {
+    const double t = i / 60.0;
+    pts += std::string(i ? "," : "") + "[" + num(100 * t) + "," + num(20 * std::sin(3 * t)) + ",0]";
+  }
+  pts += "]";
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "strokes": {"s": {"points": )" + pts + R"(, "tolerance": 0.05}}})";
+  const auto result = run_recipe(parse_recipe(text));
+  const auto& c = result.curve("s");
+  // every stroke point is within the tolerance of the curve (dense sampling of the curve)
+  double worst = 0;
+  for (int i = 0; i <= 60; ++i) {
+    const double t = i / 60.0;
+    const Eigen::Vector3d q(100 * t, 20 * std::sin(3 * t), 0);
+    double best = 1e300;
+    for (int k = 0; k <= 4000; ++k) best = std::min(best, (surface::evaluate(c, k / 4000.0) - q).norm());
+    worst = std::max(worst, best);
+  }
+  CHECK(worst <= 0.05 + 1e-3);  // + the sampling's chord error
+}
+
+TEST_CASE("a constrained sketch is solved and its entities become curves", "[recipe]") {
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "sketches": {"slot": {
+      "plane": {"origin": [0, 0, 10], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {"a": [0, 0], "b": [9, 1], "c": [9.5, 6]},
+      "entities": {"base": {"line": ["a", "b"]}, "side": {"line": ["b", "c"]}},
+      "constraints": [
+        {"type": "fixed", "point": "a"},
+        {"type": "horizontal", "entity": "base"},
+        {"type": "perpendicular", "entities": ["base", "side"]},
+        {"type": "distance", "points": ["a", "b"], "value": 12},
+        {"type": "distance", "points": ["b", "c"], "value": 5}
+      ]}},
+    "surfaces": {}})";
+  const auto result = run_recipe(parse_recipe(text));
+  const auto& base = result.curve("slot.base");
+  const auto& side = result.curve("slot.side");
+  CHECK((surface::evaluate(base, 1.0) - Eigen::Vector3d(12, 0, 10)).norm() < 1e-8);
+  CHECK((surface::evaluate(side, 1.0) - Eigen::Vector3d(12, 5, 10)).norm() < 1e-8);
+}
+
+TEST_CASE("a revolve of a line is a cylinder and a fill meets its curves", "[recipe]") {
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "curves": {
+      "profile": {"line": {"from": [30, 0, 0], "to": [30, 0, 80]}},
+      "a": {"line": {"from": [0, 0, 0], "to": [100, 0, 0]}},
+      "b": {"bspline": {"degree": 2, "knots": [0, 0, 0, 1, 1, 1], "points": [[100, 0, 0], [110, 50, 10], [100, 100, 0]]}},
+      "c": {"line": {"from": [100, 100, 0], "to": [0, 100, 0]}},
+      "d": {"line": {"from": [0, 100, 0], "to": [0, 0, 0]}}
+    },
+    "surfaces": {
+      "can": {"revolve": {"profile": "profile", "axis": {"point": [0, 0, 0], "direction": [0, 0, 1]}, "angle": 270}},
+      "patch": {"fill": {"curves": ["a", "b", "c", "d"], "style": "curved"}}
+    }})";
+  const auto result = run_recipe(parse_recipe(text));
+  const auto& can = result.surface("can");
+  CHECK(can.is_rational());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> d(0.0, 1.0);
+  for (int k = 0; k < 50; ++k) {
+    const Eigen::Vector3d x = surface::evaluate(can, d(rng), d(rng));
+    CHECK_THAT(std::hypot(x.x(), x.y()), Catch::Matchers::WithinAbs(30.0, 1e-12));
+  }
+  // the fill passes through the midpoint of its curved edge b
+  const auto& patch = result.surface("patch");
+  const Eigen::Vector3d mid = surface::evaluate(result.curve("b"), 0.5);
+  double best = 1e300;
+  for (int i = 0; i <= 200; ++i)
+    for (double e : {0.0, 1.0}) {
+      best = std::min(best, (surface::evaluate(patch, e, i / 200.0) - mid).norm());
+      best = std::min(best, (surface::evaluate(patch, i / 200.0, e) - mid).norm());
+    }
+  CHECK(best < 1e-9);
+}
+
+TEST_CASE("direct manipulation moves the surface points exactly onto their targets", "[recipe]") {
+  const auto parent = dome();
+  const Eigen::Vector3d p = surface::evaluate(parent, 0.4, 0.6);
+  const std::string step = R"({"kind": "direct_manipulation",
+     "lattice": {"kind": "bspline_lattice",
+       "frame": {"origin": [-10, -10, -30], "s": [120, 0, 0], "t": [0, 120, 0], "u": [0, 0, 80]},
+       "cells": [3, 3, 1], "degrees": [3, 3, 1]},
+     "moves": [{"surface_point": [0.4, 0.6], "to": [)" +
+                           num(p.x()) + "," + num(p.y()) + "," + num(p.z() + 12) + R"(]},
+               {"surface_point": [0.7, 0.2], "to": [70, 20, 5]}]})";
+  const std::string text = recipe_with(R"(, "pulled": {"deform": {"surface": "dome", "deformation": "pull"}})",
+                                       R"("deformations": {"pull": [)" + step + "]}");
+  const auto result = run_recipe(parse_recipe(text));
+  const auto& s = result.surface("pulled");
+  CHECK((surface::evaluate(s, 0.4, 0.6) - (p + Eigen::Vector3d(0, 0, 12))).norm() < 1e-10);
+  CHECK((surface::evaluate(s, 0.7, 0.2) - Eigen::Vector3d(70, 20, 5)).norm() < 1e-10);
+}
+
+TEST_CASE("a style step leaves every control vertex outside the bound untouched", "[recipe]") {
+  const std::string text = recipe_with(
+      R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
+      R"("curves": {
+           "bound": {"arc": {"center": [50, 50, 25], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0], "radius": 30, "start": 0, "end": 360}},
+           "target": {"line": {"from": [35, 50, 30], "to": [65, 50, 30]}}},
+         "deformations": {"crease": [{"kind": "style", "bound": "bound", "target": "target", "mode": "paper"}]})");
+  const auto result = run_recipe(parse_recipe(text));
+  const auto parent = dome();
+  const auto& styled = result.surface("styled");
+  REQUIRE(styled.points.rows() == parent.points.rows());
+  int moved = 0, outside_moved = 0;
+  for (Eigen::Index r = 0; r < parent.points.rows(); ++r) {
+    const bool changed = styled.points.row(r) != parent.points.row(r);
+    moved += changed;
+    // a vertex whose xy lies outside the bound's circle (with a margin for the projection)
+    const double d = std::hypot(parent.points(r, 0) - 50, parent.points(r, 1) - 50);
+    if (d > 31 && changed) ++outside_moved;
+  }
+  CHECK(moved > 0);
+  CHECK(outside_moved == 0);
+}
+
+TEST_CASE("a replay gives bit-identical surfaces", "[recipe]") {
+  const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                                       std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
+  const auto a = run_recipe(parse_recipe(text));
+  const auto b = run_recipe(parse_recipe(text));
+  CHECK(surface::identical(a.surface("bulged"), b.surface("bulged")));
+}
+
+TEST_CASE("deform_surfaces applies a recipe's stack to other surfaces, as the recipe does", "[recipe]") {
+  const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                                       std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
+  const Recipe recipe = parse_recipe(text);
+  const auto own = run_recipe(recipe);
+  const auto other = deform_surfaces(recipe, {dome(), dome()}, "part");
+  REQUIRE(other.surfaces.size() == 2);
+  CHECK(other.surfaces[1].first == "part-1");
+  CHECK(surface::identical(other.surfaces[0].second, own.surface("bulged")));
+  REQUIRE(other.exports.size() == 1);
+  CHECK(other.exports[0].surfaces.size() == 2);
+  const auto [category, message] = error_of([&] { deform_surfaces(recipe, {dome()}, "x", "nope"); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("shape"));
+}
+
+TEST_CASE("outputs are written whole, read back identical, and a failure leaves nothing", "[recipe]") {
+  const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                                       std::string(R"("deformations": {"shape": [)") + lattice_step +
+                                           R"(]}, "exports": {"part": {"surfaces": ["bulged", "dome"]}})");
+  auto result = run_recipe(parse_recipe(text));
+  const fs::path out = output_dir("write");
+  const auto files = write_outputs(result, out);
+  CHECK(files.size() == 4);
+  const auto back = surface::read_step(out / "part.step");
+  REQUIRE(back.size() == 2);
+  CHECK(surface::identical(back[0], result.surface("bulged")));
+  CHECK(surface::identical(back[1], dome()));
+  CHECK(surface::identical(surface::read_iges(out / "part.igs")[0], result.surface("bulged")));
+  CHECK(fs::file_size(out / "part.glb") > 1000);
+  std::ifstream in(out / "report.json");
+  std::stringstream report;
+  report << in.rdbuf();
+  CHECK_THAT(report.str(), Contains("\"path\": \"surfaces.bulged.steps[0]\""));
+  CHECK_THAT(report.str(), Contains("\"valid\": true"));
+  CHECK_THAT(report.str(), Contains("\"read_back_identical\": true"));
+
+  // an output folder under a regular file cannot be made: Io, and no temporary folder is left
+  const fs::path blocker = output_dir("blocker");
+  fs::create_directories(blocker.parent_path());
+  std::ofstream(blocker) << "x";
+  const auto [category, message] = error_of([&] { write_outputs(result, blocker / "out"); });
+  CHECK(category == ErrorCategory::Io);
+  int entries = 0;
+  for (const auto& e : fs::directory_iterator(blocker.parent_path()))
+    entries += e.path().filename().string().find(".clayform-") != std::string::npos;
+  CHECK(entries == 0);
+}
+
+TEST_CASE("an imported STEP surface is read bit for bit", "[recipe]") {
+  const fs::path dir = output_dir("import");
+  fs::create_directories(dir);
+  surface::write_step({dome()}, dir / "dome.step");
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "surfaces": {"d": {"import": {"file": "dome.step"}}}})";
+  const auto result = run_recipe(parse_recipe(text, dir));
+  CHECK(surface::identical(result.surface("d"), dome()));
+  const auto problems = check_recipe(text, dir / "elsewhere");
+  CHECK(mentions(problems, "surfaces.d.import.file", "no file"));
+}
+
+TEST_CASE("check_recipe reports every problem at once, each with its path", "[recipe]") {
+  const std::string text = R"({"format": "clayform.recipe", "version": 2, "units": "inch", "colour": 1,
+    "curves": {
+      "a": {"line": {"from": [0, 0, 0], "to": [1, 0]}},
+      "b": {"reversed": "zzz"},
+      "bad name": {"line": {"from": [0, 0, 0], "to": [1, 0, 0]}},
+      "k": {"bspline": {"degree": 3, "knots": [0, 0, 0, 1, 1, 1], "points": [[0, 0, 0], [1, 0, 0], [2, 1, 0], [3, 0, 0]]}}
+    },
+    "surfaces": {
+      "s": {"fill": {"curvs": ["a"]}},
+      "t": {"deform": {"surface": "u", "deformation": "none"}},
+      "u": {"skin": {"sections": ["a", "b"], "degree": "three"}}
+    },
+    "deformations": {"d": [{"kind": "bezier_lattice", "frame": {"origin": [0, 0, 0], "s": [1, 0, 0], "t": [0, 1, 0], "u": [0, 0, 1]},
+                            "degrees": [1, 1, 1], "moves": [{"index": [2, 0, 0], "by": [0, 0, 1]}]},
+                           {"kind": "wobble"}]},
+    "composition": {"mode": "approximate"},
+    "exports": {"e": {"surfaces": ["nope"], "formats": ["stl"]}}
+  })";
+  const auto problems = check_recipe(text);
+  INFO(dump(problems));
+  CHECK(mentions(problems, "version", "not supported"));
+  CHECK(mentions(problems, "units", "millimetres"));
+  CHECK(mentions(problems, "colour", "unknown key"));
+  CHECK(mentions(problems, "curves.a.line.to", "expected [x, y, z]"));
+  CHECK(mentions(problems, "curves.b.reversed", "no curve named \"zzz\""));
+  CHECK(mentions(problems, "curves.bad name", "not allowed"));
+  CHECK(mentions(problems, "curves.k.bspline", "knot"));
+  CHECK(mentions(problems, "surfaces.s.fill.curvs", "unknown key"));
+  CHECK(mentions(problems, "surfaces.s.fill.curves", "missing"));
+  CHECK(mentions(problems, "surfaces.t.deform.surface", "defined later"));
+  CHECK(mentions(problems, "surfaces.t.deform.deformation", "no deformation stack named \"none\""));
+  CHECK(mentions(problems, "surfaces.u.skin.degree", "expected an integer"));
+  CHECK(mentions(problems, "deformations.d[0].moves[0].index[0]", "expected an integer in [0, 1]"));
+  CHECK(mentions(problems, "deformations.d[1].kind", "expected one of"));
+  CHECK(mentions(problems, "composition.mode", "exact, refit"));
+  CHECK(mentions(problems, "exports.e.surfaces[0]", "no surface named \"nope\""));
+  CHECK(mentions(problems, "exports.e.formats[0]", "step, iges, glb"));
+  CHECK(problems.size() >= 17);
+  const auto [category, message] = error_of([&] { parse_recipe(text); });
+  CHECK(category == ErrorCategory::Recipe);
+  CHECK_THAT(message, Contains("problems:"));
+}
+
+TEST_CASE("syntax errors come with their line and column, repeated keys with their path", "[recipe]") {
+  // line 3 lacks the comma after the "version" member: the parser stops at "name" (line 4, col 3)
+  const std::string text = "{\n  \"format\": \"clayform.recipe\",\n  \"version\": 1\n  \"name\": \"x\"\n}\n";
+  const auto problems = check_recipe(text);
+  REQUIRE(problems.size() == 1);
+  CHECK(problems[0].line == 4);
+  CHECK(problems[0].column == 3);
+  CHECK_THAT(to_string(problems[0]), Contains("line 4, column 3"));
+
+  const std::string twice = R"({"format": "clayform.recipe", "version": 1,
+    "curves": {"a": {"line": {"from": [0, 0, 0], "to": [1, 0, 0]}}, "a": {"line": {"from": [0, 0, 0], "to": [2, 0, 0]}}}})";
+  CHECK(mentions(check_recipe(twice), "curves.a", "appears twice"));
+  CHECK(mentions(check_recipe(R"({"format": "clayform.recipe", "version": 1, "name": 1e999})"), "(syntax)", "finite"));
+}
+
+TEST_CASE("load_recipe names the file and takes the name from its stem", "[recipe]") {
+  const fs::path dir = output_dir("load");
+  fs::create_directories(dir);
+  std::ofstream(dir / "my-part.json") << R"({"format": "clayform.recipe", "version": 1})";
+  CHECK(load_recipe(dir / "my-part.json").name() == "my-part");
+  const auto [category, message] = error_of([&] { load_recipe(dir / "missing.json"); });
+  CHECK(category == ErrorCategory::Io);
+  CHECK_THAT(message, Contains("missing.json"));
+}
+
+TEST_CASE("a taper composes exactly and a cylindrical extended lattice is refitted", "[recipe]") {
+  const std::string steps = R"("deformations": {
+      "flare": [{"kind": "taper", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": [1, 0.004]}],
+      "dent": [{"kind": "extended_lattice", "name": "dent",
+                "generator": {"cylinder": {"origin": [50, 50, -30], "radius": 60, "height": 60, "sectors": 8}},
+                "moves": [{"index": [1, 2, 2], "by": [0, 0, 12]}]}]})";
+  const std::string text = recipe_with(
+      R"(, "flared": {"deform": {"surface": "dome", "deformation": "flare"}},
+         "dented": {"deform": {"surface": "dome", "deformation": "dent", "composition": {"mode": "refit", "tolerance": 0.2, "relative": false}}})",
+      steps);
+  const auto result = run_recipe(parse_recipe(text));
+  const auto parent = dome();
+
+  deform::Taper taper;
+  taper.frame.origin = {50, 50, 0};
+  taper.profile = {1, 0.004};
+  const auto& flared = result.surface("flared");
+  const auto [lo, hi] = surface::control_box(flared);
+  CHECK(max_gap(flared, [&](double u, double v) {
+          return deform::deform_point(taper, surface::evaluate(parent, u, v));
+        }) <= 1e-12 * (hi - lo).norm());
+
+  deform::CylinderSpec spec;
+  spec.origin = {50, 50, -30};
+  spec.radius = 60;
+  spec.height = 60;
+  spec.sectors = 8;
+  auto lattice = deform::make_cylindrical_lattice(spec);
+  lattice.points.row(deform::cylindrical_index(spec, 1, 2, 2)) += Eigen::RowVector3d(0, 0, 12);
+  const double gap = max_gap(result.surface("dented"), [&](double u, double v) {
+    return deform::deform_point(lattice, surface::evaluate(parent, u, v));
+  }, 100);
+  CHECK(gap <= 0.2);
+  // the dent is there: the lattice moves the surface by about 1 mm (its control point by 12)
+  double moved = 0;
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j) {
+      const Eigen::Vector3d x = surface::evaluate(parent, i / 20.0, j / 20.0);
+      moved = std::max(moved, (deform::deform_point(lattice, x) - x).norm());
+    }
+  CHECK(moved > 0.8);
+}
