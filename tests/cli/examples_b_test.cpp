@@ -10,8 +10,6 @@
 #include <clay/recipe.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/primitives.hpp>
-#include <clay/surface/revolve.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -28,7 +26,6 @@ using Catch::Matchers::WithinAbs;
 
 namespace {
 
-namespace shapes {
 using namespace clay::deform;
 namespace surface = clay::surface;
 using V3 = Eigen::Vector3d;
@@ -36,18 +33,13 @@ using R3 = Eigen::RowVector3d;
 
 inline constexpr double pi = 3.14159265358979323846;
 
-// ---- handset (Sederberg–Parry figs. 14-16) ----
-inline surface::Superellipsoid bar_shape() {
-  surface::Superellipsoid s;
-  s.radii = {100, 24, 15};
-  s.e1 = 0.4;
-  s.e2 = 0.4;
-  return s;
-}
-inline constexpr double bar_tolerance = 0.02;
+// The rebuilt deformations: the same numbers as examples/recipes/tools/make_recipes.py, built here
+// with the deform library's own constructors (not read from the recipes).
 
-// Local C1 lattice at one end: x in [x0, x0 + 70], the planes i = fixed_a, fixed_b kept.
-// end = +1: mouthpiece (x > 0, s_min face crossed), end = -1: earpiece (x < 0, s_max face crossed).
+// ---- handset (Sederberg–Parry figs. 14-16) ----
+// Local C1 Bézier lattice (3, 2, 2) over one end of the bar, x in [40, 110] or [-110, -40].
+// end = +1: mouthpiece (x > 0, the bar crosses the s_min face, planes i = 0, 1 stay), end = -1:
+// earpiece (the s_max face, planes i = 2, 3 stay).
 inline BezierLattice end_lattice(int end, double drop, double widen) {
   Frame f;
   f.origin = end > 0 ? V3(40, -32, -20) : V3(-110, -32, -20);
@@ -58,7 +50,7 @@ inline BezierLattice end_lattice(int end, double drop, double widen) {
   // The two free planes: far from the crossed face.
   const int far_i = end > 0 ? 3 : 0, mid_i = end > 0 ? 2 : 1;
   const double sy[3] = {-1, 0, 1};
-  const double dz_far[3] = {-drop, -0.5 * drop, 0.0};   // k = 0 (bottom), 1, 2 (top)
+  const double dz_far[3] = {-drop, -0.5 * drop, 0.0};  // k = 0 (bottom), 1, 2 (top)
   for (int j = 0; j <= 2; ++j)
     for (int k = 0; k <= 2; ++k) {
       l.points.row(l.index(far_i, j, k)) += R3(-end * 0.1 * drop, sy[j] * 32 * widen, dz_far[k]);
@@ -113,18 +105,13 @@ inline ExtendedLattice sandpie_lattice() {
   // Flutes: every second sector boundary of the radial-4 cylinder pulled towards the axis.
   for (int a = 0; a < 36; a += 6) {
     const double t = 2 * pi * a / 36.0;
-    for (int k = 0; k <= 3; ++k) l.points.row(cylindrical_index(c, 4, a, k)) += R3(-5 * std::cos(t), -5 * std::sin(t), 0);
+    for (int k = 0; k <= 3; ++k)
+      l.points.row(cylindrical_index(c, 4, a, k)) += R3(-5 * std::cos(t), -5 * std::sin(t), 0);
   }
   return l;
 }
 
 // ---- cushion (Coquillart fig. 10) ----
-inline surface::BSplineSurface cushion_parent() {
-  surface::Points3 p(7, 3);
-  p << 0, 0, 14, 30, 0, 14, 52, 0, 12, 60, 0, 0, 52, 0, -12, 30, 0, -14, 0, 0, -14;
-  const auto profile = surface::make_curve(3, {0, 0, 0, 0, 0.3, 0.5, 0.7, 1, 1, 1, 1}, p);
-  return surface::revolve(profile, surface::Axis{}).surface;
-}
 inline CylinderSpec cushion_spec() {
   CylinderSpec c;
   c.origin = {0, 0, -20};
@@ -154,8 +141,8 @@ inline ExtendedLattice cushion_lattice() {
 // ---- S (Coquillart fig. 8) ----
 // Arc of radius r about c from angle a0 to a1 (degrees) as `n` cubic Bézier segments, appended
 // (without the first point when `skip_first`).
-inline void arc(std::vector<Eigen::Vector2d>& out, Eigen::Vector2d c, double r, double a0, double a1, int n,
-                bool skip_first) {
+inline void arc(std::vector<Eigen::Vector2d>& out, Eigen::Vector2d c, double r, double a0,
+                double a1, int n, bool skip_first) {
   const double d = (a1 - a0) / n * pi / 180, h = 4.0 / 3.0 * std::tan(std::abs(d) / 4) * r;
   for (int s = 0; s < n; ++s) {
     const double t0 = a0 * pi / 180 + s * d, t1 = t0 + d;
@@ -174,8 +161,8 @@ inline constexpr double s_radius = 15, s_half_width = 5;
 // offset > 0: to the left of the stroke.
 inline std::vector<Eigen::Vector2d> s_section(double offset) {
   std::vector<Eigen::Vector2d> pts;
-  arc(pts, {0, s_radius}, s_radius - offset, 30, 270, 4, false);     // upper bowl, counter-clockwise
-  arc(pts, {0, -s_radius}, s_radius + offset, 90, -150, 4, true);    // lower bowl, clockwise
+  arc(pts, {0, s_radius}, s_radius - offset, 30, 270, 4, false);   // upper bowl, counter-clockwise
+  arc(pts, {0, -s_radius}, s_radius + offset, 90, -150, 4, true);  // lower bowl, clockwise
   return pts;
 }
 inline PrismSpec s_spec() {
@@ -195,52 +182,9 @@ inline ExtendedLattice s_lattice() {
   return l;
 }
 
-// ---- Güdükbay–Özgüç fig. 7 ----
-inline surface::Superellipsoid post_shape() {
-  surface::Superellipsoid s;
-  s.radii = {25, 25, 60};
-  s.e1 = 0.5;
-  s.e2 = 0.5;
-  return s;
-}
-inline DeformationStack taper_twist() {
-  Taper t;
-  t.profile = {1.0, -0.006};
-  Twist w;
-  w.angle = {0.0, 0.0131};
-  DeformationStack s;
-  s.steps.push_back({t, "taper", true});
-  s.steps.push_back({w, "twist", true});
-  return s;
-}
-inline surface::Superellipsoid beam_shape() {
-  surface::Superellipsoid s;
-  s.radii = {16, 60, 16};
-  s.e1 = 0.5;
-  s.e2 = 0.5;
-  return s;
-}
-inline DeformationStack taper_bend(double y_min, double y_max) {
-  Taper t;
-  t.frame.axis = {0, 1, 0};
-  t.frame.reference = {1, 0, 0};
-  t.profile = {1.0, -0.004};
-  Bend b;
-  b.y_min = y_min;
-  b.y_max = y_max;
-  b.center = 0;
-  b.rate = (pi / 2) / (y_max - y_min);
-  DeformationStack s;
-  s.steps.push_back({t, "taper", true});
-  s.steps.push_back({b, "bend", true});
-  return s;
-}
-}  // namespace shapes
-
-using namespace shapes;
-
 RunResult run_example(const std::string& name) {
-  return run_recipe(load_recipe(std::filesystem::path(CLAY_EXAMPLES_DIR) / "recipes" / (name + ".json")));
+  return run_recipe(
+      load_recipe(std::filesystem::path(CLAY_EXAMPLES_DIR) / "recipes" / (name + ".json")));
 }
 
 const StepReport& step_at(const RunResult& r, const std::string& path) {
@@ -287,8 +231,9 @@ Check compare(const surface::BSplineSurface& parent, const surface::BSplineSurfa
 
 }  // namespace
 
-TEST_CASE("recipe example handset: local C1 lattices then a global bend, against the pointwise stack",
-          "[recipe][examples]") {
+TEST_CASE(
+    "recipe example handset: local C1 lattices then a global bend, against the pointwise stack",
+    "[recipe][examples]") {
   const RunResult r = run_example("handset");
   const DeformationStack stack = handset_stack();
   // The local lattices move interior planes only: C1 with the bar across the face it crosses.
@@ -298,13 +243,14 @@ TEST_CASE("recipe example handset: local C1 lattices then a global bend, against
   const auto& ear = std::get<BezierLattice>(stack.steps[1].deformation);
   CHECK(with_continuity(mouth, mouth_face).points == mouth.points);
   CHECK(with_continuity(ear, ear_face).points == ear.points);
-  double bounds = 0;
+  double bounds = 0, sampled = 0;
   for (int i = 0; i < 3; ++i) {
     const StepReport& s = step_at(r, "surfaces.handset.steps[" + std::to_string(i) + "]");
     CHECK(figure<std::string>(s, "composition") == "refit");
     CHECK(figure<bool>(s, "certified"));
     CHECK(figure<double>(s, "max_deviation_mm") <= figure<double>(s, "tolerance_mm"));
     bounds += figure<double>(s, "max_deviation_mm");
+    sampled += figure<double>(s, "sampled_max_mm");
     // Fold-free, independently: the Jacobian of the lattice rebuilt here.
     const JacobianBounds j = std::visit(
         [](const auto& d) -> JacobianBounds {
@@ -326,8 +272,13 @@ TEST_CASE("recipe example handset: local C1 lattices then a global bend, against
   CHECK(handset.v.degree == 3);
   // Each refit's bound is its own; the later lattices stretch it by at most their Lipschitz
   // constant (about 1.5 here), so the whole stack is within 1.5 x the sum of the bounds.
-  const Check all = compare(bar, handset, [&](const V3& x) { return deform_point(stack, x); }, 400);
+  const Check all = compare(
+      bar, handset, [&](const V3& x) { return deform_point(stack, x); }, 400);
   CHECK(all.worst <= 1.5 * bounds);
+  // The certified bounds are loose near the local lattices' faces (first-order cells); the refit
+  // also samples every cell on a grid four times denser than its fit, and random parameters find
+  // no larger deviation than those samples (same stretch allowance): a check at the 0.05 mm level.
+  CHECK(all.worst <= 1.5 * sampled);
   // Between the local lattices only the global bend acts.
   const Check middle = compare(
       bar, handset, [&](const V3& x) { return deform_point(arch(), x); }, 400,
@@ -336,7 +287,8 @@ TEST_CASE("recipe example handset: local C1 lattices then a global bend, against
   CHECK(middle.worst <= 1.5 * bounds);
 }
 
-TEST_CASE("recipe example sandpie: cylindrical extended lattice, mound and outside sheet", "[recipe][examples]") {
+TEST_CASE("recipe example sandpie: cylindrical extended lattice, mound and outside sheet",
+          "[recipe][examples]") {
   const RunResult r = run_example("sandpie");
   const StepReport& s = step_at(r, "surfaces.sandpie.steps[0]");
   CHECK(figure<std::string>(s, "composition") == "refit");
@@ -345,11 +297,13 @@ TEST_CASE("recipe example sandpie: cylindrical extended lattice, mound and outsi
   const ExtendedLattice lattice = sandpie_lattice();
   const surface::BSplineSurface& sheet = r.surface("sheet");
   const surface::BSplineSurface& pie = r.surface("sandpie");
-  const Check all = compare(sheet, pie, [&](const V3& x) { return deform_point(lattice, x); }, 300);
+  const Check all = compare(
+      sheet, pie, [&](const V3& x) { return deform_point(lattice, x); }, 300);
   CHECK(all.worst <= tolerance);
   // Outside the cylinder (radius 40 mm) the sheet stays where it was.
   const Check outside = compare(
-      sheet, pie, [](const V3& x) { return x; }, 300, [](const V3& x) { return x.head<2>().norm() > 40.5; });
+      sheet, pie, [](const V3& x) { return x; }, 300,
+      [](const V3& x) { return x.head<2>().norm() > 40.5; });
   CHECK(outside.count > 100);
   CHECK(outside.worst <= tolerance);
   // Closed form: in the inner ring every control point moved by (0, 0, 14), so the top is flat.
@@ -370,11 +324,13 @@ TEST_CASE("recipe example cushion: hollow on the axis and folds, against the poi
   const ExtendedLattice lattice = cushion_lattice();
   const surface::BSplineSurface& parent = r.surface("cushion_parent");
   const surface::BSplineSurface& cushion = r.surface("cushion");
-  const Check all = compare(parent, cushion, [&](const V3& x) { return deform_point(lattice, x); }, 300);
+  const Check all = compare(
+      parent, cushion, [&](const V3& x) { return deform_point(lattice, x); }, 300);
   CHECK(all.worst <= tolerance);
   // Closed form on the axis (u = 0 of the inner ring: only the axis points act): the top pole at
   // height 14 mm, w = 34/40, moves by sum_k B_k(w) dz_k with dz = (12, 4, -4, -12).
-  const double w = 34.0 / 40.0, b[4] = {std::pow(1 - w, 3), 3 * w * std::pow(1 - w, 2), 3 * w * w * (1 - w), w * w * w};
+  const double w = 34.0 / 40.0, b[4] = {std::pow(1 - w, 3), 3 * w * std::pow(1 - w, 2),
+                                        3 * w * w * (1 - w), w * w * w};
   const double top = 14 + 12 * b[0] + 4 * b[1] - 4 * b[2] - 12 * b[3];
   int poles = 0;
   for (double u : {parent.u.domain().first, parent.u.domain().second})
@@ -391,8 +347,9 @@ TEST_CASE("recipe example cushion: hollow on the axis and folds, against the poi
   CHECK(poles > 0);
 }
 
-TEST_CASE("recipe example s_letter: prismatic lattice lofted on an S, groove depth and outside sheet",
-          "[recipe][examples]") {
+TEST_CASE(
+    "recipe example s_letter: prismatic lattice lofted on an S, groove depth and outside sheet",
+    "[recipe][examples]") {
   const RunResult r = run_example("s_letter");
   const StepReport& s = step_at(r, "surfaces.engraved.steps[0]");
   CHECK(figure<std::string>(s, "composition") == "refit");
@@ -402,7 +359,8 @@ TEST_CASE("recipe example s_letter: prismatic lattice lofted on an S, groove dep
   REQUIRE(lattice.rest.rows() == 7 * 25 * 4);  // no welded points: rows as the recipe's moves say
   const surface::BSplineSurface& sheet = r.surface("sheet");
   const surface::BSplineSurface& engraved = r.surface("engraved");
-  const Check all = compare(sheet, engraved, [&](const V3& x) { return deform_point(lattice, x); }, 300);
+  const Check all = compare(
+      sheet, engraved, [&](const V3& x) { return deform_point(lattice, x); }, 300);
   CHECK(all.worst <= tolerance);
   // Points the lattice leaves alone (outside the band, or where nothing moved) stay.
   const Check still = compare(
@@ -437,8 +395,9 @@ TEST_CASE("recipe example superellipsoid_taper_twist: exact taper, certified twi
   CHECK(all.worst <= bound + 1e-9 * 150);
 }
 
-TEST_CASE("recipe example superellipsoid_bend: exact taper, certified bend with a region, closed forms",
-          "[recipe][examples]") {
+TEST_CASE(
+    "recipe example superellipsoid_bend: exact taper, certified bend with a region, closed forms",
+    "[recipe][examples]") {
   const RunResult r = run_example("superellipsoid_bend");
   const StepReport& taper = step_at(r, "surfaces.bent.steps[0]");
   const StepReport& bend = step_at(r, "surfaces.bent.steps[1]");
@@ -461,8 +420,8 @@ TEST_CASE("recipe example superellipsoid_bend: exact taper, certified bend with 
   const Check all = compare(r.surface("beam"), r.surface("bent"), closed_form, 400);
   CHECK(all.worst <= bound + 1e-9 * 150);
   // The end beyond y_max moves rigidly with the region's end, turned by 90 degrees.
-  const Check tip = compare(
-      r.surface("beam"), r.surface("bent"), closed_form, 400, [](const V3& p) { return p.y() > 45; });
+  const Check tip = compare(r.surface("beam"), r.surface("bent"), closed_form, 400,
+                            [](const V3& p) { return p.y() > 45; });
   CHECK(tip.count > 10);
   CHECK(tip.worst <= bound + 1e-9 * 150);
 }
