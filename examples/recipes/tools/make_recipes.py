@@ -110,7 +110,8 @@ def handset():
         "would also multiply the degree by 7, 7 and 5, far above the exchange limit 25. The "
         "tolerance is 2e-3 because the certificate treats the cells that straddle a local "
         "lattice's C1 face as only continuous (first-order remainder) and halves them: the sampled "
-        "deviation is some 30 times below the certified bound.",
+        "deviation is 15 to 20 times below the certified bound. The steps come in the paper's order "
+        "(local lattices on the straight bar, the global one last).",
         {"mode": "refit", "tolerance": 2e-3, "degree": 3},
         {"bar": {"superellipsoid": {"radii": [100, 24, 15], "e1": 0.4, "e2": 0.4, "tolerance": 0.1}},
          "handset": {"deform": {"surface": "bar", "deformation": "handset"}}},
@@ -225,8 +226,8 @@ def s_letter():
         "each, as 8 cubic Bézier segments; the offsets at +-5 mm are concentric arcs. The prism is "
         "12 mm high across a flat 90 x 90 mm sheet (here flat, as the planar surface of fig. 9). The "
         "three middle rows across the band (rows i = 2, 3, 4 of 7) are pushed 4 mm down in the "
-        "middle and top layers (k = 1..3), except the two rows at each end of the stroke: the "
-        "groove has a flat bottom and joins the sheet with C1 continuity at the band's sides and "
+        "middle and top layers (k = 1..3), except the two control points at each end of the stroke "
+        "(j = 0, 1 and 23, 24 of 25): the groove has a flat bottom and joins the sheet with C1 continuity at the band's sides and "
         "ends. Moves by row: row = (i * 25 + j) * 4 + k (no points are welded for an open S). "
         "Composition refit, bicubic, 1e-3 of the size, sampled (certified = false for an extended "
         "lattice).",
