@@ -287,7 +287,7 @@ TEST_CASE(
   CHECK(middle.worst <= 1.5 * bounds);
 }
 
-TEST_CASE("recipe example sandpie: cylindrical extended lattice, mound and outside sheet",
+TEST_CASE("example sandpie: cylindrical extended lattice, mound and outside sheet",
           "[recipe][examples]") {
   const RunResult r = run_example("sandpie");
   const StepReport& s = step_at(r, "surfaces.sandpie.steps[0]");
@@ -314,7 +314,7 @@ TEST_CASE("recipe example sandpie: cylindrical extended lattice, mound and outsi
   CHECK(top.worst <= tolerance);
 }
 
-TEST_CASE("recipe example cushion: hollow on the axis and folds, against the pointwise lattice",
+TEST_CASE("example cushion: hollow on the axis and folds, against the pointwise lattice",
           "[recipe][examples]") {
   const RunResult r = run_example("cushion");
   const StepReport& s = step_at(r, "surfaces.cushion.steps[0]");
@@ -374,7 +374,7 @@ TEST_CASE(
   CHECK_THAT(centre.z(), WithinAbs(-3.5, tolerance));
 }
 
-TEST_CASE("recipe example superellipsoid_taper_twist: exact taper, certified twist, closed forms",
+TEST_CASE("example superellipsoid_taper_twist: exact taper, certified twist, closed forms",
           "[recipe][examples]") {
   const RunResult r = run_example("superellipsoid_taper_twist");
   const StepReport& taper = step_at(r, "surfaces.twisted.steps[0]");
