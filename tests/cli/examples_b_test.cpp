@@ -231,9 +231,8 @@ Check compare(const surface::BSplineSurface& parent, const surface::BSplineSurfa
 
 }  // namespace
 
-TEST_CASE(
-    "recipe example handset: local C1 lattices then a global bend, against the pointwise stack",
-    "[recipe][examples]") {
+TEST_CASE("example handset: local C1 lattices then a global bend, against the pointwise stack",
+          "[recipe][examples]") {
   const RunResult r = run_example("handset");
   const DeformationStack stack = handset_stack();
   // The local lattices move interior planes only: C1 with the bar across the face it crosses.
@@ -347,9 +346,8 @@ TEST_CASE("example cushion: hollow on the axis and folds, against the pointwise 
   CHECK(poles > 0);
 }
 
-TEST_CASE(
-    "recipe example s_letter: prismatic lattice lofted on an S, groove depth and outside sheet",
-    "[recipe][examples]") {
+TEST_CASE("example s_letter: prismatic lattice lofted on an S, groove depth and outside sheet",
+          "[recipe][examples]") {
   const RunResult r = run_example("s_letter");
   const StepReport& s = step_at(r, "surfaces.engraved.steps[0]");
   CHECK(figure<std::string>(s, "composition") == "refit");
@@ -395,9 +393,8 @@ TEST_CASE("example superellipsoid_taper_twist: exact taper, certified twist, clo
   CHECK(all.worst <= bound + 1e-9 * 150);
 }
 
-TEST_CASE(
-    "recipe example superellipsoid_bend: exact taper, certified bend with a region, closed forms",
-    "[recipe][examples]") {
+TEST_CASE("example superellipsoid_bend: exact taper, certified bend with a region, closed forms",
+          "[recipe][examples]") {
   const RunResult r = run_example("superellipsoid_bend");
   const StepReport& taper = step_at(r, "surfaces.bent.steps[0]");
   const StepReport& bend = step_at(r, "surfaces.bent.steps[1]");
