@@ -978,12 +978,30 @@ class RecipeChecker {
             }
           if (const Json* m = c_.member(v, p, "composition", false, ""))
             d.composition = composition(*m, key_path(p, "composition"), d.composition);
+          if (!d.composition.refit) exact_composable(d.deformation, key_path(p, "deformation"));
         }
         def.build = d;
       }
     }
     names_.surfaces.push_back(name);
     if (c_.problems.size() == before) data.surfaces.push_back(std::move(def));
+  }
+
+  /// In exact mode every enabled step must be one compose_exact handles: twists, bends and
+  /// extended lattices are not polynomial maps of the surface's control points (DESIGN.md).
+  void exact_composable(const std::string& stack_name, const std::string& path) {
+    for (const auto& stack : data.stacks) {
+      if (stack.name != stack_name) continue;
+      for (const auto& step : stack.steps) {
+        const auto* d = std::get_if<deform::Deformation>(&step.step);
+        if (!step.enabled || !d) continue;
+        if (std::holds_alternative<deform::Twist>(*d) || std::holds_alternative<deform::Bend>(*d) ||
+            std::holds_alternative<deform::ExtendedLattice>(*d))
+          c_.add(path, step.path + " is a " + step.kind + ", which cannot be composed exactly (only " +
+                           "Bézier and B-spline lattices and tapers can); give this surface or the recipe " +
+                           "\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4}");
+      }
+    }
   }
 
   std::optional<surface::BSplineSurface> inline_surface(const Json& j, const std::string& path) {
