@@ -1,17 +1,17 @@
 #!/usr/bin/env bash
-# Runs Clayform's main job on the bundled default example and prints where the outputs are.
-# Until the recipe runner lands it builds the sample surfaces of examples/01_export_surfaces.cpp,
-# exports them to STEP (AP214), IGES and a glTF preview, reads them back and writes a report.
-# Installs missing Debian packages first. Output folder: $1, default ./out/demo.
+# Runs Clayform's main job on the bundled default example and prints where the outputs are:
+# the sail recipe (examples/recipes/sail.json) — a sail filled from three curves, styled by a bound
+# and a target curve, given a billow by a Bézier lattice composed exactly — replayed by
+# `clayform run` into STEP (AP214), IGES, a glTF preview and report.json, then `clayform info`
+# on the STEP file. Installs missing Debian packages first. Output folder: $1, default ./out/demo.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 clay_ensure_packages
-clay_build --target clayform example_01_export_surfaces
+clay_build --target clayform
 out=${1:-$CLAY_ROOT/out/demo}
-mkdir -p "$out"
-"$CLAY_BUILD/examples/example_01_export_surfaces" "$out"
+"$CLAY_BUILD/cli/clayform" run "$CLAY_ROOT/examples/recipes/sail.json" --out "$out" --progress
 echo
 echo "==> what the files hold (clayform info):"
-"$CLAY_BUILD/cli/clayform" info "$out/sample.step"
+"$CLAY_BUILD/cli/clayform" info "$out/sail.step"
 echo
 echo "Outputs in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"

@@ -122,8 +122,25 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
   const auto files = clay::recipe::write_outputs(result, out);
   bool valid = true;
   for (const auto& e : result.exports) valid = valid && (!e.checked || e.valid);
-  std::printf("%s: %zu step(s) in %.2f s; outputs in %s:\n", result.recipe.c_str(), result.steps.size(),
-              result.seconds, out.string().c_str());
+  std::printf("%s: %zu step(s) in %.2f s\n", result.recipe.c_str(), result.steps.size(), result.seconds);
+  // How each deformed surface was computed: exact composition or certified refit, and how close.
+  for (const auto& step : result.steps) {
+    const clay::recipe::Figure* mode = nullptr;
+    double relative = -1, mm = -1;
+    for (const auto& [name, value] : step.figures) {
+      if (name == "composition") mode = &value;
+      if (name == "max_deviation" && std::holds_alternative<double>(value)) relative = std::get<double>(value);
+      if (name == "max_deviation_mm" && std::holds_alternative<double>(value)) mm = std::get<double>(value);
+    }
+    if (mode && relative >= 0)
+      std::printf("  %s (%s): %s composition, max deviation %.2g of the size (%.2g mm)\n", step.path.c_str(),
+                  step.kind.c_str(), std::get<std::string>(*mode).c_str(), relative, mm);
+  }
+  for (const auto& e : result.exports)
+    if (e.checked)
+      std::printf("  export %s: %zu surface(s), read back %s%s\n", e.name.c_str(), e.surfaces.size(),
+                  e.valid ? "valid (BRepCheck)" : "INVALID", e.read_back_identical ? ", bit-identical" : "");
+  std::printf("outputs in %s:\n", out.string().c_str());
   for (const auto& f : files) std::printf("  %s\n", f.string().c_str());
   for (const auto& e : result.exports)
     if (e.checked && !e.valid) {

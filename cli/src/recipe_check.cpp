@@ -266,12 +266,14 @@ class Checker {
       build();
       return true;
     } catch (const Error& e) {
-      add(path, e.what());
+      add(path, e.message());
       return false;
     }
   }
+  /// The library's problems(x, path) messages, which start with the path themselves.
   void add_all(const std::string& path, const std::vector<std::string>& list) {
-    for (const auto& p : list) add(path, p);
+    for (const auto& p : list)
+      add(path, p.rfind(path + ": ", 0) == 0 ? p.substr(path.size() + 2) : p.rfind(path + " ", 0) == 0 ? p.substr(path.size() + 1) : p);
   }
 };
 
@@ -978,12 +980,30 @@ class RecipeChecker {
             }
           if (const Json* m = c_.member(v, p, "composition", false, ""))
             d.composition = composition(*m, key_path(p, "composition"), d.composition);
+          if (!d.composition.refit) exact_composable(d.deformation, key_path(p, "deformation"));
         }
         def.build = d;
       }
     }
     names_.surfaces.push_back(name);
     if (c_.problems.size() == before) data.surfaces.push_back(std::move(def));
+  }
+
+  /// In exact mode every enabled step must be one compose_exact handles: twists, bends and
+  /// extended lattices are not polynomial maps of the surface's control points (DESIGN.md).
+  void exact_composable(const std::string& stack_name, const std::string& path) {
+    for (const auto& stack : data.stacks) {
+      if (stack.name != stack_name) continue;
+      for (const auto& step : stack.steps) {
+        const auto* d = std::get_if<deform::Deformation>(&step.step);
+        if (!step.enabled || !d) continue;
+        if (std::holds_alternative<deform::Twist>(*d) || std::holds_alternative<deform::Bend>(*d) ||
+            std::holds_alternative<deform::ExtendedLattice>(*d))
+          c_.add(path, step.path + " is a " + step.kind + ", which cannot be composed exactly (only " +
+                           "Bézier and B-spline lattices and tapers can); give this surface or the recipe " +
+                           "\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4}");
+      }
+    }
   }
 
   std::optional<surface::BSplineSurface> inline_surface(const Json& j, const std::string& path) {
@@ -1340,7 +1360,7 @@ class RecipeChecker {
       auto stack = deform::stack_from_json(doc.dump());
       return std::move(stack.steps.front().deformation);
     } catch (const Error& e) {
-      std::string m = e.what();
+      std::string m = e.message();
       for (std::string_view prefix : {"deformation stack JSON: "})
         if (m.rfind(prefix, 0) == 0) m.erase(0, prefix.size());
       // "steps[0].points[5]: ..." → "<path>.points[5]: ..."; "steps[0] (kind): ..." → "<path> (kind): ..."
@@ -1628,7 +1648,16 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
     }
     return true;
   };
-  return Json::parse(text.begin(), text.end(), cb);
+  try {
+    return Json::parse(text.begin(), text.end(), cb);
+  } catch (const Json::out_of_range& e) {  // a number beyond the double range: name where it is
+    element();                             // the number being read is the next element
+    levels.push_back({});                  // so path() includes the innermost level
+    std::string what = e.what();
+    if (const auto k = what.find("] "); k != std::string::npos) what = what.substr(k + 2);
+    c.add(path(), what + "; give finite numbers within the range of a double");
+    throw;
+  }
 }
 
 }  // namespace
@@ -1652,7 +1681,9 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   } catch (const Json::exception& e) {  // a number beyond the range of a double
     std::string what = e.what();
     if (const auto k = what.find("] "); k != std::string::npos) what = what.substr(k + 2);
-    out.problems.push_back({"(syntax)", what + "; give finite numbers within the range of a double", 0, 0});
+    out.problems = std::move(c.problems);  // where the number is (parse_reporting_duplicates)
+    if (out.problems.empty())
+      out.problems.push_back({"(syntax)", what + "; give finite numbers within the range of a double", 0, 0});
     return out;
   }
   RecipeChecker rc(c, base_dir);

@@ -125,7 +125,7 @@ class Runner {
     try {
       f(rep);
     } catch (const Error& e) {
-      throw Error(e.category(), path + " (" + kind + "): " + e.what());
+      throw Error(e.category(), path + " (" + kind + "): " + e.message());
     }
     rep.seconds = seconds_since(t0);
     if (options_.progress) options_.progress(rep);
@@ -285,25 +285,30 @@ class Runner {
                                 StepReport& rep) {
     const auto r = deform::deform_surface(d, s, deformation_options(c));
     const auto& o = r.report.steps.front();
-    rep.figures.emplace_back("degree_u", static_cast<long long>(r.surface.u.degree));
-    rep.figures.emplace_back("degree_v", static_cast<long long>(r.surface.v.degree));
-    rep.figures.emplace_back("control_points", static_cast<long long>(r.surface.points.rows()));
+    auto sizes = [&] {
+      rep.figures.emplace_back("degree_u", static_cast<long long>(r.surface.u.degree));
+      rep.figures.emplace_back("degree_v", static_cast<long long>(r.surface.v.degree));
+      rep.figures.emplace_back("control_points", static_cast<long long>(r.surface.points.rows()));
+    };
     if (o.method == deform::StepOutcome::Method::exact) {
       rep.figures.emplace_back("composition", std::string("exact"));
-      rep.figures.emplace_back("exact", true);
-      rep.figures.emplace_back("patches", static_cast<long long>(o.compose.patches));
       rep.figures.emplace_back("max_deviation", o.compose.max_deviation);  // relative to size
       rep.figures.emplace_back("max_deviation_mm", o.compose.max_deviation * o.compose.size);
+      sizes();
+      rep.figures.emplace_back("exact", true);
+      rep.figures.emplace_back("patches", static_cast<long long>(o.compose.patches));
       rep.figures.emplace_back("size", o.compose.size);
       rep.message += ": exact, " + o.compose.brief();
     } else {
       const auto& f = o.refit;
+      const double bound = f.certified ? f.certified_bound : f.sampled_max;
       rep.figures.emplace_back("composition", std::string("refit"));
+      rep.figures.emplace_back("max_deviation", bound / f.size);
+      rep.figures.emplace_back("max_deviation_mm", bound);
+      sizes();
       rep.figures.emplace_back("exact", false);
       rep.figures.emplace_back("certified", f.certified);
       rep.figures.emplace_back("tolerance_mm", f.tolerance);
-      rep.figures.emplace_back("max_deviation_mm", f.certified ? f.certified_bound : f.sampled_max);
-      rep.figures.emplace_back("max_deviation", (f.certified ? f.certified_bound : f.sampled_max) / f.size);
       rep.figures.emplace_back("sampled_max_mm", f.sampled_max);
       rep.figures.emplace_back("size", f.size);
       rep.message += ": refit (" + o.reason + "), " + f.brief();
@@ -338,8 +343,7 @@ class Runner {
                    {"added_key_points", static_cast<long long>(x.added_key_points)},
                    {"degree_u", static_cast<long long>(r.surface.u.degree)},
                    {"degree_v", static_cast<long long>(r.surface.v.degree)},
-                   {"control_points", static_cast<long long>(r.surface.points.rows())},
-                   {"exact", true}};
+                   {"control_points", static_cast<long long>(r.surface.points.rows())}};
     rep.message += ": " + x.message;
     return r.surface;
   }

@@ -11,12 +11,14 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <numeric>
 #include <sstream>
 #include <thread>
 #include <utility>
 
+#include "extended_internal.hpp"
 #include "messages.hpp"
 
 namespace clay::deform {
@@ -888,6 +890,26 @@ Eigen::Vector3d deform_point(const ExtendedLattice& lattice, const Eigen::Vector
   const Points3 p = x.transpose();
   return evaluate(lattice, freeze(lattice, p, o), DeformOptions{1}).row(0).transpose();
 }
+
+namespace detail {
+
+std::function<Eigen::Vector3d(const Eigen::Vector3d&)> prepared_point_map(const ExtendedLattice& lattice) {
+  validate(lattice);
+  FreezeOptions o;  // as deform_point: default options, one thread
+  o.threads = 1;
+  auto data = std::make_shared<const std::pair<ExtendedLattice, Prepared>>(lattice, prepare(lattice, o));
+  return [data, o](const Eigen::Vector3d& x) -> Eigen::Vector3d {
+    if (!x.allFinite())
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "freeze: point row 0 is not finite " + format(x) + "; give finite coordinates");
+    Counters count;
+    const FrozenPoint f = locate(data->second, x, o, count);
+    if (f.chunk < 0) return x;
+    return chunk_point(data->first.points, data->first.chunks[static_cast<std::size_t>(f.chunk)], f.uvw);
+  };
+}
+
+}  // namespace detail
 
 Points3 deform_points(const ExtendedLattice& lattice, const Points3& points, const DeformOptions& options) {
   options.validate();

@@ -30,6 +30,7 @@
 #include <variant>
 #include <vector>
 
+#include "extended_internal.hpp"
 #include "messages.hpp"
 
 namespace clay::deform {
@@ -356,7 +357,7 @@ Certifier certifier(const BSplineLattice& d) {
           [cells](const Points3& h) { return cells->info(h, 0); }, {}};
 }
 Certifier certifier(const ExtendedLattice& d) {
-  return {"extended lattice", [d](const Eigen::Vector3d& x) { return deform_point(d, x); }, {},
+  return {"extended lattice", detail::prepared_point_map(d), {},
           "an extended lattice is evaluated through Newton-frozen chunk coordinates, for which no "
           "derivative bounds are known"};
 }
@@ -380,8 +381,7 @@ Certifier certifier(const DeformationStack& stack) {
             if (why_not.empty())
               why_not = "steps[" + std::to_string(i) + "] is an extended lattice, evaluated through "
                         "Newton-frozen chunk coordinates, for which no derivative bounds are known";
-            steps.push_back({[d](const Eigen::Vector3d& x) { return deform_point(d, x); }, {},
-                             index});
+            steps.push_back({detail::prepared_point_map(d), {}, index});
           } else if constexpr (std::is_same_v<T, BezierLattice> ||
                                std::is_same_v<T, BSplineLattice>) {
             auto cells = std::make_shared<LatticeCells>(lattice_cells(d));

@@ -31,6 +31,10 @@ using surface::BSplineSurface;
 
 namespace {
 
+// Below this share of a key point's basis weight on free vertices the net counts as too coarse
+// there (the displacement that meets it is amplified by 1 / share): refine while allowed.
+constexpr double min_free_share = 0.1;
+
 // Chebyshev distance (in vertices) from every vertex to the nearest vertex with E = 0; vertices
 // of a region covering the whole net get INT_MAX.
 std::vector<int> distance_to_outside(const BSplineSurface& s, const std::vector<std::uint8_t>& e) {
@@ -257,7 +261,13 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       reg.count_v = s.count_v();
       reg.factors = region_factors(s, reg.polygon, reg.target_trace, reg.margin);
     };
-    if (rank < nk && refinements < options.max_refinements) {
+    // A key point held mostly by fixed vertices (its free share Σ_free R_ij(u_k, v_k) is small)
+    // is met only by moving the free ones by about distance / share: independent in rank, yet
+    // amplified into a net metres away (seen on a filled sail, shares ~1e-4). Such a net is too
+    // coarse there as well.
+    double min_share = 1.0;
+    for (Eigen::Index k = 0; k < nk; ++k) min_share = std::min(min_share, B.row(k).sum());
+    if ((rank < nk || min_share < min_free_share) && refinements < options.max_refinements) {
       refine();
       continue;
     }
@@ -376,6 +386,10 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     if (!report.conflicting_key_points.empty())
       msg << "; " << report.conflicting_key_points.size()
           << " key points cannot be met (the net is too coarse there: allow more max_refinements)";
+    if (min_share < min_free_share)
+      msg << "; a key point is held mostly by fixed vertices (free share " << min_share
+          << "): the free vertices move up to " << 1.0 / std::max(min_share, 1e-300)
+          << " times its distance (allow more max_refinements, or a bound further from the target)";
     if (options.curve_tolerance > 0 && report.target_curve_deviation > options.curve_tolerance * size)
       msg << "; the target curve is still missed by " << report.target_curve_deviation << " mm, more than "
           << "curve_tolerance x size = " << options.curve_tolerance * size

@@ -162,9 +162,9 @@ TEST_CASE("a twist needs the refit mode, and the refit is within its tolerance",
   const std::string twist = R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.01]})";
   const std::string exact = recipe_with(R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin"}})",
                                         R"("deformations": {"spin": [)" + twist + "]}");
-  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(exact)); });
-  CHECK(category == ErrorCategory::InvalidArgument);
-  CHECK_THAT(message, Contains("surfaces.spun.steps[0] (twist)"));
+  // refused by the check already, naming the surface, the step and the fix
+  CHECK(mentions(check_recipe(exact), "surfaces.spun.deform.deformation", "deformations.spin[0] is a twist"));
+  CHECK(mentions(check_recipe(exact), "surfaces.spun.deform.deformation", "\"mode\": \"refit\""));
 
   const std::string refit = recipe_with(
       R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 0.01, "relative": false}}})",
@@ -404,7 +404,8 @@ TEST_CASE("check_recipe reports every problem at once, each with its path", "[re
     },
     "deformations": {"d": [{"kind": "bezier_lattice", "frame": {"origin": [0, 0, 0], "s": [1, 0, 0], "t": [0, 1, 0], "u": [0, 0, 1]},
                             "degrees": [1, 1, 1], "moves": [{"index": [2, 0, 0], "by": [0, 0, 1]}]},
-                           {"kind": "wobble"}]},
+                           {"kind": "wobble"},
+                           {"kind": "taper", "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": "x"}]},
     "composition": {"mode": "approximate"},
     "exports": {"e": {"surfaces": ["nope"], "formats": ["stl"]}}
   })";
@@ -424,6 +425,7 @@ TEST_CASE("check_recipe reports every problem at once, each with its path", "[re
   CHECK(mentions(problems, "surfaces.u.skin.degree", "expected an integer"));
   CHECK(mentions(problems, "deformations.d[0].moves[0].index[0]", "expected an integer in [0, 1]"));
   CHECK(mentions(problems, "deformations.d[1].kind", "expected one of"));
+  CHECK(mentions(problems, "deformations.d[2].profile", "expected"));
   CHECK(mentions(problems, "composition.mode", "exact, refit"));
   CHECK(mentions(problems, "exports.e.surfaces[0]", "no surface named \"nope\""));
   CHECK(mentions(problems, "exports.e.formats[0]", "step, iges, glb"));
@@ -445,7 +447,7 @@ TEST_CASE("syntax errors come with their line and column, repeated keys with the
   const std::string twice = R"({"format": "clayform.recipe", "version": 1,
     "curves": {"a": {"line": {"from": [0, 0, 0], "to": [1, 0, 0]}}, "a": {"line": {"from": [0, 0, 0], "to": [2, 0, 0]}}}})";
   CHECK(mentions(check_recipe(twice), "curves.a", "appears twice"));
-  CHECK(mentions(check_recipe(R"({"format": "clayform.recipe", "version": 1, "name": 1e999})"), "(syntax)", "finite"));
+  CHECK(mentions(check_recipe(R"({"format": "clayform.recipe", "version": 1, "name": 1e999})"), "name", "finite"));
 }
 
 TEST_CASE("load_recipe names the file and takes the name from its stem", "[recipe]") {
@@ -499,4 +501,15 @@ TEST_CASE("a taper composes exactly and a cylindrical extended lattice is refitt
       moved = std::max(moved, (deform::deform_point(lattice, x) - x).norm());
     }
   CHECK(moved > 0.8);
+}
+
+TEST_CASE("a step failing at run time is named by its path, with its category", "[recipe]") {
+  // the lattice covers only half of the dome: exact composition refuses a surface leaving it
+  const std::string small = R"({"kind": "bezier_lattice", "frame": {"origin": [-10, -10, -20], "s": [60, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]}, "degrees": [1, 1, 1]})";
+  const std::string text = recipe_with(R"(, "cut": {"deform": {"surface": "dome", "deformation": "half"}})",
+                                       R"("deformations": {"half": [)" + small + "]}");
+  REQUIRE(check_recipe(text).empty());
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
+  CHECK(category == ErrorCategory::OutOfDomain);
+  CHECK_THAT(message, Contains("surfaces.cut.steps[0] (bezier_lattice): "));
 }
