@@ -69,9 +69,19 @@ Mesh tessellate(const surface::BSplineSurface& s, int per_span) {
   m.nu = static_cast<int>(us.size());
   m.nv = static_cast<int>(vs.size());
   m.points = surface::evaluate_grid(s, us, vs);
-  m.normals.assign(us.size() * vs.size(), Vector3d::Zero());
-  // Fallback where S_u x S_v vanishes: the cells around the point, each by its diagonals (a cell
-  // with one collapsed edge still has a proper normal).
+  const size_t count = us.size() * vs.size();
+  m.normals.assign(count, Vector3d::Zero());
+  std::vector<surface::SurfaceDerivatives> d(count);
+  double su = 0, sv = 0;  // largest |S_u| and |S_v|: the scale below which a derivative vanishes
+  for (int i = 0; i < m.nu; ++i)
+    for (int j = 0; j < m.nv; ++j) {
+      auto& e = d[static_cast<size_t>(i * m.nv + j)];
+      e = surface::derivatives(s, us[static_cast<size_t>(i)], vs[static_cast<size_t>(j)], 2);
+      su = std::max(su, e.du.norm());
+      sv = std::max(sv, e.dv.norm());
+    }
+  // The cells around a point, each by its diagonals (a cell with one collapsed edge still has a
+  // proper normal), oriented like S_u x S_v: the reference for the orientation at a pole.
   auto cell_normal = [&](int i, int j) -> Vector3d {
     if (i < 0 || j < 0 || i >= m.nu - 1 || j >= m.nv - 1) return Vector3d::Zero();
     const Vector3d n = (m.point(i + 1, j + 1) - m.point(i, j)).cross(m.point(i, j + 1) - m.point(i + 1, j));
@@ -80,10 +90,23 @@ Mesh tessellate(const surface::BSplineSurface& s, int per_span) {
   };
   for (int i = 0; i < m.nu; ++i)
     for (int j = 0; j < m.nv; ++j) {
-      const auto d = surface::derivatives(s, us[static_cast<size_t>(i)], vs[static_cast<size_t>(j)], 1);
-      Vector3d n = d.du.cross(d.dv);
-      if (!(n.norm() > 1e-9 * d.du.norm() * d.dv.norm()))  // also when S_u or S_v is zero
-        n = cell_normal(i - 1, j - 1) + cell_normal(i - 1, j) + cell_normal(i, j - 1) + cell_normal(i, j);
+      const auto& e = d[static_cast<size_t>(i * m.nv + j)];
+      Vector3d cells = cell_normal(i - 1, j - 1) + cell_normal(i - 1, j) + cell_normal(i, j - 1) + cell_normal(i, j);
+      cells = cells.norm() > 0 ? Vector3d(cells.normalized()) : cells;
+      // Trusted when it exists and is within 60 degrees of the cells around it.
+      auto trusted = [&](const Vector3d& n, double scale) {
+        return n.norm() > 1e-9 * scale && (cells.norm() == 0 || n.normalized().dot(cells) > 0.5);
+      };
+      const double lu = e.du.norm() / su, lv = e.dv.norm() / sv;
+      Vector3d n = e.du.cross(e.dv);
+      if (lu < 1e-8 || lv < 1e-8 || !trusted(n, e.du.norm() * e.dv.norm())) {
+        // A pole (S_v ~ 0 along an edge u = a, exactly or nearly, as after a refit): near it
+        // S_v ~ (u - a) S_uv, so the limit normal is S_u x S_uv (S_uv x S_v when S_u vanishes);
+        // else the cells around the point.
+        n = lv <= lu ? e.du.cross(e.duv) : e.duv.cross(e.dv);
+        if (n.dot(cells) < 0) n = -n;
+        if (!trusted(n, std::max(e.du.norm(), e.dv.norm()) * e.duv.norm())) n = cells;
+      }
       const double len = n.norm();
       m.normals[static_cast<size_t>(i * m.nv + j)] = len > 0 ? Vector3d(n / len) : Vector3d::Zero();
     }

@@ -59,8 +59,10 @@ struct Image {
 ///
 /// Each surface is tessellated on the grid of its knot spans (samples_per_span), split into
 /// triangles and z-buffered. The unit normal at each grid point is S_u x S_v from
-/// surface::derivatives; where that vanishes (a collapsed edge or a pole) it is the average of the
-/// normals of the neighbouring grid cells (cross product of the cell diagonals). Normals are
+/// surface::derivatives; at a pole, where S_v vanishes along an edge (S_u along an edge of v), it
+/// is the limit S_u x S_uv (S_uv x S_v), oriented like the neighbouring grid cells, and where that
+/// vanishes too the average of the normals of the neighbouring cells (cross product of the cell
+/// diagonals). Normals are
 /// interpolated across each triangle and shaded per sample (Phong shading): two-sided Lambert
 /// under a key light above-left of the eye (weight 0.6) and a head light (0.25), ambient 0.15,
 /// plus a soft Blinn–Phong highlight of the key light (exponent 50, strength 0.35) so that the
