@@ -238,7 +238,8 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; every usage error 1 (CLI11's own codes vary by error kind).
+    return app.exit(e) == 0 ? 0 : 1;
   }
   try {
     if (*info_cmd) return info(file);

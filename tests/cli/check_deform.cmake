@@ -40,3 +40,11 @@ execute_process(COMMAND ${CLAYFORM} --help OUTPUT_VARIABLE out RESULT_VARIABLE r
 if(NOT rc EQUAL 0 OR NOT out MATCHES "Exit codes: 0 success")
   message(FATAL_ERROR "clayform --help: exit ${rc}:\n${out}")
 endif()
+# Usage errors (a missing required option, an unknown one) exit 1, as --help says.
+foreach(args "run" "run x.json" "deform x.step --out y" "info a b c" "--frobnicate")
+  separate_arguments(list UNIX_COMMAND "${args}")
+  execute_process(COMMAND ${CLAYFORM} ${list} OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 1)
+    message(FATAL_ERROR "clayform ${args}: exit ${rc} (expected 1, usage):\n${out}${err}")
+  endif()
+endforeach()
