@@ -270,6 +270,27 @@ class Checker {
       return false;
     }
   }
+  /// `value` when `list` (its problems(value, path)) is empty; else the problems, and nullopt.
+  template <class T>
+  std::optional<T> checked(T value, const std::string& path, const std::vector<std::string>& list) {
+    if (list.empty()) return value;
+    add_all(path, list);
+    return std::nullopt;
+  }
+
+  /// Reads the required [x, y, z] members of j into their targets; false when any is bad.
+  bool vec3_members(const Json& j, const std::string& path,
+                    std::initializer_list<std::pair<const char*, Eigen::Vector3d*>> members) {
+    bool ok = true;
+    for (auto [key, target] : members) {
+      const Json* v = member(j, path, key, true, "[x, y, z] (mm)");
+      const auto x = v ? vec3(*v, key_path(path, key)) : std::nullopt;
+      ok = ok && x.has_value();
+      if (x) *target = *x;
+    }
+    return ok;
+  }
+
   /// The library's problems(x, path) messages, which start with the path themselves.
   void add_all(const std::string& path, const std::vector<std::string>& list) {
     for (const auto& p : list)
@@ -462,21 +483,9 @@ class RecipeChecker {
     if (!c_.object(j, path, {"origin", "x_axis", "y_axis"}, "a plane {origin, x_axis, y_axis}"))
       return std::nullopt;
     sketch::SketchPlane pl;
-    bool ok = true;
-    for (auto [key, target] : {std::pair{"origin", &pl.origin}, std::pair{"x_axis", &pl.x_axis},
-                               std::pair{"y_axis", &pl.y_axis}}) {
-      const Json* v = c_.member(j, path, key, true, "[x, y, z]");
-      const auto x = v ? c_.vec3(*v, key_path(path, key)) : std::nullopt;
-      ok = ok && x.has_value();
-      if (x) *target = *x;
-    }
-    if (!ok) return std::nullopt;
-    const auto list = sketch::problems(pl, path);
-    if (!list.empty()) {
-      c_.add_all(path, list);
+    if (!c_.vec3_members(j, path, {{"origin", &pl.origin}, {"x_axis", &pl.x_axis}, {"y_axis", &pl.y_axis}}))
       return std::nullopt;
-    }
-    return pl;
+    return c_.checked(pl, path, sketch::problems(pl, path));
   }
 
   void stroke(const std::string& name, const Json& j, const std::string& path) {
@@ -520,12 +529,7 @@ class RecipeChecker {
     curve.points = *points;
     curve.weights = weights ? Eigen::Map<const Eigen::VectorXd>(weights->data(), static_cast<Eigen::Index>(weights->size())).eval()
                             : Eigen::VectorXd::Ones(points->rows()).eval();
-    const auto list = surface::problems(curve, path);
-    if (!list.empty()) {
-      c_.add_all(path, list);
-      return std::nullopt;
-    }
-    return curve;
+    return c_.checked(curve, path, surface::problems(curve, path));
   }
 
   void curve(const std::string& name, const Json& j, const std::string& path) {
@@ -1037,12 +1041,7 @@ class RecipeChecker {
     s.points = *points;
     s.weights = weights ? Eigen::Map<const Eigen::VectorXd>(weights->data(), static_cast<Eigen::Index>(weights->size())).eval()
                         : Eigen::VectorXd::Ones(points->rows()).eval();
-    const auto list = surface::problems(s, path);
-    if (!list.empty()) {
-      c_.add_all(path, list);
-      return std::nullopt;
-    }
-    return s;
+    return c_.checked(s, path, surface::problems(s, path));
   }
 
   // ---- deformations -----------------------------------------------------------------------
@@ -1050,21 +1049,9 @@ class RecipeChecker {
   std::optional<deform::Frame> lattice_frame(const Json& j, const std::string& path) {
     if (!c_.object(j, path, {"origin", "s", "t", "u"}, "a lattice frame {origin, s, t, u}")) return std::nullopt;
     deform::Frame f;
-    bool ok = true;
-    for (auto [key, target] : {std::pair{"origin", &f.origin}, std::pair{"s", &f.s}, std::pair{"t", &f.t},
-                               std::pair{"u", &f.u}}) {
-      const Json* v = c_.member(j, path, key, true, "[x, y, z] (mm)");
-      const auto x = v ? c_.vec3(*v, key_path(path, key)) : std::nullopt;
-      ok = ok && x.has_value();
-      if (x) *target = *x;
-    }
-    if (!ok) return std::nullopt;
-    const auto list = deform::problems(f, path);
-    if (!list.empty()) {
-      c_.add_all(path, list);
+    if (!c_.vec3_members(j, path, {{"origin", &f.origin}, {"s", &f.s}, {"t", &f.t}, {"u", &f.u}}))
       return std::nullopt;
-    }
-    return f;
+    return c_.checked(f, path, deform::problems(f, path));
   }
 
   std::optional<std::array<int, 3>> triple(const Json& obj, const std::string& path, std::string_view key,

@@ -389,25 +389,25 @@ class Runner {
 
 }  // namespace
 
-const BSplineSurface& RunResult::surface(std::string_view name) const {
+namespace {
+
+/// The value named `name` in a run's (name, value) list, or InvalidArgument naming the defined ones.
+template <class T>
+const T& named(const std::vector<std::pair<std::string, T>>& list, std::string_view name, const char* what) {
   std::string known;
-  for (const auto& [n, s] : surfaces) {
-    if (n == name) return s;
+  for (const auto& [n, value] : list) {
+    if (n == name) return value;
     known += (known.empty() ? "" : ", ") + n;
   }
-  throw Error(ErrorCategory::InvalidArgument,
-              "no surface named '" + std::string(name) + "' in the run; its surfaces: " + known);
+  throw Error(ErrorCategory::InvalidArgument, "no " + std::string(what) + " named '" + std::string(name) +
+                                                  "' in the run; its " + what + "s: " + known);
 }
 
-const BSplineCurve& RunResult::curve(std::string_view name) const {
-  std::string known;
-  for (const auto& [n, c] : curves) {
-    if (n == name) return c;
-    known += (known.empty() ? "" : ", ") + n;
-  }
-  throw Error(ErrorCategory::InvalidArgument,
-              "no curve named '" + std::string(name) + "' in the run; its curves: " + known);
-}
+}  // namespace
+
+const BSplineSurface& RunResult::surface(std::string_view name) const { return named(surfaces, name, "surface"); }
+
+const BSplineCurve& RunResult::curve(std::string_view name) const { return named(curves, name, "curve"); }
 
 RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
   if (!recipe.data) throw Error(ErrorCategory::InvalidArgument, "run_recipe: empty recipe; load or parse one first");
