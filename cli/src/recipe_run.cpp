@@ -81,7 +81,7 @@ class Runner {
 
   /// One named surface deformed by a stack (the deform command and `deform` surfaces).
   BSplineSurface deform(const BSplineSurface& parent, const StackDef& stack, const Composition& c,
-                        const std::string& path) {
+                        const std::string& path, const std::string& name) {
     BSplineSurface s = parent;
     for (std::size_t i = 0; i < stack.steps.size(); ++i) {
       const StepDef& step = stack.steps[i];
@@ -92,7 +92,14 @@ class Runner {
           rep.message += ": disabled, skipped";
           return;
         }
+        Stage stage{name, p, step.kind, s, {}, {}};
+        if (const auto* style = std::get_if<StyleDef>(&step.step)) {
+          if (!style->bound.empty()) stage.curves.push_back(style->bound);
+          stage.curves.push_back(style->target);
+        }
         s = std::visit([&](const auto& d) { return apply(d, s, c, rep); }, step.step);
+        stage.after = s;
+        result_.stages.push_back(std::move(stage));
       });
     }
     return s;
@@ -197,7 +204,7 @@ class Runner {
     if (const auto* d = std::get_if<DeformDef>(&def.build)) {
       const StackDef& stack = *std::find_if(data_.stacks.begin(), data_.stacks.end(),
                                             [&](const StackDef& s) { return s.name == d->deformation; });
-      BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path);
+      BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name);
       result_.surfaces.emplace_back(def.name, std::move(s));
       return;
     }
@@ -454,7 +461,7 @@ RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface
   x.schema = d.exports.empty() ? "AP214" : d.exports.front().schema;
   for (std::size_t k = 0; k < surfaces.size(); ++k) {
     const std::string name = std::string(stem) + "-" + std::to_string(k);
-    BSplineSurface s = runner.deform(surfaces[k], *stack, d.composition, "input[" + std::to_string(k) + "]");
+    BSplineSurface s = runner.deform(surfaces[k], *stack, d.composition, "input[" + std::to_string(k) + "]", name);
     result.surfaces.emplace_back(name, s);
     x.surface_names.push_back(name);
     x.surfaces.push_back(std::move(s));

@@ -148,6 +148,11 @@ TEST_CASE("a Bezier lattice step with moves equals the lattice applied pointwise
   CHECK(gap <= 1e-12 * (hi - lo).norm());
   const StepReport& step = result.steps.back();
   CHECK(step.path == "surfaces.bulged.steps[0]");
+  REQUIRE(result.stages.size() == 1);  // the before/after of the one step
+  CHECK(result.stages[0].surface == "bulged");
+  CHECK(result.stages[0].step == "surfaces.bulged.steps[0]");
+  CHECK(surface::identical(result.stages[0].before, parent));
+  CHECK(surface::identical(result.stages[0].after, result.surface("bulged")));
   CHECK(step.kind == "bezier_lattice");
   bool exact = false, fold_free = false;
   for (const auto& [name, value] : step.figures) {
@@ -318,6 +323,8 @@ TEST_CASE("a style step leaves every control vertex outside the bound untouched"
   }
   CHECK(moved > 0);
   CHECK(outside_moved == 0);
+  REQUIRE(result.stages.size() == 1);
+  CHECK(result.stages[0].curves == std::vector<std::string>{"bound", "target"});
 }
 
 TEST_CASE("a replay gives bit-identical surfaces", "[recipe]") {

@@ -92,6 +92,17 @@ struct ExportResult {
   std::vector<std::string> problems;  ///< BRepCheck findings
 };
 
+/// One enabled step of a deformed surface's stack: the surface before and after it (what a
+/// viewer's before/after toggle shows), and the named curves it used (a style step's bound and
+/// target).
+struct Stage {
+  std::string surface;  ///< the deformed surface's name ("sail"; "<stem>-<k>" for deform_surfaces)
+  std::string step;     ///< the step's report path ("surfaces.sail.steps[1]")
+  std::string kind;     ///< the step's kind ("style", "bezier_lattice", ...)
+  surface::BSplineSurface before, after;
+  std::vector<std::string> curves;  ///< names of the curves the step used, in RunResult::curves
+};
+
 /// Everything a run computed, in memory. Nothing is written until write_outputs.
 struct RunResult {
   std::string recipe;  ///< the recipe's name
@@ -99,6 +110,7 @@ struct RunResult {
   std::vector<std::pair<std::string, surface::BSplineSurface>> surfaces;  ///< every named surface
   std::vector<ExportResult> exports;  ///< in document order
   std::vector<StepReport> steps;      ///< every step in order of execution
+  std::vector<Stage> stages;          ///< every enabled deformation step, in order of execution
   double seconds = 0;                 ///< wall time of the whole run
   /// The named surface. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
   const surface::BSplineSurface& surface(std::string_view name) const;
