@@ -92,12 +92,12 @@ class Runner {
           rep.message += ": disabled, skipped";
           return;
         }
-        Stage stage{name, p, step.kind, s, {}, {}};
+        Stage stage{name, p, step.kind, s, {}, {}, {}};
         if (const auto* style = std::get_if<StyleDef>(&step.step)) {
           if (!style->bound.empty()) stage.curves.push_back(style->bound);
           stage.curves.push_back(style->target);
         }
-        s = std::visit([&](const auto& d) { return apply(d, s, c, rep); }, step.step);
+        s = std::visit([&](const auto& d) { return apply(d, s, c, rep, stage); }, step.step);
         stage.after = s;
         result_.stages.push_back(std::move(stage));
       });
@@ -325,13 +325,16 @@ class Runner {
   }
 
   BSplineSurface apply(const deform::Deformation& d, const BSplineSurface& s, const Composition& c,
-                       StepReport& rep) {
+                       StepReport& rep, Stage& stage) {
+    stage.map = [d](const Eigen::Vector3d& x) {
+      return std::visit([&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, d);
+    };
     BSplineSurface out = compose(d, s, c, rep);
     lattice_figures(d, rep);
     return out;
   }
 
-  BSplineSurface apply(const StyleDef& d, const BSplineSurface& s, const Composition&, StepReport& rep) {
+  BSplineSurface apply(const StyleDef& d, const BSplineSurface& s, const Composition&, StepReport& rep, Stage&) {
     const auto r = d.bound.empty() ? deform::style_deform(s, curve_of(d.target), d.options)
                                    : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
     const auto& x = r.report;
@@ -355,7 +358,8 @@ class Runner {
     return r.surface;
   }
 
-  BSplineSurface apply(const DirectDef& d, const BSplineSurface& s, const Composition& c, StepReport& rep) {
+  BSplineSurface apply(const DirectDef& d, const BSplineSurface& s, const Composition& c, StepReport& rep,
+                       Stage& stage) {
     std::vector<deform::PointMove> moves;
     for (const auto& m : d.moves) {
       Eigen::Vector3d x = m.point;
@@ -388,6 +392,9 @@ class Runner {
                    {"displacement_norm", r.displacement_norm}};
     if (!r.feasible) rep.warning = true;
     rep.message += ": " + r.message;
+    stage.map = [lattice](const Eigen::Vector3d& x) {
+      return std::visit([&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, lattice);
+    };
     BSplineSurface out = compose(lattice, s, c, rep);
     lattice_figures(lattice, rep);
     return out;

@@ -153,6 +153,9 @@ TEST_CASE("a Bezier lattice step with moves equals the lattice applied pointwise
   CHECK(result.stages[0].step == "surfaces.bulged.steps[0]");
   CHECK(surface::identical(result.stages[0].before, parent));
   CHECK(surface::identical(result.stages[0].after, result.surface("bulged")));
+  REQUIRE(result.stages[0].map);
+  const Eigen::Vector3d x(30, 40, 5);
+  CHECK((result.stages[0].map(x) - deform::deform_point(lattice, x)).norm() == 0.0);
   CHECK(step.kind == "bezier_lattice");
   bool exact = false, fold_free = false;
   for (const auto& [name, value] : step.figures) {
@@ -325,6 +328,7 @@ TEST_CASE("a style step leaves every control vertex outside the bound untouched"
   CHECK(outside_moved == 0);
   REQUIRE(result.stages.size() == 1);
   CHECK(result.stages[0].curves == std::vector<std::string>{"bound", "target"});
+  CHECK(!result.stages[0].map);
 }
 
 TEST_CASE("a replay gives bit-identical surfaces", "[recipe]") {

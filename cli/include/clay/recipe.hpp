@@ -7,6 +7,8 @@
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
+#include <Eigen/Core>
+
 #include <filesystem>
 #include <functional>
 #include <memory>
@@ -101,6 +103,9 @@ struct Stage {
   std::string kind;     ///< the step's kind ("style", "bezier_lattice", ...)
   surface::BSplineSurface before, after;
   std::vector<std::string> curves;  ///< names of the curves the step used, in RunResult::curves
+  /// The step's deformation of space, point by point (`after` equals it applied to `before`,
+  /// exactly or within the refit's bound); empty for a style step, which moves control points.
+  std::function<Eigen::Vector3d(const Eigen::Vector3d&)> map;
 };
 
 /// Everything a run computed, in memory. Nothing is written until write_outputs.
