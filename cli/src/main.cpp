@@ -3,6 +3,7 @@
 #include <clay/deform.hpp>
 #include <clay/recipe.hpp>
 #include <clay/render.hpp>
+#include <clay/serve.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -232,6 +233,26 @@ int main(int argc, char** argv) {
                          "tessellation: samples per knot span [1, 64]")
       ->capture_default_str();
   render_cmd->add_flag("--net", render_options.control_net, "draw the control nets");
+  // clayform view / snapshot (clay/serve.hpp)
+  std::string run_dir, host = "127.0.0.1";
+  int port = 8765;
+  auto* view_cmd = app.add_subcommand(
+      "view", "Serve a run folder to the browser viewer: open the printed address (the folder needs the "
+              "view/ data every run writes, and the viewer's build, viewer/dist or $CLAYFORM_VIEWER_DIR)");
+  view_cmd->add_option("DIR", run_dir, "the --out folder of clayform run or deform")->required();
+  view_cmd->add_option("--port", port, "TCP port, 0 for any free one")->capture_default_str();
+  view_cmd->add_option("--host", host, "address to listen on")->capture_default_str();
+  clay::recipe::SnapshotOptions snapshot_options;
+  auto* snapshot_cmd = app.add_subcommand(
+      "snapshot", "Write a PNG picture of the viewer's page on a run folder (headless chromium)");
+  snapshot_cmd->add_option("DIR", run_dir, "the --out folder of clayform run or deform")->required();
+  snapshot_cmd->add_option("--png", png_file, "the picture to write (.png)")->required();
+  snapshot_cmd->add_option("--width", snapshot_options.width, "picture width in pixels [16, 8192]")
+      ->capture_default_str();
+  snapshot_cmd->add_option("--height", snapshot_options.height, "picture height in pixels [16, 8192]")
+      ->capture_default_str();
+  snapshot_cmd->add_option("--mode", snapshot_options.mode, "shaded, zebra, gaussian, mean or deviation")
+      ->capture_default_str();
   app.footer(
       "Exit codes: 0 success, 1 usage, 2 invalid argument, 3 invalid geometry or out of domain, "
       "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 70 internal error.");
@@ -246,6 +267,24 @@ int main(int argc, char** argv) {
     if (*render_cmd) {
       if (!eye.empty()) render_options.eye_direction = {eye[0], eye[1], eye[2]};
       return render_picture(file, png_file, render_options);
+    }
+    if (*view_cmd) {
+      clay::recipe::ServeOptions o;
+      o.host = host;
+      o.port = port;
+      clay::recipe::ViewServer server(run_dir, o);
+      std::printf("Serving %s at %s (Ctrl-C to stop)\n", run_dir.c_str(), server.url().c_str());
+      std::fflush(stdout);
+      server.run();
+      return 0;
+    }
+    if (*snapshot_cmd) {
+      const auto start = std::chrono::steady_clock::now();
+      clay::recipe::snapshot(run_dir, png_file, snapshot_options);
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::printf("%s: %s view -> %s (%d x %d, %.1f s)\n", run_dir.c_str(), snapshot_options.mode.c_str(),
+                  png_file.c_str(), snapshot_options.width, snapshot_options.height, s);
+      return 0;
     }
     const bool show = !quiet && (progress || ::isatty(STDOUT_FILENO));
     if (*validate_cmd) return validate(recipe_file);

@@ -3,6 +3,7 @@
 #include <clay/error.hpp>
 #include <clay/recipe.hpp>
 #include <clay/surface/exchange.hpp>
+#include <clay/view.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -151,6 +152,7 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
       if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + (tmp / "report.json").string() + "\"");
     }
     names.push_back("report.json");
+    write_view_data(result, tmp);  // view/manifest.json and view/NNN.bin (clay/view.hpp)
     fs::create_directories(target, ec);
     if (ec)
       throw Error(ErrorCategory::Io, "cannot create the output folder \"" + target.string() + "\": " + ec.message());
@@ -161,6 +163,14 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
         throw Error(ErrorCategory::Io, "cannot move \"" + n + "\" into \"" + target.string() + "\": " + ec.message());
       written.push_back(target / n);
     }
+    // The view folder as a whole: a previous run's meshes go, this run's come in one rename.
+    fs::remove_all(target / "view", ec);
+    if (ec)
+      throw Error(ErrorCategory::Io, "cannot replace \"" + (target / "view").string() + "\": " + ec.message());
+    fs::rename(tmp / "view", target / "view", ec);
+    if (ec)
+      throw Error(ErrorCategory::Io, "cannot move \"view\" into \"" + target.string() + "\": " + ec.message());
+    written.push_back(target / "view");
     fs::remove_all(tmp, ec);
     return written;
   } catch (...) {

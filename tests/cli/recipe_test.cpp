@@ -362,7 +362,8 @@ TEST_CASE("outputs are written whole, read back identical, and a failure leaves 
   auto result = run_recipe(parse_recipe(text));
   const fs::path out = output_dir("write");
   const auto files = write_outputs(result, out);
-  CHECK(files.size() == 4);
+  CHECK(files.size() == 5);  // part.step, part.igs, part.glb, report.json, view/
+  CHECK(files.back() == out / "view");
   const auto back = surface::read_step(out / "part.step");
   REQUIRE(back.size() == 2);
   CHECK(surface::identical(back[0], result.surface("bulged")));

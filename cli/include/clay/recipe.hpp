@@ -143,11 +143,13 @@ RunResult deform_surfaces(const Recipe& recipe, const std::vector<surface::BSpli
 /// exchange figures (valid is filled in by write_outputs; report_json alone leaves it out).
 std::string report_json(const RunResult& result);
 
-/// Writes every export (NAME.step, NAME.igs, NAME.glb per its formats) and report.json into
-/// `out_dir` (created when missing). The files are first written into a temporary folder next
+/// Writes every export (NAME.step, NAME.igs, NAME.glb per its formats), report.json and the view
+/// folder (view/manifest.json and view/NNN.bin, clay/view.hpp) into `out_dir` (created when
+/// missing). The files are first written into a temporary folder next
 /// to `out_dir` and each STEP file is read back and checked (BRepCheck); only when everything
 /// succeeded are they moved into `out_dir`, so a failure leaves no partial files. Returns the
-/// paths written. Throws clay::Error (Io, Exchange) naming the file.
+/// paths written (the view folder as one entry, last). Throws clay::Error (Io, Exchange) naming
+/// the file.
 std::vector<std::filesystem::path> write_outputs(RunResult& result, const std::filesystem::path& out_dir);
 
 }  // namespace clay::recipe

@@ -1,0 +1,63 @@
+#pragma once
+/// Serving a run to the browser viewer and taking pictures of it (issue #9): `clayform view` and
+/// `clayform snapshot` (docs/recipe.md "Viewing a run"). The built front end (viewer/dist) is
+/// served at `/`, the run folder (with its view/manifest.json, clay/view.hpp) under `/run/`.
+#include <filesystem>
+#include <memory>
+#include <string>
+
+namespace clay::recipe {
+
+/// The built front end: the environment variable CLAYFORM_VIEWER_DIR when set and not empty, else
+/// the folder compiled in (the source tree's viewer/dist).
+std::filesystem::path viewer_dir();
+
+/// Settings of ViewServer.
+struct ServeOptions {
+  std::string host = "127.0.0.1";
+  int port = 8765;                      ///< 0: any free port (see ViewServer::port)
+  std::filesystem::path viewer;         ///< the built front end; empty: viewer_dir()
+};
+
+/// An HTTP server (cpp-httplib) of one run folder: `/` and static files from the front end,
+/// `/run/...` from the run folder; content types by extension (.bin application/octet-stream,
+/// .glb model/gltf-binary); paths containing ".." are refused (400). Binds in the constructor.
+class ViewServer {
+ public:
+  /// Checks `run_dir`/view/manifest.json and the front end's index.html (clay::Error(Io) naming
+  /// the fix when missing) and binds the port (clay::Error(Io) when it cannot).
+  ViewServer(const std::filesystem::path& run_dir, const ServeOptions& options = {});
+  ~ViewServer();  ///< stops and joins
+  ViewServer(const ViewServer&) = delete;
+  ViewServer& operator=(const ViewServer&) = delete;
+
+  int port() const noexcept;  ///< the bound port
+  std::string url() const;    ///< "http://HOST:PORT/"
+  void run();                 ///< serves in this thread until stop() (from another thread)
+  void start();               ///< serves in a thread of its own
+  void stop();                ///< stops serving (and joins the thread of start)
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Settings of snapshot.
+struct SnapshotOptions {
+  int width = 1280;                                    ///< picture width in pixels [16, 8192]
+  int height = 800;                                    ///< picture height in pixels [16, 8192]
+  std::string mode = "shaded";                         ///< shaded, zebra, gaussian, mean or deviation
+  std::filesystem::path viewer;                        ///< the built front end; empty: viewer_dir()
+  std::filesystem::path chromium = "/usr/bin/chromium";  ///< Debian's chromium
+  int timeout_seconds = 60;                            ///< chromium is killed after this
+};
+
+/// A PNG picture of the viewer's page on the run folder: serves it on a free port of 127.0.0.1,
+/// runs chromium headless (--screenshot, a temporary profile removed afterwards) on
+/// `/?mode=MODE`, waits for it (killed after the timeout), checks `png` was written.
+/// Throws clay::Error: InvalidArgument for a bad mode or size, Io when chromium is missing (naming
+/// the Debian package), fails, times out or writes no picture.
+void snapshot(const std::filesystem::path& run_dir, const std::filesystem::path& png,
+              const SnapshotOptions& options = {});
+
+}  // namespace clay::recipe

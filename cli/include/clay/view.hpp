@@ -1,0 +1,57 @@
+#pragma once
+/// The view data of a run (issue #9): grid tessellations of every exported surface and of every
+/// deformation stage's before/after, with exact normals, Gaussian and mean curvature and the
+/// refit deviation, written as `view/manifest.json` and `view/NNN.bin` for the browser viewer
+/// (`clayform view`, docs/recipe.md "Viewing a run").
+#include <clay/recipe.hpp>
+
+#include <Eigen/Core>
+
+#include <filesystem>
+#include <functional>
+#include <vector>
+
+namespace clay::recipe {
+
+/// A grid tessellation: rows x cols vertices, vertex (i, j) at index i * cols + j, u along rows
+/// (parameter us[i]) and v along columns (vs[j]).
+struct ViewMesh {
+  int rows = 0, cols = 0;
+  std::vector<double> us, vs;
+  std::vector<Eigen::Vector3d> position;  ///< S(u, v), mm
+  std::vector<Eigen::Vector3d> normal;    ///< unit S_u x S_v (the neighbouring cells' average where degenerate)
+  std::vector<double> gaussian;           ///< K, 1/mm^2
+  std::vector<double> mean;               ///< H, 1/mm, positive when the surface bends towards its normal
+  std::vector<double> deviation;          ///< mm; 0 unless set by set_deviation
+  std::vector<char> degenerate;           ///< 1 where S_u x S_v vanishes (curvatures are the neighbours' average)
+};
+
+/// The grid parameters of one direction: about 8 samples per knot span following the knots, at
+/// least 17 and at most 161 in all, ends included.
+std::vector<double> view_parameters(const surface::BSplineBasis& basis);
+
+/// The surface on the grid view_parameters(u) x view_parameters(v), with exact normals and
+/// curvatures from the first and second derivatives: K = (LN - M^2) / (EG - F^2),
+/// H = (EN - 2FM + GL) / (2 (EG - F^2)). Where S_u x S_v vanishes (a pole, a collapsed edge) the
+/// normal is the normalized average of the neighbouring cells' normals and K, H the average of
+/// the non-degenerate neighbouring vertices'. Deviation all 0.
+ViewMesh tessellate(const surface::BSplineSurface& surface);
+
+/// Sets mesh.deviation to |S(u, v) - map(B(u, v))| at every vertex, with S the tessellated
+/// surface (the refit) and B the surface before the step, its domain mapped affinely onto S's.
+void set_deviation(ViewMesh& mesh, const surface::BSplineSurface& before,
+                   const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map);
+
+/// The .bin layout: little-endian float32, attribute after attribute (position 3, normal 3,
+/// gaussian 1, mean 1, deviation 1 floats per vertex), rows * cols * 9 floats.
+std::vector<float> view_floats(const ViewMesh& mesh);
+
+/// Writes `dir/view/manifest.json` (format "clayform.view", version 1) and the meshes
+/// `dir/view/NNN.bin`: every surface of every export (its final mesh, its control net, the figures
+/// of the step that made it) and per enabled deformation step its before/after meshes and nets,
+/// the curves it used (200-point polylines) and its figures; a refitted step's `after` carries its
+/// deviation from the step's deformation applied pointwise to `before`. Identical meshes share a
+/// file. Throws clay::Error(Io) naming the file that cannot be written.
+void write_view_data(const RunResult& result, const std::filesystem::path& dir);
+
+}  // namespace clay::recipe

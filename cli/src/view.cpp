@@ -1,0 +1,335 @@
+// The view data of a run: grid meshes with exact normals and curvatures, the refit deviation, and
+// the manifest the browser viewer reads (docs/recipe.md "Viewing a run").
+#include <clay/error.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
+#include <clay/view.hpp>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <system_error>
+
+namespace clay::recipe {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+
+constexpr int max_samples = 161;
+constexpr int min_samples = 17;
+constexpr int per_span = 8;
+constexpr int curve_samples = 200;
+
+Json figure_json(const Figure& f) {
+  return std::visit([](const auto& x) { return Json(x); }, f);
+}
+
+Json figures_json(const StepReport* step) {
+  Json j = Json::object();
+  if (step)
+    for (const auto& [name, value] : step->figures) j[name] = figure_json(value);
+  return j;
+}
+
+Json point_json(const Vector3d& p) { return Json::array({p.x(), p.y(), p.z()}); }
+
+Json net_json(const surface::BSplineSurface& s) {
+  Json points = Json::array();
+  for (Eigen::Index r = 0; r < s.points.rows(); ++r) points.push_back(point_json(s.points.row(r).transpose()));
+  return Json{{"rows", s.count_u()}, {"cols", s.count_v()}, {"points", std::move(points)}};
+}
+
+Json curve_json(const std::string& name, const surface::BSplineCurve& c) {
+  const auto [t0, t1] = c.basis.domain();
+  const auto ts = surface::linspace(t0, t1, curve_samples);
+  const surface::Points3 p = surface::evaluate_many(c, ts);
+  Json points = Json::array();
+  for (Eigen::Index r = 0; r < p.rows(); ++r) points.push_back(point_json(p.row(r).transpose()));
+  return Json{{"name", name}, {"points", std::move(points)}};
+}
+
+const StepReport* step_named(const RunResult& r, const std::string& path) {
+  for (const auto& s : r.steps)
+    if (s.path == path) return &s;
+  return nullptr;
+}
+
+/// The step's name from its report message ("deformations.spin[0] 'bulge': ..."), or empty.
+std::string step_name(const StepReport* step) {
+  if (!step) return {};
+  const std::string& m = step->message;
+  const auto space = m.find(' ');
+  if (space == std::string::npos || space + 1 >= m.size() || m[space + 1] != '\'') return {};
+  const auto end = m.find('\'', space + 2);
+  if (end == std::string::npos) return {};
+  return m.substr(space + 2, end - space - 2);
+}
+
+bool is_refit(const StepReport* step) {
+  if (!step) return false;
+  for (const auto& [name, value] : step->figures)
+    if (name == "composition") return std::holds_alternative<std::string>(value) && std::get<std::string>(value) == "refit";
+  return false;
+}
+
+/// Normalized a, or zero when a vanishes.
+Vector3d unit_or_zero(const Vector3d& a) {
+  const double n = a.norm();
+  return n > 0 && std::isfinite(n) ? Vector3d(a / n) : Vector3d::Zero();
+}
+
+}  // namespace
+
+std::vector<double> view_parameters(const surface::BSplineBasis& basis) {
+  const auto breaks = surface::breakpoints(basis);
+  const int spans = static_cast<int>(breaks.size()) - 1;
+  const auto [t0, t1] = basis.domain();
+  if (spans < 1 || spans > max_samples - 1) return surface::linspace(t0, t1, max_samples);
+  int per = std::clamp((max_samples - 1) / spans, 1, per_span);
+  if (spans * per < min_samples - 1) per = (min_samples - 1 + spans - 1) / spans;
+  return surface::span_samples(basis, per);
+}
+
+ViewMesh tessellate(const surface::BSplineSurface& s) {
+  ViewMesh m;
+  m.us = view_parameters(s.u);
+  m.vs = view_parameters(s.v);
+  m.rows = static_cast<int>(m.us.size());
+  m.cols = static_cast<int>(m.vs.size());
+  const std::size_t n = static_cast<std::size_t>(m.rows) * static_cast<std::size_t>(m.cols);
+  m.position.resize(n);
+  m.normal.assign(n, Vector3d::Zero());
+  m.gaussian.assign(n, 0.0);
+  m.mean.assign(n, 0.0);
+  m.deviation.assign(n, 0.0);
+  m.degenerate.assign(n, 0);
+  // Absolute floor for a vanishing first derivative: 1e-10 of the model's size per unit parameter.
+  const auto [lo, hi] = surface::control_box(s);
+  const double size = std::max((hi - lo).norm(), std::numeric_limits<double>::min());
+  const auto [u0, u1] = s.u.domain();
+  const auto [v0, v1] = s.v.domain();
+  const double floor_u = 1e-10 * size / (u1 - u0), floor_v = 1e-10 * size / (v1 - v0);
+  const auto at = [&](int i, int j) { return static_cast<std::size_t>(i) * static_cast<std::size_t>(m.cols) + static_cast<std::size_t>(j); };
+  for (int i = 0; i < m.rows; ++i)
+    for (int j = 0; j < m.cols; ++j) {
+      const auto d = surface::derivatives(s, m.us[static_cast<std::size_t>(i)], m.vs[static_cast<std::size_t>(j)], 2);
+      const std::size_t k = at(i, j);
+      m.position[k] = d.point;
+      const Vector3d c = d.du.cross(d.dv);
+      const double cn = c.norm(), nu = d.du.norm(), nv = d.dv.norm();
+      if (!(nu > floor_u && nv > floor_v && cn > 1e-10 * nu * nv) || !std::isfinite(cn)) {
+        m.degenerate[k] = 1;
+        continue;
+      }
+      const Vector3d normal = c / cn;
+      const double E = d.du.dot(d.du), F = d.du.dot(d.dv), G = d.dv.dot(d.dv);
+      const double L = d.duu.dot(normal), M = d.duv.dot(normal), N = d.dvv.dot(normal);
+      const double det = cn * cn;  // EG - F^2 = |S_u x S_v|^2, without the cancellation
+      m.normal[k] = normal;
+      m.gaussian[k] = (L * N - M * M) / det;
+      m.mean[k] = (E * N - 2 * F * M + G * L) / (2 * det);
+    }
+  // Degenerate vertices: the neighbouring cells' normals, the neighbouring vertices' curvatures.
+  for (int i = 0; i < m.rows; ++i)
+    for (int j = 0; j < m.cols; ++j) {
+      const std::size_t k = at(i, j);
+      if (!m.degenerate[k]) continue;
+      Vector3d sum = Vector3d::Zero();
+      for (int a = std::max(i - 1, 0); a < std::min(i + 1, m.rows - 1); ++a)
+        for (int b = std::max(j - 1, 0); b < std::min(j + 1, m.cols - 1); ++b) {
+          // cell (a, b): its diagonals' cross product is twice the S_u x S_v of a flat cell
+          const Vector3d d1 = m.position[at(a + 1, b + 1)] - m.position[at(a, b)];
+          const Vector3d d2 = m.position[at(a, b + 1)] - m.position[at(a + 1, b)];
+          sum += unit_or_zero(d1.cross(d2));
+        }
+      double K = 0, H = 0;
+      int count = 0;
+      Vector3d near = Vector3d::Zero();
+      for (int a = std::max(i - 1, 0); a <= std::min(i + 1, m.rows - 1); ++a)
+        for (int b = std::max(j - 1, 0); b <= std::min(j + 1, m.cols - 1); ++b) {
+          const std::size_t q = at(a, b);
+          if (m.degenerate[q]) continue;
+          K += m.gaussian[q];
+          H += m.mean[q];
+          near += m.normal[q];
+          ++count;
+        }
+      Vector3d normal = unit_or_zero(sum);
+      if (normal.isZero()) normal = unit_or_zero(near);
+      if (normal.isZero()) normal = Vector3d::UnitZ();  // a surface collapsed to a point or a curve
+      m.normal[k] = normal;
+      m.gaussian[k] = count ? K / count : 0.0;
+      m.mean[k] = count ? H / count : 0.0;
+    }
+  return m;
+}
+
+void set_deviation(ViewMesh& mesh, const surface::BSplineSurface& before,
+                   const std::function<Vector3d(const Vector3d&)>& map) {
+  if (!map || mesh.us.empty() || mesh.vs.empty()) return;
+  const auto [a0, a1] = before.u.domain();
+  const auto [b0, b1] = before.v.domain();
+  const double u0 = mesh.us.front(), u1 = mesh.us.back(), v0 = mesh.vs.front(), v1 = mesh.vs.back();
+  const auto onto = [](double t, double s0, double s1, double r0, double r1) {
+    if (t == s1) return r1;
+    return std::clamp(r0 + (t - s0) / (s1 - s0) * (r1 - r0), r0, r1);
+  };
+  for (int i = 0; i < mesh.rows; ++i)
+    for (int j = 0; j < mesh.cols; ++j) {
+      const double u = onto(mesh.us[static_cast<std::size_t>(i)], u0, u1, a0, a1);
+      const double v = onto(mesh.vs[static_cast<std::size_t>(j)], v0, v1, b0, b1);
+      const std::size_t k = static_cast<std::size_t>(i) * static_cast<std::size_t>(mesh.cols) + static_cast<std::size_t>(j);
+      mesh.deviation[k] = (mesh.position[k] - map(surface::evaluate(before, u, v))).norm();
+    }
+}
+
+std::vector<float> view_floats(const ViewMesh& m) {
+  const std::size_t n = m.position.size();
+  std::vector<float> f;
+  f.reserve(9 * n);
+  for (const auto& p : m.position)
+    for (int c = 0; c < 3; ++c) f.push_back(static_cast<float>(p[c]));
+  for (const auto& p : m.normal)
+    for (int c = 0; c < 3; ++c) f.push_back(static_cast<float>(p[c]));
+  for (double x : m.gaussian) f.push_back(static_cast<float>(x));
+  for (double x : m.mean) f.push_back(static_cast<float>(x));
+  for (double x : m.deviation) f.push_back(static_cast<float>(x));
+  return f;
+}
+
+void write_view_data(const RunResult& result, const fs::path& dir) {
+  const fs::path view = dir / "view";
+  std::error_code ec;
+  fs::create_directories(view, ec);
+  if (ec) throw Error(ErrorCategory::Io, "cannot create the folder \"" + view.string() + "\": " + ec.message());
+
+  // Meshes, shared between identical surfaces with the same deviation (source -1: none, else the
+  // refitted stage's index).
+  struct Written {
+    const surface::BSplineSurface* surface;
+    int source;
+    std::string file;
+    int rows, cols;
+    Vector3d lo, hi;  // of the mesh's vertices
+  };
+  std::vector<Written> written;
+  Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  const auto mesh = [&](const surface::BSplineSurface& s, int source, bool boxed) -> Json {
+    for (const auto& w : written)
+      if (w.source == source && surface::identical(*w.surface, s)) {
+        if (boxed) {
+          lo = lo.cwiseMin(w.lo);
+          hi = hi.cwiseMax(w.hi);
+        }
+        return Json{{"file", w.file}, {"rows", w.rows}, {"cols", w.cols}};
+      }
+    ViewMesh m = tessellate(s);
+    if (source >= 0) {
+      const Stage& stage = result.stages[static_cast<std::size_t>(source)];
+      set_deviation(m, stage.before, stage.map);
+    }
+    Vector3d mlo = Vector3d::Constant(std::numeric_limits<double>::infinity()), mhi = -mlo;
+    for (const auto& p : m.position) {
+      mlo = mlo.cwiseMin(p);
+      mhi = mhi.cwiseMax(p);
+    }
+    if (boxed) {
+      lo = lo.cwiseMin(mlo);
+      hi = hi.cwiseMax(mhi);
+    }
+    char name[32];
+    std::snprintf(name, sizeof name, "%03zu.bin", written.size());
+    std::vector<float> f = view_floats(m);
+    if constexpr (std::endian::native == std::endian::big)
+      for (float& x : f) {
+        std::uint32_t b;
+        std::memcpy(&b, &x, 4);
+        b = ((b & 0xFFu) << 24) | ((b & 0xFF00u) << 8) | ((b >> 8) & 0xFF00u) | (b >> 24);
+        std::memcpy(&x, &b, 4);
+      }
+    std::ofstream out(view / name, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(f.data()), static_cast<std::streamsize>(f.size() * sizeof(float)));
+    if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + (view / name).string() + "\"; check the space and permissions");
+    written.push_back({&s, source, name, m.rows, m.cols, mlo, mhi});
+    return Json{{"file", name}, {"rows", m.rows}, {"cols", m.cols}};
+  };
+
+  Json surfaces = Json::array();
+  for (const auto& e : result.exports)
+    for (std::size_t k = 0; k < e.surfaces.size() && k < e.surface_names.size(); ++k) {
+      const std::string& name = e.surface_names[k];
+      const surface::BSplineSurface& s = e.surfaces[k];
+      std::vector<std::size_t> own;
+      for (std::size_t q = 0; q < result.stages.size(); ++q)
+        if (result.stages[q].surface == name) own.push_back(q);
+      Json stages = Json::array();
+      for (std::size_t q : own) {
+        const Stage& st = result.stages[q];
+        const StepReport* rep = step_named(result, st.step);
+        const bool refit = st.map && is_refit(rep);
+        const std::string step = step_name(rep);
+        Json curves = Json::array();
+        for (const auto& c : st.curves)
+          for (const auto& [n, curve] : result.curves)
+            if (n == c) {
+              curves.push_back(curve_json(n, curve));
+              break;
+            }
+        Json x = Json::object();
+        x["step"] = st.step;
+        x["kind"] = st.kind;
+        x["label"] = st.kind + (step.empty() ? "" : " '" + step + "'");
+        x["before"] = mesh(st.before, -1, false);
+        x["after"] = mesh(st.after, refit ? static_cast<int>(q) : -1, false);
+        x["net_before"] = net_json(st.before);
+        x["net_after"] = net_json(st.after);
+        x["curves"] = std::move(curves);
+        x["figures"] = figures_json(rep);
+        x["refit"] = refit;
+        stages.push_back(std::move(x));
+      }
+      // The final mesh: the last stage's `after` (with its deviation) when it is this surface.
+      int source = -1;
+      if (!own.empty()) {
+        const Stage& last = result.stages[own.back()];
+        if (surface::identical(last.after, s) && last.map && is_refit(step_named(result, last.step)))
+          source = static_cast<int>(own.back());
+      }
+      const StepReport* made = own.empty() ? step_named(result, "surfaces." + name)
+                                           : step_named(result, result.stages[own.back()].step);
+      Json x = Json::object();
+      x["name"] = name;
+      x["export"] = e.name;
+      x["figures"] = figures_json(made);
+      x["mesh"] = mesh(s, source, true);
+      x["net"] = net_json(s);
+      x["stages"] = std::move(stages);
+      surfaces.push_back(std::move(x));
+    }
+
+  Json j = Json::object();
+  j["format"] = "clayform.view";
+  j["version"] = 1;
+  j["recipe"] = result.recipe;
+  j["report"] = "../report.json";
+  j["surfaces"] = std::move(surfaces);
+  if (!std::isfinite(lo.x())) lo = hi = Vector3d::Zero();
+  j["box"] = Json{{"min", point_json(lo)}, {"max", point_json(hi)}};
+  std::ofstream out(view / "manifest.json", std::ios::binary);
+  out << j.dump(1) << "\n";
+  if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + (view / "manifest.json").string() + "\"");
+}
+
+}  // namespace clay::recipe
