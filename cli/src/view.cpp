@@ -115,32 +115,49 @@ ViewMesh tessellate(const surface::BSplineSurface& s) {
   m.mean.assign(n, 0.0);
   m.deviation.assign(n, 0.0);
   m.degenerate.assign(n, 0);
-  // Absolute floor for a vanishing first derivative: 1e-10 of the model's size per unit parameter.
-  const auto [lo, hi] = surface::control_box(s);
-  const double size = std::max((hi - lo).norm(), std::numeric_limits<double>::min());
-  const auto [u0, u1] = s.u.domain();
-  const auto [v0, v1] = s.v.domain();
-  const double floor_u = 1e-10 * size / (u1 - u0), floor_v = 1e-10 * size / (v1 - v0);
   const auto at = [&](int i, int j) { return static_cast<std::size_t>(i) * static_cast<std::size_t>(m.cols) + static_cast<std::size_t>(j); };
+  std::vector<surface::SurfaceDerivatives> d(n);
+  double max_u = 0, max_v = 0;
   for (int i = 0; i < m.rows; ++i)
     for (int j = 0; j < m.cols; ++j) {
-      const auto d = surface::derivatives(s, m.us[static_cast<std::size_t>(i)], m.vs[static_cast<std::size_t>(j)], 2);
-      const std::size_t k = at(i, j);
-      m.position[k] = d.point;
-      const Vector3d c = d.du.cross(d.dv);
-      const double cn = c.norm(), nu = d.du.norm(), nv = d.dv.norm();
-      if (!(nu > floor_u && nv > floor_v && cn > 1e-10 * nu * nv) || !std::isfinite(cn)) {
-        m.degenerate[k] = 1;
-        continue;
-      }
-      const Vector3d normal = c / cn;
-      const double E = d.du.dot(d.du), F = d.du.dot(d.dv), G = d.dv.dot(d.dv);
-      const double L = d.duu.dot(normal), M = d.duv.dot(normal), N = d.dvv.dot(normal);
-      const double det = cn * cn;  // EG - F^2 = |S_u x S_v|^2, without the cancellation
-      m.normal[k] = normal;
-      m.gaussian[k] = (L * N - M * M) / det;
-      m.mean[k] = (E * N - 2 * F * M + G * L) / (2 * det);
+      auto& x = d[at(i, j)];
+      x = surface::derivatives(s, m.us[static_cast<std::size_t>(i)], m.vs[static_cast<std::size_t>(j)], 2);
+      max_u = std::max(max_u, x.du.norm());
+      max_v = std::max(max_v, x.dv.norm());
     }
+  // Grid lines collapsed to (almost) a point: a pole, a collapsed edge, or the tiny ring a refit
+  // leaves of one (about its tolerance across), where the curvature formulas blow up. A line is
+  // collapsed when its polyline is shorter than 1e-3 of the longest line of its direction.
+  std::vector<double> row_length(static_cast<std::size_t>(m.rows), 0.0), col_length(static_cast<std::size_t>(m.cols), 0.0);
+  for (int i = 0; i < m.rows; ++i)
+    for (int j = 0; j < m.cols; ++j) {
+      if (j + 1 < m.cols) row_length[static_cast<std::size_t>(i)] += (d[at(i, j + 1)].point - d[at(i, j)].point).norm();
+      if (i + 1 < m.rows) col_length[static_cast<std::size_t>(j)] += (d[at(i + 1, j)].point - d[at(i, j)].point).norm();
+    }
+  const double longest_row = *std::max_element(row_length.begin(), row_length.end());
+  const double longest_col = *std::max_element(col_length.begin(), col_length.end());
+  // Degenerate: on a collapsed line, a first derivative below 1e-5 of its largest on the grid, or
+  // parallel first derivatives.
+  const double floor_u = 1e-5 * max_u, floor_v = 1e-5 * max_v;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& x = d[k];
+    m.position[k] = x.point;
+    const Vector3d c = x.du.cross(x.dv);
+    const double cn = c.norm(), nu = x.du.norm(), nv = x.dv.norm();
+    const bool collapsed = row_length[k / static_cast<std::size_t>(m.cols)] <= 1e-3 * longest_row ||
+                           col_length[k % static_cast<std::size_t>(m.cols)] <= 1e-3 * longest_col;
+    if (collapsed || !(nu > floor_u && nv > floor_v && cn > 1e-8 * nu * nv) || !std::isfinite(cn)) {
+      m.degenerate[k] = 1;
+      continue;
+    }
+    const Vector3d normal = c / cn;
+    const double E = x.du.dot(x.du), F = x.du.dot(x.dv), G = x.dv.dot(x.dv);
+    const double L = x.duu.dot(normal), M = x.duv.dot(normal), N = x.dvv.dot(normal);
+    const double det = cn * cn;  // EG - F^2 = |S_u x S_v|^2, without the cancellation
+    m.normal[k] = normal;
+    m.gaussian[k] = (L * N - M * M) / det;
+    m.mean[k] = (E * N - 2 * F * M + G * L) / (2 * det);
+  }
   // Degenerate vertices: the neighbouring cells' normals, the neighbouring vertices' curvatures.
   for (int i = 0; i < m.rows; ++i)
     for (int j = 0; j < m.cols; ++j) {

@@ -177,6 +177,25 @@ TEST_CASE("a sphere's mesh has K = 1 over r squared and a mean curvature of size
   CHECK(worst_pole < 1.0);
 }
 
+TEST_CASE("a pole opened into a tiny ring, as a refit leaves it, is treated as degenerate", "[view]") {
+  const Vector3d c(0, 0, 0);
+  const double r = 40;
+  auto s = sphere(c, r);
+  // move the south pole's copies onto a ring of radius 1e-4 mm: the surface's K and H there are
+  // of the order of 1/(1e-4 r) and 1e-4 / r^2 is the ring's share of S_u
+  for (int i = 0; i < s.count_u(); ++i) {
+    const double a = 2 * pi * i / (s.count_u() - 1);
+    s.points.row(s.index(i, 0)) += 1e-4 * Eigen::RowVector3d(std::cos(a), std::sin(a), 0);
+  }
+  const ViewMesh m = tessellate(s);
+  double worst = 0;
+  for (std::size_t k = 0; k < m.position.size(); ++k) {
+    worst = std::max(worst, std::abs(m.gaussian[k] * r * r - 1));
+    if (k % static_cast<std::size_t>(m.cols) == 0) CHECK(m.degenerate[k] == 1);
+  }
+  CHECK(worst < 1e-3);  // the neighbours' K, within the ring's disturbance of the next row
+}
+
 TEST_CASE("a cylinder's mesh has K = 0 and a mean curvature of size 1 over 2r", "[view]") {
   const double r = 30;
   surface::Points3 ends(2, 3);

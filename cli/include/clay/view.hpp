@@ -32,9 +32,12 @@ std::vector<double> view_parameters(const surface::BSplineBasis& basis);
 
 /// The surface on the grid view_parameters(u) x view_parameters(v), with exact normals and
 /// curvatures from the first and second derivatives: K = (LN - M^2) / (EG - F^2),
-/// H = (EN - 2FM + GL) / (2 (EG - F^2)). Where S_u x S_v vanishes (a pole, a collapsed edge) the
-/// normal is the normalized average of the neighbouring cells' normals and K, H the average of
-/// the non-degenerate neighbouring vertices'. Deviation all 0.
+/// H = (EN - 2FM + GL) / (2 (EG - F^2)). Where the surface is degenerate — on a grid line
+/// collapsed to less than 1e-3 of the longest line of its direction (a pole, a collapsed edge, or
+/// the tiny ring a refit leaves of one, where the formulas blow up), |S_u| or |S_v| below 1e-5 of
+/// its largest on the grid, or S_u parallel to S_v — the normal is the normalized
+/// average of the neighbouring cells' normals and K, H the average of the non-degenerate
+/// neighbouring vertices'. Deviation all 0.
 ViewMesh tessellate(const surface::BSplineSurface& surface);
 
 /// Sets mesh.deviation to |S(u, v) - map(B(u, v))| at every vertex, with S the tessellated
