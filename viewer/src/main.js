@@ -36,7 +36,14 @@ body.dataset.mode = mode;
 
 // ---------------------------------------------------------------------------------------- scene
 const canvas = document.getElementById('view');
-const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+let renderer;
+try {
+  // preserveDrawingBuffer: screenshots (clayform snapshot, the e2e test) read the canvas any time
+  renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+} catch (e) {
+  fail(new Error(`WebGL is not available in this browser (${e.message})`));
+  throw e;
+}
 renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
 renderer.setClearColor(0x30343a);
 const scene = new THREE.Scene();
@@ -66,7 +73,9 @@ function requestRender(then) {
   if (then) afterFrame.push(then);
   if (framePending) return;
   framePending = true;
-  requestAnimationFrame(() => {
+  // A microtask, not requestAnimationFrame: headless Chromium's --screenshot with a virtual time
+  // budget (clayform snapshot) may take its picture before any animation frame runs.
+  queueMicrotask(() => {
     framePending = false;
     // key light over the viewer's right shoulder, rim light from behind: highlights follow the eye
     const eye = camera.position.clone();
@@ -94,7 +103,7 @@ function resize() {
   camera.updateProjectionMatrix();
   requestRender();
 }
-window.addEventListener('resize', resize);
+new ResizeObserver(resize).observe(document.getElementById('stage'));
 
 function fitCamera(box) {
   const center = box.getCenter(new THREE.Vector3());
@@ -174,7 +183,7 @@ async function applyStates() {
   const anyBefore = surfaces.some((s) => s.state.side === 'before');
   body.dataset.stage = anyBefore ? 'before' : 'after';
   const global = document.getElementById('toggle-before-after');
-  global.setAttribute('aria-pressed', anyBefore ? 'true' : 'false');
+  global.setAttribute('aria-pressed', surfaces.every((s) => s.state.stage < 0) ? 'false' : 'true');
   applyVisibility();
   applyMode();
 }
@@ -202,7 +211,7 @@ function range(values) {
 function applyMode() {
   body.dataset.mode = mode;
   for (const m of MODES) document.getElementById(`mode-${m}`).setAttribute('aria-pressed', m === mode ? 'true' : 'false');
-  document.getElementById('zebra-controls').hidden = mode !== 'zebra';
+  document.getElementById('zebra-controls').classList.toggle('inactive', mode !== 'zebra');
   surfaces.forEach((s) => (s.mesh.material = materials[mode]));
   const legend = document.getElementById('legend');
   const scalar = SCALAR[mode];
@@ -222,12 +231,13 @@ function applyMode() {
     legend.dataset.lo = legend.dataset.hi = '';
   }
   surfaces.forEach((s) => {
-    let text = '';
+    let stat = null;
     if (scalar) {
-      const [lo, hi] = range(s.data[mode]);
-      text = `${mode === 'gaussian' ? 'K' : mode === 'mean' ? 'H' : 'deviation'}: ${formatNumber(lo)} … ${formatNumber(hi)} ${scalar.unit}`;
+      const [min, max] = range(s.data[mode]);
+      const symbol = mode === 'gaussian' ? 'K' : mode === 'mean' ? 'H' : 'deviation';
+      stat = { min, max, text: `${symbol}: ${formatNumber(min)} … ${formatNumber(max)} ${scalar.unit}` };
     }
-    s.panel.update(s.state, text);
+    s.panel.update(s.state, stat);
   });
   requestRender();
 }
@@ -289,11 +299,12 @@ function toggleStage(index, k) {
   });
 }
 
+/** From the final surfaces to every first stage's before; from anything else back to the final surfaces. */
 function toggleAll() {
-  const anyBefore = surfaces.some((s) => s.state.side === 'before');
+  const allFinal = surfaces.every((s) => s.state.stage < 0);
   withLoading(() => {
     surfaces.forEach((s) => {
-      s.state = !anyBefore && s.entry.stages && s.entry.stages.length ? { stage: 0, side: 'before' } : { stage: -1, side: 'after' };
+      s.state = allFinal && s.entry.stages && s.entry.stages.length ? { stage: 0, side: 'before' } : { stage: -1, side: 'after' };
     });
   });
 }

@@ -37,9 +37,9 @@ void main() {
 export function zebraMaterial() {
   return new THREE.ShaderMaterial({
     uniforms: {
-      axisA: { value: new THREE.Vector3(0, 0, 1) },
-      axisB: { value: new THREE.Vector3(1, 0, 0) },
-      axisC: { value: new THREE.Vector3(0, 1, 0) },
+      axisA: { value: new THREE.Vector3(1, 0, 0) },
+      axisB: { value: new THREE.Vector3(0, 1, 0) },
+      axisC: { value: new THREE.Vector3(0, 0, 1) },
       stripes: { value: 24 },
     },
     vertexShader: worldVertex,

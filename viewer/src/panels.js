@@ -99,7 +99,7 @@ export function surfacePanel(surface, index, actions) {
     root.append(el('h3', { text: 'deformation steps' }), list);
   }
 
-  function update(state, statText) {
+  function update(state, stat) {
     toggles.forEach((t, k) => {
       const before = state.stage === k && state.side === 'before';
       const shown = state.stage === k || (state.stage < 0 && k === toggles.length - 1);
@@ -109,7 +109,14 @@ export function surfacePanel(surface, index, actions) {
     });
     showing.textContent =
       state.stage < 0 ? 'showing: final surface' : `showing: step ${state.stage + 1} ${state.side}`;
-    stats.textContent = statText || '';
+    stats.textContent = stat ? stat.text : '';
+    if (stat) {
+      stats.dataset.min = String(stat.min);
+      stats.dataset.max = String(stat.max);
+    } else {
+      delete stats.dataset.min;
+      delete stats.dataset.max;
+    }
   }
   return { root, update };
 }
