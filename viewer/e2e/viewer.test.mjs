@@ -196,7 +196,7 @@ await check('zebra mode changes data-mode and the picture', async () => {
   return differ(shaded, zebra, MIN_FRACTION_MODE, 'shaded vs zebra');
 });
 
-await check('zebra stripes move when the eye moves', async () => {
+await check('orbiting the camera (mouse drag) redraws the zebra view', async () => {
   const before = await shot('zebra-0');
   const box = await page.locator('#view').boundingBox();
   const x = box.x + box.width / 2, y = box.y + box.height / 2;
