@@ -67,7 +67,7 @@ function quantileOf(sorted, q) {
 }
 /** docs/viewer.md: curvature maps use [-R, R], R = max(|p2|, |p98|); deviation [0, max]. */
 function expectedRange(meshes, attr) {
-  const values = meshes.flatMap((m) => Array.from(readAttr(m, attr))).sort((a, b) => a - b);
+  const values = meshes.flatMap((m) => Array.from(readAttr(m, attr))).filter(Number.isFinite).sort((a, b) => a - b);
   const max = values[values.length - 1];
   if (attr === 'deviation') return [0, max > 0 ? max : 1];
   let r = Math.max(Math.abs(quantileOf(values, 0.02)), Math.abs(quantileOf(values, 0.98)));

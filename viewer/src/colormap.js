@@ -52,17 +52,19 @@ export const ROBUST_HIGH = 0.98;
  * The colour range of a set of Float32Arrays.
  * diverging: symmetric about zero, [-R, R] with R = max(|p2|, |p98|), so white is always zero.
  * sequential (deviation, never negative): [0, max], the largest value is the figure that matters.
- * Returns {lo, hi, min, max, zero} (zero: every value is 0).
+ * Non-finite values are left out. Returns {lo, hi, min, max, zero} (zero: every value is 0).
  */
 export function colourRange(arrays, diverging) {
   let n = 0;
   for (const a of arrays) n += a.length;
-  const all = new Float32Array(n);
+  let all = new Float32Array(n);
   let o = 0;
   for (const a of arrays) {
     all.set(a, o);
     o += a.length;
   }
+  if (!all.every(Number.isFinite)) all = all.filter(Number.isFinite); // never NaN ends
+  n = all.length;
   all.sort();
   const min = n ? all[0] : 0;
   const max = n ? all[n - 1] : 0;
