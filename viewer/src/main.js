@@ -64,8 +64,13 @@ const materials = {
   mean: scalarMaterial('mean', true),
   deviation: scalarMaterial('deviation', false),
 };
-const netMaterial = new THREE.LineBasicMaterial({ color: 0xffd166, transparent: true, opacity: 0.85 });
-const netDotMaterial = new THREE.PointsMaterial({ color: 0xffd166, size: 5, sizeAttenuation: false });
+const netMaterial = new THREE.LineBasicMaterial({ color: 0xffd166, transparent: true, opacity: 0.55 });
+const netDotMaterial = new THREE.PointsMaterial({ color: 0xffd166, size: 4, sizeAttenuation: false });
+// Nets drawn with their control points as dots up to this size; the net overlay starts switched
+// off when the nets shown hold more points than DENSE_NETS (an exact composition's net can be far
+// denser than the surface's sampling and would hide it).
+const NET_DOTS_MAX = 400;
+const DENSE_NETS = 2000;
 
 let framePending = false;
 let afterFrame = [];
@@ -144,7 +149,8 @@ function buildNet(net) {
   const group = new THREE.Group();
   if (net && net.points && net.points.length) {
     const { lines, dots } = netGeometry(net);
-    group.add(new THREE.LineSegments(lines, netMaterial), new THREE.Points(dots, netDotMaterial));
+    group.add(new THREE.LineSegments(lines, netMaterial));
+    if (net.points.length <= NET_DOTS_MAX) group.add(new THREE.Points(dots, netDotMaterial));
   }
   return group;
 }
@@ -382,6 +388,11 @@ async function start() {
     surfaces.push({ entry, state, group, mesh, net, curves, panel, data: null });
   });
   body.dataset.surfaces = String(surfaces.length);
+  const netPoints = surfaces.reduce((n, s) => n + ((netOf(s) && netOf(s).points) || []).length, 0);
+  if (netPoints > DENSE_NETS) {
+    document.getElementById('show-net').checked = false;
+    document.getElementById('show-net').parentElement.title = `off at start: the nets hold ${netPoints} control points`;
+  }
   if (!surfaces.length) showMessage('This run has no surfaces.');
   loadReport();
   await applyStates();
