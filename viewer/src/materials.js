@@ -117,10 +117,14 @@ vec3 colourMap(float t) {
 void main() {
   float t = (vValue - lo) / (hi - lo);
   vec3 c = colourMap(t);
+  // contour lines at the inner tenths of the range, only where the field varies across the
+  // pixel (not on regions where it is constant, e.g. zero deviation or a flat part)
   float q = t * 10.0;
   float d = abs(fract(q + 0.5) - 0.5);
-  float w = max(fwidth(q), 1e-5);
-  float line = contours * (1.0 - smoothstep(0.5 * w, 1.5 * w, d));
+  float fw = fwidth(q);
+  float w = max(fw, 1e-5);
+  float inside = step(0.05, q) * step(q, 9.95) * step(1e-3, fw);
+  float line = contours * inside * (1.0 - smoothstep(0.5 * w, 1.5 * w, d));
   c = mix(c, c * 0.45, 0.7 * line);
   float light = 0.62 + 0.38 * abs(normalize(vViewNormal).z);
   gl_FragColor = vec4(c * light, 1.0);
