@@ -284,6 +284,18 @@ await check('the before/after toggle shows the first stage before and changes th
   return note;
 });
 
+await check('two quick before/after toggles end on the final surfaces', async () => {
+  if (!hasStages) return 'skipped: this run has no deformation stage';
+  await page.evaluate(() => {
+    const b = document.getElementById('toggle-before-after');
+    b.click();
+    b.click();
+  });
+  await waitReady();
+  assert((await attr('stage')) === 'after', `data-stage ${await attr('stage')}`);
+  assert((await attr('vertices')) === String(vertices(finals)), `data-vertices ${await attr('vertices')}`);
+});
+
 await check('URL parameters ?mode=zebra&stage=before', async () => {
   await page.goto(`${base}?mode=zebra&stage=before`, { waitUntil: 'load' });
   await waitReady();

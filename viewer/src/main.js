@@ -172,9 +172,13 @@ function disposeGroup(group) {
   });
 }
 
+let generation = 0; // of state changes: only the latest one's completion applies and sets data-ready
+
 /** Loads what every surface's state shows and swaps it into the scene. */
 async function applyStates() {
+  const token = generation;
   const loaded = await Promise.all(surfaces.map((s) => store.load(meshOf(s))));
+  if (token !== generation) return; // a later change superseded this one
   surfaces.forEach((s, i) => {
     s.data = loaded[i];
     s.mesh.geometry = loaded[i].geometry;
@@ -288,11 +292,12 @@ function setMode(m) {
 }
 
 async function withLoading(change) {
+  const mine = ++generation;
   body.dataset.ready = '0';
   try {
     change();
     await applyStates();
-    requestRender(() => (body.dataset.ready = '1'));
+    if (mine === generation) requestRender(() => mine === generation && (body.dataset.ready = '1'));
   } catch (e) {
     fail(e);
   }
