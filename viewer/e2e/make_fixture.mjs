@@ -171,6 +171,26 @@ export function makeFixture(dir) {
   return manifest;
 }
 
+/**
+ * A run with one flat plate z = 0 over [0, 200] x [0, 200] (K = H = 0, normal +z) and no net: on a
+ * plane the reflection lines of an environment at infinity depend on the view direction only, so
+ * under a pure camera translation they stay put on the screen while the plate moves.
+ */
+export function makePlate(dir) {
+  const view = join(dir, 'view');
+  mkdirSync(view, { recursive: true });
+  const mesh = grid(9, 9, (s, t) => ({ p: [200 * s, 200 * t, 0], n: [0, 0, 1], K: 0, H: 0, d: 0 }));
+  writeFileSync(join(view, '000.bin'), meshBytes(mesh));
+  const manifest = {
+    format: 'clayform.view', version: 1, recipe: 'plate', report: '../report.json',
+    surfaces: [{ name: 'plate', export: 'plate', figures: {}, mesh: { file: '000.bin', rows: 9, cols: 9 }, net: null, stages: [] }],
+    box: { min: [0, 0, 0], max: [200, 200, 0] },
+  };
+  writeFileSync(join(view, 'manifest.json'), JSON.stringify(manifest));
+  writeFileSync(join(dir, 'report.json'), JSON.stringify({ format: 'clayform.report', version: 1, recipe: 'plate', ok: true, warnings: false, steps: [], exports: [] }));
+  return manifest;
+}
+
 if (process.argv[1] === fileURLToPath(import.meta.url)) {
   const dir = process.argv[2];
   if (!dir) {

@@ -15,7 +15,7 @@ import { tmpdir } from 'node:os';
 import { dirname, extname, join, normalize, resolve, sep } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
-import { makeFixture, DOME, DEVIATION_MAX } from './make_fixture.mjs';
+import { makeFixture, makePlate, DOME, DEVIATION_MAX } from './make_fixture.mjs';
 import { decodePng, differingPixels } from './png.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -104,12 +104,18 @@ if (fixtureDir) {
   const first = join(brokenDir, 'view', manifest.surfaces[0].mesh.file);
   writeFileSync(first, readFileSync(first).subarray(0, 1000));
 }
+// /plate/ serves the page with a run holding one flat plate (make_fixture.mjs, makePlate).
+const plateDir = mkdtempSync(join(tmpdir(), 'clayform-viewer-plate-'));
+makePlate(plateDir);
 const server = createServer((req, res) => {
   let url = decodeURIComponent(new URL(req.url, 'http://127.0.0.1').pathname);
   let run = runDir;
   if (brokenDir && url.startsWith('/broken/')) {
     url = url.slice(7);
     run = brokenDir;
+  } else if (url.startsWith('/plate/')) {
+    url = url.slice(6);
+    run = plateDir;
   }
   const ok = url.startsWith('/run/') ? serveFile(res, run, url.slice(5)) : serveFile(res, dist, url === '/' ? 'index.html' : url.slice(1));
   if (!ok) {
@@ -342,6 +348,59 @@ await check('net and curve overlays can be hidden', async () => {
   return `${n} pixels differ`;
 });
 
+await check('zebra stripes are reflections: on a plate they stay put when the camera translates', async () => {
+  const other = await browser.newPage({ viewport: { width: 900, height: 650 } });
+  other.on('pageerror', (e) => problems.push(`plate page error: ${e.message}`));
+  try {
+    await other.goto(`${base}plate/?mode=zebra`, { waitUntil: 'load' });
+    await other.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 30000 });
+    await other.$eval('#zebra-stripes', (e) => {
+      e.value = '64';
+      e.dispatchEvent(new Event('input'));
+    });
+    const frames = () => other.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
+    const grab = async () => decodePng(await other.locator('#view').screenshot({ style: '#legend, #message { visibility: hidden !important; }' }));
+    await frames();
+    const a = await grab();
+    const box = await other.locator('#view').boundingBox();
+    const x = box.x + box.width / 2, y = box.y + box.height / 2;
+    await other.mouse.move(x, y);
+    await other.mouse.down({ button: 'right' }); // OrbitControls: pan = translate eye and target together
+    await other.mouse.move(x + 70, y + 30, { steps: 5 });
+    await other.mouse.up({ button: 'right' });
+    await frames();
+    const b = await grab();
+    // pixels on the plate in both pictures, away from its edges (2 px)
+    const W = a.width, H = a.height;
+    const onPlate = (img, k) => Math.max(...BACKGROUND.map((c, i) => Math.abs(img.rgba[4 * k + i] - c))) > 8;
+    const inside = (img, px, py) => {
+      for (let dy = -2; dy <= 2; dy++) for (let dx = -2; dx <= 2; dx++) {
+        const qx = px + dx, qy = py + dy;
+        if (qx < 0 || qy < 0 || qx >= W || qy >= H || !onPlate(img, qy * W + qx)) return false;
+      }
+      return true;
+    };
+    let both = 0, changed = 0, white = 0, black = 0, moved = 0;
+    for (let py = 0; py < H; py++) for (let px = 0; px < W; px++) {
+      const k = py * W + px;
+      if (onPlate(a, k) !== onPlate(b, k)) moved++;
+      if (!inside(a, px, py) || !inside(b, px, py)) continue;
+      both++;
+      const v = a.rgba[4 * k];
+      if (v > 200) white++;
+      else if (v < 50) black++;
+      if (Math.abs(v - b.rgba[4 * k]) > PIXEL_THRESHOLD) changed++;
+    }
+    assert(moved > 2000, `the plate did not move on the screen (${moved} pixels)`);
+    assert(both > 20000, `only ${both} pixels on the plate in both pictures`);
+    assert(white > 0.1 * both && black > 0.1 * both, `no stripes to compare: ${white} white, ${black} black of ${both}`);
+    assert(changed <= 0.01 * both, `${changed} of ${both} plate pixels changed: the stripes moved with the plate`);
+    return `plate moved over ${moved} pixels; of ${both} pixels on it in both pictures (${white} white, ${black} black) ${changed} changed`;
+  } finally {
+    await other.close();
+  }
+});
+
 await check('a mesh file cut short is reported, not drawn (fixture only)', async () => {
   if (!brokenDir) return 'skipped: only with the fixture';
   const other = await browser.newPage({ viewport: { width: 800, height: 600 } });
@@ -369,6 +428,7 @@ await check('no console error, no request outside 127.0.0.1', async () => {
 await browser.close();
 server.close();
 if (fixtureDir) rmSync(fixtureDir, { recursive: true, force: true });
+rmSync(plateDir, { recursive: true, force: true });
 const passed = results.filter(Boolean).length;
 const failed = results.length - passed;
 console.log(`viewer e2e: ${runDir === fixtureDir ? 'fixture' : runDir}; load to data-ready ${loadMs} ms; total ${Date.now() - started} ms`);
