@@ -281,6 +281,24 @@ for (const m of ['gaussian', 'mean', 'deviation']) {
   });
 }
 
+await check('hiding a surface from its panel removes it and sets the colour range from the others', async () => {
+  if (manifest.surfaces.length < 2) return 'skipped: needs two surfaces';
+  await page.click('#mode-gaussian');
+  await nextFrames();
+  const all = await shot('gaussian-all');
+  await page.uncheck('.surface-panel[data-surface="0"] .surface-visible');
+  await nextFrames();
+  const rest = await shot('gaussian-without-first');
+  const [lo, hi] = expectedRange(finals.slice(1), 'gaussian');
+  const legend = await page.$eval('#legend', (l) => [Number(l.dataset.lo), Number(l.dataset.hi)]);
+  near(legend[0], lo, 1e-6, 'legend low end without the first surface');
+  near(legend[1], hi, 1e-6, 'legend high end without the first surface');
+  const note = differ(all, rest, MIN_FRACTION_STAGE, 'hiding the first surface');
+  await page.check('.surface-panel[data-surface="0"] .surface-visible');
+  await nextFrames();
+  return note;
+});
+
 await check('the before/after toggle shows the first stage before and changes the picture', async () => {
   if (!hasStages) return 'skipped: this run has no deformation stage';
   await page.click('#mode-shaded');

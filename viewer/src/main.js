@@ -226,7 +226,8 @@ function applyMode() {
   const legend = document.getElementById('legend');
   const scalar = SCALAR[mode];
   if (scalar) {
-    const r = colourRange(surfaces.map((s) => s.data[mode]), scalar.diverging);
+    // one range over the surfaces shown, so their colours compare
+    const r = colourRange(surfaces.filter((s) => s.group.visible).map((s) => s.data[mode]), scalar.diverging);
     materials[mode].uniforms.lo.value = r.lo;
     materials[mode].uniforms.hi.value = r.hi;
     showLegend(legend, scalar, r);
@@ -320,6 +321,11 @@ function toggleAll() {
   });
 }
 
+function showSurface(index, shown) {
+  surfaces[index].group.visible = shown;
+  applyMode();
+}
+
 function focusSurface(index) {
   const g = surfaces[index].mesh.geometry;
   if (g.boundingBox) fitCamera(g.boundingBox.clone());
@@ -388,7 +394,7 @@ async function start() {
     const curves = new THREE.Group();
     group.add(mesh, net, curves);
     scene.add(group);
-    const panel = surfacePanel(entry, index, { onToggle: toggleStage, onFocus: focusSurface });
+    const panel = surfacePanel(entry, index, { onToggle: toggleStage, onFocus: focusSurface, onVisible: showSurface });
     panels.append(panel.root);
     surfaces.push({ entry, state, group, mesh, net, curves, panel, data: null });
   });

@@ -46,18 +46,20 @@ export function figuresTable(figures) {
 
 /**
  * Builds the panel of `surface` (manifest entry) number `index`. `actions`:
- * onToggle(index, stage), onFocus(index). Returns {root, update(state, stats)}.
+ * onToggle(index, stage), onFocus(index), onVisible(index, shown). Returns {root, update(state, stats)}.
  */
 export function surfacePanel(surface, index, actions) {
   const name = el('button', { class: 'surface-name', title: 'Fit the camera to this surface', text: surface.name });
   name.addEventListener('click', () => actions.onFocus(index));
+  const visible = el('input', { type: 'checkbox', class: 'surface-visible', title: 'Show this surface', checked: '' });
+  visible.addEventListener('change', () => actions.onVisible(index, visible.checked));
   const meta = el('div', { class: 'meta' });
   const showing = el('div', { class: 'showing' });
   const stats = el('div', { class: 'stats' });
   const root = el(
     'section',
     { class: 'surface-panel', 'data-surface': String(index) },
-    el('h2', {}, name, el('span', { class: 'export', text: surface.export ? ` ${surface.export}` : '' })),
+    el('h2', {}, visible, name, el('span', { class: 'export', text: surface.export ? ` ${surface.export}` : '' })),
     meta,
     showing,
     stats,
