@@ -20,6 +20,7 @@
 
 
 #include "messages.hpp"
+#include "seal.hpp"
 
 namespace clay::deform {
 
@@ -661,6 +662,7 @@ ComposeResult finish(const surface::BezierPatches& bp, std::vector<ComposedPatch
     net = transposed(t);
   }
   ComposeResult result{to_surface(net, rational), {}};
+  detail::keep_closed_and_collapsed(original, result.surface, pointwise);
   report.degree_u = net.pu;
   report.degree_v = net.pv;
   report.control_points = static_cast<long>(net.nu) * net.nv;

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "extended_internal.hpp"
+#include "seal.hpp"
 #include "messages.hpp"
 
 namespace clay::deform {
@@ -711,6 +712,8 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     for (Eigen::Index r = 0; r < values.rows(); ++r)
       values.row(r) = deformed(d, values.row(r).transpose()).transpose();
     result.surface = least_squares(bu, bv, us, vs, values);
+    detail::keep_closed_and_collapsed(surface, result.surface,
+                                      [&](const Eigen::Vector3d& x) { return deformed(d, x); });
     const Certificate cert = certify(surface, result.surface, d, base, budget, rounding);
 
     report.summary.iterations = iteration;

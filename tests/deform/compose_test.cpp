@@ -429,3 +429,38 @@ TEST_CASE("compose_exact finds lower degrees: an axis-aligned affine sheet") {
   CHECK(deviation(s, r.surface, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); }, 300, rng) <=
         1e-12 * clay::test::size_of(lattice.points));
 }
+
+TEST_CASE("Exact composition keeps a closed side closed and a pole a point, bit for bit", "[compose]") {
+  // A full revolution of a half circle whose ends lie exactly on the axis: closed in u, its
+  // first and last columns collapsed to the poles.
+  clay::surface::Points3 p(5, 3);
+  p << 0, 0, -30, 30, 0, -30, 30, 0, 0, 30, 0, 30, 0, 0, 30;
+  Eigen::VectorXd w(5);
+  w << 1, std::sqrt(0.5), 1, std::sqrt(0.5), 1;
+  const auto sphere =
+      clay::surface::revolve(clay::surface::make_curve(2, {0, 0, 0, 0.5, 0.5, 1, 1, 1}, p, w), {{0, 0, 0}, {0, 0, 1}}, 360)
+          .surface;
+  Frame f;
+  f.origin = {-40, -40, -40};
+  f.s = {80, 5, 0};
+  f.t = {0, 80, 3};
+  f.u = {2, 0, 80};
+  BezierLattice lattice = make_bezier_lattice(f, {2, 2, 2});
+  lattice.points.row(lattice.index(1, 1, 2)) += Eigen::RowVector3d(4, -3, 9);
+  lattice.points.row(lattice.index(2, 1, 1)) += Eigen::RowVector3d(6, 2, -1);
+  const auto result = compose_exact(lattice, sphere);
+  const auto& s = result.surface;
+  const int mu = s.count_u(), mv = s.count_v();
+  for (int j = 0; j < mv; ++j) {
+    CHECK(s.points.row(s.index(0, j)) == s.points.row(s.index(mu - 1, j)));
+    CHECK(s.weights[s.index(0, j)] == s.weights[s.index(mu - 1, j)]);
+  }
+  const Eigen::RowVector3d south = deform_point(lattice, sphere.points.row(0).transpose()).transpose();
+  const Eigen::RowVector3d north =
+      deform_point(lattice, sphere.points.row(sphere.count_v() - 1).transpose()).transpose();
+  for (int i = 0; i < mu; ++i) {
+    CHECK(s.points.row(s.index(i, 0)) == south);
+    CHECK(s.points.row(s.index(i, mv - 1)) == north);
+  }
+  CHECK(result.report.max_deviation < 1e-13);
+}

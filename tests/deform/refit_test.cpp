@@ -8,6 +8,7 @@
 #include <clay/deform.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/surface/revolve.hpp>
 #include <clay/surface/skin.hpp>
 
 #include <cmath>
@@ -384,4 +385,33 @@ TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]
   auto [c5, w5] = error_of([&] { refit_deformed(loft, collapse); });
   CHECK(c5 == ErrorCategory::InvalidGeometry);
   CHECK_THAT(w5, Contains("absolute tolerance"));
+}
+
+TEST_CASE("Refit keeps a closed side closed and a pole a point, bit for bit", "[refit]") {
+  // A full revolution of a half circle: closed in u (first row == last row), both ends of the
+  // profile on the axis (the columns j = 0 and j = last collapse to the poles).
+  surface::Points3 p(5, 3);
+  p << 0, 0, -30, 30, 0, -30, 30, 0, 0, 30, 0, 30, 0, 0, 30;  // ends exactly on the axis
+  Eigen::VectorXd w(5);
+  w << 1, std::sqrt(0.5), 1, std::sqrt(0.5), 1;
+  const auto profile = surface::make_curve(2, {0, 0, 0, 0.5, 0.5, 1, 1, 1}, p, w);
+  const auto sphere = surface::revolve(profile, {{0, 0, 0}, {0, 0, 1}}, 360).surface;
+  Twist twist;
+  twist.frame.origin = {5, -3, 0};
+  twist.frame.axis = {0.1, 0.2, 1};
+  twist.angle = {0.1, 0.02};
+  RefitOptions options;
+  options.tolerance = 1e-3;
+  const auto fit = refit_deformed(sphere, twist, options);
+  const auto& s = fit.surface;
+  const int mu = s.count_u(), mv = s.count_v();
+  for (int j = 0; j < mv; ++j) CHECK(s.points.row(s.index(0, j)) == s.points.row(s.index(mu - 1, j)));
+  const Eigen::RowVector3d south = deform_point(twist, Eigen::Vector3d(0, 0, -30)).transpose();
+  const Eigen::RowVector3d north = deform_point(twist, Eigen::Vector3d(0, 0, 30)).transpose();
+  for (int i = 0; i < mu; ++i) {
+    CHECK(s.points.row(s.index(i, 0)) == south);
+    CHECK(s.points.row(s.index(i, mv - 1)) == north);
+  }
+  CHECK(fit.report.certified);
+  CHECK(fit.report.certified_bound <= fit.report.tolerance);
 }

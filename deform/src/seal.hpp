@@ -1,0 +1,55 @@
+#pragma once
+// Internal to clay_deform: what the exact image of a surface keeps exactly, a computed image
+// (an exact composition, a refit) keeps exactly too.
+#include <clay/surface/bspline_surface.hpp>
+
+#include <Eigen/Core>
+
+#include <initializer_list>
+#include <utility>
+
+namespace clay::deform::detail {
+
+/// A side of `original` that is closed (its first and last rows, or columns, of control points
+/// and weights equal bit for bit) stays closed in `image`, and a collapsed side (a pole: one
+/// point) stays one point, `map` of the pole. `image` is `original` deformed by `map`, computed
+/// with rounding (composition: ~1e-14 of the size) or approximated (refit: poles left up to
+/// ~1e-3 mm open, which shades as a dark spot); a closed side that is open by rounding is also
+/// "closed" by a STEP reader, so the file would not read back as written. The changes are within
+/// that rounding or approximation; callers measure or certify the result after this.
+template <class Map>
+void keep_closed_and_collapsed(const surface::BSplineSurface& original, surface::BSplineSurface& image, Map&& map) {
+  const int nu = original.count_u(), nv = original.count_v(), mu = image.count_u(), mv = image.count_v();
+  auto same = [&](int i0, int j0, int i1, int j1) {
+    const Eigen::Index a = original.index(i0, j0), b = original.index(i1, j1);
+    return original.points.row(a) == original.points.row(b) && original.weights[a] == original.weights[b];
+  };
+  auto copy = [&](Eigen::Index to, Eigen::Index from) {
+    image.points.row(to) = image.points.row(from);
+    image.weights[to] = image.weights[from];
+  };
+  bool closed_v = true, closed_u = true;
+  for (int i = 0; i < nu && closed_v; ++i) closed_v = same(i, 0, i, nv - 1);
+  for (int j = 0; j < nv && closed_u; ++j) closed_u = same(0, j, nu - 1, j);
+  if (closed_v)
+    for (int i = 0; i < mu; ++i) copy(image.index(i, mv - 1), image.index(i, 0));
+  if (closed_u)
+    for (int j = 0; j < mv; ++j) copy(image.index(mu - 1, j), image.index(0, j));
+  auto point = [&](int i, int j) { return original.points.row(original.index(i, j)); };
+  for (const auto& [side, image_side] : {std::pair{0, 0}, std::pair{nu - 1, mu - 1}}) {
+    bool collapsed = true;
+    for (int j = 1; j < nv && collapsed; ++j) collapsed = point(side, j) == point(side, 0);
+    if (!collapsed) continue;
+    const Eigen::RowVector3d pole = map(Eigen::Vector3d(point(side, 0).transpose())).transpose();
+    for (int j = 0; j < mv; ++j) image.points.row(image.index(image_side, j)) = pole;
+  }
+  for (const auto& [side, image_side] : {std::pair{0, 0}, std::pair{nv - 1, mv - 1}}) {
+    bool collapsed = true;
+    for (int i = 1; i < nu && collapsed; ++i) collapsed = point(i, side) == point(0, side);
+    if (!collapsed) continue;
+    const Eigen::RowVector3d pole = map(Eigen::Vector3d(point(0, side).transpose())).transpose();
+    for (int i = 0; i < mu; ++i) image.points.row(image.index(i, image_side)) = pole;
+  }
+}
+
+}  // namespace clay::deform::detail
