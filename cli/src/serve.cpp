@@ -53,8 +53,8 @@ ViewServer::ViewServer(const fs::path& run_dir, const ServeOptions& options) : i
                                    "the --out folder of `clayform run` or `clayform deform`, or run the recipe again");
   if (!fs::is_regular_file(viewer / "index.html"))
     throw Error(ErrorCategory::Io, "no viewer build at \"" + viewer.string() + "\" (index.html is missing); build it "
-                                   "with `npm ci && npm run build` in viewer/, or set CLAYFORM_VIEWER_DIR to a built "
-                                   "viewer's folder");
+                                   "with scripts/viewer.sh (or `npm ci && npm run build` in viewer/), or set "
+                                   "CLAYFORM_VIEWER_DIR to a built viewer's folder");
   auto& s = impl_->server;
   for (const auto& [ext, type] : std::initializer_list<std::pair<const char*, const char*>>{
            {"html", "text/html; charset=utf-8"},
