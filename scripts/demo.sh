@@ -3,7 +3,8 @@
 # the sail recipe (examples/recipes/sail.json) — a sail filled from three curves, styled by a bound
 # and a target curve, given a billow by a Bézier lattice composed exactly — replayed by
 # `clayform run` into STEP (AP214), IGES, a glTF preview and report.json, then `clayform info`
-# on the STEP file. Installs missing Debian packages first. Output folder: $1, default ./out/demo.
+# on the STEP file, and a picture of it through the browser viewer (clayform snapshot). Installs
+# missing Debian packages first. Output folder: $1, default ./out/demo.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 clay_ensure_packages
 clay_build --target clayform
@@ -12,6 +13,11 @@ out=${1:-$CLAY_ROOT/out/demo}
 echo
 echo "==> what the files hold (clayform info):"
 "$CLAY_BUILD/cli/clayform" info "$out/sail.step"
+echo
+echo "==> a picture through the browser viewer (clayform snapshot, headless Chromium):"
+"$CLAY_ROOT/scripts/viewer.sh"
+"$CLAY_BUILD/cli/clayform" snapshot "$out" --png "$out/sail.png" --width 1280 --height 800
+echo "Look at it interactively: $CLAY_BUILD/cli/clayform view $out  (then open http://127.0.0.1:8765/)"
 echo
 echo "Outputs in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"
