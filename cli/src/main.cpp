@@ -251,6 +251,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   snapshot_cmd->add_option("--height", snapshot_options.height, "picture height in pixels [16, 8192]")
       ->capture_default_str();
+  snapshot_cmd->add_flag("--bare", snapshot_options.bare, "the picture alone, without toolbar and panels");
   snapshot_cmd->add_option("--mode", snapshot_options.mode, "shaded, zebra, gaussian, mean or deviation")
       ->capture_default_str();
   app.footer(

@@ -193,7 +193,7 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
                                 "--window-size=" + std::to_string(options.width) + "," + std::to_string(options.height),
                                 "--virtual-time-budget=10000",
                                 "--screenshot=" + out.string(),
-                                server.url() + "?mode=" + options.mode};
+                                server.url() + "?mode=" + options.mode + (options.bare ? "&ui=0" : "")};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

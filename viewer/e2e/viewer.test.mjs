@@ -348,6 +348,17 @@ await check('URL parameters ?mode=zebra&stage=before', async () => {
   assert((await attr('vertices')) === String(vertices(befores)), `data-vertices ${await attr('vertices')}`);
 });
 
+await check('URL parameter ?ui=0 shows the picture alone', async () => {
+  await page.goto(`${base}?ui=0`, { waitUntil: 'load' });
+  await waitReady();
+  assert(!(await page.isVisible('#toolbar')), 'toolbar visible with ?ui=0');
+  assert(!(await page.isVisible('#panels')), 'panels visible with ?ui=0');
+  const box = await page.locator('#view').boundingBox();
+  const size = page.viewportSize();
+  assert(box && Math.abs(box.width - size.width) <= 1 && Math.abs(box.height - size.height) <= 1,
+         `canvas ${JSON.stringify(box)} does not fill the ${size.width} x ${size.height} window`);
+});
+
 await check('net and curve overlays can be hidden', async () => {
   if (empty) return 'skipped: this run has no surface';
   await page.goto(`${base}?mode=shaded`, { waitUntil: 'load' });

@@ -27,6 +27,9 @@ function showMessage(text, isError) {
   messageBox.classList.toggle('error', !!isError);
 }
 
+// ?ui=0: the picture alone (no toolbar, no panels), for `clayform snapshot --bare`.
+if (params.get('ui') === '0') body.classList.add('bare');
+
 let mode = params.get('mode') || 'shaded';
 if (!MODES.includes(mode)) {
   showMessage(`unknown mode "${mode}": showing shaded (modes: ${MODES.join(', ')})`);

@@ -47,6 +47,7 @@ struct SnapshotOptions {
   int width = 1280;                                    ///< picture width in pixels [16, 8192]
   int height = 800;                                    ///< picture height in pixels [16, 8192]
   std::string mode = "shaded";                         ///< shaded, zebra, gaussian, mean or deviation
+  bool bare = false;                                   ///< the picture alone: no toolbar, no panels (?ui=0)
   std::filesystem::path viewer;                        ///< the built front end; empty: viewer_dir()
   std::filesystem::path chromium = "/usr/bin/chromium";  ///< Debian's chromium
   int timeout_seconds = 60;                            ///< chromium is killed after this
