@@ -1321,14 +1321,39 @@ class RecipeChecker {
         spec.sections.push_back(std::move(section));
       }
       if (!ok || !c_.attempt(p, [&] { lat = deform::make_prismatic_lattice(spec); })) return std::nullopt;
+      // A control point by its welded row, or by its index [i, j, k] in the lattice before
+      // welding (i across the sections, j along them, k along the extrusion), found through the
+      // chunk that holds it: chunk (a, b, c) is chunks[(a * segments + b) * layers + c].
       const auto rows = lat.rest.rows();
-      row_of = [this, rows](const Json& m, const std::string& mp) -> std::optional<Eigen::Index> {
-        const Json* r = c_.member(m, mp, "row", true, "a control-point row");
-        if (!r) return std::nullopt;
-        const auto x = c_.integer(*r, key_path(mp, "row"), 0, static_cast<int>(rows) - 1);
-        return x ? std::optional<Eigen::Index>(*x) : std::nullopt;
+      const int gaps = static_cast<int>(spec.sections.size()) - 1;
+      const int segments = (static_cast<int>(spec.sections.front().size()) - 1) / 3;
+      const int layers = spec.layers;
+      const auto chunks = lat.chunks;
+      row_of = [this, rows, gaps, segments, layers, chunks](const Json& m,
+                                                            const std::string& mp) -> std::optional<Eigen::Index> {
+        if (m.contains("row") == m.contains("index")) {
+          c_.add(mp, "give exactly one of \"row\" (a control-point row) and \"index\" ([i, j, k])");
+          return std::nullopt;
+        }
+        if (m.contains("row")) {
+          const auto x = c_.integer(m.at("row"), key_path(mp, "row"), 0, static_cast<int>(rows) - 1);
+          return x ? std::optional<Eigen::Index>(*x) : std::nullopt;
+        }
+        const Json& idx = m.at("index");
+        const std::string ip = key_path(mp, "index");
+        if (!idx.is_array() || idx.size() != 3) {
+          c_.add(ip, "expected [i, j, k], found " + found(idx));
+          return std::nullopt;
+        }
+        const auto i = c_.integer(idx[0], index_path(ip, 0), 0, 3 * gaps);
+        const auto jj = c_.integer(idx[1], index_path(ip, 1), 0, 3 * segments);
+        const auto k = c_.integer(idx[2], index_path(ip, 2), 0, 3 * layers);
+        if (!i || !jj || !k) return std::nullopt;
+        const int a = std::min(*i / 3, gaps - 1), b = std::min(*jj / 3, segments - 1), c = std::min(*k / 3, layers - 1);
+        const auto& chunk = chunks[static_cast<std::size_t>((a * segments + b) * layers + c)];
+        return chunk[static_cast<std::size_t>(((*i - 3 * a) * 4 + (*jj - 3 * b)) * 4 + (*k - 3 * c))];
       };
-      index_keys = {std::string_view("row")};
+      index_keys = {std::string_view("row"), std::string_view("index")};
     }
     if (const Json* m = c_.member(j, path, "moves", false, ""))
       if (!apply_moves(*m, key_path(path, "moves"), lat.points, row_of, index_keys)) return std::nullopt;

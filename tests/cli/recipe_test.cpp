@@ -525,3 +525,43 @@ TEST_CASE("a step failing at run time is named by its path, with its category", 
   CHECK(category == ErrorCategory::OutOfDomain);
   CHECK_THAT(message, Contains("surfaces.cut.steps[0] (bezier_lattice): "));
 }
+
+TEST_CASE("a prismatic lattice's control points can be moved by index", "[recipe]") {
+  // Two straight sections 30 mm apart, one segment, one layer: before welding, control point
+  // (i, j, k) rests at (10 j, 10 i, 10 k). The test finds the moved row by that position.
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "surfaces": {
+      "sheet": {"bspline": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
+                "points": [[2, 2, 15], [2, 28, 15], [28, 2, 15], [28, 28, 15]]}},
+      "pressed": {"deform": {"surface": "sheet", "deformation": "press",
+                  "composition": {"mode": "refit", "tolerance": 0.5, "relative": false}}}},
+    "deformations": {"press": [{"kind": "extended_lattice", "generator": {"prism": {
+        "sections": [[[0, 0], [10, 0], [20, 0], [30, 0]], [[0, 30], [10, 30], [20, 30], [30, 30]]],
+        "extrusion": [0, 0, 30]}},
+      "moves": [{"index": [1, 2, 1], "by": [0, 0, -6]}, {"row": 0, "by": [0, 0, 0]}]}]}})";
+  const auto result = run_recipe(parse_recipe(text));
+  REQUIRE(result.stages.size() == 1);
+  deform::PrismSpec spec;
+  spec.sections = {{{0, 0}, {10, 0}, {20, 0}, {30, 0}}, {{0, 30}, {10, 30}, {20, 30}, {30, 30}}};
+  spec.extrusion = {0, 0, 30};
+  auto lattice = deform::make_prismatic_lattice(spec);
+  int found = 0;
+  for (Eigen::Index r = 0; r < lattice.rest.rows(); ++r)
+    if ((lattice.rest.row(r) - Eigen::RowVector3d(20, 10, 10)).norm() < 1e-12) {
+      lattice.points.row(r) += Eigen::RowVector3d(0, 0, -6);
+      ++found;
+    }
+  REQUIRE(found == 1);
+  for (const Eigen::Vector3d& x : {Eigen::Vector3d(20, 10, 15), Eigen::Vector3d(12, 17, 15), Eigen::Vector3d(25, 5, 15)})
+    CHECK((result.stages[0].map(x) - deform::deform_point(lattice, x)).norm() < 1e-12);
+  // closed form at (20, 10, 15) = parameters (1/3, 2/3, 1/2) of the linear rest lattice: the move
+  // times B_1^3(1/3) B_2^3(2/3) B_1^3(1/2) = (4/9)(4/9)(3/8)
+  const Eigen::Vector3d x(20, 10, 15);
+  CHECK_THAT((result.stages[0].map(x) - x).z(), Catch::Matchers::WithinAbs(-6.0 * 4 / 9 * 4 / 9 * 3 / 8, 1e-12));
+  const std::string both = R"({"format": "clayform.recipe", "version": 1, "deformations": {"d": [{"kind": "extended_lattice",
+      "generator": {"prism": {"sections": [[[0, 0], [10, 0], [20, 0], [30, 0]], [[0, 30], [10, 30], [20, 30], [30, 30]]]}},
+      "moves": [{"index": [1, 2, 1], "row": 3, "by": [0, 0, 1]}, {"index": [4, 0, 0], "by": [0, 0, 1]}]}]}})";
+  const auto problems = check_recipe(both);
+  CHECK(mentions(problems, "deformations.d[0].moves[0]", "exactly one of \"row\""));
+  CHECK(mentions(problems, "deformations.d[0].moves[1].index[0]", "[0, 3]"));
+}
