@@ -688,9 +688,26 @@ class RecipeChecker {
       if (!n) return std::nullopt;
       const auto it = points.find(*n);
       if (it != points.end()) return it->second;
+      // "E.start" / "E.end": an end point of a line, arc or B-spline curve entity (a curve's
+      // first or last control point: the curve is clamped).
+      if (const auto dot = n->rfind('.'); dot != std::string::npos) {
+        const std::string e = n->substr(0, dot), end = n->substr(dot + 1);
+        const auto ei = entities.find(e);
+        if (ei != entities.end() && (end == "start" || end == "end")) {
+          const bool start = end == "start";
+          const auto& entity = def.sketch.entities[static_cast<std::size_t>(ei->second.index)];
+          if (const auto* l = std::get_if<sketch::Line>(&entity)) return start ? l->start : l->end;
+          if (const auto* a = std::get_if<sketch::Arc>(&entity)) return start ? a->start : a->end;
+          if (const auto* c = std::get_if<sketch::Curve>(&entity))
+            return start ? c->control_points.front() : c->control_points.back();
+          c_.add(p, "\"" + e + "\" is a circle, which has no end points; refer to its center point");
+          return std::nullopt;
+        }
+      }
       std::vector<std::string> known;
       for (const auto& [k, id] : points) known.push_back(k);
-      c_.add(p, "no point named \"" + *n + "\" in this sketch; " + listing(known));
+      c_.add(p, "no point named \"" + *n + "\" in this sketch (an entity's end is \"ENTITY.start\" or "
+                "\"ENTITY.end\"); " + listing(known));
       return std::nullopt;
     };
     auto entity_ref = [&](const Json& v, const std::string& p) -> std::optional<sketch::EntityId> {
@@ -709,9 +726,28 @@ class RecipeChecker {
         for (const auto& [ename, ev] : ents->items()) {
           const std::string p = key_path(ep, ename);
           std::string kind;
-          if (!one_of(ev, p, {"line", "circle", "arc"}, "a sketch entity", kind)) continue;
+          if (!one_of(ev, p, {"line", "circle", "arc", "bspline", "curve"}, "a sketch entity", kind)) continue;
           const Json& v = ev.at(kind);
           const std::string kp = key_path(p, kind);
+          if (kind == "bspline" || kind == "curve") {
+            // A clamped B-spline whose control points become sketch points (the solver moves
+            // them): inline, or a curve of the "curves" section given inline there.
+            std::optional<surface::BSplineCurve> curve;
+            if (kind == "bspline") {
+              curve = inline_curve(v, kp);
+            } else if (const auto source = curve_ref(v, kp)) {
+              const auto cd = std::find_if(data.curves.begin(), data.curves.end(),
+                                           [&](const CurveDef& d) { return d.name == *source; });
+              if (cd != data.curves.end() && cd->curve)
+                curve = cd->curve;
+              else
+                c_.add(kp, "\"" + *source + "\" is computed when the recipe runs (a stroke or a reversed "
+                           "curve); a sketch needs its curve's control points now: give it inline "
+                           "(\"bspline\") or in \"curves\" as bspline, line, arc or polyline");
+            }
+            if (curve) c_.attempt(kp, [&] { entities[ename] = def.sketch.add_curve(*curve, plane_id); });
+            continue;
+          }
           if (kind == "line") {
             if (!v.is_array() || v.size() != 2) {
               c_.add(kp, "expected [\"P\", \"Q\"] (two point names), found " + found(v));

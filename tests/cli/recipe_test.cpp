@@ -565,3 +565,48 @@ TEST_CASE("a prismatic lattice's control points can be moved by index", "[recipe
   CHECK(mentions(problems, "deformations.d[0].moves[0]", "exactly one of \"row\""));
   CHECK(mentions(problems, "deformations.d[0].moves[1].index[0]", "[0, 3]"));
 }
+
+TEST_CASE("B-spline curves in a sketch are joined G2 by the solver", "[recipe]") {
+  // Two planar cubics, one inline, one from "curves", that do not meet; the sketch joins the end
+  // of one to the start of the other with position, tangent and curvature continuity.
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "curves": {"right": {"bspline": {"degree": 3, "knots": [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
+               "points": [[62, 8, 0], [75, 20, 0], [90, 18, 0], [105, 5, 0], [120, 0, 0]]}}},
+    "sketches": {"s": {
+      "plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {},
+      "entities": {
+        "left": {"bspline": {"degree": 3, "knots": [0, 0, 0, 0, 0.5, 1, 1, 1, 1],
+                 "points": [[0, 0, 0], [15, 10, 0], [30, 25, 0], [45, 20, 0], [58, 12, 0]]}},
+        "right": {"curve": "right"}},
+      "constraints": [
+        {"type": "fixed", "point": "left.start"},
+        {"type": "fixed", "point": "right.end"},
+        {"type": "coincident", "points": ["left.end", "right.start"]},
+        {"type": "tangent", "ends": [{"entity": "left", "end": "end"}, {"entity": "right", "end": "start"}]},
+        {"type": "curvature", "ends": [{"entity": "left", "end": "end"}, {"entity": "right", "end": "start"}]}
+      ]}}})";
+  const auto result = run_recipe(parse_recipe(text));
+  const auto& a = result.curve("s.left");
+  const auto& b = result.curve("s.right");
+  const auto da = surface::derivatives(a, 1.0), db = surface::derivatives(b, 0.0);
+  CHECK((da.point - db.point).norm() < 1e-8);
+  CHECK((surface::evaluate(a, 0.0) - Eigen::Vector3d(0, 0, 0)).norm() < 1e-9);   // fixed
+  CHECK((surface::evaluate(b, 1.0) - Eigen::Vector3d(120, 0, 0)).norm() < 1e-9);  // fixed
+  // tangent directions equal, curvatures |C' x C''| / |C'|^3 (signed in the plane) equal
+  CHECK((da.d1.normalized() - db.d1.normalized()).norm() < 1e-8);
+  const auto kappa = [](const surface::CurveDerivatives& d) {
+    return d.d1.cross(d.d2).z() / std::pow(d.d1.norm(), 3);
+  };
+  CHECK_THAT(kappa(da), Catch::Matchers::WithinAbs(kappa(db), 1e-9));
+  // a circle has no ends; a stroke's curve is not known before the run
+  const std::string bad = R"({"format": "clayform.recipe", "version": 1,
+    "strokes": {"st": {"points": [[0, 0, 0], [10, 1, 0], [20, 0, 0]]}},
+    "sketches": {"s": {"plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {"c": [0, 0]},
+      "entities": {"o": {"circle": {"center": "c", "radius": 5}}, "f": {"curve": "st"}},
+      "constraints": [{"type": "fixed", "point": "o.start"}]}}})";
+  const auto problems = check_recipe(bad);
+  CHECK(mentions(problems, "sketches.s.constraints[0].point", "circle, which has no end points"));
+  CHECK(mentions(problems, "sketches.s.entities.f.curve", "computed when the recipe runs"));
+}
