@@ -1,7 +1,8 @@
 # Runs an example recipe through the command twice and checks its outputs:
 #   clayform validate RECIPE              exits 0
 #   clayform run RECIPE --out OUT         exits 0 and writes every export's files and report.json
-#   clayform info OUT/*.step              exits 0 (read back, BRepCheck valid)
+#   clayform info OUT/*.step              exits 0 (read back, BRepCheck valid); the report says
+#                                         every export reads back valid and bit-identical
 #   a second run into OUT-again           gives byte-identical STEP geometry (the header's
 #                                         FILE_NAME line holds a timestamp and is left out)
 # Arguments: -DCLAYFORM=... -DRECIPE=... -DOUT=...
@@ -23,6 +24,9 @@ endif()
 file(READ ${OUT}/report.json report)
 if(report MATCHES "\"valid\": false")
   message(FATAL_ERROR "clayform run ${RECIPE}: an export reads back invalid:\n${report}")
+endif()
+if(report MATCHES "\"read_back_identical\": false")
+  message(FATAL_ERROR "clayform run ${RECIPE}: an export does not read back bit-identical:\n${report}")
 endif()
 file(GLOB steps ${OUT}/*.step)
 if(NOT steps)
