@@ -325,6 +325,16 @@ class RecipeChecker {
  public:
   RecipeChecker(Checker& c, fs::path base) : c_(c), base_(std::move(base)) {}
   RecipeData data;
+  /// Set when a deferred sketch is built again at run time: the run's curves by name.
+  std::function<const surface::BSplineCurve*(const std::string&)> runtime_curve;
+
+  /// Builds one sketch from its JSON at run time (rebuild_sketch): every curve name is known.
+  void rebuild(const std::string& name, const Json& j, const std::string& path) {
+    names_.curves_declared.clear();
+    sketch(name, j, path);
+  }
+  /// The curves a rebuild may refer to (all the run's curves).
+  void know_curves(std::vector<std::string> names) { names_.curves = std::move(names); }
 
   void run(const Json& root) {
     if (!c_.object(root, "", {"format", "version", "name", "description", "units", "composition",
@@ -648,7 +658,8 @@ class RecipeChecker {
   }
 
   void sketch(const std::string& name, const Json& j, const std::string& path) {
-    SketchDef def{name, path, {}, {}, {}, {}};
+    SketchDef def{name, path, {}, {}, {}, {}, {}};
+    bool deferred = false;
     const auto register_entities = [&] {
       const auto e = j.is_object() ? j.find("entities") : j.end();
       if (j.is_object() && e != j.end() && e->is_object())
@@ -738,12 +749,27 @@ class RecipeChecker {
             } else if (const auto source = curve_ref(v, kp)) {
               const auto cd = std::find_if(data.curves.begin(), data.curves.end(),
                                            [&](const CurveDef& d) { return d.name == *source; });
-              if (cd != data.curves.end() && cd->curve)
+              if (runtime_curve) {
+                if (const surface::BSplineCurve* c = runtime_curve(*source)) curve = *c;
+              } else if (cd != data.curves.end() && cd->curve) {
                 curve = cd->curve;
-              else
-                c_.add(kp, "\"" + *source + "\" is computed when the recipe runs (a stroke or a reversed "
-                           "curve); a sketch needs its curve's control points now: give it inline "
-                           "(\"bspline\") or in \"curves\" as bspline, line, arc or polyline");
+              } else {
+                // A stroke's fit or a reversed curve: known when the recipe runs. Checked here
+                // with a stand-in (a straight cubic in the plane), built again then.
+                surface::Points3 stand_in(4, 3);
+                for (int k = 0; k < 4; ++k)
+                  stand_in.row(k) = (plane_id.free() ? Eigen::Vector3d(k, 0, 0)
+                                                     : sketch::to_world(def.sketch.planes[static_cast<std::size_t>(plane_id.index)],
+                                                                        Eigen::Vector2d(k, 0)))
+                                        .transpose();
+                surface::BSplineCurve c;
+                c.basis.degree = 3;
+                c.basis.knots.assign({0, 0, 0, 0, 1, 1, 1, 1});
+                c.points = stand_in;
+                c.weights = Eigen::VectorXd::Ones(4);
+                curve = std::move(c);
+                deferred = true;
+              }
             }
             if (curve) c_.attempt(kp, [&] { entities[ename] = def.sketch.add_curve(*curve, plane_id); });
             continue;
@@ -810,6 +836,7 @@ class RecipeChecker {
       ordered.emplace_back(name + "." + ename, entities.at(ename));
     }
     def.entities = std::move(ordered);
+    if (deferred) def.deferred_json = j.dump();
     data.sketches.push_back(std::move(def));
   }
 
@@ -1739,6 +1766,30 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   out.data = std::move(rc.data);
   out.problems = std::move(c.problems);
   return out;
+}
+
+SketchDef rebuild_sketch(const SketchDef& def,
+                         const std::function<const surface::BSplineCurve*(const std::string&)>& curve) {
+  Checker c;
+  RecipeChecker rc(c, {});
+  rc.runtime_curve = curve;
+  std::vector<std::string> names;  // every name resolves through `curve`; unknown ones are reported
+  const Json j = Json::parse(def.deferred_json);
+  if (j.contains("entities") && j["entities"].is_object())
+    for (const auto& [e, v] : j["entities"].items())
+      if (v.is_object() && v.contains("curve") && v["curve"].is_string()) {
+        const std::string n = v["curve"].get<std::string>();
+        if (curve(n)) names.push_back(n);
+      }
+  rc.know_curves(std::move(names));
+  rc.rebuild(def.name, j, def.path);
+  if (!c.problems.empty()) {
+    std::string m = "with the run's curves the sketch has " + std::to_string(c.problems.size()) + " problem" +
+                    (c.problems.size() == 1 ? "" : "s") + ":";
+    for (const auto& p : c.problems) m += "\n  " + to_string(p);
+    throw Error(ErrorCategory::InvalidGeometry, m);
+  }
+  return std::move(rc.data.sketches.front());
 }
 
 std::string to_string(const Problem& problem) {

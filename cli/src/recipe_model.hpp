@@ -15,6 +15,7 @@
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/skin.hpp>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <variant>
@@ -50,7 +51,16 @@ struct SketchDef {
   std::vector<constraints::Constraint> constraints;
   constraints::SolveOptions solve;
   std::vector<std::pair<std::string, sketch::EntityId>> entities;  // curve name "SKETCH.E"
+  // A sketch using curves known only when the recipe runs (strokes, reversed curves) was checked
+  // with stand-ins and is built again by rebuild_sketch from its JSON with the real curves.
+  std::string deferred_json;
 };
+
+/// The sketch `def` (deferred) built again with the run's curves (`curve` returns nullptr for an
+/// unknown name). Throws clay::Error(InvalidGeometry) listing the problems the real curves bring
+/// (a fitted curve off the sketch's plane, ...).
+SketchDef rebuild_sketch(const SketchDef& def,
+                         const std::function<const surface::BSplineCurve*(const std::string&)>& curve);
 
 struct FillDef { std::vector<std::string> curves; surface::FillOptions options; };
 struct SkinDef { std::vector<std::string> sections; surface::LoftOptions options; };

@@ -168,7 +168,14 @@ class Runner {
     add_curve(c.name, std::move(out));
   }
 
-  void sketch(const SketchDef& s, StepReport& rep) {
+  void sketch(const SketchDef& checked, StepReport& rep) {
+    // A sketch using a stroke's fit or a reversed curve is built now, with the real curves.
+    const SketchDef s = checked.deferred_json.empty()
+                            ? checked
+                            : rebuild_sketch(checked, [&](const std::string& n) -> const BSplineCurve* {
+                                const auto it = curve_index_.find(n);
+                                return it == curve_index_.end() ? nullptr : &result_.curves[it->second].second;
+                              });
     const auto solved = constraints::solve(s.sketch, s.constraints, s.solve);
     const auto& r = solved.report;
     if (!r.summary.converged()) {

@@ -599,14 +599,55 @@ TEST_CASE("B-spline curves in a sketch are joined G2 by the solver", "[recipe]")
     return d.d1.cross(d.d2).z() / std::pow(d.d1.norm(), 3);
   };
   CHECK_THAT(kappa(da), Catch::Matchers::WithinAbs(kappa(db), 1e-9));
-  // a circle has no ends; a stroke's curve is not known before the run
+  // a circle has no ends
   const std::string bad = R"({"format": "clayform.recipe", "version": 1,
-    "strokes": {"st": {"points": [[0, 0, 0], [10, 1, 0], [20, 0, 0]]}},
     "sketches": {"s": {"plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
       "points": {"c": [0, 0]},
-      "entities": {"o": {"circle": {"center": "c", "radius": 5}}, "f": {"curve": "st"}},
+      "entities": {"o": {"circle": {"center": "c", "radius": 5}}},
       "constraints": [{"type": "fixed", "point": "o.start"}]}}})";
-  const auto problems = check_recipe(bad);
-  CHECK(mentions(problems, "sketches.s.constraints[0].point", "circle, which has no end points"));
-  CHECK(mentions(problems, "sketches.s.entities.f.curve", "computed when the recipe runs"));
+  CHECK(mentions(check_recipe(bad), "sketches.s.constraints[0].point", "circle, which has no end points"));
+  // a stroke drawn 5 mm off the sketch's plane passes the check (its curve is not known yet) and
+  // is refused when the sketch is built with it, naming the sketch
+  const std::string off = R"({"format": "clayform.recipe", "version": 1,
+    "strokes": {"st": {"points": [[0, 0, 5], [10, 1, 5], [20, 3, 5], [30, 2, 5]]}},
+    "sketches": {"s": {"plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {}, "entities": {"f": {"curve": "st"}}, "constraints": [{"type": "fixed", "point": "f.start"}]}}})";
+  REQUIRE(check_recipe(off).empty());
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(off)); });
+  CHECK(category == ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Contains("sketches.s (sketch): with the run's curves the sketch has"));
+  CHECK_THAT(message, Contains("sketches.s.entities.f.curve: add_curve (curve #0): control point 0 is 5 mm off plane"));
+}
+
+TEST_CASE("a fitted stroke joins a sketch, built when the recipe runs", "[recipe]") {
+  // A stroke drawn on the xy plane is fitted, then constrained: its end meets a line tangentially.
+  std::string pts = "[";
+  for (int i = 0; i <= 40; ++i) {
+    const double t = i / 40.0;
+    pts += std::string(i ? "," : "") + "[" + num(60 * t) + "," + num(12 * std::sin(2.5 * t)) + ",0]";
+  }
+  pts += "]";
+  const std::string plane = R"({"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]})";
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "strokes": {"swoosh": {"points": )" + pts + R"(, "plane": )" + plane + R"(, "tolerance": 0.05}},
+    "sketches": {"s": {"plane": )" + plane + R"(,
+      "points": {"q": [100, 20]},
+      "entities": {"swoosh": {"curve": "swoosh"}, "run": {"line": ["swoosh.end", "q"]}},
+      "constraints": [
+        {"type": "fixed", "point": "swoosh.start"},
+        {"type": "fixed", "point": "q"},
+        {"type": "tangent", "ends": [{"entity": "swoosh", "end": "end"}, {"entity": "run", "end": "start"}]}
+      ]}}})";
+  REQUIRE(check_recipe(text).empty());
+  const auto result = run_recipe(parse_recipe(text));
+  const auto& fitted = result.curve("swoosh");
+  const auto& solved = result.curve("s.swoosh");
+  const auto& line = result.curve("s.run");
+  CHECK(solved.points.rows() == fitted.points.rows());  // the stroke's own curve, not a stand-in
+  CHECK((surface::evaluate(solved, 0.0) - surface::evaluate(fitted, 0.0)).norm() < 1e-9);
+  const auto end = surface::derivatives(solved, 1.0);
+  CHECK((end.point - surface::evaluate(line, 0.0)).norm() < 1e-8);
+  CHECK((surface::evaluate(line, 1.0) - Eigen::Vector3d(100, 20, 0)).norm() < 1e-9);
+  const Eigen::Vector3d along = (surface::evaluate(line, 1.0) - surface::evaluate(line, 0.0)).normalized();
+  CHECK((end.d1.normalized() - along).norm() < 1e-8);
 }
