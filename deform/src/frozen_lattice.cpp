@@ -184,6 +184,7 @@ template <int L, int M, int N>
   const int n = N >= 0 ? N : K.deg[2];
   const int Q = m + 1, R = n + 1;
   const int per_coordinate = (l + 1) * Q * R;
+#pragma GCC unroll 3
   for (int c = 0; c < 3; ++c) {
     const double* a = coef + c * per_coordinate;
     vd as = {};
@@ -309,12 +310,13 @@ template <int L, int M, int N, int Stride>
   vd x, y, z;
   // In-cell coordinates of the chunk in input order, overwritten by each point's result; cells;
   // the order sorted by cell (W spare entries for the last cell's partial block).
-  double* S = sc.s.data();
-  double* T = sc.t.data();
-  double* U = sc.u.data();
-  std::int32_t* cell = sc.cell.data();
-  std::int32_t* order = sc.order.data();
-  std::int32_t* count = sc.count.data();  // cell_count + 2 entries
+  // Restrict: the arrays never overlap, which lets the sort keep its pointers in registers.
+  double* __restrict S = sc.s.data();
+  double* __restrict T = sc.t.data();
+  double* __restrict U = sc.u.data();
+  std::int32_t* __restrict cell = sc.cell.data();
+  std::int32_t* __restrict order = sc.order.data();
+  std::int32_t* __restrict count = sc.count.data();  // cell_count + 2 entries
   const int outside = K.cell_count;
   for (std::size_t c0 = begin; c0 < end; c0 += chunk_points) {
     const std::size_t n = std::min(chunk_points, end - c0);
@@ -361,12 +363,23 @@ template <int L, int M, int N, int Stride>
           u[q] = U[i];
         }
         horner_block<L, M, N>(K, coef, s, t, u, r);
-        const int cnt = std::min(W, stop - p);
-        for (int q = 0; q < cnt; ++q) {  // the result replaces the point's coordinates
-          const std::int32_t i = order[p + q];
-          S[i] = r[0][q];
-          T[i] = r[1][q];
-          U[i] = r[2][q];
+        // The result replaces the point's coordinates. Lanes taken from registers (a lane
+        // reloaded from a vector just stored would wait for the store to reach the cache).
+        if (stop - p >= W) {
+#pragma GCC unroll 8
+          for (int q = 0; q < W; ++q) {
+            const std::int32_t i = order[p + q];
+            S[i] = r[0][q];
+            T[i] = r[1][q];
+            U[i] = r[2][q];
+          }
+        } else {
+          for (int q = 0; q < stop - p; ++q) {
+            const std::int32_t i = order[p + q];
+            S[i] = r[0][q];
+            T[i] = r[1][q];
+            U[i] = r[2][q];
+          }
         }
       }
       start = stop;
