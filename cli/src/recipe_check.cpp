@@ -694,16 +694,38 @@ class RecipeChecker {
         c_.add(pp, "expected an object of NAME: position, found " + found(*pts));
       }
     }
+    // A point or entity declared in this sketch but not built has its own problem reported at
+    // its declaration; references to it stay quiet rather than adding a follow-on "no point".
+    // An entity left unbuilt because it refers to such a point or entity is quiet too.
+    const std::string points_path = key_path(path, "points"), entities_path = key_path(path, "entities");
+    std::set<std::string> unbuilt_by_reference;
+    std::string building;  // the entity being built, while entities are read
+    auto failed = [&](const Json* section, const std::string& section_path, const std::string& declared) {
+      if (!section || !section->is_object() || !section->contains(declared)) return false;
+      const std::string at = key_path(section_path, declared);
+      const bool quiet =
+          (section_path == entities_path && unbuilt_by_reference.count(declared) > 0) ||
+          std::any_of(c_.problems.begin(), c_.problems.end(), [&](const Problem& q) {
+            return q.path == at || q.path.rfind(at + ".", 0) == 0 || q.path.rfind(at + "[", 0) == 0;
+          });
+      if (quiet && !building.empty()) unbuilt_by_reference.insert(building);
+      return quiet;
+    };
+    const Json* declared_points = j.contains("points") ? &j.at("points") : nullptr;
+    const Json* declared_entities = j.contains("entities") ? &j.at("entities") : nullptr;
     auto point_ref = [&](const Json& v, const std::string& p) -> std::optional<sketch::PointId> {
       const auto n = c_.string(v, p);
       if (!n) return std::nullopt;
       const auto it = points.find(*n);
       if (it != points.end()) return it->second;
+      if (failed(declared_points, points_path, *n)) return std::nullopt;
       // "E.start" / "E.end": an end point of a line, arc or B-spline curve entity (a curve's
       // first or last control point: the curve is clamped).
       if (const auto dot = n->rfind('.'); dot != std::string::npos) {
         const std::string e = n->substr(0, dot), end = n->substr(dot + 1);
         const auto ei = entities.find(e);
+        if (ei == entities.end() && (end == "start" || end == "end") && failed(declared_entities, entities_path, e))
+          return std::nullopt;
         if (ei != entities.end() && (end == "start" || end == "end")) {
           const bool start = end == "start";
           const auto& entity = def.sketch.entities[static_cast<std::size_t>(ei->second.index)];
@@ -726,6 +748,7 @@ class RecipeChecker {
       if (!n) return std::nullopt;
       const auto it = entities.find(*n);
       if (it != entities.end()) return it->second;
+      if (failed(declared_entities, entities_path, *n)) return std::nullopt;
       std::vector<std::string> known;
       for (const auto& [k, id] : entities) known.push_back(k);
       c_.add(p, "no entity named \"" + *n + "\" in this sketch; " + listing(known));
@@ -736,6 +759,7 @@ class RecipeChecker {
       if (ents->is_object()) {
         for (const auto& [ename, ev] : ents->items()) {
           const std::string p = key_path(ep, ename);
+          building = ename;
           std::string kind;
           if (!one_of(ev, p, {"line", "circle", "arc", "bspline", "curve"}, "a sketch entity", kind)) continue;
           const Json& v = ev.at(kind);
@@ -813,6 +837,7 @@ class RecipeChecker {
       } else {
         c_.add(ep, "expected an object of NAME: {line|circle|arc}, found " + found(*ents));
       }
+      building.clear();
     }
     if (const Json* cons = c_.member(j, path, "constraints", false, "")) {
       const std::string cp = key_path(path, "constraints");

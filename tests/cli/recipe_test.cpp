@@ -617,6 +617,27 @@ TEST_CASE("B-spline curves in a sketch are joined G2 by the solver", "[recipe]")
   CHECK(category == ErrorCategory::InvalidGeometry);
   CHECK_THAT(message, Contains("sketches.s (sketch): with the run's curves the sketch has"));
   CHECK_THAT(message, Contains("sketches.s.entities.f.curve: add_curve (curve #0): control point 0 is 5 mm off plane"));
+  // the constraint on "f.start" adds no follow-on problem: the entity's own is the one reported
+  CHECK_THAT(message, Contains("the sketch has 1 problem:"));
+  CHECK_THAT(message, !Contains("no point named"));
+  // the same when the check sees the curve (inline, off the plane): one problem, at the entity
+  const std::string off_inline = R"({"format": "clayform.recipe", "version": 1,
+    "sketches": {"s": {"plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {"q": [40, 0]},
+      "entities": {"f": {"bspline": {"degree": 3, "knots": [0, 0, 0, 0, 1, 1, 1, 1],
+                                     "points": [[0, 0, 5], [10, 1, 5], [20, 3, 5], [30, 2, 5]]}},
+                   "g": {"line": ["f.end", "q"]}},
+      "constraints": [{"type": "fixed", "point": "f.start"},
+                      {"type": "tangent", "ends": [{"entity": "f", "end": "end"}, {"entity": "g", "end": "start"}]}]}}})";
+  const auto problems = check_recipe(off_inline);
+  REQUIRE(problems.size() == 1);
+  CHECK(mentions(problems, "sketches.s.entities.f.bspline", "5 mm off plane"));
+  // a name declared nowhere is still reported
+  const std::string typo = R"({"format": "clayform.recipe", "version": 1,
+    "sketches": {"s": {"plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {"q": [40, 0]}, "entities": {},
+      "constraints": [{"type": "fixed", "point": "f.start"}]}}})";
+  CHECK(mentions(check_recipe(typo), "sketches.s.constraints[0].point", "no point named \"f.start\""));
 }
 
 TEST_CASE("a fitted stroke joins a sketch, built when the recipe runs", "[recipe]") {
