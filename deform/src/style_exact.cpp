@@ -34,6 +34,11 @@ namespace {
 // Below this share of a key point's basis weight on free vertices the net counts as too coarse
 // there (the displacement that meets it is amplified by 1 / share): refine while allowed.
 constexpr double min_free_share = 0.1;
+// A solve that moves a free vertex more than this many times the farthest key point's distance
+// meets its key points through a net wound up between them (nearly dependent rows that the rank
+// test passes): the net is too coarse for them as well. Within this bound are the moves that a
+// key point with the smallest allowed free share needs (1 / min_free_share).
+constexpr double max_amplification = 1 / min_free_share;
 
 // Chebyshev distance (in vertices) from every vertex to the nearest vertex with E = 0; vertices
 // of a region covering the whole net get INT_MAX.
@@ -206,6 +211,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   const PolygonLocator bound(region.polygon, parameter_tolerance(parent));
   auto in_region = [&](const TraceSample& t) { return region.polygon.empty() || bound.inside({t.u, t.v}); };
   int refinements = 0, additions = 0;
+  std::size_t accepted_points = points.size();  // key points before the last round of additions
+  double amplification = 0;
 
   for (;;) {
     std::shared_ptr<const NetCache> net;
@@ -317,11 +324,22 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
         }
       }
     }
-    // Key points independent but so nearly dependent that the solve misses them: a finer net.
+    // Key points independent but so nearly dependent that the solve misses them, or met only by
+    // a wound-up net: a finer net. When the net may not be refined further and the last key points
+    // added are what winds it up, they are taken back (the miss of the target curve is reported).
     const Eigen::MatrixXd achieved = B * d - rhs;
     const bool missed = nk > 0 && achieved.rowwise().norm().maxCoeff() > tol;
-    if (missed && refinements < options.max_refinements) {
+    const double farthest = nk > 0 ? rhs.rowwise().norm().maxCoeff() : 0.0;
+    amplification = nf > 0 && farthest > 0 ? d.rowwise().norm().maxCoeff() / farthest : 0.0;
+    const bool wound = amplification > max_amplification;
+    if ((missed || wound) && refinements < options.max_refinements) {
       refine();
+      continue;
+    }
+    if (wound && points.size() > accepted_points) {
+      points.resize(accepted_points);
+      report.added_key_points = static_cast<int>(accepted_points - keys.points.size());
+      additions = options.max_key_point_rounds;  // no more rounds
       continue;
     }
     out.surface = s;
@@ -363,6 +381,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
         ++added;
       }
       if (added > 0) {
+        accepted_points = points.size() - added;
         ++additions;
         report.added_key_points += static_cast<int>(added);
         continue;
@@ -386,6 +405,9 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     if (!report.conflicting_key_points.empty())
       msg << "; " << report.conflicting_key_points.size()
           << " key points cannot be met (the net is too coarse there: allow more max_refinements)";
+    if (amplification > max_amplification)
+      msg << "; the free vertices move up to " << amplification
+          << " times the farthest key point's distance (allow more max_refinements)";
     if (min_share < min_free_share)
       msg << "; a key point is held mostly by fixed vertices (free share " << min_share
           << "): the free vertices move up to " << 1.0 / std::max(min_share, 1e-300)
