@@ -151,10 +151,10 @@ int target_samples(const BSplineCurve& target, const StyleOptions& options) {
   return std::clamp(16 * spans, 32, 4096);
 }
 
-surface::SurfaceProjection project_from(const BSplineSurface& s, const Eigen::Vector3d& x, double u,
-                                        double v, const surface::ProjectionOptions& options) {
-  auto p = surface::project_normal(s, x, u, v, options);
-  if (!p.summary.converged()) p = surface::closest_point(s, x, options);
+surface::SurfaceProjection project_from(const surface::SurfaceProjector& projector,
+                                        const Eigen::Vector3d& x, double u, double v) {
+  auto p = projector.project_normal(x, u, v);
+  if (!p.summary.converged()) p = projector.closest_point(x);
   return p;
 }
 
@@ -216,14 +216,6 @@ Eigen::Vector3d normal_or_zero(const BSplineSurface& s, double u, double v) {
   const double len = n.norm();
   if (!(len > 1e-300 * d.du.norm() * d.dv.norm()) || len == 0) return Eigen::Vector3d::Zero();
   return n / len;
-}
-
-// Same with a prepared projector.
-surface::SurfaceProjection project_from(const surface::SurfaceProjector& projector,
-                                        const Eigen::Vector3d& x, double u, double v) {
-  auto p = projector.project_normal(x, u, v);
-  if (!p.summary.converged()) p = projector.closest_point(x);
-  return p;
 }
 
 // Whether a sample lies in the region: inside the bound polygon, or anywhere when the region was
@@ -398,9 +390,10 @@ void measure(const BSplineSurface& parent, const BSplineSurface& result,
       static_cast<int>(std::count(factors.begin(), factors.end(), std::uint8_t{1}));
 
   report.target_deviation = 0;
+  const surface::SurfaceProjector projector(result, options.projection);  // validated once
   for (const KeyPoint& k : report.key_points) {
     if (!k.influenced) continue;
-    const auto p = project_from(result, k.point, k.u, k.v, options.projection);
+    const auto p = project_from(projector, k.point, k.u, k.v);
     report.target_deviation = std::max(report.target_deviation, p.distance);
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -412,7 +405,7 @@ void measure(const BSplineSurface& parent, const BSplineSurface& result,
   const RegionTest sample_inside(region, parent);
   for (const TraceSample& t : samples) {
     if (!sample_inside(t.u, t.v)) continue;
-    const auto p = project_from(result, t.point, t.u, t.v, options.projection);
+    const auto p = project_from(projector, t.point, t.u, t.v);
     report.target_curve_deviation = std::max(report.target_curve_deviation, p.distance);
   }
 

@@ -40,6 +40,11 @@ constexpr double min_free_share = 0.1;
 // and is refined while allowed. Within this bound are the moves that a key point with a free
 // share of min_free_share needs.
 constexpr double max_amplification = 1 / min_free_share;
+// The range-space solve is kept when it meets the key points to this fraction of the tolerance
+// (else the KKT system is solved): the refinement decisions are then those of the KKT solve.
+constexpr double range_space_accuracy = 1e-3;
+// Nets with up to this many free vertices keep H^-1 (dense, 2 MB at the limit).
+constexpr Eigen::Index dense_inverse_limit = 512;
 
 // Chebyshev distance (in vertices) from every vertex to the nearest vertex with E = 0; vertices
 // of a region covering the whole net get INT_MAX.
@@ -126,6 +131,13 @@ struct NetCache {
   std::vector<Eigen::Index> free_index;     // per vertex: its unknown, or -1 when fixed
   std::vector<Eigen::Index> free_rows;      // per unknown: its vertex
   Eigen::SparseMatrix<double> H;            // thin-plate energy L^T L + ridge, free vertices
+  // H = P^T L D L^T P, factorized once per net: every drag on the net reuses it (only the
+  // key-point rows B change), so a solve costs nk triangular solves instead of a KKT factorization.
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> energy;
+  bool factorized = false;
+  // H^-1 itself on nets of up to dense_inverse_limit free vertices (at most 2 MB): a key-point
+  // row has (p+1)(q+1) nonzeros, so H^-1 B^T is then that many columns of it per key point.
+  Eigen::MatrixXd inverse;
 };
 
 namespace {
@@ -177,7 +189,38 @@ std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s, const std::
   // A tiny ridge keeps H definite where the free vertices reach the border of the net.
   for (Eigen::Index c = 0; c < nf; ++c) H.coeffRef(c, c) += 1e-12 * std::max(max_diag, 1.0);
   cache->H = std::move(H);
+  cache->energy.compute(cache->H);
+  cache->factorized = cache->energy.info() == Eigen::Success;
+  if (cache->factorized && nf <= dense_inverse_limit)
+    cache->inverse = cache->energy.solve(Eigen::MatrixXd::Identity(nf, nf));
   return cache;
+}
+
+// The energy minimum subject to B d = r by the KKT system [H B^T; B 0] [d; μ] = [0; r]: LU, dense
+// for small systems (an interactive region, where it beats the sparse ordering analysis), sparse
+// beyond (at 509 unknowns, a refined hood, a third of dense LU's time). It meets independent key
+// points to rounding without the squared conditioning of the range-space solve.
+Eigen::MatrixXd kkt_solve(const Eigen::SparseMatrix<double>& H, const Eigen::MatrixXd& B, const Eigen::MatrixXd& rhs) {
+  const Eigen::Index nf = H.rows(), nk = B.rows();
+  std::vector<Eigen::Triplet<double>> kkt;
+  for (Eigen::Index c = 0; c < nf; ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(H, c); it; ++it) kkt.emplace_back(it.row(), it.col(), it.value());
+  for (Eigen::Index k = 0; k < nk; ++k)
+    for (Eigen::Index c = 0; c < nf; ++c)
+      if (B(k, c) != 0) {
+        kkt.emplace_back(nf + k, c, B(k, c));
+        kkt.emplace_back(c, nf + k, B(k, c));
+      }
+  Eigen::SparseMatrix<double> K(nf + nk, nf + nk);
+  K.setFromTriplets(kkt.begin(), kkt.end());
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(nf + nk, 3);
+  b.bottomRows(nk) = rhs;
+  if (nf + nk <= 200) return Eigen::PartialPivLU<Eigen::MatrixXd>(Eigen::MatrixXd(K)).solve(b).topRows(nf);
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+  lu.compute(K);
+  if (lu.info() != Eigen::Success)
+    throw Error(ErrorCategory::Internal, "style deformation: the key-point system could not be factorized");
+  return Eigen::MatrixXd(lu.solve(b)).topRows(nf);
 }
 
 
@@ -280,39 +323,38 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       continue;
     }
 
-    // The energy minimum subject to the key points: the KKT system [H B^T; B 0] [d; μ] = [0; r],
-    // sparse LU, when the key points are independent (they are then met to rounding, with no
-    // squaring of the condition number as in a Schur complement B H^-1 B^T). Dependent key points:
+    // The energy minimum subject to the key points, when they are independent: d = H^-1 B^T μ with
+    // (B H^-1 B^T) μ = r, else the KKT system (kkt_solve). Dependent key points:
     // d = d0 + Z y with d0 the minimal-norm least-squares solution of B d = r, Z a basis of null(B)
     // and y minimising the energy — the least-squares compromise of least energy.
     Eigen::MatrixXd d = Eigen::MatrixXd::Zero(nf, 3);
     if (nk > 0 && nf > 0) {
       if (rank == nk) {
-        std::vector<Eigen::Triplet<double>> kkt;
-        for (Eigen::Index c = 0; c < nf; ++c)
-          for (Eigen::SparseMatrix<double>::InnerIterator it(net->H, c); it; ++it)
-            kkt.emplace_back(it.row(), it.col(), it.value());
-        for (Eigen::Index k = 0; k < nk; ++k)
-          for (Eigen::Index c = 0; c < nf; ++c)
-            if (B(k, c) != 0) {
-              kkt.emplace_back(nf + k, c, B(k, c));
-              kkt.emplace_back(c, nf + k, B(k, c));
-            }
-        Eigen::SparseMatrix<double> K(nf + nk, nf + nk);
-        K.setFromTriplets(kkt.begin(), kkt.end());
-        Eigen::MatrixXd b = Eigen::MatrixXd::Zero(nf + nk, 3);
-        b.bottomRows(nk) = rhs;
-        if (nf + nk <= 200) {
-          // Small systems (an interactive region): dense LU beats the sparse ordering analysis
-          // (at 509 unknowns, a refined hood, sparse LU takes a third of dense LU's time).
-          d = Eigen::MatrixXd(Eigen::PartialPivLU<Eigen::MatrixXd>(Eigen::MatrixXd(K)).solve(b)).topRows(nf);
-        } else {
-          Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-          lu.compute(K);
-          if (lu.info() != Eigen::Success)
-            throw Error(ErrorCategory::Internal, "style deformation: the key-point system could not be factorized");
-          d = Eigen::MatrixXd(lu.solve(b)).topRows(nf);
+        // Range space first: Y = H^-1 B^T from the net's factorization, S = B Y (nk x nk, SPD),
+        // S μ = r, d = Y μ, one step of refinement on the key-point residual. It is accepted
+        // when it meets the key points to far below the tolerance; otherwise (S squares the
+        // conditioning of nearly dependent rows) the KKT system decides.
+        bool solved = false;
+        if (net->factorized) {
+          Eigen::MatrixXd Y;
+          if (net->inverse.size() > 0) {
+            Y = Eigen::MatrixXd::Zero(nf, nk);
+            for (Eigen::Index k = 0; k < nk; ++k)
+              for (Eigen::Index c = 0; c < nf; ++c)
+                if (B(k, c) != 0) Y.col(k) += B(k, c) * net->inverse.col(c);
+          } else {
+            Y = net->energy.solve(Eigen::MatrixXd(B.transpose()));
+          }
+          const Eigen::MatrixXd S = B * Y;
+          const Eigen::LDLT<Eigen::MatrixXd> schur(S);
+          if (schur.info() == Eigen::Success && schur.isPositive()) {
+            Eigen::MatrixXd mu = schur.solve(rhs);
+            mu += schur.solve(rhs - B * (Y * mu));
+            d = Y * mu;
+            solved = (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol && d.allFinite();
+          }
         }
+        if (!solved) d = kkt_solve(net->H, B, rhs);
       } else {
         Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(B);
         cod.setThreshold(1e-10);
@@ -354,6 +396,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     if (!missed && options.curve_tolerance > 0 && additions < options.max_key_point_rounds) {
       const double limit = options.curve_tolerance * size;
       std::vector<double> miss(trace.size(), 0.0);
+      const surface::SurfaceProjector result(out.surface, options.projection);  // validated once
       for (size_t k = 0; k < trace.size(); ++k) {
         if (!in_region(trace[k])) continue;
         // The distance from the wanted point (λ scales the move as for key points) to the result;
@@ -363,7 +406,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
         const Eigen::Vector3d wanted = foot + options.lambda * (trace[k].point - foot);
         miss[k] = (surface::evaluate(out.surface, trace[k].u, trace[k].v) - wanted).norm();
         if (miss[k] > limit)
-          miss[k] = project_from(out.surface, wanted, trace[k].u, trace[k].v, options.projection).distance;
+          miss[k] = project_from(result, wanted, trace[k].u, trace[k].v).distance;
       }
       size_t added = 0;
       for (size_t k = 0; k < trace.size(); ++k) {

@@ -80,9 +80,10 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
                           const surface::BSplineCurve& target,
                           const std::vector<TraceSample>& trace, int per_row);
 
-/// Projection of `x` onto `s` by Newton from (u, v), the global closest point where Newton fails.
-surface::SurfaceProjection project_from(const surface::BSplineSurface& s, const Eigen::Vector3d& x,
-                                        double u, double v, const surface::ProjectionOptions& options);
+/// Projection of `x` by Newton from (u, v), the global closest point where Newton fails (the
+/// projector validates its surface once and evaluates closest_point's start grid only then).
+surface::SurfaceProjection project_from(const surface::SurfaceProjector& projector,
+                                        const Eigen::Vector3d& x, double u, double v);
 
 /// Fills the quality figures of `report` that compare `result` with `parent` on the region:
 /// locality, boundary jumps, target deviations (key points and, when `samples` is not empty, the

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <numeric>
 #include <string>
 
@@ -175,14 +176,27 @@ SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vect
   return SurfaceProjector(surface, options).closest_point(point);
 }
 
+// The start grid of closest_point: parameters and points, row iu * vs.size() + iv.
+struct SurfaceProjector::StartGrid {
+  std::once_flag once;
+  std::vector<double> us, vs;
+  Points3 points;
+};
+
 SurfaceProjector::SurfaceProjector(BSplineSurface surface, const ProjectionOptions& options)
-    : surface_(std::move(surface)), options_(options) {
+    : surface_(std::move(surface)), options_(options), grid_(std::make_shared<StartGrid>()) {
   options_.validate();
   validate(surface_);
   size_ = net_size(surface_);
-  us_ = span_samples(surface_.u, options_.samples_per_span);
-  vs_ = span_samples(surface_.v, options_.samples_per_span);
-  grid_ = evaluate_grid(surface_, us_, vs_);
+}
+
+const SurfaceProjector::StartGrid& SurfaceProjector::start_grid() const {
+  std::call_once(grid_->once, [this] {
+    grid_->us = span_samples(surface_.u, options_.samples_per_span);
+    grid_->vs = span_samples(surface_.v, options_.samples_per_span);
+    grid_->points = evaluate_grid(surface_, grid_->us, grid_->vs);
+  });
+  return *grid_;
 }
 
 SurfaceProjection SurfaceProjector::project_normal(const Eigen::Vector3d& point, double u0,
@@ -195,12 +209,13 @@ SurfaceProjection SurfaceProjector::project_normal(const Eigen::Vector3d& point,
 
 SurfaceProjection SurfaceProjector::closest_point(const Eigen::Vector3d& point) const {
   check_point(point);
+  const StartGrid& grid = start_grid();
   // Newton from the `starts` grid samples nearest to the point; the nearest result wins.
-  const size_t starts = std::min(static_cast<size_t>(grid_.rows()), static_cast<size_t>(options_.starts));
+  const size_t starts = std::min(static_cast<size_t>(grid.points.rows()), static_cast<size_t>(options_.starts));
   std::vector<std::pair<double, Eigen::Index>> best_samples;  // (squared distance, row), sorted
   best_samples.reserve(starts + 1);
-  for (Eigen::Index r = 0; r < grid_.rows(); ++r) {
-    const double d2 = (grid_.row(r) - point.transpose()).squaredNorm();
+  for (Eigen::Index r = 0; r < grid.points.rows(); ++r) {
+    const double d2 = (grid.points.row(r) - point.transpose()).squaredNorm();
     if (best_samples.size() == starts && d2 >= best_samples.back().first) continue;
     const auto at = std::upper_bound(best_samples.begin(), best_samples.end(), std::make_pair(d2, r));
     best_samples.insert(at, {d2, r});
@@ -209,8 +224,8 @@ SurfaceProjection SurfaceProjector::closest_point(const Eigen::Vector3d& point) 
   SurfaceProjection best;
   bool have = false;
   for (const auto& [d2, r] : best_samples) {
-    const double u0 = us_[static_cast<size_t>(r) / vs_.size()];
-    const double v0 = vs_[static_cast<size_t>(r) % vs_.size()];
+    const double u0 = grid.us[static_cast<size_t>(r) / grid.vs.size()];
+    const double v0 = grid.vs[static_cast<size_t>(r) % grid.vs.size()];
     SurfaceProjection candidate = newton(surface_, size_, point, u0, v0, options_);
     if (!have || candidate.distance < best.distance) {
       best = std::move(candidate);

@@ -363,6 +363,72 @@ TEST_CASE("exact mode: the hood passes through every key point and joins the par
   CHECK(style_deform(s, hood_bound(), hood_target(), options).report.target_deviation > 1e-3 * size);
 }
 
+TEST_CASE("exact mode: the displacement is the least thin-plate energy that meets the key points", "[style]") {
+  // First-order optimality, checked from the definitions alone: with E(d) the thin-plate energy of
+  // the displacement net (docs/deform.md) and B the key-point rows, any move z of the moved
+  // vertices with B z = 0 leaves the key points met, so the gradient of E must be orthogonal to
+  // all of them: its projection onto null(B) vanishes. B is read off the surface by moving one
+  // control point at a time (linear in the points), not from the basis code the solver uses.
+  const BSplineSurface s = hood(16, 16);
+  StyleOptions options;
+  options.mode = StyleMode::exact;
+  const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
+  INFO(r.report.message);
+  const BSplineSurface& net = r.refined_parent;
+  const Points3 d = r.surface.points - net.points;
+  const int nu = net.count_u(), nv = net.count_v();
+  std::vector<Eigen::Index> moved;
+  for (Eigen::Index row = 0; row < d.rows(); ++row)
+    if (!d.row(row).isZero(0)) moved.push_back(row);
+  REQUIRE(moved.size() > 100);
+
+  // Gradient of E / 2 = L^T L x over the whole net (fixed vertices have x = 0).
+  auto half_gradient = [&](const Points3& x) {
+    Points3 grad = Points3::Zero(x.rows(), 3);
+    auto stencil = [&](std::initializer_list<std::pair<Eigen::Index, double>> terms) {
+      Eigen::RowVector3d value = Eigen::RowVector3d::Zero();
+      for (const auto& [row, c] : terms) value += c * x.row(row);
+      for (const auto& [row, c] : terms) grad.row(row) += c * value;
+    };
+    const double twist = std::sqrt(2.0);
+    for (int i = 0; i < nu; ++i)
+      for (int j = 0; j < nv; ++j) {
+        if (i > 0 && i + 1 < nu) stencil({{net.index(i - 1, j), 1.0}, {net.index(i, j), -2.0}, {net.index(i + 1, j), 1.0}});
+        if (j > 0 && j + 1 < nv) stencil({{net.index(i, j - 1), 1.0}, {net.index(i, j), -2.0}, {net.index(i, j + 1), 1.0}});
+        if (i + 1 < nu && j + 1 < nv)
+          stencil({{net.index(i, j), twist}, {net.index(i + 1, j), -twist}, {net.index(i, j + 1), -twist},
+                   {net.index(i + 1, j + 1), twist}});
+      }
+    return Eigen::MatrixXd(grad(moved, Eigen::all));
+  };
+  std::vector<const KeyPoint*> keys;
+  for (const KeyPoint& k : r.report.key_points)
+    if (k.influenced) keys.push_back(&k);
+  const Eigen::Index nk = static_cast<Eigen::Index>(keys.size()), nm = static_cast<Eigen::Index>(moved.size());
+  Eigen::MatrixXd B(nk, nm);
+  for (Eigen::Index c = 0; c < nm; ++c) {
+    BSplineSurface unit = net;
+    unit.points.row(moved[static_cast<size_t>(c)]).x() += 1.0;
+    for (Eigen::Index k = 0; k < nk; ++k) {
+      const KeyPoint& kp = *keys[static_cast<size_t>(k)];
+      B(k, c) = (clay::surface::evaluate(unit, kp.u, kp.v) - clay::surface::evaluate(net, kp.u, kp.v)).x();
+    }
+  }
+  // The projection onto null(B): g - B^T (B B^T)^-1 B g.
+  auto projected = [&](const Eigen::MatrixXd& x) -> Eigen::MatrixXd {
+    return x - B.transpose() * (B * B.transpose()).ldlt().solve(B * x);
+  };
+  const Eigen::MatrixXd g = half_gradient(d);
+  CHECK(projected(g).norm() <= 1e-8 * g.norm());
+  // The check can fail: the minimal-norm displacement meets the same key points, and is not the
+  // least energy.
+  Points3 minimal_norm = Points3::Zero(d.rows(), 3);
+  const Eigen::MatrixXd rhs = B * d(moved, Eigen::all);
+  minimal_norm(moved, Eigen::all) = B.transpose() * (B * B.transpose()).ldlt().solve(rhs);
+  const Eigen::MatrixXd g_other = half_gradient(minimal_norm);
+  CHECK(projected(g_other).norm() > 1e-2 * g_other.norm());
+}
+
 TEST_CASE("exact mode on a sail with uneven knots, with and without a bound curve", "[style]") {
   const BSplineSurface s = sail();
   const double size = size_of(s);

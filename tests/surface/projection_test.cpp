@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <random>
+#include <thread>
+#include <vector>
 
 #include "random_geometry.hpp"
 
@@ -151,4 +153,35 @@ TEST_CASE("SurfaceProjector: the cylinder's closed-form distance, and the free f
   ProjectionOptions bad;
   bad.starts = 0;
   CHECK_THROWS_AS(SurfaceProjector(s, bad), clay::Error);
+}
+
+TEST_CASE("SurfaceProjector: the start grid is evaluated once, shared by copies and threads", "[projection]") {
+  // The grid is built on the first closest_point; threads racing for it, on the projector and on
+  // a copy made before it existed, get the free function's results bit for bit.
+  const double r = 50.0, h = 80.0;
+  const BSplineSurface s = quarter_cylinder(r, h);
+  std::vector<Eigen::Vector3d> points;
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<double> angle(0.05, 1.52), rho(5.0, 120.0), z(1.0, 79.0);
+  for (int k = 0; k < 200; ++k) {
+    const double a = angle(rng), q = rho(rng);
+    points.emplace_back(q * std::cos(a), q * std::sin(a), z(rng));
+  }
+  for (int round = 0; round < 20; ++round) {
+    const SurfaceProjector projector(s);
+    const SurfaceProjector copy = projector;  // before any grid exists
+    std::vector<SurfaceProjection> a(points.size()), b(points.size());
+    std::thread other([&] {
+      for (size_t k = 0; k < points.size(); ++k) b[k] = copy.closest_point(points[k]);
+    });
+    for (size_t k = 0; k < points.size(); ++k) a[k] = projector.closest_point(points[k]);
+    other.join();
+    for (size_t k = 0; k < points.size(); k += 17) {
+      const SurfaceProjection free = closest_point(s, points[k]);
+      CHECK(a[k].u == free.u);
+      CHECK(b[k].u == free.u);
+      CHECK(a[k].v == free.v);
+      CHECK(b[k].v == free.v);
+    }
+  }
 }

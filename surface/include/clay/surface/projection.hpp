@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <vector>
 
 namespace clay::surface {
@@ -48,12 +49,13 @@ SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vect
                                 const ProjectionOptions& options = {});
 
 /// A surface prepared for many projections: validated once, with the start grid of
-/// closest_point evaluated once. Same results as the free functions (bit for bit). An immutable
-/// value: copyable and safe to share between threads.
+/// closest_point evaluated once, on the first closest_point (so a projector used only for
+/// project_normal costs no grid). Same results as the free functions (bit for bit). An immutable
+/// value: copyable (copies share the grid) and safe to share between threads.
 class SurfaceProjector {
  public:
-  /// Copies and validates the surface and evaluates the start grid. Throws clay::Error:
-  /// InvalidGeometry for an invalid surface, InvalidArgument for bad options.
+  /// Copies and validates the surface. Throws clay::Error: InvalidGeometry for an invalid
+  /// surface, InvalidArgument for bad options.
   explicit SurfaceProjector(BSplineSurface surface, const ProjectionOptions& options = {});
 
   /// The surface projected onto.
@@ -67,11 +69,13 @@ class SurfaceProjector {
   SurfaceProjection closest_point(const Eigen::Vector3d& point) const;
 
  private:
+  struct StartGrid;
+  const StartGrid& start_grid() const;
+
   BSplineSurface surface_;
   ProjectionOptions options_;
-  double size_ = 0;              // diagonal of the control box
-  std::vector<double> us_, vs_;  // start grid parameters
-  Points3 grid_;                 // start grid points, row iu * vs_.size() + iv
+  double size_ = 0;                    // diagonal of the control box
+  std::shared_ptr<StartGrid> grid_;    // evaluated once, on first use
 };
 
 }  // namespace clay::surface
