@@ -318,16 +318,17 @@ template <int L, int M, int N, int Stride>
   std::int32_t* __restrict order = sc.order.data();
   std::int32_t* __restrict count = sc.count.data();  // cell_count + 2 entries
   const int outside = K.cell_count;
-  for (std::size_t c0 = begin; c0 < end; c0 += chunk_points) {
-    const std::size_t n = std::min(chunk_points, end - c0);
-    std::fill(count, count + outside + 2, 0);
-    // 1. Local coordinates and cells, a block at a time, and the histogram of cells. Whole
-    // blocks, then a tail padded with the last point (only its cnt entries counted). Element
-    // access goes through arrays: on a vector variable it would keep the vector in memory.
-    std::size_t b = 0;
+  // The two lambdas are always inlined: a lambda is not cloned per instruction set, inlined it is
+  // compiled for the clone it is in.
+  // 1. Local coordinates and cells of input points [first + from, first + n) into scratch
+  // [from, n), a block at a time, and the histogram of cells. Whole blocks, then a tail padded
+  // with the last point (only its cnt entries counted). Element access goes through arrays: on a
+  // vector variable it would keep the vector in memory.
+  auto locate_range = [&](std::size_t first, std::size_t from, std::size_t n) __attribute__((always_inline)) {
+    std::size_t b = from;
     for (; b + W <= n; b += W) {
-      prefetch_block<Stride>(io, c0 + b + prefetch_distance);
-      load_block<Stride>(io, c0 + b, x, y, z);
+      prefetch_block<Stride>(io, first + b + prefetch_distance);
+      load_block<Stride>(io, first + b, x, y, z);
       locate_block(K, x, y, z, S + b, T + b, U + b, cell + b);
       for (std::size_t q = 0; q < W; ++q) ++count[cell[b + q] + 1];
     }
@@ -335,7 +336,7 @@ template <int L, int M, int N, int Stride>
       const std::size_t cnt = n - b;
       double px[W], py[W], pz[W];
       for (std::size_t q = 0; q < W; ++q) {
-        const std::size_t i = c0 + b + std::min(q, cnt - 1);
+        const std::size_t i = first + b + std::min(q, cnt - 1);
         px[q] = io.in[0][i * Stride];
         py[q] = io.in[1][i * Stride];
         pz[q] = io.in[2][i * Stride];
@@ -344,6 +345,28 @@ template <int L, int M, int N, int Stride>
       locate_block(K, x, y, z, S + b, T + b, U + b, cell + b);
       for (std::size_t q = 0; q < cnt; ++q) ++count[cell[b + q] + 1];
     }
+  };
+  // 5. Results of scratch [from, n) out to points [first + from, first + n), in input order.
+  auto output_range = [&](std::size_t first, std::size_t from, std::size_t n) __attribute__((always_inline)) {
+    std::size_t b = from;
+    for (; b + W <= n; b += W) {
+      load(x, S + b);
+      load(y, T + b);
+      load(z, U + b);
+      prefetch_output<Stride>(io, first + b + prefetch_distance);
+      store_block<Stride>(io, first + b, x, y, z);
+    }
+    for (; b < n; ++b) {
+      io.out[0][(first + b) * Stride] = S[b];
+      io.out[1][(first + b) * Stride] = T[b];
+      io.out[2][(first + b) * Stride] = U[b];
+    }
+  };
+  std::size_t c0 = begin;
+  std::fill(count, count + outside + 2, 0);
+  locate_range(c0, 0, std::min(chunk_points, end - c0));
+  for (; c0 < end; c0 += chunk_points) {
+    const std::size_t n = std::min(chunk_points, end - c0);
     // 2. Counting sort by cell (indices only: one store per point into a small array).
     for (int c = 0; c <= outside; ++c) count[c + 1] += count[c];  // count[c] = start of cell c
     for (std::size_t i = 0; i < n; ++i) order[count[cell[i]]++] = static_cast<std::int32_t>(i);
@@ -385,25 +408,39 @@ template <int L, int M, int N, int Stride>
       start = stop;
     }
     // 4. Points outside (sorted last) get their own coordinates back, read before this chunk's
-    // output is written (so `out` may be `in`); then the results go out in input order.
+    // output is written (so `out` may be `in`).
     for (int p = start; p < count[outside]; ++p) {
       const std::size_t i = static_cast<std::size_t>(order[p]);
       S[i] = io.in[0][(c0 + i) * Stride];
       T[i] = io.in[1][(c0 + i) * Stride];
       U[i] = io.in[2][(c0 + i) * Stride];
     }
-    for (b = 0; b + W <= n; b += W) {
+    // 5. The results go out in input order, and the next chunk is located into the same scratch
+    // entries in the same pass: one loop with a write stream and a read stream keeps more memory
+    // requests in flight than two loops with one each. (Block b of the next chunk overwrites
+    // block b of this one only after it went out; the chunks are disjoint ranges of the points,
+    // so `out` may still be `in`.)
+    const std::size_t c1 = c0 + chunk_points;
+    if (c1 >= end) {
+      output_range(c0, 0, n);
+      break;
+    }
+    const std::size_t n1 = std::min(chunk_points, end - c1);  // <= n
+    std::fill(count, count + outside + 2, 0);
+    std::size_t b = 0;
+    for (; b + W <= n1; b += W) {
       load(x, S + b);
       load(y, T + b);
       load(z, U + b);
       prefetch_output<Stride>(io, c0 + b + prefetch_distance);
       store_block<Stride>(io, c0 + b, x, y, z);
+      prefetch_block<Stride>(io, c1 + b + prefetch_distance);
+      load_block<Stride>(io, c1 + b, x, y, z);
+      locate_block(K, x, y, z, S + b, T + b, U + b, cell + b);
+      for (std::size_t q = 0; q < W; ++q) ++count[cell[b + q] + 1];
     }
-    for (; b < n; ++b) {
-      io.out[0][(c0 + b) * Stride] = S[b];
-      io.out[1][(c0 + b) * Stride] = T[b];
-      io.out[2][(c0 + b) * Stride] = U[b];
-    }
+    output_range(c0, b, n);
+    locate_range(c1, b, n1);
   }
 }
 
