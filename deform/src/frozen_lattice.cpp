@@ -304,6 +304,16 @@ template <int L, int M, int N, int Stride>
   std::memcpy(cell, &narrow, sizeof narrow);
 }
 
+/// Counting sort of a chunk's indices by cell, from the histogram count[c + 1] = points in cell
+/// c; after it count[c] is the end of cell c, and W spare entries repeat the last index. Its own
+/// function (scalar code, not cloned): inside the large driver its pointers were kept on the stack.
+[[gnu::noinline]] void counting_sort(const std::int32_t* __restrict cell, std::int32_t* __restrict order,
+                                     std::int32_t* __restrict count, std::size_t n, int outside) {
+  for (int c = 0; c <= outside; ++c) count[c + 1] += count[c];  // count[c] = start of cell c
+  for (std::size_t i = 0; i < n; ++i) order[count[cell[i]]++] = static_cast<std::int32_t>(i);
+  for (std::size_t p = n; p < n + W; ++p) order[p] = order[n - 1];  // spare lanes
+}
+
 template <int L, int M, int N, int Stride>
 [[gnu::always_inline]] inline void bspline_range(const Kernel& K, const Io& io, std::size_t begin,
                                                  std::size_t end, Scratch& sc) {
@@ -368,9 +378,7 @@ template <int L, int M, int N, int Stride>
   for (; c0 < end; c0 += chunk_points) {
     const std::size_t n = std::min(chunk_points, end - c0);
     // 2. Counting sort by cell (indices only: one store per point into a small array).
-    for (int c = 0; c <= outside; ++c) count[c + 1] += count[c];  // count[c] = start of cell c
-    for (std::size_t i = 0; i < n; ++i) order[count[cell[i]]++] = static_cast<std::int32_t>(i);
-    for (std::size_t p = n; p < n + W; ++p) order[p] = order[n - 1];  // spare lanes
+    counting_sort(cell, order, count, n, outside);
     // Now count[c] = end of cell c. 3. Blocks within one cell, coefficients broadcast; a last
     // partial block reads (but does not write) points of the next cell, not yet evaluated.
     int start = 0;
