@@ -41,8 +41,10 @@ constexpr double min_free_share = 0.1;
 // share of min_free_share needs.
 constexpr double max_amplification = 1 / min_free_share;
 // The range-space solve is kept when it meets the key points to this fraction of the tolerance
-// (else the KKT system is solved): the refinement decisions are then those of the KKT solve.
+// (else the KKT system is solved)...
 constexpr double range_space_accuracy = 1e-3;
+// ... and when H d = B^T μ holds to this fraction of |B^T μ| (rounding on the hood: ~1e-11).
+constexpr double range_space_stationarity = 1e-8;
 // Nets with up to this many free vertices keep H^-1 (dense, 2 MB at the limit).
 constexpr Eigen::Index dense_inverse_limit = 512;
 
@@ -351,7 +353,14 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
             Eigen::MatrixXd mu = schur.solve(rhs);
             mu += schur.solve(rhs - B * (Y * mu));
             d = Y * mu;
-            solved = (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol && d.allFinite();
+            // Both KKT conditions: the key points (B d = r) and stationarity (H d = B^T μ). The
+            // first alone cannot see an inaccurate Y, since S was made from the same Y; the
+            // second can (a nearly singular H, held definite only by its ridge where the free
+            // vertices reach the net's border, or μ large along S's weak directions).
+            const Eigen::MatrixXd force = B.transpose() * mu;
+            const double stationarity = (net->H * d - force).cwiseAbs().maxCoeff();
+            solved = d.allFinite() && (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
+                     stationarity <= range_space_stationarity * force.cwiseAbs().maxCoeff();
           }
         }
         if (!solved) d = kkt_solve(net->H, B, rhs);

@@ -6,6 +6,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <mutex>
 #include <numeric>
@@ -176,9 +177,12 @@ SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vect
   return SurfaceProjector(surface, options).closest_point(point);
 }
 
-// The start grid of closest_point: parameters and points, row iu * vs.size() + iv.
+// The start grid of closest_point: parameters and points, row iu * vs.size() + iv. Built under a
+// mutex, published by `ready` (not std::call_once: in GCC 12's libstdc++ a call_once whose
+// function throws leaves the flag deadlocked, GCC PR 66146).
 struct SurfaceProjector::StartGrid {
-  std::once_flag once;
+  std::mutex mutex;
+  std::atomic<bool> ready{false};
   std::vector<double> us, vs;
   Points3 points;
 };
@@ -191,12 +195,24 @@ SurfaceProjector::SurfaceProjector(BSplineSurface surface, const ProjectionOptio
 }
 
 const SurfaceProjector::StartGrid& SurfaceProjector::start_grid() const {
-  std::call_once(grid_->once, [this] {
-    grid_->us = span_samples(surface_.u, options_.samples_per_span);
-    grid_->vs = span_samples(surface_.v, options_.samples_per_span);
-    grid_->points = evaluate_grid(surface_, grid_->us, grid_->vs);
-  });
-  return *grid_;
+  if (!grid_)
+    throw Error(ErrorCategory::InvalidArgument,
+                "SurfaceProjector: used after being moved from; assign a projector to it first");
+  StartGrid& g = *grid_;
+  if (!g.ready.load(std::memory_order_acquire)) {
+    const std::lock_guard<std::mutex> lock(g.mutex);
+    if (!g.ready.load(std::memory_order_relaxed)) {
+      // Built aside, then moved in: a throw (bad_alloc) leaves the grid empty and unpublished.
+      std::vector<double> us = span_samples(surface_.u, options_.samples_per_span);
+      std::vector<double> vs = span_samples(surface_.v, options_.samples_per_span);
+      Points3 points = evaluate_grid(surface_, us, vs);
+      g.us = std::move(us);
+      g.vs = std::move(vs);
+      g.points = std::move(points);
+      g.ready.store(true, std::memory_order_release);
+    }
+  }
+  return g;
 }
 
 SurfaceProjection SurfaceProjector::project_normal(const Eigen::Vector3d& point, double u0,

@@ -110,7 +110,7 @@ TEST_CASE("fast evaluation equals de Boor for B-spline lattices, one and two thr
       40'001);
   // Several sort chunks (32,768 points) per thread, so that each chunk's output runs fused with
   // the next one's locate, the last chunk shorter and ending in a partial block (4 chunks and
-  // 13 points on one thread; 2 chunks and 8 points a thread on two).
+  // 13 points on one thread; 2 chunks and 8 or 5 points a thread on two).
   check_against_reference(
       clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 3}, {8, 8, 8}), rng, 0.3), rng,
       131'085);

@@ -157,15 +157,18 @@ TEST_CASE("SurfaceProjector: the cylinder's closed-form distance, and the free f
 
 TEST_CASE("SurfaceProjector: the start grid is evaluated once, shared by copies and threads", "[projection]") {
   // The grid is built on the first closest_point; threads racing for it, on the projector and on
-  // a copy made before it existed, get the free function's results bit for bit.
+  // a copy made before it existed, get the cylinder's closed-form distance and the same
+  // parameters.
   const double r = 50.0, h = 80.0;
   const BSplineSurface s = quarter_cylinder(r, h);
   std::vector<Eigen::Vector3d> points;
+  std::vector<double> distance;
   std::mt19937 rng(53);
   std::uniform_real_distribution<double> angle(0.05, 1.52), rho(5.0, 120.0), z(1.0, 79.0);
   for (int k = 0; k < 200; ++k) {
     const double a = angle(rng), q = rho(rng);
     points.emplace_back(q * std::cos(a), q * std::sin(a), z(rng));
+    distance.push_back(std::abs(q - r));
   }
   for (int round = 0; round < 20; ++round) {
     const SurfaceProjector projector(s);
@@ -176,12 +179,15 @@ TEST_CASE("SurfaceProjector: the start grid is evaluated once, shared by copies 
     });
     for (size_t k = 0; k < points.size(); ++k) a[k] = projector.closest_point(points[k]);
     other.join();
-    for (size_t k = 0; k < points.size(); k += 17) {
-      const SurfaceProjection free = closest_point(s, points[k]);
-      CHECK(a[k].u == free.u);
-      CHECK(b[k].u == free.u);
-      CHECK(a[k].v == free.v);
-      CHECK(b[k].v == free.v);
+    for (size_t k = 0; k < points.size(); ++k) {
+      CHECK_THAT(a[k].distance, WithinAbs(distance[k], 1e-9));
+      CHECK(a[k].u == b[k].u);
+      CHECK(a[k].v == b[k].v);
     }
   }
+  // A moved-from projector says so instead of reading a grid it no longer has.
+  SurfaceProjector from(s);
+  const SurfaceProjector to = std::move(from);
+  CHECK_THAT(to.closest_point(points[0]).distance, WithinAbs(distance[0], 1e-9));
+  CHECK_THROWS_AS(from.closest_point(points[0]), clay::Error);  // NOLINT(bugprone-use-after-move)
 }

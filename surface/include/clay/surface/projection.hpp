@@ -51,7 +51,8 @@ SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vect
 /// A surface prepared for many projections: validated once, with the start grid of
 /// closest_point evaluated once, on the first closest_point (so a projector used only for
 /// project_normal costs no grid). Same results as the free functions (bit for bit). An immutable
-/// value: copyable (copies share the grid) and safe to share between threads.
+/// value: copyable (copies share the grid) and safe to share between threads. A moved-from
+/// projector throws InvalidArgument from closest_point until a projector is assigned to it.
 class SurfaceProjector {
  public:
   /// Copies and validates the surface. Throws clay::Error: InvalidGeometry for an invalid
