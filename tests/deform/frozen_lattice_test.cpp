@@ -124,6 +124,12 @@ TEST_CASE("fast evaluation equals de Boor for B-spline lattices, one and two thr
                                                             clay::test::random_basis(rng, 2, 5, true, 2)};
   check_against_reference(clay::test::displaced(make_bspline_lattice(random_frame(rng), bases), rng, 0.3),
                           rng, 35'000);
+  // Non-uniform cubic: the specialized kernel with the out-of-line cell search.
+  const std::array<clay::surface::BSplineBasis, 3> cubic = {clay::test::random_basis(rng, 3, 9, true, 1),
+                                                            clay::test::random_basis(rng, 3, 6, true, 1),
+                                                            clay::test::random_basis(rng, 3, 8, false, 1)};
+  check_against_reference(clay::test::displaced(make_bspline_lattice(random_frame(rng), cubic), rng, 0.3),
+                          rng, 35'000);
   check_against_reference(clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 3}, {2, 2, 2}), rng),
                           rng, 3);
 }
