@@ -73,7 +73,7 @@ Constraint end_tangent(CurveEnd end, const Eigen::Vector3d& direction) {
 
 std::string describe(const Constraint& c, const sketch::Sketch& sketch) {
   auto p = [&](size_t i) {
-    return i < c.points.size() ? "point #" + std::to_string(c.points[i].index) : std::string("?");
+    return i < c.points.size() ? sketch::describe(sketch, c.points[i]) : std::string("?");
   };
   auto e = [&](size_t i) {
     return i < c.entities.size() ? sketch::describe(sketch, c.entities[i]) : std::string("?");
@@ -107,8 +107,11 @@ std::string describe(const Constraint& c, const sketch::Sketch& sketch) {
     case ConstraintKind::Curvature: text = "G2 joint " + end(0) + " to " + end(1); break;
     case ConstraintKind::EndTangent: text = "tangent at " + end(0) + " along a given direction"; break;
   }
-  if (!c.label.empty()) text += " [" + c.label + "]";
   return text;
+}
+
+std::string constraint_name(const Constraint& c, int index) {
+  return c.label.empty() ? "constraint #" + std::to_string(index) : c.label;
 }
 
 }  // namespace clay::constraints

@@ -204,9 +204,7 @@ class Builder {
 
  private:
   std::string name() const {
-    std::string out = "constraint #" + std::to_string(k_);
-    if (c_ && !c_->label.empty()) out += " (" + c_->label + ")";
-    return out;
+    return c_ ? constraint_name(*c_, k_) : "constraint #" + std::to_string(k_);
   }
   [[noreturn]] void fail(const std::string& message) const {
     throw Error(ErrorCategory::InvalidArgument, message);
@@ -256,7 +254,7 @@ class Builder {
     for (sketch::PointId p : points) {
       const int pl = var(p).plane;
       if (pl < 0 || (plane != -2 && pl != plane))
-        fail(name() + ": needs its points in one sketch plane, but point #" + std::to_string(p.index) +
+        fail(name() + ": needs its points in one sketch plane, but " + sketch::describe(s_, p) +
              (pl < 0 ? " is a free 3D point" : " lies in plane #" + std::to_string(pl)) +
              "; create the geometry in one plane");
       plane = pl;

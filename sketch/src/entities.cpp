@@ -16,7 +16,19 @@ std::string num(double x) {
   return buffer;
 }
 
-std::string point_name(int index) { return "point #" + std::to_string(index); }
+/// The name of a point for messages: its recipe name when the sketch has one.
+std::string point_name(const Sketch& s, int index) {
+  if (index >= 0 && index < static_cast<int>(s.point_names.size()) && !s.point_names[static_cast<size_t>(index)].empty())
+    return "point \"" + s.point_names[static_cast<size_t>(index)] + "\"";
+  return "point #" + std::to_string(index);
+}
+
+/// "kind \"name\"" or "kind #index".
+std::string named(const Sketch& s, const char* kind, size_t index) {
+  if (index < s.entity_names.size() && !s.entity_names[index].empty())
+    return std::string(kind) + " \"" + s.entity_names[index] + "\"";
+  return std::string(kind) + " #" + std::to_string(index);
+}
 
 [[noreturn]] void fail(ErrorCategory category, const std::string& message) {
   throw Error(category, message);
@@ -45,7 +57,7 @@ PlaneId Sketch::add_plane(const SketchPlane& plane) {
 PointId Sketch::add_point(const Eigen::Vector3d& p) {
   if (!finite(p))
     fail(ErrorCategory::InvalidGeometry,
-         "add_point: " + point_name(static_cast<int>(points.size())) + " has a non-finite coordinate");
+         "add_point: " + point_name(*this, static_cast<int>(points.size())) + " has a non-finite coordinate");
   points.push_back({p, {}});
   return {static_cast<int>(points.size()) - 1};
 }
@@ -57,7 +69,7 @@ PointId Sketch::add_point(PlaneId plane, const Eigen::Vector2d& ab) {
              std::to_string(planes.size()) + " planes)");
   if (!ab.allFinite())
     fail(ErrorCategory::InvalidGeometry,
-         "add_point: " + point_name(static_cast<int>(points.size())) + " has a non-finite coordinate");
+         "add_point: " + point_name(*this, static_cast<int>(points.size())) + " has a non-finite coordinate");
   points.push_back({to_world(planes[static_cast<size_t>(plane.index)], ab), plane});
   return {static_cast<int>(points.size()) - 1};
 }
@@ -67,7 +79,7 @@ namespace {
 void check_point(const Sketch& s, PointId p, const std::string& who) {
   if (p.index < 0 || p.index >= static_cast<int>(s.points.size()))
     fail(ErrorCategory::InvalidArgument,
-         who + ": " + point_name(p.index) + " does not exist (the sketch has " +
+         who + ": " + point_name(s, p.index) + " does not exist (the sketch has " +
              std::to_string(s.points.size()) + " points)");
 }
 
@@ -81,7 +93,7 @@ void check_plane(const Sketch& s, PlaneId plane, const std::string& who) {
 void check_in_plane(const Sketch& s, PointId p, PlaneId plane, const std::string& who) {
   if (!(s.points[static_cast<size_t>(p.index)].plane == plane))
     fail(ErrorCategory::InvalidGeometry,
-         who + ": " + point_name(p.index) + " is not a point of plane #" +
+         who + ": " + point_name(s, p.index) + " is not a point of plane #" +
              std::to_string(plane.index) + "; create it with add_point(plane, ab)");
 }
 
@@ -100,25 +112,25 @@ std::string entity_name(const Sketch& s, size_t index) {
         else return "curve";
       },
       s.entities[index]);
-  return std::string(kind) + " #" + std::to_string(index);
+  return named(s, kind, index);
 }
 
 }  // namespace
 
 EntityId Sketch::add_line(PointId start, PointId end) {
-  const std::string who = "add_line (line #" + std::to_string(entities.size()) + ")";
+  const std::string who = "add_line (" + named(*this, "line", entities.size()) + ")";
   check_point(*this, start, who);
   check_point(*this, end, who);
   const double length = (position(*this, end) - position(*this, start)).norm();
   if (start == end || !(length > 1e-12 * model_size(*this)))
     fail(ErrorCategory::InvalidGeometry,
-         who + ": zero length (" + point_name(start.index) + " and " + point_name(end.index) +
+         who + ": zero length (" + point_name(*this, start.index) + " and " + point_name(*this, end.index) +
              " coincide); give two distinct points");
   return push(*this, Line{start, end});
 }
 
 EntityId Sketch::add_circle(PointId center, double radius, PlaneId plane) {
-  const std::string who = "add_circle (circle #" + std::to_string(entities.size()) + ")";
+  const std::string who = "add_circle (" + named(*this, "circle", entities.size()) + ")";
   check_point(*this, center, who);
   check_plane(*this, plane, who);
   check_in_plane(*this, center, plane, who);
@@ -128,7 +140,7 @@ EntityId Sketch::add_circle(PointId center, double radius, PlaneId plane) {
 }
 
 EntityId Sketch::add_arc(PointId center, PointId start, PointId end, PlaneId plane) {
-  const std::string who = "add_arc (arc #" + std::to_string(entities.size()) + ")";
+  const std::string who = "add_arc (" + named(*this, "arc", entities.size()) + ")";
   for (PointId p : {center, start, end}) {
     check_point(*this, p, who);
   }
@@ -140,8 +152,8 @@ EntityId Sketch::add_arc(PointId center, PointId start, PointId end, PlaneId pla
     fail(ErrorCategory::InvalidGeometry, who + ": zero radius (start point on the center)");
   if (std::abs(r1 - r0) > 1e-9 * r0)
     fail(ErrorCategory::InvalidGeometry,
-         who + ": start and end are at different distances from the center (" + num(r0) + " and " +
-             num(r1) + " mm); place the end on the circle through the start");
+         who + ": start and end are at different distances from the center (" + distinct_numbers(r0, r1) +
+             " mm); place the end on the circle through the start");
   if (start == end || (position(*this, end) - position(*this, start)).norm() <= 1e-12 * r0)
     fail(ErrorCategory::InvalidGeometry,
          who + ": start and end coincide (a zero-length arc); use a circle for a full turn");
@@ -149,7 +161,7 @@ EntityId Sketch::add_arc(PointId center, PointId start, PointId end, PlaneId pla
 }
 
 EntityId Sketch::add_curve(const surface::BSplineCurve& curve, PlaneId plane) {
-  const std::string who = "add_curve (curve #" + std::to_string(entities.size()) + ")";
+  const std::string who = "add_curve (" + named(*this, "curve", entities.size()) + ")";
   surface::validate(curve, who);
   if (!surface::is_clamped(curve.basis))
     fail(ErrorCategory::InvalidGeometry,
@@ -192,6 +204,18 @@ EntityId Sketch::add_curve(const surface::BSplineCurve& curve, PlaneId plane) {
 Eigen::Vector3d position(const Sketch& sketch, PointId point) {
   check_point(sketch, point, "position");
   return sketch.points[static_cast<size_t>(point.index)].position;
+}
+
+std::string describe(const Sketch& sketch, PointId point) { return point_name(sketch, point.index); }
+
+std::string distinct_numbers(double a, double b) {
+  char x[40], y[40];
+  for (int digits = 3; digits <= 17; ++digits) {
+    std::snprintf(x, sizeof x, "%.*g", digits, a);
+    std::snprintf(y, sizeof y, "%.*g", digits, b);
+    if (std::string(x) != y) break;
+  }
+  return std::string(x) + " and " + y;
 }
 
 std::string describe(const Sketch& sketch, EntityId entity) {
@@ -249,14 +273,14 @@ std::vector<std::string> problems(const Sketch& sketch) {
   }
   for (int i = 0; i < np; ++i) {
     const SketchPoint& p = sketch.points[static_cast<size_t>(i)];
-    if (!finite(p.position)) out.push_back(point_name(i) + " has a non-finite coordinate");
+    if (!finite(p.position)) out.push_back(point_name(sketch, i) + " has a non-finite coordinate");
     if (p.plane.index >= nplanes)
-      out.push_back(point_name(i) + " refers to plane #" + std::to_string(p.plane.index) +
+      out.push_back(point_name(sketch, i) + " refers to plane #" + std::to_string(p.plane.index) +
                     ", which does not exist");
     else if (!p.plane.free()) {
       const double d = std::abs(signed_distance(sketch.planes[static_cast<size_t>(p.plane.index)], p.position));
       if (d > 1e-9 * size)
-        out.push_back(point_name(i) + " is " + num(d) + " mm off its plane #" +
+        out.push_back(point_name(sketch, i) + " is " + num(d) + " mm off its plane #" +
                       std::to_string(p.plane.index));
     }
   }
@@ -286,7 +310,7 @@ std::vector<std::string> problems(const Sketch& sketch) {
       const double r1 = (pos(a->end) - pos(a->center)).norm();
       if (!(r0 > 1e-12 * size)) out.push_back(who + " has zero radius");
       else if (std::abs(r1 - r0) > 1e-9 * size)
-        out.push_back(who + " has unequal radii " + num(r0) + " and " + num(r1) + " mm");
+        out.push_back(who + " has unequal radii " + distinct_numbers(r0, r1) + " mm");
     } else {
       const Curve& curve = std::get<Curve>(e);
       bool dangling = false;

@@ -58,7 +58,7 @@ struct Constraint {
   std::vector<CurveEnd> ends;
   double value = 0;
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  ///< EndTangent only (world)
-  std::string label;                                    ///< shown in reports when set
+  std::string label;  ///< names the constraint in messages when set (constraint_name)
 };
 
 /// The point stays at its current position.
@@ -101,8 +101,11 @@ Constraint curvature(CurveEnd a, CurveEnd b);
 /// along increasing parameter) is along `direction` (world, nonzero).
 Constraint end_tangent(CurveEnd end, const Eigen::Vector3d& direction);
 
-/// The constraint in words, naming its points and entities as the sketch calls them, with its
-/// label when set: "angle 60 degrees from line #1 to line #2".
+/// The constraint in words, naming its points and entities as the sketch calls them (their
+/// names when the sketch has them): "angle 60 degrees from line #1 to line #2".
 std::string describe(const Constraint& constraint, const sketch::Sketch& sketch);
+/// How messages name the constraint at `index` of a list: its label when set (a recipe labels
+/// each with its path, "sketches.s.constraints[3]"), else "constraint #3".
+std::string constraint_name(const Constraint& constraint, int index);
 
 }  // namespace clay::constraints

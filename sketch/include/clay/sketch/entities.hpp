@@ -74,6 +74,10 @@ struct Sketch {
   std::vector<SketchPlane> planes;
   std::vector<SketchPoint> points;
   std::vector<Entity> entities;
+  /// Optional names for messages (a recipe gives its own): point_names[k] names point k and
+  /// entity_names[k] entity k; a missing or empty name reads "point #k", "line #k".
+  std::vector<std::string> point_names;
+  std::vector<std::string> entity_names;
 
   /// Adds a plane (validated).
   PlaneId add_plane(const SketchPlane& plane);
@@ -101,8 +105,14 @@ Eigen::Vector3d position(const Sketch& sketch, PointId point);
 /// an exact rational quadratic (surface::circular_arc). Throws clay::Error(InvalidArgument) for a
 /// missing id.
 surface::BSplineCurve curve_of(const Sketch& sketch, EntityId entity);
-/// A short name for messages: "line #3", "arc #0", "curve #2", "point #7".
+/// A short name for messages: "line \"luff\"" when entity_names names it, else "line #3",
+/// "arc #0", "curve #2".
 std::string describe(const Sketch& sketch, EntityId entity);
+/// The same for a point: "point \"tip\"" or "point #7".
+std::string describe(const Sketch& sketch, PointId point);
+/// Two numbers for a message that says they differ: each with the fewest significant digits
+/// (at least 3) that tell them apart, "1200.004 and 1200.01".
+std::string distinct_numbers(double a, double b);
 
 /// Every problem of the sketch in words (dangling ids, points off their plane by more than 1e-9
 /// of the model size, zero-length lines, non-positive radii, unequal arc radii, invalid curves).
