@@ -5,12 +5,15 @@
 //   zigzag:    the same chain with ±60° angles between neighbours instead of H/V (DOF 1);
 //   rectangles: R independent rectangles (8 points, 4 coincident, 2 H, 2 V, width, height,
 //              one corner fixed; DOF 0).
+//   loose staircase: the staircase with its last 1-10 vertical constraints removed (1-10 DOF);
+//   free end:  one line, fixed start, length 10, end drawn at (0.02, 10.5) (DOF 1; issue #18).
 // Targets (issue #3): 1,000-segment chains < 50 ms, 3,000 < 200 ms, 750 rectangles < 30 ms.
 #include <clay/constraints.hpp>
 
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstddef>
 #include <numbers>
 #include <random>
 #include <stdexcept>
@@ -52,6 +55,29 @@ Case staircase(int n) {
   }
   Case c = chain(corners, rng);
   for (int k = 0; k < n; ++k) c.constraints.push_back(k % 2 == 0 ? horizontal(EntityId{k}) : vertical(EntityId{k}));
+  return c;
+}
+
+/// The staircase with its last `free` vertical constraints removed: `free` degrees of freedom
+/// (issue #18: under-constrained sketches, the normal state while a stylist draws).
+Case loose_staircase(int n, int free) {
+  Case c = staircase(n);
+  const size_t first_hv = c.constraints.size() - static_cast<size_t>(n);  // H/V appended last, by segment
+  for (int k = n - 1, removed = 0; k >= 0 && removed < free; --k)
+    if (k % 2 == 1) {
+      c.constraints.erase(c.constraints.begin() + static_cast<std::ptrdiff_t>(first_hv + static_cast<size_t>(k)));
+      ++removed;
+    }
+  return c;
+}
+
+/// One line with a fixed start and a length of 10, its end drawn at (0.02, 10.5): 1 DOF.
+Case free_end_line() {
+  Case c;
+  const auto plane = c.sketch.add_plane({});
+  const PointId a = c.sketch.add_point(plane, {0, 0}), b = c.sketch.add_point(plane, {0.02, 10.5});
+  c.sketch.add_line(a, b);
+  c.constraints = {fixed(a), distance(a, b, 10)};
   return c;
 }
 
@@ -102,6 +128,7 @@ void run(benchmark::State& state, const Case& c, int expected_dof) {
     benchmark::DoNotOptimize(r.sketch.points.data());
     last = std::move(r.report);
   }
+  state.counters["iterations"] = last.summary.iterations;  // also when it fails: the figure to compare
   if (!last.summary.converged() || last.degrees_of_freedom != expected_dof)
     state.SkipWithError(("not solved as expected: " + last.summary.brief()).c_str());
   state.counters["equations"] = last.equations;
@@ -113,6 +140,11 @@ void run(benchmark::State& state, const Case& c, int expected_dof) {
 
 void staircase_chain(benchmark::State& state) { run(state, staircase(static_cast<int>(state.range(0))), 0); }
 void zigzag_chain(benchmark::State& state) { run(state, zigzag(static_cast<int>(state.range(0))), 1); }
+void loose_staircase_chain(benchmark::State& state) {
+  run(state, loose_staircase(static_cast<int>(state.range(0)), static_cast<int>(state.range(1))),
+      static_cast<int>(state.range(1)));
+}
+void free_end(benchmark::State& state) { run(state, free_end_line(), 1); }
 void independent_rectangles(benchmark::State& state) {
   run(state, rectangles(static_cast<int>(state.range(0))), 0);
 }
@@ -121,5 +153,8 @@ void independent_rectangles(benchmark::State& state) {
 
 BENCHMARK(staircase_chain)->Arg(10)->Arg(100)->Arg(1000)->Arg(3000)->Unit(benchmark::kMillisecond);
 BENCHMARK(zigzag_chain)->Arg(10)->Arg(100)->Arg(1000)->Arg(3000)->Unit(benchmark::kMillisecond);
+BENCHMARK(loose_staircase_chain)->Args({10, 1})->Args({100, 5})->Args({1000, 1})->Args({1000, 10})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(free_end)->Unit(benchmark::kMicrosecond);
 BENCHMARK(independent_rectangles)->Arg(10)->Arg(100)->Arg(750)->Arg(1000)->Arg(3000)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

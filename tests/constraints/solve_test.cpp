@@ -432,3 +432,118 @@ TEST_CASE("points on curves and arcs, equal radii, and joints across planes and 
     if (!t.points[i].plane.free())
       CHECK(std::abs(clay::sketch::signed_distance(t.planes[static_cast<size_t>(t.points[i].plane.index)], t.points[i].position)) < 1e-12);
 }
+
+// Issue #18: under-constrained sketches (the normal state while a stylist draws) must converge.
+// Levenberg–Marquardt damped with diag(JᵀJ) let a nearly zero Jacobian column (a free end's
+// coordinate) swing: a line with a fixed start and a length of 10, its end drawn at (0.02, 10.5),
+// stopped after 101 iterations at residual 0.508.
+namespace {
+
+/// One line from a fixed start at the origin to `end`, with a length of 10: 1 DOF.
+Sketch free_end_line(const Eigen::Vector2d& end, std::vector<Constraint>& constraints) {
+  Sketch s;
+  const PlaneId plane = s.add_plane({});
+  const PointId a = s.add_point(plane, {0, 0});
+  const PointId b = s.add_point(plane, end);
+  s.add_line(a, b);
+  constraints = {fixed(a), distance(a, b, 10)};
+  return s;
+}
+
+/// A horizontal/vertical staircase of n segments (own end points, coincident joints, a length
+/// each, first point fixed) drawn off by up to ±1 mm, with the last `free` vertical constraints
+/// removed: `free` degrees of freedom.
+Sketch staircase_with_freedom(int n, int free, std::vector<Constraint>& constraints, double drawn_off = 1.0) {
+  Sketch s;
+  const PlaneId plane = s.add_plane({});
+  Eigen::Vector2d corner(0, 0);
+  std::vector<PointId> ends;
+  constraints.clear();
+  unsigned state = 12345;
+  auto jitter = [&] {
+    state = state * 1103515245u + 12345u;
+    return drawn_off * (((state >> 8) % 2001) / 1000.0 - 1.0);
+  };
+  std::vector<int> verticals;
+  for (int k = 0; k < n; ++k) {
+    const double length = 10 + k % 3;
+    const Eigen::Vector2d next = corner + (k % 2 == 0 ? Eigen::Vector2d(length, 0) : Eigen::Vector2d(0, length));
+    const PointId a = s.add_point(plane, corner + Eigen::Vector2d(jitter(), jitter()));
+    const PointId b = s.add_point(plane, next + Eigen::Vector2d(jitter(), jitter()));
+    const EntityId line = s.add_line(a, b);
+    if (k > 0) constraints.push_back(coincident(ends.back(), a));
+    else constraints.push_back(fixed(a));
+    ends.push_back(b);
+    constraints.push_back(distance(a, b, length));
+    if (k % 2 == 0) constraints.push_back(horizontal(line));
+    else verticals.push_back(static_cast<int>(constraints.size())), constraints.push_back(vertical(line));
+    corner = next;
+  }
+  for (int k = 0; k < free; ++k) constraints.erase(constraints.begin() + verticals[verticals.size() - 1 - static_cast<size_t>(k)]);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("a line with a fixed start and a length converges whatever direction its free end takes", "[constraints]") {
+  // Every free-DOF direction around the circle, and ends a hair off vertical and horizontal, each
+  // drawn 5 % too long or too short.
+  std::vector<Eigen::Vector2d> ends;
+  for (int k = 0; k < 72; ++k) {
+    const double a = k * 5.0 * pi / 180;
+    ends.push_back(10.5 * Eigen::Vector2d(std::cos(a), std::sin(a)));
+    ends.push_back(9.5 * Eigen::Vector2d(std::cos(a + 1e-3), std::sin(a + 1e-3)));
+  }
+  for (double e : {0.02, -0.02, 1e-6, 0.0})
+    for (double r : {10.5, 9.5, 30.0, 0.5}) {
+      ends.push_back({e, r});
+      ends.push_back({r, e});
+      ends.push_back({-r, e});
+      ends.push_back({e, -r});
+    }
+  int worst_iterations = 0;
+  for (const Eigen::Vector2d& end : ends) {
+    std::vector<Constraint> c;
+    const Sketch s = free_end_line(end, c);
+    const SolveResult r = solve(s, c);
+    INFO("end drawn at (" << end.x() << ", " << end.y() << "): " << r.report.summary.brief());
+    REQUIRE(r.report.summary.termination == clay::Termination::Converged);
+    REQUIRE(r.report.max_residual <= 1e-10);
+    // The independent measurement: the solved end is 10 from the fixed start, which stayed put.
+    CHECK_THAT((at(r.sketch, PointId{1}) - at(r.sketch, PointId{0})).norm(), WithinAbs(10, 1e-10));
+    CHECK(at(r.sketch, PointId{0}).norm() == 0);
+    CHECK(r.report.degrees_of_freedom == 1);
+    // The least change: the end moves along the line's direction (a minimum-norm step), it does
+    // not swing round the circle.
+    const Eigen::Vector3d drawn = clay::sketch::position(s, PointId{1});
+    CHECK((at(r.sketch, PointId{1}).normalized() - drawn.normalized()).norm() < 1e-9);
+    worst_iterations = std::max(worst_iterations, r.report.summary.iterations);
+  }
+  CHECK(worst_iterations <= 20);  // 5 for ends drawn near the circle, 17 for one drawn 20 times too short
+}
+
+TEST_CASE("staircases of up to 1,000 segments with 1 to 10 free verticals converge in few iterations", "[constraints]") {
+  int worst_iterations = 0;
+  // Drawn off by up to 1 mm, and nearly exactly (0.02 mm: the free ends then start nearly
+  // vertical, where Marquardt's damping swung them).
+  for (double drawn_off : {1.0, 0.02})
+  for (int n : {10, 100, 1000})
+    for (int free : {1, 2, 5, 10}) {
+      if (free > n / 2) continue;  // only the odd segments are vertical
+      std::vector<Constraint> c;
+      const Sketch s = staircase_with_freedom(n, free, c, drawn_off);
+      const SolveResult r = solve(s, c);
+      INFO(n << " segments, " << free << " DOF: " << r.report.summary.brief());
+      REQUIRE(r.report.summary.termination == clay::Termination::Converged);
+      REQUIRE(r.report.max_residual <= 1e-10);
+      CHECK(r.report.degrees_of_freedom == free);
+      // Independent check of the chain: each segment's length, joints closed.
+      for (int k = 0; k < n; ++k) {
+        const Eigen::Vector3d a = at(r.sketch, PointId{2 * k}), b = at(r.sketch, PointId{2 * k + 1});
+        CHECK_THAT((b - a).norm(), WithinAbs(10 + k % 3, 1e-10));
+        if (k > 0) CHECK((a - at(r.sketch, PointId{2 * k - 1})).norm() < 1e-10);
+      }
+      worst_iterations = std::max(worst_iterations, r.report.summary.iterations);
+    }
+  CHECK(worst_iterations <= 25);
+}
