@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <optional>
@@ -396,43 +397,172 @@ ComposedPatch compose_patch(const BezierLattice& cell, const std::array<Factor, 
 // ---- containment of a patch in a cell -------------------------------------------------------
 
 /// Where c = C / W leaves [lo, hi] (beyond tol) on the patch: the patch-local parameter and value,
-/// `certain` false when subdivision could not decide (the bound crosses, no point does).
+/// `certain` false when the search could not decide within its budget (then `value` is a bound of
+/// c from the convex hull, not a value of the surface).
 struct Violation {
   double x = 0, y = 0, value = 0;
   bool certain = true;
 };
 
-/// Certifies lo − tol <= C / W <= hi + tol on [x0, x1] x [y0, y1] (convex hull of the ratios
-/// C_ij / W_ij: c is a convex combination of them), subdividing where the hull crosses.
-std::optional<Violation> leaves(const Poly& cw, double lo, double hi, double tol, double x0, double x1,
-                                double y0, double y1, int depth) {
-  double mn = std::numeric_limits<double>::infinity(), mx = -mn;
-  for (int i = 0; i <= cw.du; ++i)
-    for (int j = 0; j <= cw.dv; ++j) {
-      const double r = cw.at(i, j, 0) / cw.at(i, j, 1);
-      mn = std::min(mn, r);
-      mx = std::max(mx, r);
+/// Bernstein coefficients of ∂g/∂x (dir 0) or ∂g/∂y (dir 1) of a dim-1 poly, degree one lower
+/// (the zero poly of degree 0 when g has degree 0 there).
+Poly derivative(const Poly& g, int dir) {
+  const int p = dir == 0 ? g.du : g.dv;
+  if (p == 0) return Poly(dir == 0 ? 0 : g.du, dir == 0 ? g.dv : 0, 1);
+  Poly d(dir == 0 ? g.du - 1 : g.du, dir == 0 ? g.dv : g.dv - 1, 1);
+  for (int i = 0; i <= d.du; ++i)
+    for (int j = 0; j <= d.dv; ++j)
+      d.at(i, j) = p * (dir == 0 ? g.at(i + 1, j) - g.at(i, j) : g.at(i, j + 1) - g.at(i, j));
+  return d;
+}
+
+double max_coefficient(const Poly& g) { return *std::max_element(g.c.begin(), g.c.end()); }
+double max_abs_coefficient(const Poly& g) {
+  double m = 0;
+  for (double x : g.c) m = std::max(m, std::abs(x));
+  return m;
+}
+
+/// g with its first and second partial derivatives, for the maximum search on one cell.
+struct Derivatives {
+  Poly g, gx, gy, gxx, gxy, gyy;
+  explicit Derivatives(Poly g_)
+      : g(std::move(g_)), gx(derivative(g, 0)), gy(derivative(g, 1)), gxx(derivative(gx, 0)),
+        gxy(derivative(gx, 1)), gyy(derivative(gy, 1)) {}
+};
+
+/// A local maximiser of g on [0, 1]^2 (projected Newton with an active set, from the Greville
+/// point of the largest coefficient). Only the tightness of the certificate below depends on it.
+std::pair<double, double> maximiser(const Derivatives& d) {
+  const Poly& g = d.g;
+  size_t best = 0;
+  for (size_t k = 1; k < g.c.size(); ++k)
+    if (g.c[k] > g.c[best]) best = k;
+  const int bi = static_cast<int>(best) / (g.dv + 1), bj = static_cast<int>(best) % (g.dv + 1);
+  double x = g.du > 0 ? static_cast<double>(bi) / g.du : 0.5, y = g.dv > 0 ? static_cast<double>(bj) / g.dv : 0.5;
+  for (int it = 0; it < 40; ++it) {
+    const double gx = value_at(d.gx, x, y), gy = value_at(d.gy, x, y);
+    const double gxx = value_at(d.gxx, x, y), gxy = value_at(d.gxy, x, y), gyy = value_at(d.gyy, x, y);
+    // A coordinate on the cell's edge whose gradient points out of the cell stays there.
+    const bool free_x = g.du > 0 && !((x <= 0 && gx < 0) || (x >= 1 && gx > 0));
+    const bool free_y = g.dv > 0 && !((y <= 0 && gy < 0) || (y >= 1 && gy > 0));
+    double sx = 0, sy = 0;
+    if (free_x && free_y) {
+      const double det = gxx * gyy - gxy * gxy;
+      if (!(gxx < 0 && det > 0)) break;  // not concave here: the subdivision decides
+      sx = -(gyy * gx - gxy * gy) / det;
+      sy = -(gxx * gy - gxy * gx) / det;
+    } else if (free_x) {
+      if (!(gxx < 0)) break;
+      sx = -gx / gxx;
+    } else if (free_y) {
+      if (!(gyy < 0)) break;
+      sy = -gy / gyy;
+    } else {
+      break;
     }
-  if (mn >= lo - tol && mx <= hi + tol) return std::nullopt;
+    const double nx = std::clamp(x + sx, 0.0, 1.0), ny = std::clamp(y + sy, 0.0, 1.0);
+    const double moved = std::abs(nx - x) + std::abs(ny - y);
+    x = nx, y = ny;
+    if (moved <= 1e-15) break;
+  }
+  return {x, y};
+}
+
+enum class Verdict { inside, outside, undecided };
+
+/// Decides g <= 0 on [0, 1]^2 for a dim-1 Bernstein poly g, or finds a point with g > 0:
+/// - inside when every coefficient is <= 0 (convex hull);
+/// - outside at a point (a corner, or a maximiser) where g > 0;
+/// - inside when g is certified concave on the cell (∂xx g <= A <= 0, ∂yy g <= B <= 0,
+///   |∂xy g| <= C with C^2 <= A B, from the coefficients of the second derivatives: the Hessian
+///   is negative semidefinite everywhere) and its tangent plane at the maximiser x*, an upper
+///   bound of a concave function, stays <= 0 at the four corners: g(x) <= g(x*) + ∇g(x*)·(x − x*).
+///   This decides a surface that touches the plane (true maximum exactly on it), where the convex
+///   hull only approaches the maximum as the cell shrinks;
+/// - undecided otherwise: subdivide.
+Verdict decide(const Poly& g, double& px, double& py) {
+  if (max_coefficient(g) <= 0) return Verdict::inside;
   for (int a = 0; a < 2; ++a)
-    for (int b = 0; b < 2; ++b) {  // the corners are points of the patch
-      const int i = a ? cw.du : 0, j = b ? cw.dv : 0;
-      const double r = cw.at(i, j, 0) / cw.at(i, j, 1);
-      if (r < lo - tol || r > hi + tol) return Violation{a ? x1 : x0, b ? y1 : y0, r, true};
-    }
-  if (depth == 0) return Violation{0.5 * (x0 + x1), 0.5 * (y0 + y1), mn < lo - tol ? mn : mx, false};
-  const double xm = 0.5 * (x0 + x1), ym = 0.5 * (y0 + y1);
-  const auto [left, right] = halve(cw, 0);
+    for (int b = 0; b < 2; ++b)
+      if (g.at(a ? g.du : 0, b ? g.dv : 0) > 0) {
+        px = a, py = b;
+        return Verdict::outside;
+      }
+  const Derivatives d(g);
+  const auto [x, y] = maximiser(d);
+  const double top = value_at(g, x, y);
+  if (top > 0) {
+    px = x, py = y;
+    return Verdict::outside;
+  }
+  const double A = max_coefficient(d.gxx), B = max_coefficient(d.gyy), C = max_abs_coefficient(d.gxy);
+  if (A <= 0 && B <= 0 && C * C <= A * B) {
+    const double gx = value_at(d.gx, x, y), gy = value_at(d.gy, x, y);
+    double bound = -std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 2; ++a)
+      for (int b = 0; b < 2; ++b) bound = std::max(bound, top + gx * (a - x) + gy * (b - y));
+    if (bound <= 0) return Verdict::inside;
+  }
+  return Verdict::undecided;
+}
+
+/// Certifies lo − tol <= C / W <= hi + tol on the patch (W > 0), or finds where it fails: the
+/// polynomials g = C − (hi + tol) W and (lo − tol) W − C must stay <= 0; each is decided cell by
+/// cell (decide above), subdividing undecided cells down to 2^-max_depth of the patch, at most
+/// `budget` cells per side. A violation found is a point of the surface (certain, with its true
+/// value); a search that runs out of budget reports the convex hull's bound (not certain).
+std::optional<Violation> leaves(const Poly& cw, double lo, double hi, double tol) {
+  constexpr int max_depth = 48;
+  constexpr int budget = 2048;
   std::optional<Violation> undecided;
-  const Poly* halves[2] = {&left, &right};
-  for (int a = 0; a < 2; ++a) {
-    const auto [bottom, top] = halve(*halves[a], 1);
-    const Poly* quarters[2] = {&bottom, &top};
-    for (int b = 0; b < 2; ++b) {
-      auto v = leaves(*quarters[b], lo, hi, tol, a ? xm : x0, a ? x1 : xm, b ? ym : y0, b ? y1 : ym,
-                      depth - 1);
-      if (v && v->certain) return v;
-      if (v && !undecided) undecided = v;
+  for (int side = 0; side < 2; ++side) {
+    const double limit = side == 0 ? hi + tol : lo - tol;
+    struct Cell {
+      Poly cw;
+      double x0, x1, y0, y1;
+      int depth;
+    };
+    // Breadth first: a clear violation in one cell is found before the budget goes on refining a
+    // near-touch in another.
+    std::deque<Cell> queue{{cw, 0, 1, 0, 1, 0}};
+    int visited = 0;
+    while (!queue.empty()) {
+      Cell cell = std::move(queue.front());
+      queue.pop_front();
+      Poly g(cell.cw.du, cell.cw.dv, 1);
+      for (int i = 0; i <= g.du; ++i)
+        for (int j = 0; j <= g.dv; ++j) {
+          const double c = cell.cw.at(i, j, 0), w = cell.cw.at(i, j, 1);
+          g.at(i, j) = side == 0 ? c - limit * w : limit * w - c;
+        }
+      double px = 0, py = 0;
+      const Verdict v = decide(g, px, py);
+      if (v == Verdict::inside) continue;
+      if (v == Verdict::outside) {
+        const double value = value_at(cell.cw, px, py, 0) / value_at(cell.cw, px, py, 1);
+        return Violation{cell.x0 + px * (cell.x1 - cell.x0), cell.y0 + py * (cell.y1 - cell.y0), value, true};
+      }
+      if (cell.depth >= max_depth || ++visited > budget) {
+        if (!undecided) {
+          double bound = side == 0 ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+          for (int i = 0; i <= g.du; ++i)
+            for (int j = 0; j <= g.dv; ++j) {
+              const double r = cell.cw.at(i, j, 0) / cell.cw.at(i, j, 1);
+              bound = side == 0 ? std::max(bound, r) : std::min(bound, r);
+            }
+          undecided = Violation{0.5 * (cell.x0 + cell.x1), 0.5 * (cell.y0 + cell.y1), bound, false};
+        }
+        if (visited > budget) break;
+        continue;
+      }
+      const double xm = 0.5 * (cell.x0 + cell.x1), ym = 0.5 * (cell.y0 + cell.y1);
+      auto [left, right] = halve(cell.cw, 0);
+      for (int a = 0; a < 2; ++a) {
+        auto [bottom, top] = halve(a ? right : left, 1);
+        queue.push_back({std::move(bottom), a ? xm : cell.x0, a ? cell.x1 : xm, cell.y0, ym, cell.depth + 1});
+        queue.push_back({std::move(top), a ? xm : cell.x0, a ? cell.x1 : xm, ym, cell.y1, cell.depth + 1});
+      }
     }
   }
   return undecided;
@@ -709,42 +839,80 @@ double lattice_size(const Points3& points) {
   return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
 }
 
-/// Roots in (0, 1) of the univariate Bernstein polynomial `b` (sign changes on a fine sample,
-/// then bisection to rounding).
-std::vector<double> roots(const std::vector<double>& b) {
-  const int p = static_cast<int>(b.size()) - 1;
-  auto value = [&](double x) {
-    std::vector<double> w = b;
-    for (int l = 1; l <= p; ++l)
-      for (int k = 0; k + l <= p; ++k)
-        w[static_cast<size_t>(k)] = (1 - x) * w[static_cast<size_t>(k)] + x * w[static_cast<size_t>(k + 1)];
-    return w[0];
-  };
-  std::vector<double> out;
-  const int n = 32 * std::max(p, 1);
-  double x0 = 0, f0 = value(0);
-  for (int k = 1; k <= n; ++k) {
-    const double x1 = static_cast<double>(k) / n, f1 = value(x1);
-    if (f1 == 0 && k < n) out.push_back(x1);
-    if ((f0 < 0 && f1 > 0) || (f0 > 0 && f1 < 0)) {
-      double a = x0, c = x1, fa = f0;
-      for (int it = 0; it < 200 && c - a > 0; ++it) {
-        const double m = 0.5 * (a + c);
-        if (m <= a || m >= c) break;
-        const double fm = value(m);
-        if (fm == 0) {
-          a = c = m;
-          break;
-        }
-        if ((fa < 0) == (fm < 0))
-          a = m, fa = fm;
-        else
-          c = m;
-      }
-      out.push_back(0.5 * (a + c));
-    }
-    x0 = x1, f0 = f1;
+/// Sign changes of a coefficient sequence, zeros skipped (Descartes' rule for the Bernstein form:
+/// the number of roots in the open interval is at most this, and of the same parity).
+int sign_changes(const std::vector<double>& b) {
+  int changes = 0;
+  double last = 0;
+  for (double x : b) {
+    if (x == 0) continue;
+    if (last != 0 && (x < 0) != (last < 0)) ++changes;
+    last = x;
   }
+  return changes;
+}
+
+/// Value of a univariate Bernstein polynomial at x (de Casteljau).
+double bernstein_value(std::vector<double> w, double x) {
+  const size_t p = w.size() - 1;
+  for (size_t l = 1; l <= p; ++l)
+    for (size_t k = 0; k + l <= p; ++k) w[k] = (1 - x) * w[k] + x * w[k + 1];
+  return w[0];
+}
+
+/// Isolates the roots of `b` (Bernstein coefficients on [a, c]) by halving: no sign change, no
+/// root; one sign change between non-zero ends, exactly one root, refined by bisection to
+/// rounding; otherwise halve. An interval narrower than 1e-13 still showing several changes holds
+/// a cluster (a double root: the surface touches the plane along an iso-line): one root, its
+/// middle — a split there is harmless.
+void isolate(const std::vector<double>& b, double a, double c, std::vector<double>& out) {
+  const int changes = sign_changes(b);
+  if (changes == 0) return;
+  if (changes == 1 && b.front() != 0 && b.back() != 0) {
+    double lo = 0, hi = 1;
+    const bool rising = b.front() < 0;
+    for (int it = 0; it < 200; ++it) {
+      const double m = 0.5 * (lo + hi);
+      if (m <= lo || m >= hi) break;
+      const double f = bernstein_value(b, m);
+      if (f == 0) {
+        lo = hi = m;
+        break;
+      }
+      if ((f < 0) == rising)
+        lo = m;
+      else
+        hi = m;
+    }
+    out.push_back(a + 0.5 * (lo + hi) * (c - a));
+    return;
+  }
+  const double m = 0.5 * (a + c);
+  if (c - a <= 1e-13 || m <= a || m >= c) {
+    out.push_back(m);
+    return;
+  }
+  const size_t p = b.size() - 1;
+  std::vector<double> w = b, left(p + 1), right(p + 1);
+  left[0] = w[0];
+  right[p] = w[p];
+  for (size_t l = 1; l <= p; ++l) {
+    for (size_t k = 0; k + l <= p; ++k) w[k] = 0.5 * (w[k] + w[k + 1]);
+    left[l] = w[0];
+    right[p - l] = w[p - l];
+  }
+  isolate(left, a, m, out);
+  if (right[0] == 0) out.push_back(m);
+  isolate(right, m, c, out);
+}
+
+/// Roots in (0, 1) of the univariate Bernstein polynomial `b`, each isolated with certainty
+/// (isolate above): two crossings closer than any sampling step are both found.
+std::vector<double> roots(const std::vector<double>& b) {
+  std::vector<double> out;
+  isolate(b, 0, 1, out);
+  std::sort(out.begin(), out.end());
+  out.erase(std::remove_if(out.begin(), out.end(), [](double x) { return !(x > 0 && x < 1); }), out.end());
   return out;
 }
 
@@ -859,7 +1027,7 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
     for (int b = 0; b < bp.count_v(); ++b) {
       const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
       for (int d = 0; d < 3; ++d)
-        if (auto v = leaves(ratio_poly(pc, d), 0, 1, face_tolerance, 0, 1, 0, 1, 6))
+        if (auto v = leaves(ratio_poly(pc, d), 0, 1, face_tolerance))
           throw_outside(bp, a, b, d, *v, "Bézier lattice");
       auto& f = factors[static_cast<size_t>(a * bp.count_v() + b)];
       f = cell_factors(pc, {0, 0, 0}, {1, 1, 1});
@@ -900,19 +1068,42 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
       std::array<double, 3> lo{}, width{};
       for (int d = 0; d < 3; ++d) {
         const Poly cw = ratio_poly(pc, d);
-        if (auto v = leaves(cw, 0, 1, face_tolerance, 0, 1, 0, 1, 6)) throw_outside(bp, a, b, d, *v, "B-spline lattice");
+        if (auto v = leaves(cw, 0, 1, face_tolerance)) throw_outside(bp, a, b, d, *v, "B-spline lattice");
         const auto& br = cells.breaks[static_cast<size_t>(d)];
         const double centre = value_at(cw, 0.5, 0.5, 0) / value_at(cw, 0.5, 0.5, 1);
         int cell = static_cast<int>(std::upper_bound(br.begin(), br.end(), centre) - br.begin()) - 1;
         cell = std::clamp(cell, 0, counts[static_cast<size_t>(d)] - 1);
-        const double c0 = br[static_cast<size_t>(cell)], c1 = br[static_cast<size_t>(cell + 1)];
-        if (auto v = leaves(cw, c0, c1, face_tolerance, 0, 1, 0, 1, 6)) {
+        // The cell holding the patch's centre, or a neighbour: a patch touching a knot plane at
+        // its centre lies in the cell on the other side.
+        // When none holds it, the message shows the smallest excursion out of its cell (a bump
+        // just over the plane rather than the far corner of the cell above).
+        auto excess = [&](const Violation& x, int c) {
+          return std::max(br[static_cast<size_t>(c)] - x.value, x.value - br[static_cast<size_t>(c + 1)]);
+        };
+        std::optional<Violation> v = leaves(cw, br[static_cast<size_t>(cell)], br[static_cast<size_t>(cell + 1)], face_tolerance);
+        int shown = cell;
+        for (int next : {cell - 1, cell + 1}) {
+          if (!v || next < 0 || next >= counts[static_cast<size_t>(d)]) continue;
+          auto w = leaves(cw, br[static_cast<size_t>(next)], br[static_cast<size_t>(next + 1)], face_tolerance);
+          if (!w) {
+            cell = next;
+            v.reset();
+          } else if (w->certain && (!v->certain || excess(*w, next) < excess(*v, shown))) {
+            v = w;
+            shown = next;
+          }
+        }
+        const double c0 = br[static_cast<size_t>(v ? shown : cell)], c1 = br[static_cast<size_t>((v ? shown : cell) + 1)];
+        if (v) {
           const double plane = v->value < c0 ? c0 : c1;
           const auto [u, w] = global_parameter(bp, a, b, v->x, v->y);
           throw Error(ErrorCategory::InvalidArgument,
                       "compose_exact: surface " + patch_name(bp, a, b) + " crosses the lattice knot plane " +
-                          coordinate_name[d] + " = " + format(plane) + " (" + coordinate_name[d] + " = " +
-                          format(v->value) + " at parameter (" + format(u) + ", " + format(w) +
+                          coordinate_name[d] + " = " + format(plane) + " (" +
+                          (v->certain ? coordinate_name[d] + std::string(" = ") + format(v->value) + " at parameter ("
+                                      : std::string("not decided: the convex hull's bound ") + coordinate_name[d] +
+                                            " = " + format(v->value) + " near parameter (") +
+                          format(u) + ", " + format(w) +
                           ")) other than along an iso-parameter line: no single polynomial patch is "
                           "exact there; approximate the deformed surface with a refit tolerance "
                           "(certified refit), or move the knot plane off the surface");

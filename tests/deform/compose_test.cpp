@@ -307,6 +307,72 @@ TEST_CASE("compose_exact with a B-spline lattice splits at knot planes met along
   }
 }
 
+// Issue #18: touching a knot plane is not crossing it, and crossings closer together than any
+// sampling step are still found. The lattice has 2 cells in t: the knot plane t = 0.5.
+TEST_CASE("compose_exact with a B-spline lattice: a surface tangent to a knot plane composes exactly") {
+  std::mt19937 rng(29);
+  const Frame frame = clay::test::random_frame(rng);
+  const BSplineLattice lattice = clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
+  const auto map = [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); };
+  const double size = clay::test::size_of(lattice.points);
+  // t(u, v) = base + sign 0.3 (4u(1-u)) (4v(1-v)): Bernstein coefficients of 4x(1-x) are 0, 2, 0.
+  // Its extremum, at (0.5, 0.5), is base + sign 0.3: exactly on the plane for base 0.2 (from
+  // below) and 0.8 (from above); the convex hull reaches 1.4 (or -0.4), so only a certificate
+  // of the true extremum can tell that the surface stays on one side.
+  const double f[3] = {0, 2, 0};
+  for (double sign : {1.0, -1.0}) {
+    const double base = sign > 0 ? 0.2 : 0.8;
+    const BSplineSurface s = surface_in(frame, 2, 2, 3, 3, false, rng, [&](int i, int j) {
+      return Eigen::Vector3d(0.4 + 0.05 * i, base + sign * 0.3 * f[i] * f[j], 0.3 + 0.1 * j);
+    });
+    INFO("touching from " << (sign > 0 ? "below" : "above"));
+    const ComposeResult r = compose_exact(lattice, s);
+    INFO(r.report.brief());
+    CHECK(r.report.patches == 1);
+    CHECK(deviation(s, r.surface, map, 1000, rng) <= 1e-12 * size);
+    // The touching point itself: the lattice's two cells meet there with C^2 continuity, so both
+    // sides give the same point; the composed surface must too.
+    CHECK((clay::surface::evaluate(r.surface, 0.5, 0.5) - map(clay::surface::evaluate(s, 0.5, 0.5))).norm() <=
+          1e-12 * size);
+  }
+  SECTION("lifted by 1e-6 the same surface crosses the plane in a tiny region: refused, with the true value") {
+    const BSplineSurface s = surface_in(frame, 2, 2, 3, 3, false, rng, [&](int i, int j) {
+      return Eigen::Vector3d(0.4 + 0.05 * i, 0.2 + 1e-6 + 0.3 * f[i] * f[j], 0.3 + 0.1 * j);
+    });
+    const auto [category, what] = error_of([&] { compose_exact(lattice, s); });
+    CHECK(category == ErrorCategory::InvalidArgument);
+    // The value is the surface's own (1e-6 above the plane), at the top of the bump.
+    CHECK_THAT(what, Contains("knot plane t = 0.5") &&
+                         Catch::Matchers::Matches(".*\\(t = 0\\.50000(09|1)[0-9]* at parameter "
+                                                  "\\((0\\.5|0\\.4999)[0-9]*, (0\\.5|0\\.4999)[0-9]*\\).*"));
+    CHECK_THAT(what, !Contains("bound"));
+  }
+}
+
+TEST_CASE("compose_exact with a B-spline lattice splits at two crossings of a knot plane inside one sampling step") {
+  std::mt19937 rng(31);
+  const Frame frame = clay::test::random_frame(rng);
+  const BSplineLattice lattice = clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
+  const auto map = [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); };
+  const double size = clay::test::size_of(lattice.points);
+  // t(u) = 0.5 + e - k (u - m)^2 crosses t = 0.5 at m -+ 0.003, between the samples 0.5 and
+  // 0.515625 of a 64-step scan (both below the plane); s depends on v only.
+  const double m = 0.5 + 1.0 / 256, k = 1.9, e = 1.71e-5;
+  const double q0 = 0.5 + e - k * m * m, q1 = 0.5 + e - k * (1 - m) * (1 - m), slope0 = 2 * k * m;
+  const double t[3] = {q0, q0 + slope0 / 2, q1};  // Bernstein coefficients of the quadratic
+  const BSplineSurface s = surface_in(frame, 2, 1, 3, 2, false, rng, [&](int i, int j) {
+    return Eigen::Vector3d(0.4 + 0.1 * j, t[i], 0.5);
+  });
+  const ComposeResult r = compose_exact(lattice, s);
+  INFO(r.report.brief());
+  CHECK(r.report.splits == 2 * 2);  // two knots, each to multiplicity 2
+  // Both crossings are knots of the result, within rounding of the closed form m -+ sqrt(e / k).
+  const std::vector<double> breaks = clay::surface::breakpoints(r.surface.u);
+  for (double root : {m - std::sqrt(e / k), m + std::sqrt(e / k)})
+    CHECK(std::any_of(breaks.begin(), breaks.end(), [&](double b) { return std::abs(b - root) < 1e-9; }));
+  CHECK(deviation(s, r.surface, map, 2000, rng) <= 1e-12 * size);
+}
+
 TEST_CASE("compose_exact composes a polynomial taper exactly") {
   std::mt19937 rng(23);
   Taper taper;
