@@ -34,6 +34,7 @@ int exit_code(clay::ErrorCategory c) {
     case clay::ErrorCategory::Io: return 5;
     case clay::ErrorCategory::Exchange: return 6;
     case clay::ErrorCategory::Recipe: return 7;
+    case clay::ErrorCategory::ToleranceNotMet: return 8;
     case clay::ErrorCategory::Internal: return 70;
   }
   return 70;
@@ -256,7 +257,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.footer(
       "Exit codes: 0 success, 1 usage, 2 invalid argument, 3 invalid geometry or out of domain, "
-      "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 70 internal error.");
+      "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 8 tolerance not met, 70 internal error.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -557,12 +557,72 @@ StyleEditor::StyleEditor(BSplineSurface parent, InfluenceRegion region, const St
   check_region(projector_.surface(), region_);
 }
 
+Summary judge_style(const StyleReport& report, const StyleOptions& options) {
+  Summary s;
+  s.iterations = 1;
+  double farthest = 0;
+  for (const KeyPoint& k : report.key_points)
+    if (k.influenced) farthest = std::max(farthest, std::abs(k.distance));
+  s.initial_residual = farthest;
+  s.final_residual = report.target_deviation;
+  std::ostringstream m;
+  m.precision(4);
+  if (report.constraint_class == ConstraintClass::over_constrained) {
+    s.termination = Termination::Failed;
+    s.message = "the target curve lies outside the bound, so no control vertex may move and the surface is "
+                "unchanged: draw the target curve (at least partly) inside the bound, or the bound around it";
+    return s;
+  }
+  s.termination = Termination::Converged;
+  if (options.lambda == 0) {
+    s.message = "lambda = 0: unchanged, as asked";
+    return s;
+  }
+  // A control vertex may move more than the surface point it shapes (a B-spline basis value is
+  // below 1), but not ten times the farthest key point's distance: beyond that the net folds.
+  constexpr double fold_factor = 10;
+  if (farthest > 0 && report.max_displacement > fold_factor * farthest) {
+    s.termination = Termination::NotConverged;
+    m << "a control vertex moves " << report.max_displacement << " mm for a target at most " << farthest
+      << " mm from the surface (" << report.max_displacement / farthest
+      << " times; at most 10 times is accepted): the surface folds. Move the bound further from the target or "
+         "the target closer to the surface";
+    if (report.mode == StyleMode::exact) m << ", or allow more max_refinements";
+    s.message = m.str();
+    return s;
+  }
+  if (report.mode == StyleMode::exact) {
+    const double size = report.model_size;
+    if (!report.conflicting_key_points.empty()) {
+      s.termination = Termination::NotConverged;
+      m << report.conflicting_key_points.size() << " key points cannot be met (missed by up to "
+        << report.target_deviation << " mm, more than tolerance x size = " << options.tolerance * size
+        << " mm): the control net is too coarse there; allow more max_refinements";
+    } else if (report.target_deviation > options.tolerance * size) {
+      s.termination = Termination::NotConverged;
+      m << "a key point is missed by " << report.target_deviation << " mm, more than tolerance x size = "
+        << options.tolerance * size << " mm; allow more max_refinements";
+    } else if (options.curve_tolerance > 0 && std::isfinite(report.target_curve_deviation) &&
+               report.target_curve_deviation > options.curve_tolerance * size) {
+      s.termination = Termination::NotConverged;
+      m << "the target curve is missed by " << report.target_curve_deviation
+        << " mm, more than curve_tolerance x size = " << options.curve_tolerance * size
+        << " mm; allow more max_key_point_rounds or max_refinements, or a larger curve_tolerance";
+    }
+    s.message = m.str();
+  }
+  if (s.converged()) s.message = report.mode == StyleMode::exact ? "the key points and the target curve are met"
+                                                                 : "the target is approximated (paper mode)";
+  return s;
+}
+
 StyleResult StyleEditor::update(const BSplineCurve& target) {
   surface::validate(target, "target curve");
   const auto trace = detail::trace_on_surface(projector_, target, detail::target_samples(target, options_), &warm_);
   StyleResult out = options_.mode == StyleMode::exact
                         ? detail::style_exact(projector_, region_, target, trace, options_, exact_)
                         : detail::style_paper(projector_, region_, target, trace, options_);
+  out.report.summary = judge_style(out.report, options_);
   warm_.resize(trace.size());
   for (size_t k = 0; k < trace.size(); ++k) warm_[k] = {trace[k].u, trace[k].v};
   return out;

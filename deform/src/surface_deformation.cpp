@@ -3,9 +3,14 @@
 #include <clay/deform/surface_deformation.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
 
+#include <algorithm>
 #include <sstream>
 #include <variant>
+
+#include "messages.hpp"
 
 namespace clay::deform {
 
@@ -78,6 +83,104 @@ Attempt try_exact(const Deformation& d, const surface::BSplineSurface& s, const 
       d);
 }
 
+/// Where a surface crosses the boundary of a lattice: the largest jump |F(x) − x| of the map
+/// there, the parameter, and the face (axis, 0 or 1).
+struct FaceJump {
+  double mm = 0;
+  double u = 0, v = 0;
+  int axis = 0;
+  int face = 0;
+};
+
+/// How far outside the unit cube local coordinates are (<= face_tolerance: inside), and along
+/// which axis and face.
+double outside_by(const Eigen::Vector3d& c, int* axis = nullptr, int* face = nullptr) {
+  double worst = -1;
+  for (int d = 0; d < 3; ++d)
+    for (int f = 0; f < 2; ++f) {
+      const double by = f == 0 ? -c[d] : c[d] - 1;
+      if (by > worst) {
+        worst = by;
+        if (axis) *axis = d;
+        if (face) *face = f;
+      }
+    }
+  return worst;
+}
+
+/// The largest jump of the lattice's map where `s` crosses the lattice's boundary: on a grid of
+/// 16 samples per knot span, every grid edge with one end inside and one outside is bisected to
+/// the crossing (40 halvings), and the map is evaluated at the last point inside. A lower bound
+/// of the true largest jump (a crossing between grid lines can be missed).
+template <class Lattice>
+FaceJump face_jump(const Lattice& lattice, const surface::BSplineSurface& s) {
+  const std::vector<double> us = surface::span_samples(s.u, 16), vs = surface::span_samples(s.v, 16);
+  const Points3 grid = surface::evaluate_grid(s, us, vs);
+  const size_t nu = us.size(), nv = vs.size();
+  std::vector<char> in(nu * nv);
+  for (size_t k = 0; k < in.size(); ++k)
+    in[k] = outside_by(local_coordinates(lattice.frame, grid.row(static_cast<Eigen::Index>(k)).transpose())) <= face_tolerance;
+  FaceJump worst;
+  auto crossing = [&](double ua, double va, double ub, double vb) {  // a inside, b outside
+    double lo = 0, hi = 1;
+    for (int it = 0; it < 40; ++it) {
+      const double m = 0.5 * (lo + hi);
+      const Eigen::Vector3d x = surface::evaluate(s, ua + m * (ub - ua), va + m * (vb - va));
+      (outside_by(local_coordinates(lattice.frame, x)) <= face_tolerance ? lo : hi) = m;
+    }
+    const double u = ua + lo * (ub - ua), v = va + lo * (vb - va);
+    const Eigen::Vector3d x = surface::evaluate(s, u, v);
+    const double jump = (deform_point(lattice, x) - x).norm();
+    if (jump > worst.mm) {
+      const Eigen::Vector3d out = local_coordinates(lattice.frame, surface::evaluate(s, ua + hi * (ub - ua), va + hi * (vb - va)));
+      worst = {jump, u, v, 0, 0};
+      outside_by(out, &worst.axis, &worst.face);
+    }
+  };
+  for (size_t i = 0; i < nu; ++i)
+    for (size_t j = 0; j < nv; ++j) {
+      const size_t k = i * nv + j;
+      for (const auto& [di, dj] : {std::pair<size_t, size_t>{1, 0}, {0, 1}}) {
+        if (i + di >= nu || j + dj >= nv) continue;
+        const size_t n = (i + di) * nv + j + dj;
+        if (in[k] == in[n]) continue;
+        if (in[k]) crossing(us[i], vs[j], us[i + di], vs[j + dj]);
+        else crossing(us[i + di], vs[j + dj], us[i], vs[j]);
+      }
+    }
+  return worst;
+}
+
+/// Refuses a lattice step whose map is torn by more than twice the tolerance where the surface
+/// leaves the lattice (see deform_surface): no continuous fit could meet the tolerance.
+void refuse_torn(const Deformation& d, const surface::BSplineSurface& s, const RefitOptions& o,
+                 const std::string& where) {
+  std::optional<FaceJump> jump;
+  if (const auto* l = std::get_if<BezierLattice>(&d)) jump = face_jump(*l, s);
+  if (const auto* l = std::get_if<BSplineLattice>(&d)) jump = face_jump(*l, s);
+  if (!jump || jump->mm == 0) return;
+  double tolerance = o.tolerance;
+  if (o.relative) {  // as refit_deformed: of the deformed surface's size, sampled 8 x 8 per span
+    const std::vector<double> su = surface::span_samples(s.u, 8), sv = surface::span_samples(s.v, 8);
+    Points3 sample = surface::evaluate_grid(s, su, sv);
+    for (Eigen::Index r = 0; r < sample.rows(); ++r)
+      sample.row(r) = std::visit([&](const auto& k) -> Eigen::Vector3d { return deform_point(k, sample.row(r).transpose()); }, d).transpose();
+    tolerance *= (sample.colwise().maxCoeff() - sample.colwise().minCoeff()).norm();
+  }
+  if (jump->mm / 2 <= tolerance) return;
+  constexpr const char* axis_name[3] = {"s", "t", "u"};
+  throw Error(ErrorCategory::ToleranceNotMet,
+              where + ": the deformation is discontinuous where the surface crosses the lattice face " +
+                  axis_name[jump->axis] + " = " + std::to_string(jump->face) + ": it jumps by " +
+                  detail::format(jump->mm, 4) + " mm there (at parameter (" + detail::format(jump->u, 6) + ", " +
+                  detail::format(jump->v, 6) +
+                  ")), because the FFD is the identity outside the lattice and that face's control points are "
+                  "displaced; the deformed surface is torn, and no refit can come closer than half the jump (" +
+                  detail::format(jump->mm / 2, 4) + " mm > the tolerance " + detail::format(tolerance, 4) +
+                  " mm). Enlarge the lattice so that it contains the surface, or keep that face's control "
+                  "points at rest");
+}
+
 RefitResult refit_step(const Deformation& d, const surface::BSplineSurface& s, const RefitOptions& o) {
   return std::visit([&](const auto& deformation) { return refit_deformed(s, deformation, o); }, d);
 }
@@ -114,7 +217,13 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
         throw Error(a.category, where + " cannot be composed exactly: " + a.reason +
                                     ". Allow a certified refit (SurfaceDeformationOptions::refit) to "
                                     "approximate this step within a tolerance");
+      refuse_torn(step.deformation, out.surface, *options.refit, where);
       RefitResult r = refit_step(step.deformation, out.surface, *options.refit);
+      if (!r.report.summary.converged() && !options.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    where + " misses its tolerance: the refit's " + r.report.summary.message +
+                        ". Nothing is returned; to accept the result anyway set "
+                        "SurfaceDeformationOptions::accept_out_of_tolerance");
       o.method = StepOutcome::Method::refit;
       o.reason = std::move(a.reason);
       o.refit = r.report;

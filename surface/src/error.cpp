@@ -11,6 +11,7 @@ std::string_view to_string(ErrorCategory category) noexcept {
     case ErrorCategory::Io: return "i/o";
     case ErrorCategory::Exchange: return "exchange";
     case ErrorCategory::Recipe: return "recipe";
+    case ErrorCategory::ToleranceNotMet: return "tolerance not met";
     case ErrorCategory::Internal: return "internal";
   }
   return "unknown";

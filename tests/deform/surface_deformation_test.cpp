@@ -177,3 +177,64 @@ TEST_CASE("deform_surface: bad input", "[surface_deformation][errors]") {
   nan_surface.points(3, 1) = std::nan("");
   CHECK(error_of([&] { deform_surface(Deformation{bulge()}, nan_surface); }).first == ErrorCategory::InvalidGeometry);
 }
+
+// Issue #18: a refit that misses its tolerance is a failure, not a warning.
+TEST_CASE("deform_surface: a lattice torn where the surface leaves it is refused at once, naming the jump",
+          "[surface_deformation][errors]") {
+  const surface::BSplineSurface s = dome();  // x, y in [0, 100]
+  // The lattice covers x in [-10, 60] only: the dome crosses its face s = 1 along x = 60, and
+  // every control point is displaced, that face's too.
+  Frame half = box_frame();
+  half.s = {70, 0, 0};
+  BezierLattice torn = make_bezier_lattice(half, {2, 2, 1});
+  for (Eigen::Index r = 0; r < torn.points.rows(); ++r) torn.points.row(r) += Eigen::RowVector3d(0, 0, 6 + r % 3);
+  const Deformation d = torn;
+  // The independent figure: at the crossing x = 60 the face s = 1 is moved by P(1, t, u) − X,
+  // here straight up by 6..8 mm, while the surface outside stays put.
+  const Eigen::Vector3d on_face = surface::evaluate(s, 0.6, 0.5);
+  const double jump = (deform_point(torn, on_face) - on_face).norm();
+  REQUIRE(jump > 5);
+  SurfaceDeformationOptions options;
+  options.refit = RefitOptions{};
+  options.refit->tolerance = 1e-4;
+  const auto [category, message] = error_of([&] { deform_surface(d, s, options); });
+  CHECK(category == ErrorCategory::ToleranceNotMet);
+  CHECK_THAT(message, Contains("steps[0]") && Contains("discontinuous") && Contains("lattice face s = 1") &&
+                          Contains("no refit can come closer than half the jump") &&
+                          Contains("Enlarge the lattice"));
+  // The figure in the message is the map's jump, measured where the surface crosses the face.
+  const auto at = message.find("jumps by ");
+  REQUIRE(at != std::string::npos);
+  const double said = std::stod(message.substr(at + 9));
+  CHECK(said <= 8 * (1 + 1e-3));  // printed to 4 digits
+  CHECK(said >= jump * (1 - 1e-3));
+  // A tolerance above half the jump is not refused up front (the refit's own bound decides).
+  options.refit->tolerance = 10;
+  options.refit->relative = false;
+  options.refit->max_iterations = 2;
+  options.accept_out_of_tolerance = true;
+  CHECK_NOTHROW(deform_surface(d, s, options));
+}
+
+TEST_CASE("deform_surface: a refit that cannot meet a too tight tolerance within its limits fails",
+          "[surface_deformation][errors]") {
+  const surface::BSplineSurface s = dome();
+  DeformationStack stack;
+  stack.steps.push_back({spin(), "spin", true});
+  SurfaceDeformationOptions options;
+  options.refit = RefitOptions{};
+  options.refit->tolerance = 1e-11;  // relative: 1.4e-9 mm, far below what 2 rounds can reach
+  options.refit->max_iterations = 2;
+  const auto [category, message] = error_of([&] { deform_surface(stack, s, options); });
+  CHECK(category == ErrorCategory::ToleranceNotMet);
+  CHECK_THAT(message, Contains("steps[0] (twist 'spin') misses its tolerance") &&
+                          Contains("iteration limit 2 reached") && Contains("accept_out_of_tolerance"));
+  // With the opt-in the result comes back, with its figures.
+  options.accept_out_of_tolerance = true;
+  const SurfaceDeformationResult r = deform_surface(stack, s, options);
+  const RefitReport& fit = r.report.steps[0].refit;
+  CHECK_FALSE(fit.summary.converged());
+  CHECK(fit.certified_bound > fit.tolerance);
+  // The bound is honest: the pointwise deformation is within it.
+  CHECK(worst_against_pointwise(stack, s, r.surface, 1000) <= fit.certified_bound);
+}

@@ -10,6 +10,7 @@ TEST_CASE("clay::Error carries category and message", "[error]") {
   CHECK(std::string(e.what()) == "degree limit: surface 'hood': degree 30 exceeds 25");
   CHECK(clay::to_string(clay::ErrorCategory::InvalidGeometry) == "invalid geometry");
   CHECK(clay::to_string(clay::ErrorCategory::Io) == "i/o");
+  CHECK(clay::to_string(clay::ErrorCategory::ToleranceNotMet) == "tolerance not met");
 }
 
 TEST_CASE("Summary::brief states the outcome in one line", "[error]") {

@@ -174,7 +174,18 @@ struct StyleReport {
   std::vector<int> conflicting_key_points;  ///< key points that cannot all be met (indices)
   double model_size = 0;         ///< diagonal of the parent's control box
   std::string message;           ///< what happened, in words
+  /// Whether the step did what it was asked (judge_style): Converged; NotConverged when the
+  /// target is missed (exact mode: a key point beyond tolerance x size, the target curve beyond
+  /// curve_tolerance x size, key points that cannot be met) or a control vertex moves more than
+  /// 10 times the farthest key point's distance (the surface folds); Failed when nothing could
+  /// move (over-constrained: the target lies outside the bound). λ = 0 is Converged: unchanged
+  /// as asked. The message names the figure and the way out.
+  Summary summary;
 };
+
+/// The outcome of a style deformation from its report and options (the rules of
+/// StyleReport::summary); style_deform and StyleEditor::update set report.summary with it.
+Summary judge_style(const StyleReport& report, const StyleOptions& options);
 
 /// The deformed surface and its report.
 struct StyleResult {

@@ -23,6 +23,10 @@ struct SurfaceDeformationOptions {
   /// For the steps that cannot be composed exactly; empty: such a step is an error that names it
   /// and why (give a refit tolerance, lower the lattice degree, move the knot plane).
   std::optional<RefitOptions> refit;
+  /// false (the default): a refitted step whose certified bound (or, uncertified, sampled
+  /// maximum) misses the refit tolerance is an error, clay::Error(ToleranceNotMet); true: it is
+  /// returned, with its figures in the step's RefitReport (summary NotConverged).
+  bool accept_out_of_tolerance = false;
 
   /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
   void validate() const;
@@ -62,6 +66,13 @@ struct SurfaceDeformationResult {
 /// invalid stack or surface, InvalidArgument for bad options, and for a step that is not exact
 /// when no refit is allowed the exact composition's own error (DegreeLimit, OutOfDomain or
 /// InvalidArgument, naming the step) or InvalidArgument for a non-polynomial kind.
+/// ToleranceNotMet, naming the step, its figure and the tolerance, for a refit that misses its
+/// tolerance (unless options.accept_out_of_tolerance), and before any refit for a lattice step
+/// whose map is torn where the surface crosses the lattice's boundary: outside the lattice the
+/// FFD is the identity, so a displaced face makes the deformed surface jump there by
+/// |F(x) − x|, and no continuous fit comes closer than half that jump; when half the jump
+/// (measured at the crossings of a 16-per-span sample grid, bisected to the face) exceeds the
+/// tolerance, the step is refused at once.
 SurfaceDeformationResult deform_surface(const DeformationStack& stack,
                                         const surface::BSplineSurface& surface,
                                         const SurfaceDeformationOptions& options = {});
