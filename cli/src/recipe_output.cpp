@@ -23,22 +23,6 @@ Json figure_json(const Figure& f) {
   return std::visit([](const auto& x) { return Json(x); }, f);
 }
 
-/// The preview's mesh tolerance: 2e-4 of the model's size (1 mm on a 5 m sail), so the preview
-/// stays a few hundred thousand triangles whatever the scale (the exchange default, 0.05 mm, would
-/// mesh a car hood into millions).
-surface::GltfWriteOptions preview_options(const std::vector<surface::BSplineSurface>& surfaces) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (const auto& s : surfaces) {
-    const auto [a, b] = surface::control_box(s);
-    lo = lo.cwiseMin(a);
-    hi = hi.cwiseMax(b);
-  }
-  surface::GltfWriteOptions o;
-  o.linear_deflection = std::max(o.linear_deflection, 2e-4 * (hi - lo).norm());
-  return o;
-}
-
 }  // namespace
 
 std::string report_json(const RunResult& result) {
@@ -127,7 +111,7 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
         } else if (format == "iges") {
           surface::write_iges(e.surfaces, tmp / file);
         } else {
-          surface::write_gltf(e.surfaces, tmp / file, preview_options(e.surfaces));
+          surface::write_gltf(e.surfaces, tmp / file);
         }
         e.files.push_back(file);
         names.push_back(file);

@@ -3,6 +3,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/surface/tessellate.hpp>
 #include <clay/view.hpp>
 
 #include <Eigen/Geometry>
@@ -28,9 +29,6 @@ using Json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
 using Eigen::Vector3d;
 
-constexpr int max_samples = 161;
-constexpr int min_samples = 17;
-constexpr int per_span = 8;
 constexpr int curve_samples = 200;
 
 Json figure_json(const Figure& f) {
@@ -151,16 +149,10 @@ std::vector<surface::SurfaceDerivatives> grid_derivatives(const surface::BSpline
 }  // namespace
 
 std::vector<double> view_parameters(const surface::BSplineBasis& basis) {
-  const auto breaks = surface::breakpoints(basis);
-  const int spans = static_cast<int>(breaks.size()) - 1;
-  const auto [t0, t1] = basis.domain();
-  if (spans < 1 || spans > max_samples - 1) return surface::linspace(t0, t1, max_samples);
-  int per = std::clamp((max_samples - 1) / spans, 1, per_span);
-  if (spans * per < min_samples - 1) per = (min_samples - 1 + spans - 1) / spans;
-  return surface::span_samples(basis, per);
+  return surface::tessellation_parameters(basis);  // the glTF preview's grid too
 }
 
-ViewMesh tessellate(const surface::BSplineSurface& s) {
+ViewMesh view_mesh(const surface::BSplineSurface& s) {
   ViewMesh m;
   m.us = view_parameters(s.u);
   m.vs = view_parameters(s.v);
@@ -308,7 +300,7 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
         }
         return Json{{"file", w.file}, {"rows", w.rows}, {"cols", w.cols}};
       }
-    ViewMesh m = tessellate(s);
+    ViewMesh m = view_mesh(s);
     if (source >= 0) {
       const Stage& stage = result.stages[static_cast<std::size_t>(source)];
       set_deviation(m, stage.before, stage.map);

@@ -3,9 +3,11 @@
 #   clayform run RECIPE --out OUT         exits 0 and writes every export's files and report.json
 #   clayform info OUT/*.step              exits 0 (read back, BRepCheck valid); the report says
 #                                         every export reads back valid and bit-identical
+#   clay_check_gltf OUT/N.glb OUT/N.step  every glTF preview's triangles cover the surfaces: area
+#                                         within 1 % of the NURBS area, the same bounding box
 #   a second run into OUT-again           gives byte-identical STEP geometry (the header's
 #                                         FILE_NAME line holds a timestamp and is left out)
-# Arguments: -DCLAYFORM=... -DRECIPE=... -DOUT=...
+# Arguments: -DCLAYFORM=... -DCHECK_GLTF=... -DRECIPE=... -DOUT=...
 file(REMOVE_RECURSE ${OUT} ${OUT}-again)
 execute_process(COMMAND ${CLAYFORM} validate ${RECIPE} OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
@@ -43,5 +45,17 @@ foreach(step ${steps})
   if(NOT first STREQUAL second)
     message(FATAL_ERROR "${name}: two runs of ${RECIPE} gave different STEP geometry")
   endif()
+endforeach()
+file(GLOB previews ${OUT}/*.glb)
+foreach(glb ${previews})
+  string(REGEX REPLACE "\\.glb$" ".step" step ${glb})
+  if(NOT EXISTS ${step})
+    message(FATAL_ERROR "${glb}: no STEP file ${step} beside it to check the preview against")
+  endif()
+  execute_process(COMMAND ${CHECK_GLTF} ${glb} ${step} OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "the glTF preview ${glb} does not match its surfaces (exit ${rc}):\n${out}${err}")
+  endif()
+  message(STATUS "${out}")
 endforeach()
 message(STATUS "${RECIPE}: ran twice, ${OUT} holds valid, byte-identical STEP geometry")

@@ -144,7 +144,7 @@ TEST_CASE("a sphere's mesh has K = 1 over r squared and a mean curvature of size
   const Vector3d c(3, -2, 5);
   const double r = 40;
   const auto s = sphere(c, r);
-  const ViewMesh m = tessellate(s);
+  const ViewMesh m = view_mesh(s);
   REQUIRE(m.rows == 33);  // around the axis: 4 quarter segments x 8 + 1
   REQUIRE(m.cols == 17);  // the half circle: 2 segments x 8 + 1
   int degenerate = 0;
@@ -187,7 +187,7 @@ TEST_CASE("a pole opened into a tiny ring, as a refit leaves it, is treated as d
     const double a = 2 * pi * i / (s.count_u() - 1);
     s.points.row(s.index(i, 0)) += 1e-4 * Eigen::RowVector3d(std::cos(a), std::sin(a), 0);
   }
-  const ViewMesh m = tessellate(s);
+  const ViewMesh m = view_mesh(s);
   double worst = 0;
   for (std::size_t k = 0; k < m.position.size(); ++k) {
     worst = std::max(worst, std::abs(m.gaussian[k] * r * r - 1));
@@ -202,7 +202,7 @@ TEST_CASE("a cylinder's mesh has K = 0 and a mean curvature of size 1 over 2r", 
   ends << r, 0, 0, r, 0, 80;
   const auto line = surface::make_curve(1, {0, 0, 1, 1}, ends);
   const auto can = surface::revolve(line, surface::Axis{}, 270.0).surface;
-  const ViewMesh m = tessellate(can);
+  const ViewMesh m = view_mesh(can);
   CHECK(m.rows == 25);
   CHECK(m.cols == 17);
   for (std::size_t k = 0; k < m.position.size(); ++k) {
@@ -228,7 +228,7 @@ TEST_CASE("a plane's mesh has K = H = 0 and the plane's normal", "[view]") {
       p.row(i * 6 + j) = (o + x * a + y * b).transpose();
     }
   const auto s = surface::make_surface(basis, basis, p);
-  const ViewMesh m = tessellate(s);
+  const ViewMesh m = view_mesh(s);
   for (std::size_t k = 0; k < m.position.size(); ++k) {
     CHECK(std::abs(m.gaussian[k]) < 1e-15);
     CHECK(std::abs(m.mean[k]) < 1e-12);

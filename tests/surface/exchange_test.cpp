@@ -3,8 +3,12 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/evaluate.hpp>
 #include <clay/surface/exchange.hpp>
+#include <clay/surface/revolve.hpp>
+#include <clay/surface/tessellate.hpp>
 
+#include <gltf_reader.hpp>
 #include <random_geometry.hpp>
 
 #include <algorithm>
@@ -13,6 +17,7 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
@@ -280,23 +285,15 @@ TEST_CASE("Failed writes throw clay::Error and leave no file behind", "[exchange
     unnamed.product_name.clear();
     REQUIRE(category_of([&] { write_step(good, folder / "unnamed.step", unnamed); }) ==
             ErrorCategory::InvalidArgument);
-    struct BadOptions {
-      double linear, angular;
-      const char* field;
-    };
-    for (const BadOptions& bad :
-         {BadOptions{0.0, 0.3, "linear_deflection"}, BadOptions{-1.0, 0.3, "linear_deflection"},
-          BadOptions{std::numeric_limits<double>::quiet_NaN(), 0.3, "linear_deflection"},
-          BadOptions{0.1, 0.0, "angular_deflection"}, BadOptions{0.1, 3.2, "angular_deflection"}}) {
+    for (double bad : {0.0, -1.0, 0.5, std::numeric_limits<double>::quiet_NaN()}) {
       GltfWriteOptions options;
-      options.linear_deflection = bad.linear;
-      options.angular_deflection = bad.angular;
+      options.relative_area = bad;
       try {
         write_gltf(good, folder / "bad.glb", options);
         FAIL("no exception");
       } catch (const Error& e) {
         REQUIRE(e.category() == ErrorCategory::InvalidArgument);
-        REQUIRE_THAT(e.message(), Catch::Matchers::Contains(bad.field));
+        REQUIRE_THAT(e.message(), Catch::Matchers::Contains("relative_area"));
       }
     }
   }
@@ -381,9 +378,7 @@ TEST_CASE("glTF preview is a binary glTF file", "[exchange][gltf]") {
                                              test::random_surface(rng, 2, 4, 4, 6, false)};
   const fs::path folder = fresh_folder("gltf");
   const fs::path file = folder / "preview.glb";
-  GltfWriteOptions options;
-  options.linear_deflection = 0.5;
-  write_gltf(surfaces, file, options);
+  write_gltf(surfaces, file);
   const std::string bytes = read_text(file);
   REQUIRE(bytes.size() > 100);
   REQUIRE(bytes.substr(0, 4) == "glTF");
@@ -397,4 +392,40 @@ TEST_CASE("glTF preview is a binary glTF file", "[exchange][gltf]") {
   REQUIRE(u32(4) == 2u);
   REQUIRE(u32(8) == bytes.size());
   REQUIRE(names_in(folder) == std::vector<std::string>{"preview.glb"});
+  // Read back independently: the triangles cover the surfaces (area within 1 % of the NURBS
+  // area by quadrature) and span their bounding box (of a dense sample of the NURBS).
+  const test::GltfTriangles back = test::read_glb(file.string());
+  double area = 0;
+  Eigen::AlignedBox3d box;
+  for (const BSplineSurface& s : surfaces) {
+    area += surface_area(s, 3);
+    const auto [u0, u1] = s.u.domain();
+    const auto [v0, v1] = s.v.domain();
+    const Points3 dense = evaluate_grid(s, linspace(u0, u1, 401), linspace(v0, v1, 401));
+    for (Eigen::Index r = 0; r < dense.rows(); ++r) box.extend(Eigen::Vector3d(dense.row(r).transpose()));
+  }
+  CHECK(back.triangles.size() > 1000);
+  CHECK(std::abs(back.area() - area) <= 0.01 * area);
+  const double size = box.diagonal().norm();
+  CHECK((back.box().min() - box.min()).norm() <= 1e-3 * size);
+  CHECK((back.box().max() - box.max()).norm() <= 1e-3 * size);
+}
+
+TEST_CASE("glTF previews of surfaces with poles and collapsed edges are not empty", "[exchange][gltf]") {
+  // A sphere of revolution (a pole at each end of every meridian) and a cone with its apex
+  // collapsed: OpenCASCADE's mesher once gave such faces zero-area meshes.
+  // The half circle x^2 + z^2 = 100, x >= 0, as two rational quadratic quarter circles.
+  const BSplineCurve meridian =
+      make_curve(2, {0, 0, 0, 0.5, 0.5, 1, 1, 1},
+                 (Points3(5, 3) << 0, 0, -10, 10, 0, -10, 10, 0, 0, 10, 0, 10, 0, 0, 10).finished(),
+                 (Eigen::VectorXd(5) << 1, std::sqrt(0.5), 1, std::sqrt(0.5), 1).finished());
+  const BSplineSurface sphere = revolve(meridian, Axis{}).surface;
+  const fs::path folder = fresh_folder("gltf_poles");
+  write_gltf({sphere}, folder / "sphere.glb");
+  const test::GltfTriangles back = test::read_glb((folder / "sphere.glb").string());
+  const double exact = 4 * std::numbers::pi * 100;  // closed form, mm^2
+  CHECK(std::abs(back.area() - exact) <= 0.01 * exact);
+  CHECK((back.box().min() - Eigen::Vector3d(-10, -10, -10)).norm() <= 1e-2);
+  CHECK((back.box().max() - Eigen::Vector3d(10, 10, 10)).norm() <= 1e-2);
+  CHECK_THAT(surface_area(sphere, 2), Catch::Matchers::WithinRel(exact, 1e-9));
 }

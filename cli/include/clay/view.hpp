@@ -38,7 +38,7 @@ std::vector<double> view_parameters(const surface::BSplineBasis& basis);
 /// its largest on the grid, or S_u parallel to S_v — the normal is the normalized
 /// average of the neighbouring cells' normals and K, H the average of the non-degenerate
 /// neighbouring vertices'. Deviation all 0.
-ViewMesh tessellate(const surface::BSplineSurface& surface);
+ViewMesh view_mesh(const surface::BSplineSurface& surface);
 
 /// Sets mesh.deviation to |S(u, v) - map(B(u, v))| at every vertex, with S the tessellated
 /// surface (the refit) and B the surface before the step, its domain mapped affinely onto S's.

@@ -12,6 +12,7 @@
 #include <clay/surface/exchange.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/tessellate.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -35,7 +36,6 @@
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepCheck_ListOfStatus.hxx>
 #include <BRepCheck_Result.hxx>
-#include <BRepMesh_IncrementalMesh.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
@@ -57,6 +57,8 @@
 #include <Message_Printer.hxx>
 #include <Message_ProgressRange.hxx>
 #include <Precision.hxx>
+#include <Poly_Triangle.hxx>
+#include <Poly_Triangulation.hxx>
 #include <RWGltf_CafWriter.hxx>
 #include <STEPControl_Controller.hxx>
 #include <STEPControl_Reader.hxx>
@@ -595,17 +597,18 @@ std::vector<BSplineSurface> read_iges(const fs::path& file) {
 void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& file,
                 const GltfWriteOptions& options) {
   constexpr std::string_view caller = "write_gltf";
-  if (!(std::isfinite(options.linear_deflection) && options.linear_deflection > 0.0))
+  if (!(options.relative_area > 0.0 && options.relative_area < 0.5))
     throw Error(ErrorCategory::InvalidArgument,
-                "write_gltf: GltfWriteOptions::linear_deflection is " +
-                    std::to_string(options.linear_deflection) +
-                    "; it must be a positive, finite length in millimetres");
-  if (!(std::isfinite(options.angular_deflection) && options.angular_deflection > 0.0 &&
-        options.angular_deflection < std::numbers::pi))
-    throw Error(ErrorCategory::InvalidArgument,
-                "write_gltf: GltfWriteOptions::angular_deflection is " +
-                    std::to_string(options.angular_deflection) +
-                    "; it must be an angle in radians in (0, pi)");
+                "write_gltf: GltfWriteOptions::relative_area is " + std::to_string(options.relative_area) +
+                    "; it must be in (0, 0.5), e.g. 0.005");
+  // The preview is our own tessellation (the viewer's grid, refined until its area is within
+  // relative_area of the surface's), attached to each face as its triangulation: OpenCASCADE's
+  // mesher gave zero-area meshes on surfaces with poles (the handset, the bent superellipsoid),
+  // and only the writer is needed from it.
+  for (size_t k = 0; k < surfaces.size(); ++k) validate(surfaces[k], surface_name(k));
+  std::vector<GridMesh> meshes;
+  meshes.reserve(surfaces.size());
+  for (const BSplineSurface& s : surfaces) meshes.push_back(tessellate_to_area(s, options.relative_area));
   ExchangeSession session;
   guarded(caller, [&] {
     const std::vector<Handle(Geom_BSplineSurface)> converted = convert_all(surfaces, caller);
@@ -613,18 +616,24 @@ void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& fil
     BRep_Builder builder;
     TopoDS_Compound compound;
     builder.MakeCompound(compound);
-    for (size_t k = 0; k < converted.size(); ++k)
-      builder.Add(compound, make_face(converted[k], surface_name(k)));
-    BRepMesh_IncrementalMesh mesher(compound, options.linear_deflection, false,
-                                    options.angular_deflection, false);
-    if (!mesher.IsDone())
-      throw Error(ErrorCategory::Exchange, "write_gltf: OpenCASCADE could not mesh the faces");
-    for (TopExp_Explorer e(compound, TopAbs_FACE); e.More(); e.Next()) {
-      TopLoc_Location location;
-      if (BRep_Tool::Triangulation(TopoDS::Face(e.Current()), location).IsNull())
-        throw Error(ErrorCategory::Exchange,
-                    "write_gltf: OpenCASCADE produced no triangles for a face; try smaller "
-                    "deflections");
+    for (size_t k = 0; k < converted.size(); ++k) {
+      TopoDS_Face face = make_face(converted[k], surface_name(k));
+      const GridMesh& m = meshes[k];
+      const int cells = (m.rows - 1) * (m.cols - 1);
+      Handle(Poly_Triangulation) triangulation =
+          new Poly_Triangulation(m.rows * m.cols, 2 * cells, Standard_False, Standard_True);
+      for (int v = 0; v < m.rows * m.cols; ++v) {
+        triangulation->SetNode(v + 1, gp_Pnt(m.positions(v, 0), m.positions(v, 1), m.positions(v, 2)));
+        const Eigen::Vector3d n = m.normals.row(v).transpose();
+        triangulation->SetNormal(v + 1, n.squaredNorm() > 0 ? gp_Dir(n.x(), n.y(), n.z()) : gp_Dir(0, 0, 1));
+      }
+      int t = 0;
+      for (int i = 0; i + 1 < m.rows; ++i)
+        for (int j = 0; j + 1 < m.cols; ++j)
+          for (const auto& tri : cell_triangles(m, i, j))
+            triangulation->SetTriangle(++t, Poly_Triangle(tri[0] + 1, tri[1] + 1, tri[2] + 1));
+      builder.UpdateFace(face, triangulation);
+      builder.Add(compound, face);
     }
     Handle(XCAFApp_Application) application = XCAFApp_Application::GetApplication();
     Handle(TDocStd_Document) document;

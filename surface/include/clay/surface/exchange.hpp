@@ -29,8 +29,8 @@ struct StepWriteOptions {
 
 /// Settings of write_gltf.
 struct GltfWriteOptions {
-  double linear_deflection = 0.05;   ///< mesher chord tolerance in millimetres, > 0
-  double angular_deflection = 0.35;  ///< mesher angle tolerance in radians, in (0, pi)
+  /// The mesh's area is within this fraction of the surface's (tessellate_to_area), in (0, 0.5).
+  double relative_area = 0.005;
 };
 
 /// What was written (or checked): size figures and OpenCASCADE's BRepCheck verdict.
@@ -74,8 +74,11 @@ std::vector<BSplineSurface> read_iges(const std::filesystem::path& file);
 /// Builds the faces that write_step/write_iges write and runs BRepCheck_Analyzer on them.
 ExchangeReport check_faces(const std::vector<BSplineSurface>& surfaces);
 
-/// Meshes the surfaces and writes a binary glTF (.glb) preview. glTF's units are metres and its
-/// up axis is Y; the writer converts. Throws as write_step, and InvalidArgument for bad options.
+/// Writes a binary glTF (.glb) preview: each surface as the grid mesh of tessellate_to_area (the
+/// viewer's tessellation, refined until its area is within options.relative_area of the
+/// surface's), with exact normals. glTF's units are metres and its up axis is Y; the writer
+/// converts. Throws as write_step, InvalidArgument for bad options, and ToleranceNotMet when a
+/// surface's mesh cannot meet the area tolerance.
 void write_gltf(const std::vector<BSplineSurface>& surfaces, const std::filesystem::path& file,
                 const GltfWriteOptions& options = {});
 
