@@ -12,6 +12,7 @@
 #include <clay/surface/arc.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/evaluate.hpp>
 #include <clay/surface/exchange.hpp>
 
 #include <nlohmann/json.hpp>
@@ -19,10 +20,12 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <numbers>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -104,7 +107,7 @@ class Checker {
   std::vector<Problem> problems;
 
   void add(std::string path, std::string message) {
-    problems.push_back({path.empty() ? "(top level)" : std::move(path), std::move(message), 0, 0});
+    problems.push_back({path.empty() ? "(top level)" : std::move(path), recipe_wording(std::move(message)), 0, 0});
   }
 
   /// True when j is an object; reports keys outside `allowed`.
@@ -475,7 +478,7 @@ class RecipeChecker {
   // ---- composition ------------------------------------------------------------------------
 
   Composition composition(const Json& j, const std::string& path, Composition c) {
-    if (!c_.object(j, path, {"mode", "tolerance", "relative", "degree", "check_samples"},
+    if (!c_.object(j, path, {"mode", "tolerance", "relative", "degree", "check_samples", "accept_out_of_tolerance"},
                    "a composition {\"mode\": \"exact\"|\"refit\", ...}"))
       return c;
     if (const Json* m = c_.member(j, path, "mode", false, ""))
@@ -484,6 +487,7 @@ class RecipeChecker {
     c.relative = c_.boolean_or(j, path, "relative", c.relative);
     c.degree = c_.integer_or(j, path, "degree", c.degree, 1, 25);
     c.check_samples = c_.integer_or(j, path, "check_samples", c.check_samples, 2, 64);
+    c.accept_out_of_tolerance = c_.boolean_or(j, path, "accept_out_of_tolerance", c.accept_out_of_tolerance);
     return c;
   }
 
@@ -694,6 +698,13 @@ class RecipeChecker {
         c_.add(pp, "expected an object of NAME: position, found " + found(*pts));
       }
     }
+    // Messages of the sketch and the solver name points and entities as the recipe does.
+    def.sketch.point_names.resize(def.sketch.points.size());
+    for (const auto& [pname, id] : points) def.sketch.point_names[static_cast<std::size_t>(id.index)] = pname;
+    auto name_next_entity = [&](const std::string& ename) {
+      def.sketch.entity_names.resize(def.sketch.entities.size() + 1);
+      def.sketch.entity_names.back() = ename;
+    };
     // A point or entity declared in this sketch but not built has its own problem reported at
     // its declaration; references to it stay quiet rather than adding a follow-on "no point".
     // An entity left unbuilt because it refers to such a point or entity is quiet too.
@@ -795,7 +806,10 @@ class RecipeChecker {
                 deferred = true;
               }
             }
-            if (curve) c_.attempt(kp, [&] { entities[ename] = def.sketch.add_curve(*curve, plane_id); });
+            if (curve) {
+              name_next_entity(ename);
+              c_.attempt(kp, [&] { entities[ename] = def.sketch.add_curve(*curve, plane_id); });
+            }
             continue;
           }
           if (kind == "line") {
@@ -805,7 +819,10 @@ class RecipeChecker {
             }
             const auto a = point_ref(v[0], index_path(kp, 0));
             const auto b = point_ref(v[1], index_path(kp, 1));
-            if (a && b) c_.attempt(kp, [&] { entities[ename] = def.sketch.add_line(*a, *b); });
+            if (a && b) {
+              name_next_entity(ename);
+              c_.attempt(kp, [&] { entities[ename] = def.sketch.add_line(*a, *b); });
+            }
           } else if (kind == "circle") {
             if (!c_.object(v, kp, {"center", "radius"}, "a circle {center, radius}")) continue;
             const Json* cj = c_.member(v, kp, "center", true, "a point name");
@@ -816,8 +833,10 @@ class RecipeChecker {
               c_.add(kp, "a circle needs the sketch's plane; give the sketch a \"plane\"");
               continue;
             }
-            if (center && r)
+            if (center && r) {
+              name_next_entity(ename);
               c_.attempt(kp, [&] { entities[ename] = def.sketch.add_circle(*center, *r, plane_id); });
+            }
           } else {
             if (!c_.object(v, kp, {"center", "start", "end"}, "an arc {center, start, end}")) continue;
             std::array<std::optional<sketch::PointId>, 3> ids;
@@ -830,8 +849,10 @@ class RecipeChecker {
               c_.add(kp, "an arc needs the sketch's plane; give the sketch a \"plane\"");
               continue;
             }
-            if (ids[0] && ids[1] && ids[2])
+            if (ids[0] && ids[1] && ids[2]) {
+              name_next_entity(ename);
               c_.attempt(kp, [&] { entities[ename] = def.sketch.add_arc(*ids[0], *ids[1], *ids[2], plane_id); });
+            }
           }
         }
       } else {
@@ -845,8 +866,10 @@ class RecipeChecker {
         c_.add(cp, "expected an array of {\"type\": ..., ...}, found " + found(*cons));
       } else {
         for (std::size_t i = 0; i < cons->size(); ++i)
-          if (auto con = constraint((*cons)[i], index_path(cp, i), point_ref, entity_ref))
+          if (auto con = constraint((*cons)[i], index_path(cp, i), point_ref, entity_ref)) {
+            con->label = index_path(cp, i);  // the solver's messages name it by its path
             def.constraints.push_back(*con);
+          }
       }
     }
     def.solve.tolerance = c_.number_or(j, path, "tolerance", def.solve.tolerance, Range{0, 1e-3, true, false});
@@ -1520,7 +1543,8 @@ class RecipeChecker {
 
   std::optional<StyleDef> style(const Json& j, const std::string& p) {
     if (!c_.object(j, p, {"kind", "name", "enabled", "target", "bound", "mode", "lambda", "relaxation", "smoothing",
-                          "key_points_per_row", "boundary_rows", "tolerance", "curve_tolerance"},
+                          "key_points_per_row", "boundary_rows", "tolerance", "curve_tolerance", "max_refinements",
+                          "max_key_point_rounds", "accept_out_of_tolerance"},
                    "a style step"))
       return std::nullopt;
     StyleDef d;
@@ -1529,6 +1553,26 @@ class RecipeChecker {
       d.target = curve_ref(*t, key_path(p, "target")).value_or("");
     if (const Json* b = c_.member(j, p, "bound", false, ""))
       d.bound = curve_ref(*b, key_path(p, "bound")).value_or("");
+    // A bound curve given inline is known now: an open one is reported here, not at run time
+    // (the rule of deform::influence_factors: ends within 1e-7 of the curve's size).
+    if (!d.bound.empty()) {
+      const auto cd = std::find_if(data.curves.begin(), data.curves.end(),
+                                   [&](const CurveDef& x) { return x.name == d.bound; });
+      if (cd != data.curves.end() && cd->curve) {
+        const surface::Points3& pts = cd->curve->points;
+        const double size = (pts.colwise().maxCoeff() - pts.colwise().minCoeff()).norm();
+        const auto [t0, t1] = cd->curve->basis.domain();
+        const double gap = (surface::evaluate(*cd->curve, t1) - surface::evaluate(*cd->curve, t0)).norm();
+        if (gap > 1e-7 * size)
+        {
+          char apart[32];
+          std::snprintf(apart, sizeof apart, "%.4g", gap);
+          c_.add(key_path(p, "bound"), "the bound curve \"" + d.bound + "\" is open: its ends are " + apart +
+                                           " mm apart; a bound curve must be closed (make its last control point "
+                                           "equal its first)");
+        }
+      }
+    }
     auto& o = d.options;
     if (const Json* m = c_.member(j, p, "mode", false, ""))
       if (const auto k = c_.choice(*m, key_path(p, "mode"), {"paper", "exact"}))
@@ -1540,6 +1584,9 @@ class RecipeChecker {
     o.boundary_rows = c_.integer_or(j, p, "boundary_rows", o.boundary_rows, 0, 4);
     o.tolerance = c_.number_or(j, p, "tolerance", o.tolerance, positive);
     o.curve_tolerance = c_.number_or(j, p, "curve_tolerance", o.curve_tolerance, positive);
+    o.max_refinements = c_.integer_or(j, p, "max_refinements", o.max_refinements, 0, 8);
+    o.max_key_point_rounds = c_.integer_or(j, p, "max_key_point_rounds", o.max_key_point_rounds, 0, 16);
+    d.accept_out_of_tolerance = c_.boolean_or(j, p, "accept_out_of_tolerance", d.accept_out_of_tolerance);
     c_.attempt(p, [&] { o.validate(); });
     if (c_.problems.size() != before) return std::nullopt;
     return d;
@@ -1815,6 +1862,33 @@ SketchDef rebuild_sketch(const SketchDef& def,
     throw Error(ErrorCategory::InvalidGeometry, m);
   }
   return std::move(rc.data.sketches.front());
+}
+
+std::string recipe_wording(std::string m) {
+  // The library's fixes, as a recipe applies them (or dropped where a recipe cannot).
+  static const std::pair<std::string_view, std::string_view> phrases[] = {
+      {"Allow a certified refit (SurfaceDeformationOptions::refit) to approximate this step within a tolerance",
+       "Allow a certified refit to approximate this step within a tolerance: give the deformation "
+       "\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4} (relative to the size)"},
+      {"set SurfaceDeformationOptions::accept_out_of_tolerance",
+       "set \"accept_out_of_tolerance\": true in the \"composition\""},
+      {"(RefitOptions::relative = false)", "(\"relative\": false in the \"composition\")"},
+      {"remove the repeated point or set FitOptions::drop_duplicates", "remove the repeated point"},
+      {" (or build the plane with make_plane)", ""},
+      {"; build the plane with make_plane(origin, normal, x direction)",
+       "; give a \"y_axis\" perpendicular to the \"x_axis\""},
+      {"reverse it or set LoftOptions::auto_orient", "reverse it (a curve {\"reversed\": NAME})"},
+      {"loosen SuperquadricOptions::tolerance, raise max_spans, ", "loosen \"tolerance\" "},
+      {"not reached at max_sections", "not reached with the most sections allowed"},
+      {"raise gap_tolerance", "raise \"gap_tolerance\""},
+  };
+  for (const auto& [from, to] : phrases)
+    for (std::size_t at = m.find(from); at != std::string::npos; at = m.find(from, at + to.size()))
+      m.replace(at, from.size(), to);
+  // What is left: a field of a C++ options struct in a validation message ("SweepOptions::
+  // twist_degrees is ..."), which for the options a recipe sets is the recipe's own key.
+  static const std::regex options_struct("\\b[A-Z][A-Za-z]*Options::");
+  return std::regex_replace(m, options_struct, "");
 }
 
 std::string to_string(const Problem& problem) {

@@ -30,6 +30,7 @@ struct Composition {
   bool relative = true;
   int degree = 3;
   int check_samples = 4;
+  bool accept_out_of_tolerance = false;  ///< "accept_out_of_tolerance": keep a refit that misses
 };
 
 struct StrokeDef {
@@ -81,6 +82,7 @@ struct SurfaceDef {
 struct StyleDef {
   std::string target, bound;  // bound empty: the target's support band (§5)
   deform::StyleOptions options;
+  bool accept_out_of_tolerance = false;  ///< keep a result that misses its target or folds
 };
 
 struct DirectMove {

@@ -11,6 +11,7 @@
 #include <clay/surface/exchange.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <map>
@@ -132,7 +133,7 @@ class Runner {
     try {
       f(rep);
     } catch (const Error& e) {
-      throw Error(e.category(), path + " (" + kind + "): " + e.message());
+      throw Error(e.category(), path + " (" + kind + "): " + recipe_wording(e.message()));
     }
     rep.seconds = seconds_since(t0);
     if (options_.progress) options_.progress(rep);
@@ -178,17 +179,41 @@ class Runner {
                               });
     const auto solved = constraints::solve(s.sketch, s.constraints, s.solve);
     const auto& r = solved.report;
-    if (!r.summary.converged()) {
-      std::string m = "the sketch does not solve (" + r.summary.brief() + ")";
-      for (const auto& d : r.conflicting) m += "; " + d.message;
-      throw Error(ErrorCategory::InvalidGeometry, m + "; remove or change a conflicting constraint");
-    }
+    if (!r.conflicting.empty())  // the summary lists every conflicting set, once
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "the sketch does not solve: " + r.summary.message + "; remove or change a conflicting constraint");
+    if (!r.summary.converged())  // nothing conflicts: the solver stopped short
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "the solver stopped before the constraints hold (" + r.summary.brief() +
+                      "); nothing conflicts: move the drawn geometry closer to what the constraints ask");
     rep.figures = {{"max_residual", r.max_residual},
                    {"degrees_of_freedom", static_cast<long long>(r.degrees_of_freedom)},
                    {"redundant_sets", static_cast<long long>(r.redundant.size())},
                    {"constraints", static_cast<long long>(s.constraints.size())}};
+    for (std::size_t k = 0; k < r.redundant.size(); ++k)  // every set, not only the first
+      rep.figures.emplace_back("redundant[" + std::to_string(k) + "]", r.redundant[k].message);
     rep.message = r.summary.brief();
     for (const auto& [name, id] : s.entities) add_curve(name, sketch::curve_of(solved.sketch, id));
+  }
+
+  /// Runs a builder that takes a list of curves, its errors naming them as the recipe does:
+  /// "curve #1" (the builder's index) becomes "curve \"leech\"".
+  template <class F>
+  static auto by_names(const std::vector<std::string>& names, const std::string& word, F build) {
+    try {
+      return build();
+    } catch (const Error& e) {
+      std::string m = e.message();
+      const std::string tag = word + " #";
+      for (std::size_t at = m.find(tag); at != std::string::npos; at = m.find(tag, at + 1)) {
+        std::size_t end = at + tag.size();
+        while (end < m.size() && std::isdigit(static_cast<unsigned char>(m[end]))) ++end;
+        if (end == at + tag.size()) continue;
+        const std::size_t k = std::stoul(m.substr(at + tag.size(), end - at - tag.size()));
+        if (k < names.size()) m.replace(at, end - at, word + " \"" + names[k] + "\"");
+      }
+      throw Error(e.category(), m);
+    }
   }
 
   std::vector<BSplineCurve> curves_named(const std::vector<std::string>& names) const {
@@ -223,11 +248,11 @@ class Runner {
               build_figures(surface::describe(b, "inline B-spline surface"), rep);
               return b;
             } else if constexpr (std::is_same_v<T, FillDef>) {
-              auto built = surface::fill(curves_named(b.curves), b.options);
+              auto built = by_names(b.curves, "curve", [&] { return surface::fill(curves_named(b.curves), b.options); });
               build_figures(built.report, rep);
               return std::move(built.surface);
             } else if constexpr (std::is_same_v<T, SkinDef>) {
-              auto built = surface::loft(curves_named(b.sections), b.options);
+              auto built = by_names(b.sections, "section", [&] { return surface::loft(curves_named(b.sections), b.options); });
               build_figures(built.report, rep);
               return std::move(built.surface);
             } else if constexpr (std::is_same_v<T, SweepDef>) {
@@ -278,6 +303,7 @@ class Runner {
       r.relative = c.relative;
       o.refit = r;
     }
+    o.accept_out_of_tolerance = c.accept_out_of_tolerance;
     return o;
   }
 
@@ -362,6 +388,15 @@ class Runner {
                    {"degree_v", static_cast<long long>(r.surface.v.degree)},
                    {"control_points", static_cast<long long>(r.surface.points.rows())}};
     rep.message += ": " + x.message;
+    rep.figures.emplace_back("outcome", std::string(x.summary.converged() ? "met" : "missed"));
+    if (!x.summary.converged()) {
+      if (!d.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    x.summary.message + ". Nothing was written; to keep such a result anyway, set "
+                    "\"accept_out_of_tolerance\": true on this step");
+      rep.warning = true;
+      rep.message += "; accepted out of tolerance: " + x.summary.message;
+    }
     return r.surface;
   }
 

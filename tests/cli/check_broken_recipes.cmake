@@ -2,7 +2,8 @@
 # checks them against DIR/expected.txt (format in its header):
 # - validate: exit 7 (recipe problems) and every expected substring printed (JSON path, or line
 #   and column for syntax errors); a RUNTIME fixture must pass validate (exit 0) instead;
-# - run --out WORK/NN: a clay error code (2..7: never 0, never 70 Internal, never a signal or
+# - no output names a C++ options struct ("...Options::"): messages name recipe keys;
+# - run --out WORK/NN: a clay error code (2..8: never 0, never 70 Internal, never a signal or
 #   the 120 s timeout), 7 with the same substrings for recipes validate refuses, the expected
 #   substrings for RUNTIME fixtures, and no partial files: WORK/NN absent or empty, nothing else
 #   left in WORK.
@@ -93,6 +94,9 @@ foreach(fixture IN LISTS fixtures)
     endif()
     check_substrings("${fixture}" validate "${text}")
   endif()
+  if(text MATCHES "Options::")
+    fail("${fixture}: clayform validate names a C++ option instead of a recipe key:\n${text}")
+  endif()
 
   # run: a clay error code, the expected message, no partial files
   string(SUBSTRING "${fixture}" 0 2 number)
@@ -102,13 +106,16 @@ foreach(fixture IN LISTS fixtures)
     OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc TIMEOUT 120)
   set(text "${out}${err}")
   if(runtime_${fixture})
-    if(NOT rc MATCHES "^[2-7]$")
-      fail("${fixture}: clayform run exited '${rc}' (expected a clay error code 2..7):\n${text}")
+    if(NOT rc MATCHES "^[2-8]$")
+      fail("${fixture}: clayform run exited '${rc}' (expected a clay error code 2..8):\n${text}")
     endif()
   elseif(NOT rc STREQUAL "7")
     fail("${fixture}: clayform run exited '${rc}' (expected 7, recipe problems):\n${text}")
   endif()
   check_substrings("${fixture}" run "${text}")
+  if(text MATCHES "Options::")
+    fail("${fixture}: clayform run names a C++ option instead of a recipe key:\n${text}")
+  endif()
   if(EXISTS "${out_dir}")
     file(GLOB_RECURSE written LIST_DIRECTORIES true "${out_dir}/*")
     if(written)

@@ -616,7 +616,7 @@ TEST_CASE("B-spline curves in a sketch are joined G2 by the solver", "[recipe]")
   const auto [category, message] = error_of([&] { run_recipe(parse_recipe(off)); });
   CHECK(category == ErrorCategory::InvalidGeometry);
   CHECK_THAT(message, Contains("sketches.s (sketch): with the run's curves the sketch has"));
-  CHECK_THAT(message, Contains("sketches.s.entities.f.curve: add_curve (curve #0): control point 0 is 5 mm off plane"));
+  CHECK_THAT(message, Contains("sketches.s.entities.f.curve: add_curve (curve \"f\"): control point 0 is 5 mm off plane"));
   // the constraint on "f.start" adds no follow-on problem: the entity's own is the one reported
   CHECK_THAT(message, Contains("the sketch has 1 problem:"));
   CHECK_THAT(message, !Contains("no point named"));
@@ -671,4 +671,144 @@ TEST_CASE("a fitted stroke joins a sketch, built when the recipe runs", "[recipe
   CHECK((surface::evaluate(line, 1.0) - Eigen::Vector3d(100, 20, 0)).norm() < 1e-9);
   const Eigen::Vector3d along = (surface::evaluate(line, 1.0) - surface::evaluate(line, 0.0)).normalized();
   CHECK((end.d1.normalized() - along).norm() < 1e-8);
+}
+
+// ---- issue #18: outside-check defects --------------------------------------------------------
+
+TEST_CASE("an under-constrained recipe sketch converges; messages use the recipe's names", "[recipe]") {
+  // The smallest case of the outside check: a fixed start, a length of 10, the end drawn at
+  // (0.02, 10.5): 1 DOF, nothing conflicts. It stopped after 101 iterations at residual 0.508.
+  const std::string free_end = R"({"format": "clayform.recipe", "version": 1,
+    "sketches": {"s": {
+      "plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {"a": [0, 0], "b": [0.02, 10.5]},
+      "entities": {"mast": {"line": ["a", "b"]}},
+      "constraints": [{"type": "fixed", "point": "a"}, {"type": "distance", "points": ["a", "b"], "value": 10}]}},
+    "surfaces": {}})";
+  const auto result = run_recipe(parse_recipe(free_end));
+  const auto& mast = result.curve("s.mast");
+  CHECK(std::abs((surface::evaluate(mast, 1.0) - surface::evaluate(mast, 0.0)).norm() - 10) < 1e-10);
+  const StepReport* sketch_step = nullptr;
+  for (const auto& s : result.steps)
+    if (s.path == "sketches.s") sketch_step = &s;
+  REQUIRE(sketch_step);
+  for (const auto& [name, value] : sketch_step->figures)
+    if (name == "degrees_of_freedom") CHECK(std::get<long long>(value) == 1);
+
+  // Conflicts are named by the recipe's names and paths, and each conflicting set once.
+  const std::string conflict = R"({"format": "clayform.recipe", "version": 1,
+    "sketches": {"s": {
+      "plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {"a": [0, 0], "b": [10, 0.3]},
+      "entities": {"boom": {"line": ["a", "b"]}},
+      "constraints": [{"type": "fixed", "point": "a"}, {"type": "fixed", "point": "b"},
+                      {"type": "distance", "points": ["a", "b"], "value": 12}]}},
+    "surfaces": {}})";
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(conflict)); });
+  CHECK(category == ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Contains("sketches.s.constraints[2] (distance 12 mm between point \"a\" and point \"b\")"));
+  CHECK_THAT(message, !Contains("point #") && !Contains("constraint #"));
+  const auto first = message.find("conflicting:");
+  REQUIRE(first != std::string::npos);
+  CHECK(message.find("conflicting:", first + 1) == std::string::npos);  // listed once
+}
+
+TEST_CASE("every redundant set of a recipe sketch is in its report", "[recipe]") {
+  // Two independent redundancies: a horizontal line fixed at both ends, and a second such line.
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "sketches": {"s": {
+      "plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
+      "points": {"a": [0, 0], "b": [10, 0], "c": [0, 5], "d": [10, 5]},
+      "entities": {"low": {"line": ["a", "b"]}, "high": {"line": ["c", "d"]}},
+      "constraints": [{"type": "fixed", "point": "a"}, {"type": "fixed", "point": "b"},
+                      {"type": "horizontal", "entity": "low"},
+                      {"type": "fixed", "point": "c"}, {"type": "fixed", "point": "d"},
+                      {"type": "horizontal", "entity": "high"}]}},
+    "surfaces": {}})";
+  const auto result = run_recipe(parse_recipe(text));
+  const StepReport& s = result.steps.front();
+  std::vector<std::string> sets;
+  long long count = -1;
+  for (const auto& [name, value] : s.figures) {
+    if (name == "redundant_sets") count = std::get<long long>(value);
+    if (name.rfind("redundant[", 0) == 0) sets.push_back(std::get<std::string>(value));
+  }
+  REQUIRE(count == 2);
+  REQUIRE(sets.size() == 2);
+  CHECK_THAT(sets[0] + sets[1], Contains("horizontal line \"low\"") && Contains("horizontal line \"high\""));
+  const std::string report = report_json(result);
+  CHECK_THAT(report, Contains("redundant[1]"));
+}
+
+TEST_CASE("a refit of a torn lattice fails the run before refitting, naming the cause", "[recipe]") {
+  // The outside check's case: the surface lies partly outside a lattice whose every control point
+  // is displaced, so the map jumps where the surface crosses the face; tolerance 1e-4.
+  const std::string torn = R"({"kind": "bezier_lattice", "frame": {"origin": [-10, -10, -20], "s": [70, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
+     "degrees": [1, 1, 1], "moves": [{"index": [0, 0, 0], "by": [0, 0, 5]}, {"index": [1, 0, 0], "by": [0, 0, 5]},
+       {"index": [0, 1, 0], "by": [0, 0, 5]}, {"index": [1, 1, 0], "by": [0, 0, 5]}, {"index": [0, 0, 1], "by": [0, 0, 5]},
+       {"index": [1, 0, 1], "by": [0, 0, 5]}, {"index": [0, 1, 1], "by": [0, 0, 5]}, {"index": [1, 1, 1], "by": [0, 0, 5]}]})";
+  const std::string text = recipe_with(
+      R"(, "cut": {"deform": {"surface": "dome", "deformation": "torn", "composition": {"mode": "refit", "tolerance": 1e-4}}})",
+      R"("deformations": {"torn": [)" + torn + "]}, " +
+          R"("exports": {"cut": {"surfaces": ["cut"]}})");
+  REQUIRE(check_recipe(text).empty());
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
+  CHECK(category == ErrorCategory::ToleranceNotMet);
+  CHECK_THAT(message, Contains("surfaces.cut.steps[0] (bezier_lattice)") && Contains("discontinuous") &&
+                          Contains("lattice face s = 1") && Contains("jumps by 5 mm"));
+  CHECK_THAT(message, !Contains("Options::"));
+  // The explicit opt-in keeps the result (with a warning in the report) when the refit runs out.
+  const std::string accepted = recipe_with(
+      R"(, "cut": {"deform": {"surface": "dome", "deformation": "torn", "composition": {"mode": "refit", "tolerance": 2.6, "relative": false, "accept_out_of_tolerance": true}}})",
+      R"("deformations": {"torn": [)" + torn + "]}");
+  REQUIRE(check_recipe(accepted).empty());
+}
+
+TEST_CASE("a step that cannot be exact names the recipe's composition key, not a C++ option", "[recipe]") {
+  // The lattice covers half of the dome: exact composition refuses it at run time.
+  const std::string small = R"({"kind": "bezier_lattice", "frame": {"origin": [-10, -10, -20], "s": [60, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]}, "degrees": [1, 1, 1]})";
+  const std::string text = recipe_with(R"(, "cut": {"deform": {"surface": "dome", "deformation": "half"}})",
+                                       R"("deformations": {"half": [)" + small + "]}");
+  REQUIRE(check_recipe(text).empty());
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
+  CHECK_THAT(message, Contains("\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4}"));
+  CHECK_THAT(message, !Contains("Options::"));
+  CHECK(recipe_wording("RefitOptions::relative = false and SweepOptions::twist_degrees is 1e300") ==
+        "relative = false and twist_degrees is 1e300");
+}
+
+TEST_CASE("a style step that misses its target fails, unless accepted out of tolerance", "[recipe]") {
+  // The target lies outside the bound: nothing may move (over-constrained).
+  const std::string curves = R"("curves": {
+           "bound": {"arc": {"center": [50, 50, 25], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0], "radius": 15, "start": 0, "end": 360}},
+           "target": {"line": {"from": [80, 80, 30], "to": [95, 80, 30]}}})";
+  auto recipe = [&](const std::string& extra) {
+    return recipe_with(R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
+                       curves + R"(, "deformations": {"crease": [{"kind": "style", "bound": "bound", "target": "target")" +
+                           extra + "}]}");
+  };
+  REQUIRE(check_recipe(recipe("")).empty());
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(recipe(""))); });
+  CHECK(category == ErrorCategory::ToleranceNotMet);
+  CHECK_THAT(message, Contains("surfaces.styled.steps[0] (style)") && Contains("outside the bound") &&
+                          Contains("\"accept_out_of_tolerance\": true"));
+  const auto kept = run_recipe(parse_recipe(recipe(R"(, "accept_out_of_tolerance": true)")));
+  bool warned = false;
+  for (const auto& s : kept.steps)
+    if (s.path == "surfaces.styled.steps[0]") warned = s.warning;
+  CHECK(warned);
+}
+
+TEST_CASE("validate knows an inline bound curve is open, and the style's refinement keys", "[recipe]") {
+  const std::string text = recipe_with(
+      R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
+      R"("curves": {
+           "bound": {"arc": {"center": [50, 50, 25], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0], "radius": 30, "start": 0, "end": 300}},
+           "target": {"line": {"from": [35, 50, 30], "to": [65, 50, 30]}}},
+         "deformations": {"crease": [{"kind": "style", "bound": "bound", "target": "target", "mode": "exact",
+                                       "max_refinements": 6, "max_key_point_rounds": 3}]})");
+  const auto problems = check_recipe(text);
+  INFO(dump(problems));
+  REQUIRE(problems.size() == 1);
+  CHECK(mentions(problems, "deformations.crease[0].bound", "is open: its ends are 30 mm apart"));
 }

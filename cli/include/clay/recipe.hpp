@@ -152,4 +152,10 @@ std::string report_json(const RunResult& result);
 /// the file.
 std::vector<std::filesystem::path> write_outputs(RunResult& result, const std::filesystem::path& out_dir);
 
+/// A library message in the recipe's words: the fixes it suggests name recipe keys, never C++
+/// options ("SurfaceDeformationOptions::refit" becomes "composition": {"mode": "refit", ...}),
+/// and fixes recipes cannot apply are left out. Every message the command prints about a recipe
+/// goes through it (the checker's problems and the run's step errors).
+std::string recipe_wording(std::string message);
+
 }  // namespace clay::recipe
