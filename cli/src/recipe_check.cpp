@@ -1888,7 +1888,11 @@ std::string recipe_wording(std::string m) {
   // What is left: a field of a C++ options struct in a validation message ("SweepOptions::
   // twist_degrees is ..."), which for the options a recipe sets is the recipe's own key.
   static const std::regex options_struct("\\b[A-Z][A-Za-z]*Options::");
-  return std::regex_replace(m, options_struct, "");
+  m = std::regex_replace(m, options_struct, "");
+  // The library's own prefixes: the recipe path in front of the message already names the step
+  // (and a recipe runs deform_surface one step at a time, so its "steps[0]" would mislead).
+  static const std::regex library_prefix("\\b(deform_surface: steps\\[[0-9]+\\] \\([^)]*\\)(: )?|compose_exact: |refit_deformed: )");
+  return std::regex_replace(m, library_prefix, "");
 }
 
 std::string to_string(const Problem& problem) {
