@@ -30,6 +30,7 @@ struct Composition {
   bool relative = true;
   int degree = 3;
   int check_samples = 4;
+  int max_control_points = 40000;  // refit: the net may not grow beyond this (RefitOptions)
 };
 
 struct StrokeDef {
