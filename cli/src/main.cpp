@@ -53,12 +53,16 @@ std::string knots_summary(const BSplineBasis& b) {
   return out;
 }
 
-/// The surfaces of a STEP or IGES file, chosen by its extension.
+/// The surfaces of a STEP or IGES file, chosen by its extension. Read in a child process
+/// (ReadOptions::isolate): a file that crashes or hangs OpenCASCADE ends in exit code 6 and a
+/// message, never in a signal.
 std::vector<BSplineSurface> read_surfaces(const fs::path& file, const char* command) {
   std::string ext = file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".step" || ext == ".stp") return read_step(file);
-  if (ext == ".igs" || ext == ".iges") return read_iges(file);
+  ReadOptions guard;
+  guard.isolate = true;
+  if (ext == ".step" || ext == ".stp") return read_step(file, guard);
+  if (ext == ".igs" || ext == ".iges") return read_iges(file, guard);
   throw clay::Error(clay::ErrorCategory::InvalidArgument,
                     std::string(command) + ": '" + file.string() + "' has extension '" + ext +
                         "'; give a .step/.stp or .igs/.iges file");
