@@ -54,12 +54,16 @@ std::string knots_summary(const BSplineBasis& b) {
   return out;
 }
 
-/// The surfaces of a STEP or IGES file, chosen by its extension.
+/// The surfaces of a STEP or IGES file, chosen by its extension. Read in a child process
+/// (ReadOptions::isolate): a file that crashes or hangs OpenCASCADE ends in exit code 6 and a
+/// message, never in a signal.
 std::vector<BSplineSurface> read_surfaces(const fs::path& file, const char* command) {
   std::string ext = file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (ext == ".step" || ext == ".stp") return read_step(file);
-  if (ext == ".igs" || ext == ".iges") return read_iges(file);
+  ReadOptions guard;
+  guard.isolate = true;
+  if (ext == ".step" || ext == ".stp") return read_step(file, guard);
+  if (ext == ".igs" || ext == ".iges") return read_iges(file, guard);
   throw clay::Error(clay::ErrorCategory::InvalidArgument,
                     std::string(command) + ": '" + file.string() + "' has extension '" + ext +
                         "'; give a .step/.stp or .igs/.iges file");
@@ -119,11 +123,10 @@ clay::recipe::RunOptions run_options(bool show) {
   return o;
 }
 
-/// Writes the outputs and lists them.
+/// Writes the outputs and lists them. An export that reads back invalid throws in write_outputs
+/// before anything is written, so every export listed here is valid.
 int finish(clay::recipe::RunResult& result, const fs::path& out) {
   const auto files = clay::recipe::write_outputs(result, out);
-  bool valid = true;
-  for (const auto& e : result.exports) valid = valid && (!e.checked || e.valid);
   std::printf("%s: %zu step(s) in %.2f s\n", result.recipe.c_str(), result.steps.size(), result.seconds);
   // How each deformed surface was computed: exact composition or certified refit, and how close.
   for (const auto& step : result.steps) {
@@ -140,16 +143,11 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
   }
   for (const auto& e : result.exports)
     if (e.checked)
-      std::printf("  export %s: %zu surface(s), read back %s%s\n", e.name.c_str(), e.surfaces.size(),
-                  e.valid ? "valid (BRepCheck)" : "INVALID", e.read_back_identical ? ", bit-identical" : "");
+      std::printf("  export %s: %zu surface(s), read back valid (BRepCheck)%s\n", e.name.c_str(),
+                  e.surfaces.size(), e.read_back_identical ? ", bit-identical" : "");
   std::printf("outputs in %s:\n", out.string().c_str());
   for (const auto& f : files) std::printf("  %s\n", f.string().c_str());
-  for (const auto& e : result.exports)
-    if (e.checked && !e.valid) {
-      std::printf("export %s: read back INVALID (BRepCheck)\n", e.name.c_str());
-      for (const auto& p : e.problems) std::printf("  problem: %s\n", p.c_str());
-    }
-  return valid ? 0 : exit_code(clay::ErrorCategory::Exchange);
+  return 0;
 }
 
 /// `clayform validate RECIPE`: every problem, with its location.

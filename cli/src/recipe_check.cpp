@@ -75,6 +75,40 @@ std::string join(const std::vector<std::string>& items, std::string_view sep = "
   return out;
 }
 
+// ---- limits ----------------------------------------------------------------------------------
+// Every count, size and magnitude a recipe can ask for has a ceiling (docs/recipe.md, "Limits"),
+// so that `validate` refuses in milliseconds what would take minutes or gigabytes to run: a fuzz
+// campaign (issue #18) found recipes that did, among them one surface listed 100,000 times in an
+// export, a lattice of 200^3 cells, 100,000 prism sections and coordinates of 2^31 mm. Each
+// ceiling is far above what styling work needs (a car is 5,000 mm long; the examples stay far
+// below every one) and low enough that the largest recipe allowed still runs in seconds.
+namespace limit {
+constexpr std::size_t text_bytes = 64u << 20;   // the recipe text: 64 MiB
+constexpr int depth = 64;                        // nesting of arrays and objects (the schema uses 8)
+constexpr double magnitude = 1e6;                // |any number|: mm (1 km), degrees, knots, weights
+constexpr std::size_t entries = 1000;            // names per section, surfaces per export, skin sections
+constexpr std::size_t curve_points = 10000;      // control points of a curve, points of a polyline
+constexpr std::size_t stroke_points = 10000;     // drawn points of a stroke
+constexpr std::size_t surface_points = 250000;   // control points of an inline surface (500 x 500)
+constexpr std::size_t sketch_items = 1000;       // points, entities, constraints of a sketch
+constexpr std::size_t steps = 100;               // steps of a deformation stack
+constexpr std::size_t moves = 10000;             // moves of a lattice step or direct manipulation
+constexpr double weight_min = 1e-6, weight_max = 1e6;  // rational weights (ratio at most 1e12)
+constexpr long lattice_points = 100000;          // control points of a Bézier or B-spline lattice
+constexpr int lattice_cells = 64;                // cells of a B-spline lattice per direction
+constexpr long chunks = 4096;                    // tricubic chunks of an extended lattice
+constexpr int prism_sections = 65;               // sections of a prism lattice (64 gaps)
+constexpr int cylinder_sectors = 256, cylinder_rings = 64, lattice_layers = 64;
+constexpr double twist_turns = 100;              // twist: turns within 1 m of its origin
+constexpr double taper_scale = 1e3;              // taper: |r(z)| bound within 1 m of its origin
+constexpr double bend_rate = 1;                  // bend: rad/mm (radius of curvature >= 1 mm)
+constexpr double bend_turns = 10;                // bend: turns over its region
+constexpr double sweep_twist_degrees = 3600;     // sweep: 10 turns
+constexpr double arc_degrees = 720;              // arc start and end angles
+constexpr double min_tolerance = 1e-9;           // smallest refit, sweep and fit tolerance
+constexpr int refit_control_points = 40000;      // a refit's net (RefitOptions' default)
+}  // namespace limit
+
 /// An allowed interval for a number, open or closed at each end.
 struct Range {
   double lo = -inf, hi = inf;
@@ -89,9 +123,16 @@ struct Range {
     return std::string(lo_open ? "(" : "[") + shortest(lo) + ", " + shortest(hi) + (hi_open ? ")" : "]");
   }
 };
-constexpr Range any{};
-constexpr Range positive{0, inf, true, false};
-constexpr Range non_negative{0, inf, false, false};
+// Every number is also within ±limit::magnitude (Checker::number).
+constexpr Range any{-limit::magnitude, limit::magnitude};
+constexpr Range positive{0, limit::magnitude, true, false};
+constexpr Range non_negative{0, limit::magnitude, false, false};
+constexpr Range tolerance_range{limit::min_tolerance, limit::magnitude};
+// Weights beyond it overflow the homogeneous products (a bottle's neck with weights 1e300 read
+// back invalid); within it a weight ratio of 1e12 is still allowed.
+constexpr Range weight_range{limit::weight_min, limit::weight_max};
+// Knot vectors are count + degree + 1 long.
+constexpr std::size_t knot_slack = surface::max_kernel_degree + 1;
 
 bool valid_name(std::string_view s) {
   if (s.empty() || s.size() > 64) return false;
@@ -144,11 +185,23 @@ class Checker {
       return std::nullopt;
     }
     const double x = j.get<double>();
-    if (!std::isfinite(x) || !r.contains(x)) {
-      add(path, shortest(x) + " is out of range; give a number " + r.text());
+    if (!std::isfinite(x) || !r.contains(x) || std::abs(x) > limit::magnitude) {
+      add(path, shortest(x) + " is out of range; give a number " + r.text() +
+                    (std::abs(x) > limit::magnitude ? " (recipe numbers are limited to ±" +
+                                                          shortest(limit::magnitude) +
+                                                          ": mm, degrees, knots and weights)"
+                                                    : ""));
       return std::nullopt;
     }
     return x;
+  }
+
+  /// False (and the problem recorded) when the array j holds more than `max` items.
+  bool at_most(const Json& j, const std::string& path, std::size_t max, std::string_view what) {
+    if (!j.is_array() || j.size() <= max) return true;
+    add(path, "an array of " + std::to_string(j.size()) + " " + std::string(what) + "; at most " +
+                  std::to_string(max) + " are allowed (recipe limit)");
+    return false;
   }
 
   std::optional<int> integer(const Json& j, const std::string& path, int lo, int hi) {
@@ -215,8 +268,10 @@ class Checker {
     return Eigen::Vector2d(*a, *b);
   }
 
-  /// An array of [x, y, z] with at least `min` rows.
-  std::optional<Points3> points(const Json& j, const std::string& path, std::size_t min) {
+  /// An array of [x, y, z] with at least `min` and at most `max` rows.
+  std::optional<Points3> points(const Json& j, const std::string& path, std::size_t min,
+                                std::size_t max = limit::curve_points) {
+    if (!at_most(j, path, max, "points")) return std::nullopt;
     if (!j.is_array() || j.size() < min) {
       add(path, "expected an array of at least " + std::to_string(min) + " points [x, y, z], found " +
                     found(j));
@@ -232,7 +287,9 @@ class Checker {
     return ok ? std::optional(p) : std::nullopt;
   }
 
-  std::optional<std::vector<double>> numbers(const Json& j, const std::string& path, std::size_t min) {
+  std::optional<std::vector<double>> numbers(const Json& j, const std::string& path, std::size_t min,
+                                             std::size_t max = limit::surface_points, Range r = any) {
+    if (!at_most(j, path, max, "numbers")) return std::nullopt;
     if (!j.is_array() || j.size() < min) {
       add(path, "expected an array of at least " + std::to_string(min) + " numbers, found " + found(j));
       return std::nullopt;
@@ -240,7 +297,7 @@ class Checker {
     std::vector<double> out;
     bool ok = true;
     for (std::size_t i = 0; i < j.size(); ++i) {
-      const auto x = number(j[i], index_path(path, i));
+      const auto x = number(j[i], index_path(path, i), r);
       ok = ok && x.has_value();
       out.push_back(x.value_or(0.0));
     }
@@ -388,6 +445,11 @@ class RecipeChecker {
       c_.add(std::string(key), "expected an object of NAME: {...} entries, found " + found(*j));
       return;
     }
+    if (j->size() > limit::entries) {
+      c_.add(std::string(key), std::to_string(j->size()) + " entries; at most " + std::to_string(limit::entries) +
+                                   " are allowed (recipe limit): split the recipe");
+      return;
+    }
     for (const auto& [name, value] : j->items()) each(name, value, key_path(std::string(key), name));
   }
 
@@ -404,7 +466,7 @@ class RecipeChecker {
     };
     auto each = [&](std::string_view section_key, auto&& f) {
       const Json* s = c_.member(root, "", section_key, false, "");
-      if (!s || !s->is_object()) return;
+      if (!s || !s->is_object() || s->size() > limit::entries) return;  // reported by section()
       for (const auto& [name, value] : s->items()) {
         const std::string path = key_path(std::string(section_key), name);
         if (!valid_name(name))
@@ -478,16 +540,21 @@ class RecipeChecker {
   // ---- composition ------------------------------------------------------------------------
 
   Composition composition(const Json& j, const std::string& path, Composition c) {
-    if (!c_.object(j, path, {"mode", "tolerance", "relative", "degree", "check_samples", "accept_out_of_tolerance"},
+    if (!c_.object(j, path, {"mode", "tolerance", "relative", "degree", "check_samples", "max_control_points",
+                             "accept_out_of_tolerance"},
                    "a composition {\"mode\": \"exact\"|\"refit\", ...}"))
       return c;
     if (const Json* m = c_.member(j, path, "mode", false, ""))
       if (const auto k = c_.choice(*m, key_path(path, "mode"), {"exact", "refit"})) c.refit = *k == 1;
-    c.tolerance = c_.number_or(j, path, "tolerance", c.tolerance, positive);
+    c.tolerance = c_.number_or(j, path, "tolerance", c.tolerance, tolerance_range);
     c.relative = c_.boolean_or(j, path, "relative", c.relative);
     c.degree = c_.integer_or(j, path, "degree", c.degree, 1, 25);
     c.check_samples = c_.integer_or(j, path, "check_samples", c.check_samples, 2, 64);
     c.accept_out_of_tolerance = c_.boolean_or(j, path, "accept_out_of_tolerance", c.accept_out_of_tolerance);
+    // The refit's cap on its net (RefitOptions::max_control_points, 40,000 at most: the default,
+    // which already takes about 20 s to reach), at least the (degree + 1)^2 of one patch.
+    c.max_control_points = c_.integer_or(j, path, "max_control_points", c.max_control_points,
+                                         (c.degree + 1) * (c.degree + 1), limit::refit_control_points);
     return c;
   }
 
@@ -509,10 +576,10 @@ class RecipeChecker {
       return;
     StrokeDef s{name, path, {}, {}};
     const Json* pts = c_.member(j, path, "points", true, "the drawn points [[x, y, z], ...]");
-    const auto p = pts ? c_.points(*pts, key_path(path, "points"), 2) : std::nullopt;
+    const auto p = pts ? c_.points(*pts, key_path(path, "points"), 2, limit::stroke_points) : std::nullopt;
     if (const Json* pl = c_.member(j, path, "plane", false, ""))
       s.stroke.plane = plane(*pl, key_path(path, "plane"));
-    s.fit.tolerance = c_.number_or(j, path, "tolerance", s.fit.tolerance, positive);
+    s.fit.tolerance = c_.number_or(j, path, "tolerance", s.fit.tolerance, tolerance_range);
     s.fit.degree = c_.integer_or(j, path, "degree", s.fit.degree, 2, 9);
     s.fit.fairness = c_.number_or(j, path, "fairness", s.fit.fairness, non_negative);
     s.fit.closing_ratio = c_.number_or(j, path, "closing_ratio", s.fit.closing_ratio, Range{0, 0.5});
@@ -532,11 +599,11 @@ class RecipeChecker {
     const Json* k = c_.member(j, path, "knots", true, "the knot vector (count + degree + 1 numbers)");
     const Json* p = c_.member(j, path, "points", true, "the control points [[x, y, z], ...]");
     const auto degree = d ? c_.integer(*d, key_path(path, "degree"), 1, surface::max_kernel_degree) : std::nullopt;
-    const auto knots = k ? c_.numbers(*k, key_path(path, "knots"), 2) : std::nullopt;
+    const auto knots = k ? c_.numbers(*k, key_path(path, "knots"), 2, limit::curve_points + knot_slack) : std::nullopt;
     const auto points = p ? c_.points(*p, key_path(path, "points"), 2) : std::nullopt;
     std::optional<std::vector<double>> weights;
     if (const Json* w = c_.member(j, path, "weights", false, ""))
-      if (!(weights = c_.numbers(*w, key_path(path, "weights"), 2))) return std::nullopt;
+      if (!(weights = c_.numbers(*w, key_path(path, "weights"), 2, limit::curve_points, weight_range))) return std::nullopt;
     if (!degree || !knots || !points) return std::nullopt;
     surface::BSplineCurve curve;
     curve.basis = {*degree, *knots};
@@ -617,8 +684,9 @@ class RecipeChecker {
     const Json* s = c_.member(v, p, "start", true, "the start angle in degrees");
     const Json* e = c_.member(v, p, "end", true, "the end angle in degrees");
     const auto radius = r ? c_.number(*r, key_path(p, "radius"), positive) : std::nullopt;
-    const auto start = s ? c_.number(*s, key_path(p, "start")) : std::nullopt;
-    const auto end = e ? c_.number(*e, key_path(p, "end")) : std::nullopt;
+    const Range angle{-limit::arc_degrees, limit::arc_degrees};
+    const auto start = s ? c_.number(*s, key_path(p, "start"), angle) : std::nullopt;
+    const auto end = e ? c_.number(*e, key_path(p, "end"), angle) : std::nullopt;
     if (!vs[0] || !vs[1] || !vs[2] || !radius || !start || !end) return std::nullopt;
     if (!(*end > *start && *end - *start <= 360.0)) {
       c_.add(p, "end − start = " + shortest(*end - *start) + " degrees; give 0 < end − start <= 360");
@@ -684,7 +752,10 @@ class RecipeChecker {
     std::map<std::string, sketch::EntityId> entities;
     if (const Json* pts = c_.member(j, path, "points", true, "an object of NAME: position")) {
       const std::string pp = key_path(path, "points");
-      if (pts->is_object()) {
+      if (pts->is_object() && pts->size() > limit::sketch_items) {
+        c_.add(pp, std::to_string(pts->size()) + " points; at most " + std::to_string(limit::sketch_items) +
+                       " are allowed in a sketch (recipe limit)");
+      } else if (pts->is_object()) {
         for (const auto& [pname, pv] : pts->items()) {
           const std::string p = key_path(pp, pname);
           if (!plane_id.free()) {
@@ -767,7 +838,10 @@ class RecipeChecker {
     };
     if (const Json* ents = c_.member(j, path, "entities", true, "an object of NAME: {line|circle|arc}")) {
       const std::string ep = key_path(path, "entities");
-      if (ents->is_object()) {
+      if (ents->is_object() && ents->size() > limit::sketch_items) {
+        c_.add(ep, std::to_string(ents->size()) + " entities; at most " + std::to_string(limit::sketch_items) +
+                       " are allowed in a sketch (recipe limit)");
+      } else if (ents->is_object()) {
         for (const auto& [ename, ev] : ents->items()) {
           const std::string p = key_path(ep, ename);
           building = ename;
@@ -864,7 +938,7 @@ class RecipeChecker {
       const std::string cp = key_path(path, "constraints");
       if (!cons->is_array()) {
         c_.add(cp, "expected an array of {\"type\": ..., ...}, found " + found(*cons));
-      } else {
+      } else if (c_.at_most(*cons, cp, limit::sketch_items, "constraints")) {
         for (std::size_t i = 0; i < cons->size(); ++i)
           if (auto con = constraint((*cons)[i], index_path(cp, i), point_ref, entity_ref)) {
             con->label = index_path(cp, i);  // the solver's messages name it by its path
@@ -1002,7 +1076,7 @@ class RecipeChecker {
       } else if (def.kind == "skin") {
         SkinDef s;
         if (c_.object(v, p, {"sections", "degree", "parametrization"}, "a skin {sections, degree, parametrization}")) {
-          s.sections = curve_refs(v, p, "sections", 2, 10000);
+          s.sections = curve_refs(v, p, "sections", 2, limit::entries);
           s.options.degree = c_.integer_or(v, p, "degree", s.options.degree, 1, surface::max_exchange_degree);
           if (const Json* m = c_.member(v, p, "parametrization", false, ""))
             if (const auto k = c_.choice(*m, key_path(p, "parametrization"), {"chord_length", "centripetal", "uniform"}))
@@ -1017,8 +1091,9 @@ class RecipeChecker {
             s.profile = curve_ref(*m, key_path(p, "profile")).value_or("");
           if (const Json* m = c_.member(v, p, "path", true, "a curve name"))
             s.path = curve_ref(*m, key_path(p, "path")).value_or("");
-          s.options.twist_degrees = c_.number_or(v, p, "twist_degrees", s.options.twist_degrees);
-          s.options.tolerance = c_.number_or(v, p, "tolerance", s.options.tolerance, positive);
+          s.options.twist_degrees = c_.number_or(v, p, "twist_degrees", s.options.twist_degrees,
+                                                 Range{-limit::sweep_twist_degrees, limit::sweep_twist_degrees});
+          s.options.tolerance = c_.number_or(v, p, "tolerance", s.options.tolerance, tolerance_range);
           c_.attempt(p, [&] { s.options.validate(); });
         }
         def.build = std::move(s);
@@ -1054,7 +1129,7 @@ class RecipeChecker {
           }
           const double e1 = c_.number_or(v, p, "e1", 1.0, Range{0, 10, true, false});
           const double e2 = c_.number_or(v, p, "e2", 1.0, Range{0, 10, true, false});
-          o.tolerance = c_.number_or(v, p, "tolerance", o.tolerance, positive);
+          o.tolerance = c_.number_or(v, p, "tolerance", o.tolerance, tolerance_range);
           o.degree = c_.integer_or(v, p, "degree", o.degree, 2, 7);
           if (toroid) {
             SupertoroidDef d{{radii, 2.0, e1, e2}, o};
@@ -1141,10 +1216,11 @@ class RecipeChecker {
     }
     const auto knots_u = ku ? c_.numbers(*ku, key_path(path, "knots_u"), 2) : std::nullopt;
     const auto knots_v = kv ? c_.numbers(*kv, key_path(path, "knots_v"), 2) : std::nullopt;
-    const auto points = p ? c_.points(*p, key_path(path, "points"), 4) : std::nullopt;
+    const auto points = p ? c_.points(*p, key_path(path, "points"), 4, limit::surface_points) : std::nullopt;
     std::optional<std::vector<double>> weights;
     if (const Json* w = c_.member(j, path, "weights", false, ""))
-      if (!(weights = c_.numbers(*w, key_path(path, "weights"), 4))) return std::nullopt;
+      if (!(weights = c_.numbers(*w, key_path(path, "weights"), 4, limit::surface_points, weight_range)))
+        return std::nullopt;
     if (!degrees || !knots_u || !knots_v || !points) return std::nullopt;
     surface::BSplineSurface s;
     s.u = {degrees->first, *knots_u};
@@ -1184,6 +1260,28 @@ class RecipeChecker {
     return ok ? std::optional(out) : std::nullopt;
   }
 
+  /// False (and the problem recorded) when a lattice of counts[0] x counts[1] x counts[2] control
+  /// points is above limit::lattice_points; checked before the lattice is built.
+  bool lattice_size_ok(std::array<long, 3> counts, const std::string& path) {
+    const long total = counts[0] * counts[1] * counts[2];
+    if (total <= limit::lattice_points) return true;
+    c_.add(path, "the lattice would have " + std::to_string(counts[0]) + " x " + std::to_string(counts[1]) + " x " +
+                     std::to_string(counts[2]) + " = " + std::to_string(total) + " control points; at most " +
+                     std::to_string(limit::lattice_points) +
+                     " are allowed (recipe limit): use fewer cells or lower degrees");
+    return false;
+  }
+
+  /// False (and the problem recorded) when an extended lattice would have more than
+  /// limit::chunks tricubic chunks; checked before the lattice is built.
+  bool chunks_ok(long chunks, const std::string& path) {
+    if (chunks <= limit::chunks) return true;
+    c_.add(path, "the lattice would have " + std::to_string(chunks) + " chunks; at most " +
+                     std::to_string(limit::chunks) +
+                     " are allowed (recipe limit): use fewer sectors, rings, sections or layers");
+    return false;
+  }
+
   /// Applies "moves" to `points` (rows found by `row_of`, which reports its own problems).
   template <class RowOf>
   bool apply_moves(const Json& moves, const std::string& path, Points3& points, RowOf&& row_of,
@@ -1192,6 +1290,7 @@ class RecipeChecker {
       c_.add(path, "expected an array of {\"index\": ..., \"to\" or \"by\": [x, y, z]}, found " + found(moves));
       return false;
     }
+    if (!c_.at_most(moves, path, limit::moves, "moves")) return false;
     bool ok = true;
     std::vector<std::string_view> keys = index_keys;
     keys.push_back("to");
@@ -1270,6 +1369,8 @@ class RecipeChecker {
     if (!bspline) {
       const auto degrees = triple(j, path, "degrees", 1, surface::max_kernel_degree, "[l, m, n]");
       if (!frame || !degrees) return std::nullopt;
+      if (!lattice_size_ok({(*degrees)[0] + 1L, (*degrees)[1] + 1L, (*degrees)[2] + 1L}, key_path(path, "degrees")))
+        return std::nullopt;
       deform::BezierLattice lat = deform::make_bezier_lattice(*frame, *degrees);
       if (!lattice_points(j, path, lat.points, lat.counts())) return std::nullopt;
       const auto list = deform::problems(lat, path);
@@ -1300,20 +1401,28 @@ class RecipeChecker {
           const Json* d = c_.member(b[k], p, "degree", true, "the degree");
           const Json* kn = c_.member(b[k], p, "knots", true, "the knot vector on [0, 1]");
           const auto degree = d ? c_.integer(*d, key_path(p, "degree"), 1, surface::max_kernel_degree) : std::nullopt;
-          const auto knots = kn ? c_.numbers(*kn, key_path(p, "knots"), 2) : std::nullopt;
+          const auto knots = kn ? c_.numbers(*kn, key_path(p, "knots"), 2, limit::lattice_points) : std::nullopt;
           ok = ok && degree && knots;
           if (degree && knots) bases[k] = {*degree, *knots};
         }
         if (!ok || !frame) return std::nullopt;
+        std::array<long, 3> counts{};
+        for (std::size_t k = 0; k < 3; ++k)
+          counts[k] = std::max(0L, static_cast<long>(bases[k].knots.size()) - bases[k].degree - 1);
+        if (!lattice_size_ok(counts, bp)) return std::nullopt;
         if (!c_.attempt(bp, [&] { lat = deform::make_bspline_lattice(*frame, bases); })) return std::nullopt;
       } else {
-        const auto cells = triple(j, path, "cells", 1, 1024, "[a, b, c]");
+        const auto cells = triple(j, path, "cells", 1, limit::lattice_cells, "[a, b, c]");
         const auto degrees = triple(j, path, "degrees", 1, surface::max_kernel_degree, "[p, q, r]");
         deform::LatticeKnots knots = deform::LatticeKnots::clamped;
         if (const Json* k = c_.member(j, path, "knots", false, ""))
           if (const auto c = c_.choice(*k, key_path(path, "knots"), {"clamped", "uniform"}))
             knots = static_cast<deform::LatticeKnots>(*c);
         if (!cells || !degrees || !frame) return std::nullopt;
+        if (!lattice_size_ok({(*cells)[0] + static_cast<long>((*degrees)[0]), (*cells)[1] + static_cast<long>((*degrees)[1]),
+                              (*cells)[2] + static_cast<long>((*degrees)[2])},
+                             path))
+          return std::nullopt;
         if (!c_.attempt(path, [&] { lat = deform::make_bspline_lattice(*frame, *degrees, *cells, knots); }))
           return std::nullopt;
       }
@@ -1378,9 +1487,10 @@ class RecipeChecker {
       spec.radius = c_.number_or(g, p, "radius", spec.radius, positive);
       spec.inner_radius = c_.number_or(g, p, "inner_radius", spec.inner_radius, non_negative);
       spec.height = c_.number_or(g, p, "height", spec.height, positive);
-      spec.sectors = c_.integer_or(g, p, "sectors", spec.sectors, 3, 1024);
-      spec.rings = c_.integer_or(g, p, "rings", spec.rings, 1, 1024);
-      spec.layers = c_.integer_or(g, p, "layers", spec.layers, 1, 1024);
+      spec.sectors = c_.integer_or(g, p, "sectors", spec.sectors, 3, limit::cylinder_sectors);
+      spec.rings = c_.integer_or(g, p, "rings", spec.rings, 1, limit::cylinder_rings);
+      spec.layers = c_.integer_or(g, p, "layers", spec.layers, 1, limit::lattice_layers);
+      if (!chunks_ok(static_cast<long>(spec.sectors) * spec.rings * spec.layers, p)) return std::nullopt;
       if (!c_.attempt(p, [&] { lat = deform::make_cylindrical_lattice(spec); })) return std::nullopt;
       row_of = [this, spec](const Json& m, const std::string& mp) -> std::optional<Eigen::Index> {
         const Json* idx = c_.member(m, mp, "index", true, "[radial, angular, axial]");
@@ -1407,7 +1517,7 @@ class RecipeChecker {
                                  std::pair{"y_axis", &spec.y_axis}, std::pair{"extrusion", &spec.extrusion}})
         if (const Json* m = c_.member(g, p, key, false, ""))
           *target = c_.vec3(*m, key_path(p, key)).value_or(*target);
-      spec.layers = c_.integer_or(g, p, "layers", spec.layers, 1, 1024);
+      spec.layers = c_.integer_or(g, p, "layers", spec.layers, 1, limit::lattice_layers);
       const Json* s = c_.member(g, p, "sections", true, "two or more sections [[[a, b], ...], ...]");
       if (!s) return std::nullopt;
       const std::string sp = key_path(p, "sections");
@@ -1415,11 +1525,17 @@ class RecipeChecker {
         c_.add(sp, "expected two or more sections (arrays of [a, b]), found " + found(*s));
         return std::nullopt;
       }
+      // Counted before any section is read: reading 100,000 of them took a minute (issue #18).
+      if (!c_.at_most(*s, sp, static_cast<std::size_t>(limit::prism_sections), "sections")) return std::nullopt;
       bool ok = true;
       for (std::size_t a = 0; a < s->size(); ++a) {
         const std::string ap = index_path(sp, a);
         if (!(*s)[a].is_array()) {
           c_.add(ap, "expected an array of [a, b] points, found " + found((*s)[a]));
+          ok = false;
+          continue;
+        }
+        if (!c_.at_most((*s)[a], ap, 3 * static_cast<std::size_t>(limit::prism_sections - 1) + 1, "section points")) {
           ok = false;
           continue;
         }
@@ -1431,7 +1547,10 @@ class RecipeChecker {
         }
         spec.sections.push_back(std::move(section));
       }
-      if (!ok || !c_.attempt(p, [&] { lat = deform::make_prismatic_lattice(spec); })) return std::nullopt;
+      const long segments_first = std::max(0L, static_cast<long>(spec.sections.front().size()) - 1) / 3;
+      if (!ok || !chunks_ok(static_cast<long>(spec.sections.size() - 1) * segments_first * spec.layers, p))
+        return std::nullopt;
+      if (!c_.attempt(p, [&] { lat = deform::make_prismatic_lattice(spec); })) return std::nullopt;
       // A control point by its welded row, or by its index [i, j, k] in the lattice before
       // welding (i across the sections, j along them, k along the extrusion), found through the
       // chunk that holds it: chunk (a, b, c) is chunks[(a * segments + b) * layers + c].
@@ -1473,6 +1592,67 @@ class RecipeChecker {
     return deform::Deformation(std::move(lat));
   }
 
+  /// Sum |c_k| 1000^k: a bound of |c(z)| for |z| <= 1 m of a polynomial with coefficients c.
+  static double bound_within_metre(const std::vector<double>& c) {
+    double sum = 0, scale = 1;
+    for (double x : c) sum += std::abs(x) * scale, scale *= 1000.0;
+    return sum;
+  }
+
+  /// The recipe's limits on a step the deformation-stack schema read (which checks only that its
+  /// numbers are finite): frames and lattice points within ±limit::magnitude, bounded twists,
+  /// tapers and bends, and extended lattices of at most limit::chunks chunks.
+  bool within_limits(const deform::Deformation& d, const std::string& path) {
+    const std::size_t before = c_.problems.size();
+    auto frame = [&](const deform::AxisFrame& f) {
+      for (auto [key, v] : {std::pair{"origin", &f.origin}, std::pair{"axis", &f.axis}, std::pair{"reference", &f.reference}})
+        if (!(v->cwiseAbs().maxCoeff() <= limit::magnitude))
+          c_.add(key_path(key_path(path, "frame"), key), "a coordinate is beyond ±" + shortest(limit::magnitude) +
+                                                             " mm (recipe limit); give the frame in millimetres within it");
+    };
+    std::visit(
+        [&](const auto& x) {
+          using T = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<T, deform::Twist>) {
+            frame(x.frame);
+            const double turns = bound_within_metre(x.angle) / (2 * std::numbers::pi);
+            if (!(turns <= limit::twist_turns))
+              c_.add(key_path(path, "angle"),
+                     "the twist may turn " + shortest(turns * 360) + " degrees within 1 m of its origin (sum of |angle[k]| · 1000^k = " +
+                         shortest(turns * 2 * std::numbers::pi) + " rad); at most " + shortest(limit::twist_turns * 360) +
+                         " degrees (" + shortest(limit::twist_turns) + " turns) are allowed (recipe limit): the coefficients are radians per mm^k");
+          } else if constexpr (std::is_same_v<T, deform::Taper>) {
+            frame(x.frame);
+            const double scale = bound_within_metre(x.profile);
+            if (!(scale <= limit::taper_scale))
+              c_.add(key_path(path, "profile"),
+                     "the taper may scale by up to " + shortest(scale) + " within 1 m of its origin (sum of |profile[k]| · 1000^k); at most " +
+                         shortest(limit::taper_scale) + " is allowed (recipe limit): the coefficients are per mm^k");
+          } else if constexpr (std::is_same_v<T, deform::Bend>) {
+            frame(x.frame);
+            for (auto [key, v] : {std::pair{"y_min", x.y_min}, std::pair{"y_max", x.y_max}, std::pair{"center", x.center}})
+              if (!(std::abs(v) <= limit::magnitude))
+                c_.add(key_path(path, key), shortest(v) + " mm is beyond ±" + shortest(limit::magnitude) + " mm (recipe limit)");
+            const double turns = std::abs(x.rate) * (x.y_max - x.y_min) / (2 * std::numbers::pi);
+            if (!(std::abs(x.rate) <= limit::bend_rate))
+              c_.add(key_path(path, "rate"), shortest(x.rate) + " rad/mm is beyond ±" + shortest(limit::bend_rate) +
+                                                 " rad/mm (recipe limit: a radius of curvature of at least 1 mm)");
+            else if (!(turns <= limit::bend_turns))
+              c_.add(key_path(path, "rate"), "the bend turns " + shortest(turns * 360) + " degrees over its region (rate · (y_max − y_min)); at most " +
+                                                 shortest(limit::bend_turns * 360) + " degrees are allowed (recipe limit)");
+          } else if constexpr (std::is_same_v<T, deform::ExtendedLattice>) {
+            if (static_cast<long>(x.chunks.size()) > limit::chunks)
+              c_.add(key_path(path, "chunks"), std::to_string(x.chunks.size()) + " chunks; at most " +
+                                                   std::to_string(limit::chunks) + " are allowed (recipe limit)");
+            for (auto [key, m] : {std::pair{"rest", &x.rest}, std::pair{"points", &x.points}})
+              if (m->size() > 0 && !(m->cwiseAbs().maxCoeff() <= limit::magnitude))
+                c_.add(key_path(path, key), "a coordinate is beyond ±" + shortest(limit::magnitude) + " mm (recipe limit)");
+          }
+        },
+        d);
+    return c_.problems.size() == before;
+  }
+
   /// A stack-schema step read by deform::stack_from_json, its errors re-rooted at `path`.
   std::optional<deform::Deformation> schema_step(const Json& j, const std::string& path) {
     Json doc = Json::object();
@@ -1507,6 +1687,7 @@ class RecipeChecker {
       return;
     }
     const std::size_t before = c_.problems.size();
+    if (!c_.at_most(j, path, limit::steps, "steps")) return;
     for (std::size_t i = 0; i < j.size(); ++i) {
       const std::string p = index_path(path, i);
       const Json& s = j[i];
@@ -1530,7 +1711,7 @@ class RecipeChecker {
       } else if (*kind == 2 && s.contains("generator")) {
         if (auto d = extended_from_generator(s, p)) step.step = std::move(*d), ok = true;
       } else if (*kind <= 5) {
-        if (auto d = schema_step(s, p)) step.step = std::move(*d), ok = true;
+        if (auto d = schema_step(s, p); d && within_limits(*d, p)) step.step = std::move(*d), ok = true;
       } else if (*kind == 6) {
         if (auto d = style(s, p)) step.step = std::move(*d), ok = true;
       } else {
@@ -1623,7 +1804,7 @@ class RecipeChecker {
       const std::string mp = key_path(p, "moves");
       if (!mj->is_array() || mj->empty()) {
         c_.add(mp, "expected a non-empty array of moves, found " + found(*mj));
-      } else {
+      } else if (c_.at_most(*mj, mp, limit::moves, "moves")) {
         for (std::size_t i = 0; i < mj->size(); ++i) {
           const std::string ip = index_path(mp, i);
           const Json& m = (*mj)[i];
@@ -1704,9 +1885,19 @@ class RecipeChecker {
       const std::string sp = key_path(path, "surfaces");
       if (!s->is_array() || s->empty()) {
         c_.add(sp, "expected a non-empty array of surface names, found " + found(*s));
-      } else {
-        for (std::size_t i = 0; i < s->size(); ++i)
-          if (const auto n = surface_ref((*s)[i], index_path(sp, i))) def.surfaces.push_back(*n);
+      } else if (c_.at_most(*s, sp, limit::entries, "surface names")) {
+        // A surface listed twice would be written as two coincident faces; 100,000 times took a
+        // minute and 4 GB (issue #18).
+        std::map<std::string, std::size_t> first;
+        for (std::size_t i = 0; i < s->size(); ++i) {
+          const auto n = surface_ref((*s)[i], index_path(sp, i));
+          if (!n) continue;
+          if (const auto [it, fresh] = first.emplace(*n, i); !fresh)
+            c_.add(index_path(sp, i), "the surface \"" + *n + "\" is already listed at [" + std::to_string(it->second) +
+                                          "]; list each surface once");
+          else
+            def.surfaces.push_back(*n);
+        }
       }
     }
     if (const Json* f = c_.member(j, path, "formats", false, "")) {
@@ -1751,6 +1942,48 @@ std::pair<int, int> line_column(std::string_view text, std::size_t byte) {
   for (std::size_t i = 0; i < end; ++i)
     if (text[i] == '\n') ++line, line_start = i + 1;
   return {line, static_cast<int>(end - line_start) + 1};
+}
+
+/// Where arrays and objects first nest deeper than limit::depth, found by counting brackets
+/// outside strings before any parser sees the text: nlohmann's parser, called on a recipe nested
+/// 100,000 levels deep, recursed ~87,000 frames and overflowed the stack (issue #18). The problem
+/// names the top-level key it is under (when there is one) and the bracket's line and column.
+std::optional<Problem> too_deep(std::string_view text) {
+  int depth = 0, line = 1;
+  std::size_t line_start = 0, string_start = 0;
+  bool in_string = false;
+  std::string key, top_key;  // the last string closed at depth 1, and the key it became
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+      line_start = i + 1;
+    }
+    if (in_string) {
+      if (c == '\\') {
+        ++i;  // the escaped character cannot end the string
+      } else if (c == '"') {
+        in_string = false;
+        if (depth == 1) key = std::string(text.substr(string_start, std::min<std::size_t>(i - string_start, 64)));
+      }
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+      string_start = i + 1;
+    } else if (c == ':' && depth == 1) {
+      top_key = key;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit::depth)
+        return Problem{top_key.empty() ? "(syntax)" : top_key,
+                       "arrays and objects nest deeper than " + std::to_string(limit::depth) +
+                           " levels here (recipe limit; a recipe needs at most 8): remove the extra brackets",
+                       line, static_cast<int>(i - line_start) + 1};
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return std::nullopt;
 }
 
 /// Parses with a callback that reports keys repeated in one object (nlohmann would keep the last
@@ -1812,6 +2045,16 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
 CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   Checker c;
   CheckOutcome out;
+  if (text.size() > limit::text_bytes) {
+    out.problems.push_back({"(top level)", "the recipe is " + std::to_string(text.size()) + " bytes; at most " +
+                                               std::to_string(limit::text_bytes) + " (64 MiB) are allowed (recipe limit)",
+                            0, 0});
+    return out;
+  }
+  if (auto deep = too_deep(text)) {
+    out.problems.push_back(std::move(*deep));
+    return out;
+  }
   Json root;
   try {
     root = parse_reporting_duplicates(text, c);
@@ -1881,6 +2124,8 @@ std::string recipe_wording(std::string m) {
       {"loosen SuperquadricOptions::tolerance, raise max_spans, ", "loosen \"tolerance\" "},
       {"not reached at max_sections", "not reached with the most sections allowed"},
       {"raise gap_tolerance", "raise \"gap_tolerance\""},
+      {"; raise the limits, the tolerance or the degree",
+       "; raise the composition's \"tolerance\", \"degree\" or \"max_control_points\", or deform less"},
   };
   for (const auto& [from, to] : phrases)
     for (std::size_t at = m.find(from); at != std::string::npos; at = m.find(from, at + to.size()))

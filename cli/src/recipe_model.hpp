@@ -31,6 +31,7 @@ struct Composition {
   int degree = 3;
   int check_samples = 4;
   bool accept_out_of_tolerance = false;  ///< "accept_out_of_tolerance": keep a refit that misses
+  int max_control_points = 40000;  // refit: the net may not grow beyond this (RefitOptions)
 };
 
 struct StrokeDef {

@@ -128,6 +128,15 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
         e.read_back_identical = back.size() == e.surfaces.size();
         for (std::size_t k = 0; e.read_back_identical && k < back.size(); ++k)
           e.read_back_identical = surface::identical(back[k], e.surfaces[k]);
+        // Checked here, before anything is moved into `out_dir`: an export that reads back
+        // invalid fails the run, and a failed run leaves nothing behind (it used to leave all its
+        // files and report the failure afterwards, issue #18).
+        if (!e.valid) {
+          std::string m = "export " + e.name + ": " + (has_step ? e.name + ".step" : e.name + ".igs") +
+                          " reads back INVALID (BRepCheck), so nothing was written to \"" + target.string() + "\"";
+          for (const auto& p : e.problems) m += "\n  problem: " + p;
+          throw Error(ErrorCategory::Exchange, m);
+        }
       }
     }
     {

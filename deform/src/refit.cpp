@@ -749,6 +749,14 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
       break;
     }
     BSplineBasis nu = split_spans(bu, mark_u), nv = split_spans(bv, mark_v);
+    // The least squares are dense per direction ((degree + 1) rows per span x count columns), so
+    // one long direction costs count^2 memory even within max_control_points: a twist of 1e6
+    // degrees grew one direction to 10,000 and took 4.4 GB (issue #18).
+    if (std::max(nu.count(), nv.count()) > options.max_count_per_direction) {
+      limit = "control point limit per direction " + std::to_string(options.max_count_per_direction) +
+              " reached (next net " + std::to_string(nu.count()) + " x " + std::to_string(nv.count()) + ")";
+      break;
+    }
     if (static_cast<long>(nu.count()) * nv.count() > options.max_control_points) {
       limit = "control point limit " + std::to_string(options.max_control_points) +
               " reached (next net " + std::to_string(nu.count()) + " x " +
@@ -803,6 +811,9 @@ void RefitOptions::validate() const {
   if (max_control_points < (degree + 1) * (degree + 1))
     fail("max_control_points = " + std::to_string(max_control_points) +
          ": must be >= (degree + 1)^2 = " + std::to_string((degree + 1) * (degree + 1)));
+  if (max_count_per_direction < degree + 1)
+    fail("max_count_per_direction = " + std::to_string(max_count_per_direction) +
+         ": must be >= degree + 1 = " + std::to_string(degree + 1));
   if (!(certificate_share > 0 && certificate_share < 1))
     fail("certificate_share = " + format(certificate_share) + ": must be in (0, 1), e.g. 0.1");
 }

@@ -856,9 +856,15 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
     if (grown + 1 > options.max_sections)
       distribute_intervals(options.max_sections - 1, piece_sigma, intervals);
   }
-  std::string method = "sweep with rotation-minimizing frames, " + std::to_string(count) + " sections";
+  // A sweep that misses its tolerance is a failure, not a result (DESIGN.md): a twist of 1e300
+  // degrees used to come back as a wild surface whose export then ran for minutes (issue #18).
   if (options.sections == 0 && worst > target)
-    method += " (tolerance " + num(target) + " mm not reached at max_sections)";
+    throw Error(ErrorCategory::InvalidArgument,
+                "sweep: the deviation " + num(worst) + " mm is still above the tolerance " + num(target) +
+                    " mm with " + std::to_string(count) + " sections, the most SweepOptions::max_sections = " +
+                    std::to_string(options.max_sections) +
+                    " allows; loosen SweepOptions::tolerance, reduce SweepOptions::twist_degrees or smooth the path");
+  const std::string method = "sweep with rotation-minimizing frames, " + std::to_string(count) + " sections";
   built.report = describe(built.surface, method);
   built.report.exact = false;
   built.report.max_deviation = worst;

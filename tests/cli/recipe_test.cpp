@@ -13,6 +13,7 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/exchange.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -803,4 +804,173 @@ TEST_CASE("validate knows an inline bound curve is open, and the style's refinem
   INFO(dump(problems));
   REQUIRE(problems.size() == 1);
   CHECK(mentions(problems, "deformations.crease[0].bound", "is open: its ends are 30 mm apart"));
+}
+
+// ---- limits (issue #18: recipes a fuzz campaign found that crashed or blew up) ----------------
+
+namespace {
+
+const char* recipe_head = R"({"format": "clayform.recipe", "version": 1, )";
+
+/// check_recipe must refuse `text` within 1 s (it used to accept each of these, or crash) with a
+/// problem at `path` whose message holds every one of `words` (the limit).
+void refused_quickly(const std::string& text, const std::string& path, std::initializer_list<std::string> words) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto problems = check_recipe(text);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  INFO(dump(problems));
+  CHECK(seconds < 1.0);
+  bool found = false;
+  for (const auto& p : problems) {
+    if (p.path != path) continue;
+    bool all = true;
+    for (const auto& w : words) all = all && p.message.find(w) != std::string::npos;
+    found = found || all;
+  }
+  CHECK(found);
+}
+
+std::string repeated(const std::string& item, std::size_t n, const char* separator = ", ") {
+  std::string s;
+  s.reserve((item.size() + 2) * n);
+  for (std::size_t k = 0; k < n; ++k) s += (k ? separator : "") + item;
+  return s;
+}
+
+const char* frame_json = R"("frame": {"origin": [0, 0, 0], "s": [100, 0, 0], "t": [0, 100, 0], "u": [0, 0, 100]})";
+
+}  // namespace
+
+TEST_CASE("a recipe nested 100,000 deep is refused at its line and column, without a crash", "[recipe][limits]") {
+  // nlohmann's parser recursed ~87,000 frames on this and overflowed the stack (SIGSEGV).
+  const std::string text = std::string(recipe_head) + "\n\"description\": " + std::string(100000, '[') +
+                           std::string(100000, ']') + ", \"x\": 1}";
+  refused_quickly(text, "description", {"deeper than 64 levels"});
+  const auto problems = check_recipe(text);
+  REQUIRE(problems.size() == 1);
+  CHECK(problems[0].line == 2);
+  CHECK(problems[0].column == 16 + 63);  // the 64th bracket: level 65 with the recipe's own object
+  CHECK_THAT(to_string(problems[0]), Contains("line 2, column 79: description: "));
+  // 64 levels are allowed (the check only counts; the parser then reports the wrong type)
+  const std::string deep64 = std::string(recipe_head) + "\"description\": " + std::string(63, '[') + std::string(63, ']') + "}";
+  CHECK(mentions(check_recipe(deep64), "description", "expected a string"));
+  // brackets inside strings do not count
+  const std::string in_string = std::string(recipe_head) + "\"description\": \"" + std::string(1000, '[') + "\"}";
+  CHECK(check_recipe(in_string).empty());
+}
+
+TEST_CASE("validate refuses an export listing one surface 100,000 times, or twice", "[recipe][limits]") {
+  // was: over 60 s and 4.2 GB at run time
+  refused_quickly(recipe_with("", R"("exports": {"e": {"surfaces": [)" + repeated("\"dome\"", 100000) + "]}}"),
+                  "exports.e.surfaces", {"100000 surface names", "at most 1000"});
+  refused_quickly(recipe_with("", R"("exports": {"e": {"surfaces": ["dome", "dome"]}})"), "exports.e.surfaces[1]",
+                  {"already listed at [0]", "list each surface once"});
+}
+
+TEST_CASE("validate refuses a B-spline lattice of 200^3 cells, and one of too many control points", "[recipe][limits]") {
+  // was: over 4.4 GB in 32 s at run time
+  auto stack = [](const std::string& cells, const std::string& degrees) {
+    return std::string(recipe_head) + R"("deformations": {"big": [{"kind": "bspline_lattice", )" + frame_json +
+           R"(, "cells": )" + cells + R"(, "degrees": )" + degrees + "}]}}";
+  };
+  refused_quickly(stack("[200, 200, 200]", "[3, 3, 3]"), "deformations.big[0].cells[0]", {"[1, 64]", "found the number 200"});
+  refused_quickly(stack("[64, 64, 64]", "[3, 3, 3]"), "deformations.big[0]",
+                  {"67 x 67 x 67 = 300763 control points", "at most 100000"});
+  CHECK(check_recipe(stack("[8, 8, 8]", "[3, 3, 3]")).empty());
+  const std::string bezier = std::string(recipe_head) + R"("deformations": {"big": [{"kind": "bezier_lattice", )" +
+                             frame_json + R"(, "degrees": [63, 63, 63]}]}})";
+  refused_quickly(bezier, "deformations.big[0].degrees", {"64 x 64 x 64 = 262144 control points", "at most 100000"});
+}
+
+TEST_CASE("validate refuses a twist of 1e6 degrees, a bend of 10 rad/mm and a taper scaling by 1e4", "[recipe][limits]") {
+  // was: over 4.4 GB in refit mode (the post of superellipsoid_taper_twist.json turned 1e6
+  // degrees over its 120 mm: 145 rad/mm)
+  const std::string axis = R"("frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]})";
+  const std::string twist = std::string(recipe_head) +
+                            R"("composition": {"mode": "refit"}, "surfaces": {"post": {"superellipsoid": {"radii": [25, 25, 60]}},
+      "twisted": {"deform": {"surface": "post", "deformation": "wring"}}},
+      "deformations": {"wring": [{"kind": "twist", )" + axis + R"(, "angle": [0, 145.44]}]}})";
+  refused_quickly(twist, "deformations.wring[0].angle", {"at most 36000 degrees (100 turns)", "radians per mm^k"});
+  const std::string fine = std::string(recipe_head) + R"("deformations": {"w": [{"kind": "twist", )" + axis +
+                           R"(, "angle": [0, 0.0131]}]}})";
+  CHECK(check_recipe(fine).empty());
+  const std::string bend = std::string(recipe_head) + R"("deformations": {"b": [{"kind": "bend", "frame": {"origin": [0, 0, 0], "axis": [0, 1, 0], "reference": [0, 0, 1]}, "y_min": -10, "y_max": 10, "center": 0, "rate": 10}]}})";
+  refused_quickly(bend, "deformations.b[0].rate", {"10 rad/mm", "1 rad/mm"});
+  const std::string taper = std::string(recipe_head) + R"("deformations": {"t": [{"kind": "taper", )" + axis +
+                            R"(, "profile": [1, 10]}]}})";
+  refused_quickly(taper, "deformations.t[0].profile", {"10001", "at most 1000"});
+}
+
+TEST_CASE("validate refuses a sweep twisted 1e300 degrees", "[recipe][limits]") {
+  // was: over 60 s at run time
+  const std::string text = std::string(recipe_head) + R"("curves": {
+      "a": {"line": {"from": [0, -5, 0], "to": [0, 5, 0]}}, "b": {"line": {"from": [0, 0, 0], "to": [0, 0, 100]}}},
+    "surfaces": {"s": {"sweep": {"profile": "a", "path": "b", "twist_degrees": 1e300}}}})";
+  refused_quickly(text, "surfaces.s.sweep.twist_degrees", {"1e+300 is out of range", "[-3600, 3600]"});
+}
+
+TEST_CASE("validate refuses a prism lattice with a coordinate of 2^31 mm or 100,000 sections", "[recipe][limits]") {
+  auto prism = [](const std::string& sections) {
+    return std::string(recipe_head) + R"("deformations": {"p": [{"kind": "extended_lattice", "generator": {"prism": {
+        "sections": )" + sections + R"(, "extrusion": [0, 0, 30]}}}]}})";
+  };
+  // was: over 60 s at run time
+  refused_quickly(prism("[[[0, 0], [10, 0], [20, 0], [2147483648, 0]], [[0, 30], [10, 30], [20, 30], [30, 30]]]"),
+                  "deformations.p[0].generator.prism.sections[0][3][0]",
+                  {"2147483648 is out of range", "[-1e+06, 1e+06]", "limited to ±1e+06"});
+  // was: validate itself over 60 s and 2.7 GB
+  refused_quickly(prism("[" + repeated("[[0, 0], [10, 0], [20, 0], [30, 0]]", 100000) + "]"),
+                  "deformations.p[0].generator.prism.sections", {"100000 sections", "at most 65"});
+}
+
+TEST_CASE("validate refuses weights of 1e300 (a bottle's neck that read back invalid)", "[recipe][limits]") {
+  const std::string text = std::string(recipe_head) + R"("curves": {"neck": {"bspline": {"degree": 2,
+      "knots": [0, 0, 0, 1, 1, 1], "points": [[30, 0, 0], [30, 0, 10], [10, 0, 20]], "weights": [1, 1e300, 1]}}}})";
+  refused_quickly(text, "curves.neck.bspline.weights[1]", {"1e+300 is out of range", "[1e-06, 1e+06]"});
+}
+
+TEST_CASE("every count and magnitude of a recipe has a limit that validate names", "[recipe][limits]") {
+  refused_quickly(std::string(recipe_head) + R"("strokes": {"s": {"points": [)" + repeated("[0, 0, 0]", 10001) + "]}}}",
+                  "strokes.s.points", {"10001 points", "at most 10000"});
+  refused_quickly(std::string(recipe_head) + R"("curves": {"p": {"polyline": {"points": [)" + repeated("[0, 0, 0]", 10001) + "]}}}}",
+                  "curves.p.polyline.points", {"at most 10000"});
+  refused_quickly(std::string(recipe_head) + R"("curves": {"a": {"arc": {"center": [0, 0, 0], "x_axis": [1, 0, 0],
+      "y_axis": [0, 1, 0], "radius": 5, "start": 100000, "end": 100090}}}})",
+                  "curves.a.arc.start", {"[-720, 720]"});
+  std::string many = std::string(recipe_head) + R"("curves": {)";
+  for (int k = 0; k <= 1000; ++k)
+    many += (k ? ", " : "") + std::string("\"c") + std::to_string(k) + R"(": {"line": {"from": [0, 0, 0], "to": [1, 0, 0]}})";
+  refused_quickly(many + "}}", "curves", {"1001 entries", "at most 1000"});
+  const std::string step = R"({"kind": "taper", "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": [1]})";
+  refused_quickly(std::string(recipe_head) + R"("deformations": {"d": [)" + repeated(step, 101) + "]}}", "deformations.d",
+                  {"101 steps", "at most 100"});
+  refused_quickly(std::string(recipe_head) + R"("deformations": {"c": [{"kind": "extended_lattice", "generator": {"cylinder": {
+      "sectors": 1000}}}]}})",
+                  "deformations.c[0].generator.cylinder.sectors", {"[3, 256]"});
+  refused_quickly(std::string(recipe_head) + R"("deformations": {"c": [{"kind": "extended_lattice", "generator": {"cylinder": {
+      "sectors": 256, "rings": 64, "layers": 64}}}]}})",
+                  "deformations.c[0].generator.cylinder", {"1048576 chunks", "at most 4096"});
+  refused_quickly(std::string(recipe_head) + R"("composition": {"mode": "refit", "tolerance": 1e-12}})", "composition.tolerance",
+                  {"[1e-09, 1e+06]"});
+  refused_quickly(std::string(recipe_head) + R"("composition": {"mode": "refit", "max_control_points": 100000}})",
+                  "composition.max_control_points", {"[16, 40000]"});
+  refused_quickly(recipe_with(R"(, "big": {"superellipsoid": {"radii": [1e7, 1, 1]}})", ""), "surfaces.big.superellipsoid.radii[0]",
+                  {"1e+07 is out of range", "limited to ±1e+06"});
+  refused_quickly(std::string(recipe_head) + std::string(64u << 20, ' ') + "}", "(top level)", {"at most 67108864"});
+}
+
+TEST_CASE("a refit that misses its tolerance at the refit's caps fails the run, naming the cap", "[recipe][limits]") {
+  // Tighter than the refit can certify within its iteration and control-point limits: a failure,
+  // not a warning (DESIGN.md), with the cap named and the recipe keys to change.
+  const std::string twist = R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.05]})";
+  const std::string text = recipe_with(
+      R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 1e-9, "max_control_points": 400}}})",
+      R"("deformations": {"spin": [)" + twist + "]}");
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
+  CHECK(category == ErrorCategory::ToleranceNotMet);
+  CHECK_THAT(message, Contains("surfaces.spun.steps[0] (twist): ") && Contains("misses its tolerance"));
+  CHECK_THAT(message, Contains("control point limit 400 reached"));
+  CHECK_THAT(message, Contains("raise the composition's \"tolerance\", \"degree\" or \"max_control_points\""));
+  CHECK_THAT(message, Contains("\"accept_out_of_tolerance\": true"));
+  CHECK_THAT(message, !Contains("Options"));
 }

@@ -327,6 +327,16 @@ TEST_CASE("Refit limits end in a not-converged report", "[refit]") {
   CHECK(c.report.summary.termination == Termination::NotConverged);
   CHECK_THAT(c.report.summary.message, Contains("control point limit 100"));
   CHECK(c.surface.count_u() * c.surface.count_v() <= 100);
+
+  // The per-direction cap bounds the dense least squares' memory (issue #18): it stops the
+  // refinement before either direction passes it, and the message names it.
+  options.max_control_points = 40000;
+  options.max_count_per_direction = 12;
+  const RefitResult d = refit_deformed(loft, twist, options);
+  CHECK(d.report.summary.termination == Termination::NotConverged);
+  CHECK_THAT(d.report.summary.message, Contains("control point limit per direction 12"));
+  CHECK(d.surface.count_u() <= 12);
+  CHECK(d.surface.count_v() <= 12);
 }
 
 TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]") {
@@ -355,6 +365,9 @@ TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]
   o = {};
   o.max_control_points = 15;
   options_error(o, "max_control_points = 15");
+  o = {};
+  o.max_count_per_direction = 3;
+  options_error(o, "max_count_per_direction = 3");
   o = {};
   o.certificate_share = 1;
   options_error(o, "certificate_share = 1");

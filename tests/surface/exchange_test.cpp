@@ -12,6 +12,7 @@
 #include <random_geometry.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <fstream>
@@ -428,4 +429,187 @@ TEST_CASE("glTF previews of surfaces with poles and collapsed edges are not empt
   CHECK((back.box().min() - Eigen::Vector3d(-10, -10, -10)).norm() <= 1e-2);
   CHECK((back.box().max() - Eigen::Vector3d(10, 10, 10)).norm() <= 1e-2);
   CHECK_THAT(surface_area(sphere, 2), Catch::Matchers::WithinRel(exact, 1e-9));
+}
+
+// ---- malformed files (issue #18: mutated files crashed or hung OpenCASCADE) ---------------------
+
+namespace {
+
+/// `text` with its first `from` replaced by `to`; fails the test when `from` is missing.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  return text.replace(at, from.size(), to);
+}
+
+/// An IGES file's lines with the data columns 1-64 of the line starting with `prefix` (offset
+/// `down` lines below it) edited, padded back to 64 columns so the fixed format stays intact.
+std::string iges_edited(const std::string& text, const std::string& prefix, int down, const std::string& from,
+                        const std::string& to) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  std::size_t at = 0;
+  while (at < lines.size() && lines[at].rfind(prefix, 0) != 0) ++at;
+  at += static_cast<std::size_t>(down);
+  REQUIRE(at < lines.size());
+  std::string data = lines[at].substr(0, 64);
+  data.erase(data.find_last_not_of(' ') + 1);
+  data = replaced(data, from, to);
+  REQUIRE(data.size() <= 64);
+  lines[at] = data + std::string(64 - data.size(), ' ') + lines[at].substr(64);
+  std::string out;
+  for (const auto& l : lines) out += l + "\n";
+  return out;
+}
+
+/// The mutated files of tests/fuzz/corpus/exchange/ (README there), made from a bicubic and a
+/// rational surface written by write_step and write_iges into `folder`: name -> what the
+/// pre-check must say.
+std::vector<std::pair<std::string, std::string>> write_mutated_files(const fs::path& folder) {
+  std::mt19937 rng(1818);
+  const std::vector<BSplineSurface> surfaces{test::random_surface(rng, 3, 3, 8, 6, false),
+                                             test::random_surface(rng, 2, 2, 3, 3, true)};
+  write_step(surfaces, folder / "valid.step");
+  write_iges(surfaces, folder / "valid.igs");
+  const std::string step = read_text(folder / "valid.step"), iges = read_text(folder / "valid.igs");
+  // The first B-spline surface's entity, the first point of its control net and a placement.
+  const std::string bspline = step.substr(step.find("B_SPLINE_SURFACE_WITH_KNOTS('',3,3,("), 36);
+  const auto placement = step.find("AXIS2_PLACEMENT_3D('',#");
+  REQUIRE(placement != std::string::npos);
+  const std::string axis = step.substr(placement, step.find(';', placement) - placement);
+  const auto comma = axis.find(',', axis.find("#"));
+  const std::string first_ref = axis.substr(axis.find('#'), comma - axis.find('#'));
+  const std::string second_ref = axis.substr(comma + 1, axis.find(',', comma + 1) - comma - 1);
+  const auto net = step.find("(#", step.find(bspline));
+  const std::string point_ref = step.substr(net + 1, step.find(',', net) - net - 1);
+  const auto point_at = step.find(point_ref + " = CARTESIAN_POINT('',(");
+  REQUIRE(point_at != std::string::npos);
+  const std::string point = step.substr(point_at, step.find(';', point_at) - point_at);
+  const auto x_at = point.find("'',(") + 4;
+  const std::string x = point.substr(x_at, point.find(',', x_at) - x_at);
+  auto coordinate = [&](const std::string& value) {
+    return replaced(step, point, replaced(point, "'',(" + x, "'',(" + value));
+  };
+  const std::string record = "128,7,5,3,3,";  // the bicubic's surface record: K1, K2, M1, M2
+  std::vector<std::pair<std::string, std::string>> files{
+      {"step-dangling-point.step", "which the file does not define (a dangling reference)"},
+      {"step-dangling-direction.step", "which the file does not define (a dangling reference)"},
+      {"step-nan-coordinate.step", "'NaN' is not a STEP value"},
+      {"step-infinite-coordinate.step", "'1.0E999' is beyond the range of a double"},
+      {"step-denormal-coordinate.step", "'4.9E-324' is denormal"},
+      {"step-absurd-coordinate.step", "larger in magnitude than 1e100"},
+      {"step-degree-99.step", "B_SPLINE_SURFACE_WITH_KNOTS has degree 99"},
+      {"step-rational-degree-99.step", "B_SPLINE_SURFACE has degree 99"},
+      {"iges-degree-99.igs", "degree M1 99 is outside [1, 25]"},
+      {"iges-counts-inconsistent.igs", "upper index K1 7000 is inconsistent"},
+      {"iges-nan-coordinate.igs", "'NaN' is not a number"},
+      {"iges-infinite-coordinate.igs", "'1.0D999' is beyond the range of a double"},
+      {"iges-denormal-coordinate.igs", "'4.9D-324' is denormal"},
+  };
+  auto write = [&](const std::string& name, const std::string& text) { std::ofstream(folder / name, std::ios::binary) << text; };
+  write(files[0].first, replaced(step, axis, replaced(axis, first_ref + ",", "#999999,")));
+  write(files[1].first, replaced(step, axis, replaced(axis, "," + second_ref + ",", ",#999998,")));
+  write(files[2].first, coordinate("NaN"));
+  write(files[3].first, coordinate("1.0E999"));
+  write(files[4].first, coordinate("4.9E-324"));
+  write(files[5].first, coordinate("1.0E+150"));
+  write(files[6].first, replaced(step, bspline, "B_SPLINE_SURFACE_WITH_KNOTS('',99,3,("));
+  write(files[7].first, replaced(step, "B_SPLINE_SURFACE(2,2,(", "B_SPLINE_SURFACE(99,2,("));
+  write(files[8].first, iges_edited(iges, record, 0, record, "128,7,5,99,3,"));
+  write(files[9].first, iges_edited(iges, record, 0, record, "128,7000,5,3,3,"));
+  // the first control point's x: the 14th line of the record (after 10 + 8 + 6 ... parameters)
+  const std::string line = [&] {
+    std::istringstream in(iges);
+    std::string l;
+    for (int k = 0; std::getline(in, l);)
+      if (l.rfind(record, 0) == 0 || k > 0)
+        if (++k == 14) return l;
+    return std::string();
+  }();
+  const std::string value = line.substr(0, line.find(','));
+  write(files[10].first, iges_edited(iges, record, 13, value, "NaN"));
+  write(files[11].first, iges_edited(iges, record, 13, value, "1.0D999"));
+  write(files[12].first, iges_edited(iges, record, 13, value, "4.9D-324"));
+  return files;
+}
+
+std::string message_of(const std::function<void()>& call) {
+  try {
+    call();
+  } catch (const Error& e) {
+    CHECK(e.category() == ErrorCategory::Exchange);
+    return e.message();
+  }
+  FAIL("no clay::Error thrown");
+  return {};
+}
+
+std::vector<BSplineSurface> read_any(const fs::path& file, const ReadOptions& options) {
+  return file.extension() == ".igs" ? read_iges(file, options) : read_step(file, options);
+}
+
+}  // namespace
+
+TEST_CASE("The pre-check refuses malformed STEP and IGES files, naming the entity and line", "[exchange][malformed]") {
+  const fs::path folder = fresh_folder("malformed");
+  const auto files = write_mutated_files(folder);
+  REQUIRE(read_step(folder / "valid.step").size() == 2);  // the originals pass
+  REQUIRE(read_iges(folder / "valid.igs").size() == 2);
+  for (const auto& [name, why] : files) {
+    INFO(name);
+    const auto start = std::chrono::steady_clock::now();
+    const std::string m = message_of([&] { (void)read_any(folder / name, {}); });
+    CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 5.0);
+    CHECK_THAT(m, Catch::Matchers::Contains(why));
+    CHECK_THAT(m, Catch::Matchers::Contains(name + "' line "));
+    CHECK_THAT(m, Catch::Matchers::Contains(name.rfind("step", 0) == 0 ? ", entity #" : ", entity 128 (directory entry "));
+  }
+  // A copy for the fuzzers' corpus (tests/fuzz/corpus/exchange/) is made from these files.
+}
+
+TEST_CASE("An isolated read survives what crashes OpenCASCADE, and stops at its limits", "[exchange][malformed]") {
+  const fs::path folder = fresh_folder("isolated");
+  (void)write_mutated_files(folder);
+  ReadOptions isolated;
+  isolated.isolate = true;
+  // Same surfaces as a direct read.
+  require_identical(read_step(folder / "valid.step", isolated), read_step(folder / "valid.step"));
+  require_identical(read_iges(folder / "valid.igs", isolated), read_iges(folder / "valid.igs"));
+  // Without the pre-check, OpenCASCADE crashes on a dangling point reference and on a B-spline
+  // record whose counts overrun it: the child dies, this process reports it.
+  ReadOptions unchecked = isolated;
+  unchecked.precheck = false;
+  for (const char* name : {"step-dangling-point.step", "iges-counts-inconsistent.igs"}) {
+    INFO(name);
+    const std::string m = message_of([&] { (void)read_any(folder / name, unchecked); });
+    CHECK_THAT(m, Catch::Matchers::Contains("OpenCASCADE crashed (SIGSEGV) while reading '"));
+    CHECK_THAT(m, Catch::Matchers::Contains(name));
+  }
+  // The time and memory limits, on a valid file.
+  ReadOptions hurried = isolated;
+  hurried.time_limit_seconds = 1e-4;
+  CHECK_THAT(message_of([&] { (void)read_step(folder / "valid.step", hurried); }),
+             Catch::Matchers::Contains("took longer than 0.0001 s"));
+  // 40,000 control points: OpenCASCADE's model of the file takes tens of MB, more than the 1 MB
+  // the child may add to what this process maps.
+  std::mt19937 rng(40000);
+  write_step({test::random_surface(rng, 3, 3, 200, 200, false)}, folder / "large.step");
+  ReadOptions starved = isolated;
+  starved.memory_limit_mb = 1;
+  CHECK_THAT(message_of([&] { (void)read_step(folder / "large.step", starved); }),
+             Catch::Matchers::Contains("needed more than 1 MB"));
+  // An error raised in the child comes back with its category and message.
+  std::ofstream(folder / "garbage.step") << "this is not a STEP file\n";
+  CHECK_THAT(message_of([&] { (void)read_step(folder / "garbage.step", isolated); }),
+             Catch::Matchers::Contains("could not be parsed as a STEP file"));
+  // The exchange lock was released: this process goes on reading.
+  REQUIRE(read_step(folder / "valid.step").size() == 2);
+  // Bad options.
+  ReadOptions bad;
+  bad.time_limit_seconds = 0;
+  REQUIRE(category_of([&] { (void)read_step(folder / "valid.step", bad); }) == ErrorCategory::InvalidArgument);
+  bad = {};
+  bad.memory_limit_mb = 0;
+  REQUIRE(category_of([&] { (void)read_iges(folder / "valid.igs", bad); }) == ErrorCategory::InvalidArgument);
 }

@@ -659,3 +659,18 @@ TEST_CASE("sweep options are validated", "[skin][sweep][errors]") {
   CHECK_THAT(error_of([&] { sweep(upright_profile(), quarter_circle(100, 0), o); }).second,
              Catch::Contains("SweepOptions::max_sections"));
 }
+
+TEST_CASE("An adaptive sweep that misses its tolerance at max_sections is an error, not a result", "[sweep][errors]") {
+  // Issue #18: a twist of 1e300 degrees came back as a wild surface (a note in the method only),
+  // whose export then ran for minutes. Now the cap is an error with the figures.
+  SweepOptions o;
+  o.twist_degrees = 1e300;
+  o.max_sections = 9;
+  const auto [category, message] = error_of([&] { sweep(upright_profile(), quarter_circle(100, 0), o); });
+  CHECK(category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Catch::Contains("is still above the tolerance"));
+  CHECK_THAT(message, Catch::Contains("with 9 sections, the most SweepOptions::max_sections = 9 allows"));
+  o.twist_degrees = 90;  // within reach: a result
+  o.max_sections = 1025;
+  CHECK(sweep(upright_profile(), quarter_circle(100, 0), o).report.max_deviation <= o.tolerance * 200);
+}

@@ -149,7 +149,8 @@ std::string report_json(const RunResult& result);
 /// to `out_dir` and each STEP file is read back and checked (BRepCheck); only when everything
 /// succeeded are they moved into `out_dir`, so a failure leaves no partial files. Returns the
 /// paths written (the view folder as one entry, last). Throws clay::Error (Io, Exchange) naming
-/// the file.
+/// the file; Exchange, with BRepCheck's findings, when an export reads back invalid (then
+/// nothing is written into `out_dir`).
 std::vector<std::filesystem::path> write_outputs(RunResult& result, const std::filesystem::path& out_dir);
 
 /// A library message in the recipe's words: the fixes it suggests name recipe keys, never C++

@@ -16,9 +16,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cfenv>
 #include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <functional>
 #include <mutex>
@@ -27,7 +32,14 @@
 #include <sstream>
 #include <string>
 
+#include "exchange_precheck.hpp"
 #include "occt/convert.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <APIHeaderSection_MakeHeader.hxx>
 #include <BRepAdaptor_Curve.hxx>
@@ -479,6 +491,289 @@ auto guarded(std::string_view caller, Body&& body) -> decltype(body()) {
   return occt::guarded(ErrorCategory::Exchange, caller, std::forward<Body>(body));
 }
 
+/// read_step's work; the caller holds the exchange session.
+std::vector<BSplineSurface> read_step_locked(const fs::path& file) {
+  constexpr std::string_view caller = "read_step";
+  return guarded(caller, [&] {
+    STEPControl_Controller::Init();
+    set_static("xstep.cascade.unit", "MM");
+    STEPControl_Reader reader;
+    if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
+      throw Error(ErrorCategory::Exchange,
+                  "read_step: " + quoted(file) + " could not be parsed as a STEP file");
+    reader.TransferRoots();
+    return surfaces_of_shape(reader.OneShape(), file, caller);
+  });
+}
+
+/// read_iges's work; the caller holds the exchange session.
+std::vector<BSplineSurface> read_iges_locked(const fs::path& file) {
+  constexpr std::string_view caller = "read_iges";
+  return guarded(caller, [&] {
+    IGESControl_Controller::Init();
+    set_static("xstep.cascade.unit", "MM");
+    // Default 1 removes knots of multiplicity = degree where it can (changes the data).
+    set_static("read.iges.bspline.continuity", 0);
+    IGESControl_Reader reader;
+    if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
+      throw Error(ErrorCategory::Exchange,
+                  "read_iges: " + quoted(file) + " could not be parsed as an IGES file");
+    reader.TransferRoots();
+    return surfaces_of_shape(reader.OneShape(), file, caller);
+  });
+}
+
+// ---- reading in a child process -------------------------------------------------------------
+// The child reads with OpenCASCADE under an address-space limit and writes what it read (or the
+// clay::Error it raised) into a pipe as raw native-endian data, then _exits; the parent collects
+// the bytes with a deadline, and the child's exit status says which of the two it was, or how it
+// died. Same machine, same build: no portable format is needed.
+
+using Reader = std::vector<BSplineSurface> (*)(const fs::path&);
+
+enum ChildStatus : int { child_read = 0, child_error = 2, child_out_of_memory = 3, child_unknown = 4 };
+
+template <class T>
+void put(std::string& out, const T& x) {
+  out.append(reinterpret_cast<const char*>(&x), sizeof x);
+}
+void put_doubles(std::string& out, const double* p, std::size_t n) {
+  put(out, static_cast<std::uint64_t>(n));
+  out.append(reinterpret_cast<const char*>(p), n * sizeof(double));
+}
+
+std::string serialize(const std::vector<BSplineSurface>& surfaces) {
+  std::string out;
+  put(out, static_cast<std::uint64_t>(surfaces.size()));
+  for (const BSplineSurface& s : surfaces) {
+    put(out, static_cast<std::int32_t>(s.u.degree));
+    put(out, static_cast<std::int32_t>(s.v.degree));
+    put_doubles(out, s.u.knots.data(), s.u.knots.size());
+    put_doubles(out, s.v.knots.data(), s.v.knots.size());
+    put_doubles(out, s.points.data(), static_cast<std::size_t>(s.points.size()));  // row-major x y z
+    put_doubles(out, s.weights.data(), static_cast<std::size_t>(s.weights.size()));
+  }
+  return out;
+}
+
+/// Reads back what serialize wrote; throws Internal when the bytes are short.
+class Unpacker {
+ public:
+  explicit Unpacker(const std::string& bytes) : bytes_(bytes) {}
+  template <class T>
+  T take() {
+    T x;
+    need(sizeof x);
+    std::memcpy(&x, bytes_.data() + at_, sizeof x);
+    at_ += sizeof x;
+    return x;
+  }
+  std::vector<double> doubles() {
+    const auto n = take<std::uint64_t>();
+    if (n > (bytes_.size() - at_) / sizeof(double)) need(bytes_.size() + 1);
+    std::vector<double> out(static_cast<std::size_t>(n));
+    std::memcpy(out.data(), bytes_.data() + at_, out.size() * sizeof(double));
+    at_ += out.size() * sizeof(double);
+    return out;
+  }
+
+ private:
+  const std::string& bytes_;
+  std::size_t at_ = 0;
+  void need(std::size_t n) const {
+    if (bytes_.size() - at_ < n)
+      throw Error(ErrorCategory::Internal, "isolated read: the child's answer is truncated");
+  }
+};
+
+std::vector<BSplineSurface> deserialize(const std::string& bytes) {
+  Unpacker in(bytes);
+  std::vector<BSplineSurface> out(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
+  for (BSplineSurface& s : out) {
+    s.u.degree = in.take<std::int32_t>();
+    s.v.degree = in.take<std::int32_t>();
+    s.u.knots = in.doubles();
+    s.v.knots = in.doubles();
+    const std::vector<double> points = in.doubles(), weights = in.doubles();
+    s.points = Eigen::Map<const Points3>(points.data(), static_cast<Eigen::Index>(points.size() / 3), 3);
+    s.weights = Eigen::Map<const Eigen::VectorXd>(weights.data(), static_cast<Eigen::Index>(weights.size()));
+  }
+  return out;
+}
+
+void write_all(int fd, const std::string& bytes) {
+  for (std::size_t at = 0; at < bytes.size();) {
+    const ssize_t n = ::write(fd, bytes.data() + at, bytes.size() - at);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;  // the parent stopped listening: it reports why
+    at += static_cast<std::size_t>(n);
+  }
+}
+
+/// Bytes of address space the process maps now (/proc/self/statm), 0 when unknown.
+unsigned long long mapped_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  unsigned long long pages = 0;
+  statm >> pages;
+  return pages * static_cast<unsigned long long>(::sysconf(_SC_PAGESIZE));
+}
+
+/// In the child: read, answer, exit. Never returns, and nothing escapes it (noexcept: whatever
+/// might would otherwise unwind into the caller's copy of its own stack and run on as a second
+/// process); never runs the parent's atexit handlers or flushes its stdio buffers (_exit).
+[[noreturn]] void answer_in_child(int fd, const fs::path& file, const ReadOptions& options, Reader read) noexcept {
+  int status = child_unknown;
+  try {
+    // Die of a crash, so the parent sees the signal: the caller's handlers (a test framework's,
+    // a crash reporter's) must not run in the child.
+    struct sigaction by_default {};
+    by_default.sa_handler = SIG_DFL;
+    for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL}) ::sigaction(sig, &by_default, nullptr);
+    // The limit counts what is mapped already (shared libraries, the parent's heap).
+    rlimit limit{};
+    ::getrlimit(RLIMIT_AS, &limit);
+    const rlim_t wanted =
+        static_cast<rlim_t>(mapped_bytes() + static_cast<unsigned long long>(options.memory_limit_mb) * 1024 * 1024);
+    if (limit.rlim_max == RLIM_INFINITY || wanted < limit.rlim_max) limit.rlim_cur = wanted;
+    ::setrlimit(RLIMIT_AS, &limit);
+    std::string payload;
+    try {
+      payload = serialize(read(file));
+      status = child_read;
+    } catch (const Error& e) {
+      if (e.message().find("Standard_OutOfMemory") != std::string::npos) {
+        status = child_out_of_memory;
+      } else {
+        put(payload, static_cast<std::int32_t>(e.category()));
+        payload += e.message();
+        status = child_error;
+      }
+    }
+    write_all(fd, payload);
+  } catch (const std::bad_alloc&) {
+    status = child_out_of_memory;
+  } catch (...) {
+    status = child_unknown;
+  }
+  ::_exit(status);
+}
+
+std::string signal_name(int sig) {
+  switch (sig) {
+    case SIGSEGV: return "SIGSEGV";
+    case SIGBUS: return "SIGBUS";
+    case SIGABRT: return "SIGABRT";
+    case SIGFPE: return "SIGFPE";
+    case SIGILL: return "SIGILL";
+    case SIGKILL: return "SIGKILL";
+    default: return "signal " + std::to_string(sig);
+  }
+}
+
+/// `read(file)` in a forked child process with options' time and memory limits. The caller holds
+/// the exchange session across the fork, so no other thread of this process is inside
+/// OpenCASCADE while the child's copy of it starts; the child calls `read` without locking.
+std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOptions& options, std::string_view caller,
+                                          Reader read) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0)
+    throw Error(ErrorCategory::Io, std::string(caller) + ": cannot create a pipe: " + std::strerror(errno));
+  // The child would otherwise write out a copy of whatever the caller has buffered.
+  std::fflush(nullptr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const int e = errno;
+    ::close(fds[0]);
+    ::close(fds[1]);
+    throw Error(ErrorCategory::Io, std::string(caller) + ": cannot start a process to read " + quoted(file) + ": " +
+                                       std::strerror(e));
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    answer_in_child(fds[1], file, options, read);
+  }
+  ::close(fds[1]);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.time_limit_seconds);
+  auto left_ms = [&] {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+    return static_cast<int>(std::clamp<long long>(left.count(), 0, 1000000));
+  };
+  std::string bytes;
+  bool timed_out = false;
+  for (char buffer[65536];;) {
+    pollfd p{fds[0], POLLIN, 0};
+    const int ready = ::poll(&p, 1, left_ms());
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready == 0) {
+      timed_out = true;
+      break;
+    }
+    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;  // end of file: the child is exiting
+    bytes.append(buffer, static_cast<std::size_t>(n));
+  }
+  ::close(fds[0]);
+  int status = 0;
+  if (!timed_out) {
+    // The pipe closed; the child exits at once unless a descendant holds it, so wait within the
+    // deadline too.
+    while (::waitpid(pid, &status, WNOHANG) == 0) {
+      if (left_ms() == 0) {
+        timed_out = true;
+        break;
+      }
+      ::usleep(1000);
+    }
+  }
+  if (timed_out) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    char limit[32];
+    std::snprintf(limit, sizeof limit, "%g", options.time_limit_seconds);
+    throw Error(ErrorCategory::Exchange, std::string(caller) + ": reading " + quoted(file) + " took longer than " +
+                                             limit + " s (ReadOptions::time_limit_seconds), so it was stopped; the file is "
+                                             "probably malformed (OpenCASCADE hangs on NaN coordinates and absurd degrees)");
+  }
+  const std::string memory = std::to_string(options.memory_limit_mb) + " MB";
+  if (WIFSIGNALED(status))
+    throw Error(ErrorCategory::Exchange, std::string(caller) + ": OpenCASCADE crashed (" + signal_name(WTERMSIG(status)) +
+                                             ") while reading " + quoted(file) +
+                                             "; the file is malformed (or it needed more than " + memory +
+                                             "): export it again or repair it");
+  switch (WIFEXITED(status) ? WEXITSTATUS(status) : child_unknown) {
+    case child_read: return deserialize(bytes);
+    case child_error: {
+      Unpacker in(bytes);
+      const auto category = static_cast<ErrorCategory>(in.take<std::int32_t>());
+      throw Error(category, bytes.substr(sizeof(std::int32_t)));
+    }
+    case child_out_of_memory:
+      throw Error(ErrorCategory::Exchange, std::string(caller) + ": reading " + quoted(file) + " needed more than " +
+                                               memory + " (ReadOptions::memory_limit_mb), so it was stopped");
+    default:
+      throw Error(ErrorCategory::Exchange, std::string(caller) + ": the process reading " + quoted(file) +
+                                               " failed without an answer (exit status " +
+                                               std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+  }
+}
+
+/// The checks and the read every public read goes through.
+std::vector<BSplineSurface> read_guarded(const fs::path& file, const ReadOptions& options, std::string_view caller,
+                                         void (*precheck)(const fs::path&, std::string_view, int), Reader read) {
+  options.validate();
+  check_readable(file, caller);
+  if (options.precheck) precheck(file, caller, max_exchange_degree);
+  ExchangeSession session;
+  std::vector<BSplineSurface> surfaces = options.isolate ? read_in_child(file, options, caller, read) : read(file);
+  // What came through the pipe is checked again here: a surface the child's OpenCASCADE accepted
+  // must still be one this kernel can use.
+  for (std::size_t k = 0; k < surfaces.size(); ++k)
+    if (const auto list = surface::problems(surfaces[k], quoted(file) + " face #" + std::to_string(k)); !list.empty())
+      throw Error(ErrorCategory::Exchange, std::string(caller) + ": " + list.front());
+  return surfaces;
+}
+
 }  // namespace
 
 // ---- public API ----------------------------------------------------------------------------
@@ -560,38 +855,22 @@ ExchangeReport write_iges(const std::vector<BSplineSurface>& surfaces, const fs:
   });
 }
 
-std::vector<BSplineSurface> read_step(const fs::path& file) {
-  constexpr std::string_view caller = "read_step";
-  ExchangeSession session;
-  check_readable(file, caller);
-  return guarded(caller, [&] {
-    STEPControl_Controller::Init();
-    set_static("xstep.cascade.unit", "MM");
-    STEPControl_Reader reader;
-    if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
-      throw Error(ErrorCategory::Exchange,
-                  "read_step: " + quoted(file) + " could not be parsed as a STEP file");
-    reader.TransferRoots();
-    return surfaces_of_shape(reader.OneShape(), file, caller);
-  });
+void ReadOptions::validate() const {
+  auto fail = [](const std::string& what) {
+    throw Error(ErrorCategory::InvalidArgument, "ReadOptions::" + what);
+  };
+  if (!(time_limit_seconds > 0 && time_limit_seconds <= 86400))
+    fail("time_limit_seconds = " + std::to_string(time_limit_seconds) + ": must be in (0, 86400]");
+  if (memory_limit_mb < 1 || memory_limit_mb > 1048576)
+    fail("memory_limit_mb = " + std::to_string(memory_limit_mb) + ": must be in [1, 1048576]");
 }
 
-std::vector<BSplineSurface> read_iges(const fs::path& file) {
-  constexpr std::string_view caller = "read_iges";
-  ExchangeSession session;
-  check_readable(file, caller);
-  return guarded(caller, [&] {
-    IGESControl_Controller::Init();
-    set_static("xstep.cascade.unit", "MM");
-    // Default 1 removes knots of multiplicity = degree where it can (changes the data).
-    set_static("read.iges.bspline.continuity", 0);
-    IGESControl_Reader reader;
-    if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
-      throw Error(ErrorCategory::Exchange,
-                  "read_iges: " + quoted(file) + " could not be parsed as an IGES file");
-    reader.TransferRoots();
-    return surfaces_of_shape(reader.OneShape(), file, caller);
-  });
+std::vector<BSplineSurface> read_step(const fs::path& file, const ReadOptions& options) {
+  return read_guarded(file, options, "read_step", &detail::precheck_step, &read_step_locked);
+}
+
+std::vector<BSplineSurface> read_iges(const fs::path& file, const ReadOptions& options) {
+  return read_guarded(file, options, "read_iges", &detail::precheck_iges, &read_iges_locked);
 }
 
 void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& file,

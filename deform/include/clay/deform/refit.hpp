@@ -47,6 +47,9 @@ struct RefitOptions {
                               ///< box (of a sample); false: tolerance in mm
   int max_iterations = 12;    ///< >= 1: fit / certify / refine rounds
   int max_control_points = 40000;  ///< >= (degree + 1)^2: no refinement beyond this net size
+  int max_count_per_direction = 1000;  ///< >= degree + 1: no refinement beyond this many control
+                                       ///< points in u or in v (the dense least squares per
+                                       ///< direction take 32 count^2 bytes)
   double certificate_share = 0.1;  ///< in (0, 1): share of the tolerance the certificate's
                                    ///< remainder may take when choosing each cell's sample density
 

@@ -84,8 +84,7 @@ struct SweepOptions {
 /// at equal arc-length steps (cubic across them, v = arc-length fraction, u = the profile's own
 /// clamped parameter), doubling their number until the largest distance between S(u, v) and the
 /// exactly moved profile at 1/4, 1/2, 3/4 of every interval is within tolerance (report: exact =
-/// false, max_deviation, the sections used in the method; "tolerance not reached" when
-/// max_sections stopped it). At path knots where the curvature (or its derivative) jumps, a copy
+/// false, max_deviation, the sections used in the method). At path knots where the curvature (or its derivative) jumps, a copy
 /// sits on the knot and v gets a triple (double) knot, matching the sweep's own C0 (C1) continuity
 /// there. A straight path without twist gives the exact extrusion (degree 1 across, exact = true).
 /// Throws clay::Error(InvalidGeometry) naming "profile" or "path" for an invalid or degenerate
@@ -95,7 +94,8 @@ struct SweepOptions {
 /// profile that reaches as far toward the path's centre of curvature as its radius of curvature
 /// (kappa n . q >= 1 - 1e-3 for a profile offset q in the moving frame, on the path table: the
 /// surface would fold through itself; the message gives the path parameter, the radius and the
-/// reach); InvalidArgument for bad options.
+/// reach); InvalidArgument for bad options and when the adaptive sweep still misses the tolerance
+/// with max_sections sections (the message gives the deviation and the tolerance in mm).
 BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
                    const SweepOptions& options = {});
 
