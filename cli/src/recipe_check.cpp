@@ -571,7 +571,7 @@ class RecipeChecker {
 
   void stroke(const std::string& name, const Json& j, const std::string& path) {
     names_.curves.push_back(name);  // defined even when broken: one problem, not a cascade
-    if (!c_.object(j, path, {"points", "plane", "tolerance", "degree", "fairness", "closing_ratio"},
+    if (!c_.object(j, path, {"points", "plane", "tolerance", "degree", "fairness", "closing_ratio", "accept_out_of_tolerance"},
                    "a stroke {points, plane, tolerance, degree, fairness, closing_ratio}"))
       return;
     StrokeDef s{name, path, {}, {}};
@@ -584,6 +584,7 @@ class RecipeChecker {
     s.fit.fairness = c_.number_or(j, path, "fairness", s.fit.fairness, non_negative);
     s.fit.closing_ratio = c_.number_or(j, path, "closing_ratio", s.fit.closing_ratio, Range{0, 0.5});
     s.fit.corner_angle = 180.0;  // one curve per stroke in a recipe (docs/recipe.md)
+    s.accept_out_of_tolerance = c_.boolean_or(j, path, "accept_out_of_tolerance", false);
     if (!p) return;
     s.stroke.points = *p;
     const auto list = sketch::problems(s.stroke, path);
@@ -1547,8 +1548,9 @@ class RecipeChecker {
         }
         spec.sections.push_back(std::move(section));
       }
+      if (!ok || spec.sections.empty()) return std::nullopt;  // each bad section reported above
       const long segments_first = std::max(0L, static_cast<long>(spec.sections.front().size()) - 1) / 3;
-      if (!ok || !chunks_ok(static_cast<long>(spec.sections.size() - 1) * segments_first * spec.layers, p))
+      if (!chunks_ok(static_cast<long>(spec.sections.size() - 1) * segments_first * spec.layers, p))
         return std::nullopt;
       if (!c_.attempt(p, [&] { lat = deform::make_prismatic_lattice(spec); })) return std::nullopt;
       // A control point by its welded row, or by its index [i, j, k] in the lattice before
@@ -1774,11 +1776,13 @@ class RecipeChecker {
   }
 
   std::optional<DirectDef> direct(const Json& j, const std::string& p) {
-    if (!c_.object(j, p, {"kind", "name", "enabled", "lattice", "moves", "locked", "tied", "tolerance"},
+    if (!c_.object(j, p, {"kind", "name", "enabled", "lattice", "moves", "locked", "tied", "tolerance",
+                          "accept_out_of_tolerance"},
                    "a direct_manipulation step"))
       return std::nullopt;
     const std::size_t before = c_.problems.size();
-    DirectDef d{deform::BezierLattice{}, {}, {}};
+    DirectDef d{deform::BezierLattice{}, {}, {}, false};
+    d.accept_out_of_tolerance = c_.boolean_or(j, p, "accept_out_of_tolerance", false);
     const Json* lj = c_.member(j, p, "lattice", true, "a bezier_lattice or bspline_lattice object with \"kind\"");
     std::array<int, 3> counts{0, 0, 0};
     if (lj) {
@@ -2124,9 +2128,18 @@ std::string recipe_wording(std::string m) {
       {"loosen SuperquadricOptions::tolerance, raise max_spans, ", "loosen \"tolerance\" "},
       {"not reached at max_sections", "not reached with the most sections allowed"},
       {"raise gap_tolerance", "raise \"gap_tolerance\""},
-      {"; raise the limits, the tolerance or the degree",
-       "; raise the composition's \"tolerance\", \"degree\" or \"max_control_points\", or deform less"},
   };
+  // A refit's advice depends on the limit it hit: a recipe can raise max_control_points (up to
+  // its 40,000 cap), not the iteration or per-direction limits.
+  if (const auto at = m.find("; raise the limits, the tolerance or the degree"); at != std::string::npos) {
+    static const std::regex net_limit("control point limit ([0-9]+) reached");
+    std::smatch hit;
+    const bool raisable = std::regex_search(m, hit, net_limit) && std::stol(hit[1].str()) < limit::refit_control_points;
+    m.replace(at, std::string_view("; raise the limits, the tolerance or the degree").size(),
+              raisable ? "; raise the composition's \"max_control_points\" (at most 40,000), loosen its "
+                         "\"tolerance\" or raise its \"degree\""
+                       : "; loosen the composition's \"tolerance\" or raise its \"degree\", or deform less");
+  }
   for (const auto& [from, to] : phrases)
     for (std::size_t at = m.find(from); at != std::string::npos; at = m.find(from, at + to.size()))
       m.replace(at, from.size(), to);

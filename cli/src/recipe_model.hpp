@@ -38,6 +38,7 @@ struct StrokeDef {
   std::string name, path;
   sketch::Stroke stroke;
   sketch::FitOptions fit;
+  bool accept_out_of_tolerance = false;  ///< keep a fit that misses its tolerance
 };
 
 /// A curve given inline (already built) or the reverse of another named curve.
@@ -96,6 +97,7 @@ struct DirectDef {
   std::variant<deform::BezierLattice, deform::BSplineLattice> lattice;
   std::vector<DirectMove> moves;
   deform::DirectManipulationOptions options;
+  bool accept_out_of_tolerance = false;  ///< keep a least-squares answer to moves it cannot meet
 };
 
 struct StepDef {

@@ -173,8 +173,15 @@ class Runner {
                    {"max_deviation", c.max_deviation},
                    {"rms_deviation", c.rms_deviation},
                    {"closed", c.closed}};
-    rep.warning = !fit.summary.converged();
     rep.message = fit.summary.brief();
+    if (!fit.summary.converged()) {  // a fit that misses its tolerance is a failure unless accepted
+      if (!s.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    "the fit misses its tolerance (" + fit.summary.brief() +
+                        "): raise the stroke's \"tolerance\" or its \"degree\", or draw it again; to keep the fit "
+                        "anyway, set \"accept_out_of_tolerance\": true on the stroke");
+      rep.warning = true;
+    }
     add_curve(s.name, c.curve);
   }
 
@@ -466,8 +473,16 @@ class Runner {
                    {"residual", r.residual},
                    {"achieved_max_error", r.achieved_max_error},
                    {"displacement_norm", r.displacement_norm}};
-    if (!r.feasible) rep.warning = true;
     rep.message += ": " + r.message;
+    if (!r.feasible) {  // moves the lattice cannot meet: a failure unless accepted
+      if (!d.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    "the lattice cannot meet every move (" + r.message +
+                        "): free more control points (fewer \"locked\"), use a finer lattice, or ask for fewer "
+                        "moves; to keep the least-squares answer anyway, set \"accept_out_of_tolerance\": true on "
+                        "this step");
+      rep.warning = true;
+    }
     stage.map = [lattice](const Eigen::Vector3d& x) {
       return std::visit([&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, lattice);
     };

@@ -109,12 +109,18 @@ double outside_by(const Eigen::Vector3d& c, int* axis = nullptr, int* face = nul
 }
 
 /// The largest jump of the lattice's map where `s` crosses the lattice's boundary: on a grid of
-/// 16 samples per knot span, every grid edge with one end inside and one outside is bisected to
-/// the crossing (40 halvings), and the map is evaluated at the last point inside. A lower bound
-/// of the true largest jump (a crossing between grid lines can be missed).
+/// 8 samples per knot span (the refit's own sizing grid), every grid edge with one end inside and
+/// one outside is bisected to the crossing (40 halvings), and the map is evaluated at the last
+/// point inside. A lower bound of the true largest jump (a crossing between grid lines can be
+/// missed). Nothing to measure when every control point is inside (the surface is in their
+/// convex hull).
 template <class Lattice>
 FaceJump face_jump(const Lattice& lattice, const surface::BSplineSurface& s) {
-  const std::vector<double> us = surface::span_samples(s.u, 16), vs = surface::span_samples(s.v, 16);
+  bool all_inside = true;
+  for (Eigen::Index r = 0; r < s.points.rows() && all_inside; ++r)
+    all_inside = outside_by(local_coordinates(lattice.frame, s.points.row(r).transpose())) <= face_tolerance;
+  if (all_inside) return {};
+  const std::vector<double> us = surface::span_samples(s.u, 8), vs = surface::span_samples(s.v, 8);
   const Points3 grid = surface::evaluate_grid(s, us, vs);
   const size_t nu = us.size(), nv = vs.size();
   std::vector<char> in(nu * nv);

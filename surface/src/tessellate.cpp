@@ -143,23 +143,32 @@ double surface_area(const BSplineSurface& s, int refine) {
   return area;
 }
 
-GridMesh tessellate_to_area(const BSplineSurface& s, double relative_area) {
+GridMesh tessellate_to_area(const BSplineSurface& s, double relative_area, int max_samples) {
   if (!(relative_area > 0 && relative_area < 0.5))
     throw Error(ErrorCategory::InvalidArgument,
                 "tessellate_to_area: relative_area = " + std::to_string(relative_area) + " must be in (0, 0.5)");
+  if (max_samples < 17 || max_samples > 4097)
+    throw Error(ErrorCategory::InvalidArgument,
+                "tessellate_to_area: max_samples = " + std::to_string(max_samples) + " must be in [17, 4097]");
   const double exact = surface_area(s, 2);
-  double got = 0;
-  for (int per_span = 8, max_samples = 161;; per_span *= 2, max_samples = std::min(2 * max_samples - 1, 1025)) {
-    GridMesh m = tessellate(s, per_span, max_samples);
-    got = mesh_area(m);
-    if (std::abs(got - exact) <= relative_area * exact) return m;
-    if (max_samples >= 1025) break;
+  // First the viewer's grid, then twice as many samples per span each round, until the area is
+  // met or both directions are at max_samples.
+  GridMesh m = tessellate(s, 8, std::min(161, max_samples));
+  for (int per_span = 16; per_span <= 2 * max_samples; per_span *= 2) {
+    if (std::abs(mesh_area(m) - exact) <= relative_area * exact) return m;
+    // A few spans keep at least 17 samples, so the first doublings may not change the grid.
+    const std::size_t rows = tessellation_parameters(s.u, per_span, max_samples).size();
+    const std::size_t cols = tessellation_parameters(s.v, per_span, max_samples).size();
+    if (static_cast<int>(rows) == m.rows && static_cast<int>(cols) == m.cols) continue;
+    m = tessellate(s, per_span, max_samples);
   }
-  char buffer[200];
+  if (std::abs(mesh_area(m) - exact) <= relative_area * exact) return m;
+  const double got = mesh_area(m);
+  char buffer[240];
   std::snprintf(buffer, sizeof buffer,
-                "tessellate_to_area: the finest grid (1025 x 1025) has area %.6g mm^2, the surface %.6g mm^2: "
-                "off by %.3g %%, more than %.3g %%",
-                got, exact, 100 * std::abs(got - exact) / exact, 100 * relative_area);
+                "tessellate_to_area: the finest grid allowed (%d x %d samples) has area %.6g mm^2, the surface "
+                "%.6g mm^2: off by %.3g %%, more than %.3g %%",
+                m.rows, m.cols, got, exact, 100 * std::abs(got - exact) / exact, 100 * relative_area);
   throw Error(ErrorCategory::ToleranceNotMet, buffer);
 }
 

@@ -618,6 +618,19 @@ unsigned long long mapped_bytes() {
   return pages * static_cast<unsigned long long>(::sysconf(_SC_PAGESIZE));
 }
 
+/// The most this process has had mapped (VmPeak of /proc/self/status), in bytes; 0 if unknown.
+unsigned long long peak_mapped_bytes() {
+  std::ifstream status("/proc/self/status");
+  std::string key;
+  unsigned long long kb = 0;
+  while (status >> key)
+    if (key == "VmPeak:") {
+      status >> kb;
+      return kb * 1024;
+    }
+  return 0;
+}
+
 /// In the child: read, answer, exit. Never returns, and nothing escapes it (noexcept: whatever
 /// might would otherwise unwind into the caller's copy of its own stack and run on as a second
 /// process); never runs the parent's atexit handlers or flushes its stdio buffers (_exit).
@@ -632,8 +645,9 @@ unsigned long long mapped_bytes() {
     // The limit counts what is mapped already (shared libraries, the parent's heap).
     rlimit limit{};
     ::getrlimit(RLIMIT_AS, &limit);
-    const rlim_t wanted =
-        static_cast<rlim_t>(mapped_bytes() + static_cast<unsigned long long>(options.memory_limit_mb) * 1024 * 1024);
+    const unsigned long long allowance = static_cast<unsigned long long>(options.memory_limit_mb) * 1024 * 1024;
+    const unsigned long long start = mapped_bytes();
+    const rlim_t wanted = static_cast<rlim_t>(start + allowance);
     if (limit.rlim_max == RLIM_INFINITY || wanted < limit.rlim_max) limit.rlim_cur = wanted;
     ::setrlimit(RLIMIT_AS, &limit);
     std::string payload;
@@ -641,7 +655,10 @@ unsigned long long mapped_bytes() {
       payload = serialize(read(file));
       status = child_read;
     } catch (const Error& e) {
-      if (e.message().find("Standard_OutOfMemory") != std::string::npos) {
+      // OpenCASCADE's parsers catch a failed allocation and report the file as unreadable: a
+      // failure after using more than half the allowance is the memory limit's doing.
+      const unsigned long long peak = peak_mapped_bytes();
+      if (e.message().find("Standard_OutOfMemory") != std::string::npos || (peak > start && peak - start > allowance / 2)) {
         status = child_out_of_memory;
       } else {
         put(payload, static_cast<std::int32_t>(e.category()));
@@ -693,33 +710,62 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
     answer_in_child(fds[1], file, options, read);
   }
   ::close(fds[1]);
+  // Whatever happens on this side (a throw included), the pipe is closed and the child reaped:
+  // killed first unless it was reaped already.
+  struct Child {
+    pid_t pid;
+    int fd;
+    bool reaped = false;
+    ~Child() {
+      if (fd >= 0) ::close(fd);
+      if (!reaped) {
+        ::kill(pid, SIGKILL);
+        while (::waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+        }
+      }
+    }
+  } child{pid, fds[0]};
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.time_limit_seconds);
-  auto left_ms = [&] {
+  auto left_ms = [&] {  // poll's timeout is an int: wait at most ~16 minutes at a time, then look again
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     return static_cast<int>(std::clamp<long long>(left.count(), 0, 1000000));
   };
+  auto past_deadline = [&] { return std::chrono::steady_clock::now() >= deadline; };
   std::string bytes;
   bool timed_out = false;
   for (char buffer[65536];;) {
-    pollfd p{fds[0], POLLIN, 0};
+    pollfd p{child.fd, POLLIN, 0};
     const int ready = ::poll(&p, 1, left_ms());
     if (ready < 0 && errno == EINTR) continue;
     if (ready == 0) {
+      if (!past_deadline()) continue;
       timed_out = true;
       break;
     }
-    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+    const ssize_t n = ::read(child.fd, buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;  // end of file: the child is exiting
     bytes.append(buffer, static_cast<std::size_t>(n));
   }
-  ::close(fds[0]);
+  ::close(child.fd);
+  child.fd = -1;
   int status = 0;
   if (!timed_out) {
     // The pipe closed; the child exits at once unless a descendant holds it, so wait within the
     // deadline too.
-    while (::waitpid(pid, &status, WNOHANG) == 0) {
-      if (left_ms() == 0) {
+    for (;;) {
+      const pid_t got = ::waitpid(pid, &status, WNOHANG);
+      if (got == pid) {
+        child.reaped = true;
+        break;
+      }
+      if (got < 0 && errno == EINTR) continue;
+      if (got < 0)  // ECHILD: reaped elsewhere (SIGCHLD ignored, or a waitpid(-1) in the host)
+        throw Error(ErrorCategory::Exchange,
+                    std::string(caller) + ": the process reading " + quoted(file) +
+                        " ended, but its exit status is lost to this process (is SIGCHLD ignored, or are children "
+                        "reaped elsewhere?); read the file without isolation to see its outcome");
+      if (past_deadline()) {
         timed_out = true;
         break;
       }
@@ -727,12 +773,10 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
     }
   }
   if (timed_out) {
-    ::kill(pid, SIGKILL);
-    ::waitpid(pid, &status, 0);
     char limit[32];
     std::snprintf(limit, sizeof limit, "%g", options.time_limit_seconds);
     throw Error(ErrorCategory::Exchange, std::string(caller) + ": reading " + quoted(file) + " took longer than " +
-                                             limit + " s (ReadOptions::time_limit_seconds), so it was stopped; the file is "
+                                             limit + " s, the time limit, so it was stopped; the file is "
                                              "probably malformed (OpenCASCADE hangs on NaN coordinates and absurd degrees)");
   }
   const std::string memory = std::to_string(options.memory_limit_mb) + " MB";
@@ -750,7 +794,7 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
     }
     case child_out_of_memory:
       throw Error(ErrorCategory::Exchange, std::string(caller) + ": reading " + quoted(file) + " needed more than " +
-                                               memory + " (ReadOptions::memory_limit_mb), so it was stopped");
+                                               memory + ", the memory limit, so it was stopped");
     default:
       throw Error(ErrorCategory::Exchange, std::string(caller) + ": the process reading " + quoted(file) +
                                                " failed without an answer (exit status " +
@@ -884,10 +928,16 @@ void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& fil
   // relative_area of the surface's), attached to each face as its triangulation: OpenCASCADE's
   // mesher gave zero-area meshes on surfaces with poles (the handset, the bent superellipsoid),
   // and only the writer is needed from it.
+  if (options.max_vertices < 289)
+    throw Error(ErrorCategory::InvalidArgument,
+                "write_gltf: GltfWriteOptions::max_vertices is " + std::to_string(options.max_vertices) +
+                    "; it must be at least 289 (a 17 x 17 grid)");
   for (size_t k = 0; k < surfaces.size(); ++k) validate(surfaces[k], surface_name(k));
+  const long share = options.max_vertices / std::max<long>(1, static_cast<long>(surfaces.size()));
+  const int max_samples = static_cast<int>(std::clamp<long>(static_cast<long>(std::sqrt(static_cast<double>(share))), 17, 1025));
   std::vector<GridMesh> meshes;
   meshes.reserve(surfaces.size());
-  for (const BSplineSurface& s : surfaces) meshes.push_back(tessellate_to_area(s, options.relative_area));
+  for (const BSplineSurface& s : surfaces) meshes.push_back(tessellate_to_area(s, options.relative_area, max_samples));
   ExchangeSession session;
   guarded(caller, [&] {
     const std::vector<Handle(Geom_BSplineSurface)> converted = convert_all(surfaces, caller);

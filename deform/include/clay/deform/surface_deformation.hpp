@@ -71,7 +71,7 @@ struct SurfaceDeformationResult {
 /// whose map is torn where the surface crosses the lattice's boundary: outside the lattice the
 /// FFD is the identity, so a displaced face makes the deformed surface jump there by
 /// |F(x) − x|, and no continuous fit comes closer than half that jump; when half the jump
-/// (measured at the crossings of a 16-per-span sample grid, bisected to the face) exceeds the
+/// (measured at the crossings of an 8-per-span sample grid, bisected to the face) exceeds the
 /// tolerance, the step is refused at once.
 SurfaceDeformationResult deform_surface(const DeformationStack& stack,
                                         const surface::BSplineSurface& surface,

@@ -31,6 +31,9 @@ struct StepWriteOptions {
 struct GltfWriteOptions {
   /// The mesh's area is within this fraction of the surface's (tessellate_to_area), in (0, 0.5).
   double relative_area = 0.005;
+  /// The budget of the whole preview: each of n surfaces gets at most sqrt(max_vertices / n)
+  /// samples a direction (17 to 1025), so a model of thousands of faces stays a preview. >= 289.
+  long max_vertices = 4'000'000;
 };
 
 /// What was written (or checked): size figures and OpenCASCADE's BRepCheck verdict.

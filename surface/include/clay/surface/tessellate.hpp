@@ -42,10 +42,11 @@ std::array<std::array<int, 3>, 2> cell_triangles(const GridMesh& mesh, int i, in
 /// clay::Error(InvalidGeometry) for an invalid surface, InvalidArgument for refine < 0.
 double surface_area(const BSplineSurface& surface, int refine = 1);
 
-/// A mesh whose area is within `relative_area` of surface_area (refine 2): tessellate with 8
-/// samples per span, then 16, 32, ... (at most 1025 samples a direction) until it is. Throws
-/// clay::Error(ToleranceNotMet) naming the areas when even the finest grid misses it, and
-/// InvalidArgument for relative_area outside (0, 0.5).
-GridMesh tessellate_to_area(const BSplineSurface& surface, double relative_area = 0.005);
+/// A mesh whose area is within `relative_area` of surface_area (refine 2): the viewer's grid
+/// (8 samples per span, at most 161), then 16, 32, ... samples per span, at most `max_samples` a
+/// direction, until it is. Throws clay::Error(ToleranceNotMet) naming the grid and the areas when
+/// even the finest grid allowed misses it, and InvalidArgument for relative_area outside
+/// (0, 0.5) or max_samples outside [17, 4097].
+GridMesh tessellate_to_area(const BSplineSurface& surface, double relative_area = 0.005, int max_samples = 1025);
 
 }  // namespace clay::surface
