@@ -1,0 +1,23 @@
+# Runs the core-only program and checks with ldd that it loads no OpenCASCADE library (libTK*):
+# the NURBS core (Clayform::surface) must not pull OCCT in. Usage:
+#   cmake -DPROGRAM=path/to/clay_core_only -P check_core_only.cmake
+execute_process(COMMAND ${PROGRAM} OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${PROGRAM} exited ${rc}:\n${out}${err}")
+endif()
+execute_process(COMMAND ldd ${PROGRAM} OUTPUT_VARIABLE libs RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "ldd ${PROGRAM} failed (${rc})")
+endif()
+if(NOT libs MATCHES "libclay_surface")
+  message(FATAL_ERROR "ldd does not list libclay_surface; is this the core-only program?\n${libs}")
+endif()
+string(REGEX MATCHALL "libTK[A-Za-z0-9]*" occt "${libs}")
+list(REMOVE_DUPLICATES occt)
+list(LENGTH occt count)
+if(count GREATER 0)
+  message(FATAL_ERROR "a program using only Clayform::surface loads ${count} OpenCASCADE libraries: ${occt}\n${libs}")
+endif()
+string(REGEX MATCHALL "\n" lines "${libs}")
+list(LENGTH lines loaded)
+message(STATUS "${out}core-only program: ${loaded} shared libraries, none of them OpenCASCADE's")
