@@ -2,6 +2,7 @@
 // writes a STEP file through the installed library; solves a small sketch (clay_constraints, which
 // links Ceres privately), deforms a point with an undisplaced lattice and round-trips a
 // deformation stack through JSON (clay_deform, which links nlohmann-json privately).
+#include <clay/constraints.hpp>
 #include <clay/deform.hpp>
 
 #include <cmath>
