@@ -20,3 +20,4 @@
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/self_intersection.hpp>
 #include <clay/surface/skin.hpp>
+#include <clay/surface/tessellate.hpp>

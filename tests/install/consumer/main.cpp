@@ -4,9 +4,11 @@
 // deformation stack through JSON (clay_deform, which links nlohmann-json privately).
 #include <clay/constraints.hpp>
 #include <clay/deform.hpp>
+#include <clay/version.hpp>
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 int main(int argc, char** argv) {
   using namespace clay::surface;
@@ -33,7 +35,8 @@ int main(int argc, char** argv) {
   const bool stack_ok = clay::deform::deform_point(clay::deform::stack_from_json(clay::deform::to_json(stack)), x) ==
                         clay::deform::deform_point(stack, x);
   const bool ok = std::abs(z - 1.25) < 1e-15 && r.valid && read_step(argv[1]).size() == 1 &&
-                  solved.report.summary.converged() && far < 1e-10 && moved < 1e-12 && stack_ok;
-  std::printf("consumer %s (z = %.17g)\n", ok ? "ok" : "FAILED", z);
+                  solved.report.summary.converged() && far < 1e-10 && moved < 1e-12 && stack_ok &&
+                  clay::version() == CLAYFORM_VERSION_STRING;  // the installed headers and library agree
+  std::printf("consumer %s (z = %.17g, Clayform %s)\n", ok ? "ok" : "FAILED", z, std::string(clay::version()).c_str());
   return ok ? 0 : 1;
 }
