@@ -3,6 +3,7 @@
 #include <clay/render.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/surface/tessellate.hpp>
 
 #include <Eigen/Geometry>
 #include <png.h>
@@ -45,71 +46,21 @@ Camera camera_for(const Vector3d& eye_direction) {
 
 constexpr int max_rows = 400;  // triangle rows per direction and surface
 
-/// Parameters along one direction: samples_per_span per knot span, at most max_rows intervals.
-std::vector<double> parameters(const surface::BSplineBasis& b, int per_span) {
-  const int spans = static_cast<int>(surface::breakpoints(b).size()) - 1;
-  if (spans > max_rows) {
-    const auto [first, last] = b.domain();
-    return surface::linspace(first, last, max_rows + 1);
-  }
-  return surface::span_samples(b, std::clamp(max_rows / spans, 1, per_span));
-}
-
-/// A tessellated surface: nu x nv grid points and unit normals, index iu * nv + iv.
+/// A tessellated surface: the kernel's one tessellator (surface::tessellate: the viewer's and the
+/// glTF preview's grid and normal rules, poles included), samples_per_span per knot span, at most
+/// max_rows intervals a direction.
 struct Mesh {
-  int nu = 0, nv = 0;
-  surface::Points3 points;
+  surface::GridMesh grid;
   std::vector<Vector3d> normals;
-  Vector3d point(int i, int j) const { return points.row(static_cast<Eigen::Index>(i) * nv + j).transpose(); }
+  int nu() const { return grid.rows; }
+  int nv() const { return grid.cols; }
+  Vector3d point(int i, int j) const { return grid.positions.row(static_cast<Eigen::Index>(i) * grid.cols + j).transpose(); }
 };
 
-Mesh tessellate(const surface::BSplineSurface& s, int per_span) {
-  const auto us = parameters(s.u, per_span), vs = parameters(s.v, per_span);
-  Mesh m;
-  m.nu = static_cast<int>(us.size());
-  m.nv = static_cast<int>(vs.size());
-  m.points = surface::evaluate_grid(s, us, vs);
-  const size_t count = us.size() * vs.size();
-  m.normals.assign(count, Vector3d::Zero());
-  std::vector<surface::SurfaceDerivatives> d(count);
-  double su = 0, sv = 0;  // largest |S_u| and |S_v|: the scale below which a derivative vanishes
-  for (int i = 0; i < m.nu; ++i)
-    for (int j = 0; j < m.nv; ++j) {
-      auto& e = d[static_cast<size_t>(i * m.nv + j)];
-      e = surface::derivatives(s, us[static_cast<size_t>(i)], vs[static_cast<size_t>(j)], 2);
-      su = std::max(su, e.du.norm());
-      sv = std::max(sv, e.dv.norm());
-    }
-  // The cells around a point, each by its diagonals (a cell with one collapsed edge still has a
-  // proper normal), oriented like S_u x S_v: the reference for the orientation at a pole.
-  auto cell_normal = [&](int i, int j) -> Vector3d {
-    if (i < 0 || j < 0 || i >= m.nu - 1 || j >= m.nv - 1) return Vector3d::Zero();
-    const Vector3d n = (m.point(i + 1, j + 1) - m.point(i, j)).cross(m.point(i, j + 1) - m.point(i + 1, j));
-    const double len = n.norm();
-    return len > 0 ? Vector3d(n / len) : Vector3d::Zero();
-  };
-  for (int i = 0; i < m.nu; ++i)
-    for (int j = 0; j < m.nv; ++j) {
-      const auto& e = d[static_cast<size_t>(i * m.nv + j)];
-      Vector3d cells = cell_normal(i - 1, j - 1) + cell_normal(i - 1, j) + cell_normal(i, j - 1) + cell_normal(i, j);
-      cells = cells.norm() > 0 ? Vector3d(cells.normalized()) : cells;
-      // Trusted when it exists and is within 60 degrees of the cells around it.
-      auto trusted = [&](const Vector3d& n, double scale) {
-        return n.norm() > 1e-9 * scale && (cells.norm() == 0 || n.normalized().dot(cells) > 0.5);
-      };
-      const double lu = e.du.norm() / su, lv = e.dv.norm() / sv;
-      Vector3d n = e.du.cross(e.dv);
-      if (lu < 1e-8 || lv < 1e-8 || !trusted(n, e.du.norm() * e.dv.norm())) {
-        // A pole (S_v ~ 0 along an edge u = a, exactly or nearly, as after a refit): near it
-        // S_v ~ (u - a) S_uv, so the limit normal is S_u x S_uv (S_uv x S_v when S_u vanishes);
-        // else the cells around the point.
-        n = lv <= lu ? e.du.cross(e.duv) : e.duv.cross(e.dv);
-        if (n.dot(cells) < 0) n = -n;
-        if (!trusted(n, std::max(e.du.norm(), e.dv.norm()) * e.duv.norm())) n = cells;
-      }
-      const double len = n.norm();
-      m.normals[static_cast<size_t>(i * m.nv + j)] = len > 0 ? Vector3d(n / len) : Vector3d::Zero();
-    }
+Mesh tessellate_for_render(const surface::BSplineSurface& s, int per_span) {
+  Mesh m{surface::tessellate(s, per_span, max_rows + 1), {}};
+  m.normals.reserve(static_cast<size_t>(m.grid.normals.rows()));
+  for (Eigen::Index r = 0; r < m.grid.normals.rows(); ++r) m.normals.emplace_back(m.grid.normals.row(r).transpose());
   return m;
 }
 
@@ -223,7 +174,7 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
   const int f = options.supersample ? 2 : 1;
   Canvas cv{f * options.width, f * options.height, {}, {}, camera_for(options.eye_direction), 0, 0, 1, 0, 1, {}, {}};
   std::vector<Mesh> meshes;
-  for (const auto& s : surfaces) meshes.push_back(tessellate(s, options.samples_per_span));
+  for (const auto& s : surfaces) meshes.push_back(tessellate_for_render(s, options.samples_per_span));
 
   // Fit: the box of everything drawn, in camera coordinates.
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -235,7 +186,7 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
       hi = hi.cwiseMax(q);
     }
   };
-  for (const auto& m : meshes) grow(m.points);
+  for (const auto& m : meshes) grow(m.grid.positions);
   if (options.control_net)
     for (const auto& s : surfaces) grow(s.points);
   const Vector3d extent = hi - lo;
@@ -259,11 +210,11 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
     const Mesh& m = meshes[k];
     const Rgb base = options.colours.empty() ? palette(k) : options.colours[k % options.colours.size()];
     std::vector<Vector3d> screen(m.normals.size());
-    for (int i = 0; i < m.nu; ++i)
-      for (int j = 0; j < m.nv; ++j) screen[static_cast<size_t>(i * m.nv + j)] = cv.project(m.point(i, j));
-    for (int i = 0; i + 1 < m.nu; ++i)
-      for (int j = 0; j + 1 < m.nv; ++j) {
-        const size_t a = static_cast<size_t>(i * m.nv + j), b = a + static_cast<size_t>(m.nv), c = b + 1, d = a + 1;
+    for (int i = 0; i < m.nu(); ++i)
+      for (int j = 0; j < m.nv(); ++j) screen[static_cast<size_t>(i * m.nv() + j)] = cv.project(m.point(i, j));
+    for (int i = 0; i + 1 < m.nu(); ++i)
+      for (int j = 0; j + 1 < m.nv(); ++j) {
+        const size_t a = static_cast<size_t>(i * m.nv() + j), b = a + static_cast<size_t>(m.nv()), c = b + 1, d = a + 1;
         cv.triangle(screen[a], screen[b], screen[c], m.normals[a], m.normals[b], m.normals[c], base);
         cv.triangle(screen[a], screen[c], screen[d], m.normals[a], m.normals[c], m.normals[d], base);
       }

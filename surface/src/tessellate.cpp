@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <string>
 
 #include "quadrature.hpp"
@@ -49,58 +48,47 @@ GridMesh tessellate(const BSplineSurface& s, int per_span, int max_samples) {
   m.cols = static_cast<int>(m.vs.size());
   m.positions = evaluate_grid(s, m.us, m.vs);
   m.normals = Points3::Zero(m.positions.rows(), 3);
-  std::vector<char> degenerate(static_cast<size_t>(m.positions.rows()), 0);
-  std::vector<SurfaceDerivatives> d(static_cast<size_t>(m.positions.rows()));
-  double max_u = 0, max_v = 0;
+  const std::size_t count = static_cast<std::size_t>(m.positions.rows());
+  std::vector<SurfaceDerivatives> d(count);
+  double max_u = 0, max_v = 0;  // the scale below which a first derivative vanishes
   for (int i = 0; i < m.rows; ++i)
     for (int j = 0; j < m.cols; ++j) {
-      auto& e = d[static_cast<size_t>(i * m.cols + j)];
-      e = derivatives(s, m.us[static_cast<size_t>(i)], m.vs[static_cast<size_t>(j)], 1);
+      auto& e = d[static_cast<std::size_t>(i * m.cols + j)];
+      e = derivatives(s, m.us[static_cast<std::size_t>(i)], m.vs[static_cast<std::size_t>(j)], 2);
       max_u = std::max(max_u, e.du.norm());
       max_v = std::max(max_v, e.dv.norm());
     }
-  // Degenerate where a first derivative is below 1e-5 of its largest on the grid (a pole of a
-  // rational revolve has |S_u| of rounding size, not 0, and its cross product is noise) or the
-  // two are parallel (the view's rule).
-  for (size_t k = 0; k < d.size(); ++k) {
-    const Eigen::Vector3d n = d[k].du.cross(d[k].dv);
-    const double nn = n.norm(), nu = d[k].du.norm(), nv = d[k].dv.norm();
-    if (std::isfinite(nn) && nu > 1e-5 * max_u && nv > 1e-5 * max_v && nn > 1e-8 * nu * nv)
-      m.normals.row(static_cast<Eigen::Index>(k)) = (n / nn).transpose();
-    else
-      degenerate[k] = 1;
-  }
-  // Where S_u x S_v vanishes: the neighbouring triangles' normals, weighted by area.
-  if (std::any_of(degenerate.begin(), degenerate.end(), [](char c) { return c != 0; })) {
-    Points3 sum = Points3::Zero(m.positions.rows(), 3);
-    for (int i = 0; i + 1 < m.rows; ++i)
-      for (int j = 0; j + 1 < m.cols; ++j)
-        for (const auto& t : cell_triangles(m, i, j)) {
-          const Eigen::Vector3d a = m.positions.row(t[0]).transpose(), b = m.positions.row(t[1]).transpose(),
-                                c = m.positions.row(t[2]).transpose();
-          const Eigen::Vector3d n = (b - a).cross(c - a);
-          for (int v : t) sum.row(v) += n.transpose();
-        }
-    // Vertices at one point (a pole: a whole grid line collapsed) share the sum of all their
-    // triangles, so a pole's normal is the axis, not tilted toward one meridian.
-    // Points within 1e-9 of the mesh's size are one point (rational evaluation rounds).
-    const double quantum = 1e-9 * std::max(1e-300, (m.positions.colwise().maxCoeff() - m.positions.colwise().minCoeff()).norm());
-    auto key = [&](Eigen::Index k) {
-      return std::array<long long, 3>{std::llround(m.positions(k, 0) / quantum), std::llround(m.positions(k, 1) / quantum),
-                                      std::llround(m.positions(k, 2) / quantum)};
-    };
-    std::map<std::array<long long, 3>, Eigen::RowVector3d> at_point;
-    for (Eigen::Index k = 0; k < m.positions.rows(); ++k)
-      if (degenerate[static_cast<size_t>(k)]) {
-        auto [it, fresh] = at_point.try_emplace(key(k), Eigen::RowVector3d::Zero());
-        it->second += sum.row(k);
+  auto point = [&](int i, int j) -> Eigen::Vector3d { return m.positions.row(i * m.cols + j).transpose(); };
+  // The cells around a point, each by its diagonals (a cell with one collapsed edge still has a
+  // proper normal), oriented like S_u x S_v: the reference for the orientation at a pole.
+  auto cell_normal = [&](int i, int j) -> Eigen::Vector3d {
+    if (i < 0 || j < 0 || i >= m.rows - 1 || j >= m.cols - 1) return Eigen::Vector3d::Zero();
+    const Eigen::Vector3d n = (point(i + 1, j + 1) - point(i, j)).cross(point(i, j + 1) - point(i + 1, j));
+    const double len = n.norm();
+    return len > 0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
+  };
+  for (int i = 0; i < m.rows; ++i)
+    for (int j = 0; j < m.cols; ++j) {
+      const SurfaceDerivatives& e = d[static_cast<std::size_t>(i * m.cols + j)];
+      Eigen::Vector3d cells = cell_normal(i - 1, j - 1) + cell_normal(i - 1, j) + cell_normal(i, j - 1) + cell_normal(i, j);
+      if (cells.norm() > 0) cells.normalize();
+      // Trusted when it exists and is within 60 degrees of the cells around it.
+      auto trusted = [&](const Eigen::Vector3d& n, double scale) {
+        return std::isfinite(n.norm()) && n.norm() > 1e-9 * scale && (cells.norm() == 0 || n.normalized().dot(cells) > 0.5);
+      };
+      const double lu = max_u > 0 ? e.du.norm() / max_u : 0, lv = max_v > 0 ? e.dv.norm() / max_v : 0;
+      Eigen::Vector3d n = e.du.cross(e.dv);
+      if (lu < 1e-8 || lv < 1e-8 || !trusted(n, e.du.norm() * e.dv.norm())) {
+        // A pole (S_v ~ 0 along an edge u = a, exactly or nearly, as after a refit): near it
+        // S_v ~ (u - a) S_uv, so the limit normal is S_u x S_uv (S_uv x S_v when S_u vanishes);
+        // else the cells around the point.
+        n = lv <= lu ? e.du.cross(e.duv) : e.duv.cross(e.dv);
+        if (n.dot(cells) < 0) n = -n;
+        if (!trusted(n, std::max(e.du.norm(), e.dv.norm()) * e.duv.norm())) n = cells;
       }
-    for (Eigen::Index k = 0; k < m.positions.rows(); ++k)
-      if (degenerate[static_cast<size_t>(k)]) {
-        const Eigen::RowVector3d n = at_point.at(key(k));
-        if (n.norm() > 0) m.normals.row(k) = n / n.norm();
-      }
-  }
+      const double len = n.norm();
+      if (len > 0) m.normals.row(i * m.cols + j) = (n / len).transpose();
+    }
   return m;
 }
 

@@ -17,8 +17,9 @@ struct GridMesh {
   int rows = 0, cols = 0;
   std::vector<double> us, vs;
   Points3 positions;  ///< S(u, v), mm
-  Points3 normals;    ///< unit S_u x S_v; where that vanishes (a pole, a collapsed edge) the
-                      ///< normalized sum of the neighbouring triangles' normals
+  Points3 normals;    ///< unit S_u x S_v; at a pole (S_u or S_v vanishing, exactly or nearly,
+                      ///< as after a refit) the limit normal S_u x S_uv (or S_uv x S_v) turned to
+                      ///< the side of the cells around it, else those cells' normal
 };
 
 /// The grid parameters of one direction: `per_span` samples per knot span following the knots
