@@ -1,7 +1,30 @@
-# House rule (STYLE.md 11): OpenCASCADE headers only in surface/src/occt/, Ceres headers only in
-# .cpp files. An include counts as OCCT when the file exists in OCCT's include folder.
+# House rules (STYLE.md 11, DESIGN.md's module graph):
+# - OpenCASCADE headers only in surface/src/occt/ (an include counts as OCCT when the file exists
+#   in OCCT's include folder), Ceres headers only in .cpp files;
+# - a module includes only the clay headers of the modules it may use:
+#     surface (the core: clay/surface*, clay/error.hpp, summary.hpp, tolerance.hpp, version.hpp)
+#       <- sketch <- constraints;  surface <- deform;  cli (recipe, render, servers) uses all.
+#   The umbrella clay/clayform.hpp is exempt (it is the whole API by design).
 # -DSOURCE_DIR=<tree to scan> -DOCCT_INCLUDE_DIR=<OCCT headers>
+cmake_minimum_required(VERSION 3.22)  # IN_LIST in a script run with -P
 set(violations "")
+set(may_use_surface surface)
+set(may_use_sketch surface sketch)
+set(may_use_constraints surface sketch constraints)
+set(may_use_deform surface deform)
+set(may_use_cli surface sketch constraints deform cli)
+# The module a clay header belongs to, or "" for a header outside the graph.
+function(module_of header out)
+  if(header MATCHES "^clay/(surface(/|\\.hpp$)|error\\.hpp$|summary\\.hpp$|tolerance\\.hpp$|version\\.hpp$)")
+    set(${out} surface PARENT_SCOPE)
+  elseif(header MATCHES "^clay/(sketch|constraints|deform)(/|\\.hpp$)")
+    set(${out} ${CMAKE_MATCH_1} PARENT_SCOPE)
+  elseif(header MATCHES "^clay/(recipe|render|serve|view)(/|\\.hpp$)")
+    set(${out} cli PARENT_SCOPE)
+  else()
+    set(${out} "" PARENT_SCOPE)
+  endif()
+endfunction()
 file(GLOB_RECURSE files RELATIVE ${SOURCE_DIR}
   ${SOURCE_DIR}/*.hpp ${SOURCE_DIR}/*.h ${SOURCE_DIR}/*.cpp ${SOURCE_DIR}/*.cc ${SOURCE_DIR}/*.hxx)
 list(FILTER files EXCLUDE REGEX "^(build|out|\\.git)/|/fixtures/")
@@ -14,6 +37,16 @@ foreach(f ${files})
     endif()
     if(EXISTS ${OCCT_INCLUDE_DIR}/${header} AND NOT f MATCHES "^surface/src/occt/")
       list(APPEND violations "${f}: OpenCASCADE header <${header}> outside surface/src/occt/")
+    endif()
+    set(from "")
+    if(f MATCHES "^(surface|sketch|constraints|deform|cli)/")
+      set(from ${CMAKE_MATCH_1})
+    endif()
+    if(from AND NOT f MATCHES "/clay/clayform\\.hpp$")
+      module_of("${header}" to)
+      if(to AND NOT to IN_LIST may_use_${from})
+        list(APPEND violations "${f}: <${header}> belongs to module ${to}, which ${from} may not use")
+      endif()
     endif()
   endforeach()
 endforeach()
