@@ -3,6 +3,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/surface/projection.hpp>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -397,7 +398,7 @@ PieceResult fit_piece(const PieceProblem& pr) {
       double moved = 0;
       for (Eigen::Index k = 0; k < count; ++k) {
         double& tk = out.params[static_cast<size_t>(k)];
-        const double tn = project_from(curve, pr.data.row(k).transpose(), tk, periodic);
+        const double tn = surface::project_normal(curve, pr.data.row(k).transpose(), tk, periodic).t;
         moved = std::max(moved, periodic ? std::min(std::abs(tn - tk), 1.0 - std::abs(tn - tk))
                                          : std::abs(tn - tk));
         tk = tn;

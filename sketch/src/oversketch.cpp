@@ -1,6 +1,7 @@
 #include <clay/sketch/oversketch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/projection.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
@@ -154,7 +155,7 @@ OversketchResult oversketch(const BSplineCurve& curve, const Stroke& stroke,
   auto locate = [&](Eigen::Index row, const char* which) {
     const Eigen::Vector3d q = pts.row(row).transpose();
     End e;
-    e.t = detail::closest_parameter(curve, q);
+    e.t = surface::closest_point(curve, q).t;
     e.distance = (surface::evaluate(curve, e.t) - q).norm();
     if (e.distance <= cap) {
       if (e.t <= t0 + at_end_tol) e.past = Past::Start;  // the stroke ends at the curve's end

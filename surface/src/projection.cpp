@@ -1,6 +1,7 @@
 #include <clay/surface/projection.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 
 #include <Eigen/Dense>
@@ -249,6 +250,100 @@ SurfaceProjection SurfaceProjector::closest_point(const Eigen::Vector3d& point) 
     }
   }
   return best;
+}
+
+// ---- curves (moved from the sketch module, where oversketch and stroke fitting used them) ---
+
+namespace {
+
+/// Newton from t0 without the input checks (closest_point runs it from several starts).
+double curve_foot(const BSplineCurve& curve, const Eigen::Vector3d& q, double t0, bool periodic) {
+  const auto [a, b] = curve.basis.domain();
+  const double period = b - a;
+  auto fold = [&](double t) {
+    if (periodic) {
+      t = a + std::fmod(t - a, period);
+      if (t < a) t += period;
+      return t >= b ? a : t;
+    }
+    return std::clamp(t, a, b);
+  };
+  double t = fold(t0);
+  CurveDerivatives d = derivatives(curve, t, 2);
+  double f = (d.point - q).squaredNorm();
+  for (int it = 0; it < 30; ++it) {
+    const Eigen::Vector3d r = d.point - q;
+    const double tt = d.d1.squaredNorm();
+    if (!(tt > 0.0)) break;
+    const double g = r.dot(d.d1);
+    double h = tt + r.dot(d.d2);
+    if (!(h > 0.1 * tt)) h = tt;  // Gauss–Newton where the Hessian is not safely positive
+    double step = std::clamp(-g / h, -0.25 * period, 0.25 * period);
+    bool accepted = false;
+    double tn = t, fn = f;
+    CurveDerivatives dn;
+    for (int ls = 0; ls < 30; ++ls) {
+      tn = fold(t + step);
+      dn = derivatives(curve, tn, 2);
+      fn = (dn.point - q).squaredNorm();
+      if (fn <= f) {
+        accepted = true;
+        break;
+      }
+      step *= 0.5;
+    }
+    if (!accepted) break;
+    const double moved = std::abs(tn - t);
+    t = tn;
+    d = dn;
+    f = fn;
+    if (moved <= 1e-15 * period) break;
+  }
+  return t;
+}
+
+CurveProjection curve_projection(const BSplineCurve& curve, const Eigen::Vector3d& q, double t) {
+  CurveProjection p;
+  p.t = t;
+  p.point = evaluate(curve, t);
+  p.distance = (p.point - q).norm();
+  return p;
+}
+
+void check_curve_input(const BSplineCurve& curve, const Eigen::Vector3d& q, const char* who) {
+  validate(curve, "curve to project onto");
+  if (!(std::isfinite(q.x()) && std::isfinite(q.y()) && std::isfinite(q.z())))
+    throw Error(ErrorCategory::InvalidGeometry, std::string(who) + ": the point to project is not finite");
+}
+
+}  // namespace
+
+CurveProjection project_normal(const BSplineCurve& curve, const Eigen::Vector3d& point, double t0, bool periodic) {
+  check_curve_input(curve, point, "project_normal");
+  return curve_projection(curve, point, curve_foot(curve, point, t0, periodic));
+}
+
+CurveProjection closest_point(const BSplineCurve& curve, const Eigen::Vector3d& point, int samples_per_span) {
+  check_curve_input(curve, point, "closest_point");
+  if (samples_per_span < 1)
+    throw Error(ErrorCategory::InvalidArgument,
+                "closest_point: samples_per_span = " + std::to_string(samples_per_span) + " must be >= 1");
+  const auto ts = span_samples(curve.basis, samples_per_span);
+  std::vector<std::pair<double, double>> ranked;  // squared distance, parameter
+  ranked.reserve(ts.size());
+  for (double t : ts) ranked.emplace_back((evaluate(curve, t) - point).squaredNorm(), t);
+  const std::size_t keep = std::min<std::size_t>(3, ranked.size());
+  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
+  double best_t = ranked.front().second, best = ranked.front().first;
+  for (std::size_t k = 0; k < keep; ++k) {
+    const double t = curve_foot(curve, point, ranked[k].second, false);
+    const double f = (evaluate(curve, t) - point).squaredNorm();
+    if (f < best) {
+      best = f;
+      best_t = t;
+    }
+  }
+  return curve_projection(curve, point, best_t);
 }
 
 }  // namespace clay::surface

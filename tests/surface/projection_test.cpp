@@ -1,12 +1,14 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
 
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <thread>
 #include <vector>
@@ -190,4 +192,31 @@ TEST_CASE("SurfaceProjector: the start grid is evaluated once, shared by copies 
   const SurfaceProjector to = std::move(from);
   CHECK_THAT(to.closest_point(points[0]).distance, WithinAbs(distance[0], 1e-9));
   CHECK_THROWS_AS(from.closest_point(points[0]), clay::Error);  // NOLINT(bugprone-use-after-move)
+}
+
+TEST_CASE("curve projection: closed forms on a circle and a segment", "[projection]") {
+  // A full circle of radius 5 about (1, 2, 0) in the xy plane, as rational quadratic arcs.
+  const Eigen::Vector3d c(1, 2, 0);
+  const BSplineCurve circle = circular_arc(c, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 5, 0, 2 * std::numbers::pi);
+  for (double angle : {0.3, 1.9, 3.0, 4.4, 6.1}) {
+    const Eigen::Vector3d q = c + 8 * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) + Eigen::Vector3d(0, 0, 3);
+    const CurveProjection p = closest_point(circle, q);
+    // The closest point of a circle: the foot in the direction of q's projection on its plane.
+    const Eigen::Vector3d foot = c + 5 * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0);
+    CHECK((p.point - foot).norm() < 1e-12);
+    CHECK(std::abs(p.distance - std::hypot(3.0, 3.0)) < 1e-12);
+    CHECK((evaluate(circle, p.t) - p.point).norm() == 0);
+  }
+  // A segment: inside, the perpendicular foot; beyond an end, the end (no silent overshoot).
+  const BSplineCurve segment = make_curve(1, {0, 0, 1, 1}, (Points3(2, 3) << 0, 0, 0, 10, 0, 0).finished());
+  CHECK(std::abs(closest_point(segment, Eigen::Vector3d(4, 3, 0)).t - 0.4) < 1e-14);
+  CHECK(closest_point(segment, Eigen::Vector3d(14, 3, 0)).t == 1.0);
+  CHECK(project_normal(segment, Eigen::Vector3d(-4, 3, 0), 0.5).t == 0.0);
+  // Periodic: Newton from near the seam wraps round it instead of stopping at the domain's end.
+  const auto [t0, t1] = circle.basis.domain();
+  const Eigen::Vector3d near_seam = c + 6 * Eigen::Vector3d(std::cos(-0.2), std::sin(-0.2), 0);
+  const CurveProjection wrapped = project_normal(circle, near_seam, t0 + 0.01 * (t1 - t0), true);
+  CHECK((wrapped.point - (c + 5 * Eigen::Vector3d(std::cos(-0.2), std::sin(-0.2), 0))).norm() < 1e-12);
+  CHECK_THROWS_AS(closest_point(segment, Eigen::Vector3d(std::nan(""), 0, 0)), clay::Error);
+  CHECK_THROWS_AS(closest_point(segment, Eigen::Vector3d(1, 0, 0), 0), clay::Error);
 }

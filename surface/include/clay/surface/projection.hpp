@@ -7,6 +7,7 @@
 /// bound constraints, so a foot point on a domain edge is found as such (a Karush–Kuhn–Tucker
 /// point), not by silently clamping the answer.
 #include <clay/summary.hpp>
+#include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
 #include <Eigen/Core>
@@ -78,5 +79,27 @@ class SurfaceProjector {
   double size_ = 0;                    // diagonal of the control box
   std::shared_ptr<StartGrid> grid_;    // evaluated once, on first use
 };
+
+// ---- curves ---------------------------------------------------------------------------------
+
+/// A point projected onto a curve: its parameter, the curve point and the distance.
+struct CurveProjection {
+  double t = 0;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  double distance = 0;
+};
+
+/// The foot point of `point` on the curve by Newton's method on (C − P) · C' = 0 from t0 (the
+/// full second-order step where the Hessian is safely positive, Gauss–Newton elsewhere), with a
+/// backtracking line search, so the distance never increases from t0's. An open curve keeps t in
+/// its domain (a foot beyond an end is the end); `periodic` wraps t around the domain (a closed,
+/// periodic curve). Throws clay::Error(InvalidGeometry) for an invalid curve or a non-finite point.
+CurveProjection project_normal(const BSplineCurve& curve, const Eigen::Vector3d& point, double t0,
+                               bool periodic = false);
+
+/// The closest point of the curve to `point`: Newton (project_normal) from the three best of
+/// `samples_per_span` samples per knot span (>= 1), the nearest foot kept. Throws as
+/// project_normal, and InvalidArgument for samples_per_span < 1.
+CurveProjection closest_point(const BSplineCurve& curve, const Eigen::Vector3d& point, int samples_per_span = 8);
 
 }  // namespace clay::surface
