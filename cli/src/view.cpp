@@ -89,63 +89,6 @@ Vector3d unit_or_zero(const Vector3d& a) {
   return n > 0 && std::isfinite(n) ? Vector3d(a / n) : Vector3d::Zero();
 }
 
-/// S and its partial derivatives up to order 2 on the grid us x vs (index iu * vs.size() + iv):
-/// the basis functions and their derivatives of each parameter computed once (The NURBS Book A2.3)
-/// and the homogeneous net contracted in u first, row by row, so a point costs 6 (q+1) 4-vector
-/// multiply-adds instead of (p+1)(q+1) (A3.6); then the rational quotient rule (A4.4).
-std::vector<surface::SurfaceDerivatives> grid_derivatives(const surface::BSplineSurface& s,
-                                                          const std::vector<double>& us,
-                                                          const std::vector<double>& vs) {
-  const int p = s.u.degree, q = s.v.degree, cu = s.count_u(), cv = s.count_v();
-  const std::size_t nv = vs.size(), wq = static_cast<std::size_t>(q + 1), wp = static_cast<std::size_t>(p + 1);
-  std::vector<int> span_v(nv);
-  std::vector<double> bv(nv * 3 * wq);
-  for (std::size_t k = 0; k < nv; ++k) {
-    span_v[k] = surface::find_span(s.v, vs[k]);
-    surface::basis_derivatives(s.v, span_v[k], vs[k], 2, std::span<double>(bv.data() + k * 3 * wq, 3 * wq));
-  }
-  std::vector<Eigen::Vector4d> net(static_cast<std::size_t>(cu) * static_cast<std::size_t>(cv));
-  for (Eigen::Index r = 0; r < s.points.rows(); ++r) {
-    const double w = s.weights[r];
-    net[static_cast<std::size_t>(r)] = Eigen::Vector4d(s.points(r, 0) * w, s.points(r, 1) * w, s.points(r, 2) * w, w);
-  }
-  std::vector<surface::SurfaceDerivatives> out(us.size() * nv);
-  std::vector<double> bu(3 * wp);
-  std::vector<Eigen::Vector4d> t(3 * static_cast<std::size_t>(cv));  // row contractions, u-derivative a at a * cv + j
-  for (std::size_t iu = 0; iu < us.size(); ++iu) {
-    const int su = surface::find_span(s.u, us[iu]);
-    surface::basis_derivatives(s.u, su, us[iu], 2, bu);
-    std::fill(t.begin(), t.end(), Eigen::Vector4d::Zero());
-    for (int i = 0; i <= p; ++i)
-      for (int j = 0; j < cv; ++j) {
-        const Eigen::Vector4d& pw = net[static_cast<std::size_t>(s.index(su - p + i, j))];
-        for (std::size_t a = 0; a < 3; ++a) t[a * static_cast<std::size_t>(cv) + static_cast<std::size_t>(j)] += bu[a * wp + static_cast<std::size_t>(i)] * pw;
-      }
-    for (std::size_t iv = 0; iv < nv; ++iv) {
-      const double* b = bv.data() + iv * 3 * wq;
-      Eigen::Vector4d A[3][3];
-      for (auto& row : A)
-        for (auto& e : row) e.setZero();
-      for (int j = 0; j <= q; ++j) {
-        const std::size_t col = static_cast<std::size_t>(span_v[iv] - q + j);
-        for (std::size_t a = 0; a < 3; ++a)
-          for (std::size_t c = 0; a + c < 3; ++c) A[a][c] += b[c * wq + static_cast<std::size_t>(j)] * t[a * static_cast<std::size_t>(cv) + col];
-      }
-      const auto P = [&](int a, int c) { return Vector3d(A[a][c].head<3>()); };
-      const auto W = [&](int a, int c) { return A[a][c][3]; };
-      const double w = W(0, 0);
-      auto& x = out[iu * nv + iv];
-      x.point = P(0, 0) / w;
-      x.du = (P(1, 0) - W(1, 0) * x.point) / w;
-      x.dv = (P(0, 1) - W(0, 1) * x.point) / w;
-      x.duu = (P(2, 0) - 2.0 * W(1, 0) * x.du - W(2, 0) * x.point) / w;
-      x.dvv = (P(0, 2) - 2.0 * W(0, 1) * x.dv - W(0, 2) * x.point) / w;
-      x.duv = (P(1, 1) - W(1, 0) * x.dv - W(0, 1) * x.du - W(1, 1) * x.point) / w;
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<double> view_parameters(const surface::BSplineBasis& basis) {
@@ -167,7 +110,7 @@ ViewMesh view_mesh(const surface::BSplineSurface& s) {
   m.degenerate.assign(n, 0);
   const auto at = [&](int i, int j) { return static_cast<std::size_t>(i) * static_cast<std::size_t>(m.cols) + static_cast<std::size_t>(j); };
   surface::validate(s, "view surface");
-  const std::vector<surface::SurfaceDerivatives> d = grid_derivatives(s, m.us, m.vs);
+  const std::vector<surface::SurfaceDerivatives> d = surface::derivatives_grid(s, m.us, m.vs);
   double max_u = 0, max_v = 0;
   for (const auto& x : d) {
     max_u = std::max(max_u, x.du.norm());

@@ -48,16 +48,12 @@ GridMesh tessellate(const BSplineSurface& s, int per_span, int max_samples) {
   m.cols = static_cast<int>(m.vs.size());
   m.positions = evaluate_grid(s, m.us, m.vs);
   m.normals = Points3::Zero(m.positions.rows(), 3);
-  const std::size_t count = static_cast<std::size_t>(m.positions.rows());
-  std::vector<SurfaceDerivatives> d(count);
+  const std::vector<SurfaceDerivatives> d = derivatives_grid(s, m.us, m.vs);
   double max_u = 0, max_v = 0;  // the scale below which a first derivative vanishes
-  for (int i = 0; i < m.rows; ++i)
-    for (int j = 0; j < m.cols; ++j) {
-      auto& e = d[static_cast<std::size_t>(i * m.cols + j)];
-      e = derivatives(s, m.us[static_cast<std::size_t>(i)], m.vs[static_cast<std::size_t>(j)], 2);
-      max_u = std::max(max_u, e.du.norm());
-      max_v = std::max(max_v, e.dv.norm());
-    }
+  for (const SurfaceDerivatives& e : d) {
+    max_u = std::max(max_u, e.du.norm());
+    max_v = std::max(max_v, e.dv.norm());
+  }
   auto point = [&](int i, int j) -> Eigen::Vector3d { return m.positions.row(i * m.cols + j).transpose(); };
   // The cells around a point, each by its diagonals (a cell with one collapsed edge still has a
   // proper normal), oriented like S_u x S_v: the reference for the orientation at a pole.

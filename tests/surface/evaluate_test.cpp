@@ -142,3 +142,26 @@ TEST_CASE("evaluate_many equals pointwise evaluation of a curve", "[evaluate]") 
     CHECK((pts.row(static_cast<Eigen::Index>(k)).transpose() - evaluate(c, ts[k])).norm() == 0.0);
   CHECK_THROWS_AS(evaluate_many(c, std::vector<double>{a, b + 1.0}), clay::Error);
 }
+
+TEST_CASE("derivatives_grid equals pointwise derivatives on random rational surfaces", "[evaluate]") {
+  std::mt19937 rng(808);
+  for (bool rational : {false, true}) {
+    const BSplineSurface s = clay::test::random_surface(rng, 3, 2, 7, 6, rational);
+    const auto [u0, u1] = s.u.domain();
+    const auto [v0, v1] = s.v.domain();
+    const std::vector<double> us = linspace(u0, u1, 23), vs = linspace(v0, v1, 19);
+    const std::vector<SurfaceDerivatives> grid = derivatives_grid(s, us, vs);
+    REQUIRE(grid.size() == us.size() * vs.size());
+    double worst = 0, scale = 0;
+    for (size_t i = 0; i < us.size(); ++i)
+      for (size_t j = 0; j < vs.size(); ++j) {
+        const SurfaceDerivatives a = grid[i * vs.size() + j], b = derivatives(s, us[i], vs[j], 2);
+        for (const auto& [x, y] : {std::pair{a.point, b.point}, {a.du, b.du}, {a.dv, b.dv}, {a.duu, b.duu},
+                                   {a.duv, b.duv}, {a.dvv, b.dvv}}) {
+          worst = std::max(worst, (x - y).norm());
+          scale = std::max(scale, y.norm());
+        }
+      }
+    CHECK(worst <= 1e-12 * scale);
+  }
+}

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <span>
+#include <vector>
 
 namespace clay::surface {
 
@@ -53,6 +54,13 @@ Points3 evaluate_many(const BSplineCurve& curve, std::span<const double> ts);
 /// evaluation.
 Points3 evaluate_grid(const BSplineSurface& surface, std::span<const double> us,
                       std::span<const double> vs);
+
+/// S and its partial derivatives up to order 2 on the grid us x vs (row iu * vs.size() + iv),
+/// equal to derivatives(surface, u, v, 2) to rounding: the basis functions and their derivatives
+/// of each parameter computed once, the homogeneous net contracted in u first, then the rational
+/// quotient rule (The NURBS Book A2.3, A3.6, A4.4). The tessellator and the viewer use it.
+std::vector<SurfaceDerivatives> derivatives_grid(const BSplineSurface& surface, std::span<const double> us,
+                                                 std::span<const double> vs);
 
 /// `count` >= 2 evenly spaced parameters covering [first, last], ends exact.
 std::vector<double> linspace(double first, double last, int count);
