@@ -429,6 +429,19 @@ TEST_CASE("glTF previews of surfaces with poles and collapsed edges are not empt
   CHECK((back.box().min() - Eigen::Vector3d(-10, -10, -10)).norm() <= 1e-2);
   CHECK((back.box().max() - Eigen::Vector3d(10, 10, 10)).norm() <= 1e-2);
   CHECK_THAT(surface_area(sphere, 2), Catch::Matchers::WithinRel(exact, 1e-9));
+  // A budget too small for the tolerance: the error names the writer, the surface and the way out.
+  GltfWriteOptions starved;
+  starved.relative_area = 1e-9;
+  starved.max_vertices = 289;
+  try {
+    write_gltf({sphere}, folder / "starved.glb", starved);
+    FAIL("no exception");
+  } catch (const Error& e) {
+    CHECK(e.category() == ErrorCategory::ToleranceNotMet);
+    CHECK_THAT(e.message(), Catch::Matchers::Contains("write_gltf: the preview of") &&
+                                Catch::Matchers::Contains("max_vertices"));
+  }
+  CHECK_FALSE(fs::exists(folder / "starved.glb"));
 }
 
 // ---- malformed files (issue #18: mutated files crashed or hung OpenCASCADE) ---------------------

@@ -937,7 +937,15 @@ void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& fil
   const int max_samples = static_cast<int>(std::clamp<long>(static_cast<long>(std::sqrt(static_cast<double>(share))), 17, 1025));
   std::vector<GridMesh> meshes;
   meshes.reserve(surfaces.size());
-  for (const BSplineSurface& s : surfaces) meshes.push_back(tessellate_to_area(s, options.relative_area, max_samples));
+  for (size_t k = 0; k < surfaces.size(); ++k) {
+    try {
+      meshes.push_back(tessellate_to_area(surfaces[k], options.relative_area, max_samples));
+    } catch (const Error& e) {  // say which surface and which file, not only the tessellator's figures
+      throw Error(e.category(), "write_gltf: the preview of " + surface_name(k) + " for " + quoted(file) +
+                                    " cannot be meshed within its area tolerance: " + e.message() +
+                                    "; raise GltfWriteOptions::max_vertices or relative_area");
+    }
+  }
   ExchangeSession session;
   guarded(caller, [&] {
     const std::vector<Handle(Geom_BSplineSurface)> converted = convert_all(surfaces, caller);
