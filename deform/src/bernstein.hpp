@@ -10,9 +10,6 @@
 
 namespace clay::deform::detail {
 
-/// Binomial coefficient C(n, k) as a double (exact for the kernel's degrees: n <= 3 * 63).
-double binomial(int n, int k) noexcept;
-
 /// Bézier extraction of one direction: for every non-empty span of the domain, its breaks and
 /// the (p+1) x (p+1) matrix E with Bézier point r = sum_q E(r, q) P_{first + q}.
 struct SpanExtraction {

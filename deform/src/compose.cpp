@@ -6,6 +6,7 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/exchange.hpp>
 #include <clay/surface/knots.hpp>
+#include <clay/internal/math.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +19,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
 
 #include "messages.hpp"
 #include "seal.hpp"
@@ -36,25 +36,6 @@ std::string fmt(double v) { return format(v, 6); }  // short figures for message
 constexpr const char* coordinate_name[3] = {"s", "t", "u"};
 
 // ---- bivariate Bernstein polynomials --------------------------------------------------------
-
-/// Binomial coefficients up to n = 127 as doubles (exact up to n = 56, to rounding beyond).
-const std::vector<double>& binomial_row(int n) {
-  static const std::vector<std::vector<double>> table = [] {
-    std::vector<std::vector<double>> t(128);
-    for (int r = 0; r < 128; ++r) {
-      t[static_cast<size_t>(r)].assign(static_cast<size_t>(r + 1), 1.0);
-      for (int k = 1; k < r; ++k)
-        t[static_cast<size_t>(r)][static_cast<size_t>(k)] =
-            t[static_cast<size_t>(r - 1)][static_cast<size_t>(k - 1)] +
-            t[static_cast<size_t>(r - 1)][static_cast<size_t>(k)];
-    }
-    return t;
-  }();
-  return table[static_cast<size_t>(n)];
-}
-double binom(int n, int k) {
-  return k < 0 || k > n ? 0.0 : binomial_row(n)[static_cast<size_t>(k)];
-}
 
 /// A bivariate polynomial of degrees (du, dv) in Bernstein form with `dim` values per
 /// coefficient: value d of coefficient (i, j) at ((i * (dv + 1) + j) * dim + d). "Scaled" polys
@@ -83,8 +64,8 @@ Poly constant_poly(double value) {
 
 /// Multiplies (or divides) coefficient (i, j) by C(du, i) C(dv, j).
 void scale(Poly& p, bool divide) {
-  const auto& bu = binomial_row(p.du);
-  const auto& bv = binomial_row(p.dv);
+  const auto& bu = internal::binomial_row(p.du);
+  const auto& bv = internal::binomial_row(p.dv);
   for (int i = 0; i <= p.du; ++i)
     for (int j = 0; j <= p.dv; ++j) {
       const double f = bu[static_cast<size_t>(i)] * bv[static_cast<size_t>(j)];
@@ -125,8 +106,8 @@ Eigen::MatrixXd reduction_matrix(int p, int e) {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(e + 1, p + 1);
   for (int i = 0; i <= e; ++i)
     for (int k = 0; k <= i; ++k) {
-      const double f = binom(i, k) / binom(e, k) * binom(p, k);
-      for (int r = 0; r <= k; ++r) m(i, r) += f * ((k - r) % 2 ? -1.0 : 1.0) * binom(k, r);
+      const double f = internal::binomial(i, k) / internal::binomial(e, k) * internal::binomial(p, k);
+      for (int r = 0; r <= k; ++r) m(i, r) += f * ((k - r) % 2 ? -1.0 : 1.0) * internal::binomial(k, r);
     }
   return m;
 }
@@ -136,7 +117,7 @@ Eigen::MatrixXd elevation_matrix(int e, int p) {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(p + 1, e + 1);
   for (int i = 0; i <= p; ++i)
     for (int k = std::max(0, i - (p - e)); k <= std::min(e, i); ++k)
-      m(i, k) = binom(e, k) * binom(p - e, i - k) / binom(p, i);
+      m(i, k) = internal::binomial(e, k) * internal::binomial(p - e, i - k) / internal::binomial(p, i);
   return m;
 }
 

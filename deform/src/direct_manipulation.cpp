@@ -2,6 +2,7 @@
 
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +18,7 @@ namespace clay::deform {
 
 namespace {
 
-using detail::finite;
+using internal::all_finite;
 using detail::format;
 
 /// All Bernstein polynomials of degree n at t (The NURBS Book A1.3), written to b[0..n].
@@ -64,7 +65,7 @@ std::vector<Eigen::Vector3d> selected_locals(const Frame& frame, const Points3& 
   std::vector<Eigen::Vector3d> locals(static_cast<size_t>(points.rows()));
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const Eigen::Vector3d x = points.row(i).transpose();
-    if (!finite(x))
+    if (!all_finite(x))
       throw Error(ErrorCategory::InvalidArgument,
                   "direct manipulation: selected point #" + std::to_string(i) + " " + format(x) +
                       " is not finite; give finite coordinates");
@@ -264,7 +265,7 @@ DirectManipulationResult<Lattice> DirectManipulator<Lattice>::move(const Points3
                 "direct manipulation: " + std::to_string(targets.rows()) + " targets for " +
                     std::to_string(n) + " selected points; give one target per selected point");
   for (Eigen::Index i = 0; i < n; ++i)
-    if (!finite(targets.row(i)))
+    if (!all_finite(targets.row(i)))
       throw Error(ErrorCategory::InvalidArgument,
                   "direct manipulation: target #" + std::to_string(i) + " " +
                       format(Eigen::Vector3d(targets.row(i).transpose())) +

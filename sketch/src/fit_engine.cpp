@@ -4,6 +4,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
+#include <clay/internal/math.hpp>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -155,7 +156,7 @@ struct Normal {
 };
 
 Normal assemble(const BSplineBasis& basis, const Points3& data, const std::vector<double>& t,
-                double lambda, const GaussRule& rule) {
+                double lambda, const internal::GaussRule& rule) {
   const int p = basis.degree;
   const int n = basis.count();
   Normal h;
@@ -344,7 +345,7 @@ PieceResult fit_piece(const PieceProblem& pr) {
   const bool periodic = pr.periodic;
   PieceResult out;
   out.params = pr.params;
-  const GaussRule rule = gauss_legendre(p);
+  const internal::GaussRule rule = internal::gauss_legendre(p);
   double alpha = pr.fairness;
   int reductions = 0;
 

@@ -8,6 +8,7 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/tolerance.hpp>
+#include <clay/internal/math.hpp>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
@@ -21,8 +22,6 @@
 #include <vector>
 
 #include "builder_tools.hpp"
-#include "quadrature.hpp"
-
 namespace clay::surface {
 namespace {
 
@@ -361,7 +360,7 @@ class PathTable {
 
   double arc(double a, double b) const {
     if (b <= a) return 0.0;
-    return detail::gauss_legendre_8(a, b,
+    return internal::gauss_legendre_8(a, b,
                                     [&](double t) { return derivatives(path_, t, 1).d1.norm(); });
   }
 

@@ -151,8 +151,9 @@ struct FreezeOptions {
                                             ///< pseudo-inverse replaces the inverse, [0, 1e-3]
   int max_iterations = 50;          ///< Newton iterations per start, 1..1000
   int max_subdivision_depth = 4;    ///< de Casteljau halvings of a chunk when Newton fails, 0..10
-  int threads = 0;                  ///< worker threads, 0 = one per hardware thread (at least
-                                    ///< 1,024 points per thread), 0..1024
+  int threads = 0;                  ///< parts the points are split into, 0 = one per hardware
+                                    ///< thread (at least 1,024 points per part), 0..1024
+  Executor executor = {};           ///< who runs the parts (clay/parallel.hpp); empty = std::threads
 
   /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
   void validate() const;
