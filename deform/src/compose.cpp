@@ -587,7 +587,7 @@ std::pair<double, double> global_parameter(const surface::BezierPatches& bp, int
                   "whole surface");
 }
 
-// ---- joining patches, knot removal ----------------------------------------------------------
+// ---- joining patches (knot removal is surface::remove_knots_u/_v) ------------------------------
 
 /// Homogeneous control net (rows i * nv + j, columns x w, y w, z w, w) with its knot vectors.
 struct Net {
@@ -635,99 +635,6 @@ Net join(const std::vector<double>& bu, const std::vector<double>& bv, std::vect
   return net;
 }
 
-/// The net with u and v (and their knots) swapped.
-Net transposed(const Net& n) {
-  Net t;
-  t.pu = n.pv, t.pv = n.pu, t.ku = n.kv, t.kv = n.ku, t.nu = n.nv, t.nv = n.nu;
-  t.h.resize(n.h.rows(), 4);
-  for (int i = 0; i < n.nu; ++i)
-    for (int j = 0; j < n.nv; ++j)
-      t.h.row(static_cast<Eigen::Index>(j) * n.nu + i) = n.h.row(static_cast<Eigen::Index>(i) * n.nv + j);
-  return t;
-}
-
-/// Removes the u knot at index r (its last occurrence, multiplicity s) once from every column,
-/// when every column allows it within `tol` (The NURBS Book A5.8, one removal, homogeneous).
-/// Returns the largest gap (>= 0) when removed, -1 when not.
-double remove_u_knot_once(Net& net, int r, int s, double tol) {
-  const int p = net.pu;
-  const auto& U = net.ku;
-  const double u = U[static_cast<size_t>(r)];
-  const int first = r - p, last = r - s, off = first - 1;
-  const int nt = last - off + 2;
-  std::vector<Eigen::RowVector4d> temp(static_cast<size_t>(nt) * static_cast<size_t>(net.nv));
-  double worst = 0;
-  auto P = [&](int i, int j) { return Eigen::RowVector4d(net.h.row(static_cast<Eigen::Index>(i) * net.nv + j)); };
-  auto alpha = [&](int i) {
-    return (u - U[static_cast<size_t>(i)]) / (U[static_cast<size_t>(i + p + 1)] - U[static_cast<size_t>(i)]);
-  };
-  for (int col = 0; col < net.nv; ++col) {
-    Eigen::RowVector4d* t = temp.data() + static_cast<size_t>(col) * static_cast<size_t>(nt);
-    t[0] = P(off, col);
-    t[last + 1 - off] = P(last + 1, col);
-    int i = first, j = last, ii = 1, jj = last - off;
-    while (j - i > 0) {
-      const double ai = alpha(i), aj = alpha(j);
-      t[ii] = (P(i, col) - (1 - ai) * t[ii - 1]) / ai;
-      t[jj] = (P(j, col) - aj * t[jj + 1]) / (1 - aj);
-      ++i, ++ii, --j, --jj;
-    }
-    double gap;
-    if (j - i < 0) {
-      gap = (t[ii - 1] - t[jj + 1]).norm();
-    } else {
-      const double ai = alpha(i);
-      gap = (P(i, col) - (ai * t[ii + 1] + (1 - ai) * t[ii - 1])).norm();
-    }
-    if (!(gap <= tol)) return -1;
-    worst = std::max(worst, gap);
-  }
-  // Commit: new points first..last from temp, drop point row fout (a block of nv rows), knot r.
-  for (int col = 0; col < net.nv; ++col) {
-    const Eigen::RowVector4d* t = temp.data() + static_cast<size_t>(col) * static_cast<size_t>(nt);
-    int i = first, j = last;
-    while (j - i > 0) {
-      net.h.row(static_cast<Eigen::Index>(i) * net.nv + col) = t[i - off];
-      net.h.row(static_cast<Eigen::Index>(j) * net.nv + col) = t[j - off];
-      ++i, --j;
-    }
-  }
-  const int fout = (2 * r - s - p) / 2;
-  double* data = net.h.data();
-  const std::ptrdiff_t row = 4 * static_cast<std::ptrdiff_t>(net.nv);
-  std::copy(data + (fout + 1) * row, data + net.nu * row, data + fout * row);
-  net.h.conservativeResize(static_cast<Eigen::Index>(net.nu - 1) * net.nv, 4);
-  net.nu -= 1;
-  net.ku.erase(net.ku.begin() + r);
-  return worst;
-}
-
-/// Removes every interior u knot as often as removal is exact; returns the number removed. The
-/// gaps of the removals of one knot value add up to at most `tol` (each removal may move the
-/// surface by about its gap, and repeated removals compound).
-int remove_u_knots(Net& net, double tol) {
-  int removed = 0;
-  const double first = net.ku.front(), last = net.ku.back();
-  std::vector<double> values;
-  for (double k : net.ku)
-    if (k != first && k != last && (values.empty() || values.back() != k)) values.push_back(k);
-  for (double value : values) {
-    double spent = 0;
-    for (;;) {
-      const auto hi = std::upper_bound(net.ku.begin(), net.ku.end(), value);
-      const auto lo = std::lower_bound(net.ku.begin(), net.ku.end(), value);
-      const int s = static_cast<int>(hi - lo);
-      if (s == 0) break;
-      const int r = static_cast<int>(hi - net.ku.begin()) - 1;
-      const double gap = remove_u_knot_once(net, r, s, tol - spent);
-      if (gap < 0) break;
-      spent += gap;
-      ++removed;
-    }
-  }
-  return removed;
-}
-
 BSplineSurface to_surface(const Net& net, bool rational) {
   BSplineSurface s;
   s.u = {net.pu, net.ku};
@@ -759,24 +666,26 @@ ComposeResult finish(const surface::BezierPatches& bp, std::vector<ComposedPatch
                      const BSplineSurface& original,
                      const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& pointwise, double size,
                      const ComposeOptions& options, int splits) {
-  Net net = join(bp.breaks_u, bp.breaks_v, patches);
+  const Net net = join(bp.breaks_u, bp.breaks_v, patches);
   ComposeReport report;
   report.patches = static_cast<int>(patches.size());
   report.splits = splits;
+  ComposeResult result{to_surface(net, rational), {}};
   if (options.knot_tolerance > 0) {
+    // The tolerance is relative to the largest homogeneous control point, as removal measures
+    // its gaps on (w·P, w).
     double hmax = 0;
     for (Eigen::Index r = 0; r < net.h.rows(); ++r) hmax = std::max(hmax, net.h.row(r).norm());
     const double tol = options.knot_tolerance * hmax;
-    report.knots_removed += remove_u_knots(net, tol);
-    Net t = transposed(net);
-    report.knots_removed += remove_u_knots(t, tol);
-    net = transposed(t);
+    auto in_u = surface::remove_knots_u(result.surface, tol);
+    auto in_v = surface::remove_knots_v(in_u.surface, tol);
+    report.knots_removed = in_u.removed + in_v.removed;
+    result.surface = std::move(in_v.surface);
   }
-  ComposeResult result{to_surface(net, rational), {}};
   detail::keep_closed_and_collapsed(original, result.surface, pointwise);
-  report.degree_u = net.pu;
-  report.degree_v = net.pv;
-  report.control_points = static_cast<long>(net.nu) * net.nv;
+  report.degree_u = result.surface.u.degree;
+  report.degree_v = result.surface.v.degree;
+  report.control_points = static_cast<long>(result.surface.points.rows());
   report.size = size;
   // The check: n x n samples inside every patch, the original and the result evaluated on the
   // whole grid at once (evaluate_grid), the original's points deformed one by one by the

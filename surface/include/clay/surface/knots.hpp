@@ -1,6 +1,7 @@
 #pragma once
-/// Knot insertion (Boehm), knot refinement and Bézier extraction. None of these change the shape:
-/// the new representation describes the same curve or surface (exactly, up to rounding).
+/// Knot insertion (Boehm), knot refinement, Bézier extraction and knot removal. None of these
+/// change the shape: the new representation describes the same curve or surface (exactly, up to
+/// rounding; knot removal within its tolerance).
 ///
 /// Every function validates its input and throws clay::Error: InvalidGeometry for an invalid
 /// object, OutOfDomain for a knot outside the parameter domain, InvalidArgument for a request that
@@ -49,5 +50,29 @@ struct BezierPatches {
 /// Splits the surface into its Bézier patches (The NURBS Book A5.7 by way of refinement); each
 /// patch keeps the surface's parameters on its span, so it evaluates like the surface there.
 BezierPatches extract_bezier(const BSplineSurface& surface);
+
+/// A curve after remove_knots, and how many knots were taken out.
+struct CurveKnotRemoval {
+  BSplineCurve curve;
+  int removed = 0;
+};
+/// A surface after remove_knots_u or _v, and how many knots were taken out.
+struct SurfaceKnotRemoval {
+  BSplineSurface surface;
+  int removed = 0;
+};
+
+/// Removes every interior knot as often as its removal moves the homogeneous control points
+/// (w·P, w) by at most `tolerance_mm` in all (The NURBS Book A5.8; the gaps of repeated
+/// removals of one knot value add up within the tolerance). For a polynomial curve that bounds
+/// how far the curve moves; exact composition joins Bézier patches with full-multiplicity knots
+/// and calls this with 1e-12 of the model size to return the smallest exact representation.
+/// Throws InvalidGeometry for an invalid curve, InvalidArgument for a negative or non-finite
+/// tolerance.
+CurveKnotRemoval remove_knots(const BSplineCurve& curve, double tolerance_mm);
+/// remove_knots in the u direction: a u knot goes only when every column of the net allows it.
+SurfaceKnotRemoval remove_knots_u(const BSplineSurface& surface, double tolerance_mm);
+/// remove_knots in the v direction.
+SurfaceKnotRemoval remove_knots_v(const BSplineSurface& surface, double tolerance_mm);
 
 }  // namespace clay::surface
