@@ -4,6 +4,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/tessellate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 #include <png.h>
@@ -152,7 +153,7 @@ struct Canvas {
 void RenderOptions::validate() const {
   if (width < 16 || width > 4096) bad_option("width", std::to_string(width), "must be in [16, 4096] pixels");
   if (height < 16 || height > 4096) bad_option("height", std::to_string(height), "must be in [16, 4096] pixels");
-  if (!eye_direction.allFinite() || !(eye_direction.norm() > 0))
+  if (!internal::all_finite(eye_direction) || !(eye_direction.norm() > 0))
     bad_option("eye_direction", "[" + text(eye_direction.x()) + ", " + text(eye_direction.y()) + ", " +
                                     text(eye_direction.z()) + "]",
                "must be finite and non-zero (the direction from the model towards the eye)");

@@ -4,6 +4,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -31,7 +32,7 @@ class Builder {
     k_ = k;
     c_ = &c;
     const std::string who = name();
-    if (!std::isfinite(c.value) || !c.direction.allFinite())
+    if (!std::isfinite(c.value) || !internal::all_finite(c.direction))
       fail(who + ": its value is not finite; give a finite number");
     switch (c.kind) {
       case ConstraintKind::Fixed: {

@@ -3,6 +3,7 @@
 
 #include <clay/constraints/solve.hpp>
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <ceres/ceres.h>
 
@@ -33,7 +34,7 @@ void SolveOptions::validate() const {
   if (!(rank_tolerance > 0 && rank_tolerance <= 1e-2))
     bad("rank_tolerance", rank_tolerance, "0 < rank_tolerance <= 1e-2");
   for (size_t k = 0; k < drag.size(); ++k)
-    if (!drag[k].target.allFinite())
+    if (!internal::all_finite(drag[k].target))
       throw Error(ErrorCategory::InvalidArgument,
                   "SolveOptions::drag[" + std::to_string(k) + "]: the target is not finite");
 }

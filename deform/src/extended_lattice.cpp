@@ -888,7 +888,7 @@ std::function<Eigen::Vector3d(const Eigen::Vector3d&)> prepared_point_map(const 
   o.threads = 1;
   auto data = std::make_shared<const std::pair<ExtendedLattice, Prepared>>(lattice, prepare(lattice, o));
   return [data, o](const Eigen::Vector3d& x) -> Eigen::Vector3d {
-    if (!x.allFinite())
+    if (!internal::all_finite(x))
       throw Error(ErrorCategory::InvalidGeometry,
                   "freeze: point row 0 is not finite " + format(x) + "; give finite coordinates");
     Counters count;

@@ -12,6 +12,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 
@@ -557,7 +558,7 @@ std::vector<double> added_breaks(const std::vector<double>& refined,
 
 Eigen::Vector3d deformed(const Certifier& d, const Eigen::Vector3d& x) {
   const Eigen::Vector3d y = d.map(x);
-  if (!y.allFinite())
+  if (!internal::all_finite(y))
     throw Error(ErrorCategory::InvalidArgument,
                 "refit_deformed: the " + d.name + " maps (" + format(x.x()) + ", " +
                     format(x.y()) + ", " + format(x.z()) +

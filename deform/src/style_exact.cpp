@@ -15,6 +15,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -359,7 +360,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
             // vertices reach the net's border, or μ large along S's weak directions).
             const Eigen::MatrixXd force = B.transpose() * mu;
             const double stationarity = (net->H * d - force).cwiseAbs().maxCoeff();
-            solved = d.allFinite() && (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
+            solved = internal::all_finite(d) && (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
                      stationarity <= range_space_stationarity * force.cwiseAbs().maxCoeff();
           }
         }

@@ -68,7 +68,7 @@ PointId Sketch::add_point(PlaneId plane, const Eigen::Vector2d& ab) {
     fail(ErrorCategory::InvalidArgument,
          "add_point: plane #" + std::to_string(plane.index) + " does not exist (the sketch has " +
              std::to_string(planes.size()) + " planes)");
-  if (!ab.allFinite())
+  if (!internal::all_finite(ab))
     fail(ErrorCategory::InvalidGeometry,
          "add_point: " + point_name(*this, static_cast<int>(points.size())) + " has a non-finite coordinate");
   points.push_back({to_world(planes[static_cast<size_t>(plane.index)], ab), plane});

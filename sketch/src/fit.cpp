@@ -2,6 +2,7 @@
 
 #include <clay/error.hpp>
 #include <clay/surface/degree_elevation.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 
@@ -153,7 +154,7 @@ Line fit_line(const Points3& pts, const std::vector<Eigen::Index>& idx) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
   line.point = c;
   line.direction = es.eigenvectors().col(2).normalized();
-  line.ok = line.direction.allFinite();
+  line.ok = internal::all_finite(line.direction);
   return line;
 }
 

@@ -5,6 +5,7 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
 #include <clay/internal/math.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -225,7 +226,7 @@ Solved solve(const Normal& h, const PointMap& map) {
   Solved out;
   if (ldlt.info() != Eigen::Success) return out;
   out.x = ldlt.solve(rhs);
-  if (ldlt.info() != Eigen::Success || !out.x.allFinite()) return out;
+  if (ldlt.info() != Eigen::Success || !internal::all_finite(out.x)) return out;
   out.points.resize(n, 3);
   for (int i = 0; i < n; ++i) {
     Eigen::Vector3d q = map.constant[static_cast<size_t>(i)];

@@ -3,6 +3,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -242,7 +243,7 @@ Profile hyperbola_profile(double limit) {
 
 void check_shape(const Eigen::Vector3d& radii, double e1, double e2, const char* what) {
   std::ostringstream m;
-  if (!radii.allFinite() || (radii.array() <= 0.0).any())
+  if (!internal::all_finite(radii) || (radii.array() <= 0.0).any())
     m << what << ": radii (" << radii.transpose() << ") must be positive and finite";
   else if (!(std::isfinite(e1) && e1 > 0.0 && e1 <= 10.0))
     m << what << ": exponent e1 = " << e1 << " is outside (0, 10]";

@@ -3,6 +3,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 
@@ -31,7 +32,7 @@ void ProjectionOptions::validate() const {
 namespace {
 
 void check_point(const Eigen::Vector3d& p) {
-  if (!p.allFinite())
+  if (!internal::all_finite(p))
     throw Error(ErrorCategory::InvalidGeometry,
                 "projection: the point to project has a non-finite coordinate; give a finite point");
 }
@@ -97,7 +98,7 @@ SurfaceProjection newton(const BSplineSurface& s, double size, const Eigen::Vect
       if (!held[0] && !held[1]) {
         if (!(M(0, 0) > 0.0 && M.determinant() > 0.0)) return false;
         step = -M.ldlt().solve(g);
-        return step.allFinite();
+        return internal::all_finite(step);
       }
       bool moved = false;
       for (int k = 0; k < 2; ++k) {
