@@ -591,7 +591,7 @@ FrozenLattice::FrozenLattice(const BSplineLattice& lattice) {
   degrees_ = {lattice.bases[0].degree, lattice.bases[1].degree, lattice.bases[2].degree};
   std::array<std::vector<detail::SpanExtraction>, 3> spans;
   for (int d = 0; d < 3; ++d) {
-    spans[static_cast<size_t>(d)] = detail::extract_spans(lattice.bases[static_cast<size_t>(d)]);
+    spans[static_cast<size_t>(d)] = surface::bezier_extraction(lattice.bases[static_cast<size_t>(d)]);
     std::vector<double> breaks;
     for (const auto& e : spans[static_cast<size_t>(d)]) breaks.push_back(e.a);
     breaks.push_back(spans[static_cast<size_t>(d)].back().b);

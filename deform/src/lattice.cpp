@@ -129,40 +129,6 @@ bool clamped_local(const Frame& frame, const Eigen::Vector3d& x, Eigen::Vector3d
   return true;
 }
 
-std::vector<SpanExtraction> extract_spans(const surface::BSplineBasis& basis) {
-  const int p = basis.degree;
-  const std::vector<double> breaks = surface::breakpoints(basis);
-  std::vector<SpanExtraction> spans;
-  std::vector<double> d(static_cast<size_t>(p + 1));
-  const double* U = basis.knots.data();
-  for (size_t c = 0; c + 1 < breaks.size(); ++c) {
-    SpanExtraction e;
-    e.a = breaks[c];
-    e.b = breaks[c + 1];
-    const int span = surface::find_span(basis, e.a);
-    e.first = span - p;
-    e.matrix.resize(p + 1, p + 1);
-    for (int q = 0; q <= p; ++q)      // blossom of the basis function first + q
-      for (int r = 0; r <= p; ++r) {  // Bézier point r = f(a^(p-r), b^r)
-        std::fill(d.begin(), d.end(), 0.0);
-        d[static_cast<size_t>(q)] = 1.0;
-        // de Boor triangle (The NURBS Book A5.1 form) with argument x_level.
-        for (int level = 1; level <= p; ++level) {
-          const double x = level <= p - r ? e.a : e.b;
-          for (int i = p; i >= level; --i) {
-            const int g = span - p + i;  // global index of d[i]
-            const double alpha = (x - U[g]) / (U[g + p + 1 - level] - U[g]);
-            d[static_cast<size_t>(i)] =
-                (1 - alpha) * d[static_cast<size_t>(i - 1)] + alpha * d[static_cast<size_t>(i)];
-          }
-        }
-        e.matrix(r, q) = d[static_cast<size_t>(p)];
-      }
-    spans.push_back(std::move(e));
-  }
-  return spans;
-}
-
 Points3 cell_points(const BSplineLattice& lattice, const SpanExtraction& ea,
                     const SpanExtraction& eb, const SpanExtraction& ec) {
   const int p = lattice.bases[0].degree, q = lattice.bases[1].degree, r = lattice.bases[2].degree;
@@ -387,7 +353,7 @@ BezierCells bezier_cells(const BSplineLattice& lattice) {
   std::array<std::vector<detail::SpanExtraction>, 3> spans;
   BezierCells out;
   for (int d = 0; d < 3; ++d) {
-    spans[d] = detail::extract_spans(lattice.bases[d]);
+    spans[d] = surface::bezier_extraction(lattice.bases[d]);
     for (const auto& e : spans[d]) out.breaks[d].push_back(e.a);
     out.breaks[d].push_back(spans[d].back().b);
   }

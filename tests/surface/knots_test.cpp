@@ -190,3 +190,28 @@ TEST_CASE("remove_knots refuses a negative or non-finite tolerance", "[knots]") 
     CHECK_THROWS_AS(remove_knots_v(s, bad), clay::Error);
   }
 }
+
+TEST_CASE("bezier_extraction: each span's operator maps the control points to a Bézier piece that evaluates like the curve", "[knots]") {
+  std::mt19937 rng(5);
+  for (int p = 1; p <= 5; ++p)
+    for (bool clamped : {true, false}) {
+      const BSplineCurve c = clay::test::random_curve(rng, p, p + 6, false, clamped, p);
+      const std::vector<SpanExtraction> spans = bezier_extraction(c.basis);
+      CHECK(spans.size() == breakpoints(c.basis).size() - 1);
+      for (const SpanExtraction& e : spans) {
+        REQUIRE(e.matrix.rows() == p + 1);
+        // Partition of unity: every Bézier point is an affine combination.
+        CHECK((e.matrix.rowwise().sum().array() - 1.0).abs().maxCoeff() < 1e-13);
+        BSplineCurve piece;
+        piece.basis.degree = p;
+        piece.basis.knots.assign(static_cast<size_t>(p + 1), e.a);
+        piece.basis.knots.insert(piece.basis.knots.end(), static_cast<size_t>(p + 1), e.b);
+        piece.points = e.matrix * c.points.middleRows(e.first, p + 1);
+        piece.weights = Eigen::VectorXd::Ones(p + 1);
+        for (int k = 0; k <= 10; ++k) {
+          const double t = k == 10 ? e.b : e.a + (e.b - e.a) * k / 10.0;
+          CHECK((evaluate(piece, t) - evaluate(c, t)).norm() < 1e-11);
+        }
+      }
+    }
+}

@@ -9,6 +9,8 @@
 /// unclamped vector's outermost value).
 #include <clay/surface/bspline_surface.hpp>
 
+#include <Eigen/Core>
+
 #include <span>
 #include <vector>
 
@@ -50,6 +52,18 @@ struct BezierPatches {
 /// Splits the surface into its Bézier patches (The NURBS Book A5.7 by way of refinement); each
 /// patch keeps the surface's parameters on its span, so it evaluates like the surface there.
 BezierPatches extract_bezier(const BSplineSurface& surface);
+
+/// The Bézier extraction operator of one non-empty span [a, b] of a basis: the span's Bézier
+/// control point r is sum_q matrix(r, q) P[first + q] (first = span index − degree).
+struct SpanExtraction {
+  double a = 0, b = 1;
+  int first = 0;
+  Eigen::MatrixXd matrix;  ///< (degree + 1) x (degree + 1)
+};
+
+/// The extraction operator of every non-empty span of the domain, by the same refinement as
+/// extract_bezier (applied to the identity), for nets of any dimension such as FFD lattices.
+std::vector<SpanExtraction> bezier_extraction(const BSplineBasis& basis);
 
 /// A curve after remove_knots, and how many knots were taken out.
 struct CurveKnotRemoval {
