@@ -847,42 +847,42 @@ RefitResult refit_validated(const BSplineSurface& surface, const D& deformation,
 
 }  // namespace
 
-RefitResult refit_deformed(const BSplineSurface& surface, const Taper& taper,
+RefitResult refit_deformed(const Taper& taper, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, taper, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const Twist& twist,
+RefitResult refit_deformed(const Twist& twist, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, twist, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const Bend& bend,
+RefitResult refit_deformed(const Bend& bend, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, bend, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const BezierLattice& lattice,
+RefitResult refit_deformed(const BezierLattice& lattice, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, lattice, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const BSplineLattice& lattice,
+RefitResult refit_deformed(const BSplineLattice& lattice, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, lattice, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const ExtendedLattice& lattice,
+RefitResult refit_deformed(const ExtendedLattice& lattice, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, lattice, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const DeformationStack& stack,
+RefitResult refit_deformed(const DeformationStack& stack, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, stack, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const PointMap& map,
+RefitResult refit_deformed(const PointMap& map, const BSplineSurface& surface,
                            const RefitOptions& options) {
   if (!map)
     throw Error(ErrorCategory::InvalidArgument,

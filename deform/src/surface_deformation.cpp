@@ -188,7 +188,7 @@ void refuse_torn(const Deformation& d, const surface::BSplineSurface& s, const R
 }
 
 RefitResult refit_step(const Deformation& d, const surface::BSplineSurface& s, const RefitOptions& o) {
-  return std::visit([&](const auto& deformation) { return refit_deformed(s, deformation, o); }, d);
+  return std::visit([&](const auto& deformation) { return refit_deformed(deformation, s, o); }, d);
 }
 
 }  // namespace

@@ -106,36 +106,36 @@ using PointMap = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 /// Refit of taper(S): certified. Throws clay::Error: InvalidArgument for bad options,
 /// InvalidGeometry for an invalid surface or taper, or a deformed surface of zero size with a
 /// relative tolerance.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const Taper& taper,
+RefitResult refit_deformed(const Taper& taper, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of twist(S): certified. Throws as the taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const Twist& twist,
+RefitResult refit_deformed(const Twist& twist, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of bend(S): certified (first-derivative remainder in cells crossing y_min or y_max,
 /// where the bend is only C0 off its neutral plane). Throws as the taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const Bend& bend,
+RefitResult refit_deformed(const Bend& bend, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of lattice(S), Sederberg–Parry eq. (2): certified; cells crossing the lattice's faces
 /// are reported in crossings. Throws as the taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const BezierLattice& lattice,
+RefitResult refit_deformed(const BezierLattice& lattice, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of lattice(S), Hsu–Hughes–Kaufman eq. (1): certified; every cell whose hull crosses a
 /// knot plane or face is reported in crossings with its sampled maximum and bound. Throws as the
 /// taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const BSplineLattice& lattice,
+RefitResult refit_deformed(const BSplineLattice& lattice, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of lattice(S) (pointwise, each point frozen alone): not certified (no derivative bounds
 /// for a Newton-frozen map); the report has the sampled maximum. Throws as the taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const ExtendedLattice& lattice,
+RefitResult refit_deformed(const ExtendedLattice& lattice, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of stack(S): certified when every enabled step is (derivative bounds chained through the
 /// steps), otherwise sampled only. Throws as the taper overload (invalid stack: InvalidGeometry).
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const DeformationStack& stack,
+RefitResult refit_deformed(const DeformationStack& stack, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of map(S) for any point map: not certified (nothing is known of its derivatives).
 /// Throws as the taper overload, and InvalidArgument for an empty map or one returning a
 /// non-finite point (naming the point).
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const PointMap& map,
+RefitResult refit_deformed(const PointMap& map, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 
 }  // namespace clay::deform
