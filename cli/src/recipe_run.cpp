@@ -170,8 +170,8 @@ class Runner {
                       " curves; a recipe stroke must give one curve: draw it as separate strokes");
     const auto& c = fit.curves.front();
     rep.figures = {{"control_points", static_cast<long long>(c.control_points)},
-                   {"max_deviation", c.max_deviation},
-                   {"rms_deviation", c.rms_deviation},
+                   {"max_deviation_mm", c.max_deviation_mm},
+                   {"rms_deviation_mm", c.rms_deviation_mm},
                    {"closed", c.closed}};
     rep.message = fit.summary.brief();
     if (!fit.summary.converged()) {  // a fit that misses its tolerance is a failure unless accepted
@@ -252,7 +252,7 @@ class Runner {
                    {"control_points", static_cast<long long>(b.count_u) * b.count_v},
                    {"rational", b.rational},
                    {"exact", b.exact},
-                   {"max_deviation", b.max_deviation}};
+                   {"max_deviation_mm", b.max_deviation_mm}};
     rep.message = b.brief();
   }
 
@@ -368,8 +368,8 @@ class Runner {
     };
     if (o.method == deform::StepOutcome::Method::exact) {
       rep.figures.emplace_back("composition", std::string("exact"));
-      rep.figures.emplace_back("max_deviation", o.compose.max_deviation);  // relative to size
-      rep.figures.emplace_back("max_deviation_mm", o.compose.max_deviation * o.compose.size);
+      rep.figures.emplace_back("max_relative_deviation", o.compose.max_relative_deviation);  // of size
+      rep.figures.emplace_back("max_deviation_mm", o.compose.max_relative_deviation * o.compose.size);
       sizes();
       rep.figures.emplace_back("exact", true);
       rep.figures.emplace_back("patches", static_cast<long long>(o.compose.patches));
@@ -379,7 +379,7 @@ class Runner {
       const auto& f = o.refit;
       const double bound = f.certified ? f.certified_bound : f.sampled_max;
       rep.figures.emplace_back("composition", std::string("refit"));
-      rep.figures.emplace_back("max_deviation", bound / f.size);
+      rep.figures.emplace_back("max_relative_deviation", bound / f.size);
       rep.figures.emplace_back("max_deviation_mm", bound);
       sizes();
       rep.figures.emplace_back("exact", false);

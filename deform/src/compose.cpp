@@ -703,7 +703,7 @@ ComposeResult finish(const surface::BezierPatches& bp, std::vector<ComposedPatch
     const Points3 after = surface::evaluate_grid(result.surface, us, vs);
     for (Eigen::Index r = 0; r < before.rows(); ++r) {
       const Eigen::Vector3d expected = pointwise(Eigen::Vector3d(before.row(r).transpose()));
-      report.max_deviation = std::max(report.max_deviation, (after.row(r).transpose() - expected).norm() / size);
+      report.max_relative_deviation = std::max(report.max_relative_deviation, (after.row(r).transpose() - expected).norm() / size);
     }
   }
   report.exact = true;
@@ -899,7 +899,7 @@ std::string ComposeReport::brief() const {
   m.precision(3);
   m << "exact composition: degree " << degree_u << " x " << degree_v << ", " << patches << " patches, "
     << control_points << " control points, " << knots_removed << " knots removed, " << splits
-    << " split knots, max deviation " << max_deviation << " x " << size << " mm";
+    << " split knots, max relative deviation " << max_relative_deviation << " x " << size << " mm";
   return m.str();
 }
 

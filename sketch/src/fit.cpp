@@ -309,8 +309,8 @@ FittedCurve report(const PieceResult& r, surface::BSplineCurve curve, bool close
   f.closed = closed;
   f.first_point = first;
   f.last_point = last;
-  f.max_deviation = r.max_deviation;
-  f.rms_deviation = r.rms_deviation;
+  f.max_deviation_mm = r.max_deviation;
+  f.rms_deviation_mm = r.rms_deviation;
   f.control_points = static_cast<int>(f.curve.points.rows());
   f.iterations = r.iterations;
   f.fairness = r.fairness;
@@ -411,7 +411,7 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
   Summary& s = out.summary;
   s.termination = Termination::Converged;
   for (const auto& c : out.curves) {
-    out.max_deviation = std::max(out.max_deviation, c.max_deviation);
+    out.max_deviation_mm = std::max(out.max_deviation_mm, c.max_deviation_mm);
     s.iterations += c.iterations;
     s.initial_residual = std::max(s.initial_residual, c.summary.initial_residual);
     if (c.summary.termination == Termination::Failed)
@@ -419,12 +419,12 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
     else if (c.summary.termination == Termination::NotConverged && s.termination == Termination::Converged)
       s.termination = Termination::NotConverged;
   }
-  s.final_residual = out.max_deviation;
+  s.final_residual = out.max_deviation_mm;
   std::ostringstream m;
   m.precision(3);
   m << out.curves.size() << (out.curves.size() == 1 ? " curve" : " curves") << ", "
     << corners.size() << (corners.size() == 1 ? " corner" : " corners") << ", "
-    << (out.closed ? "closed" : "open") << "; max deviation " << out.max_deviation
+    << (out.closed ? "closed" : "open") << "; max deviation " << out.max_deviation_mm
     << " mm for tolerance " << options.tolerance << " mm";
   if (s.termination != Termination::Converged) m << " (see the curves' summaries)";
   s.message = m.str();

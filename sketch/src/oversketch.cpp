@@ -238,8 +238,8 @@ OversketchResult oversketch(const BSplineCurve& curve, const Stroke& stroke,
   OversketchResult out;
   out.cut_start = a;
   out.cut_end = b;
-  out.max_deviation = fitted.max_deviation;
-  out.rms_deviation = fitted.rms_deviation;
+  out.max_deviation_mm = fitted.max_deviation;
+  out.rms_deviation_mm = fitted.rms_deviation;
   out.iterations = fitted.iterations;
   out.summary = fitted.summary;
   if (fitted.summary.termination == Termination::Failed) return out;

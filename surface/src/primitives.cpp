@@ -291,7 +291,7 @@ BuiltSurface assemble(const std::function<Profile(double)>& make_m, const std::f
   }
   BuiltSurface out{s, describe(s, method)};
   out.report.exact = m.exact && h.exact;
-  out.report.max_deviation = worst;
+  out.report.max_deviation_mm = worst;
   out.report.samples = static_cast<int>(ss.size() * ts.size());
   return out;
 }

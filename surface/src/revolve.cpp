@@ -134,7 +134,7 @@ BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle
     }
   }
   out.report.exact = true;
-  out.report.max_deviation = worst;
+  out.report.max_deviation_mm = worst;
   out.report.samples = static_cast<int>(us.size() * vs.size());
   return out;
 }

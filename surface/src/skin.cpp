@@ -699,7 +699,7 @@ BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& 
   if (!turned.empty()) method += " (reversed: #" + turned + ")";
   built.report = describe(built.surface, method);
   built.report.exact = true;
-  built.report.max_deviation = worst;
+  built.report.max_deviation_mm = worst;
   built.report.samples = static_cast<int>(us.size() * count);
   return built;
 }
@@ -772,7 +772,7 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
     const double worst = deviation(built.surface, linspace(0.0, 1.0, 9), samples);
     built.report = describe(built.surface, "sweep along a straight path (exact extrusion)");
     built.report.exact = true;
-    built.report.max_deviation = worst;
+    built.report.max_deviation_mm = worst;
     built.report.samples = samples;
     return built;
   }
@@ -866,7 +866,7 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
   const std::string method = "sweep with rotation-minimizing frames, " + std::to_string(count) + " sections";
   built.report = describe(built.surface, method);
   built.report.exact = false;
-  built.report.max_deviation = worst;
+  built.report.max_deviation_mm = worst;
   built.report.samples = samples;
   return built;
 }

@@ -126,7 +126,7 @@ void check_exact_composition(const StepReport& s) {
   INFO(s.path << ": " << s.message);
   CHECK(figure<std::string>(s, "composition") == "exact");
   CHECK(figure<bool>(s, "exact"));
-  CHECK(figure<double>(s, "max_deviation") <= 1e-12);
+  CHECK(figure<double>(s, "max_relative_deviation") <= 1e-12);
   CHECK(figure<bool>(s, "fold_free"));
 }
 

@@ -37,7 +37,7 @@ TEST_CASE("BuildReport describes a surface in one line", "[error]") {
   const BSplineSurface s = make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
   BuildReport r = describe(s, "bilinear");
   r.exact = true;
-  r.max_deviation = 0.0;
+  r.max_deviation_mm = 0.0;
   r.samples = 9;
   CHECK(r.count_u == 2);
   CHECK_FALSE(r.rational);

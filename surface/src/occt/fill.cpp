@@ -532,7 +532,7 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
   if (!note.empty()) method += " (" + note + ")";
   built.report = describe(built.surface, method);
   built.report.exact = true;
-  built.report.max_deviation = worst;
+  built.report.max_deviation_mm = worst;
   built.report.samples = samples;
   return built;
 }
@@ -638,7 +638,7 @@ NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
   method += ")";
   out.built.report = describe(s, method);
   out.built.report.exact = false;
-  out.built.report.max_deviation =
+  out.built.report.max_deviation_mm =
       *std::max_element(out.curve_deviations.begin(), out.curve_deviations.end());
   out.built.report.samples = samples;
   return out;

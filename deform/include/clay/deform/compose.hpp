@@ -38,7 +38,7 @@ struct ComposeOptions {
   /// net (dimensionless, in [0, 1e-6]). 0 keeps every patch boundary (a C0 patchwork).
   double knot_tolerance = 1e-12;
   /// Samples per patch and direction at which the result is compared with the pointwise
-  /// deformation of the original for ComposeReport::max_deviation (>= 0; 0 skips the check).
+  /// deformation of the original for ComposeReport::max_relative_deviation (>= 0; 0 skips the check).
   int check_samples = 4;
 
   /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
@@ -56,7 +56,7 @@ struct ComposeReport {
   /// Largest distance between the result and the pointwise deformation (deform_point of the
   /// original surface's points) over check_samples² parameters per patch, divided by `size`
   /// (dimensionless; ~1e-15 for an exact composition). 0 when check_samples is 0.
-  double max_deviation = 0.0;
+  double max_relative_deviation = 0.0;
   double size = 0.0;         ///< the reference length (mm): the lattice control points' box
                              ///< diagonal, or the surface's control box diagonal for a taper
   bool exact = true;         ///< true: the result is the composition, exact up to rounding

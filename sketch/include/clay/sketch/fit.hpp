@@ -74,14 +74,14 @@ struct FittedCurve {
   Eigen::Index first_point = 0; ///< first stroke point fitted by this curve
   Eigen::Index last_point = 0;  ///< last stroke point fitted (inclusive; wraps past the stroke's
                                 ///< end for the last curve of a closed stroke with corners)
-  double max_deviation = 0;     ///< mm, largest distance from its stroke points to the curve,
+  double max_deviation_mm = 0;  ///< largest distance from its stroke points to the curve,
                                 ///< measured at each point's foot point (Newton projection)
-  double rms_deviation = 0;     ///< mm, root mean square of the same distances
+  double rms_deviation_mm = 0;  ///< root mean square of the same distances
   int control_points = 0;       ///< curve.points.rows()
   int iterations = 0;           ///< refinement iterations
   double fairness = 0;          ///< fairness weight in use at the end (after reductions)
   double noise = 0;             ///< mm, estimated noise of its stroke points per coordinate
-  Summary summary;              ///< converged when max_deviation <= tolerance
+  Summary summary;              ///< converged when max_deviation_mm <= tolerance
 };
 
 /// The curves fitted to one stroke, in drawing order; consecutive curves share their joint point
@@ -90,7 +90,7 @@ struct StrokeFit {
   std::vector<FittedCurve> curves;    ///< in drawing order
   std::vector<Eigen::Index> corners;  ///< stroke index of each corner (the last point before it)
   bool closed = false;                ///< the chain closes (one closed curve, or corners all round)
-  double max_deviation = 0;           ///< mm, largest of the curves' max_deviation
+  double max_deviation_mm = 0;        ///< largest of the curves' max_deviation_mm
   double plane_offset = 0;            ///< mm, largest distance of a stroke point from its plane
   Summary summary;                    ///< converged when every curve converged
 };

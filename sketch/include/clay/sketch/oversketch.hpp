@@ -58,8 +58,8 @@ struct OversketchResult {
   double cut_end = 0;                ///< parameter where it ends (a domain end for a new head/tail)
   std::optional<Joint> start_joint;  ///< absent when the stroke replaced the curve's head
   std::optional<Joint> end_joint;    ///< absent when the stroke replaced the curve's tail
-  double max_deviation = 0;          ///< mm, stroke points to the new part (foot points)
-  double rms_deviation = 0;          ///< mm
+  double max_deviation_mm = 0;       ///< stroke points to the new part (foot points)
+  double rms_deviation_mm = 0;       ///< root mean square of the same distances
   int control_points = 0;            ///< control points of the new part
   int iterations = 0;                ///< refinement iterations of the new part's fit
   Summary summary;                   ///< the new part's fit; converged when within tolerance
