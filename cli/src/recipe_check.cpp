@@ -1237,7 +1237,7 @@ class RecipeChecker {
       } else {
         const auto cells = triple(j, path, "cells", 1, limit::lattice_cells, "[a, b, c]");
         const auto degrees = triple(j, path, "degrees", 1, surface::max_kernel_degree, "[p, q, r]");
-        deform::LatticeKnots knots = deform::LatticeKnots::clamped;
+        deform::LatticeKnots knots = deform::LatticeKnots::Clamped;
         if (const Json* k = c_.member(j, path, "knots", false, ""))
           if (const auto c = c_.choice(*k, key_path(path, "knots"), {"clamped", "uniform"}))
             knots = static_cast<deform::LatticeKnots>(*c);
@@ -1568,7 +1568,7 @@ class RecipeChecker {
     auto& o = d.options;
     if (const Json* m = c_.member(j, p, "mode", false, ""))
       if (const auto k = c_.choice(*m, key_path(p, "mode"), {"paper", "exact"}))
-        o.mode = *k == 0 ? deform::StyleMode::paper : deform::StyleMode::exact;
+        o.mode = *k == 0 ? deform::StyleMode::Paper : deform::StyleMode::Exact;
     o.lambda = c_.number_or(j, p, "lambda", o.lambda, Range{0, 1});
     o.relaxation = c_.boolean_or(j, p, "relaxation", o.relaxation);
     o.smoothing = c_.boolean_or(j, p, "smoothing", o.smoothing);

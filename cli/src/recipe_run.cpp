@@ -366,7 +366,7 @@ class Runner {
       rep.figures.emplace_back("degree_v", static_cast<long long>(r.surface.v.degree));
       rep.figures.emplace_back("control_points", static_cast<long long>(r.surface.points.rows()));
     };
-    if (o.method == deform::StepOutcome::Method::exact) {
+    if (o.method == deform::StepOutcome::Method::Exact) {
       rep.figures.emplace_back("composition", std::string("exact"));
       rep.figures.emplace_back("max_relative_deviation", o.compose.max_relative_deviation);  // of size
       rep.figures.emplace_back("max_deviation_mm", o.compose.max_relative_deviation * o.compose.size);
@@ -412,7 +412,7 @@ class Runner {
     const auto r = d.bound.empty() ? deform::style_deform(s, curve_of(d.target), d.options)
                                    : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
     const auto& x = r.report;
-    rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::exact ? "exact" : "paper")},
+    rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::Exact ? "exact" : "paper")},
                    {"constraint_class", std::string(deform::to_string(x.constraint_class))},
                    {"key_points", static_cast<long long>(x.m)},
                    {"influenced_vertices", static_cast<long long>(x.influenced_vertices)},

@@ -264,7 +264,7 @@ BSplineLattice make_bspline_lattice(const Frame& frame, std::array<int, 3> degre
   std::array<surface::BSplineBasis, 3> bases;
   for (int d = 0; d < 3; ++d) {
     const int p = degrees[d], n = cells[d];
-    if (knots == LatticeKnots::clamped) {
+    if (knots == LatticeKnots::Clamped) {
       bases[d] = surface::clamped_uniform_basis(p, n + p, 0.0, 1.0);
     } else {
       bases[d].degree = p;

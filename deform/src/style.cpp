@@ -24,9 +24,9 @@ using surface::Points3;
 
 std::string_view to_string(ConstraintClass c) noexcept {
   switch (c) {
-    case ConstraintClass::over_constrained: return "over-constrained";
-    case ConstraintClass::under_constrained: return "under-constrained";
-    case ConstraintClass::well_constrained: return "well-constrained";
+    case ConstraintClass::OverConstrained: return "over-constrained";
+    case ConstraintClass::UnderConstrained: return "under-constrained";
+    case ConstraintClass::WellConstrained: return "well-constrained";
   }
   return "?";
 }
@@ -245,7 +245,7 @@ KeyPoint make_key_point(const BSplineSurface& s, const InfluenceRegion& region, 
   k.distance = (k.point - k.foot).dot(k.normal);
   const double gu = continuous_index(surface::greville_abscissae(s.u), u);
   const double gv = continuous_index(surface::greville_abscissae(s.v), v);
-  k.row = static_cast<int>(std::lround(direction == KeyDirection::u ? gu : gv));
+  k.row = static_cast<int>(std::lround(direction == KeyDirection::U ? gu : gv));
   k.influenced = region.inside(static_cast<int>(std::lround(gu)), static_cast<int>(std::lround(gv)));
   return k;
 }
@@ -257,7 +257,7 @@ bool begin_report(const KeyPoints& keys, const StyleOptions& options, StyleMode 
   report.direction = keys.direction;
   report.m = static_cast<int>(keys.points.size());
   report.key_points = keys.points;
-  if (keys.constraint_class == ConstraintClass::over_constrained) {
+  if (keys.constraint_class == ConstraintClass::OverConstrained) {
     report.message = "over-constrained: the target curve lies outside the bound; the surface is unchanged";
     return true;
   }
@@ -288,11 +288,11 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
     gv_hi = std::max(gv_hi, gv);
     inside += sample_inside(t.u, t.v) ? 1 : 0;
   }
-  out.direction = (gu_hi - gu_lo >= gv_hi - gv_lo) ? KeyDirection::u : KeyDirection::v;
-  out.constraint_class = inside == 0 ? ConstraintClass::over_constrained
-                         : inside == static_cast<int>(trace.size()) ? ConstraintClass::well_constrained
-                                                                    : ConstraintClass::under_constrained;
-  const bool along_u = out.direction == KeyDirection::u;
+  out.direction = (gu_hi - gu_lo >= gv_hi - gv_lo) ? KeyDirection::U : KeyDirection::V;
+  out.constraint_class = inside == 0 ? ConstraintClass::OverConstrained
+                         : inside == static_cast<int>(trace.size()) ? ConstraintClass::WellConstrained
+                                                                    : ConstraintClass::UnderConstrained;
+  const bool along_u = out.direction == KeyDirection::U;
   const std::vector<double>& along = along_u ? xu : xv;
   auto coord = [&](double u, double v) { return along_u ? u : v; };
   double lo = 1e300, hi = -1e300;
@@ -567,7 +567,7 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
   s.final_residual = report.target_deviation;
   std::ostringstream m;
   m.precision(4);
-  if (report.constraint_class == ConstraintClass::over_constrained) {
+  if (report.constraint_class == ConstraintClass::OverConstrained) {
     s.termination = Termination::Failed;
     s.message = "the target curve lies outside the bound, so no control vertex may move and the surface is "
                 "unchanged: draw the target curve (at least partly) inside the bound, or the bound around it";
@@ -587,11 +587,11 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
       << " mm from the surface (" << report.max_displacement / farthest
       << " times; at most 10 times is accepted): the surface folds. Move the bound further from the target or "
          "the target closer to the surface";
-    if (report.mode == StyleMode::exact) m << ", or allow more max_refinements";
+    if (report.mode == StyleMode::Exact) m << ", or allow more max_refinements";
     s.message = m.str();
     return s;
   }
-  if (report.mode == StyleMode::exact) {
+  if (report.mode == StyleMode::Exact) {
     const double size = report.model_size;
     if (!report.conflicting_key_points.empty()) {
       s.termination = Termination::NotConverged;
@@ -611,7 +611,7 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
     }
     s.message = m.str();
   }
-  if (s.converged()) s.message = report.mode == StyleMode::exact ? "the key points and the target curve are met"
+  if (s.converged()) s.message = report.mode == StyleMode::Exact ? "the key points and the target curve are met"
                                                                  : "the target is approximated (paper mode)";
   return s;
 }
@@ -619,7 +619,7 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
 StyleResult StyleEditor::update(const BSplineCurve& target) {
   surface::validate(target, "target curve");
   const auto trace = detail::trace_on_surface(projector_, target, detail::target_samples(target, options_), &warm_);
-  StyleResult out = options_.mode == StyleMode::exact
+  StyleResult out = options_.mode == StyleMode::Exact
                         ? detail::style_exact(projector_, region_, target, trace, options_, exact_)
                         : detail::style_paper(projector_, region_, target, trace, options_);
   out.report.summary = judge_style(out.report, options_);
@@ -637,13 +637,13 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
   KeyPoints keys = find_key_points(projector, region, target, trace, 1);
   StyleResult out{parent, parent, {}};
   StyleReport& report = out.report;
-  if (begin_report(keys, options, StyleMode::paper, report)) {
+  if (begin_report(keys, options, StyleMode::Paper, report)) {
     detail::measure(parent, out.surface, region.factors, region, trace, options, report);
     return out;
   }
 
   // Rows of the net in the key direction (vertices (row, col) for direction u, (col, row) for v).
-  const bool along_u = keys.direction == KeyDirection::u;
+  const bool along_u = keys.direction == KeyDirection::U;
   const int rows = along_u ? parent.count_u() : parent.count_v();
   const int cols = along_u ? parent.count_v() : parent.count_u();
   auto vertex = [&](int row, int col) { return along_u ? parent.index(row, col) : parent.index(col, row); };

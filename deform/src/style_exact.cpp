@@ -250,7 +250,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   // The key points are those of the parent's net (eq. 8): refinement adds freedom, not
   // constraints. Key points are added where the result still misses the target curve.
   const KeyPoints keys = find_key_points(projector, region, target, trace, options.key_points_per_row);
-  if (begin_report(keys, options, StyleMode::exact, report)) {
+  if (begin_report(keys, options, StyleMode::Exact, report)) {
     measure(parent, parent, region.factors, region, trace, options, report);
     return out;
   }

@@ -25,9 +25,9 @@ std::string SurfaceDeformationReport::brief() const {
     out << "steps[" << s.step << "] " << s.kind;
     if (!s.name.empty()) out << " '" << s.name << "'";
     switch (s.method) {
-      case StepOutcome::Method::skipped: out << ": disabled, skipped"; break;
-      case StepOutcome::Method::exact: out << ": exact, " << s.compose.brief(); break;
-      case StepOutcome::Method::refit: out << ": refit, " << s.refit.brief(); break;
+      case StepOutcome::Method::Skipped: out << ": disabled, skipped"; break;
+      case StepOutcome::Method::Exact: out << ": exact, " << s.compose.brief(); break;
+      case StepOutcome::Method::Refit: out << ": refit, " << s.refit.brief(); break;
     }
     out << "\n";
   }
@@ -213,7 +213,7 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
     }
     Attempt a = try_exact(step.deformation, out.surface, options.compose);
     if (a.result) {
-      o.method = StepOutcome::Method::exact;
+      o.method = StepOutcome::Method::Exact;
       o.compose = a.result->report;
       out.surface = std::move(a.result->surface);
     } else {
@@ -230,7 +230,7 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
                     where + " misses its tolerance: the refit's " + r.report.summary.message +
                         ". Nothing is returned; to accept the result anyway set "
                         "SurfaceDeformationOptions::accept_out_of_tolerance");
-      o.method = StepOutcome::Method::refit;
+      o.method = StepOutcome::Method::Refit;
       o.reason = std::move(a.reason);
       o.refit = r.report;
       report.exact = false;

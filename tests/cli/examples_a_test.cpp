@@ -142,7 +142,7 @@ TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow c
   // The style step, recomputed with the deform library from the recipe's numbers.
   const Json& draft = j.at("deformations").at("shape").at(0);
   deform::StyleOptions options;
-  options.mode = deform::StyleMode::exact;
+  options.mode = deform::StyleMode::Exact;
   options.key_points_per_row = draft.at("key_points_per_row").get<int>();
   options.curve_tolerance = draft.at("curve_tolerance").get<double>();
   const deform::StyleResult styled =

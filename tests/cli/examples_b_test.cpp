@@ -236,8 +236,8 @@ TEST_CASE("example handset: local C1 lattices then a global bend, against the po
   const RunResult r = run_example("handset");
   const DeformationStack stack = handset_stack();
   // The local lattices move interior planes only: C1 with the bar across the face it crosses.
-  const FaceContinuity mouth_face[] = {{Face::s_min, 1}};
-  const FaceContinuity ear_face[] = {{Face::s_max, 1}};
+  const FaceContinuity mouth_face[] = {{Face::SMin, 1}};
+  const FaceContinuity ear_face[] = {{Face::SMax, 1}};
   const auto& mouth = std::get<BezierLattice>(stack.steps[0].deformation);
   const auto& ear = std::get<BezierLattice>(stack.steps[1].deformation);
   CHECK(with_continuity(mouth, mouth_face).points == mouth.points);

@@ -150,7 +150,7 @@ TEST_CASE("feasible requests reach their targets with the least displacement", "
   }
   SECTION("uniform-knot B-spline lattice, 5 points") {
     check_minimal_norm(clay::test::displaced(make_bspline_lattice(random_frame(rng, true), {2, 2, 2}, {3, 2, 3},
-                                                                  LatticeKnots::uniform),
+                                                                  LatticeKnots::Uniform),
                                              rng),
                        rng, 5);
   }
@@ -219,7 +219,7 @@ TEST_CASE("locked control points keep their positions bit for bit", "[deform]") 
   std::mt19937 rng(46);
   const BSplineLattice lattice =
       clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 3}, {3, 3, 3}), rng);
-  const FaceContinuity faces[] = {{Face::s_min, 1}, {Face::u_max, 0}};
+  const FaceContinuity faces[] = {{Face::SMin, 1}, {Face::UMax, 0}};
   DirectManipulationOptions options;
   options.locked = locked_control_points(lattice, faces);
   const Points3 x = sample_points(lattice.frame, rng, 6, 0.15, 0.85);
@@ -391,7 +391,7 @@ TEST_CASE("docs snippet: lift one point and pin another with the bottom kept C1"
   frame.t = {10, 100, 0};
   frame.u = {0, 0, 40};
   BSplineLattice lattice = make_bspline_lattice(frame, {3, 3, 3}, {8, 8, 8});
-  const FaceContinuity keep[] = {{Face::u_min, 1}};
+  const FaceContinuity keep[] = {{Face::UMin, 1}};
   DirectManipulationOptions options;
   options.locked = locked_control_points(lattice, keep);
   const PointMove moves[] = {{frame.point(0.5, 0.5, 0.9), frame.point(0.5, 0.5, 0.9) + Eigen::Vector3d(0, 0, 12)},

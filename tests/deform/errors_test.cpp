@@ -58,7 +58,7 @@ TEST_CASE("bad options and arguments are rejected naming the field", "[deform]")
   CHECK_THAT(what, Contains("DeformOptions::threads = -1") && Contains("0 <= threads"));
   CHECK_THAT(error_of([] { make_bspline_lattice(Frame{}, {3, 3, 3}, {2, 0, 2}); }).second,
              Contains("cells along t = 0"));
-  const FaceContinuity too_smooth[] = {{Face::t_min, 4}};
+  const FaceContinuity too_smooth[] = {{Face::TMin, 4}};
   CHECK_THAT(error_of([&] { locked_control_points(L, too_smooth); }).second,
              Contains("FaceContinuity{t_min}.order = 4") && Contains("0 <= order <= 1"));
   std::vector<double> a(3), b(2);

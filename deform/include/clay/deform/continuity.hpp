@@ -13,11 +13,11 @@
 namespace clay::deform {
 
 /// A face of the lattice: s = 0, s = 1, t = 0, t = 1, u = 0, u = 1.
-enum class Face { s_min, s_max, t_min, t_max, u_min, u_max };
+enum class Face { SMin, SMax, TMin, TMax, UMin, UMax };
 
 /// C^order continuity with the undeformed space across one face.
 struct FaceContinuity {
-  Face face = Face::s_min;  ///< the face across which the continuity holds
+  Face face = Face::SMin;  ///< the face across which the continuity holds
   int order = 1;  ///< k of C^k, 0 <= k <= degree in the face's normal direction
 };
 

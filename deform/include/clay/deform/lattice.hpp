@@ -113,10 +113,10 @@ enum class LatticeKnots {
   /// fills the frame and its faces interpolate the border control points — what Hsu et al. get
   /// by tripling the border points — while every control point stays free and the undisplaced
   /// lattice is exactly the identity. The default.
-  clamped,
+  Clamped,
   /// Uniform knots of step 1/cells extended past [0, 1] (Hsu et al.'s "phantom control points"):
   /// the undisplaced border control points lie outside the frame, at their Greville abscissae.
-  uniform,
+  Uniform,
 };
 
 /// A trivariate tensor-product B-spline FFD (Hsu–Hughes–Kaufman eq. (1), any degree per
@@ -145,7 +145,7 @@ struct BSplineLattice {
 /// a degree < 1 (or > max_kernel_degree) or cells < 1, InvalidGeometry for an invalid frame.
 BSplineLattice make_bspline_lattice(const Frame& frame, std::array<int, 3> degrees,
                                     std::array<int, 3> cells,
-                                    LatticeKnots knots = LatticeKnots::clamped);
+                                    LatticeKnots knots = LatticeKnots::Clamped);
 
 /// The undisplaced lattice on given bases (any valid knot vectors with domain [0, 1]), control
 /// points at the Greville abscissae. Throws clay::Error(InvalidGeometry) naming the basis.

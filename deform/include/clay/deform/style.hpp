@@ -4,11 +4,11 @@
 /// it should take, and the control vertices inside the bound move toward the target.
 ///
 /// Two modes (docs/deform.md, "Style deformation"):
-/// - `StyleMode::paper` follows the paper: influence factors (eq. 2), key points and their signed
+/// - `StyleMode::Paper` follows the paper: influence factors (eq. 2), key points and their signed
 ///   normal distances (eqs. 3, 8), the force shared by area weights and distributed along the
 ///   control-net curve (eqs. 4-7) with the symmetric smoothing of eqs. 12-13, relaxation intervals
 ///   (eqs. 10-11) and the approximation scale λ (eq. 9). It approximates the target.
-/// - `StyleMode::exact` goes beyond the paper: the displacements of the influenced vertices are
+/// - `StyleMode::Exact` goes beyond the paper: the displacements of the influenced vertices are
 ///   solved (fairness energy on the control net, the key points as equality constraints) so the
 ///   surface passes through every key point, vertices outside the bound stay fixed and the
 ///   `boundary_rows` layers of vertices inside the bound edge stay fixed too, so the deformed
@@ -33,15 +33,15 @@ namespace clay::deform {
 
 /// Which of the two algorithms style_deform runs.
 enum class StyleMode {
-  paper,  ///< Han–De Amicis–Conti forces (eqs. 3-13): approximates the target
-  exact,  ///< fair least-norm displacements through the key points (beyond the paper)
+  Paper,  ///< Han–De Amicis–Conti forces (eqs. 3-13): approximates the target
+  Exact,  ///< fair least-norm displacements through the key points (beyond the paper)
 };
 
 /// How the target curve relates to the bound (Han et al. §4.3).
 enum class ConstraintClass {
-  over_constrained,   ///< the target lies completely outside the bound: the surface is unchanged
-  under_constrained,  ///< the target lies partly inside the bound
-  well_constrained,   ///< the target lies completely inside the bound
+  OverConstrained,   ///< the target lies completely outside the bound: the surface is unchanged
+  UnderConstrained,  ///< the target lies partly inside the bound
+  WellConstrained,   ///< the target lies completely inside the bound
 };
 
 /// Name of a constraint class ("over-constrained", ...).
@@ -50,11 +50,11 @@ std::string_view to_string(ConstraintClass c) noexcept;
 /// Direction the target runs along in parameter space (Han et al. eq. 8): `u` means it crosses
 /// the control-net rows i = const (vertices (i, 0..count_v-1)), so there is a key point per row and
 /// its force is distributed along that row, in v.
-enum class KeyDirection { u, v };
+enum class KeyDirection { U, V };
 
 /// Settings of the style deformation. Lengths in mm.
 struct StyleOptions {
-  StyleMode mode = StyleMode::paper;  ///< paper forces or exact key-point interpolation
+  StyleMode mode = StyleMode::Paper;  ///< paper forces or exact key-point interpolation
   double lambda = 1.0;     ///< approximation scale λ in [0, 1] (eq. 9); 0 leaves the surface as is
   bool relaxation = true;  ///< paper: let the end forces fall off to the bound (eqs. 10-11)
   bool smoothing = true;   ///< paper: distribute each force symmetrically along its control-net
@@ -135,8 +135,8 @@ struct KeyPoint {
 
 /// The key points of a target on a region: direction, class and points.
 struct KeyPoints {
-  KeyDirection direction = KeyDirection::u;  ///< eq. 8: the direction the target runs along
-  ConstraintClass constraint_class = ConstraintClass::over_constrained;  ///< §4.3
+  KeyDirection direction = KeyDirection::U;  ///< eq. 8: the direction the target runs along
+  ConstraintClass constraint_class = ConstraintClass::OverConstrained;  ///< §4.3
   std::vector<KeyPoint> points;  ///< in order along the target curve; m = points.size()
 };
 
@@ -151,9 +151,9 @@ KeyPoints key_points(const surface::BSplineSurface& parent, const InfluenceRegio
 
 /// What a style deformation did and how well (DESIGN.md quality figures). Lengths in mm.
 struct StyleReport {
-  StyleMode mode = StyleMode::paper;
-  ConstraintClass constraint_class = ConstraintClass::over_constrained;
-  KeyDirection direction = KeyDirection::u;
+  StyleMode mode = StyleMode::Paper;
+  ConstraintClass constraint_class = ConstraintClass::OverConstrained;
+  KeyDirection direction = KeyDirection::U;
   int m = 0;  ///< number of key points (eq. 8)
   std::vector<KeyPoint> key_points;  ///< on the parent surface
   int influenced_vertices = 0;       ///< vertices with E = 1

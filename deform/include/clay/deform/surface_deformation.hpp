@@ -37,7 +37,7 @@ struct StepOutcome {
   int step = 0;          ///< index in the stack
   std::string kind;      ///< kind_name of the deformation
   std::string name;      ///< the step's name
-  enum class Method { skipped, exact, refit } method = Method::skipped;  ///< disabled, composed, refitted
+  enum class Method { Skipped, Exact, Refit } method = Method::Skipped;  ///< disabled, composed, refitted
   std::string reason;    ///< why a step was refitted (the exact composition's refusal), else empty
   ComposeReport compose; ///< when exact
   RefitReport refit;     ///< when refitted
