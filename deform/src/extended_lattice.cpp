@@ -781,7 +781,7 @@ void FreezeOptions::validate() const {
                  "0 <= threads <= 1024 (0 = one per hardware thread)");
 }
 
-std::string FreezeSummary::brief() const {
+std::string FreezeReport::brief() const {
   char buffer[320];
   std::snprintf(buffer, sizeof buffer,
                 "frozen %lld points: %lld inside, %lld outside, %lld unresolved; %lld found after "
@@ -827,7 +827,7 @@ FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points, const
     total.worst_residual = std::max(total.worst_residual, c.worst_residual);
     total.worst_initial = std::max(total.worst_initial, c.worst_initial);
   }
-  FreezeSummary& s = out.summary;
+  FreezeReport& s = out.report;
   s.inside = total.inside;
   s.outside = total.outside;
   s.unresolved = total.unresolved;

@@ -52,7 +52,7 @@ void apply_in_place(const ExtendedLattice& d, Points3& p, const DeformOptions& o
   f.threads = o.threads;
   const FrozenPoints frozen = freeze(d, p, f);
   p = evaluate(d, frozen, o);
-  report.freezes.push_back({step, frozen.summary});
+  report.freezes.push_back({step, frozen.report});
 }
 void apply_in_place(const Taper& d, Points3& p, const DeformOptions& o, std::size_t,
                     StackReport&) {
@@ -179,7 +179,7 @@ Eigen::Vector3d deform_point(const DeformationStack& stack, const Eigen::Vector3
 
 bool StackReport::converged() const noexcept {
   for (const Freeze& f : freezes)
-    if (!f.summary.summary.converged()) return false;
+    if (!f.report.summary.converged()) return false;
   return true;
 }
 
@@ -187,7 +187,7 @@ std::string StackReport::brief() const {
   if (freezes.empty()) return "no extended lattice step";
   std::string text;
   for (const Freeze& f : freezes)
-    text += (text.empty() ? "steps[" : "; steps[") + std::to_string(f.step) + "]: " + f.summary.brief();
+    text += (text.empty() ? "steps[" : "; steps[") + std::to_string(f.step) + "]: " + f.report.brief();
   return text;
 }
 

@@ -455,7 +455,7 @@ TEST_CASE("deform_points on a stack with an extended lattice equals deform_point
   CHECK(worst < 1e-13 * size);
   REQUIRE(report.freezes.size() == 1);
   CHECK(report.freezes[0].step == 1);
-  const FreezeSummary& f = report.freezes[0].summary;
+  const FreezeReport& f = report.freezes[0].report;
   CHECK(report.converged());
   CHECK(f.inside + f.outside == points.rows());
   CHECK(f.inside > points.rows() / 2);
@@ -486,8 +486,8 @@ TEST_CASE("points an extended lattice step cannot place are left unchanged and r
   deform_points(stack, points, out, report);
   REQUIRE(report.freezes.size() == 1);
   CHECK_FALSE(report.converged());
-  CHECK(report.freezes[0].summary.summary.termination == clay::Termination::NotConverged);
-  CHECK(report.freezes[0].summary.unresolved == 1);
+  CHECK(report.freezes[0].report.summary.termination == clay::Termination::NotConverged);
+  CHECK(report.freezes[0].report.unresolved == 1);
   CHECK_THAT(report.brief(), Contains("steps[0]: frozen 2 points: 1 inside, 0 outside, 1 unresolved"));
   const Eigen::Vector3d off = points.row(1).transpose();
   CHECK(same_bits(Eigen::Vector3d(out.row(1).transpose()), deform_point(twist, off)));

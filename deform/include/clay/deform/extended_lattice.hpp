@@ -163,7 +163,7 @@ struct FreezeOptions {
 /// outside [0, 1]^3): left unchanged by evaluate().
 inline constexpr int outside_chunk = -1;
 /// FrozenPoint::chunk of a point that some chunk's hull holds but where Newton did not converge
-/// even after subdivision (reported in FreezeSummary::unresolved): left unchanged.
+/// even after subdivision (reported in FreezeReport::unresolved): left unchanged.
 inline constexpr int unresolved_chunk = -2;
 
 /// A point's place in the lattice: its chunk (or outside_chunk / unresolved_chunk) and (u, v, w)
@@ -175,7 +175,7 @@ struct FrozenPoint {
 };
 
 /// What freezing did.
-struct FreezeSummary {
+struct FreezeReport {
   /// Converged when no point is unresolved; iterations = Newton iterations over all points,
   /// final_residual = the largest |L(u,v,w) − x| over inside points (mm, rest shape).
   Summary summary;
@@ -196,7 +196,7 @@ struct FreezeSummary {
 struct FrozenPoints {
   std::vector<FrozenPoint> points;
   Points3 positions;  ///< the frozen points (N x 3, mm)
-  FreezeSummary summary;
+  FreezeReport report;
   Eigen::Index control_points = 0;  ///< rows of the lattice when frozen
   std::size_t chunks = 0;           ///< chunks of the lattice when frozen
 };

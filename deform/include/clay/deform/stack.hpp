@@ -59,13 +59,13 @@ Eigen::Vector3d deform_point(const DeformationStack& stack, const Eigen::Vector3
 
 /// What deform_points did at the steps that iterate. An extended lattice step freezes the points
 /// reaching it by Newton's method (Coquillart §3.3); a point it cannot place (unresolved) is left
-/// unchanged by that step and the step's FreezeSummary is NotConverged — an outcome, not an
+/// unchanged by that step and the step's FreezeReport is NotConverged — an outcome, not an
 /// error, so the deformation goes on and this report is the only place it shows.
 struct StackReport {
   /// The freeze of one enabled extended lattice step.
   struct Freeze {
     std::size_t step = 0;   ///< index of the step in stack.steps
-    FreezeSummary summary;  ///< inside / outside / unresolved counts, Newton residuals
+    FreezeReport report;  ///< inside / outside / unresolved counts, Newton residuals
   };
   std::vector<Freeze> freezes;  ///< one per enabled extended lattice step, in order of application
 
