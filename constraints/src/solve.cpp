@@ -22,11 +22,12 @@
 
 namespace clay::constraints {
 
-void SolveOptions::validate() const {
-  auto bad = [](const std::string& field, double value, const std::string& rule) {
+std::vector<std::string> SolveOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, double value, const std::string& rule) {
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%g", value);
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SolveOptions::" + field + " = " + buffer + " breaks the rule " + rule);
   };
   if (!(tolerance > 0 && tolerance <= 1e-3)) bad("tolerance", tolerance, "0 < tolerance <= 1e-3");
@@ -35,9 +36,12 @@ void SolveOptions::validate() const {
     bad("rank_tolerance", rank_tolerance, "0 < rank_tolerance <= 1e-2");
   for (size_t k = 0; k < drag.size(); ++k)
     if (!internal::all_finite(drag[k].target))
-      throw Error(ErrorCategory::InvalidArgument,
+      out.push_back(
                   "SolveOptions::drag[" + std::to_string(k) + "]: the target is not finite");
+  return out;
 }
+
+void SolveOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace detail {
 namespace {

@@ -7,6 +7,7 @@
 #include <clay/surface/exchange.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/internal/math.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -882,17 +883,21 @@ std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface, co
 
 // ---- public ---------------------------------------------------------------------------------
 
-void ComposeOptions::validate() const {
+std::vector<std::string> ComposeOptions::problems() const {
+  std::vector<std::string> out;
   if (!(knot_tolerance >= 0 && knot_tolerance <= 1e-6))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "ComposeOptions: knot_tolerance = " + format(knot_tolerance) +
                     " breaks the rule 0 <= knot_tolerance <= 1e-6 (relative, exact removal only); give "
                     "e.g. 1e-12, or 0 to keep every patch boundary");
   if (check_samples < 0 || check_samples > 64)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "ComposeOptions: check_samples = " + std::to_string(check_samples) +
                     " breaks the rule 0 <= check_samples <= 64; give e.g. 4, or 0 to skip the check");
+  return out;
 }
+
+void ComposeOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string ComposeReport::brief() const {
   std::ostringstream m;

@@ -122,14 +122,15 @@ double lattice_size(const Frame& f) {
 
 // ---- options and report ---------------------------------------------------------------------
 
-void DirectManipulationOptions::validate() const {
+std::vector<std::string> DirectManipulationOptions::problems() const {
+  std::vector<std::string> out;
   if (!(std::isfinite(rank_tolerance) && rank_tolerance > 0 && rank_tolerance < 1))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "DirectManipulationOptions::rank_tolerance = " + format(rank_tolerance) +
                     " breaks the rule 0 < rank_tolerance < 1; give a small relative threshold "
                     "such as 1e-10");
   if (!(std::isfinite(tolerance) && tolerance > 0))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "DirectManipulationOptions::tolerance = " + format(tolerance) +
                     " breaks the rule tolerance > 0 (finite, relative to the lattice size); "
                     "give e.g. 1e-7");
@@ -137,23 +138,26 @@ void DirectManipulationOptions::validate() const {
   for (size_t g = 0; g < tied.size(); ++g) {
     const std::string name = "DirectManipulationOptions::tied[" + std::to_string(g) + "]";
     if (tied[g].size() < 2)
-      throw Error(ErrorCategory::InvalidArgument,
+      out.push_back(
                   name + " has " + std::to_string(tied[g].size()) +
                       " control point(s), breaking the rule of at least 2 per group; "
                       "drop the group or add the rows it ties");
     for (const Eigen::Index r : tied[g]) {
       if (r < 0)
-        throw Error(ErrorCategory::InvalidArgument,
+        out.push_back(
                     name + " holds the row " + std::to_string(r) +
                         ", breaking the rule row >= 0; give control point rows (lattice.index)");
       if (!seen.insert(r).second)
-        throw Error(ErrorCategory::InvalidArgument,
+        out.push_back(
                     name + " holds the row " + std::to_string(r) +
                         " that is already tied (in this or an earlier group); merge the groups "
                         "that share it");
     }
   }
+  return out;
 }
+
+void DirectManipulationOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string DirectManipulationReport::brief() const {
   return std::string(feasible ? "feasible" : "not feasible") + ": " + std::to_string(requested) +

@@ -760,26 +760,33 @@ ExtendedLattice make_prismatic_lattice(const PrismSpec& spec) {
 
 // ---- freezing and deformation ----------------------------------------------------------------------------
 
-void FreezeOptions::validate() const {
+std::vector<std::string> FreezeOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, const std::string& value, const std::string& rule) {
+    out.push_back(field + " = " + value + " breaks the rule " + rule);
+  };
   if (!(newton_tolerance > 0 && newton_tolerance <= 1e-3))
-    bad_argument("FreezeOptions::newton_tolerance", format(newton_tolerance),
+    bad("FreezeOptions::newton_tolerance", format(newton_tolerance),
                  "0 < newton_tolerance <= 1e-3 (relative to the chunk size)");
   if (!(parameter_tolerance >= 0 && parameter_tolerance <= 1e-3))
-    bad_argument("FreezeOptions::parameter_tolerance", format(parameter_tolerance),
+    bad("FreezeOptions::parameter_tolerance", format(parameter_tolerance),
                  "0 <= parameter_tolerance <= 1e-3");
   if (!(pseudo_inverse_threshold >= 0 && pseudo_inverse_threshold <= 1e-3))
-    bad_argument("FreezeOptions::pseudo_inverse_threshold", format(pseudo_inverse_threshold),
+    bad("FreezeOptions::pseudo_inverse_threshold", format(pseudo_inverse_threshold),
                  "0 <= pseudo_inverse_threshold <= 1e-3");
   if (max_iterations < 1 || max_iterations > 1000)
-    bad_argument("FreezeOptions::max_iterations", std::to_string(max_iterations),
+    bad("FreezeOptions::max_iterations", std::to_string(max_iterations),
                  "1 <= max_iterations <= 1000");
   if (max_subdivision_depth < 0 || max_subdivision_depth > 10)
-    bad_argument("FreezeOptions::max_subdivision_depth", std::to_string(max_subdivision_depth),
+    bad("FreezeOptions::max_subdivision_depth", std::to_string(max_subdivision_depth),
                  "0 <= max_subdivision_depth <= 10");
   if (threads < 0 || threads > 1024)
-    bad_argument("FreezeOptions::threads", std::to_string(threads),
+    bad("FreezeOptions::threads", std::to_string(threads),
                  "0 <= threads <= 1024 (0 = one per hardware thread)");
+  return out;
 }
+
+void FreezeOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string FreezeReport::brief() const {
   char buffer[320];

@@ -798,9 +798,10 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
 
 }  // namespace
 
-void RefitOptions::validate() const {
-  auto fail = [](const std::string& what) {
-    throw Error(ErrorCategory::InvalidArgument, "RefitOptions::" + what);
+std::vector<std::string> RefitOptions::problems() const {
+  std::vector<std::string> out;
+  auto fail = [&out](const std::string& what) {
+    out.push_back("RefitOptions::" + what);
   };
   if (degree < 1 || degree > 25)
     fail("degree = " + std::to_string(degree) +
@@ -817,7 +818,10 @@ void RefitOptions::validate() const {
          ": must be >= degree + 1 = " + std::to_string(degree + 1));
   if (!(certificate_share > 0 && certificate_share < 1))
     fail("certificate_share = " + format(certificate_share) + ": must be in (0, 1), e.g. 0.1");
+  return out;
 }
+
+void RefitOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string RefitReport::brief() const {
   char buffer[256];

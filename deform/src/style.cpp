@@ -8,6 +8,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 
@@ -31,9 +32,10 @@ std::string_view to_string(ConstraintClass c) noexcept {
   return "?";
 }
 
-void StyleOptions::validate() const {
-  auto fail = [](const std::string& what) {
-    throw Error(ErrorCategory::InvalidArgument, "style options: " + what);
+std::vector<std::string> StyleOptions::problems() const {
+  std::vector<std::string> out;
+  auto fail = [&out](const std::string& what) {
+    out.push_back("style options: " + what);
   };
   if (!(lambda >= 0 && lambda <= 1))
     fail("lambda = " + std::to_string(lambda) + " must lie in [0, 1] (Han et al. eq. 9)");
@@ -54,8 +56,11 @@ void StyleOptions::validate() const {
          " must lie in [0, 0.1] (relative to the model size; 0 = key points only)");
   if (max_key_point_rounds < 0)
     fail("max_key_point_rounds = " + std::to_string(max_key_point_rounds) + " must be >= 0");
-  projection.validate();
+  internal::append(out, projection.problems());
+  return out;
 }
+
+void StyleOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 int InfluenceRegion::inside_count() const noexcept {
   return static_cast<int>(std::count(factors.begin(), factors.end(), std::uint8_t{1}));

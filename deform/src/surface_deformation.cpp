@@ -5,6 +5,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <sstream>
@@ -14,10 +15,14 @@
 
 namespace clay::deform {
 
-void SurfaceDeformationOptions::validate() const {
-  compose.validate();
-  if (refit) refit->validate();
+std::vector<std::string> SurfaceDeformationOptions::problems() const {
+  std::vector<std::string> out;
+  internal::append(out, compose.problems());
+  if (refit) internal::append(out, refit->problems());
+  return out;
 }
+
+void SurfaceDeformationOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string SurfaceDeformationReport::brief() const {
   std::ostringstream out;

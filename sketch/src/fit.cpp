@@ -17,11 +17,12 @@
 
 namespace clay::sketch {
 
-void FitOptions::validate() const {
-  auto bad = [](const std::string& field, double value, const std::string& rule) {
+std::vector<std::string> FitOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, double value, const std::string& rule) {
     std::ostringstream s;
     s << "FitOptions::" << field << " = " << value << " " << rule;
-    throw Error(ErrorCategory::InvalidArgument, s.str());
+    out.push_back(s.str());
   };
   if (!(std::isfinite(tolerance) && tolerance > 0.0))
     bad("tolerance", tolerance, "must be a positive distance in mm");
@@ -40,7 +41,10 @@ void FitOptions::validate() const {
   if (!(std::isfinite(closing_ratio) && closing_ratio >= 0.0 && closing_ratio <= 0.5))
     bad("closing_ratio", closing_ratio, "must be in [0, 0.5] (0 never closes)");
   if (end_samples < 1) bad("end_samples", end_samples, "must be >= 1 (1: the drawn end point)");
+  return out;
 }
+
+void FitOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace detail {
 

@@ -18,16 +18,20 @@
 
 namespace clay::surface {
 
-void SuperquadricOptions::validate() const {
-  auto bad = [](const std::string& field, double value, const std::string& rule) {
+std::vector<std::string> SuperquadricOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, double value, const std::string& rule) {
     std::ostringstream m;
     m << "SuperquadricOptions::" << field << " = " << value << " " << rule;
-    throw Error(ErrorCategory::InvalidArgument, m.str());
+    out.push_back(m.str());
   };
   if (!(std::isfinite(tolerance) && tolerance > 0.0)) bad("tolerance", tolerance, "must be a positive length in mm");
   if (degree < 2 || degree > 7) bad("degree", degree, "must be in [2, 7]");
   if (max_spans < 8) bad("max_spans", max_spans, "must be >= 8");
+  return out;
 }
+
+void SuperquadricOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace {
 

@@ -16,9 +16,10 @@
 
 namespace clay::surface {
 
-void ProjectionOptions::validate() const {
-  auto bad = [](const std::string& field, const std::string& rule) {
-    throw Error(ErrorCategory::InvalidArgument, "ProjectionOptions::" + field + " " + rule);
+std::vector<std::string> ProjectionOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, const std::string& rule) {
+    out.push_back("ProjectionOptions::" + field + " " + rule);
   };
   if (max_iterations < 1) bad("max_iterations", "= " + std::to_string(max_iterations) + " must be >= 1");
   if (!(parametric_tolerance > 0.0 && parametric_tolerance < 1.0))
@@ -27,7 +28,10 @@ void ProjectionOptions::validate() const {
     bad("cosine_tolerance", "= " + std::to_string(cosine_tolerance) + " must be in (0, 1)");
   if (samples_per_span < 1) bad("samples_per_span", "= " + std::to_string(samples_per_span) + " must be >= 1");
   if (starts < 1) bad("starts", "= " + std::to_string(starts) + " must be >= 1");
+  return out;
 }
+
+void ProjectionOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace {
 

@@ -9,6 +9,7 @@
 #include <clay/surface/knots.hpp>
 #include <clay/tolerance.hpp>
 #include <clay/internal/math.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
@@ -584,31 +585,39 @@ BSplineBasis joined_basis(const std::vector<double>& v, const std::vector<int>& 
 
 }  // namespace
 
-void LoftOptions::validate() const {
+std::vector<std::string> LoftOptions::problems() const {
+  std::vector<std::string> out;
   if (degree < 1 || degree > max_kernel_degree)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "LoftOptions::degree is " + std::to_string(degree) + "; it must be in [1, " +
                     std::to_string(max_kernel_degree) + "]");
   if (!(tolerance > 0.0 && tolerance <= 1e-2))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
+  return out;
 }
 
-void SweepOptions::validate() const {
+void LoftOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+
+std::vector<std::string> SweepOptions::problems() const {
+  std::vector<std::string> out;
   if (!std::isfinite(twist_degrees))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SweepOptions::twist_degrees is " + num(twist_degrees) + "; it must be finite");
   if (sections != 0 && sections < 2)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SweepOptions::sections is " + std::to_string(sections) +
                     "; it must be 0 (adaptive) or >= 2");
   if (!(tolerance > 0.0 && tolerance <= 1e-1))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SweepOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-1]");
   if (max_sections < 2)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SweepOptions::max_sections is " + std::to_string(max_sections) + "; it must be >= 2");
+  return out;
 }
+
+void SweepOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves) {
   if (curves.empty())

@@ -547,3 +547,12 @@ TEST_CASE("staircases of up to 1,000 segments with 1 to 10 free verticals conver
     }
   CHECK(worst_iterations <= 25);
 }
+
+TEST_CASE("SolveOptions lists every bad field", "[solve]") {
+  clay::constraints::SolveOptions o;
+  o.tolerance = 0;
+  o.max_iterations = 0;
+  o.rank_tolerance = 1;
+  CHECK(o.problems().size() == 3);
+  CHECK_THROWS_AS(o.validate(), clay::Error);
+}

@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <clay/error.hpp>
 #include <clay/sketch/fit.hpp>
+#include <clay/sketch/oversketch.hpp>
 #include <clay/surface/evaluate.hpp>
 
 #include <Eigen/Geometry>
@@ -294,4 +296,17 @@ TEST_CASE("a closed stroke with corners gives a closed chain of curves", "[fit]"
     for (const auto& vertex : v) nearest = std::min(nearest, (b.points.row(0).transpose() - vertex).norm());
     CHECK(nearest <= o.tolerance);
   }
+}
+
+TEST_CASE("FitOptions and OversketchOptions list every bad field", "[fit]") {
+  FitOptions f;
+  f.tolerance = 0;
+  f.degree = 1;
+  f.closing_ratio = 0.9;
+  CHECK(f.problems().size() == 3);
+  OversketchOptions o;
+  o.capture_distance = -1;
+  o.fit.max_iterations = 0;
+  CHECK(o.problems().size() == 2);
+  CHECK_THROWS_AS(o.validate(), clay::Error);
 }

@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace clay::render {
@@ -37,7 +38,9 @@ struct RenderOptions {
   /// per surface (golden-angle hue steps from blue).
   std::vector<Rgb> colours;
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

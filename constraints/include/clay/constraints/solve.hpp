@@ -38,7 +38,9 @@ struct SolveOptions {
   /// constraints as heavy equations), then solves the constraints alone from there.
   std::vector<Drag> drag;
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

@@ -29,6 +29,7 @@
 #include <clay/surface/bspline_surface.hpp>
 
 #include <string>
+#include <vector>
 
 namespace clay::deform {
 
@@ -41,7 +42,9 @@ struct ComposeOptions {
   /// deformation of the original for ComposeReport::max_relative_deviation (>= 0; 0 skips the check).
   int check_samples = 4;
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

@@ -60,8 +60,9 @@ struct DirectManipulationOptions {
   /// every selected point's new image is within tolerance × size of its target.
   double tolerance = 1e-7;
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken. (The
-  /// sizes and row indices are checked against the lattice by the solve.)
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

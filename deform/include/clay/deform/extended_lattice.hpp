@@ -155,7 +155,9 @@ struct FreezeOptions {
                                     ///< thread (at least 1,024 points per part), 0..1024
   Executor executor = {};           ///< who runs the parts (clay/parallel.hpp); empty = std::threads
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

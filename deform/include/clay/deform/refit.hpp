@@ -53,7 +53,9 @@ struct RefitOptions {
   double certificate_share = 0.1;  ///< in (0, 1): share of the tolerance the certificate's
                                    ///< remainder may take when choosing each cell's sample density
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

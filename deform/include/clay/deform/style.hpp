@@ -76,7 +76,9 @@ struct StyleOptions {
                               ///< projections); off for interactive drags: they are then NaN
   surface::ProjectionOptions projection;  ///< projection of the curves onto the surface
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

@@ -28,7 +28,9 @@ struct SurfaceDeformationOptions {
   /// returned, with its figures in the step's RefitReport (summary NotConverged).
   bool accept_out_of_tolerance = false;
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

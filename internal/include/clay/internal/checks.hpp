@@ -22,6 +22,11 @@ bool all_finite(const Eigen::DenseBase<Derived>& m) {
   return true;
 }
 
+/// Appends `more` to `out` (an Options struct's problems() gathering those of its parts).
+inline void append(std::vector<std::string>& out, const std::vector<std::string>& more) {
+  out.insert(out.end(), more.begin(), more.end());
+}
+
 /// The problems, "; "-separated, in one line.
 inline std::string join_problems(const std::vector<std::string>& list) {
   std::string text;

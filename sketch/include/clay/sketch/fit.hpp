@@ -39,6 +39,7 @@
 
 #include <Eigen/Core>
 
+#include <string>
 #include <vector>
 
 namespace clay::sketch {
@@ -62,8 +63,9 @@ struct FitOptions {
   int end_samples = 60;           ///< samples in the end-point estimate, >= 1 (1: the drawn point)
   bool drop_duplicates = false;   ///< drop repeated consecutive points instead of refusing them
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range, its value and
-  /// the rule.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

@@ -21,6 +21,8 @@
 #include <clay/surface/bspline_curve.hpp>
 
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace clay::sketch {
 
@@ -38,7 +40,9 @@ struct OversketchOptions {
                    ///< part; its degree is the curve's (fit.degree is not used) and it is not
                    ///< split at corners
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

@@ -34,6 +34,11 @@ struct GltfWriteOptions {
   /// The budget of the whole preview: each of n surfaces gets at most sqrt(max_vertices / n)
   /// samples a direction (17 to 1025), so a model of thousands of faces stays a preview. >= 289.
   long max_vertices = 4'000'000;
+
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
+  void validate() const;
 };
 
 /// What was written (or checked): size figures and OpenCASCADE's BRepCheck verdict.
@@ -84,7 +89,9 @@ struct ReadOptions {
   double time_limit_seconds = 120;  ///< isolate: the child is killed after this, in (0, 86400]
   long memory_limit_mb = 4096;      ///< isolate: address space the child may add, in [1, 1048576]
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

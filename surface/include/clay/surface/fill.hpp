@@ -5,6 +5,7 @@
 /// curves (OpenCASCADE's BRepOffsetAPI_MakeFilling), reporting how far each curve is from it.
 #include <clay/surface/build_report.hpp>
 
+#include <string>
 #include <vector>
 
 namespace clay::surface {
@@ -22,7 +23,9 @@ struct FillOptions {
   double gap_tolerance = 1e-7;  ///< mm, > 0 and finite: ends of consecutive boundary curves must
                                 ///< meet within this; they are then joined at their midpoint
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -68,7 +71,9 @@ struct NSidedFillOptions {
                                ///< their midpoint)
   int samples_per_curve = 64;  ///< points per curve where the deviation is measured, >= 2
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

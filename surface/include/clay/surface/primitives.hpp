@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 
+#include <string>
 #include <vector>
 
 namespace clay::surface {
@@ -30,7 +31,9 @@ struct SuperquadricOptions {
   double tolerance = 1e-3;  ///< mm: largest allowed distance from the analytic surface, > 0
   int degree = 3;           ///< degree of approximated directions, in [2, 7]
   int max_spans = 4096;     ///< knot spans per approximated direction before giving up, >= 8
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace clay::surface {
@@ -25,7 +26,9 @@ struct ProjectionOptions {
   int samples_per_span = 4;           ///< closest_point: start grid density per knot span, >= 1
   int starts = 4;                     ///< closest_point: Newton runs from the best grid samples, >= 1
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

@@ -5,6 +5,7 @@
 /// the sections (the profile), its v direction across them (along the path).
 #include <clay/surface/build_report.hpp>
 
+#include <string>
 #include <vector>
 
 namespace clay::surface {
@@ -26,7 +27,9 @@ struct LoftOptions {
                             ///< points): consecutive sections closer than this coincide, a section
                             ///< whose control polygon is shorter is degenerate; in (0, 1e-2]
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -71,7 +74,9 @@ struct SweepOptions {
                              ///< the largest tangent turn (radians) at a path knot; in (0, 1e-1]
   int max_sections = 1025;   ///< adaptive refinement stops here, >= 2
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
