@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -322,6 +323,15 @@ TEST_CASE("a manipulator factorizes once and follows dragged targets", "[deform]
     const auto once = manipulate(lattice, moves_of(x, targets));
     CHECK((result.lattice.points - once.lattice.points).cwiseAbs().maxCoeff() == 0.0);
   }
+  // A copy shares the factorization (read-only) and answers bit for bit alike, also after the
+  // original is gone.
+  auto copy = std::make_unique<DirectManipulator<BezierLattice>>(drag);
+  const DirectManipulator<BezierLattice> second = *copy;
+  copy.reset();
+  Points3 targets = drag.images();
+  targets.col(0).array() -= 0.75;
+  CHECK((second.move(targets).lattice.points - drag.move(targets).lattice.points).cwiseAbs().maxCoeff() == 0.0);
+  CHECK(second.rank() == drag.rank());
 }
 
 TEST_CASE("direct manipulation rejects bad requests naming the culprit", "[deform]") {

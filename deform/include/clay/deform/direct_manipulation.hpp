@@ -25,9 +25,9 @@
 #include <clay/deform/lattice.hpp>
 
 #include <Eigen/Core>
-#include <Eigen/QR>
 #include <Eigen/SparseCore>
 
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -118,21 +118,17 @@ class DirectManipulator {
   DirectManipulationResult<Lattice> move(const Points3& targets) const;
 
   /// Current deformed images deform_point(lattice, X_i) of the selected points (N x 3).
-  const Points3& images() const noexcept { return images_; }
+  const Points3& images() const noexcept;
   /// Number of unknowns m (columns of B S that act on some selected point).
-  int unknowns() const noexcept { return static_cast<int>(columns_.size()); }
+  int unknowns() const noexcept;
   /// Numerical rank of B S.
-  int rank() const noexcept { return rank_; }
+  int rank() const noexcept;
 
  private:
-  Lattice lattice_;
-  Points3 points_, images_;
-  DirectManipulationOptions options_;
-  double size_ = 0;
-  Eigen::MatrixXd a_;                                   ///< B S on the unknowns, N x m
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_;
-  std::vector<std::vector<Eigen::Index>> columns_;      ///< control point rows of each unknown
-  int rank_ = 0;
+  // The factorization lives in the source (pimpl), so no Eigen decomposition is part of the API;
+  // copies share it read-only, which is safe since every member function is const.
+  struct State;
+  std::shared_ptr<const State> state_;
 };
 
 /// One-off direct manipulation: DirectManipulator(lattice, points, options).move(targets).
