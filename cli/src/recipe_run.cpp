@@ -473,11 +473,11 @@ class Runner {
                    {"residual", r.residual},
                    {"achieved_max_error", r.achieved_max_error},
                    {"displacement_norm", r.displacement_norm}};
-    rep.message += ": " + r.message;
+    rep.message += ": " + r.summary.message;
     if (!r.feasible) {  // moves the lattice cannot meet: a failure unless accepted
       if (!d.accept_out_of_tolerance)
         throw Error(ErrorCategory::ToleranceNotMet,
-                    "the lattice cannot meet every move (" + r.message +
+                    "the lattice cannot meet every move (" + r.summary.message +
                         "): free more control points (fewer \"locked\"), use a finer lattice, or ask for fewer "
                         "moves; to keep the least-squares answer anyway, set \"accept_out_of_tolerance\": true on "
                         "this step");

@@ -649,4 +649,13 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
   return result;
 }
 
+std::string SolveReport::brief() const {
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, "; largest residual %.3g, %d unknowns (%d substituted), %s",
+                max_residual, unknowns, substituted,
+                degrees_of_freedom < 0 ? "degrees of freedom not diagnosed"
+                                       : (std::to_string(degrees_of_freedom) + " degrees of freedom").c_str());
+  return summary.brief() + buffer;
+}
+
 }  // namespace clay::constraints

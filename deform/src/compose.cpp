@@ -708,6 +708,9 @@ ComposeResult finish(const surface::BezierPatches& bp, std::vector<ComposedPatch
     }
   }
   report.exact = true;
+  report.summary.termination = Termination::Converged;
+  report.summary.final_residual = report.max_relative_deviation;
+  report.summary.message = report.brief();
   result.report = report;
   return result;
 }

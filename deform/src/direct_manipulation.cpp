@@ -323,18 +323,22 @@ DirectManipulationResult<Lattice> DirectManipulator<Lattice>::move(const Points3
 
   const std::string counts = "rank " + std::to_string(rep.rank) + " for " + std::to_string(n) +
                              " point(s) and " + std::to_string(rep.unknowns) + " unknowns";
+  rep.summary.final_residual = rep.achieved_max_error;
+  rep.summary.termination = rep.feasible ? Termination::Converged
+                            : rep.rank == 0 ? Termination::Failed
+                                            : Termination::NotConverged;
   if (rep.feasible) {
-    rep.message = "every selected point reaches its target (largest miss " +
+    rep.summary.message = "every selected point reaches its target (largest miss " +
                   format(rep.achieved_max_error, 3) + " mm, tolerance " + format(tolerance, 3) +
                   " mm); " + counts +
                   (rep.rank < rep.requested ? " (some requests repeat others)" : "");
   } else if (rep.rank == 0) {
-    rep.message = "no free control point acts on the selected points (those that do are all "
+    rep.summary.message = "no free control point acts on the selected points (those that do are all "
                   "locked, or weigh below rank_tolerance): nothing moved, largest miss " +
                   format(rep.achieved_max_error, 3) +
                   " mm; unlock control points near the selected points";
   } else {
-    rep.message = "the request cannot be met (" + counts + "): least-squares compromise, residual " +
+    rep.summary.message = "the request cannot be met (" + counts + "): least-squares compromise, residual " +
                   format(rep.residual, 3) + " mm, largest miss " + format(rep.achieved_max_error, 3) +
                   " mm above the tolerance " + format(tolerance, 3) +
                   " mm; refine the lattice (more cells or a higher degree), unlock control points "

@@ -201,6 +201,8 @@ void deform_points(const DeformationStack& stack, const Points3& points, Points3
     if (stack.steps[i].enabled)
       std::visit([&](const auto& d) { apply_in_place(d, out, options, i, report); },
                  stack.steps[i].deformation);
+  report.summary.termination = report.converged() ? Termination::Converged : Termination::NotConverged;
+  report.summary.message = report.brief();
 }
 
 void deform_points(const DeformationStack& stack, const Points3& points, Points3& out,

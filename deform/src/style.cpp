@@ -747,4 +747,13 @@ StyleResult style_deform(const BSplineSurface& parent, const BSplineCurve& targe
   return style_deform(parent, influence_from_target(parent, target, options), target, options);
 }
 
+std::string StyleReport::brief() const {
+  std::ostringstream text;
+  text.precision(3);
+  text << summary.brief() << "; " << to_string(constraint_class) << ", " << key_points.size() << " key points, "
+    << moved_vertices << " vertices moved (largest " << max_displacement << " mm), target deviation "
+    << target_deviation << " mm";
+  return text.str();
+}
+
 }  // namespace clay::deform

@@ -247,6 +247,11 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
   report.degree_u = out.surface.u.degree;
   report.degree_v = out.surface.v.degree;
   report.control_points = static_cast<long>(out.surface.points.rows());
+  bool within = true;  // every refit within its tolerance (else it was accepted out of tolerance)
+  for (const StepOutcome& o : report.steps)
+    within = within && (o.method != StepOutcome::Method::Refit || o.refit.summary.converged());
+  report.summary.termination = within ? Termination::Converged : Termination::NotConverged;
+  report.summary.message = report.brief();
   return out;
 }
 

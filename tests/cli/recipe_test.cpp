@@ -837,7 +837,10 @@ void refused_quickly(const std::string& text, const std::string& path, std::init
   const auto problems = check_recipe(text);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   INFO(dump(problems));
-  CHECK(seconds < 1.0);
+  // The cases took a minute or more (and gigabytes) before the limits; refused, they take
+  // milliseconds. The bound only separates the two: speed itself is measured in bench/, and this
+  // test also runs on a loaded machine and under the sanitizers.
+  CHECK(seconds < 20.0);
   bool found = false;
   for (const auto& p : problems) {
     if (p.path != path) continue;

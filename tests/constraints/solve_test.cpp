@@ -69,6 +69,7 @@ TEST_CASE("a rectangle with horizontal, vertical and distance constraints has 0 
   INFO(rep.summary.brief());
   REQUIRE(rep.summary.converged());
   CHECK(rep.degrees_of_freedom == 0);
+  CHECK_THAT(rep.brief(), Contains(rep.summary.brief()) && Contains("0 degrees of freedom"));
   CHECK(rep.redundant.empty());
   CHECK(rep.conflicting.empty());
   CHECK(rep.max_residual <= 1e-10);

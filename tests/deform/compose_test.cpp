@@ -131,6 +131,9 @@ TEST_CASE("compose_exact matches the pointwise Bezier FFD on random surfaces and
     CHECK(dev <= 1e-12 * size);
     CHECK(r.report.max_relative_deviation <= 1e-12);
     CHECK(r.report.exact);
+    CHECK(r.report.summary.converged());
+    CHECK(r.report.summary.final_residual == r.report.max_relative_deviation);
+    CHECK(r.report.summary.message == r.report.brief());
     CHECK(r.surface.is_rational() == rational);
     // Random control points: every coordinate has full degree, so the rule gives (L p, L q).
     const int L = ld[0] + ld[1] + ld[2];

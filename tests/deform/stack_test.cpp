@@ -486,6 +486,8 @@ TEST_CASE("points an extended lattice step cannot place are left unchanged and r
   deform_points(stack, points, out, report);
   REQUIRE(report.freezes.size() == 1);
   CHECK_FALSE(report.converged());
+  CHECK(report.summary.termination == clay::Termination::NotConverged);
+  CHECK(report.summary.message == report.brief());
   CHECK(report.freezes[0].report.summary.termination == clay::Termination::NotConverged);
   CHECK(report.freezes[0].report.unresolved == 1);
   CHECK_THAT(report.brief(), Contains("steps[0]: frozen 2 points: 1 inside, 0 outside, 1 unresolved"));

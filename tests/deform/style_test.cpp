@@ -213,6 +213,8 @@ TEST_CASE("paper mode: forces along the normal, peak and symmetric fall-off (eqs
   StyleOptions options;
   options.lambda = 0.5;
   const StyleResult r = style_deform(s, bound, line, options);
+  CHECK_THAT(r.report.brief(), Catch::Matchers::StartsWith(r.report.summary.brief()) &&
+                                   Catch::Matchers::Contains("key points"));
   const InfluenceRegion region = influence_factors(s, bound);
   CHECK(r.report.constraint_class == ConstraintClass::WellConstrained);
   CHECK(r.report.direction == KeyDirection::U);

@@ -91,6 +91,8 @@ TEST_CASE("deform_surface: a stack of exact steps stays an exact NURBS", "[surfa
   INFO(r.report.brief());
   REQUIRE(r.report.steps.size() == 3);
   CHECK(r.report.exact);
+  CHECK(r.report.summary.converged());
+  CHECK(r.report.summary.message == r.report.brief());
   CHECK(r.report.steps[0].method == StepOutcome::Method::Exact);
   CHECK(r.report.steps[1].method == StepOutcome::Method::Exact);
   CHECK(r.report.steps[2].method == StepOutcome::Method::Skipped);

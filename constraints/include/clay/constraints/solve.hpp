@@ -68,6 +68,9 @@ struct SolveReport {
                                  ///< direction) differs from the start: a different solution
   double solve_seconds = 0;      ///< wall time of the solve
   double diagnose_seconds = 0;   ///< wall time of the rank / dependency analysis
+
+  /// One line: the summary, the largest residual, the unknowns and the degrees of freedom.
+  std::string brief() const;
 };
 
 /// The solved sketch and its report.

@@ -26,6 +26,7 @@
 /// that every patch lies in the lattice and throws otherwise; it never returns a wrong surface.
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
+#include <clay/summary.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
 #include <string>
@@ -63,6 +64,9 @@ struct ComposeReport {
   double size = 0.0;         ///< the reference length (mm): the lattice control points' box
                              ///< diagonal, or the surface's control box diagonal for a taper
   bool exact = true;         ///< true: the result is the composition, exact up to rounding
+  /// Converged (a composition that cannot be exact throws instead); message = brief(),
+  /// final_residual = max_relative_deviation.
+  Summary summary;
 
   /// One line: degrees, patches, control points, knots removed, deviation.
   std::string brief() const;

@@ -23,6 +23,7 @@
 ///   factorization B S = C D of eq. (3). Cost O(N² m): ~11 ms for 100 points on a cubic 8³-cell
 ///   lattice, then ~0.7 ms per move of the targets (DirectManipulator).
 #include <clay/deform/lattice.hpp>
+#include <clay/summary.hpp>
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -75,7 +76,10 @@ struct DirectManipulationReport {
   double achieved_max_error = 0;  ///< max_i |deform_point(new lattice, X_i) − target_i| (mm)
   double displacement_norm = 0;   ///< Frobenius norm of new − old lattice.points (mm)
   bool feasible = false;          ///< achieved_max_error <= tolerance × size
-  std::string message;            ///< what happened, in words
+  /// Converged when feasible; NotConverged for a least-squares compromise; Failed when no free
+  /// control point acts on the points. The message says what happened, in words;
+  /// final_residual = achieved_max_error.
+  Summary summary;
 
   /// One line, e.g. "feasible: 3 points moved, rank 3 of 3, largest miss 2.1e-14 mm".
   std::string brief() const;

@@ -8,6 +8,7 @@
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
+#include <clay/summary.hpp>
 
 #include <Eigen/Core>
 
@@ -68,6 +69,9 @@ struct StackReport {
     FreezeReport report;  ///< inside / outside / unresolved counts, Newton residuals
   };
   std::vector<Freeze> freezes;  ///< one per enabled extended lattice step, in order of application
+  /// Converged when no freeze left a point unresolved, else NotConverged (those points are left
+  /// unchanged); message = brief().
+  Summary summary;
 
   /// True when no freeze left a point unresolved (also when the stack has no extended lattice).
   bool converged() const noexcept;

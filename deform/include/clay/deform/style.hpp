@@ -183,6 +183,9 @@ struct StyleReport {
   /// move (over-constrained: the target lies outside the bound). λ = 0 is Converged: unchanged
   /// as asked. The message names the figure and the way out.
   Summary summary;
+
+  /// One line: the summary, the class of the constraint and the figures that judge it.
+  std::string brief() const;
 };
 
 /// The outcome of a style deformation from its report and options (the rules of

@@ -52,6 +52,9 @@ struct SurfaceDeformationReport {
   bool certified = true;           ///< every refitted step carries a certified bound
   int degree_u = 0, degree_v = 0;  ///< degrees of the result
   long control_points = 0;         ///< control points of the result
+  /// Converged (a step that misses its tolerance throws ToleranceNotMet unless accepted, then
+  /// NotConverged); message = brief().
+  Summary summary;
   /// One line per step: "steps[1] twist 'spin': refit, certified 3.1e-3 mm (tolerance ...)".
   std::string brief() const;
 };
