@@ -2,6 +2,8 @@
 /// Serving a run to the browser viewer and taking pictures of it (issue #9): `clayform view` and
 /// `clayform snapshot` (docs/recipe.md "Viewing a run"). The built front end (viewer/dist) is
 /// served at `/`, the run folder (with its view/manifest.json, clay/view.hpp) under `/run/`.
+#include <clay/recipe/export.hpp>
+
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -10,7 +12,7 @@ namespace clay::recipe {
 
 /// The built front end: the environment variable CLAYFORM_VIEWER_DIR when set and not empty, else
 /// the folder compiled in (the source tree's viewer/dist).
-std::filesystem::path viewer_dir();
+CLAY_RECIPE_API std::filesystem::path viewer_dir();
 
 /// Settings of ViewServer.
 struct ServeOptions {
@@ -22,7 +24,7 @@ struct ServeOptions {
 /// An HTTP server (cpp-httplib) of one run folder: `/` and static files from the front end,
 /// `/run/...` from the run folder; content types by extension (.bin application/octet-stream,
 /// .glb model/gltf-binary); paths containing ".." are refused (400). Binds in the constructor.
-class ViewServer {
+class CLAY_RECIPE_API ViewServer {
  public:
   /// Checks `run_dir`/view/manifest.json and the front end's index.html (clay::Error(Io) naming
   /// the fix when missing) and binds the port (clay::Error(Io) when it cannot).
@@ -58,7 +60,8 @@ struct SnapshotOptions {
 /// `/?mode=MODE`, waits for it (killed after the timeout), checks `png` was written.
 /// Throws clay::Error: InvalidArgument for a bad mode or size, Io when chromium is missing (naming
 /// the Debian package), fails, times out or writes no picture.
-void snapshot(const std::filesystem::path& run_dir, const std::filesystem::path& png,
-              const SnapshotOptions& options = {});
+CLAY_RECIPE_API void snapshot(const std::filesystem::path& run_dir,
+                              const std::filesystem::path& png,
+                              const SnapshotOptions& options = {});
 
 }  // namespace clay::recipe

@@ -3,6 +3,7 @@
 /// regular deformations and deformation stacks, can be used alike: a one-off
 /// `deform_point(d, x)` and a bulk `deform_points(d, points, options)` on an N x 3 row-major
 /// matrix (and on structure-of-arrays columns). The PointDeformation concept checks both.
+#include <clay/deform/export.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
 #include <Eigen/Core>
@@ -13,7 +14,7 @@
 namespace clay::deform {
 
 /// Settings of deform_points().
-struct DeformOptions {
+struct CLAY_DEFORM_API DeformOptions {
   int threads = 0;  ///< worker threads, >= 0; 0 = std::thread::hardware_concurrency(). Fewer are
                     ///< used when there are few points (at least 16,384 points per thread).
 

@@ -2,6 +2,7 @@
 /// Surfaces of revolution as exact rational B-spline surfaces (The NURBS Book A8.1): every
 /// circle is an exact rational quadratic, not an approximation.
 #include <clay/surface/build_report.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
@@ -27,6 +28,7 @@ struct Axis {
 /// would intersect itself in each case); InvalidArgument for an axis of zero length or an angle
 /// outside (0, 360]. Not detected: a non-planar profile whose meridian (distance to the axis,
 /// height along it) crosses itself although the profile does not.
-BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle_degrees = 360.0);
+CLAY_SURFACE_API BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis,
+                                      double angle_degrees = 360.0);
 
 }  // namespace clay::surface
