@@ -4,6 +4,8 @@
 /// parts − 1 std::threads and works on the first part itself. An embedder that owns a thread
 /// pool hands it in as an Executor (DeformOptions::executor) and caps the parts with
 /// DeformOptions::threads, so the kernel starts no thread of its own.
+#include <clay/surface/export.hpp>
+
 #include <cstddef>
 #include <functional>
 
@@ -17,6 +19,6 @@ using Executor =
 
 /// The default Executor: parts − 1 new std::threads plus the calling thread. Every task runs to
 /// its end; the first exception thrown by a task is rethrown on the calling thread afterwards.
-void run_on_threads(std::size_t parts, const std::function<void(std::size_t part)>& task);
+CLAY_SURFACE_API void run_on_threads(std::size_t parts, const std::function<void(std::size_t part)>& task);
 
 }  // namespace clay

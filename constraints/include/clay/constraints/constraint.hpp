@@ -4,6 +4,7 @@
 /// A Constraint is plain data made by the factory functions below; a list of them and a Sketch
 /// go to solve() (clay/constraints/solve.hpp). Lengths are millimetres, angles degrees.
 /// Constraints marked "planar" need their entities in one sketch plane and act in it.
+#include <clay/constraints/export.hpp>
 #include <clay/sketch/entities.hpp>
 
 #include <Eigen/Core>
@@ -109,50 +110,51 @@ struct Constraint {
 };
 
 /// The point stays at its current position.
-Constraint fixed(PointId point);
+CLAY_CONSTRAINTS_API Constraint fixed(PointId point);
 /// The two points coincide.
-Constraint coincident(PointId a, PointId b);
+CLAY_CONSTRAINTS_API Constraint coincident(PointId a, PointId b);
 /// The point lies on the curve entity (a line counts as its infinite line, an arc as its circle).
-Constraint point_on(PointId point, EntityId curve);
+CLAY_CONSTRAINTS_API Constraint point_on(PointId point, EntityId curve);
 /// Planar: the line is parallel to its plane's x axis.
-Constraint horizontal(EntityId line);
+CLAY_CONSTRAINTS_API Constraint horizontal(EntityId line);
 /// Planar: the line is parallel to its plane's y axis.
-Constraint vertical(EntityId line);
+CLAY_CONSTRAINTS_API Constraint vertical(EntityId line);
 /// Planar: the lines are parallel, pointing the same way they point at the start.
-Constraint parallel(EntityId a, EntityId b);
+CLAY_CONSTRAINTS_API Constraint parallel(EntityId a, EntityId b);
 /// Planar: the lines are perpendicular.
-Constraint perpendicular(EntityId a, EntityId b);
+CLAY_CONSTRAINTS_API Constraint perpendicular(EntityId a, EntityId b);
 /// The points are `distance` mm apart (> 0; use coincident for 0).
-Constraint distance(PointId a, PointId b, double distance);
+CLAY_CONSTRAINTS_API Constraint distance(PointId a, PointId b, double distance);
 /// Planar: the point is `distance` mm from the (infinite) line, on the side where it starts.
-Constraint distance(PointId point, EntityId line, double distance);
+CLAY_CONSTRAINTS_API Constraint distance(PointId point, EntityId line, double distance);
 /// Planar: the angle turning line a's direction into line b's is `degrees` in (0, 180], turning
 /// the way it turns at the start.
-Constraint angle(EntityId a, EntityId b, double degrees);
+CLAY_CONSTRAINTS_API Constraint angle(EntityId a, EntityId b, double degrees);
 /// The circle's or arc's radius is `radius` mm (> 0).
-Constraint radius(EntityId circle_or_arc, double radius);
+CLAY_CONSTRAINTS_API Constraint radius(EntityId circle_or_arc, double radius);
 /// The two lines have equal length.
-Constraint equal_length(EntityId a, EntityId b);
+CLAY_CONSTRAINTS_API Constraint equal_length(EntityId a, EntityId b);
 /// The two circles/arcs have equal radius.
-Constraint equal_radius(EntityId a, EntityId b);
+CLAY_CONSTRAINTS_API Constraint equal_radius(EntityId a, EntityId b);
 /// The point is the midpoint of the line.
-Constraint midpoint(PointId point, EntityId line);
+CLAY_CONSTRAINTS_API Constraint midpoint(PointId point, EntityId line);
 /// Planar: a and b are mirror images about the (infinite) line.
-Constraint symmetric(PointId a, PointId b, EntityId line);
+CLAY_CONSTRAINTS_API Constraint symmetric(PointId a, PointId b, EntityId line);
 /// G1 joint between two curve ends (lines, arcs, B-spline curves): the end points coincide and
 /// the curve a continues into curve b with a parallel tangent of the same sense.
-Constraint tangent(CurveEnd a, CurveEnd b);
+CLAY_CONSTRAINTS_API Constraint tangent(CurveEnd a, CurveEnd b);
 /// G2 joint: tangent(a, b) and equal curvature vectors at the joint.
-Constraint curvature(CurveEnd a, CurveEnd b);
+CLAY_CONSTRAINTS_API Constraint curvature(CurveEnd a, CurveEnd b);
 /// The tangent at a curve end, pointing out of the curve's end (or into it at its start, i.e.
 /// along increasing parameter) is along `direction` (world, nonzero).
-Constraint end_tangent(CurveEnd end, const Eigen::Vector3d& direction);
+CLAY_CONSTRAINTS_API Constraint end_tangent(CurveEnd end, const Eigen::Vector3d& direction);
 
 /// The constraint in words, naming its points and entities as the sketch calls them (their
 /// names when the sketch has them): "angle 60 degrees from line #1 to line #2".
-std::string describe(const Constraint& constraint, const sketch::Sketch& sketch);
+CLAY_CONSTRAINTS_API std::string describe(const Constraint& constraint,
+                                          const sketch::Sketch& sketch);
 /// How messages name the constraint at `index` of a list: its label when set (a recipe labels
 /// each with its path, "sketches.s.constraints[3]"), else "constraint #3".
-std::string constraint_name(const Constraint& constraint, int index);
+CLAY_CONSTRAINTS_API std::string constraint_name(const Constraint& constraint, int index);
 
 }  // namespace clay::constraints

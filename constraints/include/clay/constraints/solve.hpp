@@ -10,6 +10,7 @@
 /// of freedom; a dependent equation gives the smallest set of constraints it depends on (its
 /// fundamental circuit), "redundant" when they all hold after the solve, "conflicting" otherwise.
 #include <clay/constraints/constraint.hpp>
+#include <clay/constraints/export.hpp>
 #include <clay/summary.hpp>
 
 #include <Eigen/Core>
@@ -26,7 +27,7 @@ struct Drag {
 };
 
 /// Settings of solve().
-struct SolveOptions {
+struct CLAY_CONSTRAINTS_API SolveOptions {
   double tolerance = 1e-10;   ///< largest residual (mm, or radians for angles) of a solved
                               ///< constraint; in (0, 1e-3]
   int max_iterations = 100;   ///< Levenberg–Marquardt iterations, >= 1
@@ -54,7 +55,7 @@ struct Dependency {
 };
 
 /// What solve() found.
-struct SolveReport {
+struct CLAY_CONSTRAINTS_API SolveReport {
   Summary summary;               ///< Converged when every constraint holds within tolerance
   double max_residual = 0;       ///< largest |residual| after the solve (mm or radians)
   int unknowns = 0;              ///< scalar unknowns before substitution
@@ -86,7 +87,8 @@ struct SolveResult {
 /// reference), for a planar constraint on entities not in one plane, for a non-positive
 /// distance/radius or a non-finite value, and for bad options; InvalidGeometry for an invalid
 /// sketch (sketch::validate).
-SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& constraints,
-                  const SolveOptions& options = {});
+CLAY_CONSTRAINTS_API SolveResult solve(const sketch::Sketch& sketch,
+                                       const std::vector<Constraint>& constraints,
+                                       const SolveOptions& options = {});
 
 }  // namespace clay::constraints

@@ -5,6 +5,7 @@
 /// and the k planes after it; for any knot vector the locked planes are those whose basis
 /// functions have a non-zero derivative of order <= k on the face (for unclamped uniform knots of
 /// degree p: p planes, whatever k < p).
+#include <clay/deform/export.hpp>
 #include <clay/deform/lattice.hpp>
 
 #include <span>
@@ -25,16 +26,18 @@ struct FaceContinuity {
 /// row r of lattice.points is locked (same index as the points). Throws clay::Error
 /// (InvalidArgument) for an order outside [0, degree] naming the face, (InvalidGeometry) for an
 /// invalid lattice.
-std::vector<bool> locked_control_points(const BezierLattice& lattice,
-                                        std::span<const FaceContinuity> faces);
+CLAY_DEFORM_API std::vector<bool> locked_control_points(const BezierLattice& lattice,
+                                                        std::span<const FaceContinuity> faces);
 /// Same for a B-spline lattice (derivatives of the basis at the face, The NURBS Book A2.3).
-std::vector<bool> locked_control_points(const BSplineLattice& lattice,
-                                        std::span<const FaceContinuity> faces);
+CLAY_DEFORM_API std::vector<bool> locked_control_points(const BSplineLattice& lattice,
+                                                        std::span<const FaceContinuity> faces);
 
 /// The lattice with its locked control points reset to their undisplaced positions, so that the
 /// deformation is C^k with the space around the faces (Sederberg–Parry §3.1). Same throws.
-BezierLattice with_continuity(BezierLattice lattice, std::span<const FaceContinuity> faces);
+CLAY_DEFORM_API BezierLattice with_continuity(BezierLattice lattice,
+                                              std::span<const FaceContinuity> faces);
 /// Same for a B-spline lattice.
-BSplineLattice with_continuity(BSplineLattice lattice, std::span<const FaceContinuity> faces);
+CLAY_DEFORM_API BSplineLattice with_continuity(BSplineLattice lattice,
+                                               std::span<const FaceContinuity> faces);
 
 }  // namespace clay::deform

@@ -3,6 +3,7 @@
 /// regular deformations and deformation stacks, can be used alike: a one-off
 /// `deform_point(d, x)` and a bulk `deform_points(d, points, options)` on an N x 3 row-major
 /// matrix (and on structure-of-arrays columns). The PointDeformation concept checks both.
+#include <clay/deform/export.hpp>
 #include <clay/parallel.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
@@ -16,7 +17,7 @@
 namespace clay::deform {
 
 /// Settings of deform_points().
-struct DeformOptions {
+struct CLAY_DEFORM_API DeformOptions {
   int threads = 0;  ///< parts the points are split into, 0..1024; 0 = one per hardware thread.
                     ///< Fewer are used when there are few points (at least 16,384 per part).
   /// Who runs the parts: empty = parts − 1 new std::threads plus the calling thread

@@ -22,6 +22,7 @@
 ///   that act on some selected point (N x m, m <= M); its rank-revealing QR is the full-rank
 ///   factorization B S = C D of eq. (3). Cost O(N² m): ~11 ms for 100 points on a cubic 8³-cell
 ///   lattice, then ~0.7 ms per move of the targets (DirectManipulator).
+#include <clay/deform/export.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/summary.hpp>
 
@@ -42,7 +43,7 @@ struct PointMove {
 };
 
 /// Settings of direct manipulation.
-struct DirectManipulationOptions {
+struct CLAY_DEFORM_API DirectManipulationOptions {
   /// Empty, or one entry per control point (row of lattice.points): true = the point must not
   /// move (e.g. locked_control_points(lattice, faces)).
   std::vector<bool> locked;
@@ -68,7 +69,7 @@ struct DirectManipulationOptions {
 };
 
 /// What a direct manipulation achieved.
-struct DirectManipulationReport {
+struct CLAY_DEFORM_API DirectManipulationReport {
   int requested = 0;  ///< number of point moves N
   int unknowns = 0;   ///< free control points and tie groups that act on some selected point (m)
   int rank = 0;       ///< numerical rank of B S on those unknowns (<= min(N, m))
@@ -96,17 +97,17 @@ struct DirectManipulationResult {
 /// basis products of each point's local coordinates (see above). Throws clay::Error:
 /// InvalidGeometry for an invalid lattice, InvalidArgument for a non-finite point, OutOfDomain
 /// for a point outside the lattice (naming its index and local coordinates).
-Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(const BSplineLattice& lattice,
-                                                              const Points3& points);
+CLAY_DEFORM_API Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(
+    const BSplineLattice& lattice, const Points3& points);
 /// Same for a Bézier lattice (Bernstein products, Sederberg–Parry eq. (2)).
-Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(const BezierLattice& lattice,
-                                                              const Points3& points);
+CLAY_DEFORM_API Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(
+    const BezierLattice& lattice, const Points3& points);
 
 /// The stateful solver: fixes the lattice, the selected points and the options, and factorizes
 /// B S once ("B⁺ need be computed only once", Hsu et al. §3.1), so that dragging the targets
 /// costs a solve per move. Lattice is BSplineLattice or BezierLattice.
 template <class Lattice>
-class DirectManipulator {
+class CLAY_DEFORM_API DirectManipulator {
  public:
   /// Selected points: N x 3 rows, undeformed space, N >= 1. Throws clay::Error: InvalidGeometry
   /// for an invalid lattice; InvalidArgument for no points, a non-finite point, bad options
@@ -137,15 +138,17 @@ class DirectManipulator {
 
 /// One-off direct manipulation: DirectManipulator(lattice, points, options).move(targets).
 /// Same throws (a request is named by its index in `moves`).
-DirectManipulationResult<BSplineLattice> manipulate(const BSplineLattice& lattice,
-                                                    std::span<const PointMove> moves,
-                                                    const DirectManipulationOptions& options = {});
+CLAY_DEFORM_API DirectManipulationResult<BSplineLattice> manipulate(
+    const BSplineLattice& lattice, std::span<const PointMove> moves,
+    const DirectManipulationOptions& options = {});
 /// Same for a Bézier lattice.
-DirectManipulationResult<BezierLattice> manipulate(const BezierLattice& lattice,
-                                                   std::span<const PointMove> moves,
-                                                   const DirectManipulationOptions& options = {});
+CLAY_DEFORM_API DirectManipulationResult<BezierLattice> manipulate(
+    const BezierLattice& lattice, std::span<const PointMove> moves,
+    const DirectManipulationOptions& options = {});
 
-extern template class DirectManipulator<BSplineLattice>;
-extern template class DirectManipulator<BezierLattice>;
+// Exported here too: an instantiation is no more visible than its arguments, and the lattices,
+// which have no out-of-line members, are not marked.
+extern template class CLAY_DEFORM_API DirectManipulator<BSplineLattice>;
+extern template class CLAY_DEFORM_API DirectManipulator<BezierLattice>;
 
 }  // namespace clay::deform

@@ -17,6 +17,7 @@
 /// Both return a surface with the same degrees (and, in paper mode, the same knots): control
 /// vertices move, nothing is refitted. Exact mode may insert knots (exactly, reported) where the
 /// control net is too coarse for the key points.
+#include <clay/deform/export.hpp>
 #include <clay/summary.hpp>
 #include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/projection.hpp>
@@ -45,7 +46,7 @@ enum class ConstraintClass {
 };
 
 /// Name of a constraint class ("over-constrained", ...).
-std::string_view to_string(ConstraintClass c) noexcept;
+CLAY_DEFORM_API std::string_view to_string(ConstraintClass c) noexcept;
 
 /// Direction the target runs along in parameter space (Han et al. eq. 8): `u` means it crosses
 /// the control-net rows i = const (vertices (i, 0..count_v-1)), so there is a key point per row and
@@ -53,7 +54,7 @@ std::string_view to_string(ConstraintClass c) noexcept;
 enum class KeyDirection { U, V };
 
 /// Settings of the style deformation. Lengths in mm.
-struct StyleOptions {
+struct CLAY_DEFORM_API StyleOptions {
   StyleMode mode = StyleMode::Paper;  ///< paper forces or exact key-point interpolation
   double lambda = 1.0;     ///< approximation scale λ in [0, 1] (eq. 9); 0 leaves the surface as is
   bool relaxation = true;  ///< paper: let the end forces fall off to the bound (eqs. 10-11)
@@ -83,7 +84,7 @@ struct StyleOptions {
 };
 
 /// Influence factors E(Q_ij) of every control vertex (Han et al. eq. 2) and where they came from.
-struct InfluenceRegion {
+struct CLAY_DEFORM_API InfluenceRegion {
   int count_u = 0;  ///< control vertices along u of the surface they belong to
   int count_v = 0;  ///< control vertices along v
   std::vector<std::uint8_t> factors;  ///< E(Q_ij) in {0, 1} at i * count_v + j
@@ -110,18 +111,18 @@ struct InfluenceRegion {
 /// clay::Error: InvalidGeometry for an invalid surface or curve, a bound curve that is not closed
 /// (ends farther apart than 1e-7 of its size) or whose projection crosses itself (naming where),
 /// InvalidArgument for bad options.
-InfluenceRegion influence_factors(const surface::BSplineSurface& parent,
-                                  const surface::BSplineCurve& bound,
-                                  const StyleOptions& options = {});
+CLAY_DEFORM_API InfluenceRegion influence_factors(const surface::BSplineSurface& parent,
+                                                  const surface::BSplineCurve& bound,
+                                                  const StyleOptions& options = {});
 
 /// The region without a bound curve (Han et al. §5): the target curve is projected onto the
 /// surface and E = 1 for every control vertex whose basis function is non-zero at a projected
 /// sample (the vertices that move the surface under the target), widened by
 /// options.boundary_rows layers so that the exact mode's fixed edge layers leave that band free.
 /// Throws as influence_factors.
-InfluenceRegion influence_from_target(const surface::BSplineSurface& parent,
-                                      const surface::BSplineCurve& target,
-                                      const StyleOptions& options = {});
+CLAY_DEFORM_API InfluenceRegion influence_from_target(const surface::BSplineSurface& parent,
+                                                      const surface::BSplineCurve& target,
+                                                      const StyleOptions& options = {});
 
 /// A key point K_i of the target curve and its force (eqs. 3, 8).
 struct KeyPoint {
@@ -148,11 +149,13 @@ struct KeyPoints {
 /// the domain (at least one key point: the middle of the target when it crosses no row). The
 /// class: over-constrained when no projected sample lies in the region, well-constrained when all
 /// do. Throws as influence_factors, and InvalidArgument when the region was made for another net.
-KeyPoints key_points(const surface::BSplineSurface& parent, const InfluenceRegion& region,
-                     const surface::BSplineCurve& target, const StyleOptions& options = {});
+CLAY_DEFORM_API KeyPoints key_points(const surface::BSplineSurface& parent,
+                                     const InfluenceRegion& region,
+                                     const surface::BSplineCurve& target,
+                                     const StyleOptions& options = {});
 
 /// What a style deformation did and how well (DESIGN.md quality figures). Lengths in mm.
-struct StyleReport {
+struct CLAY_DEFORM_API StyleReport {
   StyleMode mode = StyleMode::Paper;
   ConstraintClass constraint_class = ConstraintClass::OverConstrained;
   KeyDirection direction = KeyDirection::U;
@@ -190,7 +193,7 @@ struct StyleReport {
 
 /// The outcome of a style deformation from its report and options (the rules of
 /// StyleReport::summary); style_deform and StyleEditor::update set report.summary with it.
-Summary judge_style(const StyleReport& report, const StyleOptions& options);
+CLAY_DEFORM_API Summary judge_style(const StyleReport& report, const StyleOptions& options);
 
 /// The deformed surface and its report.
 struct StyleResult {
@@ -204,8 +207,10 @@ struct StyleResult {
 /// Deforms `parent` toward `target` inside `region` (influence_factors or influence_from_target of
 /// the same surface). λ = 0 and the over-constrained class return the parent bit for bit; vertices
 /// with E = 0 are never written. Throws as key_points.
-StyleResult style_deform(const surface::BSplineSurface& parent, const InfluenceRegion& region,
-                         const surface::BSplineCurve& target, const StyleOptions& options = {});
+CLAY_DEFORM_API StyleResult style_deform(const surface::BSplineSurface& parent,
+                                         const InfluenceRegion& region,
+                                         const surface::BSplineCurve& target,
+                                         const StyleOptions& options = {});
 
 namespace detail {
 struct ExactCache;  // the exact mode's free vertices and fairness matrix (style_exact.cpp)
@@ -218,7 +223,7 @@ struct ExactCache;  // the exact mode's free vertices and fairness matrix (style
 /// update(target) returns what style_deform(parent, region, target, options) returns, up to the
 /// projection tolerance (the Newton starts differ) — in exact mode, where those differences can
 /// change which key points are added, up to curve_tolerance. Copies share the cache (immutable).
-class StyleEditor {
+class CLAY_DEFORM_API StyleEditor {
  public:
   /// Throws clay::Error: InvalidGeometry for an invalid parent, InvalidArgument for bad options or
   /// a region made for another control net.
@@ -243,11 +248,14 @@ class StyleEditor {
 };
 
 /// One-off with a bound curve: influence_factors, then style_deform.
-StyleResult style_deform(const surface::BSplineSurface& parent, const surface::BSplineCurve& bound,
-                         const surface::BSplineCurve& target, const StyleOptions& options = {});
+CLAY_DEFORM_API StyleResult style_deform(const surface::BSplineSurface& parent,
+                                         const surface::BSplineCurve& bound,
+                                         const surface::BSplineCurve& target,
+                                         const StyleOptions& options = {});
 
 /// One-off without a bound curve (§5): influence_from_target, then style_deform.
-StyleResult style_deform(const surface::BSplineSurface& parent, const surface::BSplineCurve& target,
-                         const StyleOptions& options = {});
+CLAY_DEFORM_API StyleResult style_deform(const surface::BSplineSurface& parent,
+                                         const surface::BSplineCurve& target,
+                                         const StyleOptions& options = {});
 
 }  // namespace clay::deform

@@ -7,6 +7,7 @@
 /// only when a refit is allowed; otherwise the step is refused with the reason and the way out.
 /// The report says, per step, which it was and with what figures.
 #include <clay/deform/compose.hpp>
+#include <clay/deform/export.hpp>
 #include <clay/deform/refit.hpp>
 #include <clay/deform/stack.hpp>
 #include <clay/surface/bspline_surface.hpp>
@@ -18,7 +19,7 @@
 namespace clay::deform {
 
 /// Settings of deform_surface.
-struct SurfaceDeformationOptions {
+struct CLAY_DEFORM_API SurfaceDeformationOptions {
   ComposeOptions compose;  ///< for the steps composed exactly
   /// For the steps that cannot be composed exactly; empty: such a step is an error that names it
   /// and why (give a refit tolerance, lower the lattice degree, move the knot plane).
@@ -46,7 +47,7 @@ struct StepOutcome {
 };
 
 /// Per-step outcomes and the result's size.
-struct SurfaceDeformationReport {
+struct CLAY_DEFORM_API SurfaceDeformationReport {
   std::vector<StepOutcome> steps;  ///< one per stack step, in order
   bool exact = true;               ///< every enabled step was composed exactly
   bool certified = true;           ///< every refitted step carries a certified bound
@@ -78,13 +79,13 @@ struct SurfaceDeformationResult {
 /// |F(x) − x|, and no continuous fit comes closer than half that jump; when half the jump
 /// (measured at the crossings of an 8-per-span sample grid, bisected to the face) exceeds the
 /// tolerance, the step is refused at once.
-SurfaceDeformationResult deform_surface(const DeformationStack& stack,
-                                        const surface::BSplineSurface& surface,
-                                        const SurfaceDeformationOptions& options = {});
+CLAY_DEFORM_API SurfaceDeformationResult
+deform_surface(const DeformationStack& stack, const surface::BSplineSurface& surface,
+               const SurfaceDeformationOptions& options = {});
 
 /// The same for one deformation.
-SurfaceDeformationResult deform_surface(const Deformation& deformation,
-                                        const surface::BSplineSurface& surface,
-                                        const SurfaceDeformationOptions& options = {});
+CLAY_DEFORM_API SurfaceDeformationResult
+deform_surface(const Deformation& deformation, const surface::BSplineSurface& surface,
+               const SurfaceDeformationOptions& options = {});
 
 }  // namespace clay::deform

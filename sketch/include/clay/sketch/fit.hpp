@@ -33,6 +33,7 @@
 ///   across the seam; the result is then clamped on the same domain and its last control point set
 ///   to its first: it closes exactly and is C^(degree-1) at the seam to rounding. A closed stroke
 ///   with corners gives a closed chain of open curves.
+#include <clay/sketch/export.hpp>
 #include <clay/sketch/stroke.hpp>
 #include <clay/summary.hpp>
 #include <clay/surface/bspline_curve.hpp>
@@ -45,7 +46,7 @@
 namespace clay::sketch {
 
 /// Settings of fit_stroke (and of the new piece in oversketch).
-struct FitOptions {
+struct CLAY_SKETCH_API FitOptions {
   double tolerance = 0.1;         ///< mm, largest distance from a stroke point to its curve
                                   ///< (averaged over 9 neighbours for a noisy stroke); > 0
   int degree = 3;                 ///< degree of the curves, in [2, 9]
@@ -104,6 +105,6 @@ struct StrokeFit {
 /// Throws clay::Error: InvalidArgument for bad options, InvalidGeometry for a stroke that
 /// problems(stroke) rejects (fewer than 2 points, NaN or infinite coordinate, repeated consecutive
 /// point unless drop_duplicates, zero length, invalid plane).
-StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options = {});
+CLAY_SKETCH_API StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options = {});
 
 }  // namespace clay::sketch

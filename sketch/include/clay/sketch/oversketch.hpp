@@ -15,6 +15,7 @@
 /// C''(0) = beta T + |C'(0)|^2 kappa (beta free; alpha taken from the G1 solution, which makes the
 /// condition linear). The three parts are joined into one B-spline with knots of multiplicity p at
 /// the joints; a rational curve keeps its weights, the new part getting the joint's weight.
+#include <clay/sketch/export.hpp>
 #include <clay/sketch/fit.hpp>
 #include <clay/sketch/stroke.hpp>
 #include <clay/summary.hpp>
@@ -33,7 +34,7 @@ enum class Continuity {
 };
 
 /// Settings of oversketch.
-struct OversketchOptions {
+struct CLAY_SKETCH_API OversketchOptions {
   Continuity continuity = Continuity::G1;  ///< at both joints
   double capture_distance = 10.0;          ///< mm, > 0: how far a stroke end may be from the curve
   FitOptions fit;  ///< tolerance, fairness, limits, end_samples and drop_duplicates for the new
@@ -75,7 +76,8 @@ struct OversketchResult {
 /// over an end of the curve, for a stroke whose ends meet the curve at one point or that runs over
 /// both of its ends (covering it all); InvalidGeometry for an invalid curve, a curve of degree 1, or a stroke that
 /// problems(stroke) rejects.
-OversketchResult oversketch(const surface::BSplineCurve& curve, const Stroke& stroke,
-                            const OversketchOptions& options = {});
+CLAY_SKETCH_API OversketchResult oversketch(const surface::BSplineCurve& curve,
+                                            const Stroke& stroke,
+                                            const OversketchOptions& options = {});
 
 }  // namespace clay::sketch

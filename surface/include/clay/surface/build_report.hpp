@@ -2,13 +2,14 @@
 /// BuildReport — what a surface builder made (fill, loft, sweep, revolve, primitives): its size,
 /// whether the construction is exact, and the deviation measured against the builder's input.
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/export.hpp>
 
 #include <string>
 
 namespace clay::surface {
 
 /// Size, exactness and measured deviation of a built surface.
-struct BuildReport {
+struct CLAY_SURFACE_API BuildReport {
   std::string method;         ///< what was built, e.g. "coons fill", "loft", "revolve"
   int degree_u = 0;           ///< degree in u
   int degree_v = 0;           ///< degree in v
@@ -33,6 +34,6 @@ struct BuiltSurface {
 
 /// Fills method, degrees, counts and rationality of `report` from `surface`; the caller sets
 /// exact, max_deviation_mm and samples.
-BuildReport describe(const BSplineSurface& surface, std::string method);
+CLAY_SURFACE_API BuildReport describe(const BSplineSurface& surface, std::string method);
 
 }  // namespace clay::surface

@@ -8,6 +8,7 @@
 /// would raise a knot's multiplicity above the degree (above degree + 1 at the domain ends of an
 /// unclamped vector's outermost value).
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
@@ -17,23 +18,28 @@
 namespace clay::surface {
 
 /// Inserts knot t `times` times (Boehm's algorithm, The NURBS Book A5.1).
-BSplineCurve insert_knot(const BSplineCurve& curve, double t, int times = 1);
+CLAY_SURFACE_API BSplineCurve insert_knot(const BSplineCurve& curve, double t, int times = 1);
 /// Inserts knot u `times` times in the u direction of the surface.
-BSplineSurface insert_knot_u(const BSplineSurface& surface, double u, int times = 1);
+CLAY_SURFACE_API BSplineSurface insert_knot_u(const BSplineSurface& surface, double u,
+                                              int times = 1);
 /// Inserts knot v `times` times in the v direction of the surface.
-BSplineSurface insert_knot_v(const BSplineSurface& surface, double v, int times = 1);
+CLAY_SURFACE_API BSplineSurface insert_knot_v(const BSplineSurface& surface, double v,
+                                              int times = 1);
 
 /// Inserts all of `knots` (sorted or not, repeats allowed) at once (The NURBS Book A5.4).
-BSplineCurve refine_knots(const BSplineCurve& curve, std::span<const double> knots);
+CLAY_SURFACE_API BSplineCurve refine_knots(const BSplineCurve& curve,
+                                           std::span<const double> knots);
 /// Knot refinement in the u direction of the surface.
-BSplineSurface refine_knots_u(const BSplineSurface& surface, std::span<const double> knots);
+CLAY_SURFACE_API BSplineSurface refine_knots_u(const BSplineSurface& surface,
+                                               std::span<const double> knots);
 /// Knot refinement in the v direction of the surface.
-BSplineSurface refine_knots_v(const BSplineSurface& surface, std::span<const double> knots);
+CLAY_SURFACE_API BSplineSurface refine_knots_v(const BSplineSurface& surface,
+                                               std::span<const double> knots);
 
 /// Splits the curve into its Bézier segments, one per non-empty knot span of the domain, each a
 /// clamped curve of the same degree on its own span [t_k, t_k+1] (parameters are kept, not
 /// normalized), so segment k evaluates like the curve on that span.
-std::vector<BSplineCurve> extract_bezier(const BSplineCurve& curve);
+CLAY_SURFACE_API std::vector<BSplineCurve> extract_bezier(const BSplineCurve& curve);
 
 /// The Bézier patches of a surface, one per pair of non-empty knot spans.
 struct BezierPatches {
@@ -51,7 +57,7 @@ struct BezierPatches {
 
 /// Splits the surface into its Bézier patches (The NURBS Book A5.7 by way of refinement); each
 /// patch keeps the surface's parameters on its span, so it evaluates like the surface there.
-BezierPatches extract_bezier(const BSplineSurface& surface);
+CLAY_SURFACE_API BezierPatches extract_bezier(const BSplineSurface& surface);
 
 /// The Bézier extraction operator of one non-empty span [a, b] of a basis: the span's Bézier
 /// control point r is sum_q matrix(r, q) P[first + q] (first = span index − degree).
@@ -63,7 +69,7 @@ struct SpanExtraction {
 
 /// The extraction operator of every non-empty span of the domain, by the same refinement as
 /// extract_bezier (applied to the identity), for nets of any dimension such as FFD lattices.
-std::vector<SpanExtraction> bezier_extraction(const BSplineBasis& basis);
+CLAY_SURFACE_API std::vector<SpanExtraction> bezier_extraction(const BSplineBasis& basis);
 
 /// A curve after remove_knots, and how many knots were taken out.
 struct CurveKnotRemoval {
@@ -83,10 +89,10 @@ struct SurfaceKnotRemoval {
 /// and calls this with 1e-12 of the model size to return the smallest exact representation.
 /// Throws InvalidGeometry for an invalid curve, InvalidArgument for a negative or non-finite
 /// tolerance.
-CurveKnotRemoval remove_knots(const BSplineCurve& curve, double tolerance_mm);
+CLAY_SURFACE_API CurveKnotRemoval remove_knots(const BSplineCurve& curve, double tolerance_mm);
 /// remove_knots in the u direction: a u knot goes only when every column of the net allows it.
-SurfaceKnotRemoval remove_knots_u(const BSplineSurface& surface, double tolerance_mm);
+CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_u(const BSplineSurface& surface, double tolerance_mm);
 /// remove_knots in the v direction.
-SurfaceKnotRemoval remove_knots_v(const BSplineSurface& surface, double tolerance_mm);
+CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_v(const BSplineSurface& surface, double tolerance_mm);
 
 }  // namespace clay::surface
