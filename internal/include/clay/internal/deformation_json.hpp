@@ -11,7 +11,6 @@
 #include <optional>
 #include <string>
 #include <string_view>
-#include <tuple>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -63,6 +62,12 @@ auto required(JsonReader& r, const Json& j, const std::string& path, std::string
   return read(*m, key_path(path, key));
 }
 
+/// A required member holding control points [[x, y, z], ...].
+inline std::optional<surface::Points3> points_member(JsonReader& r, const Json& j, const std::string& path,
+                                                     std::string_view key, std::string_view hint) {
+  return required(r, j, path, key, hint, [&](const Json& v, const std::string& p) { return r.points(v, p, 0); });
+}
+
 inline bool read_fields(JsonReader& r, deform::BezierLattice& d, const Json& j, const std::string& path) {
   r.object(j, path, {"kind", "name", "enabled", "frame", "degrees", "points"}, "a bezier_lattice step");
   const auto frame = required(r, j, path, "frame", "the lattice frame {origin, s, t, u}",
@@ -84,8 +89,7 @@ inline bool read_fields(JsonReader& r, deform::BezierLattice& d, const Json& j, 
   } else {
     ok = false;
   }
-  const auto pts = required(r, j, path, "points", "the control points [[x, y, z], ...]",
-                            [&](const Json& v, const std::string& p) { return r.points(v, p, 0); });
+  const auto pts = points_member(r, j, path, "points", "the control points [[x, y, z], ...]");
   if (pts) d.points = *pts;
   return ok && pts.has_value();
 }
@@ -123,18 +127,15 @@ inline bool read_fields(JsonReader& r, deform::BSplineLattice& d, const Json& j,
   } else {
     ok = false;
   }
-  const auto pts = required(r, j, path, "points", "the control points [[x, y, z], ...]",
-                            [&](const Json& v, const std::string& p) { return r.points(v, p, 0); });
+  const auto pts = points_member(r, j, path, "points", "the control points [[x, y, z], ...]");
   if (pts) d.points = *pts;
   return ok && pts.has_value();
 }
 
 inline bool read_fields(JsonReader& r, deform::ExtendedLattice& d, const Json& j, const std::string& path) {
   r.object(j, path, {"kind", "name", "enabled", "rest", "points", "chunks"}, "an extended_lattice step");
-  const auto rest = required(r, j, path, "rest", "the rest control points [[x, y, z], ...]",
-                             [&](const Json& v, const std::string& p) { return r.points(v, p, 0); });
-  const auto pts = required(r, j, path, "points", "the current control points [[x, y, z], ...]",
-                            [&](const Json& v, const std::string& p) { return r.points(v, p, 0); });
+  const auto rest = points_member(r, j, path, "rest", "the rest control points [[x, y, z], ...]");
+  const auto pts = points_member(r, j, path, "points", "the current control points [[x, y, z], ...]");
   bool ok = rest && pts;
   if (rest) d.rest = *rest;
   if (pts) d.points = *pts;
@@ -220,12 +221,18 @@ inline bool read_fields(JsonReader& r, deform::Bend& d, const Json& j, const std
   return ok;
 }
 
+/// Calls f(T{}) for every alternative T of deform::Deformation, in the variant's order.
+template <class F>
+void for_each_kind(F&& f) {
+  [&]<std::size_t... I>(std::index_sequence<I...>) {
+    (f(std::variant_alternative_t<I, deform::Deformation>{}), ...);
+  }(std::make_index_sequence<std::variant_size_v<deform::Deformation>>{});
+}
+
 /// The kinds of the schema, in the variant's order.
 inline std::vector<std::string> deformation_kinds() {
   std::vector<std::string> out;
-  std::apply([&](auto... none) { (out.emplace_back(kind_of(none)), ...); },
-             std::tuple<deform::BezierLattice, deform::BSplineLattice, deform::ExtendedLattice, deform::Taper,
-                        deform::Twist, deform::Bend>{});
+  for_each_kind([&](const auto& none) { out.emplace_back(kind_of(none)); });
   return out;
 }
 
@@ -234,20 +241,14 @@ inline std::vector<std::string> deformation_kinds() {
 inline std::optional<deform::Deformation> read_deformation(JsonReader& r, std::string_view kind, const Json& j,
                                                            const std::string& path) {
   std::optional<deform::Deformation> out;
-  auto attempt = [&](auto value) {
-    if (out || kind != kind_of(value)) return;
-    if (read_fields(r, value, j, path)) out = std::move(value);
-  };
   bool known = false;
-  auto check = [&](auto value) { known = known || kind == kind_of(value); };
-  check(deform::BezierLattice{}), check(deform::BSplineLattice{}), check(deform::ExtendedLattice{});
-  check(deform::Taper{}), check(deform::Twist{}), check(deform::Bend{});
-  if (!known) {
+  for_each_kind([&](auto value) {
+    if (kind != kind_of(value)) return;
+    known = true;
+    if (read_fields(r, value, j, path)) out = std::move(value);
+  });
+  if (!known)
     r.add(key_path(path, "kind"), "unknown kind \"" + std::string(kind) + "\"; give one of " + join(deformation_kinds()));
-    return std::nullopt;
-  }
-  attempt(deform::BezierLattice{}), attempt(deform::BSplineLattice{}), attempt(deform::ExtendedLattice{});
-  attempt(deform::Taper{}), attempt(deform::Twist{}), attempt(deform::Bend{});
   return out;
 }
 

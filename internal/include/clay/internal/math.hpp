@@ -1,10 +1,13 @@
 #pragma once
 // Small numerical tools shared by every module (internal, not installed): binomial coefficients
 // and Gauss–Legendre quadrature.
+#include <clay/error.hpp>
+
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace clay::internal {
@@ -23,6 +26,10 @@ inline const std::vector<double>& binomial_row(int n) {
     }
     return t;
   }();
+  // Every caller's degrees are bounded far below (lattices 3 x 63); past the table is a bug.
+  if (n < 0 || n > max_binomial_row)
+    throw Error(ErrorCategory::Internal, "binomial_row(" + std::to_string(n) + "): beyond the table of rows 0.." +
+                                             std::to_string(max_binomial_row));
   return table[static_cast<size_t>(n)];
 }
 
