@@ -588,68 +588,49 @@ std::pair<double, double> global_parameter(const surface::BezierPatches& bp, int
                   "whole surface");
 }
 
-// ---- joining patches (knot removal is surface::remove_knots_u/_v) ------------------------------
+// ---- joining patches (surface::join_bezier_patches, then surface::remove_knots_u/_v) ------------
 
-/// Homogeneous control net (rows i * nv + j, columns x w, y w, z w, w) with its knot vectors.
-struct Net {
-  int pu = 0, pv = 0;
-  std::vector<double> ku, kv;
-  int nu = 0, nv = 0;  // control point counts
-  Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> h;  // nu * nv x 4, rows contiguous
-};
-
-/// The patches (row-major over breaks) elevated to common degrees and joined with interior knots
-/// of full multiplicity (C0); shared boundary coefficients are averaged.
-Net join(const std::vector<double>& bu, const std::vector<double>& bv, std::vector<ComposedPatch>& patches) {
-  Net net;
-  for (const auto& p : patches) {
-    net.pu = std::max(net.pu, p.du);
-    net.pv = std::max(net.pv, p.dv);
+/// The composed patches as the Bézier patches of surface::join_bezier_patches: control points
+/// (x w, y w, z w) / w and weights w of each homogeneous Bernstein net (w = 1 when polynomial).
+surface::BezierPatches as_bezier_patches(const surface::BezierPatches& bp, const std::vector<ComposedPatch>& patches,
+                                         bool rational) {
+  surface::BezierPatches out;
+  out.breaks_u = bp.breaks_u;
+  out.breaks_v = bp.breaks_v;
+  out.patches.reserve(patches.size());
+  const int cv = bp.count_v();
+  for (std::size_t k = 0; k < patches.size(); ++k) {
+    const ComposedPatch& p = patches[k];
+    const auto a = static_cast<std::size_t>(static_cast<int>(k) / cv), b = static_cast<std::size_t>(static_cast<int>(k) % cv);
+    const int du = std::max(p.du, 1), dv = std::max(p.dv, 1);
+    const Poly h = to_degree(to_degree(p.h, du, 0), dv, 1);
+    BSplineSurface s;
+    s.u = {du, std::vector<double>(static_cast<std::size_t>(du + 1), bp.breaks_u[a])};
+    s.u.knots.insert(s.u.knots.end(), static_cast<std::size_t>(du + 1), bp.breaks_u[a + 1]);
+    s.v = {dv, std::vector<double>(static_cast<std::size_t>(dv + 1), bp.breaks_v[b])};
+    s.v.knots.insert(s.v.knots.end(), static_cast<std::size_t>(dv + 1), bp.breaks_v[b + 1]);
+    s.points.resize((du + 1) * (dv + 1), 3);
+    s.weights = Eigen::VectorXd::Ones(s.points.rows());
+    for (int i = 0; i <= du; ++i)
+      for (int j = 0; j <= dv; ++j) {
+        const Eigen::Index r = s.index(i, j);
+        const double w = rational ? h.at(i, j, 3) : 1.0;
+        for (int d = 0; d < 3; ++d) s.points(r, d) = h.at(i, j, d) / w;
+        s.weights(r) = w;
+      }
+    out.patches.push_back(std::move(s));
   }
-  net.pu = std::max(net.pu, 1);
-  net.pv = std::max(net.pv, 1);
-  const int cu = static_cast<int>(bu.size()) - 1, cv = static_cast<int>(bv.size()) - 1;
-  auto knots = [](const std::vector<double>& b, int p) {
-    std::vector<double> k;
-    for (size_t i = 0; i < b.size(); ++i)
-      k.insert(k.end(), static_cast<size_t>(i == 0 || i + 1 == b.size() ? p + 1 : p), b[i]);
-    return k;
-  };
-  net.ku = knots(bu, net.pu);
-  net.kv = knots(bv, net.pv);
-  net.nu = cu * net.pu + 1;
-  net.nv = cv * net.pv + 1;
-  net.h.setZero(static_cast<Eigen::Index>(net.nu) * net.nv, 4);
-  Eigen::VectorXd count = Eigen::VectorXd::Zero(net.h.rows());
-  for (int a = 0; a < cu; ++a)
-    for (int b = 0; b < cv; ++b) {
-      auto& p = patches[static_cast<size_t>(a * cv + b)];
-      const Poly h = to_degree(to_degree(p.h, net.pu, 0), net.pv, 1);
-      for (int i = 0; i <= net.pu; ++i)
-        for (int j = 0; j <= net.pv; ++j) {
-          const Eigen::Index r = static_cast<Eigen::Index>(a * net.pu + i) * net.nv + (b * net.pv + j);
-          for (int d = 0; d < 4; ++d) net.h(r, d) += h.at(i, j, d);
-          count(r) += 1;
-        }
-    }
-  for (Eigen::Index r = 0; r < net.h.rows(); ++r) net.h.row(r) /= count(r);
-  return net;
+  return out;
 }
 
-BSplineSurface to_surface(const Net& net, bool rational) {
-  BSplineSurface s;
-  s.u = {net.pu, net.ku};
-  s.v = {net.pv, net.kv};
-  s.points.resize(net.h.rows(), 3);
-  s.weights.resize(net.h.rows());
-  const double w0 = net.h(0, 3);
-  const bool all_equal = (net.h.col(3).array() == w0).all();
-  for (Eigen::Index r = 0; r < net.h.rows(); ++r) {
-    const double w = net.h(r, 3);
-    s.points.row(r) = rational ? Eigen::RowVector3d(net.h.row(r).head<3>() / w) : Eigen::RowVector3d(net.h.row(r).head<3>());
-    s.weights(r) = rational && !all_equal ? w : 1.0;
+/// The largest homogeneous control point |(w P, w)|: knot removal measures its gaps on those.
+double largest_homogeneous_point(const BSplineSurface& s) {
+  double hmax = 0;
+  for (Eigen::Index r = 0; r < s.points.rows(); ++r) {
+    const double w = s.weights.size() ? s.weights(r) : 1.0;
+    hmax = std::max(hmax, std::hypot((w * s.points.row(r)).norm(), w));
   }
-  return s;
+  return hmax;
 }
 
 // ---- the pipeline shared by the entry points ------------------------------------------------
@@ -663,21 +644,22 @@ BSplineSurface to_surface(const Net& net, bool rational) {
 }
 
 /// Joins composed patches, removes knots, measures the deviation against `pointwise`.
-ComposeResult finish(const surface::BezierPatches& bp, std::vector<ComposedPatch>& patches, bool rational,
+ComposeResult finish(const surface::BezierPatches& bp, const std::vector<ComposedPatch>& patches, bool rational,
                      const BSplineSurface& original,
                      const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& pointwise, double size,
                      const ComposeOptions& options, int splits) {
-  const Net net = join(bp.breaks_u, bp.breaks_v, patches);
   ComposeReport report;
   report.patches = static_cast<int>(patches.size());
   report.splits = splits;
-  ComposeResult result{to_surface(net, rational), {}};
+  ComposeResult result{surface::join_bezier_patches(as_bezier_patches(bp, patches, rational)), {}};
+  // A rational composition whose weights all came out equal is polynomial: weights 1.
+  if (result.surface.weights.size() > 0 &&
+      (result.surface.weights.array() == result.surface.weights(0)).all())
+    result.surface.weights.setOnes();
   if (options.knot_tolerance > 0) {
     // The tolerance is relative to the largest homogeneous control point, as removal measures
     // its gaps on (w·P, w).
-    double hmax = 0;
-    for (Eigen::Index r = 0; r < net.h.rows(); ++r) hmax = std::max(hmax, net.h.row(r).norm());
-    const double tol = options.knot_tolerance * hmax;
+    const double tol = options.knot_tolerance * largest_homogeneous_point(result.surface);
     auto in_u = surface::remove_knots_u(result.surface, tol);
     auto in_v = surface::remove_knots_v(in_u.surface, tol);
     report.knots_removed = in_u.removed + in_v.removed;

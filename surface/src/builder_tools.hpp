@@ -1,5 +1,5 @@
 #pragma once
-// Small curve helpers shared by the surface builders (skin.cpp, revolve.cpp, occt/fill.cpp) and
+// Small curve helpers shared by the surface builders (loft.cpp, sweep.cpp, revolve.cpp, occt/fill.cpp) and
 // the self-intersection search; internal.
 #include <clay/error.hpp>
 #include <clay/surface/bspline_curve.hpp>

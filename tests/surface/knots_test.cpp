@@ -1,11 +1,13 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
 
 #include <cmath>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "error_of.hpp"
@@ -177,6 +179,55 @@ TEST_CASE("remove_knots undoes knot refinement and keeps the knots a shape needs
     CHECK(in_v.surface.v.knots == s.v.knots);
     CHECK(relative_deviation(s, in_v.surface) < 1e-12);
   }
+}
+
+TEST_CASE("join_bezier_patches undoes extract_bezier: C0 joined, then remove_knots gives the surface back", "[knots]") {
+  std::mt19937 rng(41);
+  for (bool rational : {false, true}) {
+    const BSplineSurface s = clay::test::random_surface(rng, 3, 2, 7, 6, rational);
+    BezierPatches bp = extract_bezier(s);
+    // One patch raised in degree (exactly): the join elevates the others to match.
+    bp.patches[1] = elevate_degree_v(elevate_degree_u(bp.patches[1], 2), 1);
+    const BSplineSurface joined = join_bezier_patches(bp);
+    CHECK(joined.u.degree == 5);
+    CHECK(joined.v.degree == 3);
+    CHECK(joined.is_rational() == rational);
+    // C0: every interior break has multiplicity = degree
+    for (std::size_t i = 1; i + 1 < bp.breaks_u.size(); ++i) CHECK(multiplicity(joined.u, bp.breaks_u[i]) == 5);
+    CHECK(joined.points.rows() == static_cast<Eigen::Index>((bp.count_u() * 5 + 1) * (bp.count_v() * 3 + 1)));
+    CHECK(relative_deviation(s, joined) < 1e-13);
+    // Without the elevated patch, removal gives the original knots and net back.
+    const BSplineSurface plain = join_bezier_patches(extract_bezier(s));
+    const SurfaceKnotRemoval in_u = remove_knots_u(plain, 1e-9);
+    const SurfaceKnotRemoval in_v = remove_knots_v(in_u.surface, 1e-9);
+    CHECK(in_v.surface.u.knots == s.u.knots);
+    CHECK(in_v.surface.v.knots == s.v.knots);
+    CHECK(relative_deviation(s, in_v.surface) < 1e-12);
+  }
+}
+
+TEST_CASE("join_bezier_patches refuses patches that do not match their breaks or do not meet", "[knots][errors]") {
+  std::mt19937 rng(43);
+  const BSplineSurface s = clay::test::random_surface(rng, 2, 2, 5, 4, true);
+  const BezierPatches good = extract_bezier(s);
+  REQUIRE(good.count_u() == 3);
+  REQUIRE(good.count_v() == 2);
+  BezierPatches missing = good;
+  missing.patches.pop_back();
+  auto [category, what] = clay::test::error_of([&] { (void)join_bezier_patches(missing); });
+  CHECK(category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(what, Catch::Matchers::Contains("5 patches for 3 x 2 break intervals"));
+  BezierPatches shifted = good;
+  shifted.breaks_u[1] += 1e-3;  // patch (0, *) no longer spans its interval
+  std::tie(category, what) = clay::test::error_of([&] { (void)join_bezier_patches(shifted); });
+  CHECK(category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(what, Catch::Matchers::Contains("patch (0, 0) is not one clamped Bézier span"));
+  BezierPatches torn = good;
+  torn.patches[3].points.row(0) += Eigen::RowVector3d(0, 0, 1);  // patch (1, 1)'s corner leaves (1, 0)'s edge
+  std::tie(category, what) = clay::test::error_of([&] { (void)join_bezier_patches(torn); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(what, Catch::Matchers::Contains("neighbouring patches do not meet"));
+  CHECK_THROWS_AS(join_bezier_patches(good, -1.0), clay::Error);
 }
 
 TEST_CASE("remove_knots refuses a negative or non-finite tolerance", "[knots]") {

@@ -59,6 +59,19 @@ struct BezierPatches {
 /// patch keeps the surface's parameters on its span, so it evaluates like the surface there.
 CLAY_SURFACE_API BezierPatches extract_bezier(const BSplineSurface& surface);
 
+/// The inverse of extract_bezier: one surface from a grid of Bézier patches, joined with
+/// interior knots of full multiplicity (C0 at every break, so remove_knots_u/_v afterwards takes
+/// out the knots the continuity allows). Patch (i, j) must be one clamped Bézier span over
+/// [breaks_u[i], breaks_u[i+1]] x [breaks_v[j], breaks_v[j+1]] of any degrees; each is elevated
+/// (exactly) to the largest degrees of all, and the control points that neighbouring patches
+/// share are averaged in homogeneous coordinates (w P, w). The result is rational when some patch
+/// is. Throws clay::Error: InvalidArgument when the breaks and patches do not match (count, span,
+/// clamping), InvalidGeometry when neighbouring patches do not meet — their shared homogeneous
+/// points differ by more than `relative_gap` times the largest homogeneous point — or a weight
+/// is not positive.
+CLAY_SURFACE_API BSplineSurface join_bezier_patches(const BezierPatches& patches,
+                                                    double relative_gap = 1e-9);
+
 /// The Bézier extraction operator of one non-empty span [a, b] of a basis: the span's Bézier
 /// control point r is sum_q matrix(r, q) P[first + q] (first = span index − degree).
 struct SpanExtraction {

@@ -1,5 +1,5 @@
-// Loft (skinning) and sweep: our own code on the value types (The NURBS Book §10.3; Wang et al.
-// 2008 for the rotation-minimizing frames).
+// Sweep: a profile along a path with rotation-minimizing frames (Wang et al. 2008), the copies
+// interpolated across v (The NURBS Book §10.3).
 #include <clay/surface/skin.hpp>
 
 #include <clay/error.hpp>
@@ -23,225 +23,18 @@
 #include <vector>
 
 #include "builder_tools.hpp"
+#include "section_interpolation.hpp"
+
 namespace clay::surface {
 namespace {
 
+using detail::averaged_basis;
+using detail::interpolate_sections;
 using detail::model_size;
 using detail::normalized;
 using detail::polygon_length;
 
 std::string num(double x) { return detail::short_number(x); }
-
-std::string name(const char* what, size_t k) { return std::string(what) + " #" + std::to_string(k); }
-
-// ---- Interpolation of compatible sections across v (The NURBS Book §10.3) ----
-
-/// Knots by averaging (The NURBS Book eq. 9.8) for parameters v (v.front() = 0, v.back() = 1).
-BSplineBasis averaged_basis(const std::vector<double>& v, int q) {
-  const int count = static_cast<int>(v.size());
-  BSplineBasis basis;
-  basis.degree = q;
-  basis.knots.assign(static_cast<size_t>(q + 1), 0.0);
-  for (int j = 1; j <= count - q - 1; ++j) {
-    double sum = 0;
-    for (int i = j; i <= j + q - 1; ++i) sum += v[static_cast<size_t>(i)];
-    basis.knots.push_back(sum / q);
-  }
-  basis.knots.insert(basis.knots.end(), static_cast<size_t>(q + 1), 1.0);
-  return basis;
-}
-
-/// The surface whose iso-curve v = v[k] is sections[k] (all compatible: same basis), degree q in
-/// v. Rational sections are interpolated in homogeneous coordinates; polynomial ones in Cartesian
-/// coordinates so the weights stay exactly 1.
-BSplineSurface interpolate_sections(const std::vector<BSplineCurve>& sections,
-                                    const std::vector<double>& v, const BSplineBasis& basis_v) {
-  const int count = static_cast<int>(sections.size());
-  const int n = sections.front().basis.count();
-  const int q = basis_v.degree;
-  if (basis_v.count() != count)
-    throw Error(ErrorCategory::Internal,
-                "loft: " + std::to_string(basis_v.count()) + " basis functions across " +
-                    std::to_string(count) + " sections (please report this input)");
-  const bool rational = std::any_of(sections.begin(), sections.end(),
-                                    [](const BSplineCurve& c) { return c.is_rational(); });
-
-  // Collocation matrix N_j(v_k): banded and totally positive (de Boor), sparse LU solves it.
-  Eigen::SparseMatrix<double> A(count, count);
-  std::vector<Eigen::Triplet<double>> entries;
-  std::vector<double> values(static_cast<size_t>(q + 1));
-  for (int k = 0; k < count; ++k) {
-    const int span = find_span(basis_v, v[static_cast<size_t>(k)]);
-    basis_functions(basis_v, span, v[static_cast<size_t>(k)], values);
-    for (int j = 0; j <= q; ++j)
-      if (values[static_cast<size_t>(j)] != 0.0)
-        entries.emplace_back(k, span - q + j, values[static_cast<size_t>(j)]);
-  }
-  A.setFromTriplets(entries.begin(), entries.end());
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-  lu.compute(A);
-  if (lu.info() != Eigen::Success)
-    throw Error(ErrorCategory::Internal,
-                "loft: the interpolation matrix across the sections is singular; the section "
-                "parameters are not increasing (please report this input)");
-
-  const int width = rational ? 4 : 3;
-  Eigen::MatrixXd rhs(count, width * n);
-  for (int k = 0; k < count; ++k) {
-    const BSplineCurve& c = sections[static_cast<size_t>(k)];
-    for (int i = 0; i < n; ++i) {
-      const double w = c.weights[i];
-      for (int d = 0; d < 3; ++d) rhs(k, width * i + d) = rational ? w * c.points(i, d) : c.points(i, d);
-      if (rational) rhs(k, width * i + 3) = w;
-    }
-  }
-  const Eigen::MatrixXd x = lu.solve(rhs);
-
-  BSplineSurface s;
-  s.u = sections.front().basis;
-  s.v = basis_v;
-  s.points.resize(static_cast<Eigen::Index>(n) * count, 3);
-  s.weights = Eigen::VectorXd::Ones(s.points.rows());
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < count; ++j) {
-      const Eigen::Index r = s.index(i, j);
-      if (rational) {
-        const double w = x(j, width * i + 3);
-        if (!(w > 0.0))
-          throw Error(ErrorCategory::InvalidGeometry,
-                      "loft: the weights interpolated across the rational sections are not "
-                      "positive at control point (" + std::to_string(i) + ", " + std::to_string(j) +
-                      ") (weight " + num(w) + "); give sections with similar weights or lower the "
-                      "loft degree");
-        s.weights[r] = w;
-        for (int d = 0; d < 3; ++d) s.points(r, d) = x(j, width * i + d) / w;
-      } else {
-        for (int d = 0; d < 3; ++d) s.points(r, d) = x(j, width * i + d);
-      }
-    }
-  return s;
-}
-
-/// Same with knots by averaging (The NURBS Book eq. 9.8) for degree q.
-BSplineSurface interpolate_sections(const std::vector<BSplineCurve>& sections,
-                                    const std::vector<double>& v, int q) {
-  return interpolate_sections(sections, v, averaged_basis(v, q));
-}
-
-// ---- Loft ----
-
-struct PreparedLoft {
-  std::vector<BSplineCurve> compatible;  // oriented, compatible, on [0, 1]
-  std::vector<bool> reversed;
-  std::vector<double> v;
-  int degree = 1;
-};
-
-std::vector<double> section_parameters(const std::vector<BSplineCurve>& c,
-                                       LoftParametrization kind) {
-  const size_t count = c.size();
-  std::vector<double> v(count, 0.0);
-  v.back() = 1.0;
-  if (kind == LoftParametrization::Uniform) {
-    for (size_t k = 1; k + 1 < count; ++k) v[k] = static_cast<double>(k) / static_cast<double>(count - 1);
-    return v;
-  }
-  // Per column i of control points: cumulative (chord or centripetal) length across the sections,
-  // normalized; then averaged over the columns (The NURBS Book eq. 10.8). Columns that do not move
-  // (e.g. a shared apex) carry no information and are skipped.
-  const Eigen::Index n = c.front().points.rows();
-  std::vector<double> sum(count, 0.0);
-  int used = 0;
-  std::vector<double> step(count, 0.0);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    double total = 0;
-    for (size_t k = 1; k < count; ++k) {
-      const double d = (c[k].points.row(i) - c[k - 1].points.row(i)).norm();
-      step[k] = kind == LoftParametrization::Centripetal ? std::sqrt(d) : d;
-      total += step[k];
-    }
-    if (!(total > 0.0)) continue;
-    ++used;
-    double run = 0;
-    for (size_t k = 1; k + 1 < count; ++k) {
-      run += step[k];
-      sum[k] += run / total;
-    }
-  }
-  for (size_t k = 1; k + 1 < count; ++k) v[k] = sum[k] / used;
-  return v;
-}
-
-PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftOptions& options) {
-  options.validate();
-  if (sections.size() < 2)
-    throw Error(ErrorCategory::InvalidArgument,
-                "loft: needs at least 2 sections, got " + std::to_string(sections.size()) +
-                    "; give two or more section curves");
-  std::vector<const BSplineCurve*> all;
-  for (size_t k = 0; k < sections.size(); ++k) {
-    validate(sections[k], name("loft section", k));
-    all.push_back(&sections[k]);
-  }
-  const double size = model_size(all);
-  const double tol = options.tolerance * size;
-  for (size_t k = 0; k < sections.size(); ++k) {
-    const double length = polygon_length(sections[k]);
-    if (!(length > tol))
-      throw Error(ErrorCategory::InvalidGeometry,
-                  "loft: section #" + std::to_string(k) + " is degenerate: its control polygon is " +
-                      num(length) + " mm long (tolerance " + num(tol) +
-                      " mm); a loft needs curves, not points: remove it or give a curve");
-  }
-  for (size_t k = 0; k < sections.size(); ++k)
-    detail::reject_self_intersection(
-        sections[k], tol, "loft: section #" + std::to_string(k),
-        "the lofted surface would intersect itself there: move the section's control points so "
-        "that it does not cross or touch itself");
-
-  PreparedLoft out;
-  std::vector<BSplineCurve> oriented;
-  for (const BSplineCurve& s : sections) oriented.push_back(normalized(s));
-  out.reversed.assign(sections.size(), false);
-  const std::vector<double> ts = linspace(0.0, 1.0, 65);
-  for (size_t k = 1; k < oriented.size(); ++k) {
-    double same = 0, against = 0, largest = 0;
-    for (double t : ts) {
-      const Eigen::Vector3d a = evaluate(oriented[k], t);
-      const double d = (a - evaluate(oriented[k - 1], t)).norm();
-      same += d * d;
-      largest = std::max(largest, d);
-      against += (a - evaluate(oriented[k - 1], 1.0 - t)).squaredNorm();
-    }
-    if (against < same) {
-      if (!options.auto_orient)
-        throw Error(ErrorCategory::InvalidGeometry,
-                    "loft: section #" + std::to_string(k) + " runs against section #" +
-                        std::to_string(k - 1) +
-                        " (it lies nearer to that section run backwards); reverse it or set "
-                        "LoftOptions::auto_orient");
-      oriented[k] = reversed(oriented[k]);
-      out.reversed[k] = true;
-      largest = 0;
-      for (double t : ts)
-        largest = std::max(largest, (evaluate(oriented[k], t) - evaluate(oriented[k - 1], t)).norm());
-    }
-    if (!(largest > tol))
-      throw Error(ErrorCategory::InvalidGeometry,
-                  "loft: sections #" + std::to_string(k - 1) + " and #" + std::to_string(k) +
-                      " coincide (largest distance " + num(largest) + " mm, tolerance " + num(tol) +
-                      " mm); remove one of them");
-  }
-  out.compatible = make_compatible(oriented);
-  out.v = section_parameters(out.compatible, options.parametrization);
-  for (size_t k = 1; k < out.v.size(); ++k)
-    if (!(out.v[k] > out.v[k - 1]))
-      throw Error(ErrorCategory::InvalidGeometry,
-                  "loft: sections #" + std::to_string(k - 1) + " and #" + std::to_string(k) +
-                      " get the same parameter (their control points coincide); remove one of them");
-  out.degree = std::min(options.degree, static_cast<int>(sections.size()) - 1);
-  return out;
-}
 
 // ---- Sweep: rotation-minimizing frames on a fine table of the path ----
 
@@ -585,20 +378,6 @@ BSplineBasis joined_basis(const std::vector<double>& v, const std::vector<int>& 
 
 }  // namespace
 
-std::vector<std::string> LoftOptions::problems() const {
-  std::vector<std::string> out;
-  if (degree < 1 || degree > max_kernel_degree)
-    out.push_back(
-                "LoftOptions::degree is " + std::to_string(degree) + "; it must be in [1, " +
-                    std::to_string(max_kernel_degree) + "]");
-  if (!(tolerance > 0.0 && tolerance <= 1e-2))
-    out.push_back(
-                "LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
-  return out;
-}
-
-void LoftOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
-
 std::vector<std::string> SweepOptions::problems() const {
   std::vector<std::string> out;
   if (!std::isfinite(twist_degrees))
@@ -618,100 +397,6 @@ std::vector<std::string> SweepOptions::problems() const {
 }
 
 void SweepOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
-
-std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves) {
-  if (curves.empty())
-    throw Error(ErrorCategory::InvalidArgument, "make_compatible: no curves given; give at least one");
-  std::vector<BSplineCurve> out;
-  int degree = 1;
-  for (size_t k = 0; k < curves.size(); ++k) {
-    validate(curves[k], name("curve", k));
-    out.push_back(normalized(curves[k]));
-    degree = std::max(degree, curves[k].basis.degree);
-  }
-  for (size_t k = 0; k < out.size(); ++k) {
-    BSplineCurve& c = out[k];
-    if (c.basis.degree < degree) c = elevate_degree(c, degree - c.basis.degree);
-  }
-
-  // Interior knots of every curve, clustered: values within 1e-12 (of the domain [0, 1]) are one.
-  struct Knot {
-    double value;
-    size_t curve;
-  };
-  std::vector<Knot> all;
-  for (size_t k = 0; k < out.size(); ++k)
-    for (double t : out[k].basis.knots)
-      if (t > 0.0 && t < 1.0) all.push_back({t, k});
-  std::sort(all.begin(), all.end(), [](const Knot& a, const Knot& b) { return a.value < b.value; });
-  std::vector<std::vector<double>> snapped(out.size());
-  std::vector<std::vector<double>> missing(out.size());
-  for (size_t i = 0; i < all.size();) {
-    const double representative = all[i].value;
-    size_t e = i;
-    std::vector<int> mult(out.size(), 0);
-    while (e < all.size() && all[e].value - representative <= tolerance::knot_relative) {
-      ++mult[all[e].curve];
-      ++e;
-    }
-    const int target = *std::max_element(mult.begin(), mult.end());
-    for (size_t k = 0; k < out.size(); ++k)
-      for (int r = mult[k]; r < target; ++r) missing[k].push_back(representative);
-    for (size_t j = i; j < e; ++j) snapped[all[j].curve].push_back(representative);
-    i = e;
-  }
-  for (size_t k = 0; k < out.size(); ++k) {
-    // Snap this curve's interior knots to their cluster's value (a change of at most 1e-12).
-    size_t next = 0;
-    for (double& t : out[k].basis.knots)
-      if (t > 0.0 && t < 1.0) t = snapped[k][next++];
-    validate(out[k], name("curve", k));
-    if (!missing[k].empty()) out[k] = refine_knots(out[k], missing[k]);
-    if (!curves[k].is_rational()) out[k].weights.setOnes();
-  }
-  for (size_t k = 1; k < out.size(); ++k)
-    if (out[k].basis.knots != out[0].basis.knots)
-      throw Error(ErrorCategory::Internal,
-                  "make_compatible: curve #" + std::to_string(k) +
-                      " did not reach the common knot vector (please report this input)");
-  return out;
-}
-
-std::vector<double> loft_parameters(const std::vector<BSplineCurve>& sections,
-                                    const LoftOptions& options) {
-  return prepare_loft(sections, options).v;
-}
-
-BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& options) {
-  const PreparedLoft prepared = prepare_loft(sections, options);
-  BuiltSurface built;
-  built.surface = interpolate_sections(prepared.compatible, prepared.v, prepared.degree);
-
-  // Exactness check: S(u, v_k) against the input section k at the same (normalized) parameter.
-  const int spans = static_cast<int>(breakpoints(built.surface.u).size()) - 1;
-  const std::vector<double> us = linspace(0.0, 1.0, std::max(65, 8 * spans + 1));
-  const Points3 grid = evaluate_grid(built.surface, us, prepared.v);
-  const size_t count = sections.size();
-  double worst = 0;
-  for (size_t k = 0; k < count; ++k) {
-    const auto [a, b] = sections[k].basis.domain();
-    for (size_t i = 0; i < us.size(); ++i) {
-      const double t = prepared.reversed[k] ? b - us[i] * (b - a) : a + us[i] * (b - a);
-      const Eigen::Vector3d expected = evaluate(sections[k], std::clamp(t, a, b));
-      worst = std::max(worst, (grid.row(static_cast<Eigen::Index>(i * count + k)).transpose() - expected).norm());
-    }
-  }
-  std::string method = "loft of " + std::to_string(count) + " sections";
-  std::string turned;
-  for (size_t k = 0; k < count; ++k)
-    if (prepared.reversed[k]) turned += (turned.empty() ? "" : ", #") + std::to_string(k);
-  if (!turned.empty()) method += " (reversed: #" + turned + ")";
-  built.report = describe(built.surface, method);
-  built.report.exact = true;
-  built.report.max_deviation_mm = worst;
-  built.report.samples = static_cast<int>(us.size() * count);
-  return built;
-}
 
 BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const SweepOptions& options) {
   options.validate();
