@@ -34,6 +34,7 @@ namespace {
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
+/// Σ_{i >= order} |c_i| i! / (i − order)! Z^(i − order): a bound of |p^(order)(z)| for |z| <= Z.
 double polynomial_bound(const std::vector<double>& c, int order, double z_abs) {
   double total = 0;
   for (std::size_t i = static_cast<std::size_t>(order); i < c.size(); ++i) {

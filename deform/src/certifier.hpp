@@ -43,7 +43,6 @@ struct Certifier {
   std::string why_not;                                // why `info` is empty
 };
 
-/// Σ_{i >= order} |c_i| i! / (i − order)! Z^(i − order): a bound of |p^(order)(z)| for |z| <= Z.
 
 /// The certifier of each deformation kind: the map, and the bounds over a hull where known.
 Certifier certifier(const Taper& d);

@@ -456,6 +456,22 @@ void parallel(std::size_t n, std::size_t threads, const Executor& executor, Work
 
 }  // namespace
 
+Eigen::Vector3d chunk_point(const Points3& control, const Chunk& chunk, const Eigen::Vector3d& uvw) {
+  // Coquillart eq. (1).
+  double bu[4], du[4], bv[4], dv[4], bw[4], dw[4];
+  bernstein(uvw[0], bu, du);
+  bernstein(uvw[1], bv, dv);
+  bernstein(uvw[2], bw, dw);
+  Vec3 x = Vec3::Zero();
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      Vec3 s = Vec3::Zero();
+      for (int k = 0; k < 4; ++k) s += bw[k] * control.row(chunk[static_cast<size_t>((i * 4 + j) * 4 + k)]).transpose();
+      x += (bu[i] * bv[j]) * s;
+    }
+  return x;
+}
+
 // ---- freezing and deformation ----------------------------------------------------------------------------
 
 std::vector<std::string> FreezeOptions::problems() const {
