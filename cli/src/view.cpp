@@ -83,11 +83,6 @@ bool is_refit(const StepReport* step) {
   return false;
 }
 
-/// Normalized a, or zero when a vanishes.
-Vector3d unit_or_zero(const Vector3d& a) {
-  const double n = a.norm();
-  return n > 0 && std::isfinite(n) ? Vector3d(a / n) : Vector3d::Zero();
-}
 
 }  // namespace
 
@@ -96,20 +91,28 @@ std::vector<double> view_parameters(const surface::BSplineBasis& basis) {
 }
 
 ViewMesh view_mesh(const surface::BSplineSurface& s) {
+  // Positions and normals are the kernel's one tessellator's (surface::tessellate: the same grid,
+  // the same limit normal at a pole), so the viewer, the PNG renderer and the glTF preview shade a
+  // pole alike. What the viewer adds is curvature.
+  const surface::GridMesh grid = surface::tessellate(s);
   ViewMesh m;
-  m.us = view_parameters(s.u);
-  m.vs = view_parameters(s.v);
-  m.rows = static_cast<int>(m.us.size());
-  m.cols = static_cast<int>(m.vs.size());
+  m.us = grid.us;
+  m.vs = grid.vs;
+  m.rows = grid.rows;
+  m.cols = grid.cols;
   const std::size_t n = static_cast<std::size_t>(m.rows) * static_cast<std::size_t>(m.cols);
   m.position.resize(n);
-  m.normal.assign(n, Vector3d::Zero());
+  m.normal.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto r = static_cast<Eigen::Index>(k);
+    m.position[k] = grid.positions.row(r).transpose();
+    m.normal[k] = grid.normals.row(r).transpose();
+  }
   m.gaussian.assign(n, 0.0);
   m.mean.assign(n, 0.0);
   m.deviation.assign(n, 0.0);
   m.degenerate.assign(n, 0);
   const auto at = [&](int i, int j) { return static_cast<std::size_t>(i) * static_cast<std::size_t>(m.cols) + static_cast<std::size_t>(j); };
-  surface::validate(s, "view surface");
   const std::vector<surface::SurfaceDerivatives> d = surface::derivatives_grid(s, m.us, m.vs);
   double max_u = 0, max_v = 0;
   for (const auto& x : d) {
@@ -122,17 +125,16 @@ ViewMesh view_mesh(const surface::BSplineSurface& s) {
   std::vector<double> row_length(static_cast<std::size_t>(m.rows), 0.0), col_length(static_cast<std::size_t>(m.cols), 0.0);
   for (int i = 0; i < m.rows; ++i)
     for (int j = 0; j < m.cols; ++j) {
-      if (j + 1 < m.cols) row_length[static_cast<std::size_t>(i)] += (d[at(i, j + 1)].point - d[at(i, j)].point).norm();
-      if (i + 1 < m.rows) col_length[static_cast<std::size_t>(j)] += (d[at(i + 1, j)].point - d[at(i, j)].point).norm();
+      if (j + 1 < m.cols) row_length[static_cast<std::size_t>(i)] += (m.position[at(i, j + 1)] - m.position[at(i, j)]).norm();
+      if (i + 1 < m.rows) col_length[static_cast<std::size_t>(j)] += (m.position[at(i + 1, j)] - m.position[at(i, j)]).norm();
     }
   const double longest_row = *std::max_element(row_length.begin(), row_length.end());
   const double longest_col = *std::max_element(col_length.begin(), col_length.end());
-  // Degenerate: on a collapsed line, a first derivative below 1e-5 of its largest on the grid, or
-  // parallel first derivatives.
+  // Degenerate (for curvature): on a collapsed line, a first derivative below 1e-5 of its largest
+  // on the grid, or parallel first derivatives.
   const double floor_u = 1e-5 * max_u, floor_v = 1e-5 * max_v;
   for (std::size_t k = 0; k < n; ++k) {
     const auto& x = d[k];
-    m.position[k] = x.point;
     const Vector3d c = x.du.cross(x.dv);
     const double cn = c.norm(), nu = x.du.norm(), nv = x.dv.norm();
     const bool collapsed = row_length[k / static_cast<std::size_t>(m.cols)] <= 1e-3 * longest_row ||
@@ -141,43 +143,28 @@ ViewMesh view_mesh(const surface::BSplineSurface& s) {
       m.degenerate[k] = 1;
       continue;
     }
-    const Vector3d normal = c / cn;
+    const Vector3d normal = c / cn;  // the exact unit normal, whatever the mesh shows
     const double E = x.du.dot(x.du), F = x.du.dot(x.dv), G = x.dv.dot(x.dv);
     const double L = x.duu.dot(normal), M = x.duv.dot(normal), N = x.dvv.dot(normal);
     const double det = cn * cn;  // EG - F^2 = |S_u x S_v|^2, without the cancellation
-    m.normal[k] = normal;
     m.gaussian[k] = (L * N - M * M) / det;
     m.mean[k] = (E * N - 2 * F * M + G * L) / (2 * det);
   }
-  // Degenerate vertices: the neighbouring cells' normals, the neighbouring vertices' curvatures.
+  // Degenerate vertices: the non-degenerate neighbouring vertices' curvatures.
   for (int i = 0; i < m.rows; ++i)
     for (int j = 0; j < m.cols; ++j) {
       const std::size_t k = at(i, j);
       if (!m.degenerate[k]) continue;
-      Vector3d sum = Vector3d::Zero();
-      for (int a = std::max(i - 1, 0); a < std::min(i + 1, m.rows - 1); ++a)
-        for (int b = std::max(j - 1, 0); b < std::min(j + 1, m.cols - 1); ++b) {
-          // cell (a, b): its diagonals' cross product is twice the S_u x S_v of a flat cell
-          const Vector3d d1 = m.position[at(a + 1, b + 1)] - m.position[at(a, b)];
-          const Vector3d d2 = m.position[at(a, b + 1)] - m.position[at(a + 1, b)];
-          sum += unit_or_zero(d1.cross(d2));
-        }
       double K = 0, H = 0;
       int count = 0;
-      Vector3d near = Vector3d::Zero();
       for (int a = std::max(i - 1, 0); a <= std::min(i + 1, m.rows - 1); ++a)
         for (int b = std::max(j - 1, 0); b <= std::min(j + 1, m.cols - 1); ++b) {
           const std::size_t q = at(a, b);
           if (m.degenerate[q]) continue;
           K += m.gaussian[q];
           H += m.mean[q];
-          near += m.normal[q];
           ++count;
         }
-      Vector3d normal = unit_or_zero(sum);
-      if (normal.isZero()) normal = unit_or_zero(near);
-      if (normal.isZero()) normal = Vector3d::UnitZ();  // a surface collapsed to a point or a curve
-      m.normal[k] = normal;
       m.gaussian[k] = count ? K / count : 0.0;
       m.mean[k] = count ? H / count : 0.0;
     }

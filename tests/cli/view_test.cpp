@@ -11,6 +11,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/revolve.hpp>
+#include <clay/surface/tessellate.hpp>
 #include <clay/view.hpp>
 
 #include <Eigen/Geometry>
@@ -158,14 +159,10 @@ TEST_CASE("a sphere's mesh has K = 1 over r squared and a mean curvature of size
     CHECK_THAT(m.normal[k].norm(), WithinAbs(1.0, 1e-14));
     if (m.degenerate[k]) {
       ++degenerate;
-      // at a pole: the average of the two neighbouring (triangular) cells' normals, which lean
-      // from the axis by less than the polar angle of the first ring of vertices
-      const std::size_t i = k / static_cast<std::size_t>(m.cols), j = k % static_cast<std::size_t>(m.cols);
+      // at a pole the limit normal, S_u x S_uv: the sphere's own normal there, along the axis
+      const std::size_t j = k % static_cast<std::size_t>(m.cols);
       REQUIRE((j == 0 || j + 1 == static_cast<std::size_t>(m.cols)));
-      const std::size_t ring = i * static_cast<std::size_t>(m.cols) + (j == 0 ? 1 : j - 1);
-      const double polar = std::acos(std::min(1.0, ((m.position[ring] - c) / r).dot(radial)));
-      const double lean = std::acos(std::min(1.0, m.normal[k].dot(radial)));
-      worst_pole = std::max(worst_pole, lean / polar);
+      worst_pole = std::max(worst_pole, (m.normal[k] - radial).norm());
     } else {
       worst_n = std::max(worst_n, (m.normal[k] - radial).norm());
     }
@@ -174,7 +171,27 @@ TEST_CASE("a sphere's mesh has K = 1 over r squared and a mean curvature of size
   CHECK(worst_k < 1e-10);
   CHECK(worst_h < 1e-10);
   CHECK(worst_n < 1e-13);
-  CHECK(worst_pole < 1.0);
+  CHECK(worst_pole < 1e-12);
+}
+
+TEST_CASE("the view mesh is the kernel tessellator's: same grid, positions and normals, poles included", "[view]") {
+  // One tessellator (issue #19): the viewer, the PNG renderer and the glTF preview shade alike.
+  for (const auto& s : {sphere(Vector3d(3, -2, 5), 40), sphere(Vector3d(0, 0, 0), 0.5)}) {
+    const ViewMesh m = view_mesh(s);
+    const surface::GridMesh g = surface::tessellate(s);
+    REQUIRE(m.rows == g.rows);
+    REQUIRE(m.cols == g.cols);
+    CHECK(m.us == g.us);
+    CHECK(m.vs == g.vs);
+    int poles = 0;
+    for (std::size_t k = 0; k < m.position.size(); ++k) {
+      const auto r = static_cast<Eigen::Index>(k);
+      CHECK(m.position[k] == Vector3d(g.positions.row(r).transpose()));
+      CHECK(m.normal[k] == Vector3d(g.normals.row(r).transpose()));
+      poles += m.degenerate[k];
+    }
+    CHECK(poles == 2 * m.rows);
+  }
 }
 
 TEST_CASE("a pole opened into a tiny ring, as a refit leaves it, is treated as degenerate", "[view]") {

@@ -20,7 +20,7 @@ struct ViewMesh {
   int rows = 0, cols = 0;
   std::vector<double> us, vs;
   std::vector<Eigen::Vector3d> position;  ///< S(u, v), mm
-  std::vector<Eigen::Vector3d> normal;    ///< unit S_u x S_v (the neighbouring cells' average where degenerate)
+  std::vector<Eigen::Vector3d> normal;    ///< surface::tessellate's: unit S_u x S_v, the limit normal at a pole
   std::vector<double> gaussian;           ///< K, 1/mm^2
   std::vector<double> mean;               ///< H, 1/mm, positive when the surface bends towards its normal
   std::vector<double> deviation;          ///< mm; 0 unless set by set_deviation
@@ -31,14 +31,14 @@ struct ViewMesh {
 /// least 17 and at most 161 in all, ends included.
 CLAY_RECIPE_API std::vector<double> view_parameters(const surface::BSplineBasis& basis);
 
-/// The surface on the grid view_parameters(u) x view_parameters(v), with exact normals and
-/// curvatures from the first and second derivatives: K = (LN - M^2) / (EG - F^2),
-/// H = (EN - 2FM + GL) / (2 (EG - F^2)). Where the surface is degenerate — on a grid line
-/// collapsed to less than 1e-3 of the longest line of its direction (a pole, a collapsed edge, or
-/// the tiny ring a refit leaves of one, where the formulas blow up), |S_u| or |S_v| below 1e-5 of
-/// its largest on the grid, or S_u parallel to S_v — the normal is the normalized
-/// average of the neighbouring cells' normals and K, H the average of the non-degenerate
-/// neighbouring vertices'. Deviation all 0.
+/// The surface as surface::tessellate meshes it (the grid view_parameters(u) x
+/// view_parameters(v), its positions and normals, so the viewer, the PNG renderer and the glTF
+/// preview shade alike, poles included), with exact curvatures from the first and second
+/// derivatives: K = (LN - M^2) / (EG - F^2), H = (EN - 2FM + GL) / (2 (EG - F^2)). Where the
+/// surface is degenerate — on a grid line collapsed to less than 1e-3 of the longest line of its
+/// direction (a pole, a collapsed edge, or the tiny ring a refit leaves of one, where the
+/// formulas blow up), |S_u| or |S_v| below 1e-5 of its largest on the grid, or S_u parallel to
+/// S_v — K and H are the average of the non-degenerate neighbouring vertices'. Deviation all 0.
 CLAY_RECIPE_API ViewMesh view_mesh(const surface::BSplineSurface& surface);
 
 /// Sets mesh.deviation to |S(u, v) - map(B(u, v))| at every vertex, with S the tessellated
