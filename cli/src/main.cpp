@@ -73,8 +73,7 @@ std::vector<BSplineSurface> read_surfaces(const fs::path& file, const char* comm
 int info(const fs::path& file) {
   const std::vector<BSplineSurface> surfaces = read_surfaces(file, "info");
   const ExchangeReport check = check_faces(surfaces);
-  std::printf("%s: %zu surface(s), BRepCheck %s at %.0e mm\n", file.string().c_str(), surfaces.size(),
-              check.valid ? "valid" : "INVALID", check.tolerance);
+  std::printf("%s: %s\n", file.string().c_str(), check.brief().c_str());
   for (size_t k = 0; k < surfaces.size(); ++k) {
     const BSplineSurface& s = surfaces[k];
     const auto [lo, hi] = control_box(s);

@@ -212,6 +212,9 @@ TEST_CASE("Bezier-like degree-25 patches: exact file, honest BRepCheck verdict",
   REQUIRE_THAT(report.problems[0], Catch::Matchers::StartsWith("surface #0: BRepCheck") &&
                                        Catch::Matchers::Contains("exact iso-curves") &&
                                        Catch::Matchers::Contains("cached power-basis"));
+  // brief() names the verdict and the first problem
+  REQUIRE_THAT(report.brief(), Catch::Matchers::Equals("1 face, max degree 25, 676 control points, NOT valid "
+                                                       "(BRepCheck at 1e-07 mm): 1 problem: " + report.problems[0]));
   const fs::path file = fresh_folder("bezier25") / "patch.igs";
   const ExchangeReport written = write_iges(surfaces, file);
   REQUIRE_FALSE(written.valid);
@@ -224,7 +227,10 @@ TEST_CASE("check_faces reports sizes and validity without writing", "[exchange][
       test::random_surface(rng, 20, 22, 40, 41, true, false),
       test::random_surface(rng, 24, 2, 45, 3, false, false),
       test::random_surface(rng, 3, 3, 4, 4, true)};
-  require_report(check_faces(surfaces), surfaces);
+  const ExchangeReport report = check_faces(surfaces);
+  require_report(report, surfaces);
+  // 40 x 41 + 45 x 3 + 4 x 4 control points, the largest degree 24
+  CHECK(report.brief() == "3 faces, max degree 24, 1791 control points, valid (BRepCheck at 1e-07 mm)");
 }
 
 TEST_CASE("Failed writes throw clay::Error and leave no file behind", "[exchange][errors]") {

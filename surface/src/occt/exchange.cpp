@@ -823,6 +823,17 @@ std::vector<BSplineSurface> read_guarded(const fs::path& file, const ReadOptions
 
 // ---- public API ----------------------------------------------------------------------------
 
+std::string ExchangeReport::brief() const {
+  char head[160];
+  std::snprintf(head, sizeof head, "%d face%s, max degree %d, %ld control points, %s (BRepCheck at %.0e mm)",
+                faces, faces == 1 ? "" : "s", max_degree, control_points, valid ? "valid" : "NOT valid", tolerance);
+  std::string line = head;
+  if (!problems.empty())
+    line += ": " + std::to_string(problems.size()) + (problems.size() == 1 ? " problem: " : " problems, the first: ") +
+            problems.front();
+  return line;
+}
+
 ExchangeReport check_faces(const std::vector<BSplineSurface>& surfaces) {
   ExchangeSession session;
   return guarded("check_faces", [&] { return build_faces(surfaces, "check_faces").report; });

@@ -56,6 +56,10 @@ struct ExchangeReport {
   /// fails BRepCheck at `tolerance` in OpenCASCADE only (see `problems`).
   double evaluation_error = 0.0;
   std::vector<std::string> problems;  ///< BRepCheck findings, in words, per face
+
+  /// One line: "3 faces, max degree 3, 147 control points, valid (BRepCheck at 1e-07 mm)", or
+  /// "... NOT valid (BRepCheck at 1e-07 mm): 2 problems, the first: <problem>".
+  CLAY_OCCT_API std::string brief() const;
 };
 
 /// Writes `surfaces` as faces to a STEP file (millimetres). Throws clay::Error: InvalidGeometry for
