@@ -757,7 +757,9 @@ class RecipeChecker {
         c_.add(pp, std::to_string(pts->size()) + " points; at most " + std::to_string(limit::sketch_items) +
                        " are allowed in a sketch (recipe limit)");
       } else if (pts->is_object()) {
-        for (const auto& [pname, pv] : pts->items()) {
+        for (const auto& item : pts->items()) {  // no structured binding: Clang 14 cannot capture one
+          const std::string& pname = item.key();
+          const Json& pv = item.value();
           const std::string p = key_path(pp, pname);
           if (!plane_id.free()) {
             if (const auto ab = c_.vec2(pv, p))
@@ -843,7 +845,9 @@ class RecipeChecker {
         c_.add(ep, std::to_string(ents->size()) + " entities; at most " + std::to_string(limit::sketch_items) +
                        " are allowed in a sketch (recipe limit)");
       } else if (ents->is_object()) {
-        for (const auto& [ename, ev] : ents->items()) {
+        for (const auto& item : ents->items()) {  // no structured binding: Clang 14 cannot capture one
+          const std::string& ename = item.key();
+          const Json& ev = item.value();
           const std::string p = key_path(ep, ename);
           building = ename;
           std::string kind;

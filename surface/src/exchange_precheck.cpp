@@ -59,7 +59,7 @@ class StepTokens {
  public:
   // The stream buffer directly: istream::get and peek build a sentry per character, which made
   // the scan a third of a read's time.
-  explicit StepTokens(std::istream& in) : in_(*in.rdbuf()) {}
+  explicit StepTokens(std::istream& in) : in_{*in.rdbuf()} {}
   int line() const { return line_; }
   bool unterminated() const { return unterminated_; }
 

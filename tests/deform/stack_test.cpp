@@ -304,7 +304,8 @@ TEST_CASE("every malformed step field is named with its path", "[deform][stack]"
        "steps[0] (bspline_lattice)"},
   };
   for (const auto& [step, expected] : cases) {
-    const auto [category, what] = error_of([&] { stack_from_json(head + step + "]}"); });
+    const std::string text = head + step + "]}";  // the lambda captures this, not the binding (Clang 14)
+    const auto [category, what] = error_of([&] { stack_from_json(text); });
     CHECK(category == ErrorCategory::Recipe);
     CHECK_THAT(what, Contains(expected));
   }
