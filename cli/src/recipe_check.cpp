@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cfenv>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -1994,6 +1995,21 @@ std::optional<Problem> too_deep(std::string_view text) {
   return std::nullopt;
 }
 
+/// Floating-point traps held (off) for a scope, the caller's environment restored on the way out:
+/// strtod reports a literal beyond the range of a double by raising overflow, as C requires, and
+/// a host that traps overflow (the Debug tests do) would die of the very number the recipe check
+/// exists to refuse. (A local helper until the internal helper library has one.)
+class FpTrapsHeld {
+ public:
+  FpTrapsHeld() { std::feholdexcept(&saved_); }
+  ~FpTrapsHeld() { std::fesetenv(&saved_); }
+  FpTrapsHeld(const FpTrapsHeld&) = delete;
+  FpTrapsHeld& operator=(const FpTrapsHeld&) = delete;
+
+ private:
+  std::fenv_t saved_;
+};
+
 /// Parses with a callback that reports keys repeated in one object (nlohmann would keep the last
 /// silently: a second curve of the same name would replace the first).
 Json parse_reporting_duplicates(std::string_view text, Checker& c) {
@@ -2036,6 +2052,7 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
     }
     return true;
   };
+  const FpTrapsHeld traps_held;  // the JSON parser's strtod
   try {
     return Json::parse(text.begin(), text.end(), cb);
   } catch (const Json::out_of_range& e) {  // a number beyond the double range: name where it is

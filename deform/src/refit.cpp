@@ -557,7 +557,7 @@ std::vector<double> added_breaks(const std::vector<double>& refined,
 
 Eigen::Vector3d deformed(const Certifier& d, const Eigen::Vector3d& x) {
   const Eigen::Vector3d y = d.map(x);
-  if (!y.allFinite())
+  if (!detail::finite(y))  // not allFinite(): its x - x traps on the infinity it is looking for
     throw Error(ErrorCategory::InvalidArgument,
                 "refit_deformed: the " + d.name + " maps (" + format(x.x()) + ", " +
                     format(x.y()) + ", " + format(x.z()) +
