@@ -56,7 +56,7 @@ void BM_ComposeExact(benchmark::State& state) {
   state.counters["degree"] = report.degree_u;
   state.counters["control_points"] = static_cast<double>(report.control_points);
   state.counters["knots_removed"] = report.knots_removed;
-  state.counters["max_deviation"] = report.max_deviation;
+  state.counters["max_deviation"] = report.max_relative_deviation;
   state.SetLabel(state.range(0) == 0 ? "lattice (3,3,1)" : "lattice (2,2,2)");
 }
 BENCHMARK(BM_ComposeExact)->ArgsProduct({{0, 1}, {4, 0}})->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -246,7 +246,7 @@ void refit_twist(benchmark::State& state) {
   const auto loft = twist_loft();
   const Twist twist{AxisFrame{}, {0.0, 0.01}};
   for (auto _ : state) {
-    auto result = refit_deformed(loft, twist);
+    auto result = refit_deformed(twist, loft);
     benchmark::DoNotOptimize(result.surface.points.data());
     state.counters["bound_mm"] = result.report.certified_bound;
     state.counters["tolerance_mm"] = result.report.tolerance;

@@ -51,7 +51,7 @@ BSplineCurve target(double lift) {
 void drag(benchmark::State& state) {
   const BSplineSurface parent = hood();
   StyleOptions options;
-  options.mode = state.range(0) == 0 ? StyleMode::paper : StyleMode::exact;
+  options.mode = state.range(0) == 0 ? StyleMode::Paper : StyleMode::Exact;
   options.report_curves = state.range(1) != 0;
   StyleEditor editor(parent, influence_factors(parent, bound(), options), options);
   const auto grid = clay::surface::linspace(0, 1, 173);

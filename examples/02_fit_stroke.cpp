@@ -69,7 +69,7 @@ int main() {
                   static_cast<long>(c.first_point), static_cast<long>(c.last_point),
                   c.curve.basis.degree, c.control_points, c.closed ? ", closed" : "");
       std::printf("  max deviation %.3f mm, rms %.3f mm, noise %.3f mm, fairness %.0e\n",
-                  c.max_deviation, c.rms_deviation, c.noise, c.fairness);
+                  c.max_deviation_mm, c.rms_deviation_mm, c.noise, c.fairness);
       std::printf("  %s\n", c.summary.brief().c_str());
     }
     std::printf("fit: %s (%.1f ms)\n", fit.summary.brief().c_str(), ms);

@@ -21,7 +21,7 @@ int main() {
   frame.u = {0, 0, 40};
   BSplineLattice lattice = make_bspline_lattice(frame, {3, 3, 3}, {8, 8, 8});  // the identity
   lattice.points.row(lattice.index(5, 5, 10)) += Eigen::RowVector3d(0, 0, 15);  // pull a top point up
-  const FaceContinuity keep[] = {{Face::u_min, 1}};        // C^1 with the space below the lattice
+  const FaceContinuity keep[] = {{Face::UMin, 1}};        // C^1 with the space below the lattice
   lattice = with_continuity(lattice, keep);
   const JacobianBounds j = jacobian_bounds(lattice);       // j.fold_free, j.min <= volume ratio <= j.max
   const FrozenLattice frozen(lattice);                     // power form, once

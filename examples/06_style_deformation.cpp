@@ -55,13 +55,13 @@ int main(int argc, char** argv) {
   StyleOptions options;                               // paper mode, λ = 1, relaxation, smoothing
   const InfluenceRegion region = influence_factors(parent, bound, options);   // eq. 2
   const StyleResult paper = style_deform(parent, region, target, options);
-  options.mode = StyleMode::exact;                    // through every key point, G1 at the bound
+  options.mode = StyleMode::Exact;                    // through every key point, G1 at the bound
   const StyleResult exact = style_deform(parent, region, target, options);
 
   const double size = exact.report.model_size;
   for (const auto* r : {&paper, &exact}) {
     const StyleReport& q = r->report;
-    std::printf("%-5s: %s\n", q.mode == StyleMode::paper ? "paper" : "exact", q.message.c_str());
+    std::printf("%-5s: %s\n", q.mode == StyleMode::Paper ? "paper" : "exact", q.message.c_str());
     std::printf("       key-point deviation %.3g mm (%.1e of the size), along the target %.3g mm\n",
                 q.target_deviation, q.target_deviation / size, q.target_curve_deviation);
     std::printf("       at the bound: position %.3g mm, tangent plane %.3g deg; locality %.3g mm\n",

@@ -134,7 +134,7 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
     double relative = -1, mm = -1;
     for (const auto& [name, value] : step.figures) {
       if (name == "composition") mode = &value;
-      if (name == "max_deviation" && std::holds_alternative<double>(value)) relative = std::get<double>(value);
+      if (name == "max_relative_deviation" && std::holds_alternative<double>(value)) relative = std::get<double>(value);
       if (name == "max_deviation_mm" && std::holds_alternative<double>(value)) mm = std::get<double>(value);
     }
     if (mode && relative >= 0)

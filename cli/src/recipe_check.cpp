@@ -15,10 +15,13 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/exchange.hpp>
 
+#include <clay/internal/deformation_json.hpp>
+#include <clay/internal/json_reader.hpp>
+#include <clay/internal/fenv.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <cfenv>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -43,38 +46,12 @@ constexpr int format_version = 1;
 constexpr double inf = std::numeric_limits<double>::infinity();
 constexpr double degrees_to_radians = std::numbers::pi / 180.0;
 
-std::string shortest(double x) {
-  char buf[32];
-  const auto end = std::to_chars(buf, buf + sizeof buf, x).ptr;
-  return std::string(buf, end);
-}
-
-/// The value in words for messages: "the string \"x\"", "the number 3", "an array of 2", ...
-std::string found(const Json& j) {
-  if (j.is_null()) return "null";
-  if (j.is_boolean()) return j.get<bool>() ? "true" : "false";
-  if (j.is_number()) return "the number " + shortest(j.get<double>());
-  if (j.is_string()) {
-    std::string s = j.get<std::string>();
-    if (s.size() > 40) s = s.substr(0, 37) + "...";
-    return "the string \"" + s + "\"";
-  }
-  if (j.is_array()) return "an array of " + std::to_string(j.size());
-  return "an object";
-}
-
-std::string key_path(const std::string& path, std::string_view key) {
-  return path.empty() ? std::string(key) : path + "." + std::string(key);
-}
-std::string index_path(const std::string& path, std::size_t i) {
-  return path + "[" + std::to_string(i) + "]";
-}
-
-std::string join(const std::vector<std::string>& items, std::string_view sep = ", ") {
-  std::string out;
-  for (std::size_t k = 0; k < items.size(); ++k) out += (k ? std::string(sep) : "") + items[k];
-  return out;
-}
+using internal::found;
+using internal::index_path;
+using internal::join;
+using internal::key_path;
+using internal::Range;
+using internal::shortest;
 
 // ---- limits ----------------------------------------------------------------------------------
 // Every count, size and magnitude a recipe can ask for has a ceiling (docs/recipe.md, "Limits"),
@@ -110,22 +87,8 @@ constexpr double min_tolerance = 1e-9;           // smallest refit, sweep and fi
 constexpr int refit_control_points = 40000;      // a refit's net (RefitOptions' default)
 }  // namespace limit
 
-/// An allowed interval for a number, open or closed at each end.
-struct Range {
-  double lo = -inf, hi = inf;
-  bool lo_open = false, hi_open = false;
-  bool contains(double x) const {
-    return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
-  }
-  std::string text() const {
-    if (lo == -inf && hi == inf) return "any finite number";
-    if (hi == inf) return std::string(lo_open ? "> " : ">= ") + shortest(lo);
-    if (lo == -inf) return std::string(hi_open ? "< " : "<= ") + shortest(hi);
-    return std::string(lo_open ? "(" : "[") + shortest(lo) + ", " + shortest(hi) + (hi_open ? ")" : "]");
-  }
-};
 // Every number is also within ±limit::magnitude (Checker::number).
-constexpr Range any{-limit::magnitude, limit::magnitude};
+constexpr Range any{-limit::magnitude, limit::magnitude, false, false};
 constexpr Range positive{0, limit::magnitude, true, false};
 constexpr Range non_negative{0, limit::magnitude, false, false};
 constexpr Range tolerance_range{limit::min_tolerance, limit::magnitude};
@@ -143,181 +106,35 @@ bool valid_name(std::string_view s) {
   });
 }
 
-/// The walk: readers that record problems and return fallbacks.
-class Checker {
+/// The walk: the shared path-aware reader (clay/internal/json_reader.hpp) with the recipe's
+/// limits and wording, and the recipe's own composite reads.
+class Checker : public internal::JsonReader {
  public:
-  std::vector<Problem> problems;
-
-  void add(std::string path, std::string message) {
-    problems.push_back({path.empty() ? "(top level)" : std::move(path), recipe_wording(std::move(message)), 0, 0});
+  Checker() {
+    magnitude = limit::magnitude;
+    magnitude_note = "recipe numbers are limited to ±" + shortest(limit::magnitude) + ": mm, degrees, knots and weights";
+    limit_note = "recipe limit";
   }
 
-  /// True when j is an object; reports keys outside `allowed`.
-  bool object(const Json& j, const std::string& path, std::initializer_list<std::string_view> allowed,
-              std::string_view what) {
-    if (!j.is_object()) {
-      add(path, "expected " + std::string(what) + " (a JSON object), found " + found(j));
-      return false;
-    }
-    for (const auto& [key, value] : j.items()) {
-      if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
-      std::vector<std::string> names(allowed.begin(), allowed.end());
-      add(key_path(path, key), "unknown key \"" + key + "\" in " + std::string(what) +
-                                   "; the keys are: " + join(names));
-    }
-    return true;
-  }
-
-  /// The member, or nullptr (reported when required).
-  const Json* member(const Json& obj, const std::string& path, std::string_view key, bool required,
-                     std::string_view hint) {
-    if (!obj.is_object()) return nullptr;
-    const auto it = obj.find(std::string(key));
-    if (it == obj.end()) {
-      if (required) add(key_path(path, key), "missing; give " + std::string(hint));
-      return nullptr;
-    }
-    return &*it;
-  }
-
-  std::optional<double> number(const Json& j, const std::string& path, Range r = any) {
-    if (!j.is_number()) {
-      add(path, "expected a number (" + r.text() + "), found " + found(j));
-      return std::nullopt;
-    }
-    const double x = j.get<double>();
-    if (!std::isfinite(x) || !r.contains(x) || std::abs(x) > limit::magnitude) {
-      add(path, shortest(x) + " is out of range; give a number " + r.text() +
-                    (std::abs(x) > limit::magnitude ? " (recipe numbers are limited to ±" +
-                                                          shortest(limit::magnitude) +
-                                                          ": mm, degrees, knots and weights)"
-                                                    : ""));
-      return std::nullopt;
-    }
-    return x;
-  }
-
-  /// False (and the problem recorded) when the array j holds more than `max` items.
-  bool at_most(const Json& j, const std::string& path, std::size_t max, std::string_view what) {
-    if (!j.is_array() || j.size() <= max) return true;
-    add(path, "an array of " + std::to_string(j.size()) + " " + std::string(what) + "; at most " +
-                  std::to_string(max) + " are allowed (recipe limit)");
-    return false;
-  }
-
-  std::optional<int> integer(const Json& j, const std::string& path, int lo, int hi) {
-    if (!j.is_number_integer() || j.get<long long>() < lo || j.get<long long>() > hi) {
-      add(path, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                    "], found " + found(j));
-      return std::nullopt;
-    }
-    return static_cast<int>(j.get<long long>());
-  }
-
-  std::optional<bool> boolean(const Json& j, const std::string& path) {
-    if (!j.is_boolean()) {
-      add(path, "expected true or false, found " + found(j));
-      return std::nullopt;
-    }
-    return j.get<bool>();
-  }
-
-  std::optional<std::string> string(const Json& j, const std::string& path) {
-    if (!j.is_string()) {
-      add(path, "expected a string, found " + found(j));
-      return std::nullopt;
-    }
-    return j.get<std::string>();
-  }
-
+  using JsonReader::choice;
   /// One of `choices` (the index), or nullopt.
-  std::optional<int> choice(const Json& j, const std::string& path,
-                            std::initializer_list<std::string_view> choices) {
-    std::vector<std::string> names(choices.begin(), choices.end());
-    if (j.is_string()) {
-      const auto s = j.get<std::string>();
-      for (std::size_t k = 0; k < names.size(); ++k)
-        if (names[k] == s) return static_cast<int>(k);
-    }
-    add(path, "expected one of " + join(names) + ", found " + found(j));
-    return std::nullopt;
+  std::optional<int> choice(const Json& j, const std::string& path, std::initializer_list<std::string_view> choices) {
+    return JsonReader::choice(j, path, std::vector<std::string>(choices.begin(), choices.end()));
   }
-
-  std::optional<Eigen::Vector3d> vec3(const Json& j, const std::string& path) {
-    if (!j.is_array() || j.size() != 3) {
-      add(path, "expected [x, y, z] (3 numbers, mm), found " + found(j));
-      return std::nullopt;
-    }
-    Eigen::Vector3d v;
-    bool ok = true;
-    for (int k = 0; k < 3; ++k) {
-      const auto x = number(j[static_cast<std::size_t>(k)], index_path(path, static_cast<std::size_t>(k)));
-      ok = ok && x.has_value();
-      v[k] = x.value_or(0.0);
-    }
-    return ok ? std::optional(v) : std::nullopt;
-  }
-
-  std::optional<Eigen::Vector2d> vec2(const Json& j, const std::string& path) {
-    if (!j.is_array() || j.size() != 2) {
-      add(path, "expected [a, b] (2 numbers, mm in the plane), found " + found(j));
-      return std::nullopt;
-    }
-    const auto a = number(j[0], index_path(path, 0));
-    const auto b = number(j[1], index_path(path, 1));
-    if (!a || !b) return std::nullopt;
-    return Eigen::Vector2d(*a, *b);
-  }
-
-  /// An array of [x, y, z] with at least `min` and at most `max` rows.
+  /// recipe limits on counts by default.
   std::optional<Points3> points(const Json& j, const std::string& path, std::size_t min,
                                 std::size_t max = limit::curve_points) {
-    if (!at_most(j, path, max, "points")) return std::nullopt;
-    if (!j.is_array() || j.size() < min) {
-      add(path, "expected an array of at least " + std::to_string(min) + " points [x, y, z], found " +
-                    found(j));
-      return std::nullopt;
-    }
-    Points3 p(static_cast<Eigen::Index>(j.size()), 3);
-    bool ok = true;
-    for (std::size_t i = 0; i < j.size(); ++i) {
-      const auto v = vec3(j[i], index_path(path, i));
-      ok = ok && v.has_value();
-      if (v) p.row(static_cast<Eigen::Index>(i)) = v->transpose();
-    }
-    return ok ? std::optional(p) : std::nullopt;
+    return JsonReader::points(j, path, min, max);
   }
-
   std::optional<std::vector<double>> numbers(const Json& j, const std::string& path, std::size_t min,
                                              std::size_t max = limit::surface_points, Range r = any) {
-    if (!at_most(j, path, max, "numbers")) return std::nullopt;
-    if (!j.is_array() || j.size() < min) {
-      add(path, "expected an array of at least " + std::to_string(min) + " numbers, found " + found(j));
-      return std::nullopt;
-    }
-    std::vector<double> out;
-    bool ok = true;
-    for (std::size_t i = 0; i < j.size(); ++i) {
-      const auto x = number(j[i], index_path(path, i), r);
-      ok = ok && x.has_value();
-      out.push_back(x.value_or(0.0));
-    }
-    return ok ? std::optional(out) : std::nullopt;
+    return JsonReader::numbers(j, path, min, max, r);
   }
-
-  // Optional members with a default: read when present, the default otherwise (or when bad).
-  double number_or(const Json& obj, const std::string& path, std::string_view key, double def,
-                   Range r = any) {
-    const Json* j = member(obj, path, key, false, "");
-    return j ? number(*j, key_path(path, key), r).value_or(def) : def;
+  std::optional<double> number(const Json& j, const std::string& path, Range r = any) {
+    return JsonReader::number(j, path, r);
   }
-  int integer_or(const Json& obj, const std::string& path, std::string_view key, int def, int lo, int hi) {
-    const Json* j = member(obj, path, key, false, "");
-    return j ? integer(*j, key_path(path, key), lo, hi).value_or(def) : def;
-  }
-  bool boolean_or(const Json& obj, const std::string& path, std::string_view key, bool def) {
-    const Json* j = member(obj, path, key, false, "");
-    return j ? boolean(*j, key_path(path, key)).value_or(def) : def;
+  double number_or(const Json& obj, const std::string& path, std::string_view key, double def, Range r = any) {
+    return JsonReader::number_or(obj, path, key, def, r);
   }
 
   /// Runs `build` and turns a clay::Error into a problem at `path`.
@@ -352,12 +169,17 @@ class Checker {
     return ok;
   }
 
-  /// The library's problems(x, path) messages, which start with the path themselves.
-  void add_all(const std::string& path, const std::vector<std::string>& list) {
-    for (const auto& p : list)
-      add(path, p.rfind(path + ": ", 0) == 0 ? p.substr(path.size() + 2) : p.rfind(path + " ", 0) == 0 ? p.substr(path.size() + 1) : p);
-  }
+ protected:
+  std::string wording(std::string message) const override { return recipe_wording(std::move(message)); }
 };
+
+/// The reader's problems as the recipe's (a syntax error's line and column are added apart).
+std::vector<Problem> recipe_problems(const Checker& c) {
+  std::vector<Problem> out;
+  out.reserve(c.problems.size());
+  for (const auto& p : c.problems) out.push_back({p.path, p.message, 0, 0});
+  return out;
+}
 
 // ---- names and references ------------------------------------------------------------------------
 
@@ -791,7 +613,7 @@ class RecipeChecker {
       const std::string at = key_path(section_path, declared);
       const bool quiet =
           (section_path == entities_path && unbuilt_by_reference.count(declared) > 0) ||
-          std::any_of(c_.problems.begin(), c_.problems.end(), [&](const Problem& q) {
+          std::any_of(c_.problems.begin(), c_.problems.end(), [&](const internal::JsonProblem& q) {
             return q.path == at || q.path.rfind(at + ".", 0) == 0 || q.path.rfind(at + "[", 0) == 0;
           });
       if (quiet && !building.empty()) unbuilt_by_reference.insert(building);
@@ -1420,7 +1242,7 @@ class RecipeChecker {
       } else {
         const auto cells = triple(j, path, "cells", 1, limit::lattice_cells, "[a, b, c]");
         const auto degrees = triple(j, path, "degrees", 1, surface::max_kernel_degree, "[p, q, r]");
-        deform::LatticeKnots knots = deform::LatticeKnots::clamped;
+        deform::LatticeKnots knots = deform::LatticeKnots::Clamped;
         if (const Json* k = c_.member(j, path, "knots", false, ""))
           if (const auto c = c_.choice(*k, key_path(path, "knots"), {"clamped", "uniform"}))
             knots = static_cast<deform::LatticeKnots>(*c);
@@ -1660,31 +1482,18 @@ class RecipeChecker {
     return c_.problems.size() == before;
   }
 
-  /// A stack-schema step read by deform::stack_from_json, its errors re-rooted at `path`.
+  /// A stack-schema step, read by the same reader as deform::stack_from_json (one walk, the
+  /// problems at their recipe paths), then its values checked by deform's problems().
   std::optional<deform::Deformation> schema_step(const Json& j, const std::string& path) {
-    Json doc = Json::object();
-    doc["format"] = "clayform.deformation-stack";
-    doc["version"] = 1;
-    doc["steps"] = Json::array({j});
-    try {
-      auto stack = deform::stack_from_json(doc.dump());
-      return std::move(stack.steps.front().deformation);
-    } catch (const Error& e) {
-      std::string m = e.message();
-      for (std::string_view prefix : {"deformation stack JSON: "})
-        if (m.rfind(prefix, 0) == 0) m.erase(0, prefix.size());
-      // "steps[0].points[5]: ..." → "<path>.points[5]: ..."; "steps[0] (kind): ..." → "<path> (kind): ..."
-      std::string where = path, what = m;
-      if (m.rfind("steps[0]", 0) == 0) {
-        const auto colon = m.find(": ");
-        if (colon != std::string::npos) {
-          where = path + m.substr(8, colon - 8);
-          what = m.substr(colon + 2);
-        }
-      }
-      c_.add(where, what);
+    auto step = internal::read_step(c_, j, path);
+    if (!step) return std::nullopt;
+    const std::string label = internal::step_label(path, *step);
+    const auto list = std::visit([&](const auto& d) { return problems(d, label); }, step->deformation);
+    if (!list.empty()) {
+      c_.add_all(label, list);
       return std::nullopt;
     }
+    return std::move(step->deformation);
   }
 
   void stack(const std::string& name, const Json& j, const std::string& path) {
@@ -1764,7 +1573,7 @@ class RecipeChecker {
     auto& o = d.options;
     if (const Json* m = c_.member(j, p, "mode", false, ""))
       if (const auto k = c_.choice(*m, key_path(p, "mode"), {"paper", "exact"}))
-        o.mode = *k == 0 ? deform::StyleMode::paper : deform::StyleMode::exact;
+        o.mode = *k == 0 ? deform::StyleMode::Paper : deform::StyleMode::Exact;
     o.lambda = c_.number_or(j, p, "lambda", o.lambda, Range{0, 1});
     o.relaxation = c_.boolean_or(j, p, "relaxation", o.relaxation);
     o.smoothing = c_.boolean_or(j, p, "smoothing", o.smoothing);
@@ -1995,21 +1804,6 @@ std::optional<Problem> too_deep(std::string_view text) {
   return std::nullopt;
 }
 
-/// Floating-point traps held (off) for a scope, the caller's environment restored on the way out:
-/// strtod reports a literal beyond the range of a double by raising overflow, as C requires, and
-/// a host that traps overflow (the Debug tests do) would die of the very number the recipe check
-/// exists to refuse. (A local helper until the internal helper library has one.)
-class FpTrapsHeld {
- public:
-  FpTrapsHeld() { std::feholdexcept(&saved_); }
-  ~FpTrapsHeld() { std::fesetenv(&saved_); }
-  FpTrapsHeld(const FpTrapsHeld&) = delete;
-  FpTrapsHeld& operator=(const FpTrapsHeld&) = delete;
-
- private:
-  std::fenv_t saved_;
-};
-
 /// Parses with a callback that reports keys repeated in one object (nlohmann would keep the last
 /// silently: a second curve of the same name would replace the first).
 Json parse_reporting_duplicates(std::string_view text, Checker& c) {
@@ -2052,7 +1846,7 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
     }
     return true;
   };
-  const FpTrapsHeld traps_held;  // the JSON parser's strtod
+  const internal::FpTrapsHeld traps_held;  // the JSON parser's strtod
   try {
     return Json::parse(text.begin(), text.end(), cb);
   } catch (const Json::out_of_range& e) {  // a number beyond the double range: name where it is
@@ -2096,7 +1890,7 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   } catch (const Json::exception& e) {  // a number beyond the range of a double
     std::string what = e.what();
     if (const auto k = what.find("] "); k != std::string::npos) what = what.substr(k + 2);
-    out.problems = std::move(c.problems);  // where the number is (parse_reporting_duplicates)
+    out.problems = recipe_problems(c);  // where the number is (parse_reporting_duplicates)
     if (out.problems.empty())
       out.problems.push_back({"(syntax)", what + "; give finite numbers within the range of a double", 0, 0});
     return out;
@@ -2104,7 +1898,7 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   RecipeChecker rc(c, base_dir);
   rc.run(root);
   out.data = std::move(rc.data);
-  out.problems = std::move(c.problems);
+  out.problems = recipe_problems(c);
   return out;
 }
 
@@ -2126,7 +1920,7 @@ SketchDef rebuild_sketch(const SketchDef& def,
   if (!c.problems.empty()) {
     std::string m = "with the run's curves the sketch has " + std::to_string(c.problems.size()) + " problem" +
                     (c.problems.size() == 1 ? "" : "s") + ":";
-    for (const auto& p : c.problems) m += "\n  " + to_string(p);
+    for (const auto& p : recipe_problems(c)) m += "\n  " + to_string(p);
     throw Error(ErrorCategory::InvalidGeometry, m);
   }
   return std::move(rc.data.sketches.front());

@@ -170,8 +170,8 @@ class Runner {
                       " curves; a recipe stroke must give one curve: draw it as separate strokes");
     const auto& c = fit.curves.front();
     rep.figures = {{"control_points", static_cast<long long>(c.control_points)},
-                   {"max_deviation", c.max_deviation},
-                   {"rms_deviation", c.rms_deviation},
+                   {"max_deviation_mm", c.max_deviation_mm},
+                   {"rms_deviation_mm", c.rms_deviation_mm},
                    {"closed", c.closed}};
     rep.message = fit.summary.brief();
     if (!fit.summary.converged()) {  // a fit that misses its tolerance is a failure unless accepted
@@ -252,7 +252,7 @@ class Runner {
                    {"control_points", static_cast<long long>(b.count_u) * b.count_v},
                    {"rational", b.rational},
                    {"exact", b.exact},
-                   {"max_deviation", b.max_deviation}};
+                   {"max_deviation_mm", b.max_deviation_mm}};
     rep.message = b.brief();
   }
 
@@ -366,10 +366,10 @@ class Runner {
       rep.figures.emplace_back("degree_v", static_cast<long long>(r.surface.v.degree));
       rep.figures.emplace_back("control_points", static_cast<long long>(r.surface.points.rows()));
     };
-    if (o.method == deform::StepOutcome::Method::exact) {
+    if (o.method == deform::StepOutcome::Method::Exact) {
       rep.figures.emplace_back("composition", std::string("exact"));
-      rep.figures.emplace_back("max_deviation", o.compose.max_deviation);  // relative to size
-      rep.figures.emplace_back("max_deviation_mm", o.compose.max_deviation * o.compose.size);
+      rep.figures.emplace_back("max_relative_deviation", o.compose.max_relative_deviation);  // of size
+      rep.figures.emplace_back("max_deviation_mm", o.compose.max_relative_deviation * o.compose.size);
       sizes();
       rep.figures.emplace_back("exact", true);
       rep.figures.emplace_back("patches", static_cast<long long>(o.compose.patches));
@@ -379,7 +379,7 @@ class Runner {
       const auto& f = o.refit;
       const double bound = f.certified ? f.certified_bound : f.sampled_max;
       rep.figures.emplace_back("composition", std::string("refit"));
-      rep.figures.emplace_back("max_deviation", bound / f.size);
+      rep.figures.emplace_back("max_relative_deviation", bound / f.size);
       rep.figures.emplace_back("max_deviation_mm", bound);
       sizes();
       rep.figures.emplace_back("exact", false);
@@ -412,7 +412,7 @@ class Runner {
     const auto r = d.bound.empty() ? deform::style_deform(s, curve_of(d.target), d.options)
                                    : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
     const auto& x = r.report;
-    rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::exact ? "exact" : "paper")},
+    rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::Exact ? "exact" : "paper")},
                    {"constraint_class", std::string(deform::to_string(x.constraint_class))},
                    {"key_points", static_cast<long long>(x.m)},
                    {"influenced_vertices", static_cast<long long>(x.influenced_vertices)},
@@ -473,11 +473,11 @@ class Runner {
                    {"residual", r.residual},
                    {"achieved_max_error", r.achieved_max_error},
                    {"displacement_norm", r.displacement_norm}};
-    rep.message += ": " + r.message;
+    rep.message += ": " + r.summary.message;
     if (!r.feasible) {  // moves the lattice cannot meet: a failure unless accepted
       if (!d.accept_out_of_tolerance)
         throw Error(ErrorCategory::ToleranceNotMet,
-                    "the lattice cannot meet every move (" + r.message +
+                    "the lattice cannot meet every move (" + r.summary.message +
                         "): free more control points (fewer \"locked\"), use a finer lattice, or ask for fewer "
                         "moves; to keep the least-squares answer anyway, set \"accept_out_of_tolerance\": true on "
                         "this step");

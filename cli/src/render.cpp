@@ -4,6 +4,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/tessellate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 #include <png.h>
@@ -21,10 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Eigen::Vector3d;
-
-[[noreturn]] void bad_option(const std::string& field, const std::string& value, const std::string& rule) {
-  throw Error(ErrorCategory::InvalidArgument, "render: RenderOptions." + field + " = " + value + "; " + rule);
-}
 
 std::string text(double x) {
   char buf[32];
@@ -149,17 +146,24 @@ struct Canvas {
 
 }  // namespace
 
-void RenderOptions::validate() const {
-  if (width < 16 || width > 4096) bad_option("width", std::to_string(width), "must be in [16, 4096] pixels");
-  if (height < 16 || height > 4096) bad_option("height", std::to_string(height), "must be in [16, 4096] pixels");
-  if (!eye_direction.allFinite() || !(eye_direction.norm() > 0))
-    bad_option("eye_direction", "[" + text(eye_direction.x()) + ", " + text(eye_direction.y()) + ", " +
+std::vector<std::string> RenderOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, const std::string& value, const std::string& rule) {
+    out.push_back("render: RenderOptions." + field + " = " + value + "; " + rule);
+  };
+  if (width < 16 || width > 4096) bad("width", std::to_string(width), "must be in [16, 4096] pixels");
+  if (height < 16 || height > 4096) bad("height", std::to_string(height), "must be in [16, 4096] pixels");
+  if (!internal::all_finite(eye_direction) || !(eye_direction.norm() > 0))
+    bad("eye_direction", "[" + text(eye_direction.x()) + ", " + text(eye_direction.y()) + ", " +
                                     text(eye_direction.z()) + "]",
                "must be finite and non-zero (the direction from the model towards the eye)");
   if (samples_per_span < 1 || samples_per_span > 64)
-    bad_option("samples_per_span", std::to_string(samples_per_span), "must be in [1, 64]");
-  if (!(margin >= 0 && margin <= 0.4)) bad_option("margin", text(margin), "must be in [0, 0.4] (fraction of the picture)");
+    bad("samples_per_span", std::to_string(samples_per_span), "must be in [1, 64]");
+  if (!(margin >= 0 && margin <= 0.4)) bad("margin", text(margin), "must be in [0, 0.4] (fraction of the picture)");
+  return out;
 }
+
+void RenderOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 Rgb Image::pixel(int x, int y) const noexcept {
   const size_t k = 3 * (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x));

@@ -1,19 +1,13 @@
 #include <clay/constraints/constraint.hpp>
 
+#include <variant>
+
+#include "equations.hpp"
+
 #include <cstdio>
 
 namespace clay::constraints {
 namespace {
-
-Constraint make(ConstraintKind kind, std::vector<PointId> points, std::vector<EntityId> entities,
-                double value = 0) {
-  Constraint c;
-  c.kind = kind;
-  c.points = std::move(points);
-  c.entities = std::move(entities);
-  c.value = value;
-  return c;
-}
 
 std::string num(double x) {
   char buffer[32];
@@ -23,55 +17,61 @@ std::string num(double x) {
 
 }  // namespace
 
-Constraint fixed(PointId point) { return make(ConstraintKind::Fixed, {point}, {}); }
-Constraint coincident(PointId a, PointId b) { return make(ConstraintKind::Coincident, {a, b}, {}); }
-Constraint point_on(PointId point, EntityId curve) {
-  return make(ConstraintKind::PointOnCurve, {point}, {curve});
-}
-Constraint horizontal(EntityId line) { return make(ConstraintKind::Horizontal, {}, {line}); }
-Constraint vertical(EntityId line) { return make(ConstraintKind::Vertical, {}, {line}); }
-Constraint parallel(EntityId a, EntityId b) { return make(ConstraintKind::Parallel, {}, {a, b}); }
-Constraint perpendicular(EntityId a, EntityId b) {
-  return make(ConstraintKind::Perpendicular, {}, {a, b});
-}
-Constraint distance(PointId a, PointId b, double d) {
-  return make(ConstraintKind::Distance, {a, b}, {}, d);
-}
-Constraint distance(PointId point, EntityId line, double d) {
-  return make(ConstraintKind::PointLineDistance, {point}, {line}, d);
-}
-Constraint angle(EntityId a, EntityId b, double degrees) {
-  return make(ConstraintKind::Angle, {}, {a, b}, degrees);
-}
-Constraint radius(EntityId circle_or_arc, double r) {
-  return make(ConstraintKind::Radius, {}, {circle_or_arc}, r);
-}
-Constraint equal_length(EntityId a, EntityId b) { return make(ConstraintKind::EqualLength, {}, {a, b}); }
-Constraint equal_radius(EntityId a, EntityId b) { return make(ConstraintKind::EqualRadius, {}, {a, b}); }
-Constraint midpoint(PointId point, EntityId line) {
-  return make(ConstraintKind::Midpoint, {point}, {line});
-}
-Constraint symmetric(PointId a, PointId b, EntityId line) {
-  return make(ConstraintKind::Symmetric, {a, b}, {line});
-}
-Constraint tangent(CurveEnd a, CurveEnd b) {
-  Constraint c = make(ConstraintKind::Tangent, {}, {});
-  c.ends = {a, b};
-  return c;
-}
-Constraint curvature(CurveEnd a, CurveEnd b) {
-  Constraint c = make(ConstraintKind::Curvature, {}, {});
-  c.ends = {a, b};
-  return c;
-}
-Constraint end_tangent(CurveEnd end, const Eigen::Vector3d& direction) {
-  Constraint c = make(ConstraintKind::EndTangent, {}, {});
-  c.ends = {end};
-  c.direction = direction;
-  return c;
+Constraint fixed(PointId point) { return {Fixed{point}, {}}; }
+Constraint coincident(PointId a, PointId b) { return {Coincident{a, b}, {}}; }
+Constraint point_on(PointId point, EntityId curve) { return {PointOnCurve{point, curve}, {}}; }
+Constraint horizontal(EntityId line) { return {Horizontal{line}, {}}; }
+Constraint vertical(EntityId line) { return {Vertical{line}, {}}; }
+Constraint parallel(EntityId a, EntityId b) { return {Parallel{a, b}, {}}; }
+Constraint perpendicular(EntityId a, EntityId b) { return {Perpendicular{a, b}, {}}; }
+Constraint distance(PointId a, PointId b, double d) { return {Distance{a, b, d}, {}}; }
+Constraint distance(PointId point, EntityId line, double d) { return {PointLineDistance{point, line, d}, {}}; }
+Constraint angle(EntityId a, EntityId b, double degrees) { return {Angle{a, b, degrees}, {}}; }
+Constraint radius(EntityId circle_or_arc, double r) { return {Radius{circle_or_arc, r}, {}}; }
+Constraint equal_length(EntityId a, EntityId b) { return {EqualLength{a, b}, {}}; }
+Constraint equal_radius(EntityId a, EntityId b) { return {EqualRadius{a, b}, {}}; }
+Constraint midpoint(PointId point, EntityId line) { return {Midpoint{point, line}, {}}; }
+Constraint symmetric(PointId a, PointId b, EntityId line) { return {Symmetric{a, b, line}, {}}; }
+Constraint tangent(CurveEnd a, CurveEnd b) { return {Tangent{a, b}, {}}; }
+Constraint curvature(CurveEnd a, CurveEnd b) { return {Curvature{a, b}, {}}; }
+Constraint end_tangent(CurveEnd end, const Eigen::Vector3d& direction) { return {EndTangent{end, direction}, {}}; }
+
+namespace detail {
+
+Lowered lower(const Constraint& constraint) {
+  Lowered l;
+  l.kind = constraint.kind();
+  l.label = constraint.label;
+  // One overload per alternative: the struct's fields in declaration order.
+  struct Flatten {
+    Lowered& l;
+    void operator()(const Fixed& c) const { l.points = {c.point}; }
+    void operator()(const Coincident& c) const { l.points = {c.a, c.b}; }
+    void operator()(const PointOnCurve& c) const { l.points = {c.point}, l.entities = {c.curve}; }
+    void operator()(const Horizontal& c) const { l.entities = {c.line}; }
+    void operator()(const Vertical& c) const { l.entities = {c.line}; }
+    void operator()(const Parallel& c) const { l.entities = {c.a, c.b}; }
+    void operator()(const Perpendicular& c) const { l.entities = {c.a, c.b}; }
+    void operator()(const Distance& c) const { l.points = {c.a, c.b}, l.value = c.mm; }
+    void operator()(const PointLineDistance& c) const { l.points = {c.point}, l.entities = {c.line}, l.value = c.mm; }
+    void operator()(const Angle& c) const { l.entities = {c.a, c.b}, l.value = c.degrees; }
+    void operator()(const Radius& c) const { l.entities = {c.circle_or_arc}, l.value = c.mm; }
+    void operator()(const EqualLength& c) const { l.entities = {c.a, c.b}; }
+    void operator()(const EqualRadius& c) const { l.entities = {c.a, c.b}; }
+    void operator()(const Midpoint& c) const { l.points = {c.point}, l.entities = {c.line}; }
+    void operator()(const Symmetric& c) const { l.points = {c.a, c.b}, l.entities = {c.line}; }
+    void operator()(const Tangent& c) const { l.ends = {c.a, c.b}; }
+    void operator()(const Curvature& c) const { l.ends = {c.a, c.b}; }
+    void operator()(const EndTangent& c) const { l.ends = {c.end}, l.direction = c.direction; }
+  };
+  std::visit(Flatten{l}, constraint.requirement);
+  return l;
 }
 
-std::string describe(const Constraint& c, const sketch::Sketch& sketch) {
+}  // namespace detail
+
+std::string describe(const Constraint& constraint, const sketch::Sketch& sketch) {
+  const detail::Lowered c = detail::lower(constraint);
   auto p = [&](size_t i) {
     return i < c.points.size() ? sketch::describe(sketch, c.points[i]) : std::string("?");
   };

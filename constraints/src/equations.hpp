@@ -14,6 +14,21 @@
 
 namespace clay::constraints::detail {
 
+/// A constraint flattened for the equation builder: the kind and the points, entities and ends it
+/// refers to, in the order the kind's struct declares them, with its value (mm or degrees).
+struct Lowered {
+  ConstraintKind kind = ConstraintKind::Fixed;
+  std::vector<PointId> points;
+  std::vector<EntityId> entities;
+  std::vector<CurveEnd> ends;
+  double value = 0;
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();  ///< EndTangent only (world)
+  std::string label;
+};
+
+/// The flat form of a typed constraint (constraint.cpp).
+Lowered lower(const Constraint& constraint);
+
 /// What an equation computes (one user constraint may give several equations).
 enum class EqKind {
   EqualScalar,    // a - b                     (coincident, horizontal, vertical; substitutable)

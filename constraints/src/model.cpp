@@ -4,6 +4,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -27,11 +28,11 @@ class Builder {
  public:
   Builder(const sketch::Sketch& s, Model& m) : s_(s), m_(m) {}
 
-  void add(const Constraint& c, int k) {
+  void add(const Lowered& c, int k) {
     k_ = k;
     c_ = &c;
     const std::string who = name();
-    if (!std::isfinite(c.value) || !c.direction.allFinite())
+    if (!std::isfinite(c.value) || !internal::all_finite(c.direction))
       fail(who + ": its value is not finite; give a finite number");
     switch (c.kind) {
       case ConstraintKind::Fixed: {
@@ -204,7 +205,7 @@ class Builder {
 
  private:
   std::string name() const {
-    return c_ ? constraint_name(*c_, k_) : "constraint #" + std::to_string(k_);
+    return c_ && !c_->label.empty() ? c_->label : "constraint #" + std::to_string(k_);
   }
   [[noreturn]] void fail(const std::string& message) const {
     throw Error(ErrorCategory::InvalidArgument, message);
@@ -515,7 +516,7 @@ class Builder {
   const sketch::Sketch& s_;
   Model& m_;
   int k_ = -1;
-  const Constraint* c_ = nullptr;
+  const Lowered* c_ = nullptr;
 };
 
 }  // namespace
@@ -552,7 +553,10 @@ Model build_model(const sketch::Sketch& sketch, const std::vector<Constraint>& c
   Builder builder(sketch, m);
   for (size_t k = 0; k < sketch.entities.size(); ++k)
     if (const Arc* a = std::get_if<Arc>(&sketch.entities[k])) builder.arc_radius(*a, static_cast<int>(k));
-  for (size_t k = 0; k < constraints.size(); ++k) builder.add(constraints[k], static_cast<int>(k));
+  for (size_t k = 0; k < constraints.size(); ++k) {
+    const Lowered flat = lower(constraints[k]);
+    builder.add(flat, static_cast<int>(k));
+  }
   return m;
 }
 

@@ -3,6 +3,7 @@
 
 #include <clay/constraints/solve.hpp>
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <ceres/ceres.h>
 
@@ -21,11 +22,12 @@
 
 namespace clay::constraints {
 
-void SolveOptions::validate() const {
-  auto bad = [](const std::string& field, double value, const std::string& rule) {
+std::vector<std::string> SolveOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, double value, const std::string& rule) {
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%g", value);
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SolveOptions::" + field + " = " + buffer + " breaks the rule " + rule);
   };
   if (!(tolerance > 0 && tolerance <= 1e-3)) bad("tolerance", tolerance, "0 < tolerance <= 1e-3");
@@ -33,10 +35,13 @@ void SolveOptions::validate() const {
   if (!(rank_tolerance > 0 && rank_tolerance <= 1e-2))
     bad("rank_tolerance", rank_tolerance, "0 < rank_tolerance <= 1e-2");
   for (size_t k = 0; k < drag.size(); ++k)
-    if (!drag[k].target.allFinite())
-      throw Error(ErrorCategory::InvalidArgument,
+    if (!internal::all_finite(drag[k].target))
+      out.push_back(
                   "SolveOptions::drag[" + std::to_string(k) + "]: the target is not finite");
+  return out;
 }
+
+void SolveOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace detail {
 namespace {
@@ -642,6 +647,15 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
     if (m.radius_var[k] >= 0)
       std::get<sketch::Circle>(result.sketch.entities[k]).radius = x[static_cast<size_t>(m.radius_var[k])];
   return result;
+}
+
+std::string SolveReport::brief() const {
+  char buffer[160];
+  std::snprintf(buffer, sizeof buffer, "; largest residual %.3g, %d unknowns (%d substituted), %s",
+                max_residual, unknowns, substituted,
+                degrees_of_freedom < 0 ? "degrees of freedom not diagnosed"
+                                       : (std::to_string(degrees_of_freedom) + " degrees of freedom").c_str());
+  return summary.brief() + buffer;
 }
 
 }  // namespace clay::constraints

@@ -2,6 +2,7 @@
 // Internal helpers on Bernstein and B-spline coefficients shared by the lattice, Jacobian and
 // frozen-lattice code.
 #include <clay/deform/lattice.hpp>
+#include <clay/surface/knots.hpp>
 
 #include <Eigen/Core>
 
@@ -10,20 +11,9 @@
 
 namespace clay::deform::detail {
 
-/// Binomial coefficient C(n, k) as a double (exact for the kernel's degrees: n <= 3 * 63).
-double binomial(int n, int k) noexcept;
-
-/// Bézier extraction of one direction: for every non-empty span of the domain, its breaks and
-/// the (p+1) x (p+1) matrix E with Bézier point r = sum_q E(r, q) P_{first + q}.
-struct SpanExtraction {
-  double a = 0, b = 1;  ///< the span [a, b]
-  int first = 0;        ///< index of the first control point acting on the span (span - p)
-  Eigen::MatrixXd matrix;
-};
-
-/// The extraction of every non-empty span of `basis` (blossoms: Bézier point r of [a, b] is
-/// f(a^(p−r), b^r), computed by the de Boor triangle with argument a or b per level).
-std::vector<SpanExtraction> extract_spans(const surface::BSplineBasis& basis);
+/// Span extraction (the Bézier extraction operator of one direction) is the core's
+/// surface::bezier_extraction.
+using surface::SpanExtraction;
 
 /// Control points of Bézier cell (ea, eb, ec) of the lattice, s-major (p+1)(q+1)(r+1) x 3.
 Points3 cell_points(const BSplineLattice& lattice, const SpanExtraction& ea,

@@ -6,6 +6,8 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/exchange.hpp>
 #include <clay/surface/knots.hpp>
+#include <clay/internal/math.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +20,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
 
 #include "messages.hpp"
 #include "seal.hpp"
@@ -36,25 +37,6 @@ std::string fmt(double v) { return format(v, 6); }  // short figures for message
 constexpr const char* coordinate_name[3] = {"s", "t", "u"};
 
 // ---- bivariate Bernstein polynomials --------------------------------------------------------
-
-/// Binomial coefficients up to n = 127 as doubles (exact up to n = 56, to rounding beyond).
-const std::vector<double>& binomial_row(int n) {
-  static const std::vector<std::vector<double>> table = [] {
-    std::vector<std::vector<double>> t(128);
-    for (int r = 0; r < 128; ++r) {
-      t[static_cast<size_t>(r)].assign(static_cast<size_t>(r + 1), 1.0);
-      for (int k = 1; k < r; ++k)
-        t[static_cast<size_t>(r)][static_cast<size_t>(k)] =
-            t[static_cast<size_t>(r - 1)][static_cast<size_t>(k - 1)] +
-            t[static_cast<size_t>(r - 1)][static_cast<size_t>(k)];
-    }
-    return t;
-  }();
-  return table[static_cast<size_t>(n)];
-}
-double binom(int n, int k) {
-  return k < 0 || k > n ? 0.0 : binomial_row(n)[static_cast<size_t>(k)];
-}
 
 /// A bivariate polynomial of degrees (du, dv) in Bernstein form with `dim` values per
 /// coefficient: value d of coefficient (i, j) at ((i * (dv + 1) + j) * dim + d). "Scaled" polys
@@ -83,8 +65,8 @@ Poly constant_poly(double value) {
 
 /// Multiplies (or divides) coefficient (i, j) by C(du, i) C(dv, j).
 void scale(Poly& p, bool divide) {
-  const auto& bu = binomial_row(p.du);
-  const auto& bv = binomial_row(p.dv);
+  const auto& bu = internal::binomial_row(p.du);
+  const auto& bv = internal::binomial_row(p.dv);
   for (int i = 0; i <= p.du; ++i)
     for (int j = 0; j <= p.dv; ++j) {
       const double f = bu[static_cast<size_t>(i)] * bv[static_cast<size_t>(j)];
@@ -125,8 +107,8 @@ Eigen::MatrixXd reduction_matrix(int p, int e) {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(e + 1, p + 1);
   for (int i = 0; i <= e; ++i)
     for (int k = 0; k <= i; ++k) {
-      const double f = binom(i, k) / binom(e, k) * binom(p, k);
-      for (int r = 0; r <= k; ++r) m(i, r) += f * ((k - r) % 2 ? -1.0 : 1.0) * binom(k, r);
+      const double f = internal::binomial(i, k) / internal::binomial(e, k) * internal::binomial(p, k);
+      for (int r = 0; r <= k; ++r) m(i, r) += f * ((k - r) % 2 ? -1.0 : 1.0) * internal::binomial(k, r);
     }
   return m;
 }
@@ -136,7 +118,7 @@ Eigen::MatrixXd elevation_matrix(int e, int p) {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(p + 1, e + 1);
   for (int i = 0; i <= p; ++i)
     for (int k = std::max(0, i - (p - e)); k <= std::min(e, i); ++k)
-      m(i, k) = binom(e, k) * binom(p - e, i - k) / binom(p, i);
+      m(i, k) = internal::binomial(e, k) * internal::binomial(p - e, i - k) / internal::binomial(p, i);
   return m;
 }
 
@@ -606,7 +588,7 @@ std::pair<double, double> global_parameter(const surface::BezierPatches& bp, int
                   "whole surface");
 }
 
-// ---- joining patches, knot removal ----------------------------------------------------------
+// ---- joining patches (knot removal is surface::remove_knots_u/_v) ------------------------------
 
 /// Homogeneous control net (rows i * nv + j, columns x w, y w, z w, w) with its knot vectors.
 struct Net {
@@ -654,99 +636,6 @@ Net join(const std::vector<double>& bu, const std::vector<double>& bv, std::vect
   return net;
 }
 
-/// The net with u and v (and their knots) swapped.
-Net transposed(const Net& n) {
-  Net t;
-  t.pu = n.pv, t.pv = n.pu, t.ku = n.kv, t.kv = n.ku, t.nu = n.nv, t.nv = n.nu;
-  t.h.resize(n.h.rows(), 4);
-  for (int i = 0; i < n.nu; ++i)
-    for (int j = 0; j < n.nv; ++j)
-      t.h.row(static_cast<Eigen::Index>(j) * n.nu + i) = n.h.row(static_cast<Eigen::Index>(i) * n.nv + j);
-  return t;
-}
-
-/// Removes the u knot at index r (its last occurrence, multiplicity s) once from every column,
-/// when every column allows it within `tol` (The NURBS Book A5.8, one removal, homogeneous).
-/// Returns the largest gap (>= 0) when removed, -1 when not.
-double remove_u_knot_once(Net& net, int r, int s, double tol) {
-  const int p = net.pu;
-  const auto& U = net.ku;
-  const double u = U[static_cast<size_t>(r)];
-  const int first = r - p, last = r - s, off = first - 1;
-  const int nt = last - off + 2;
-  std::vector<Eigen::RowVector4d> temp(static_cast<size_t>(nt) * static_cast<size_t>(net.nv));
-  double worst = 0;
-  auto P = [&](int i, int j) { return Eigen::RowVector4d(net.h.row(static_cast<Eigen::Index>(i) * net.nv + j)); };
-  auto alpha = [&](int i) {
-    return (u - U[static_cast<size_t>(i)]) / (U[static_cast<size_t>(i + p + 1)] - U[static_cast<size_t>(i)]);
-  };
-  for (int col = 0; col < net.nv; ++col) {
-    Eigen::RowVector4d* t = temp.data() + static_cast<size_t>(col) * static_cast<size_t>(nt);
-    t[0] = P(off, col);
-    t[last + 1 - off] = P(last + 1, col);
-    int i = first, j = last, ii = 1, jj = last - off;
-    while (j - i > 0) {
-      const double ai = alpha(i), aj = alpha(j);
-      t[ii] = (P(i, col) - (1 - ai) * t[ii - 1]) / ai;
-      t[jj] = (P(j, col) - aj * t[jj + 1]) / (1 - aj);
-      ++i, ++ii, --j, --jj;
-    }
-    double gap;
-    if (j - i < 0) {
-      gap = (t[ii - 1] - t[jj + 1]).norm();
-    } else {
-      const double ai = alpha(i);
-      gap = (P(i, col) - (ai * t[ii + 1] + (1 - ai) * t[ii - 1])).norm();
-    }
-    if (!(gap <= tol)) return -1;
-    worst = std::max(worst, gap);
-  }
-  // Commit: new points first..last from temp, drop point row fout (a block of nv rows), knot r.
-  for (int col = 0; col < net.nv; ++col) {
-    const Eigen::RowVector4d* t = temp.data() + static_cast<size_t>(col) * static_cast<size_t>(nt);
-    int i = first, j = last;
-    while (j - i > 0) {
-      net.h.row(static_cast<Eigen::Index>(i) * net.nv + col) = t[i - off];
-      net.h.row(static_cast<Eigen::Index>(j) * net.nv + col) = t[j - off];
-      ++i, --j;
-    }
-  }
-  const int fout = (2 * r - s - p) / 2;
-  double* data = net.h.data();
-  const std::ptrdiff_t row = 4 * static_cast<std::ptrdiff_t>(net.nv);
-  std::copy(data + (fout + 1) * row, data + net.nu * row, data + fout * row);
-  net.h.conservativeResize(static_cast<Eigen::Index>(net.nu - 1) * net.nv, 4);
-  net.nu -= 1;
-  net.ku.erase(net.ku.begin() + r);
-  return worst;
-}
-
-/// Removes every interior u knot as often as removal is exact; returns the number removed. The
-/// gaps of the removals of one knot value add up to at most `tol` (each removal may move the
-/// surface by about its gap, and repeated removals compound).
-int remove_u_knots(Net& net, double tol) {
-  int removed = 0;
-  const double first = net.ku.front(), last = net.ku.back();
-  std::vector<double> values;
-  for (double k : net.ku)
-    if (k != first && k != last && (values.empty() || values.back() != k)) values.push_back(k);
-  for (double value : values) {
-    double spent = 0;
-    for (;;) {
-      const auto hi = std::upper_bound(net.ku.begin(), net.ku.end(), value);
-      const auto lo = std::lower_bound(net.ku.begin(), net.ku.end(), value);
-      const int s = static_cast<int>(hi - lo);
-      if (s == 0) break;
-      const int r = static_cast<int>(hi - net.ku.begin()) - 1;
-      const double gap = remove_u_knot_once(net, r, s, tol - spent);
-      if (gap < 0) break;
-      spent += gap;
-      ++removed;
-    }
-  }
-  return removed;
-}
-
 BSplineSurface to_surface(const Net& net, bool rational) {
   BSplineSurface s;
   s.u = {net.pu, net.ku};
@@ -778,24 +667,26 @@ ComposeResult finish(const surface::BezierPatches& bp, std::vector<ComposedPatch
                      const BSplineSurface& original,
                      const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& pointwise, double size,
                      const ComposeOptions& options, int splits) {
-  Net net = join(bp.breaks_u, bp.breaks_v, patches);
+  const Net net = join(bp.breaks_u, bp.breaks_v, patches);
   ComposeReport report;
   report.patches = static_cast<int>(patches.size());
   report.splits = splits;
+  ComposeResult result{to_surface(net, rational), {}};
   if (options.knot_tolerance > 0) {
+    // The tolerance is relative to the largest homogeneous control point, as removal measures
+    // its gaps on (w·P, w).
     double hmax = 0;
     for (Eigen::Index r = 0; r < net.h.rows(); ++r) hmax = std::max(hmax, net.h.row(r).norm());
     const double tol = options.knot_tolerance * hmax;
-    report.knots_removed += remove_u_knots(net, tol);
-    Net t = transposed(net);
-    report.knots_removed += remove_u_knots(t, tol);
-    net = transposed(t);
+    auto in_u = surface::remove_knots_u(result.surface, tol);
+    auto in_v = surface::remove_knots_v(in_u.surface, tol);
+    report.knots_removed = in_u.removed + in_v.removed;
+    result.surface = std::move(in_v.surface);
   }
-  ComposeResult result{to_surface(net, rational), {}};
   detail::keep_closed_and_collapsed(original, result.surface, pointwise);
-  report.degree_u = net.pu;
-  report.degree_v = net.pv;
-  report.control_points = static_cast<long>(net.nu) * net.nv;
+  report.degree_u = result.surface.u.degree;
+  report.degree_v = result.surface.v.degree;
+  report.control_points = static_cast<long>(result.surface.points.rows());
   report.size = size;
   // The check: n x n samples inside every patch, the original and the result evaluated on the
   // whole grid at once (evaluate_grid), the original's points deformed one by one by the
@@ -813,10 +704,13 @@ ComposeResult finish(const surface::BezierPatches& bp, std::vector<ComposedPatch
     const Points3 after = surface::evaluate_grid(result.surface, us, vs);
     for (Eigen::Index r = 0; r < before.rows(); ++r) {
       const Eigen::Vector3d expected = pointwise(Eigen::Vector3d(before.row(r).transpose()));
-      report.max_deviation = std::max(report.max_deviation, (after.row(r).transpose() - expected).norm() / size);
+      report.max_relative_deviation = std::max(report.max_relative_deviation, (after.row(r).transpose() - expected).norm() / size);
     }
   }
   report.exact = true;
+  report.summary.termination = Termination::Converged;
+  report.summary.final_residual = report.max_relative_deviation;
+  report.summary.message = report.brief();
   result.report = report;
   return result;
 }
@@ -992,24 +886,28 @@ std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface, co
 
 // ---- public ---------------------------------------------------------------------------------
 
-void ComposeOptions::validate() const {
+std::vector<std::string> ComposeOptions::problems() const {
+  std::vector<std::string> out;
   if (!(knot_tolerance >= 0 && knot_tolerance <= 1e-6))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "ComposeOptions: knot_tolerance = " + format(knot_tolerance) +
                     " breaks the rule 0 <= knot_tolerance <= 1e-6 (relative, exact removal only); give "
                     "e.g. 1e-12, or 0 to keep every patch boundary");
   if (check_samples < 0 || check_samples > 64)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "ComposeOptions: check_samples = " + std::to_string(check_samples) +
                     " breaks the rule 0 <= check_samples <= 64; give e.g. 4, or 0 to skip the check");
+  return out;
 }
+
+void ComposeOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string ComposeReport::brief() const {
   std::ostringstream m;
   m.precision(3);
   m << "exact composition: degree " << degree_u << " x " << degree_v << ", " << patches << " patches, "
     << control_points << " control points, " << knots_removed << " knots removed, " << splits
-    << " split knots, max deviation " << max_deviation << " x " << size << " mm";
+    << " split knots, max relative deviation " << max_relative_deviation << " x " << size << " mm";
   return m.str();
 }
 

@@ -2,9 +2,13 @@
 
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
+#include <clay/internal/checks.hpp>
+
+#include <Eigen/QR>  // the complete orthogonal decomposition
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
@@ -17,7 +21,7 @@ namespace clay::deform {
 
 namespace {
 
-using detail::finite;
+using internal::all_finite;
 using detail::format;
 
 /// All Bernstein polynomials of degree n at t (The NURBS Book A1.3), written to b[0..n].
@@ -64,7 +68,7 @@ std::vector<Eigen::Vector3d> selected_locals(const Frame& frame, const Points3& 
   std::vector<Eigen::Vector3d> locals(static_cast<size_t>(points.rows()));
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const Eigen::Vector3d x = points.row(i).transpose();
-    if (!finite(x))
+    if (!all_finite(x))
       throw Error(ErrorCategory::InvalidArgument,
                   "direct manipulation: selected point #" + std::to_string(i) + " " + format(x) +
                       " is not finite; give finite coordinates");
@@ -121,14 +125,15 @@ double lattice_size(const Frame& f) {
 
 // ---- options and report ---------------------------------------------------------------------
 
-void DirectManipulationOptions::validate() const {
+std::vector<std::string> DirectManipulationOptions::problems() const {
+  std::vector<std::string> out;
   if (!(std::isfinite(rank_tolerance) && rank_tolerance > 0 && rank_tolerance < 1))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "DirectManipulationOptions::rank_tolerance = " + format(rank_tolerance) +
                     " breaks the rule 0 < rank_tolerance < 1; give a small relative threshold "
                     "such as 1e-10");
   if (!(std::isfinite(tolerance) && tolerance > 0))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "DirectManipulationOptions::tolerance = " + format(tolerance) +
                     " breaks the rule tolerance > 0 (finite, relative to the lattice size); "
                     "give e.g. 1e-7");
@@ -136,23 +141,26 @@ void DirectManipulationOptions::validate() const {
   for (size_t g = 0; g < tied.size(); ++g) {
     const std::string name = "DirectManipulationOptions::tied[" + std::to_string(g) + "]";
     if (tied[g].size() < 2)
-      throw Error(ErrorCategory::InvalidArgument,
+      out.push_back(
                   name + " has " + std::to_string(tied[g].size()) +
                       " control point(s), breaking the rule of at least 2 per group; "
                       "drop the group or add the rows it ties");
     for (const Eigen::Index r : tied[g]) {
       if (r < 0)
-        throw Error(ErrorCategory::InvalidArgument,
+        out.push_back(
                     name + " holds the row " + std::to_string(r) +
                         ", breaking the rule row >= 0; give control point rows (lattice.index)");
       if (!seen.insert(r).second)
-        throw Error(ErrorCategory::InvalidArgument,
+        out.push_back(
                     name + " holds the row " + std::to_string(r) +
                         " that is already tied (in this or an earlier group); merge the groups "
                         "that share it");
     }
   }
+  return out;
 }
+
+void DirectManipulationOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string DirectManipulationReport::brief() const {
   return std::string(feasible ? "feasible" : "not feasible") + ": " + std::to_string(requested) +
@@ -175,38 +183,57 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(const BezierLattic
 
 // ---- the solver -----------------------------------------------------------------------------
 
+/// The factorization and what it was made for (pimpl: no Eigen decomposition in the header).
+template <class Lattice>
+struct DirectManipulator<Lattice>::State {
+  Lattice lattice;
+  Points3 points, images;
+  DirectManipulationOptions options;
+  double size = 0;
+  Eigen::MatrixXd a;  ///< B S on the unknowns, N x m
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod;
+  std::vector<std::vector<Eigen::Index>> columns;  ///< control point rows of each unknown
+  int rank = 0;
+};
+
 template <class Lattice>
 DirectManipulator<Lattice>::DirectManipulator(const Lattice& lattice, const Points3& points,
                                               const DirectManipulationOptions& options)
-    : lattice_(lattice), points_(points), options_(options) {
-  validate(lattice_);
-  options_.validate();
-  if (points_.rows() == 0)
+    : state_([&] {
+        // Built once, then shared read-only by every copy (move() is const).
+        auto st = std::make_shared<State>();
+        State& s = *st;
+        s.lattice = lattice;
+        s.points = points;
+        s.options = options;
+  validate(s.lattice);
+  s.options.validate();
+  if (s.points.rows() == 0)
     throw Error(ErrorCategory::InvalidArgument,
                 "direct manipulation: no point selected; give at least one point to move");
-  const Eigen::Index M = lattice_.points.rows();
-  if (!options_.locked.empty() && static_cast<Eigen::Index>(options_.locked.size()) != M)
+  const Eigen::Index M = s.lattice.points.rows();
+  if (!s.options.locked.empty() && static_cast<Eigen::Index>(s.options.locked.size()) != M)
     throw Error(ErrorCategory::InvalidArgument,
-                "DirectManipulationOptions::locked has " + std::to_string(options_.locked.size()) +
+                "DirectManipulationOptions::locked has " + std::to_string(s.options.locked.size()) +
                     " entries for a lattice of " + std::to_string(M) +
                     " control points; give one entry per control point, or none");
-  for (size_t g = 0; g < options_.tied.size(); ++g)
-    for (const Eigen::Index r : options_.tied[g])
+  for (size_t g = 0; g < s.options.tied.size(); ++g)
+    for (const Eigen::Index r : s.options.tied[g])
       if (r >= M)
         throw Error(ErrorCategory::InvalidArgument,
                     "DirectManipulationOptions::tied[" + std::to_string(g) + "] holds the row " +
                         std::to_string(r) + ", outside the lattice's rows [0, " +
                         std::to_string(M) + "); give rows lattice.index(i, j, k)");
-  size_ = lattice_size(lattice_.frame);
+  s.size = lattice_size(s.lattice.frame);
 
   // The unknowns before restriction: Hsu's S (eq. (6)) compressed to a vector, unknown[r] = the
   // unknown row r follows, or -1 when locked; a group with a locked row is locked as a whole.
   std::vector<Eigen::Index> unknown(static_cast<size_t>(M), -2);
   std::vector<std::vector<Eigen::Index>> members;
   auto is_locked = [&](Eigen::Index r) {
-    return !options_.locked.empty() && options_.locked[static_cast<size_t>(r)];
+    return !s.options.locked.empty() && s.options.locked[static_cast<size_t>(r)];
   };
-  for (const auto& group : options_.tied) {
+  for (const auto& group : s.options.tied) {
     const bool locked = std::any_of(group.begin(), group.end(), is_locked);
     for (const Eigen::Index r : group)
       unknown[static_cast<size_t>(r)] = locked ? -1 : static_cast<Eigen::Index>(members.size());
@@ -224,94 +251,115 @@ DirectManipulator<Lattice>::DirectManipulator(const Lattice& lattice, const Poin
 
   // B (eq. (2)), then B S restricted to the unknowns acting on some selected point: the others
   // would get a zero displacement in the minimal-norm solution anyway.
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> b = influence(lattice_, points_);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor> b = influence(s.lattice, s.points);
   std::vector<Eigen::Index> column(members.size(), -1);
   for (Eigen::Index i = 0; i < b.outerSize(); ++i)
     for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(b, i); it; ++it) {
       const Eigen::Index g = unknown[static_cast<size_t>(it.col())];
       if (g < 0 || column[static_cast<size_t>(g)] >= 0) continue;
-      column[static_cast<size_t>(g)] = static_cast<Eigen::Index>(columns_.size());
-      columns_.push_back(members[static_cast<size_t>(g)]);
+      column[static_cast<size_t>(g)] = static_cast<Eigen::Index>(s.columns.size());
+      s.columns.push_back(members[static_cast<size_t>(g)]);
     }
-  a_ = Eigen::MatrixXd::Zero(points_.rows(), static_cast<Eigen::Index>(columns_.size()));
+  s.a = Eigen::MatrixXd::Zero(s.points.rows(), static_cast<Eigen::Index>(s.columns.size()));
   for (Eigen::Index i = 0; i < b.outerSize(); ++i)
     for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(b, i); it; ++it) {
       const Eigen::Index g = unknown[static_cast<size_t>(it.col())];
-      if (g >= 0) a_(i, column[static_cast<size_t>(g)]) += it.value();  // Hsu eq. (6): B S
+      if (g >= 0) s.a(i, column[static_cast<size_t>(g)]) += it.value();  // Hsu eq. (6): B S
     }
 
-  images_.resize(points_.rows(), 3);
-  for (Eigen::Index i = 0; i < points_.rows(); ++i)
-    images_.row(i) = deform_point(lattice_, Eigen::Vector3d(points_.row(i).transpose())).transpose();
+  s.images.resize(s.points.rows(), 3);
+  for (Eigen::Index i = 0; i < s.points.rows(); ++i)
+    s.images.row(i) = deform_point(s.lattice, Eigen::Vector3d(s.points.row(i).transpose())).transpose();
 
-  if (a_.cols() > 0) {
+  if (s.a.cols() > 0) {
     // Rank-revealing QR + RZ: the full-rank factorization B S = C D of eq. (3). B is
     // dimensionless (its rows sum to 1), so pivots are compared with rank_tolerance itself, not
     // with the largest pivot: a point that only tiny weights reach (on a face next to locked
     // planes) gets no move rather than a huge one. Eigen's threshold is relative to the largest
     // pivot, which is the largest column norm (the first column pivot).
-    cod_.setThreshold(options_.rank_tolerance / a_.colwise().norm().maxCoeff());
-    cod_.compute(a_);
-    rank_ = static_cast<int>(cod_.rank());
+    s.cod.setThreshold(s.options.rank_tolerance / s.a.colwise().norm().maxCoeff());
+    s.cod.compute(s.a);
+    s.rank = static_cast<int>(s.cod.rank());
   }
-}
+  return std::shared_ptr<const State>(std::move(st));
+  }()) {}
 
 template <class Lattice>
 DirectManipulationResult<Lattice> DirectManipulator<Lattice>::move(const Points3& targets) const {
-  const Eigen::Index n = points_.rows();
+  const State& s = *state_;
+  const Eigen::Index n = s.points.rows();
   if (targets.rows() != n)
     throw Error(ErrorCategory::InvalidArgument,
                 "direct manipulation: " + std::to_string(targets.rows()) + " targets for " +
                     std::to_string(n) + " selected points; give one target per selected point");
   for (Eigen::Index i = 0; i < n; ++i)
-    if (!finite(targets.row(i)))
+    if (!all_finite(targets.row(i)))
       throw Error(ErrorCategory::InvalidArgument,
                   "direct manipulation: target #" + std::to_string(i) + " " +
                       format(Eigen::Vector3d(targets.row(i).transpose())) +
                       " is not finite; give finite coordinates");
 
   // Δq = target − current image (eq. (2)), ΔP = (B S)⁺ Δq (eqs. (5), (7)).
-  const Eigen::MatrixXd dq = targets - images_;
-  Eigen::MatrixXd dp = Eigen::MatrixXd::Zero(a_.cols(), 3);
-  if (rank_ > 0) dp = cod_.solve(dq);
+  const Eigen::MatrixXd dq = targets - s.images;
+  Eigen::MatrixXd dp = Eigen::MatrixXd::Zero(s.a.cols(), 3);
+  if (s.rank > 0) dp = s.cod.solve(dq);
 
-  DirectManipulationResult<Lattice> out{lattice_, {}};
-  for (size_t c = 0; c < columns_.size(); ++c)
-    for (const Eigen::Index r : columns_[c]) out.lattice.points.row(r) += dp.row(static_cast<Eigen::Index>(c));
+  DirectManipulationResult<Lattice> out{s.lattice, {}};
+  for (size_t c = 0; c < s.columns.size(); ++c)
+    for (const Eigen::Index r : s.columns[c]) out.lattice.points.row(r) += dp.row(static_cast<Eigen::Index>(c));
 
   DirectManipulationReport& rep = out.report;
   rep.requested = static_cast<int>(n);
-  rep.unknowns = unknowns();
-  rep.rank = rank_;
-  rep.residual = (a_ * dp - dq).norm();
+  rep.unknowns = static_cast<int>(s.columns.size());
+  rep.rank = s.rank;
+  rep.residual = (s.a * dp - dq).norm();
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d reached = deform_point(out.lattice, Eigen::Vector3d(points_.row(i).transpose()));
+    const Eigen::Vector3d reached = deform_point(out.lattice, Eigen::Vector3d(s.points.row(i).transpose()));
     rep.achieved_max_error = std::max(rep.achieved_max_error, (reached - targets.row(i).transpose()).norm());
   }
-  rep.displacement_norm = (out.lattice.points - lattice_.points).norm();
-  const double tolerance = options_.tolerance * size_;
+  rep.displacement_norm = (out.lattice.points - s.lattice.points).norm();
+  const double tolerance = s.options.tolerance * s.size;
   rep.feasible = rep.achieved_max_error <= tolerance;
 
   const std::string counts = "rank " + std::to_string(rep.rank) + " for " + std::to_string(n) +
                              " point(s) and " + std::to_string(rep.unknowns) + " unknowns";
+  rep.summary.final_residual = rep.achieved_max_error;
+  rep.summary.termination = rep.feasible ? Termination::Converged
+                            : rep.rank == 0 ? Termination::Failed
+                                            : Termination::NotConverged;
   if (rep.feasible) {
-    rep.message = "every selected point reaches its target (largest miss " +
+    rep.summary.message = "every selected point reaches its target (largest miss " +
                   format(rep.achieved_max_error, 3) + " mm, tolerance " + format(tolerance, 3) +
                   " mm); " + counts +
                   (rep.rank < rep.requested ? " (some requests repeat others)" : "");
   } else if (rep.rank == 0) {
-    rep.message = "no free control point acts on the selected points (those that do are all "
+    rep.summary.message = "no free control point acts on the selected points (those that do are all "
                   "locked, or weigh below rank_tolerance): nothing moved, largest miss " +
                   format(rep.achieved_max_error, 3) +
                   " mm; unlock control points near the selected points";
   } else {
-    rep.message = "the request cannot be met (" + counts + "): least-squares compromise, residual " +
+    rep.summary.message = "the request cannot be met (" + counts + "): least-squares compromise, residual " +
                   format(rep.residual, 3) + " mm, largest miss " + format(rep.achieved_max_error, 3) +
                   " mm above the tolerance " + format(tolerance, 3) +
                   " mm; refine the lattice (more cells or a higher degree), unlock control points "
                   "or drop conflicting requests";
   }
   return out;
+}
+
+template <class Lattice>
+const Points3& DirectManipulator<Lattice>::images() const noexcept {
+  return state_->images;
+}
+
+template <class Lattice>
+int DirectManipulator<Lattice>::unknowns() const noexcept {
+  return static_cast<int>(state_->columns.size());
+}
+
+template <class Lattice>
+int DirectManipulator<Lattice>::rank() const noexcept {
+  return state_->rank;
 }
 
 template class DirectManipulator<BSplineLattice>;

@@ -4,6 +4,8 @@
 #include <clay/deform/extended_lattice.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/parallel.hpp>
 
 #include <Eigen/Dense>  // determinant, LU, JacobiSVD
 
@@ -15,7 +17,6 @@
 #include <numbers>
 #include <numeric>
 #include <sstream>
-#include <thread>
 #include <utility>
 
 #include "extended_internal.hpp"
@@ -33,10 +34,9 @@ constexpr std::size_t min_evaluate_points_per_thread = 16384;
 constexpr int max_count = 1024;               // sectors, rings, layers, ...
 constexpr long long max_chunks = 1'000'000;   // per generated lattice
 
-using detail::finite;
+using internal::all_finite;
 using detail::format;
-using detail::throw_problems;
-
+using internal::throw_problems;
 
 [[noreturn]] void bad_argument(const std::string& field, const std::string& value,
                                const std::string& rule) {
@@ -460,23 +460,12 @@ FrozenPoint locate(const Prepared& prep, const Vec3& x, const FreezeOptions& o, 
   return out;
 }
 
-std::size_t thread_count(int requested, std::size_t n, std::size_t per_thread) {
-  std::size_t threads = requested > 0 ? static_cast<std::size_t>(requested)
-                                      : std::max(1u, std::thread::hardware_concurrency());
-  return std::max<std::size_t>(1, std::min(threads, n / per_thread));
-}
-
-/// Runs work(begin, end, part) on `threads` contiguous ranges of [0, n).
+/// Runs work(begin, end, part) on `threads` contiguous ranges of [0, n), on `executor`.
 template <class Work>
-void parallel(std::size_t n, std::size_t threads, Work&& work) {
-  auto range = [&](std::size_t part) {
+void parallel(std::size_t n, std::size_t threads, const Executor& executor, Work&& work) {
+  internal::run_parts(threads, executor, [&](std::size_t part) {
     work(n * part / threads, n * (part + 1) / threads, part);
-  };
-  std::vector<std::thread> pool;
-  pool.reserve(threads - 1);
-  for (std::size_t part = 1; part < threads; ++part) pool.emplace_back(range, part);
-  range(0);
-  for (auto& t : pool) t.join();
+  });
 }
 
 /// Unit-circle control point `angular` (0 .. 3 sectors − 1) of the cubic Bézier arcs.
@@ -507,7 +496,7 @@ std::vector<std::string> problems(const ExtendedLattice& lattice, std::string_vi
     out.push_back(n + ": no chunks; give at least one chunk of 64 control point indices");
   for (const auto* m : {&lattice.rest, &lattice.points})
     for (Eigen::Index r = 0; r < m->rows(); ++r)
-      if (!finite(m->row(r))) {
+      if (!all_finite(m->row(r))) {
         out.push_back(n + ": " + (m == &lattice.rest ? "rest" : "current") + " control point row " +
                       std::to_string(r) + " is not finite " + format(Vec3(m->row(r).transpose())) +
                       "; give finite coordinates");
@@ -545,7 +534,7 @@ std::vector<std::string> problems(const ExtendedLattice& lattice, std::string_vi
 
 void validate(const ExtendedLattice& lattice, std::string_view name) {
   const auto list = problems(lattice, name);
-  if (!list.empty()) throw_problems(ErrorCategory::InvalidGeometry, list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
 }
 
 Eigen::Vector3d chunk_point(const Points3& control, const Chunk& chunk, const Eigen::Vector3d& uvw) {
@@ -614,10 +603,10 @@ ExtendedLattice merge_coincident_points(const ExtendedLattice& lattice, double t
 // ---- cylindrical lattice -----------------------------------------------------------------------------
 
 void CylinderSpec::validate() const {
-  if (!finite(origin)) bad_argument("CylinderSpec::origin", format(origin), "finite coordinates");
-  if (!finite(axis) || !(axis.norm() > 0))
+  if (!all_finite(origin)) bad_argument("CylinderSpec::origin", format(origin), "finite coordinates");
+  if (!all_finite(axis) || !(axis.norm() > 0))
     bad_argument("CylinderSpec::axis", format(axis), "a finite non-zero direction");
-  if (!finite(reference) || !(reference.cross(axis).norm() > 1e-9 * reference.norm() * axis.norm()))
+  if (!all_finite(reference) || !(reference.cross(axis).norm() > 1e-9 * reference.norm() * axis.norm()))
     bad_argument("CylinderSpec::reference", format(reference),
                  "a finite direction not parallel to the axis " + format(axis));
   if (!(std::isfinite(radius) && radius > 0))
@@ -695,14 +684,14 @@ ExtendedLattice make_cylindrical_lattice(const CylinderSpec& spec) {
 // ---- prismatic lattice ----------------------------------------------------------------------------------
 
 void PrismSpec::validate() const {
-  if (!finite(origin)) bad_argument("PrismSpec::origin", format(origin), "finite coordinates");
-  if (!finite(x_axis) || !(x_axis.norm() > 0))
+  if (!all_finite(origin)) bad_argument("PrismSpec::origin", format(origin), "finite coordinates");
+  if (!all_finite(x_axis) || !(x_axis.norm() > 0))
     bad_argument("PrismSpec::x_axis", format(x_axis), "a finite non-zero direction");
-  if (!finite(y_axis) || !(y_axis.cross(x_axis).norm() > 1e-9 * y_axis.norm() * x_axis.norm()))
+  if (!all_finite(y_axis) || !(y_axis.cross(x_axis).norm() > 1e-9 * y_axis.norm() * x_axis.norm()))
     bad_argument("PrismSpec::y_axis", format(y_axis),
                  "a finite direction not parallel to x_axis " + format(x_axis));
   const Vec3 normal = x_axis.cross(y_axis).normalized();
-  if (!finite(extrusion) || !(std::abs(extrusion.dot(normal)) > 1e-9 * extrusion.norm()))
+  if (!all_finite(extrusion) || !(std::abs(extrusion.dot(normal)) > 1e-9 * extrusion.norm()))
     bad_argument("PrismSpec::extrusion", format(extrusion),
                  "a finite vector off the plane of x_axis and y_axis (extrusion . normal != 0)");
   if (sections.size() < 2)
@@ -718,7 +707,7 @@ void PrismSpec::validate() const {
       bad_argument(field, std::to_string(n),
                    "= sections[0].size() = " + std::to_string(count) + " (every section alike)");
     for (size_t p = 0; p < n; ++p)
-      if (!finite(sections[s][p]))
+      if (!all_finite(sections[s][p]))
         bad_argument("PrismSpec::sections[" + std::to_string(s) + "][" + std::to_string(p) + "]",
                      "(" + format(sections[s][p].x()) + ", " + format(sections[s][p].y()) + ")",
                      "finite coordinates");
@@ -771,28 +760,35 @@ ExtendedLattice make_prismatic_lattice(const PrismSpec& spec) {
 
 // ---- freezing and deformation ----------------------------------------------------------------------------
 
-void FreezeOptions::validate() const {
+std::vector<std::string> FreezeOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, const std::string& value, const std::string& rule) {
+    out.push_back(field + " = " + value + " breaks the rule " + rule);
+  };
   if (!(newton_tolerance > 0 && newton_tolerance <= 1e-3))
-    bad_argument("FreezeOptions::newton_tolerance", format(newton_tolerance),
+    bad("FreezeOptions::newton_tolerance", format(newton_tolerance),
                  "0 < newton_tolerance <= 1e-3 (relative to the chunk size)");
   if (!(parameter_tolerance >= 0 && parameter_tolerance <= 1e-3))
-    bad_argument("FreezeOptions::parameter_tolerance", format(parameter_tolerance),
+    bad("FreezeOptions::parameter_tolerance", format(parameter_tolerance),
                  "0 <= parameter_tolerance <= 1e-3");
   if (!(pseudo_inverse_threshold >= 0 && pseudo_inverse_threshold <= 1e-3))
-    bad_argument("FreezeOptions::pseudo_inverse_threshold", format(pseudo_inverse_threshold),
+    bad("FreezeOptions::pseudo_inverse_threshold", format(pseudo_inverse_threshold),
                  "0 <= pseudo_inverse_threshold <= 1e-3");
   if (max_iterations < 1 || max_iterations > 1000)
-    bad_argument("FreezeOptions::max_iterations", std::to_string(max_iterations),
+    bad("FreezeOptions::max_iterations", std::to_string(max_iterations),
                  "1 <= max_iterations <= 1000");
   if (max_subdivision_depth < 0 || max_subdivision_depth > 10)
-    bad_argument("FreezeOptions::max_subdivision_depth", std::to_string(max_subdivision_depth),
+    bad("FreezeOptions::max_subdivision_depth", std::to_string(max_subdivision_depth),
                  "0 <= max_subdivision_depth <= 10");
   if (threads < 0 || threads > 1024)
-    bad_argument("FreezeOptions::threads", std::to_string(threads),
+    bad("FreezeOptions::threads", std::to_string(threads),
                  "0 <= threads <= 1024 (0 = one per hardware thread)");
+  return out;
 }
 
-std::string FreezeSummary::brief() const {
+void FreezeOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+
+std::string FreezeReport::brief() const {
   char buffer[320];
   std::snprintf(buffer, sizeof buffer,
                 "frozen %lld points: %lld inside, %lld outside, %lld unresolved; %lld found after "
@@ -809,7 +805,7 @@ FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points, const
   options.validate();
   validate(lattice);
   for (Eigen::Index r = 0; r < points.rows(); ++r)
-    if (!finite(points.row(r)))
+    if (!all_finite(points.row(r)))
       throw Error(ErrorCategory::InvalidGeometry,
                   "freeze: point row " + std::to_string(r) + " is not finite " +
                       format(Vec3(points.row(r).transpose())) + "; give finite coordinates");
@@ -820,9 +816,9 @@ FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points, const
   out.positions = points;
   out.control_points = lattice.rest.rows();
   out.chunks = lattice.chunks.size();
-  const std::size_t threads = thread_count(options.threads, n, min_freeze_points_per_thread);
+  const std::size_t threads = internal::part_count(options.threads, n, min_freeze_points_per_thread);
   std::vector<Counters> counts(threads);
-  parallel(n, threads, [&](std::size_t b, std::size_t e, std::size_t part) {
+  parallel(n, threads, options.executor, [&](std::size_t b, std::size_t e, std::size_t part) {
     for (std::size_t i = b; i < e; ++i)
       out.points[i] = locate(prep, points.row(static_cast<Eigen::Index>(i)).transpose(), options, counts[part]);
   });
@@ -838,7 +834,7 @@ FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points, const
     total.worst_residual = std::max(total.worst_residual, c.worst_residual);
     total.worst_initial = std::max(total.worst_initial, c.worst_initial);
   }
-  FreezeSummary& s = out.summary;
+  FreezeReport& s = out.report;
   s.inside = total.inside;
   s.outside = total.outside;
   s.unresolved = total.unresolved;
@@ -870,8 +866,8 @@ Points3 evaluate(const ExtendedLattice& lattice, const FrozenPoints& frozen, con
                     " positions); only moving control points keeps a freeze valid: freeze again");
   const std::size_t n = frozen.points.size();
   Points3 out(static_cast<Eigen::Index>(n), 3);
-  const std::size_t threads = thread_count(options.threads, n, min_evaluate_points_per_thread);
-  parallel(n, threads, [&](std::size_t b, std::size_t e, std::size_t) {
+  const std::size_t threads = internal::part_count(options.threads, n, min_evaluate_points_per_thread);
+  parallel(n, threads, options.executor, [&](std::size_t b, std::size_t e, std::size_t) {
     for (std::size_t i = b; i < e; ++i) {
       const FrozenPoint& f = frozen.points[i];
       const auto r = static_cast<Eigen::Index>(i);
@@ -899,7 +895,7 @@ std::function<Eigen::Vector3d(const Eigen::Vector3d&)> prepared_point_map(const 
   o.threads = 1;
   auto data = std::make_shared<const std::pair<ExtendedLattice, Prepared>>(lattice, prepare(lattice, o));
   return [data, o](const Eigen::Vector3d& x) -> Eigen::Vector3d {
-    if (!x.allFinite())
+    if (!internal::all_finite(x))
       throw Error(ErrorCategory::InvalidGeometry,
                   "freeze: point row 0 is not finite " + format(x) + "; give finite coordinates");
     Counters count;

@@ -6,6 +6,7 @@
 #include <clay/deform/frozen_lattice.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/parallel.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +14,6 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "bernstein.hpp"
@@ -599,7 +599,7 @@ FrozenLattice::FrozenLattice(const BSplineLattice& lattice) {
   degrees_ = {lattice.bases[0].degree, lattice.bases[1].degree, lattice.bases[2].degree};
   std::array<std::vector<detail::SpanExtraction>, 3> spans;
   for (int d = 0; d < 3; ++d) {
-    spans[static_cast<size_t>(d)] = detail::extract_spans(lattice.bases[static_cast<size_t>(d)]);
+    spans[static_cast<size_t>(d)] = surface::bezier_extraction(lattice.bases[static_cast<size_t>(d)]);
     std::vector<double> breaks;
     for (const auto& e : spans[static_cast<size_t>(d)]) breaks.push_back(e.a);
     breaks.push_back(spans[static_cast<size_t>(d)].back().b);
@@ -618,9 +618,7 @@ void run(const FrozenLattice& lattice, const Io& io, std::size_t n, bool rows,
   options.validate();
   const Kernel K = FrozenLatticeAccess::kernel(lattice);
   const bool bezier = K.cell_count == 1;
-  std::size_t threads = options.threads > 0 ? static_cast<std::size_t>(options.threads)
-                                            : std::max(1u, std::thread::hardware_concurrency());
-  threads = std::max<std::size_t>(1, std::min(threads, n / min_points_per_thread));
+  const std::size_t threads = internal::part_count(options.threads, n, min_points_per_thread);
   std::vector<Scratch> scratch(bezier ? 0 : threads);
   for (auto& sc : scratch) {
     // Whole blocks plus W spare entries (the last partial block of a cell spills over); the
@@ -645,11 +643,7 @@ void run(const FrozenLattice& lattice, const Io& io, std::size_t n, bool rows,
       else run_bspline_columns(K, io, b, e, scratch[part]);
     }
   };
-  std::vector<std::thread> pool;
-  pool.reserve(threads - 1);
-  for (std::size_t part = 1; part < threads; ++part) pool.emplace_back(work, part);
-  work(0);
-  for (auto& th : pool) th.join();
+  internal::run_parts(threads, options.executor, work);
 }
 
 }  // namespace

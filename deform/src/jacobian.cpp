@@ -1,6 +1,7 @@
 #include <clay/deform/jacobian.hpp>
 
 #include <clay/surface/basis.hpp>
+#include <clay/internal/math.hpp>
 
 #include <Eigen/LU>
 
@@ -52,7 +53,7 @@ BernsteinVolume product(const BernsteinVolume& A, const BernsteinVolume& B) {
   BernsteinVolume C = zeros(dc);
   auto scale = [](int n) {
     std::vector<double> s(static_cast<size_t>(n + 1));
-    for (int i = 0; i <= n; ++i) s[static_cast<size_t>(i)] = detail::binomial(n, i);
+    for (int i = 0; i <= n; ++i) s[static_cast<size_t>(i)] = internal::binomial(n, i);
     return s;
   };
   std::array<std::vector<double>, 3> sa, sb, sc;

@@ -2,6 +2,8 @@
 
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/math.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -16,10 +18,9 @@ namespace clay::deform {
 
 namespace {
 
-using detail::finite;
+using internal::all_finite;
 using detail::format;
-using detail::throw_problems;
-
+using internal::throw_problems;
 
 constexpr const char* direction_name[3] = {"s", "t", "u"};
 
@@ -44,7 +45,7 @@ void point_problems(const Points3& points, std::array<int, 3> counts, std::strin
     return;
   }
   for (Eigen::Index r = 0; r < points.rows(); ++r)
-    if (!finite(points.row(r))) {
+    if (!all_finite(points.row(r))) {
       const int k = static_cast<int>(r % counts[2]);
       const int j = static_cast<int>((r / counts[2]) % counts[1]);
       const int i = static_cast<int>(r / (static_cast<Eigen::Index>(counts[1]) * counts[2]));
@@ -81,7 +82,7 @@ std::vector<std::string> problems(const Frame& frame, std::string_view name) {
   const std::pair<const char*, const Eigen::Vector3d*> vectors[4] = {
       {"origin X0", &frame.origin}, {"edge S", &frame.s}, {"edge T", &frame.t}, {"edge U", &frame.u}};
   for (const auto& [what, v] : vectors)
-    if (!finite(*v))
+    if (!all_finite(*v))
       out.push_back(n + ": " + what + " " + format(*v) + " is not finite; give finite coordinates");
   if (!out.empty()) return out;
   for (int d = 1; d < 4; ++d)
@@ -100,7 +101,7 @@ std::vector<std::string> problems(const Frame& frame, std::string_view name) {
 
 void validate(const Frame& frame, std::string_view name) {
   const auto list = problems(frame, name);
-  if (!list.empty()) throw_problems(ErrorCategory::InvalidGeometry, list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
 }
 
 Eigen::Vector3d local_coordinates(const Frame& frame, const Eigen::Vector3d& x) noexcept {
@@ -126,48 +127,6 @@ bool clamped_local(const Frame& frame, const Eigen::Vector3d& x, Eigen::Vector3d
   if (!inside(local)) return false;
   local = local.cwiseMax(0.0).cwiseMin(1.0);
   return true;
-}
-
-double binomial(int n, int k) noexcept {
-  if (k < 0 || k > n) return 0;
-  k = std::min(k, n - k);
-  double c = 1;
-  for (int i = 1; i <= k; ++i) c = c * (n - k + i) / i;  // exact: each step is an integer
-  return std::round(c);
-}
-
-std::vector<SpanExtraction> extract_spans(const surface::BSplineBasis& basis) {
-  const int p = basis.degree;
-  const std::vector<double> breaks = surface::breakpoints(basis);
-  std::vector<SpanExtraction> spans;
-  std::vector<double> d(static_cast<size_t>(p + 1));
-  const double* U = basis.knots.data();
-  for (size_t c = 0; c + 1 < breaks.size(); ++c) {
-    SpanExtraction e;
-    e.a = breaks[c];
-    e.b = breaks[c + 1];
-    const int span = surface::find_span(basis, e.a);
-    e.first = span - p;
-    e.matrix.resize(p + 1, p + 1);
-    for (int q = 0; q <= p; ++q)      // blossom of the basis function first + q
-      for (int r = 0; r <= p; ++r) {  // Bézier point r = f(a^(p-r), b^r)
-        std::fill(d.begin(), d.end(), 0.0);
-        d[static_cast<size_t>(q)] = 1.0;
-        // de Boor triangle (The NURBS Book A5.1 form) with argument x_level.
-        for (int level = 1; level <= p; ++level) {
-          const double x = level <= p - r ? e.a : e.b;
-          for (int i = p; i >= level; --i) {
-            const int g = span - p + i;  // global index of d[i]
-            const double alpha = (x - U[g]) / (U[g + p + 1 - level] - U[g]);
-            d[static_cast<size_t>(i)] =
-                (1 - alpha) * d[static_cast<size_t>(i - 1)] + alpha * d[static_cast<size_t>(i)];
-          }
-        }
-        e.matrix(r, q) = d[static_cast<size_t>(p)];
-      }
-    spans.push_back(std::move(e));
-  }
-  return spans;
 }
 
 Points3 cell_points(const BSplineLattice& lattice, const SpanExtraction& ea,
@@ -225,7 +184,7 @@ std::vector<double> bernstein_to_power(const std::vector<double>& bernstein,
             for (int e = p; e >= level; --e)
               line[static_cast<size_t>(e)] -= line[static_cast<size_t>(e - 1)];
           for (int e = 0; e < n[d]; ++e)
-            c[static_cast<size_t>(base + e * stride[d])] = binomial(p, e) * line[static_cast<size_t>(e)];
+            c[static_cast<size_t>(base + e * stride[d])] = internal::binomial(p, e) * line[static_cast<size_t>(e)];
         }
   }
   return c;
@@ -261,7 +220,7 @@ std::vector<std::string> problems(const BezierLattice& lattice, std::string_view
 
 void validate(const BezierLattice& lattice, std::string_view name) {
   const auto list = problems(lattice, name);
-  if (!list.empty()) throw_problems(ErrorCategory::InvalidGeometry, list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
 }
 
 Points3 undisplaced_points(const BezierLattice& lattice) {
@@ -305,7 +264,7 @@ BSplineLattice make_bspline_lattice(const Frame& frame, std::array<int, 3> degre
   std::array<surface::BSplineBasis, 3> bases;
   for (int d = 0; d < 3; ++d) {
     const int p = degrees[d], n = cells[d];
-    if (knots == LatticeKnots::clamped) {
+    if (knots == LatticeKnots::Clamped) {
       bases[d] = surface::clamped_uniform_basis(p, n + p, 0.0, 1.0);
     } else {
       bases[d].degree = p;
@@ -345,7 +304,7 @@ BSplineLattice make_bspline_lattice(const Frame& frame, std::array<surface::BSpl
   lattice.bases = std::move(bases);
   bool bases_ok = true;
   const auto list = structure_problems(lattice, "make_bspline_lattice", bases_ok);
-  if (!list.empty()) throw_problems(ErrorCategory::InvalidGeometry, list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
   lattice.points = undisplaced_points(lattice);
   return lattice;
 }
@@ -359,7 +318,7 @@ std::vector<std::string> problems(const BSplineLattice& lattice, std::string_vie
 
 void validate(const BSplineLattice& lattice, std::string_view name) {
   const auto list = problems(lattice, name);
-  if (!list.empty()) throw_problems(ErrorCategory::InvalidGeometry, list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
 }
 
 Points3 undisplaced_points(const BSplineLattice& lattice) {
@@ -394,7 +353,7 @@ BezierCells bezier_cells(const BSplineLattice& lattice) {
   std::array<std::vector<detail::SpanExtraction>, 3> spans;
   BezierCells out;
   for (int d = 0; d < 3; ++d) {
-    spans[d] = detail::extract_spans(lattice.bases[d]);
+    spans[d] = surface::bezier_extraction(lattice.bases[d]);
     for (const auto& e : spans[d]) out.breaks[d].push_back(e.a);
     out.breaks[d].push_back(spans[d].back().b);
   }

@@ -29,20 +29,4 @@ inline std::string format(double v, int precision = 17) {
   return m.str();
 }
 
-/// std::isfinite on every coordinate (Eigen's allFinite computes x − x, which raises FE_INVALID
-/// on an infinity where floating-point traps are on).
-template <class V>
-bool finite(const V& v) {
-  for (Eigen::Index i = 0; i < v.size(); ++i)
-    if (!std::isfinite(v(i))) return false;
-  return true;
-}
-
-/// Throws clay::Error(category) whose message lists every problem, "; "-separated.
-[[noreturn]] inline void throw_problems(ErrorCategory category, const std::vector<std::string>& list) {
-  std::string text;
-  for (size_t k = 0; k < list.size(); ++k) text += (k ? "; " : "") + list[k];
-  throw Error(category, text);
-}
-
 }  // namespace clay::deform::detail

@@ -12,6 +12,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 
@@ -557,7 +558,7 @@ std::vector<double> added_breaks(const std::vector<double>& refined,
 
 Eigen::Vector3d deformed(const Certifier& d, const Eigen::Vector3d& x) {
   const Eigen::Vector3d y = d.map(x);
-  if (!detail::finite(y))  // not allFinite(): its x - x traps on the infinity it is looking for
+  if (!internal::all_finite(y))
     throw Error(ErrorCategory::InvalidArgument,
                 "refit_deformed: the " + d.name + " maps (" + format(x.x()) + ", " +
                     format(x.y()) + ", " + format(x.z()) +
@@ -797,9 +798,10 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
 
 }  // namespace
 
-void RefitOptions::validate() const {
-  auto fail = [](const std::string& what) {
-    throw Error(ErrorCategory::InvalidArgument, "RefitOptions::" + what);
+std::vector<std::string> RefitOptions::problems() const {
+  std::vector<std::string> out;
+  auto fail = [&out](const std::string& what) {
+    out.push_back("RefitOptions::" + what);
   };
   if (degree < 1 || degree > 25)
     fail("degree = " + std::to_string(degree) +
@@ -816,7 +818,10 @@ void RefitOptions::validate() const {
          ": must be >= degree + 1 = " + std::to_string(degree + 1));
   if (!(certificate_share > 0 && certificate_share < 1))
     fail("certificate_share = " + format(certificate_share) + ": must be in (0, 1), e.g. 0.1");
+  return out;
 }
+
+void RefitOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string RefitReport::brief() const {
   char buffer[256];
@@ -846,42 +851,42 @@ RefitResult refit_validated(const BSplineSurface& surface, const D& deformation,
 
 }  // namespace
 
-RefitResult refit_deformed(const BSplineSurface& surface, const Taper& taper,
+RefitResult refit_deformed(const Taper& taper, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, taper, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const Twist& twist,
+RefitResult refit_deformed(const Twist& twist, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, twist, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const Bend& bend,
+RefitResult refit_deformed(const Bend& bend, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, bend, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const BezierLattice& lattice,
+RefitResult refit_deformed(const BezierLattice& lattice, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, lattice, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const BSplineLattice& lattice,
+RefitResult refit_deformed(const BSplineLattice& lattice, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, lattice, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const ExtendedLattice& lattice,
+RefitResult refit_deformed(const ExtendedLattice& lattice, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, lattice, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const DeformationStack& stack,
+RefitResult refit_deformed(const DeformationStack& stack, const BSplineSurface& surface,
                            const RefitOptions& options) {
   return refit_validated(surface, stack, options);
 }
 
-RefitResult refit_deformed(const BSplineSurface& surface, const PointMap& map,
+RefitResult refit_deformed(const PointMap& map, const BSplineSurface& surface,
                            const RefitOptions& options) {
   if (!map)
     throw Error(ErrorCategory::InvalidArgument,

@@ -4,6 +4,7 @@
 #include <clay/deform/regular.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>  // cross products
 
@@ -19,12 +20,8 @@ namespace clay::deform {
 
 namespace {
 
-using detail::finite;
+using internal::all_finite;
 using detail::format;
-
-[[noreturn]] void throw_problems(const std::vector<std::string>& list) {
-  detail::throw_problems(ErrorCategory::InvalidGeometry, list);
-}
 
 /// Which of Barr's local axes `axis` and `reference` are.
 enum class Layout {
@@ -228,7 +225,7 @@ std::vector<std::string> problems(const AxisFrame& frame, std::string_view name)
   const std::pair<const char*, const Eigen::Vector3d*> vectors[3] = {
       {"origin", &frame.origin}, {"axis", &frame.axis}, {"reference", &frame.reference}};
   for (const auto& [what, v] : vectors)
-    if (!finite(*v))
+    if (!all_finite(*v))
       out.push_back(n + ": " + what + " " + format(*v) + " is not finite; give finite coordinates");
   if (!out.empty()) return out;
   if (frame.axis.norm() == 0)
@@ -250,7 +247,7 @@ std::vector<std::string> problems(const AxisFrame& frame, std::string_view name)
 
 void validate(const AxisFrame& frame, std::string_view name) {
   const auto list = problems(frame, name);
-  if (!list.empty()) throw_problems(list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
 }
 
 std::vector<std::string> problems(const Taper& taper, std::string_view name) {
@@ -285,15 +282,15 @@ std::vector<std::string> problems(const Bend& bend, std::string_view name) {
 
 void validate(const Taper& taper, std::string_view name) {
   const auto list = problems(taper, name);
-  if (!list.empty()) throw_problems(list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
 }
 void validate(const Twist& twist, std::string_view name) {
   const auto list = problems(twist, name);
-  if (!list.empty()) throw_problems(list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
 }
 void validate(const Bend& bend, std::string_view name) {
   const auto list = problems(bend, name);
-  if (!list.empty()) throw_problems(list);
+  internal::throw_if(ErrorCategory::InvalidGeometry, list);
 }
 
 // ---- one point --------------------------------------------------------------------------------

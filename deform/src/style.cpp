@@ -8,6 +8,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 
@@ -24,16 +25,17 @@ using surface::Points3;
 
 std::string_view to_string(ConstraintClass c) noexcept {
   switch (c) {
-    case ConstraintClass::over_constrained: return "over-constrained";
-    case ConstraintClass::under_constrained: return "under-constrained";
-    case ConstraintClass::well_constrained: return "well-constrained";
+    case ConstraintClass::OverConstrained: return "over-constrained";
+    case ConstraintClass::UnderConstrained: return "under-constrained";
+    case ConstraintClass::WellConstrained: return "well-constrained";
   }
   return "?";
 }
 
-void StyleOptions::validate() const {
-  auto fail = [](const std::string& what) {
-    throw Error(ErrorCategory::InvalidArgument, "style options: " + what);
+std::vector<std::string> StyleOptions::problems() const {
+  std::vector<std::string> out;
+  auto fail = [&out](const std::string& what) {
+    out.push_back("style options: " + what);
   };
   if (!(lambda >= 0 && lambda <= 1))
     fail("lambda = " + std::to_string(lambda) + " must lie in [0, 1] (Han et al. eq. 9)");
@@ -54,8 +56,11 @@ void StyleOptions::validate() const {
          " must lie in [0, 0.1] (relative to the model size; 0 = key points only)");
   if (max_key_point_rounds < 0)
     fail("max_key_point_rounds = " + std::to_string(max_key_point_rounds) + " must be >= 0");
-  projection.validate();
+  internal::append(out, projection.problems());
+  return out;
 }
+
+void StyleOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 int InfluenceRegion::inside_count() const noexcept {
   return static_cast<int>(std::count(factors.begin(), factors.end(), std::uint8_t{1}));
@@ -245,7 +250,7 @@ KeyPoint make_key_point(const BSplineSurface& s, const InfluenceRegion& region, 
   k.distance = (k.point - k.foot).dot(k.normal);
   const double gu = continuous_index(surface::greville_abscissae(s.u), u);
   const double gv = continuous_index(surface::greville_abscissae(s.v), v);
-  k.row = static_cast<int>(std::lround(direction == KeyDirection::u ? gu : gv));
+  k.row = static_cast<int>(std::lround(direction == KeyDirection::U ? gu : gv));
   k.influenced = region.inside(static_cast<int>(std::lround(gu)), static_cast<int>(std::lround(gv)));
   return k;
 }
@@ -257,7 +262,7 @@ bool begin_report(const KeyPoints& keys, const StyleOptions& options, StyleMode 
   report.direction = keys.direction;
   report.m = static_cast<int>(keys.points.size());
   report.key_points = keys.points;
-  if (keys.constraint_class == ConstraintClass::over_constrained) {
+  if (keys.constraint_class == ConstraintClass::OverConstrained) {
     report.message = "over-constrained: the target curve lies outside the bound; the surface is unchanged";
     return true;
   }
@@ -288,11 +293,11 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
     gv_hi = std::max(gv_hi, gv);
     inside += sample_inside(t.u, t.v) ? 1 : 0;
   }
-  out.direction = (gu_hi - gu_lo >= gv_hi - gv_lo) ? KeyDirection::u : KeyDirection::v;
-  out.constraint_class = inside == 0 ? ConstraintClass::over_constrained
-                         : inside == static_cast<int>(trace.size()) ? ConstraintClass::well_constrained
-                                                                    : ConstraintClass::under_constrained;
-  const bool along_u = out.direction == KeyDirection::u;
+  out.direction = (gu_hi - gu_lo >= gv_hi - gv_lo) ? KeyDirection::U : KeyDirection::V;
+  out.constraint_class = inside == 0 ? ConstraintClass::OverConstrained
+                         : inside == static_cast<int>(trace.size()) ? ConstraintClass::WellConstrained
+                                                                    : ConstraintClass::UnderConstrained;
+  const bool along_u = out.direction == KeyDirection::U;
   const std::vector<double>& along = along_u ? xu : xv;
   auto coord = [&](double u, double v) { return along_u ? u : v; };
   double lo = 1e300, hi = -1e300;
@@ -567,7 +572,7 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
   s.final_residual = report.target_deviation;
   std::ostringstream m;
   m.precision(4);
-  if (report.constraint_class == ConstraintClass::over_constrained) {
+  if (report.constraint_class == ConstraintClass::OverConstrained) {
     s.termination = Termination::Failed;
     s.message = "the target curve lies outside the bound, so no control vertex may move and the surface is "
                 "unchanged: draw the target curve (at least partly) inside the bound, or the bound around it";
@@ -587,11 +592,11 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
       << " mm from the surface (" << report.max_displacement / farthest
       << " times; at most 10 times is accepted): the surface folds. Move the bound further from the target or "
          "the target closer to the surface";
-    if (report.mode == StyleMode::exact) m << ", or allow more max_refinements";
+    if (report.mode == StyleMode::Exact) m << ", or allow more max_refinements";
     s.message = m.str();
     return s;
   }
-  if (report.mode == StyleMode::exact) {
+  if (report.mode == StyleMode::Exact) {
     const double size = report.model_size;
     if (!report.conflicting_key_points.empty()) {
       s.termination = Termination::NotConverged;
@@ -611,7 +616,7 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
     }
     s.message = m.str();
   }
-  if (s.converged()) s.message = report.mode == StyleMode::exact ? "the key points and the target curve are met"
+  if (s.converged()) s.message = report.mode == StyleMode::Exact ? "the key points and the target curve are met"
                                                                  : "the target is approximated (paper mode)";
   return s;
 }
@@ -619,7 +624,7 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
 StyleResult StyleEditor::update(const BSplineCurve& target) {
   surface::validate(target, "target curve");
   const auto trace = detail::trace_on_surface(projector_, target, detail::target_samples(target, options_), &warm_);
-  StyleResult out = options_.mode == StyleMode::exact
+  StyleResult out = options_.mode == StyleMode::Exact
                         ? detail::style_exact(projector_, region_, target, trace, options_, exact_)
                         : detail::style_paper(projector_, region_, target, trace, options_);
   out.report.summary = judge_style(out.report, options_);
@@ -637,13 +642,13 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
   KeyPoints keys = find_key_points(projector, region, target, trace, 1);
   StyleResult out{parent, parent, {}};
   StyleReport& report = out.report;
-  if (begin_report(keys, options, StyleMode::paper, report)) {
+  if (begin_report(keys, options, StyleMode::Paper, report)) {
     detail::measure(parent, out.surface, region.factors, region, trace, options, report);
     return out;
   }
 
   // Rows of the net in the key direction (vertices (row, col) for direction u, (col, row) for v).
-  const bool along_u = keys.direction == KeyDirection::u;
+  const bool along_u = keys.direction == KeyDirection::U;
   const int rows = along_u ? parent.count_u() : parent.count_v();
   const int cols = along_u ? parent.count_v() : parent.count_u();
   auto vertex = [&](int row, int col) { return along_u ? parent.index(row, col) : parent.index(col, row); };
@@ -740,6 +745,15 @@ StyleResult style_deform(const BSplineSurface& parent, const BSplineCurve& bound
 StyleResult style_deform(const BSplineSurface& parent, const BSplineCurve& target,
                          const StyleOptions& options) {
   return style_deform(parent, influence_from_target(parent, target, options), target, options);
+}
+
+std::string StyleReport::brief() const {
+  std::ostringstream text;
+  text.precision(3);
+  text << summary.brief() << "; " << to_string(constraint_class) << ", " << key_points.size() << " key points, "
+    << moved_vertices << " vertices moved (largest " << max_displacement << " mm), target deviation "
+    << target_deviation << " mm";
+  return text.str();
 }
 
 }  // namespace clay::deform

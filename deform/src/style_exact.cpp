@@ -15,6 +15,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -249,7 +250,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   // The key points are those of the parent's net (eq. 8): refinement adds freedom, not
   // constraints. Key points are added where the result still misses the target curve.
   const KeyPoints keys = find_key_points(projector, region, target, trace, options.key_points_per_row);
-  if (begin_report(keys, options, StyleMode::exact, report)) {
+  if (begin_report(keys, options, StyleMode::Exact, report)) {
     measure(parent, parent, region.factors, region, trace, options, report);
     return out;
   }
@@ -363,7 +364,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
             // vertices reach the net's border, or μ large along S's weak directions).
             const Eigen::MatrixXd force = B.transpose() * mu;
             const double stationarity = (net->H * d - force).cwiseAbs().maxCoeff();
-            solved = d.allFinite() && (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
+            solved = internal::all_finite(d) && (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
                      stationarity <= range_space_stationarity * force.cwiseAbs().maxCoeff();
           }
         }

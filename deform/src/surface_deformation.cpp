@@ -5,6 +5,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <sstream>
@@ -14,10 +15,14 @@
 
 namespace clay::deform {
 
-void SurfaceDeformationOptions::validate() const {
-  compose.validate();
-  if (refit) refit->validate();
+std::vector<std::string> SurfaceDeformationOptions::problems() const {
+  std::vector<std::string> out;
+  internal::append(out, compose.problems());
+  if (refit) internal::append(out, refit->problems());
+  return out;
 }
+
+void SurfaceDeformationOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::string SurfaceDeformationReport::brief() const {
   std::ostringstream out;
@@ -25,9 +30,9 @@ std::string SurfaceDeformationReport::brief() const {
     out << "steps[" << s.step << "] " << s.kind;
     if (!s.name.empty()) out << " '" << s.name << "'";
     switch (s.method) {
-      case StepOutcome::Method::skipped: out << ": disabled, skipped"; break;
-      case StepOutcome::Method::exact: out << ": exact, " << s.compose.brief(); break;
-      case StepOutcome::Method::refit: out << ": refit, " << s.refit.brief(); break;
+      case StepOutcome::Method::Skipped: out << ": disabled, skipped"; break;
+      case StepOutcome::Method::Exact: out << ": exact, " << s.compose.brief(); break;
+      case StepOutcome::Method::Refit: out << ": refit, " << s.refit.brief(); break;
     }
     out << "\n";
   }
@@ -188,7 +193,7 @@ void refuse_torn(const Deformation& d, const surface::BSplineSurface& s, const R
 }
 
 RefitResult refit_step(const Deformation& d, const surface::BSplineSurface& s, const RefitOptions& o) {
-  return std::visit([&](const auto& deformation) { return refit_deformed(s, deformation, o); }, d);
+  return std::visit([&](const auto& deformation) { return refit_deformed(deformation, s, o); }, d);
 }
 
 }  // namespace
@@ -213,7 +218,7 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
     }
     Attempt a = try_exact(step.deformation, out.surface, options.compose);
     if (a.result) {
-      o.method = StepOutcome::Method::exact;
+      o.method = StepOutcome::Method::Exact;
       o.compose = a.result->report;
       out.surface = std::move(a.result->surface);
     } else {
@@ -230,7 +235,7 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
                     where + " misses its tolerance: the refit's " + r.report.summary.message +
                         ". Nothing is returned; to accept the result anyway set "
                         "SurfaceDeformationOptions::accept_out_of_tolerance");
-      o.method = StepOutcome::Method::refit;
+      o.method = StepOutcome::Method::Refit;
       o.reason = std::move(a.reason);
       o.refit = r.report;
       report.exact = false;
@@ -242,6 +247,11 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
   report.degree_u = out.surface.u.degree;
   report.degree_v = out.surface.v.degree;
   report.control_points = static_cast<long>(out.surface.points.rows());
+  bool within = true;  // every refit within its tolerance (else it was accepted out of tolerance)
+  for (const StepOutcome& o : report.steps)
+    within = within && (o.method != StepOutcome::Method::Refit || o.refit.summary.converged());
+  report.summary.termination = within ? Termination::Converged : Termination::NotConverged;
+  report.summary.message = report.brief();
   return out;
 }
 

@@ -2,6 +2,7 @@
 #include <clay/sketch/entities.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -34,7 +35,7 @@ std::string named(const Sketch& s, const char* kind, size_t index) {
   throw Error(category, message);
 }
 
-bool finite(const Eigen::Vector3d& v) { return v.allFinite(); }
+bool finite(const Eigen::Vector3d& v) { return internal::all_finite(v); }
 
 double model_size(const Sketch& sketch) {
   if (sketch.points.empty()) return 1.0;
@@ -67,7 +68,7 @@ PointId Sketch::add_point(PlaneId plane, const Eigen::Vector2d& ab) {
     fail(ErrorCategory::InvalidArgument,
          "add_point: plane #" + std::to_string(plane.index) + " does not exist (the sketch has " +
              std::to_string(planes.size()) + " planes)");
-  if (!ab.allFinite())
+  if (!internal::all_finite(ab))
     fail(ErrorCategory::InvalidGeometry,
          "add_point: " + point_name(*this, static_cast<int>(points.size())) + " has a non-finite coordinate");
   points.push_back({to_world(planes[static_cast<size_t>(plane.index)], ab), plane});
@@ -332,9 +333,7 @@ std::vector<std::string> problems(const Sketch& sketch) {
 void validate(const Sketch& sketch) {
   const std::vector<std::string> list = problems(sketch);
   if (list.empty()) return;
-  std::string message = "sketch is invalid: ";
-  for (size_t k = 0; k < list.size(); ++k) message += (k ? "; " : "") + list[k];
-  fail(ErrorCategory::InvalidGeometry, message);
+  fail(ErrorCategory::InvalidGeometry, "sketch is invalid: " + internal::join_problems(list));
 }
 
 }  // namespace clay::sketch

@@ -2,6 +2,7 @@
 
 #include <clay/error.hpp>
 #include <clay/surface/degree_elevation.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 
@@ -16,11 +17,12 @@
 
 namespace clay::sketch {
 
-void FitOptions::validate() const {
-  auto bad = [](const std::string& field, double value, const std::string& rule) {
+std::vector<std::string> FitOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, double value, const std::string& rule) {
     std::ostringstream s;
     s << "FitOptions::" << field << " = " << value << " " << rule;
-    throw Error(ErrorCategory::InvalidArgument, s.str());
+    out.push_back(s.str());
   };
   if (!(std::isfinite(tolerance) && tolerance > 0.0))
     bad("tolerance", tolerance, "must be a positive distance in mm");
@@ -39,7 +41,10 @@ void FitOptions::validate() const {
   if (!(std::isfinite(closing_ratio) && closing_ratio >= 0.0 && closing_ratio <= 0.5))
     bad("closing_ratio", closing_ratio, "must be in [0, 0.5] (0 never closes)");
   if (end_samples < 1) bad("end_samples", end_samples, "must be >= 1 (1: the drawn end point)");
+  return out;
 }
+
+void FitOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace detail {
 
@@ -153,7 +158,7 @@ Line fit_line(const Points3& pts, const std::vector<Eigen::Index>& idx) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
   line.point = c;
   line.direction = es.eigenvectors().col(2).normalized();
-  line.ok = line.direction.allFinite();
+  line.ok = internal::all_finite(line.direction);
   return line;
 }
 
@@ -308,8 +313,8 @@ FittedCurve report(const PieceResult& r, surface::BSplineCurve curve, bool close
   f.closed = closed;
   f.first_point = first;
   f.last_point = last;
-  f.max_deviation = r.max_deviation;
-  f.rms_deviation = r.rms_deviation;
+  f.max_deviation_mm = r.max_deviation;
+  f.rms_deviation_mm = r.rms_deviation;
   f.control_points = static_cast<int>(f.curve.points.rows());
   f.iterations = r.iterations;
   f.fairness = r.fairness;
@@ -410,7 +415,7 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
   Summary& s = out.summary;
   s.termination = Termination::Converged;
   for (const auto& c : out.curves) {
-    out.max_deviation = std::max(out.max_deviation, c.max_deviation);
+    out.max_deviation_mm = std::max(out.max_deviation_mm, c.max_deviation_mm);
     s.iterations += c.iterations;
     s.initial_residual = std::max(s.initial_residual, c.summary.initial_residual);
     if (c.summary.termination == Termination::Failed)
@@ -418,12 +423,12 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
     else if (c.summary.termination == Termination::NotConverged && s.termination == Termination::Converged)
       s.termination = Termination::NotConverged;
   }
-  s.final_residual = out.max_deviation;
+  s.final_residual = out.max_deviation_mm;
   std::ostringstream m;
   m.precision(3);
   m << out.curves.size() << (out.curves.size() == 1 ? " curve" : " curves") << ", "
     << corners.size() << (corners.size() == 1 ? " corner" : " corners") << ", "
-    << (out.closed ? "closed" : "open") << "; max deviation " << out.max_deviation
+    << (out.closed ? "closed" : "open") << "; max deviation " << out.max_deviation_mm
     << " mm for tolerance " << options.tolerance << " mm";
   if (s.termination != Termination::Converged) m << " (see the curves' summaries)";
   s.message = m.str();

@@ -4,6 +4,8 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
+#include <clay/internal/math.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -155,7 +157,7 @@ struct Normal {
 };
 
 Normal assemble(const BSplineBasis& basis, const Points3& data, const std::vector<double>& t,
-                double lambda, const GaussRule& rule) {
+                double lambda, const internal::GaussRule& rule) {
   const int p = basis.degree;
   const int n = basis.count();
   Normal h;
@@ -224,7 +226,7 @@ Solved solve(const Normal& h, const PointMap& map) {
   Solved out;
   if (ldlt.info() != Eigen::Success) return out;
   out.x = ldlt.solve(rhs);
-  if (ldlt.info() != Eigen::Success || !out.x.allFinite()) return out;
+  if (ldlt.info() != Eigen::Success || !internal::all_finite(out.x)) return out;
   out.points.resize(n, 3);
   for (int i = 0; i < n; ++i) {
     Eigen::Vector3d q = map.constant[static_cast<size_t>(i)];
@@ -344,7 +346,7 @@ PieceResult fit_piece(const PieceProblem& pr) {
   const bool periodic = pr.periodic;
   PieceResult out;
   out.params = pr.params;
-  const GaussRule rule = gauss_legendre(p);
+  const internal::GaussRule rule = internal::gauss_legendre(p);
   double alpha = pr.fairness;
   int reductions = 0;
 

@@ -5,6 +5,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 
@@ -18,21 +19,25 @@
 
 namespace clay::sketch {
 
-void OversketchOptions::validate() const {
+std::vector<std::string> OversketchOptions::problems() const {
+  std::vector<std::string> out;
   if (!(std::isfinite(capture_distance) && capture_distance > 0.0)) {
     std::ostringstream s;
     s << "OversketchOptions::capture_distance = " << capture_distance
       << " must be a positive distance in mm";
-    throw Error(ErrorCategory::InvalidArgument, s.str());
+    out.push_back(s.str());
   }
   if (continuity != Continuity::G1 && continuity != Continuity::G2)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "OversketchOptions::continuity = " + std::to_string(static_cast<int>(continuity)) +
                     " must be Continuity::G1 or Continuity::G2");
   FitOptions f = fit;
   f.degree = 3;  // not used: the curve's degree is
-  f.validate();
+  internal::append(out, f.problems());
+  return out;
 }
+
+void OversketchOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace {
 
@@ -240,8 +245,8 @@ OversketchResult oversketch(const BSplineCurve& curve, const Stroke& stroke,
   OversketchResult out;
   out.cut_start = a;
   out.cut_end = b;
-  out.max_deviation = fitted.max_deviation;
-  out.rms_deviation = fitted.rms_deviation;
+  out.max_deviation_mm = fitted.max_deviation;
+  out.rms_deviation_mm = fitted.rms_deviation;
   out.iterations = fitted.iterations;
   out.summary = fitted.summary;
   if (fitted.summary.termination == Termination::Failed) return out;

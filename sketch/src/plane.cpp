@@ -1,22 +1,21 @@
 #include <clay/sketch/plane.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 
 #include <cmath>
 #include <sstream>
 
-#include "checks.hpp"
-
 namespace clay::sketch {
 
 std::vector<std::string> problems(const SketchPlane& plane, std::string_view name) {
   std::vector<std::string> found;
   auto say = [&](const std::string& what) { found.push_back(std::string(name) + ": " + what); };
-  if (!detail::all_finite(plane.origin)) say("origin has a non-finite coordinate; give a finite origin");
-  if (!detail::all_finite(plane.x_axis)) say("x axis has a non-finite coordinate; give a finite unit vector");
-  if (!detail::all_finite(plane.y_axis)) say("y axis has a non-finite coordinate; give a finite unit vector");
+  if (!internal::all_finite(plane.origin)) say("origin has a non-finite coordinate; give a finite origin");
+  if (!internal::all_finite(plane.x_axis)) say("x axis has a non-finite coordinate; give a finite unit vector");
+  if (!internal::all_finite(plane.y_axis)) say("y axis has a non-finite coordinate; give a finite unit vector");
   if (!found.empty()) return found;
   std::ostringstream s;
   s.precision(17);
@@ -41,7 +40,7 @@ std::vector<std::string> problems(const SketchPlane& plane, std::string_view nam
 }
 
 void validate(const SketchPlane& plane, std::string_view name) {
-  detail::throw_if(problems(plane, name));
+  internal::throw_if(ErrorCategory::InvalidGeometry, problems(plane, name));
 }
 
 SketchPlane make_plane(const Eigen::Vector3d& origin, const Eigen::Vector3d& normal,
@@ -49,14 +48,14 @@ SketchPlane make_plane(const Eigen::Vector3d& origin, const Eigen::Vector3d& nor
   auto bad = [](const std::string& what) {
     throw Error(ErrorCategory::InvalidArgument, "make_plane: " + what);
   };
-  if (!detail::all_finite(origin)) bad("origin has a non-finite coordinate; give a finite origin");
-  if (!detail::all_finite(normal)) bad("normal has a non-finite coordinate; give a finite normal");
+  if (!internal::all_finite(origin)) bad("origin has a non-finite coordinate; give a finite origin");
+  if (!internal::all_finite(normal)) bad("normal has a non-finite coordinate; give a finite normal");
   const double ln = normal.norm();
   if (!(ln > 0.0)) bad("normal has zero length; give the plane's normal direction");
   const Eigen::Vector3d n = normal / ln;
   Eigen::Vector3d x;
   if (x_direction) {
-    if (!detail::all_finite(*x_direction)) bad("x direction has a non-finite coordinate; give a finite vector");
+    if (!internal::all_finite(*x_direction)) bad("x direction has a non-finite coordinate; give a finite vector");
     const double lx = x_direction->norm();
     if (!(lx > 0.0)) bad("x direction has zero length; give a direction in the plane");
     x = *x_direction / lx;

@@ -1,14 +1,13 @@
 #include <clay/sketch/stroke.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 
 #include "stroke_points.hpp"
-
-#include "checks.hpp"
 
 namespace clay::sketch {
 namespace detail {
@@ -52,7 +51,7 @@ std::vector<std::string> problems(const Stroke& stroke, std::string_view name,
   }
   int bad = 0;
   for (Eigen::Index i = 0; i < n; ++i) {
-    if (detail::all_finite(stroke.points.row(i))) continue;
+    if (internal::all_finite(stroke.points.row(i))) continue;
     if (bad++ < 3) {
       std::ostringstream s;
       s << "point " << i << " has a non-finite coordinate (" << stroke.points(i, 0) << ", "
@@ -89,7 +88,7 @@ std::vector<std::string> problems(const Stroke& stroke, std::string_view name,
 }
 
 void validate(const Stroke& stroke, std::string_view name, bool allow_duplicates) {
-  detail::throw_if(problems(stroke, name, allow_duplicates));
+  internal::throw_if(ErrorCategory::InvalidGeometry, problems(stroke, name, allow_duplicates));
 }
 
 double length(const Stroke& stroke) {

@@ -1,6 +1,7 @@
 #include <clay/surface/arc.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <cmath>
 #include <numbers>
@@ -15,7 +16,7 @@ BSplineCurve circular_arc(const Eigen::Vector3d& center, const Eigen::Vector3d& 
   auto bad = [](const std::string& what) {
     throw Error(ErrorCategory::InvalidArgument, "circular_arc: " + what);
   };
-  if (!center.allFinite() || !x_axis.allFinite() || !y_axis.allFinite() || !std::isfinite(radius) ||
+  if (!internal::all_finite(center) || !internal::all_finite(x_axis) || !internal::all_finite(y_axis) || !std::isfinite(radius) ||
       !std::isfinite(start) || !std::isfinite(end))
     bad("non-finite input; give finite center, axes, radius and angles");
   if (!(radius >= 0.0)) bad("radius " + std::to_string(radius) + " is negative; give radius >= 0");

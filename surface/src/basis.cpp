@@ -85,7 +85,7 @@ std::vector<std::string> problems(const BSplineBasis& basis, std::string_view na
 }
 
 void validate(const BSplineBasis& basis, std::string_view name) {
-  detail::throw_if(problems(basis, name));
+  internal::throw_if(ErrorCategory::InvalidGeometry, problems(basis, name));
 }
 
 bool is_clamped(const BSplineBasis& basis) noexcept {

@@ -41,7 +41,7 @@ std::vector<std::string> problems(const BSplineCurve& curve, std::string_view na
 }
 
 void validate(const BSplineCurve& curve, std::string_view name) {
-  detail::throw_if(problems(curve, name));
+  internal::throw_if(ErrorCategory::InvalidGeometry, problems(curve, name));
 }
 
 bool identical(const BSplineCurve& a, const BSplineCurve& b) noexcept {

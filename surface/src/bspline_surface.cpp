@@ -39,7 +39,7 @@ std::vector<std::string> problems(const BSplineSurface& surface, std::string_vie
 }
 
 void validate(const BSplineSurface& surface, std::string_view name) {
-  detail::throw_if(problems(surface, name));
+  internal::throw_if(ErrorCategory::InvalidGeometry, problems(surface, name));
 }
 
 bool identical(const BSplineSurface& a, const BSplineSurface& b) noexcept {

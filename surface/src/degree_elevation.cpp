@@ -1,7 +1,7 @@
 #include <clay/surface/degree_elevation.hpp>
 
 #include <clay/error.hpp>
-
+#include <clay/internal/math.hpp>
 #include <algorithm>
 #include <string>
 #include <vector>
@@ -36,13 +36,6 @@ void mirror(Strip& strip) {
   strip.rows = Rows(strip.rows.colwise().reverse());
 }
 
-double binomial(int n, int k) {
-  if (k < 0 || k > n) return 0.0;
-  double r = 1.0;
-  for (int i = 1; i <= k; ++i) r = r * (n - k + i) / i;
-  return r;
-}
-
 }  // namespace
 
 void clamp(Strip& strip) {
@@ -70,10 +63,10 @@ void elevate_degree(Strip& strip, int t) {
   Eigen::MatrixXd bezalfs = Eigen::MatrixXd::Zero(ph + 1, p + 1);
   bezalfs(0, 0) = bezalfs(ph, p) = 1.0;
   for (int i = 1; i <= ph2; ++i) {
-    const double inv = 1.0 / binomial(ph, i);
+    const double inv = 1.0 / internal::binomial(ph, i);
     const int mpi = std::min(p, i);
     for (int j = std::max(0, i - t); j <= mpi; ++j)
-      bezalfs(i, j) = inv * binomial(p, j) * binomial(t, i - j);
+      bezalfs(i, j) = inv * internal::binomial(p, j) * internal::binomial(t, i - j);
   }
   for (int i = ph2 + 1; i <= ph - 1; ++i) {
     const int mpi = std::min(p, i);

@@ -2,11 +2,11 @@
 #include "exchange_precheck.hpp"
 
 #include <clay/error.hpp>
+#include <clay/internal/fenv.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
-#include <cfenv>
 #include <cfloat>
 #include <cmath>
 #include <cstdlib>
@@ -19,21 +19,6 @@ namespace clay::surface::detail {
 namespace {
 
 namespace fs = std::filesystem;
-
-/// Floating-point traps held (off) for a scope, the caller's environment restored on the way out:
-/// strtod reports a literal beyond the range of a double by raising overflow, as C requires, and
-/// a host that traps overflow (the Debug tests do) would die of the very number the pre-check
-/// exists to refuse. (A local helper until the internal helper library has one.)
-class FpTrapsHeld {
- public:
-  FpTrapsHeld() { std::feholdexcept(&saved_); }
-  ~FpTrapsHeld() { std::fesetenv(&saved_); }
-  FpTrapsHeld(const FpTrapsHeld&) = delete;
-  FpTrapsHeld& operator=(const FpTrapsHeld&) = delete;
-
- private:
-  std::fenv_t saved_;
-};
 
 /// Why the number written as `token` is refused, or "" when it is fine. IGES may write
 /// exponents with D (Fortran).
@@ -169,7 +154,7 @@ int degree_count(const std::string& word, bool complex) {
 }  // namespace
 
 void precheck_step(const fs::path& file, std::string_view caller, int max_degree) {
-  const FpTrapsHeld traps_held;  // bad_number's strtod
+  const internal::FpTrapsHeld traps_held;  // bad_number's strtod
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(ErrorCategory::Io, std::string(caller) + ": '" + file.string() + "' cannot be opened");
   StepTokens tokens(in);
@@ -336,7 +321,7 @@ void check_bspline(const IgesRecord& r, int type, std::string_view caller, const
 }  // namespace
 
 void precheck_iges(const fs::path& file, std::string_view caller, int max_degree) {
-  const FpTrapsHeld traps_held;  // bad_number's strtod
+  const internal::FpTrapsHeld traps_held;  // bad_number's strtod
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(ErrorCategory::Io, std::string(caller) + ": '" + file.string() + "' cannot be opened");
   char delimiter = ',', end = ';';

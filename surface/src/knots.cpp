@@ -216,6 +216,26 @@ std::vector<BSplineCurve> extract_bezier(const BSplineCurve& curve) {
   return out;
 }
 
+std::vector<SpanExtraction> bezier_extraction(const BSplineBasis& basis) {
+  validate(basis, "bezier_extraction basis");
+  // The same refinement as extract_bezier, applied to the identity: row r of a span's strip is
+  // then Bézier point r as a combination of the original control points.
+  const int n = basis.count(), p = basis.degree;
+  detail::Strip strip{basis, detail::Rows::Identity(n, n), false};
+  detail::refine_knots(strip, detail::bezier_refinement_knots(strip.basis));
+  const std::vector<double> breaks = breakpoints(basis);
+  const std::vector<detail::Strip> spans = bezier_strips(strip);
+  std::vector<SpanExtraction> out(spans.size());
+  for (size_t s = 0; s < spans.size(); ++s) {
+    SpanExtraction& e = out[s];
+    e.a = breaks[s];
+    e.b = breaks[s + 1];
+    e.first = find_span(basis, e.a) - p;
+    e.matrix = spans[s].rows.middleCols(e.first, p + 1);
+  }
+  return out;
+}
+
 BezierPatches extract_bezier(const BSplineSurface& surface) {
   validate(surface);
   BezierPatches out;

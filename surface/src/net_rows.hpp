@@ -88,5 +88,7 @@ void refine_knots(Strip& strip, std::vector<double> sorted_knots);
 std::vector<double> bezier_refinement_knots(const BSplineBasis& basis);
 void clamp(Strip& strip);
 void elevate_degree(Strip& strip, int times);
+/// Removes every interior knot as often as A5.8 allows within `tolerance` (knot_removal.cpp).
+int remove_knots(Strip& strip, double tolerance);
 
 }  // namespace clay::surface::detail

@@ -3,6 +3,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -17,16 +18,20 @@
 
 namespace clay::surface {
 
-void SuperquadricOptions::validate() const {
-  auto bad = [](const std::string& field, double value, const std::string& rule) {
+std::vector<std::string> SuperquadricOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, double value, const std::string& rule) {
     std::ostringstream m;
     m << "SuperquadricOptions::" << field << " = " << value << " " << rule;
-    throw Error(ErrorCategory::InvalidArgument, m.str());
+    out.push_back(m.str());
   };
   if (!(std::isfinite(tolerance) && tolerance > 0.0)) bad("tolerance", tolerance, "must be a positive length in mm");
   if (degree < 2 || degree > 7) bad("degree", degree, "must be in [2, 7]");
   if (max_spans < 8) bad("max_spans", max_spans, "must be >= 8");
+  return out;
 }
+
+void SuperquadricOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace {
 
@@ -242,7 +247,7 @@ Profile hyperbola_profile(double limit) {
 
 void check_shape(const Eigen::Vector3d& radii, double e1, double e2, const char* what) {
   std::ostringstream m;
-  if (!radii.allFinite() || (radii.array() <= 0.0).any())
+  if (!internal::all_finite(radii) || (radii.array() <= 0.0).any())
     m << what << ": radii (" << radii.transpose() << ") must be positive and finite";
   else if (!(std::isfinite(e1) && e1 > 0.0 && e1 <= 10.0))
     m << what << ": exponent e1 = " << e1 << " is outside (0, 10]";
@@ -290,7 +295,7 @@ BuiltSurface assemble(const std::function<Profile(double)>& make_m, const std::f
   }
   BuiltSurface out{s, describe(s, method)};
   out.report.exact = m.exact && h.exact;
-  out.report.max_deviation = worst;
+  out.report.max_deviation_mm = worst;
   out.report.samples = static_cast<int>(ss.size() * ts.size());
   return out;
 }

@@ -3,6 +3,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 
@@ -15,9 +16,10 @@
 
 namespace clay::surface {
 
-void ProjectionOptions::validate() const {
-  auto bad = [](const std::string& field, const std::string& rule) {
-    throw Error(ErrorCategory::InvalidArgument, "ProjectionOptions::" + field + " " + rule);
+std::vector<std::string> ProjectionOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const std::string& field, const std::string& rule) {
+    out.push_back("ProjectionOptions::" + field + " " + rule);
   };
   if (max_iterations < 1) bad("max_iterations", "= " + std::to_string(max_iterations) + " must be >= 1");
   if (!(parametric_tolerance > 0.0 && parametric_tolerance < 1.0))
@@ -26,12 +28,15 @@ void ProjectionOptions::validate() const {
     bad("cosine_tolerance", "= " + std::to_string(cosine_tolerance) + " must be in (0, 1)");
   if (samples_per_span < 1) bad("samples_per_span", "= " + std::to_string(samples_per_span) + " must be >= 1");
   if (starts < 1) bad("starts", "= " + std::to_string(starts) + " must be >= 1");
+  return out;
 }
+
+void ProjectionOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 namespace {
 
 void check_point(const Eigen::Vector3d& p) {
-  if (!p.allFinite())
+  if (!internal::all_finite(p))
     throw Error(ErrorCategory::InvalidGeometry,
                 "projection: the point to project has a non-finite coordinate; give a finite point");
 }
@@ -97,7 +102,7 @@ SurfaceProjection newton(const BSplineSurface& s, double size, const Eigen::Vect
       if (!held[0] && !held[1]) {
         if (!(M(0, 0) > 0.0 && M.determinant() > 0.0)) return false;
         step = -M.ldlt().solve(g);
-        return step.allFinite();
+        return internal::all_finite(step);
       }
       bool moved = false;
       for (int k = 0; k < 2; ++k) {

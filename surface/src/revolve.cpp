@@ -4,6 +4,7 @@
 #include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/tolerance.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 
@@ -65,7 +66,7 @@ void check_profile_against_axis(const BSplineCurve& profile, const Eigen::Vector
 
 BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle_degrees) {
   validate(profile, "revolve profile");
-  if (!axis.point.allFinite() || !axis.direction.allFinite())
+  if (!internal::all_finite(axis.point) || !internal::all_finite(axis.direction))
     throw Error(ErrorCategory::InvalidArgument, "revolve: the axis has a non-finite coordinate");
   const double length = axis.direction.norm();
   if (!(length > 1e-12))
@@ -133,7 +134,7 @@ BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle
     }
   }
   out.report.exact = true;
-  out.report.max_deviation = worst;
+  out.report.max_deviation_mm = worst;
   out.report.samples = static_cast<int>(us.size() * vs.size());
   return out;
 }

@@ -6,6 +6,7 @@
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
+#include <clay/internal/math.hpp>
 
 #include <Eigen/Dense>
 
@@ -19,8 +20,6 @@
 
 #include "builder_tools.hpp"
 #include "homogeneous.hpp"
-#include "quadrature.hpp"
-
 namespace clay::surface {
 namespace {
 
@@ -494,7 +493,7 @@ class Search {
          k < pieces_.size() && pieces_[k].t0 < t; ++k) {
       const double a = std::max(s, pieces_[k].t0), b = std::min(t, pieces_[k].t1);
       if (b > a)
-        sum += detail::gauss_legendre_8(a, b, [&](double x) {
+        sum += internal::gauss_legendre_8(a, b, [&](double x) {
           return derivatives(segments_[pieces_[k].segment], x, 1).d1.norm();
         });
     }

@@ -8,6 +8,8 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/tolerance.hpp>
+#include <clay/internal/math.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
@@ -21,8 +23,6 @@
 #include <vector>
 
 #include "builder_tools.hpp"
-#include "quadrature.hpp"
-
 namespace clay::surface {
 namespace {
 
@@ -361,7 +361,7 @@ class PathTable {
 
   double arc(double a, double b) const {
     if (b <= a) return 0.0;
-    return detail::gauss_legendre_8(a, b,
+    return internal::gauss_legendre_8(a, b,
                                     [&](double t) { return derivatives(path_, t, 1).d1.norm(); });
   }
 
@@ -585,31 +585,39 @@ BSplineBasis joined_basis(const std::vector<double>& v, const std::vector<int>& 
 
 }  // namespace
 
-void LoftOptions::validate() const {
+std::vector<std::string> LoftOptions::problems() const {
+  std::vector<std::string> out;
   if (degree < 1 || degree > max_kernel_degree)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "LoftOptions::degree is " + std::to_string(degree) + "; it must be in [1, " +
                     std::to_string(max_kernel_degree) + "]");
   if (!(tolerance > 0.0 && tolerance <= 1e-2))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
+  return out;
 }
 
-void SweepOptions::validate() const {
+void LoftOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+
+std::vector<std::string> SweepOptions::problems() const {
+  std::vector<std::string> out;
   if (!std::isfinite(twist_degrees))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SweepOptions::twist_degrees is " + num(twist_degrees) + "; it must be finite");
   if (sections != 0 && sections < 2)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SweepOptions::sections is " + std::to_string(sections) +
                     "; it must be 0 (adaptive) or >= 2");
   if (!(tolerance > 0.0 && tolerance <= 1e-1))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SweepOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-1]");
   if (max_sections < 2)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "SweepOptions::max_sections is " + std::to_string(max_sections) + "; it must be >= 2");
+  return out;
 }
+
+void SweepOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves) {
   if (curves.empty())
@@ -700,7 +708,7 @@ BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& 
   if (!turned.empty()) method += " (reversed: #" + turned + ")";
   built.report = describe(built.surface, method);
   built.report.exact = true;
-  built.report.max_deviation = worst;
+  built.report.max_deviation_mm = worst;
   built.report.samples = static_cast<int>(us.size() * count);
   return built;
 }
@@ -773,7 +781,7 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
     const double worst = deviation(built.surface, linspace(0.0, 1.0, 9), samples);
     built.report = describe(built.surface, "sweep along a straight path (exact extrusion)");
     built.report.exact = true;
-    built.report.max_deviation = worst;
+    built.report.max_deviation_mm = worst;
     built.report.samples = samples;
     return built;
   }
@@ -867,7 +875,7 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
   const std::string method = "sweep with rotation-minimizing frames, " + std::to_string(count) + " sections";
   built.report = describe(built.surface, method);
   built.report.exact = false;
-  built.report.max_deviation = worst;
+  built.report.max_deviation_mm = worst;
   built.report.samples = samples;
   return built;
 }

@@ -3,6 +3,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/tessellate.hpp>
+#include <clay/internal/math.hpp>
 
 #include <Eigen/Geometry>
 
@@ -10,8 +11,6 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
-
-#include "quadrature.hpp"
 
 namespace clay::surface {
 
@@ -118,8 +117,8 @@ double surface_area(const BSplineSurface& s, int refine) {
   double area = 0;
   for (size_t a = 0; a + 1 < pu.size(); ++a)
     for (size_t b = 0; b + 1 < pv.size(); ++b)
-      area += detail::gauss_legendre_8(pu[a], pu[a + 1], [&](double u) {
-        return detail::gauss_legendre_8(pv[b], pv[b + 1], [&](double v) {
+      area += internal::gauss_legendre_8(pu[a], pu[a + 1], [&](double u) {
+        return internal::gauss_legendre_8(pv[b], pv[b + 1], [&](double v) {
           const SurfaceDerivatives d = derivatives(s, u, v, 1);
           return d.du.cross(d.dv).norm();
         });

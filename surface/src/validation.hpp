@@ -1,7 +1,7 @@
 #pragma once
 // Shared checks of control nets (internal).
 #include <clay/error.hpp>
-
+#include <clay/internal/checks.hpp>
 #include <Eigen/Core>
 
 #include <cmath>
@@ -25,7 +25,7 @@ void check_net(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& 
   }
   int bad_points = 0, bad_weights = 0;
   for (Eigen::Index r = 0; r < points.rows(); ++r) {
-    if (!points.row(r).allFinite() && bad_points++ < 3)
+    if (!internal::all_finite(points.row(r)) && bad_points++ < 3)
       found.push_back(std::string(name) + ": " + label(r) +
                       " has a non-finite coordinate (NaN or infinity); give finite coordinates");
     const double w = weights[r];
@@ -33,16 +33,6 @@ void check_net(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& 
       found.push_back(std::string(name) + ": weight of " + label(r) + " is " + std::to_string(w) +
                       "; weights must be positive and finite");
   }
-}
-
-[[noreturn]] inline void throw_problems(const std::vector<std::string>& found) {
-  std::string text;
-  for (const auto& f : found) text += (text.empty() ? "" : "; ") + f;
-  throw Error(ErrorCategory::InvalidGeometry, text);
-}
-
-inline void throw_if(const std::vector<std::string>& found) {
-  if (!found.empty()) throw_problems(found);
 }
 
 }  // namespace clay::surface::detail

@@ -126,7 +126,7 @@ void check_exact_composition(const StepReport& s) {
   INFO(s.path << ": " << s.message);
   CHECK(figure<std::string>(s, "composition") == "exact");
   CHECK(figure<bool>(s, "exact"));
-  CHECK(figure<double>(s, "max_deviation") <= 1e-12);
+  CHECK(figure<double>(s, "max_relative_deviation") <= 1e-12);
   CHECK(figure<bool>(s, "fold_free"));
 }
 
@@ -142,7 +142,7 @@ TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow c
   // The style step, recomputed with the deform library from the recipe's numbers.
   const Json& draft = j.at("deformations").at("shape").at(0);
   deform::StyleOptions options;
-  options.mode = deform::StyleMode::exact;
+  options.mode = deform::StyleMode::Exact;
   options.key_points_per_row = draft.at("key_points_per_row").get<int>();
   options.curve_tolerance = draft.at("curve_tolerance").get<double>();
   const deform::StyleResult styled =

@@ -847,29 +847,17 @@ namespace {
 
 const char* recipe_head = R"({"format": "clayform.recipe", "version": 1, )";
 
-// Under AddressSanitizer (scripts/test.sh's sanitize part: Debug, -O1, every access checked) the
-// same check runs several times slower; the limit is there to catch the blow-ups of issue #18
-// (over 60 s, gigabytes), which a constant factor does not hide.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr double slowdown = 10;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr double slowdown = 10;
-#else
-constexpr double slowdown = 1;
-#endif
-#else
-constexpr double slowdown = 1;
-#endif
-
-/// check_recipe must refuse `text` within 1 s (10 s sanitized) — it used to accept each of
+/// check_recipe must refuse `text` quickly — it used to accept each of
 /// these, or crash — with a problem at `path` whose message holds every one of `words` (the limit).
 void refused_quickly(const std::string& text, const std::string& path, std::initializer_list<std::string> words) {
   const auto start = std::chrono::steady_clock::now();
   const auto problems = check_recipe(text);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   INFO(dump(problems));
-  CHECK(seconds < 1.0 * slowdown);
+  // The cases took a minute or more (and gigabytes) before the limits; refused, they take
+  // milliseconds. The bound only separates the two: speed itself is measured in bench/, and this
+  // test also runs on a loaded machine and under the sanitizers.
+  CHECK(seconds < 20.0);
   bool found = false;
   for (const auto& p : problems) {
     if (p.path != path) continue;

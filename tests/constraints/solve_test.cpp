@@ -69,6 +69,7 @@ TEST_CASE("a rectangle with horizontal, vertical and distance constraints has 0 
   INFO(rep.summary.brief());
   REQUIRE(rep.summary.converged());
   CHECK(rep.degrees_of_freedom == 0);
+  CHECK_THAT(rep.brief(), Contains(rep.summary.brief()) && Contains("0 degrees of freedom"));
   CHECK(rep.redundant.empty());
   CHECK(rep.conflicting.empty());
   CHECK(rep.max_residual <= 1e-10);
@@ -324,9 +325,13 @@ TEST_CASE("independent rectangles are separate components", "[constraints]") {
       s.add_line({l.start.index + offset}, {l.end.index + offset});
     }
     for (Constraint c : r.constraints) {
-      for (PointId& p : c.points) p.index += offset;
-      for (EntityId& e : c.entities) e.index += eoffset;
-      if (c.kind == ConstraintKind::Fixed) continue;
+      if (c.kind() == ConstraintKind::Fixed) continue;
+      // The rectangle's constraints, moved to its copy's points and lines (typed alternatives).
+      if (auto* q = std::get_if<Coincident>(&c.requirement)) q->a.index += offset, q->b.index += offset;
+      else if (auto* h = std::get_if<Horizontal>(&c.requirement)) h->line.index += eoffset;
+      else if (auto* v = std::get_if<Vertical>(&c.requirement)) v->line.index += eoffset;
+      else if (auto* d = std::get_if<Distance>(&c.requirement)) d->a.index += offset, d->b.index += offset;
+      else FAIL("the rectangle uses a constraint kind this test does not move");
       cs.push_back(c);
     }
   }
@@ -546,4 +551,31 @@ TEST_CASE("staircases of up to 1,000 segments with 1 to 10 free verticals conver
       worst_iterations = std::max(worst_iterations, r.report.summary.iterations);
     }
   CHECK(worst_iterations <= 25);
+}
+
+TEST_CASE("SolveOptions lists every bad field", "[solve]") {
+  clay::constraints::SolveOptions o;
+  o.tolerance = 0;
+  o.max_iterations = 0;
+  o.rank_tolerance = 1;
+  CHECK(o.problems().size() == 3);
+  CHECK_THROWS_AS(o.validate(), clay::Error);
+}
+
+TEST_CASE("a constraint is a typed requirement; the factories and the structs build the same", "[constraints]") {
+  const PointId a{0}, b{1};
+  const Constraint made = distance(a, b, 12.5);
+  const Constraint typed{Distance{a, b, 12.5}, "rig.constraints[0]"};
+  CHECK(made.kind() == ConstraintKind::Distance);
+  CHECK(typed.kind() == ConstraintKind::Distance);
+  const Distance& d = std::get<Distance>(made.requirement);
+  CHECK(d.a.index == 0);
+  CHECK(d.b.index == 1);
+  CHECK(d.mm == 12.5);
+  CHECK(constraint_name(typed, 4) == "rig.constraints[0]");
+  CHECK(constraint_name(made, 4) == "constraint #4");
+  // Every kind is an alternative at its enum's index.
+  CHECK(static_cast<int>(end_tangent(clay::constraints::CurveEnd{}, Eigen::Vector3d::UnitX()).kind()) ==
+        static_cast<int>(std::variant_size_v<Requirement>) - 1);
+  CHECK(std::holds_alternative<Tangent>(tangent({}, {}).requirement));
 }

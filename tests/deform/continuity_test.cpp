@@ -40,27 +40,27 @@ std::pair<double, double> derivative_jump_on_s_min(const Lattice& L, std::mt1993
 TEST_CASE("locked planes: face plane and k more for Bezier and clamped lattices", "[deform]") {
   std::mt19937 rng(11);
   const BezierLattice B = make_bezier_lattice(random_frame(rng), {3, 3, 3});
-  const FaceContinuity c1[] = {{Face::s_min, 1}};
+  const FaceContinuity c1[] = {{Face::SMin, 1}};
   CHECK(count_locked(locked_control_points(B, c1)) == 2 * 16);
   const std::vector<bool> locked = locked_control_points(B, c1);
   CHECK(locked[static_cast<size_t>(B.index(1, 3, 2))]);
   CHECK(!locked[static_cast<size_t>(B.index(2, 0, 0))]);
-  const FaceContinuity two[] = {{Face::s_min, 0}, {Face::u_max, 2}};
+  const FaceContinuity two[] = {{Face::SMin, 0}, {Face::UMax, 2}};
   // 16 on s = 0, 48 on the three u planes, 12 counted twice.
   CHECK(count_locked(locked_control_points(B, two)) == 16 + 48 - 12);
 
   const BSplineLattice S = make_bspline_lattice(random_frame(rng), {3, 3, 3}, {4, 4, 4});
-  const FaceContinuity t2[] = {{Face::t_max, 2}};
+  const FaceContinuity t2[] = {{Face::TMax, 2}};
   CHECK(count_locked(locked_control_points(S, t2)) == 3 * 49);
   // Unclamped uniform knots: every function of the first span touches the face, so p planes.
-  const BSplineLattice U = make_bspline_lattice(random_frame(rng), {3, 3, 3}, {4, 4, 4}, LatticeKnots::uniform);
-  const FaceContinuity u0[] = {{Face::u_min, 0}};
+  const BSplineLattice U = make_bspline_lattice(random_frame(rng), {3, 3, 3}, {4, 4, 4}, LatticeKnots::Uniform);
+  const FaceContinuity u0[] = {{Face::UMin, 0}};
   CHECK(count_locked(locked_control_points(U, u0)) == 3 * 49);
 }
 
 TEST_CASE("local C1 deformation matches the undeformed space across the fixed face", "[deform]") {
   std::mt19937 rng(12);
-  const FaceContinuity faces[] = {{Face::s_min, 1}, {Face::t_max, 1}};
+  const FaceContinuity faces[] = {{Face::SMin, 1}, {Face::TMax, 1}};
   {
     const BezierLattice free = clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 3, 3}), rng, 0.2);
     const BezierLattice local = with_continuity(free, faces);
@@ -71,7 +71,7 @@ TEST_CASE("local C1 deformation matches the undeformed space across the fixed fa
     // The same lattice without the reset does jump (the test can fail).
     CHECK(derivative_jump_on_s_min(free, rng).first > 1e-3);
   }
-  for (LatticeKnots knots : {LatticeKnots::clamped, LatticeKnots::uniform}) {
+  for (LatticeKnots knots : {LatticeKnots::Clamped, LatticeKnots::Uniform}) {
     const BSplineLattice free =
         clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 2, 3}, {3, 4, 2}, knots), rng, 0.2);
     const BSplineLattice local = with_continuity(free, faces);
@@ -85,7 +85,7 @@ TEST_CASE("local C1 deformation matches the undeformed space across the fixed fa
 
 TEST_CASE("C0 keeps positions but not derivatives on the face", "[deform]") {
   std::mt19937 rng(13);
-  const FaceContinuity c0[] = {{Face::u_min, 0}};
+  const FaceContinuity c0[] = {{Face::UMin, 0}};
   const BezierLattice L =
       with_continuity(clay::test::displaced(make_bezier_lattice(random_frame(rng), {2, 2, 3}), rng, 0.2), c0);
   std::uniform_real_distribution<double> c(0.0, 1.0);

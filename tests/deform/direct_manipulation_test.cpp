@@ -10,6 +10,7 @@
 
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -150,7 +151,7 @@ TEST_CASE("feasible requests reach their targets with the least displacement", "
   }
   SECTION("uniform-knot B-spline lattice, 5 points") {
     check_minimal_norm(clay::test::displaced(make_bspline_lattice(random_frame(rng, true), {2, 2, 2}, {3, 2, 3},
-                                                                  LatticeKnots::uniform),
+                                                                  LatticeKnots::Uniform),
                                              rng),
                        rng, 5);
   }
@@ -170,7 +171,7 @@ TEST_CASE("the same point pulled to two targets gets the least-squares compromis
   const PointMove moves[] = {{x, t1}, {x, t2}};
   const auto result = manipulate(lattice, moves);
   const auto& r = result.report;
-  INFO(r.message);
+  INFO(r.summary.message);
   CHECK_FALSE(r.feasible);
   CHECK(r.rank == 1);
   // Both rows of B are equal: the least-squares image is the midpoint, each target missed by
@@ -179,7 +180,7 @@ TEST_CASE("the same point pulled to two targets gets the least-squares compromis
   CHECK((deform_point(result.lattice, x) - (t1 + t2) / 2).norm() < 1e-10);
   CHECK_THAT(r.achieved_max_error, WithinAbs(half, 1e-10));
   CHECK_THAT(r.residual, WithinAbs(std::sqrt(2.0) * half, 1e-10));
-  CHECK_THAT(r.message, Contains("cannot be met") && Contains("refine the lattice"));
+  CHECK_THAT(r.summary.message, Contains("cannot be met") && Contains("refine the lattice"));
   // Minimal norm: the one-point move to the midpoint (eq. (4)).
   const PointMove mid{x, (t1 + t2) / 2};
   const auto single = manipulate(lattice, std::span(&mid, 1));
@@ -189,7 +190,7 @@ TEST_CASE("the same point pulled to two targets gets the least-squares compromis
   const auto repeated = manipulate(lattice, twice);
   CHECK(repeated.report.feasible);
   CHECK(repeated.report.rank == 1);
-  CHECK_THAT(repeated.report.message, Contains("some requests repeat others"));
+  CHECK_THAT(repeated.report.summary.message, Contains("some requests repeat others"));
   CHECK((repeated.lattice.points - single.lattice.points).cwiseAbs().maxCoeff() < 1e-10);
 }
 
@@ -219,7 +220,7 @@ TEST_CASE("locked control points keep their positions bit for bit", "[deform]") 
   std::mt19937 rng(46);
   const BSplineLattice lattice =
       clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 3}, {3, 3, 3}), rng);
-  const FaceContinuity faces[] = {{Face::s_min, 1}, {Face::u_max, 0}};
+  const FaceContinuity faces[] = {{Face::SMin, 1}, {Face::UMax, 0}};
   DirectManipulationOptions options;
   options.locked = locked_control_points(lattice, faces);
   const Points3 x = sample_points(lattice.frame, rng, 6, 0.15, 0.85);
@@ -261,7 +262,7 @@ TEST_CASE("locked control points keep their positions bit for bit", "[deform]") 
     CHECK_THAT(stuck.report.achieved_max_error, WithinAbs(1.0, 1e-12));
     CHECK_THAT(stuck.report.residual, WithinAbs(1.0, 1e-12));
     CHECK(stuck.report.displacement_norm == 0.0);
-    CHECK_THAT(stuck.report.message, Contains("all locked"));
+    CHECK_THAT(stuck.report.summary.message, Contains("all locked"));
   }
 }
 
@@ -319,9 +320,20 @@ TEST_CASE("a manipulator factorizes once and follows dragged targets", "[deform]
     targets.col(2).array() += step;
     const auto result = drag.move(targets);
     CHECK(worst_miss(result.lattice, x, targets) < 1e-10);
+    CHECK(result.report.summary.converged());
+    CHECK(result.report.summary.final_residual == result.report.achieved_max_error);
     const auto once = manipulate(lattice, moves_of(x, targets));
     CHECK((result.lattice.points - once.lattice.points).cwiseAbs().maxCoeff() == 0.0);
   }
+  // A copy shares the factorization (read-only) and answers bit for bit alike, also after the
+  // original is gone.
+  auto copy = std::make_unique<DirectManipulator<BezierLattice>>(drag);
+  const DirectManipulator<BezierLattice> second = *copy;
+  copy.reset();
+  Points3 targets = drag.images();
+  targets.col(0).array() -= 0.75;
+  CHECK((second.move(targets).lattice.points - drag.move(targets).lattice.points).cwiseAbs().maxCoeff() == 0.0);
+  CHECK(second.rank() == drag.rank());
 }
 
 TEST_CASE("direct manipulation rejects bad requests naming the culprit", "[deform]") {
@@ -391,7 +403,7 @@ TEST_CASE("docs snippet: lift one point and pin another with the bottom kept C1"
   frame.t = {10, 100, 0};
   frame.u = {0, 0, 40};
   BSplineLattice lattice = make_bspline_lattice(frame, {3, 3, 3}, {8, 8, 8});
-  const FaceContinuity keep[] = {{Face::u_min, 1}};
+  const FaceContinuity keep[] = {{Face::UMin, 1}};
   DirectManipulationOptions options;
   options.locked = locked_control_points(lattice, keep);
   const PointMove moves[] = {{frame.point(0.5, 0.5, 0.9), frame.point(0.5, 0.5, 0.9) + Eigen::Vector3d(0, 0, 12)},

@@ -58,7 +58,7 @@ TEST_CASE("bad options and arguments are rejected naming the field", "[deform]")
   CHECK_THAT(what, Contains("DeformOptions::threads = -1") && Contains("0 <= threads"));
   CHECK_THAT(error_of([] { make_bspline_lattice(Frame{}, {3, 3, 3}, {2, 0, 2}); }).second,
              Contains("cells along t = 0"));
-  const FaceContinuity too_smooth[] = {{Face::t_min, 4}};
+  const FaceContinuity too_smooth[] = {{Face::TMin, 4}};
   CHECK_THAT(error_of([&] { locked_control_points(L, too_smooth); }).second,
              Contains("FaceContinuity{t_min}.order = 4") && Contains("0 <= order <= 1"));
   std::vector<double> a(3), b(2);
@@ -76,4 +76,47 @@ TEST_CASE("a B-spline basis whose domain is not the unit interval is rejected", 
   });
   CHECK(category == ErrorCategory::InvalidGeometry);
   CHECK_THAT(what, Contains("t basis") && Contains("is not [0, 1]"));
+}
+
+TEST_CASE("Options structs list every bad field, not only the first", "[deform][errors]") {
+  RefitOptions refit;
+  refit.degree = 0;
+  refit.tolerance = -1;
+  refit.certificate_share = 2;
+  const auto list = refit.problems();
+  REQUIRE(list.size() == 3);
+  CHECK_THAT(list[0], Contains("degree = 0"));
+  CHECK_THAT(list[1], Contains("tolerance = -1"));
+  CHECK_THAT(list[2], Contains("certificate_share = 2"));
+  const auto [category, what] = error_of([&] { refit.validate(); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(what, Contains("degree = 0") && Contains("tolerance = -1") && Contains("certificate_share = 2"));
+  CHECK(RefitOptions{}.problems().empty());
+
+  // Nested options: the parts' problems are gathered too.
+  SurfaceDeformationOptions both;
+  both.compose.check_samples = -1;
+  both.refit = RefitOptions{};
+  both.refit->max_iterations = 0;
+  CHECK(both.problems().size() == 2);
+
+  StyleOptions style;
+  style.lambda = 2;
+  style.bound_samples = 1;
+  style.projection.starts = 0;
+  CHECK(style.problems().size() == 3);
+
+  DirectManipulationOptions direct;
+  direct.tolerance = 0;
+  direct.tied = {{1}, {-2, 3}};
+  CHECK(direct.problems().size() == 3);
+
+  FreezeOptions freeze;
+  freeze.max_iterations = 0;
+  freeze.threads = -1;
+  CHECK(freeze.problems().size() == 2);
+  ComposeOptions compose;
+  compose.knot_tolerance = 1;
+  compose.check_samples = 100;
+  CHECK(compose.problems().size() == 2);
 }

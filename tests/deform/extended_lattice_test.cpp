@@ -184,10 +184,10 @@ TEST_CASE("freezing then re-evaluating an undisplaced cylindrical lattice return
     FreezeOptions o;
     o.threads = threads;
     const FrozenPoints f = freeze(L, p, o);
-    INFO(f.summary.brief());
-    CHECK(f.summary.summary.converged());
-    CHECK(f.summary.inside == p.rows());
-    CHECK(f.summary.outside == 0);
+    INFO(f.report.brief());
+    CHECK(f.report.summary.converged());
+    CHECK(f.report.inside == p.rows());
+    CHECK(f.report.outside == 0);
     const Identity id = identity_errors(L, p, f);
     INFO("rest map " << id.rest_map << " mm, evaluate " << id.evaluated << " mm, outside the cube "
                      << id.outside_cube << ", lattice size " << size_of(L.rest) << " mm");
@@ -195,7 +195,7 @@ TEST_CASE("freezing then re-evaluating an undisplaced cylindrical lattice return
     CHECK(id.evaluated < 1e-9);
     CHECK(id.evaluated < 1e-14 * size_of(L.rest));  // Newton polished to rounding (~1e-15)
     CHECK(id.outside_cube <= 1e-9);
-    CHECK(f.summary.summary.final_residual < 1e-12 * size_of(L.rest));
+    CHECK(f.report.summary.final_residual < 1e-12 * size_of(L.rest));
   }
   // Points on the axis are in an innermost chunk (the degenerate ones), at u = 0.
   const FrozenPoints f = freeze(L, p.middleRows(3000, 41));
@@ -252,8 +252,8 @@ TEST_CASE("points outside an extended lattice come back bit-identical", "[deform
   }
   p.row(0) << 1e6, -1e6, 3e5;  // far away, outside the candidate grid
   const FrozenPoints f = freeze(L, p);
-  CHECK(f.summary.outside == 300);
-  CHECK(f.summary.inside == 0);
+  CHECK(f.report.outside == 300);
+  CHECK(f.report.inside == 0);
   for (const FrozenPoint& q : f.points) CHECK(q.chunk == outside_chunk);
   CHECK(evaluate(L, f) == p);
   CHECK(deform_points(L, p) == p);
@@ -280,8 +280,8 @@ TEST_CASE("a prismatic lattice lofted from planar curves is the identity when un
   CHECK(L.rest.rows() == 7 * 7 * 7);  // nothing coincides: no welding
   const Points3 p = rest_samples(L, rng, 1500);
   const FrozenPoints f = freeze(L, p);
-  INFO(f.summary.brief());
-  CHECK(f.summary.inside == p.rows());
+  INFO(f.report.brief());
+  CHECK(f.report.inside == p.rows());
   const Identity id = identity_errors(L, p, f);
   INFO("rest map " << id.rest_map << ", evaluate " << id.evaluated);
   CHECK(id.rest_map < 1e-14 * size_of(L.rest));
@@ -308,7 +308,7 @@ TEST_CASE("a prismatic lattice lofted from planar curves is the identity when un
   CHECK(R.chunks[3][(2 * 4 + 3) * 4 + 1] == R.chunks[0][(2 * 4 + 0) * 4 + 1]);
   const Points3 q = rest_samples(R, rng, 500);
   const FrozenPoints g = freeze(R, q);
-  CHECK(g.summary.inside == q.rows());
+  CHECK(g.report.inside == q.rows());
   CHECK(identity_errors(R, q, g).evaluated < 1e-14 * size_of(R.rest));
 }
 
@@ -322,10 +322,10 @@ TEST_CASE("degenerate chunks do not crash and use the pseudo-inverse", "[deform]
   });
   const Points3 p = rest_samples(S, rng, 400);
   const FrozenPoints f = freeze(S, p);
-  INFO(f.summary.brief());
-  CHECK(f.summary.pseudo_inverse_steps > 0);
-  CHECK(f.summary.unresolved == 0);
-  CHECK(f.summary.inside == p.rows());
+  INFO(f.report.brief());
+  CHECK(f.report.pseudo_inverse_steps > 0);
+  CHECK(f.report.unresolved == 0);
+  CHECK(f.report.inside == p.rows());
   const Identity id = identity_errors(S, p, f);
   CHECK(id.rest_map < 1e-9);
   CHECK(id.evaluated < 1e-9);
@@ -336,8 +336,8 @@ TEST_CASE("degenerate chunks do not crash and use the pseudo-inverse", "[deform]
   Points3 q(4, 3);
   q << 5, 4, 0, 2, 7, 0, 5, 4, 1e-3, 5, 4, -2;
   const FrozenPoints g = freeze(F, q);
-  INFO(g.summary.brief());
-  CHECK(g.summary.pseudo_inverse_steps > 0);
+  INFO(g.report.brief());
+  CHECK(g.report.pseudo_inverse_steps > 0);
   CHECK(g.points[0].chunk == 0);
   CHECK(g.points[1].chunk == 0);
   CHECK(g.points[2].chunk == outside_chunk);
@@ -349,7 +349,7 @@ TEST_CASE("degenerate chunks do not crash and use the pseudo-inverse", "[deform]
   Points3 r(2, 3);
   r << 0, 0, 4.5, 0, 0, 9;
   const FrozenPoints h = freeze(N, r);
-  CHECK(h.summary.inside == 2);
+  CHECK(h.report.inside == 2);
   CHECK((evaluate(N, h) - r).norm() < 1e-9);
 }
 
@@ -363,11 +363,11 @@ TEST_CASE("a strongly twisted chunk needs subdivision and the report counts it",
   });
   const Points3 p = rest_samples(T, rng, 1000);
   const FrozenPoints f = freeze(T, p);
-  INFO(f.summary.brief());
-  CHECK(f.summary.summary.converged());
-  CHECK(f.summary.inside == p.rows());
-  CHECK(f.summary.subdivided > 0);
-  CHECK(f.summary.splits >= f.summary.subdivided);
+  INFO(f.report.brief());
+  CHECK(f.report.summary.converged());
+  CHECK(f.report.inside == p.rows());
+  CHECK(f.report.subdivided > 0);
+  CHECK(f.report.splits >= f.report.subdivided);
   const Identity id = identity_errors(T, p, f);
   CHECK(id.rest_map < 1e-9);
   CHECK(id.evaluated < 1e-9);
@@ -375,9 +375,9 @@ TEST_CASE("a strongly twisted chunk needs subdivision and the report counts it",
   FreezeOptions o;
   o.max_subdivision_depth = 0;
   const FrozenPoints g = freeze(T, p, o);
-  CHECK(g.summary.unresolved == f.summary.subdivided);
-  CHECK(g.summary.summary.termination == clay::Termination::NotConverged);
-  CHECK_THAT(g.summary.summary.message, Contains("max_subdivision_depth"));
+  CHECK(g.report.unresolved == f.report.subdivided);
+  CHECK(g.report.summary.termination == clay::Termination::NotConverged);
+  CHECK_THAT(g.report.summary.message, Contains("max_subdivision_depth"));
   const Points3 moved = evaluate(displaced(T, rng, 1.0), g);
   for (Eigen::Index r = 0; r < p.rows(); ++r)
     if (g.points[static_cast<size_t>(r)].chunk == unresolved_chunk) CHECK(moved.row(r) == p.row(r));
@@ -533,5 +533,5 @@ TEST_CASE("the docs snippet pushes the axis of a cylindrical lattice up", "[defo
   CHECK(out.row(2) == points.row(2));
   // Radius 29.9 lies in ring 1, whose chunks do not use the axis rows: unchanged to rounding.
   CHECK((out.row(1) - points.row(1)).norm() < 1e-12);
-  CHECK_THAT(frozen.summary.brief(), Contains("2 inside, 1 outside, 0 unresolved"));
+  CHECK_THAT(frozen.report.brief(), Contains("2 inside, 1 outside, 0 unresolved"));
 }

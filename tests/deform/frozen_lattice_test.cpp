@@ -115,7 +115,7 @@ TEST_CASE("fast evaluation equals de Boor for B-spline lattices, one and two thr
       clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 3}, {8, 8, 8}), rng, 0.3), rng,
       131'085);
   check_against_reference(clay::test::displaced(make_bspline_lattice(random_frame(rng), {2, 3, 1}, {3, 5, 2},
-                                                                     LatticeKnots::uniform),
+                                                                     LatticeKnots::Uniform),
                                                 rng, 0.3),
                           rng, 20'000);
   // Non-uniform knots (binary-search cell lookup) and degrees without a specialized kernel.

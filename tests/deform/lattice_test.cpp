@@ -82,7 +82,7 @@ TEST_CASE("undisplaced B-spline lattices are the identity, clamped, uniform and 
   };
   for (const Case& c : {Case{{1, 1, 1}, {1, 1, 1}}, Case{{3, 3, 3}, {8, 8, 8}},
                         Case{{2, 3, 1}, {3, 5, 2}}, Case{{4, 2, 5}, {2, 7, 3}}}) {
-    for (LatticeKnots knots : {LatticeKnots::clamped, LatticeKnots::uniform}) {
+    for (LatticeKnots knots : {LatticeKnots::Clamped, LatticeKnots::Uniform}) {
       const BSplineLattice L = make_bspline_lattice(random_frame(rng), c.degrees, c.cells, knots);
       const double size = size_of(L.points);
       const auto points = sample_points(L.frame, rng, 200);
@@ -145,7 +145,7 @@ TEST_CASE("Bezier cells reproduce the B-spline lattice pointwise", "[deform]") {
   std::mt19937 rng(7);
   std::vector<BSplineLattice> lattices = {
       make_bspline_lattice(random_frame(rng), {3, 3, 3}, {4, 3, 5}),
-      make_bspline_lattice(random_frame(rng), {2, 1, 3}, {3, 4, 2}, LatticeKnots::uniform),
+      make_bspline_lattice(random_frame(rng), {2, 1, 3}, {3, 4, 2}, LatticeKnots::Uniform),
   };
   std::array<clay::surface::BSplineBasis, 3> bases = {clay::test::random_basis(rng, 3, 8, true, 3),
                                                       clay::test::random_basis(rng, 2, 6, false, 2),

@@ -85,7 +85,7 @@ TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independentl
   const surface::BSplineSurface loft = loft_surface();
   Twist twist;
   twist.angle = {0.0, 0.01};  // 1.2 rad over the 120 mm of the loft
-  const RefitResult r = refit_deformed(loft, twist);
+  const RefitResult r = refit_deformed(twist, loft);
   const RefitReport& rep = r.report;
   INFO(rep.brief() << " / " << rep.summary.brief());
   REQUIRE(rep.summary.termination == Termination::Converged);
@@ -124,7 +124,7 @@ TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor",
   const surface::BSplineSurface sheet = sheet_in(f, 0.1, 0.9, 0.2);
   RefitOptions options;
   options.tolerance = 1e-5;
-  const RefitResult r = refit_deformed(sheet, lattice, options);
+  const RefitResult r = refit_deformed(lattice, sheet, options);
   INFO(r.report.brief());
   REQUIRE(r.report.summary.converged());
   REQUIRE(r.report.certified);
@@ -146,7 +146,7 @@ TEST_CASE("B-spline lattice knot planes crossed by the surface are detected and 
   const surface::BSplineSurface sheet = sheet_in(f, 0.05, 0.95, 0.25);
   RefitOptions options;
   options.tolerance = 1e-4;
-  const RefitResult r = refit_deformed(sheet, lattice, options);
+  const RefitResult r = refit_deformed(lattice, sheet, options);
   INFO(r.report.brief() << " / " << r.report.summary.message);
   REQUIRE(r.report.certified);
   REQUIRE(r.report.summary.converged());
@@ -198,7 +198,7 @@ TEST_CASE("Refit keeps the original's C0 seams and breakpoints", "[refit]") {
   const surface::BSplineSurface s = surface::make_surface(bu, bv, p);
   Taper taper;
   taper.profile = {1.0, 0.004};
-  const RefitResult r = refit_deformed(s, taper);
+  const RefitResult r = refit_deformed(taper, s);
   REQUIRE(r.report.summary.converged());
   REQUIRE(r.report.certified);
   CHECK(surface::multiplicity(r.surface.u, 0.5) == 3);
@@ -238,7 +238,7 @@ TEST_CASE("Refit of a rational surface under a stack is certified", "[refit]") {
   RefitOptions options;
   options.tolerance = 1e-3;
   options.relative = false;  // mm
-  const RefitResult r = refit_deformed(s, stack, options);
+  const RefitResult r = refit_deformed(stack, s, options);
   INFO(r.report.brief());
   REQUIRE(r.report.certified);
   REQUIRE(r.report.summary.converged());
@@ -264,7 +264,7 @@ TEST_CASE("A bend region end crossing the surface gets a first-derivative bound"
   RefitOptions options;
   options.tolerance = 1e-3;
   options.max_iterations = 3;
-  const RefitResult r = refit_deformed(sheet, bend, options);
+  const RefitResult r = refit_deformed(bend, sheet, options);
   INFO(r.report.brief() << " / " << r.report.summary.message);
   REQUIRE(r.report.certified);
   CHECK(r.report.lipschitz_cells > 0);
@@ -280,7 +280,7 @@ TEST_CASE("Point maps and extended lattices are fitted but not certified", "[ref
   const PointMap wave = [](const Eigen::Vector3d& x) {
     return Eigen::Vector3d(x.x() + 2 * std::sin(x.z() / 30), x.y(), x.z());
   };
-  const RefitResult r = refit_deformed(loft, wave);
+  const RefitResult r = refit_deformed(wave, loft);
   CHECK_FALSE(r.report.certified);
   CHECK(std::isinf(r.report.certified_bound));
   CHECK(r.report.summary.converged());
@@ -303,7 +303,7 @@ TEST_CASE("Point maps and extended lattices are fitted but not certified", "[ref
   RefitOptions options;
   options.tolerance = 1e-4;
   options.max_iterations = 2;
-  const RefitResult x = refit_deformed(sheet_in(f, 0.2, 0.8, 0.1), e, options);
+  const RefitResult x = refit_deformed(e, sheet_in(f, 0.2, 0.8, 0.1), options);
   CHECK_FALSE(x.report.certified);
   CHECK_THAT(x.report.summary.message, Contains("Newton-frozen"));
 }
@@ -315,7 +315,7 @@ TEST_CASE("Refit limits end in a not-converged report", "[refit]") {
   RefitOptions options;
   options.tolerance = 1e-7;
   options.max_iterations = 1;
-  const RefitResult r = refit_deformed(loft, twist, options);
+  const RefitResult r = refit_deformed(twist, loft, options);
   CHECK(r.report.summary.termination == Termination::NotConverged);
   CHECK(r.report.summary.iterations == 1);
   CHECK_THAT(r.report.summary.message, Contains("iteration limit 1"));
@@ -323,7 +323,7 @@ TEST_CASE("Refit limits end in a not-converged report", "[refit]") {
 
   options.max_iterations = 10;
   options.max_control_points = 100;
-  const RefitResult c = refit_deformed(loft, twist, options);
+  const RefitResult c = refit_deformed(twist, loft, options);
   CHECK(c.report.summary.termination == Termination::NotConverged);
   CHECK_THAT(c.report.summary.message, Contains("control point limit 100"));
   CHECK(c.surface.count_u() * c.surface.count_v() <= 100);
@@ -332,7 +332,7 @@ TEST_CASE("Refit limits end in a not-converged report", "[refit]") {
   // refinement before either direction passes it, and the message names it.
   options.max_control_points = 40000;
   options.max_count_per_direction = 12;
-  const RefitResult d = refit_deformed(loft, twist, options);
+  const RefitResult d = refit_deformed(twist, loft, options);
   CHECK(d.report.summary.termination == Termination::NotConverged);
   CHECK_THAT(d.report.summary.message, Contains("control point limit per direction 12"));
   CHECK(d.surface.count_u() <= 12);
@@ -343,7 +343,7 @@ TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]
   const surface::BSplineSurface loft = loft_surface();
   Twist twist;
   auto options_error = [&](RefitOptions o, const char* field) {
-    const auto [category, what] = error_of([&] { refit_deformed(loft, twist, o); });
+    const auto [category, what] = error_of([&] { refit_deformed(twist, loft, o); });
     CHECK(category == ErrorCategory::InvalidArgument);
     CHECK_THAT(what, Contains(field));
   };
@@ -374,28 +374,28 @@ TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]
 
   surface::BSplineSurface bad = loft;
   bad.points(0, 0) = std::numeric_limits<double>::quiet_NaN();
-  auto [c1, w1] = error_of([&] { refit_deformed(bad, twist); });
+  auto [c1, w1] = error_of([&] { refit_deformed(twist, bad); });
   CHECK(c1 == ErrorCategory::InvalidGeometry);
   CHECK_THAT(w1, Contains("refit_deformed surface"));
 
   Twist bad_twist;
   bad_twist.angle = {};
-  auto [c2, w2] = error_of([&] { refit_deformed(loft, bad_twist); });
+  auto [c2, w2] = error_of([&] { refit_deformed(bad_twist, loft); });
   CHECK(c2 == ErrorCategory::InvalidGeometry);
 
-  auto [c3, w3] = error_of([&] { refit_deformed(loft, PointMap{}); });
+  auto [c3, w3] = error_of([&] { refit_deformed(PointMap{}, loft); });
   CHECK(c3 == ErrorCategory::InvalidArgument);
   CHECK_THAT(w3, Contains("empty"));
 
   const PointMap broken = [](const Eigen::Vector3d& x) {
     return x.z() > 60 ? Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()) : x;
   };
-  auto [c4, w4] = error_of([&] { refit_deformed(loft, broken); });
+  auto [c4, w4] = error_of([&] { refit_deformed(broken, loft); });
   CHECK(c4 == ErrorCategory::InvalidArgument);
   CHECK_THAT(w4, Contains("non-finite"));
 
   const PointMap collapse = [](const Eigen::Vector3d&) { return Eigen::Vector3d(1, 2, 3); };
-  auto [c5, w5] = error_of([&] { refit_deformed(loft, collapse); });
+  auto [c5, w5] = error_of([&] { refit_deformed(collapse, loft); });
   CHECK(c5 == ErrorCategory::InvalidGeometry);
   CHECK_THAT(w5, Contains("absolute tolerance"));
 }
@@ -415,7 +415,7 @@ TEST_CASE("Refit keeps a closed side closed and a pole a point, bit for bit", "[
   twist.angle = {0.1, 0.02};
   RefitOptions options;
   options.tolerance = 1e-3;
-  const auto fit = refit_deformed(sphere, twist, options);
+  const auto fit = refit_deformed(twist, sphere, options);
   const auto& s = fit.surface;
   const int mu = s.count_u(), mv = s.count_v();
   for (int j = 0; j < mv; ++j) CHECK(s.points.row(s.index(0, j)) == s.points.row(s.index(mu - 1, j)));

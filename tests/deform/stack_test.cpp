@@ -218,16 +218,16 @@ TEST_CASE("malformed stack JSON is rejected naming the path and the fix", "[defo
   };
   CHECK_THAT(recipe_error("{\"format\": "), Contains("not valid JSON") && Contains("fix the syntax"));
   CHECK_THAT(recipe_error(replaced("\"version\": 1", "\"version\": 2")),
-             Contains("version: 2 is not supported") && Contains("reads version 1"));
+             Contains("version: the number 2 is not supported") && Contains("reads version 1"));
   CHECK_THAT(recipe_error(replaced("clayform.deformation-stack", "clayform.recipe")),
              Contains("format: expected \"clayform.deformation-stack\", found the string \"clayform.recipe\""));
   CHECK_THAT(recipe_error(replaced("\"kind\":\"twist\"", "\"kind\":\"wobble\"")),
              Contains("steps[1].kind: unknown kind \"wobble\"") &&
                  Contains("one of bezier_lattice, bspline_lattice, extended_lattice, taper, twist, bend"));
   CHECK_THAT(recipe_error(replaced("\"rate\":", "\"rat\":1,\"rate\":")),
-             Contains("steps[3]: unknown key \"rat\" in a bend step") && Contains("y_min, y_max, center, rate"));
+             Contains("steps[3].rat: unknown key \"rat\" in a bend step") && Contains("y_min, y_max, center, rate"));
   CHECK_THAT(recipe_error(replaced(",\"y_min\":-20.0", "")),
-             Contains("steps[3]: the key \"y_min\" is missing") && Contains("bent region"));
+             Contains("steps[3].y_min: missing; give the start of the bent region"));
   // points[5] of the first lattice with two numbers.
   {
     std::string t = good;
@@ -237,40 +237,39 @@ TEST_CASE("malformed stack JSON is rejected naming the path and the fix", "[defo
     const auto close = t.find(']', at);
     t.erase(comma, close - comma);  // keep only x
     t.insert(t.find(']', at), ",1");
-    CHECK_THAT(recipe_error(t), Contains("steps[0].points[5]: expected 3 numbers, found an array of 2") &&
-                                    Contains("give [x, y, z]"));
+    CHECK_THAT(recipe_error(t), Contains("steps[0].points[5]: expected [x, y, z] (3 numbers, mm), found an array of 2"));
   }
   CHECK_THAT(recipe_error(replaced("\"degrees\":[3,2,3]", "\"degrees\":[3,2]")),
              Contains("steps[0].degrees: expected 3 integers, found an array of 2"));
   CHECK_THAT(recipe_error(replaced("\"degrees\":[3,2,3]", "\"degrees\":[3,2.5,3]")),
-             Contains("steps[0].degrees[1]: expected an integer, found 2.5"));
+             Contains("steps[0].degrees[1]: expected an integer in [0, 1000000000], found the number 2.5"));
   // Wrong counts: one degree more than the points given.
   CHECK_THAT(recipe_error(replaced("\"degrees\":[3,2,3]", "\"degrees\":[3,3,3]")),
              Contains("steps[0] (bezier_lattice 'global')") && Contains("48 control points") &&
                  Contains("4 x 4 x 4 = 64"));
   // NaN: written as null by JSON libraries, or a number out of range.
   CHECK_THAT(recipe_error(replaced("\"rate\":0.02", "\"rate\":null")),
-             Contains("steps[3].rate: expected a number, found null"));
+             Contains("steps[3].rate: expected a number (any finite number), found null"));
   CHECK_THAT(recipe_error(replaced("\"rate\":0.02", "\"rate\":NaN")), Contains("not valid JSON"));
   CHECK_THAT(recipe_error(replaced("\"rate\":0.02", "\"rate\":1e999")),
              Contains("could not be read") && Contains("number overflow"));
   CHECK_THAT(recipe_error(replaced("\"y_min\":-20.0", "\"y_min\":30.0")),
              Contains("steps[3] (bend): y_min = 30 > y_max = 25"));
   CHECK_THAT(recipe_error(replaced("\"enabled\":true", "\"enabled\":1")),
-             Contains("steps[0].enabled: expected true or false, found 1"));
+             Contains("steps[0].enabled: expected true or false, found the number 1"));
   CHECK_THAT(recipe_error(replaced("\"frame\":{\"origin\"", "\"frame\":{\"o\":0,\"origin\"")),
-             Contains("steps[0].frame: unknown key \"o\" in a lattice frame"));
+             Contains("steps[0].frame.o: unknown key \"o\" in a lattice frame"));
   CHECK_THAT(recipe_error(replaced("\"angle\":[", "\"angle\":[\"0\",")),
-             Contains("steps[1].angle[0]: expected a number, found the string \"0\""));
+             Contains("steps[1].angle[0]: expected a number (any finite number), found the string \"0\""));
   CHECK_THAT(recipe_error("[1, 2]"), Contains("(top level): expected the stack"));
   CHECK_THAT(recipe_error(R"({"format": "clayform.deformation-stack", "version": 1, "steps": {}})"),
              Contains("steps: expected an array of steps, found an object"));
   CHECK_THAT(recipe_error(R"({"format": "clayform.deformation-stack", "version": 1, "steps": [{"kind": "bspline_lattice"}]})"),
-             Contains("steps[0]: the key \"frame\" is missing"));
+             Contains("steps[0].frame: missing; give the lattice frame"));
   CHECK_THAT(recipe_error(R"({"format": "clayform.deformation-stack", "version": 1, "steps": [{"name": "x"}]})"),
-             Contains("steps[0]: the key \"kind\" is missing"));
+             Contains("steps[0].kind: missing; give the kind of deformation"));
   CHECK_THAT(recipe_error(R"({"format": "clayform.deformation-stack", "steps": []})"),
-             Contains("the key \"version\" is missing"));
+             Contains("version: missing; give \"version\": 1"));
 }
 
 TEST_CASE("every malformed step field is named with its path", "[deform][stack]") {
@@ -280,26 +279,26 @@ TEST_CASE("every malformed step field is named with its path", "[deform][stack]"
   const std::string basis = R"({"degree": 1, "knots": [0, 0, 1, 1]})";
   const std::pair<std::string, std::string> cases[] = {
       {"7", "steps[0]: expected a step"},
-      {R"({"kind": 3})", "steps[0].kind: expected a string, found 3"},
-      {R"({"kind": "twist", "name": 5, )" + axis + R"(, "angle": [0]})", "steps[0].name: expected a string, found 5"},
+      {R"({"kind": 3})", "steps[0].kind: expected a string, found the number 3"},
+      {R"({"kind": "twist", "name": 5, )" + axis + R"(, "angle": [0]})", "steps[0].name: expected a string, found the number 5"},
       {R"({"kind": "twist", "frame": [1, 2, 3], "angle": [0]})", "steps[0].frame: expected an axis frame"},
       {R"({"kind": "twist", "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1]}, "angle": [0]})",
-       "steps[0].frame: the key \"reference\" is missing"},
-      {R"({"kind": "twist", )" + axis + R"(, "angle": 0.5})", "steps[0].angle: expected an array of numbers, found 0.5"},
+       "steps[0].frame.reference: missing; give [x, y, z]"},
+      {R"({"kind": "twist", )" + axis + R"(, "angle": 0.5})", "steps[0].angle: expected an array of numbers, found the number 0.5"},
       {R"({"kind": "taper", )" + axis + R"(, "profile": []})", "steps[0] (taper): profile is empty"},
       {R"({"kind": "bezier_lattice", )" + cube + R"(, "degrees": [1, 1, 1], "points": {}})",
-       "steps[0].points: expected an array of control points"},
+       "steps[0].points: expected an array of points [x, y, z], found an object"},
       {R"({"kind": "bezier_lattice", )" + cube + R"(, "degrees": [1, 1, 1e12], "points": []})",
-       "steps[0].degrees[2]: expected an integer, found 1000000000000.0"},
+       "steps[0].degrees[2]: expected an integer in [0, 1000000000], found the number 1e+12"},
       {R"({"kind": "bezier_lattice", )" + cube + R"(, "degrees": [1, 1, 10000000000], "points": []})",
-       "steps[0].degrees[2]: the integer 10000000000 is out of range"},
+       "steps[0].degrees[2]: expected an integer in [0, 1000000000], found the number 1e+10"},
       {R"({"kind": "bspline_lattice", )" + cube + R"(, "bases": [)" + basis + "," + basis + R"(], "points": []})",
        "steps[0].bases: expected 3 bases (along S, T, U), found an array of 2"},
       {R"({"kind": "bspline_lattice", )" + cube + R"(, "bases": [)" + basis + "," + basis + R"(, 4], "points": []})",
        "steps[0].bases[2]: expected a basis"},
       {R"({"kind": "bspline_lattice", )" + cube + R"(, "bases": [)" + basis + "," + basis +
            R"(, {"degree": 1, "knots": [0, 0, 1, 1], "weights": []}], "points": []})",
-       "steps[0].bases[2]: unknown key \"weights\" in a basis"},
+       "steps[0].bases[2].weights: unknown key \"weights\" in a basis"},
       {R"({"kind": "bspline_lattice", )" + cube + R"(, "bases": [)" + basis + "," + basis +
            R"(, {"degree": 1, "knots": [0, 0, 2, 2]}], "points": []})",
        "steps[0] (bspline_lattice)"},
@@ -311,7 +310,7 @@ TEST_CASE("every malformed step field is named with its path", "[deform][stack]"
     CHECK_THAT(what, Contains(expected));
   }
   CHECK_THAT(error_of([&] { stack_from_json(head + "], \"extra\": 1}"); }).second,
-             Contains("(top level): unknown key \"extra\" in a deformation stack"));
+             Contains("extra: unknown key \"extra\" in the stack"));
 }
 
 TEST_CASE("an invalid stack is rejected naming the step", "[deform][stack]") {
@@ -458,7 +457,7 @@ TEST_CASE("deform_points on a stack with an extended lattice equals deform_point
   CHECK(worst < 1e-13 * size);
   REQUIRE(report.freezes.size() == 1);
   CHECK(report.freezes[0].step == 1);
-  const FreezeSummary& f = report.freezes[0].summary;
+  const FreezeReport& f = report.freezes[0].report;
   CHECK(report.converged());
   CHECK(f.inside + f.outside == points.rows());
   CHECK(f.inside > points.rows() / 2);
@@ -489,8 +488,10 @@ TEST_CASE("points an extended lattice step cannot place are left unchanged and r
   deform_points(stack, points, out, report);
   REQUIRE(report.freezes.size() == 1);
   CHECK_FALSE(report.converged());
-  CHECK(report.freezes[0].summary.summary.termination == clay::Termination::NotConverged);
-  CHECK(report.freezes[0].summary.unresolved == 1);
+  CHECK(report.summary.termination == clay::Termination::NotConverged);
+  CHECK(report.summary.message == report.brief());
+  CHECK(report.freezes[0].report.summary.termination == clay::Termination::NotConverged);
+  CHECK(report.freezes[0].report.unresolved == 1);
   CHECK_THAT(report.brief(), Contains("steps[0]: frozen 2 points: 1 inside, 0 outside, 1 unresolved"));
   const Eigen::Vector3d off = points.row(1).transpose();
   CHECK(same_bits(Eigen::Vector3d(out.row(1).transpose()), deform_point(twist, off)));
@@ -527,7 +528,7 @@ TEST_CASE("malformed extended lattice JSON is rejected naming the path", "[defor
   CHECK_THAT(recipe_error(with_chunk_entry(good, 0, 63, "-1")),
              Contains("steps[1].chunks[0][63]: index -1 is out of range " + range));
   CHECK_THAT(recipe_error(with_chunk_entry(good, 2, 5, "7.5")),
-             Contains("steps[1].chunks[2][5]: expected an integer, found 7.5"));
+             Contains("steps[1].chunks[2][5]: expected an integer, found the number 7.5"));
   CHECK_THAT(recipe_error(with_chunk_entry(good, 4, 0, "0,0")),
              Contains("steps[1].chunks[4]: expected 64 indices") && Contains("found an array of 65"));
 
@@ -543,13 +544,13 @@ TEST_CASE("malformed extended lattice JSON is rejected naming the path", "[defor
        "steps[0].chunks[0]: expected 64 indices (control point (i, j, k) at (i * 4 + j) * 4 + k), found an array of 3"},
       {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": {})", "steps[0].chunks: expected an array of chunks"},
       {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": [7])", "steps[0].chunks[0]: expected 64 indices"},
-      {two + R"("points": [[0, 0, 0], [1, 2, 3]])", "steps[0]: the key \"chunks\" is missing"},
+      {two + R"("points": [[0, 0, 0], [1, 2, 3]])", "steps[0].chunks: missing; give the chunks, each 64 row indices"},
       {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": [], "frame": 1)",
-       "steps[0]: unknown key \"frame\" in an extended_lattice step; the keys are kind, name, enabled, rest, points, chunks"},
+       "steps[0].frame: unknown key \"frame\" in an extended_lattice step; the keys are: kind, name, enabled, rest, points, chunks"},
       {R"("rest": [], "points": [], "chunks": [[0]])", "steps[0].chunks[0]: expected 64 indices"},
       {R"("rest": [], "points": [], "chunks": [)" + chunk + "]",
        "steps[0].chunks[0][0]: index 0 is out of range (rest has no rows)"},
-      {two + R"("points": [[0, 0, 0], [1, 2, null]], "chunks": [])", "steps[0].points[1][2]: expected a number, found null"},
+      {two + R"("points": [[0, 0, 0], [1, 2, null]], "chunks": [])", "steps[0].points[1][2]: expected a number (any finite number), found null"},
       // The lattice's own problems(), prefixed with the step.
       {two + R"("points": [[0, 0, 0], [1, 2, 3]], "chunks": [])", "steps[0] (extended_lattice): no chunks"},
   };
@@ -583,4 +584,17 @@ TEST_CASE("a number beyond a double leaves the caller's floating-point environme
 #if defined(__GLIBC__)
   CHECK(fegetexcept() == traps);
 #endif
+}
+
+TEST_CASE("the stack reader reports every problem at once, each with its path", "[deform][stack]") {
+  // Three independent faults in two steps and the header: one read names all three.
+  const std::string text = R"({"format": "clayform.deformation-stack", "version": 1, "steps": [
+    {"kind": "twist", "frame": {"origin": [0, 0, "x"], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0]},
+    {"kind": "bend", "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]},
+     "y_min": 0, "y_max": 1, "center": 0, "rate": null}], "colour": "red"})";
+  const auto [category, what] = error_of([&] { stack_from_json(text); });
+  CHECK(category == ErrorCategory::Recipe);
+  CHECK_THAT(what, Contains("steps[0].frame.origin[2]: expected a number (any finite number), found the string \"x\""));
+  CHECK_THAT(what, Contains("steps[1].rate: expected a number (any finite number), found null"));
+  CHECK_THAT(what, Contains("colour: unknown key \"colour\" in the stack"));
 }

@@ -184,8 +184,8 @@ TEST_CASE("key points lie on the target where it crosses the control-net rows (H
   const BSplineCurve line = bezier(a, a + (b - a) / 3, a + 2 * (b - a) / 3, b);
   const InfluenceRegion region = influence_factors(s, ellipse({50, 50, 0}, 49, 49));
   const KeyPoints keys = key_points(s, region, line);
-  CHECK(keys.direction == KeyDirection::u);  // 71 mm along x against 30 along y
-  CHECK(keys.constraint_class == ConstraintClass::well_constrained);
+  CHECK(keys.direction == KeyDirection::U);  // 71 mm along x against 30 along y
+  CHECK(keys.constraint_class == ConstraintClass::WellConstrained);
   const auto xu = clay::surface::greville_abscissae(s.u);
   std::vector<int> rows;
   for (int r = 0; r < 15; ++r)
@@ -213,9 +213,11 @@ TEST_CASE("paper mode: forces along the normal, peak and symmetric fall-off (eqs
   StyleOptions options;
   options.lambda = 0.5;
   const StyleResult r = style_deform(s, bound, line, options);
+  CHECK_THAT(r.report.brief(), Catch::Matchers::StartsWith(r.report.summary.brief()) &&
+                                   Catch::Matchers::Contains("key points"));
   const InfluenceRegion region = influence_factors(s, bound);
-  CHECK(r.report.constraint_class == ConstraintClass::well_constrained);
-  CHECK(r.report.direction == KeyDirection::u);
+  CHECK(r.report.constraint_class == ConstraintClass::WellConstrained);
+  CHECK(r.report.direction == KeyDirection::U);
   REQUIRE(r.report.m > 3);
   for (Eigen::Index row = 0; row < s.points.rows(); ++row) {
     const Eigen::RowVector3d d = r.surface.points.row(row) - s.points.row(row);
@@ -256,13 +258,13 @@ TEST_CASE("paper mode: forces along the normal, peak and symmetric fall-off (eqs
 TEST_CASE("locality: vertices outside the bound are bit-identical, in both modes", "[style]") {
   const BSplineSurface s = hood(16, 16);
   const double size = size_of(s);
-  for (StyleMode mode : {StyleMode::paper, StyleMode::exact}) {
+  for (StyleMode mode : {StyleMode::Paper, StyleMode::Exact}) {
     StyleOptions options;
     options.mode = mode;
     const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
     INFO(r.report.message);
     const BSplineSurface& before = r.refined_parent;
-    if (mode == StyleMode::paper) {
+    if (mode == StyleMode::Paper) {
       CHECK(clay::surface::identical(before, s));  // the paper's mode never changes the knots
     } else {
       CHECK(r.report.knots_inserted > 0);  // the ends of the target need a finer net here
@@ -284,7 +286,7 @@ TEST_CASE("locality: vertices outside the bound are bit-identical, in both modes
 
 TEST_CASE("lambda = 0 and the over-constrained class leave the surface bit-identical", "[style]") {
   const BSplineSurface s = hood();
-  for (StyleMode mode : {StyleMode::paper, StyleMode::exact}) {
+  for (StyleMode mode : {StyleMode::Paper, StyleMode::Exact}) {
     StyleOptions options;
     options.mode = mode;
     options.lambda = 0;
@@ -294,26 +296,26 @@ TEST_CASE("lambda = 0 and the over-constrained class leave the surface bit-ident
     // A target beside the bound, completely outside it.
     const BSplineCurve outside = bezier({450, -150, 60}, {480, -50, 80}, {480, 50, 80}, {450, 150, 60});
     const StyleResult over = style_deform(s, hood_bound(), outside, options);
-    CHECK(over.report.constraint_class == ConstraintClass::over_constrained);
+    CHECK(over.report.constraint_class == ConstraintClass::OverConstrained);
     CHECK(clay::surface::identical(over.surface, s));
     CHECK(over.report.message.find("over-constrained") != std::string::npos);
     // Half in, half out.
     const BSplineCurve partly = bezier({-60, -380, 60}, {-40, -200, 150}, {-40, 0, 150}, {-60, 100, 120});
     CHECK(style_deform(s, hood_bound(), partly, options).report.constraint_class ==
-          ConstraintClass::under_constrained);
+          ConstraintClass::UnderConstrained);
   }
 }
 
 TEST_CASE("mirror-symmetric input gives a mirror-symmetric result to 1e-12", "[style]") {
   const BSplineSurface s = hood();
   const double size = size_of(s);
-  for (StyleMode mode : {StyleMode::paper, StyleMode::exact}) {
+  for (StyleMode mode : {StyleMode::Paper, StyleMode::Exact}) {
     for (bool smoothing : {true, false}) {
       StyleOptions options;
       options.mode = mode;
       options.smoothing = smoothing;
       const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
-      CHECK(r.report.direction == KeyDirection::v);
+      CHECK(r.report.direction == KeyDirection::V);
       // The exact mode refines this net: mirror-symmetrically too.
       const auto& kv = r.surface.v.knots;
       for (size_t k = 0; k < kv.size(); ++k) CHECK_THAT(kv[k] + kv[kv.size() - 1 - k], WithinAbs(1.0, 1e-15));
@@ -329,7 +331,7 @@ TEST_CASE("mirror-symmetric input gives a mirror-symmetric result to 1e-12", "[s
       // The paper's mode is symmetric to rounding. The exact mode solves a thin-plate KKT system
       // whose conditioning grows with the refinement; its rounding (not the key points, which
       // come in mirrored pairs) leaves an asymmetry of about 2e-11 of the size here.
-      CHECK(worst <= (mode == StyleMode::paper ? 1e-12 : 1e-10));
+      CHECK(worst <= (mode == StyleMode::Paper ? 1e-12 : 1e-10));
       CHECK(r.report.max_displacement > 1);
     }
   }
@@ -339,7 +341,7 @@ TEST_CASE("exact mode: the hood passes through every key point and joins the par
   const BSplineSurface s = hood(16, 16);
   const double size = size_of(s);
   StyleOptions options;
-  options.mode = StyleMode::exact;
+  options.mode = StyleMode::Exact;
   const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
   INFO(r.report.message);
   REQUIRE(r.report.m >= 4);
@@ -359,7 +361,7 @@ TEST_CASE("exact mode: the hood passes through every key point and joins the par
   CHECK(r.report.boundary_tangent_angle <= 0.5);
   CHECK(r.report.locality == 0.0);
   // The paper's mode only approximates: its key-point deviation is far larger.
-  options.mode = StyleMode::paper;
+  options.mode = StyleMode::Paper;
   CHECK(style_deform(s, hood_bound(), hood_target(), options).report.target_deviation > 1e-3 * size);
 }
 
@@ -371,7 +373,7 @@ TEST_CASE("exact mode: the displacement is the least thin-plate energy that meet
   // control point at a time (linear in the points), not from the basis code the solver uses.
   const BSplineSurface s = hood(16, 16);
   StyleOptions options;
-  options.mode = StyleMode::exact;
+  options.mode = StyleMode::Exact;
   const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
   INFO(r.report.message);
   const BSplineSurface& net = r.refined_parent;
@@ -436,12 +438,12 @@ TEST_CASE("exact mode on a sail with uneven knots, with and without a bound curv
   const BSplineCurve target = bezier({500, 2200, 380}, {800, 2500, 450}, {1100, 2500, 450}, {1300, 2300, 300});
   const BSplineCurve bound = ellipse({900, 2400, 600}, 750, 900);
   StyleOptions options;
-  options.mode = StyleMode::exact;
+  options.mode = StyleMode::Exact;
   for (bool with_bound : {true, false}) {
     const StyleResult r = with_bound ? style_deform(s, bound, target, options) : style_deform(s, target, options);
     INFO((with_bound ? "with bound: " : "without: ") << r.report.message);
     REQUIRE(r.report.m >= 2);
-    CHECK(r.report.constraint_class != ConstraintClass::over_constrained);
+    CHECK(r.report.constraint_class != ConstraintClass::OverConstrained);
     for (const KeyPoint& k : r.report.key_points)
       if (k.influenced) {
         INFO((clay::surface::evaluate(r.surface, k.u, k.v) - k.point).norm() << " at " << k.u << " " << k.v << " D " << k.distance);
@@ -458,7 +460,7 @@ TEST_CASE("exact mode refines a coarse net by knot insertion and reports conflic
   const BSplineSurface s = hood(6, 6);
   const double size = size_of(s);
   StyleOptions options;
-  options.mode = StyleMode::exact;
+  options.mode = StyleMode::Exact;
   options.key_points_per_row = 2;
   const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
   INFO(r.report.message);
@@ -525,7 +527,7 @@ TEST_CASE("style deformation errors name the object and the fix", "[style]") {
 TEST_CASE("StyleEditor: drags give the one-off results and reuse the exact factorization", "[style]") {
   const BSplineSurface s = hood(16, 16);
   const double size = size_of(s);
-  for (StyleMode mode : {StyleMode::paper, StyleMode::exact}) {
+  for (StyleMode mode : {StyleMode::Paper, StyleMode::Exact}) {
     StyleOptions options;
     options.mode = mode;
     const InfluenceRegion region = influence_factors(s, hood_bound(), options);
@@ -539,11 +541,11 @@ TEST_CASE("StyleEditor: drags give the one-off results and reuse the exact facto
       // Paper mode: the same up to the projection tolerance (the Newton starts differ). Exact
       // mode: the key points added where the target is missed may then differ too; both results
       // follow the target within curve_tolerance.
-      const double agree = mode == StyleMode::paper ? 1e-9 : options.curve_tolerance;
+      const double agree = mode == StyleMode::Paper ? 1e-9 : options.curve_tolerance;
       CHECK((dragged.surface.points - once.surface.points).cwiseAbs().maxCoeff() <= agree * size);
       CHECK(dragged.report.m == once.report.m);
       CHECK(dragged.report.knots_inserted == once.report.knots_inserted);
-      if (mode == StyleMode::exact) CHECK(dragged.report.target_deviation <= 1e-6 * size);
+      if (mode == StyleMode::Exact) CHECK(dragged.report.target_deviation <= 1e-6 * size);
     }
   }
   CHECK_THROWS_AS(StyleEditor(hood(8, 8), influence_factors(s, hood_bound())), clay::Error);

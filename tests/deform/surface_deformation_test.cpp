@@ -91,9 +91,11 @@ TEST_CASE("deform_surface: a stack of exact steps stays an exact NURBS", "[surfa
   INFO(r.report.brief());
   REQUIRE(r.report.steps.size() == 3);
   CHECK(r.report.exact);
-  CHECK(r.report.steps[0].method == StepOutcome::Method::exact);
-  CHECK(r.report.steps[1].method == StepOutcome::Method::exact);
-  CHECK(r.report.steps[2].method == StepOutcome::Method::skipped);
+  CHECK(r.report.summary.converged());
+  CHECK(r.report.summary.message == r.report.brief());
+  CHECK(r.report.steps[0].method == StepOutcome::Method::Exact);
+  CHECK(r.report.steps[1].method == StepOutcome::Method::Exact);
+  CHECK(r.report.steps[2].method == StepOutcome::Method::Skipped);
   // The dome is axis-aligned in the lattice: s is linear in u only, t in v only, u bicubic, so
   // the bulge gives degree 2 + 0 + 3 = 5 and the linear taper 5 + 5 = 10 in each direction.
   CHECK(r.surface.u.degree == 10);
@@ -115,8 +117,8 @@ TEST_CASE("deform_surface: a twist is refitted with a certified bound that holds
   const SurfaceDeformationResult r = deform_surface(stack, s, options);
   INFO(r.report.brief());
   CHECK_FALSE(r.report.exact);
-  CHECK(r.report.steps[0].method == StepOutcome::Method::exact);
-  REQUIRE(r.report.steps[1].method == StepOutcome::Method::refit);
+  CHECK(r.report.steps[0].method == StepOutcome::Method::Exact);
+  REQUIRE(r.report.steps[1].method == StepOutcome::Method::Refit);
   CHECK_THAT(r.report.steps[1].reason, Contains("not polynomial"));
   const RefitReport& fit = r.report.steps[1].refit;
   REQUIRE(fit.certified);
@@ -151,7 +153,7 @@ TEST_CASE("deform_surface: above the degree limit, a refit when allowed, the Deg
   options.refit = RefitOptions{};
   const SurfaceDeformationResult r = deform_surface(d, s, options);
   INFO(r.report.brief());
-  REQUIRE(r.report.steps[0].method == StepOutcome::Method::refit);
+  REQUIRE(r.report.steps[0].method == StepOutcome::Method::Refit);
   CHECK_THAT(r.report.steps[0].reason, Contains("degree"));
   CHECK(r.surface.u.degree == 3);
   DeformationStack one;

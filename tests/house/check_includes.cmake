@@ -5,6 +5,8 @@
 #     surface (the core: clay/surface*, clay/error.hpp, summary.hpp, tolerance.hpp, version.hpp)
 #       <- sketch <- constraints;  surface <- deform;  cli (recipe, render, servers) uses all.
 #   The umbrella clay/clayform.hpp is exempt (it is the whole API by design).
+# - clay/internal/ (the shared helpers, never installed) only from sources, never from a public
+#   header under include/.
 # -DSOURCE_DIR=<tree to scan> -DOCCT_INCLUDE_DIR=<OCCT headers>
 cmake_minimum_required(VERSION 3.22)  # IN_LIST in a script run with -P
 set(violations "")
@@ -15,8 +17,10 @@ set(may_use_deform surface deform)
 set(may_use_cli surface sketch constraints deform cli)
 # The module a clay header belongs to, or "" for a header outside the graph.
 function(module_of header out)
-  if(header MATCHES "^clay/(surface(/|\\.hpp$)|error\\.hpp$|summary\\.hpp$|tolerance\\.hpp$|version\\.hpp$)")
+  if(header MATCHES "^clay/(surface(/|\\.hpp$)|error\\.hpp$|summary\\.hpp$|tolerance\\.hpp$|version\\.hpp$|parallel\\.hpp$)")
     set(${out} surface PARENT_SCOPE)
+  elseif(header STREQUAL "clay/internal/deformation_json.hpp")
+    set(${out} deform PARENT_SCOPE)  # the stack schema's reader, shared with the recipe
   elseif(header MATCHES "^clay/(sketch|constraints|deform)(/|\\.hpp$)")
     set(${out} ${CMAKE_MATCH_1} PARENT_SCOPE)
   elseif(header MATCHES "^clay/(recipe|render|serve|view)(/|\\.hpp$)")
@@ -37,6 +41,9 @@ foreach(f ${files})
     endif()
     if(EXISTS ${OCCT_INCLUDE_DIR}/${header} AND NOT f MATCHES "^surface/src/occt/")
       list(APPEND violations "${f}: OpenCASCADE header <${header}> outside surface/src/occt/")
+    endif()
+    if(header MATCHES "^clay/internal/" AND f MATCHES "/include/clay/" AND NOT f MATCHES "^internal/")
+      list(APPEND violations "${f}: public header includes the internal <${header}>, which is not installed")
     endif()
     set(from "")
     if(f MATCHES "^(surface|sketch|constraints|deform|cli)/")

@@ -9,7 +9,10 @@ function(run)
   set(last_output "${out}" PARENT_SCOPE)
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
-foreach(f include/clay/surface/bspline_surface.hpp include/clay/deform.hpp
+foreach(f include/clay/surface/bspline_surface.hpp include/clay/deform.hpp include/clay/version.hpp
+          include/clay/surface/export.hpp include/clay/surface/exchange_export.hpp
+          include/clay/sketch/export.hpp include/clay/constraints/export.hpp
+          include/clay/deform/export.hpp include/clay/recipe/export.hpp
           lib/cmake/Clayform/ClayformConfig.cmake lib/cmake/Clayform/ClayformConfigVersion.cmake
           bin/clayform)
   if(NOT EXISTS ${WORK_DIR}/prefix/${f})

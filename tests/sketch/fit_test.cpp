@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <clay/error.hpp>
 #include <clay/sketch/fit.hpp>
+#include <clay/sketch/oversketch.hpp>
 #include <clay/surface/evaluate.hpp>
 
 #include <Eigen/Geometry>
@@ -85,13 +87,13 @@ TEST_CASE("noisy 3D stroke: few control points, within 0.2 mm of the true curve,
   CHECK(n.energy_ratio <= 1.5);
   CHECK(n.energy_ratio >= 1 / 1.5);
   // The reported deviation is the stroke's distance to the curve (checked on a dense polyline).
-  CHECK_THAT(c.max_deviation, WithinAbs(stroke_deviation(n.stroke.points, c.curve), 1e-4));
-  CHECK(c.rms_deviation < c.max_deviation);
+  CHECK_THAT(c.max_deviation_mm, WithinAbs(stroke_deviation(n.stroke.points, c.curve), 1e-4));
+  CHECK(c.rms_deviation_mm < c.max_deviation_mm);
   CHECK(c.first_point == 0);
   CHECK(c.last_point == 299);
   // The noise is the only thing left: the rms residual is about sqrt(2) sigma (two normal
   // components), and the noise estimate is near sigma.
-  CHECK_THAT(c.rms_deviation, WithinAbs(std::sqrt(2.0) * noise_sigma, 0.03));
+  CHECK_THAT(c.rms_deviation_mm, WithinAbs(std::sqrt(2.0) * noise_sigma, 0.03));
   CHECK_THAT(c.noise, WithinAbs(noise_sigma, 0.03));
 }
 
@@ -123,7 +125,7 @@ TEST_CASE("a clean stroke is fitted within a tight tolerance, ends interpolated"
   const FittedCurve& c = fit.curves[0];
   INFO(c.summary.brief());
   CHECK(c.summary.converged());
-  CHECK(c.max_deviation <= o.tolerance);
+  CHECK(c.max_deviation_mm <= o.tolerance);
   CHECK(stroke_deviation(s.points, c.curve) <= o.tolerance + 1e-5);
   // Clean: the end estimate stays at the drawn point (within the tolerance it may move).
   CHECK((c.curve.points.row(0) - s.points.row(0)).norm() <= o.tolerance);
@@ -294,4 +296,17 @@ TEST_CASE("a closed stroke with corners gives a closed chain of curves", "[fit]"
     for (const auto& vertex : v) nearest = std::min(nearest, (b.points.row(0).transpose() - vertex).norm());
     CHECK(nearest <= o.tolerance);
   }
+}
+
+TEST_CASE("FitOptions and OversketchOptions list every bad field", "[fit]") {
+  FitOptions f;
+  f.tolerance = 0;
+  f.degree = 1;
+  f.closing_ratio = 0.9;
+  CHECK(f.problems().size() == 3);
+  OversketchOptions o;
+  o.capture_distance = -1;
+  o.fit.max_iterations = 0;
+  CHECK(o.problems().size() == 2);
+  CHECK_THROWS_AS(o.validate(), clay::Error);
 }

@@ -121,7 +121,7 @@ TEST_CASE("oversketch G1: joints exact, kept parts unchanged, new part follows t
   CHECK(unchanged(old, r.curve, 0.0, r.cut_start) <= 1e-12 * 170);
   CHECK(unchanged(old, r.curve, r.cut_end, 1.0) <= 1e-12 * 170);
   // The new part follows the stroke within the tolerance.
-  CHECK(r.max_deviation <= o.fit.tolerance);
+  CHECK(r.max_deviation_mm <= o.fit.tolerance);
   CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance + 1e-4);
 }
 

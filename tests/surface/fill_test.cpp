@@ -97,7 +97,7 @@ void check_fill(const std::vector<BSplineCurve>& boundary, FillStyle style, bool
   const double size = curves_size(boundary);
   INFO(built.report.brief());
   CHECK(built.report.exact);
-  CHECK(built.report.max_deviation <= 1e-9 * size);
+  CHECK(built.report.max_deviation_mm <= 1e-9 * size);
   CHECK(problems(built.surface).empty());
   for (const BSplineCurve& c : boundary) {
     if (pointwise)
@@ -183,7 +183,7 @@ TEST_CASE("Coons fill of straight sides raises them to degree 3", "[fill]") {
   const BuiltSurface built = fill(sides);
   INFO(built.report.brief());
   CHECK_THAT(built.report.method, Catch::Contains("raised from degree 1 to 3"));
-  CHECK(built.report.max_deviation < 1e-12 * 200);
+  CHECK(built.report.max_deviation_mm < 1e-12 * 200);
   CHECK(built.surface.u.degree == 3);
   CHECK(built.surface.v.degree == 3);
   for (const BSplineCurve& c : sides) CHECK(edge_error(built.surface, c) < 1e-12 * 200);
@@ -205,8 +205,8 @@ TEST_CASE("fill joins corners within gap_tolerance and reports it", "[fill]") {
   o.gap_tolerance = 1e-4;
   const BuiltSurface built = fill(quad, o);
   CHECK_THAT(built.report.method, Catch::Contains("corners joined"));
-  CHECK(built.report.max_deviation <= 1e-5 + 1e-9);
-  CHECK(built.report.max_deviation >= 0.99e-5);
+  CHECK(built.report.max_deviation_mm <= 1e-5 + 1e-9);
+  CHECK(built.report.max_deviation_mm >= 0.99e-5);
 }
 
 TEST_CASE("fill rejects a boundary with a gap, naming the curves and the gap", "[fill][errors]") {
@@ -357,9 +357,9 @@ TEST_CASE("n-sided fill of a 5-sided dome with an interior curve reports a measu
   INFO(result.built.report.brief() << ", size " << size);
   CHECK_FALSE(result.built.report.exact);
   REQUIRE(result.curve_deviations.size() == 6);
-  CHECK(result.built.report.max_deviation ==
+  CHECK(result.built.report.max_deviation_mm ==
         *std::max_element(result.curve_deviations.begin(), result.curve_deviations.end()));
-  CHECK(result.built.report.max_deviation < 1e-5 * size);  // measured 1.2e-6 mm on 211 mm
+  CHECK(result.built.report.max_deviation_mm < 1e-5 * size);  // measured 1.2e-6 mm on 211 mm
   // Independent measurement: closest points of 4x denser samples, each against its reported value.
   for (size_t k = 0; k < all.size(); ++k) {
     double worst = 0;

@@ -4,8 +4,11 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
 
+#include <cmath>
 #include <random>
+#include <vector>
 
+#include "error_of.hpp"
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
@@ -135,4 +138,80 @@ TEST_CASE("knot operations refuse bad requests", "[knots][errors]") {
   BSplineCurve broken = c;
   broken.points(2, 2) = std::nan("");
   CHECK_THROWS_AS(extract_bezier(broken), clay::Error);
+}
+
+TEST_CASE("remove_knots undoes knot refinement and keeps the knots a shape needs", "[knots]") {
+  std::mt19937 rng(77);
+  for (int p = 1; p <= 6; ++p)
+    for (bool rational : {false, true}) {
+      const BSplineCurve c = clay::test::random_curve(rng, p, p + 4, rational);
+      // Raising every interior knot to multiplicity p (Bézier form): all the new copies are
+      // removable, no original knot is.
+      std::vector<double> extra;
+      const auto [a, b] = c.basis.domain();
+      for (double k : c.basis.knots)
+        if (k > a && k < b && (extra.empty() || extra.back() != k))
+          for (int r = multiplicity(c.basis, k); r < p; ++r) extra.push_back(k);
+      const BSplineCurve refined = refine_knots(c, extra);
+      const int inserted = static_cast<int>(extra.size());
+      const CurveKnotRemoval back = remove_knots(refined, 1e-9);
+      CHECK(back.removed == inserted);
+      CHECK(back.curve.basis.knots == c.basis.knots);
+      CHECK((back.curve.points - c.points).cwiseAbs().maxCoeff() < 1e-9);
+      CHECK((back.curve.weights - c.weights).cwiseAbs().maxCoeff() < 1e-11);
+      // Random control points: no original knot can go within a tight tolerance.
+      CHECK(remove_knots(c, 1e-9).removed == 0);
+    }
+  for (bool rational : {false, true}) {
+    const BSplineSurface s = clay::test::random_surface(rng, 3, 2, 7, 6, rational);
+    const BezierPatches bp = extract_bezier(s);  // the breaks
+    std::vector<double> extra_u, extra_v;
+    for (size_t i = 1; i + 1 < bp.breaks_u.size(); ++i) extra_u.insert(extra_u.end(), 2, bp.breaks_u[i]);
+    for (size_t j = 1; j + 1 < bp.breaks_v.size(); ++j) extra_v.push_back(bp.breaks_v[j]);
+    const BSplineSurface refined = refine_knots_v(refine_knots_u(s, extra_u), extra_v);
+    const SurfaceKnotRemoval in_u = remove_knots_u(refined, 1e-9);
+    const SurfaceKnotRemoval in_v = remove_knots_v(in_u.surface, 1e-9);
+    CHECK(in_u.removed == static_cast<int>(extra_u.size()));
+    CHECK(in_v.removed == static_cast<int>(extra_v.size()));
+    CHECK(in_v.surface.u.knots == s.u.knots);
+    CHECK(in_v.surface.v.knots == s.v.knots);
+    CHECK(relative_deviation(s, in_v.surface) < 1e-12);
+  }
+}
+
+TEST_CASE("remove_knots refuses a negative or non-finite tolerance", "[knots]") {
+  std::mt19937 rng(3);
+  const BSplineCurve c = clay::test::random_curve(rng, 3, 6, false);
+  const BSplineSurface s = clay::test::random_surface(rng, 2, 2, 4, 4, false);
+  for (double bad : {-1e-9, std::nan(""), HUGE_VAL}) {
+    const auto [category, what] = clay::test::error_of([&] { (void)remove_knots(c, bad); });
+    CHECK(category == clay::ErrorCategory::InvalidArgument);
+    CHECK_THAT(what, Catch::Matchers::Contains("remove_knots: tolerance_mm"));
+    CHECK_THROWS_AS(remove_knots_v(s, bad), clay::Error);
+  }
+}
+
+TEST_CASE("bezier_extraction: each span's operator maps the control points to a Bézier piece that evaluates like the curve", "[knots]") {
+  std::mt19937 rng(5);
+  for (int p = 1; p <= 5; ++p)
+    for (bool clamped : {true, false}) {
+      const BSplineCurve c = clay::test::random_curve(rng, p, p + 6, false, clamped, p);
+      const std::vector<SpanExtraction> spans = bezier_extraction(c.basis);
+      CHECK(spans.size() == breakpoints(c.basis).size() - 1);
+      for (const SpanExtraction& e : spans) {
+        REQUIRE(e.matrix.rows() == p + 1);
+        // Partition of unity: every Bézier point is an affine combination.
+        CHECK((e.matrix.rowwise().sum().array() - 1.0).abs().maxCoeff() < 1e-13);
+        BSplineCurve piece;
+        piece.basis.degree = p;
+        piece.basis.knots.assign(static_cast<size_t>(p + 1), e.a);
+        piece.basis.knots.insert(piece.basis.knots.end(), static_cast<size_t>(p + 1), e.b);
+        piece.points = e.matrix * c.points.middleRows(e.first, p + 1);
+        piece.weights = Eigen::VectorXd::Ones(p + 1);
+        for (int k = 0; k <= 10; ++k) {
+          const double t = k == 10 ? e.b : e.a + (e.b - e.a) * k / 10.0;
+          CHECK((evaluate(piece, t) - evaluate(c, t)).norm() < 1e-11);
+        }
+      }
+    }
 }

@@ -53,7 +53,7 @@ TEST_CASE("superellipsoid with exponents (1, 1) is an exact sphere", "[primitive
   CHECK(built.report.exact);
   CHECK(built.surface.is_rational());
   CHECK(worst_over(built.surface, [](const Eigen::Vector3d& p) { return p.norm() - 40.0; }) < 1e-12 * 40.0);
-  CHECK(built.report.max_deviation < 1e-12 * 40.0);
+  CHECK(built.report.max_deviation_mm < 1e-12 * 40.0);
   // Poles: the whole u = end rows collapse to (0, 0, +-40).
   CHECK((evaluate(built.surface, built.surface.u.domain().second, 0.3) - Eigen::Vector3d(0, 0, 40)).norm() < 1e-13);
 }
@@ -108,7 +108,7 @@ TEST_CASE("approximated superquadrics meet the tolerance against the analytic fo
     shape.e2 = c.e2;
     const BuiltSurface built = superellipsoid(shape, options);
     CHECK_FALSE(built.report.exact);
-    CHECK(built.report.max_deviation <= options.tolerance);
+    CHECK(built.report.max_deviation_mm <= options.tolerance);
     // Independent: Barr's formula at the same (eta, omega), on a grid other than the builder's.
     REQUIRE(built.surface.u.domain().second == 2.0);  // two north-south segments
     REQUIRE(built.surface.v.domain().second == 4.0);  // four quarter turns
@@ -128,7 +128,7 @@ TEST_CASE("approximated superquadrics meet the tolerance against the analytic fo
     tor.e1 = c.e1;
     tor.e2 = c.e2;
     const BuiltSurface t = supertoroid(tor, options);
-    CHECK(t.report.max_deviation <= options.tolerance);
+    CHECK(t.report.max_deviation_mm <= options.tolerance);
     worst = 0;
     for (double su : linspace(0, 4, 97))
       for (double sv : linspace(0, 4, 97)) {
@@ -154,7 +154,7 @@ TEST_CASE("approximated superquadrics meet the tolerance against the analytic fo
       worst = std::max(worst, (evaluate(h.surface, su, sv) - x).norm());
     }
   CHECK(worst <= options.tolerance);
-  CHECK(h.report.max_deviation <= options.tolerance);
+  CHECK(h.report.max_deviation_mm <= options.tolerance);
 }
 
 TEST_CASE("spherical product of two curves is their exact product", "[primitives]") {

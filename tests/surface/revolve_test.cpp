@@ -76,7 +76,7 @@ TEST_CASE("revolved points lie at the exact radius and height of their profile p
         INFO("angle " << angle << ", rational profile " << rational);
         CHECK(revolution_error(built.surface, profile, axis) < 1e-12 * size);
         CHECK(built.report.exact);
-        CHECK(built.report.max_deviation < 1e-12 * size);
+        CHECK(built.report.max_deviation_mm < 1e-12 * size);
         CHECK(built.surface.is_rational());
         CHECK(built.surface.u.degree == 2);
         CHECK(built.surface.v.knots == profile.basis.knots);

@@ -139,7 +139,7 @@ TEST_CASE("loft passes through every section exactly (polynomial and rational)",
     INFO("rational " << rational << ": " << built.report.brief() << ", independent " << err);
     CHECK(err < 1e-9 * size);
     CHECK(built.report.exact);
-    CHECK(built.report.max_deviation < 1e-9 * size);
+    CHECK(built.report.max_deviation_mm < 1e-9 * size);
     CHECK(built.surface.v.degree == 3);
     CHECK(built.surface.u.degree == 4);
     CHECK(built.surface.is_rational() == rational);
@@ -310,7 +310,7 @@ TEST_CASE("sweep along a straight path is the exact extrusion", "[skin][sweep]")
   const double size = box_size(built.surface);
   CHECK(built.report.exact);
   CHECK(built.surface.v.degree == 1);
-  CHECK(built.report.max_deviation < 1e-12 * size);
+  CHECK(built.report.max_deviation_mm < 1e-12 * size);
   double worst = 0;
   const auto [a, b] = profile.basis.domain();
   for (double u : linspace(a, b, 41))
@@ -327,7 +327,7 @@ TEST_CASE("sweep along a quarter circle is the surface of revolution within tole
   const double err = revolution_error(built.surface, profile);
   INFO(built.report.brief() << "; independent deviation " << err << " mm, size " << size);
   CHECK_FALSE(built.report.exact);
-  CHECK(built.report.max_deviation <= 1e-6 * size);
+  CHECK(built.report.max_deviation_mm <= 1e-6 * size);
   CHECK(err <= 1e-6 * size);
   // The first section is the profile itself and the last one the profile turned by 90 degrees
   // (sections are interpolated exactly; on a planar path the frames are exact rotations).
@@ -359,7 +359,7 @@ TEST_CASE("sweep of a rational circle along a quarter circle is a torus within t
     }
   INFO(built.report.brief() << "; distance to the torus " << worst);
   CHECK(built.surface.is_rational());
-  CHECK(built.report.max_deviation <= 1e-6 * size);
+  CHECK(built.report.max_deviation_mm <= 1e-6 * size);
   CHECK(worst <= 1e-6 * size);
 }
 
@@ -379,7 +379,7 @@ TEST_CASE("sweep along a planar path does not twist: the plane-normal offset is 
   const BuiltSurface built = sweep(profile, path);
   const double size = box_size(built.surface);
   INFO(built.report.brief());
-  CHECK(built.report.max_deviation <= 1e-6 * size);
+  CHECK(built.report.max_deviation_mm <= 1e-6 * size);
   // Rotation-minimizing frames on a planar curve turn about the plane normal only, so every
   // surface point keeps the height (z) of the profile point it comes from.
   double worst = 0;
@@ -478,7 +478,7 @@ TEST_CASE("sweep along a space curve follows independently integrated rotation-m
     }
   }
   INFO(built.report.brief() << "; independent deviation " << worst << " mm, size " << size);
-  CHECK(built.report.max_deviation <= 1e-6 * size);
+  CHECK(built.report.max_deviation_mm <= 1e-6 * size);
   CHECK(worst <= 2e-6 * size);
 }
 
@@ -496,7 +496,7 @@ TEST_CASE("sweep along a line continued by a tangent arc (curvature jump) keeps 
   const BuiltSurface built = sweep(profile, path);
   const double size = box_size(built.surface);
   INFO(built.report.brief());
-  CHECK(built.report.max_deviation <= 1e-6 * size);
+  CHECK(built.report.max_deviation_mm <= 1e-6 * size);
   CHECK(built.surface.count_v() <= 65);
   // The join sits at arc-length fraction 50 / (50 + 25 pi), a triple knot in v.
   const double join = 50.0 / (50.0 + 25.0 * std::numbers::pi);
@@ -535,7 +535,7 @@ TEST_CASE("sweep with twist turns the profile about the path", "[skin][sweep]") 
   const double size = box_size(built.surface);
   INFO(built.report.brief());
   CHECK_FALSE(built.report.exact);
-  CHECK(built.report.max_deviation <= 1e-6 * size);
+  CHECK(built.report.max_deviation_mm <= 1e-6 * size);
   const Eigen::Vector3d axis_point(100, 0, 0);
   for (double v : {0.25, 0.5, 1.0}) {
     const Eigen::Matrix3d rot = Eigen::AngleAxisd(v * std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -558,9 +558,9 @@ TEST_CASE("sweep with a fixed number of sections reports its deviation", "[skin]
   INFO(coarse.report.brief() << "; independent " << err);
   // The report compares points at equal arc length (it includes the drift along the path), the
   // independent check the shape of each iso-curve: the same order of magnitude.
-  CHECK(coarse.report.max_deviation > 1e-3 * box_size(coarse.surface));
-  CHECK(coarse.report.max_deviation >= 0.5 * err);
-  CHECK(coarse.report.max_deviation <= 2.0 * err);
+  CHECK(coarse.report.max_deviation_mm > 1e-3 * box_size(coarse.surface));
+  CHECK(coarse.report.max_deviation_mm >= 0.5 * err);
+  CHECK(coarse.report.max_deviation_mm <= 2.0 * err);
 }
 
 TEST_CASE("sweep rejects a path of zero length", "[skin][sweep][errors]") {
@@ -672,5 +672,5 @@ TEST_CASE("An adaptive sweep that misses its tolerance at max_sections is an err
   CHECK_THAT(message, Catch::Contains("with 9 sections, the most SweepOptions::max_sections = 9 allows"));
   o.twist_degrees = 90;  // within reach: a result
   o.max_sections = 1025;
-  CHECK(sweep(upright_profile(), quarter_circle(100, 0), o).report.max_deviation <= o.tolerance * 200);
+  CHECK(sweep(upright_profile(), quarter_circle(100, 0), o).report.max_deviation_mm <= o.tolerance * 200);
 }

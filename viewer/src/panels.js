@@ -23,7 +23,7 @@ function formatValue(v) {
 
 // Units of the report's figures (docs/recipe.md, "Figures per kind").
 const UNITS = {
-  max_deviation_mm: 'mm', sampled_max_mm: 'mm', tolerance_mm: 'mm', rms_deviation: 'mm',
+  max_deviation_mm: 'mm', sampled_max_mm: 'mm', tolerance_mm: 'mm', rms_deviation_mm: 'mm',
   max_displacement: 'mm', target_deviation: 'mm', target_curve_deviation: 'mm',
   boundary_position_jump: 'mm', boundary_tangent_angle: '°', size: 'mm', seconds: 's',
 };

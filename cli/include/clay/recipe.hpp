@@ -4,6 +4,7 @@
 /// composition mode and the exports — checked with every problem at once, replayed bit for bit,
 /// and applied to other surfaces (Coquillart's recording operator). The `clayform` command is a
 /// shell over these functions.
+#include <clay/recipe/export.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
@@ -31,13 +32,13 @@ struct Problem {
 };
 
 /// "path: message", or "line L, column C: message" for a syntax error.
-std::string to_string(const Problem& problem);
+CLAY_RECIPE_API std::string to_string(const Problem& problem);
 
 struct RecipeData;  // the checked recipe (recipe_model.hpp, internal)
 
 /// A checked recipe: every reference resolved, every field typed and in range. Cheap to copy
 /// (shared, immutable).
-struct Recipe {
+struct CLAY_RECIPE_API Recipe {
   std::shared_ptr<const RecipeData> data;
   /// The recipe's name (its "name", or the file stem when read with load_recipe).
   const std::string& name() const;
@@ -50,15 +51,17 @@ struct Recipe {
 /// range, names that are malformed or defined twice, references to missing or later objects.
 /// Files named by `import` surfaces are resolved against `base_dir` and must exist. Empty when
 /// the recipe can be run. Never throws for bad text.
-std::vector<Problem> check_recipe(std::string_view text, const std::filesystem::path& base_dir = {});
+CLAY_RECIPE_API std::vector<Problem> check_recipe(std::string_view text,
+                                                  const std::filesystem::path& base_dir = {});
 
 /// The checked recipe. Throws clay::Error(Recipe) listing every problem of check_recipe, one per
 /// line.
-Recipe parse_recipe(std::string_view text, const std::filesystem::path& base_dir = {});
+CLAY_RECIPE_API Recipe parse_recipe(std::string_view text,
+                                    const std::filesystem::path& base_dir = {});
 
 /// Reads and parses a recipe file (imports resolved next to it; the name defaults to the stem).
 /// Throws clay::Error: Io when the file cannot be read, Recipe for its problems.
-Recipe load_recipe(const std::filesystem::path& file);
+CLAY_RECIPE_API Recipe load_recipe(const std::filesystem::path& file);
 
 /// A figure of a step's report: a flag, a count, a measure (mm, degrees, ratio) or a word.
 using Figure = std::variant<bool, long long, double, std::string>;
@@ -109,7 +112,7 @@ struct Stage {
 };
 
 /// Everything a run computed, in memory. Nothing is written until write_outputs.
-struct RunResult {
+struct CLAY_RECIPE_API RunResult {
   std::string recipe;  ///< the recipe's name
   std::vector<std::pair<std::string, surface::BSplineCurve>> curves;      ///< every named curve
   std::vector<std::pair<std::string, surface::BSplineSurface>> surfaces;  ///< every named surface
@@ -128,20 +131,21 @@ struct RunResult {
 /// recipe gives bit-identical surfaces (no step's arithmetic depends on timing or on how work is
 /// split between threads). Throws clay::Error with the
 /// failing step's path first ("surfaces.sail.steps[2] (twist): ...") and that step's category.
-RunResult run_recipe(const Recipe& recipe, const RunOptions& options = {});
+CLAY_RECIPE_API RunResult run_recipe(const Recipe& recipe, const RunOptions& options = {});
 
 /// Applies the recipe's deformation stack `deformation` (may be empty when the recipe has
 /// exactly one) to each of `surfaces` with the recipe's composition mode: the "clayform deform"
 /// use. The result's surfaces are named "<stem>-<k>" (k from 0) and one export "<stem>" holds
 /// them all, with the recipe's first export's formats (all three when it has none).
-RunResult deform_surfaces(const Recipe& recipe, const std::vector<surface::BSplineSurface>& surfaces,
-                          std::string_view stem, std::string_view deformation = {},
-                          const RunOptions& options = {});
+CLAY_RECIPE_API RunResult deform_surfaces(const Recipe& recipe,
+                                          const std::vector<surface::BSplineSurface>& surfaces,
+                                          std::string_view stem, std::string_view deformation = {},
+                                          const RunOptions& options = {});
 
 /// The report of a run as JSON text (schema "clayform.report", version 1, docs/recipe.md):
 /// per step its path, kind, seconds, warning, message and figures; per export its files and
 /// exchange figures (valid is filled in by write_outputs; report_json alone leaves it out).
-std::string report_json(const RunResult& result);
+CLAY_RECIPE_API std::string report_json(const RunResult& result);
 
 /// Writes every export (NAME.step, NAME.igs, NAME.glb per its formats), report.json and the view
 /// folder (view/manifest.json and view/NNN.bin, clay/view.hpp) into `out_dir` (created when
@@ -151,12 +155,13 @@ std::string report_json(const RunResult& result);
 /// paths written (the view folder as one entry, last). Throws clay::Error (Io, Exchange) naming
 /// the file; Exchange, with BRepCheck's findings, when an export reads back invalid (then
 /// nothing is written into `out_dir`).
-std::vector<std::filesystem::path> write_outputs(RunResult& result, const std::filesystem::path& out_dir);
+CLAY_RECIPE_API std::vector<std::filesystem::path> write_outputs(
+    RunResult& result, const std::filesystem::path& out_dir);
 
 /// A library message in the recipe's words: the fixes it suggests name recipe keys, never C++
 /// options ("SurfaceDeformationOptions::refit" becomes "composition": {"mode": "refit", ...}),
 /// and fixes recipes cannot apply are left out. Every message the command prints about a recipe
 /// goes through it (the checker's problems and the run's step errors).
-std::string recipe_wording(std::string message);
+CLAY_RECIPE_API std::string recipe_wording(std::string message);
 
 }  // namespace clay::recipe

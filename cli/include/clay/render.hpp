@@ -2,6 +2,7 @@
 /// Pictures of surfaces: a small software renderer (orthographic camera, z-buffer, Lambert and a
 /// soft specular highlight) and a PNG writer, for README figures and `clayform render`. No GPU,
 /// no window, no OpenCASCADE: the surfaces are tessellated with surface::evaluate_grid.
+#include <clay/render/export.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
 #include <Eigen/Core>
@@ -9,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace clay::render {
@@ -17,7 +19,7 @@ namespace clay::render {
 using Rgb = std::array<std::uint8_t, 3>;
 
 /// How a picture is made. Every field is checked by validate().
-struct RenderOptions {
+struct CLAY_RENDER_API RenderOptions {
   int width = 960;   ///< picture width in pixels, in [16, 8192]
   int height = 640;  ///< picture height in pixels, in [16, 8192]
   /// Direction from the model towards the eye (any length > 0, finite): the camera sits far along
@@ -37,13 +39,15 @@ struct RenderOptions {
   /// per surface (golden-angle hue steps from blue).
   std::vector<Rgb> colours;
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
 /// An 8-bit RGB picture: pixel (x, y), x to the right and y down from the top-left corner, is
 /// rgb[3 * (y * width + x) + c] for channel c (red, green, blue).
-struct Image {
+struct CLAY_RENDER_API Image {
   int width = 0;
   int height = 0;
   std::vector<std::uint8_t> rgb;
@@ -70,11 +74,12 @@ struct Image {
 ///
 /// Throws clay::Error: InvalidArgument for bad options or no surfaces, InvalidGeometry for an
 /// invalid surface (surface::validate).
-Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderOptions& options = {});
+CLAY_RENDER_API Image render(const std::vector<surface::BSplineSurface>& surfaces,
+                             const RenderOptions& options = {});
 
 /// Writes `image` as an 8-bit RGB PNG (libpng), atomically: into a temporary file next to `file`,
 /// then renamed over it. Throws clay::Error: InvalidArgument when the image's size and pixel count
 /// disagree, Io naming the file when it cannot be written.
-void write_png(const Image& image, const std::filesystem::path& file);
+CLAY_RENDER_API void write_png(const Image& image, const std::filesystem::path& file);
 
 }  // namespace clay::render

@@ -2,6 +2,7 @@
 /// Serving a run to the browser viewer and taking pictures of it (issue #9): `clayform view` and
 /// `clayform snapshot` (docs/recipe.md "Viewing a run"). The built front end (viewer/dist) is
 /// served at `/`, the run folder (with its view/manifest.json, clay/view.hpp) under `/run/`.
+
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -58,7 +59,8 @@ struct SnapshotOptions {
 /// `/?mode=MODE`, waits for it (killed after the timeout), checks `png` was written.
 /// Throws clay::Error: InvalidArgument for a bad mode or size, Io when chromium is missing (naming
 /// the Debian package), fails, times out or writes no picture.
-void snapshot(const std::filesystem::path& run_dir, const std::filesystem::path& png,
-              const SnapshotOptions& options = {});
+void snapshot(const std::filesystem::path& run_dir,
+                              const std::filesystem::path& png,
+                              const SnapshotOptions& options = {});
 
 }  // namespace clay::recipe

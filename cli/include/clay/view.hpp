@@ -4,6 +4,7 @@
 /// refit deviation, written as `view/manifest.json` and `view/NNN.bin` for the browser viewer
 /// (`clayform view`, docs/recipe.md "Viewing a run").
 #include <clay/recipe.hpp>
+#include <clay/recipe/export.hpp>
 
 #include <Eigen/Core>
 
@@ -28,7 +29,7 @@ struct ViewMesh {
 
 /// The grid parameters of one direction: about 8 samples per knot span following the knots, at
 /// least 17 and at most 161 in all, ends included.
-std::vector<double> view_parameters(const surface::BSplineBasis& basis);
+CLAY_RECIPE_API std::vector<double> view_parameters(const surface::BSplineBasis& basis);
 
 /// The surface on the grid view_parameters(u) x view_parameters(v), with exact normals and
 /// curvatures from the first and second derivatives: K = (LN - M^2) / (EG - F^2),
@@ -38,16 +39,17 @@ std::vector<double> view_parameters(const surface::BSplineBasis& basis);
 /// its largest on the grid, or S_u parallel to S_v — the normal is the normalized
 /// average of the neighbouring cells' normals and K, H the average of the non-degenerate
 /// neighbouring vertices'. Deviation all 0.
-ViewMesh view_mesh(const surface::BSplineSurface& surface);
+CLAY_RECIPE_API ViewMesh view_mesh(const surface::BSplineSurface& surface);
 
 /// Sets mesh.deviation to |S(u, v) - map(B(u, v))| at every vertex, with S the tessellated
 /// surface (the refit) and B the surface before the step, its domain mapped affinely onto S's.
-void set_deviation(ViewMesh& mesh, const surface::BSplineSurface& before,
-                   const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map);
+CLAY_RECIPE_API void set_deviation(
+    ViewMesh& mesh, const surface::BSplineSurface& before,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map);
 
 /// The .bin layout: little-endian float32, attribute after attribute (position 3, normal 3,
 /// gaussian 1, mean 1, deviation 1 floats per vertex), rows * cols * 9 floats.
-std::vector<float> view_floats(const ViewMesh& mesh);
+CLAY_RECIPE_API std::vector<float> view_floats(const ViewMesh& mesh);
 
 /// Writes `dir/view/manifest.json` (format "clayform.view", version 1) and the meshes
 /// `dir/view/NNN.bin`: every surface of every export (its final mesh, its control net, the figures
@@ -55,6 +57,6 @@ std::vector<float> view_floats(const ViewMesh& mesh);
 /// the curves it used (200-point polylines) and its figures; a refitted step's `after` carries its
 /// deviation from the step's deformation applied pointwise to `before`. Identical meshes share a
 /// file. Throws clay::Error(Io) naming the file that cannot be written.
-void write_view_data(const RunResult& result, const std::filesystem::path& dir);
+CLAY_RECIPE_API void write_view_data(const RunResult& result, const std::filesystem::path& dir);
 
 }  // namespace clay::recipe

@@ -3,6 +3,8 @@
 ///
 /// Every error carries a category (what kind of problem, mapped to exit codes by the CLI) and a
 /// message that names the offending object, the value found and what would fix it.
+#include <clay/surface/export.hpp>
+
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -24,10 +26,10 @@ enum class ErrorCategory {
 };
 
 /// Human-readable name of a category ("invalid geometry", ...).
-std::string_view to_string(ErrorCategory category) noexcept;
+CLAY_SURFACE_API std::string_view to_string(ErrorCategory category) noexcept;
 
 /// The exception raised by Clayform. what() is "<category>: <message>".
-class Error : public std::runtime_error {
+class CLAY_SURFACE_API Error : public std::runtime_error {
  public:
   /// Build an error of `category` whose message names the object, the value and the fix.
   Error(ErrorCategory category, const std::string& message);

@@ -1,6 +1,8 @@
 #pragma once
 /// Summary — the outcome of iterative work (projection, fitting, solving, refitting).
 /// Not converging is an outcome reported here, not an exception (Ceres' Solver::Summary).
+#include <clay/surface/export.hpp>
+
 #include <string>
 
 namespace clay {
@@ -13,7 +15,7 @@ enum class Termination {
 };
 
 /// Outcome of an iterative computation.
-struct Summary {
+struct CLAY_SURFACE_API Summary {
   Termination termination = Termination::Failed;
   std::string message;          ///< what happened, in words
   int iterations = 0;           ///< iterations performed

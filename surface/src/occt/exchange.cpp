@@ -13,11 +13,12 @@
 
 #include <clay/error.hpp>
 #include <clay/surface/tessellate.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/fenv.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <cfenv>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -134,25 +135,11 @@ class QuietMessages {
   std::vector<Message_Gravity> saved_;
 };
 
-/// While alive, floating-point exceptions do not trap (OpenCASCADE's algorithms may divide by
-/// zero internally and expect IEEE results, while a caller, e.g. a debug test run, may have
-/// enabled traps). The caller's environment, flags included, is restored on exit.
-class NonStopFloatingPoint {
- public:
-  NonStopFloatingPoint() { std::feholdexcept(&saved_); }
-  ~NonStopFloatingPoint() { std::fesetenv(&saved_); }
-  NonStopFloatingPoint(const NonStopFloatingPoint&) = delete;
-  NonStopFloatingPoint& operator=(const NonStopFloatingPoint&) = delete;
-
- private:
-  std::fenv_t saved_;
-};
-
 /// The exchange lock, quiet messages and non-stop floating point, for one public call.
 struct ExchangeSession {
   std::lock_guard<std::mutex> lock{exchange_mutex()};
   QuietMessages quiet;
-  NonStopFloatingPoint floating_point;
+  internal::FpTrapsHeld floating_point;
 };
 
 std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
@@ -899,15 +886,19 @@ ExchangeReport write_iges(const std::vector<BSplineSurface>& surfaces, const fs:
   });
 }
 
-void ReadOptions::validate() const {
-  auto fail = [](const std::string& what) {
-    throw Error(ErrorCategory::InvalidArgument, "ReadOptions::" + what);
+std::vector<std::string> ReadOptions::problems() const {
+  std::vector<std::string> out;
+  auto fail = [&out](const std::string& what) {
+    out.push_back("ReadOptions::" + what);
   };
   if (!(time_limit_seconds > 0 && time_limit_seconds <= 86400))
     fail("time_limit_seconds = " + std::to_string(time_limit_seconds) + ": must be in (0, 86400]");
   if (memory_limit_mb < 1 || memory_limit_mb > 1048576)
     fail("memory_limit_mb = " + std::to_string(memory_limit_mb) + ": must be in [1, 1048576]");
+  return out;
 }
+
+void ReadOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 std::vector<BSplineSurface> read_step(const fs::path& file, const ReadOptions& options) {
   return read_guarded(file, options, "read_step", &detail::precheck_step, &read_step_locked);
@@ -917,21 +908,28 @@ std::vector<BSplineSurface> read_iges(const fs::path& file, const ReadOptions& o
   return read_guarded(file, options, "read_iges", &detail::precheck_iges, &read_iges_locked);
 }
 
+std::vector<std::string> GltfWriteOptions::problems() const {
+  std::vector<std::string> out;
+  if (!(relative_area > 0.0 && relative_area < 0.5))
+    out.push_back("GltfWriteOptions::relative_area is " + std::to_string(relative_area) +
+                  "; it must be in (0, 0.5), e.g. 0.005");
+  if (max_vertices < 289)
+    out.push_back("GltfWriteOptions::max_vertices is " + std::to_string(max_vertices) +
+                  "; it must be at least 289 (a 17 x 17 grid)");
+  return out;
+}
+
+void GltfWriteOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+
 void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& file,
                 const GltfWriteOptions& options) {
   constexpr std::string_view caller = "write_gltf";
-  if (!(options.relative_area > 0.0 && options.relative_area < 0.5))
-    throw Error(ErrorCategory::InvalidArgument,
-                "write_gltf: GltfWriteOptions::relative_area is " + std::to_string(options.relative_area) +
-                    "; it must be in (0, 0.5), e.g. 0.005");
   // The preview is our own tessellation (the viewer's grid, refined until its area is within
   // relative_area of the surface's), attached to each face as its triangulation: OpenCASCADE's
   // mesher gave zero-area meshes on surfaces with poles (the handset, the bent superellipsoid),
   // and only the writer is needed from it.
-  if (options.max_vertices < 289)
-    throw Error(ErrorCategory::InvalidArgument,
-                "write_gltf: GltfWriteOptions::max_vertices is " + std::to_string(options.max_vertices) +
-                    "; it must be at least 289 (a 17 x 17 grid)");
+  const auto bad = options.problems();
+  if (!bad.empty()) throw Error(ErrorCategory::InvalidArgument, "write_gltf: " + internal::join_problems(bad));
   for (size_t k = 0; k < surfaces.size(); ++k) validate(surfaces[k], surface_name(k));
   const long share = options.max_vertices / std::max<long>(1, static_cast<long>(surfaces.size()));
   const int max_samples = static_cast<int>(std::clamp<long>(static_cast<long>(std::sqrt(static_cast<double>(share))), 17, 1025));

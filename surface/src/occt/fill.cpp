@@ -11,6 +11,7 @@
 #include <clay/surface/self_intersection.hpp>
 #include <clay/surface/skin.hpp>
 #include <clay/tolerance.hpp>
+#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -374,15 +375,19 @@ auto with_occt(const char* what, F f) {
 
 }  // namespace
 
-void FillOptions::validate() const {
+std::vector<std::string> FillOptions::problems() const {
+  std::vector<std::string> out;
   if (!(gap_tolerance > 0.0 && std::isfinite(gap_tolerance)))
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "FillOptions::gap_tolerance is " + num(gap_tolerance) + "; it must be > 0 and finite");
   if (style != FillStyle::Stretch && style != FillStyle::Coons && style != FillStyle::Curved)
-    throw Error(ErrorCategory::InvalidArgument,
+    out.push_back(
                 "FillOptions::style is " + std::to_string(static_cast<int>(style)) +
                     "; it must be Stretch, Coons or Curved");
+  return out;
 }
+
+void FillOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& options) {
   options.validate();
@@ -532,14 +537,15 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
   if (!note.empty()) method += " (" + note + ")";
   built.report = describe(built.surface, method);
   built.report.exact = true;
-  built.report.max_deviation = worst;
+  built.report.max_deviation_mm = worst;
   built.report.samples = samples;
   return built;
 }
 
-void NSidedFillOptions::validate() const {
-  auto bad = [](const char* field, const std::string& value, const char* rule) {
-    throw Error(ErrorCategory::InvalidArgument,
+std::vector<std::string> NSidedFillOptions::problems() const {
+  std::vector<std::string> out;
+  auto bad = [&out](const char* field, const std::string& value, const char* rule) {
+    out.push_back(
                 std::string("NSidedFillOptions::") + field + " is " + value + "; it must be " + rule);
   };
   if (degree < 2 || degree > 14) bad("degree", std::to_string(degree), "in [2, 14]");
@@ -558,7 +564,10 @@ void NSidedFillOptions::validate() const {
   if (!(gap_tolerance > 0 && std::isfinite(gap_tolerance)))
     bad("gap_tolerance", num(gap_tolerance), "> 0 and finite");
   if (samples_per_curve < 2) bad("samples_per_curve", std::to_string(samples_per_curve), ">= 2");
+  return out;
 }
+
+void NSidedFillOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
 
 NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
                         const std::vector<BSplineCurve>& interior, const NSidedFillOptions& options) {
@@ -638,7 +647,7 @@ NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
   method += ")";
   out.built.report = describe(s, method);
   out.built.report.exact = false;
-  out.built.report.max_deviation =
+  out.built.report.max_deviation_mm =
       *std::max_element(out.curve_deviations.begin(), out.curve_deviations.end());
   out.built.report.samples = samples;
   return out;

@@ -10,6 +10,7 @@
 /// of freedom; a dependent equation gives the smallest set of constraints it depends on (its
 /// fundamental circuit), "redundant" when they all hold after the solve, "conflicting" otherwise.
 #include <clay/constraints/constraint.hpp>
+#include <clay/constraints/export.hpp>
 #include <clay/summary.hpp>
 
 #include <Eigen/Core>
@@ -26,7 +27,7 @@ struct Drag {
 };
 
 /// Settings of solve().
-struct SolveOptions {
+struct CLAY_CONSTRAINTS_API SolveOptions {
   double tolerance = 1e-10;   ///< largest residual (mm, or radians for angles) of a solved
                               ///< constraint; in (0, 1e-3]
   int max_iterations = 100;   ///< Levenberg–Marquardt iterations, >= 1
@@ -38,7 +39,9 @@ struct SolveOptions {
   /// constraints as heavy equations), then solves the constraints alone from there.
   std::vector<Drag> drag;
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -52,7 +55,7 @@ struct Dependency {
 };
 
 /// What solve() found.
-struct SolveReport {
+struct CLAY_CONSTRAINTS_API SolveReport {
   Summary summary;               ///< Converged when every constraint holds within tolerance
   double max_residual = 0;       ///< largest |residual| after the solve (mm or radians)
   int unknowns = 0;              ///< scalar unknowns before substitution
@@ -66,6 +69,9 @@ struct SolveReport {
                                  ///< direction) differs from the start: a different solution
   double solve_seconds = 0;      ///< wall time of the solve
   double diagnose_seconds = 0;   ///< wall time of the rank / dependency analysis
+
+  /// One line: the summary, the largest residual, the unknowns and the degrees of freedom.
+  std::string brief() const;
 };
 
 /// The solved sketch and its report.
@@ -81,7 +87,8 @@ struct SolveResult {
 /// reference), for a planar constraint on entities not in one plane, for a non-positive
 /// distance/radius or a non-finite value, and for bad options; InvalidGeometry for an invalid
 /// sketch (sketch::validate).
-SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& constraints,
-                  const SolveOptions& options = {});
+CLAY_CONSTRAINTS_API SolveResult solve(const sketch::Sketch& sketch,
+                                       const std::vector<Constraint>& constraints,
+                                       const SolveOptions& options = {});
 
 }  // namespace clay::constraints

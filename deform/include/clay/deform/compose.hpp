@@ -24,29 +24,34 @@
 /// The FFD is the identity outside the lattice (lattice.hpp), so a surface that leaves the lattice
 /// is not one polynomial patch there: compose_exact certifies (Bernstein bounds and subdivision)
 /// that every patch lies in the lattice and throws otherwise; it never returns a wrong surface.
+#include <clay/deform/export.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
+#include <clay/summary.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
 #include <string>
+#include <vector>
 
 namespace clay::deform {
 
 /// Settings of compose_exact.
-struct ComposeOptions {
+struct CLAY_DEFORM_API ComposeOptions {
   /// Knot removal tolerance, relative to the largest homogeneous control point of the composed
   /// net (dimensionless, in [0, 1e-6]). 0 keeps every patch boundary (a C0 patchwork).
   double knot_tolerance = 1e-12;
   /// Samples per patch and direction at which the result is compared with the pointwise
-  /// deformation of the original for ComposeReport::max_deviation (>= 0; 0 skips the check).
+  /// deformation of the original for ComposeReport::max_relative_deviation (>= 0; 0 skips the check).
   int check_samples = 4;
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
 /// What compose_exact built, and how closely it matches the pointwise deformation.
-struct ComposeReport {
+struct CLAY_DEFORM_API ComposeReport {
   int degree_u = 0;          ///< degree of the result in u
   int degree_v = 0;          ///< degree of the result in v
   int patches = 0;           ///< Bézier patches composed (after any splits at lattice knot planes)
@@ -56,10 +61,13 @@ struct ComposeReport {
   /// Largest distance between the result and the pointwise deformation (deform_point of the
   /// original surface's points) over check_samples² parameters per patch, divided by `size`
   /// (dimensionless; ~1e-15 for an exact composition). 0 when check_samples is 0.
-  double max_deviation = 0.0;
+  double max_relative_deviation = 0.0;
   double size = 0.0;         ///< the reference length (mm): the lattice control points' box
                              ///< diagonal, or the surface's control box diagonal for a taper
   bool exact = true;         ///< true: the result is the composition, exact up to rounding
+  /// Converged (a composition that cannot be exact throws instead); message = brief(),
+  /// final_residual = max_relative_deviation.
+  Summary summary;
 
   /// One line: degrees, patches, control points, knots removed, deviation.
   std::string brief() const;
@@ -77,8 +85,9 @@ struct ComposeResult {
 /// the lattice (naming the patch, the local coordinate and a parameter where it is outside),
 /// DegreeLimit when the exact degree exceeds surface::max_exchange_degree (naming the degree and
 /// the ways out: a lattice of lower degree in the thickness direction, or a refit tolerance).
-ComposeResult compose_exact(const BezierLattice& lattice, const surface::BSplineSurface& surface,
-                            const ComposeOptions& options = {});
+CLAY_DEFORM_API ComposeResult compose_exact(const BezierLattice& lattice,
+                                            const surface::BSplineSurface& surface,
+                                            const ComposeOptions& options = {});
 
 /// The surface deformed by the B-spline lattice (Hsu–Hughes–Kaufman eq. (1)), exactly, through
 /// its Bézier cells (bezier_cells). Where a local coordinate that depends on one surface
@@ -86,8 +95,9 @@ ComposeResult compose_exact(const BezierLattice& lattice, const surface::BSpline
 /// resulting patch must then lie in one cell and is composed with it. Throws as the Bézier
 /// overload, and clay::Error(InvalidArgument) when a patch crosses a knot plane otherwise (naming
 /// the patch, the plane and a parameter of the crossing): such a surface needs a refit tolerance.
-ComposeResult compose_exact(const BSplineLattice& lattice, const surface::BSplineSurface& surface,
-                            const ComposeOptions& options = {});
+CLAY_DEFORM_API ComposeResult compose_exact(const BSplineLattice& lattice,
+                                            const surface::BSplineSurface& surface,
+                                            const ComposeOptions& options = {});
 
 /// The surface tapered by a polynomial profile (Güdükbay–Özgüç 1990 §3.1.1: X = r(z) x,
 /// Y = r(z) y, Z = z), exactly: with D the profile degree, degree D·d(z) + e per direction, where
@@ -96,7 +106,8 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const surface::BSplin
 /// Throws clay::Error: InvalidGeometry for an invalid taper or surface, InvalidArgument for bad
 /// options, DegreeLimit above surface::max_exchange_degree (naming the degree; ways out: a
 /// profile of lower degree, or a refit tolerance).
-ComposeResult compose_exact(const Taper& taper, const surface::BSplineSurface& surface,
-                            const ComposeOptions& options = {});
+CLAY_DEFORM_API ComposeResult compose_exact(const Taper& taper,
+                                            const surface::BSplineSurface& surface,
+                                            const ComposeOptions& options = {});
 
 }  // namespace clay::deform

@@ -3,21 +3,30 @@
 /// regular deformations and deformation stacks, can be used alike: a one-off
 /// `deform_point(d, x)` and a bulk `deform_points(d, points, options)` on an N x 3 row-major
 /// matrix (and on structure-of-arrays columns). The PointDeformation concept checks both.
+#include <clay/deform/export.hpp>
+#include <clay/parallel.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
 #include <Eigen/Core>
 
 #include <concepts>
 #include <span>
+#include <string>
+#include <vector>
 
 namespace clay::deform {
 
 /// Settings of deform_points().
-struct DeformOptions {
-  int threads = 0;  ///< worker threads, >= 0; 0 = std::thread::hardware_concurrency(). Fewer are
-                    ///< used when there are few points (at least 16,384 points per thread).
+struct CLAY_DEFORM_API DeformOptions {
+  int threads = 0;  ///< parts the points are split into, 0..1024; 0 = one per hardware thread.
+                    ///< Fewer are used when there are few points (at least 16,384 per part).
+  /// Who runs the parts: empty = parts − 1 new std::threads plus the calling thread
+  /// (clay::run_on_threads); an embedder hands in its own pool here (clay/parallel.hpp).
+  Executor executor = {};
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 

@@ -22,12 +22,14 @@
 ///   that act on some selected point (N x m, m <= M); its rank-revealing QR is the full-rank
 ///   factorization B S = C D of eq. (3). Cost O(N² m): ~11 ms for 100 points on a cubic 8³-cell
 ///   lattice, then ~0.7 ms per move of the targets (DirectManipulator).
+#include <clay/deform/export.hpp>
 #include <clay/deform/lattice.hpp>
+#include <clay/summary.hpp>
 
 #include <Eigen/Core>
-#include <Eigen/QR>
 #include <Eigen/SparseCore>
 
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -41,7 +43,7 @@ struct PointMove {
 };
 
 /// Settings of direct manipulation.
-struct DirectManipulationOptions {
+struct CLAY_DEFORM_API DirectManipulationOptions {
   /// Empty, or one entry per control point (row of lattice.points): true = the point must not
   /// move (e.g. locked_control_points(lattice, faces)).
   std::vector<bool> locked;
@@ -60,13 +62,14 @@ struct DirectManipulationOptions {
   /// every selected point's new image is within tolerance × size of its target.
   double tolerance = 1e-7;
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken. (The
-  /// sizes and row indices are checked against the lattice by the solve.)
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
 /// What a direct manipulation achieved.
-struct DirectManipulationReport {
+struct CLAY_DEFORM_API DirectManipulationReport {
   int requested = 0;  ///< number of point moves N
   int unknowns = 0;   ///< free control points and tie groups that act on some selected point (m)
   int rank = 0;       ///< numerical rank of B S on those unknowns (<= min(N, m))
@@ -74,7 +77,10 @@ struct DirectManipulationReport {
   double achieved_max_error = 0;  ///< max_i |deform_point(new lattice, X_i) − target_i| (mm)
   double displacement_norm = 0;   ///< Frobenius norm of new − old lattice.points (mm)
   bool feasible = false;          ///< achieved_max_error <= tolerance × size
-  std::string message;            ///< what happened, in words
+  /// Converged when feasible; NotConverged for a least-squares compromise; Failed when no free
+  /// control point acts on the points. The message says what happened, in words;
+  /// final_residual = achieved_max_error.
+  Summary summary;
 
   /// One line, e.g. "feasible: 3 points moved, rank 3 of 3, largest miss 2.1e-14 mm".
   std::string brief() const;
@@ -91,17 +97,17 @@ struct DirectManipulationResult {
 /// basis products of each point's local coordinates (see above). Throws clay::Error:
 /// InvalidGeometry for an invalid lattice, InvalidArgument for a non-finite point, OutOfDomain
 /// for a point outside the lattice (naming its index and local coordinates).
-Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(const BSplineLattice& lattice,
-                                                              const Points3& points);
+CLAY_DEFORM_API Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(
+    const BSplineLattice& lattice, const Points3& points);
 /// Same for a Bézier lattice (Bernstein products, Sederberg–Parry eq. (2)).
-Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(const BezierLattice& lattice,
-                                                              const Points3& points);
+CLAY_DEFORM_API Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(
+    const BezierLattice& lattice, const Points3& points);
 
 /// The stateful solver: fixes the lattice, the selected points and the options, and factorizes
 /// B S once ("B⁺ need be computed only once", Hsu et al. §3.1), so that dragging the targets
 /// costs a solve per move. Lattice is BSplineLattice or BezierLattice.
 template <class Lattice>
-class DirectManipulator {
+class CLAY_DEFORM_API DirectManipulator {
  public:
   /// Selected points: N x 3 rows, undeformed space, N >= 1. Throws clay::Error: InvalidGeometry
   /// for an invalid lattice; InvalidArgument for no points, a non-finite point, bad options
@@ -117,34 +123,32 @@ class DirectManipulator {
   DirectManipulationResult<Lattice> move(const Points3& targets) const;
 
   /// Current deformed images deform_point(lattice, X_i) of the selected points (N x 3).
-  const Points3& images() const noexcept { return images_; }
+  const Points3& images() const noexcept;
   /// Number of unknowns m (columns of B S that act on some selected point).
-  int unknowns() const noexcept { return static_cast<int>(columns_.size()); }
+  int unknowns() const noexcept;
   /// Numerical rank of B S.
-  int rank() const noexcept { return rank_; }
+  int rank() const noexcept;
 
  private:
-  Lattice lattice_;
-  Points3 points_, images_;
-  DirectManipulationOptions options_;
-  double size_ = 0;
-  Eigen::MatrixXd a_;                                   ///< B S on the unknowns, N x m
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod_;
-  std::vector<std::vector<Eigen::Index>> columns_;      ///< control point rows of each unknown
-  int rank_ = 0;
+  // The factorization lives in the source (pimpl), so no Eigen decomposition is part of the API;
+  // copies share it read-only, which is safe since every member function is const.
+  struct State;
+  std::shared_ptr<const State> state_;
 };
 
 /// One-off direct manipulation: DirectManipulator(lattice, points, options).move(targets).
 /// Same throws (a request is named by its index in `moves`).
-DirectManipulationResult<BSplineLattice> manipulate(const BSplineLattice& lattice,
-                                                    std::span<const PointMove> moves,
-                                                    const DirectManipulationOptions& options = {});
+CLAY_DEFORM_API DirectManipulationResult<BSplineLattice> manipulate(
+    const BSplineLattice& lattice, std::span<const PointMove> moves,
+    const DirectManipulationOptions& options = {});
 /// Same for a Bézier lattice.
-DirectManipulationResult<BezierLattice> manipulate(const BezierLattice& lattice,
-                                                   std::span<const PointMove> moves,
-                                                   const DirectManipulationOptions& options = {});
+CLAY_DEFORM_API DirectManipulationResult<BezierLattice> manipulate(
+    const BezierLattice& lattice, std::span<const PointMove> moves,
+    const DirectManipulationOptions& options = {});
 
-extern template class DirectManipulator<BSplineLattice>;
-extern template class DirectManipulator<BezierLattice>;
+// Exported here too: an instantiation is no more visible than its arguments, and the lattices,
+// which have no out-of-line members, are not marked.
+extern template class CLAY_DEFORM_API DirectManipulator<BSplineLattice>;
+extern template class CLAY_DEFORM_API DirectManipulator<BezierLattice>;
 
 }  // namespace clay::deform

@@ -15,6 +15,7 @@
 /// along w) is row chunk[(i * 4 + j) * 4 + k] of `rest` / `points`, the s-major order of
 /// BezierLattice (k fastest).
 #include <clay/deform/deformation.hpp>
+#include <clay/deform/export.hpp>
 #include <clay/summary.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
@@ -48,17 +49,19 @@ struct ExtendedLattice {
 /// non-finite coordinates (naming the row), a chunk whose rest control points all coincide (zero
 /// extent). Degenerate chunks (collapsed faces or edges, flat chunks) are allowed. Empty when
 /// valid.
-std::vector<std::string> problems(const ExtendedLattice& lattice,
-                                  std::string_view name = "extended lattice");
+CLAY_DEFORM_API std::vector<std::string> problems(const ExtendedLattice& lattice,
+                                                  std::string_view name = "extended lattice");
 
 /// Throws clay::Error(InvalidGeometry) listing problems(lattice, name) when there are any.
-void validate(const ExtendedLattice& lattice, std::string_view name = "extended lattice");
+CLAY_DEFORM_API void validate(const ExtendedLattice& lattice,
+                              std::string_view name = "extended lattice");
 
 /// Coquillart eq. (1): L(u, v, w) = sum_ijk B_i(u) B_j(v) B_k(w) P_ijk with the cubic Bernstein
 /// polynomials B and P_ijk = control.row(chunk[(i * 4 + j) * 4 + k]) — pass `rest` for the rest
 /// shape, `points` for the current one. Any (u, v, w), also outside [0, 1]^3 (the polynomial).
 /// Precondition: the indices are rows of `control`.
-Eigen::Vector3d chunk_point(const Points3& control, const Chunk& chunk, const Eigen::Vector3d& uvw);
+CLAY_DEFORM_API Eigen::Vector3d chunk_point(const Points3& control, const Chunk& chunk,
+                                            const Eigen::Vector3d& uvw);
 
 /// Welds control points whose rest positions lie within `tolerance` (mm) of each other
 /// (Coquillart §3.1.4: welding is merging points): they become one row (the lowest index's rest
@@ -66,12 +69,13 @@ Eigen::Vector3d chunk_point(const Points3& control, const Chunk& chunk, const Ei
 /// elementary lattices into a composite one (append rows and chunks, then weld). Throws
 /// clay::Error: InvalidArgument for a negative or non-finite tolerance, InvalidGeometry for an
 /// invalid lattice.
-ExtendedLattice merge_coincident_points(const ExtendedLattice& lattice, double tolerance);
+CLAY_DEFORM_API ExtendedLattice merge_coincident_points(const ExtendedLattice& lattice,
+                                                        double tolerance);
 
 // ---- cylindrical lattice ----------------------------------------------------------------------
 
 /// A cylinder cut into sectors (around the axis), rings (radial) and layers (along the axis).
-struct CylinderSpec {
+struct CLAY_DEFORM_API CylinderSpec {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();     ///< centre of the bottom disc (mm)
   Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();      ///< axis direction (normalized)
   Eigen::Vector3d reference = Eigen::Vector3d::UnitX();  ///< angle 0 (made orthogonal to the axis)
@@ -99,20 +103,20 @@ struct CylinderSpec {
 /// radius at 90°, 3.7e-7 at 30°), so the lattice contains the cylinder. The identity of the
 /// undisplaced lattice comes from freezing, not from the arc being a circle.
 /// Throws clay::Error(InvalidArgument) for a bad spec.
-ExtendedLattice make_cylindrical_lattice(const CylinderSpec& spec);
+CLAY_DEFORM_API ExtendedLattice make_cylindrical_lattice(const CylinderSpec& spec);
 
 /// Row of control point (radial, angular, axial) of make_cylindrical_lattice(spec):
 /// radial in [0, 3 rings], angular any integer (taken modulo 3 sectors: the seam is welded),
 /// axial in [0, 3 layers]. With inner_radius = 0 every (0, angular, axial) is the one axis row
 /// `axial`. Throws clay::Error: OutOfDomain for radial or axial out of range, InvalidArgument for
 /// a bad spec.
-int cylindrical_index(const CylinderSpec& spec, int radial, int angular, int axial);
+CLAY_DEFORM_API int cylindrical_index(const CylinderSpec& spec, int radial, int angular, int axial);
 
 // ---- prismatic lattice lofted from planar curves ------------------------------------------------
 
 /// A prism over a planar 2D lattice lofted from section curves (Coquillart §3.1.4: "EFFD
 /// lattices can also be created from two-dimensional lattices ... loft, sweep, extrusion").
-struct PrismSpec {
+struct CLAY_DEFORM_API PrismSpec {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();   ///< where 2D point (0, 0) sits (mm)
   Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX();  ///< 2D x direction (normalized)
   Eigen::Vector3d y_axis = Eigen::Vector3d::UnitY();  ///< 2D y direction (made orthogonal to x)
@@ -137,12 +141,12 @@ struct PrismSpec {
 /// welding; coincident rest points (a closed curve's seam, sections that touch) are then welded
 /// by merge_coincident_points at 1e-12 of the lattice size, which drops duplicate rows.
 /// Throws clay::Error(InvalidArgument) for a bad spec.
-ExtendedLattice make_prismatic_lattice(const PrismSpec& spec);
+CLAY_DEFORM_API ExtendedLattice make_prismatic_lattice(const PrismSpec& spec);
 
 // ---- freezing and deformation -----------------------------------------------------------------
 
 /// Settings of freeze().
-struct FreezeOptions {
+struct CLAY_DEFORM_API FreezeOptions {
   /// Residual |L(u,v,w) − x| / chunk size at convergence, (0, 1e-3].
   double newton_tolerance = 1e-12;
   /// A root this far outside [0, 1]^3 still counts as inside, [0, 1e-3].
@@ -151,10 +155,13 @@ struct FreezeOptions {
                                             ///< pseudo-inverse replaces the inverse, [0, 1e-3]
   int max_iterations = 50;          ///< Newton iterations per start, 1..1000
   int max_subdivision_depth = 4;    ///< de Casteljau halvings of a chunk when Newton fails, 0..10
-  int threads = 0;                  ///< worker threads, 0 = one per hardware thread (at least
-                                    ///< 1,024 points per thread), 0..1024
+  int threads = 0;                  ///< parts the points are split into, 0 = one per hardware
+                                    ///< thread (at least 1,024 points per part), 0..1024
+  Executor executor = {};           ///< who runs the parts (clay/parallel.hpp); empty = std::threads
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -162,7 +169,7 @@ struct FreezeOptions {
 /// outside [0, 1]^3): left unchanged by evaluate().
 inline constexpr int outside_chunk = -1;
 /// FrozenPoint::chunk of a point that some chunk's hull holds but where Newton did not converge
-/// even after subdivision (reported in FreezeSummary::unresolved): left unchanged.
+/// even after subdivision (reported in FreezeReport::unresolved): left unchanged.
 inline constexpr int unresolved_chunk = -2;
 
 /// A point's place in the lattice: its chunk (or outside_chunk / unresolved_chunk) and (u, v, w)
@@ -174,7 +181,7 @@ struct FrozenPoint {
 };
 
 /// What freezing did.
-struct FreezeSummary {
+struct CLAY_DEFORM_API FreezeReport {
   /// Converged when no point is unresolved; iterations = Newton iterations over all points,
   /// final_residual = the largest |L(u,v,w) − x| over inside points (mm, rest shape).
   Summary summary;
@@ -195,7 +202,7 @@ struct FreezeSummary {
 struct FrozenPoints {
   std::vector<FrozenPoint> points;
   Points3 positions;  ///< the frozen points (N x 3, mm)
-  FreezeSummary summary;
+  FreezeReport report;
   Eigen::Index control_points = 0;  ///< rows of the lattice when frozen
   std::size_t chunks = 0;           ///< chunks of the lattice when frozen
 };
@@ -212,22 +219,23 @@ struct FrozenPoints {
 /// up to max_subdivision_depth. The first root within parameter_tolerance of [0, 1]^3 wins (on
 /// shared faces any chunk gives the same image). Throws clay::Error: InvalidGeometry for an
 /// invalid lattice or non-finite points, InvalidArgument for bad options.
-FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points,
-                    const FreezeOptions& options = {});
+CLAY_DEFORM_API FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points,
+                                    const FreezeOptions& options = {});
 
 /// Coquillart §3.4: the deformed frozen points, eq. (1) on the current control points at the
 /// frozen (u, v, w); points outside (or unresolved) are returned unchanged. Throws clay::Error:
 /// InvalidGeometry for an invalid lattice, InvalidArgument when the lattice's row or chunk count
 /// changed since freezing (freeze again) or for bad options.
-Points3 evaluate(const ExtendedLattice& lattice, const FrozenPoints& frozen,
-                 const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 evaluate(const ExtendedLattice& lattice, const FrozenPoints& frozen,
+                                 const DeformOptions& options = {});
 
 /// One point: freezes x in the rest shape (default FreezeOptions) and evaluates the current
 /// shape there; x itself when outside. Throws like freeze().
-Eigen::Vector3d deform_point(const ExtendedLattice& lattice, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Vector3d deform_point(const ExtendedLattice& lattice,
+                                             const Eigen::Vector3d& x);
 
 /// One-off freeze + evaluate of every row (threads as `options` says). Throws like freeze().
-Points3 deform_points(const ExtendedLattice& lattice, const Points3& points,
-                      const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 deform_points(const ExtendedLattice& lattice, const Points3& points,
+                                      const DeformOptions& options = {});
 
 }  // namespace clay::deform

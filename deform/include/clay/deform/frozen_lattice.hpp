@@ -10,6 +10,7 @@
 /// are found by arithmetic, others by binary search) so that every block shares one cell's
 /// coefficients. Nothing is allocated per point.
 #include <clay/deform/deformation.hpp>
+#include <clay/deform/export.hpp>
 #include <clay/deform/lattice.hpp>
 
 #include <Eigen/Core>
@@ -22,7 +23,7 @@ namespace clay::deform {
 /// A lattice prepared for fast evaluation: the frame's dual vectors and the power-basis
 /// coefficients of every Bézier cell. Build it once and deform many point sets with it; it is an
 /// immutable value (copyable, safe to share between threads).
-class FrozenLattice {
+class CLAY_DEFORM_API FrozenLattice {
  public:
   /// Freezes a Bézier lattice (one cell). Throws clay::Error(InvalidGeometry) for an invalid one.
   explicit FrozenLattice(const BezierLattice& lattice);
@@ -53,28 +54,29 @@ class FrozenLattice {
 };
 
 /// Deformed position of x by the frozen power form (one point; the bulk functions are faster).
-Eigen::Vector3d deform_point(const FrozenLattice& lattice, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Vector3d deform_point(const FrozenLattice& lattice,
+                                             const Eigen::Vector3d& x);
 
 /// Deforms every row of `points` (N x 3, row-major, mm); rows outside the lattice are copied
 /// unchanged. Throws clay::Error(InvalidArgument) for bad options.
-Points3 deform_points(const FrozenLattice& lattice, const Points3& points,
-                      const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 deform_points(const FrozenLattice& lattice, const Points3& points,
+                                      const DeformOptions& options = {});
 
 /// Same into `out` (resized to points.rows() x 3 when needed, so a reused buffer costs no
 /// allocation). `out` may be `points` itself.
-void deform_points(const FrozenLattice& lattice, const Points3& points, Points3& out,
-                   const DeformOptions& options = {});
+CLAY_DEFORM_API void deform_points(const FrozenLattice& lattice, const Points3& points,
+                                   Points3& out, const DeformOptions& options = {});
 
 /// Structure-of-arrays form: writes the deformed in[i] to out[i]. `out` may be `in` itself.
 /// Throws clay::Error(InvalidArgument) for columns of different sizes or bad options.
-void deform_points(const FrozenLattice& lattice, PointColumns in, MutablePointColumns out,
-                   const DeformOptions& options = {});
+CLAY_DEFORM_API void deform_points(const FrozenLattice& lattice, PointColumns in,
+                                   MutablePointColumns out, const DeformOptions& options = {});
 
 /// One-off: freezes the lattice and deforms the points (Sederberg–Parry eq. (2)).
-Points3 deform_points(const BezierLattice& lattice, const Points3& points,
-                      const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 deform_points(const BezierLattice& lattice, const Points3& points,
+                                      const DeformOptions& options = {});
 /// One-off: freezes the lattice and deforms the points (Hsu–Hughes–Kaufman eq. (1)).
-Points3 deform_points(const BSplineLattice& lattice, const Points3& points,
-                      const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 deform_points(const BSplineLattice& lattice, const Points3& points,
+                                      const DeformOptions& options = {});
 
 }  // namespace clay::deform

@@ -6,6 +6,7 @@
 /// Normalization: the Jacobian reported is the volume ratio det(dX_fd / dX), the determinant of
 /// the map in world coordinates, = det(dX_fd/ds, dX_fd/dt, dX_fd/du) / (S × T · U). The identity
 /// (undisplaced lattice) has Jacobian exactly 1, whatever the frame's size, skew or handedness.
+#include <clay/deform/export.hpp>
 #include <clay/deform/lattice.hpp>
 
 #include <Eigen/Core>
@@ -23,7 +24,7 @@ struct BernsteinVolume {
 };
 
 /// Value at local coordinates (s, t, u) in [0, 1]^3 by de Casteljau's algorithm.
-double evaluate(const BernsteinVolume& volume, double s, double t, double u);
+CLAY_DEFORM_API double evaluate(const BernsteinVolume& volume, double s, double t, double u);
 
 /// Bounds of the Jacobian from the Bernstein coefficients (convex hull property).
 struct JacobianBounds {
@@ -37,21 +38,23 @@ struct JacobianBounds {
 /// (3l − 1, 3m − 1, 3n − 1): det(X_s, X_t, X_u) formed by exact Bernstein products of the
 /// derivative lattices l ΔP, m ΔP, n ΔP (Sederberg–Parry §4). Throws clay::Error(InvalidGeometry)
 /// for an invalid lattice.
-BernsteinVolume jacobian_bernstein(const BezierLattice& lattice);
+CLAY_DEFORM_API BernsteinVolume jacobian_bernstein(const BezierLattice& lattice);
 
 /// Per Bézier cell of a B-spline lattice (bezier_cells order): each cell's Jacobian on the cell's
 /// own unit cube.
-std::vector<BernsteinVolume> jacobian_bernstein(const BSplineLattice& lattice);
+CLAY_DEFORM_API std::vector<BernsteinVolume> jacobian_bernstein(const BSplineLattice& lattice);
 
 /// min / max of the coefficients of jacobian_bernstein(lattice) and fold_free = min > 0.
-JacobianBounds jacobian_bounds(const BezierLattice& lattice);
+CLAY_DEFORM_API JacobianBounds jacobian_bounds(const BezierLattice& lattice);
 /// Same over all cells of a B-spline lattice.
-JacobianBounds jacobian_bounds(const BSplineLattice& lattice);
+CLAY_DEFORM_API JacobianBounds jacobian_bounds(const BSplineLattice& lattice);
 
 /// The 3 x 3 derivative dX_fd / dX at x (world coordinates) from the derivative of eq. (2) by
 /// de Casteljau; the identity outside the lattice. Precondition: a valid lattice.
-Eigen::Matrix3d jacobian_matrix(const BezierLattice& lattice, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Matrix3d jacobian_matrix(const BezierLattice& lattice,
+                                                const Eigen::Vector3d& x);
 /// Same for a B-spline lattice (basis derivatives, The NURBS Book A2.3).
-Eigen::Matrix3d jacobian_matrix(const BSplineLattice& lattice, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Matrix3d jacobian_matrix(const BSplineLattice& lattice,
+                                                const Eigen::Vector3d& x);
 
 }  // namespace clay::deform

@@ -14,6 +14,7 @@
 ///   deformed region must join the space around it.
 /// - Control points: row (i * (m + 1) + j) * (n + 1) + k of `points` holds P_ijk (i along S, j
 ///   along T, k along U; k fastest), the same s-major order for both lattice kinds.
+#include <clay/deform/export.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
@@ -51,17 +52,19 @@ struct Frame {
 
 /// Every problem of the frame, in words naming `name`: non-finite vectors, an edge of zero length,
 /// or edges that do not span space (|S × T · U| <= 1e-12 |S| |T| |U|). Empty when valid.
-std::vector<std::string> problems(const Frame& frame, std::string_view name = "lattice frame");
+CLAY_DEFORM_API std::vector<std::string> problems(const Frame& frame,
+                                                  std::string_view name = "lattice frame");
 
 /// Throws clay::Error(InvalidGeometry) listing problems(frame, name) when there are any.
-void validate(const Frame& frame, std::string_view name = "lattice frame");
+CLAY_DEFORM_API void validate(const Frame& frame, std::string_view name = "lattice frame");
 
 /// Local coordinates (s, t, u) of x by Sederberg–Parry eq. (1):
 /// s = T × U · (X − X0) / (T × U · S), and the same for t and u. Precondition: a valid frame.
-Eigen::Vector3d local_coordinates(const Frame& frame, const Eigen::Vector3d& x) noexcept;
+CLAY_DEFORM_API Eigen::Vector3d local_coordinates(const Frame& frame,
+                                                  const Eigen::Vector3d& x) noexcept;
 
 /// True when the local coordinates lie within face_tolerance of the unit cube.
-bool inside(const Eigen::Vector3d& local) noexcept;
+CLAY_DEFORM_API bool inside(const Eigen::Vector3d& local) noexcept;
 
 // ---- Bézier lattice (Sederberg & Parry 1986) -------------------------------------------------
 
@@ -86,24 +89,26 @@ struct BezierLattice {
 /// P_ijk = X0 + i/l S + j/m T + k/n U (Sederberg–Parry §2), whose deformation is the identity.
 /// Throws clay::Error: InvalidArgument for a degree < 1 or > surface::max_kernel_degree,
 /// InvalidGeometry for an invalid frame.
-BezierLattice make_bezier_lattice(const Frame& frame, std::array<int, 3> degrees);
+CLAY_DEFORM_API BezierLattice make_bezier_lattice(const Frame& frame, std::array<int, 3> degrees);
 
 /// Every invariant the lattice breaks, in words naming `name`: frame problems, degrees outside
 /// [1, max_kernel_degree], a control point count other than (l+1)(m+1)(n+1), non-finite control
 /// points (naming P_ijk). Empty when valid.
-std::vector<std::string> problems(const BezierLattice& lattice,
-                                  std::string_view name = "Bézier lattice");
+CLAY_DEFORM_API std::vector<std::string> problems(const BezierLattice& lattice,
+                                                  std::string_view name = "Bézier lattice");
 
 /// Throws clay::Error(InvalidGeometry) listing problems(lattice, name) when there are any.
-void validate(const BezierLattice& lattice, std::string_view name = "Bézier lattice");
+CLAY_DEFORM_API void validate(const BezierLattice& lattice,
+                              std::string_view name = "Bézier lattice");
 
 /// The control points of the undisplaced lattice with the same frame and degrees.
-Points3 undisplaced_points(const BezierLattice& lattice);
+CLAY_DEFORM_API Points3 undisplaced_points(const BezierLattice& lattice);
 
 /// Deformed position of x by Sederberg–Parry eq. (2), evaluated by de Casteljau's algorithm in
 /// u, then t, then s: the plain reference evaluation. Points outside the lattice are returned
 /// unchanged. Precondition: a valid lattice (validate()); this one-off function does not check.
-Eigen::Vector3d deform_point(const BezierLattice& lattice, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Vector3d deform_point(const BezierLattice& lattice,
+                                             const Eigen::Vector3d& x);
 
 // ---- B-spline lattice (Hsu, Hughes & Kaufman 1992) -------------------------------------------
 
@@ -113,10 +118,10 @@ enum class LatticeKnots {
   /// fills the frame and its faces interpolate the border control points — what Hsu et al. get
   /// by tripling the border points — while every control point stays free and the undisplaced
   /// lattice is exactly the identity. The default.
-  clamped,
+  Clamped,
   /// Uniform knots of step 1/cells extended past [0, 1] (Hsu et al.'s "phantom control points"):
   /// the undisplaced border control points lie outside the frame, at their Greville abscissae.
-  uniform,
+  Uniform,
 };
 
 /// A trivariate tensor-product B-spline FFD (Hsu–Hughes–Kaufman eq. (1), any degree per
@@ -143,31 +148,33 @@ struct BSplineLattice {
 /// xi_i = (k_{i+1} + ... + k_{i+p}) / p, P_ijk = X0 + xi_i S + xi_j T + xi_k U, so the map is
 /// exactly the identity (linear precision of B-splines). Throws clay::Error: InvalidArgument for
 /// a degree < 1 (or > max_kernel_degree) or cells < 1, InvalidGeometry for an invalid frame.
-BSplineLattice make_bspline_lattice(const Frame& frame, std::array<int, 3> degrees,
-                                    std::array<int, 3> cells,
-                                    LatticeKnots knots = LatticeKnots::clamped);
+CLAY_DEFORM_API BSplineLattice make_bspline_lattice(const Frame& frame, std::array<int, 3> degrees,
+                                                    std::array<int, 3> cells,
+                                                    LatticeKnots knots = LatticeKnots::Clamped);
 
 /// The undisplaced lattice on given bases (any valid knot vectors with domain [0, 1]), control
 /// points at the Greville abscissae. Throws clay::Error(InvalidGeometry) naming the basis.
-BSplineLattice make_bspline_lattice(const Frame& frame,
-                                    std::array<surface::BSplineBasis, 3> bases);
+CLAY_DEFORM_API BSplineLattice make_bspline_lattice(const Frame& frame,
+                                                    std::array<surface::BSplineBasis, 3> bases);
 
 /// Every invariant the lattice breaks, in words naming `name`: frame and basis problems, a
 /// domain other than [0, 1], a control point count other than the product of the basis counts,
 /// non-finite control points (naming P_ijk). Empty when valid.
-std::vector<std::string> problems(const BSplineLattice& lattice,
-                                  std::string_view name = "B-spline lattice");
+CLAY_DEFORM_API std::vector<std::string> problems(const BSplineLattice& lattice,
+                                                  std::string_view name = "B-spline lattice");
 
 /// Throws clay::Error(InvalidGeometry) listing problems(lattice, name) when there are any.
-void validate(const BSplineLattice& lattice, std::string_view name = "B-spline lattice");
+CLAY_DEFORM_API void validate(const BSplineLattice& lattice,
+                              std::string_view name = "B-spline lattice");
 
 /// The Greville control points of the undisplaced lattice with the same frame and bases.
-Points3 undisplaced_points(const BSplineLattice& lattice);
+CLAY_DEFORM_API Points3 undisplaced_points(const BSplineLattice& lattice);
 
 /// Deformed position of x by Hsu–Hughes–Kaufman eq. (1): the tensor-product sum over the
 /// (p+1)(q+1)(r+1) non-zero basis functions (The NURBS Book A2.1/A2.2 from clay::surface).
 /// Points outside the lattice are returned unchanged. Precondition: a valid lattice.
-Eigen::Vector3d deform_point(const BSplineLattice& lattice, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Vector3d deform_point(const BSplineLattice& lattice,
+                                             const Eigen::Vector3d& x);
 
 /// The B-spline lattice cut into Bézier lattices, one per non-empty knot span in each direction.
 /// Cell (a, b, c) covers [breaks[0][a], breaks[0][a+1]] x ... in local coordinates and is a
@@ -192,6 +199,6 @@ struct BezierCells {
 /// Bézier extraction per direction (knot insertion to full multiplicity, computed as blossoms:
 /// Bézier point r of span [a, b] is the blossom f(a^(p−r), b^r)). Throws clay::Error
 /// (InvalidGeometry) for an invalid lattice.
-BezierCells bezier_cells(const BSplineLattice& lattice);
+CLAY_DEFORM_API BezierCells bezier_cells(const BSplineLattice& lattice);
 
 }  // namespace clay::deform

@@ -23,6 +23,7 @@
 /// - Extended lattices (Newton-frozen, no derivative bounds) and plain point maps are fitted the
 ///   same way but not certified: the report then has certified == false and only the sampled
 ///   maximum, and says why.
+#include <clay/deform/export.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
@@ -40,7 +41,7 @@
 namespace clay::deform {
 
 /// Settings of refit_deformed().
-struct RefitOptions {
+struct CLAY_DEFORM_API RefitOptions {
   int degree = 3;             ///< degree of the fit in u and v, 1..25 (the exchange limit)
   double tolerance = 1e-4;    ///< > 0: allowed deviation, relative to the size when `relative`
   bool relative = true;       ///< true: tolerance x diagonal of the deformed surface's bounding
@@ -53,7 +54,9 @@ struct RefitOptions {
   double certificate_share = 0.1;  ///< in (0, 1): share of the tolerance the certificate's
                                    ///< remainder may take when choosing each cell's sample density
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -71,7 +74,7 @@ struct KnotPlaneCrossing {
 };
 
 /// What refit_deformed() did.
-struct RefitReport {
+struct CLAY_DEFORM_API RefitReport {
   /// Converged: the certified bound (or, when not certified, the sampled maximum) is within the
   /// tolerance; NotConverged: iteration or control point limit reached first.
   Summary summary;
@@ -106,36 +109,36 @@ using PointMap = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 /// Refit of taper(S): certified. Throws clay::Error: InvalidArgument for bad options,
 /// InvalidGeometry for an invalid surface or taper, or a deformed surface of zero size with a
 /// relative tolerance.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const Taper& taper,
+CLAY_DEFORM_API RefitResult refit_deformed(const Taper& taper, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of twist(S): certified. Throws as the taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const Twist& twist,
+CLAY_DEFORM_API RefitResult refit_deformed(const Twist& twist, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of bend(S): certified (first-derivative remainder in cells crossing y_min or y_max,
 /// where the bend is only C0 off its neutral plane). Throws as the taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const Bend& bend,
+CLAY_DEFORM_API RefitResult refit_deformed(const Bend& bend, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of lattice(S), Sederberg–Parry eq. (2): certified; cells crossing the lattice's faces
 /// are reported in crossings. Throws as the taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const BezierLattice& lattice,
+CLAY_DEFORM_API RefitResult refit_deformed(const BezierLattice& lattice, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of lattice(S), Hsu–Hughes–Kaufman eq. (1): certified; every cell whose hull crosses a
 /// knot plane or face is reported in crossings with its sampled maximum and bound. Throws as the
 /// taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const BSplineLattice& lattice,
+CLAY_DEFORM_API RefitResult refit_deformed(const BSplineLattice& lattice, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of lattice(S) (pointwise, each point frozen alone): not certified (no derivative bounds
 /// for a Newton-frozen map); the report has the sampled maximum. Throws as the taper overload.
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const ExtendedLattice& lattice,
+CLAY_DEFORM_API RefitResult refit_deformed(const ExtendedLattice& lattice, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of stack(S): certified when every enabled step is (derivative bounds chained through the
 /// steps), otherwise sampled only. Throws as the taper overload (invalid stack: InvalidGeometry).
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const DeformationStack& stack,
+CLAY_DEFORM_API RefitResult refit_deformed(const DeformationStack& stack, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 /// Refit of map(S) for any point map: not certified (nothing is known of its derivatives).
 /// Throws as the taper overload, and InvalidArgument for an empty map or one returning a
 /// non-finite point (naming the point).
-RefitResult refit_deformed(const surface::BSplineSurface& surface, const PointMap& map,
+CLAY_DEFORM_API RefitResult refit_deformed(const PointMap& map, const surface::BSplineSurface& surface,
                            const RefitOptions& options = {});
 
 }  // namespace clay::deform

@@ -16,6 +16,7 @@
 ///   polynomial tapers compose exactly with polynomial surfaces.
 /// - The maps are global: they deform all of space (the bend outside its region rigidly).
 #include <clay/deform/deformation.hpp>
+#include <clay/deform/export.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
 #include <Eigen/Core>
@@ -40,10 +41,11 @@ struct AxisFrame {
 /// Every problem of the frame, in words naming `name`: non-finite vectors, a zero axis or
 /// reference, or a reference parallel to the axis (its part perpendicular to the axis shorter
 /// than 1e-9 of its length). Empty when valid.
-std::vector<std::string> problems(const AxisFrame& frame, std::string_view name = "axis frame");
+CLAY_DEFORM_API std::vector<std::string> problems(const AxisFrame& frame,
+                                                  std::string_view name = "axis frame");
 
 /// Throws clay::Error(InvalidGeometry) listing problems(frame, name) when there are any.
-void validate(const AxisFrame& frame, std::string_view name = "axis frame");
+CLAY_DEFORM_API void validate(const AxisFrame& frame, std::string_view name = "axis frame");
 
 /// Most coefficients a taper profile or twist angle polynomial may have (degree 63, the kernel's
 /// degree limit).
@@ -83,55 +85,60 @@ struct Bend {
 /// Every problem of the deformation, in words naming `name`: frame problems, an empty profile
 /// or one with more than max_profile_coefficients coefficients, non-finite coefficients (naming
 /// the index). Empty when valid.
-std::vector<std::string> problems(const Taper& taper, std::string_view name = "taper");
+CLAY_DEFORM_API std::vector<std::string> problems(const Taper& taper,
+                                                  std::string_view name = "taper");
 /// Same for a twist (naming angle[i]).
-std::vector<std::string> problems(const Twist& twist, std::string_view name = "twist");
+CLAY_DEFORM_API std::vector<std::string> problems(const Twist& twist,
+                                                  std::string_view name = "twist");
 /// Same for a bend: frame problems, non-finite y_min, y_max, center or rate, y_min > y_max.
-std::vector<std::string> problems(const Bend& bend, std::string_view name = "bend");
+CLAY_DEFORM_API std::vector<std::string> problems(const Bend& bend, std::string_view name = "bend");
 
 /// Throws clay::Error(InvalidGeometry) listing problems(taper, name) when there are any.
-void validate(const Taper& taper, std::string_view name = "taper");
+CLAY_DEFORM_API void validate(const Taper& taper, std::string_view name = "taper");
 /// Throws clay::Error(InvalidGeometry) listing problems(twist, name) when there are any.
-void validate(const Twist& twist, std::string_view name = "twist");
+CLAY_DEFORM_API void validate(const Twist& twist, std::string_view name = "twist");
 /// Throws clay::Error(InvalidGeometry) listing problems(bend, name) when there are any.
-void validate(const Bend& bend, std::string_view name = "bend");
+CLAY_DEFORM_API void validate(const Bend& bend, std::string_view name = "bend");
 
 /// Tapered position of x (§3.1.1). Precondition: a valid taper (this one-off does not check).
-Eigen::Vector3d deform_point(const Taper& taper, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Vector3d deform_point(const Taper& taper, const Eigen::Vector3d& x);
 /// Twisted position of x (§3.1.2). Precondition: a valid twist.
-Eigen::Vector3d deform_point(const Twist& twist, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Vector3d deform_point(const Twist& twist, const Eigen::Vector3d& x);
 /// Bent position of x (§3.1.3); evaluated in a form without 1/k, so small rates are accurate
 /// and rate = 0 returns x exactly. Precondition: a valid bend.
-Eigen::Vector3d deform_point(const Bend& bend, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Vector3d deform_point(const Bend& bend, const Eigen::Vector3d& x);
 
 /// The 3 x 3 derivative dX/dx (world coordinates) of the taper at x: analytic.
-Eigen::Matrix3d jacobian_matrix(const Taper& taper, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Matrix3d jacobian_matrix(const Taper& taper, const Eigen::Vector3d& x);
 /// The derivative of the twist at x (determinant 1 everywhere).
-Eigen::Matrix3d jacobian_matrix(const Twist& twist, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Matrix3d jacobian_matrix(const Twist& twist, const Eigen::Vector3d& x);
 /// The derivative of the bend at x. Inside the region the y column is scaled by 1 − k z with
 /// respect to the rigid parts, so across y_min and y_max the map is continuous everywhere but
 /// its derivative only on the neutral plane z = 0 (docs/deform.md). At y = y_min or y_max
 /// exactly, the derivative of the bent side is returned.
-Eigen::Matrix3d jacobian_matrix(const Bend& bend, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Matrix3d jacobian_matrix(const Bend& bend, const Eigen::Vector3d& x);
 
 /// Deforms every row of `points` (N x 3 row-major, mm) into `out` (resized when needed; may be
 /// `points` itself), bit-identical to deform_point per row, on options.threads workers over
 /// contiguous ranges, no allocation per point. Throws clay::Error: InvalidGeometry for an
 /// invalid taper, InvalidArgument for bad options.
-void deform_points(const Taper& taper, const Points3& points, Points3& out,
-                   const DeformOptions& options = {});
+CLAY_DEFORM_API void deform_points(const Taper& taper, const Points3& points, Points3& out,
+                                   const DeformOptions& options = {});
 /// Same for a twist.
-void deform_points(const Twist& twist, const Points3& points, Points3& out,
-                   const DeformOptions& options = {});
+CLAY_DEFORM_API void deform_points(const Twist& twist, const Points3& points, Points3& out,
+                                   const DeformOptions& options = {});
 /// Same for a bend.
-void deform_points(const Bend& bend, const Points3& points, Points3& out,
-                   const DeformOptions& options = {});
+CLAY_DEFORM_API void deform_points(const Bend& bend, const Points3& points, Points3& out,
+                                   const DeformOptions& options = {});
 
 /// The deformed rows as a new matrix (see the overload with `out`).
-Points3 deform_points(const Taper& taper, const Points3& points, const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 deform_points(const Taper& taper, const Points3& points,
+                                      const DeformOptions& options = {});
 /// The deformed rows as a new matrix.
-Points3 deform_points(const Twist& twist, const Points3& points, const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 deform_points(const Twist& twist, const Points3& points,
+                                      const DeformOptions& options = {});
 /// The deformed rows as a new matrix.
-Points3 deform_points(const Bend& bend, const Points3& points, const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 deform_points(const Bend& bend, const Points3& points,
+                                      const DeformOptions& options = {});
 
 }  // namespace clay::deform

@@ -5,9 +5,11 @@
 /// extended lattices among them) — and their JSON form (schema "clayform.deformation-stack"
 /// version 1, docs/deform.md), which round-trips every number bit for bit.
 #include <clay/deform/deformation.hpp>
+#include <clay/deform/export.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
+#include <clay/summary.hpp>
 
 #include <Eigen/Core>
 
@@ -42,32 +44,36 @@ struct DeformationStack {
 
 /// The JSON name of a deformation kind: "bezier_lattice", "bspline_lattice",
 /// "extended_lattice", "taper", "twist" or "bend".
-std::string_view kind_name(const Deformation& deformation) noexcept;
+CLAY_DEFORM_API std::string_view kind_name(const Deformation& deformation) noexcept;
 
 /// Every problem of every step (disabled ones too), each naming the step as
 /// "steps[i] (kind 'name')" followed by the deformation's own problems(). Empty when valid.
-std::vector<std::string> problems(const DeformationStack& stack);
+CLAY_DEFORM_API std::vector<std::string> problems(const DeformationStack& stack);
 
 /// Throws clay::Error(InvalidGeometry) listing problems(stack) when there are any.
-void validate(const DeformationStack& stack);
+CLAY_DEFORM_API void validate(const DeformationStack& stack);
 
 /// x deformed by every enabled step in order, each by its reference deform_point (lattices by
 /// de Casteljau / de Boor, not frozen; an extended lattice freezes x alone, default
 /// FreezeOptions, and leaves it unchanged when outside or unresolved). Precondition: a valid
 /// stack (this one-off does not check, except that an extended lattice step validates itself).
-Eigen::Vector3d deform_point(const DeformationStack& stack, const Eigen::Vector3d& x);
+CLAY_DEFORM_API Eigen::Vector3d deform_point(const DeformationStack& stack,
+                                             const Eigen::Vector3d& x);
 
 /// What deform_points did at the steps that iterate. An extended lattice step freezes the points
 /// reaching it by Newton's method (Coquillart §3.3); a point it cannot place (unresolved) is left
-/// unchanged by that step and the step's FreezeSummary is NotConverged — an outcome, not an
+/// unchanged by that step and the step's FreezeReport is NotConverged — an outcome, not an
 /// error, so the deformation goes on and this report is the only place it shows.
-struct StackReport {
+struct CLAY_DEFORM_API StackReport {
   /// The freeze of one enabled extended lattice step.
   struct Freeze {
     std::size_t step = 0;   ///< index of the step in stack.steps
-    FreezeSummary summary;  ///< inside / outside / unresolved counts, Newton residuals
+    FreezeReport report;  ///< inside / outside / unresolved counts, Newton residuals
   };
   std::vector<Freeze> freezes;  ///< one per enabled extended lattice step, in order of application
+  /// Converged when no freeze left a point unresolved, else NotConverged (those points are left
+  /// unchanged); message = brief().
+  Summary summary;
 
   /// True when no freeze left a point unresolved (also when the stack has no extended lattice).
   bool converged() const noexcept;
@@ -83,28 +89,29 @@ struct StackReport {
 /// derivatives). Points an extended lattice cannot place are left unchanged by that step: use
 /// the overload with a StackReport to learn about them. Throws clay::Error: InvalidGeometry for
 /// an invalid stack, InvalidArgument for bad options.
-Points3 deform_points(const DeformationStack& stack, const Points3& points,
-                      const DeformOptions& options = {});
+CLAY_DEFORM_API Points3 deform_points(const DeformationStack& stack, const Points3& points,
+                                      const DeformOptions& options = {});
 
 /// Same into `out` (resized when needed; may be `points` itself).
-void deform_points(const DeformationStack& stack, const Points3& points, Points3& out,
-                   const DeformOptions& options = {});
+CLAY_DEFORM_API void deform_points(const DeformationStack& stack, const Points3& points,
+                                   Points3& out, const DeformOptions& options = {});
 
 /// Same into `out`, and `report` (overwritten) lists the freeze of every enabled extended
 /// lattice step: check report.converged().
-void deform_points(const DeformationStack& stack, const Points3& points, Points3& out,
-                   StackReport& report, const DeformOptions& options = {});
+CLAY_DEFORM_API void deform_points(const DeformationStack& stack, const Points3& points,
+                                   Points3& out, StackReport& report,
+                                   const DeformOptions& options = {});
 
 /// The stack as JSON text (schema "clayform.deformation-stack", version 1, in docs/deform.md):
 /// numbers are written in shortest round-trip form, so stack_from_json(to_json(s)) restores every
 /// double bit for bit. Throws clay::Error: InvalidGeometry for an invalid stack (JSON has no
 /// NaN), InvalidArgument for a step name that is not valid UTF-8.
-std::string to_json(const DeformationStack& stack);
+CLAY_DEFORM_API std::string to_json(const DeformationStack& stack);
 
 /// Parses a stack written by to_json (or by hand). Throws clay::Error(Recipe) for malformed
 /// input, naming the JSON path and the fix ("steps[2].points[5]: expected 3 numbers, found 2;
 /// ..."): not JSON, a wrong format or version, unknown kinds or keys, missing or mistyped fields,
 /// wrong counts, non-finite numbers, and every problems() of the resulting stack.
-DeformationStack stack_from_json(std::string_view json);
+CLAY_DEFORM_API DeformationStack stack_from_json(std::string_view json);
 
 }  // namespace clay::deform

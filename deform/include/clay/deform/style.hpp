@@ -4,11 +4,11 @@
 /// it should take, and the control vertices inside the bound move toward the target.
 ///
 /// Two modes (docs/deform.md, "Style deformation"):
-/// - `StyleMode::paper` follows the paper: influence factors (eq. 2), key points and their signed
+/// - `StyleMode::Paper` follows the paper: influence factors (eq. 2), key points and their signed
 ///   normal distances (eqs. 3, 8), the force shared by area weights and distributed along the
 ///   control-net curve (eqs. 4-7) with the symmetric smoothing of eqs. 12-13, relaxation intervals
 ///   (eqs. 10-11) and the approximation scale λ (eq. 9). It approximates the target.
-/// - `StyleMode::exact` goes beyond the paper: the displacements of the influenced vertices are
+/// - `StyleMode::Exact` goes beyond the paper: the displacements of the influenced vertices are
 ///   solved (fairness energy on the control net, the key points as equality constraints) so the
 ///   surface passes through every key point, vertices outside the bound stay fixed and the
 ///   `boundary_rows` layers of vertices inside the bound edge stay fixed too, so the deformed
@@ -17,6 +17,7 @@
 /// Both return a surface with the same degrees (and, in paper mode, the same knots): control
 /// vertices move, nothing is refitted. Exact mode may insert knots (exactly, reported) where the
 /// control net is too coarse for the key points.
+#include <clay/deform/export.hpp>
 #include <clay/summary.hpp>
 #include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/projection.hpp>
@@ -33,28 +34,28 @@ namespace clay::deform {
 
 /// Which of the two algorithms style_deform runs.
 enum class StyleMode {
-  paper,  ///< Han–De Amicis–Conti forces (eqs. 3-13): approximates the target
-  exact,  ///< fair least-norm displacements through the key points (beyond the paper)
+  Paper,  ///< Han–De Amicis–Conti forces (eqs. 3-13): approximates the target
+  Exact,  ///< fair least-norm displacements through the key points (beyond the paper)
 };
 
 /// How the target curve relates to the bound (Han et al. §4.3).
 enum class ConstraintClass {
-  over_constrained,   ///< the target lies completely outside the bound: the surface is unchanged
-  under_constrained,  ///< the target lies partly inside the bound
-  well_constrained,   ///< the target lies completely inside the bound
+  OverConstrained,   ///< the target lies completely outside the bound: the surface is unchanged
+  UnderConstrained,  ///< the target lies partly inside the bound
+  WellConstrained,   ///< the target lies completely inside the bound
 };
 
 /// Name of a constraint class ("over-constrained", ...).
-std::string_view to_string(ConstraintClass c) noexcept;
+CLAY_DEFORM_API std::string_view to_string(ConstraintClass c) noexcept;
 
 /// Direction the target runs along in parameter space (Han et al. eq. 8): `u` means it crosses
 /// the control-net rows i = const (vertices (i, 0..count_v-1)), so there is a key point per row and
 /// its force is distributed along that row, in v.
-enum class KeyDirection { u, v };
+enum class KeyDirection { U, V };
 
 /// Settings of the style deformation. Lengths in mm.
-struct StyleOptions {
-  StyleMode mode = StyleMode::paper;  ///< paper forces or exact key-point interpolation
+struct CLAY_DEFORM_API StyleOptions {
+  StyleMode mode = StyleMode::Paper;  ///< paper forces or exact key-point interpolation
   double lambda = 1.0;     ///< approximation scale λ in [0, 1] (eq. 9); 0 leaves the surface as is
   bool relaxation = true;  ///< paper: let the end forces fall off to the bound (eqs. 10-11)
   bool smoothing = true;   ///< paper: distribute each force symmetrically along its control-net
@@ -76,12 +77,14 @@ struct StyleOptions {
                               ///< projections); off for interactive drags: they are then NaN
   surface::ProjectionOptions projection;  ///< projection of the curves onto the surface
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
 /// Influence factors E(Q_ij) of every control vertex (Han et al. eq. 2) and where they came from.
-struct InfluenceRegion {
+struct CLAY_DEFORM_API InfluenceRegion {
   int count_u = 0;  ///< control vertices along u of the surface they belong to
   int count_v = 0;  ///< control vertices along v
   std::vector<std::uint8_t> factors;  ///< E(Q_ij) in {0, 1} at i * count_v + j
@@ -108,18 +111,18 @@ struct InfluenceRegion {
 /// clay::Error: InvalidGeometry for an invalid surface or curve, a bound curve that is not closed
 /// (ends farther apart than 1e-7 of its size) or whose projection crosses itself (naming where),
 /// InvalidArgument for bad options.
-InfluenceRegion influence_factors(const surface::BSplineSurface& parent,
-                                  const surface::BSplineCurve& bound,
-                                  const StyleOptions& options = {});
+CLAY_DEFORM_API InfluenceRegion influence_factors(const surface::BSplineSurface& parent,
+                                                  const surface::BSplineCurve& bound,
+                                                  const StyleOptions& options = {});
 
 /// The region without a bound curve (Han et al. §5): the target curve is projected onto the
 /// surface and E = 1 for every control vertex whose basis function is non-zero at a projected
 /// sample (the vertices that move the surface under the target), widened by
 /// options.boundary_rows layers so that the exact mode's fixed edge layers leave that band free.
 /// Throws as influence_factors.
-InfluenceRegion influence_from_target(const surface::BSplineSurface& parent,
-                                      const surface::BSplineCurve& target,
-                                      const StyleOptions& options = {});
+CLAY_DEFORM_API InfluenceRegion influence_from_target(const surface::BSplineSurface& parent,
+                                                      const surface::BSplineCurve& target,
+                                                      const StyleOptions& options = {});
 
 /// A key point K_i of the target curve and its force (eqs. 3, 8).
 struct KeyPoint {
@@ -135,8 +138,8 @@ struct KeyPoint {
 
 /// The key points of a target on a region: direction, class and points.
 struct KeyPoints {
-  KeyDirection direction = KeyDirection::u;  ///< eq. 8: the direction the target runs along
-  ConstraintClass constraint_class = ConstraintClass::over_constrained;  ///< §4.3
+  KeyDirection direction = KeyDirection::U;  ///< eq. 8: the direction the target runs along
+  ConstraintClass constraint_class = ConstraintClass::OverConstrained;  ///< §4.3
   std::vector<KeyPoint> points;  ///< in order along the target curve; m = points.size()
 };
 
@@ -146,14 +149,16 @@ struct KeyPoints {
 /// the domain (at least one key point: the middle of the target when it crosses no row). The
 /// class: over-constrained when no projected sample lies in the region, well-constrained when all
 /// do. Throws as influence_factors, and InvalidArgument when the region was made for another net.
-KeyPoints key_points(const surface::BSplineSurface& parent, const InfluenceRegion& region,
-                     const surface::BSplineCurve& target, const StyleOptions& options = {});
+CLAY_DEFORM_API KeyPoints key_points(const surface::BSplineSurface& parent,
+                                     const InfluenceRegion& region,
+                                     const surface::BSplineCurve& target,
+                                     const StyleOptions& options = {});
 
 /// What a style deformation did and how well (DESIGN.md quality figures). Lengths in mm.
-struct StyleReport {
-  StyleMode mode = StyleMode::paper;
-  ConstraintClass constraint_class = ConstraintClass::over_constrained;
-  KeyDirection direction = KeyDirection::u;
+struct CLAY_DEFORM_API StyleReport {
+  StyleMode mode = StyleMode::Paper;
+  ConstraintClass constraint_class = ConstraintClass::OverConstrained;
+  KeyDirection direction = KeyDirection::U;
   int m = 0;  ///< number of key points (eq. 8)
   std::vector<KeyPoint> key_points;  ///< on the parent surface
   int influenced_vertices = 0;       ///< vertices with E = 1
@@ -181,11 +186,14 @@ struct StyleReport {
   /// move (over-constrained: the target lies outside the bound). λ = 0 is Converged: unchanged
   /// as asked. The message names the figure and the way out.
   Summary summary;
+
+  /// One line: the summary, the class of the constraint and the figures that judge it.
+  std::string brief() const;
 };
 
 /// The outcome of a style deformation from its report and options (the rules of
 /// StyleReport::summary); style_deform and StyleEditor::update set report.summary with it.
-Summary judge_style(const StyleReport& report, const StyleOptions& options);
+CLAY_DEFORM_API Summary judge_style(const StyleReport& report, const StyleOptions& options);
 
 /// The deformed surface and its report.
 struct StyleResult {
@@ -199,8 +207,10 @@ struct StyleResult {
 /// Deforms `parent` toward `target` inside `region` (influence_factors or influence_from_target of
 /// the same surface). λ = 0 and the over-constrained class return the parent bit for bit; vertices
 /// with E = 0 are never written. Throws as key_points.
-StyleResult style_deform(const surface::BSplineSurface& parent, const InfluenceRegion& region,
-                         const surface::BSplineCurve& target, const StyleOptions& options = {});
+CLAY_DEFORM_API StyleResult style_deform(const surface::BSplineSurface& parent,
+                                         const InfluenceRegion& region,
+                                         const surface::BSplineCurve& target,
+                                         const StyleOptions& options = {});
 
 namespace detail {
 struct ExactCache;  // the exact mode's free vertices and fairness matrix (style_exact.cpp)
@@ -213,7 +223,7 @@ struct ExactCache;  // the exact mode's free vertices and fairness matrix (style
 /// update(target) returns what style_deform(parent, region, target, options) returns, up to the
 /// projection tolerance (the Newton starts differ) — in exact mode, where those differences can
 /// change which key points are added, up to curve_tolerance. Copies share the cache (immutable).
-class StyleEditor {
+class CLAY_DEFORM_API StyleEditor {
  public:
   /// Throws clay::Error: InvalidGeometry for an invalid parent, InvalidArgument for bad options or
   /// a region made for another control net.
@@ -238,11 +248,14 @@ class StyleEditor {
 };
 
 /// One-off with a bound curve: influence_factors, then style_deform.
-StyleResult style_deform(const surface::BSplineSurface& parent, const surface::BSplineCurve& bound,
-                         const surface::BSplineCurve& target, const StyleOptions& options = {});
+CLAY_DEFORM_API StyleResult style_deform(const surface::BSplineSurface& parent,
+                                         const surface::BSplineCurve& bound,
+                                         const surface::BSplineCurve& target,
+                                         const StyleOptions& options = {});
 
 /// One-off without a bound curve (§5): influence_from_target, then style_deform.
-StyleResult style_deform(const surface::BSplineSurface& parent, const surface::BSplineCurve& target,
-                         const StyleOptions& options = {});
+CLAY_DEFORM_API StyleResult style_deform(const surface::BSplineSurface& parent,
+                                         const surface::BSplineCurve& target,
+                                         const StyleOptions& options = {});
 
 }  // namespace clay::deform

@@ -7,6 +7,7 @@
 /// only when a refit is allowed; otherwise the step is refused with the reason and the way out.
 /// The report says, per step, which it was and with what figures.
 #include <clay/deform/compose.hpp>
+#include <clay/deform/export.hpp>
 #include <clay/deform/refit.hpp>
 #include <clay/deform/stack.hpp>
 #include <clay/surface/bspline_surface.hpp>
@@ -18,7 +19,7 @@
 namespace clay::deform {
 
 /// Settings of deform_surface.
-struct SurfaceDeformationOptions {
+struct CLAY_DEFORM_API SurfaceDeformationOptions {
   ComposeOptions compose;  ///< for the steps composed exactly
   /// For the steps that cannot be composed exactly; empty: such a step is an error that names it
   /// and why (give a refit tolerance, lower the lattice degree, move the knot plane).
@@ -28,7 +29,9 @@ struct SurfaceDeformationOptions {
   /// returned, with its figures in the step's RefitReport (summary NotConverged).
   bool accept_out_of_tolerance = false;
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -37,19 +40,22 @@ struct StepOutcome {
   int step = 0;          ///< index in the stack
   std::string kind;      ///< kind_name of the deformation
   std::string name;      ///< the step's name
-  enum class Method { skipped, exact, refit } method = Method::skipped;  ///< disabled, composed, refitted
+  enum class Method { Skipped, Exact, Refit } method = Method::Skipped;  ///< disabled, composed, refitted
   std::string reason;    ///< why a step was refitted (the exact composition's refusal), else empty
   ComposeReport compose; ///< when exact
   RefitReport refit;     ///< when refitted
 };
 
 /// Per-step outcomes and the result's size.
-struct SurfaceDeformationReport {
+struct CLAY_DEFORM_API SurfaceDeformationReport {
   std::vector<StepOutcome> steps;  ///< one per stack step, in order
   bool exact = true;               ///< every enabled step was composed exactly
   bool certified = true;           ///< every refitted step carries a certified bound
   int degree_u = 0, degree_v = 0;  ///< degrees of the result
   long control_points = 0;         ///< control points of the result
+  /// Converged (a step that misses its tolerance throws ToleranceNotMet unless accepted, then
+  /// NotConverged); message = brief().
+  Summary summary;
   /// One line per step: "steps[1] twist 'spin': refit, certified 3.1e-3 mm (tolerance ...)".
   std::string brief() const;
 };
@@ -73,13 +79,13 @@ struct SurfaceDeformationResult {
 /// |F(x) − x|, and no continuous fit comes closer than half that jump; when half the jump
 /// (measured at the crossings of an 8-per-span sample grid, bisected to the face) exceeds the
 /// tolerance, the step is refused at once.
-SurfaceDeformationResult deform_surface(const DeformationStack& stack,
-                                        const surface::BSplineSurface& surface,
-                                        const SurfaceDeformationOptions& options = {});
+CLAY_DEFORM_API SurfaceDeformationResult
+deform_surface(const DeformationStack& stack, const surface::BSplineSurface& surface,
+               const SurfaceDeformationOptions& options = {});
 
 /// The same for one deformation.
-SurfaceDeformationResult deform_surface(const Deformation& deformation,
-                                        const surface::BSplineSurface& surface,
-                                        const SurfaceDeformationOptions& options = {});
+CLAY_DEFORM_API SurfaceDeformationResult
+deform_surface(const Deformation& deformation, const surface::BSplineSurface& surface,
+               const SurfaceDeformationOptions& options = {});
 
 }  // namespace clay::deform

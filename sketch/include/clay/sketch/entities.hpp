@@ -6,6 +6,7 @@
 /// Entities share points (a line's end is a point, a B-spline's control points are points), so a
 /// constraint on a point moves every entity built on it. A point either lies in a sketch plane
 /// (two unknowns: its plane coordinates) or is free in 3D (three unknowns).
+#include <clay/sketch/export.hpp>
 #include <clay/sketch/plane.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
@@ -70,7 +71,7 @@ using Entity = std::variant<Line, Circle, Arc, Curve>;
 
 /// Planes, points and entities. Add with the member functions (they check references and
 /// reject degenerate geometry); read the geometry back with the free functions below.
-struct Sketch {
+struct CLAY_SKETCH_API Sketch {
   std::vector<SketchPlane> planes;
   std::vector<SketchPoint> points;
   std::vector<Entity> entities;
@@ -100,24 +101,24 @@ struct Sketch {
 };
 
 /// The world position of a point. Throws clay::Error(InvalidArgument) for a missing id.
-Eigen::Vector3d position(const Sketch& sketch, PointId point);
+CLAY_SKETCH_API Eigen::Vector3d position(const Sketch& sketch, PointId point);
 /// The B-spline curve of any entity: a Curve as itself, a Line as degree 1, a Circle or an Arc as
 /// an exact rational quadratic (surface::circular_arc). Throws clay::Error(InvalidArgument) for a
 /// missing id.
-surface::BSplineCurve curve_of(const Sketch& sketch, EntityId entity);
+CLAY_SKETCH_API surface::BSplineCurve curve_of(const Sketch& sketch, EntityId entity);
 /// A short name for messages: "line \"luff\"" when entity_names names it, else "line #3",
 /// "arc #0", "curve #2".
-std::string describe(const Sketch& sketch, EntityId entity);
+CLAY_SKETCH_API std::string describe(const Sketch& sketch, EntityId entity);
 /// The same for a point: "point \"tip\"" or "point #7".
-std::string describe(const Sketch& sketch, PointId point);
+CLAY_SKETCH_API std::string describe(const Sketch& sketch, PointId point);
 /// Two numbers for a message that says they differ: each with the fewest significant digits
 /// (at least 3) that tell them apart, "1200.004 and 1200.01".
-std::string distinct_numbers(double a, double b);
+CLAY_SKETCH_API std::string distinct_numbers(double a, double b);
 
 /// Every problem of the sketch in words (dangling ids, points off their plane by more than 1e-9
 /// of the model size, zero-length lines, non-positive radii, unequal arc radii, invalid curves).
-std::vector<std::string> problems(const Sketch& sketch);
+CLAY_SKETCH_API std::vector<std::string> problems(const Sketch& sketch);
 /// Throws clay::Error(InvalidGeometry) listing problems(sketch) when there are any.
-void validate(const Sketch& sketch);
+CLAY_SKETCH_API void validate(const Sketch& sketch);
 
 }  // namespace clay::sketch

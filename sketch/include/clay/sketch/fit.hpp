@@ -33,18 +33,20 @@
 ///   across the seam; the result is then clamped on the same domain and its last control point set
 ///   to its first: it closes exactly and is C^(degree-1) at the seam to rounding. A closed stroke
 ///   with corners gives a closed chain of open curves.
+#include <clay/sketch/export.hpp>
 #include <clay/sketch/stroke.hpp>
 #include <clay/summary.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
 #include <Eigen/Core>
 
+#include <string>
 #include <vector>
 
 namespace clay::sketch {
 
 /// Settings of fit_stroke (and of the new piece in oversketch).
-struct FitOptions {
+struct CLAY_SKETCH_API FitOptions {
   double tolerance = 0.1;         ///< mm, largest distance from a stroke point to its curve
                                   ///< (averaged over 9 neighbours for a noisy stroke); > 0
   int degree = 3;                 ///< degree of the curves, in [2, 9]
@@ -62,8 +64,9 @@ struct FitOptions {
   int end_samples = 60;           ///< samples in the end-point estimate, >= 1 (1: the drawn point)
   bool drop_duplicates = false;   ///< drop repeated consecutive points instead of refusing them
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range, its value and
-  /// the rule.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -74,14 +77,14 @@ struct FittedCurve {
   Eigen::Index first_point = 0; ///< first stroke point fitted by this curve
   Eigen::Index last_point = 0;  ///< last stroke point fitted (inclusive; wraps past the stroke's
                                 ///< end for the last curve of a closed stroke with corners)
-  double max_deviation = 0;     ///< mm, largest distance from its stroke points to the curve,
+  double max_deviation_mm = 0;  ///< largest distance from its stroke points to the curve,
                                 ///< measured at each point's foot point (Newton projection)
-  double rms_deviation = 0;     ///< mm, root mean square of the same distances
+  double rms_deviation_mm = 0;  ///< root mean square of the same distances
   int control_points = 0;       ///< curve.points.rows()
   int iterations = 0;           ///< refinement iterations
   double fairness = 0;          ///< fairness weight in use at the end (after reductions)
   double noise = 0;             ///< mm, estimated noise of its stroke points per coordinate
-  Summary summary;              ///< converged when max_deviation <= tolerance
+  Summary summary;              ///< converged when max_deviation_mm <= tolerance
 };
 
 /// The curves fitted to one stroke, in drawing order; consecutive curves share their joint point
@@ -90,7 +93,7 @@ struct StrokeFit {
   std::vector<FittedCurve> curves;    ///< in drawing order
   std::vector<Eigen::Index> corners;  ///< stroke index of each corner (the last point before it)
   bool closed = false;                ///< the chain closes (one closed curve, or corners all round)
-  double max_deviation = 0;           ///< mm, largest of the curves' max_deviation
+  double max_deviation_mm = 0;        ///< largest of the curves' max_deviation_mm
   double plane_offset = 0;            ///< mm, largest distance of a stroke point from its plane
   Summary summary;                    ///< converged when every curve converged
 };
@@ -102,6 +105,6 @@ struct StrokeFit {
 /// Throws clay::Error: InvalidArgument for bad options, InvalidGeometry for a stroke that
 /// problems(stroke) rejects (fewer than 2 points, NaN or infinite coordinate, repeated consecutive
 /// point unless drop_duplicates, zero length, invalid plane).
-StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options = {});
+CLAY_SKETCH_API StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options = {});
 
 }  // namespace clay::sketch

@@ -15,12 +15,15 @@
 /// C''(0) = beta T + |C'(0)|^2 kappa (beta free; alpha taken from the G1 solution, which makes the
 /// condition linear). The three parts are joined into one B-spline with knots of multiplicity p at
 /// the joints; a rational curve keeps its weights, the new part getting the joint's weight.
+#include <clay/sketch/export.hpp>
 #include <clay/sketch/fit.hpp>
 #include <clay/sketch/stroke.hpp>
 #include <clay/summary.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace clay::sketch {
 
@@ -31,14 +34,16 @@ enum class Continuity {
 };
 
 /// Settings of oversketch.
-struct OversketchOptions {
+struct CLAY_SKETCH_API OversketchOptions {
   Continuity continuity = Continuity::G1;  ///< at both joints
   double capture_distance = 10.0;          ///< mm, > 0: how far a stroke end may be from the curve
   FitOptions fit;  ///< tolerance, fairness, limits, end_samples and drop_duplicates for the new
                    ///< part; its degree is the curve's (fit.degree is not used) and it is not
                    ///< split at corners
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -58,8 +63,8 @@ struct OversketchResult {
   double cut_end = 0;                ///< parameter where it ends (a domain end for a new head/tail)
   std::optional<Joint> start_joint;  ///< absent when the stroke replaced the curve's head
   std::optional<Joint> end_joint;    ///< absent when the stroke replaced the curve's tail
-  double max_deviation = 0;          ///< mm, stroke points to the new part (foot points)
-  double rms_deviation = 0;          ///< mm
+  double max_deviation_mm = 0;       ///< stroke points to the new part (foot points)
+  double rms_deviation_mm = 0;       ///< root mean square of the same distances
   int control_points = 0;            ///< control points of the new part
   int iterations = 0;                ///< refinement iterations of the new part's fit
   Summary summary;                   ///< the new part's fit; converged when within tolerance
@@ -71,7 +76,8 @@ struct OversketchResult {
 /// over an end of the curve, for a stroke whose ends meet the curve at one point or that runs over
 /// both of its ends (covering it all); InvalidGeometry for an invalid curve, a curve of degree 1, or a stroke that
 /// problems(stroke) rejects.
-OversketchResult oversketch(const surface::BSplineCurve& curve, const Stroke& stroke,
-                            const OversketchOptions& options = {});
+CLAY_SKETCH_API OversketchResult oversketch(const surface::BSplineCurve& curve,
+                                            const Stroke& stroke,
+                                            const OversketchOptions& options = {});
 
 }  // namespace clay::sketch

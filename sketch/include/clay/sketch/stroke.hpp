@@ -5,6 +5,7 @@
 /// A stroke is raw input: noisy, densely sampled, possibly with corners. fit_stroke()
 /// (clay/sketch/fit.hpp) turns it into B-spline curves; oversketch() (clay/sketch/oversketch.hpp)
 /// uses one to redraw part of a curve.
+#include <clay/sketch/export.hpp>
 #include <clay/sketch/plane.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
@@ -30,13 +31,15 @@ struct Stroke {
 /// (closer than 1e-12 of the stroke's size, after projection onto the plane when there is one;
 /// not reported when `allow_duplicates`), a stroke of zero length, an invalid plane. Empty when
 /// the stroke can be fitted.
-std::vector<std::string> problems(const Stroke& stroke, std::string_view name = "stroke",
-                                  bool allow_duplicates = false);
+CLAY_SKETCH_API std::vector<std::string> problems(const Stroke& stroke,
+                                                  std::string_view name = "stroke",
+                                                  bool allow_duplicates = false);
 
 /// Throws clay::Error(InvalidGeometry) listing problems(stroke, name, allow_duplicates).
-void validate(const Stroke& stroke, std::string_view name = "stroke", bool allow_duplicates = false);
+CLAY_SKETCH_API void validate(const Stroke& stroke, std::string_view name = "stroke",
+                              bool allow_duplicates = false);
 
 /// Length of the polyline (mm), after projection onto the plane when there is one.
-double length(const Stroke& stroke);
+CLAY_SKETCH_API double length(const Stroke& stroke);
 
 }  // namespace clay::sketch

@@ -1,6 +1,7 @@
 #pragma once
 /// Exact circular arcs as rational quadratic B-spline curves (The NURBS Book A7.1).
 #include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
@@ -12,7 +13,9 @@ namespace clay::surface {
 /// last control point is a bit-for-bit copy of its first. `x_axis` and `y_axis` must be
 /// orthonormal; radius >= 0 (0 gives a curve collapsed to `center`). Throws
 /// clay::Error(InvalidArgument) naming the bad value.
-BSplineCurve circular_arc(const Eigen::Vector3d& center, const Eigen::Vector3d& x_axis,
-                          const Eigen::Vector3d& y_axis, double radius, double start, double end);
+CLAY_SURFACE_API BSplineCurve circular_arc(const Eigen::Vector3d& center,
+                                           const Eigen::Vector3d& x_axis,
+                                           const Eigen::Vector3d& y_axis, double radius,
+                                           double start, double end);
 
 }  // namespace clay::surface

@@ -4,6 +4,7 @@
 /// C(t) = sum_i N_{i,p}(t) w_i P_i / sum_i N_{i,p}(t) w_i. Weights are all 1 for a polynomial curve;
 /// one type serves both so that no algorithm exists twice.
 #include <clay/surface/basis.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
@@ -18,7 +19,7 @@ using Points3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 /// A B-spline curve: basis, control points (basis.count() rows) and weights (basis.count() entries,
 /// positive, all 1 when polynomial).
-struct BSplineCurve {
+struct CLAY_SURFACE_API BSplineCurve {
   BSplineBasis basis;
   Points3 points;
   Eigen::VectorXd weights;
@@ -29,20 +30,21 @@ struct BSplineCurve {
 
 /// Builds and validates a curve; `weights` empty means polynomial (all 1).
 /// Throws clay::Error(InvalidGeometry) naming every broken invariant.
-BSplineCurve make_curve(int degree, std::vector<double> knots, Points3 points,
-                        Eigen::VectorXd weights = {});
+CLAY_SURFACE_API BSplineCurve make_curve(int degree, std::vector<double> knots, Points3 points,
+                                         Eigen::VectorXd weights = {});
 
 /// Every invariant the curve breaks, in words, each naming `name`. Empty when valid.
-std::vector<std::string> problems(const BSplineCurve& curve, std::string_view name = "curve");
+CLAY_SURFACE_API std::vector<std::string> problems(const BSplineCurve& curve,
+                                                   std::string_view name = "curve");
 
 /// Throws clay::Error(InvalidGeometry) listing problems(curve, name) when there are any.
-void validate(const BSplineCurve& curve, std::string_view name = "curve");
+CLAY_SURFACE_API void validate(const BSplineCurve& curve, std::string_view name = "curve");
 
 /// True when degree, knots, control points and weights are equal bit for bit.
-bool identical(const BSplineCurve& a, const BSplineCurve& b) noexcept;
+CLAY_SURFACE_API bool identical(const BSplineCurve& a, const BSplineCurve& b) noexcept;
 
 /// The same curve run backwards on the same domain [a, b]: reversed(c)(t) = c(a + b - t). Knots
 /// are mirrored, control points and weights reversed (exact up to the rounding of a + b - t).
-BSplineCurve reversed(const BSplineCurve& curve);
+CLAY_SURFACE_API BSplineCurve reversed(const BSplineCurve& curve);
 
 }  // namespace clay::surface

@@ -6,6 +6,7 @@
 /// i * v.count() + j of `points` (u-major); `weights` uses the same index and is all 1 when the
 /// surface is polynomial.
 #include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
@@ -16,7 +17,7 @@
 namespace clay::surface {
 
 /// A B-spline surface: a basis per direction, the control net and its weights.
-struct BSplineSurface {
+struct CLAY_SURFACE_API BSplineSurface {
   BSplineBasis u;
   BSplineBasis v;
   Points3 points;           ///< u.count() * v.count() rows, index i * v.count() + j
@@ -34,21 +35,23 @@ struct BSplineSurface {
 
 /// Builds and validates a surface; `weights` empty means polynomial (all 1).
 /// Throws clay::Error(InvalidGeometry) naming every broken invariant.
-BSplineSurface make_surface(BSplineBasis u, BSplineBasis v, Points3 points,
-                            Eigen::VectorXd weights = {});
+CLAY_SURFACE_API BSplineSurface make_surface(BSplineBasis u, BSplineBasis v, Points3 points,
+                                             Eigen::VectorXd weights = {});
 
 /// Every invariant the surface breaks, in words, each naming `name`. Empty when valid: both bases
 /// valid, points.rows() == u.count() * v.count(), weights of the same size, positive and finite,
 /// coordinates finite.
-std::vector<std::string> problems(const BSplineSurface& surface, std::string_view name = "surface");
+CLAY_SURFACE_API std::vector<std::string> problems(const BSplineSurface& surface,
+                                                   std::string_view name = "surface");
 
 /// Throws clay::Error(InvalidGeometry) listing problems(surface, name) when there are any.
-void validate(const BSplineSurface& surface, std::string_view name = "surface");
+CLAY_SURFACE_API void validate(const BSplineSurface& surface, std::string_view name = "surface");
 
 /// True when degrees, knots, control points and weights are equal bit for bit.
-bool identical(const BSplineSurface& a, const BSplineSurface& b) noexcept;
+CLAY_SURFACE_API bool identical(const BSplineSurface& a, const BSplineSurface& b) noexcept;
 
 /// Axis-aligned box of the control points {min, max} (it contains the surface).
-std::pair<Eigen::Vector3d, Eigen::Vector3d> control_box(const BSplineSurface& surface);
+CLAY_SURFACE_API std::pair<Eigen::Vector3d, Eigen::Vector3d> control_box(
+    const BSplineSurface& surface);
 
 }  // namespace clay::surface

@@ -8,6 +8,7 @@
 /// internally (OpenCASCADE 7.6's translators are not thread-safe), so they may be called from
 /// several threads.
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/exchange_export.hpp>
 
 #include <filesystem>
 #include <string>
@@ -34,6 +35,11 @@ struct GltfWriteOptions {
   /// The budget of the whole preview: each of n surfaces gets at most sqrt(max_vertices / n)
   /// samples a direction (17 to 1025), so a model of thousands of faces stays a preview. >= 289.
   long max_vertices = 4'000'000;
+
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
+  void validate() const;
 };
 
 /// What was written (or checked): size figures and OpenCASCADE's BRepCheck verdict.
@@ -55,19 +61,20 @@ struct ExchangeReport {
 /// Writes `surfaces` as faces to a STEP file (millimetres). Throws clay::Error: InvalidGeometry for
 /// an invalid surface, DegreeLimit above max_exchange_degree, Exchange when OpenCASCADE refuses the
 /// model, Io when the file cannot be written. Returns the face count and BRepCheck verdict.
-ExchangeReport write_step(const std::vector<BSplineSurface>& surfaces,
-                          const std::filesystem::path& file, const StepWriteOptions& options = {});
+CLAY_OCCT_API ExchangeReport write_step(const std::vector<BSplineSurface>& surfaces,
+                                        const std::filesystem::path& file,
+                                        const StepWriteOptions& options = {});
 
 /// Writes `surfaces` as faces to an IGES file (trimmed surfaces, entity 144, over rational B-spline
 /// surfaces, entity 128; millimetres). Throws as write_step.
-ExchangeReport write_iges(const std::vector<BSplineSurface>& surfaces,
-                          const std::filesystem::path& file);
+CLAY_OCCT_API ExchangeReport write_iges(const std::vector<BSplineSurface>& surfaces,
+                                        const std::filesystem::path& file);
 
 /// How read_step and read_iges protect the caller from a malformed file. OpenCASCADE 7.6 crashes
 /// (SIGSEGV) or hangs inside its translators on some malformed files — a single dangling `#n`
 /// reference in STEP, a corrupt IGES B-spline record, NaN, infinite or denormal coordinates, degree
 /// 99 (issue #18) — where no exception can reach the caller.
-struct ReadOptions {
+struct CLAY_OCCT_API ReadOptions {
   /// Scan the file's text before OpenCASCADE sees it: STEP — every `#n` reference names a
   /// defined entity, numbers are finite, not denormal and at most 1e100 in magnitude, B-spline
   /// degrees are in [1, max_exchange_degree]; IGES — the parameter data's numbers the same, and
@@ -84,7 +91,9 @@ struct ReadOptions {
   double time_limit_seconds = 120;  ///< isolate: the child is killed after this, in (0, 86400]
   long memory_limit_mb = 4096;      ///< isolate: address space the child may add, in [1, 1048576]
 
-  /// Throws clay::Error(InvalidArgument) naming the field, its value and the rule broken.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -95,20 +104,23 @@ struct ReadOptions {
 /// when the file is missing or cannot be opened, Exchange when it cannot be parsed, holds no
 /// surface, fails the pre-check (naming the entity and line) or, isolated, crashes, hangs or
 /// exhausts the child process (see ReadOptions); InvalidArgument for bad options.
-std::vector<BSplineSurface> read_step(const std::filesystem::path& file, const ReadOptions& options = {});
+CLAY_OCCT_API std::vector<BSplineSurface> read_step(const std::filesystem::path& file,
+                                                    const ReadOptions& options = {});
 
 /// Reads every B-spline surface of an IGES file. Throws as read_step.
-std::vector<BSplineSurface> read_iges(const std::filesystem::path& file, const ReadOptions& options = {});
+CLAY_OCCT_API std::vector<BSplineSurface> read_iges(const std::filesystem::path& file,
+                                                    const ReadOptions& options = {});
 
 /// Builds the faces that write_step/write_iges write and runs BRepCheck_Analyzer on them.
-ExchangeReport check_faces(const std::vector<BSplineSurface>& surfaces);
+CLAY_OCCT_API ExchangeReport check_faces(const std::vector<BSplineSurface>& surfaces);
 
 /// Writes a binary glTF (.glb) preview: each surface as the grid mesh of tessellate_to_area (the
 /// viewer's tessellation, refined until its area is within options.relative_area of the
 /// surface's), with exact normals. glTF's units are metres and its up axis is Y; the writer
 /// converts. Throws as write_step, InvalidArgument for bad options, and ToleranceNotMet when a
 /// surface's mesh cannot meet the area tolerance.
-void write_gltf(const std::vector<BSplineSurface>& surfaces, const std::filesystem::path& file,
-                const GltfWriteOptions& options = {});
+CLAY_OCCT_API void write_gltf(const std::vector<BSplineSurface>& surfaces,
+                              const std::filesystem::path& file,
+                              const GltfWriteOptions& options = {});
 
 }  // namespace clay::surface

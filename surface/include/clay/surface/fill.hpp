@@ -4,7 +4,9 @@
 /// fill_n_sided() approximates a plate through any number of boundary curves and optional interior
 /// curves (OpenCASCADE's BRepOffsetAPI_MakeFilling), reporting how far each curve is from it.
 #include <clay/surface/build_report.hpp>
+#include <clay/surface/exchange_export.hpp>
 
+#include <string>
 #include <vector>
 
 namespace clay::surface {
@@ -17,12 +19,14 @@ enum class FillStyle {
 };
 
 /// Settings of fill().
-struct FillOptions {
+struct CLAY_OCCT_API FillOptions {
   FillStyle style = FillStyle::Coons;  ///< interior blend
   double gap_tolerance = 1e-7;  ///< mm, > 0 and finite: ends of consecutive boundary curves must
                                 ///< meet within this; they are then joined at their midpoint
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -35,7 +39,7 @@ struct FillOptions {
 /// of the loop (v = 0), v along the second (u = 1); 3 curves: the side u = 0 collapses to the corner
 /// where the loop closes; 2 curves: Stretch and Coons give the ruled surface between them (the
 /// second curve turned to run like the first; no loop needed), Curved the patch spanned by two
-/// curves that share a corner. The report is exact; its max_deviation is the largest distance
+/// curves that share a corner. The report is exact; its max_deviation_mm is the largest distance
 /// between each input curve and the surface edge it became, on dense samples (rounding, plus at
 /// most half a joined gap), and its method lists what was reversed, raised or joined. Throws
 /// clay::Error: InvalidArgument for a count outside [2, 4] or bad options; InvalidGeometry for an
@@ -46,13 +50,14 @@ struct FillOptions {
 /// crossing each other count too: "curve #1 at t = 0.5 and curve #3 at t = 0.5 meet at point
 /// ..."; with 2 curves each is checked on its own); InvalidGeometry with OpenCASCADE's message if
 /// it still fails.
-BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& options = {});
+CLAY_OCCT_API BuiltSurface fill(const std::vector<BSplineCurve>& boundary,
+                                const FillOptions& options = {});
 
 /// Settings of fill_n_sided(): BRepOffsetAPI_MakeFilling's parameters. Defaults are OpenCASCADE's
 /// except degree (5, not 3), tolerance_3d (1e-5, not 1e-4) and max_segments (20, not 9): on a
 /// 5-sided sphere cap and a cubic dome (~200 mm) they bring the measured curve-to-surface distance
 /// from 6e-4 and 1.7e-3 mm down to 3.4e-6 and 1.2e-6 mm, at the same cost (20-40 ms).
-struct NSidedFillOptions {
+struct CLAY_OCCT_API NSidedFillOptions {
   int degree = 5;              ///< order of the plate's energy criterion, 2..14 (OCCT "Degree")
   int points_on_curve = 15;    ///< constraint points per curve, 2..1000 (OCCT "NbPtsOnCur")
   int iterations = 2;          ///< plate iterations, 1..50 (OCCT "NbIter")
@@ -68,7 +73,9 @@ struct NSidedFillOptions {
                                ///< their midpoint)
   int samples_per_curve = 64;  ///< points per curve where the deviation is measured, >= 2
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -84,14 +91,14 @@ struct NSidedFill {
 /// fill()) and optional interior curves it must pass through: OpenCASCADE's plate
 /// (BRepOffsetAPI_MakeFilling, GeomPlate: a thin-plate energy minimized under point constraints,
 /// then approximated by a B-spline), returned as that B-spline surface, untrimmed: it covers the
-/// N-sided region and extends beyond it (the boundary curves trim it). Not exact: max_deviation is
+/// N-sided region and extends beyond it (the boundary curves trim it). Not exact: max_deviation_mm is
 /// the largest of curve_deviations, measured with closest_point() on options.samples_per_curve
 /// points of every curve. Throws clay::Error: InvalidArgument for fewer than 3 boundary curves or
 /// bad options; InvalidGeometry for invalid or degenerate curves, a boundary that does not close
 /// (naming each gap as fill() does), a boundary loop that crosses, touches or doubles back onto
 /// itself (as fill() checks it), or when OpenCASCADE fails (its message included).
-NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
-                        const std::vector<BSplineCurve>& interior = {},
-                        const NSidedFillOptions& options = {});
+CLAY_OCCT_API NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
+                                      const std::vector<BSplineCurve>& interior = {},
+                                      const NSidedFillOptions& options = {});
 
 }  // namespace clay::surface

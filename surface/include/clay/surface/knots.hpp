@@ -1,12 +1,16 @@
 #pragma once
-/// Knot insertion (Boehm), knot refinement and Bézier extraction. None of these change the shape:
-/// the new representation describes the same curve or surface (exactly, up to rounding).
+/// Knot insertion (Boehm), knot refinement, Bézier extraction and knot removal. None of these
+/// change the shape: the new representation describes the same curve or surface (exactly, up to
+/// rounding; knot removal within its tolerance).
 ///
 /// Every function validates its input and throws clay::Error: InvalidGeometry for an invalid
 /// object, OutOfDomain for a knot outside the parameter domain, InvalidArgument for a request that
 /// would raise a knot's multiplicity above the degree (above degree + 1 at the domain ends of an
 /// unclamped vector's outermost value).
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/export.hpp>
+
+#include <Eigen/Core>
 
 #include <span>
 #include <vector>
@@ -14,23 +18,28 @@
 namespace clay::surface {
 
 /// Inserts knot t `times` times (Boehm's algorithm, The NURBS Book A5.1).
-BSplineCurve insert_knot(const BSplineCurve& curve, double t, int times = 1);
+CLAY_SURFACE_API BSplineCurve insert_knot(const BSplineCurve& curve, double t, int times = 1);
 /// Inserts knot u `times` times in the u direction of the surface.
-BSplineSurface insert_knot_u(const BSplineSurface& surface, double u, int times = 1);
+CLAY_SURFACE_API BSplineSurface insert_knot_u(const BSplineSurface& surface, double u,
+                                              int times = 1);
 /// Inserts knot v `times` times in the v direction of the surface.
-BSplineSurface insert_knot_v(const BSplineSurface& surface, double v, int times = 1);
+CLAY_SURFACE_API BSplineSurface insert_knot_v(const BSplineSurface& surface, double v,
+                                              int times = 1);
 
 /// Inserts all of `knots` (sorted or not, repeats allowed) at once (The NURBS Book A5.4).
-BSplineCurve refine_knots(const BSplineCurve& curve, std::span<const double> knots);
+CLAY_SURFACE_API BSplineCurve refine_knots(const BSplineCurve& curve,
+                                           std::span<const double> knots);
 /// Knot refinement in the u direction of the surface.
-BSplineSurface refine_knots_u(const BSplineSurface& surface, std::span<const double> knots);
+CLAY_SURFACE_API BSplineSurface refine_knots_u(const BSplineSurface& surface,
+                                               std::span<const double> knots);
 /// Knot refinement in the v direction of the surface.
-BSplineSurface refine_knots_v(const BSplineSurface& surface, std::span<const double> knots);
+CLAY_SURFACE_API BSplineSurface refine_knots_v(const BSplineSurface& surface,
+                                               std::span<const double> knots);
 
 /// Splits the curve into its Bézier segments, one per non-empty knot span of the domain, each a
 /// clamped curve of the same degree on its own span [t_k, t_k+1] (parameters are kept, not
 /// normalized), so segment k evaluates like the curve on that span.
-std::vector<BSplineCurve> extract_bezier(const BSplineCurve& curve);
+CLAY_SURFACE_API std::vector<BSplineCurve> extract_bezier(const BSplineCurve& curve);
 
 /// The Bézier patches of a surface, one per pair of non-empty knot spans.
 struct BezierPatches {
@@ -48,6 +57,42 @@ struct BezierPatches {
 
 /// Splits the surface into its Bézier patches (The NURBS Book A5.7 by way of refinement); each
 /// patch keeps the surface's parameters on its span, so it evaluates like the surface there.
-BezierPatches extract_bezier(const BSplineSurface& surface);
+CLAY_SURFACE_API BezierPatches extract_bezier(const BSplineSurface& surface);
+
+/// The Bézier extraction operator of one non-empty span [a, b] of a basis: the span's Bézier
+/// control point r is sum_q matrix(r, q) P[first + q] (first = span index − degree).
+struct SpanExtraction {
+  double a = 0, b = 1;
+  int first = 0;
+  Eigen::MatrixXd matrix;  ///< (degree + 1) x (degree + 1)
+};
+
+/// The extraction operator of every non-empty span of the domain, by the same refinement as
+/// extract_bezier (applied to the identity), for nets of any dimension such as FFD lattices.
+CLAY_SURFACE_API std::vector<SpanExtraction> bezier_extraction(const BSplineBasis& basis);
+
+/// A curve after remove_knots, and how many knots were taken out.
+struct CurveKnotRemoval {
+  BSplineCurve curve;
+  int removed = 0;
+};
+/// A surface after remove_knots_u or _v, and how many knots were taken out.
+struct SurfaceKnotRemoval {
+  BSplineSurface surface;
+  int removed = 0;
+};
+
+/// Removes every interior knot as often as its removal moves the homogeneous control points
+/// (w·P, w) by at most `tolerance_mm` in all (The NURBS Book A5.8; the gaps of repeated
+/// removals of one knot value add up within the tolerance). For a polynomial curve that bounds
+/// how far the curve moves; exact composition joins Bézier patches with full-multiplicity knots
+/// and calls this with 1e-12 of the model size to return the smallest exact representation.
+/// Throws InvalidGeometry for an invalid curve, InvalidArgument for a negative or non-finite
+/// tolerance.
+CLAY_SURFACE_API CurveKnotRemoval remove_knots(const BSplineCurve& curve, double tolerance_mm);
+/// remove_knots in the u direction: a u knot goes only when every column of the net allows it.
+CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_u(const BSplineSurface& surface, double tolerance_mm);
+/// remove_knots in the v direction.
+CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_v(const BSplineSurface& surface, double tolerance_mm);
 
 }  // namespace clay::surface

@@ -18,19 +18,23 @@
 /// slope is infinite where cos or sin vanish when e < 1, smooth in s, so a few hundred spans reach
 /// 1e-3 mm even for e = 0.3.
 #include <clay/surface/build_report.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
+#include <string>
 #include <vector>
 
 namespace clay::surface {
 
 /// Settings of the superquadric builders.
-struct SuperquadricOptions {
+struct CLAY_SURFACE_API SuperquadricOptions {
   double tolerance = 1e-3;  ///< mm: largest allowed distance from the analytic surface, > 0
   int degree = 3;           ///< degree of approximated directions, in [2, 7]
   int max_spans = 4096;     ///< knot spans per approximated direction before giving up, >= 8
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -63,24 +67,26 @@ struct Superhyperboloid {
 /// S(s, t) = (m_x(s) h_x(t), m_x(s) h_y(t), m_y(s)). Exact: control point (i, j) is
 /// (M_i.x H_j.x, M_i.x H_j.y, M_i.y) with weight w_i w_j. Throws clay::Error(InvalidGeometry)
 /// for an invalid curve.
-BSplineSurface spherical_product(const BSplineCurve& m, const BSplineCurve& h);
+CLAY_SURFACE_API BSplineSurface spherical_product(const BSplineCurve& m, const BSplineCurve& h);
 
 /// Superellipsoid as a B-spline surface: u along eta (south to north pole), v along omega. With
 /// e1 = e2 = 1 it is the exact rational ellipsoid (a sphere for equal radii).
-BuiltSurface superellipsoid(const Superellipsoid& shape, const SuperquadricOptions& options = {});
+CLAY_SURFACE_API BuiltSurface superellipsoid(const Superellipsoid& shape,
+                                             const SuperquadricOptions& options = {});
 
 /// Supertoroid as a B-spline surface (closed in both directions). With e1 = e2 = 1 and equal
 /// radii r it is the exact rational torus of major radius r * hole and minor radius r.
-BuiltSurface supertoroid(const Supertoroid& shape, const SuperquadricOptions& options = {});
+CLAY_SURFACE_API BuiltSurface supertoroid(const Supertoroid& shape,
+                                          const SuperquadricOptions& options = {});
 
 /// Superhyperboloid of one sheet (closed around z). Exact rational when e1 = e2 = 1.
-BuiltSurface superhyperboloid_one_sheet(const Superhyperboloid& shape,
-                                        const SuperquadricOptions& options = {});
+CLAY_SURFACE_API BuiltSurface superhyperboloid_one_sheet(const Superhyperboloid& shape,
+                                                         const SuperquadricOptions& options = {});
 
 /// Superhyperboloid of two sheets: two surfaces, the sheet around +x (omega in
 /// [-omega_limit, omega_limit]) and the sheet around -x (omega + pi), which is the first mirrored
 /// in the yz plane. Exact when e1 = e2 = 1.
-std::vector<BuiltSurface> superhyperboloid_two_sheets(const Superhyperboloid& shape,
-                                                      const SuperquadricOptions& options = {});
+CLAY_SURFACE_API std::vector<BuiltSurface> superhyperboloid_two_sheets(
+    const Superhyperboloid& shape, const SuperquadricOptions& options = {});
 
 }  // namespace clay::surface

@@ -9,23 +9,27 @@
 #include <clay/summary.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace clay::surface {
 
 /// Settings of project_normal and closest_point.
-struct ProjectionOptions {
+struct CLAY_SURFACE_API ProjectionOptions {
   int max_iterations = 50;            ///< Newton iterations per start, >= 1
   double parametric_tolerance = 1e-14;///< step size below which Newton stops (relative to domain)
   double cosine_tolerance = 1e-12;    ///< |cos| between S_u or S_v and S - P that counts as normal
   int samples_per_span = 4;           ///< closest_point: start grid density per knot span, >= 1
   int starts = 4;                     ///< closest_point: Newton runs from the best grid samples, >= 1
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -41,20 +45,22 @@ struct SurfaceProjection {
 /// The foot point of `point` reached by Newton from (u0, v0): a point where S - P is normal to the
 /// surface (or a constrained minimum on the domain edge). Throws clay::Error: OutOfDomain for a
 /// start outside the domain, InvalidGeometry for an invalid surface or a non-finite point.
-SurfaceProjection project_normal(const BSplineSurface& surface, const Eigen::Vector3d& point,
-                                 double u0, double v0, const ProjectionOptions& options = {});
+CLAY_SURFACE_API SurfaceProjection project_normal(const BSplineSurface& surface,
+                                                  const Eigen::Vector3d& point, double u0,
+                                                  double v0, const ProjectionOptions& options = {});
 
 /// The closest point of the surface to `point`: Newton from the best samples of a grid of
 /// samples_per_span points per knot span, the nearest result kept. Throws as project_normal.
-SurfaceProjection closest_point(const BSplineSurface& surface, const Eigen::Vector3d& point,
-                                const ProjectionOptions& options = {});
+CLAY_SURFACE_API SurfaceProjection closest_point(const BSplineSurface& surface,
+                                                 const Eigen::Vector3d& point,
+                                                 const ProjectionOptions& options = {});
 
 /// A surface prepared for many projections: validated once, with the start grid of
 /// closest_point evaluated once, on the first closest_point (so a projector used only for
 /// project_normal costs no grid). Same results as the free functions (bit for bit). An immutable
 /// value: copyable (copies share the grid) and safe to share between threads. A moved-from
 /// projector throws InvalidArgument from closest_point until a projector is assigned to it.
-class SurfaceProjector {
+class CLAY_SURFACE_API SurfaceProjector {
  public:
   /// Copies and validates the surface. Throws clay::Error: InvalidGeometry for an invalid
   /// surface, InvalidArgument for bad options.
@@ -94,12 +100,15 @@ struct CurveProjection {
 /// backtracking line search, so the distance never increases from t0's. An open curve keeps t in
 /// its domain (a foot beyond an end is the end); `periodic` wraps t around the domain (a closed,
 /// periodic curve). Throws clay::Error(InvalidGeometry) for an invalid curve or a non-finite point.
-CurveProjection project_normal(const BSplineCurve& curve, const Eigen::Vector3d& point, double t0,
-                               bool periodic = false);
+CLAY_SURFACE_API CurveProjection project_normal(const BSplineCurve& curve,
+                                                const Eigen::Vector3d& point, double t0,
+                                                bool periodic = false);
 
 /// The closest point of the curve to `point`: Newton (project_normal) from the three best of
 /// `samples_per_span` samples per knot span (>= 1), the nearest foot kept. Throws as
 /// project_normal, and InvalidArgument for samples_per_span < 1.
-CurveProjection closest_point(const BSplineCurve& curve, const Eigen::Vector3d& point, int samples_per_span = 8);
+CLAY_SURFACE_API CurveProjection closest_point(const BSplineCurve& curve,
+                                               const Eigen::Vector3d& point,
+                                               int samples_per_span = 8);
 
 }  // namespace clay::surface

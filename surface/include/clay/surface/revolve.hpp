@@ -2,6 +2,7 @@
 /// Surfaces of revolution as exact rational B-spline surfaces (The NURBS Book A8.1): every
 /// circle is an exact rational quadratic, not an approximation.
 #include <clay/surface/build_report.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
@@ -19,7 +20,7 @@ struct Axis {
 /// (same degree, knots and parameters). A full revolution closes exactly (the last row of control
 /// points copies the first). Control points on the axis stay there (poles, as on a sphere).
 ///
-/// The report is exact; its max_deviation is the largest difference, over a dense sample, between
+/// The report is exact; its max_deviation_mm is the largest difference, over a dense sample, between
 /// a surface point's distance to the axis (and height along it) and those of the profile point it
 /// comes from. Throws clay::Error: InvalidGeometry for an invalid profile, a profile lying on the
 /// axis, a profile that touches or crosses the axis between its ends, or a profile that crosses,
@@ -27,6 +28,7 @@ struct Axis {
 /// would intersect itself in each case); InvalidArgument for an axis of zero length or an angle
 /// outside (0, 360]. Not detected: a non-planar profile whose meridian (distance to the axis,
 /// height along it) crosses itself although the profile does not.
-BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle_degrees = 360.0);
+CLAY_SURFACE_API BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis,
+                                      double angle_degrees = 360.0);
 
 }  // namespace clay::surface

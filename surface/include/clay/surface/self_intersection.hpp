@@ -4,6 +4,7 @@
 /// The surface builders use it to refuse sections, profiles, paths and boundary curves that meet
 /// themselves (the surface built on them would intersect itself).
 #include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/export.hpp>
 
 #include <Eigen/Core>
 
@@ -53,7 +54,7 @@ inline constexpr double self_intersection_arc_factor = 100.0;
 ///
 /// Throws clay::Error: InvalidGeometry for an invalid curve (see validate()); InvalidArgument for
 /// a tolerance that is not positive and finite.
-std::optional<CurveSelfIntersection> find_self_intersection(const BSplineCurve& curve,
-                                                            double tolerance);
+CLAY_SURFACE_API std::optional<CurveSelfIntersection> find_self_intersection(
+    const BSplineCurve& curve, double tolerance);
 
 }  // namespace clay::surface

@@ -4,7 +4,9 @@
 /// Both are our own code on the value types (no OpenCASCADE). The surface's u direction runs along
 /// the sections (the profile), its v direction across them (along the path).
 #include <clay/surface/build_report.hpp>
+#include <clay/surface/export.hpp>
 
+#include <string>
 #include <vector>
 
 namespace clay::surface {
@@ -17,7 +19,7 @@ enum class LoftParametrization {
 };
 
 /// Settings of loft().
-struct LoftOptions {
+struct CLAY_SURFACE_API LoftOptions {
   int degree = 3;  ///< degree across the sections (v), 1..max_kernel_degree; the loft uses
                    ///< min(degree, sections - 1), so the surface is C^(degree-1) across sections
   LoftParametrization parametrization = LoftParametrization::ChordLength;  ///< v spacing
@@ -26,7 +28,9 @@ struct LoftOptions {
                             ///< points): consecutive sections closer than this coincide, a section
                             ///< whose control polygon is shorter is degenerate; in (0, 1e-2]
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -37,20 +41,20 @@ struct LoftOptions {
 /// same degree and knot vector. Throws clay::Error(InvalidGeometry) for an invalid curve (named
 /// "curve #k", 0-based) or when the degree would exceed max_kernel_degree; InvalidArgument for an
 /// empty list.
-std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves);
+CLAY_SURFACE_API std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves);
 
 /// The v parameter at which loft(sections, options) interpolates each section (0 first, 1 last):
 /// the chord-length (or centripetal, or uniform) parameters of the compatible sections' control
 /// points averaged over the control point columns (The NURBS Book §10.3, eq. 10.8). Throws as loft.
-std::vector<double> loft_parameters(const std::vector<BSplineCurve>& sections,
-                                    const LoftOptions& options = {});
+CLAY_SURFACE_API std::vector<double> loft_parameters(const std::vector<BSplineCurve>& sections,
+                                                     const LoftOptions& options = {});
 
 /// A surface through 2 or more section curves (skinning, The NURBS Book §10.3): the sections are
 /// made compatible (make_compatible), then each column of their control points (homogeneous, so
 /// rational sections work) is interpolated across the sections with degree
 /// min(options.degree, sections - 1), the averaged parameters of loft_parameters and knots by
 /// averaging (eq. 9.8). Exact: S(u, v_k) equals section k at its normalized parameter u in [0, 1];
-/// the report's max_deviation measures exactly that on a dense sample (rounding, ~1e-15 of size).
+/// the report's max_deviation_mm measures exactly that on a dense sample (rounding, ~1e-15 of size).
 /// A section running against its predecessor is reversed when options.auto_orient (the report's
 /// method says which). Throws clay::Error: InvalidArgument for fewer than 2 sections or bad
 /// options; InvalidGeometry naming the section index (0-based) for an invalid or degenerate
@@ -58,10 +62,11 @@ std::vector<double> loft_parameters(const std::vector<BSplineCurve>& sections,
 /// back onto itself within options.tolerance × size (find_self_intersection; the message gives
 /// both parameters and the point), two consecutive coincident sections, a reversed section when
 /// auto_orient is false, or rational sections whose interpolated weights are not positive.
-BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& options = {});
+CLAY_SURFACE_API BuiltSurface loft(const std::vector<BSplineCurve>& sections,
+                                   const LoftOptions& options = {});
 
 /// Settings of sweep().
-struct SweepOptions {
+struct CLAY_SURFACE_API SweepOptions {
   double twist_degrees = 0;  ///< total rotation of the profile about the path tangent from start to
                              ///< end, spread in proportion to arc length; finite
   int sections = 0;          ///< profile copies placed along the path: 0 = adaptive (refined until
@@ -71,7 +76,9 @@ struct SweepOptions {
                              ///< the largest tangent turn (radians) at a path knot; in (0, 1e-1]
   int max_sections = 1025;   ///< adaptive refinement stops here, >= 2
 
-  /// Throws clay::Error(InvalidArgument) naming the first field outside its range.
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
 };
 
@@ -84,7 +91,7 @@ struct SweepOptions {
 /// at equal arc-length steps (cubic across them, v = arc-length fraction, u = the profile's own
 /// clamped parameter), doubling their number until the largest distance between S(u, v) and the
 /// exactly moved profile at 1/4, 1/2, 3/4 of every interval is within tolerance (report: exact =
-/// false, max_deviation, the sections used in the method). At path knots where the curvature (or its derivative) jumps, a copy
+/// false, max_deviation_mm, the sections used in the method). At path knots where the curvature (or its derivative) jumps, a copy
 /// sits on the knot and v gets a triple (double) knot, matching the sweep's own C0 (C1) continuity
 /// there. A straight path without twist gives the exact extrusion (degree 1 across, exact = true).
 /// Throws clay::Error(InvalidGeometry) naming "profile" or "path" for an invalid or degenerate
@@ -96,7 +103,7 @@ struct SweepOptions {
 /// surface would fold through itself; the message gives the path parameter, the radius and the
 /// reach); InvalidArgument for bad options and when the adaptive sweep still misses the tolerance
 /// with max_sections sections (the message gives the deviation and the tolerance in mm).
-BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
-                   const SweepOptions& options = {});
+CLAY_SURFACE_API BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
+                                    const SweepOptions& options = {});
 
 }  // namespace clay::surface

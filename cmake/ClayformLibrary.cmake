@@ -1,0 +1,29 @@
+# clayform_library(<target> <MACRO> <header>): what every Clayform shared library shares (issue #19).
+#
+# - Hidden symbol visibility: only what a public header marks with <MACRO> (CLAY_SURFACE_API, ...)
+#   is exported; internal functions (namespace detail, src/*.hpp) and inline functions are not.
+#   An embedder links against the API, not against whatever happened to have external linkage.
+# - <header> (e.g. clay/surface/export.hpp) defines <MACRO>; GenerateExportHeader writes it under
+#   the calling folder's build tree, include/<header>, which is on the target's include path and is
+#   installed with the other headers (top CMakeLists.txt).
+# - VERSION and SOVERSION from project(VERSION), here and nowhere else. While the major version is
+#   0 the ABI may break at every minor release, so SOVERSION is 0.<minor> (libclay_surface.so.0.1:
+#   a program built against 0.1 never loads a 0.2 library); from 1.0 on it is the major version.
+#   ClayformConfigVersion.cmake's SameMinorVersion says the same to find_package.
+include(GenerateExportHeader)
+
+if(PROJECT_VERSION_MAJOR EQUAL 0)
+  set(CLAYFORM_SOVERSION 0.${PROJECT_VERSION_MINOR})
+else()
+  set(CLAYFORM_SOVERSION ${PROJECT_VERSION_MAJOR})
+endif()
+
+function(clayform_library target macro header)
+  set_target_properties(${target} PROPERTIES
+    VERSION ${PROJECT_VERSION} SOVERSION ${CLAYFORM_SOVERSION}
+    CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON)
+  string(REGEX REPLACE "_API$" "" base ${macro})
+  generate_export_header(${target} BASE_NAME ${base} EXPORT_MACRO_NAME ${macro}
+    EXPORT_FILE_NAME ${CMAKE_CURRENT_BINARY_DIR}/include/${header})
+  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_BINARY_DIR}/include>)
+endfunction()
