@@ -1753,7 +1753,7 @@ std::pair<int, int> line_column(std::string_view text, std::size_t byte) {
     if (k > 0) end = k - 1;
   } else {
     auto literal = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+'; };
-    while (end > 0 && end <= text.size() && literal(text[end]) && literal(text[end - 1])) --end;
+    while (end > 0 && end < text.size() && literal(text[end]) && literal(text[end - 1])) --end;
   }
   int line = 1;
   std::size_t line_start = 0;

@@ -21,6 +21,8 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <string_view>
+#include <vector>
 
 #include "error_of.hpp"
 
@@ -462,6 +464,23 @@ TEST_CASE("syntax errors come with their line and column, repeated keys with the
     "curves": {"a": {"line": {"from": [0, 0, 0], "to": [1, 0, 0]}}, "a": {"line": {"from": [0, 0, 0], "to": [2, 0, 0]}}}})";
   CHECK(mentions(check_recipe(twice), "curves.a", "appears twice"));
   CHECK(mentions(check_recipe(R"({"format": "clayform.recipe", "version": 1, "name": 1e999})"), "name", "finite"));
+}
+
+TEST_CASE("a text that ends inside a number or literal is placed without reading past its end", "[recipe]") {
+  // Found by fuzz_recipe (issue #19): the parser reports the end of input one past the last byte,
+  // and the search for the token's start read that byte. The text lies in a buffer of exactly its
+  // size, so AddressSanitizer (scripts/test.sh's sanitize part) sees any read past it.
+  for (const std::string& text : std::vector<std::string>{R"({"format": "clayform.recipe", "version": 1)",
+                                                           R"({"format": "clayform.recipe", "version": tru)",
+                                 std::string("{\n  \"version\": 1.5e")}) {
+    const std::vector<char> exact(text.begin(), text.end());
+    const auto problems = check_recipe(std::string_view(exact.data(), exact.size()));
+    REQUIRE(problems.size() == 1);
+    CHECK(problems[0].path == "(syntax)");
+    CHECK(problems[0].line >= 1);
+    CHECK(problems[0].column >= 1);
+    CHECK(problems[0].column <= static_cast<int>(text.size()) + 1);
+  }
 }
 
 TEST_CASE("a number beyond a double leaves the caller's floating-point environment as it was", "[recipe]") {
