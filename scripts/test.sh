@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds Clayform and runs its tests in three timed parts, then prints a summary:
 #   release   build/ (Release, warnings as errors) and the whole ctest suite: what users get.
-#   sanitize  build-sanitize/ (Clang, Debug at -O1: assertions and the tests' floating-point traps
+#   sanitize  build-sanitize/ (Clang, Debug at -O2: assertions and the tests' floating-point traps
 #             on; AddressSanitizer + UndefinedBehaviorSanitizer, every finding fatal) and the
 #             whole ctest suite again, examples included.
 #   fuzz      the libFuzzer targets of tests/fuzz (built in build-sanitize/), each for
@@ -43,10 +43,9 @@ clay_sanitizer_env() {
 clay_sanitize_build() {
   if [[ ! -f "$CLAY_SANITIZE_BUILD/CMakeCache.txt" ]]; then
     echo "==> configuring $CLAY_SANITIZE_BUILD"
-    # -O2: Eigen's expression templates must be inlined (at -O1 Clang 14 leaves its kernels and
-    # coefficient accessors as calls: a recipe ran 34x slower than Release, at -O2 about Nx);
-    # line tables are all a sanitizer report needs (full -g makes objects bigger, links slower).
-    # No benchmarks: nothing runs them here.
+    # -O2: Eigen's expression templates must be inlined (so must UBSan leave Eigen's headers
+    # alone: cmake/sanitizer-ignorelist.txt); line tables are all a sanitizer report needs (full
+    # -g makes objects bigger, links slower). No benchmarks: nothing runs them here.
     cmake -S "$CLAY_ROOT" -B "$CLAY_SANITIZE_BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Debug \
       -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_CXX_FLAGS_DEBUG="-O2 -gline-tables-only" \
       -DCLAYFORM_SANITIZE=address,undefined -DCLAYFORM_BUILD_FUZZ=ON -DCLAYFORM_BUILD_BENCH=OFF \
