@@ -17,6 +17,7 @@
 
 #include <clay/internal/deformation_json.hpp>
 #include <clay/internal/json_reader.hpp>
+#include <clay/internal/fenv.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -579,7 +580,9 @@ class RecipeChecker {
         c_.add(pp, std::to_string(pts->size()) + " points; at most " + std::to_string(limit::sketch_items) +
                        " are allowed in a sketch (recipe limit)");
       } else if (pts->is_object()) {
-        for (const auto& [pname, pv] : pts->items()) {
+        for (const auto& item : pts->items()) {  // no structured binding: Clang 14 cannot capture one
+          const std::string& pname = item.key();
+          const Json& pv = item.value();
           const std::string p = key_path(pp, pname);
           if (!plane_id.free()) {
             if (const auto ab = c_.vec2(pv, p))
@@ -665,7 +668,9 @@ class RecipeChecker {
         c_.add(ep, std::to_string(ents->size()) + " entities; at most " + std::to_string(limit::sketch_items) +
                        " are allowed in a sketch (recipe limit)");
       } else if (ents->is_object()) {
-        for (const auto& [ename, ev] : ents->items()) {
+        for (const auto& item : ents->items()) {  // no structured binding: Clang 14 cannot capture one
+          const std::string& ename = item.key();
+          const Json& ev = item.value();
           const std::string p = key_path(ep, ename);
           building = ename;
           std::string kind;
@@ -1748,7 +1753,7 @@ std::pair<int, int> line_column(std::string_view text, std::size_t byte) {
     if (k > 0) end = k - 1;
   } else {
     auto literal = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+'; };
-    while (end > 0 && end <= text.size() && literal(text[end]) && literal(text[end - 1])) --end;
+    while (end > 0 && end < text.size() && literal(text[end]) && literal(text[end - 1])) --end;
   }
   int line = 1;
   std::size_t line_start = 0;
@@ -1841,6 +1846,7 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
     }
     return true;
   };
+  const internal::FpTrapsHeld traps_held;  // the JSON parser's strtod
   try {
     return Json::parse(text.begin(), text.end(), cb);
   } catch (const Json::out_of_range& e) {  // a number beyond the double range: name where it is

@@ -81,6 +81,14 @@ using vd = double __attribute__((vector_size(W * sizeof(double))));
 using vi = long long __attribute__((vector_size(W * sizeof(long long))));
 using vi32 = std::int32_t __attribute__((vector_size(W * sizeof(std::int32_t))));
 
+// Lanes of a then b picked by constant indices: GCC's __builtin_shuffle takes the indices as a
+// vector, Clang has only __builtin_shufflevector (the same meaning, the indices as arguments).
+#if defined(__clang__)
+#define CLAY_SHUFFLE(a, b, ...) __builtin_shufflevector(a, b, __VA_ARGS__)
+#else
+#define CLAY_SHUFFLE(a, b, ...) __builtin_shuffle(a, b, vi{__VA_ARGS__})
+#endif
+
 [[gnu::always_inline]] inline void load(vd& v, const double* p) { std::memcpy(&v, p, sizeof v); }
 
 [[gnu::always_inline]] inline void store(double* p, const vd& v) { std::memcpy(p, &v, sizeof v); }
@@ -91,20 +99,20 @@ using vi32 = std::int32_t __attribute__((vector_size(W * sizeof(std::int32_t))))
   load(a, p);
   load(b, p + W);
   load(c, p + 2 * W);
-  x = __builtin_shuffle(__builtin_shuffle(a, b, vi{0, 3, 6, 9, 12, 15, 0, 0}), c, vi{0, 1, 2, 3, 4, 5, 10, 13});
-  y = __builtin_shuffle(__builtin_shuffle(a, b, vi{1, 4, 7, 10, 13, 0, 0, 0}), c, vi{0, 1, 2, 3, 4, 8, 11, 14});
-  z = __builtin_shuffle(__builtin_shuffle(a, b, vi{2, 5, 8, 11, 14, 0, 0, 0}), c, vi{0, 1, 2, 3, 4, 9, 12, 15});
+  x = CLAY_SHUFFLE(CLAY_SHUFFLE(a, b, 0, 3, 6, 9, 12, 15, 0, 0), c, 0, 1, 2, 3, 4, 5, 10, 13);
+  y = CLAY_SHUFFLE(CLAY_SHUFFLE(a, b, 1, 4, 7, 10, 13, 0, 0, 0), c, 0, 1, 2, 3, 4, 8, 11, 14);
+  z = CLAY_SHUFFLE(CLAY_SHUFFLE(a, b, 2, 5, 8, 11, 14, 0, 0, 0), c, 0, 1, 2, 3, 4, 9, 12, 15);
 }
 
 /// The inverse of load_rows.
 [[gnu::always_inline]] inline void store_rows(double* p, const vd& x, const vd& y, const vd& z) {
   // a = x0 y0 z0 x1 y1 z1 x2 y2, b = z2 x3 y3 z3 x4 y4 z4 x5, c = y5 z5 x6 y6 z6 x7 y7 z7
-  const vd xy = __builtin_shuffle(x, y, vi{0, 8, 0, 1, 9, 0, 2, 10});
-  const vd a = __builtin_shuffle(xy, z, vi{0, 1, 8, 3, 4, 9, 6, 7});
-  const vd zx = __builtin_shuffle(z, x, vi{2, 11, 0, 3, 12, 0, 4, 13});
-  const vd b = __builtin_shuffle(zx, y, vi{0, 1, 11, 3, 4, 12, 6, 7});
-  const vd yz = __builtin_shuffle(y, z, vi{5, 13, 0, 6, 14, 0, 7, 15});
-  const vd c = __builtin_shuffle(yz, x, vi{0, 1, 14, 3, 4, 15, 6, 7});
+  const vd xy = CLAY_SHUFFLE(x, y, 0, 8, 0, 1, 9, 0, 2, 10);
+  const vd a = CLAY_SHUFFLE(xy, z, 0, 1, 8, 3, 4, 9, 6, 7);
+  const vd zx = CLAY_SHUFFLE(z, x, 2, 11, 0, 3, 12, 0, 4, 13);
+  const vd b = CLAY_SHUFFLE(zx, y, 0, 1, 11, 3, 4, 12, 6, 7);
+  const vd yz = CLAY_SHUFFLE(y, z, 5, 13, 0, 6, 14, 0, 7, 15);
+  const vd c = CLAY_SHUFFLE(yz, x, 0, 1, 14, 3, 4, 15, 6, 7);
   store(p, a);
   store(p + W, b);
   store(p + 2 * W, c);

@@ -10,6 +10,7 @@
 #include <clay/error.hpp>
 #include <clay/internal/checks.hpp>
 #include <clay/internal/deformation_json.hpp>
+#include <clay/internal/fenv.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -249,6 +250,7 @@ std::string to_json(const DeformationStack& stack) {
 DeformationStack stack_from_json(std::string_view json) {
   Json root;
   try {
+    const internal::FpTrapsHeld traps_held;  // the JSON parser's strtod
     root = Json::parse(json.begin(), json.end());
   } catch (const Json::parse_error& e) {
     throw Error(ErrorCategory::Recipe,

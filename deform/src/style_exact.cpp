@@ -319,8 +319,12 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     // is met only by moving the free ones by about distance / share: independent in rank, yet
     // amplified into a net metres away (seen on a filled sail, shares ~1e-4). The share is only
     // reported; what refines the net is the amplification the solve below actually shows.
+    // No free vertex (a net too coarse for the region): every share is 0. B has no columns then,
+    // and Eigen's row() of it would offset a null pointer (undefined behaviour, UBSan).
     double min_share = 1.0;
-    for (Eigen::Index k = 0; k < nk; ++k) min_share = std::min(min_share, B.row(k).sum());
+    if (nf == 0 && nk > 0) min_share = 0.0;
+    if (nf > 0)
+      for (Eigen::Index k = 0; k < nk; ++k) min_share = std::min(min_share, B.row(k).sum());
     if (rank < nk && refinements < options.max_refinements) {
       refine();
       continue;

@@ -135,7 +135,9 @@ OversketchResult oversketch(const BSplineCurve& curve, const Stroke& stroke,
     for (Eigen::Index i = 0; i < pts.rows(); ++i)
       pts.row(i) = to_world(*stroke.plane, Eigen::Vector2d(pts(i, 0), pts(i, 1))).transpose();
 
-  const auto [t0, t1] = curve.basis.domain();
+  // Not a structured binding: lambdas below capture t0 and t1, which Clang 14 refuses for bindings.
+  const auto domain = curve.basis.domain();
+  const double t0 = domain.first, t1 = domain.second;
   const double at_end_tol = 1e-9 * (t1 - t0);
   const Eigen::Vector3d curve_start = surface::evaluate(curve, t0);
   const Eigen::Vector3d curve_end = surface::evaluate(curve, t1);

@@ -2,6 +2,7 @@
 #include "exchange_precheck.hpp"
 
 #include <clay/error.hpp>
+#include <clay/internal/fenv.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -59,7 +60,7 @@ class StepTokens {
  public:
   // The stream buffer directly: istream::get and peek build a sentry per character, which made
   // the scan a third of a read's time.
-  explicit StepTokens(std::istream& in) : in_(*in.rdbuf()) {}
+  explicit StepTokens(std::istream& in) : in_{*in.rdbuf()} {}
   int line() const { return line_; }
   bool unterminated() const { return unterminated_; }
 
@@ -153,6 +154,7 @@ int degree_count(const std::string& word, bool complex) {
 }  // namespace
 
 void precheck_step(const fs::path& file, std::string_view caller, int max_degree) {
+  const internal::FpTrapsHeld traps_held;  // bad_number's strtod
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(ErrorCategory::Io, std::string(caller) + ": '" + file.string() + "' cannot be opened");
   StepTokens tokens(in);
@@ -319,6 +321,7 @@ void check_bspline(const IgesRecord& r, int type, std::string_view caller, const
 }  // namespace
 
 void precheck_iges(const fs::path& file, std::string_view caller, int max_degree) {
+  const internal::FpTrapsHeld traps_held;  // bad_number's strtod
   std::ifstream in(file, std::ios::binary);
   if (!in) throw Error(ErrorCategory::Io, std::string(caller) + ": '" + file.string() + "' cannot be opened");
   char delimiter = ',', end = ';';

@@ -263,7 +263,9 @@ namespace {
 
 /// Newton from t0 without the input checks (closest_point runs it from several starts).
 double curve_foot(const BSplineCurve& curve, const Eigen::Vector3d& q, double t0, bool periodic) {
-  const auto [a, b] = curve.basis.domain();
+  // Not a structured binding: the lambda captures a and b, which Clang 14 refuses for bindings.
+  const auto domain = curve.basis.domain();
+  const double a = domain.first, b = domain.second;
   const double period = b - a;
   auto fold = [&](double t) {
     if (periodic) {

@@ -5,6 +5,7 @@
 #include <clay/deform.hpp>
 
 #include <bit>
+#include <cfenv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -303,7 +304,8 @@ TEST_CASE("every malformed step field is named with its path", "[deform][stack]"
        "steps[0] (bspline_lattice)"},
   };
   for (const auto& [step, expected] : cases) {
-    const auto [category, what] = error_of([&] { stack_from_json(head + step + "]}"); });
+    const std::string text = head + step + "]}";  // the lambda captures this, not the binding (Clang 14)
+    const auto [category, what] = error_of([&] { stack_from_json(text); });
     CHECK(category == ErrorCategory::Recipe);
     CHECK_THAT(what, Contains(expected));
   }
@@ -563,6 +565,25 @@ TEST_CASE("malformed extended lattice JSON is rejected naming the path", "[defor
   std::string t = good;
   t.insert(t.find("\"chunks\":[") + 10, flat + ",");
   CHECK_THAT(recipe_error(t), Contains("steps[1] (extended_lattice 'cylinder'): chunk 0 has zero extent"));
+}
+
+TEST_CASE("a number beyond a double leaves the caller's floating-point environment as it was", "[deform][stack]") {
+  // strtod reports 1e999 by raising overflow; a host trapping overflow (the Debug tests do) died of
+  // it inside stack_from_json (issue #19). The parser runs with the traps held, the flags restored.
+  std::feclearexcept(FE_ALL_EXCEPT);
+#if defined(__GLIBC__)
+  const int traps = fegetexcept();
+#endif
+  const auto [category, what] = error_of([] {
+    stack_from_json(R"({"format": "clayform.deformation-stack", "version": 1, "steps": [{"kind": "taper",
+        "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": [1, 1e999]}]})");
+  });
+  CHECK(category == ErrorCategory::Recipe);
+  CHECK_THAT(what, Contains("number overflow parsing '1e999'") && Contains("give finite numbers"));
+  CHECK(std::fetestexcept(FE_OVERFLOW | FE_INVALID | FE_DIVBYZERO) == 0);
+#if defined(__GLIBC__)
+  CHECK(fegetexcept() == traps);
+#endif
 }
 
 TEST_CASE("the stack reader reports every problem at once, each with its path", "[deform][stack]") {

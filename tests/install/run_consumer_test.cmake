@@ -23,8 +23,17 @@ file(GLOB_RECURSE leaked ${WORK_DIR}/prefix/include/*occt* ${WORK_DIR}/prefix/in
 if(leaked)
   message(FATAL_ERROR "internal headers were installed: ${leaked}")
 endif()
+# The consumer is compiled like the project: same compiler and, for a sanitized build (whose
+# libraries call the sanitizer runtime), the same -fsanitize, which links that runtime in.
+set(consumer_flags)
+if(CXX_COMPILER)
+  list(APPEND consumer_flags -DCMAKE_CXX_COMPILER=${CXX_COMPILER})
+endif()
+if(SANITIZE)
+  list(APPEND consumer_flags -DCMAKE_CXX_FLAGS=-fsanitize=${SANITIZE} -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=${SANITIZE})
+endif()
 run(${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${WORK_DIR}/build -G ${GENERATOR}
-    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix)
+    -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${WORK_DIR}/prefix ${consumer_flags})
 run(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 run(${WORK_DIR}/build/consumer ${WORK_DIR}/consumer.step)
 if(NOT last_output MATCHES "consumer ok")

@@ -14,11 +14,11 @@
 #include <clay/error.hpp>
 #include <clay/surface/tessellate.hpp>
 #include <clay/internal/checks.hpp>
+#include <clay/internal/fenv.hpp>
 
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
-#include <cfenv>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -135,25 +135,11 @@ class QuietMessages {
   std::vector<Message_Gravity> saved_;
 };
 
-/// While alive, floating-point exceptions do not trap (OpenCASCADE's algorithms may divide by
-/// zero internally and expect IEEE results, while a caller, e.g. a debug test run, may have
-/// enabled traps). The caller's environment, flags included, is restored on exit.
-class NonStopFloatingPoint {
- public:
-  NonStopFloatingPoint() { std::feholdexcept(&saved_); }
-  ~NonStopFloatingPoint() { std::fesetenv(&saved_); }
-  NonStopFloatingPoint(const NonStopFloatingPoint&) = delete;
-  NonStopFloatingPoint& operator=(const NonStopFloatingPoint&) = delete;
-
- private:
-  std::fenv_t saved_;
-};
-
 /// The exchange lock, quiet messages and non-stop floating point, for one public call.
 struct ExchangeSession {
   std::lock_guard<std::mutex> lock{exchange_mutex()};
   QuietMessages quiet;
-  NonStopFloatingPoint floating_point;
+  internal::FpTrapsHeld floating_point;
 };
 
 std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
