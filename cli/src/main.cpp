@@ -1,8 +1,8 @@
 // clayform — the command-line shell over the kernel: parse, call one library function, print the
 // outcome, map error categories to exit codes (STYLE.md rule 18).
 #include <clay/deform.hpp>
-#include <clay/recipe.hpp>
-#include <clay/render.hpp>
+#include <clay/recipe/recipe.hpp>
+#include <clay/render/render.hpp>
 #include <clay/serve.hpp>
 
 #include <CLI/CLI.hpp>
@@ -166,7 +166,7 @@ int validate(const fs::path& file) {
   return exit_code(clay::ErrorCategory::Recipe);
 }
 
-// ---- clayform render (clay/render.hpp) ----
+// ---- clayform render (clay/render/render.hpp) ----
 
 /// `clayform render FILE --png OUT.png`: a picture of the surfaces of a STEP or IGES file.
 int render_picture(const fs::path& file, const fs::path& png, const clay::render::RenderOptions& options) {

@@ -7,7 +7,7 @@
 #include <clay/deform/direct_manipulation.hpp>
 #include <clay/deform/stack.hpp>
 #include <clay/deform/style.hpp>
-#include <clay/recipe.hpp>
+#include <clay/recipe/recipe.hpp>
 #include <clay/sketch/fit.hpp>
 #include <clay/sketch/stroke.hpp>
 #include <clay/surface/fill.hpp>

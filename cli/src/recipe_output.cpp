@@ -1,9 +1,9 @@
 // The outputs of a run: STEP, IGES and glTF per export, read back and checked, and report.json —
 // written into a temporary folder and moved into place only when everything succeeded.
 #include <clay/error.hpp>
-#include <clay/recipe.hpp>
+#include <clay/recipe/recipe.hpp>
 #include <clay/surface/exchange.hpp>
-#include <clay/view.hpp>
+#include <clay/recipe/view.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -145,7 +145,7 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
       if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + (tmp / "report.json").string() + "\"");
     }
     names.push_back("report.json");
-    write_view_data(result, tmp);  // view/manifest.json and view/NNN.bin (clay/view.hpp)
+    write_view_data(result, tmp);  // view/manifest.json and view/NNN.bin (clay/recipe/view.hpp)
     fs::create_directories(target, ec);
     if (ec)
       throw Error(ErrorCategory::Io, "cannot create the output folder \"" + target.string() + "\": " + ec.message());

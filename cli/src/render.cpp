@@ -1,6 +1,6 @@
-// Software rendering of surfaces into an RGB picture and a PNG writer (clay/render.hpp).
+// Software rendering of surfaces into an RGB picture and a PNG writer (clay/render/render.hpp).
 #include <clay/error.hpp>
-#include <clay/render.hpp>
+#include <clay/render/render.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/tessellate.hpp>

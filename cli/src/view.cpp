@@ -4,7 +4,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/tessellate.hpp>
-#include <clay/view.hpp>
+#include <clay/recipe/view.hpp>
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>

@@ -9,7 +9,7 @@
 #include <clay/deform/direct_manipulation.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/style.hpp>
-#include <clay/recipe.hpp>
+#include <clay/recipe/recipe.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/evaluate.hpp>

@@ -7,7 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include <clay/deform.hpp>
-#include <clay/recipe.hpp>
+#include <clay/recipe/recipe.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 

@@ -7,7 +7,7 @@
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
-#include <clay/recipe.hpp>
+#include <clay/recipe/recipe.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>

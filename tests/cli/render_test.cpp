@@ -1,8 +1,8 @@
-// Pictures of surfaces (clay/render.hpp): the orthographic fit against its closed form, the
+// Pictures of surfaces (clay/render/render.hpp): the orthographic fit against its closed form, the
 // z-buffer, the shading of planes, the control net, the PNG read back with libpng, and every error.
 #include <catch2/catch.hpp>
 
-#include <clay/render.hpp>
+#include <clay/render/render.hpp>
 #include <clay/surface/basis.hpp>
 
 #include <png.h>

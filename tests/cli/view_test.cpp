@@ -5,14 +5,14 @@
 #include <catch2/catch.hpp>
 
 #include <clay/deform/regular.hpp>
-#include <clay/recipe.hpp>
+#include <clay/recipe/recipe.hpp>
 #include <clay/serve.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/tessellate.hpp>
-#include <clay/view.hpp>
+#include <clay/recipe/view.hpp>
 
 #include <Eigen/Geometry>
 #include <httplib.h>

@@ -1,8 +1,8 @@
-// libFuzzer target: clay::recipe::check_recipe on arbitrary bytes. Its contract (clay/recipe.hpp):
+// libFuzzer target: clay::recipe::check_recipe on arbitrary bytes. Its contract (clay/recipe/recipe.hpp):
 // every problem of the text at once, and never a throw for bad text. So an exception escaping it
 // is a finding, and so is a sanitizer report, a failed assertion, a floating-point trap (invalid,
 // divide by zero, overflow) and a problem without a message.
-#include <clay/recipe.hpp>
+#include <clay/recipe/recipe.hpp>
 
 #include <cstdint>
 #include <cstdio>

@@ -1,7 +1,7 @@
 #pragma once
 /// Serving a run to the browser viewer and taking pictures of it (issue #9): `clayform view` and
 /// `clayform snapshot` (docs/recipe.md "Viewing a run"). The built front end (viewer/dist) is
-/// served at `/`, the run folder (with its view/manifest.json, clay/view.hpp) under `/run/`.
+/// served at `/`, the run folder (with its view/manifest.json, clay/recipe/view.hpp) under `/run/`.
 
 #include <filesystem>
 #include <memory>

@@ -148,7 +148,7 @@ CLAY_RECIPE_API RunResult deform_surfaces(const Recipe& recipe,
 CLAY_RECIPE_API std::string report_json(const RunResult& result);
 
 /// Writes every export (NAME.step, NAME.igs, NAME.glb per its formats), report.json and the view
-/// folder (view/manifest.json and view/NNN.bin, clay/view.hpp) into `out_dir` (created when
+/// folder (view/manifest.json and view/NNN.bin, clay/recipe/view.hpp) into `out_dir` (created when
 /// missing). The files are first written into a temporary folder next
 /// to `out_dir` and each STEP file is read back and checked (BRepCheck); only when everything
 /// succeeded are they moved into `out_dir`, so a failure leaves no partial files. Returns the

@@ -3,7 +3,7 @@
 /// deformation stage's before/after, with exact normals, Gaussian and mean curvature and the
 /// refit deviation, written as `view/manifest.json` and `view/NNN.bin` for the browser viewer
 /// (`clayform view`, docs/recipe.md "Viewing a run").
-#include <clay/recipe.hpp>
+#include <clay/recipe/recipe.hpp>
 #include <clay/recipe/export.hpp>
 
 #include <Eigen/Core>
