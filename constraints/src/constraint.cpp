@@ -1,4 +1,5 @@
 #include <clay/constraints/constraint.hpp>
+#include <clay/internal/format.hpp>
 
 #include <variant>
 
@@ -9,11 +10,7 @@
 namespace clay::constraints {
 namespace {
 
-std::string num(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", x);
-  return buffer;
-}
+std::string num(double x) { return internal::with_digits(x, 6); }
 
 }  // namespace
 

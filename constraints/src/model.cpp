@@ -5,6 +5,7 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/internal/checks.hpp>
+#include <clay/internal/format.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -17,11 +18,7 @@ using sketch::Circle;
 using sketch::Curve;
 using sketch::Line;
 
-std::string num(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.6g", x);
-  return buffer;
-}
+std::string num(double x) { return internal::with_digits(x, 6); }
 
 /// Builds the equations of one constraint; knows the sketch, the model and the constraint index.
 class Builder {

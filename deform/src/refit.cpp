@@ -13,6 +13,7 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/internal/checks.hpp>
+#include <clay/internal/format.hpp>
 
 #include <Eigen/Dense>
 
@@ -47,11 +48,7 @@ constexpr double infinity = std::numeric_limits<double>::infinity();
 
 using detail::format;
 
-std::string short_format(double v) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.3g", v);
-  return buffer;
-}
+std::string short_format(double v) { return internal::with_digits(v, 3); }
 
 using detail::Bounds;
 using detail::Certifier;

@@ -3,6 +3,7 @@
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/internal/checks.hpp>
+#include <clay/internal/format.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -11,11 +12,7 @@
 namespace clay::sketch {
 namespace {
 
-std::string num(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.3g", x);
-  return buffer;
-}
+std::string num(double x) { return internal::with_digits(x, 3); }
 
 /// The name of a point for messages: its recipe name when the sketch has one.
 std::string point_name(const Sketch& s, int index) {

@@ -4,7 +4,7 @@
 #include <clay/error.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/knots.hpp>
-#include <clay/internal/checks.hpp>
+#include <clay/internal/format.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -15,11 +15,7 @@ namespace clay::surface {
 
 namespace {
 
-std::string number(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.17g", x);
-  return buffer;
-}
+std::string number(double x) { return internal::shortest(x); }
 
 /// True when `basis` is one clamped span [a, b] of degree p: p + 1 copies of a, then of b.
 bool single_span(const BSplineBasis& basis, double a, double b) {

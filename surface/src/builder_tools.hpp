@@ -5,6 +5,7 @@
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/self_intersection.hpp>
+#include <clay/internal/format.hpp>
 
 #include <Eigen/Core>
 
@@ -16,18 +17,10 @@
 namespace clay::surface::detail {
 
 /// A number for messages: 3 significant digits ("0.25", "1e-07").
-inline std::string short_number(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.3g", x);
-  return buffer;
-}
+inline std::string short_number(double x) { return internal::with_digits(x, 3); }
 
 /// A parameter or coordinate for messages: 4 significant digits ("0.3125", "-12.5").
-inline std::string parameter_text(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.4g", x);
-  return buffer;
-}
+inline std::string parameter_text(double x) { return internal::with_digits(x, 4); }
 
 /// "(x, y, z)" with 4 significant digits; coordinates within `zero` of 0 (rounding noise below
 /// the tolerance of the result) are written as 0.

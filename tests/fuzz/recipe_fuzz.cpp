@@ -10,15 +10,10 @@
 #include <exception>
 #include <string_view>
 
-#if defined(__GLIBC__)
-#include <fenv.h>
-#endif
+#include "fuzz_traps.hpp"
 
-// The floating-point traps of the Debug tests (tests/main.cpp).
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
-#if defined(__GLIBC__)
-  feenableexcept(FE_INVALID | FE_DIVBYZERO | FE_OVERFLOW);
-#endif
+  clay::fuzz::enable_traps();
   return 0;
 }
 

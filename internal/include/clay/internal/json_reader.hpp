@@ -5,6 +5,8 @@
 // needs to parse a message to learn where a problem is.
 #include <clay/surface/bspline_curve.hpp>
 
+#include <clay/internal/format.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include <Eigen/Core>
@@ -29,13 +31,6 @@ struct JsonProblem {
   std::string path;
   std::string message;
 };
-
-/// The shortest text that reads back as x.
-inline std::string shortest(double x) {
-  char buf[32];
-  const auto end = std::to_chars(buf, buf + sizeof buf, x).ptr;
-  return std::string(buf, end);
-}
 
 /// The value in words for messages: "the string \"x\"", "the number 3", "an array of 2", ...
 inline std::string found(const Json& j) {
