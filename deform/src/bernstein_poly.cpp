@@ -32,28 +32,6 @@ void scale(Poly& p, bool divide) {
     }
 }
 
-/// out += a * b for scaled polys (b scalar-valued); out has degrees a + b and a's dim.
-void mul_add(const Poly& a, const Poly& b, Poly& out) {
-  const int arow = (a.dv + 1) * a.dim;
-  const int orow = (out.dv + 1) * out.dim;
-  for (int k = 0; k <= b.du; ++k)
-    for (int l = 0; l <= b.dv; ++l) {
-      const double f = b.at(k, l);
-      if (f == 0) continue;
-      for (int i = 0; i <= a.du; ++i) {
-        const double* src = a.c.data() + i * arow;
-        double* dst = out.c.data() + (i + k) * orow + l * out.dim;
-        for (int x = 0; x < arow; ++x) dst[x] += f * src[x];
-      }
-    }
-}
-
-Poly multiply(const Poly& a, const Poly& b) {
-  Poly out(a.du + b.du, a.dv + b.dv, a.dim);
-  mul_add(a, b, out);
-  return out;
-}
-
 /// The matrix taking Bernstein coefficients of degree p to those of degree e <= p of the
 /// power-basis truncation (a_k = C(p, k) Δ^k b_0 for k <= e, then b'_i = Σ_k C(i,k)/C(e,k) a_k).
 Eigen::MatrixXd reduction_matrix(int p, int e) {

@@ -291,7 +291,7 @@ double largest_homogeneous_point(const BSplineSurface& s) {
   double hmax = 0;
   for (Eigen::Index r = 0; r < s.points.rows(); ++r) {
     const double w = s.weights.size() ? s.weights(r) : 1.0;
-    hmax = std::max(hmax, std::hypot((w * s.points.row(r)).norm(), w));
+    hmax = std::max(hmax, std::sqrt((w * s.points.row(r)).squaredNorm() + w * w));
   }
   return hmax;
 }

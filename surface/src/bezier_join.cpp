@@ -77,28 +77,31 @@ BSplineSurface join_bezier_patches(const BezierPatches& bp, double relative_gap)
       rational = rational || s.is_rational();
     }
   const int nu = cu * pu + 1, nv = cv * pv + 1;
+  // Homogeneous sums of the points that land on each net row, and how many did; a shared point
+  // is compared with the mean of those before it (no second net is kept for the check).
   Eigen::Matrix<double, Eigen::Dynamic, 4> h = Eigen::Matrix<double, Eigen::Dynamic, 4>::Zero(
       static_cast<Eigen::Index>(nu) * nv, 4);
-  // The first patch to write a shared point sets it; the others are compared with it, then added.
-  Eigen::Matrix<double, Eigen::Dynamic, 4> first(h.rows(), 4);
   Eigen::VectorXi count = Eigen::VectorXi::Zero(h.rows());
   double gap = 0, largest = 0;
   for (int a = 0; a < cu; ++a)
     for (int b = 0; b < cv; ++b) {
-      BSplineSurface s = bp.patch(a, b);
-      if (s.u.degree < pu) s = elevate_degree_u(s, pu - s.u.degree);
-      if (s.v.degree < pv) s = elevate_degree_v(s, pv - s.v.degree);
+      const BSplineSurface& given = bp.patch(a, b);
+      BSplineSurface elevated;  // only when the patch is below the common degrees
+      if (given.u.degree < pu || given.v.degree < pv) {
+        elevated = given;
+        if (elevated.u.degree < pu) elevated = elevate_degree_u(elevated, pu - elevated.u.degree);
+        if (elevated.v.degree < pv) elevated = elevate_degree_v(elevated, pv - elevated.v.degree);
+      }
+      const BSplineSurface& s = elevated.points.rows() > 0 ? elevated : given;
+      const bool weighted = s.weights.size() == s.points.rows();  // once: is_rational() scans them all
       for (int i = 0; i <= pu; ++i)
         for (int j = 0; j <= pv; ++j) {
           const Eigen::Index k = s.index(i, j);
-          const double w = s.is_rational() ? s.weights(k) : 1.0;
+          const double w = weighted ? s.weights(k) : 1.0;
           Eigen::Matrix<double, 1, 4> hw;
           hw << w * s.points.row(k), w;
           const Eigen::Index r = static_cast<Eigen::Index>(a * pu + i) * nv + (b * pv + j);
-          if (count(r) == 0)
-            first.row(r) = hw;
-          else
-            gap = std::max(gap, (hw - first.row(r)).norm());
+          if (count(r) > 0) gap = std::max(gap, (hw - h.row(r) / count(r)).norm());
           largest = std::max(largest, hw.norm());
           h.row(r) += hw;
           ++count(r);

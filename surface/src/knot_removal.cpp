@@ -7,6 +7,7 @@
 #include <clay/internal/checks.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -61,11 +62,14 @@ double remove_knot_once(Strip& strip, int r, int s, double tolerance) {
     strip.rows.row(j) = t.row(j - off);
     ++i, --j;
   }
-  const int out = (2 * r - s - p) / 2;  // the control point that disappears
-  Rows kept(strip.rows.rows() - 1, strip.rows.cols());
-  kept.topRows(out) = strip.rows.topRows(out);
-  kept.bottomRows(strip.rows.rows() - 1 - out) = strip.rows.bottomRows(strip.rows.rows() - 1 - out);
-  strip.rows = std::move(kept);
+  // The control point that disappears: the rows below it move up one, in place (rows are
+  // contiguous, row-major), and the last row goes. A fresh copy of the whole net per removal made
+  // knot removal 5x slower on compose_exact's nets.
+  const Eigen::Index out = (2 * r - s - p) / 2, rows = strip.rows.rows(), cols = strip.rows.cols();
+  double* data = strip.rows.data();
+  std::memmove(data + out * cols, data + (out + 1) * cols,
+               static_cast<std::size_t>((rows - 1 - out) * cols) * sizeof(double));
+  strip.rows.conservativeResize(rows - 1, cols);
   strip.basis.knots.erase(strip.basis.knots.begin() + r);
   return gap;
 }
