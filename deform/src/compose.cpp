@@ -251,7 +251,7 @@ std::pair<double, double> global_parameter(const surface::BezierPatches& bp, int
                   "whole surface");
 }
 
-// ---- joining patches (surface::join_bezier_patches, then surface::remove_knots_u/_v) ------------
+// ---- joining patches (surface::join_bezier_patches, then surface::remove_knots) ---------------
 
 /// The composed patches as the Bézier patches of surface::join_bezier_patches: control points
 /// (x w, y w, z w) / w and weights w of each homogeneous Bernstein net (w = 1 when polynomial).
@@ -323,10 +323,9 @@ ComposeResult finish(const surface::BezierPatches& bp, const std::vector<Compose
     // The tolerance is relative to the largest homogeneous control point, as removal measures
     // its gaps on (w·P, w).
     const double tol = options.knot_tolerance * largest_homogeneous_point(result.surface);
-    auto in_u = surface::remove_knots_u(result.surface, tol);
-    auto in_v = surface::remove_knots_v(in_u.surface, tol);
-    report.knots_removed = in_u.removed + in_v.removed;
-    result.surface = std::move(in_v.surface);
+    auto removal = surface::remove_knots(result.surface, tol);
+    report.knots_removed = removal.removed;
+    result.surface = std::move(removal.surface);
   }
   detail::keep_closed_and_collapsed(original, result.surface, pointwise);
   report.degree_u = result.surface.u.degree;

@@ -135,6 +135,26 @@ CurveKnotRemoval remove_knots(const BSplineCurve& curve, double tolerance_mm) {
   return out;
 }
 
+SurfaceKnotRemoval remove_knots(const BSplineSurface& surface, double tolerance_mm) {
+  validate(surface);
+  check_tolerance(tolerance_mm, "remove_knots");
+  // One homogeneous net for both directions: the u strip is regrouped into the v strip directly,
+  // without the surface in between (its division by w, a second validate and a second
+  // conversion). compose_exact calls this on every result, and the copies of two separate
+  // remove_knots_u/_v calls cost it as much time as the removal itself (docs/perf/compose.md).
+  detail::Strip in_u = detail::surface_strip(surface, detail::Direction::U);
+  SurfaceKnotRemoval out;
+  out.removed = detail::remove_knots(in_u, tolerance_mm);
+  const Eigen::Index nu = in_u.rows.rows(), nv = in_u.rows.cols() / 4;
+  detail::Strip in_v{surface.v, detail::Rows(nv, 4 * nu), in_u.polynomial};
+  for (Eigen::Index i = 0; i < nu; ++i)
+    for (Eigen::Index j = 0; j < nv; ++j) in_v.rows.block<1, 4>(j, 4 * i) = in_u.rows.block<1, 4>(i, 4 * j);
+  in_u.rows.resize(0, 0);
+  out.removed += detail::remove_knots(in_v, tolerance_mm);
+  out.surface = detail::surface_from_strip(std::move(in_v), in_u.basis, detail::Direction::V);
+  return out;
+}
+
 SurfaceKnotRemoval remove_knots_u(const BSplineSurface& surface, double tolerance_mm) {
   return remove_in(surface, detail::Direction::U, tolerance_mm, "remove_knots_u");
 }

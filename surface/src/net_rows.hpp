@@ -36,26 +36,30 @@ inline BSplineCurve curve_from_strip(Strip strip) {
 
 enum class Direction { U, V };
 
-/// The surface's homogeneous net as count_d rows of width 4 * count_other.
+/// The surface's homogeneous net as count_d rows of width 4 * count_other, written straight from
+/// the points and weights (no intermediate homogeneous net: these strips are the largest
+/// temporaries of knot removal and refinement).
 inline Strip surface_strip(const BSplineSurface& s, Direction d) {
-  const Homogeneous h = to_homogeneous(s.points, s.weights);
   const int nu = s.count_u(), nv = s.count_v();
-  if (d == Direction::U) {
-    Rows rows(nu, 4 * nv);
-    for (int i = 0; i < nu; ++i)
-      for (int j = 0; j < nv; ++j) rows.block<1, 4>(i, 4 * j) = h.row(s.index(i, j));
-    return {s.u, std::move(rows), !s.is_rational()};
-  }
-  Rows rows(nv, 4 * nu);
-  for (int j = 0; j < nv; ++j)
-    for (int i = 0; i < nu; ++i) rows.block<1, 4>(j, 4 * i) = h.row(s.index(i, j));
-  return {s.v, std::move(rows), !s.is_rational()};
+  const bool along_u = d == Direction::U;
+  Rows rows(along_u ? nu : nv, 4 * (along_u ? nv : nu));
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const Eigen::Index r = s.index(i, j);
+      const double w = s.weights(r);
+      auto out = along_u ? rows.block<1, 4>(i, 4 * j) : rows.block<1, 4>(j, 4 * i);
+      out.head<3>() = w * s.points.row(r);
+      out(3) = w;
+    }
+  return {along_u ? s.u : s.v, std::move(rows), !s.is_rational()};
 }
 
-/// Inverse of surface_strip: `other` is the basis of the untouched direction.
+/// Inverse of surface_strip: `other` is the basis of the untouched direction. Weights exactly 1
+/// stay exactly 1 (as from_homogeneous), so a polynomial net stays bit-identical.
 inline BSplineSurface surface_from_strip(Strip strip, const BSplineBasis& other, Direction d) {
   BSplineSurface s;
-  if (d == Direction::U) {
+  const bool along_u = d == Direction::U;
+  if (along_u) {
     s.u = std::move(strip.basis);
     s.v = other;
   } else {
@@ -63,13 +67,19 @@ inline BSplineSurface surface_from_strip(Strip strip, const BSplineBasis& other,
     s.v = std::move(strip.basis);
   }
   const int nu = s.count_u(), nv = s.count_v();
-  Homogeneous h(static_cast<Eigen::Index>(nu) * nv, 4);
+  s.points.resize(static_cast<Eigen::Index>(nu) * nv, 3);
+  s.weights.resize(s.points.rows());
   for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j)
-      h.row(s.index(i, j)) = d == Direction::U ? strip.rows.block<1, 4>(i, 4 * j)
-                                               : strip.rows.block<1, 4>(j, 4 * i);
-  if (strip.polynomial) h.col(3).setOnes();
-  from_homogeneous(h, s.points, s.weights);
+    for (int j = 0; j < nv; ++j) {
+      const Eigen::Index r = s.index(i, j);
+      const auto h = along_u ? strip.rows.block<1, 4>(i, 4 * j) : strip.rows.block<1, 4>(j, 4 * i);
+      const double w = strip.polynomial ? 1.0 : h(3);
+      s.weights(r) = w;
+      if (w == 1.0)
+        s.points.row(r) = h.head<3>();
+      else
+        s.points.row(r) = h.head<3>() / w;
+    }
   return s;
 }
 

@@ -178,6 +178,13 @@ TEST_CASE("remove_knots undoes knot refinement and keeps the knots a shape needs
     CHECK(in_v.surface.u.knots == s.u.knots);
     CHECK(in_v.surface.v.knots == s.v.knots);
     CHECK(relative_deviation(s, in_v.surface) < 1e-12);
+    // Both directions in one call: the same knots, the original surface again.
+    const SurfaceKnotRemoval both = remove_knots(refined, 1e-9);
+    CHECK(both.removed == static_cast<int>(extra_u.size() + extra_v.size()));
+    CHECK(both.surface.u.knots == s.u.knots);
+    CHECK(both.surface.v.knots == s.v.knots);
+    CHECK(both.surface.is_rational() == rational);
+    CHECK(relative_deviation(s, both.surface) < 1e-12);
   }
 }
 
@@ -239,6 +246,7 @@ TEST_CASE("remove_knots refuses a negative or non-finite tolerance", "[knots]") 
     CHECK(category == clay::ErrorCategory::InvalidArgument);
     CHECK_THAT(what, Catch::Matchers::Contains("remove_knots: tolerance_mm"));
     CHECK_THROWS_AS(remove_knots_v(s, bad), clay::Error);
+    CHECK_THROWS_AS(remove_knots(s, bad), clay::Error);
   }
 }
 

@@ -89,7 +89,7 @@ struct CurveKnotRemoval {
   BSplineCurve curve;
   int removed = 0;
 };
-/// A surface after remove_knots_u or _v, and how many knots were taken out.
+/// A surface after remove_knots, remove_knots_u or _v, and how many knots were taken out.
 struct SurfaceKnotRemoval {
   BSplineSurface surface;
   int removed = 0;
@@ -107,5 +107,9 @@ CLAY_SURFACE_API CurveKnotRemoval remove_knots(const BSplineCurve& curve, double
 CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_u(const BSplineSurface& surface, double tolerance_mm);
 /// remove_knots in the v direction.
 CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_v(const BSplineSurface& surface, double tolerance_mm);
+/// remove_knots in both directions, u then v (the gaps of each direction within `tolerance_mm`):
+/// the result of remove_knots_v(remove_knots_u(s, t).surface, t), with one homogeneous net and
+/// no surface in between.
+CLAY_SURFACE_API SurfaceKnotRemoval remove_knots(const BSplineSurface& surface, double tolerance_mm);
 
 }  // namespace clay::surface
