@@ -1,5 +1,11 @@
 # clayform_library(<target> <MACRO> <header>): what every Clayform shared library shares (issue #19).
 #
+# - Its package name: clay_<name> is Clayform::<name>, as an ALIAS in this build and as the
+#   exported name (EXPORT_NAME) in ClayformTargets.cmake, so an embedder writes the same
+#   target_link_libraries(app Clayform::deform) against a build tree (add_subdirectory) or an
+#   installed package (find_package).
+# - Public headers: the calling folder's include/, from the source tree while building and from
+#   the install prefix once installed.
 # - Hidden symbol visibility: only what a public header marks with <MACRO> (CLAY_SURFACE_API, ...)
 #   is exported; internal functions (namespace detail, src/*.hpp) and inline functions are not.
 #   An embedder links against the API, not against whatever happened to have external linkage.
@@ -19,11 +25,16 @@ else()
 endif()
 
 function(clayform_library target macro header)
-  set_target_properties(${target} PROPERTIES
+  string(REGEX REPLACE "^clay_" "" name ${target})
+  add_library(Clayform::${name} ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${name}
     VERSION ${PROJECT_VERSION} SOVERSION ${CLAYFORM_SOVERSION}
     CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON)
   string(REGEX REPLACE "_API$" "" base ${macro})
   generate_export_header(${target} BASE_NAME ${base} EXPORT_MACRO_NAME ${macro}
     EXPORT_FILE_NAME ${CMAKE_CURRENT_BINARY_DIR}/include/${header})
-  target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${CMAKE_CURRENT_BINARY_DIR}/include>)
+  target_include_directories(${target} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_BINARY_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
 endfunction()
