@@ -28,8 +28,9 @@ clay::surface::BSplineSurface bicubic_sheet(const Frame& f) {
   s.weights = Eigen::VectorXd::Ones(13 * 13);
   for (int i = 0; i < 13; ++i)
     for (int j = 0; j < 13; ++j)
-      s.points.row(s.index(i, j)) =
-          f.point(0.05 + 0.9 * i / 12.0 + wiggle(rng), 0.05 + 0.9 * j / 12.0 + wiggle(rng), bump(rng)).transpose();
+      s.points.row(s.index(i, j)) = f.point(0.05 + 0.9 * i / 12.0 + wiggle(rng),
+                                            0.05 + 0.9 * j / 12.0 + wiggle(rng), bump(rng))
+                                        .transpose();
   return s;
 }
 
@@ -37,13 +38,15 @@ BezierLattice lattice(std::array<int, 3> degrees) {
   BezierLattice l = make_bezier_lattice(skewed_frame(), degrees);
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> c(-8.0, 8.0);
-  for (Eigen::Index r = 0; r < l.points.rows(); ++r) l.points.row(r) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
+  for (Eigen::Index r = 0; r < l.points.rows(); ++r)
+    l.points.row(r) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
   return l;
 }
 
 // Arguments: lattice (0 = (3, 3, 1), 1 = (2, 2, 2)), check samples per patch and direction.
 void BM_ComposeExact(benchmark::State& state) {
-  const BezierLattice l = lattice(state.range(0) == 0 ? std::array<int, 3>{3, 3, 1} : std::array<int, 3>{2, 2, 2});
+  const BezierLattice l =
+      lattice(state.range(0) == 0 ? std::array<int, 3>{3, 3, 1} : std::array<int, 3>{2, 2, 2});
   const auto s = bicubic_sheet(l.frame);
   ComposeOptions options;
   options.check_samples = static_cast<int>(state.range(1));
@@ -59,7 +62,10 @@ void BM_ComposeExact(benchmark::State& state) {
   state.counters["max_deviation"] = report.max_relative_deviation;
   state.SetLabel(state.range(0) == 0 ? "lattice (3,3,1)" : "lattice (2,2,2)");
 }
-BENCHMARK(BM_ComposeExact)->ArgsProduct({{0, 1}, {4, 0}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_ComposeExact)
+    ->ArgsProduct({{0, 1}, {4, 0}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 

@@ -35,8 +35,10 @@ Case chain(const std::vector<Eigen::Vector2d>& corners, std::mt19937& rng) {
   const auto plane = c.sketch.add_plane({});
   std::vector<PointId> ends;
   for (size_t k = 0; k + 1 < corners.size(); ++k) {
-    const PointId a = c.sketch.add_point(plane, corners[k] + Eigen::Vector2d(jitter(rng), jitter(rng)));
-    const PointId b = c.sketch.add_point(plane, corners[k + 1] + Eigen::Vector2d(jitter(rng), jitter(rng)));
+    const PointId a =
+        c.sketch.add_point(plane, corners[k] + Eigen::Vector2d(jitter(rng), jitter(rng)));
+    const PointId b =
+        c.sketch.add_point(plane, corners[k + 1] + Eigen::Vector2d(jitter(rng), jitter(rng)));
     c.sketch.add_line(a, b);
     if (k > 0) c.constraints.push_back(coincident(ends.back(), a));
     ends.push_back(b);
@@ -51,10 +53,12 @@ Case staircase(int n) {
   std::vector<Eigen::Vector2d> corners{{0, 0}};
   for (int k = 0; k < n; ++k) {
     const double length = 10 + k % 3;
-    corners.push_back(corners.back() + (k % 2 == 0 ? Eigen::Vector2d(length, 0) : Eigen::Vector2d(0, length)));
+    corners.push_back(corners.back() +
+                      (k % 2 == 0 ? Eigen::Vector2d(length, 0) : Eigen::Vector2d(0, length)));
   }
   Case c = chain(corners, rng);
-  for (int k = 0; k < n; ++k) c.constraints.push_back(k % 2 == 0 ? horizontal(EntityId{k}) : vertical(EntityId{k}));
+  for (int k = 0; k < n; ++k)
+    c.constraints.push_back(k % 2 == 0 ? horizontal(EntityId{k}) : vertical(EntityId{k}));
   return c;
 }
 
@@ -62,10 +66,12 @@ Case staircase(int n) {
 /// (issue #18: under-constrained sketches, the normal state while a stylist draws).
 Case loose_staircase(int n, int free) {
   Case c = staircase(n);
-  const size_t first_hv = c.constraints.size() - static_cast<size_t>(n);  // H/V appended last, by segment
+  const size_t first_hv =
+      c.constraints.size() - static_cast<size_t>(n);  // H/V appended last, by segment
   for (int k = n - 1, removed = 0; k >= 0 && removed < free; --k)
     if (k % 2 == 1) {
-      c.constraints.erase(c.constraints.begin() + static_cast<std::ptrdiff_t>(first_hv + static_cast<size_t>(k)));
+      c.constraints.erase(c.constraints.begin() +
+                          static_cast<std::ptrdiff_t>(first_hv + static_cast<size_t>(k)));
       ++removed;
     }
   return c;
@@ -101,15 +107,20 @@ Case rectangles(int r) {
   for (int k = 0; k < r; ++k) {
     const Eigen::Vector2d o(60.0 * (k % 50), 40.0 * (k / 50));
     const double w = 30 + k % 7, h = 20 + k % 5;
-    const Eigen::Vector2d q[4] = {o, o + Eigen::Vector2d(w, 0), o + Eigen::Vector2d(w, h), o + Eigen::Vector2d(0, h)};
+    const Eigen::Vector2d q[4] = {o, o + Eigen::Vector2d(w, 0), o + Eigen::Vector2d(w, h),
+                                  o + Eigen::Vector2d(0, h)};
     std::vector<PointId> p;
     std::vector<EntityId> side;
     for (int s = 0; s < 4; ++s) {
       p.push_back(c.sketch.add_point(plane, q[s] + Eigen::Vector2d(jitter(rng), jitter(rng))));
-      p.push_back(c.sketch.add_point(plane, q[(s + 1) % 4] + Eigen::Vector2d(jitter(rng), jitter(rng))));
-      side.push_back(c.sketch.add_line(p[static_cast<size_t>(2 * s)], p[static_cast<size_t>(2 * s + 1)]));
+      p.push_back(
+          c.sketch.add_point(plane, q[(s + 1) % 4] + Eigen::Vector2d(jitter(rng), jitter(rng))));
+      side.push_back(
+          c.sketch.add_line(p[static_cast<size_t>(2 * s)], p[static_cast<size_t>(2 * s + 1)]));
     }
-    for (int s = 0; s < 4; ++s) c.constraints.push_back(coincident(p[static_cast<size_t>(2 * s + 1)], p[static_cast<size_t>((2 * s + 2) % 8)]));
+    for (int s = 0; s < 4; ++s)
+      c.constraints.push_back(
+          coincident(p[static_cast<size_t>(2 * s + 1)], p[static_cast<size_t>((2 * s + 2) % 8)]));
     c.constraints.push_back(horizontal(side[0]));
     c.constraints.push_back(vertical(side[1]));
     c.constraints.push_back(horizontal(side[2]));
@@ -128,7 +139,8 @@ void run(benchmark::State& state, const Case& c, int expected_dof) {
     benchmark::DoNotOptimize(r.sketch.points.data());
     last = std::move(r.report);
   }
-  state.counters["iterations"] = last.summary.iterations;  // also when it fails: the figure to compare
+  state.counters["iterations"] =
+      last.summary.iterations;  // also when it fails: the figure to compare
   if (!last.summary.converged() || last.degrees_of_freedom != expected_dof)
     state.SkipWithError(("not solved as expected: " + last.summary.brief()).c_str());
   state.counters["equations"] = last.equations;
@@ -138,8 +150,12 @@ void run(benchmark::State& state, const Case& c, int expected_dof) {
   state.counters["diagnose_ms"] = 1e3 * last.diagnose_seconds;
 }
 
-void staircase_chain(benchmark::State& state) { run(state, staircase(static_cast<int>(state.range(0))), 0); }
-void zigzag_chain(benchmark::State& state) { run(state, zigzag(static_cast<int>(state.range(0))), 1); }
+void staircase_chain(benchmark::State& state) {
+  run(state, staircase(static_cast<int>(state.range(0))), 0);
+}
+void zigzag_chain(benchmark::State& state) {
+  run(state, zigzag(static_cast<int>(state.range(0))), 1);
+}
 void loose_staircase_chain(benchmark::State& state) {
   run(state, loose_staircase(static_cast<int>(state.range(0)), static_cast<int>(state.range(1))),
       static_cast<int>(state.range(1)));
@@ -153,8 +169,18 @@ void independent_rectangles(benchmark::State& state) {
 
 BENCHMARK(staircase_chain)->Arg(10)->Arg(100)->Arg(1000)->Arg(3000)->Unit(benchmark::kMillisecond);
 BENCHMARK(zigzag_chain)->Arg(10)->Arg(100)->Arg(1000)->Arg(3000)->Unit(benchmark::kMillisecond);
-BENCHMARK(loose_staircase_chain)->Args({10, 1})->Args({100, 5})->Args({1000, 1})->Args({1000, 10})
+BENCHMARK(loose_staircase_chain)
+    ->Args({10, 1})
+    ->Args({100, 5})
+    ->Args({1000, 1})
+    ->Args({1000, 10})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(free_end)->Unit(benchmark::kMicrosecond);
-BENCHMARK(independent_rectangles)->Arg(10)->Arg(100)->Arg(750)->Arg(1000)->Arg(3000)->Unit(benchmark::kMillisecond);
+BENCHMARK(independent_rectangles)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(750)
+    ->Arg(1000)
+    ->Arg(3000)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();

@@ -43,7 +43,8 @@ Lattice displaced(Lattice lattice) {
 }
 
 FrozenLattice frozen(bool bspline) {
-  if (bspline) return FrozenLattice(displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8})));
+  if (bspline)
+    return FrozenLattice(displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8})));
   return FrozenLattice(displaced(make_bezier_lattice(skewed_frame(), {3, 3, 3})));
 }
 
@@ -52,7 +53,8 @@ Points3 random_points(Eigen::Index n) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   Points3 p(n, 3);
-  for (Eigen::Index r = 0; r < n; ++r) p.row(r) = f.point(unit(rng), unit(rng), unit(rng)).transpose();
+  for (Eigen::Index r = 0; r < n; ++r)
+    p.row(r) = f.point(unit(rng), unit(rng), unit(rng)).transpose();
   return p;
 }
 
@@ -114,13 +116,15 @@ CylinderSpec bench_cylinder() {
 /// Points uniform in the cylinder (area-uniform radius), random order.
 Points3 cylinder_points(const CylinderSpec& s, Eigen::Index n) {
   const Eigen::Vector3d e3 = s.axis.normalized();
-  const Eigen::Vector3d e1 = (s.reference - s.reference.dot(e3) * e3).normalized(), e2 = e3.cross(e1);
+  const Eigen::Vector3d e1 = (s.reference - s.reference.dot(e3) * e3).normalized(),
+                        e2 = e3.cross(e1);
   std::mt19937 rng(13);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   Points3 p(n, 3);
   for (Eigen::Index r = 0; r < n; ++r) {
     const double rho = s.radius * std::sqrt(unit(rng)), a = 6.283185307179586 * unit(rng);
-    p.row(r) = (s.origin + s.height * unit(rng) * e3 + rho * (std::cos(a) * e1 + std::sin(a) * e2)).transpose();
+    p.row(r) = (s.origin + s.height * unit(rng) * e3 + rho * (std::cos(a) * e1 + std::sin(a) * e2))
+                   .transpose();
   }
   return p;
 }
@@ -171,9 +175,12 @@ void regular(benchmark::State& state) {
   const DeformOptions options{static_cast<int>(state.range(1))};
   const auto kind = state.range(2);
   for (auto _ : state) {
-    if (kind == 0) deform_points(twist, in, out, options);
-    else if (kind == 1) deform_points(bend, in, out, options);
-    else deform_points(taper, in, out, options);
+    if (kind == 0)
+      deform_points(twist, in, out, options);
+    else if (kind == 1)
+      deform_points(bend, in, out, options);
+    else
+      deform_points(taper, in, out, options);
     benchmark::DoNotOptimize(out.data());
     benchmark::ClobberMemory();
   }
@@ -195,13 +202,15 @@ std::vector<PointMove> point_moves(const BSplineLattice& lattice, Eigen::Index n
   std::vector<PointMove> moves;
   for (Eigen::Index r = 0; r < n; ++r) {
     const Eigen::Vector3d x = lattice.frame.point(unit(rng), unit(rng), unit(rng));
-    moves.push_back({x, deform_point(lattice, x) + Eigen::Vector3d(offset(rng), offset(rng), offset(rng))});
+    moves.push_back(
+        {x, deform_point(lattice, x) + Eigen::Vector3d(offset(rng), offset(rng), offset(rng))});
   }
   return moves;
 }
 
 void manipulate_once(benchmark::State& state) {
-  const BSplineLattice lattice = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  const BSplineLattice lattice =
+      displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
   const auto moves = point_moves(lattice, state.range(0));
   for (auto _ : state) {
     auto result = manipulate(lattice, moves);
@@ -211,7 +220,8 @@ void manipulate_once(benchmark::State& state) {
 }
 
 void manipulate_drag(benchmark::State& state) {
-  const BSplineLattice lattice = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  const BSplineLattice lattice =
+      displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
   const auto moves = point_moves(lattice, state.range(0));
   Points3 points(state.range(0), 3), targets(state.range(0), 3);
   for (Eigen::Index r = 0; r < points.rows(); ++r) {
@@ -234,8 +244,8 @@ clay::surface::BSplineSurface twist_loft() {
     Points3 p(6, 3);
     for (int i = 0; i < 6; ++i) {
       const double a = 0.6 * i;
-      p.row(i) << scales[s] * 40 * std::cos(a), scales[s] * (25 + wobbles[s] * (i % 2)) * std::sin(a),
-          40.0 * s;
+      p.row(i) << scales[s] * 40 * std::cos(a),
+          scales[s] * (25 + wobbles[s] * (i % 2)) * std::sin(a), 40.0 * s;
     }
     sections.push_back(clay::surface::make_curve(3, {0, 0, 0, 0, 1.0 / 3, 2.0 / 3, 1, 1, 1, 1}, p));
   }
@@ -262,7 +272,17 @@ BENCHMARK(columns)->Apply(arguments);
 BENCHMARK(extended_freeze)->Apply(extended_arguments);
 BENCHMARK(extended_evaluate)->Apply(extended_arguments);
 BENCHMARK(regular)->Apply(regular_arguments);
-BENCHMARK(manipulate_once)->ArgName("points")->Arg(10)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
-BENCHMARK(manipulate_drag)->ArgName("points")->Arg(10)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
+BENCHMARK(manipulate_once)
+    ->ArgName("points")
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(400)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(manipulate_drag)
+    ->ArgName("points")
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(400)
+    ->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

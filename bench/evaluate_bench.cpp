@@ -22,7 +22,8 @@ BSplineSurface bicubic_20x20(bool rational) {
   std::uniform_real_distribution<double> jitter(-5.0, 5.0), weight(0.5, 2.0);
   for (int i = 0; i < 23; ++i)
     for (int j = 0; j < 23; ++j) {
-      p.row(i * 23 + j) << 50.0 * i + jitter(rng), 50.0 * j + jitter(rng), 30.0 * std::sin(0.4 * i) * std::cos(0.3 * j);
+      p.row(i * 23 + j) << 50.0 * i + jitter(rng), 50.0 * j + jitter(rng),
+          30.0 * std::sin(0.4 * i) * std::cos(0.3 * j);
       if (rational) w[i * 23 + j] = weight(rng);
     }
   return make_surface(b, b, p, w);

@@ -27,8 +27,10 @@ BSplineSurface hood() {
   Points3 p(n * n, 3);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
-      const double x = -600 + 1200 * xi[static_cast<size_t>(i)], y = -400 + 800 * xi[static_cast<size_t>(j)];
-      p.row(i * n + j) << x, y, 80 * (1 - (x / 700) * (x / 700)) * (1 - (y / 500) * (y / 500)) + 0.05 * x;
+      const double x = -600 + 1200 * xi[static_cast<size_t>(i)],
+                   y = -400 + 800 * xi[static_cast<size_t>(j)];
+      p.row(i * n + j) << x, y,
+          80 * (1 - (x / 700) * (x / 700)) * (1 - (y / 500) * (y / 500)) + 0.05 * x;
     }
   return clay::surface::make_surface(b, b, p);
 }
@@ -36,7 +38,8 @@ BSplineSurface hood() {
 BSplineCurve bound() {
   BSplineCurve e = clay::surface::circular_arc(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(),
                                                Eigen::Vector3d::UnitY(), 1.0, 0.0, 2 * pi);
-  for (Eigen::Index r = 0; r < e.points.rows(); ++r) e.points.row(r) << 350 * e.points(r, 0), 250 * e.points(r, 1), 150;
+  for (Eigen::Index r = 0; r < e.points.rows(); ++r)
+    e.points.row(r) << 350 * e.points(r, 0), 250 * e.points(r, 1), 150;
   return e;
 }
 

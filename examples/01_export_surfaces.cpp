@@ -40,8 +40,8 @@ BSplineSurface hood() {
 /// rational quarter circle about z. Every point lies on the torus exactly.
 BSplineSurface torus_patch(double R, double r) {
   const double w = std::sqrt(0.5);
-  const double ring[3][2] = {{1, 0}, {1, 1}, {0, 1}};           // about z, weights 1, w, 1
-  const double tube[3][2] = {{R + r, 0}, {R + r, r}, {R, r}};    // (radius, z), weights 1, w, 1
+  const double ring[3][2] = {{1, 0}, {1, 1}, {0, 1}};          // about z, weights 1, w, 1
+  const double tube[3][2] = {{R + r, 0}, {R + r, r}, {R, r}};  // (radius, z), weights 1, w, 1
   const double wt[3] = {1, w, 1};
   Points3 p(9, 3);
   Eigen::VectorXd weights(9);
@@ -98,21 +98,25 @@ int main(int argc, char** argv) {
       report["surfaces"].push_back({{"degree", {s.u.degree, s.v.degree}},
                                     {"control_points", s.points.rows()},
                                     {"rational", s.is_rational()}});
-    report["step"] = {{"file", "sample.step"}, {"schema", "AP214"}, {"faces", step.faces},
-                      {"valid", step.valid}, {"bytes", fs::file_size(out / "sample.step")}};
-    report["iges"] = {{"file", "sample.igs"}, {"faces", iges.faces}, {"valid", iges.valid},
+    report["step"] = {{"file", "sample.step"},
+                      {"schema", "AP214"},
+                      {"faces", step.faces},
+                      {"valid", step.valid},
+                      {"bytes", fs::file_size(out / "sample.step")}};
+    report["iges"] = {{"file", "sample.igs"},
+                      {"faces", iges.faces},
+                      {"valid", iges.valid},
                       {"bytes", fs::file_size(out / "sample.igs")}};
     report["gltf"] = {{"file", "sample.glb"}, {"bytes", fs::file_size(out / "sample.glb")}};
     report["round_trip_bit_identical"] = lossless;
     report["torus_radius_error_mm"] = torus_dev;
-    report["timings_ms"] = {
-        {"write", std::chrono::duration<double, std::milli>(t1 - t0).count()},
-        {"read", std::chrono::duration<double, std::milli>(t2 - t1).count()}};
+    report["timings_ms"] = {{"write", std::chrono::duration<double, std::milli>(t1 - t0).count()},
+                            {"read", std::chrono::duration<double, std::milli>(t2 - t1).count()}};
     std::ofstream(out / "report.json") << report.dump(2) << "\n";
 
-    std::printf("wrote %s (AP214, %d faces, %s), %s, %s\n", (out / "sample.step").c_str(), step.faces,
-                step.valid ? "BRepCheck valid" : "INVALID", (out / "sample.igs").c_str(),
-                (out / "sample.glb").c_str());
+    std::printf("wrote %s (AP214, %d faces, %s), %s, %s\n", (out / "sample.step").c_str(),
+                step.faces, step.valid ? "BRepCheck valid" : "INVALID",
+                (out / "sample.igs").c_str(), (out / "sample.glb").c_str());
     std::printf("read back: %s; torus radius error %.2e mm; report %s\n",
                 lossless ? "bit-identical" : "DIFFERENT", torus_dev, (out / "report.json").c_str());
     return (lossless && step.valid && iges.valid && torus_dev < 1e-9) ? 0 : 1;

@@ -19,8 +19,10 @@ int main() {
     return Eigen::Vector2d(centre + r * Eigen::Vector2d(std::cos(t), std::sin(t)));
   };
   const PointId right = s.add_point(xy, right_centre), left = s.add_point(xy, left_centre);
-  const PointId b = s.add_point(xy, polar(right_centre, 9.5, -95)), c = s.add_point(xy, polar(right_centre, 9.5, 88));
-  const PointId d = s.add_point(xy, polar(left_centre, 10.5, 92)), a = s.add_point(xy, polar(left_centre, 10.5, 268));
+  const PointId b = s.add_point(xy, polar(right_centre, 9.5, -95)),
+                c = s.add_point(xy, polar(right_centre, 9.5, 88));
+  const PointId d = s.add_point(xy, polar(left_centre, 10.5, 92)),
+                a = s.add_point(xy, polar(left_centre, 10.5, 268));
   const EntityId bottom = s.add_line(a, b), top = s.add_line(c, d);
   const EntityId arc_right = s.add_arc(right, b, c, xy);  // counterclockwise from b up to c
   const EntityId arc_left = s.add_arc(left, d, a, xy);    // from d down to a
@@ -46,9 +48,9 @@ int main() {
   const Eigen::Vector3d pb = clay::sketch::position(solved.sketch, b);
   std::printf("  bottom edge from (%.9f, %.9f) to (%.9f, %.9f)\n", pa.x(), pa.y(), pb.x(), pb.y());
   // Independent check: the bottom edge runs under the centres, 10 mm below them.
-  const bool first_ok = solved.report.summary.converged() && solved.report.degrees_of_freedom == 0 &&
-                        std::abs(pa.x() - 0) < 1e-9 && std::abs(pa.y() - (0.5 - 10)) < 1e-9 &&
-                        std::abs(pb.x() - 60) < 1e-9;
+  const bool first_ok = solved.report.summary.converged() &&
+                        solved.report.degrees_of_freedom == 0 && std::abs(pa.x() - 0) < 1e-9 &&
+                        std::abs(pa.y() - (0.5 - 10)) < 1e-9 && std::abs(pb.x() - 60) < 1e-9;
 
   // A bottom length that contradicts the centre distance.
   cs.push_back(distance(a, b, 55));

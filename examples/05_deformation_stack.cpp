@@ -87,14 +87,17 @@ int run(const std::filesystem::path& folder) {
   const Twist twist{{Eigen::Vector3d(0, 0, 10), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ()},
                     {0, 0.002}};
   const Bend bend{{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ()},
-                  -60, 60, 0, 0.003};  // y_min, y_max, centre, rate (rad/mm): radius 333 mm
+                  -60,
+                  60,
+                  0,
+                  0.003};  // y_min, y_max, centre, rate (rad/mm): radius 333 mm
 
   DeformationStack stack{
       {{bulge, "bulge", true}, {dent, "dent", true}, {twist, "twist", true}, {bend, "bend", true}}};
   Points3 out;
-  StackReport report;                                  // what freezing the dent's points did
-  deform_points(stack, samples, out, report);          // lattices frozen once, steps in order
-  const std::string text = to_json(stack);             // clayform.deformation-stack, version 1
+  StackReport report;                                    // what freezing the dent's points did
+  deform_points(stack, samples, out, report);            // lattices frozen once, steps in order
+  const std::string text = to_json(stack);               // clayform.deformation-stack, version 1
   const DeformationStack again = stack_from_json(text);  // bit-identical
   const Points3 out_again = deform_points(again, samples);
 
@@ -118,8 +121,8 @@ int run(const std::filesystem::path& folder) {
   for (Eigen::Index r = 0; r < samples.rows(); ++r) {
     moved = std::max(moved, (out.row(r) - samples.row(r)).norm());
     if (r % 37 == 0)
-      worst = std::max(worst, (out.row(r).transpose() -
-                               deform_point(stack, samples.row(r).transpose())).norm());
+      worst = std::max(
+          worst, (out.row(r).transpose() - deform_point(stack, samples.row(r).transpose())).norm());
   }
   const bool same = identical(out, out_again) && identical(out, out_file) && read_back == text;
   std::printf("%lld points of the parent surface, 4 steps; largest displacement %.3f mm\n",

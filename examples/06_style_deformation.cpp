@@ -30,8 +30,10 @@ surface::BSplineSurface hood() {
   surface::Points3 p(n * n, 3);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
-      const double x = -600 + 1200 * xi[static_cast<size_t>(i)], y = -400 + 800 * xi[static_cast<size_t>(j)];
-      p.row(i * n + j) << x, y, 80 * (1 - (x / 700) * (x / 700)) * (1 - (y / 500) * (y / 500)) + 0.05 * x;
+      const double x = -600 + 1200 * xi[static_cast<size_t>(i)],
+                   y = -400 + 800 * xi[static_cast<size_t>(j)];
+      p.row(i * n + j) << x, y,
+          80 * (1 - (x / 700) * (x / 700)) * (1 - (y / 500) * (y / 500)) + 0.05 * x;
     }
   return surface::make_surface(basis, basis, p);
 }
@@ -39,12 +41,14 @@ surface::BSplineSurface hood() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const std::filesystem::path out = argc > 1 ? argv[1] : std::filesystem::temp_directory_path() / "clayform_06";
+  const std::filesystem::path out =
+      argc > 1 ? argv[1] : std::filesystem::temp_directory_path() / "clayform_06";
   std::filesystem::create_directories(out);
   const surface::BSplineSurface parent = hood();
 
   // The bound: an ellipse 700 x 500 mm drawn above the hood (it is projected onto it).
-  surface::BSplineCurve bound = surface::circular_arc({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1.0, 0.0, 2 * M_PI);
+  surface::BSplineCurve bound =
+      surface::circular_arc({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, 1.0, 0.0, 2 * M_PI);
   for (Eigen::Index r = 0; r < bound.points.rows(); ++r)
     bound.points.row(r) << 350 * bound.points(r, 0), 250 * bound.points(r, 1), 150;
   // The target: a crease line across the hood rising up to 50 mm above it.
@@ -52,10 +56,10 @@ int main(int argc, char** argv) {
   t << -60, -180, 70, -40, -60, 150, -40, 60, 150, -60, 180, 70;
   const surface::BSplineCurve target = surface::make_curve(3, {0, 0, 0, 0, 1, 1, 1, 1}, t);
 
-  StyleOptions options;                               // paper mode, λ = 1, relaxation, smoothing
-  const InfluenceRegion region = influence_factors(parent, bound, options);   // eq. 2
+  StyleOptions options;  // paper mode, λ = 1, relaxation, smoothing
+  const InfluenceRegion region = influence_factors(parent, bound, options);  // eq. 2
   const StyleResult paper = style_deform(parent, region, target, options);
-  options.mode = StyleMode::Exact;                    // through every key point, G1 at the bound
+  options.mode = StyleMode::Exact;  // through every key point, G1 at the bound
   const StyleResult exact = style_deform(parent, region, target, options);
 
   const double size = exact.report.model_size;
@@ -70,10 +74,12 @@ int main(int argc, char** argv) {
   const auto step = surface::write_step({paper.surface, exact.surface}, out / "hood.step");
   const auto back = surface::read_step(out / "hood.step");
   const bool round_trip = back.size() == 2 && surface::identical(back[1], exact.surface);
-  std::printf("STEP: %s, %d faces, valid %s, read back bit for bit: %s\n", (out / "hood.step").c_str(),
-              step.faces, step.valid ? "yes" : "no", round_trip ? "yes" : "no");
+  std::printf("STEP: %s, %d faces, valid %s, read back bit for bit: %s\n",
+              (out / "hood.step").c_str(), step.faces, step.valid ? "yes" : "no",
+              round_trip ? "yes" : "no");
 
-  const bool ok = exact.report.target_deviation <= 1e-6 * size && exact.report.boundary_tangent_angle <= 0.5 &&
-                  exact.report.locality == 0 && paper.report.locality == 0 && round_trip && step.valid;
+  const bool ok = exact.report.target_deviation <= 1e-6 * size &&
+                  exact.report.boundary_tangent_angle <= 0.5 && exact.report.locality == 0 &&
+                  paper.report.locality == 0 && round_trip && step.valid;
   return ok ? 0 : 1;
 }

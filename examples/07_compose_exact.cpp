@@ -25,7 +25,8 @@ namespace surface = clay::surface;
 int main(int argc, char** argv) {
   try {
     const std::filesystem::path folder =
-        argc > 1 ? std::filesystem::path(argv[1]) : std::filesystem::temp_directory_path() / "clayform-example-07";
+        argc > 1 ? std::filesystem::path(argv[1])
+                 : std::filesystem::temp_directory_path() / "clayform-example-07";
     std::filesystem::create_directories(folder);
 
     Frame frame;  // a 200 x 120 x 60 mm box
@@ -46,7 +47,8 @@ int main(int argc, char** argv) {
     for (int i = 0; i < 7; ++i)
       for (int j = 0; j < 7; ++j)
         sheet.points.row(sheet.index(i, j)) =
-            frame.point(0.1 + 0.8 * i / 6, 0.1 + 0.8 * j / 6, 0.3 + 0.05 * ((i + j) % 3)).transpose();
+            frame.point(0.1 + 0.8 * i / 6, 0.1 + 0.8 * j / 6, 0.3 + 0.05 * ((i + j) % 3))
+                .transpose();
 
     const ComposeResult result = compose_exact(lattice, sheet);
     std::printf("%s\n", result.report.brief().c_str());
@@ -59,17 +61,19 @@ int main(int argc, char** argv) {
         const Eigen::Vector3d expected = deform_point(lattice, surface::evaluate(sheet, u, v));
         worst = std::max(worst, (surface::evaluate(result.surface, u, v) - expected).norm());
       }
-    const double size = (lattice.points.colwise().maxCoeff() - lattice.points.colwise().minCoeff()).norm();
-    std::printf("pointwise check: max deviation %.3g mm (%.3g of the lattice size)\n", worst, worst / size);
+    const double size =
+        (lattice.points.colwise().maxCoeff() - lattice.points.colwise().minCoeff()).norm();
+    std::printf("pointwise check: max deviation %.3g mm (%.3g of the lattice size)\n", worst,
+                worst / size);
 
     const auto step = folder / "composed.step", iges = folder / "composed.igs";
     const surface::ExchangeReport written = surface::write_step({result.surface}, step);
     surface::write_iges({result.surface}, iges);
     const bool same = surface::identical(surface::read_step(step).at(0), result.surface) &&
                       surface::identical(surface::read_iges(iges).at(0), result.surface);
-    std::printf("wrote %s and %s (degree %d, %ld control points), read back %s\n", step.string().c_str(),
-                iges.string().c_str(), written.max_degree, written.control_points,
-                same ? "bit-identical" : "DIFFERENT");
+    std::printf("wrote %s and %s (degree %d, %ld control points), read back %s\n",
+                step.string().c_str(), iges.string().c_str(), written.max_degree,
+                written.control_points, same ? "bit-identical" : "DIFFERENT");
     return worst <= 1e-12 * size && same ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

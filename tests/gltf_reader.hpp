@@ -10,9 +10,9 @@
 
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <stdexcept>
 #include <string>
@@ -45,7 +45,8 @@ inline GltfTriangles read_glb(const std::string& path) {
     std::memcpy(&v, bytes.data() + at, 4);
     return v;
   };
-  if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0 || u32(4) != 2 || u32(8) != bytes.size())
+  if (bytes.size() < 20 || bytes.compare(0, 4, "glTF") != 0 || u32(4) != 2 ||
+      u32(8) != bytes.size())
     throw std::runtime_error(path + ": not a binary glTF 2 file");
   const std::uint32_t json_length = u32(12);
   if (u32(16) != 0x4E4F534Au) throw std::runtime_error(path + ": the first chunk is not JSON");
@@ -56,13 +57,15 @@ inline GltfTriangles read_glb(const std::string& path) {
 
   auto view_of = [&](const nlohmann::json& accessor, std::size_t element) {
     const auto& view = j.at("bufferViews").at(accessor.at("bufferView").get<std::size_t>());
-    const std::size_t offset = bin + view.value("byteOffset", std::size_t{0}) + accessor.value("byteOffset", std::size_t{0});
+    const std::size_t offset = bin + view.value("byteOffset", std::size_t{0}) +
+                               accessor.value("byteOffset", std::size_t{0});
     const std::size_t stride = view.value("byteStride", element);
     return std::pair<std::size_t, std::size_t>{offset, stride};
   };
   auto positions = [&](std::size_t index) {
     const auto& a = j.at("accessors").at(index);
-    if (a.at("componentType") != 5126 || a.at("type") != "VEC3") throw std::runtime_error(path + ": positions not float VEC3");
+    if (a.at("componentType") != 5126 || a.at("type") != "VEC3")
+      throw std::runtime_error(path + ": positions not float VEC3");
     const auto [offset, stride] = view_of(a, 12);
     std::vector<Eigen::Vector3d> out;
     for (std::size_t k = 0; k < a.at("count").get<std::size_t>(); ++k) {
@@ -94,36 +97,44 @@ inline GltfTriangles read_glb(const std::string& path) {
     }
     Eigen::Affine3d a = Eigen::Affine3d::Identity();
     if (node.contains("translation"))
-      a.translate(Eigen::Vector3d(node["translation"][0], node["translation"][1], node["translation"][2]));
+      a.translate(
+          Eigen::Vector3d(node["translation"][0], node["translation"][1], node["translation"][2]));
     if (node.contains("rotation"))
-      a.rotate(Eigen::Quaterniond(node["rotation"][3], node["rotation"][0], node["rotation"][1], node["rotation"][2]));
-    if (node.contains("scale")) a.scale(Eigen::Vector3d(node["scale"][0], node["scale"][1], node["scale"][2]));
+      a.rotate(Eigen::Quaterniond(node["rotation"][3], node["rotation"][0], node["rotation"][1],
+                                  node["rotation"][2]));
+    if (node.contains("scale"))
+      a.scale(Eigen::Vector3d(node["scale"][0], node["scale"][1], node["scale"][2]));
     return Eigen::Matrix4d(a.matrix());
   };
 
   GltfTriangles out;
-  std::function<void(std::size_t, const Eigen::Matrix4d&)> visit = [&](std::size_t n, const Eigen::Matrix4d& parent) {
-    const auto& node = j.at("nodes").at(n);
-    const Eigen::Matrix4d m = parent * local(node);
-    if (node.contains("mesh"))
-      for (const auto& prim : j.at("meshes").at(node["mesh"].get<std::size_t>()).at("primitives")) {
-        if (prim.value("mode", 4) != 4) throw std::runtime_error(path + ": a primitive is not triangles");
-        const auto p = positions(prim.at("attributes").at("POSITION"));
-        const auto idx = indices(prim.at("indices"));
-        for (std::size_t k = 0; k + 2 < idx.size(); k += 3) {
-          std::array<Eigen::Vector3d, 3> t;
-          for (int c = 0; c < 3; ++c) {
-            const Eigen::Vector3d g = (m * p.at(idx[k + static_cast<std::size_t>(c)]).homogeneous()).head<3>();
-            t[static_cast<std::size_t>(c)] = 1000.0 * Eigen::Vector3d(g.x(), -g.z(), g.y());
+  std::function<void(std::size_t, const Eigen::Matrix4d&)> visit =
+      [&](std::size_t n, const Eigen::Matrix4d& parent) {
+        const auto& node = j.at("nodes").at(n);
+        const Eigen::Matrix4d m = parent * local(node);
+        if (node.contains("mesh"))
+          for (const auto& prim :
+               j.at("meshes").at(node["mesh"].get<std::size_t>()).at("primitives")) {
+            if (prim.value("mode", 4) != 4)
+              throw std::runtime_error(path + ": a primitive is not triangles");
+            const auto p = positions(prim.at("attributes").at("POSITION"));
+            const auto idx = indices(prim.at("indices"));
+            for (std::size_t k = 0; k + 2 < idx.size(); k += 3) {
+              std::array<Eigen::Vector3d, 3> t;
+              for (int c = 0; c < 3; ++c) {
+                const Eigen::Vector3d g =
+                    (m * p.at(idx[k + static_cast<std::size_t>(c)]).homogeneous()).head<3>();
+                t[static_cast<std::size_t>(c)] = 1000.0 * Eigen::Vector3d(g.x(), -g.z(), g.y());
+              }
+              out.triangles.push_back(t);
+            }
           }
-          out.triangles.push_back(t);
-        }
-      }
-    if (node.contains("children"))
-      for (const auto& c : node["children"]) visit(c.get<std::size_t>(), m);
-  };
+        if (node.contains("children"))
+          for (const auto& c : node["children"]) visit(c.get<std::size_t>(), m);
+      };
   const std::size_t scene = j.value("scene", std::size_t{0});
-  for (const auto& n : j.at("scenes").at(scene).at("nodes")) visit(n.get<std::size_t>(), Eigen::Matrix4d::Identity());
+  for (const auto& n : j.at("scenes").at(scene).at("nodes"))
+    visit(n.get<std::size_t>(), Eigen::Matrix4d::Identity());
   return out;
 }
 

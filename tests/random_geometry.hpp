@@ -17,7 +17,8 @@ inline surface::BSplineBasis random_basis(std::mt19937& rng, int degree, int cou
   basis.degree = degree;
   const int m = count + degree + 1;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::uniform_int_distribution<int> mult_pick(1, std::max(1, std::min(max_interior_multiplicity, degree)));
+  std::uniform_int_distribution<int> mult_pick(
+      1, std::max(1, std::min(max_interior_multiplicity, degree)));
   std::vector<double> knots;
   if (clamped) {
     knots.assign(static_cast<size_t>(degree + 1), a);
@@ -34,7 +35,8 @@ inline surface::BSplineBasis random_basis(std::mt19937& rng, int degree, int cou
   } else {
     // Unclamped: distinct increasing knots around [a, b], with domain ends a and b exactly.
     std::vector<double> values;
-    for (int i = 0; i < m; ++i) values.push_back(static_cast<double>(i) + 0.5 * (unit(rng) - 0.5) * 0.8);
+    for (int i = 0; i < m; ++i)
+      values.push_back(static_cast<double>(i) + 0.5 * (unit(rng) - 0.5) * 0.8);
     std::sort(values.begin(), values.end());
     const double lo = values[static_cast<size_t>(degree)];
     const double hi = values[static_cast<size_t>(count)];
@@ -99,13 +101,15 @@ inline double relative_deviation(const surface::BSplineSurface& a, const surface
   const auto vs = surface::linspace(va, vb, n);
   double worst = 0;
   for (double u : us)
-    for (double v : vs) worst = std::max(worst, (surface::evaluate(a, u, v) - surface::evaluate(b, u, v)).norm());
+    for (double v : vs)
+      worst = std::max(worst, (surface::evaluate(a, u, v) - surface::evaluate(b, u, v)).norm());
   const auto [lo, hi] = surface::control_box(a);
   return worst / (hi - lo).norm();
 }
 
 /// Same for curves, on n samples.
-inline double relative_deviation(const surface::BSplineCurve& a, const surface::BSplineCurve& b, int n = 201) {
+inline double relative_deviation(const surface::BSplineCurve& a, const surface::BSplineCurve& b,
+                                 int n = 201) {
   const auto [ta, tb] = a.basis.domain();
   double worst = 0;
   for (double t : surface::linspace(ta, tb, n))

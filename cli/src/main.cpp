@@ -7,16 +7,16 @@
 
 #include <CLI/CLI.hpp>
 
+#include <unistd.h>
 #include <cctype>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <iostream>
+#include <sstream>
 #include <string>
-#include <unistd.h>
 #include <variant>
 
 namespace {
@@ -27,15 +27,24 @@ using namespace clay::surface;
 /// Exit codes: 0 success, 1 usage (CLI11), then one per error category.
 int exit_code(clay::ErrorCategory c) {
   switch (c) {
-    case clay::ErrorCategory::InvalidArgument: return 2;
-    case clay::ErrorCategory::InvalidGeometry: return 3;
-    case clay::ErrorCategory::OutOfDomain: return 3;
-    case clay::ErrorCategory::DegreeLimit: return 4;
-    case clay::ErrorCategory::Io: return 5;
-    case clay::ErrorCategory::Exchange: return 6;
-    case clay::ErrorCategory::Recipe: return 7;
-    case clay::ErrorCategory::ToleranceNotMet: return 8;
-    case clay::ErrorCategory::Internal: return 70;
+    case clay::ErrorCategory::InvalidArgument:
+      return 2;
+    case clay::ErrorCategory::InvalidGeometry:
+      return 3;
+    case clay::ErrorCategory::OutOfDomain:
+      return 3;
+    case clay::ErrorCategory::DegreeLimit:
+      return 4;
+    case clay::ErrorCategory::Io:
+      return 5;
+    case clay::ErrorCategory::Exchange:
+      return 6;
+    case clay::ErrorCategory::Recipe:
+      return 7;
+    case clay::ErrorCategory::ToleranceNotMet:
+      return 8;
+    case clay::ErrorCategory::Internal:
+      return 70;
   }
   return 70;
 }
@@ -79,9 +88,10 @@ int info(const fs::path& file) {
     const auto [lo, hi] = control_box(s);
     std::printf("  #%zu degree (%d, %d), %d x %d control points, %s\n", k, s.u.degree, s.v.degree,
                 s.count_u(), s.count_v(), s.is_rational() ? "rational" : "polynomial");
-    std::printf("     u knots %s\n     v knots %s\n", knots_summary(s.u).c_str(), knots_summary(s.v).c_str());
-    std::printf("     control box [%.6g, %.6g, %.6g] .. [%.6g, %.6g, %.6g] mm\n", lo.x(), lo.y(), lo.z(),
-                hi.x(), hi.y(), hi.z());
+    std::printf("     u knots %s\n     v knots %s\n", knots_summary(s.u).c_str(),
+                knots_summary(s.v).c_str());
+    std::printf("     control box [%.6g, %.6g, %.6g] .. [%.6g, %.6g, %.6g] mm\n", lo.x(), lo.y(),
+                lo.z(), hi.x(), hi.y(), hi.z());
   }
   for (const auto& p : check.problems) std::printf("  problem: %s\n", p.c_str());
   return check.valid ? 0 : exit_code(clay::ErrorCategory::Exchange);
@@ -92,13 +102,16 @@ std::string figure_text(const clay::recipe::Figure& f) {
   return std::visit(
       [](const auto& x) -> std::string {
         using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, bool>) return x ? "yes" : "no";
-        else if constexpr (std::is_same_v<T, std::string>) return x;
+        if constexpr (std::is_same_v<T, bool>)
+          return x ? "yes" : "no";
+        else if constexpr (std::is_same_v<T, std::string>)
+          return x;
         else if constexpr (std::is_same_v<T, double>) {
           char buf[32];
           std::snprintf(buf, sizeof buf, "%.3g", x);
           return buf;
-        } else return std::to_string(x);
+        } else
+          return std::to_string(x);
       },
       f);
 }
@@ -126,19 +139,23 @@ clay::recipe::RunOptions run_options(bool show) {
 /// before anything is written, so every export listed here is valid.
 int finish(clay::recipe::RunResult& result, const fs::path& out) {
   const auto files = clay::recipe::write_outputs(result, out);
-  std::printf("%s: %zu step(s) in %.2f s\n", result.recipe.c_str(), result.steps.size(), result.seconds);
+  std::printf("%s: %zu step(s) in %.2f s\n", result.recipe.c_str(), result.steps.size(),
+              result.seconds);
   // How each deformed surface was computed: exact composition or certified refit, and how close.
   for (const auto& step : result.steps) {
     const clay::recipe::Figure* mode = nullptr;
     double relative = -1, mm = -1;
     for (const auto& [name, value] : step.figures) {
       if (name == "composition") mode = &value;
-      if (name == "max_relative_deviation" && std::holds_alternative<double>(value)) relative = std::get<double>(value);
-      if (name == "max_deviation_mm" && std::holds_alternative<double>(value)) mm = std::get<double>(value);
+      if (name == "max_relative_deviation" && std::holds_alternative<double>(value))
+        relative = std::get<double>(value);
+      if (name == "max_deviation_mm" && std::holds_alternative<double>(value))
+        mm = std::get<double>(value);
     }
     if (mode && relative >= 0)
-      std::printf("  %s (%s): %s composition, max deviation %.2g of the size (%.2g mm)\n", step.path.c_str(),
-                  step.kind.c_str(), std::get<std::string>(*mode).c_str(), relative, mm);
+      std::printf("  %s (%s): %s composition, max deviation %.2g of the size (%.2g mm)\n",
+                  step.path.c_str(), step.kind.c_str(), std::get<std::string>(*mode).c_str(),
+                  relative, mm);
   }
   for (const auto& e : result.exports)
     if (e.checked)
@@ -152,7 +169,9 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
 /// `clayform validate RECIPE`: every problem, with its location.
 int validate(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw clay::Error(clay::ErrorCategory::Io, "validate: cannot read '" + file.string() + "'; check the path");
+  if (!in)
+    throw clay::Error(clay::ErrorCategory::Io,
+                      "validate: cannot read '" + file.string() + "'; check the path");
   std::ostringstream text;
   text << in.rdbuf();
   const auto problems = clay::recipe::check_recipe(text.str(), file.parent_path());
@@ -161,7 +180,8 @@ int validate(const fs::path& file) {
     std::printf("%s: valid recipe\n", file.string().c_str());
     return 0;
   }
-  std::printf("%s: %zu problem%s\n", file.string().c_str(), problems.size(), problems.size() == 1 ? "" : "s");
+  std::printf("%s: %zu problem%s\n", file.string().c_str(), problems.size(),
+              problems.size() == 1 ? "" : "s");
   for (const auto& p : problems) std::printf("  %s\n", clay::recipe::to_string(p).c_str());
   return exit_code(clay::ErrorCategory::Recipe);
 }
@@ -169,14 +189,16 @@ int validate(const fs::path& file) {
 // ---- clayform render (clay/render/render.hpp) ----
 
 /// `clayform render FILE --png OUT.png`: a picture of the surfaces of a STEP or IGES file.
-int render_picture(const fs::path& file, const fs::path& png, const clay::render::RenderOptions& options) {
+int render_picture(const fs::path& file, const fs::path& png,
+                   const clay::render::RenderOptions& options) {
   const std::vector<BSplineSurface> surfaces = read_surfaces(file, "render");
   const auto start = std::chrono::steady_clock::now();
   const clay::render::Image image = clay::render::render(surfaces, options);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   clay::render::write_png(image, png);
-  std::printf("%s: %zu surface(s) -> %s (%d x %d, %.0f ms)\n", file.string().c_str(), surfaces.size(),
-              png.string().c_str(), image.width, image.height, ms);
+  std::printf("%s: %zu surface(s) -> %s (%d x %d, %.0f ms)\n", file.string().c_str(),
+              surfaces.size(), png.string().c_str(), image.width, image.height, ms);
   return 0;
 }
 
@@ -187,29 +209,35 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("clayform ") + CLAYFORM_VERSION);
   app.require_subcommand(1);
   std::string file;
-  auto* info_cmd = app.add_subcommand("info", "List the surfaces of a STEP or IGES file: degrees, "
-                                              "control points, knots, rational, box, validity");
+  auto* info_cmd = app.add_subcommand("info",
+                                      "List the surfaces of a STEP or IGES file: degrees, "
+                                      "control points, knots, rational, box, validity");
   info_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
   std::string recipe_file, out_dir, deformation;
   bool quiet = false, progress = false;
   auto* run_cmd = app.add_subcommand(
-      "run", "Run a recipe: build, deform and export every surface; writes NAME.step/.igs/.glb and "
-             "report.json into --out only when every step succeeded");
+      "run",
+      "Run a recipe: build, deform and export every surface; writes NAME.step/.igs/.glb and "
+      "report.json into --out only when every step succeeded");
   run_cmd->add_option("RECIPE", recipe_file, "a recipe (.json, docs/recipe.md)")->required();
   run_cmd->add_option("--out", out_dir, "output folder (created when missing)")->required();
   run_cmd->add_flag("--quiet", quiet, "no progress lines");
   run_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
   auto* validate_cmd = app.add_subcommand(
-      "validate", "Check a recipe without running it: every problem at once, with its JSON path (and "
-                  "line and column for syntax errors)");
+      "validate",
+      "Check a recipe without running it: every problem at once, with its JSON path (and "
+      "line and column for syntax errors)");
   validate_cmd->add_option("RECIPE", recipe_file, "a recipe (.json)")->required();
   auto* deform_cmd = app.add_subcommand(
-      "deform", "Apply a recipe's deformation stack to every surface of a STEP or IGES file; writes "
-                "STEM.step/.igs/.glb and report.json into --out");
+      "deform",
+      "Apply a recipe's deformation stack to every surface of a STEP or IGES file; writes "
+      "STEM.step/.igs/.glb and report.json into --out");
   deform_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
-  deform_cmd->add_option("--recipe", recipe_file, "the recipe holding the deformation stack")->required();
+  deform_cmd->add_option("--recipe", recipe_file, "the recipe holding the deformation stack")
+      ->required();
   deform_cmd->add_option("--out", out_dir, "output folder (created when missing)")->required();
-  deform_cmd->add_option("--deformation", deformation, "which stack (needed when the recipe has several)");
+  deform_cmd->add_option("--deformation", deformation,
+                         "which stack (needed when the recipe has several)");
   deform_cmd->add_flag("--quiet", quiet, "no progress lines");
   deform_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
   // clayform render
@@ -217,44 +245,54 @@ int main(int argc, char** argv) {
   std::vector<double> eye;
   clay::render::RenderOptions render_options;
   auto* render_cmd = app.add_subcommand(
-      "render", "Write a PNG picture of the surfaces of a STEP or IGES file: orthographic view fitted "
-                "to the model, one hue per surface, shading with a soft highlight");
+      "render",
+      "Write a PNG picture of the surfaces of a STEP or IGES file: orthographic view fitted "
+      "to the model, one hue per surface, shading with a soft highlight");
   render_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
   render_cmd->add_option("--png", png_file, "the picture to write (.png)")->required();
   render_cmd->add_option("--width", render_options.width, "picture width in pixels [16, 4096]")
       ->capture_default_str();
   render_cmd->add_option("--height", render_options.height, "picture height in pixels [16, 4096]")
       ->capture_default_str();
-  render_cmd->add_option("--eye", eye, "direction from the model towards the eye, X Y Z (default -1 -1.2 0.9)")
+  render_cmd
+      ->add_option("--eye", eye,
+                   "direction from the model towards the eye, X Y Z (default -1 -1.2 0.9)")
       ->expected(3);
-  render_cmd->add_option("--samples", render_options.samples_per_span,
-                         "tessellation: samples per knot span [1, 64]")
+  render_cmd
+      ->add_option("--samples", render_options.samples_per_span,
+                   "tessellation: samples per knot span [1, 64]")
       ->capture_default_str();
   render_cmd->add_flag("--net", render_options.control_net, "draw the control nets");
   // clayform view / snapshot (clay/serve.hpp)
   std::string run_dir, host = "127.0.0.1";
   int port = 8765;
   auto* view_cmd = app.add_subcommand(
-      "view", "Serve a run folder to the browser viewer: open the printed address (the folder needs the "
-              "view/ data every run writes, and the viewer's build, viewer/dist or $CLAYFORM_VIEWER_DIR)");
+      "view",
+      "Serve a run folder to the browser viewer: open the printed address (the folder needs the "
+      "view/ data every run writes, and the viewer's build, viewer/dist or $CLAYFORM_VIEWER_DIR)");
   view_cmd->add_option("DIR", run_dir, "the --out folder of clayform run or deform")->required();
   view_cmd->add_option("--port", port, "TCP port, 0 for any free one")->capture_default_str();
   view_cmd->add_option("--host", host, "address to listen on")->capture_default_str();
   clay::recipe::SnapshotOptions snapshot_options;
   auto* snapshot_cmd = app.add_subcommand(
       "snapshot", "Write a PNG picture of the viewer's page on a run folder (headless chromium)");
-  snapshot_cmd->add_option("DIR", run_dir, "the --out folder of clayform run or deform")->required();
+  snapshot_cmd->add_option("DIR", run_dir, "the --out folder of clayform run or deform")
+      ->required();
   snapshot_cmd->add_option("--png", png_file, "the picture to write (.png)")->required();
   snapshot_cmd->add_option("--width", snapshot_options.width, "picture width in pixels [16, 8192]")
       ->capture_default_str();
-  snapshot_cmd->add_option("--height", snapshot_options.height, "picture height in pixels [16, 8192]")
+  snapshot_cmd
+      ->add_option("--height", snapshot_options.height, "picture height in pixels [16, 8192]")
       ->capture_default_str();
-  snapshot_cmd->add_flag("--bare", snapshot_options.bare, "the picture alone, without toolbar and panels");
-  snapshot_cmd->add_option("--mode", snapshot_options.mode, "shaded, zebra, gaussian, mean or deviation")
+  snapshot_cmd->add_flag("--bare", snapshot_options.bare,
+                         "the picture alone, without toolbar and panels");
+  snapshot_cmd
+      ->add_option("--mode", snapshot_options.mode, "shaded, zebra, gaussian, mean or deviation")
       ->capture_default_str();
   app.footer(
       "Exit codes: 0 success, 1 usage, 2 invalid argument, 3 invalid geometry or out of domain, "
-      "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 8 tolerance not met, 70 internal error.");
+      "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 8 tolerance not met, "
+      "70 internal error.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -280,9 +318,11 @@ int main(int argc, char** argv) {
     if (*snapshot_cmd) {
       const auto start = std::chrono::steady_clock::now();
       clay::recipe::snapshot(run_dir, png_file, snapshot_options);
-      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      std::printf("%s: %s view -> %s (%d x %d, %.1f s)\n", run_dir.c_str(), snapshot_options.mode.c_str(),
-                  png_file.c_str(), snapshot_options.width, snapshot_options.height, s);
+      const double s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      std::printf("%s: %s view -> %s (%d x %d, %.1f s)\n", run_dir.c_str(),
+                  snapshot_options.mode.c_str(), png_file.c_str(), snapshot_options.width,
+                  snapshot_options.height, s);
       return 0;
     }
     const bool show = !quiet && (progress || ::isatty(STDOUT_FILENO));
@@ -295,15 +335,16 @@ int main(int argc, char** argv) {
     if (*deform_cmd) {
       const auto recipe = clay::recipe::load_recipe(recipe_file);
       const auto surfaces = read_surfaces(file, "deform");
-      auto result = clay::recipe::deform_surfaces(recipe, surfaces, fs::path(file).stem().string(), deformation,
-                                                  run_options(show));
+      auto result = clay::recipe::deform_surfaces(recipe, surfaces, fs::path(file).stem().string(),
+                                                  deformation, run_options(show));
       return finish(result, out_dir);
     }
   } catch (const clay::Error& e) {
     std::fprintf(stderr, "clayform: %s\n", e.what());
     return exit_code(e.category());
   } catch (const std::exception& e) {  // a bug, never a crash: say so and exit with Internal
-    std::fprintf(stderr, "clayform: internal error: %s; please report it with the input\n", e.what());
+    std::fprintf(stderr, "clayform: internal error: %s; please report it with the input\n",
+                 e.what());
     return exit_code(clay::ErrorCategory::Internal);
   }
   return 0;

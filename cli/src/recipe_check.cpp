@@ -13,8 +13,9 @@ void RecipeChecker::rebuild(const std::string& name, const Json& j, const std::s
 }
 
 void RecipeChecker::run(const Json& root) {
-  if (!c_.object(root, "", {"format", "version", "name", "description", "units", "composition",
-                            "strokes", "curves", "sketches", "surfaces", "deformations", "exports"},
+  if (!c_.object(root, "",
+                 {"format", "version", "name", "description", "units", "composition", "strokes",
+                  "curves", "sketches", "surfaces", "deformations", "exports"},
                  "a recipe {\"format\": \"clayform.recipe\", \"version\": 1, ...}"))
     return;
   const Json* format = c_.member(root, "", "format", true, "\"format\": \"clayform.recipe\"");
@@ -33,19 +34,26 @@ void RecipeChecker::run(const Json& root) {
   if (const Json* j = c_.member(root, "", "units", false, "")) {
     const auto u = c_.string(*j, "units");
     if (u && *u != "mm")
-      c_.add("units", "\"" + *u + "\" is not supported: Clayform models are in millimetres; "
-                      "convert the lengths and write \"units\": \"mm\"");
+      c_.add("units", "\"" + *u +
+                          "\" is not supported: Clayform models are in millimetres; "
+                          "convert the lengths and write \"units\": \"mm\"");
   }
   if (const Json* j = c_.member(root, "", "composition", false, ""))
     data.composition = composition(*j, "composition", Composition{});
 
   declare(root);
-  section(root, "strokes", [&](const std::string& n, const Json& j, const std::string& p) { stroke(n, j, p); });
-  section(root, "curves", [&](const std::string& n, const Json& j, const std::string& p) { curve(n, j, p); });
-  section(root, "sketches", [&](const std::string& n, const Json& j, const std::string& p) { sketch(n, j, p); });
-  section(root, "deformations", [&](const std::string& n, const Json& j, const std::string& p) { stack(n, j, p); });
-  section(root, "surfaces", [&](const std::string& n, const Json& j, const std::string& p) { surface(n, j, p); });
-  section(root, "exports", [&](const std::string& n, const Json& j, const std::string& p) { exporting(n, j, p); });
+  section(root, "strokes",
+          [&](const std::string& n, const Json& j, const std::string& p) { stroke(n, j, p); });
+  section(root, "curves",
+          [&](const std::string& n, const Json& j, const std::string& p) { curve(n, j, p); });
+  section(root, "sketches",
+          [&](const std::string& n, const Json& j, const std::string& p) { sketch(n, j, p); });
+  section(root, "deformations",
+          [&](const std::string& n, const Json& j, const std::string& p) { stack(n, j, p); });
+  section(root, "surfaces",
+          [&](const std::string& n, const Json& j, const std::string& p) { surface(n, j, p); });
+  section(root, "exports",
+          [&](const std::string& n, const Json& j, const std::string& p) { exporting(n, j, p); });
 }
 
 void RecipeChecker::declare(const Json& root) {
@@ -67,8 +75,10 @@ void RecipeChecker::declare(const Json& root) {
       f(name, value, path);
     }
   };
-  each("strokes", [&](const std::string& n, const Json&, const std::string& p) { declare_curve(n, p); });
-  each("curves", [&](const std::string& n, const Json&, const std::string& p) { declare_curve(n, p); });
+  each("strokes",
+       [&](const std::string& n, const Json&, const std::string& p) { declare_curve(n, p); });
+  each("curves",
+       [&](const std::string& n, const Json&, const std::string& p) { declare_curve(n, p); });
   each("sketches", [&](const std::string& n, const Json& v, const std::string& p) {
     if (!v.is_object()) return;
     const auto e = v.find("entities");
@@ -84,9 +94,8 @@ void RecipeChecker::declare(const Json& root) {
   each("surfaces", [&](const std::string& n, const Json&, const std::string&) {
     names_.surfaces_declared.insert(n);
   });
-  each("deformations", [&](const std::string& n, const Json&, const std::string&) {
-    names_.stacks.push_back(n);
-  });
+  each("deformations",
+       [&](const std::string& n, const Json&, const std::string&) { names_.stacks.push_back(n); });
   each("exports", [&](const std::string&, const Json&, const std::string&) {});
 }
 
@@ -95,8 +104,9 @@ std::optional<std::string> RecipeChecker::curve_ref(const Json& j, const std::st
   if (!name) return std::nullopt;
   if (Names::has(names_.curves, *name)) return name;
   if (names_.curves_declared.count(*name))
-    c_.add(path, "the curve \"" + *name + "\" is defined later in the recipe; a curve may only use "
-                 "curves defined before it (move its definition up)");
+    c_.add(path, "the curve \"" + *name +
+                     "\" is defined later in the recipe; a curve may only use "
+                     "curves defined before it (move its definition up)");
   else
     c_.add(path, "no curve named \"" + *name + "\"; " + listing(names_.curves));
   return std::nullopt;
@@ -107,20 +117,24 @@ std::optional<std::string> RecipeChecker::surface_ref(const Json& j, const std::
   if (!name) return std::nullopt;
   if (Names::has(names_.surfaces, *name)) return name;
   if (names_.surfaces_declared.count(*name))
-    c_.add(path, "the surface \"" + *name + "\" is defined later in \"surfaces\" (or is this one); "
-                 "surfaces are built in document order: move its definition up");
+    c_.add(path, "the surface \"" + *name +
+                     "\" is defined later in \"surfaces\" (or is this one); "
+                     "surfaces are built in document order: move its definition up");
   else
     c_.add(path, "no surface named \"" + *name + "\"; " + listing(names_.surfaces));
   return std::nullopt;
 }
 
-std::vector<std::string> RecipeChecker::curve_refs(const Json& obj, const std::string& path, std::string_view key, std::size_t min, std::size_t max) {
+std::vector<std::string> RecipeChecker::curve_refs(const Json& obj, const std::string& path,
+                                                   std::string_view key, std::size_t min,
+                                                   std::size_t max) {
   const Json* j = c_.member(obj, path, key, true, "an array of curve names");
   if (!j) return {};
   const std::string p = key_path(path, key);
   if (!j->is_array() || j->size() < min || j->size() > max) {
-    c_.add(p, "expected an array of " + std::to_string(min) + (max > min ? " to " + std::to_string(max) : "") +
-                  " curve names, found " + found(*j));
+    c_.add(p, "expected an array of " + std::to_string(min) +
+                  (max > min ? " to " + std::to_string(max) : "") + " curve names, found " +
+                  found(*j));
     return {};
   }
   std::vector<std::string> out;
@@ -130,8 +144,9 @@ std::vector<std::string> RecipeChecker::curve_refs(const Json& obj, const std::s
 }
 
 Composition RecipeChecker::composition(const Json& j, const std::string& path, Composition c) {
-  if (!c_.object(j, path, {"mode", "tolerance", "relative", "degree", "check_samples", "max_control_points",
-                           "accept_out_of_tolerance"},
+  if (!c_.object(j, path,
+                 {"mode", "tolerance", "relative", "degree", "check_samples", "max_control_points",
+                  "accept_out_of_tolerance"},
                  "a composition {\"mode\": \"exact\"|\"refit\", ...}"))
     return c;
   if (const Json* m = c_.member(j, path, "mode", false, ""))
@@ -140,16 +155,20 @@ Composition RecipeChecker::composition(const Json& j, const std::string& path, C
   c.relative = c_.boolean_or(j, path, "relative", c.relative);
   c.degree = c_.integer_or(j, path, "degree", c.degree, 1, 25);
   c.check_samples = c_.integer_or(j, path, "check_samples", c.check_samples, 2, 64);
-  c.accept_out_of_tolerance = c_.boolean_or(j, path, "accept_out_of_tolerance", c.accept_out_of_tolerance);
+  c.accept_out_of_tolerance =
+      c_.boolean_or(j, path, "accept_out_of_tolerance", c.accept_out_of_tolerance);
   // The refit's cap on its net (RefitOptions::max_control_points, 40,000 at most: the default,
   // which already takes about 20 s to reach), at least the (degree + 1)^2 of one patch.
-  c.max_control_points = c_.integer_or(j, path, "max_control_points", c.max_control_points,
-                                       (c.degree + 1) * (c.degree + 1), limit::refit_control_points);
+  c.max_control_points =
+      c_.integer_or(j, path, "max_control_points", c.max_control_points,
+                    (c.degree + 1) * (c.degree + 1), limit::refit_control_points);
   return c;
 }
 
 void RecipeChecker::exporting(const std::string& name, const Json& j, const std::string& path) {
-  if (!c_.object(j, path, {"surfaces", "formats", "schema"}, "an export {surfaces, formats, schema}")) return;
+  if (!c_.object(j, path, {"surfaces", "formats", "schema"},
+                 "an export {surfaces, formats, schema}"))
+    return;
   const std::size_t before = c_.problems.size();
   ExportDef def{name, path, {}, {"step", "iges", "glb"}, "AP214"};
   if (const Json* s = c_.member(j, path, "surfaces", true, "an array of surface names")) {
@@ -164,8 +183,8 @@ void RecipeChecker::exporting(const std::string& name, const Json& j, const std:
         const auto n = surface_ref((*s)[i], index_path(sp, i));
         if (!n) continue;
         if (const auto [it, fresh] = first.emplace(*n, i); !fresh)
-          c_.add(index_path(sp, i), "the surface \"" + *n + "\" is already listed at [" + std::to_string(it->second) +
-                                        "]; list each surface once");
+          c_.add(index_path(sp, i), "the surface \"" + *n + "\" is already listed at [" +
+                                        std::to_string(it->second) + "]; list each surface once");
         else
           def.surfaces.push_back(*n);
       }
@@ -188,7 +207,8 @@ void RecipeChecker::exporting(const std::string& name, const Json& j, const std:
     }
   }
   if (const Json* s = c_.member(j, path, "schema", false, ""))
-    if (const auto k = c_.choice(*s, key_path(path, "schema"), {"AP214", "AP242"})) def.schema = *k == 0 ? "AP214" : "AP242";
+    if (const auto k = c_.choice(*s, key_path(path, "schema"), {"AP214", "AP242"}))
+      def.schema = *k == 0 ? "AP214" : "AP242";
   if (c_.problems.size() == before) data.exports.push_back(std::move(def));
 }
 
@@ -210,7 +230,9 @@ std::pair<int, int> line_column(std::string_view text, std::size_t byte) {
     while (k > 0 && !(text[k - 1] == '"' && (k < 2 || text[k - 2] != '\\'))) --k;
     if (k > 0) end = k - 1;
   } else {
-    auto literal = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+'; };
+    auto literal = [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+';
+    };
     while (end > 0 && end < text.size() && literal(text[end]) && literal(text[end - 1])) --end;
   }
   int line = 1;
@@ -240,7 +262,8 @@ std::optional<Problem> too_deep(std::string_view text) {
         ++i;  // the escaped character cannot end the string
       } else if (c == '"') {
         in_string = false;
-        if (depth == 1) key = std::string(text.substr(string_start, std::min<std::size_t>(i - string_start, 64)));
+        if (depth == 1)
+          key = std::string(text.substr(string_start, std::min<std::size_t>(i - string_start, 64)));
       }
       continue;
     }
@@ -251,10 +274,11 @@ std::optional<Problem> too_deep(std::string_view text) {
       top_key = key;
     } else if (c == '[' || c == '{') {
       if (++depth > limit::depth)
-        return Problem{top_key.empty() ? "(syntax)" : top_key,
-                       "arrays and objects nest deeper than " + std::to_string(limit::depth) +
-                           " levels here (recipe limit; a recipe needs at most 8): remove the extra brackets",
-                       line, static_cast<int>(i - line_start) + 1};
+        return Problem{
+            top_key.empty() ? "(syntax)" : top_key,
+            "arrays and objects nest deeper than " + std::to_string(limit::depth) +
+                " levels here (recipe limit; a recipe needs at most 8): remove the extra brackets",
+            line, static_cast<int>(i - line_start) + 1};
     } else if (c == ']' || c == '}') {
       --depth;
     }
@@ -275,7 +299,8 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
   auto path = [&] {
     std::string p;
     for (std::size_t i = 0; i + 1 < levels.size(); ++i)
-      p = levels[i].array ? index_path(p, static_cast<std::size_t>(levels[i].index)) : key_path(p, levels[i].key);
+      p = levels[i].array ? index_path(p, static_cast<std::size_t>(levels[i].index))
+                          : key_path(p, levels[i].key);
     return p;
   };
   auto element = [&] {
@@ -283,8 +308,14 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
   };
   Json::parser_callback_t cb = [&](int, Json::parse_event_t event, Json& parsed) {
     switch (event) {
-      case Json::parse_event_t::object_start: element(); levels.push_back({false, -1, "", {}}); break;
-      case Json::parse_event_t::array_start: element(); levels.push_back({true, -1, "", {}}); break;
+      case Json::parse_event_t::object_start:
+        element();
+        levels.push_back({false, -1, "", {}});
+        break;
+      case Json::parse_event_t::array_start:
+        element();
+        levels.push_back({true, -1, "", {}});
+        break;
       case Json::parse_event_t::object_end:
       case Json::parse_event_t::array_end:
         if (!levels.empty()) levels.pop_back();
@@ -294,13 +325,16 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
         top.key = parsed.get<std::string>();
         if (!top.keys.insert(top.key).second) {
           levels.push_back({});  // so path() includes top's key
-          c.add(path(), "the key \"" + top.key + "\" appears twice in this object; only the last would "
-                        "count: remove or rename one");
+          c.add(path(), "the key \"" + top.key +
+                            "\" appears twice in this object; only the last would "
+                            "count: remove or rename one");
           levels.pop_back();
         }
         break;
       }
-      case Json::parse_event_t::value: element(); break;
+      case Json::parse_event_t::value:
+        element();
+        break;
     }
     return true;
   };
@@ -323,8 +357,10 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   Checker c;
   CheckOutcome out;
   if (text.size() > limit::text_bytes) {
-    out.problems.push_back({"(top level)", "the recipe is " + std::to_string(text.size()) + " bytes; at most " +
-                                               std::to_string(limit::text_bytes) + " (64 MiB) are allowed (recipe limit)",
+    out.problems.push_back({"(top level)",
+                            "the recipe is " + std::to_string(text.size()) + " bytes; at most " +
+                                std::to_string(limit::text_bytes) +
+                                " (64 MiB) are allowed (recipe limit)",
                             0, 0});
     return out;
   }
@@ -340,9 +376,12 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
     std::string what = e.what();
     // "[json.exception.parse_error.101] parse error at line 3, column 5: syntax error while
     // parsing object - unexpected ..." → keep the part after the position.
-    if (const auto k = what.find(": syntax error"); k != std::string::npos) what = what.substr(k + 2);
-    else if (const auto k2 = what.find("] "); k2 != std::string::npos) what = what.substr(k2 + 2);
-    out.problems.push_back({"(syntax)", what + "; fix the JSON syntax (NaN and Infinity are not JSON numbers)",
+    if (const auto k = what.find(": syntax error"); k != std::string::npos)
+      what = what.substr(k + 2);
+    else if (const auto k2 = what.find("] "); k2 != std::string::npos)
+      what = what.substr(k2 + 2);
+    out.problems.push_back({"(syntax)",
+                            what + "; fix the JSON syntax (NaN and Infinity are not JSON numbers)",
                             line, column});
     return out;
   } catch (const Json::exception& e) {  // a number beyond the range of a double
@@ -350,7 +389,8 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
     if (const auto k = what.find("] "); k != std::string::npos) what = what.substr(k + 2);
     out.problems = recipe_problems(c);  // where the number is (parse_reporting_duplicates)
     if (out.problems.empty())
-      out.problems.push_back({"(syntax)", what + "; give finite numbers within the range of a double", 0, 0});
+      out.problems.push_back(
+          {"(syntax)", what + "; give finite numbers within the range of a double", 0, 0});
     return out;
   }
   RecipeChecker rc(c, base_dir);
@@ -360,8 +400,9 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   return out;
 }
 
-SketchDef rebuild_sketch(const SketchDef& def,
-                         const std::function<const surface::BSplineCurve*(const std::string&)>& curve) {
+SketchDef rebuild_sketch(
+    const SketchDef& def,
+    const std::function<const surface::BSplineCurve*(const std::string&)>& curve) {
   Checker c;
   RecipeChecker rc(c, {});
   rc.runtime_curve = curve;
@@ -376,8 +417,8 @@ SketchDef rebuild_sketch(const SketchDef& def,
   rc.know_curves(std::move(names));
   rc.rebuild(def.name, j, def.path);
   if (!c.problems.empty()) {
-    std::string m = "with the run's curves the sketch has " + std::to_string(c.problems.size()) + " problem" +
-                    (c.problems.size() == 1 ? "" : "s") + ":";
+    std::string m = "with the run's curves the sketch has " + std::to_string(c.problems.size()) +
+                    " problem" + (c.problems.size() == 1 ? "" : "s") + ":";
     for (const auto& p : recipe_problems(c)) m += "\n  " + to_string(p);
     throw Error(ErrorCategory::InvalidGeometry, m);
   }
@@ -387,7 +428,8 @@ SketchDef rebuild_sketch(const SketchDef& def,
 std::string recipe_wording(std::string m) {
   // The library's fixes, as a recipe applies them (or dropped where a recipe cannot).
   static const std::pair<std::string_view, std::string_view> phrases[] = {
-      {"Allow a certified refit (SurfaceDeformationOptions::refit) to approximate this step within a tolerance",
+      {"Allow a certified refit (SurfaceDeformationOptions::refit) to approximate this step within "
+       "a tolerance",
        "Allow a certified refit to approximate this step within a tolerance: give the deformation "
        "\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4} (relative to the size)"},
       {"set SurfaceDeformationOptions::accept_out_of_tolerance",
@@ -404,14 +446,18 @@ std::string recipe_wording(std::string m) {
   };
   // A refit's advice depends on the limit it hit: a recipe can raise max_control_points (up to
   // its 40,000 cap), not the iteration or per-direction limits.
-  if (const auto at = m.find("; raise the limits, the tolerance or the degree"); at != std::string::npos) {
+  if (const auto at = m.find("; raise the limits, the tolerance or the degree");
+      at != std::string::npos) {
     static const std::regex net_limit("control point limit ([0-9]+) reached");
     std::smatch hit;
-    const bool raisable = std::regex_search(m, hit, net_limit) && std::stol(hit[1].str()) < limit::refit_control_points;
-    m.replace(at, std::string_view("; raise the limits, the tolerance or the degree").size(),
-              raisable ? "; raise the composition's \"max_control_points\" (at most 40,000), loosen its "
-                         "\"tolerance\" or raise its \"degree\""
-                       : "; loosen the composition's \"tolerance\" or raise its \"degree\", or deform less");
+    const bool raisable = std::regex_search(m, hit, net_limit) &&
+                          std::stol(hit[1].str()) < limit::refit_control_points;
+    m.replace(
+        at, std::string_view("; raise the limits, the tolerance or the degree").size(),
+        raisable
+            ? "; raise the composition's \"max_control_points\" (at most 40,000), loosen its "
+              "\"tolerance\" or raise its \"degree\""
+            : "; loosen the composition's \"tolerance\" or raise its \"degree\", or deform less");
   }
   for (const auto& [from, to] : phrases)
     for (std::size_t at = m.find(from); at != std::string::npos; at = m.find(from, at + to.size()))
@@ -422,13 +468,16 @@ std::string recipe_wording(std::string m) {
   m = std::regex_replace(m, options_struct, "");
   // The library's own prefixes: the recipe path in front of the message already names the step
   // (and a recipe runs deform_surface one step at a time, so its "steps[0]" would mislead).
-  static const std::regex library_prefix("\\b(deform_surface: steps\\[[0-9]+\\] \\([^)]*\\)(: )?|compose_exact: |refit_deformed: )");
+  static const std::regex library_prefix(
+      "\\b(deform_surface: steps\\[[0-9]+\\] \\([^)]*\\)(: )?|compose_exact: |refit_deformed: )");
   return std::regex_replace(m, library_prefix, "");
 }
 
 std::string to_string(const Problem& problem) {
   std::string s;
-  if (problem.line > 0) s = "line " + std::to_string(problem.line) + ", column " + std::to_string(problem.column) + ": ";
+  if (problem.line > 0)
+    s = "line " + std::to_string(problem.line) + ", column " + std::to_string(problem.column) +
+        ": ";
   if (problem.path != "(syntax)") s += problem.path + ": ";
   return s + problem.message;
 }
@@ -450,13 +499,15 @@ Recipe parse_recipe(std::string_view text, const fs::path& base_dir) {
 
 Recipe load_recipe(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(ErrorCategory::Io, "cannot read the recipe \"" + file.string() + "\"; check the path");
+  if (!in)
+    throw Error(ErrorCategory::Io,
+                "cannot read the recipe \"" + file.string() + "\"; check the path");
   std::ostringstream text;
   text << in.rdbuf();
   CheckOutcome out = check(text.str(), file.parent_path());
   if (!out.problems.empty()) {
-    std::string m = file.string() + ": the recipe has " + std::to_string(out.problems.size()) + " problem" +
-                    (out.problems.size() == 1 ? "" : "s") + ":";
+    std::string m = file.string() + ": the recipe has " + std::to_string(out.problems.size()) +
+                    " problem" + (out.problems.size() == 1 ? "" : "s") + ":";
     for (const auto& p : out.problems) m += "\n  " + to_string(p);
     throw Error(ErrorCategory::Recipe, m);
   }

@@ -7,19 +7,23 @@ std::optional<sketch::SketchPlane> RecipeChecker::plane(const Json& j, const std
   if (!c_.object(j, path, {"origin", "x_axis", "y_axis"}, "a plane {origin, x_axis, y_axis}"))
     return std::nullopt;
   sketch::SketchPlane pl;
-  if (!c_.vec3_members(j, path, {{"origin", &pl.origin}, {"x_axis", &pl.x_axis}, {"y_axis", &pl.y_axis}}))
+  if (!c_.vec3_members(j, path,
+                       {{"origin", &pl.origin}, {"x_axis", &pl.x_axis}, {"y_axis", &pl.y_axis}}))
     return std::nullopt;
   return c_.checked(pl, path, sketch::problems(pl, path));
 }
 
 void RecipeChecker::stroke(const std::string& name, const Json& j, const std::string& path) {
   names_.curves.push_back(name);  // defined even when broken: one problem, not a cascade
-  if (!c_.object(j, path, {"points", "plane", "tolerance", "degree", "fairness", "closing_ratio", "accept_out_of_tolerance"},
+  if (!c_.object(j, path,
+                 {"points", "plane", "tolerance", "degree", "fairness", "closing_ratio",
+                  "accept_out_of_tolerance"},
                  "a stroke {points, plane, tolerance, degree, fairness, closing_ratio}"))
     return;
   StrokeDef s{name, path, {}, {}};
   const Json* pts = c_.member(j, path, "points", true, "the drawn points [[x, y, z], ...]");
-  const auto p = pts ? c_.points(*pts, key_path(path, "points"), 2, limit::stroke_points) : std::nullopt;
+  const auto p =
+      pts ? c_.points(*pts, key_path(path, "points"), 2, limit::stroke_points) : std::nullopt;
   if (const Json* pl = c_.member(j, path, "plane", false, ""))
     s.stroke.plane = plane(*pl, key_path(path, "plane"));
   s.fit.tolerance = c_.number_or(j, path, "tolerance", s.fit.tolerance, tolerance_range);
@@ -35,31 +39,40 @@ void RecipeChecker::stroke(const std::string& name, const Json& j, const std::st
   if (c_.attempt(path, [&] { s.fit.validate(); })) data.strokes.push_back(std::move(s));
 }
 
-std::optional<surface::BSplineCurve> RecipeChecker::inline_curve(const Json& j, const std::string& path) {
+std::optional<surface::BSplineCurve> RecipeChecker::inline_curve(const Json& j,
+                                                                 const std::string& path) {
   if (!c_.object(j, path, {"degree", "knots", "points", "weights"},
                  "a B-spline curve {degree, knots, points, weights}"))
     return std::nullopt;
   const Json* d = c_.member(j, path, "degree", true, "the degree, e.g. 3");
   const Json* k = c_.member(j, path, "knots", true, "the knot vector (count + degree + 1 numbers)");
   const Json* p = c_.member(j, path, "points", true, "the control points [[x, y, z], ...]");
-  const auto degree = d ? c_.integer(*d, key_path(path, "degree"), 1, surface::max_kernel_degree) : std::nullopt;
-  const auto knots = k ? c_.numbers(*k, key_path(path, "knots"), 2, limit::curve_points + knot_slack) : std::nullopt;
+  const auto degree =
+      d ? c_.integer(*d, key_path(path, "degree"), 1, surface::max_kernel_degree) : std::nullopt;
+  const auto knots =
+      k ? c_.numbers(*k, key_path(path, "knots"), 2, limit::curve_points + knot_slack)
+        : std::nullopt;
   const auto points = p ? c_.points(*p, key_path(path, "points"), 2) : std::nullopt;
   std::optional<std::vector<double>> weights;
   if (const Json* w = c_.member(j, path, "weights", false, ""))
-    if (!(weights = c_.numbers(*w, key_path(path, "weights"), 2, limit::curve_points, weight_range))) return std::nullopt;
+    if (!(weights =
+              c_.numbers(*w, key_path(path, "weights"), 2, limit::curve_points, weight_range)))
+      return std::nullopt;
   if (!degree || !knots || !points) return std::nullopt;
   surface::BSplineCurve curve;
   curve.basis = {*degree, *knots};
   curve.points = *points;
-  curve.weights = weights ? Eigen::Map<const Eigen::VectorXd>(weights->data(), static_cast<Eigen::Index>(weights->size())).eval()
+  curve.weights = weights ? Eigen::Map<const Eigen::VectorXd>(
+                                weights->data(), static_cast<Eigen::Index>(weights->size()))
+                                .eval()
                           : Eigen::VectorXd::Ones(points->rows()).eval();
   return c_.checked(curve, path, surface::problems(curve, path));
 }
 
 void RecipeChecker::curve(const std::string& name, const Json& j, const std::string& path) {
   CurveDef def{name, path, "", std::nullopt, ""};
-  const bool ok = one_of(j, path, {"bspline", "line", "arc", "polyline", "reversed"}, "a curve", def.kind);
+  const bool ok =
+      one_of(j, path, {"bspline", "line", "arc", "polyline", "reversed"}, "a curve", def.kind);
   const std::string p = key_path(path, def.kind);
   if (ok) {
     const Json& v = j.at(def.kind);
@@ -94,7 +107,8 @@ void RecipeChecker::curve(const std::string& name, const Json& j, const std::str
   if (def.curve || !def.reversed_of.empty()) data.curves.push_back(std::move(def));
 }
 
-std::optional<surface::BSplineCurve> RecipeChecker::polyline_curve(const Points3& pts, const std::string& path) {
+std::optional<surface::BSplineCurve> RecipeChecker::polyline_curve(const Points3& pts,
+                                                                   const std::string& path) {
   const auto n = pts.rows();
   for (Eigen::Index i = 1; i < n; ++i)
     if (pts.row(i) == pts.row(i - 1)) {
@@ -107,7 +121,8 @@ std::optional<surface::BSplineCurve> RecipeChecker::polyline_curve(const Points3
   c.basis.knots.resize(static_cast<std::size_t>(n) + 2);
   c.basis.knots.front() = 0.0;
   for (Eigen::Index i = 0; i < n; ++i)
-    c.basis.knots[static_cast<std::size_t>(i) + 1] = static_cast<double>(i) / static_cast<double>(n - 1);
+    c.basis.knots[static_cast<std::size_t>(i) + 1] =
+        static_cast<double>(i) / static_cast<double>(n - 1);
   c.basis.knots.back() = 1.0;
   c.points = pts;
   c.weights = Eigen::VectorXd::Ones(n);
@@ -144,7 +159,9 @@ std::optional<surface::BSplineCurve> RecipeChecker::arc(const Json& v, const std
   return out;
 }
 
-bool RecipeChecker::one_of(const Json& j, const std::string& path, std::initializer_list<std::string_view> kinds, std::string_view what, std::string& kind) {
+bool RecipeChecker::one_of(const Json& j, const std::string& path,
+                           std::initializer_list<std::string_view> kinds, std::string_view what,
+                           std::string& kind) {
   std::vector<std::string> names(kinds.begin(), kinds.end());
   if (!j.is_object()) {
     c_.add(path, "expected " + std::string(what) + " as an object with one of " + join(names) +
@@ -195,7 +212,8 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
   if (const Json* pts = c_.member(j, path, "points", true, "an object of NAME: position")) {
     const std::string pp = key_path(path, "points");
     if (pts->is_object() && pts->size() > limit::sketch_items) {
-      c_.add(pp, std::to_string(pts->size()) + " points; at most " + std::to_string(limit::sketch_items) +
+      c_.add(pp, std::to_string(pts->size()) + " points; at most " +
+                     std::to_string(limit::sketch_items) +
                      " are allowed in a sketch (recipe limit)");
     } else if (pts->is_object()) {
       for (const auto& item : pts->items()) {  // no structured binding: Clang 14 cannot capture one
@@ -215,7 +233,8 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
   }
   // Messages of the sketch and the solver name points and entities as the recipe does.
   def.sketch.point_names.resize(def.sketch.points.size());
-  for (const auto& [pname, id] : points) def.sketch.point_names[static_cast<std::size_t>(id.index)] = pname;
+  for (const auto& [pname, id] : points)
+    def.sketch.point_names[static_cast<std::size_t>(id.index)] = pname;
   auto name_next_entity = [&](const std::string& ename) {
     def.sketch.entity_names.resize(def.sketch.entities.size() + 1);
     def.sketch.entity_names.back() = ename;
@@ -223,10 +242,12 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
   // A point or entity declared in this sketch but not built has its own problem reported at
   // its declaration; references to it stay quiet rather than adding a follow-on "no point".
   // An entity left unbuilt because it refers to such a point or entity is quiet too.
-  const std::string points_path = key_path(path, "points"), entities_path = key_path(path, "entities");
+  const std::string points_path = key_path(path, "points"),
+                    entities_path = key_path(path, "entities");
   std::set<std::string> unbuilt_by_reference;
   std::string building;  // the entity being built, while entities are read
-  auto failed = [&](const Json* section, const std::string& section_path, const std::string& declared) {
+  auto failed = [&](const Json* section, const std::string& section_path,
+                    const std::string& declared) {
     if (!section || !section->is_object() || !section->contains(declared)) return false;
     const std::string at = key_path(section_path, declared);
     const bool quiet =
@@ -250,7 +271,8 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
     if (const auto dot = n->rfind('.'); dot != std::string::npos) {
       const std::string e = n->substr(0, dot), end = n->substr(dot + 1);
       const auto ei = entities.find(e);
-      if (ei == entities.end() && (end == "start" || end == "end") && failed(declared_entities, entities_path, e))
+      if (ei == entities.end() && (end == "start" || end == "end") &&
+          failed(declared_entities, entities_path, e))
         return std::nullopt;
       if (ei != entities.end() && (end == "start" || end == "end")) {
         const bool start = end == "start";
@@ -265,8 +287,10 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
     }
     std::vector<std::string> known;
     for (const auto& [k, id] : points) known.push_back(k);
-    c_.add(p, "no point named \"" + *n + "\" in this sketch (an entity's end is \"ENTITY.start\" or "
-              "\"ENTITY.end\"); " + listing(known));
+    c_.add(p, "no point named \"" + *n +
+                  "\" in this sketch (an entity's end is \"ENTITY.start\" or "
+                  "\"ENTITY.end\"); " +
+                  listing(known));
     return std::nullopt;
   };
   auto entity_ref = [&](const Json& v, const std::string& p) -> std::optional<sketch::EntityId> {
@@ -280,19 +304,23 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
     c_.add(p, "no entity named \"" + *n + "\" in this sketch; " + listing(known));
     return std::nullopt;
   };
-  if (const Json* ents = c_.member(j, path, "entities", true, "an object of NAME: {line|circle|arc}")) {
+  if (const Json* ents =
+          c_.member(j, path, "entities", true, "an object of NAME: {line|circle|arc}")) {
     const std::string ep = key_path(path, "entities");
     if (ents->is_object() && ents->size() > limit::sketch_items) {
-      c_.add(ep, std::to_string(ents->size()) + " entities; at most " + std::to_string(limit::sketch_items) +
+      c_.add(ep, std::to_string(ents->size()) + " entities; at most " +
+                     std::to_string(limit::sketch_items) +
                      " are allowed in a sketch (recipe limit)");
     } else if (ents->is_object()) {
-      for (const auto& item : ents->items()) {  // no structured binding: Clang 14 cannot capture one
+      for (const auto& item :
+           ents->items()) {  // no structured binding: Clang 14 cannot capture one
         const std::string& ename = item.key();
         const Json& ev = item.value();
         const std::string p = key_path(ep, ename);
         building = ename;
         std::string kind;
-        if (!one_of(ev, p, {"line", "circle", "arc", "bspline", "curve"}, "a sketch entity", kind)) continue;
+        if (!one_of(ev, p, {"line", "circle", "arc", "bspline", "curve"}, "a sketch entity", kind))
+          continue;
         const Json& v = ev.at(kind);
         const std::string kp = key_path(p, kind);
         if (kind == "bspline" || kind == "curve") {
@@ -313,10 +341,13 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
               // with a stand-in (a straight cubic in the plane), built again then.
               surface::Points3 stand_in(4, 3);
               for (int k = 0; k < 4; ++k)
-                stand_in.row(k) = (plane_id.free() ? Eigen::Vector3d(k, 0, 0)
-                                                   : sketch::to_world(def.sketch.planes[static_cast<std::size_t>(plane_id.index)],
-                                                                      Eigen::Vector2d(k, 0)))
-                                      .transpose();
+                stand_in.row(k) =
+                    (plane_id.free()
+                         ? Eigen::Vector3d(k, 0, 0)
+                         : sketch::to_world(
+                               def.sketch.planes[static_cast<std::size_t>(plane_id.index)],
+                               Eigen::Vector2d(k, 0)))
+                        .transpose();
               surface::BSplineCurve c;
               c.basis.degree = 3;
               c.basis.knots.assign({0, 0, 0, 0, 1, 1, 1, 1});
@@ -358,12 +389,14 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
             c_.attempt(kp, [&] { entities[ename] = def.sketch.add_circle(*center, *r, plane_id); });
           }
         } else {
-          if (!c_.object(v, kp, {"center", "start", "end"}, "an arc {center, start, end}")) continue;
+          if (!c_.object(v, kp, {"center", "start", "end"}, "an arc {center, start, end}"))
+            continue;
           std::array<std::optional<sketch::PointId>, 3> ids;
           int k = 0;
           for (const char* key : {"center", "start", "end"}) {
             const Json* m = c_.member(v, kp, key, true, "a point name");
-            ids[static_cast<std::size_t>(k++)] = m ? point_ref(*m, key_path(kp, key)) : std::nullopt;
+            ids[static_cast<std::size_t>(k++)] =
+                m ? point_ref(*m, key_path(kp, key)) : std::nullopt;
           }
           if (plane_id.free()) {
             c_.add(kp, "an arc needs the sketch's plane; give the sketch a \"plane\"");
@@ -371,7 +404,9 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
           }
           if (ids[0] && ids[1] && ids[2]) {
             name_next_entity(ename);
-            c_.attempt(kp, [&] { entities[ename] = def.sketch.add_arc(*ids[0], *ids[1], *ids[2], plane_id); });
+            c_.attempt(kp, [&] {
+              entities[ename] = def.sketch.add_arc(*ids[0], *ids[1], *ids[2], plane_id);
+            });
           }
         }
       }
@@ -392,7 +427,8 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
         }
     }
   }
-  def.solve.tolerance = c_.number_or(j, path, "tolerance", def.solve.tolerance, Range{0, 1e-3, true, false});
+  def.solve.tolerance =
+      c_.number_or(j, path, "tolerance", def.solve.tolerance, Range{0, 1e-3, true, false});
   register_entities();
   if (c_.problems.size() != before) return;
   for (const auto& [ename, id] : entities) def.entities.emplace_back(name + "." + ename, id);

@@ -4,14 +4,17 @@
 namespace clay::recipe::check_detail {
 
 std::optional<deform::Frame> RecipeChecker::lattice_frame(const Json& j, const std::string& path) {
-  if (!c_.object(j, path, {"origin", "s", "t", "u"}, "a lattice frame {origin, s, t, u}")) return std::nullopt;
+  if (!c_.object(j, path, {"origin", "s", "t", "u"}, "a lattice frame {origin, s, t, u}"))
+    return std::nullopt;
   deform::Frame f;
   if (!c_.vec3_members(j, path, {{"origin", &f.origin}, {"s", &f.s}, {"t", &f.t}, {"u", &f.u}}))
     return std::nullopt;
   return c_.checked(f, path, deform::problems(f, path));
 }
 
-std::optional<std::array<int, 3>> RecipeChecker::triple(const Json& obj, const std::string& path, std::string_view key, int lo, int hi, std::string_view hint) {
+std::optional<std::array<int, 3>> RecipeChecker::triple(const Json& obj, const std::string& path,
+                                                        std::string_view key, int lo, int hi,
+                                                        std::string_view hint) {
   const Json* j = c_.member(obj, path, key, true, hint);
   if (!j) return std::nullopt;
   const std::string p = key_path(path, key);
@@ -32,8 +35,9 @@ std::optional<std::array<int, 3>> RecipeChecker::triple(const Json& obj, const s
 bool RecipeChecker::lattice_size_ok(std::array<long, 3> counts, const std::string& path) {
   const long total = counts[0] * counts[1] * counts[2];
   if (total <= limit::lattice_points) return true;
-  c_.add(path, "the lattice would have " + std::to_string(counts[0]) + " x " + std::to_string(counts[1]) + " x " +
-                   std::to_string(counts[2]) + " = " + std::to_string(total) + " control points; at most " +
+  c_.add(path, "the lattice would have " + std::to_string(counts[0]) + " x " +
+                   std::to_string(counts[1]) + " x " + std::to_string(counts[2]) + " = " +
+                   std::to_string(total) + " control points; at most " +
                    std::to_string(limit::lattice_points) +
                    " are allowed (recipe limit): use fewer cells or lower degrees");
   return false;
@@ -47,7 +51,8 @@ bool RecipeChecker::chunks_ok(long chunks, const std::string& path) {
   return false;
 }
 
-std::optional<Eigen::Index> RecipeChecker::lattice_row(const Json& m, const std::string& p, std::array<int, 3> counts) {
+std::optional<Eigen::Index> RecipeChecker::lattice_row(const Json& m, const std::string& p,
+                                                       std::array<int, 3> counts) {
   const Json* idx = c_.member(m, p, "index", true, "[i, j, k]");
   if (!idx) return std::nullopt;
   const std::string ip = key_path(p, "index");
@@ -65,8 +70,11 @@ std::optional<Eigen::Index> RecipeChecker::lattice_row(const Json& m, const std:
   return ok ? std::optional(row) : std::nullopt;
 }
 
-std::optional<deform::Deformation> RecipeChecker::lattice(const Json& j, const std::string& path, bool bspline, std::initializer_list<std::string_view> extra_keys) {
-  std::vector<std::string_view> keys{"kind", "name", "enabled", "frame", "degrees", "points", "moves"};
+std::optional<deform::Deformation> RecipeChecker::lattice(
+    const Json& j, const std::string& path, bool bspline,
+    std::initializer_list<std::string_view> extra_keys) {
+  std::vector<std::string_view> keys{"kind",    "name",   "enabled", "frame",
+                                     "degrees", "points", "moves"};
   if (bspline) keys.insert(keys.end(), {"bases", "cells", "knots"});
   keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
   for (const auto& [key, v] : j.items()) {
@@ -74,7 +82,8 @@ std::optional<deform::Deformation> RecipeChecker::lattice(const Json& j, const s
     if (std::find(keys.begin(), keys.end(), key) == keys.end())
       c_.add(key_path(path, key), "unknown key \"" + key + "\" in a " +
                                       std::string(bspline ? "bspline_lattice" : "bezier_lattice") +
-                                      " step; the keys are: " + join(std::vector<std::string>(keys.begin(), keys.end())));
+                                      " step; the keys are: " +
+                                      join(std::vector<std::string>(keys.begin(), keys.end())));
   }
   const Json* fj = c_.member(j, path, "frame", true, "{\"origin\", \"s\", \"t\", \"u\"}");
   const auto frame = fj ? lattice_frame(*fj, key_path(path, "frame")) : std::nullopt;
@@ -82,7 +91,8 @@ std::optional<deform::Deformation> RecipeChecker::lattice(const Json& j, const s
   if (!bspline) {
     const auto degrees = triple(j, path, "degrees", 1, surface::max_kernel_degree, "[l, m, n]");
     if (!frame || !degrees) return std::nullopt;
-    if (!lattice_size_ok({(*degrees)[0] + 1L, (*degrees)[1] + 1L, (*degrees)[2] + 1L}, key_path(path, "degrees")))
+    if (!lattice_size_ok({(*degrees)[0] + 1L, (*degrees)[1] + 1L, (*degrees)[2] + 1L},
+                         key_path(path, "degrees")))
       return std::nullopt;
     deform::BezierLattice lat = deform::make_bezier_lattice(*frame, *degrees);
     if (!lattice_points(j, path, lat.points, lat.counts())) return std::nullopt;
@@ -93,7 +103,9 @@ std::optional<deform::Deformation> RecipeChecker::lattice(const Json& j, const s
     std::optional<deform::BSplineLattice> lat;
     const bool has_bases = j.contains("bases");
     if (has_bases == j.contains("cells")) {
-      c_.add(path, "give either \"bases\" (three {degree, knots}) or \"cells\" with \"degrees\" and \"knots\"");
+      c_.add(path,
+             "give either \"bases\" (three {degree, knots}) or \"cells\" with \"degrees\" and "
+             "\"knots\"");
       return std::nullopt;
     }
     if (has_bases) {
@@ -113,8 +125,10 @@ std::optional<deform::Deformation> RecipeChecker::lattice(const Json& j, const s
         }
         const Json* d = c_.member(b[k], p, "degree", true, "the degree");
         const Json* kn = c_.member(b[k], p, "knots", true, "the knot vector on [0, 1]");
-        const auto degree = d ? c_.integer(*d, key_path(p, "degree"), 1, surface::max_kernel_degree) : std::nullopt;
-        const auto knots = kn ? c_.numbers(*kn, key_path(p, "knots"), 2, limit::lattice_points) : std::nullopt;
+        const auto degree =
+            d ? c_.integer(*d, key_path(p, "degree"), 1, surface::max_kernel_degree) : std::nullopt;
+        const auto knots =
+            kn ? c_.numbers(*kn, key_path(p, "knots"), 2, limit::lattice_points) : std::nullopt;
         ok = ok && degree && knots;
         if (degree && knots) bases[k] = {*degree, *knots};
       }
@@ -123,7 +137,8 @@ std::optional<deform::Deformation> RecipeChecker::lattice(const Json& j, const s
       for (std::size_t k = 0; k < 3; ++k)
         counts[k] = std::max(0L, static_cast<long>(bases[k].knots.size()) - bases[k].degree - 1);
       if (!lattice_size_ok(counts, bp)) return std::nullopt;
-      if (!c_.attempt(bp, [&] { lat = deform::make_bspline_lattice(*frame, bases); })) return std::nullopt;
+      if (!c_.attempt(bp, [&] { lat = deform::make_bspline_lattice(*frame, bases); }))
+        return std::nullopt;
     } else {
       const auto cells = triple(j, path, "cells", 1, limit::lattice_cells, "[a, b, c]");
       const auto degrees = triple(j, path, "degrees", 1, surface::max_kernel_degree, "[p, q, r]");
@@ -132,11 +147,13 @@ std::optional<deform::Deformation> RecipeChecker::lattice(const Json& j, const s
         if (const auto c = c_.choice(*k, key_path(path, "knots"), {"clamped", "uniform"}))
           knots = static_cast<deform::LatticeKnots>(*c);
       if (!cells || !degrees || !frame) return std::nullopt;
-      if (!lattice_size_ok({(*cells)[0] + static_cast<long>((*degrees)[0]), (*cells)[1] + static_cast<long>((*degrees)[1]),
+      if (!lattice_size_ok({(*cells)[0] + static_cast<long>((*degrees)[0]),
+                            (*cells)[1] + static_cast<long>((*degrees)[1]),
                             (*cells)[2] + static_cast<long>((*degrees)[2])},
                            path))
         return std::nullopt;
-      if (!c_.attempt(path, [&] { lat = deform::make_bspline_lattice(*frame, *degrees, *cells, knots); }))
+      if (!c_.attempt(path,
+                      [&] { lat = deform::make_bspline_lattice(*frame, *degrees, *cells, knots); }))
         return std::nullopt;
     }
     if (!lattice_points(j, path, lat->points, lat->counts())) return std::nullopt;
@@ -147,7 +164,8 @@ std::optional<deform::Deformation> RecipeChecker::lattice(const Json& j, const s
   return out;
 }
 
-bool RecipeChecker::lattice_points(const Json& j, const std::string& path, Points3& points, std::array<int, 3> counts) {
+bool RecipeChecker::lattice_points(const Json& j, const std::string& path, Points3& points,
+                                   std::array<int, 3> counts) {
   const bool has_points = j.contains("points"), has_moves = j.contains("moves");
   if (has_points && has_moves) {
     c_.add(path, "give either \"points\" (every control point) or \"moves\" (by index), not both");
@@ -157,39 +175,47 @@ bool RecipeChecker::lattice_points(const Json& j, const std::string& path, Point
     const auto p = c_.points(j.at("points"), key_path(path, "points"), 1);
     if (!p) return false;
     if (p->rows() != points.rows()) {
-      c_.add(key_path(path, "points"), "found " + std::to_string(p->rows()) + " control points, the lattice has " +
-                                           std::to_string(points.rows()) + " (" + std::to_string(counts[0]) + " x " +
-                                           std::to_string(counts[1]) + " x " + std::to_string(counts[2]) +
-                                           "); give all, s-major, or use \"moves\"");
+      c_.add(key_path(path, "points"),
+             "found " + std::to_string(p->rows()) + " control points, the lattice has " +
+                 std::to_string(points.rows()) + " (" + std::to_string(counts[0]) + " x " +
+                 std::to_string(counts[1]) + " x " + std::to_string(counts[2]) +
+                 "); give all, s-major, or use \"moves\"");
       return false;
     }
     points = *p;
     return true;
   }
   if (!has_moves) return true;  // undisplaced (an identity step)
-  return apply_moves(j.at("moves"), key_path(path, "moves"), points,
-                     [&](const Json& m, const std::string& p) { return lattice_row(m, p, counts); },
-                     std::vector<std::string_view>{"index"});
+  return apply_moves(
+      j.at("moves"), key_path(path, "moves"), points,
+      [&](const Json& m, const std::string& p) { return lattice_row(m, p, counts); },
+      std::vector<std::string_view>{"index"});
 }
 
-std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const Json& j, const std::string& path) {
+std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const Json& j,
+                                                                          const std::string& path) {
   for (const auto& [key, v] : j.items()) {
     (void)v;
     if (key != "kind" && key != "name" && key != "enabled" && key != "generator" && key != "moves")
-      c_.add(key_path(path, key), "unknown key \"" + key + "\" in an extended_lattice step with a generator; "
+      c_.add(key_path(path, key), "unknown key \"" + key +
+                                      "\" in an extended_lattice step with a generator; "
                                       "the keys are: kind, name, enabled, generator, moves");
   }
   const std::string gp = key_path(path, "generator");
   std::string kind;
-  if (!one_of(j.at("generator"), gp, {"cylinder", "prism"}, "a lattice generator", kind)) return std::nullopt;
+  if (!one_of(j.at("generator"), gp, {"cylinder", "prism"}, "a lattice generator", kind))
+    return std::nullopt;
   const Json& g = j.at("generator").at(kind);
   const std::string p = key_path(gp, kind);
   deform::ExtendedLattice lat;
   std::function<std::optional<Eigen::Index>(const Json&, const std::string&)> row_of;
   std::vector<std::string_view> index_keys{"index"};
   if (kind == "cylinder") {
-    if (!c_.object(g, p, {"origin", "axis", "reference", "radius", "inner_radius", "height", "sectors", "rings", "layers"},
-                   "a cylinder lattice {origin, axis, reference, radius, inner_radius, height, sectors, rings, layers}"))
+    if (!c_.object(g, p,
+                   {"origin", "axis", "reference", "radius", "inner_radius", "height", "sectors",
+                    "rings", "layers"},
+                   "a cylinder lattice {origin, axis, reference, radius, inner_radius, height, "
+                   "sectors, rings, layers}"))
       return std::nullopt;
     deform::CylinderSpec spec;
     for (auto [key, target] : {std::pair{"origin", &spec.origin}, std::pair{"axis", &spec.axis},
@@ -202,7 +228,8 @@ std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const 
     spec.sectors = c_.integer_or(g, p, "sectors", spec.sectors, 3, limit::cylinder_sectors);
     spec.rings = c_.integer_or(g, p, "rings", spec.rings, 1, limit::cylinder_rings);
     spec.layers = c_.integer_or(g, p, "layers", spec.layers, 1, limit::lattice_layers);
-    if (!chunks_ok(static_cast<long>(spec.sectors) * spec.rings * spec.layers, p)) return std::nullopt;
+    if (!chunks_ok(static_cast<long>(spec.sectors) * spec.rings * spec.layers, p))
+      return std::nullopt;
     if (!c_.attempt(p, [&] { lat = deform::make_cylindrical_lattice(spec); })) return std::nullopt;
     row_of = [this, spec](const Json& m, const std::string& mp) -> std::optional<Eigen::Index> {
       const Json* idx = c_.member(m, mp, "index", true, "[radial, angular, axial]");
@@ -225,8 +252,9 @@ std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const 
                    "a prism lattice {origin, x_axis, y_axis, extrusion, sections, layers}"))
       return std::nullopt;
     deform::PrismSpec spec;
-    for (auto [key, target] : {std::pair{"origin", &spec.origin}, std::pair{"x_axis", &spec.x_axis},
-                               std::pair{"y_axis", &spec.y_axis}, std::pair{"extrusion", &spec.extrusion}})
+    for (auto [key, target] :
+         {std::pair{"origin", &spec.origin}, std::pair{"x_axis", &spec.x_axis},
+          std::pair{"y_axis", &spec.y_axis}, std::pair{"extrusion", &spec.extrusion}})
       if (const Json* m = c_.member(g, p, key, false, ""))
         *target = c_.vec3(*m, key_path(p, key)).value_or(*target);
     spec.layers = c_.integer_or(g, p, "layers", spec.layers, 1, limit::lattice_layers);
@@ -238,7 +266,8 @@ std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const 
       return std::nullopt;
     }
     // Counted before any section is read: reading 100,000 of them took a minute (issue #18).
-    if (!c_.at_most(*s, sp, static_cast<std::size_t>(limit::prism_sections), "sections")) return std::nullopt;
+    if (!c_.at_most(*s, sp, static_cast<std::size_t>(limit::prism_sections), "sections"))
+      return std::nullopt;
     bool ok = true;
     for (std::size_t a = 0; a < s->size(); ++a) {
       const std::string ap = index_path(sp, a);
@@ -247,7 +276,8 @@ std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const 
         ok = false;
         continue;
       }
-      if (!c_.at_most((*s)[a], ap, 3 * static_cast<std::size_t>(limit::prism_sections - 1) + 1, "section points")) {
+      if (!c_.at_most((*s)[a], ap, 3 * static_cast<std::size_t>(limit::prism_sections - 1) + 1,
+                      "section points")) {
         ok = false;
         continue;
       }
@@ -260,7 +290,8 @@ std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const 
       spec.sections.push_back(std::move(section));
     }
     if (!ok || spec.sections.empty()) return std::nullopt;  // each bad section reported above
-    const long segments_first = std::max(0L, static_cast<long>(spec.sections.front().size()) - 1) / 3;
+    const long segments_first =
+        std::max(0L, static_cast<long>(spec.sections.front().size()) - 1) / 3;
     if (!chunks_ok(static_cast<long>(spec.sections.size() - 1) * segments_first * spec.layers, p))
       return std::nullopt;
     if (!c_.attempt(p, [&] { lat = deform::make_prismatic_lattice(spec); })) return std::nullopt;
@@ -272,8 +303,8 @@ std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const 
     const int segments = (static_cast<int>(spec.sections.front().size()) - 1) / 3;
     const int layers = spec.layers;
     const auto chunks = lat.chunks;
-    row_of = [this, rows, gaps, segments, layers, chunks](const Json& m,
-                                                          const std::string& mp) -> std::optional<Eigen::Index> {
+    row_of = [this, rows, gaps, segments, layers, chunks](
+                 const Json& m, const std::string& mp) -> std::optional<Eigen::Index> {
       if (m.contains("row") == m.contains("index")) {
         c_.add(mp, "give exactly one of \"row\" (a control-point row) and \"index\" ([i, j, k])");
         return std::nullopt;
@@ -292,14 +323,16 @@ std::optional<deform::Deformation> RecipeChecker::extended_from_generator(const 
       const auto jj = c_.integer(idx[1], index_path(ip, 1), 0, 3 * segments);
       const auto k = c_.integer(idx[2], index_path(ip, 2), 0, 3 * layers);
       if (!i || !jj || !k) return std::nullopt;
-      const int a = std::min(*i / 3, gaps - 1), b = std::min(*jj / 3, segments - 1), c = std::min(*k / 3, layers - 1);
+      const int a = std::min(*i / 3, gaps - 1), b = std::min(*jj / 3, segments - 1),
+                c = std::min(*k / 3, layers - 1);
       const auto& chunk = chunks[static_cast<std::size_t>((a * segments + b) * layers + c)];
       return chunk[static_cast<std::size_t>(((*i - 3 * a) * 4 + (*jj - 3 * b)) * 4 + (*k - 3 * c))];
     };
     index_keys = {std::string_view("row"), std::string_view("index")};
   }
   if (const Json* m = c_.member(j, path, "moves", false, ""))
-    if (!apply_moves(*m, key_path(path, "moves"), lat.points, row_of, index_keys)) return std::nullopt;
+    if (!apply_moves(*m, key_path(path, "moves"), lat.points, row_of, index_keys))
+      return std::nullopt;
   const auto list = deform::problems(lat, path);
   if (!list.empty()) return c_.add_all(path, list), std::nullopt;
   return deform::Deformation(std::move(lat));
@@ -314,10 +347,12 @@ double RecipeChecker::bound_within_metre(const std::vector<double>& c) {
 bool RecipeChecker::within_limits(const deform::Deformation& d, const std::string& path) {
   const std::size_t before = c_.problems.size();
   auto frame = [&](const deform::AxisFrame& f) {
-    for (auto [key, v] : {std::pair{"origin", &f.origin}, std::pair{"axis", &f.axis}, std::pair{"reference", &f.reference}})
+    for (auto [key, v] : {std::pair{"origin", &f.origin}, std::pair{"axis", &f.axis},
+                          std::pair{"reference", &f.reference}})
       if (!(v->cwiseAbs().maxCoeff() <= limit::magnitude))
-        c_.add(key_path(key_path(path, "frame"), key), "a coordinate is beyond ±" + shortest(limit::magnitude) +
-                                                           " mm (recipe limit); give the frame in millimetres within it");
+        c_.add(key_path(key_path(path, "frame"), key),
+               "a coordinate is beyond ±" + shortest(limit::magnitude) +
+                   " mm (recipe limit); give the frame in millimetres within it");
   };
   std::visit(
       [&](const auto& x) {
@@ -327,46 +362,60 @@ bool RecipeChecker::within_limits(const deform::Deformation& d, const std::strin
           const double turns = bound_within_metre(x.angle) / (2 * std::numbers::pi);
           if (!(turns <= limit::twist_turns))
             c_.add(key_path(path, "angle"),
-                   "the twist may turn " + shortest(turns * 360) + " degrees within 1 m of its origin (sum of |angle[k]| · 1000^k = " +
-                       shortest(turns * 2 * std::numbers::pi) + " rad); at most " + shortest(limit::twist_turns * 360) +
-                       " degrees (" + shortest(limit::twist_turns) + " turns) are allowed (recipe limit): the coefficients are radians per mm^k");
+                   "the twist may turn " + shortest(turns * 360) +
+                       " degrees within 1 m of its origin (sum of |angle[k]| · 1000^k = " +
+                       shortest(turns * 2 * std::numbers::pi) + " rad); at most " +
+                       shortest(limit::twist_turns * 360) + " degrees (" +
+                       shortest(limit::twist_turns) +
+                       " turns) are allowed (recipe limit): the coefficients are radians per mm^k");
         } else if constexpr (std::is_same_v<T, deform::Taper>) {
           frame(x.frame);
           const double scale = bound_within_metre(x.profile);
           if (!(scale <= limit::taper_scale))
             c_.add(key_path(path, "profile"),
-                   "the taper may scale by up to " + shortest(scale) + " within 1 m of its origin (sum of |profile[k]| · 1000^k); at most " +
-                       shortest(limit::taper_scale) + " is allowed (recipe limit): the coefficients are per mm^k");
+                   "the taper may scale by up to " + shortest(scale) +
+                       " within 1 m of its origin (sum of |profile[k]| · 1000^k); at most " +
+                       shortest(limit::taper_scale) +
+                       " is allowed (recipe limit): the coefficients are per mm^k");
         } else if constexpr (std::is_same_v<T, deform::Bend>) {
           frame(x.frame);
-          for (auto [key, v] : {std::pair{"y_min", x.y_min}, std::pair{"y_max", x.y_max}, std::pair{"center", x.center}})
+          for (auto [key, v] : {std::pair{"y_min", x.y_min}, std::pair{"y_max", x.y_max},
+                                std::pair{"center", x.center}})
             if (!(std::abs(v) <= limit::magnitude))
-              c_.add(key_path(path, key), shortest(v) + " mm is beyond ±" + shortest(limit::magnitude) + " mm (recipe limit)");
+              c_.add(key_path(path, key), shortest(v) + " mm is beyond ±" +
+                                              shortest(limit::magnitude) + " mm (recipe limit)");
           const double turns = std::abs(x.rate) * (x.y_max - x.y_min) / (2 * std::numbers::pi);
           if (!(std::abs(x.rate) <= limit::bend_rate))
-            c_.add(key_path(path, "rate"), shortest(x.rate) + " rad/mm is beyond ±" + shortest(limit::bend_rate) +
-                                               " rad/mm (recipe limit: a radius of curvature of at least 1 mm)");
+            c_.add(key_path(path, "rate"),
+                   shortest(x.rate) + " rad/mm is beyond ±" + shortest(limit::bend_rate) +
+                       " rad/mm (recipe limit: a radius of curvature of at least 1 mm)");
           else if (!(turns <= limit::bend_turns))
-            c_.add(key_path(path, "rate"), "the bend turns " + shortest(turns * 360) + " degrees over its region (rate · (y_max − y_min)); at most " +
-                                               shortest(limit::bend_turns * 360) + " degrees are allowed (recipe limit)");
+            c_.add(key_path(path, "rate"),
+                   "the bend turns " + shortest(turns * 360) +
+                       " degrees over its region (rate · (y_max − y_min)); at most " +
+                       shortest(limit::bend_turns * 360) + " degrees are allowed (recipe limit)");
         } else if constexpr (std::is_same_v<T, deform::ExtendedLattice>) {
           if (static_cast<long>(x.chunks.size()) > limit::chunks)
             c_.add(key_path(path, "chunks"), std::to_string(x.chunks.size()) + " chunks; at most " +
-                                                 std::to_string(limit::chunks) + " are allowed (recipe limit)");
+                                                 std::to_string(limit::chunks) +
+                                                 " are allowed (recipe limit)");
           for (auto [key, m] : {std::pair{"rest", &x.rest}, std::pair{"points", &x.points}})
             if (m->size() > 0 && !(m->cwiseAbs().maxCoeff() <= limit::magnitude))
-              c_.add(key_path(path, key), "a coordinate is beyond ±" + shortest(limit::magnitude) + " mm (recipe limit)");
+              c_.add(key_path(path, key), "a coordinate is beyond ±" + shortest(limit::magnitude) +
+                                              " mm (recipe limit)");
         }
       },
       d);
   return c_.problems.size() == before;
 }
 
-std::optional<deform::Deformation> RecipeChecker::schema_step(const Json& j, const std::string& path) {
+std::optional<deform::Deformation> RecipeChecker::schema_step(const Json& j,
+                                                              const std::string& path) {
   auto step = internal::read_step(c_, j, path);
   if (!step) return std::nullopt;
   const std::string label = internal::step_label(path, *step);
-  const auto list = std::visit([&](const auto& d) { return problems(d, label); }, step->deformation);
+  const auto list =
+      std::visit([&](const auto& d) { return problems(d, label); }, step->deformation);
   if (!list.empty()) {
     c_.add_all(label, list);
     return std::nullopt;
@@ -393,11 +442,12 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
     const Json* k = c_.member(s, p, "kind", true, "the step's kind, e.g. \"bezier_lattice\"");
     if (!k) continue;
     const auto kind = c_.choice(*k, key_path(p, "kind"),
-                                {"bezier_lattice", "bspline_lattice", "extended_lattice", "taper", "twist",
-                                 "bend", "style", "direct_manipulation"});
+                                {"bezier_lattice", "bspline_lattice", "extended_lattice", "taper",
+                                 "twist", "bend", "style", "direct_manipulation"});
     if (!kind) continue;
     step.kind = k->get<std::string>();
-    if (const Json* n = c_.member(s, p, "name", false, "")) step.name = c_.string(*n, key_path(p, "name")).value_or("");
+    if (const Json* n = c_.member(s, p, "name", false, ""))
+      step.name = c_.string(*n, key_path(p, "name")).value_or("");
     step.enabled = c_.boolean_or(s, p, "enabled", true);
     bool ok = false;
     if (*kind <= 1) {
@@ -405,7 +455,8 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
     } else if (*kind == 2 && s.contains("generator")) {
       if (auto d = extended_from_generator(s, p)) step.step = std::move(*d), ok = true;
     } else if (*kind <= 5) {
-      if (auto d = schema_step(s, p); d && within_limits(*d, p)) step.step = std::move(*d), ok = true;
+      if (auto d = schema_step(s, p); d && within_limits(*d, p))
+        step.step = std::move(*d), ok = true;
     } else if (*kind == 6) {
       if (auto d = style(s, p)) step.step = std::move(*d), ok = true;
     } else {
@@ -417,10 +468,12 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
 }
 
 std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p) {
-  if (!c_.object(j, p, {"kind", "name", "enabled", "target", "bound", "mode", "lambda", "relaxation", "smoothing",
-                        "key_points_per_row", "boundary_rows", "tolerance", "curve_tolerance", "max_refinements",
-                        "max_key_point_rounds", "accept_out_of_tolerance"},
-                 "a style step"))
+  if (!c_.object(
+          j, p,
+          {"kind", "name", "enabled", "target", "bound", "mode", "lambda", "relaxation",
+           "smoothing", "key_points_per_row", "boundary_rows", "tolerance", "curve_tolerance",
+           "max_refinements", "max_key_point_rounds", "accept_out_of_tolerance"},
+          "a style step"))
     return std::nullopt;
   StyleDef d;
   const std::size_t before = c_.problems.size();
@@ -437,14 +490,15 @@ std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p
       const surface::Points3& pts = cd->curve->points;
       const double size = (pts.colwise().maxCoeff() - pts.colwise().minCoeff()).norm();
       const auto [t0, t1] = cd->curve->basis.domain();
-      const double gap = (surface::evaluate(*cd->curve, t1) - surface::evaluate(*cd->curve, t0)).norm();
-      if (gap > 1e-7 * size)
-      {
+      const double gap =
+          (surface::evaluate(*cd->curve, t1) - surface::evaluate(*cd->curve, t0)).norm();
+      if (gap > 1e-7 * size) {
         char apart[32];
         std::snprintf(apart, sizeof apart, "%.4g", gap);
-        c_.add(key_path(p, "bound"), "the bound curve \"" + d.bound + "\" is open: its ends are " + apart +
-                                         " mm apart; a bound curve must be closed (make its last control point "
-                                         "equal its first)");
+        c_.add(key_path(p, "bound"),
+               "the bound curve \"" + d.bound + "\" is open: its ends are " + apart +
+                   " mm apart; a bound curve must be closed (make its last control point "
+                   "equal its first)");
       }
     }
   }
@@ -460,28 +514,35 @@ std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p
   o.tolerance = c_.number_or(j, p, "tolerance", o.tolerance, positive);
   o.curve_tolerance = c_.number_or(j, p, "curve_tolerance", o.curve_tolerance, positive);
   o.max_refinements = c_.integer_or(j, p, "max_refinements", o.max_refinements, 0, 8);
-  o.max_key_point_rounds = c_.integer_or(j, p, "max_key_point_rounds", o.max_key_point_rounds, 0, 16);
-  d.accept_out_of_tolerance = c_.boolean_or(j, p, "accept_out_of_tolerance", d.accept_out_of_tolerance);
+  o.max_key_point_rounds =
+      c_.integer_or(j, p, "max_key_point_rounds", o.max_key_point_rounds, 0, 16);
+  d.accept_out_of_tolerance =
+      c_.boolean_or(j, p, "accept_out_of_tolerance", d.accept_out_of_tolerance);
   c_.attempt(p, [&] { o.validate(); });
   if (c_.problems.size() != before) return std::nullopt;
   return d;
 }
 
 std::optional<DirectDef> RecipeChecker::direct(const Json& j, const std::string& p) {
-  if (!c_.object(j, p, {"kind", "name", "enabled", "lattice", "moves", "locked", "tied", "tolerance",
-                        "accept_out_of_tolerance"},
+  if (!c_.object(j, p,
+                 {"kind", "name", "enabled", "lattice", "moves", "locked", "tied", "tolerance",
+                  "accept_out_of_tolerance"},
                  "a direct_manipulation step"))
     return std::nullopt;
   const std::size_t before = c_.problems.size();
   DirectDef d{deform::BezierLattice{}, {}, {}, false};
   d.accept_out_of_tolerance = c_.boolean_or(j, p, "accept_out_of_tolerance", false);
-  const Json* lj = c_.member(j, p, "lattice", true, "a bezier_lattice or bspline_lattice object with \"kind\"");
+  const Json* lj =
+      c_.member(j, p, "lattice", true, "a bezier_lattice or bspline_lattice object with \"kind\"");
   std::array<int, 3> counts{0, 0, 0};
   if (lj) {
     const std::string lp = key_path(p, "lattice");
-    const Json* k = lj->is_object() ? c_.member(*lj, lp, "kind", true, "\"bezier_lattice\" or \"bspline_lattice\"") : nullptr;
+    const Json* k = lj->is_object() ? c_.member(*lj, lp, "kind", true,
+                                                "\"bezier_lattice\" or \"bspline_lattice\"")
+                                    : nullptr;
     if (!lj->is_object()) c_.add(lp, "expected a lattice object, found " + found(*lj));
-    const auto kind = k ? c_.choice(*k, key_path(lp, "kind"), {"bezier_lattice", "bspline_lattice"}) : std::nullopt;
+    const auto kind = k ? c_.choice(*k, key_path(lp, "kind"), {"bezier_lattice", "bspline_lattice"})
+                        : std::nullopt;
     if (kind) {
       if (auto lat = lattice(*lj, lp, *kind == 1, {})) {
         if (auto* b = std::get_if<deform::BezierLattice>(&*lat)) {
@@ -495,7 +556,8 @@ std::optional<DirectDef> RecipeChecker::direct(const Json& j, const std::string&
       }
     }
   }
-  const Json* mj = c_.member(j, p, "moves", true, "[{\"point\": [x,y,z] | \"surface_point\": [u, v], \"to\": [x,y,z]}]");
+  const Json* mj = c_.member(j, p, "moves", true,
+                             "[{\"point\": [x,y,z] | \"surface_point\": [u, v], \"to\": [x,y,z]}]");
   if (mj) {
     const std::string mp = key_path(p, "moves");
     if (!mj->is_array() || mj->empty()) {
@@ -504,7 +566,9 @@ std::optional<DirectDef> RecipeChecker::direct(const Json& j, const std::string&
       for (std::size_t i = 0; i < mj->size(); ++i) {
         const std::string ip = index_path(mp, i);
         const Json& m = (*mj)[i];
-        if (!c_.object(m, ip, {"point", "surface_point", "to"}, "a move {point | surface_point, to}")) continue;
+        if (!c_.object(m, ip, {"point", "surface_point", "to"},
+                       "a move {point | surface_point, to}"))
+          continue;
         DirectMove move;
         const bool has_point = m.contains("point"), has_uv = m.contains("surface_point");
         if (has_point == has_uv) {
@@ -544,7 +608,8 @@ std::optional<DirectDef> RecipeChecker::direct(const Json& j, const std::string&
     } else if (rows > 0) {
       d.options.locked.assign(static_cast<std::size_t>(rows), false);
       for (std::size_t i = 0; i < lk->size(); ++i)
-        if (const auto r = index_row((*lk)[i], index_path(lp, i))) d.options.locked[static_cast<std::size_t>(*r)] = true;
+        if (const auto r = index_row((*lk)[i], index_path(lp, i)))
+          d.options.locked[static_cast<std::size_t>(*r)] = true;
     }
   }
   if (const Json* tj = c_.member(j, p, "tied", false, "")) {

@@ -6,8 +6,9 @@ namespace clay::recipe::check_detail {
 void RecipeChecker::surface(const std::string& name, const Json& j, const std::string& path) {
   SurfaceDef def{name, path, "", surface::BSplineSurface{}};
   const std::size_t before = c_.problems.size();
-  if (one_of(j, path, {"bspline", "fill", "skin", "sweep", "revolve", "superellipsoid", "supertoroid",
-                       "import", "deform"},
+  if (one_of(j, path,
+             {"bspline", "fill", "skin", "sweep", "revolve", "superellipsoid", "supertoroid",
+              "import", "deform"},
              "a surface", def.kind)) {
     const Json& v = j.at(def.kind);
     const std::string p = key_path(path, def.kind);
@@ -15,35 +16,42 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
       if (auto s = inline_surface(v, p)) def.build = std::move(*s);
     } else if (def.kind == "fill") {
       FillDef f;
-      if (c_.object(v, p, {"curves", "style", "gap_tolerance"}, "a fill {curves, style, gap_tolerance}")) {
+      if (c_.object(v, p, {"curves", "style", "gap_tolerance"},
+                    "a fill {curves, style, gap_tolerance}")) {
         f.curves = curve_refs(v, p, "curves", 2, 4);
         if (const Json* s = c_.member(v, p, "style", false, ""))
           if (const auto k = c_.choice(*s, key_path(p, "style"), {"stretch", "coons", "curved"}))
             f.options.style = static_cast<surface::FillStyle>(*k);
-        f.options.gap_tolerance = c_.number_or(v, p, "gap_tolerance", f.options.gap_tolerance, positive);
+        f.options.gap_tolerance =
+            c_.number_or(v, p, "gap_tolerance", f.options.gap_tolerance, positive);
         c_.attempt(p, [&] { f.options.validate(); });
       }
       def.build = std::move(f);
     } else if (def.kind == "skin") {
       SkinDef s;
-      if (c_.object(v, p, {"sections", "degree", "parametrization"}, "a skin {sections, degree, parametrization}")) {
+      if (c_.object(v, p, {"sections", "degree", "parametrization"},
+                    "a skin {sections, degree, parametrization}")) {
         s.sections = curve_refs(v, p, "sections", 2, limit::entries);
-        s.options.degree = c_.integer_or(v, p, "degree", s.options.degree, 1, surface::max_exchange_degree);
+        s.options.degree =
+            c_.integer_or(v, p, "degree", s.options.degree, 1, surface::max_exchange_degree);
         if (const Json* m = c_.member(v, p, "parametrization", false, ""))
-          if (const auto k = c_.choice(*m, key_path(p, "parametrization"), {"chord_length", "centripetal", "uniform"}))
+          if (const auto k = c_.choice(*m, key_path(p, "parametrization"),
+                                       {"chord_length", "centripetal", "uniform"}))
             s.options.parametrization = static_cast<surface::LoftParametrization>(*k);
         c_.attempt(p, [&] { s.options.validate(); });
       }
       def.build = std::move(s);
     } else if (def.kind == "sweep") {
       SweepDef s;
-      if (c_.object(v, p, {"profile", "path", "twist_degrees", "tolerance"}, "a sweep {profile, path, twist_degrees, tolerance}")) {
+      if (c_.object(v, p, {"profile", "path", "twist_degrees", "tolerance"},
+                    "a sweep {profile, path, twist_degrees, tolerance}")) {
         if (const Json* m = c_.member(v, p, "profile", true, "a curve name"))
           s.profile = curve_ref(*m, key_path(p, "profile")).value_or("");
         if (const Json* m = c_.member(v, p, "path", true, "a curve name"))
           s.path = curve_ref(*m, key_path(p, "path")).value_or("");
-        s.options.twist_degrees = c_.number_or(v, p, "twist_degrees", s.options.twist_degrees,
-                                               Range{-limit::sweep_twist_degrees, limit::sweep_twist_degrees});
+        s.options.twist_degrees =
+            c_.number_or(v, p, "twist_degrees", s.options.twist_degrees,
+                         Range{-limit::sweep_twist_degrees, limit::sweep_twist_degrees});
         s.options.tolerance = c_.number_or(v, p, "tolerance", s.options.tolerance, tolerance_range);
         c_.attempt(p, [&] { s.options.validate(); });
       }
@@ -53,7 +61,8 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
       if (c_.object(v, p, {"profile", "axis", "angle"}, "a revolve {profile, axis, angle}")) {
         if (const Json* m = c_.member(v, p, "profile", true, "a curve name"))
           r.profile = curve_ref(*m, key_path(p, "profile")).value_or("");
-        if (const Json* a = c_.member(v, p, "axis", true, "{\"point\": [x, y, z], \"direction\": [x, y, z]}")) {
+        if (const Json* a =
+                c_.member(v, p, "axis", true, "{\"point\": [x, y, z], \"direction\": [x, y, z]}")) {
           const std::string ap = key_path(p, "axis");
           if (c_.object(*a, ap, {"point", "direction"}, "an axis {point, direction}")) {
             if (const Json* m = c_.member(*a, ap, "point", true, "[x, y, z]"))
@@ -61,7 +70,8 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
             if (const Json* m = c_.member(*a, ap, "direction", true, "[x, y, z]"))
               r.axis.direction = c_.vec3(*m, key_path(ap, "direction")).value_or(r.axis.direction);
             if (r.axis.direction.norm() == 0.0)
-              c_.add(key_path(ap, "direction"), "the axis direction is zero; give a non-zero vector");
+              c_.add(key_path(ap, "direction"),
+                     "the axis direction is zero; give a non-zero vector");
           }
         }
         r.angle = c_.number_or(v, p, "angle", r.angle, Range{0, 360, true, false});
@@ -70,13 +80,16 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
     } else if (def.kind == "superellipsoid" || def.kind == "supertoroid") {
       const bool toroid = def.kind == "supertoroid";
       std::initializer_list<std::string_view> keys_e{"radii", "e1", "e2", "tolerance", "degree"};
-      std::initializer_list<std::string_view> keys_t{"radii", "e1", "e2", "tolerance", "degree", "hole"};
-      if (c_.object(v, p, toroid ? keys_t : keys_e, toroid ? "a supertoroid" : "a superellipsoid")) {
+      std::initializer_list<std::string_view> keys_t{"radii",     "e1",     "e2",
+                                                     "tolerance", "degree", "hole"};
+      if (c_.object(v, p, toroid ? keys_t : keys_e,
+                    toroid ? "a supertoroid" : "a superellipsoid")) {
         surface::SuperquadricOptions o;
         Eigen::Vector3d radii = Eigen::Vector3d::Ones();
         if (const Json* m = c_.member(v, p, "radii", false, "")) {
           radii = c_.vec3(*m, key_path(p, "radii")).value_or(radii);
-          if (!(radii.minCoeff() > 0)) c_.add(key_path(p, "radii"), "every radius must be > 0 (mm)");
+          if (!(radii.minCoeff() > 0))
+            c_.add(key_path(p, "radii"), "every radius must be > 0 (mm)");
         }
         const double e1 = c_.number_or(v, p, "e1", 1.0, Range{0, 10, true, false});
         const double e2 = c_.number_or(v, p, "e2", 1.0, Range{0, 10, true, false});
@@ -93,15 +106,20 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
     } else if (def.kind == "import") {
       ImportDef d;
       if (c_.object(v, p, {"file", "index"}, "an import {file, index}")) {
-        if (const Json* f = c_.member(v, p, "file", true, "the path of a .step/.stp/.igs/.iges file"))
+        if (const Json* f =
+                c_.member(v, p, "file", true, "the path of a .step/.stp/.igs/.iges file"))
           if (const auto s = c_.string(*f, key_path(p, "file"))) {
             d.file = fs::path(*s).is_absolute() ? fs::path(*s) : base_ / *s;
             std::string ext = d.file.extension().string();
-            for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+            for (char& ch : ext)
+              ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
             if (ext != ".step" && ext != ".stp" && ext != ".igs" && ext != ".iges")
-              c_.add(key_path(p, "file"), "\"" + *s + "\" is not a STEP or IGES file; give a .step, .stp, .igs or .iges file");
+              c_.add(key_path(p, "file"),
+                     "\"" + *s +
+                         "\" is not a STEP or IGES file; give a .step, .stp, .igs or .iges file");
             else if (!fs::is_regular_file(d.file))
-              c_.add(key_path(p, "file"), "no file \"" + d.file.string() + "\" (paths are relative to the recipe's folder)");
+              c_.add(key_path(p, "file"), "no file \"" + d.file.string() +
+                                              "\" (paths are relative to the recipe's folder)");
           }
         d.index = c_.integer_or(v, p, "index", 0, 0, 1000000);
       }
@@ -109,7 +127,8 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
     } else {  // deform
       DeformDef d;
       d.composition = data.composition;
-      if (c_.object(v, p, {"surface", "deformation", "composition"}, "a deform {surface, deformation, composition}")) {
+      if (c_.object(v, p, {"surface", "deformation", "composition"},
+                    "a deform {surface, deformation, composition}")) {
         if (const Json* m = c_.member(v, p, "surface", true, "the name of an earlier surface"))
           d.surface = surface_ref(*m, key_path(p, "surface")).value_or("");
         if (const Json* m = c_.member(v, p, "deformation", true, "the name of a deformation stack"))
@@ -117,7 +136,8 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
             if (Names::has(names_.stacks, *s))
               d.deformation = *s;
             else
-              c_.add(key_path(p, "deformation"), "no deformation stack named \"" + *s + "\"; " + listing(names_.stacks));
+              c_.add(key_path(p, "deformation"),
+                     "no deformation stack named \"" + *s + "\"; " + listing(names_.stacks));
           }
         if (const Json* m = c_.member(v, p, "composition", false, ""))
           d.composition = composition(*m, key_path(p, "composition"), d.composition);
@@ -138,44 +158,54 @@ void RecipeChecker::exact_composable(const std::string& stack_name, const std::s
       if (!step.enabled || !d) continue;
       if (std::holds_alternative<deform::Twist>(*d) || std::holds_alternative<deform::Bend>(*d) ||
           std::holds_alternative<deform::ExtendedLattice>(*d))
-        c_.add(path, step.path + " is a " + step.kind + ", which cannot be composed exactly (only " +
-                         "Bézier and B-spline lattices and tapers can); give this surface or the recipe " +
-                         "\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4}");
+        c_.add(
+            path,
+            step.path + " is a " + step.kind + ", which cannot be composed exactly (only " +
+                "Bézier and B-spline lattices and tapers can); give this surface or the recipe " +
+                "\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4}");
     }
   }
 }
 
-std::optional<surface::BSplineSurface> RecipeChecker::inline_surface(const Json& j, const std::string& path) {
+std::optional<surface::BSplineSurface> RecipeChecker::inline_surface(const Json& j,
+                                                                     const std::string& path) {
   if (!c_.object(j, path, {"degrees", "knots_u", "knots_v", "points", "weights"},
                  "a B-spline surface {degrees, knots_u, knots_v, points, weights}"))
     return std::nullopt;
   const Json* d = c_.member(j, path, "degrees", true, "[p, q]");
   const Json* ku = c_.member(j, path, "knots_u", true, "the u knot vector");
   const Json* kv = c_.member(j, path, "knots_v", true, "the v knot vector");
-  const Json* p = c_.member(j, path, "points", true, "count_u x count_v control points, (i, j) at row i * count_v + j");
+  const Json* p = c_.member(j, path, "points", true,
+                            "count_u x count_v control points, (i, j) at row i * count_v + j");
   std::optional<std::pair<int, int>> degrees;
   if (d) {
     if (!d->is_array() || d->size() != 2) {
       c_.add(key_path(path, "degrees"), "expected [p, q], found " + found(*d));
     } else {
-      const auto a = c_.integer((*d)[0], index_path(key_path(path, "degrees"), 0), 1, surface::max_kernel_degree);
-      const auto b = c_.integer((*d)[1], index_path(key_path(path, "degrees"), 1), 1, surface::max_kernel_degree);
+      const auto a = c_.integer((*d)[0], index_path(key_path(path, "degrees"), 0), 1,
+                                surface::max_kernel_degree);
+      const auto b = c_.integer((*d)[1], index_path(key_path(path, "degrees"), 1), 1,
+                                surface::max_kernel_degree);
       if (a && b) degrees = std::pair{*a, *b};
     }
   }
   const auto knots_u = ku ? c_.numbers(*ku, key_path(path, "knots_u"), 2) : std::nullopt;
   const auto knots_v = kv ? c_.numbers(*kv, key_path(path, "knots_v"), 2) : std::nullopt;
-  const auto points = p ? c_.points(*p, key_path(path, "points"), 4, limit::surface_points) : std::nullopt;
+  const auto points =
+      p ? c_.points(*p, key_path(path, "points"), 4, limit::surface_points) : std::nullopt;
   std::optional<std::vector<double>> weights;
   if (const Json* w = c_.member(j, path, "weights", false, ""))
-    if (!(weights = c_.numbers(*w, key_path(path, "weights"), 4, limit::surface_points, weight_range)))
+    if (!(weights =
+              c_.numbers(*w, key_path(path, "weights"), 4, limit::surface_points, weight_range)))
       return std::nullopt;
   if (!degrees || !knots_u || !knots_v || !points) return std::nullopt;
   surface::BSplineSurface s;
   s.u = {degrees->first, *knots_u};
   s.v = {degrees->second, *knots_v};
   s.points = *points;
-  s.weights = weights ? Eigen::Map<const Eigen::VectorXd>(weights->data(), static_cast<Eigen::Index>(weights->size())).eval()
+  s.weights = weights ? Eigen::Map<const Eigen::VectorXd>(
+                            weights->data(), static_cast<Eigen::Index>(weights->size()))
+                            .eval()
                       : Eigen::VectorXd::Ones(points->rows()).eval();
   return c_.checked(s, path, surface::problems(s, path));
 }

@@ -20,8 +20,8 @@
 #include <clay/surface/exchange.hpp>
 
 #include <clay/internal/deformation_json.hpp>
-#include <clay/internal/json_reader.hpp>
 #include <clay/internal/fenv.hpp>
+#include <clay/internal/json_reader.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -38,7 +38,6 @@
 #include <sstream>
 
 namespace clay::recipe::check_detail {
-
 
 using Json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
@@ -64,30 +63,30 @@ using internal::shortest;
 // ceiling is far above what styling work needs (a car is 5,000 mm long; the examples stay far
 // below every one) and low enough that the largest recipe allowed still runs in seconds.
 namespace limit {
-constexpr std::size_t text_bytes = 64u << 20;   // the recipe text: 64 MiB
-constexpr int depth = 64;                        // nesting of arrays and objects (the schema uses 8)
-constexpr double magnitude = 1e6;                // |any number|: mm (1 km), degrees, knots, weights
-constexpr std::size_t entries = 1000;            // names per section, surfaces per export, skin sections
-constexpr std::size_t curve_points = 10000;      // control points of a curve, points of a polyline
-constexpr std::size_t stroke_points = 10000;     // drawn points of a stroke
-constexpr std::size_t surface_points = 250000;   // control points of an inline surface (500 x 500)
-constexpr std::size_t sketch_items = 1000;       // points, entities, constraints of a sketch
-constexpr std::size_t steps = 100;               // steps of a deformation stack
-constexpr std::size_t moves = 10000;             // moves of a lattice step or direct manipulation
+constexpr std::size_t text_bytes = 64u << 20;  // the recipe text: 64 MiB
+constexpr int depth = 64;                      // nesting of arrays and objects (the schema uses 8)
+constexpr double magnitude = 1e6;              // |any number|: mm (1 km), degrees, knots, weights
+constexpr std::size_t entries = 1000;  // names per section, surfaces per export, skin sections
+constexpr std::size_t curve_points = 10000;     // control points of a curve, points of a polyline
+constexpr std::size_t stroke_points = 10000;    // drawn points of a stroke
+constexpr std::size_t surface_points = 250000;  // control points of an inline surface (500 x 500)
+constexpr std::size_t sketch_items = 1000;      // points, entities, constraints of a sketch
+constexpr std::size_t steps = 100;              // steps of a deformation stack
+constexpr std::size_t moves = 10000;            // moves of a lattice step or direct manipulation
 constexpr double weight_min = 1e-6, weight_max = 1e6;  // rational weights (ratio at most 1e12)
-constexpr long lattice_points = 100000;          // control points of a Bézier or B-spline lattice
-constexpr int lattice_cells = 64;                // cells of a B-spline lattice per direction
-constexpr long chunks = 4096;                    // tricubic chunks of an extended lattice
-constexpr int prism_sections = 65;               // sections of a prism lattice (64 gaps)
+constexpr long lattice_points = 100000;  // control points of a Bézier or B-spline lattice
+constexpr int lattice_cells = 64;        // cells of a B-spline lattice per direction
+constexpr long chunks = 4096;            // tricubic chunks of an extended lattice
+constexpr int prism_sections = 65;       // sections of a prism lattice (64 gaps)
 constexpr int cylinder_sectors = 256, cylinder_rings = 64, lattice_layers = 64;
-constexpr double twist_turns = 100;              // twist: turns within 1 m of its origin
-constexpr double taper_scale = 1e3;              // taper: |r(z)| bound within 1 m of its origin
-constexpr double bend_rate = 1;                  // bend: rad/mm (radius of curvature >= 1 mm)
-constexpr double bend_turns = 10;                // bend: turns over its region
-constexpr double sweep_twist_degrees = 3600;     // sweep: 10 turns
-constexpr double arc_degrees = 720;              // arc start and end angles
-constexpr double min_tolerance = 1e-9;           // smallest refit, sweep and fit tolerance
-constexpr int refit_control_points = 40000;      // a refit's net (RefitOptions' default)
+constexpr double twist_turns = 100;           // twist: turns within 1 m of its origin
+constexpr double taper_scale = 1e3;           // taper: |r(z)| bound within 1 m of its origin
+constexpr double bend_rate = 1;               // bend: rad/mm (radius of curvature >= 1 mm)
+constexpr double bend_turns = 10;             // bend: turns over its region
+constexpr double sweep_twist_degrees = 3600;  // sweep: 10 turns
+constexpr double arc_degrees = 720;           // arc start and end angles
+constexpr double min_tolerance = 1e-9;        // smallest refit, sweep and fit tolerance
+constexpr int refit_control_points = 40000;   // a refit's net (RefitOptions' default)
 }  // namespace limit
 
 // Every number is also within ±limit::magnitude (Checker::number).
@@ -115,13 +114,15 @@ class Checker : public internal::JsonReader {
  public:
   Checker() {
     magnitude = limit::magnitude;
-    magnitude_note = "recipe numbers are limited to ±" + shortest(limit::magnitude) + ": mm, degrees, knots and weights";
+    magnitude_note = "recipe numbers are limited to ±" + shortest(limit::magnitude) +
+                     ": mm, degrees, knots and weights";
     limit_note = "recipe limit";
   }
 
   using JsonReader::choice;
   /// One of `choices` (the index), or nullopt.
-  std::optional<int> choice(const Json& j, const std::string& path, std::initializer_list<std::string_view> choices) {
+  std::optional<int> choice(const Json& j, const std::string& path,
+                            std::initializer_list<std::string_view> choices) {
     return JsonReader::choice(j, path, std::vector<std::string>(choices.begin(), choices.end()));
   }
   /// recipe limits on counts by default.
@@ -129,14 +130,17 @@ class Checker : public internal::JsonReader {
                                 std::size_t max = limit::curve_points) {
     return JsonReader::points(j, path, min, max);
   }
-  std::optional<std::vector<double>> numbers(const Json& j, const std::string& path, std::size_t min,
-                                             std::size_t max = limit::surface_points, Range r = any) {
+  std::optional<std::vector<double>> numbers(const Json& j, const std::string& path,
+                                             std::size_t min,
+                                             std::size_t max = limit::surface_points,
+                                             Range r = any) {
     return JsonReader::numbers(j, path, min, max, r);
   }
   std::optional<double> number(const Json& j, const std::string& path, Range r = any) {
     return JsonReader::number(j, path, r);
   }
-  double number_or(const Json& obj, const std::string& path, std::string_view key, double def, Range r = any) {
+  double number_or(const Json& obj, const std::string& path, std::string_view key, double def,
+                   Range r = any) {
     return JsonReader::number_or(obj, path, key, def, r);
   }
 
@@ -173,7 +177,9 @@ class Checker : public internal::JsonReader {
   }
 
  protected:
-  std::string wording(std::string message) const override { return recipe_wording(std::move(message)); }
+  std::string wording(std::string message) const override {
+    return recipe_wording(std::move(message));
+  }
 };
 
 /// The reader's problems as the recipe's (a syntax error's line and column are added apart).
@@ -184,16 +190,17 @@ inline std::vector<Problem> recipe_problems(const Checker& c) {
   return out;
 }
 
-// ---- names and references ------------------------------------------------------------------------
+// ---- names and references
+// ------------------------------------------------------------------------
 
 /// What has been defined so far, and what the whole document declares (to tell "missing" from
 /// "defined later").
 struct Names {
-  std::vector<std::string> curves;            // strokes, curves and sketch entities, in order
-  std::set<std::string> curves_declared;      // everything the document declares as a curve
+  std::vector<std::string> curves;        // strokes, curves and sketch entities, in order
+  std::set<std::string> curves_declared;  // everything the document declares as a curve
   std::vector<std::string> surfaces;
   std::set<std::string> surfaces_declared;
-  std::vector<std::string> stacks;            // all stacks (may be referenced from anywhere)
+  std::vector<std::string> stacks;  // all stacks (may be referenced from anywhere)
 
   static bool has(const std::vector<std::string>& list, const std::string& name) {
     return std::find(list.begin(), list.end(), name) != list.end();
@@ -203,8 +210,8 @@ struct Names {
 inline std::string listing(const std::vector<std::string>& names) {
   if (names.empty()) return "none is defined";
   if (names.size() <= 12) return "defined: " + join(names);
-  return "defined: " + join(std::vector<std::string>(names.begin(), names.begin() + 12)) + ", ... (" +
-         std::to_string(names.size()) + " in all)";
+  return "defined: " + join(std::vector<std::string>(names.begin(), names.begin() + 12)) +
+         ", ... (" + std::to_string(names.size()) + " in all)";
 }
 
 class RecipeChecker {
@@ -235,11 +242,13 @@ class RecipeChecker {
       return;
     }
     if (j->size() > limit::entries) {
-      c_.add(std::string(key), std::to_string(j->size()) + " entries; at most " + std::to_string(limit::entries) +
+      c_.add(std::string(key), std::to_string(j->size()) + " entries; at most " +
+                                   std::to_string(limit::entries) +
                                    " are allowed (recipe limit): split the recipe");
       return;
     }
-    for (const auto& [name, value] : j->items()) each(name, value, key_path(std::string(key), name));
+    for (const auto& [name, value] : j->items())
+      each(name, value, key_path(std::string(key), name));
   }
 
   /// First pass: every name the document declares (for "defined later" and the stacks, which
@@ -250,8 +259,8 @@ class RecipeChecker {
 
   std::optional<std::string> surface_ref(const Json& j, const std::string& path);
 
-  std::vector<std::string> curve_refs(const Json& obj, const std::string& path, std::string_view key,
-                                      std::size_t min, std::size_t max);
+  std::vector<std::string> curve_refs(const Json& obj, const std::string& path,
+                                      std::string_view key, std::size_t min, std::size_t max);
 
   // ---- composition ------------------------------------------------------------------------
 
@@ -287,10 +296,11 @@ class RecipeChecker {
     }
     const Json* t = c_.member(j, path, "type", true, "the constraint type, e.g. \"coincident\"");
     if (!t) return std::nullopt;
-    const auto type = c_.choice(*t, key_path(path, "type"),
-                                {"fixed", "coincident", "point_on", "horizontal", "vertical", "parallel",
-                                 "perpendicular", "distance", "angle", "radius", "equal_length",
-                                 "equal_radius", "midpoint", "symmetric", "tangent", "curvature"});
+    const auto type =
+        c_.choice(*t, key_path(path, "type"),
+                  {"fixed", "coincident", "point_on", "horizontal", "vertical", "parallel",
+                   "perpendicular", "distance", "angle", "radius", "equal_length", "equal_radius",
+                   "midpoint", "symmetric", "tangent", "curvature"});
     if (!type) return std::nullopt;
     auto point = [&](std::string_view key) -> std::optional<sketch::PointId> {
       const Json* m = c_.member(j, path, key, true, "a point name");
@@ -301,7 +311,8 @@ class RecipeChecker {
       return m ? entity_ref(*m, key_path(path, key)) : std::nullopt;
     };
     auto pair_of = [&](std::string_view key, auto&& ref) {
-      using Id = typename std::invoke_result_t<decltype(ref), const Json&, const std::string&>::value_type;
+      using Id =
+          typename std::invoke_result_t<decltype(ref), const Json&, const std::string&>::value_type;
       std::optional<std::pair<Id, Id>> out;
       const Json* m = c_.member(j, path, key, true, "two names [\"a\", \"b\"]");
       if (!m) return out;
@@ -320,7 +331,8 @@ class RecipeChecker {
       return m ? c_.number(*m, key_path(path, "value"), r) : std::nullopt;
     };
     auto end_ref = [&](const Json& v, const std::string& p) -> std::optional<cs::CurveEnd> {
-      if (!c_.object(v, p, {"entity", "end"}, "a curve end {\"entity\": e, \"end\": \"start\"|\"end\"}"))
+      if (!c_.object(v, p, {"entity", "end"},
+                     "a curve end {\"entity\": e, \"end\": \"start\"|\"end\"}"))
         return std::nullopt;
       const Json* e = c_.member(v, p, "entity", true, "an entity name");
       const Json* w = c_.member(v, p, "end", true, "\"start\" or \"end\"");
@@ -336,31 +348,99 @@ class RecipeChecker {
     std::vector<std::string_view> allowed{"type"};
     std::optional<cs::Constraint> out;
     switch (*type) {
-      case 0: allowed.push_back("point"); if (auto p = point("point")) out = cs::fixed(*p); break;
-      case 1: allowed.push_back("points"); if (auto p = pair_of("points", point_ref)) out = cs::coincident(p->first, p->second); break;
-      case 2: allowed.insert(allowed.end(), {"point", "entity"}); { auto p = point("point"); auto e = entity("entity"); if (p && e) out = cs::point_on(*p, *e); } break;
-      case 3: allowed.push_back("entity"); if (auto e = entity("entity")) out = cs::horizontal(*e); break;
-      case 4: allowed.push_back("entity"); if (auto e = entity("entity")) out = cs::vertical(*e); break;
-      case 5: allowed.push_back("entities"); if (auto e = pair_of("entities", entity_ref)) out = cs::parallel(e->first, e->second); break;
-      case 6: allowed.push_back("entities"); if (auto e = pair_of("entities", entity_ref)) out = cs::perpendicular(e->first, e->second); break;
-      case 7: allowed.insert(allowed.end(), {"points", "value"}); { auto p = pair_of("points", point_ref); auto v = value(positive); if (p && v) out = cs::distance(p->first, p->second, *v); } break;
-      case 8: allowed.insert(allowed.end(), {"entities", "value"}); { auto e = pair_of("entities", entity_ref); auto v = value(Range{0, 180, true, false}); if (e && v) out = cs::angle(e->first, e->second, *v); } break;
-      case 9: allowed.insert(allowed.end(), {"entity", "value"}); { auto e = entity("entity"); auto v = value(positive); if (e && v) out = cs::radius(*e, *v); } break;
-      case 10: allowed.push_back("entities"); if (auto e = pair_of("entities", entity_ref)) out = cs::equal_length(e->first, e->second); break;
-      case 11: allowed.push_back("entities"); if (auto e = pair_of("entities", entity_ref)) out = cs::equal_radius(e->first, e->second); break;
-      case 12: allowed.insert(allowed.end(), {"point", "entity"}); { auto p = point("point"); auto e = entity("entity"); if (p && e) out = cs::midpoint(*p, *e); } break;
-      case 13: allowed.insert(allowed.end(), {"points", "entity"}); { auto p = pair_of("points", point_ref); auto e = entity("entity"); if (p && e) out = cs::symmetric(p->first, p->second, *e); } break;
+      case 0:
+        allowed.push_back("point");
+        if (auto p = point("point")) out = cs::fixed(*p);
+        break;
+      case 1:
+        allowed.push_back("points");
+        if (auto p = pair_of("points", point_ref)) out = cs::coincident(p->first, p->second);
+        break;
+      case 2:
+        allowed.insert(allowed.end(), {"point", "entity"});
+        {
+          auto p = point("point");
+          auto e = entity("entity");
+          if (p && e) out = cs::point_on(*p, *e);
+        }
+        break;
+      case 3:
+        allowed.push_back("entity");
+        if (auto e = entity("entity")) out = cs::horizontal(*e);
+        break;
+      case 4:
+        allowed.push_back("entity");
+        if (auto e = entity("entity")) out = cs::vertical(*e);
+        break;
+      case 5:
+        allowed.push_back("entities");
+        if (auto e = pair_of("entities", entity_ref)) out = cs::parallel(e->first, e->second);
+        break;
+      case 6:
+        allowed.push_back("entities");
+        if (auto e = pair_of("entities", entity_ref)) out = cs::perpendicular(e->first, e->second);
+        break;
+      case 7:
+        allowed.insert(allowed.end(), {"points", "value"});
+        {
+          auto p = pair_of("points", point_ref);
+          auto v = value(positive);
+          if (p && v) out = cs::distance(p->first, p->second, *v);
+        }
+        break;
+      case 8:
+        allowed.insert(allowed.end(), {"entities", "value"});
+        {
+          auto e = pair_of("entities", entity_ref);
+          auto v = value(Range{0, 180, true, false});
+          if (e && v) out = cs::angle(e->first, e->second, *v);
+        }
+        break;
+      case 9:
+        allowed.insert(allowed.end(), {"entity", "value"});
+        {
+          auto e = entity("entity");
+          auto v = value(positive);
+          if (e && v) out = cs::radius(*e, *v);
+        }
+        break;
+      case 10:
+        allowed.push_back("entities");
+        if (auto e = pair_of("entities", entity_ref)) out = cs::equal_length(e->first, e->second);
+        break;
+      case 11:
+        allowed.push_back("entities");
+        if (auto e = pair_of("entities", entity_ref)) out = cs::equal_radius(e->first, e->second);
+        break;
+      case 12:
+        allowed.insert(allowed.end(), {"point", "entity"});
+        {
+          auto p = point("point");
+          auto e = entity("entity");
+          if (p && e) out = cs::midpoint(*p, *e);
+        }
+        break;
+      case 13:
+        allowed.insert(allowed.end(), {"points", "entity"});
+        {
+          auto p = pair_of("points", point_ref);
+          auto e = entity("entity");
+          if (p && e) out = cs::symmetric(p->first, p->second, *e);
+        }
+        break;
       default: {
         allowed.push_back("ends");
-        if (auto e = pair_of("ends", end_ref)) out = *type == 14 ? cs::tangent(e->first, e->second) : cs::curvature(e->first, e->second);
+        if (auto e = pair_of("ends", end_ref))
+          out = *type == 14 ? cs::tangent(e->first, e->second) : cs::curvature(e->first, e->second);
       }
     }
     for (const auto& [key, v] : j.items()) {
       (void)v;
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-        c_.add(key_path(path, key), "unknown key \"" + key + "\" for a " + t->get<std::string>() +
-                                        " constraint; its keys are: " +
-                                        join(std::vector<std::string>(allowed.begin(), allowed.end())));
+        c_.add(key_path(path, key),
+               "unknown key \"" + key + "\" for a " + t->get<std::string>() +
+                   " constraint; its keys are: " +
+                   join(std::vector<std::string>(allowed.begin(), allowed.end())));
     }
     return out;
   }
@@ -379,8 +459,9 @@ class RecipeChecker {
 
   std::optional<deform::Frame> lattice_frame(const Json& j, const std::string& path);
 
-  std::optional<std::array<int, 3>> triple(const Json& obj, const std::string& path, std::string_view key,
-                                           int lo, int hi, std::string_view hint);
+  std::optional<std::array<int, 3>> triple(const Json& obj, const std::string& path,
+                                           std::string_view key, int lo, int hi,
+                                           std::string_view hint);
 
   /// False (and the problem recorded) when a lattice of counts[0] x counts[1] x counts[2] control
   /// points is above limit::lattice_points; checked before the lattice is built.
@@ -395,7 +476,8 @@ class RecipeChecker {
   bool apply_moves(const Json& moves, const std::string& path, Points3& points, RowOf&& row_of,
                    const std::vector<std::string_view>& index_keys) {
     if (!moves.is_array()) {
-      c_.add(path, "expected an array of {\"index\": ..., \"to\" or \"by\": [x, y, z]}, found " + found(moves));
+      c_.add(path, "expected an array of {\"index\": ..., \"to\" or \"by\": [x, y, z]}, found " +
+                       found(moves));
       return false;
     }
     if (!c_.at_most(moves, path, limit::moves, "moves")) return false;
@@ -440,16 +522,19 @@ class RecipeChecker {
   }
 
   /// An [i, j, k] index in counts, as a row of an s-major lattice.
-  std::optional<Eigen::Index> lattice_row(const Json& m, const std::string& p, std::array<int, 3> counts);
+  std::optional<Eigen::Index> lattice_row(const Json& m, const std::string& p,
+                                          std::array<int, 3> counts);
 
   /// A Bézier or B-spline lattice from recipe fields (points or moves).
   std::optional<deform::Deformation> lattice(const Json& j, const std::string& path, bool bspline,
                                              std::initializer_list<std::string_view> extra_keys);
 
   /// "points" (all of them) or "moves" (from the undisplaced points already in `points`).
-  bool lattice_points(const Json& j, const std::string& path, Points3& points, std::array<int, 3> counts);
+  bool lattice_points(const Json& j, const std::string& path, Points3& points,
+                      std::array<int, 3> counts);
 
-  std::optional<deform::Deformation> extended_from_generator(const Json& j, const std::string& path);
+  std::optional<deform::Deformation> extended_from_generator(const Json& j,
+                                                             const std::string& path);
 
   /// Sum |c_k| 1000^k: a bound of |c(z)| for |z| <= 1 m of a polynomial with coefficients c.
   static double bound_within_metre(const std::vector<double>& c);

@@ -25,13 +25,13 @@ namespace clay::recipe {
 
 /// The composition mode of deform surfaces.
 struct Composition {
-  bool refit = false;      ///< "refit": steps that cannot be exact are refitted
+  bool refit = false;  ///< "refit": steps that cannot be exact are refitted
   double tolerance = 1e-4;
   bool relative = true;
   int degree = 3;
   int check_samples = 4;
   bool accept_out_of_tolerance = false;  ///< "accept_out_of_tolerance": keep a refit that misses
-  int max_control_points = 40000;  // refit: the net may not grow beyond this (RefitOptions)
+  int max_control_points = 40000;        // refit: the net may not grow beyond this (RefitOptions)
 };
 
 struct StrokeDef {
@@ -62,17 +62,43 @@ struct SketchDef {
 /// The sketch `def` (deferred) built again with the run's curves (`curve` returns nullptr for an
 /// unknown name). Throws clay::Error(InvalidGeometry) listing the problems the real curves bring
 /// (a fitted curve off the sketch's plane, ...).
-SketchDef rebuild_sketch(const SketchDef& def,
-                         const std::function<const surface::BSplineCurve*(const std::string&)>& curve);
+SketchDef rebuild_sketch(
+    const SketchDef& def,
+    const std::function<const surface::BSplineCurve*(const std::string&)>& curve);
 
-struct FillDef { std::vector<std::string> curves; surface::FillOptions options; };
-struct SkinDef { std::vector<std::string> sections; surface::LoftOptions options; };
-struct SweepDef { std::string profile, path; surface::SweepOptions options; };
-struct RevolveDef { std::string profile; surface::Axis axis; double angle = 360; };
-struct SuperellipsoidDef { surface::Superellipsoid shape; surface::SuperquadricOptions options; };
-struct SupertoroidDef { surface::Supertoroid shape; surface::SuperquadricOptions options; };
-struct ImportDef { std::filesystem::path file; int index = 0; };
-struct DeformDef { std::string surface, deformation; Composition composition; };
+struct FillDef {
+  std::vector<std::string> curves;
+  surface::FillOptions options;
+};
+struct SkinDef {
+  std::vector<std::string> sections;
+  surface::LoftOptions options;
+};
+struct SweepDef {
+  std::string profile, path;
+  surface::SweepOptions options;
+};
+struct RevolveDef {
+  std::string profile;
+  surface::Axis axis;
+  double angle = 360;
+};
+struct SuperellipsoidDef {
+  surface::Superellipsoid shape;
+  surface::SuperquadricOptions options;
+};
+struct SupertoroidDef {
+  surface::Supertoroid shape;
+  surface::SuperquadricOptions options;
+};
+struct ImportDef {
+  std::filesystem::path file;
+  int index = 0;
+};
+struct DeformDef {
+  std::string surface, deformation;
+  Composition composition;
+};
 
 struct SurfaceDef {
   std::string name, path, kind;
@@ -88,7 +114,7 @@ struct StyleDef {
 };
 
 struct DirectMove {
-  bool on_surface = false;     // point holds (u, v, 0) on the deformed step's input surface
+  bool on_surface = false;  // point holds (u, v, 0) on the deformed step's input surface
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   Eigen::Vector3d to = Eigen::Vector3d::Zero();
 };

@@ -2,15 +2,15 @@
 // written into a temporary folder and moved into place only when everything succeeded.
 #include <clay/error.hpp>
 #include <clay/recipe/recipe.hpp>
-#include <clay/surface/exchange.hpp>
 #include <clay/recipe/view.hpp>
+#include <clay/surface/exchange.hpp>
 
 #include <nlohmann/json.hpp>
 
+#include <unistd.h>
 #include <fstream>
 #include <limits>
 #include <system_error>
-#include <unistd.h>
 
 namespace clay::recipe {
 
@@ -64,8 +64,11 @@ std::string report_json(const RunResult& result) {
     for (const auto& s : e.surfaces) {
       points += s.points.rows();
       degree = std::max({degree, s.u.degree, s.v.degree});
-      sizes.push_back({{"degree_u", s.u.degree}, {"degree_v", s.v.degree}, {"count_u", s.count_u()},
-                       {"count_v", s.count_v()}, {"rational", s.is_rational()}});
+      sizes.push_back({{"degree_u", s.u.degree},
+                       {"degree_v", s.v.degree},
+                       {"count_u", s.count_u()},
+                       {"count_v", s.count_v()},
+                       {"rational", s.is_rational()}});
     }
     x["patches"] = e.surfaces.size();
     x["control_points"] = points;
@@ -83,26 +86,32 @@ std::string report_json(const RunResult& result) {
 }
 
 std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) {
-  if (out_dir.empty()) throw Error(ErrorCategory::InvalidArgument, "write_outputs: give an output folder");
+  if (out_dir.empty())
+    throw Error(ErrorCategory::InvalidArgument, "write_outputs: give an output folder");
   const fs::path target = fs::absolute(out_dir).lexically_normal();
-  const fs::path parent = target.has_filename() ? target.parent_path() : target.parent_path().parent_path();
-  const std::string leaf = target.has_filename() ? target.filename().string() : target.parent_path().filename().string();
+  const fs::path parent =
+      target.has_filename() ? target.parent_path() : target.parent_path().parent_path();
+  const std::string leaf =
+      target.has_filename() ? target.filename().string() : target.parent_path().filename().string();
   std::error_code ec;
   fs::create_directories(parent, ec);
   if (ec)
-    throw Error(ErrorCategory::Io, "cannot create the folder \"" + parent.string() + "\": " + ec.message() +
-                                       "; check the path and permissions");
+    throw Error(ErrorCategory::Io, "cannot create the folder \"" + parent.string() +
+                                       "\": " + ec.message() + "; check the path and permissions");
   const fs::path tmp = parent / ("." + leaf + ".clayform-" + std::to_string(::getpid()));
   fs::remove_all(tmp, ec);
   fs::create_directory(tmp, ec);
   if (ec)
-    throw Error(ErrorCategory::Io, "cannot create the temporary folder \"" + tmp.string() + "\": " + ec.message());
+    throw Error(ErrorCategory::Io,
+                "cannot create the temporary folder \"" + tmp.string() + "\": " + ec.message());
   std::vector<std::string> names;
   try {
     for (auto& e : result.exports) {
       e.files.clear();
       for (const auto& format : e.formats) {
-        const std::string file = e.name + (format == "step" ? ".step" : format == "iges" ? ".igs" : ".glb");
+        const std::string file = e.name + (format == "step"   ? ".step"
+                                           : format == "iges" ? ".igs"
+                                                              : ".glb");
         if (format == "step") {
           surface::StepWriteOptions o;
           o.schema = e.schema == "AP242" ? surface::StepSchema::AP242 : surface::StepSchema::AP214;
@@ -117,10 +126,13 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
         names.push_back(file);
       }
       // Read back what a CAD system will read (STEP first) and check it.
-      const bool has_step = std::find(e.formats.begin(), e.formats.end(), "step") != e.formats.end();
-      const bool has_iges = std::find(e.formats.begin(), e.formats.end(), "iges") != e.formats.end();
+      const bool has_step =
+          std::find(e.formats.begin(), e.formats.end(), "step") != e.formats.end();
+      const bool has_iges =
+          std::find(e.formats.begin(), e.formats.end(), "iges") != e.formats.end();
       if (has_step || has_iges) {
-        const auto back = has_step ? surface::read_step(tmp / (e.name + ".step")) : surface::read_iges(tmp / (e.name + ".igs"));
+        const auto back = has_step ? surface::read_step(tmp / (e.name + ".step"))
+                                   : surface::read_iges(tmp / (e.name + ".igs"));
         const auto check = surface::check_faces(back);
         e.checked = true;
         e.valid = check.valid;
@@ -132,8 +144,10 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
         // invalid fails the run, and a failed run leaves nothing behind (it used to leave all its
         // files and report the failure afterwards, issue #18).
         if (!e.valid) {
-          std::string m = "export " + e.name + ": " + (has_step ? e.name + ".step" : e.name + ".igs") +
-                          " reads back INVALID (BRepCheck), so nothing was written to \"" + target.string() + "\"";
+          std::string m = "export " + e.name + ": " +
+                          (has_step ? e.name + ".step" : e.name + ".igs") +
+                          " reads back INVALID (BRepCheck), so nothing was written to \"" +
+                          target.string() + "\"";
           for (const auto& p : e.problems) m += "\n  problem: " + p;
           throw Error(ErrorCategory::Exchange, m);
         }
@@ -142,27 +156,32 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
     {
       std::ofstream out(tmp / "report.json", std::ios::binary);
       out << report_json(result);
-      if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + (tmp / "report.json").string() + "\"");
+      if (!out)
+        throw Error(ErrorCategory::Io, "cannot write \"" + (tmp / "report.json").string() + "\"");
     }
     names.push_back("report.json");
     write_view_data(result, tmp);  // view/manifest.json and view/NNN.bin (clay/recipe/view.hpp)
     fs::create_directories(target, ec);
     if (ec)
-      throw Error(ErrorCategory::Io, "cannot create the output folder \"" + target.string() + "\": " + ec.message());
+      throw Error(ErrorCategory::Io,
+                  "cannot create the output folder \"" + target.string() + "\": " + ec.message());
     std::vector<fs::path> written;
     for (const auto& n : names) {
       fs::rename(tmp / n, target / n, ec);  // same file system: atomic per file
       if (ec)
-        throw Error(ErrorCategory::Io, "cannot move \"" + n + "\" into \"" + target.string() + "\": " + ec.message());
+        throw Error(ErrorCategory::Io,
+                    "cannot move \"" + n + "\" into \"" + target.string() + "\": " + ec.message());
       written.push_back(target / n);
     }
     // The view folder as a whole: a previous run's meshes go, this run's come in one rename.
     fs::remove_all(target / "view", ec);
     if (ec)
-      throw Error(ErrorCategory::Io, "cannot replace \"" + (target / "view").string() + "\": " + ec.message());
+      throw Error(ErrorCategory::Io,
+                  "cannot replace \"" + (target / "view").string() + "\": " + ec.message());
     fs::rename(tmp / "view", target / "view", ec);
     if (ec)
-      throw Error(ErrorCategory::Io, "cannot move \"view\" into \"" + target.string() + "\": " + ec.message());
+      throw Error(ErrorCategory::Io,
+                  "cannot move \"view\" into \"" + target.string() + "\": " + ec.message());
     written.push_back(target / "view");
     fs::remove_all(tmp, ec);
     return written;

@@ -55,13 +55,17 @@ auto in_recipe_words(const Words& words, F&& build) {
 /// The run's state: named results so far, and the reports.
 class Runner {
  public:
-  Runner(const RecipeData& d, const RunOptions& o, RunResult& r) : data_(d), options_(o), result_(r) {}
+  Runner(const RecipeData& d, const RunOptions& o, RunResult& r)
+      : data_(d), options_(o), result_(r) {}
 
   /// Strokes, curves and sketches: every named curve.
   void curves() {
-    for (const auto& s : data_.strokes) timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); });
-    for (const auto& c : data_.curves) timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); });
-    for (const auto& s : data_.sketches) timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); });
+    for (const auto& s : data_.strokes)
+      timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); });
+    for (const auto& c : data_.curves)
+      timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); });
+    for (const auto& s : data_.sketches)
+      timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); });
   }
   /// Every named surface, in document order.
   void surfaces() {
@@ -84,11 +88,13 @@ class Runner {
           degree = std::max({degree, x.surfaces.back().u.degree, x.surfaces.back().v.degree});
         }
         if (degree > surface::max_exchange_degree &&
-            std::any_of(e.formats.begin(), e.formats.end(), [](const auto& f) { return f != "glb"; }))
-          throw Error(ErrorCategory::DegreeLimit,
-                      "degree " + std::to_string(degree) + " is above the exchange limit " +
-                          std::to_string(surface::max_exchange_degree) +
-                          " of STEP/IGES; lower the lattice degrees or compose with \"mode\": \"refit\"");
+            std::any_of(e.formats.begin(), e.formats.end(),
+                        [](const auto& f) { return f != "glb"; }))
+          throw Error(
+              ErrorCategory::DegreeLimit,
+              "degree " + std::to_string(degree) + " is above the exchange limit " +
+                  std::to_string(surface::max_exchange_degree) +
+                  " of STEP/IGES; lower the lattice degrees or compose with \"mode\": \"refit\"");
         rep.figures = {{"patches", static_cast<long long>(x.surfaces.size())},
                        {"control_points", static_cast<long long>(points)},
                        {"degree", static_cast<long long>(degree)}};
@@ -126,12 +132,14 @@ class Runner {
   const BSplineSurface& surface_of(const std::string& name) const {
     for (const auto& [n, s] : result_.surfaces)
       if (n == name) return s;
-    throw Error(ErrorCategory::Internal, "recipe run: surface '" + name + "' missing after checking");
+    throw Error(ErrorCategory::Internal,
+                "recipe run: surface '" + name + "' missing after checking");
   }
   const BSplineCurve& curve_of(const std::string& name) const {
     const auto it = curve_index_.find(name);
     if (it == curve_index_.end())
-      throw Error(ErrorCategory::Internal, "recipe run: curve '" + name + "' missing after checking");
+      throw Error(ErrorCategory::Internal,
+                  "recipe run: curve '" + name + "' missing after checking");
     return result_.curves[it->second].second;
   }
 
@@ -178,7 +186,8 @@ class Runner {
       if (!s.accept_out_of_tolerance)
         throw Error(ErrorCategory::ToleranceNotMet,
                     "the fit misses its tolerance (" + fit.summary.brief() +
-                        "): raise the stroke's \"tolerance\" or its \"degree\", or draw it again; to keep the fit "
+                        "): raise the stroke's \"tolerance\" or its \"degree\", or draw it again; "
+                        "to keep the fit "
                         "anyway, set \"accept_out_of_tolerance\": true on the stroke");
       rep.warning = true;
     }
@@ -195,21 +204,24 @@ class Runner {
 
   void sketch(const SketchDef& checked, StepReport& rep) {
     // A sketch using a stroke's fit or a reversed curve is built now, with the real curves.
-    const SketchDef s = checked.deferred_json.empty()
-                            ? checked
-                            : rebuild_sketch(checked, [&](const std::string& n) -> const BSplineCurve* {
-                                const auto it = curve_index_.find(n);
-                                return it == curve_index_.end() ? nullptr : &result_.curves[it->second].second;
-                              });
+    const SketchDef s =
+        checked.deferred_json.empty()
+            ? checked
+            : rebuild_sketch(checked, [&](const std::string& n) -> const BSplineCurve* {
+                const auto it = curve_index_.find(n);
+                return it == curve_index_.end() ? nullptr : &result_.curves[it->second].second;
+              });
     const auto solved = constraints::solve(s.sketch, s.constraints, s.solve);
     const auto& r = solved.report;
     if (!r.conflicting.empty())  // the summary lists every conflicting set, once
       throw Error(ErrorCategory::InvalidGeometry,
-                  "the sketch does not solve: " + r.summary.message + "; remove or change a conflicting constraint");
+                  "the sketch does not solve: " + r.summary.message +
+                      "; remove or change a conflicting constraint");
     if (!r.summary.converged())  // nothing conflicts: the solver stopped short
-      throw Error(ErrorCategory::InvalidGeometry,
-                  "the solver stopped before the constraints hold (" + r.summary.brief() +
-                      "); nothing conflicts: move the drawn geometry closer to what the constraints ask");
+      throw Error(
+          ErrorCategory::InvalidGeometry,
+          "the solver stopped before the constraints hold (" + r.summary.brief() +
+              "); nothing conflicts: move the drawn geometry closer to what the constraints ask");
     rep.figures = {{"max_residual", r.max_residual},
                    {"degrees_of_freedom", static_cast<long long>(r.degrees_of_freedom)},
                    {"redundant_sets", static_cast<long long>(r.redundant.size())},
@@ -260,8 +272,9 @@ class Runner {
     static const Words superquadric_words{{"SuperquadricOptions::tolerance", "\"tolerance\""},
                                           {", raise max_spans", ""}};
     if (const auto* d = std::get_if<DeformDef>(&def.build)) {
-      const StackDef& stack = *std::find_if(data_.stacks.begin(), data_.stacks.end(),
-                                            [&](const StackDef& s) { return s.name == d->deformation; });
+      const StackDef& stack =
+          *std::find_if(data_.stacks.begin(), data_.stacks.end(),
+                        [&](const StackDef& s) { return s.name == d->deformation; });
       BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name);
       result_.surfaces.emplace_back(def.name, std::move(s));
       return;
@@ -274,11 +287,15 @@ class Runner {
               build_figures(surface::describe(b, "inline B-spline surface"), rep);
               return b;
             } else if constexpr (std::is_same_v<T, FillDef>) {
-              auto built = by_names(b.curves, "curve", [&] { return surface::fill(curves_named(b.curves), b.options); });
+              auto built = by_names(b.curves, "curve", [&] {
+                return surface::fill(curves_named(b.curves), b.options);
+              });
               build_figures(built.report, rep);
               return std::move(built.surface);
             } else if constexpr (std::is_same_v<T, SkinDef>) {
-              auto built = by_names(b.sections, "section", [&] { return surface::loft(curves_named(b.sections), b.options); });
+              auto built = by_names(b.sections, "section", [&] {
+                return surface::loft(curves_named(b.sections), b.options);
+              });
               build_figures(built.report, rep);
               return std::move(built.surface);
             } else if constexpr (std::is_same_v<T, SweepDef>) {
@@ -294,16 +311,19 @@ class Runner {
               build_figures(built.report, rep);
               return std::move(built.surface);
             } else if constexpr (std::is_same_v<T, SuperellipsoidDef>) {
-              auto built = in_recipe_words(superquadric_words, [&] { return surface::superellipsoid(b.shape, b.options); });
+              auto built = in_recipe_words(
+                  superquadric_words, [&] { return surface::superellipsoid(b.shape, b.options); });
               build_figures(built.report, rep);
               return std::move(built.surface);
             } else if constexpr (std::is_same_v<T, SupertoroidDef>) {
-              auto built = in_recipe_words(superquadric_words, [&] { return surface::supertoroid(b.shape, b.options); });
+              auto built = in_recipe_words(
+                  superquadric_words, [&] { return surface::supertoroid(b.shape, b.options); });
               build_figures(built.report, rep);
               return std::move(built.surface);
             } else if constexpr (std::is_same_v<T, ImportDef>) {
               std::string ext = b.file.extension().string();
-              for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+              for (char& ch : ext)
+                ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
               // A file from elsewhere: read in a child process, so a file that crashes or hangs
               // OpenCASCADE fails this step instead of the run (surface::ReadOptions).
               surface::ReadOptions guard;
@@ -312,10 +332,11 @@ class Runner {
                                                            : surface::read_step(b.file, guard);
               if (b.index >= static_cast<int>(all.size()))
                 throw Error(ErrorCategory::InvalidArgument,
-                            "index " + std::to_string(b.index) + " but \"" + b.file.string() + "\" holds " +
-                                std::to_string(all.size()) + " surface(s); give an index below " +
-                                std::to_string(all.size()));
-              build_figures(surface::describe(all[static_cast<std::size_t>(b.index)], "import"), rep);
+                            "index " + std::to_string(b.index) + " but \"" + b.file.string() +
+                                "\" holds " + std::to_string(all.size()) +
+                                " surface(s); give an index below " + std::to_string(all.size()));
+              build_figures(surface::describe(all[static_cast<std::size_t>(b.index)], "import"),
+                            rep);
               return std::move(all[static_cast<std::size_t>(b.index)]);
             } else {
               throw Error(ErrorCategory::Internal, "recipe run: deform handled above");
@@ -353,12 +374,13 @@ class Runner {
     rep.figures.emplace_back("volume_ratio_max", j->max);
     if (!j->fold_free) {
       rep.warning = true;
-      rep.message += "; the lattice may fold (Jacobian coefficient " + format("%.3g", j->min) + " <= 0)";
+      rep.message +=
+          "; the lattice may fold (Jacobian coefficient " + format("%.3g", j->min) + " <= 0)";
     }
   }
 
-  static BSplineSurface compose(const deform::Deformation& d, const BSplineSurface& s, const Composition& c,
-                                StepReport& rep) {
+  static BSplineSurface compose(const deform::Deformation& d, const BSplineSurface& s,
+                                const Composition& c, StepReport& rep) {
     const auto r = deform::deform_surface(d, s, deformation_options(c));
     const auto& o = r.report.steps.front();
     auto sizes = [&] {
@@ -368,8 +390,10 @@ class Runner {
     };
     if (o.method == deform::StepOutcome::Method::Exact) {
       rep.figures.emplace_back("composition", std::string("exact"));
-      rep.figures.emplace_back("max_relative_deviation", o.compose.max_relative_deviation);  // of size
-      rep.figures.emplace_back("max_deviation_mm", o.compose.max_relative_deviation * o.compose.size);
+      rep.figures.emplace_back("max_relative_deviation",
+                               o.compose.max_relative_deviation);  // of size
+      rep.figures.emplace_back("max_deviation_mm",
+                               o.compose.max_relative_deviation * o.compose.size);
       sizes();
       rep.figures.emplace_back("exact", true);
       rep.figures.emplace_back("patches", static_cast<long long>(o.compose.patches));
@@ -401,16 +425,19 @@ class Runner {
   BSplineSurface apply(const deform::Deformation& d, const BSplineSurface& s, const Composition& c,
                        StepReport& rep, Stage& stage) {
     stage.map = [d](const Eigen::Vector3d& x) {
-      return std::visit([&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, d);
+      return std::visit(
+          [&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, d);
     };
     BSplineSurface out = compose(d, s, c, rep);
     lattice_figures(d, rep);
     return out;
   }
 
-  BSplineSurface apply(const StyleDef& d, const BSplineSurface& s, const Composition&, StepReport& rep, Stage&) {
-    const auto r = d.bound.empty() ? deform::style_deform(s, curve_of(d.target), d.options)
-                                   : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
+  BSplineSurface apply(const StyleDef& d, const BSplineSurface& s, const Composition&,
+                       StepReport& rep, Stage&) {
+    const auto r = d.bound.empty()
+                       ? deform::style_deform(s, curve_of(d.target), d.options)
+                       : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
     const auto& x = r.report;
     rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::Exact ? "exact" : "paper")},
                    {"constraint_class", std::string(deform::to_string(x.constraint_class))},
@@ -433,16 +460,17 @@ class Runner {
     if (!x.summary.converged()) {
       if (!d.accept_out_of_tolerance)
         throw Error(ErrorCategory::ToleranceNotMet,
-                    x.summary.message + ". Nothing was written; to keep such a result anyway, set "
-                    "\"accept_out_of_tolerance\": true on this step");
+                    x.summary.message +
+                        ". Nothing was written; to keep such a result anyway, set "
+                        "\"accept_out_of_tolerance\": true on this step");
       rep.warning = true;
       rep.message += "; accepted out of tolerance: " + x.summary.message;
     }
     return r.surface;
   }
 
-  BSplineSurface apply(const DirectDef& d, const BSplineSurface& s, const Composition& c, StepReport& rep,
-                       Stage& stage) {
+  BSplineSurface apply(const DirectDef& d, const BSplineSurface& s, const Composition& c,
+                       StepReport& rep, Stage& stage) {
     std::vector<deform::PointMove> moves;
     for (const auto& m : d.moves) {
       Eigen::Vector3d x = m.point;
@@ -451,9 +479,10 @@ class Runner {
         const auto [v0, v1] = s.v.domain();
         if (m.point.x() < u0 || m.point.x() > u1 || m.point.y() < v0 || m.point.y() > v1)
           throw Error(ErrorCategory::OutOfDomain,
-                      "surface_point (" + format("%.17g", m.point.x()) + ", " + format("%.17g", m.point.y()) +
-                          ") is outside the surface's domain [" + format("%g", u0) + ", " + format("%g", u1) +
-                          "] x [" + format("%g", v0) + ", " + format("%g", v1) + "]; give parameters inside it");
+                      "surface_point (" + format("%.17g", m.point.x()) + ", " +
+                          format("%.17g", m.point.y()) + ") is outside the surface's domain [" +
+                          format("%g", u0) + ", " + format("%g", u1) + "] x [" + format("%g", v0) +
+                          ", " + format("%g", v1) + "]; give parameters inside it");
         x = surface::evaluate(s, m.point.x(), m.point.y());
       }
       moves.push_back({x, m.to});
@@ -478,13 +507,16 @@ class Runner {
       if (!d.accept_out_of_tolerance)
         throw Error(ErrorCategory::ToleranceNotMet,
                     "the lattice cannot meet every move (" + r.summary.message +
-                        "): free more control points (fewer \"locked\"), use a finer lattice, or ask for fewer "
-                        "moves; to keep the least-squares answer anyway, set \"accept_out_of_tolerance\": true on "
+                        "): free more control points (fewer \"locked\"), use a finer lattice, or "
+                        "ask for fewer "
+                        "moves; to keep the least-squares answer anyway, set "
+                        "\"accept_out_of_tolerance\": true on "
                         "this step");
       rep.warning = true;
     }
     stage.map = [lattice](const Eigen::Vector3d& x) {
-      return std::visit([&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, lattice);
+      return std::visit(
+          [&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, lattice);
     };
     BSplineSurface out = compose(lattice, s, c, rep);
     lattice_figures(lattice, rep);
@@ -496,26 +528,35 @@ class Runner {
 
 namespace {
 
-/// The value named `name` in a run's (name, value) list, or InvalidArgument naming the defined ones.
+/// The value named `name` in a run's (name, value) list, or InvalidArgument naming the defined
+/// ones.
 template <class T>
-const T& named(const std::vector<std::pair<std::string, T>>& list, std::string_view name, const char* what) {
+const T& named(const std::vector<std::pair<std::string, T>>& list, std::string_view name,
+               const char* what) {
   std::string known;
   for (const auto& [n, value] : list) {
     if (n == name) return value;
     known += (known.empty() ? "" : ", ") + n;
   }
-  throw Error(ErrorCategory::InvalidArgument, "no " + std::string(what) + " named '" + std::string(name) +
-                                                  "' in the run; its " + what + "s: " + known);
+  throw Error(ErrorCategory::InvalidArgument, "no " + std::string(what) + " named '" +
+                                                  std::string(name) + "' in the run; its " + what +
+                                                  "s: " + known);
 }
 
 }  // namespace
 
-const BSplineSurface& RunResult::surface(std::string_view name) const { return named(surfaces, name, "surface"); }
+const BSplineSurface& RunResult::surface(std::string_view name) const {
+  return named(surfaces, name, "surface");
+}
 
-const BSplineCurve& RunResult::curve(std::string_view name) const { return named(curves, name, "curve"); }
+const BSplineCurve& RunResult::curve(std::string_view name) const {
+  return named(curves, name, "curve");
+}
 
 RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
-  if (!recipe.data) throw Error(ErrorCategory::InvalidArgument, "run_recipe: empty recipe; load or parse one first");
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "run_recipe: empty recipe; load or parse one first");
   const auto t0 = Clock::now();
   RunResult result;
   result.recipe = recipe.data->name;
@@ -528,8 +569,11 @@ RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
 }
 
 RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface>& surfaces,
-                          std::string_view stem, std::string_view deformation, const RunOptions& options) {
-  if (!recipe.data) throw Error(ErrorCategory::InvalidArgument, "deform_surfaces: empty recipe; load or parse one first");
+                          std::string_view stem, std::string_view deformation,
+                          const RunOptions& options) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "deform_surfaces: empty recipe; load or parse one first");
   const RecipeData& d = *recipe.data;
   std::string names;
   for (const auto& s : d.stacks) names += (names.empty() ? "" : ", ") + s.name;
@@ -537,17 +581,19 @@ RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface
   if (deformation.empty()) {
     if (d.stacks.size() != 1)
       throw Error(ErrorCategory::InvalidArgument,
-                  "the recipe has " + std::to_string(d.stacks.size()) + " deformation stacks (" + names +
-                      "); name one with --deformation");
+                  "the recipe has " + std::to_string(d.stacks.size()) + " deformation stacks (" +
+                      names + "); name one with --deformation");
     stack = &d.stacks.front();
   } else {
     for (const auto& s : d.stacks)
       if (s.name == deformation) stack = &s;
     if (!stack)
-      throw Error(ErrorCategory::InvalidArgument, "the recipe has no deformation stack '" + std::string(deformation) +
+      throw Error(ErrorCategory::InvalidArgument, "the recipe has no deformation stack '" +
+                                                      std::string(deformation) +
                                                       "'; its stacks: " + names);
   }
-  if (surfaces.empty()) throw Error(ErrorCategory::InvalidArgument, "deform_surfaces: no surfaces given");
+  if (surfaces.empty())
+    throw Error(ErrorCategory::InvalidArgument, "deform_surfaces: no surfaces given");
   const auto t0 = Clock::now();
   RunResult result;
   result.recipe = d.name;
@@ -555,11 +601,13 @@ RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface
   runner.curves();  // the curves its style steps use
   ExportResult x;
   x.name = std::string(stem);
-  x.formats = d.exports.empty() ? std::vector<std::string>{"step", "iges", "glb"} : d.exports.front().formats;
+  x.formats = d.exports.empty() ? std::vector<std::string>{"step", "iges", "glb"}
+                                : d.exports.front().formats;
   x.schema = d.exports.empty() ? "AP214" : d.exports.front().schema;
   for (std::size_t k = 0; k < surfaces.size(); ++k) {
     const std::string name = std::string(stem) + "-" + std::to_string(k);
-    BSplineSurface s = runner.deform(surfaces[k], *stack, d.composition, "input[" + std::to_string(k) + "]", name);
+    BSplineSurface s =
+        runner.deform(surfaces[k], *stack, d.composition, "input[" + std::to_string(k) + "]", name);
     result.surfaces.emplace_back(name, s);
     x.surface_names.push_back(name);
     x.surfaces.push_back(std::move(s));

@@ -1,14 +1,14 @@
 // Software rendering of surfaces into an RGB picture and a PNG writer (clay/render/render.hpp).
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/render/render.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/tessellate.hpp>
-#include <clay/internal/checks.hpp>
 
-#include <Eigen/Geometry>
 #include <png.h>
 #include <unistd.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
@@ -36,7 +36,8 @@ struct Camera {
 
 Camera camera_for(const Vector3d& eye_direction) {
   const Vector3d w = eye_direction.normalized();
-  const Vector3d world_up = Vector3d::UnitZ().cross(w).norm() < 1e-6 ? Vector3d::UnitY() : Vector3d::UnitZ();
+  const Vector3d world_up =
+      Vector3d::UnitZ().cross(w).norm() < 1e-6 ? Vector3d::UnitY() : Vector3d::UnitZ();
   const Vector3d r = world_up.cross(w).normalized();
   return {r, w.cross(r), w};
 }
@@ -51,20 +52,25 @@ struct Mesh {
   std::vector<Vector3d> normals;
   int nu() const { return grid.rows; }
   int nv() const { return grid.cols; }
-  Vector3d point(int i, int j) const { return grid.positions.row(static_cast<Eigen::Index>(i) * grid.cols + j).transpose(); }
+  Vector3d point(int i, int j) const {
+    return grid.positions.row(static_cast<Eigen::Index>(i) * grid.cols + j).transpose();
+  }
 };
 
 Mesh tessellate_for_render(const surface::BSplineSurface& s, int per_span) {
   Mesh m{surface::tessellate(s, per_span, max_rows + 1), {}};
   m.normals.reserve(static_cast<size_t>(m.grid.normals.rows()));
-  for (Eigen::Index r = 0; r < m.grid.normals.rows(); ++r) m.normals.emplace_back(m.grid.normals.row(r).transpose());
+  for (Eigen::Index r = 0; r < m.grid.normals.rows(); ++r)
+    m.normals.emplace_back(m.grid.normals.row(r).transpose());
   return m;
 }
 
 /// Base colour of surface k: golden-angle hue steps from blue, soft saturation (HSV -> RGB).
 Rgb palette(size_t k) {
-  const double h = std::fmod(0.58 + 0.381966 * static_cast<double>(k), 1.0) * 6.0, s = 0.45, v = 0.92;
-  const double f = h - std::floor(h), p = v * (1 - s), q = v * (1 - s * f), t = v * (1 - s * (1 - f));
+  const double h = std::fmod(0.58 + 0.381966 * static_cast<double>(k), 1.0) * 6.0, s = 0.45,
+               v = 0.92;
+  const double f = h - std::floor(h), p = v * (1 - s), q = v * (1 - s * f),
+               t = v * (1 - s * (1 - f));
   const double rgb[6][3] = {{v, t, p}, {q, v, p}, {p, v, t}, {p, q, v}, {t, p, v}, {v, p, q}};
   const auto* c = rgb[static_cast<int>(h) % 6];
   auto byte = [](double x) { return static_cast<std::uint8_t>(std::lround(255 * x)); };
@@ -73,16 +79,17 @@ Rgb palette(size_t k) {
 
 /// The sample buffers (supersampled when asked) and the projection of world points onto them.
 struct Canvas {
-  int width, height;               // in samples
-  std::vector<float> depth;        // towards the eye, normalized to [0, 1] over the model; -1 empty
-  std::vector<std::uint8_t> rgb;   // shaded colour per sample
+  int width, height;              // in samples
+  std::vector<float> depth;       // towards the eye, normalized to [0, 1] over the model; -1 empty
+  std::vector<std::uint8_t> rgb;  // shaded colour per sample
   Camera cam;
   double centre_x, centre_y, scale, depth_min, depth_scale;
-  Vector3d light, half;            // unit key light and Blinn–Phong half vector
+  Vector3d light, half;  // unit key light and Blinn–Phong half vector
 
   Vector3d project(const Vector3d& p) const {
     return {0.5 * width + (p.dot(cam.right) - centre_x) * scale,
-            0.5 * height - (p.dot(cam.up) - centre_y) * scale, (p.dot(cam.eye) - depth_min) * depth_scale};
+            0.5 * height - (p.dot(cam.up) - centre_y) * scale,
+            (p.dot(cam.eye) - depth_min) * depth_scale};
   }
 
   void put(int x, int y, const Rgb& c) {
@@ -112,28 +119,34 @@ struct Canvas {
     const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
     if (!(std::abs(area) > 1e-12)) return;
     const int x0 = std::max(0, static_cast<int>(std::floor(std::min({a.x(), b.x(), c.x()}) - 0.5)));
-    const int x1 = std::min(width - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), c.x()}) - 0.5)));
+    const int x1 =
+        std::min(width - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), c.x()}) - 0.5)));
     const int y0 = std::max(0, static_cast<int>(std::floor(std::min({a.y(), b.y(), c.y()}) - 0.5)));
-    const int y1 = std::min(height - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), c.y()}) - 0.5)));
+    const int y1 =
+        std::min(height - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), c.y()}) - 0.5)));
     auto edge = [](const Vector3d& p, const Vector3d& q, double x, double y) {
       return (q.x() - p.x()) * (y - p.y()) - (q.y() - p.y()) * (x - p.x());
     };
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const double px = x + 0.5, py = y + 0.5;
-        const double la = edge(b, c, px, py) / area, lb = edge(c, a, px, py) / area, lc = edge(a, b, px, py) / area;
+        const double la = edge(b, c, px, py) / area, lb = edge(c, a, px, py) / area,
+                     lc = edge(a, b, px, py) / area;
         if (la < 0 || lb < 0 || lc < 0) continue;
         const float z = static_cast<float>(la * a.z() + lb * b.z() + lc * c.z());
-        float& stored = depth[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)];
+        float& stored =
+            depth[static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x)];
         if (z <= stored) continue;
         stored = z;
         put(x, y, shade(la * na + lb * nb + lc * nc, base));
       }
   }
 
-  /// A line `thick` samples wide, drawn over everything (a control net is seen through the surface).
+  /// A line `thick` samples wide, drawn over everything (a control net is seen through the
+  /// surface).
   void line(const Vector3d& a, const Vector3d& b, int thick, const Rgb& c) {
-    const int steps = static_cast<int>(std::ceil(std::max(std::abs(b.x() - a.x()), std::abs(b.y() - a.y())))) + 1;
+    const int steps =
+        static_cast<int>(std::ceil(std::max(std::abs(b.x() - a.x()), std::abs(b.y() - a.y())))) + 1;
     for (int k = 0; k <= steps; ++k) {
       const Vector3d p = a + (b - a) * (static_cast<double>(k) / steps);
       const int x = static_cast<int>(std::floor(p.x() - 0.5 * (thick - 1)));
@@ -151,34 +164,55 @@ std::vector<std::string> RenderOptions::problems() const {
   auto bad = [&out](const std::string& field, const std::string& value, const std::string& rule) {
     out.push_back("render: RenderOptions." + field + " = " + value + "; " + rule);
   };
-  if (width < 16 || width > 4096) bad("width", std::to_string(width), "must be in [16, 4096] pixels");
-  if (height < 16 || height > 4096) bad("height", std::to_string(height), "must be in [16, 4096] pixels");
+  if (width < 16 || width > 4096)
+    bad("width", std::to_string(width), "must be in [16, 4096] pixels");
+  if (height < 16 || height > 4096)
+    bad("height", std::to_string(height), "must be in [16, 4096] pixels");
   if (!internal::all_finite(eye_direction) || !(eye_direction.norm() > 0))
-    bad("eye_direction", "[" + text(eye_direction.x()) + ", " + text(eye_direction.y()) + ", " +
-                                    text(eye_direction.z()) + "]",
-               "must be finite and non-zero (the direction from the model towards the eye)");
+    bad("eye_direction",
+        "[" + text(eye_direction.x()) + ", " + text(eye_direction.y()) + ", " +
+            text(eye_direction.z()) + "]",
+        "must be finite and non-zero (the direction from the model towards the eye)");
   if (samples_per_span < 1 || samples_per_span > 64)
     bad("samples_per_span", std::to_string(samples_per_span), "must be in [1, 64]");
-  if (!(margin >= 0 && margin <= 0.4)) bad("margin", text(margin), "must be in [0, 0.4] (fraction of the picture)");
+  if (!(margin >= 0 && margin <= 0.4))
+    bad("margin", text(margin), "must be in [0, 0.4] (fraction of the picture)");
   return out;
 }
 
-void RenderOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void RenderOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 Rgb Image::pixel(int x, int y) const noexcept {
-  const size_t k = 3 * (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x));
+  const size_t k =
+      3 * (static_cast<size_t>(y) * static_cast<size_t>(width) + static_cast<size_t>(x));
   return {rgb[k], rgb[k + 1], rgb[k + 2]};
 }
 
 Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderOptions& options) {
   options.validate();
-  if (surfaces.empty()) throw Error(ErrorCategory::InvalidArgument, "render: no surfaces; give at least one");
-  for (size_t k = 0; k < surfaces.size(); ++k) surface::validate(surfaces[k], "render: surface #" + std::to_string(k));
+  if (surfaces.empty())
+    throw Error(ErrorCategory::InvalidArgument, "render: no surfaces; give at least one");
+  for (size_t k = 0; k < surfaces.size(); ++k)
+    surface::validate(surfaces[k], "render: surface #" + std::to_string(k));
 
   const int f = options.supersample ? 2 : 1;
-  Canvas cv{f * options.width, f * options.height, {}, {}, camera_for(options.eye_direction), 0, 0, 1, 0, 1, {}, {}};
+  Canvas cv{f * options.width,
+            f * options.height,
+            {},
+            {},
+            camera_for(options.eye_direction),
+            0,
+            0,
+            1,
+            0,
+            1,
+            {},
+            {}};
   std::vector<Mesh> meshes;
-  for (const auto& s : surfaces) meshes.push_back(tessellate_for_render(s, options.samples_per_span));
+  for (const auto& s : surfaces)
+    meshes.push_back(tessellate_for_render(s, options.samples_per_span));
 
   // Fit: the box of everything drawn, in camera coordinates.
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
@@ -195,8 +229,10 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
     for (const auto& s : surfaces) grow(s.points);
   const Vector3d extent = hi - lo;
   const double room = 1 - 2 * options.margin;
-  const double sx = extent.x() > 0 ? room * cv.width / extent.x() : std::numeric_limits<double>::infinity();
-  const double sy = extent.y() > 0 ? room * cv.height / extent.y() : std::numeric_limits<double>::infinity();
+  const double sx =
+      extent.x() > 0 ? room * cv.width / extent.x() : std::numeric_limits<double>::infinity();
+  const double sy =
+      extent.y() > 0 ? room * cv.height / extent.y() : std::numeric_limits<double>::infinity();
   cv.scale = std::isfinite(std::min(sx, sy)) ? std::min(sx, sy) : 1.0;
   cv.centre_x = 0.5 * (lo.x() + hi.x());
   cv.centre_y = 0.5 * (lo.y() + hi.y());
@@ -208,19 +244,26 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
   const size_t samples = static_cast<size_t>(cv.width) * static_cast<size_t>(cv.height);
   cv.depth.assign(samples, -1.0f);
   cv.rgb.resize(3 * samples);
-  for (size_t k = 0; k < samples; ++k) std::copy(options.background.begin(), options.background.end(), cv.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(k));
+  for (size_t k = 0; k < samples; ++k)
+    std::copy(options.background.begin(), options.background.end(),
+              cv.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(k));
 
   for (size_t k = 0; k < meshes.size(); ++k) {
     const Mesh& m = meshes[k];
-    const Rgb base = options.colours.empty() ? palette(k) : options.colours[k % options.colours.size()];
+    const Rgb base =
+        options.colours.empty() ? palette(k) : options.colours[k % options.colours.size()];
     std::vector<Vector3d> screen(m.normals.size());
     for (int i = 0; i < m.nu(); ++i)
-      for (int j = 0; j < m.nv(); ++j) screen[static_cast<size_t>(i * m.nv() + j)] = cv.project(m.point(i, j));
+      for (int j = 0; j < m.nv(); ++j)
+        screen[static_cast<size_t>(i * m.nv() + j)] = cv.project(m.point(i, j));
     for (int i = 0; i + 1 < m.nu(); ++i)
       for (int j = 0; j + 1 < m.nv(); ++j) {
-        const size_t a = static_cast<size_t>(i * m.nv() + j), b = a + static_cast<size_t>(m.nv()), c = b + 1, d = a + 1;
-        cv.triangle(screen[a], screen[b], screen[c], m.normals[a], m.normals[b], m.normals[c], base);
-        cv.triangle(screen[a], screen[c], screen[d], m.normals[a], m.normals[c], m.normals[d], base);
+        const size_t a = static_cast<size_t>(i * m.nv() + j), b = a + static_cast<size_t>(m.nv()),
+                     c = b + 1, d = a + 1;
+        cv.triangle(screen[a], screen[b], screen[c], m.normals[a], m.normals[b], m.normals[c],
+                    base);
+        cv.triangle(screen[a], screen[c], screen[d], m.normals[a], m.normals[c], m.normals[d],
+                    base);
       }
   }
   if (options.control_net)
@@ -235,29 +278,37 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
     }
 
   // Average f x f samples per pixel.
-  Image image{options.width, options.height, std::vector<std::uint8_t>(3 * static_cast<size_t>(options.width) * static_cast<size_t>(options.height))};
+  Image image{options.width, options.height,
+              std::vector<std::uint8_t>(3 * static_cast<size_t>(options.width) *
+                                        static_cast<size_t>(options.height))};
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x)
       for (int c = 0; c < 3; ++c) {
         int sum = 0;
         for (int dy = 0; dy < f; ++dy)
           for (int dx = 0; dx < f; ++dx)
-            sum += cv.rgb[3 * (static_cast<size_t>(f * y + dy) * static_cast<size_t>(cv.width) + static_cast<size_t>(f * x + dx)) + static_cast<size_t>(c)];
-        image.rgb[3 * (static_cast<size_t>(y) * static_cast<size_t>(image.width) + static_cast<size_t>(x)) + static_cast<size_t>(c)] =
-            static_cast<std::uint8_t>((sum + f * f / 2) / (f * f));
+            sum += cv.rgb[3 * (static_cast<size_t>(f * y + dy) * static_cast<size_t>(cv.width) +
+                               static_cast<size_t>(f * x + dx)) +
+                          static_cast<size_t>(c)];
+        image.rgb[3 * (static_cast<size_t>(y) * static_cast<size_t>(image.width) +
+                       static_cast<size_t>(x)) +
+                  static_cast<size_t>(c)] = static_cast<std::uint8_t>((sum + f * f / 2) / (f * f));
       }
   return image;
 }
 
 void write_png(const Image& image, const fs::path& file) {
-  const size_t expected = 3 * static_cast<size_t>(std::max(image.width, 0)) * static_cast<size_t>(std::max(image.height, 0));
+  const size_t expected = 3 * static_cast<size_t>(std::max(image.width, 0)) *
+                          static_cast<size_t>(std::max(image.height, 0));
   if (image.width <= 0 || image.height <= 0 || image.rgb.size() != expected)
     throw Error(ErrorCategory::InvalidArgument,
-                "write_png: an image of " + std::to_string(image.width) + " x " + std::to_string(image.height) +
-                    " pixels needs " + std::to_string(expected) + " bytes (3 per pixel, both sizes > 0), it has " +
+                "write_png: an image of " + std::to_string(image.width) + " x " +
+                    std::to_string(image.height) + " pixels needs " + std::to_string(expected) +
+                    " bytes (3 per pixel, both sizes > 0), it has " +
                     std::to_string(image.rgb.size()));
   if (!file.has_filename())
-    throw Error(ErrorCategory::InvalidArgument, "write_png: \"" + file.string() + "\" names no file; give e.g. picture.png");
+    throw Error(ErrorCategory::InvalidArgument,
+                "write_png: \"" + file.string() + "\" names no file; give e.g. picture.png");
   const fs::path tmp = (file.has_parent_path() ? file.parent_path() : fs::path(".")) /
                        ("." + file.filename().string() + ".clayform-" + std::to_string(::getpid()));
   png_image png{};
@@ -270,14 +321,16 @@ void write_png(const Image& image, const fs::path& file) {
     const std::string why = png.message;
     png_image_free(&png);
     fs::remove(tmp, ec);
-    throw Error(ErrorCategory::Io, "write_png: cannot write \"" + file.string() + "\" (temporary \"" + tmp.string() +
-                                       "\"): " + why + "; check that the folder exists and is writable");
+    throw Error(ErrorCategory::Io, "write_png: cannot write \"" + file.string() +
+                                       "\" (temporary \"" + tmp.string() + "\"): " + why +
+                                       "; check that the folder exists and is writable");
   }
   fs::rename(tmp, file, ec);
   if (ec) {
     const std::string why = ec.message();
     fs::remove(tmp, ec);
-    throw Error(ErrorCategory::Io, "write_png: cannot move the picture to \"" + file.string() + "\": " + why);
+    throw Error(ErrorCategory::Io,
+                "write_png: cannot move the picture to \"" + file.string() + "\": " + why);
   }
 }
 

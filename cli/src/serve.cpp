@@ -46,15 +46,21 @@ struct ViewServer::Impl {
   std::thread thread;
 };
 
-ViewServer::ViewServer(const fs::path& run_dir, const ServeOptions& options) : impl_(std::make_unique<Impl>()) {
+ViewServer::ViewServer(const fs::path& run_dir, const ServeOptions& options)
+    : impl_(std::make_unique<Impl>()) {
   const fs::path viewer = options.viewer.empty() ? viewer_dir() : options.viewer;
   if (!fs::is_regular_file(run_dir / "view" / "manifest.json"))
-    throw Error(ErrorCategory::Io, "no view data in \"" + run_dir.string() + "\" (view/manifest.json is missing); give "
-                                   "the --out folder of `clayform run` or `clayform deform`, or run the recipe again");
+    throw Error(
+        ErrorCategory::Io,
+        "no view data in \"" + run_dir.string() +
+            "\" (view/manifest.json is missing); give "
+            "the --out folder of `clayform run` or `clayform deform`, or run the recipe again");
   if (!fs::is_regular_file(viewer / "index.html"))
-    throw Error(ErrorCategory::Io, "no viewer build at \"" + viewer.string() + "\" (index.html is missing); build it "
-                                   "with scripts/viewer.sh (or `npm ci && npm run build` in viewer/), or set "
-                                   "CLAYFORM_VIEWER_DIR to a built viewer's folder");
+    throw Error(ErrorCategory::Io,
+                "no viewer build at \"" + viewer.string() +
+                    "\" (index.html is missing); build it "
+                    "with scripts/viewer.sh (or `npm ci && npm run build` in viewer/), or set "
+                    "CLAYFORM_VIEWER_DIR to a built viewer's folder");
   auto& s = impl_->server;
   for (const auto& [ext, type] : std::initializer_list<std::pair<const char*, const char*>>{
            {"html", "text/html; charset=utf-8"},
@@ -72,7 +78,8 @@ ViewServer::ViewServer(const fs::path& run_dir, const ServeOptions& options) : i
            {"txt", "text/plain; charset=utf-8"}})
     s.set_file_extension_and_mimetype_mapping(ext, type);
   s.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
-    if (req.path.find("..") == std::string::npos) return httplib::Server::HandlerResponse::Unhandled;
+    if (req.path.find("..") == std::string::npos)
+      return httplib::Server::HandlerResponse::Unhandled;
     res.status = 400;
     res.set_content("refused: a path with \"..\"\n", "text/plain");
     return httplib::Server::HandlerResponse::Handled;
@@ -82,18 +89,24 @@ ViewServer::ViewServer(const fs::path& run_dir, const ServeOptions& options) : i
     res.set_header("Cache-Control", "no-store");
   });
   const fs::path run = fs::absolute(run_dir).lexically_normal();
-  if (!s.set_mount_point("/run/", run.string()) || !s.set_mount_point("/", fs::absolute(viewer).lexically_normal().string()))
-    throw Error(ErrorCategory::Io, "cannot serve \"" + run.string() + "\" and \"" + viewer.string() + "\"");
+  if (!s.set_mount_point("/run/", run.string()) ||
+      !s.set_mount_point("/", fs::absolute(viewer).lexically_normal().string()))
+    throw Error(ErrorCategory::Io,
+                "cannot serve \"" + run.string() + "\" and \"" + viewer.string() + "\"");
   impl_->host = options.host;
   if (options.port < 0 || options.port > 65535)
-    throw Error(ErrorCategory::InvalidArgument, "port " + std::to_string(options.port) + " is out of range; give 0..65535 (0: any free port)");
+    throw Error(ErrorCategory::InvalidArgument,
+                "port " + std::to_string(options.port) +
+                    " is out of range; give 0..65535 (0: any free port)");
   if (options.port == 0) {
     impl_->port = s.bind_to_any_port(options.host);
     if (impl_->port <= 0)
-      throw Error(ErrorCategory::Io, "cannot listen on " + options.host + "; check the host address");
+      throw Error(ErrorCategory::Io,
+                  "cannot listen on " + options.host + "; check the host address");
   } else {
     if (!s.bind_to_port(options.host, options.port))
-      throw Error(ErrorCategory::Io, "cannot listen on " + options.host + ":" + std::to_string(options.port) +
+      throw Error(ErrorCategory::Io, "cannot listen on " + options.host + ":" +
+                                         std::to_string(options.port) +
                                          " (in use?); give another --port, or 0 for any free one");
     impl_->port = options.port;
   }
@@ -103,7 +116,9 @@ ViewServer::~ViewServer() { stop(); }
 
 int ViewServer::port() const noexcept { return impl_->port; }
 
-std::string ViewServer::url() const { return "http://" + impl_->host + ":" + std::to_string(impl_->port) + "/"; }
+std::string ViewServer::url() const {
+  return "http://" + impl_->host + ":" + std::to_string(impl_->port) + "/";
+}
 
 void ViewServer::run() { impl_->server.listen_after_bind(); }
 
@@ -126,7 +141,9 @@ std::string tail_of(const fs::path& file, int lines) {
   for (std::string line; std::getline(in, line);)
     if (!line.empty()) all.push_back(line);
   std::string out;
-  for (std::size_t k = all.size() > static_cast<std::size_t>(lines) ? all.size() - static_cast<std::size_t>(lines) : 0;
+  for (std::size_t k = all.size() > static_cast<std::size_t>(lines)
+                           ? all.size() - static_cast<std::size_t>(lines)
+                           : 0;
        k < all.size(); ++k)
     out += "\n  " + all[k];
   return out;
@@ -138,13 +155,15 @@ struct TempDir {
   TempDir() {
     std::string pattern = (fs::temp_directory_path() / "clayform-chromium-XXXXXX").string();
     if (!::mkdtemp(pattern.data()))
-      throw Error(ErrorCategory::Io, "cannot create a temporary folder in \"" + fs::temp_directory_path().string() +
+      throw Error(ErrorCategory::Io, "cannot create a temporary folder in \"" +
+                                         fs::temp_directory_path().string() +
                                          "\": " + std::strerror(errno));
     path = pattern;
   }
   ~TempDir() {
     std::error_code ec;
-    for (int attempt = 0; attempt < 5; ++attempt) {  // a chromium helper may still be writing its profile
+    for (int attempt = 0; attempt < 5;
+         ++attempt) {  // a chromium helper may still be writing its profile
       fs::remove_all(path, ec);
       if (!ec && !fs::exists(path, ec)) return;
       std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -160,14 +179,18 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
   static const std::array<const char*, 5> modes{"shaded", "zebra", "gaussian", "mean", "deviation"};
   if (std::find(modes.begin(), modes.end(), options.mode) == modes.end())
     throw Error(ErrorCategory::InvalidArgument,
-                "snapshot: unknown mode '" + options.mode + "'; give shaded, zebra, gaussian, mean or deviation");
+                "snapshot: unknown mode '" + options.mode +
+                    "'; give shaded, zebra, gaussian, mean or deviation");
   if (options.width < 16 || options.width > 8192 || options.height < 16 || options.height > 8192)
-    throw Error(ErrorCategory::InvalidArgument, "snapshot: picture size " + std::to_string(options.width) + " x " +
-                                                    std::to_string(options.height) + " is out of range; give 16..8192 pixels");
-  if (png.empty()) throw Error(ErrorCategory::InvalidArgument, "snapshot: give the picture to write (--png FILE)");
+    throw Error(ErrorCategory::InvalidArgument,
+                "snapshot: picture size " + std::to_string(options.width) + " x " +
+                    std::to_string(options.height) + " is out of range; give 16..8192 pixels");
+  if (png.empty())
+    throw Error(ErrorCategory::InvalidArgument, "snapshot: give the picture to write (--png FILE)");
   if (::access(options.chromium.c_str(), X_OK) != 0)
-    throw Error(ErrorCategory::Io, "snapshot needs chromium at \"" + options.chromium.string() +
-                                       "\", which is missing; install Debian's package: apt-get install chromium");
+    throw Error(ErrorCategory::Io,
+                "snapshot needs chromium at \"" + options.chromium.string() +
+                    "\", which is missing; install Debian's package: apt-get install chromium");
   ServeOptions so;
   so.port = 0;
   so.viewer = options.viewer;
@@ -179,25 +202,27 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
   server.start();
   TempDir profile;
   const fs::path log = profile.path / "chromium.log";
-  std::vector<std::string> args{options.chromium.string(),
-                                "--headless",
-                                "--no-sandbox",
-                                "--disable-gpu",
-                                "--disable-quic",
-                                "--no-first-run",
-                                "--disable-background-networking",
-                                "--disable-component-update",
-                                "--disable-sync",
-                                "--hide-scrollbars",
-                                "--user-data-dir=" + (profile.path / "profile").string(),
-                                "--window-size=" + std::to_string(options.width) + "," + std::to_string(options.height),
-                                "--virtual-time-budget=10000",
-                                "--screenshot=" + out.string(),
-                                server.url() + "?mode=" + options.mode + (options.bare ? "&ui=0" : "")};
+  std::vector<std::string> args{
+      options.chromium.string(),
+      "--headless",
+      "--no-sandbox",
+      "--disable-gpu",
+      "--disable-quic",
+      "--no-first-run",
+      "--disable-background-networking",
+      "--disable-component-update",
+      "--disable-sync",
+      "--hide-scrollbars",
+      "--user-data-dir=" + (profile.path / "profile").string(),
+      "--window-size=" + std::to_string(options.width) + "," + std::to_string(options.height),
+      "--virtual-time-budget=10000",
+      "--screenshot=" + out.string(),
+      server.url() + "?mode=" + options.mode + (options.bare ? "&ui=0" : "")};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  // The environment, with HOME in the temporary folder (chromium's wrapper and crash handler write there).
+  // The environment, with HOME in the temporary folder (chromium's wrapper and crash handler write
+  // there).
   std::vector<std::string> env;
   for (char** e = environ; e && *e; ++e)
     if (std::strncmp(*e, "HOME=", 5) != 0) env.emplace_back(*e);
@@ -210,25 +235,30 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
   posix_spawnattr_t attr;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
   posix_spawnattr_init(&attr);
-  posix_spawnattr_setpgroup(&attr, 0);  // its own process group: a timeout kills every helper process
+  posix_spawnattr_setpgroup(&attr,
+                            0);  // its own process group: a timeout kills every helper process
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
   pid_t pid = 0;
   const int spawned = ::posix_spawn(&pid, argv[0], &actions, &attr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
   if (spawned != 0)
-    throw Error(ErrorCategory::Io, "cannot start \"" + options.chromium.string() + "\": " + std::strerror(spawned) +
+    throw Error(ErrorCategory::Io, "cannot start \"" + options.chromium.string() +
+                                       "\": " + std::strerror(spawned) +
                                        "; install Debian's package: apt-get install chromium");
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(options.timeout_seconds);
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::seconds(options.timeout_seconds);
   int status = 0;
   bool timed_out = false;
   for (;;) {
     const pid_t r = ::waitpid(pid, &status, WNOHANG);
     if (r == pid) break;
-    if (r < 0 && errno != EINTR) throw Error(ErrorCategory::Io, std::string("waiting for chromium: ") + std::strerror(errno));
+    if (r < 0 && errno != EINTR)
+      throw Error(ErrorCategory::Io, std::string("waiting for chromium: ") + std::strerror(errno));
     if (std::chrono::steady_clock::now() > deadline) {
       timed_out = true;
       ::kill(-pid, SIGKILL);
@@ -240,15 +270,18 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
   ::kill(-pid, SIGKILL);  // helper processes left behind by the browser, if any
   server.stop();
   if (timed_out)
-    throw Error(ErrorCategory::Io, "chromium did not finish within " + std::to_string(options.timeout_seconds) +
+    throw Error(ErrorCategory::Io, "chromium did not finish within " +
+                                       std::to_string(options.timeout_seconds) +
                                        " s; it was stopped. Its last output:" + tail_of(log, 8));
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0)
-    throw Error(ErrorCategory::Io, "chromium failed (" +
-                                       (WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
-                                                          : "signal " + std::to_string(WTERMSIG(status))) +
-                                       "). Its last output:" + tail_of(log, 8));
+    throw Error(ErrorCategory::Io,
+                "chromium failed (" +
+                    (WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
+                                       : "signal " + std::to_string(WTERMSIG(status))) +
+                    "). Its last output:" + tail_of(log, 8));
   if (!fs::is_regular_file(out, ec) || fs::file_size(out, ec) == 0)
-    throw Error(ErrorCategory::Io, "chromium wrote no picture at \"" + out.string() + "\". Its last output:" + tail_of(log, 8));
+    throw Error(ErrorCategory::Io, "chromium wrote no picture at \"" + out.string() +
+                                       "\". Its last output:" + tail_of(log, 8));
 }
 
 }  // namespace clay::recipe

@@ -1,10 +1,10 @@
 // The view data of a run: grid meshes with exact normals and curvatures, the refit deviation, and
 // the manifest the browser viewer reads (docs/recipe.md "Viewing a run").
 #include <clay/error.hpp>
+#include <clay/recipe/view.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/tessellate.hpp>
-#include <clay/recipe/view.hpp>
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -46,7 +46,8 @@ Json point_json(const Vector3d& p) { return Json::array({p.x(), p.y(), p.z()}); 
 
 Json net_json(const surface::BSplineSurface& s) {
   Json points = Json::array();
-  for (Eigen::Index r = 0; r < s.points.rows(); ++r) points.push_back(point_json(s.points.row(r).transpose()));
+  for (Eigen::Index r = 0; r < s.points.rows(); ++r)
+    points.push_back(point_json(s.points.row(r).transpose()));
   return Json{{"rows", s.count_u()}, {"cols", s.count_v()}, {"points", std::move(points)}};
 }
 
@@ -79,10 +80,10 @@ std::string step_name(const StepReport* step) {
 bool is_refit(const StepReport* step) {
   if (!step) return false;
   for (const auto& [name, value] : step->figures)
-    if (name == "composition") return std::holds_alternative<std::string>(value) && std::get<std::string>(value) == "refit";
+    if (name == "composition")
+      return std::holds_alternative<std::string>(value) && std::get<std::string>(value) == "refit";
   return false;
 }
-
 
 }  // namespace
 
@@ -112,7 +113,10 @@ ViewMesh view_mesh(const surface::BSplineSurface& s) {
   m.mean.assign(n, 0.0);
   m.deviation.assign(n, 0.0);
   m.degenerate.assign(n, 0);
-  const auto at = [&](int i, int j) { return static_cast<std::size_t>(i) * static_cast<std::size_t>(m.cols) + static_cast<std::size_t>(j); };
+  const auto at = [&](int i, int j) {
+    return static_cast<std::size_t>(i) * static_cast<std::size_t>(m.cols) +
+           static_cast<std::size_t>(j);
+  };
   const std::vector<surface::SurfaceDerivatives> d = surface::derivatives_grid(s, m.us, m.vs);
   double max_u = 0, max_v = 0;
   for (const auto& x : d) {
@@ -122,11 +126,16 @@ ViewMesh view_mesh(const surface::BSplineSurface& s) {
   // Grid lines collapsed to (almost) a point: a pole, a collapsed edge, or the tiny ring a refit
   // leaves of one (about its tolerance across), where the curvature formulas blow up. A line is
   // collapsed when its polyline is shorter than 1e-3 of the longest line of its direction.
-  std::vector<double> row_length(static_cast<std::size_t>(m.rows), 0.0), col_length(static_cast<std::size_t>(m.cols), 0.0);
+  std::vector<double> row_length(static_cast<std::size_t>(m.rows), 0.0),
+      col_length(static_cast<std::size_t>(m.cols), 0.0);
   for (int i = 0; i < m.rows; ++i)
     for (int j = 0; j < m.cols; ++j) {
-      if (j + 1 < m.cols) row_length[static_cast<std::size_t>(i)] += (m.position[at(i, j + 1)] - m.position[at(i, j)]).norm();
-      if (i + 1 < m.rows) col_length[static_cast<std::size_t>(j)] += (m.position[at(i + 1, j)] - m.position[at(i, j)]).norm();
+      if (j + 1 < m.cols)
+        row_length[static_cast<std::size_t>(i)] +=
+            (m.position[at(i, j + 1)] - m.position[at(i, j)]).norm();
+      if (i + 1 < m.rows)
+        col_length[static_cast<std::size_t>(j)] +=
+            (m.position[at(i + 1, j)] - m.position[at(i, j)]).norm();
     }
   const double longest_row = *std::max_element(row_length.begin(), row_length.end());
   const double longest_col = *std::max_element(col_length.begin(), col_length.end());
@@ -185,7 +194,8 @@ void set_deviation(ViewMesh& mesh, const surface::BSplineSurface& before,
     for (int j = 0; j < mesh.cols; ++j) {
       const double u = onto(mesh.us[static_cast<std::size_t>(i)], u0, u1, a0, a1);
       const double v = onto(mesh.vs[static_cast<std::size_t>(j)], v0, v1, b0, b1);
-      const std::size_t k = static_cast<std::size_t>(i) * static_cast<std::size_t>(mesh.cols) + static_cast<std::size_t>(j);
+      const std::size_t k = static_cast<std::size_t>(i) * static_cast<std::size_t>(mesh.cols) +
+                            static_cast<std::size_t>(j);
       mesh.deviation[k] = (mesh.position[k] - map(surface::evaluate(before, u, v))).norm();
     }
 }
@@ -208,7 +218,9 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
   const fs::path view = dir / "view";
   std::error_code ec;
   fs::create_directories(view, ec);
-  if (ec) throw Error(ErrorCategory::Io, "cannot create the folder \"" + view.string() + "\": " + ec.message());
+  if (ec)
+    throw Error(ErrorCategory::Io,
+                "cannot create the folder \"" + view.string() + "\": " + ec.message());
 
   // Meshes, shared between identical surfaces with the same deviation (source -1: none, else the
   // refitted stage's index).
@@ -255,8 +267,11 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
         std::memcpy(&x, &b, 4);
       }
     std::ofstream out(view / name, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(f.data()), static_cast<std::streamsize>(f.size() * sizeof(float)));
-    if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + (view / name).string() + "\"; check the space and permissions");
+    out.write(reinterpret_cast<const char*>(f.data()),
+              static_cast<std::streamsize>(f.size() * sizeof(float)));
+    if (!out)
+      throw Error(ErrorCategory::Io, "cannot write \"" + (view / name).string() +
+                                         "\"; check the space and permissions");
     written.push_back({&s, source, name, m.rows, m.cols, mlo, mhi});
     return Json{{"file", name}, {"rows", m.rows}, {"cols", m.cols}};
   };
@@ -299,7 +314,8 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
       int source = -1;
       if (!own.empty()) {
         const Stage& last = result.stages[own.back()];
-        if (surface::identical(last.after, s) && last.map && is_refit(step_named(result, last.step)))
+        if (surface::identical(last.after, s) && last.map &&
+            is_refit(step_named(result, last.step)))
           source = static_cast<int>(own.back());
       }
       const StepReport* made = own.empty() ? step_named(result, "surfaces." + name)
@@ -324,7 +340,8 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
   j["box"] = Json{{"min", point_json(lo)}, {"max", point_json(hi)}};
   std::ofstream out(view / "manifest.json", std::ios::binary);
   out << j.dump() << "\n";  // compact: the nets are thousands of points
-  if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + (view / "manifest.json").string() + "\"");
+  if (!out)
+    throw Error(ErrorCategory::Io, "cannot write \"" + (view / "manifest.json").string() + "\"");
 }
 
 }  // namespace clay::recipe

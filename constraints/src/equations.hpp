@@ -75,16 +75,16 @@ struct EndSpec {
 /// One equation block: `rows` residuals over `scalars` (unreduced scalar indices, the slots).
 struct Equation {
   EqKind kind = EqKind::EqualScalar;
-  int constraint = -1;       // index into the user's list; -1 for implicit (arc radius)
-  int entity = -1;           // implicit equations: the entity they belong to
+  int constraint = -1;  // index into the user's list; -1 for implicit (arc radius)
+  int entity = -1;      // implicit equations: the entity they belong to
   int rows = 1;
   std::vector<int> scalars;  // slot -> unreduced scalar
   std::vector<PointRef> points;
-  bool planar = false;       // residuals in plane coordinates of `plane` (else world)
+  bool planar = false;  // residuals in plane coordinates of `plane` (else world)
   int plane = -1;
-  std::vector<double> data;  // kind-specific constants
-  int extra = -1;            // slot of the first extra unknown (t, alpha, beta)
-  std::vector<EndSpec> ends; // Joint (2), EndTangent (1)
+  std::vector<double> data;   // kind-specific constants
+  int extra = -1;             // slot of the first extra unknown (t, alpha, beta)
+  std::vector<EndSpec> ends;  // Joint (2), EndTangent (1)
   bool substitutable = false;
 };
 
@@ -101,7 +101,7 @@ struct Model {
   std::vector<int> radius_var;       // per entity: circle radius scalar, else -1
   std::vector<Equation> equations;
   std::vector<sketch::SketchPlane> planes;
-  double size = 1;                   // model size (mm)
+  double size = 1;  // model size (mm)
 };
 
 /// Builds the model; throws clay::Error naming the constraint for bad references or values.
@@ -286,14 +286,19 @@ void residuals(const Model& m, const Equation& eq, const T* v, T* r) {
       const V3<T> d1 = point_at(m, eq, v, 1) - point_at(m, eq, v, 0);
       const V3<T> d2 = point_at(m, eq, v, 3) - point_at(m, eq, v, 2);
       const T cr = cross_z<T>(d1, d2), dt = d1.dot(d2);
-      if (eq.kind == EqKind::Parallel) r[0] = cr / (norm3<T>(d1) * norm3<T>(d2));
-      else if (eq.kind == EqKind::Perpendicular) r[0] = dt / (norm3<T>(d1) * norm3<T>(d2));
-      else r[0] = wrap_angle<T>(atan2(cr * eq.data[1], dt) - eq.data[0]);
+      if (eq.kind == EqKind::Parallel)
+        r[0] = cr / (norm3<T>(d1) * norm3<T>(d2));
+      else if (eq.kind == EqKind::Perpendicular)
+        r[0] = dt / (norm3<T>(d1) * norm3<T>(d2));
+      else
+        r[0] = wrap_angle<T>(atan2(cr * eq.data[1], dt) - eq.data[0]);
       return;
     }
     case EqKind::RadiusValue:
-      if (eq.data[1] > 0) r[0] = v[0] - eq.data[0];  // circle radius unknown
-      else r[0] = norm3<T>(point_at(m, eq, v, 1) - point_at(m, eq, v, 0)) - eq.data[0];
+      if (eq.data[1] > 0)
+        r[0] = v[0] - eq.data[0];  // circle radius unknown
+      else
+        r[0] = norm3<T>(point_at(m, eq, v, 1) - point_at(m, eq, v, 0)) - eq.data[0];
       return;
     case EqKind::EqualLength:
       r[0] = norm3<T>(point_at(m, eq, v, 1) - point_at(m, eq, v, 0)) -
@@ -302,7 +307,8 @@ void residuals(const Model& m, const Equation& eq, const T* v, T* r) {
     case EqKind::EqualRadius: {
       // data: [a is circle, b is circle]; circle radius at slot data[2]/data[3], arcs by points
       auto radius_of = [&](int which) -> T {
-        if (eq.data[static_cast<size_t>(which)] > 0) return v[static_cast<int>(eq.data[static_cast<size_t>(2 + which)])];
+        if (eq.data[static_cast<size_t>(which)] > 0)
+          return v[static_cast<int>(eq.data[static_cast<size_t>(2 + which)])];
         const int first = static_cast<int>(eq.data[static_cast<size_t>(2 + which)]);
         return norm3<T>(point_at(m, eq, v, first + 1) - point_at(m, eq, v, first));
       };
@@ -344,7 +350,8 @@ void residuals(const Model& m, const Equation& eq, const T* v, T* r) {
       return;
     }
     case EqKind::Target: {
-      const V3<T> d = point_at(m, eq, v, 0) - Eigen::Vector3d(eq.data[0], eq.data[1], eq.data[2]).cast<T>();
+      const V3<T> d =
+          point_at(m, eq, v, 0) - Eigen::Vector3d(eq.data[0], eq.data[1], eq.data[2]).cast<T>();
       for (int i = 0; i < eq.rows; ++i) r[i] = d[i];
       return;
     }

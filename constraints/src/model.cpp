@@ -2,10 +2,10 @@
 #include "equations.hpp"
 
 #include <clay/error.hpp>
-#include <clay/surface/basis.hpp>
-#include <clay/surface/evaluate.hpp>
 #include <clay/internal/checks.hpp>
 #include <clay/internal/format.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -46,7 +46,8 @@ class Builder {
       }
       case ConstraintKind::Coincident:
         need(2, 0, 0);
-        if (point(0) == point(1)) fail(who + ": a point cannot be coincident with itself; name two points");
+        if (point(0) == point(1))
+          fail(who + ": a point cannot be coincident with itself; name two points");
         coincide(point(0), point(1));
         return;
       case ConstraintKind::PointOnCurve:
@@ -80,7 +81,8 @@ class Builder {
         for (sketch::PointId p : {a.start, a.end, b.start, b.end}) add_point(eq, p);
         if (c.kind == ConstraintKind::Angle) {
           if (!(c.value > 0 && c.value <= 180))
-            fail(who + ": angle " + num(c.value) + " degrees is outside (0, 180]; use parallel for 0");
+            fail(who + ": angle " + num(c.value) +
+                 " degrees is outside (0, 180]; use parallel for 0");
           const double turn = start_cross(eq);
           eq.data = {c.value * std::numbers::pi / 180.0, turn < 0 ? -1.0 : 1.0};
         }
@@ -212,31 +214,37 @@ class Builder {
     if (c_->points.size() != points || c_->entities.size() != entities || c_->ends.size() != ends)
       fail(name() + ": needs " + std::to_string(points) + " points, " + std::to_string(entities) +
            " entities and " + std::to_string(ends) + " curve ends, got " +
-           std::to_string(c_->points.size()) + ", " + std::to_string(c_->entities.size()) + " and " +
-           std::to_string(c_->ends.size()) + "; make it with the factory functions");
+           std::to_string(c_->points.size()) + ", " + std::to_string(c_->entities.size()) +
+           " and " + std::to_string(c_->ends.size()) + "; make it with the factory functions");
     for (size_t i = 0; i < points; ++i) {
       const int p = c_->points[i].index;
       if (p < 0 || p >= static_cast<int>(s_.points.size()))
-        fail(name() + ": refers to point #" + std::to_string(p) + ", which does not exist (the sketch has " +
-             std::to_string(s_.points.size()) + " points)");
+        fail(name() + ": refers to point #" + std::to_string(p) +
+             ", which does not exist (the sketch has " + std::to_string(s_.points.size()) +
+             " points)");
     }
     for (size_t i = 0; i < entities; ++i) check_entity(c_->entities[i]);
   }
   void check_entity(sketch::EntityId e) const {
     if (e.index < 0 || e.index >= static_cast<int>(s_.entities.size()))
       fail(name() + ": refers to entity #" + std::to_string(e.index) +
-           ", which does not exist (the sketch has " + std::to_string(s_.entities.size()) + " entities)");
+           ", which does not exist (the sketch has " + std::to_string(s_.entities.size()) +
+           " entities)");
   }
 
   sketch::PointId point(size_t i) const { return c_->points[i]; }
   sketch::EntityId entity(int i) const { return c_->entities[static_cast<size_t>(i)]; }
-  const sketch::Entity& ent(int i) const { return s_.entities[static_cast<size_t>(entity(i).index)]; }
+  const sketch::Entity& ent(int i) const {
+    return s_.entities[static_cast<size_t>(entity(i).index)];
+  }
   const Line& line(int i) const {
     const Line* l = std::get_if<Line>(&ent(i));
     if (!l) fail(name() + ": " + sketch::describe(s_, entity(i)) + " is not a line");
     return *l;
   }
-  const PointRef& var(sketch::PointId p) const { return m_.point_vars[static_cast<size_t>(p.index)]; }
+  const PointRef& var(sketch::PointId p) const {
+    return m_.point_vars[static_cast<size_t>(p.index)];
+  }
 
   Equation make(EqKind kind) const {
     Equation eq;
@@ -372,7 +380,8 @@ class Builder {
       push(std::move(eq));
     } else {
       const Curve& spline = std::get<Curve>(entity_value);
-      if (spline.degree > 30) fail(name() + ": curve degree " + std::to_string(spline.degree) + " is above 30");
+      if (spline.degree > 30)
+        fail(name() + ": curve degree " + std::to_string(spline.degree) + " is above 30");
       for (sketch::PointId q : spline.control_points)
         if (q == p) fail(name() + ": the point is a control point of the curve already");
       Equation eq = make(EqKind::PointOnCurve);
@@ -397,7 +406,9 @@ class Builder {
     }
   }
 
-  Eigen::Vector3d position(sketch::PointId p) const { return s_.points[static_cast<size_t>(p.index)].position; }
+  Eigen::Vector3d position(sketch::PointId p) const {
+    return s_.points[static_cast<size_t>(p.index)].position;
+  }
 
   /// End point and end specification of a curve end (line, arc or B-spline curve).
   sketch::PointId end_point(const CurveEnd& end) const {
@@ -406,7 +417,8 @@ class Builder {
     if (const Arc* a = std::get_if<Arc>(&e)) return end.at_start ? a->start : a->end;
     if (const Curve* c = std::get_if<Curve>(&e))
       return end.at_start ? c->control_points.front() : c->control_points.back();
-    fail(name() + ": " + sketch::describe(s_, end.curve) + " has no ends (a full circle); use an arc");
+    fail(name() + ": " + sketch::describe(s_, end.curve) +
+         " has no ends (a full circle); use an arc");
   }
 
   EndSpec end_spec(Equation& eq, const CurveEnd& end) const {
@@ -460,7 +472,8 @@ class Builder {
     const CurveEnd a = c_->ends[0], b = c_->ends[1];
     check_end(a);
     check_end(b);
-    if (a.curve == b.curve && a.at_start == b.at_start) fail(name() + ": give two different curve ends");
+    if (a.curve == b.curve && a.at_start == b.at_start)
+      fail(name() + ": give two different curve ends");
     const sketch::PointId pa = end_point(a), pb = end_point(b);
     if (!(pa == pb)) coincide(pa, pb);
     Equation eq = make(EqKind::Joint);
@@ -477,7 +490,8 @@ class Builder {
     const double alpha = out_a.norm() > 0 ? b1.norm() / out_a.norm() : 1.0;
     eq.extra = add_extra(eq, alpha > 0 ? alpha : 1.0);
     if (curvature) {
-      const double beta = out_a.squaredNorm() > 0 ? (b2 - a2 * alpha * alpha).dot(out_a) / out_a.squaredNorm() : 0;
+      const double beta =
+          out_a.squaredNorm() > 0 ? (b2 - a2 * alpha * alpha).dot(out_a) / out_a.squaredNorm() : 0;
       add_extra(eq, beta);
     }
     push(std::move(eq));
@@ -488,7 +502,8 @@ class Builder {
     const CurveEnd end = c_->ends[0];
     check_end(end);
     const double length = c_->direction.norm();
-    if (!(length > 0)) fail(name() + ": the tangent direction is the zero vector; give a direction");
+    if (!(length > 0))
+      fail(name() + ": the tangent direction is the zero vector; give a direction");
     Equation eq = make(EqKind::EndTangent);
     eq.ends.push_back(end_spec(eq, end));
     decide_frame(eq);
@@ -534,7 +549,8 @@ Model build_model(const sketch::Sketch& sketch, const std::vector<Constraint>& c
       for (int i = 0; i < 3; ++i) m.scalars.push_back({p.position[i]});
     } else {
       r.dim = 2;
-      const Eigen::Vector2d ab = sketch::to_plane(sketch.planes[static_cast<size_t>(p.plane.index)], p.position);
+      const Eigen::Vector2d ab =
+          sketch::to_plane(sketch.planes[static_cast<size_t>(p.plane.index)], p.position);
       m.scalars.push_back({ab.x()});
       m.scalars.push_back({ab.y()});
     }
@@ -549,7 +565,8 @@ Model build_model(const sketch::Sketch& sketch, const std::vector<Constraint>& c
     }
   Builder builder(sketch, m);
   for (size_t k = 0; k < sketch.entities.size(); ++k)
-    if (const Arc* a = std::get_if<Arc>(&sketch.entities[k])) builder.arc_radius(*a, static_cast<int>(k));
+    if (const Arc* a = std::get_if<Arc>(&sketch.entities[k]))
+      builder.arc_radius(*a, static_cast<int>(k));
   for (size_t k = 0; k < constraints.size(); ++k) {
     const Lowered flat = lower(constraints[k]);
     builder.add(flat, static_cast<int>(k));

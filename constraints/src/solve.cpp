@@ -27,8 +27,7 @@ std::vector<std::string> SolveOptions::problems() const {
   auto bad = [&out](const std::string& field, double value, const std::string& rule) {
     char buffer[32];
     std::snprintf(buffer, sizeof buffer, "%g", value);
-    out.push_back(
-                "SolveOptions::" + field + " = " + buffer + " breaks the rule " + rule);
+    out.push_back("SolveOptions::" + field + " = " + buffer + " breaks the rule " + rule);
   };
   if (!(tolerance > 0 && tolerance <= 1e-3)) bad("tolerance", tolerance, "0 < tolerance <= 1e-3");
   if (max_iterations < 1) bad("max_iterations", max_iterations, ">= 1");
@@ -36,12 +35,13 @@ std::vector<std::string> SolveOptions::problems() const {
     bad("rank_tolerance", rank_tolerance, "0 < rank_tolerance <= 1e-2");
   for (size_t k = 0; k < drag.size(); ++k)
     if (!internal::all_finite(drag[k].target))
-      out.push_back(
-                  "SolveOptions::drag[" + std::to_string(k) + "]: the target is not finite");
+      out.push_back("SolveOptions::drag[" + std::to_string(k) + "]: the target is not finite");
   return out;
 }
 
-void SolveOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void SolveOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 namespace detail {
 namespace {
@@ -75,12 +75,12 @@ struct UnionFind {
 /// The substitution: scalar -> class representative, which classes are fixed (and to what),
 /// and the constraints whose equalities closed a cycle or clashed with a fixed value.
 struct Reduction {
-  std::vector<int> rep;           // per scalar
-  std::vector<int> block;         // per scalar: Ceres block index, -1 when fixed
-  std::vector<double> fixed;      // per scalar (valid at reps): fixed value
-  std::vector<char> is_fixed;     // per scalar (valid at reps)
-  std::vector<double> values;     // per block
-  std::set<int> flagged;          // constraints involved in a dependency found here
+  std::vector<int> rep;        // per scalar
+  std::vector<int> block;      // per scalar: Ceres block index, -1 when fixed
+  std::vector<double> fixed;   // per scalar (valid at reps): fixed value
+  std::vector<char> is_fixed;  // per scalar (valid at reps)
+  std::vector<double> values;  // per block
+  std::set<int> flagged;       // constraints involved in a dependency found here
   int substituted = 0;
 };
 
@@ -145,7 +145,10 @@ class EquationCost {
  public:
   EquationCost(const Model& m, const Equation& eq, std::vector<int> slot_param,
                std::vector<double> slot_const, double weight)
-      : m_(m), eq_(eq), slot_param_(std::move(slot_param)), slot_const_(std::move(slot_const)),
+      : m_(m),
+        eq_(eq),
+        slot_param_(std::move(slot_param)),
+        slot_const_(std::move(slot_const)),
         weight_(weight) {}
 
   template <class T>
@@ -213,7 +216,7 @@ struct CeresSystem {
   template <class BlockOf, class ConstantOf>
   void add(const Model& m, const Equation& eq, int index, BlockOf block_of, ConstantOf constant_of,
            double weight = 1) {
-    std::vector<int> unique;       // block indices used, in first-use order
+    std::vector<int> unique;  // block indices used, in first-use order
     std::vector<int> slot_param, slot_const_index;
     std::vector<double> slot_const;
     for (int s : eq.scalars) {
@@ -409,7 +412,8 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
     if (p < 0 || p >= static_cast<int>(sketch.points.size()))
       throw Error(ErrorCategory::InvalidArgument,
                   "SolveOptions::drag[" + std::to_string(k) + "]: point #" + std::to_string(p) +
-                      " does not exist (the sketch has " + std::to_string(sketch.points.size()) + " points)");
+                      " does not exist (the sketch has " + std::to_string(sketch.points.size()) +
+                      " points)");
   }
   const size_t n = m.scalars.size();
   Reduction red = reduce(m);
@@ -437,9 +441,11 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
       const int b = red.block[s];
       if (b < 0 || red.rep[s] != static_cast<int>(s)) continue;
       if (std::isfinite(m.scalars[s].lower))
-        sys.problem.SetParameterLowerBound(sys.blocks[static_cast<size_t>(b)], 0, m.scalars[s].lower);
+        sys.problem.SetParameterLowerBound(sys.blocks[static_cast<size_t>(b)], 0,
+                                           m.scalars[s].lower);
       if (std::isfinite(m.scalars[s].upper))
-        sys.problem.SetParameterUpperBound(sys.blocks[static_cast<size_t>(b)], 0, m.scalars[s].upper);
+        sys.problem.SetParameterUpperBound(sys.blocks[static_cast<size_t>(b)], 0,
+                                           m.scalars[s].upper);
     }
   };
 
@@ -457,7 +463,8 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
       eq.plane = v.plane;
       Eigen::Vector3d target = d.target;
       if (eq.planar) {
-        const Eigen::Vector2d ab = clay::sketch::to_plane(m.planes[static_cast<size_t>(v.plane)], d.target);
+        const Eigen::Vector2d ab =
+            clay::sketch::to_plane(m.planes[static_cast<size_t>(v.plane)], d.target);
         target = {ab.x(), ab.y(), 0};
       }
       eq.data = {target.x(), target.y(), target.z()};
@@ -476,7 +483,8 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
     pull.add_blocks(values);
     add_bounds(pull);
     for (size_t e = 0; e < m.equations.size(); ++e)
-      if (!m.equations[e].substitutable) pull.add(m, m.equations[e], static_cast<int>(e), block_of, constant_of, 1e2);
+      if (!m.equations[e].substitutable)
+        pull.add(m, m.equations[e], static_cast<int>(e), block_of, constant_of, 1e2);
     for (const Equation& eq : drag_equations) pull.add(m, eq, -1, block_of, constant_of, 1.0);
     auto anchor_block = [](int s) { return -1 - s; };
     for (const Equation& eq : anchors) pull.add(m, eq, -1, anchor_block, constant_of, 1e-4);
@@ -487,7 +495,8 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
   sys.add_blocks(values);
   add_bounds(sys);
   for (size_t e = 0; e < m.equations.size(); ++e)
-    if (!m.equations[e].substitutable) sys.add(m, m.equations[e], static_cast<int>(e), block_of, constant_of);
+    if (!m.equations[e].substitutable)
+      sys.add(m, m.equations[e], static_cast<int>(e), block_of, constant_of);
   report.equations = static_cast<int>(sys.equation_of_row.size());
   run_ceres(sys, m, options, true, &iterations);
   report.solve_seconds = seconds_since(t0);
@@ -514,8 +523,10 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
         const int b = red.block[static_cast<size_t>(s)];
         if (b < 0) continue;
         used[static_cast<size_t>(b)] = 1;
-        if (first < 0) first = b;
-        else uf.unite(first, b);
+        if (first < 0)
+          first = b;
+        else
+          uf.unite(first, b);
       }
     }
     std::set<int> roots;
@@ -532,18 +543,24 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
     if (before != 0 && after != before) report.flipped.push_back(eq.constraint);
   }
   std::sort(report.flipped.begin(), report.flipped.end());
-  report.flipped.erase(std::unique(report.flipped.begin(), report.flipped.end()), report.flipped.end());
+  report.flipped.erase(std::unique(report.flipped.begin(), report.flipped.end()),
+                       report.flipped.end());
 
   const Clock::time_point t1 = Clock::now();
   if (options.diagnose) {
     // Rank of the reduced system: degrees of freedom, and whether anything depends.
     std::vector<std::vector<int>> dead;
     const Eigen::SparseMatrix<double> J = sys.jacobian();
-    const int rank = dependent_rows<Eigen::COLAMDOrdering<int>>(J, options.rank_tolerance, false, &dead);
+    const int rank =
+        dependent_rows<Eigen::COLAMDOrdering<int>>(J, options.rank_tolerance, false, &dead);
     report.degrees_of_freedom = static_cast<int>(values.size()) - rank;
     std::set<int> flagged = red.flagged;
-    for (const auto& d : dead) flagged.insert(sys.equations.empty() ? -1 :
-        m.equations[static_cast<size_t>(sys.equation_of_row[static_cast<size_t>(d[0])])].constraint);
+    for (const auto& d : dead)
+      flagged.insert(
+          sys.equations.empty()
+              ? -1
+              : m.equations[static_cast<size_t>(sys.equation_of_row[static_cast<size_t>(d[0])])]
+                    .constraint);
     // Equations left without unknowns (all their scalars fixed or merged) depend on the
     // substitutions that emptied them.
     for (size_t e = 0; e < m.equations.size(); ++e) {
@@ -574,25 +591,32 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
       for (size_t e = 0; e < m.equations.size(); ++e) {
         const Equation& eq = m.equations[e];
         if (!bad_parts.count(parts.find(eq.scalars[0]))) continue;
-        whole.add(m, eq, static_cast<int>(e), [&](int s) { return full_block[static_cast<size_t>(s)]; },
-                  [&](int s) { return x[static_cast<size_t>(s)]; });
+        whole.add(
+            m, eq, static_cast<int>(e), [&](int s) { return full_block[static_cast<size_t>(s)]; },
+            [&](int s) { return x[static_cast<size_t>(s)]; });
       }
       std::vector<std::vector<int>> circuits;
-      dependent_rows<Eigen::NaturalOrdering<int>>(whole.jacobian(), options.rank_tolerance, true, &circuits);
+      dependent_rows<Eigen::NaturalOrdering<int>>(whole.jacobian(), options.rank_tolerance, true,
+                                                  &circuits);
       std::set<std::vector<int>> seen;
       for (const auto& rows : circuits) {
         std::set<int> ids;
         bool implicit = false;
         for (int r : rows) {
-          const int c = m.equations[static_cast<size_t>(whole.equation_of_row[static_cast<size_t>(r)])].constraint;
-          if (c >= 0) ids.insert(c);
-          else implicit = true;
+          const int c =
+              m.equations[static_cast<size_t>(whole.equation_of_row[static_cast<size_t>(r)])]
+                  .constraint;
+          if (c >= 0)
+            ids.insert(c);
+          else
+            implicit = true;
         }
         std::vector<int> list(ids.begin(), ids.end());
         if (list.empty() || !seen.insert(list).second) continue;
         Dependency dep;
         dep.constraints = list;
-        for (int c : list) dep.conflicting = dep.conflicting || worst_of[static_cast<size_t>(c)] > options.tolerance;
+        for (int c : list)
+          dep.conflicting = dep.conflicting || worst_of[static_cast<size_t>(c)] > options.tolerance;
         dep.message = std::string(dep.conflicting ? "conflicting: " : "redundant: ") +
                       constraint_list(list, constraints, sketch) +
                       (implicit ? " (with the equal radii of an arc)" : "");
@@ -612,27 +636,31 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
       for (double r : row) r0 = std::max(r0, std::abs(r));
     s.initial_residual = r0;
   }
-  const std::string dof = report.degrees_of_freedom >= 0
-                              ? ", " + std::to_string(report.degrees_of_freedom) + " degrees of freedom left"
-                              : "";
+  const std::string dof =
+      report.degrees_of_freedom >= 0
+          ? ", " + std::to_string(report.degrees_of_freedom) + " degrees of freedom left"
+          : "";
   if (!report.conflicting.empty()) {
     s.termination = Termination::Failed;
     s.message = std::to_string(report.conflicting.size()) + " conflicting set(s): ";
-    for (size_t k = 0; k < report.conflicting.size(); ++k) s.message += (k ? "; " : "") + report.conflicting[k].message;
+    for (size_t k = 0; k < report.conflicting.size(); ++k)
+      s.message += (k ? "; " : "") + report.conflicting[k].message;
   } else if (report.max_residual <= options.tolerance) {
     s.termination = Termination::Converged;
     s.message = "all " + std::to_string(constraints.size()) + " constraints hold" + dof;
     if (!report.redundant.empty())
       for (size_t k = 0; k < report.redundant.size(); ++k)
-        s.message += (k ? "; " : "; " + std::to_string(report.redundant.size()) + " redundant set(s): ") +
-                     report.redundant[k].message;
+        s.message +=
+            (k ? "; " : "; " + std::to_string(report.redundant.size()) + " redundant set(s): ") +
+            report.redundant[k].message;
   } else {
     s.termination = Termination::NotConverged;
     s.message = "largest residual " + std::to_string(report.max_residual) + " after " +
                 std::to_string(iterations) + " iterations" + dof;
   }
   if (!report.flipped.empty())
-    s.message += "; orientation flipped for " + constraint_list(report.flipped, constraints, sketch);
+    s.message +=
+        "; orientation flipped for " + constraint_list(report.flipped, constraints, sketch);
 
   // Write back.
   SolveResult result{sketch, std::move(report)};
@@ -641,11 +669,13 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
     const double* p = x.data() + v.offset;
     result.sketch.points[i].position =
         v.dim == 3 ? Eigen::Vector3d(p[0], p[1], p[2])
-                   : clay::sketch::to_world(m.planes[static_cast<size_t>(v.plane)], Eigen::Vector2d(p[0], p[1]));
+                   : clay::sketch::to_world(m.planes[static_cast<size_t>(v.plane)],
+                                            Eigen::Vector2d(p[0], p[1]));
   }
   for (size_t k = 0; k < sketch.entities.size(); ++k)
     if (m.radius_var[k] >= 0)
-      std::get<sketch::Circle>(result.sketch.entities[k]).radius = x[static_cast<size_t>(m.radius_var[k])];
+      std::get<sketch::Circle>(result.sketch.entities[k]).radius =
+          x[static_cast<size_t>(m.radius_var[k])];
   return result;
 }
 
@@ -653,8 +683,9 @@ std::string SolveReport::brief() const {
   char buffer[160];
   std::snprintf(buffer, sizeof buffer, "; largest residual %.3g, %d unknowns (%d substituted), %s",
                 max_residual, unknowns, substituted,
-                degrees_of_freedom < 0 ? "degrees of freedom not diagnosed"
-                                       : (std::to_string(degrees_of_freedom) + " degrees of freedom").c_str());
+                degrees_of_freedom < 0
+                    ? "degrees of freedom not diagnosed"
+                    : (std::to_string(degrees_of_freedom) + " degrees of freedom").c_str());
   return summary.brief() + buffer;
 }
 

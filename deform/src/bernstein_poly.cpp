@@ -38,8 +38,10 @@ Eigen::MatrixXd reduction_matrix(int p, int e) {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(e + 1, p + 1);
   for (int i = 0; i <= e; ++i)
     for (int k = 0; k <= i; ++k) {
-      const double f = internal::binomial(i, k) / internal::binomial(e, k) * internal::binomial(p, k);
-      for (int r = 0; r <= k; ++r) m(i, r) += f * ((k - r) % 2 ? -1.0 : 1.0) * internal::binomial(k, r);
+      const double f =
+          internal::binomial(i, k) / internal::binomial(e, k) * internal::binomial(p, k);
+      for (int r = 0; r <= k; ++r)
+        m(i, r) += f * ((k - r) % 2 ? -1.0 : 1.0) * internal::binomial(k, r);
     }
   return m;
 }
@@ -49,7 +51,8 @@ Eigen::MatrixXd elevation_matrix(int e, int p) {
   Eigen::MatrixXd m = Eigen::MatrixXd::Zero(p + 1, e + 1);
   for (int i = 0; i <= p; ++i)
     for (int k = std::max(0, i - (p - e)); k <= std::min(e, i); ++k)
-      m(i, k) = internal::binomial(e, k) * internal::binomial(p - e, i - k) / internal::binomial(p, i);
+      m(i, k) =
+          internal::binomial(e, k) * internal::binomial(p - e, i - k) / internal::binomial(p, i);
   return m;
 }
 
@@ -85,7 +88,8 @@ int exact_degree(const Poly& a, int dir, double tol, bool positive) {
   int best = p;
   for (int e = p - 1; e >= 0; --e) {
     const Poly reduced = to_degree(a, e, dir);
-    if (positive && std::any_of(reduced.c.begin(), reduced.c.end(), [](double x) { return !(x > 0); }))
+    if (positive &&
+        std::any_of(reduced.c.begin(), reduced.c.end(), [](double x) { return !(x > 0); }))
       break;
     const Poly back = to_degree(reduced, p, dir);
     bool same = true;
@@ -136,7 +140,8 @@ std::pair<Poly, Poly> halve(const Poly& a, int dir) {
       put(hi, p, w[static_cast<size_t>(p)]);
       for (int l = 1; l <= p; ++l) {
         for (int k = 0; k + l <= p; ++k)
-          w[static_cast<size_t>(k)] = 0.5 * (w[static_cast<size_t>(k)] + w[static_cast<size_t>(k + 1)]);
+          w[static_cast<size_t>(k)] =
+              0.5 * (w[static_cast<size_t>(k)] + w[static_cast<size_t>(k + 1)]);
         put(lo, l, w[0]);
         put(hi, p - l, w[static_cast<size_t>(p - l)]);
       }

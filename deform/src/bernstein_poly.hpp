@@ -13,7 +13,8 @@ namespace clay::deform::detail {
 /// A bivariate polynomial of degrees (du, dv) in Bernstein form with `dim` values per
 /// coefficient: value d of coefficient (i, j) at ((i * (dv + 1) + j) * dim + d). "Scaled" polys
 /// hold C(du, i) C(dv, j) times the Bernstein coefficients, so that a product is a plain 2D
-/// convolution (exact Bernstein multiplication: B_i^a B_k^b = C(a,i) C(b,k) / C(a+b,i+k) B_{i+k}^{a+b}).
+/// convolution (exact Bernstein multiplication: B_i^a B_k^b = C(a,i) C(b,k) / C(a+b,i+k)
+/// B_{i+k}^{a+b}).
 struct Poly {
   int du = 0, dv = 0, dim = 1;
   std::vector<double> c;

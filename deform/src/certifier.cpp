@@ -4,10 +4,10 @@
 #include "certifier.hpp"
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 
@@ -133,8 +133,7 @@ HullInfo bend_info(const Bend& d, const Points3& hull) {
 Bounds bezier_lattice_bounds(const BezierLattice& lattice) {
   Eigen::Matrix3d m;
   m.col(0) = lattice.frame.s, m.col(1) = lattice.frame.t, m.col(2) = lattice.frame.u;
-  const double inverse_norm =
-      Eigen::JacobiSVD<Eigen::Matrix3d>(m.inverse()).singularValues()(0);
+  const double inverse_norm = Eigen::JacobiSVD<Eigen::Matrix3d>(m.inverse()).singularValues()(0);
   const auto n = lattice.counts();
   const auto& d = lattice.degrees;
   auto point = [&](int i, int j, int k) -> Eigen::Vector3d {
@@ -291,29 +290,41 @@ Points3 image_hull(const PointMap& map, const Points3& hull, double first) {
 // ---- certifiers per deformation ---------------------------------------------------------------
 
 Certifier certifier(const Taper& d) {
-  return {"taper", [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
-          [d](const Points3& h) { return taper_info(d, h); }, {}};
+  return {"taper",
+          [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
+          [d](const Points3& h) { return taper_info(d, h); },
+          {}};
 }
 Certifier certifier(const Twist& d) {
-  return {"twist", [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
-          [d](const Points3& h) { return twist_info(d, h); }, {}};
+  return {"twist",
+          [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
+          [d](const Points3& h) { return twist_info(d, h); },
+          {}};
 }
 Certifier certifier(const Bend& d) {
-  return {"bend", [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
-          [d](const Points3& h) { return bend_info(d, h); }, {}};
+  return {"bend",
+          [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
+          [d](const Points3& h) { return bend_info(d, h); },
+          {}};
 }
 Certifier certifier(const BezierLattice& d) {
   auto cells = std::make_shared<LatticeCells>(lattice_cells(d));
-  return {"Bézier lattice", [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
-          [cells](const Points3& h) { return cells->info(h, 0); }, {}};
+  return {"Bézier lattice",
+          [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
+          [cells](const Points3& h) { return cells->info(h, 0); },
+          {}};
 }
 Certifier certifier(const BSplineLattice& d) {
   auto cells = std::make_shared<LatticeCells>(lattice_cells(d));
-  return {"B-spline lattice", [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
-          [cells](const Points3& h) { return cells->info(h, 0); }, {}};
+  return {"B-spline lattice",
+          [d](const Eigen::Vector3d& x) { return deform_point(d, x); },
+          [cells](const Points3& h) { return cells->info(h, 0); },
+          {}};
 }
 Certifier certifier(const ExtendedLattice& d) {
-  return {"extended lattice", detail::prepared_point_map(d), {},
+  return {"extended lattice",
+          detail::prepared_point_map(d),
+          {},
           "an extended lattice is evaluated through Newton-frozen chunk coordinates, for which no "
           "derivative bounds are known"};
 }
@@ -335,7 +346,8 @@ Certifier certifier(const DeformationStack& stack) {
           using T = std::decay_t<decltype(d)>;
           if constexpr (std::is_same_v<T, ExtendedLattice>) {
             if (why_not.empty())
-              why_not = "steps[" + std::to_string(i) + "] is an extended lattice, evaluated through "
+              why_not = "steps[" + std::to_string(i) +
+                        "] is an extended lattice, evaluated through "
                         "Newton-frozen chunk coordinates, for which no derivative bounds are known";
             steps.push_back({detail::prepared_point_map(d), {}, index});
           } else if constexpr (std::is_same_v<T, BezierLattice> ||
@@ -347,8 +359,7 @@ Certifier certifier(const DeformationStack& stack) {
           } else {
             const Certifier c = certifier(d);
             auto info = c.info;
-            steps.push_back(
-                {c.map, [info](const Points3& h, int) { return info(h); }, index});
+            steps.push_back({c.map, [info](const Points3& h, int) { return info(h); }, index});
           }
         },
         step.deformation);

@@ -43,7 +43,6 @@ struct Certifier {
   std::string why_not;                                // why `info` is empty
 };
 
-
 /// The certifier of each deformation kind: the map, and the bounds over a hull where known.
 Certifier certifier(const Taper& d);
 Certifier certifier(const Twist& d);

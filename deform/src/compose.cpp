@@ -3,11 +3,11 @@
 #include <clay/deform/compose.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/math.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/exchange.hpp>
 #include <clay/surface/knots.hpp>
-#include <clay/internal/math.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -38,17 +38,17 @@ std::string fmt(double v) { return format(v, 6); }  // short figures for message
 
 constexpr const char* coordinate_name[3] = {"s", "t", "u"};
 
-using detail::Poly;
-using detail::Violation;
 using detail::constant_poly;
-using detail::leaves;
-using detail::value_at;
-using detail::halve;
-using detail::to_degree;
 using detail::exact_degree;
-using detail::multiply;
+using detail::halve;
+using detail::leaves;
 using detail::mul_add;
+using detail::multiply;
+using detail::Poly;
 using detail::scale;
+using detail::to_degree;
+using detail::value_at;
+using detail::Violation;
 
 // ---- one Bézier patch of the surface in lattice coordinates ---------------------------------
 
@@ -76,7 +76,8 @@ PatchCoordinates patch_coordinates(const BSplineSurface& patch, const Eigen::Vec
       pc.w.at(i, j) = w;
       wmax = std::max(wmax, w);
       xmax = std::max(xmax, x.norm());
-      for (int d = 0; d < 3; ++d) pc.c[static_cast<size_t>(d)].at(i, j) = w * dual[static_cast<size_t>(d)].dot(x);
+      for (int d = 0; d < 3; ++d)
+        pc.c[static_cast<size_t>(d)].at(i, j) = w * dual[static_cast<size_t>(d)].dot(x);
     }
   double dmax = 0;
   for (const auto& v : dual) dmax = std::max(dmax, v.norm());
@@ -85,7 +86,8 @@ PatchCoordinates patch_coordinates(const BSplineSurface& patch, const Eigen::Vec
   return pc;
 }
 
-/// Dual vectors of a frame: local coordinate d of X is dual[d] · (X − X0) (Sederberg–Parry eq. (1)).
+/// Dual vectors of a frame: local coordinate d of X is dual[d] · (X − X0) (Sederberg–Parry eq.
+/// (1)).
 std::array<Eigen::Vector3d, 3> dual_vectors(const Frame& f) {
   const Eigen::Vector3d tu = f.t.cross(f.u), su = f.s.cross(f.u), st = f.s.cross(f.t);
   return {tu / tu.dot(f.s), su / su.dot(f.t), st / st.dot(f.u)};
@@ -175,7 +177,8 @@ std::pair<int, int> composed_degrees(const std::array<Factor, 3>& f, std::array<
 /// Sederberg–Parry eq. (2) with the factors' polynomials in place of s, t, u: u (k) innermost,
 /// then t (j), then s (i). `dim` 3 (polynomial: the weight is W^0 = 1) or 4 (the weight
 /// Σ B B B · 1 = W^L rides along).
-ComposedPatch compose_patch(const BezierLattice& cell, const std::array<Factor, 3>& f, bool rational) {
+ComposedPatch compose_patch(const BezierLattice& cell, const std::array<Factor, 3>& f,
+                            bool rational) {
   const int dim = rational ? 4 : 3;
   const auto n = cell.counts();
   std::vector<Poly> along_s;
@@ -188,7 +191,8 @@ ComposedPatch compose_patch(const BezierLattice& cell, const std::array<Factor, 
       along_u.reserve(static_cast<size_t>(n[2]));
       for (int k = 0; k < n[2]; ++k) {
         Poly p(0, 0, dim);
-        for (int d = 0; d < 3; ++d) p.c[static_cast<size_t>(d)] = cell.points(cell.index(i, j, k), d);
+        for (int d = 0; d < 3; ++d)
+          p.c[static_cast<size_t>(d)] = cell.points(cell.index(i, j, k), d);
         if (rational) p.c[3] = 1;
         along_u.push_back(std::move(p));
       }
@@ -227,36 +231,40 @@ Poly ratio_poly(const PatchCoordinates& pc, int d) {
 /// Name of a patch and its parameter box, and of a patch-local parameter, for messages.
 std::string patch_name(const surface::BezierPatches& bp, int a, int b) {
   return "patch (" + std::to_string(a) + ", " + std::to_string(b) + ") over u in [" +
-         fmt(bp.breaks_u[static_cast<size_t>(a)]) + ", " + fmt(bp.breaks_u[static_cast<size_t>(a + 1)]) +
-         "], v in [" + fmt(bp.breaks_v[static_cast<size_t>(b)]) + ", " +
+         fmt(bp.breaks_u[static_cast<size_t>(a)]) + ", " +
+         fmt(bp.breaks_u[static_cast<size_t>(a + 1)]) + "], v in [" +
+         fmt(bp.breaks_v[static_cast<size_t>(b)]) + ", " +
          fmt(bp.breaks_v[static_cast<size_t>(b + 1)]) + "]";
 }
 std::pair<double, double> global_parameter(const surface::BezierPatches& bp, int a, int b, double x,
                                            double y) {
-  const double u0 = bp.breaks_u[static_cast<size_t>(a)], u1 = bp.breaks_u[static_cast<size_t>(a + 1)];
-  const double v0 = bp.breaks_v[static_cast<size_t>(b)], v1 = bp.breaks_v[static_cast<size_t>(b + 1)];
+  const double u0 = bp.breaks_u[static_cast<size_t>(a)],
+               u1 = bp.breaks_u[static_cast<size_t>(a + 1)];
+  const double v0 = bp.breaks_v[static_cast<size_t>(b)],
+               v1 = bp.breaks_v[static_cast<size_t>(b + 1)];
   return {u0 + x * (u1 - u0), v0 + y * (v1 - v0)};
 }
 
-[[noreturn]] void throw_outside(const surface::BezierPatches& bp, int a, int b, int d, const Violation& v,
-                                std::string_view lattice_kind) {
+[[noreturn]] void throw_outside(const surface::BezierPatches& bp, int a, int b, int d,
+                                const Violation& v, std::string_view lattice_kind) {
   const auto [u, w] = global_parameter(bp, a, b, v.x, v.y);
-  throw Error(ErrorCategory::OutOfDomain,
-              "compose_exact: surface " + patch_name(bp, a, b) + " leaves the " + std::string(lattice_kind) +
-                  ": local coordinate " + coordinate_name[d] + " = " + format(v.value) +
-                  (v.certain ? " at" : " (bound; not certified inside) near") + " parameter (" +
-                  format(u) + ", " + format(w) +
-                  ") is outside [0, 1]; the FFD is the identity outside the lattice, so the deformed "
-                  "surface is not one polynomial there: enlarge the lattice frame to contain the "
-                  "whole surface");
+  throw Error(
+      ErrorCategory::OutOfDomain,
+      "compose_exact: surface " + patch_name(bp, a, b) + " leaves the " +
+          std::string(lattice_kind) + ": local coordinate " + coordinate_name[d] + " = " +
+          format(v.value) + (v.certain ? " at" : " (bound; not certified inside) near") +
+          " parameter (" + format(u) + ", " + format(w) +
+          ") is outside [0, 1]; the FFD is the identity outside the lattice, so the deformed "
+          "surface is not one polynomial there: enlarge the lattice frame to contain the "
+          "whole surface");
 }
 
 // ---- joining patches (surface::join_bezier_patches, then surface::remove_knots) ---------------
 
 /// The composed patches as the Bézier patches of surface::join_bezier_patches: control points
 /// (x w, y w, z w) / w and weights w of each homogeneous Bernstein net (w = 1 when polynomial).
-surface::BezierPatches as_bezier_patches(const surface::BezierPatches& bp, const std::vector<ComposedPatch>& patches,
-                                         bool rational) {
+surface::BezierPatches as_bezier_patches(const surface::BezierPatches& bp,
+                                         const std::vector<ComposedPatch>& patches, bool rational) {
   surface::BezierPatches out;
   out.breaks_u = bp.breaks_u;
   out.breaks_v = bp.breaks_v;
@@ -264,7 +272,8 @@ surface::BezierPatches as_bezier_patches(const surface::BezierPatches& bp, const
   const int cv = bp.count_v();
   for (std::size_t k = 0; k < patches.size(); ++k) {
     const ComposedPatch& p = patches[k];
-    const auto a = static_cast<std::size_t>(static_cast<int>(k) / cv), b = static_cast<std::size_t>(static_cast<int>(k) % cv);
+    const auto a = static_cast<std::size_t>(static_cast<int>(k) / cv),
+               b = static_cast<std::size_t>(static_cast<int>(k) % cv);
     const int du = std::max(p.du, 1), dv = std::max(p.dv, 1);
     const Poly h = to_degree(to_degree(p.h, du, 0), dv, 1);
     BSplineSurface s;
@@ -298,19 +307,20 @@ double largest_homogeneous_point(const BSplineSurface& s) {
 
 // ---- the pipeline shared by the entry points ------------------------------------------------
 
-[[noreturn]] void throw_degree(int du, int dv, const std::string& what, const std::string& ways_out) {
+[[noreturn]] void throw_degree(int du, int dv, const std::string& what,
+                               const std::string& ways_out) {
   throw Error(ErrorCategory::DegreeLimit,
-              "compose_exact: the exact composition " + what + " has degree (" + std::to_string(du) +
-                  ", " + std::to_string(dv) + "), above the exchange limit " +
+              "compose_exact: the exact composition " + what + " has degree (" +
+                  std::to_string(du) + ", " + std::to_string(dv) + "), above the exchange limit " +
                   std::to_string(surface::max_exchange_degree) +
                   " (surface::max_exchange_degree, OpenCASCADE and most CAD systems); " + ways_out);
 }
 
 /// Joins composed patches, removes knots, measures the deviation against `pointwise`.
-ComposeResult finish(const surface::BezierPatches& bp, const std::vector<ComposedPatch>& patches, bool rational,
-                     const BSplineSurface& original,
-                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& pointwise, double size,
-                     const ComposeOptions& options, int splits) {
+ComposeResult finish(const surface::BezierPatches& bp, const std::vector<ComposedPatch>& patches,
+                     bool rational, const BSplineSurface& original,
+                     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& pointwise,
+                     double size, const ComposeOptions& options, int splits) {
   ComposeReport report;
   report.patches = static_cast<int>(patches.size());
   report.splits = splits;
@@ -340,7 +350,8 @@ ComposeResult finish(const surface::BezierPatches& bp, const std::vector<Compose
     auto samples = [n](const std::vector<double>& breaks) {
       std::vector<double> out;
       for (size_t a = 0; a + 1 < breaks.size(); ++a)
-        for (int x = 0; x < n; ++x) out.push_back(breaks[a] + (x + 0.5) / n * (breaks[a + 1] - breaks[a]));
+        for (int x = 0; x < n; ++x)
+          out.push_back(breaks[a] + (x + 0.5) / n * (breaks[a + 1] - breaks[a]));
       return out;
     };
     const auto us = samples(bp.breaks_u), vs = samples(bp.breaks_v);
@@ -348,7 +359,8 @@ ComposeResult finish(const surface::BezierPatches& bp, const std::vector<Compose
     const Points3 after = surface::evaluate_grid(result.surface, us, vs);
     for (Eigen::Index r = 0; r < before.rows(); ++r) {
       const Eigen::Vector3d expected = pointwise(Eigen::Vector3d(before.row(r).transpose()));
-      report.max_relative_deviation = std::max(report.max_relative_deviation, (after.row(r).transpose() - expected).norm() / size);
+      report.max_relative_deviation = std::max(report.max_relative_deviation,
+                                               (after.row(r).transpose() - expected).norm() / size);
     }
   }
   report.exact = true;
@@ -450,14 +462,16 @@ std::vector<double> roots(const std::vector<double>& b) {
   std::vector<double> out;
   isolate(b, 0, 1, out);
   std::sort(out.begin(), out.end());
-  out.erase(std::remove_if(out.begin(), out.end(), [](double x) { return !(x > 0 && x < 1); }), out.end());
+  out.erase(std::remove_if(out.begin(), out.end(), [](double x) { return !(x > 0 && x < 1); }),
+            out.end());
   return out;
 }
 
 /// Splits `surface` where a local coordinate that depends on one surface parameter only crosses
 /// an interior knot plane of the lattice (HHK lattices meet the surface along iso-lines there):
 /// knots inserted to full multiplicity. Returns the split surface and the number of knots added.
-std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface, const BSplineLattice& lattice,
+std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface,
+                                               const BSplineLattice& lattice,
                                                const std::array<std::vector<double>, 3>& breaks) {
   const auto dual = dual_vectors(lattice.frame);
   const auto bp = surface::extract_bezier(surface);
@@ -472,12 +486,15 @@ std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface, co
           // (dir 0; y0 = the patch's first row), i.e. c(x, y) = c(x, y0).
           const int other = dir == 0 ? c.dv : c.du;
           const int p = dir == 0 ? c.du : c.dv;
-          auto get = [&](const Poly& q, int k, int o) { return dir == 0 ? q.at(k, o) : q.at(o, k); };
+          auto get = [&](const Poly& q, int k, int o) {
+            return dir == 0 ? q.at(k, o) : q.at(o, k);
+          };
           Poly c_row(p, 0, 1), w_row(p, 0, 1), c_all(p, other, 1), w_all(p, other, 1);
           for (int k = 0; k <= p; ++k) {
             c_row.at(k, 0) = get(c, k, 0);
             w_row.at(k, 0) = get(pc.w, k, 0);
-            for (int o = 0; o <= other; ++o) c_all.at(k, o) = get(c, k, o), w_all.at(k, o) = get(pc.w, k, o);
+            for (int o = 0; o <= other; ++o)
+              c_all.at(k, o) = get(c, k, o), w_all.at(k, o) = get(pc.w, k, o);
           }
           scale(c_row, false), scale(w_row, false), scale(c_all, false), scale(w_all, false);
           Poly g = multiply(c_all, w_row);
@@ -486,14 +503,18 @@ std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface, co
           mul_add(neg_w, c_row, g);
           scale(g, true);
           bool one_parameter = true;
-          for (double x : g.c) one_parameter = one_parameter && std::abs(x) <= 1e-13 * pc.c_scale * pc.w_scale;
+          for (double x : g.c)
+            one_parameter = one_parameter && std::abs(x) <= 1e-13 * pc.c_scale * pc.w_scale;
           if (!one_parameter) continue;
           const auto& br = breaks[static_cast<size_t>(d)];
-          const double x0 = dir == 0 ? bp.breaks_u[static_cast<size_t>(a)] : bp.breaks_v[static_cast<size_t>(b)];
-          const double x1 = dir == 0 ? bp.breaks_u[static_cast<size_t>(a + 1)] : bp.breaks_v[static_cast<size_t>(b + 1)];
+          const double x0 =
+              dir == 0 ? bp.breaks_u[static_cast<size_t>(a)] : bp.breaks_v[static_cast<size_t>(b)];
+          const double x1 = dir == 0 ? bp.breaks_u[static_cast<size_t>(a + 1)]
+                                     : bp.breaks_v[static_cast<size_t>(b + 1)];
           for (size_t plane = 1; plane + 1 < br.size(); ++plane) {
             std::vector<double> h(static_cast<size_t>(p + 1));
-            for (int k = 0; k <= p; ++k) h[static_cast<size_t>(k)] = get(c, k, 0) - br[plane] * get(pc.w, k, 0);
+            for (int k = 0; k <= p; ++k)
+              h[static_cast<size_t>(k)] = get(c, k, 0) - br[plane] * get(pc.w, k, 0);
             for (double x : roots(h)) {
               const double t = x0 + x * (x1 - x0);
               if (t - x0 > 1e-13 * (x1 - x0) && x1 - t > 1e-13 * (x1 - x0))
@@ -512,14 +533,18 @@ std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface, co
     const auto [d0, d1] = (dir == 0 ? surface.u : surface.v).domain();
     const double merge = 1e-12 * (d1 - d0);
     std::sort(c.begin(), c.end());
-    c.erase(std::unique(c.begin(), c.end(), [&](double x, double y) { return y - x <= merge; }), c.end());
+    c.erase(std::unique(c.begin(), c.end(), [&](double x, double y) { return y - x <= merge; }),
+            c.end());
     const int p = dir == 0 ? out.u.degree : out.v.degree;
     const auto existing = surface::breakpoints(dir == 0 ? surface.u : surface.v);
     for (double t : c) {
-      if (std::any_of(existing.begin(), existing.end(), [&](double b) { return std::abs(b - t) <= merge; })) continue;
+      if (std::any_of(existing.begin(), existing.end(),
+                      [&](double b) { return std::abs(b - t) <= merge; }))
+        continue;
       const int have = surface::multiplicity(dir == 0 ? out.u : out.v, t);
       if (have >= p) continue;
-      out = dir == 0 ? surface::insert_knot_u(out, t, p - have) : surface::insert_knot_v(out, t, p - have);
+      out = dir == 0 ? surface::insert_knot_u(out, t, p - have)
+                     : surface::insert_knot_v(out, t, p - have);
       added += p - have;
     }
   }
@@ -534,24 +559,26 @@ std::vector<std::string> ComposeOptions::problems() const {
   std::vector<std::string> out;
   if (!(knot_tolerance >= 0 && knot_tolerance <= 1e-6))
     out.push_back(
-                "ComposeOptions: knot_tolerance = " + format(knot_tolerance) +
-                    " breaks the rule 0 <= knot_tolerance <= 1e-6 (relative, exact removal only); give "
-                    "e.g. 1e-12, or 0 to keep every patch boundary");
+        "ComposeOptions: knot_tolerance = " + format(knot_tolerance) +
+        " breaks the rule 0 <= knot_tolerance <= 1e-6 (relative, exact removal only); give "
+        "e.g. 1e-12, or 0 to keep every patch boundary");
   if (check_samples < 0 || check_samples > 64)
-    out.push_back(
-                "ComposeOptions: check_samples = " + std::to_string(check_samples) +
-                    " breaks the rule 0 <= check_samples <= 64; give e.g. 4, or 0 to skip the check");
+    out.push_back("ComposeOptions: check_samples = " + std::to_string(check_samples) +
+                  " breaks the rule 0 <= check_samples <= 64; give e.g. 4, or 0 to skip the check");
   return out;
 }
 
-void ComposeOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void ComposeOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 std::string ComposeReport::brief() const {
   std::ostringstream m;
   m.precision(3);
-  m << "exact composition: degree " << degree_u << " x " << degree_v << ", " << patches << " patches, "
-    << control_points << " control points, " << knots_removed << " knots removed, " << splits
-    << " split knots, max relative deviation " << max_relative_deviation << " x " << size << " mm";
+  m << "exact composition: degree " << degree_u << " x " << degree_v << ", " << patches
+    << " patches, " << control_points << " control points, " << knots_removed << " knots removed, "
+    << splits << " split knots, max relative deviation " << max_relative_deviation << " x " << size
+    << " mm";
   return m.str();
 }
 
@@ -575,19 +602,22 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
       f = cell_factors(pc, {0, 0, 0}, {1, 1, 1});
       const auto [du, dv] = composed_degrees(f, lattice.degrees);
       if (std::max(du, dv) > surface::max_exchange_degree)
-        throw_degree(du, dv,
-                     "of surface " + patch_name(bp, a, b) + " (degree " + std::to_string(surface.u.degree) +
-                         " x " + std::to_string(surface.v.degree) + ") with a Bézier lattice of degrees (" +
-                         std::to_string(lattice.degrees[0]) + ", " + std::to_string(lattice.degrees[1]) +
-                         ", " + std::to_string(lattice.degrees[2]) + ")",
-                     "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
-                     "the deformed surface with a refit tolerance (certified refit)");
+        throw_degree(
+            du, dv,
+            "of surface " + patch_name(bp, a, b) + " (degree " + std::to_string(surface.u.degree) +
+                " x " + std::to_string(surface.v.degree) + ") with a Bézier lattice of degrees (" +
+                std::to_string(lattice.degrees[0]) + ", " + std::to_string(lattice.degrees[1]) +
+                ", " + std::to_string(lattice.degrees[2]) + ")",
+            "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
+            "the deformed surface with a refit tolerance (certified refit)");
     }
   std::vector<ComposedPatch> patches(static_cast<size_t>(np));
-  for (size_t k = 0; k < patches.size(); ++k) patches[k] = compose_patch(lattice, factors[k], rational);
-  return finish(bp, patches, rational, surface,
-                [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, lattice_size(lattice.points),
-                options, 0);
+  for (size_t k = 0; k < patches.size(); ++k)
+    patches[k] = compose_patch(lattice, factors[k], rational);
+  return finish(
+      bp, patches, rational, surface,
+      [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); },
+      lattice_size(lattice.points), options, 0);
 }
 
 ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface& surface,
@@ -610,23 +640,28 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
       std::array<double, 3> lo{}, width{};
       for (int d = 0; d < 3; ++d) {
         const Poly cw = ratio_poly(pc, d);
-        if (auto v = leaves(cw, 0, 1, face_tolerance)) throw_outside(bp, a, b, d, *v, "B-spline lattice");
+        if (auto v = leaves(cw, 0, 1, face_tolerance))
+          throw_outside(bp, a, b, d, *v, "B-spline lattice");
         const auto& br = cells.breaks[static_cast<size_t>(d)];
         const double centre = value_at(cw, 0.5, 0.5, 0) / value_at(cw, 0.5, 0.5, 1);
-        int cell = static_cast<int>(std::upper_bound(br.begin(), br.end(), centre) - br.begin()) - 1;
+        int cell =
+            static_cast<int>(std::upper_bound(br.begin(), br.end(), centre) - br.begin()) - 1;
         cell = std::clamp(cell, 0, counts[static_cast<size_t>(d)] - 1);
         // The cell holding the patch's centre, or a neighbour: a patch touching a knot plane at
         // its centre lies in the cell on the other side.
         // When none holds it, the message shows the smallest excursion out of its cell (a bump
         // just over the plane rather than the far corner of the cell above).
         auto excess = [&](const Violation& x, int c) {
-          return std::max(br[static_cast<size_t>(c)] - x.value, x.value - br[static_cast<size_t>(c + 1)]);
+          return std::max(br[static_cast<size_t>(c)] - x.value,
+                          x.value - br[static_cast<size_t>(c + 1)]);
         };
-        std::optional<Violation> v = leaves(cw, br[static_cast<size_t>(cell)], br[static_cast<size_t>(cell + 1)], face_tolerance);
+        std::optional<Violation> v = leaves(cw, br[static_cast<size_t>(cell)],
+                                            br[static_cast<size_t>(cell + 1)], face_tolerance);
         int shown = cell;
         for (int next : {cell - 1, cell + 1}) {
           if (!v || next < 0 || next >= counts[static_cast<size_t>(d)]) continue;
-          auto w = leaves(cw, br[static_cast<size_t>(next)], br[static_cast<size_t>(next + 1)], face_tolerance);
+          auto w = leaves(cw, br[static_cast<size_t>(next)], br[static_cast<size_t>(next + 1)],
+                          face_tolerance);
           if (!w) {
             cell = next;
             v.reset();
@@ -635,20 +670,25 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
             shown = next;
           }
         }
-        const double c0 = br[static_cast<size_t>(v ? shown : cell)], c1 = br[static_cast<size_t>((v ? shown : cell) + 1)];
+        const double c0 = br[static_cast<size_t>(v ? shown : cell)],
+                     c1 = br[static_cast<size_t>((v ? shown : cell) + 1)];
         if (v) {
           const double plane = v->value < c0 ? c0 : c1;
           const auto [u, w] = global_parameter(bp, a, b, v->x, v->y);
-          throw Error(ErrorCategory::InvalidArgument,
-                      "compose_exact: surface " + patch_name(bp, a, b) + " crosses the lattice knot plane " +
-                          coordinate_name[d] + " = " + format(plane) + " (" +
-                          (v->certain ? coordinate_name[d] + std::string(" = ") + format(v->value) + " at parameter ("
-                                      : std::string("not decided: the convex hull's bound ") + coordinate_name[d] +
-                                            " = " + format(v->value) + " near parameter (") +
-                          format(u) + ", " + format(w) +
-                          ")) other than along an iso-parameter line: no single polynomial patch is "
-                          "exact there; approximate the deformed surface with a refit tolerance "
-                          "(certified refit), or move the knot plane off the surface");
+          throw Error(
+              ErrorCategory::InvalidArgument,
+              "compose_exact: surface " + patch_name(bp, a, b) +
+                  " crosses the lattice knot plane " + coordinate_name[d] + " = " + format(plane) +
+                  " (" +
+                  (v->certain
+                       ? coordinate_name[d] + std::string(" = ") + format(v->value) +
+                             " at parameter ("
+                       : std::string("not decided: the convex hull's bound ") + coordinate_name[d] +
+                             " = " + format(v->value) + " near parameter (") +
+                  format(u) + ", " + format(w) +
+                  ")) other than along an iso-parameter line: no single polynomial patch is "
+                  "exact there; approximate the deformed surface with a refit tolerance "
+                  "(certified refit), or move the knot plane off the surface");
         }
         index[static_cast<size_t>(d)] = cell;
         lo[static_cast<size_t>(d)] = c0;
@@ -659,21 +699,26 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
       factors[k] = cell_factors(pc, lo, width);
       const auto [du, dv] = composed_degrees(factors[k], cell_of[k]->degrees);
       if (std::max(du, dv) > surface::max_exchange_degree)
-        throw_degree(du, dv,
-                     "of surface " + patch_name(bp, a, b) + " with a B-spline lattice of degrees (" +
-                         std::to_string(lattice.bases[0].degree) + ", " + std::to_string(lattice.bases[1].degree) +
-                         ", " + std::to_string(lattice.bases[2].degree) + ")",
-                     "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
-                     "the deformed surface with a refit tolerance (certified refit)");
+        throw_degree(
+            du, dv,
+            "of surface " + patch_name(bp, a, b) + " with a B-spline lattice of degrees (" +
+                std::to_string(lattice.bases[0].degree) + ", " +
+                std::to_string(lattice.bases[1].degree) + ", " +
+                std::to_string(lattice.bases[2].degree) + ")",
+            "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
+            "the deformed surface with a refit tolerance (certified refit)");
     }
   std::vector<ComposedPatch> patches(bp.patches.size());
-  for (size_t k = 0; k < patches.size(); ++k) patches[k] = compose_patch(*cell_of[k], factors[k], rational);
-  return finish(bp, patches, rational, split,
-                [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, lattice_size(lattice.points),
-                options, splits);
+  for (size_t k = 0; k < patches.size(); ++k)
+    patches[k] = compose_patch(*cell_of[k], factors[k], rational);
+  return finish(
+      bp, patches, rational, split,
+      [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); },
+      lattice_size(lattice.points), options, splits);
 }
 
-ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface, const ComposeOptions& options) {
+ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface,
+                            const ComposeOptions& options) {
   options.validate();
   validate(taper, "compose_exact: taper");
   surface::validate(surface, "compose_exact: surface");
@@ -694,7 +739,8 @@ ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface, c
   std::vector<ComposedPatch> patches(bp.patches.size());
   for (int a = 0; a < bp.count_u(); ++a)
     for (int b = 0; b < bp.count_v(); ++b) {
-      const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), taper.frame.origin, {ex, ey, ez});
+      const PatchCoordinates pc =
+          patch_coordinates(bp.patch(a, b), taper.frame.origin, {ex, ey, ez});
       const auto wd = weight_degrees(pc);
       const double tol = degree_tolerance * pc.c_scale;
       // e: joint exact degrees of (X, Y, Z, W) on the patch.
@@ -737,16 +783,19 @@ ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface, c
         for (int i = 0; i <= D; ++i) {
           if (profile[static_cast<size_t>(i)] == 0) continue;
           Poly term = multiply(zp[static_cast<size_t>(i)], wp[static_cast<size_t>(D - i)]);
-          for (size_t k = 0; k < R.c.size(); ++k) R.c[k] += profile[static_cast<size_t>(i)] * term.c[k];
+          for (size_t k = 0; k < R.c.size(); ++k)
+            R.c[k] += profile[static_cast<size_t>(i)] * term.c[k];
         }
         WD = std::move(wp.back());
       }
       const int du = R.du + eu, dv = R.dv + ev;
       if (std::max(du, dv) > surface::max_exchange_degree)
-        throw_degree(du, dv,
-                     "of surface " + patch_name(bp, a, b) + " with a taper profile of degree " + std::to_string(D),
-                     "use a taper profile of lower degree, or approximate the deformed surface with a "
-                     "refit tolerance (certified refit)");
+        throw_degree(
+            du, dv,
+            "of surface " + patch_name(bp, a, b) + " with a taper profile of degree " +
+                std::to_string(D),
+            "use a taper profile of lower degree, or approximate the deformed surface with a "
+            "refit tolerance (certified refit)");
       Poly rxy = multiply(xy, R), wzw = multiply(zw, WD);
       scale(rxy, true);
       scale(wzw, true);
@@ -755,7 +804,8 @@ ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface, c
       out.h = Poly(du, dv, 4);
       for (int i = 0; i <= du; ++i)
         for (int j = 0; j <= dv; ++j) {
-          const double X = rxy.at(i, j, 0), Y = rxy.at(i, j, 1), Z = wzw.at(i, j, 0), W = wzw.at(i, j, 1);
+          const double X = rxy.at(i, j, 0), Y = rxy.at(i, j, 1), Z = wzw.at(i, j, 0),
+                       W = wzw.at(i, j, 1);
           for (int d = 0; d < 3; ++d)
             out.h.at(i, j, d) = ex[d] * X + ey[d] * Y + ez[d] * Z + taper.frame.origin[d] * W;
           out.h.at(i, j, 3) = rational ? W : 1.0;
@@ -763,8 +813,10 @@ ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface, c
       patches[static_cast<size_t>(a * bp.count_v() + b)] = std::move(out);
     }
   const auto box = surface::control_box(surface);
-  return finish(bp, patches, rational, surface, [&](const Eigen::Vector3d& x) { return deform_point(taper, x); },
-                (box.second - box.first).norm(), options, 0);
+  return finish(
+      bp, patches, rational, surface,
+      [&](const Eigen::Vector3d& x) { return deform_point(taper, x); },
+      (box.second - box.first).norm(), options, 0);
 }
 
 }  // namespace clay::deform

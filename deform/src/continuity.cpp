@@ -21,13 +21,14 @@ void check_order(const FaceContinuity& fc, int degree) {
   if (fc.order < 0 || fc.order > degree)
     throw Error(ErrorCategory::InvalidArgument,
                 std::string("FaceContinuity{") + face_name[static_cast<int>(fc.face)] +
-                    "}.order = " + std::to_string(fc.order) + " breaks the rule 0 <= order <= " +
-                    std::to_string(degree) +
+                    "}.order = " + std::to_string(fc.order) +
+                    " breaks the rule 0 <= order <= " + std::to_string(degree) +
                     " (the lattice degree across that face); ask for C^0 up to C^degree");
 }
 
 /// Marks every control point whose index along direction d is flagged in `planes`.
-void mark(std::vector<bool>& locked, std::array<int, 3> counts, int d, const std::vector<bool>& planes) {
+void mark(std::vector<bool>& locked, std::array<int, 3> counts, int d,
+          const std::vector<bool>& planes) {
   for (int i = 0; i < counts[0]; ++i)
     for (int j = 0; j < counts[1]; ++j)
       for (int k = 0; k < counts[2]; ++k) {
@@ -50,7 +51,8 @@ std::vector<bool> locked_control_points(const BezierLattice& lattice,
     check_order(fc, p);
     // Sederberg–Parry §3.1: C^k needs the face plane and the k planes next to it undisplaced.
     std::vector<bool> planes(static_cast<size_t>(p + 1), false);
-    for (int r = 0; r <= fc.order; ++r) planes[static_cast<size_t>(at_max(fc.face) ? p - r : r)] = true;
+    for (int r = 0; r <= fc.order; ++r)
+      planes[static_cast<size_t>(at_max(fc.face) ? p - r : r)] = true;
     mark(locked, counts, d, planes);
   }
   return locked;
@@ -93,7 +95,8 @@ Lattice reset(Lattice lattice, std::span<const FaceContinuity> faces) {
   const std::vector<bool> locked = locked_control_points(lattice, faces);
   const Points3 rest = undisplaced_points(lattice);
   for (size_t r = 0; r < locked.size(); ++r)
-    if (locked[r]) lattice.points.row(static_cast<Eigen::Index>(r)) = rest.row(static_cast<Eigen::Index>(r));
+    if (locked[r])
+      lattice.points.row(static_cast<Eigen::Index>(r)) = rest.row(static_cast<Eigen::Index>(r));
   return lattice;
 }
 

@@ -15,6 +15,8 @@ std::vector<std::string> DeformOptions::problems() const {
   return out;
 }
 
-void DeformOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void DeformOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 }  // namespace clay::deform

@@ -1,8 +1,8 @@
 #include <clay/deform/direct_manipulation.hpp>
 
 #include <clay/error.hpp>
-#include <clay/surface/basis.hpp>
 #include <clay/internal/checks.hpp>
+#include <clay/surface/basis.hpp>
 
 #include <Eigen/QR>  // the complete orthogonal decomposition
 
@@ -21,8 +21,8 @@ namespace clay::deform {
 
 namespace {
 
-using internal::all_finite;
 using detail::format;
+using internal::all_finite;
 
 /// All Bernstein polynomials of degree n at t (The NURBS Book A1.3), written to b[0..n].
 void all_bernstein(int n, double t, std::vector<double>& b) {
@@ -69,9 +69,9 @@ std::vector<Eigen::Vector3d> selected_locals(const Frame& frame, const Points3& 
   for (Eigen::Index i = 0; i < points.rows(); ++i) {
     const Eigen::Vector3d x = points.row(i).transpose();
     if (!all_finite(x))
-      throw Error(ErrorCategory::InvalidArgument,
-                  "direct manipulation: selected point #" + std::to_string(i) + " " + format(x) +
-                      " is not finite; give finite coordinates");
+      throw Error(ErrorCategory::InvalidArgument, "direct manipulation: selected point #" +
+                                                      std::to_string(i) + " " + format(x) +
+                                                      " is not finite; give finite coordinates");
     const Eigen::Vector3d local = local_coordinates(frame, x);
     if (!inside(local))
       throw Error(ErrorCategory::OutOfDomain,
@@ -98,9 +98,9 @@ std::vector<Eigen::Triplet<double>> influence_triplets(const Lattice& lattice,
         for (size_t e = 0; e < b[2].values.size(); ++e) {
           const double w = b[0].values[a] * b[1].values[c] * b[2].values[e];
           if (w == 0.0) continue;
-          const Eigen::Index column = lattice.index(b[0].first + static_cast<int>(a),
-                                                    b[1].first + static_cast<int>(c),
-                                                    b[2].first + static_cast<int>(e));
+          const Eigen::Index column =
+              lattice.index(b[0].first + static_cast<int>(a), b[1].first + static_cast<int>(c),
+                            b[2].first + static_cast<int>(e));
           triplets.emplace_back(static_cast<int>(i), static_cast<int>(column), w);
         }
   }
@@ -108,7 +108,8 @@ std::vector<Eigen::Triplet<double>> influence_triplets(const Lattice& lattice,
 }
 
 template <class Lattice>
-Eigen::SparseMatrix<double, Eigen::RowMajor> influence(const Lattice& lattice, const Points3& points) {
+Eigen::SparseMatrix<double, Eigen::RowMajor> influence(const Lattice& lattice,
+                                                       const Points3& points) {
   validate(lattice);
   const auto locals = selected_locals(lattice.frame, points);
   Eigen::SparseMatrix<double, Eigen::RowMajor> b(points.rows(), lattice.points.rows());
@@ -128,39 +129,36 @@ double lattice_size(const Frame& f) {
 std::vector<std::string> DirectManipulationOptions::problems() const {
   std::vector<std::string> out;
   if (!(std::isfinite(rank_tolerance) && rank_tolerance > 0 && rank_tolerance < 1))
-    out.push_back(
-                "DirectManipulationOptions::rank_tolerance = " + format(rank_tolerance) +
-                    " breaks the rule 0 < rank_tolerance < 1; give a small relative threshold "
-                    "such as 1e-10");
+    out.push_back("DirectManipulationOptions::rank_tolerance = " + format(rank_tolerance) +
+                  " breaks the rule 0 < rank_tolerance < 1; give a small relative threshold "
+                  "such as 1e-10");
   if (!(std::isfinite(tolerance) && tolerance > 0))
-    out.push_back(
-                "DirectManipulationOptions::tolerance = " + format(tolerance) +
-                    " breaks the rule tolerance > 0 (finite, relative to the lattice size); "
-                    "give e.g. 1e-7");
+    out.push_back("DirectManipulationOptions::tolerance = " + format(tolerance) +
+                  " breaks the rule tolerance > 0 (finite, relative to the lattice size); "
+                  "give e.g. 1e-7");
   std::set<Eigen::Index> seen;
   for (size_t g = 0; g < tied.size(); ++g) {
     const std::string name = "DirectManipulationOptions::tied[" + std::to_string(g) + "]";
     if (tied[g].size() < 2)
-      out.push_back(
-                  name + " has " + std::to_string(tied[g].size()) +
-                      " control point(s), breaking the rule of at least 2 per group; "
-                      "drop the group or add the rows it ties");
+      out.push_back(name + " has " + std::to_string(tied[g].size()) +
+                    " control point(s), breaking the rule of at least 2 per group; "
+                    "drop the group or add the rows it ties");
     for (const Eigen::Index r : tied[g]) {
       if (r < 0)
-        out.push_back(
-                    name + " holds the row " + std::to_string(r) +
-                        ", breaking the rule row >= 0; give control point rows (lattice.index)");
+        out.push_back(name + " holds the row " + std::to_string(r) +
+                      ", breaking the rule row >= 0; give control point rows (lattice.index)");
       if (!seen.insert(r).second)
-        out.push_back(
-                    name + " holds the row " + std::to_string(r) +
-                        " that is already tied (in this or an earlier group); merge the groups "
-                        "that share it");
+        out.push_back(name + " holds the row " + std::to_string(r) +
+                      " that is already tied (in this or an earlier group); merge the groups "
+                      "that share it");
     }
   }
   return out;
 }
 
-void DirectManipulationOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void DirectManipulationOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 std::string DirectManipulationReport::brief() const {
   return std::string(feasible ? "feasible" : "not feasible") + ": " + std::to_string(requested) +
@@ -206,83 +204,88 @@ DirectManipulator<Lattice>::DirectManipulator(const Lattice& lattice, const Poin
         s.lattice = lattice;
         s.points = points;
         s.options = options;
-  validate(s.lattice);
-  s.options.validate();
-  if (s.points.rows() == 0)
-    throw Error(ErrorCategory::InvalidArgument,
-                "direct manipulation: no point selected; give at least one point to move");
-  const Eigen::Index M = s.lattice.points.rows();
-  if (!s.options.locked.empty() && static_cast<Eigen::Index>(s.options.locked.size()) != M)
-    throw Error(ErrorCategory::InvalidArgument,
-                "DirectManipulationOptions::locked has " + std::to_string(s.options.locked.size()) +
-                    " entries for a lattice of " + std::to_string(M) +
-                    " control points; give one entry per control point, or none");
-  for (size_t g = 0; g < s.options.tied.size(); ++g)
-    for (const Eigen::Index r : s.options.tied[g])
-      if (r >= M)
-        throw Error(ErrorCategory::InvalidArgument,
-                    "DirectManipulationOptions::tied[" + std::to_string(g) + "] holds the row " +
-                        std::to_string(r) + ", outside the lattice's rows [0, " +
-                        std::to_string(M) + "); give rows lattice.index(i, j, k)");
-  s.size = lattice_size(s.lattice.frame);
+        validate(s.lattice);
+        s.options.validate();
+        if (s.points.rows() == 0)
+          throw Error(ErrorCategory::InvalidArgument,
+                      "direct manipulation: no point selected; give at least one point to move");
+        const Eigen::Index M = s.lattice.points.rows();
+        if (!s.options.locked.empty() && static_cast<Eigen::Index>(s.options.locked.size()) != M)
+          throw Error(ErrorCategory::InvalidArgument,
+                      "DirectManipulationOptions::locked has " +
+                          std::to_string(s.options.locked.size()) + " entries for a lattice of " +
+                          std::to_string(M) +
+                          " control points; give one entry per control point, or none");
+        for (size_t g = 0; g < s.options.tied.size(); ++g)
+          for (const Eigen::Index r : s.options.tied[g])
+            if (r >= M)
+              throw Error(ErrorCategory::InvalidArgument,
+                          "DirectManipulationOptions::tied[" + std::to_string(g) +
+                              "] holds the row " + std::to_string(r) +
+                              ", outside the lattice's rows [0, " + std::to_string(M) +
+                              "); give rows lattice.index(i, j, k)");
+        s.size = lattice_size(s.lattice.frame);
 
-  // The unknowns before restriction: Hsu's S (eq. (6)) compressed to a vector, unknown[r] = the
-  // unknown row r follows, or -1 when locked; a group with a locked row is locked as a whole.
-  std::vector<Eigen::Index> unknown(static_cast<size_t>(M), -2);
-  std::vector<std::vector<Eigen::Index>> members;
-  auto is_locked = [&](Eigen::Index r) {
-    return !s.options.locked.empty() && s.options.locked[static_cast<size_t>(r)];
-  };
-  for (const auto& group : s.options.tied) {
-    const bool locked = std::any_of(group.begin(), group.end(), is_locked);
-    for (const Eigen::Index r : group)
-      unknown[static_cast<size_t>(r)] = locked ? -1 : static_cast<Eigen::Index>(members.size());
-    if (!locked) members.push_back(group);
-  }
-  for (Eigen::Index r = 0; r < M; ++r) {
-    if (unknown[static_cast<size_t>(r)] != -2) continue;
-    if (is_locked(r)) {
-      unknown[static_cast<size_t>(r)] = -1;
-    } else {
-      unknown[static_cast<size_t>(r)] = static_cast<Eigen::Index>(members.size());
-      members.push_back({r});
-    }
-  }
+        // The unknowns before restriction: Hsu's S (eq. (6)) compressed to a vector, unknown[r] =
+        // the unknown row r follows, or -1 when locked; a group with a locked row is locked as a
+        // whole.
+        std::vector<Eigen::Index> unknown(static_cast<size_t>(M), -2);
+        std::vector<std::vector<Eigen::Index>> members;
+        auto is_locked = [&](Eigen::Index r) {
+          return !s.options.locked.empty() && s.options.locked[static_cast<size_t>(r)];
+        };
+        for (const auto& group : s.options.tied) {
+          const bool locked = std::any_of(group.begin(), group.end(), is_locked);
+          for (const Eigen::Index r : group)
+            unknown[static_cast<size_t>(r)] =
+                locked ? -1 : static_cast<Eigen::Index>(members.size());
+          if (!locked) members.push_back(group);
+        }
+        for (Eigen::Index r = 0; r < M; ++r) {
+          if (unknown[static_cast<size_t>(r)] != -2) continue;
+          if (is_locked(r)) {
+            unknown[static_cast<size_t>(r)] = -1;
+          } else {
+            unknown[static_cast<size_t>(r)] = static_cast<Eigen::Index>(members.size());
+            members.push_back({r});
+          }
+        }
 
-  // B (eq. (2)), then B S restricted to the unknowns acting on some selected point: the others
-  // would get a zero displacement in the minimal-norm solution anyway.
-  const Eigen::SparseMatrix<double, Eigen::RowMajor> b = influence(s.lattice, s.points);
-  std::vector<Eigen::Index> column(members.size(), -1);
-  for (Eigen::Index i = 0; i < b.outerSize(); ++i)
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(b, i); it; ++it) {
-      const Eigen::Index g = unknown[static_cast<size_t>(it.col())];
-      if (g < 0 || column[static_cast<size_t>(g)] >= 0) continue;
-      column[static_cast<size_t>(g)] = static_cast<Eigen::Index>(s.columns.size());
-      s.columns.push_back(members[static_cast<size_t>(g)]);
-    }
-  s.a = Eigen::MatrixXd::Zero(s.points.rows(), static_cast<Eigen::Index>(s.columns.size()));
-  for (Eigen::Index i = 0; i < b.outerSize(); ++i)
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(b, i); it; ++it) {
-      const Eigen::Index g = unknown[static_cast<size_t>(it.col())];
-      if (g >= 0) s.a(i, column[static_cast<size_t>(g)]) += it.value();  // Hsu eq. (6): B S
-    }
+        // B (eq. (2)), then B S restricted to the unknowns acting on some selected point: the
+        // others would get a zero displacement in the minimal-norm solution anyway.
+        const Eigen::SparseMatrix<double, Eigen::RowMajor> b = influence(s.lattice, s.points);
+        std::vector<Eigen::Index> column(members.size(), -1);
+        for (Eigen::Index i = 0; i < b.outerSize(); ++i)
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(b, i); it; ++it) {
+            const Eigen::Index g = unknown[static_cast<size_t>(it.col())];
+            if (g < 0 || column[static_cast<size_t>(g)] >= 0) continue;
+            column[static_cast<size_t>(g)] = static_cast<Eigen::Index>(s.columns.size());
+            s.columns.push_back(members[static_cast<size_t>(g)]);
+          }
+        s.a = Eigen::MatrixXd::Zero(s.points.rows(), static_cast<Eigen::Index>(s.columns.size()));
+        for (Eigen::Index i = 0; i < b.outerSize(); ++i)
+          for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(b, i); it; ++it) {
+            const Eigen::Index g = unknown[static_cast<size_t>(it.col())];
+            if (g >= 0) s.a(i, column[static_cast<size_t>(g)]) += it.value();  // Hsu eq. (6): B S
+          }
 
-  s.images.resize(s.points.rows(), 3);
-  for (Eigen::Index i = 0; i < s.points.rows(); ++i)
-    s.images.row(i) = deform_point(s.lattice, Eigen::Vector3d(s.points.row(i).transpose())).transpose();
+        s.images.resize(s.points.rows(), 3);
+        for (Eigen::Index i = 0; i < s.points.rows(); ++i)
+          s.images.row(i) =
+              deform_point(s.lattice, Eigen::Vector3d(s.points.row(i).transpose())).transpose();
 
-  if (s.a.cols() > 0) {
-    // Rank-revealing QR + RZ: the full-rank factorization B S = C D of eq. (3). B is
-    // dimensionless (its rows sum to 1), so pivots are compared with rank_tolerance itself, not
-    // with the largest pivot: a point that only tiny weights reach (on a face next to locked
-    // planes) gets no move rather than a huge one. Eigen's threshold is relative to the largest
-    // pivot, which is the largest column norm (the first column pivot).
-    s.cod.setThreshold(s.options.rank_tolerance / s.a.colwise().norm().maxCoeff());
-    s.cod.compute(s.a);
-    s.rank = static_cast<int>(s.cod.rank());
-  }
-  return std::shared_ptr<const State>(std::move(st));
-  }()) {}
+        if (s.a.cols() > 0) {
+          // Rank-revealing QR + RZ: the full-rank factorization B S = C D of eq. (3). B is
+          // dimensionless (its rows sum to 1), so pivots are compared with rank_tolerance itself,
+          // not with the largest pivot: a point that only tiny weights reach (on a face next to
+          // locked planes) gets no move rather than a huge one. Eigen's threshold is relative to
+          // the largest pivot, which is the largest column norm (the first column pivot).
+          s.cod.setThreshold(s.options.rank_tolerance / s.a.colwise().norm().maxCoeff());
+          s.cod.compute(s.a);
+          s.rank = static_cast<int>(s.cod.rank());
+        }
+        return std::shared_ptr<const State>(std::move(st));
+      }()) {}
 
 template <class Lattice>
 DirectManipulationResult<Lattice> DirectManipulator<Lattice>::move(const Points3& targets) const {
@@ -306,7 +309,8 @@ DirectManipulationResult<Lattice> DirectManipulator<Lattice>::move(const Points3
 
   DirectManipulationResult<Lattice> out{s.lattice, {}};
   for (size_t c = 0; c < s.columns.size(); ++c)
-    for (const Eigen::Index r : s.columns[c]) out.lattice.points.row(r) += dp.row(static_cast<Eigen::Index>(c));
+    for (const Eigen::Index r : s.columns[c])
+      out.lattice.points.row(r) += dp.row(static_cast<Eigen::Index>(c));
 
   DirectManipulationReport& rep = out.report;
   rep.requested = static_cast<int>(n);
@@ -314,8 +318,10 @@ DirectManipulationResult<Lattice> DirectManipulator<Lattice>::move(const Points3
   rep.rank = s.rank;
   rep.residual = (s.a * dp - dq).norm();
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d reached = deform_point(out.lattice, Eigen::Vector3d(s.points.row(i).transpose()));
-    rep.achieved_max_error = std::max(rep.achieved_max_error, (reached - targets.row(i).transpose()).norm());
+    const Eigen::Vector3d reached =
+        deform_point(out.lattice, Eigen::Vector3d(s.points.row(i).transpose()));
+    rep.achieved_max_error =
+        std::max(rep.achieved_max_error, (reached - targets.row(i).transpose()).norm());
   }
   rep.displacement_norm = (out.lattice.points - s.lattice.points).norm();
   const double tolerance = s.options.tolerance * s.size;
@@ -324,25 +330,26 @@ DirectManipulationResult<Lattice> DirectManipulator<Lattice>::move(const Points3
   const std::string counts = "rank " + std::to_string(rep.rank) + " for " + std::to_string(n) +
                              " point(s) and " + std::to_string(rep.unknowns) + " unknowns";
   rep.summary.final_residual = rep.achieved_max_error;
-  rep.summary.termination = rep.feasible ? Termination::Converged
+  rep.summary.termination = rep.feasible    ? Termination::Converged
                             : rep.rank == 0 ? Termination::Failed
                                             : Termination::NotConverged;
   if (rep.feasible) {
     rep.summary.message = "every selected point reaches its target (largest miss " +
-                  format(rep.achieved_max_error, 3) + " mm, tolerance " + format(tolerance, 3) +
-                  " mm); " + counts +
-                  (rep.rank < rep.requested ? " (some requests repeat others)" : "");
+                          format(rep.achieved_max_error, 3) + " mm, tolerance " +
+                          format(tolerance, 3) + " mm); " + counts +
+                          (rep.rank < rep.requested ? " (some requests repeat others)" : "");
   } else if (rep.rank == 0) {
-    rep.summary.message = "no free control point acts on the selected points (those that do are all "
-                  "locked, or weigh below rank_tolerance): nothing moved, largest miss " +
-                  format(rep.achieved_max_error, 3) +
-                  " mm; unlock control points near the selected points";
+    rep.summary.message =
+        "no free control point acts on the selected points (those that do are all "
+        "locked, or weigh below rank_tolerance): nothing moved, largest miss " +
+        format(rep.achieved_max_error, 3) + " mm; unlock control points near the selected points";
   } else {
-    rep.summary.message = "the request cannot be met (" + counts + "): least-squares compromise, residual " +
-                  format(rep.residual, 3) + " mm, largest miss " + format(rep.achieved_max_error, 3) +
-                  " mm above the tolerance " + format(tolerance, 3) +
-                  " mm; refine the lattice (more cells or a higher degree), unlock control points "
-                  "or drop conflicting requests";
+    rep.summary.message =
+        "the request cannot be met (" + counts + "): least-squares compromise, residual " +
+        format(rep.residual, 3) + " mm, largest miss " + format(rep.achieved_max_error, 3) +
+        " mm above the tolerance " + format(tolerance, 3) +
+        " mm; refine the lattice (more cells or a higher degree), unlock control points "
+        "or drop conflicting requests";
   }
   return out;
 }
@@ -370,7 +377,8 @@ template class DirectManipulator<BezierLattice>;
 namespace {
 
 template <class Lattice>
-DirectManipulationResult<Lattice> manipulate_impl(const Lattice& lattice, std::span<const PointMove> moves,
+DirectManipulationResult<Lattice> manipulate_impl(const Lattice& lattice,
+                                                  std::span<const PointMove> moves,
                                                   const DirectManipulationOptions& options) {
   Points3 points(static_cast<Eigen::Index>(moves.size()), 3), targets(points.rows(), 3);
   for (size_t i = 0; i < moves.size(); ++i) {

@@ -27,8 +27,8 @@ namespace clay::deform {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using internal::all_finite;
 using detail::format;
+using internal::all_finite;
 using Ctrl = std::array<Vec3, chunk_control_points>;
 
 constexpr std::size_t min_freeze_points_per_thread = 1024;
@@ -81,18 +81,22 @@ Ctrl halve(const Ctrl& in, int dir, bool upper) {
     for (int b = 0; b < 4; ++b) {
       // The other two indices, in the order of the remaining directions.
       int base;
-      if (dir == 0) base = a * 4 + b;
-      else if (dir == 1) base = a * 16 + b;
-      else base = a * 16 + b * 4;
+      if (dir == 0)
+        base = a * 4 + b;
+      else if (dir == 1)
+        base = a * 16 + b;
+      else
+        base = a * 16 + b * 4;
       const Vec3 p0 = in[static_cast<size_t>(base)], p1 = in[static_cast<size_t>(base + stride)],
                  p2 = in[static_cast<size_t>(base + 2 * stride)],
                  p3 = in[static_cast<size_t>(base + 3 * stride)];
       const Vec3 q01 = 0.5 * (p0 + p1), q12 = 0.5 * (p1 + p2), q23 = 0.5 * (p2 + p3);
       const Vec3 r0 = 0.5 * (q01 + q12), r1 = 0.5 * (q12 + q23);
       const Vec3 m = 0.5 * (r0 + r1);
-      const std::array<Vec3, 4> half = upper ? std::array<Vec3, 4>{m, r1, q23, p3}
-                                             : std::array<Vec3, 4>{p0, q01, r0, m};
-      for (int r = 0; r < 4; ++r) out[static_cast<size_t>(base + r * stride)] = half[static_cast<size_t>(r)];
+      const std::array<Vec3, 4> half =
+          upper ? std::array<Vec3, 4>{m, r1, q23, p3} : std::array<Vec3, 4>{p0, q01, r0, m};
+      for (int r = 0; r < 4; ++r)
+        out[static_cast<size_t>(base + r * stride)] = half[static_cast<size_t>(r)];
     }
   return out;
 }
@@ -104,11 +108,10 @@ constexpr int max_directions = fixed_directions + 3;
 
 const std::array<Vec3, fixed_directions>& dop_directions() {
   static const std::array<Vec3, fixed_directions> d = [] {
-    std::array<Vec3, fixed_directions> r = {Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),
-                                            Vec3(1, 1, 0),  Vec3(1, -1, 0), Vec3(1, 0, 1),
-                                            Vec3(1, 0, -1), Vec3(0, 1, 1),  Vec3(0, 1, -1),
-                                            Vec3(1, 1, 1),  Vec3(1, 1, -1), Vec3(1, -1, 1),
-                                            Vec3(-1, 1, 1)};
+    std::array<Vec3, fixed_directions> r = {
+        Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1), Vec3(1, 1, 0),  Vec3(1, -1, 0),
+        Vec3(1, 0, 1),  Vec3(1, 0, -1), Vec3(0, 1, 1), Vec3(0, 1, -1), Vec3(1, 1, 1),
+        Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(-1, 1, 1)};
     for (auto& v : r) v.normalize();
     return r;
   }();
@@ -162,14 +165,15 @@ Dop make_dop(const Ctrl& P, double margin) {
   return dop;
 }
 
-// ---- prepared chunks and the candidate grid -------------------------------------------------------
+// ---- prepared chunks and the candidate grid
+// -------------------------------------------------------
 
 struct ChunkData {
-  Ctrl ctrl;     // rest control points relative to `centre`
-  Vec3 centre;   // centre of the control points' bounding box
-  Vec3 lo, hi;   // bounding box of the control points with the margin (absolute)
-  double size;   // bounding box diagonal (mm)
-  double margin; // hull tests accept points this close to the hull (mm)
+  Ctrl ctrl;      // rest control points relative to `centre`
+  Vec3 centre;    // centre of the control points' bounding box
+  Vec3 lo, hi;    // bounding box of the control points with the margin (absolute)
+  double size;    // bounding box diagonal (mm)
+  double margin;  // hull tests accept points this close to the hull (mm)
   Dop dop;
 };
 
@@ -238,10 +242,10 @@ Prepared prepare(const ExtendedLattice& lattice, const FreezeOptions& options) {
     std::array<int, 3> a{}, b{};
     for (int d = 0; d < 3; ++d) {
       const int n = g.n[static_cast<size_t>(d)];
-      a[static_cast<size_t>(d)] =
-          std::clamp(static_cast<int>((prep.chunks[c].lo[d] - g.lo[d]) * g.inverse_cell[d]), 0, n - 1);
-      b[static_cast<size_t>(d)] =
-          std::clamp(static_cast<int>((prep.chunks[c].hi[d] - g.lo[d]) * g.inverse_cell[d]), 0, n - 1);
+      a[static_cast<size_t>(d)] = std::clamp(
+          static_cast<int>((prep.chunks[c].lo[d] - g.lo[d]) * g.inverse_cell[d]), 0, n - 1);
+      b[static_cast<size_t>(d)] = std::clamp(
+          static_cast<int>((prep.chunks[c].hi[d] - g.lo[d]) * g.inverse_cell[d]), 0, n - 1);
     }
     for (int x = a[0]; x <= b[0]; ++x)
       for (int y = a[1]; y <= b[1]; ++y)
@@ -250,14 +254,15 @@ Prepared prepare(const ExtendedLattice& lattice, const FreezeOptions& options) {
   }
   g.start.assign(static_cast<size_t>(cells) + 1, 0);
   for (int c = 0; c < cells; ++c)
-    g.start[static_cast<size_t>(c) + 1] = g.start[static_cast<size_t>(c)] +
-                                          static_cast<int>(lists[static_cast<size_t>(c)].size());
+    g.start[static_cast<size_t>(c) + 1] =
+        g.start[static_cast<size_t>(c)] + static_cast<int>(lists[static_cast<size_t>(c)].size());
   g.items.reserve(static_cast<size_t>(g.start.back()));
   for (const auto& l : lists) g.items.insert(g.items.end(), l.begin(), l.end());
   return prep;
 }
 
-// ---- Newton's method (Coquillart §3.3) ---------------------------------------------------------------
+// ---- Newton's method (Coquillart §3.3)
+// ---------------------------------------------------------------
 
 struct Counters {
   Eigen::Index inside = 0, outside = 0, unresolved = 0, subdivided = 0, splits = 0, pseudo = 0;
@@ -275,7 +280,8 @@ struct NewtonRun {
 /// Jacobian, or the Moore–Penrose pseudo-inverse where the Jacobian is (nearly) singular (Lukács,
 /// as Coquillart §3.3 proposes). Fails on divergence (q leaves [-1, 2]^3), on a stall of
 /// pseudo-inverse steps, or at the iteration limit.
-NewtonRun newton(const ChunkData& cd, const Vec3& x, Vec3 q, const FreezeOptions& o, Counters& count) {
+NewtonRun newton(const ChunkData& cd, const Vec3& x, Vec3 q, const FreezeOptions& o,
+                 Counters& count) {
   NewtonRun run;
   const double tol = o.newton_tolerance * cd.size;
   const double cutoff = std::max(o.pseudo_inverse_threshold, 1e-15);
@@ -331,7 +337,8 @@ NewtonRun newton(const ChunkData& cd, const Vec3& x, Vec3 q, const FreezeOptions
     if (it == o.max_iterations) return run;
     ++count.iterations;
     if (!step_of(r, step, pseudo)) return run;
-    if (pseudo && rn >= 0.999 * previous) return run;  // the pseudo-inverse cannot reduce it further
+    if (pseudo && rn >= 0.999 * previous)
+      return run;  // the pseudo-inverse cannot reduce it further
     previous = rn;
     q += step;
     for (int d = 0; d < 3; ++d)
@@ -404,8 +411,8 @@ FrozenPoint locate(const Prepared& prep, const Vec3& x, const FreezeOptions& o, 
     count.worst_residual = std::max(count.worst_residual, run.residual);
     count.worst_initial = std::max(count.worst_initial, run.initial);
   };
-  for (int i = prep.grid.start[static_cast<size_t>(cell)]; i < prep.grid.start[static_cast<size_t>(cell) + 1];
-       ++i) {
+  for (int i = prep.grid.start[static_cast<size_t>(cell)];
+       i < prep.grid.start[static_cast<size_t>(cell) + 1]; ++i) {
     const int c = prep.grid.items[static_cast<size_t>(i)];
     const ChunkData& cd = prep.chunks[static_cast<size_t>(c)];
     if (!((x.array() >= cd.lo.array()).all() && (x.array() <= cd.hi.array()).all())) continue;
@@ -419,16 +426,18 @@ FrozenPoint locate(const Prepared& prep, const Vec3& x, const FreezeOptions& o, 
       }
       continue;  // the root lies outside this chunk
     }
-    if (failures < 64) failed[failures++] = c;
-    else overflow = true;
+    if (failures < 64)
+      failed[failures++] = c;
+    else
+      overflow = true;
   }
   bool unresolved = overflow;
   for (int f = 0; f < failures; ++f) {
     const ChunkData& cd = prep.chunks[static_cast<size_t>(failed[f])];
     NewtonRun found;
-    const Outcome r = o.max_subdivision_depth > 0
-                          ? subdivide(cd, cd.ctrl, Vec3::Zero(), 1.0, 1, x - cd.centre, o, count, found)
-                          : Outcome::unresolved;
+    const Outcome r = o.max_subdivision_depth > 0 ? subdivide(cd, cd.ctrl, Vec3::Zero(), 1.0, 1,
+                                                              x - cd.centre, o, count, found)
+                                                  : Outcome::unresolved;
     if (r == Outcome::inside) {
       accept(failed[f], found);
       ++count.subdivided;
@@ -453,10 +462,10 @@ void parallel(std::size_t n, std::size_t threads, const Executor& executor, Work
   });
 }
 
-
 }  // namespace
 
-Eigen::Vector3d chunk_point(const Points3& control, const Chunk& chunk, const Eigen::Vector3d& uvw) {
+Eigen::Vector3d chunk_point(const Points3& control, const Chunk& chunk,
+                            const Eigen::Vector3d& uvw) {
   // Coquillart eq. (1).
   double bu[4], du[4], bv[4], dv[4], bw[4], dw[4];
   bernstein(uvw[0], bu, du);
@@ -466,13 +475,15 @@ Eigen::Vector3d chunk_point(const Points3& control, const Chunk& chunk, const Ei
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) {
       Vec3 s = Vec3::Zero();
-      for (int k = 0; k < 4; ++k) s += bw[k] * control.row(chunk[static_cast<size_t>((i * 4 + j) * 4 + k)]).transpose();
+      for (int k = 0; k < 4; ++k)
+        s += bw[k] * control.row(chunk[static_cast<size_t>((i * 4 + j) * 4 + k)]).transpose();
       x += (bu[i] * bv[j]) * s;
     }
   return x;
 }
 
-// ---- freezing and deformation ----------------------------------------------------------------------------
+// ---- freezing and deformation
+// ----------------------------------------------------------------------------
 
 std::vector<std::string> FreezeOptions::problems() const {
   std::vector<std::string> out;
@@ -481,26 +492,28 @@ std::vector<std::string> FreezeOptions::problems() const {
   };
   if (!(newton_tolerance > 0 && newton_tolerance <= 1e-3))
     bad("FreezeOptions::newton_tolerance", format(newton_tolerance),
-                 "0 < newton_tolerance <= 1e-3 (relative to the chunk size)");
+        "0 < newton_tolerance <= 1e-3 (relative to the chunk size)");
   if (!(parameter_tolerance >= 0 && parameter_tolerance <= 1e-3))
     bad("FreezeOptions::parameter_tolerance", format(parameter_tolerance),
-                 "0 <= parameter_tolerance <= 1e-3");
+        "0 <= parameter_tolerance <= 1e-3");
   if (!(pseudo_inverse_threshold >= 0 && pseudo_inverse_threshold <= 1e-3))
     bad("FreezeOptions::pseudo_inverse_threshold", format(pseudo_inverse_threshold),
-                 "0 <= pseudo_inverse_threshold <= 1e-3");
+        "0 <= pseudo_inverse_threshold <= 1e-3");
   if (max_iterations < 1 || max_iterations > 1000)
     bad("FreezeOptions::max_iterations", std::to_string(max_iterations),
-                 "1 <= max_iterations <= 1000");
+        "1 <= max_iterations <= 1000");
   if (max_subdivision_depth < 0 || max_subdivision_depth > 10)
     bad("FreezeOptions::max_subdivision_depth", std::to_string(max_subdivision_depth),
-                 "0 <= max_subdivision_depth <= 10");
+        "0 <= max_subdivision_depth <= 10");
   if (threads < 0 || threads > 1024)
     bad("FreezeOptions::threads", std::to_string(threads),
-                 "0 <= threads <= 1024 (0 = one per hardware thread)");
+        "0 <= threads <= 1024 (0 = one per hardware thread)");
   return out;
 }
 
-void FreezeOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void FreezeOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 std::string FreezeReport::brief() const {
   char buffer[320];
@@ -508,14 +521,16 @@ std::string FreezeReport::brief() const {
                 "frozen %lld points: %lld inside, %lld outside, %lld unresolved; %lld found after "
                 "subdivision (%lld splits), %lld pseudo-inverse steps, %d Newton iterations, worst "
                 "residual %.3g mm",
-                static_cast<long long>(inside + outside + unresolved), static_cast<long long>(inside),
-                static_cast<long long>(outside), static_cast<long long>(unresolved),
-                static_cast<long long>(subdivided), static_cast<long long>(splits),
-                static_cast<long long>(pseudo_inverse_steps), summary.iterations, summary.final_residual);
+                static_cast<long long>(inside + outside + unresolved),
+                static_cast<long long>(inside), static_cast<long long>(outside),
+                static_cast<long long>(unresolved), static_cast<long long>(subdivided),
+                static_cast<long long>(splits), static_cast<long long>(pseudo_inverse_steps),
+                summary.iterations, summary.final_residual);
   return buffer;
 }
 
-FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points, const FreezeOptions& options) {
+FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points,
+                    const FreezeOptions& options) {
   options.validate();
   validate(lattice);
   for (Eigen::Index r = 0; r < points.rows(); ++r)
@@ -530,11 +545,13 @@ FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points, const
   out.positions = points;
   out.control_points = lattice.rest.rows();
   out.chunks = lattice.chunks.size();
-  const std::size_t threads = internal::part_count(options.threads, n, min_freeze_points_per_thread);
+  const std::size_t threads =
+      internal::part_count(options.threads, n, min_freeze_points_per_thread);
   std::vector<Counters> counts(threads);
   parallel(n, threads, options.executor, [&](std::size_t b, std::size_t e, std::size_t part) {
     for (std::size_t i = b; i < e; ++i)
-      out.points[i] = locate(prep, points.row(static_cast<Eigen::Index>(i)).transpose(), options, counts[part]);
+      out.points[i] =
+          locate(prep, points.row(static_cast<Eigen::Index>(i)).transpose(), options, counts[part]);
   });
   Counters total;
   for (const Counters& c : counts) {
@@ -555,38 +572,47 @@ FrozenPoints freeze(const ExtendedLattice& lattice, const Points3& points, const
   s.subdivided = total.subdivided;
   s.splits = total.splits;
   s.pseudo_inverse_steps = total.pseudo;
-  s.summary.termination = total.unresolved == 0 ? Termination::Converged : Termination::NotConverged;
-  s.summary.iterations = static_cast<int>(std::min<long long>(total.iterations, std::numeric_limits<int>::max()));
+  s.summary.termination =
+      total.unresolved == 0 ? Termination::Converged : Termination::NotConverged;
+  s.summary.iterations =
+      static_cast<int>(std::min<long long>(total.iterations, std::numeric_limits<int>::max()));
   s.summary.initial_residual = total.worst_initial;
   s.summary.final_residual = total.worst_residual;
   s.summary.message = s.brief();
   if (total.unresolved > 0)
-    s.summary.message += "; unresolved points are left unchanged: raise max_iterations or "
-                         "max_subdivision_depth, or untangle the lattice";
+    s.summary.message +=
+        "; unresolved points are left unchanged: raise max_iterations or "
+        "max_subdivision_depth, or untangle the lattice";
   return out;
 }
 
-Points3 evaluate(const ExtendedLattice& lattice, const FrozenPoints& frozen, const DeformOptions& options) {
+Points3 evaluate(const ExtendedLattice& lattice, const FrozenPoints& frozen,
+                 const DeformOptions& options) {
   options.validate();
   validate(lattice);
   if (lattice.rest.rows() != frozen.control_points || lattice.chunks.size() != frozen.chunks ||
       static_cast<Eigen::Index>(frozen.points.size()) != frozen.positions.rows())
     throw Error(ErrorCategory::InvalidArgument,
-                "evaluate: the points were frozen on a lattice of " + std::to_string(frozen.control_points) +
-                    " control points and " + std::to_string(frozen.chunks) + " chunks, this one has " +
-                    std::to_string(lattice.rest.rows()) + " and " + std::to_string(lattice.chunks.size()) +
-                    " (" + std::to_string(frozen.points.size()) + " frozen points, " +
+                "evaluate: the points were frozen on a lattice of " +
+                    std::to_string(frozen.control_points) + " control points and " +
+                    std::to_string(frozen.chunks) + " chunks, this one has " +
+                    std::to_string(lattice.rest.rows()) + " and " +
+                    std::to_string(lattice.chunks.size()) + " (" +
+                    std::to_string(frozen.points.size()) + " frozen points, " +
                     std::to_string(frozen.positions.rows()) +
                     " positions); only moving control points keeps a freeze valid: freeze again");
   const std::size_t n = frozen.points.size();
   Points3 out(static_cast<Eigen::Index>(n), 3);
-  const std::size_t threads = internal::part_count(options.threads, n, min_evaluate_points_per_thread);
+  const std::size_t threads =
+      internal::part_count(options.threads, n, min_evaluate_points_per_thread);
   parallel(n, threads, options.executor, [&](std::size_t b, std::size_t e, std::size_t) {
     for (std::size_t i = b; i < e; ++i) {
       const FrozenPoint& f = frozen.points[i];
       const auto r = static_cast<Eigen::Index>(i);
       if (f.chunk >= 0 && static_cast<std::size_t>(f.chunk) < lattice.chunks.size())
-        out.row(r) = chunk_point(lattice.points, lattice.chunks[static_cast<std::size_t>(f.chunk)], f.uvw).transpose();
+        out.row(r) =
+            chunk_point(lattice.points, lattice.chunks[static_cast<std::size_t>(f.chunk)], f.uvw)
+                .transpose();
       else
         out.row(r) = frozen.positions.row(r);
     }
@@ -603,11 +629,13 @@ Eigen::Vector3d deform_point(const ExtendedLattice& lattice, const Eigen::Vector
 
 namespace detail {
 
-std::function<Eigen::Vector3d(const Eigen::Vector3d&)> prepared_point_map(const ExtendedLattice& lattice) {
+std::function<Eigen::Vector3d(const Eigen::Vector3d&)> prepared_point_map(
+    const ExtendedLattice& lattice) {
   validate(lattice);
   FreezeOptions o;  // as deform_point: default options, one thread
   o.threads = 1;
-  auto data = std::make_shared<const std::pair<ExtendedLattice, Prepared>>(lattice, prepare(lattice, o));
+  auto data =
+      std::make_shared<const std::pair<ExtendedLattice, Prepared>>(lattice, prepare(lattice, o));
   return [data, o](const Eigen::Vector3d& x) -> Eigen::Vector3d {
     if (!internal::all_finite(x))
       throw Error(ErrorCategory::InvalidGeometry,
@@ -615,13 +643,15 @@ std::function<Eigen::Vector3d(const Eigen::Vector3d&)> prepared_point_map(const 
     Counters count;
     const FrozenPoint f = locate(data->second, x, o, count);
     if (f.chunk < 0) return x;
-    return chunk_point(data->first.points, data->first.chunks[static_cast<std::size_t>(f.chunk)], f.uvw);
+    return chunk_point(data->first.points, data->first.chunks[static_cast<std::size_t>(f.chunk)],
+                       f.uvw);
   };
 }
 
 }  // namespace detail
 
-Points3 deform_points(const ExtendedLattice& lattice, const Points3& points, const DeformOptions& options) {
+Points3 deform_points(const ExtendedLattice& lattice, const Points3& points,
+                      const DeformOptions& options) {
   options.validate();
   FreezeOptions o;
   o.threads = options.threads;

@@ -10,6 +10,7 @@ namespace clay::deform::detail {
 /// prepared once (deform_point prepares them per call, which dominated refits of extended
 /// lattices: one call per sample). Safe to call from several threads. Throws like freeze() for
 /// an invalid lattice (here) or a non-finite point (per call).
-std::function<Eigen::Vector3d(const Eigen::Vector3d&)> prepared_point_map(const ExtendedLattice& lattice);
+std::function<Eigen::Vector3d(const Eigen::Vector3d&)> prepared_point_map(
+    const ExtendedLattice& lattice);
 
 }  // namespace clay::deform::detail

@@ -27,8 +27,8 @@ namespace clay::deform {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using internal::all_finite;
 using detail::format;
+using internal::all_finite;
 
 [[noreturn]] void bad_argument(const std::string& field, const std::string& value,
                                const std::string& rule) {
@@ -37,7 +37,8 @@ using detail::format;
 
 }  // namespace
 
-// ---- the lattice ---------------------------------------------------------------------------------
+// ---- the lattice
+// ---------------------------------------------------------------------------------
 
 std::vector<std::string> problems(const ExtendedLattice& lattice, std::string_view name) {
   std::vector<std::string> out;
@@ -62,9 +63,10 @@ std::vector<std::string> problems(const ExtendedLattice& lattice, std::string_vi
     for (int e = 0; e < chunk_control_points; ++e) {
       const int index = lattice.chunks[c][static_cast<size_t>(e)];
       if (index < 0 || index >= rows) {
-        out.push_back(n + ": chunk " + std::to_string(c) + " control point (" + std::to_string(e / 16) +
-                      ", " + std::to_string(e / 4 % 4) + ", " + std::to_string(e % 4) + ") has index " +
-                      std::to_string(index) + " outside [0, " + std::to_string(rows) +
+        out.push_back(n + ": chunk " + std::to_string(c) + " control point (" +
+                      std::to_string(e / 16) + ", " + std::to_string(e / 4 % 4) + ", " +
+                      std::to_string(e % 4) + ") has index " + std::to_string(index) +
+                      " outside [0, " + std::to_string(rows) +
                       "); give row indices of rest / points");
         bad_index = true;
         break;
@@ -94,7 +96,8 @@ void validate(const ExtendedLattice& lattice, std::string_view name) {
 
 ExtendedLattice merge_coincident_points(const ExtendedLattice& lattice, double tolerance) {
   if (!(std::isfinite(tolerance) && tolerance >= 0))
-    bad_argument("merge_coincident_points: tolerance", format(tolerance), "0 <= tolerance < infinity (mm)");
+    bad_argument("merge_coincident_points: tolerance", format(tolerance),
+                 "0 <= tolerance < infinity (mm)");
   validate(lattice);
   const Eigen::Index rows = lattice.rest.rows();
   // Union-find over pairs within the tolerance, found by a sweep along x; the root is the
@@ -102,13 +105,16 @@ ExtendedLattice merge_coincident_points(const ExtendedLattice& lattice, double t
   std::vector<Eigen::Index> parent(static_cast<size_t>(rows));
   std::iota(parent.begin(), parent.end(), Eigen::Index{0});
   auto find = [&](Eigen::Index i) {
-    while (parent[static_cast<size_t>(i)] != i) i = parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
+    while (parent[static_cast<size_t>(i)] != i)
+      i = parent[static_cast<size_t>(i)] =
+          parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
     return i;
   };
   std::vector<Eigen::Index> order(static_cast<size_t>(rows));
   std::iota(order.begin(), order.end(), Eigen::Index{0});
-  std::sort(order.begin(), order.end(),
-            [&](Eigen::Index a, Eigen::Index b) { return lattice.rest(a, 0) < lattice.rest(b, 0); });
+  std::sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) {
+    return lattice.rest(a, 0) < lattice.rest(b, 0);
+  });
   for (size_t a = 0; a < order.size(); ++a)
     for (size_t b = a + 1; b < order.size(); ++b) {
       const Eigen::Index i = order[a], j = order[b];
@@ -138,6 +144,5 @@ ExtendedLattice merge_coincident_points(const ExtendedLattice& lattice, double t
     for (int& index : chunk) index = number[static_cast<size_t>(find(index))];
   return out;
 }
-
 
 }  // namespace clay::deform

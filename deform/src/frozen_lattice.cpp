@@ -19,7 +19,8 @@
 #include "bernstein.hpp"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define CLAY_DEFORM_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#define CLAY_DEFORM_CLONES \
+  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define CLAY_DEFORM_CLONES
 #endif
@@ -35,7 +36,7 @@ namespace clay::deform {
 
 namespace {
 
-constexpr int W = 8;                      // points per block (one AVX-512 register of doubles)
+constexpr int W = 8;  // points per block (one AVX-512 register of doubles)
 // B-spline lattices: points sorted by cell at a time. 32 bytes of scratch per point, 1 MB per
 // worker, in a 2 MB L2; with 8 x 8 x 8 cells about 64 points per cell, so the partly filled last
 // block of each cell wastes about 5 % of the evaluation (11 % at 16,384; 65,536 spills L2 and
@@ -151,7 +152,8 @@ template <int Stride>
 
 /// Loads block [first, first + 8) (Stride 3: rows, 1: columns).
 template <int Stride>
-[[gnu::always_inline]] inline void load_block(const Io& io, std::size_t first, vd& x, vd& y, vd& z) {
+[[gnu::always_inline]] inline void load_block(const Io& io, std::size_t first, vd& x, vd& y,
+                                              vd& z) {
   if constexpr (Stride == 3) {
     load_rows(io.in[0] + first * 3, x, y, z);
   } else {
@@ -176,8 +178,8 @@ template <int Stride>
 /// Local coordinates (eq. (1) through the dual vectors), clamped to [0, 1], and how far outside
 /// the unit cube the point is (|ls − s| + |lt − t| + |lu − u|: inside when <= face_tolerance,
 /// outside also when NaN). One comparison per block instead of six keeps GCC on mask registers.
-[[gnu::always_inline]] inline void local_block(const Kernel& K, const vd& x, const vd& y, const vd& z,
-                                               vd& s, vd& t, vd& u, vd& outside) {
+[[gnu::always_inline]] inline void local_block(const Kernel& K, const vd& x, const vd& y,
+                                               const vd& z, vd& s, vd& t, vd& u, vd& outside) {
   const vd zero = {}, one = zero + 1.0;
   const vd dx = x - K.origin[0], dy = y - K.origin[1], dz = z - K.origin[2];
   const vd ls = K.dual[0][0] * dx + K.dual[0][1] * dy + K.dual[0][2] * dz;
@@ -275,7 +277,8 @@ template <int L, int M, int N, int Stride>
 /// breaks are not all uniform. On entry S, T, U hold the clamped lattice coordinates and cell[q]
 /// is nonzero for points inside. Out of line and scalar: inlined, its lane-by-lane access kept
 /// the vectors of the uniform path in memory (four zmm spills per block in every B-spline loop).
-[[gnu::noinline]] void cells_by_search(const Kernel& K, double* S, double* T, double* U, std::int32_t* cell) {
+[[gnu::noinline]] void cells_by_search(const Kernel& K, double* S, double* T, double* U,
+                                       std::int32_t* cell) {
   for (int q = 0; q < W; ++q) {
     double ls, lt, lu;
     const int a = cell_of(K, 0, S[q], ls);
@@ -291,8 +294,9 @@ template <int L, int M, int N, int Stride>
 /// Pass 1 for one block: in-cell coordinates into S, T, U and the cells into cell (input order).
 /// Uniform breaks in every direction: vectorized (cell = floor(v n) by truncation, v >= 0);
 /// otherwise cells_by_search. Points outside the lattice get cell K.cell_count.
-[[gnu::always_inline]] inline void locate_block(const Kernel& K, const vd& x, const vd& y, const vd& z,
-                                                double* S, double* T, double* U, std::int32_t* cell) {
+[[gnu::always_inline]] inline void locate_block(const Kernel& K, const vd& x, const vd& y,
+                                                const vd& z, double* S, double* T, double* U,
+                                                std::int32_t* cell) {
   vd s, t, u, out;
   local_block(K, x, y, z, s, t, u, out);
   const vd tol = vd{} + face_tolerance;
@@ -306,7 +310,8 @@ template <int L, int M, int N, int Stride>
     return;
   }
   const vd fs = s * K.cells[0], ft = t * K.cells[1], fu = u * K.cells[2];
-  vi a = __builtin_convertvector(fs, vi), b = __builtin_convertvector(ft, vi), c = __builtin_convertvector(fu, vi);
+  vi a = __builtin_convertvector(fs, vi), b = __builtin_convertvector(ft, vi),
+     c = __builtin_convertvector(fu, vi);
   const vi la = vi{} + (K.cells[0] - 1), lb = vi{} + (K.cells[1] - 1), lc = vi{} + (K.cells[2] - 1);
   a = a > la ? la : a;
   b = b > lb ? lb : b;
@@ -315,17 +320,20 @@ template <int L, int M, int N, int Stride>
   store(T, ft - __builtin_convertvector(b, vd));
   store(U, fu - __builtin_convertvector(c, vd));
   // The cell number in doubles (exact: small integers), then one conversion.
-  const vd id = (__builtin_convertvector(a, vd) * K.cells[1] + __builtin_convertvector(b, vd)) * K.cells[2] +
-                __builtin_convertvector(c, vd);
-  const vi32 narrow = __builtin_convertvector(__builtin_convertvector(out <= tol ? id : vd{} + K.cell_count, vi), vi32);
+  const vd id =
+      (__builtin_convertvector(a, vd) * K.cells[1] + __builtin_convertvector(b, vd)) * K.cells[2] +
+      __builtin_convertvector(c, vd);
+  const vi32 narrow = __builtin_convertvector(
+      __builtin_convertvector(out <= tol ? id : vd{} + K.cell_count, vi), vi32);
   std::memcpy(cell, &narrow, sizeof narrow);
 }
 
 /// Counting sort of a chunk's indices by cell, from the histogram count[c + 1] = points in cell
 /// c; after it count[c] is the end of cell c, and W spare entries repeat the last index. Its own
 /// function (scalar code, not cloned): inside the large driver its pointers were kept on the stack.
-[[gnu::noinline]] void counting_sort(const std::int32_t* __restrict cell, std::int32_t* __restrict order,
-                                     std::int32_t* __restrict count, std::size_t n, int outside) {
+[[gnu::noinline]] void counting_sort(const std::int32_t* __restrict cell,
+                                     std::int32_t* __restrict order, std::int32_t* __restrict count,
+                                     std::size_t n, int outside) {
   for (int c = 0; c <= outside; ++c) count[c + 1] += count[c];  // count[c] = start of cell c
   for (std::size_t i = 0; i < n; ++i) order[count[cell[i]]++] = static_cast<std::int32_t>(i);
   for (std::size_t p = n; p < n + W; ++p) order[p] = order[n - 1];  // spare lanes
@@ -351,7 +359,8 @@ template <int L, int M, int N, int Stride>
   // [from, n), a block at a time, and the histogram of cells. Whole blocks, then a tail padded
   // with the last point (only its cnt entries counted). Element access goes through arrays: on a
   // vector variable it would keep the vector in memory.
-  auto locate_range = [&](std::size_t first, std::size_t from, std::size_t n) __attribute__((always_inline)) {
+  auto locate_range = [&](std::size_t first, std::size_t from, std::size_t n)
+      __attribute__((always_inline)) {
     std::size_t b = from;
     for (; b + W <= n; b += W) {
       prefetch_block<Stride>(io, first + b + prefetch_distance);
@@ -374,7 +383,8 @@ template <int L, int M, int N, int Stride>
     }
   };
   // 5. Results of scratch [from, n) out to points [first + from, first + n), in input order.
-  auto output_range = [&](std::size_t first, std::size_t from, std::size_t n) __attribute__((always_inline)) {
+  auto output_range = [&](std::size_t first, std::size_t from, std::size_t n)
+      __attribute__((always_inline)) {
     std::size_t b = from;
     for (; b + W <= n; b += W) {
       load(x, S + b);
@@ -510,15 +520,16 @@ template <int Stride>
   return bspline_range<-1, -1, -1, Stride>(K, io, b, e, sc);
 }
 
-CLAY_DEFORM_CLONES void run_bezier_rows(const Kernel& K, const Io& io, std::size_t b, std::size_t e) {
+CLAY_DEFORM_CLONES void run_bezier_rows(const Kernel& K, const Io& io, std::size_t b,
+                                        std::size_t e) {
   bezier_dispatch<3>(K, io, b, e);
 }
 CLAY_DEFORM_CLONES void run_bezier_columns(const Kernel& K, const Io& io, std::size_t b,
                                            std::size_t e) {
   bezier_dispatch<1>(K, io, b, e);
 }
-CLAY_DEFORM_CLONES void run_bspline_rows(const Kernel& K, const Io& io, std::size_t b, std::size_t e,
-                                         Scratch& sc) {
+CLAY_DEFORM_CLONES void run_bspline_rows(const Kernel& K, const Io& io, std::size_t b,
+                                         std::size_t e, Scratch& sc) {
   bspline_dispatch<3>(K, io, b, e, sc);
 }
 CLAY_DEFORM_CLONES void run_bspline_columns(const Kernel& K, const Io& io, std::size_t b,
@@ -564,7 +575,8 @@ struct FrozenLatticeAccess {
     std::vector<double> b(per * 3);
     for (size_t r = 0; r < per; ++r)
       for (int c = 0; c < 3; ++c)
-        b[r * 3 + static_cast<size_t>(c)] = bezier_points(static_cast<Eigen::Index>(r), c) - f.center_[c];
+        b[r * 3 + static_cast<size_t>(c)] =
+            bezier_points(static_cast<Eigen::Index>(r), c) - f.center_[c];
     const std::vector<double> a = detail::bernstein_to_power(b, deg, 3);
     // Kernel layout: coordinate-major, then s-major coefficient index.
     for (int c = 0; c < 3; ++c)
@@ -599,7 +611,8 @@ FrozenLattice::FrozenLattice(const BSplineLattice& lattice) {
   degrees_ = {lattice.bases[0].degree, lattice.bases[1].degree, lattice.bases[2].degree};
   std::array<std::vector<detail::SpanExtraction>, 3> spans;
   for (int d = 0; d < 3; ++d) {
-    spans[static_cast<size_t>(d)] = surface::bezier_extraction(lattice.bases[static_cast<size_t>(d)]);
+    spans[static_cast<size_t>(d)] =
+        surface::bezier_extraction(lattice.bases[static_cast<size_t>(d)]);
     std::vector<double> breaks;
     for (const auto& e : spans[static_cast<size_t>(d)]) breaks.push_back(e.a);
     breaks.push_back(spans[static_cast<size_t>(d)].back().b);
@@ -636,11 +649,15 @@ void run(const FrozenLattice& lattice, const Io& io, std::size_t n, bool rows,
     const std::size_t e = std::min(n, blocks * (part + 1) / threads * W);
     if (b >= e) return;
     if (bezier) {
-      if (rows) run_bezier_rows(K, io, b, e);
-      else run_bezier_columns(K, io, b, e);
+      if (rows)
+        run_bezier_rows(K, io, b, e);
+      else
+        run_bezier_columns(K, io, b, e);
     } else {
-      if (rows) run_bspline_rows(K, io, b, e, scratch[part]);
-      else run_bspline_columns(K, io, b, e, scratch[part]);
+      if (rows)
+        run_bspline_rows(K, io, b, e, scratch[part]);
+      else
+        run_bspline_columns(K, io, b, e, scratch[part]);
     }
   };
   internal::run_parts(threads, options.executor, work);
@@ -681,8 +698,9 @@ void deform_points(const FrozenLattice& lattice, PointColumns in, MutablePointCo
                     std::to_string(in.y.size()) + "/" + std::to_string(in.z.size()) + ", out " +
                     std::to_string(out.x.size()) + "/" + std::to_string(out.y.size()) + "/" +
                     std::to_string(out.z.size()) + "; give six columns of the same size");
-  run(lattice, Io{{in.x.data(), in.y.data(), in.z.data()}, {out.x.data(), out.y.data(), out.z.data()}},
-      n, false, options);
+  run(lattice,
+      Io{{in.x.data(), in.y.data(), in.z.data()}, {out.x.data(), out.y.data(), out.z.data()}}, n,
+      false, options);
 }
 
 Points3 deform_points(const BezierLattice& lattice, const Points3& points,

@@ -1,7 +1,7 @@
 #include <clay/deform/jacobian.hpp>
 
-#include <clay/surface/basis.hpp>
 #include <clay/internal/math.hpp>
+#include <clay/surface/basis.hpp>
 
 #include <Eigen/LU>
 
@@ -17,7 +17,8 @@ namespace {
 using Index3 = std::array<int, 3>;
 
 size_t size_of(Index3 deg) {
-  return static_cast<size_t>(deg[0] + 1) * static_cast<size_t>(deg[1] + 1) * static_cast<size_t>(deg[2] + 1);
+  return static_cast<size_t>(deg[0] + 1) * static_cast<size_t>(deg[1] + 1) *
+         static_cast<size_t>(deg[2] + 1);
 }
 
 BernsteinVolume zeros(Index3 deg) {
@@ -82,7 +83,8 @@ BernsteinVolume product(const BernsteinVolume& A, const BernsteinVolume& B) {
     for (int j = 0; j <= dc[1]; ++j)
       for (int k = 0; k <= dc[2]; ++k)
         C.coefficients[at(dc, i, j, k)] /= sc[0][static_cast<size_t>(i)] *
-                                           sc[1][static_cast<size_t>(j)] * sc[2][static_cast<size_t>(k)];
+                                           sc[1][static_cast<size_t>(j)] *
+                                           sc[2][static_cast<size_t>(k)];
   return C;
 }
 
@@ -121,7 +123,9 @@ double evaluate(const BernsteinVolume& v, double s, double t, double u) {
     c[static_cast<size_t>(i)] = a[0];
   }
   for (int level = 1; level < n0; ++level)
-    for (int i = 0; i < n0 - level; ++i) c[static_cast<size_t>(i)] = (1 - x[0]) * c[static_cast<size_t>(i)] + x[0] * c[static_cast<size_t>(i) + 1];
+    for (int i = 0; i < n0 - level; ++i)
+      c[static_cast<size_t>(i)] =
+          (1 - x[0]) * c[static_cast<size_t>(i)] + x[0] * c[static_cast<size_t>(i) + 1];
   return c[0];
 }
 
@@ -130,7 +134,8 @@ BernsteinVolume jacobian_bernstein(const BezierLattice& lattice) {
   // Sederberg–Parry §4: det(X_s, X_t, X_u) = X_s . (X_t x X_u), each a Bernstein polynomial.
   std::array<std::array<BernsteinVolume, 3>, 3> D;  // D[direction][coordinate]
   for (int d = 0; d < 3; ++d)
-    for (int c = 0; c < 3; ++c) D[static_cast<size_t>(d)][static_cast<size_t>(c)] = derivative(lattice, d, c);
+    for (int c = 0; c < 3; ++c)
+      D[static_cast<size_t>(d)][static_cast<size_t>(c)] = derivative(lattice, d, c);
   const auto& Xs = D[0];
   const auto& Xt = D[1];
   const auto& Xu = D[2];
@@ -182,7 +187,8 @@ Eigen::Matrix3d jacobian_matrix(const BezierLattice& lattice, const Eigen::Vecto
   if (!detail::clamped_local(lattice.frame, x, local)) return Eigen::Matrix3d::Identity();
   Eigen::Matrix3d M;  // columns dX/ds, dX/dt, dX/du
   for (int d = 0; d < 3; ++d)
-    for (int c = 0; c < 3; ++c) M(c, d) = evaluate(derivative(lattice, d, c), local[0], local[1], local[2]);
+    for (int c = 0; c < 3; ++c)
+      M(c, d) = evaluate(derivative(lattice, d, c), local[0], local[1], local[2]);
   return M * edges(lattice.frame).inverse();
 }
 
@@ -197,17 +203,21 @@ Eigen::Matrix3d jacobian_matrix(const BSplineLattice& lattice, const Eigen::Vect
     p[static_cast<size_t>(d)] = basis.degree;
     span[static_cast<size_t>(d)] = surface::find_span(basis, local[d]);
     N[static_cast<size_t>(d)].resize(static_cast<size_t>(2 * (basis.degree + 1)));
-    surface::basis_derivatives(basis, span[static_cast<size_t>(d)], local[d], 1, N[static_cast<size_t>(d)]);
+    surface::basis_derivatives(basis, span[static_cast<size_t>(d)], local[d], 1,
+                               N[static_cast<size_t>(d)]);
   }
   auto value = [&](int d, int q, int order) {
-    return N[static_cast<size_t>(d)][static_cast<size_t>(order * (p[static_cast<size_t>(d)] + 1) + q)];
+    return N[static_cast<size_t>(d)]
+            [static_cast<size_t>(order * (p[static_cast<size_t>(d)] + 1) + q)];
   };
   Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
   for (int i = 0; i <= p[0]; ++i)
     for (int j = 0; j <= p[1]; ++j)
       for (int k = 0; k <= p[2]; ++k) {
         const Eigen::Vector3d P =
-            lattice.points.row(lattice.index(span[0] - p[0] + i, span[1] - p[1] + j, span[2] - p[2] + k)).transpose();
+            lattice.points
+                .row(lattice.index(span[0] - p[0] + i, span[1] - p[1] + j, span[2] - p[2] + k))
+                .transpose();
         M.col(0) += value(0, i, 1) * value(1, j, 0) * value(2, k, 0) * P;
         M.col(1) += value(0, i, 0) * value(1, j, 1) * value(2, k, 0) * P;
         M.col(2) += value(0, i, 0) * value(1, j, 0) * value(2, k, 1) * P;

@@ -1,9 +1,9 @@
 #include <clay/deform/lattice.hpp>
 
 #include <clay/error.hpp>
-#include <clay/surface/basis.hpp>
 #include <clay/internal/checks.hpp>
 #include <clay/internal/math.hpp>
+#include <clay/surface/basis.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -18,8 +18,8 @@ namespace clay::deform {
 
 namespace {
 
-using internal::all_finite;
 using detail::format;
+using internal::all_finite;
 using internal::throw_problems;
 
 constexpr const char* direction_name[3] = {"s", "t", "u"};
@@ -79,8 +79,10 @@ void de_casteljau(Eigen::Vector3d* pts, int count, double t) {
 std::vector<std::string> problems(const Frame& frame, std::string_view name) {
   std::vector<std::string> out;
   const std::string n(name);
-  const std::pair<const char*, const Eigen::Vector3d*> vectors[4] = {
-      {"origin X0", &frame.origin}, {"edge S", &frame.s}, {"edge T", &frame.t}, {"edge U", &frame.u}};
+  const std::pair<const char*, const Eigen::Vector3d*> vectors[4] = {{"origin X0", &frame.origin},
+                                                                     {"edge S", &frame.s},
+                                                                     {"edge T", &frame.t},
+                                                                     {"edge U", &frame.u}};
   for (const auto& [what, v] : vectors)
     if (!all_finite(*v))
       out.push_back(n + ": " + what + " " + format(*v) + " is not finite; give finite coordinates");
@@ -93,8 +95,8 @@ std::vector<std::string> problems(const Frame& frame, std::string_view name) {
   const double volume = frame.volume();
   if (!(std::abs(volume) > 1e-12 * scale))
     out.push_back(n + ": edges S " + format(frame.s) + ", T " + format(frame.t) + ", U " +
-                  format(frame.u) + " are coplanar (S x T . U = " + format(volume) +
-                  ", relative " + format(volume / scale) +
+                  format(frame.u) + " are coplanar (S x T . U = " + format(volume) + ", relative " +
+                  format(volume / scale) +
                   "): the lattice has zero volume; give three independent edge vectors");
   return out;
 }
@@ -141,14 +143,16 @@ Points3 cell_points(const BSplineLattice& lattice, const SpanExtraction& ea,
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
         for (int kk = 0; kk < R; ++kk)
           sum += ec.matrix(k, kk) *
-                 lattice.points.row(lattice.index(ea.first + i, eb.first + j, ec.first + kk)).transpose();
+                 lattice.points.row(lattice.index(ea.first + i, eb.first + j, ec.first + kk))
+                     .transpose();
         a[static_cast<size_t>((i * Q + j) * R + k)] = sum;
       }
   for (int i = 0; i < P; ++i)
     for (int j = 0; j < Q; ++j)
       for (int k = 0; k < R; ++k) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        for (int jj = 0; jj < Q; ++jj) sum += eb.matrix(j, jj) * a[static_cast<size_t>((i * Q + jj) * R + k)];
+        for (int jj = 0; jj < Q; ++jj)
+          sum += eb.matrix(j, jj) * a[static_cast<size_t>((i * Q + jj) * R + k)];
         b[static_cast<size_t>((i * Q + j) * R + k)] = sum;
       }
   Points3 out(P * Q * R, 3);
@@ -156,7 +160,8 @@ Points3 cell_points(const BSplineLattice& lattice, const SpanExtraction& ea,
     for (int j = 0; j < Q; ++j)
       for (int k = 0; k < R; ++k) {
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        for (int ii = 0; ii < P; ++ii) sum += ea.matrix(i, ii) * b[static_cast<size_t>((ii * Q + j) * R + k)];
+        for (int ii = 0; ii < P; ++ii)
+          sum += ea.matrix(i, ii) * b[static_cast<size_t>((ii * Q + j) * R + k)];
         out.row((i * Q + j) * R + k) = sum.transpose();
       }
   return out;
@@ -178,13 +183,15 @@ std::vector<double> bernstein_to_power(const std::vector<double>& bernstein,
       for (int b = 0; b < n[o2]; ++b)
         for (int v = 0; v < dim; ++v) {
           const long base = a * stride[o1] + b * stride[o2] + v;
-          for (int e = 0; e < n[d]; ++e) line[static_cast<size_t>(e)] = c[static_cast<size_t>(base + e * stride[d])];
+          for (int e = 0; e < n[d]; ++e)
+            line[static_cast<size_t>(e)] = c[static_cast<size_t>(base + e * stride[d])];
           // Forward differences in place: line[e] becomes Δ^e b_0.
           for (int level = 1; level <= p; ++level)
             for (int e = p; e >= level; --e)
               line[static_cast<size_t>(e)] -= line[static_cast<size_t>(e - 1)];
           for (int e = 0; e < n[d]; ++e)
-            c[static_cast<size_t>(base + e * stride[d])] = internal::binomial(p, e) * line[static_cast<size_t>(e)];
+            c[static_cast<size_t>(base + e * stride[d])] =
+                internal::binomial(p, e) * line[static_cast<size_t>(e)];
         }
   }
   return c;
@@ -240,7 +247,8 @@ Eigen::Vector3d deform_point(const BezierLattice& lattice, const Eigen::Vector3d
   std::vector<Eigen::Vector3d> ti(static_cast<size_t>(Q)), si(static_cast<size_t>(P));
   for (int i = 0; i < P; ++i) {
     for (int j = 0; j < Q; ++j) {
-      for (int k = 0; k < R; ++k) row[static_cast<size_t>(k)] = lattice.points.row(lattice.index(i, j, k)).transpose();
+      for (int k = 0; k < R; ++k)
+        row[static_cast<size_t>(k)] = lattice.points.row(lattice.index(i, j, k)).transpose();
       de_casteljau(row.data(), R, local.z());
       ti[static_cast<size_t>(j)] = row[0];
     }
@@ -298,7 +306,8 @@ std::vector<std::string> structure_problems(const BSplineLattice& lattice, const
 
 }  // namespace
 
-BSplineLattice make_bspline_lattice(const Frame& frame, std::array<surface::BSplineBasis, 3> bases) {
+BSplineLattice make_bspline_lattice(const Frame& frame,
+                                    std::array<surface::BSplineBasis, 3> bases) {
   BSplineLattice lattice;
   lattice.frame = frame;
   lattice.bases = std::move(bases);
@@ -343,8 +352,10 @@ Eigen::Vector3d deform_point(const BSplineLattice& lattice, const Eigen::Vector3
   for (int i = 0; i <= p; ++i)
     for (int j = 0; j <= q; ++j)
       for (int k = 0; k <= r; ++k)
-        sum += N[0][static_cast<size_t>(i)] * N[1][static_cast<size_t>(j)] * N[2][static_cast<size_t>(k)] *
-               lattice.points.row(lattice.index(span[0] - p + i, span[1] - q + j, span[2] - r + k)).transpose();
+        sum += N[0][static_cast<size_t>(i)] * N[1][static_cast<size_t>(j)] *
+               N[2][static_cast<size_t>(k)] *
+               lattice.points.row(lattice.index(span[0] - p + i, span[1] - q + j, span[2] - r + k))
+                   .transpose();
   return sum;
 }
 

@@ -26,11 +26,11 @@ namespace clay::deform {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
-using internal::all_finite;
 using detail::format;
+using internal::all_finite;
 
-constexpr int max_count = 1024;               // sectors, rings, layers, ...
-constexpr long long max_chunks = 1'000'000;   // per generated lattice
+constexpr int max_count = 1024;              // sectors, rings, layers, ...
+constexpr long long max_chunks = 1'000'000;  // per generated lattice
 
 [[noreturn]] void bad_argument(const std::string& field, const std::string& value,
                                const std::string& rule) {
@@ -57,13 +57,16 @@ Eigen::Vector2d arc_point(int angular, int sectors) {
 
 }  // namespace
 
-// ---- cylindrical lattice -----------------------------------------------------------------------------
+// ---- cylindrical lattice
+// -----------------------------------------------------------------------------
 
 void CylinderSpec::validate() const {
-  if (!all_finite(origin)) bad_argument("CylinderSpec::origin", format(origin), "finite coordinates");
+  if (!all_finite(origin))
+    bad_argument("CylinderSpec::origin", format(origin), "finite coordinates");
   if (!all_finite(axis) || !(axis.norm() > 0))
     bad_argument("CylinderSpec::axis", format(axis), "a finite non-zero direction");
-  if (!all_finite(reference) || !(reference.cross(axis).norm() > 1e-9 * reference.norm() * axis.norm()))
+  if (!all_finite(reference) ||
+      !(reference.cross(axis).norm() > 1e-9 * reference.norm() * axis.norm()))
     bad_argument("CylinderSpec::reference", format(reference),
                  "a finite direction not parallel to the axis " + format(axis));
   if (!(std::isfinite(radius) && radius > 0))
@@ -88,7 +91,8 @@ int cylindrical_index(const CylinderSpec& spec, int radial, int angular, int axi
   if (radial < 0 || radial >= nI || axial < 0 || axial >= nK)
     throw Error(ErrorCategory::OutOfDomain,
                 "cylindrical_index: (radial, axial) = (" + std::to_string(radial) + ", " +
-                    std::to_string(axial) + ") breaks the rule 0 <= radial <= " + std::to_string(nI - 1) +
+                    std::to_string(axial) +
+                    ") breaks the rule 0 <= radial <= " + std::to_string(nI - 1) +
                     ", 0 <= axial <= " + std::to_string(nK - 1) + " (3 rings, 3 layers)");
   const int j = ((angular % nJ) + nJ) % nJ;
   if (spec.inner_radius == 0) {
@@ -138,7 +142,8 @@ ExtendedLattice make_cylindrical_lattice(const CylinderSpec& spec) {
   return L;
 }
 
-// ---- prismatic lattice ----------------------------------------------------------------------------------
+// ---- prismatic lattice
+// ----------------------------------------------------------------------------------
 
 void PrismSpec::validate() const {
   if (!all_finite(origin)) bad_argument("PrismSpec::origin", format(origin), "finite coordinates");
@@ -170,8 +175,8 @@ void PrismSpec::validate() const {
                      "finite coordinates");
   }
   check_count("PrismSpec", "layers", layers, 1);
-  const long long chunks =
-      static_cast<long long>(sections.size() - 1) * static_cast<long long>((count - 1) / 3) * layers;
+  const long long chunks = static_cast<long long>(sections.size() - 1) *
+                           static_cast<long long>((count - 1) / 3) * layers;
   if (chunks > max_chunks)
     bad_argument("PrismSpec (sections - 1) * segments * layers", std::to_string(chunks),
                  "<= " + std::to_string(max_chunks) + " chunks");
@@ -191,13 +196,14 @@ ExtendedLattice make_prismatic_lattice(const PrismSpec& spec) {
   for (int i = 0; i < nI; ++i) {
     const int a = std::min(i / 3, gaps - 1), r = i - 3 * a;  // row r of the ruled gap a
     for (int j = 0; j < nJ; ++j) {
-      const Eigen::Vector2d p = ((3 - r) * spec.sections[static_cast<size_t>(a)][static_cast<size_t>(j)] +
-                                 r * spec.sections[static_cast<size_t>(a) + 1][static_cast<size_t>(j)]) /
-                                3.0;
+      const Eigen::Vector2d p =
+          ((3 - r) * spec.sections[static_cast<size_t>(a)][static_cast<size_t>(j)] +
+           r * spec.sections[static_cast<size_t>(a) + 1][static_cast<size_t>(j)]) /
+          3.0;
       for (int k = 0; k < nK; ++k)
-        L.rest.row(index(i, j, k)) =
-            (spec.origin + p.x() * e1 + p.y() * e2 + (static_cast<double>(k) / (nK - 1)) * spec.extrusion)
-                .transpose();
+        L.rest.row(index(i, j, k)) = (spec.origin + p.x() * e1 + p.y() * e2 +
+                                      (static_cast<double>(k) / (nK - 1)) * spec.extrusion)
+                                         .transpose();
     }
   }
   L.points = L.rest;
@@ -208,12 +214,12 @@ ExtendedLattice make_prismatic_lattice(const PrismSpec& spec) {
         for (int i = 0; i < 4; ++i)
           for (int j = 0; j < 4; ++j)
             for (int k = 0; k < 4; ++k)
-              chunk[static_cast<size_t>((i * 4 + j) * 4 + k)] = index(3 * a + i, 3 * b + j, 3 * c + k);
+              chunk[static_cast<size_t>((i * 4 + j) * 4 + k)] =
+                  index(3 * a + i, 3 * b + j, 3 * c + k);
         L.chunks.push_back(chunk);
       }
   const double size = (L.rest.colwise().maxCoeff() - L.rest.colwise().minCoeff()).norm();
   return merge_coincident_points(L, 1e-12 * size);
 }
-
 
 }  // namespace clay::deform

@@ -17,8 +17,12 @@ namespace {
 struct Derivatives {
   Poly g, gx, gy, gxx, gxy, gyy;
   explicit Derivatives(Poly g_)
-      : g(std::move(g_)), gx(derivative(g, 0)), gy(derivative(g, 1)), gxx(derivative(gx, 0)),
-        gxy(derivative(gx, 1)), gyy(derivative(gy, 1)) {}
+      : g(std::move(g_)),
+        gx(derivative(g, 0)),
+        gy(derivative(g, 1)),
+        gxx(derivative(gx, 0)),
+        gxy(derivative(gx, 1)),
+        gyy(derivative(gy, 1)) {}
 };
 
 /// A local maximiser of g on [0, 1]^2 (projected Newton with an active set, from the Greville
@@ -29,10 +33,12 @@ std::pair<double, double> maximiser(const Derivatives& d) {
   for (size_t k = 1; k < g.c.size(); ++k)
     if (g.c[k] > g.c[best]) best = k;
   const int bi = static_cast<int>(best) / (g.dv + 1), bj = static_cast<int>(best) % (g.dv + 1);
-  double x = g.du > 0 ? static_cast<double>(bi) / g.du : 0.5, y = g.dv > 0 ? static_cast<double>(bj) / g.dv : 0.5;
+  double x = g.du > 0 ? static_cast<double>(bi) / g.du : 0.5,
+         y = g.dv > 0 ? static_cast<double>(bj) / g.dv : 0.5;
   for (int it = 0; it < 40; ++it) {
     const double gx = value_at(d.gx, x, y), gy = value_at(d.gy, x, y);
-    const double gxx = value_at(d.gxx, x, y), gxy = value_at(d.gxy, x, y), gyy = value_at(d.gyy, x, y);
+    const double gxx = value_at(d.gxx, x, y), gxy = value_at(d.gxy, x, y),
+                 gyy = value_at(d.gyy, x, y);
     // A coordinate on the cell's edge whose gradient points out of the cell stays there.
     const bool free_x = g.du > 0 && !((x <= 0 && gx < 0) || (x >= 1 && gx > 0));
     const bool free_y = g.dv > 0 && !((y <= 0 && gy < 0) || (y >= 1 && gy > 0));
@@ -86,7 +92,8 @@ Verdict decide(const Poly& g, double& px, double& py) {
     px = x, py = y;
     return Verdict::outside;
   }
-  const double A = max_coefficient(d.gxx), B = max_coefficient(d.gyy), C = max_abs_coefficient(d.gxy);
+  const double A = max_coefficient(d.gxx), B = max_coefficient(d.gyy),
+               C = max_abs_coefficient(d.gxy);
   if (A <= 0 && B <= 0 && C * C <= A * B) {
     const double gx = value_at(d.gx, x, y), gy = value_at(d.gy, x, y);
     double bound = -std::numeric_limits<double>::infinity();
@@ -128,11 +135,13 @@ std::optional<Violation> leaves(const Poly& cw, double lo, double hi, double tol
       if (v == Verdict::inside) continue;
       if (v == Verdict::outside) {
         const double value = value_at(cell.cw, px, py, 0) / value_at(cell.cw, px, py, 1);
-        return Violation{cell.x0 + px * (cell.x1 - cell.x0), cell.y0 + py * (cell.y1 - cell.y0), value, true};
+        return Violation{cell.x0 + px * (cell.x1 - cell.x0), cell.y0 + py * (cell.y1 - cell.y0),
+                         value, true};
       }
       if (cell.depth >= max_depth || ++visited > budget) {
         if (!undecided) {
-          double bound = side == 0 ? -std::numeric_limits<double>::infinity() : std::numeric_limits<double>::infinity();
+          double bound = side == 0 ? -std::numeric_limits<double>::infinity()
+                                   : std::numeric_limits<double>::infinity();
           for (int i = 0; i <= g.du; ++i)
             for (int j = 0; j <= g.dv; ++j) {
               const double r = cell.cw.at(i, j, 0) / cell.cw.at(i, j, 1);
@@ -147,8 +156,10 @@ std::optional<Violation> leaves(const Poly& cw, double lo, double hi, double tol
       auto [left, right] = halve(cell.cw, 0);
       for (int a = 0; a < 2; ++a) {
         auto [bottom, top] = halve(a ? right : left, 1);
-        queue.push_back({std::move(bottom), a ? xm : cell.x0, a ? cell.x1 : xm, cell.y0, ym, cell.depth + 1});
-        queue.push_back({std::move(top), a ? xm : cell.x0, a ? cell.x1 : xm, ym, cell.y1, cell.depth + 1});
+        queue.push_back(
+            {std::move(bottom), a ? xm : cell.x0, a ? cell.x1 : xm, cell.y0, ym, cell.depth + 1});
+        queue.push_back(
+            {std::move(top), a ? xm : cell.x0, a ? cell.x1 : xm, ym, cell.y1, cell.depth + 1});
       }
     }
   }

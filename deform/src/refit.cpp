@@ -9,11 +9,11 @@
 #include <clay/deform/refit.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/format.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
-#include <clay/internal/checks.hpp>
-#include <clay/internal/format.hpp>
 
 #include <Eigen/Dense>
 
@@ -34,8 +34,8 @@
 
 #include "certifier.hpp"
 #include "extended_internal.hpp"
-#include "seal.hpp"
 #include "messages.hpp"
+#include "seal.hpp"
 
 namespace clay::deform {
 
@@ -96,7 +96,8 @@ Eigen::MatrixXd collocation(const BSplineBasis& basis, const std::vector<double>
     const int span = surface::find_span(basis, t[r]);
     surface::basis_functions(basis, span, t[r], values);
     for (int k = 0; k <= basis.degree; ++k)
-      a(static_cast<Eigen::Index>(r), span - basis.degree + k) = values[static_cast<std::size_t>(k)];
+      a(static_cast<Eigen::Index>(r), span - basis.degree + k) =
+          values[static_cast<std::size_t>(k)];
   }
   return a;
 }
@@ -192,8 +193,8 @@ Eigen::Vector3d deformed(const Certifier& d, const Eigen::Vector3d& x) {
   const Eigen::Vector3d y = d.map(x);
   if (!internal::all_finite(y))
     throw Error(ErrorCategory::InvalidArgument,
-                "refit_deformed: the " + d.name + " maps (" + format(x.x()) + ", " +
-                    format(x.y()) + ", " + format(x.z()) +
+                "refit_deformed: the " + d.name + " maps (" + format(x.x()) + ", " + format(x.y()) +
+                    ", " + format(x.z()) +
                     ") to a non-finite point; use a deformation defined on the whole surface");
   return y;
 }
@@ -218,8 +219,8 @@ struct Certificate {
 /// Every cell of `fit` (pair of its non-empty spans): sampled deviation on a uniform grid of at
 /// least `base` intervals per direction, and (when the certifier has bounds) the bound
 /// max|e(grid)| + remainder + rounding allowance.
-Certificate certify(const BSplineSurface& original, const BSplineSurface& fit,
-                    const Certifier& d, int base, double budget, double rounding) {
+Certificate certify(const BSplineSurface& original, const BSplineSurface& fit, const Certifier& d,
+                    int base, double budget, double rounding) {
   const surface::BezierPatches fit_patches = surface::extract_bezier(fit);
   const std::vector<double> added_u =
       added_breaks(fit_patches.breaks_u, surface::breakpoints(original.u));
@@ -230,7 +231,8 @@ Certificate certify(const BSplineSurface& original, const BSplineSurface& fit,
   if (!added_v.empty()) refined = surface::refine_knots_v(refined, added_v);
   const surface::BezierPatches s_patches = surface::extract_bezier(refined);
   if (s_patches.count_u() != fit_patches.count_u() || s_patches.count_v() != fit_patches.count_v())
-    throw Error(ErrorCategory::Internal, "refit_deformed: the fit's and the surface's cells differ");
+    throw Error(ErrorCategory::Internal,
+                "refit_deformed: the fit's and the surface's cells differ");
 
   const int cap = std::max(base, 64);
   Certificate out;
@@ -255,8 +257,8 @@ Certificate certify(const BSplineSurface& original, const BSplineSurface& fit,
         const PatchBounds s = patch_bounds(sp), f = patch_bounds(fp);
         const double l1 = info.bounds.first, l2 = info.bounds.second;
         auto grid = [&](double need) {
-          return static_cast<int>(std::clamp(std::ceil(need), static_cast<double>(base),
-                                             static_cast<double>(cap)));
+          return static_cast<int>(
+              std::clamp(std::ceil(need), static_cast<double>(base), static_cast<double>(cap)));
         };
         if (std::isfinite(l2)) {
           // Taylor: |e − I e| <= (h_u^2 / 8) sup|e_uu| + (h_v^2 / 8) sup|e_vv|
@@ -279,8 +281,10 @@ Certificate certify(const BSplineSurface& original, const BSplineSurface& fit,
           out.certified = false;
         }
       }
-      const std::vector<double> us = surface::linspace(sp.u.knots.front(), sp.u.knots.back(), nu + 1);
-      const std::vector<double> vs = surface::linspace(sp.v.knots.front(), sp.v.knots.back(), nv + 1);
+      const std::vector<double> us =
+          surface::linspace(sp.u.knots.front(), sp.u.knots.back(), nu + 1);
+      const std::vector<double> vs =
+          surface::linspace(sp.v.knots.front(), sp.v.knots.back(), nv + 1);
       const Points3 s_values = surface::evaluate_grid(sp, us, vs);
       const Points3 f_values = surface::evaluate_grid(fp, us, vs);
       for (Eigen::Index r = 0; r < s_values.rows(); ++r) {
@@ -340,7 +344,8 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
   const std::size_t initial_u = bu.knots.size(), initial_v = bv.knots.size();
   std::string limit;
   for (int iteration = 1;; ++iteration) {
-    const std::vector<double> us = fit_parameters(bu, intervals), vs = fit_parameters(bv, intervals);
+    const std::vector<double> us = fit_parameters(bu, intervals),
+                              vs = fit_parameters(bv, intervals);
     Points3 values = surface::evaluate_grid(surface, us, vs);
     for (Eigen::Index r = 0; r < values.rows(); ++r)
       values.row(r) = deformed(d, values.row(r).transpose()).transpose();
@@ -386,8 +391,9 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     // one long direction costs count^2 memory even within max_control_points: a twist of 1e6
     // degrees grew one direction to 10,000 and took 4.4 GB (issue #18).
     if (std::max(nu.count(), nv.count()) > options.max_count_per_direction) {
-      limit = "control point limit per direction " + std::to_string(options.max_count_per_direction) +
-              " reached (next net " + std::to_string(nu.count()) + " x " + std::to_string(nv.count()) + ")";
+      limit = "control point limit per direction " +
+              std::to_string(options.max_count_per_direction) + " reached (next net " +
+              std::to_string(nu.count()) + " x " + std::to_string(nv.count()) + ")";
       break;
     }
     if (static_cast<long>(nu.count()) * nv.count() > options.max_control_points) {
@@ -432,9 +438,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
 
 std::vector<std::string> RefitOptions::problems() const {
   std::vector<std::string> out;
-  auto fail = [&out](const std::string& what) {
-    out.push_back("RefitOptions::" + what);
-  };
+  auto fail = [&out](const std::string& what) { out.push_back("RefitOptions::" + what); };
   if (degree < 1 || degree > 25)
     fail("degree = " + std::to_string(degree) +
          ": must be in [1, 25] (the exchange degree limit); 3 is usual");
@@ -453,7 +457,9 @@ std::vector<std::string> RefitOptions::problems() const {
   return out;
 }
 
-void RefitOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void RefitOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 std::string RefitReport::brief() const {
   char buffer[256];
@@ -476,7 +482,8 @@ namespace {
 
 // Every deformation kind: validated, then fitted and certified by its certifier.
 template <class D>
-RefitResult refit_validated(const BSplineSurface& surface, const D& deformation, const RefitOptions& options) {
+RefitResult refit_validated(const BSplineSurface& surface, const D& deformation,
+                            const RefitOptions& options) {
   validate(deformation);
   return refit(surface, certifier(deformation), options);
 }

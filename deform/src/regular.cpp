@@ -20,8 +20,8 @@ namespace clay::deform {
 
 namespace {
 
-using internal::all_finite;
 using detail::format;
+using internal::all_finite;
 
 /// Which of Barr's local axes `axis` and `reference` are.
 enum class Layout {
@@ -162,8 +162,8 @@ Eigen::Matrix3d bend_jacobian_local(const Bend& d, const Eigen::Vector3d& l) {
   const bool inside = l.y() >= d.y_min && l.y() <= d.y_max;
   const double stretch = inside ? 1 - d.rate * l.z() : 1.0;
   Eigen::Matrix3d j;
-  j << 1, 0, 0,             //
-      0, c * stretch, -s,   //
+  j << 1, 0, 0,            //
+      0, c * stretch, -s,  //
       0, s * stretch, c;
   return j;
 }
@@ -209,8 +209,8 @@ void polynomial_problems(const std::vector<double>& c, std::string_view name, co
                   " (degree 63); give a polynomial of lower degree");
   for (std::size_t i = 0; i < c.size(); ++i)
     if (!std::isfinite(c[i])) {
-      out.push_back(std::string(name) + ": " + field + "[" + std::to_string(i) + "] = " +
-                    format(c[i]) + " is not finite; give finite coefficients");
+      out.push_back(std::string(name) + ": " + field + "[" + std::to_string(i) +
+                    "] = " + format(c[i]) + " is not finite; give finite coefficients");
       return;
     }
 }
@@ -229,18 +229,20 @@ std::vector<std::string> problems(const AxisFrame& frame, std::string_view name)
       out.push_back(n + ": " + what + " " + format(*v) + " is not finite; give finite coordinates");
   if (!out.empty()) return out;
   if (frame.axis.norm() == 0)
-    out.push_back(n + ": axis (0, 0, 0) has zero length; give a non-zero direction for the "
-                      "deformation axis");
+    out.push_back(n +
+                  ": axis (0, 0, 0) has zero length; give a non-zero direction for the "
+                  "deformation axis");
   if (frame.reference.norm() == 0)
-    out.push_back(n + ": reference (0, 0, 0) has zero length; give a non-zero direction not "
-                      "parallel to the axis");
+    out.push_back(n +
+                  ": reference (0, 0, 0) has zero length; give a non-zero direction not "
+                  "parallel to the axis");
   if (!out.empty()) return out;
   const Eigen::Vector3d a = frame.axis.normalized();
   const double perpendicular = (frame.reference - frame.reference.dot(a) * a).norm();
   if (!(perpendicular > 1e-9 * frame.reference.norm()))
     out.push_back(n + ": reference " + format(frame.reference) + " is parallel to the axis " +
-                  format(frame.axis) +
-                  " (relative perpendicular part " + format(perpendicular / frame.reference.norm()) +
+                  format(frame.axis) + " (relative perpendicular part " +
+                  format(perpendicular / frame.reference.norm()) +
                   "), so it fixes no other axis; give a reference direction across the axis");
   return out;
 }

@@ -18,11 +18,14 @@ namespace clay::deform::detail {
 /// "closed" by a STEP reader, so the file would not read back as written. The changes are within
 /// that rounding or approximation; callers measure or certify the result after this.
 template <class Map>
-void keep_closed_and_collapsed(const surface::BSplineSurface& original, surface::BSplineSurface& image, Map&& map) {
-  const int nu = original.count_u(), nv = original.count_v(), mu = image.count_u(), mv = image.count_v();
+void keep_closed_and_collapsed(const surface::BSplineSurface& original,
+                               surface::BSplineSurface& image, Map&& map) {
+  const int nu = original.count_u(), nv = original.count_v(), mu = image.count_u(),
+            mv = image.count_v();
   auto same = [&](int i0, int j0, int i1, int j1) {
     const Eigen::Index a = original.index(i0, j0), b = original.index(i1, j1);
-    return original.points.row(a) == original.points.row(b) && original.weights[a] == original.weights[b];
+    return original.points.row(a) == original.points.row(b) &&
+           original.weights[a] == original.weights[b];
   };
   auto copy = [&](Eigen::Index to, Eigen::Index from) {
     image.points.row(to) = image.points.row(from);

@@ -45,8 +45,8 @@ void apply_in_place(const BSplineLattice& d, Points3& p, const DeformOptions& o,
                     StackReport&) {
   deform_points(FrozenLattice(d), p, p, o);
 }
-void apply_in_place(const ExtendedLattice& d, Points3& p, const DeformOptions& o,
-                    std::size_t step, StackReport& report) {
+void apply_in_place(const ExtendedLattice& d, Points3& p, const DeformOptions& o, std::size_t step,
+                    StackReport& report) {
   // deform_points(ExtendedLattice): freeze on the rest shape (Coquillart §3.3), evaluate eq. (1)
   // on the moved control points (§3.4); unresolved points stay, the summary says so.
   FreezeOptions f;
@@ -55,21 +55,19 @@ void apply_in_place(const ExtendedLattice& d, Points3& p, const DeformOptions& o
   p = evaluate(d, frozen, o);
   report.freezes.push_back({step, frozen.report});
 }
-void apply_in_place(const Taper& d, Points3& p, const DeformOptions& o, std::size_t,
-                    StackReport&) {
+void apply_in_place(const Taper& d, Points3& p, const DeformOptions& o, std::size_t, StackReport&) {
   deform_points(d, p, p, o);
 }
-void apply_in_place(const Twist& d, Points3& p, const DeformOptions& o, std::size_t,
-                    StackReport&) {
+void apply_in_place(const Twist& d, Points3& p, const DeformOptions& o, std::size_t, StackReport&) {
   deform_points(d, p, p, o);
 }
-void apply_in_place(const Bend& d, Points3& p, const DeformOptions& o, std::size_t,
-                    StackReport&) {
+void apply_in_place(const Bend& d, Points3& p, const DeformOptions& o, std::size_t, StackReport&) {
   deform_points(d, p, p, o);
 }
 
 std::string step_label(const DeformationStep& step, std::size_t i) {
-  std::string label = "steps[" + std::to_string(i) + "] (" + std::string(kind_name(step.deformation));
+  std::string label =
+      "steps[" + std::to_string(i) + "] (" + std::string(kind_name(step.deformation));
   if (!step.name.empty()) label += " '" + step.name + "'";
   return label + ")";
 }
@@ -154,8 +152,8 @@ std::vector<std::string> problems(const DeformationStack& stack) {
   std::vector<std::string> out;
   for (std::size_t i = 0; i < stack.steps.size(); ++i) {
     const std::string label = step_label(stack.steps[i], i);
-    const auto list = std::visit([&](const auto& d) { return problems(d, label); },
-                                 stack.steps[i].deformation);
+    const auto list =
+        std::visit([&](const auto& d) { return problems(d, label); }, stack.steps[i].deformation);
     out.insert(out.end(), list.begin(), list.end());
   }
   return out;
@@ -188,7 +186,8 @@ std::string StackReport::brief() const {
   if (freezes.empty()) return "no extended lattice step";
   std::string text;
   for (const Freeze& f : freezes)
-    text += (text.empty() ? "steps[" : "; steps[") + std::to_string(f.step) + "]: " + f.report.brief();
+    text +=
+        (text.empty() ? "steps[" : "; steps[") + std::to_string(f.step) + "]: " + f.report.brief();
   return text;
 }
 
@@ -202,7 +201,8 @@ void deform_points(const DeformationStack& stack, const Points3& points, Points3
     if (stack.steps[i].enabled)
       std::visit([&](const auto& d) { apply_in_place(d, out, options, i, report); },
                  stack.steps[i].deformation);
-  report.summary.termination = report.converged() ? Termination::Converged : Termination::NotConverged;
+  report.summary.termination =
+      report.converged() ? Termination::Converged : Termination::NotConverged;
   report.summary.message = report.brief();
 }
 
@@ -258,30 +258,37 @@ DeformationStack stack_from_json(std::string_view json) {
                     "): " + e.what() + "; fix the syntax (NaN and Infinity are not JSON numbers)");
   } catch (const Json::exception& e) {  // e.g. a number beyond the range of a double
     throw Error(ErrorCategory::Recipe, std::string("deformation stack JSON could not be read: ") +
-                                           e.what() + "; give finite numbers within the range of a double");
+                                           e.what() +
+                                           "; give finite numbers within the range of a double");
   }
   // Every problem with its path (the shared reader), then the values of the steps read.
   internal::JsonReader r;
   DeformationStack stack;
-  if (r.object(root, "", {"format", "version", "steps"}, "the stack {\"format\", \"version\", \"steps\"}")) {
-    const Json* format = r.member(root, "", "format", true, "\"format\": \"clayform.deformation-stack\"");
+  if (r.object(root, "", {"format", "version", "steps"},
+               "the stack {\"format\", \"version\", \"steps\"}")) {
+    const Json* format =
+        r.member(root, "", "format", true, "\"format\": \"clayform.deformation-stack\"");
     if (format && (!format->is_string() || format->get<std::string>() != format_name))
-      r.add("format", "expected \"" + std::string(format_name) + "\", found " + internal::found(*format) +
-                          "; this is not a deformation stack file");
+      r.add("format", "expected \"" + std::string(format_name) + "\", found " +
+                          internal::found(*format) + "; this is not a deformation stack file");
     const Json* version = r.member(root, "", "version", true, "\"version\": 1");
     if (version && (!version->is_number_integer() || version->get<long long>() != format_version))
       r.add("version", internal::found(*version) + " is not supported: this build reads version " +
-                           std::to_string(format_version) + "; write the file with a matching clayform");
+                           std::to_string(format_version) +
+                           "; write the file with a matching clayform");
     const Json* steps = r.member(root, "", "steps", true, "the list of steps, [] for none");
-    if (steps && !steps->is_array()) r.add("steps", "expected an array of steps, found " + internal::found(*steps));
+    if (steps && !steps->is_array())
+      r.add("steps", "expected an array of steps, found " + internal::found(*steps));
     if (steps && steps->is_array()) {
       stack.steps.reserve(steps->size());
       for (std::size_t i = 0; i < steps->size(); ++i) {
         const std::string path = internal::index_path("steps", i);
         if (auto step = internal::read_step(r, (*steps)[i], path)) {
-          r.add_all(internal::step_label(path, *step),
-                    std::visit([&](const auto& d) { return problems(d, internal::step_label(path, *step)); },
-                               step->deformation));
+          r.add_all(
+              internal::step_label(path, *step),
+              std::visit(
+                  [&](const auto& d) { return problems(d, internal::step_label(path, *step)); },
+                  step->deformation));
           stack.steps.push_back(std::move(*step));
         }
       }

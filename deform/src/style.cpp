@@ -6,9 +6,9 @@
 #include "style_internal.hpp"
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 
@@ -25,30 +25,31 @@ using surface::Points3;
 
 std::string_view to_string(ConstraintClass c) noexcept {
   switch (c) {
-    case ConstraintClass::OverConstrained: return "over-constrained";
-    case ConstraintClass::UnderConstrained: return "under-constrained";
-    case ConstraintClass::WellConstrained: return "well-constrained";
+    case ConstraintClass::OverConstrained:
+      return "over-constrained";
+    case ConstraintClass::UnderConstrained:
+      return "under-constrained";
+    case ConstraintClass::WellConstrained:
+      return "well-constrained";
   }
   return "?";
 }
 
 std::vector<std::string> StyleOptions::problems() const {
   std::vector<std::string> out;
-  auto fail = [&out](const std::string& what) {
-    out.push_back("style options: " + what);
-  };
+  auto fail = [&out](const std::string& what) { out.push_back("style options: " + what); };
   if (!(lambda >= 0 && lambda <= 1))
     fail("lambda = " + std::to_string(lambda) + " must lie in [0, 1] (Han et al. eq. 9)");
   if (curve_samples != 0 && curve_samples < 8)
     fail("curve_samples = " + std::to_string(curve_samples) + " must be 0 (automatic) or >= 8");
-  if (bound_samples < 8)
-    fail("bound_samples = " + std::to_string(bound_samples) + " must be >= 8");
+  if (bound_samples < 8) fail("bound_samples = " + std::to_string(bound_samples) + " must be >= 8");
   if (key_points_per_row < 1)
     fail("key_points_per_row = " + std::to_string(key_points_per_row) + " must be >= 1");
   if (boundary_rows < 0 || boundary_rows > 4)
     fail("boundary_rows = " + std::to_string(boundary_rows) + " must lie in [0, 4]");
   if (!(tolerance > 0 && tolerance <= 1e-3))
-    fail("tolerance = " + std::to_string(tolerance) + " must lie in (0, 1e-3] (relative to the model size)");
+    fail("tolerance = " + std::to_string(tolerance) +
+         " must lie in (0, 1e-3] (relative to the model size)");
   if (max_refinements < 0)
     fail("max_refinements = " + std::to_string(max_refinements) + " must be >= 0");
   if (!(curve_tolerance >= 0 && curve_tolerance <= 1e-1))
@@ -60,7 +61,9 @@ std::vector<std::string> StyleOptions::problems() const {
   return out;
 }
 
-void StyleOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void StyleOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 int InfluenceRegion::inside_count() const noexcept {
   return static_cast<int>(std::count(factors.begin(), factors.end(), std::uint8_t{1}));
@@ -84,7 +87,8 @@ std::vector<TraceSample> trace_on_surface(const surface::SurfaceProjector& proje
       p = projector.closest_point(s.point);
     } else {
       // Newton from the previous sample, or from the same sample of the previous drag position.
-      const Eigen::Vector2d start = have_warm ? (*warm)[k] : Eigen::Vector2d(out[k - 1].u, out[k - 1].v);
+      const Eigen::Vector2d start =
+          have_warm ? (*warm)[k] : Eigen::Vector2d(out[k - 1].u, out[k - 1].v);
       p = projector.project_normal(s.point, start.x(), start.y());
       if (!p.summary.converged()) p = projector.closest_point(s.point);
     }
@@ -94,7 +98,8 @@ std::vector<TraceSample> trace_on_surface(const surface::SurfaceProjector& proje
   return out;
 }
 
-PolygonLocator::PolygonLocator(const std::vector<Eigen::Vector2d>& polygon, double on_edge_tolerance)
+PolygonLocator::PolygonLocator(const std::vector<Eigen::Vector2d>& polygon,
+                               double on_edge_tolerance)
     : polygon_(&polygon), tolerance_(on_edge_tolerance) {
   if (polygon.empty()) return;
   y_lo_ = 1e300;
@@ -111,8 +116,10 @@ PolygonLocator::PolygonLocator(const std::vector<Eigen::Vector2d>& polygon, doub
   const size_t n = polygon.size();
   for (size_t i = 0; i < n; ++i) {
     const double a = polygon[i].y(), b = polygon[(i + 1) % n].y();
-    const int first = bin_of(std::min(a, b) - tolerance_), last = bin_of(std::max(a, b) + tolerance_);
-    for (int k = first; k <= last; ++k) bins_[static_cast<size_t>(k)].push_back(static_cast<int>(i));
+    const int first = bin_of(std::min(a, b) - tolerance_),
+              last = bin_of(std::max(a, b) + tolerance_);
+    for (int k = first; k <= last; ++k)
+      bins_[static_cast<size_t>(k)].push_back(static_cast<int>(i));
   }
 }
 
@@ -124,7 +131,8 @@ int PolygonLocator::bin_of(double y) const noexcept {
 }
 
 bool PolygonLocator::inside(const Eigen::Vector2d& p) const {
-  if (bins_.empty() || p.y() < y_lo_ || p.y() > y_lo_ + static_cast<double>(bins_.size()) / inverse_height_)
+  if (bins_.empty() || p.y() < y_lo_ ||
+      p.y() > y_lo_ + static_cast<double>(bins_.size()) / inverse_height_)
     return false;
   // Winding number: only edges whose y-range holds p.y can cross the ray, and those are in p's
   // bin; so are the edges p can lie on.
@@ -134,7 +142,8 @@ bool PolygonLocator::inside(const Eigen::Vector2d& p) const {
   for (int i : bins_[static_cast<size_t>(bin_of(p.y()))]) {
     const Eigen::Vector2d& a = poly[static_cast<size_t>(i)];
     const Eigen::Vector2d& b = poly[(static_cast<size_t>(i) + 1) % n];
-    if (p.x() >= std::min(a.x(), b.x()) - tolerance_ && p.x() <= std::max(a.x(), b.x()) + tolerance_) {
+    if (p.x() >= std::min(a.x(), b.x()) - tolerance_ &&
+        p.x() <= std::max(a.x(), b.x()) + tolerance_) {
       const Eigen::Vector2d ab = b - a;
       const double len2 = ab.squaredNorm();
       const double s = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
@@ -171,8 +180,7 @@ double parameter_tolerance(const BSplineSurface& s) {
 
 std::vector<std::uint8_t> region_factors(const BSplineSurface& surface,
                                          const std::vector<Eigen::Vector2d>& polygon,
-                                         const std::vector<Eigen::Vector2d>& trace,
-                                         int margin) {
+                                         const std::vector<Eigen::Vector2d>& trace, int margin) {
   const int nu = surface.count_u(), nv = surface.count_v();
   std::vector<std::uint8_t> e(static_cast<size_t>(nu) * static_cast<size_t>(nv), 0);
   if (!polygon.empty()) {
@@ -238,8 +246,9 @@ class RegionTest {
 
 }  // namespace
 
-KeyPoint make_key_point(const BSplineSurface& s, const InfluenceRegion& region, const Eigen::Vector3d& point,
-                        double t, double u, double v, KeyDirection direction) {
+KeyPoint make_key_point(const BSplineSurface& s, const InfluenceRegion& region,
+                        const Eigen::Vector3d& point, double t, double u, double v,
+                        KeyDirection direction) {
   KeyPoint k;
   k.curve_parameter = t;
   k.point = point;
@@ -251,7 +260,8 @@ KeyPoint make_key_point(const BSplineSurface& s, const InfluenceRegion& region, 
   const double gu = continuous_index(surface::greville_abscissae(s.u), u);
   const double gv = continuous_index(surface::greville_abscissae(s.v), v);
   k.row = static_cast<int>(std::lround(direction == KeyDirection::U ? gu : gv));
-  k.influenced = region.inside(static_cast<int>(std::lround(gu)), static_cast<int>(std::lround(gv)));
+  k.influenced =
+      region.inside(static_cast<int>(std::lround(gu)), static_cast<int>(std::lround(gv)));
   return k;
 }
 
@@ -263,7 +273,8 @@ bool begin_report(const KeyPoints& keys, const StyleOptions& options, StyleMode 
   report.m = static_cast<int>(keys.points.size());
   report.key_points = keys.points;
   if (keys.constraint_class == ConstraintClass::OverConstrained) {
-    report.message = "over-constrained: the target curve lies outside the bound; the surface is unchanged";
+    report.message =
+        "over-constrained: the target curve lies outside the bound; the surface is unchanged";
     return true;
   }
   if (options.lambda == 0) {
@@ -295,8 +306,9 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
   }
   out.direction = (gu_hi - gu_lo >= gv_hi - gv_lo) ? KeyDirection::U : KeyDirection::V;
   out.constraint_class = inside == 0 ? ConstraintClass::OverConstrained
-                         : inside == static_cast<int>(trace.size()) ? ConstraintClass::WellConstrained
-                                                                    : ConstraintClass::UnderConstrained;
+                         : inside == static_cast<int>(trace.size())
+                             ? ConstraintClass::WellConstrained
+                             : ConstraintClass::UnderConstrained;
   const bool along_u = out.direction == KeyDirection::U;
   const std::vector<double>& along = along_u ? xu : xv;
   auto coord = [&](double u, double v) { return along_u ? u : v; };
@@ -327,7 +339,8 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
     // The first sample interval whose projection crosses c.
     size_t k = 0;
     for (; k + 1 < trace.size(); ++k) {
-      const double a = coord(trace[k].u, trace[k].v) - c, b = coord(trace[k + 1].u, trace[k + 1].v) - c;
+      const double a = coord(trace[k].u, trace[k].v) - c,
+                   b = coord(trace[k + 1].u, trace[k + 1].v) - c;
       if ((a <= 0 && b >= 0) || (a >= 0 && b <= 0)) break;
     }
     if (k + 1 >= trace.size()) continue;  // cannot happen for c in [lo, hi]; kept for safety
@@ -365,8 +378,10 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
       if (tb == ta) break;
     }
     // Land exactly on the row where the root is that close (the row is what eq. 8 counts).
-    if (along_u) u = std::abs(u - c) <= ftol ? c : u;
-    else v = std::abs(v - c) <= ftol ? c : v;
+    if (along_u)
+      u = std::abs(u - c) <= ftol ? c : u;
+    else
+      v = std::abs(v - c) <= ftol ? c : v;
     out.points.push_back(make_key(t, u, v));
   }
   if (out.points.empty()) {
@@ -430,7 +445,8 @@ void measure(const BSplineSurface& parent, const BSplineSurface& result,
         for (int n = 0; n < 4; ++n) {
           const int a = i + di[n], b = j + dj[n];
           if (a < 0 || b < 0 || a >= nu || b >= nv || e(a, b)) continue;
-          edge.push_back(0.5 * (g + Eigen::Vector2d(xu[static_cast<size_t>(a)], xv[static_cast<size_t>(b)])));
+          edge.push_back(
+              0.5 * (g + Eigen::Vector2d(xu[static_cast<size_t>(a)], xv[static_cast<size_t>(b)])));
         }
       }
   }
@@ -443,7 +459,8 @@ void measure(const BSplineSurface& parent, const BSplineSurface& result,
     const Eigen::Vector3d na = normal_or_zero(parent, uv.x(), uv.y());
     const Eigen::Vector3d nb = normal_or_zero(result, uv.x(), uv.y());
     if (na.isZero() || nb.isZero()) continue;
-    const double angle = std::atan2(na.cross(nb).norm(), na.dot(nb)) * (180.0 / 3.14159265358979323846);
+    const double angle =
+        std::atan2(na.cross(nb).norm(), na.dot(nb)) * (180.0 / 3.14159265358979323846);
     report.boundary_tangent_angle = std::max(report.boundary_tangent_angle, angle);
   }
 }
@@ -464,7 +481,8 @@ void check_region(const BSplineSurface& parent, const InfluenceRegion& region) {
 }
 
 // Where the projection of the bound polygon crosses itself: indices of two non-adjacent edges.
-std::optional<std::pair<size_t, size_t>> polygon_crossing(const std::vector<Eigen::Vector2d>& poly) {
+std::optional<std::pair<size_t, size_t>> polygon_crossing(
+    const std::vector<Eigen::Vector2d>& poly) {
   const size_t n = poly.size();
   auto orient = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
     return (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
@@ -477,9 +495,11 @@ std::optional<std::pair<size_t, size_t>> polygon_crossing(const std::vector<Eige
       if (i == 0 && j == n - 1) continue;  // adjacent through the closing edge
       const Eigen::Vector2d& c = poly[j];
       const Eigen::Vector2d& d = poly[(j + 1) % n];
-      if ((c.cwiseMax(d).array() < lo_ab.array()).any() || (c.cwiseMin(d).array() > hi_ab.array()).any())
+      if ((c.cwiseMax(d).array() < lo_ab.array()).any() ||
+          (c.cwiseMin(d).array() > hi_ab.array()).any())
         continue;
-      const double o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a), o4 = orient(c, d, b);
+      const double o1 = orient(a, b, c), o2 = orient(a, b, d), o3 = orient(c, d, a),
+                   o4 = orient(c, d, b);
       if (((o1 > 0 && o2 < 0) || (o1 < 0 && o2 > 0)) && ((o3 > 0 && o4 < 0) || (o3 < 0 && o4 > 0)))
         return std::make_pair(i, j);
     }
@@ -501,7 +521,8 @@ InfluenceRegion influence_factors(const BSplineSurface& parent, const BSplineCur
   check_inputs(parent, bound, "bound curve", options);
   const auto [a, b] = bound.basis.domain();
   const Eigen::Vector3d first = surface::evaluate(bound, a), last = surface::evaluate(bound, b);
-  const double size = (bound.points.colwise().maxCoeff() - bound.points.colwise().minCoeff()).norm();
+  const double size =
+      (bound.points.colwise().maxCoeff() - bound.points.colwise().minCoeff()).norm();
   if (!((first - last).norm() <= 1e-7 * size)) {
     std::ostringstream msg;
     msg << "bound curve: its ends are " << (first - last).norm()
@@ -533,7 +554,8 @@ InfluenceRegion influence_from_target(const BSplineSurface& parent, const BSplin
                                       const StyleOptions& options) {
   check_inputs(parent, target, "target curve", options);
   const surface::SurfaceProjector projector(parent, options.projection);
-  const auto trace = detail::trace_on_surface(projector, target, detail::target_samples(target, options), nullptr);
+  const auto trace =
+      detail::trace_on_surface(projector, target, detail::target_samples(target, options), nullptr);
   std::vector<Eigen::Vector2d> uv;
   uv.reserve(trace.size());
   for (const auto& t : trace) uv.emplace_back(t.u, t.v);
@@ -551,7 +573,8 @@ KeyPoints key_points(const BSplineSurface& parent, const InfluenceRegion& region
   check_inputs(parent, target, "target curve", options);
   check_region(parent, region);
   const surface::SurfaceProjector projector(parent, options.projection);
-  const auto trace = detail::trace_on_surface(projector, target, detail::target_samples(target, options), nullptr);
+  const auto trace =
+      detail::trace_on_surface(projector, target, detail::target_samples(target, options), nullptr);
   return detail::find_key_points(projector, region, target, trace, 1);
 }
 
@@ -574,8 +597,10 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
   m.precision(4);
   if (report.constraint_class == ConstraintClass::OverConstrained) {
     s.termination = Termination::Failed;
-    s.message = "the target curve lies outside the bound, so no control vertex may move and the surface is "
-                "unchanged: draw the target curve (at least partly) inside the bound, or the bound around it";
+    s.message =
+        "the target curve lies outside the bound, so no control vertex may move and the surface is "
+        "unchanged: draw the target curve (at least partly) inside the bound, or the bound around "
+        "it";
     return s;
   }
   s.termination = Termination::Converged;
@@ -588,9 +613,10 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
   constexpr double fold_factor = 10;
   if (farthest > 0 && report.max_displacement > fold_factor * farthest) {
     s.termination = Termination::NotConverged;
-    m << "a control vertex moves " << report.max_displacement << " mm for a target at most " << farthest
-      << " mm from the surface (" << report.max_displacement / farthest
-      << " times; at most 10 times is accepted): the surface folds. Move the bound further from the target or "
+    m << "a control vertex moves " << report.max_displacement << " mm for a target at most "
+      << farthest << " mm from the surface (" << report.max_displacement / farthest
+      << " times; at most 10 times is accepted): the surface folds. Move the bound further from "
+         "the target or "
          "the target closer to the surface";
     if (report.mode == StyleMode::Exact) m << ", or allow more max_refinements";
     s.message = m.str();
@@ -601,12 +627,14 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
     if (!report.conflicting_key_points.empty()) {
       s.termination = Termination::NotConverged;
       m << report.conflicting_key_points.size() << " key points cannot be met (missed by up to "
-        << report.target_deviation << " mm, more than tolerance x size = " << options.tolerance * size
+        << report.target_deviation
+        << " mm, more than tolerance x size = " << options.tolerance * size
         << " mm): the control net is too coarse there; allow more max_refinements";
     } else if (report.target_deviation > options.tolerance * size) {
       s.termination = Termination::NotConverged;
-      m << "a key point is missed by " << report.target_deviation << " mm, more than tolerance x size = "
-        << options.tolerance * size << " mm; allow more max_refinements";
+      m << "a key point is missed by " << report.target_deviation
+        << " mm, more than tolerance x size = " << options.tolerance * size
+        << " mm; allow more max_refinements";
     } else if (options.curve_tolerance > 0 && std::isfinite(report.target_curve_deviation) &&
                report.target_curve_deviation > options.curve_tolerance * size) {
       s.termination = Termination::NotConverged;
@@ -616,14 +644,16 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
     }
     s.message = m.str();
   }
-  if (s.converged()) s.message = report.mode == StyleMode::Exact ? "the key points and the target curve are met"
-                                                                 : "the target is approximated (paper mode)";
+  if (s.converged())
+    s.message = report.mode == StyleMode::Exact ? "the key points and the target curve are met"
+                                                : "the target is approximated (paper mode)";
   return s;
 }
 
 StyleResult StyleEditor::update(const BSplineCurve& target) {
   surface::validate(target, "target curve");
-  const auto trace = detail::trace_on_surface(projector_, target, detail::target_samples(target, options_), &warm_);
+  const auto trace = detail::trace_on_surface(projector_, target,
+                                              detail::target_samples(target, options_), &warm_);
   StyleResult out = options_.mode == StyleMode::Exact
                         ? detail::style_exact(projector_, region_, target, trace, options_, exact_)
                         : detail::style_paper(projector_, region_, target, trace, options_);
@@ -651,8 +681,12 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
   const bool along_u = keys.direction == KeyDirection::U;
   const int rows = along_u ? parent.count_u() : parent.count_v();
   const int cols = along_u ? parent.count_v() : parent.count_u();
-  auto vertex = [&](int row, int col) { return along_u ? parent.index(row, col) : parent.index(col, row); };
-  auto E = [&](int row, int col) { return region.factors[static_cast<size_t>(vertex(row, col))] != 0; };
+  auto vertex = [&](int row, int col) {
+    return along_u ? parent.index(row, col) : parent.index(col, row);
+  };
+  auto E = [&](int row, int col) {
+    return region.factors[static_cast<size_t>(vertex(row, col))] != 0;
+  };
   const auto xi_cols = surface::greville_abscissae(along_u ? parent.v : parent.u);
 
   Points3 delta = Points3::Zero(parent.points.rows(), 3);
@@ -681,10 +715,13 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
       const int c0 = std::min(static_cast<int>(std::floor(g)), cols - 1);
       const double frac = g - c0;
       if (E(row, c0)) delta.row(vertex(row, c0)) += factor * (1 - frac) * f;
-      if (c0 + 1 < cols && frac > 0 && E(row, c0 + 1)) delta.row(vertex(row, c0 + 1)) += factor * frac * f;
+      if (c0 + 1 < cols && frac > 0 && E(row, c0 + 1))
+        delta.row(vertex(row, c0 + 1)) += factor * frac * f;
     }
   };
-  auto peak = [&](const KeyPoint& k) { return detail::continuous_index(xi_cols, along_u ? k.v : k.u); };
+  auto peak = [&](const KeyPoint& k) {
+    return detail::continuous_index(xi_cols, along_u ? k.v : k.u);
+  };
 
   // Eqs. 3, 5, 9: f_i = λ E(Q_j) D(K_i) along the normal at the projection.
   const KeyPoint* first = nullptr;
@@ -750,9 +787,9 @@ StyleResult style_deform(const BSplineSurface& parent, const BSplineCurve& targe
 std::string StyleReport::brief() const {
   std::ostringstream text;
   text.precision(3);
-  text << summary.brief() << "; " << to_string(constraint_class) << ", " << key_points.size() << " key points, "
-    << moved_vertices << " vertices moved (largest " << max_displacement << " mm), target deviation "
-    << target_deviation << " mm";
+  text << summary.brief() << "; " << to_string(constraint_class) << ", " << key_points.size()
+       << " key points, " << moved_vertices << " vertices moved (largest " << max_displacement
+       << " mm), target deviation " << target_deviation << " mm";
   return text.str();
 }
 

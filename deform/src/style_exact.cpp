@@ -12,10 +12,10 @@
 #include "style_internal.hpp"
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
@@ -121,7 +121,8 @@ Eigen::AlignedBox2d region_box(const BSplineSurface& s, const InfluenceRegion& r
       if (reg.inside(i, j)) {
         const size_t a = static_cast<size_t>(i), b = static_cast<size_t>(j);
         box.extend(Eigen::Vector2d(xu[a > 0 ? a - 1 : a], xv[b > 0 ? b - 1 : b]));
-        box.extend(Eigen::Vector2d(xu[std::min(a + 1, xu.size() - 1)], xv[std::min(b + 1, xv.size() - 1)]));
+        box.extend(Eigen::Vector2d(xu[std::min(a + 1, xu.size() - 1)],
+                                   xv[std::min(b + 1, xv.size() - 1)]));
       }
   return box;
 }
@@ -130,10 +131,10 @@ Eigen::AlignedBox2d region_box(const BSplineSurface& s, const InfluenceRegion& r
 
 // The free vertices of one net (knot vectors) and the fairness matrix over them.
 struct NetCache {
-  std::vector<double> knots_u, knots_v;     // the net it was built for
-  std::vector<Eigen::Index> free_index;     // per vertex: its unknown, or -1 when fixed
-  std::vector<Eigen::Index> free_rows;      // per unknown: its vertex
-  Eigen::SparseMatrix<double> H;            // thin-plate energy L^T L + ridge, free vertices
+  std::vector<double> knots_u, knots_v;  // the net it was built for
+  std::vector<Eigen::Index> free_index;  // per vertex: its unknown, or -1 when fixed
+  std::vector<Eigen::Index> free_rows;   // per unknown: its vertex
+  Eigen::SparseMatrix<double> H;         // thin-plate energy L^T L + ridge, free vertices
   // H = P^T L D L^T P, factorized once per net: every drag on the net reuses it (only the
   // key-point rows B change), so a solve costs nk triangular solves instead of a KKT factorization.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> energy;
@@ -147,7 +148,8 @@ namespace {
 
 // Free vertices of `s` (influenced, more than boundary_rows layers inside the region's edge) and
 // the factorized thin-plate fairness of their displacements (fixed vertices have d = 0).
-std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s, const std::vector<std::uint8_t>& factors,
+std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s,
+                                            const std::vector<std::uint8_t>& factors,
                                             int boundary_rows) {
   auto cache = std::make_shared<NetCache>();
   cache->knots_u = s.u.knots;
@@ -168,7 +170,8 @@ std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s, const std::
   const auto& free_index = cache->free_index;
   auto add_stencil = [&](std::initializer_list<std::tuple<int, int, double>> terms) {
     bool any = false;
-    for (const auto& [i, j, c] : terms) any = any || free_index[static_cast<size_t>(s.index(i, j))] >= 0;
+    for (const auto& [i, j, c] : terms)
+      any = any || free_index[static_cast<size_t>(s.index(i, j))] >= 0;
     if (!any) return;
     for (const auto& [i, j, c] : terms) {
       const Eigen::Index f = free_index[static_cast<size_t>(s.index(i, j))];
@@ -203,11 +206,13 @@ std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s, const std::
 // for small systems (an interactive region, where it beats the sparse ordering analysis), sparse
 // beyond (at 509 unknowns, a refined hood, a third of dense LU's time). It meets independent key
 // points to rounding without the squared conditioning of the range-space solve.
-Eigen::MatrixXd kkt_solve(const Eigen::SparseMatrix<double>& H, const Eigen::MatrixXd& B, const Eigen::MatrixXd& rhs) {
+Eigen::MatrixXd kkt_solve(const Eigen::SparseMatrix<double>& H, const Eigen::MatrixXd& B,
+                          const Eigen::MatrixXd& rhs) {
   const Eigen::Index nf = H.rows(), nk = B.rows();
   std::vector<Eigen::Triplet<double>> kkt;
   for (Eigen::Index c = 0; c < nf; ++c)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(H, c); it; ++it) kkt.emplace_back(it.row(), it.col(), it.value());
+    for (Eigen::SparseMatrix<double>::InnerIterator it(H, c); it; ++it)
+      kkt.emplace_back(it.row(), it.col(), it.value());
   for (Eigen::Index k = 0; k < nk; ++k)
     for (Eigen::Index c = 0; c < nf; ++c)
       if (B(k, c) != 0) {
@@ -218,14 +223,15 @@ Eigen::MatrixXd kkt_solve(const Eigen::SparseMatrix<double>& H, const Eigen::Mat
   K.setFromTriplets(kkt.begin(), kkt.end());
   Eigen::MatrixXd b = Eigen::MatrixXd::Zero(nf + nk, 3);
   b.bottomRows(nk) = rhs;
-  if (nf + nk <= 200) return Eigen::PartialPivLU<Eigen::MatrixXd>(Eigen::MatrixXd(K)).solve(b).topRows(nf);
+  if (nf + nk <= 200)
+    return Eigen::PartialPivLU<Eigen::MatrixXd>(Eigen::MatrixXd(K)).solve(b).topRows(nf);
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
   lu.compute(K);
   if (lu.info() != Eigen::Success)
-    throw Error(ErrorCategory::Internal, "style deformation: the key-point system could not be factorized");
+    throw Error(ErrorCategory::Internal,
+                "style deformation: the key-point system could not be factorized");
   return Eigen::MatrixXd(lu.solve(b)).topRows(nf);
 }
-
 
 }  // namespace
 
@@ -249,14 +255,17 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
 
   // The key points are those of the parent's net (eq. 8): refinement adds freedom, not
   // constraints. Key points are added where the result still misses the target curve.
-  const KeyPoints keys = find_key_points(projector, region, target, trace, options.key_points_per_row);
+  const KeyPoints keys =
+      find_key_points(projector, region, target, trace, options.key_points_per_row);
   if (begin_report(keys, options, StyleMode::Exact, report)) {
     measure(parent, parent, region.factors, region, trace, options, report);
     return out;
   }
   std::vector<KeyPoint> points = keys.points;
   const PolygonLocator bound(region.polygon, parameter_tolerance(parent));
-  auto in_region = [&](const TraceSample& t) { return region.polygon.empty() || bound.inside({t.u, t.v}); };
+  auto in_region = [&](const TraceSample& t) {
+    return region.polygon.empty() || bound.inside({t.u, t.v});
+  };
   int refinements = 0, additions = 0;
   std::size_t accepted_points = points.size();  // key points before the last round of additions
   double amplification = 0;
@@ -288,7 +297,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     for (Eigen::Index k = 0; k < nk; ++k) {
       const KeyPoint& kp = points[static_cast<size_t>(active[static_cast<size_t>(k)])];
       for (const auto& [r, value] : basis_at(s, kp.u, kp.v))
-        if (free_index[static_cast<size_t>(r)] >= 0) B(k, free_index[static_cast<size_t>(r)]) = value;
+        if (free_index[static_cast<size_t>(r)] >= 0)
+          B(k, free_index[static_cast<size_t>(r)]) = value;
       rhs.row(k) = options.lambda * (kp.point - kp.foot).transpose();
     }
     // Rank of the key-point system from a rank-revealing QR of B^T = Q R P^T: the last nf - rank
@@ -364,7 +374,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
             // vertices reach the net's border, or μ large along S's weak directions).
             const Eigen::MatrixXd force = B.transpose() * mu;
             const double stationarity = (net->H * d - force).cwiseAbs().maxCoeff();
-            solved = internal::all_finite(d) && (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
+            solved = internal::all_finite(d) &&
+                     (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
                      stationarity <= range_space_stationarity * force.cwiseAbs().maxCoeff();
           }
         }
@@ -403,7 +414,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     out.surface = s;
     out.refined_parent = s;
     for (Eigen::Index f = 0; f < nf; ++f)
-      if (!d.row(f).isZero(0)) out.surface.points.row(free_rows[static_cast<size_t>(f)]) += d.row(f);
+      if (!d.row(f).isZero(0))
+        out.surface.points.row(free_rows[static_cast<size_t>(f)]) += d.row(f);
 
     // Where the result still misses the target by more than curve_tolerance, add key points at
     // the local maxima of the miss along the target's samples and solve again.
@@ -432,11 +444,14 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
         if (!peak) continue;
         // Not next to a key point already there (nearly equal rows would make the system
         // ill-conditioned): at least half a sample step away along the curve.
-        const double gap = 0.5 * (trace.back().t - trace.front().t) / static_cast<double>(trace.size() - 1);
+        const double gap =
+            0.5 * (trace.back().t - trace.front().t) / static_cast<double>(trace.size() - 1);
         bool crowded = false;
-        for (const KeyPoint& p : points) crowded = crowded || std::abs(p.curve_parameter - trace[k].t) < gap;
+        for (const KeyPoint& p : points)
+          crowded = crowded || std::abs(p.curve_parameter - trace[k].t) < gap;
         if (crowded) continue;
-        points.push_back(make_key_point(s, reg, trace[k].point, trace[k].t, trace[k].u, trace[k].v, keys.direction));
+        points.push_back(make_key_point(s, reg, trace[k].point, trace[k].t, trace[k].u, trace[k].v,
+                                        keys.direction));
         ++added;
       }
       if (added > 0) {
@@ -452,12 +467,14 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     report.rank = rank;
     report.degrees_of_freedom = 3 * (static_cast<int>(nf) - rank);
     for (Eigen::Index k = 0; k < nk; ++k)
-      if (achieved.row(k).norm() > tol) report.conflicting_key_points.push_back(active[static_cast<size_t>(k)]);
+      if (achieved.row(k).norm() > tol)
+        report.conflicting_key_points.push_back(active[static_cast<size_t>(k)]);
     measure(s, out.surface, reg.factors, reg, trace, options, report);
     std::ostringstream msg;
-    msg << to_string(report.constraint_class) << ", m = " << report.m << " key points ("
-        << nk << " influenced";
-    if (report.added_key_points > 0) msg << ", " << report.added_key_points << " added where the target was missed";
+    msg << to_string(report.constraint_class) << ", m = " << report.m << " key points (" << nk
+        << " influenced";
+    if (report.added_key_points > 0)
+      msg << ", " << report.added_key_points << " added where the target was missed";
     msg << "), " << nf << " free vertices, rank " << rank << ", " << report.degrees_of_freedom
         << " degrees of freedom left";
     if (report.knots_inserted > 0) msg << ", " << report.knots_inserted << " knots inserted";
@@ -471,8 +488,10 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       msg << "; a key point is held mostly by fixed vertices (free share " << min_share
           << "): the free vertices move up to " << 1.0 / std::max(min_share, 1e-300)
           << " times its distance (allow more max_refinements, or a bound further from the target)";
-    if (options.curve_tolerance > 0 && report.target_curve_deviation > options.curve_tolerance * size)
-      msg << "; the target curve is still missed by " << report.target_curve_deviation << " mm, more than "
+    if (options.curve_tolerance > 0 &&
+        report.target_curve_deviation > options.curve_tolerance * size)
+      msg << "; the target curve is still missed by " << report.target_curve_deviation
+          << " mm, more than "
           << "curve_tolerance x size = " << options.curve_tolerance * size
           << " mm (allow more max_key_point_rounds or max_refinements)";
     report.message = msg.str();

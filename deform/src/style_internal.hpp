@@ -13,9 +13,9 @@ namespace clay::deform::detail {
 
 /// A sample of a curve and its projection onto the surface.
 struct TraceSample {
-  double t = 0;                                      // curve parameter
-  Eigen::Vector3d point = Eigen::Vector3d::Zero();   // C(t)
-  double u = 0, v = 0;                               // foot point parameters
+  double t = 0;                                     // curve parameter
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  // C(t)
+  double u = 0, v = 0;                              // foot point parameters
 };
 
 /// `count` samples of the curve (uniform in its parameter, ends included) projected onto the
@@ -54,8 +54,7 @@ double parameter_tolerance(const surface::BSplineSurface& s);
 /// does not move the surface, so the parameter-space region stays.
 std::vector<std::uint8_t> region_factors(const surface::BSplineSurface& surface,
                                          const std::vector<Eigen::Vector2d>& polygon,
-                                         const std::vector<Eigen::Vector2d>& trace,
-                                         int margin);
+                                         const std::vector<Eigen::Vector2d>& trace, int margin);
 
 /// Diagonal of the control box: the model size tolerances are relative to.
 double model_size(const surface::BSplineSurface& surface);
@@ -68,11 +67,13 @@ double continuous_index(const std::vector<double>& xi, double x);
 /// normal (zero at a pole), signed distance D(K) (eq. 3), the row it drives and E of the vertex
 /// nearest to the foot point.
 KeyPoint make_key_point(const surface::BSplineSurface& s, const InfluenceRegion& region,
-                        const Eigen::Vector3d& point, double t, double u, double v, KeyDirection direction);
+                        const Eigen::Vector3d& point, double t, double u, double v,
+                        KeyDirection direction);
 
 /// Fills the report's mode, class, direction, m and key points; true (with the message) when the
 /// surface stays as it is: the over-constrained class or λ = 0.
-bool begin_report(const KeyPoints& keys, const StyleOptions& options, StyleMode mode, StyleReport& report);
+bool begin_report(const KeyPoints& keys, const StyleOptions& options, StyleMode mode,
+                  StyleReport& report);
 
 /// Key points of the traced target on the projector's surface (whose net `region.factors`
 /// describes): Han et al. eq. 8 with `per_row` key points per control-net row interval crossed.

@@ -3,9 +3,9 @@
 #include <clay/deform/surface_deformation.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <sstream>
@@ -22,7 +22,9 @@ std::vector<std::string> SurfaceDeformationOptions::problems() const {
   return out;
 }
 
-void SurfaceDeformationOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void SurfaceDeformationOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 std::string SurfaceDeformationReport::brief() const {
   std::ostringstream out;
@@ -30,14 +32,23 @@ std::string SurfaceDeformationReport::brief() const {
     out << "steps[" << s.step << "] " << s.kind;
     if (!s.name.empty()) out << " '" << s.name << "'";
     switch (s.method) {
-      case StepOutcome::Method::Skipped: out << ": disabled, skipped"; break;
-      case StepOutcome::Method::Exact: out << ": exact, " << s.compose.brief(); break;
-      case StepOutcome::Method::Refit: out << ": refit, " << s.refit.brief(); break;
+      case StepOutcome::Method::Skipped:
+        out << ": disabled, skipped";
+        break;
+      case StepOutcome::Method::Exact:
+        out << ": exact, " << s.compose.brief();
+        break;
+      case StepOutcome::Method::Refit:
+        out << ": refit, " << s.refit.brief();
+        break;
     }
     out << "\n";
   }
   out << "result: degree " << degree_u << " x " << degree_v << ", " << control_points
-      << " control points, " << (exact ? "exact" : certified ? "certified refit" : "refit (not certified)");
+      << " control points, "
+      << (exact       ? "exact"
+          : certified ? "certified refit"
+                      : "refit (not certified)");
   return out.str();
 }
 
@@ -67,7 +78,8 @@ Attempt attempt(F compose) {
     return {compose(), {}, {}};
   } catch (const Error& e) {
     const ErrorCategory c = e.category();
-    if (c == ErrorCategory::DegreeLimit || c == ErrorCategory::OutOfDomain || c == ErrorCategory::InvalidArgument)
+    if (c == ErrorCategory::DegreeLimit || c == ErrorCategory::OutOfDomain ||
+        c == ErrorCategory::InvalidArgument)
       return {std::nullopt, e.what(), c};
     throw;
   }
@@ -123,14 +135,17 @@ template <class Lattice>
 FaceJump face_jump(const Lattice& lattice, const surface::BSplineSurface& s) {
   bool all_inside = true;
   for (Eigen::Index r = 0; r < s.points.rows() && all_inside; ++r)
-    all_inside = outside_by(local_coordinates(lattice.frame, s.points.row(r).transpose())) <= face_tolerance;
+    all_inside =
+        outside_by(local_coordinates(lattice.frame, s.points.row(r).transpose())) <= face_tolerance;
   if (all_inside) return {};
   const std::vector<double> us = surface::span_samples(s.u, 8), vs = surface::span_samples(s.v, 8);
   const Points3 grid = surface::evaluate_grid(s, us, vs);
   const size_t nu = us.size(), nv = vs.size();
   std::vector<char> in(nu * nv);
   for (size_t k = 0; k < in.size(); ++k)
-    in[k] = outside_by(local_coordinates(lattice.frame, grid.row(static_cast<Eigen::Index>(k)).transpose())) <= face_tolerance;
+    in[k] =
+        outside_by(local_coordinates(
+            lattice.frame, grid.row(static_cast<Eigen::Index>(k)).transpose())) <= face_tolerance;
   FaceJump worst;
   auto crossing = [&](double ua, double va, double ub, double vb) {  // a inside, b outside
     double lo = 0, hi = 1;
@@ -143,7 +158,8 @@ FaceJump face_jump(const Lattice& lattice, const surface::BSplineSurface& s) {
     const Eigen::Vector3d x = surface::evaluate(s, u, v);
     const double jump = (deform_point(lattice, x) - x).norm();
     if (jump > worst.mm) {
-      const Eigen::Vector3d out = local_coordinates(lattice.frame, surface::evaluate(s, ua + hi * (ub - ua), va + hi * (vb - va)));
+      const Eigen::Vector3d out = local_coordinates(
+          lattice.frame, surface::evaluate(s, ua + hi * (ub - ua), va + hi * (vb - va)));
       worst = {jump, u, v, 0, 0};
       outside_by(out, &worst.axis, &worst.face);
     }
@@ -155,8 +171,10 @@ FaceJump face_jump(const Lattice& lattice, const surface::BSplineSurface& s) {
         if (i + di >= nu || j + dj >= nv) continue;
         const size_t n = (i + di) * nv + j + dj;
         if (in[k] == in[n]) continue;
-        if (in[k]) crossing(us[i], vs[j], us[i + di], vs[j + dj]);
-        else crossing(us[i + di], vs[j + dj], us[i], vs[j]);
+        if (in[k])
+          crossing(us[i], vs[j], us[i + di], vs[j + dj]);
+        else
+          crossing(us[i + di], vs[j + dj], us[i], vs[j]);
       }
     }
   return worst;
@@ -172,27 +190,37 @@ void refuse_torn(const Deformation& d, const surface::BSplineSurface& s, const R
   if (!jump || jump->mm == 0) return;
   double tolerance = o.tolerance;
   if (o.relative) {  // as refit_deformed: of the deformed surface's size, sampled 8 x 8 per span
-    const std::vector<double> su = surface::span_samples(s.u, 8), sv = surface::span_samples(s.v, 8);
+    const std::vector<double> su = surface::span_samples(s.u, 8),
+                              sv = surface::span_samples(s.v, 8);
     Points3 sample = surface::evaluate_grid(s, su, sv);
     for (Eigen::Index r = 0; r < sample.rows(); ++r)
-      sample.row(r) = std::visit([&](const auto& k) -> Eigen::Vector3d { return deform_point(k, sample.row(r).transpose()); }, d).transpose();
+      sample.row(r) = std::visit(
+                          [&](const auto& k) -> Eigen::Vector3d {
+                            return deform_point(k, sample.row(r).transpose());
+                          },
+                          d)
+                          .transpose();
     tolerance *= (sample.colwise().maxCoeff() - sample.colwise().minCoeff()).norm();
   }
   if (jump->mm / 2 <= tolerance) return;
   constexpr const char* axis_name[3] = {"s", "t", "u"};
-  throw Error(ErrorCategory::ToleranceNotMet,
-              where + ": the deformation is discontinuous where the surface crosses the lattice face " +
-                  axis_name[jump->axis] + " = " + std::to_string(jump->face) + ": it jumps by " +
-                  detail::format(jump->mm, 4) + " mm there (at parameter (" + detail::format(jump->u, 6) + ", " +
-                  detail::format(jump->v, 6) +
-                  ")), because the FFD is the identity outside the lattice and that face's control points are "
-                  "displaced; the deformed surface is torn, and no refit can come closer than half the jump (" +
-                  detail::format(jump->mm / 2, 4) + " mm > the tolerance " + detail::format(tolerance, 4) +
-                  " mm). Enlarge the lattice so that it contains the surface, or keep that face's control "
-                  "points at rest");
+  throw Error(
+      ErrorCategory::ToleranceNotMet,
+      where + ": the deformation is discontinuous where the surface crosses the lattice face " +
+          axis_name[jump->axis] + " = " + std::to_string(jump->face) + ": it jumps by " +
+          detail::format(jump->mm, 4) + " mm there (at parameter (" + detail::format(jump->u, 6) +
+          ", " + detail::format(jump->v, 6) +
+          ")), because the FFD is the identity outside the lattice and that face's control points "
+          "are "
+          "displaced; the deformed surface is torn, and no refit can come closer than half the "
+          "jump (" +
+          detail::format(jump->mm / 2, 4) + " mm > the tolerance " + detail::format(tolerance, 4) +
+          " mm). Enlarge the lattice so that it contains the surface, or keep that face's control "
+          "points at rest");
 }
 
-RefitResult refit_step(const Deformation& d, const surface::BSplineSurface& s, const RefitOptions& o) {
+RefitResult refit_step(const Deformation& d, const surface::BSplineSurface& s,
+                       const RefitOptions& o) {
   return std::visit([&](const auto& deformation) { return refit_deformed(deformation, s, o); }, d);
 }
 
@@ -225,9 +253,10 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
       const std::string where = "deform_surface: steps[" + std::to_string(i) + "] (" + o.kind +
                                 (o.name.empty() ? "" : " '" + o.name + "'") + ")";
       if (!options.refit)
-        throw Error(a.category, where + " cannot be composed exactly: " + a.reason +
-                                    ". Allow a certified refit (SurfaceDeformationOptions::refit) to "
-                                    "approximate this step within a tolerance");
+        throw Error(a.category,
+                    where + " cannot be composed exactly: " + a.reason +
+                        ". Allow a certified refit (SurfaceDeformationOptions::refit) to "
+                        "approximate this step within a tolerance");
       refuse_torn(step.deformation, out.surface, *options.refit, where);
       RefitResult r = refit_step(step.deformation, out.surface, *options.refit);
       if (!r.report.summary.converged() && !options.accept_out_of_tolerance)

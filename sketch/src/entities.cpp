@@ -1,9 +1,9 @@
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/format.hpp>
 #include <clay/sketch/entities.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
-#include <clay/internal/checks.hpp>
-#include <clay/internal/format.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -16,7 +16,8 @@ std::string num(double x) { return internal::with_digits(x, 3); }
 
 /// The name of a point for messages: its recipe name when the sketch has one.
 std::string point_name(const Sketch& s, int index) {
-  if (index >= 0 && index < static_cast<int>(s.point_names.size()) && !s.point_names[static_cast<size_t>(index)].empty())
+  if (index >= 0 && index < static_cast<int>(s.point_names.size()) &&
+      !s.point_names[static_cast<size_t>(index)].empty())
     return "point \"" + s.point_names[static_cast<size_t>(index)] + "\"";
   return "point #" + std::to_string(index);
 }
@@ -55,19 +56,21 @@ PlaneId Sketch::add_plane(const SketchPlane& plane) {
 PointId Sketch::add_point(const Eigen::Vector3d& p) {
   if (!finite(p))
     fail(ErrorCategory::InvalidGeometry,
-         "add_point: " + point_name(*this, static_cast<int>(points.size())) + " has a non-finite coordinate");
+         "add_point: " + point_name(*this, static_cast<int>(points.size())) +
+             " has a non-finite coordinate");
   points.push_back({p, {}});
   return {static_cast<int>(points.size()) - 1};
 }
 
 PointId Sketch::add_point(PlaneId plane, const Eigen::Vector2d& ab) {
   if (plane.index < 0 || plane.index >= static_cast<int>(planes.size()))
-    fail(ErrorCategory::InvalidArgument,
-         "add_point: plane #" + std::to_string(plane.index) + " does not exist (the sketch has " +
-             std::to_string(planes.size()) + " planes)");
+    fail(ErrorCategory::InvalidArgument, "add_point: plane #" + std::to_string(plane.index) +
+                                             " does not exist (the sketch has " +
+                                             std::to_string(planes.size()) + " planes)");
   if (!internal::all_finite(ab))
     fail(ErrorCategory::InvalidGeometry,
-         "add_point: " + point_name(*this, static_cast<int>(points.size())) + " has a non-finite coordinate");
+         "add_point: " + point_name(*this, static_cast<int>(points.size())) +
+             " has a non-finite coordinate");
   points.push_back({to_world(planes[static_cast<size_t>(plane.index)], ab), plane});
   return {static_cast<int>(points.size()) - 1};
 }
@@ -76,9 +79,9 @@ namespace {
 
 void check_point(const Sketch& s, PointId p, const std::string& who) {
   if (p.index < 0 || p.index >= static_cast<int>(s.points.size()))
-    fail(ErrorCategory::InvalidArgument,
-         who + ": " + point_name(s, p.index) + " does not exist (the sketch has " +
-             std::to_string(s.points.size()) + " points)");
+    fail(ErrorCategory::InvalidArgument, who + ": " + point_name(s, p.index) +
+                                             " does not exist (the sketch has " +
+                                             std::to_string(s.points.size()) + " points)");
 }
 
 void check_plane(const Sketch& s, PlaneId plane, const std::string& who) {
@@ -104,10 +107,14 @@ std::string entity_name(const Sketch& s, size_t index) {
   const char* kind = std::visit(
       [](const auto& e) -> const char* {
         using T = std::decay_t<decltype(e)>;
-        if constexpr (std::is_same_v<T, Line>) return "line";
-        else if constexpr (std::is_same_v<T, Circle>) return "circle";
-        else if constexpr (std::is_same_v<T, Arc>) return "arc";
-        else return "curve";
+        if constexpr (std::is_same_v<T, Line>)
+          return "line";
+        else if constexpr (std::is_same_v<T, Circle>)
+          return "circle";
+        else if constexpr (std::is_same_v<T, Arc>)
+          return "arc";
+        else
+          return "curve";
       },
       s.entities[index]);
   return named(s, kind, index);
@@ -121,9 +128,9 @@ EntityId Sketch::add_line(PointId start, PointId end) {
   check_point(*this, end, who);
   const double length = (position(*this, end) - position(*this, start)).norm();
   if (start == end || !(length > 1e-12 * model_size(*this)))
-    fail(ErrorCategory::InvalidGeometry,
-         who + ": zero length (" + point_name(*this, start.index) + " and " + point_name(*this, end.index) +
-             " coincide); give two distinct points");
+    fail(ErrorCategory::InvalidGeometry, who + ": zero length (" + point_name(*this, start.index) +
+                                             " and " + point_name(*this, end.index) +
+                                             " coincide); give two distinct points");
   return push(*this, Line{start, end});
 }
 
@@ -133,7 +140,8 @@ EntityId Sketch::add_circle(PointId center, double radius, PlaneId plane) {
   check_plane(*this, plane, who);
   check_in_plane(*this, center, plane, who);
   if (!(radius > 0) || !std::isfinite(radius))
-    fail(ErrorCategory::InvalidGeometry, who + ": radius " + num(radius) + " must be positive and finite");
+    fail(ErrorCategory::InvalidGeometry,
+         who + ": radius " + num(radius) + " must be positive and finite");
   return push(*this, Circle{center, radius, plane});
 }
 
@@ -150,8 +158,8 @@ EntityId Sketch::add_arc(PointId center, PointId start, PointId end, PlaneId pla
     fail(ErrorCategory::InvalidGeometry, who + ": zero radius (start point on the center)");
   if (std::abs(r1 - r0) > 1e-9 * r0)
     fail(ErrorCategory::InvalidGeometry,
-         who + ": start and end are at different distances from the center (" + distinct_numbers(r0, r1) +
-             " mm); place the end on the circle through the start");
+         who + ": start and end are at different distances from the center (" +
+             distinct_numbers(r0, r1) + " mm); place the end on the circle through the start");
   if (start == end || (position(*this, end) - position(*this, start)).norm() <= 1e-12 * r0)
     fail(ErrorCategory::InvalidGeometry,
          who + ": start and end coincide (a zero-length arc); use a circle for a full turn");
@@ -163,8 +171,9 @@ EntityId Sketch::add_curve(const surface::BSplineCurve& curve, PlaneId plane) {
   surface::validate(curve, who);
   if (!surface::is_clamped(curve.basis))
     fail(ErrorCategory::InvalidGeometry,
-         who + ": the curve is not clamped, so its ends are not control points; clamp it "
-               "(surface::clamp) first");
+         who +
+             ": the curve is not clamped, so its ends are not control points; clamp it "
+             "(surface::clamp) first");
   double length = 0;
   Eigen::Vector3d lo = curve.points.row(0).transpose(), hi = lo;
   for (Eigen::Index i = 1; i < curve.points.rows(); ++i) {
@@ -192,9 +201,9 @@ EntityId Sketch::add_curve(const surface::BSplineCurve& curve, PlaneId plane) {
   c.weights = curve.weights;
   for (Eigen::Index i = 0; i < curve.points.rows(); ++i) {
     const Eigen::Vector3d p = curve.points.row(i).transpose();
-    c.control_points.push_back(plane.free()
-                                   ? add_point(p)
-                                   : add_point(plane, to_plane(planes[static_cast<size_t>(plane.index)], p)));
+    c.control_points.push_back(
+        plane.free() ? add_point(p)
+                     : add_point(plane, to_plane(planes[static_cast<size_t>(plane.index)], p)));
   }
   return push(*this, std::move(c));
 }
@@ -204,7 +213,9 @@ Eigen::Vector3d position(const Sketch& sketch, PointId point) {
   return sketch.points[static_cast<size_t>(point.index)].position;
 }
 
-std::string describe(const Sketch& sketch, PointId point) { return point_name(sketch, point.index); }
+std::string describe(const Sketch& sketch, PointId point) {
+  return point_name(sketch, point.index);
+}
 
 std::string distinct_numbers(double a, double b) {
   char x[40], y[40];
@@ -224,9 +235,9 @@ std::string describe(const Sketch& sketch, EntityId entity) {
 
 surface::BSplineCurve curve_of(const Sketch& sketch, EntityId entity) {
   if (entity.index < 0 || entity.index >= static_cast<int>(sketch.entities.size()))
-    fail(ErrorCategory::InvalidArgument,
-         "curve_of: entity #" + std::to_string(entity.index) + " does not exist (the sketch has " +
-             std::to_string(sketch.entities.size()) + " entities)");
+    fail(ErrorCategory::InvalidArgument, "curve_of: entity #" + std::to_string(entity.index) +
+                                             " does not exist (the sketch has " +
+                                             std::to_string(sketch.entities.size()) + " entities)");
   const Entity& e = sketch.entities[static_cast<size_t>(entity.index)];
   if (const Line* line = std::get_if<Line>(&e)) {
     surface::Points3 p(2, 3);
@@ -253,7 +264,8 @@ surface::BSplineCurve curve_of(const Sketch& sketch, EntityId entity) {
   const double start = std::atan2(s.y(), s.x());
   double end = std::atan2(t.y(), t.x());
   while (end <= start) end += 2 * std::numbers::pi;
-  return surface::circular_arc(position(sketch, a.center), pl.x_axis, pl.y_axis, s.norm(), start, end);
+  return surface::circular_arc(position(sketch, a.center), pl.x_axis, pl.y_axis, s.norm(), start,
+                               end);
 }
 
 std::vector<std::string> problems(const Sketch& sketch) {
@@ -276,7 +288,8 @@ std::vector<std::string> problems(const Sketch& sketch) {
       out.push_back(point_name(sketch, i) + " refers to plane #" + std::to_string(p.plane.index) +
                     ", which does not exist");
     else if (!p.plane.free()) {
-      const double d = std::abs(signed_distance(sketch.planes[static_cast<size_t>(p.plane.index)], p.position));
+      const double d =
+          std::abs(signed_distance(sketch.planes[static_cast<size_t>(p.plane.index)], p.position));
       if (d > 1e-9 * size)
         out.push_back(point_name(sketch, i) + " is " + num(d) + " mm off its plane #" +
                       std::to_string(p.plane.index));
@@ -295,7 +308,8 @@ std::vector<std::string> problems(const Sketch& sketch) {
         out.push_back(who + " has zero length");
     } else if (const Circle* c = std::get_if<Circle>(&e)) {
       if (bad_point(c->center)) out.push_back(who + " refers to a missing center point");
-      if (c->plane.index < 0 || c->plane.index >= nplanes) out.push_back(who + " has no valid plane");
+      if (c->plane.index < 0 || c->plane.index >= nplanes)
+        out.push_back(who + " has no valid plane");
       if (!(c->radius > 0) || !std::isfinite(c->radius))
         out.push_back(who + " has radius " + num(c->radius) + " (must be positive)");
     } else if (const Arc* a = std::get_if<Arc>(&e)) {
@@ -303,10 +317,12 @@ std::vector<std::string> problems(const Sketch& sketch) {
         out.push_back(who + " refers to a missing point");
         continue;
       }
-      if (a->plane.index < 0 || a->plane.index >= nplanes) out.push_back(who + " has no valid plane");
+      if (a->plane.index < 0 || a->plane.index >= nplanes)
+        out.push_back(who + " has no valid plane");
       const double r0 = (pos(a->start) - pos(a->center)).norm();
       const double r1 = (pos(a->end) - pos(a->center)).norm();
-      if (!(r0 > 1e-12 * size)) out.push_back(who + " has zero radius");
+      if (!(r0 > 1e-12 * size))
+        out.push_back(who + " has zero radius");
       else if (std::abs(r1 - r0) > 1e-9 * size)
         out.push_back(who + " has unequal radii " + distinct_numbers(r0, r1) + " mm");
     } else {

@@ -1,8 +1,8 @@
 #include <clay/sketch/fit.hpp>
 
 #include <clay/error.hpp>
-#include <clay/surface/degree_elevation.hpp>
 #include <clay/internal/checks.hpp>
+#include <clay/surface/degree_elevation.hpp>
 
 #include <Eigen/Dense>
 
@@ -44,7 +44,9 @@ std::vector<std::string> FitOptions::problems() const {
   return out;
 }
 
-void FitOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void FitOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 namespace detail {
 
@@ -53,8 +55,8 @@ Points3 prepared_points(const Stroke& stroke, bool drop_duplicates, double& plan
   plane_offset = 0.0;
   if (stroke.plane)
     for (Eigen::Index i = 0; i < stroke.points.rows(); ++i)
-      plane_offset = std::max(plane_offset,
-                              std::abs(signed_distance(*stroke.plane, stroke.points.row(i).transpose())));
+      plane_offset = std::max(
+          plane_offset, std::abs(signed_distance(*stroke.plane, stroke.points.row(i).transpose())));
   Points3 w = working_points(stroke);
   if (!drop_duplicates) return w;
   const double eps = duplicate_distance(w);
@@ -114,7 +116,8 @@ Smoothed smooth(const Points3& pts, bool closed) {
   out.points = smoothed(pts, closed);
   out.s.assign(static_cast<size_t>(n), 0.0);
   for (Eigen::Index i = 1; i < n; ++i)
-    out.s[static_cast<size_t>(i)] = out.s[static_cast<size_t>(i - 1)] + (out.points.row(i) - out.points.row(i - 1)).norm();
+    out.s[static_cast<size_t>(i)] =
+        out.s[static_cast<size_t>(i - 1)] + (out.points.row(i) - out.points.row(i - 1)).norm();
   out.length = out.s.back() + (closed ? (out.points.row(0) - out.points.row(n - 1)).norm() : 0.0);
   return out;
 }
@@ -323,7 +326,8 @@ FittedCurve report(const PieceResult& r, surface::BSplineCurve curve, bool close
   return f;
 }
 
-surface::BSplineCurve to_world_curve(surface::BSplineCurve c, const std::optional<SketchPlane>& plane) {
+surface::BSplineCurve to_world_curve(surface::BSplineCurve c,
+                                     const std::optional<SketchPlane>& plane) {
   if (!plane) return c;
   for (Eigen::Index i = 0; i < c.points.rows(); ++i)
     c.points.row(i) = to_world(*plane, Eigen::Vector2d(c.points(i, 0), c.points(i, 1))).transpose();
@@ -341,7 +345,8 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
   for (Eigen::Index i = 1; i < n; ++i) total += (pts.row(i) - pts.row(i - 1)).norm();
   const double gap = (pts.row(n - 1) - pts.row(0)).norm();
   const bool closed = n >= 2 * options.degree + 2 && gap <= options.closing_ratio * total;
-  const double window = options.corner_window > 0 ? options.corner_window : 10.0 * options.tolerance;
+  const double window =
+      options.corner_window > 0 ? options.corner_window : 10.0 * options.tolerance;
   std::vector<Corner> corners = detail::find_corners(pts, closed, options.corner_angle, window);
   const bool plane = stroke.plane.has_value();
   for (auto& c : corners)
@@ -351,7 +356,8 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
                       const Eigen::Vector3d& b) {
     PieceProblem pr = detail::piece_problem(options);
     pr.data.resize(static_cast<Eigen::Index>(idx.size()), 3);
-    for (size_t k = 0; k < idx.size(); ++k) pr.data.row(static_cast<Eigen::Index>(k)) = pts.row(idx[k]);
+    for (size_t k = 0; k < idx.size(); ++k)
+      pr.data.row(static_cast<Eigen::Index>(k)) = pts.row(idx[k]);
     pr.params = detail::anchored_parameters(a, pr.data, b);
     pr.start.kind = EndKind::Point;
     pr.start.point = a;
@@ -398,8 +404,10 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
     // Each end is estimated from its own curve's points only (never across a corner).
     const Eigen::Index head = corners.empty() ? n : corners.front().split + 1;
     const Eigen::Index tail = corners.empty() ? n : n - corners.back().split - 1;
-    const Eigen::Vector3d a = detail::end_anchor(pts.topRows(head), true, options.end_samples, limit);
-    const Eigen::Vector3d b = detail::end_anchor(pts.bottomRows(tail), false, options.end_samples, limit);
+    const Eigen::Vector3d a =
+        detail::end_anchor(pts.topRows(head), true, options.end_samples, limit);
+    const Eigen::Vector3d b =
+        detail::end_anchor(pts.bottomRows(tail), false, options.end_samples, limit);
     Eigen::Vector3d from = a;
     Eigen::Index first = 0;
     for (const Corner& c : corners) {
@@ -420,7 +428,8 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
     s.initial_residual = std::max(s.initial_residual, c.summary.initial_residual);
     if (c.summary.termination == Termination::Failed)
       s.termination = Termination::Failed;
-    else if (c.summary.termination == Termination::NotConverged && s.termination == Termination::Converged)
+    else if (c.summary.termination == Termination::NotConverged &&
+             s.termination == Termination::Converged)
       s.termination = Termination::NotConverged;
   }
   s.final_residual = out.max_deviation_mm;

@@ -1,11 +1,11 @@
 #include "fit_engine.hpp"
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/math.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
-#include <clay/internal/math.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -13,8 +13,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <sstream>
 #include <optional>
+#include <sstream>
 
 #include "curve_tools.hpp"
 
@@ -65,16 +65,19 @@ struct PointMap {
 /// constrained end.
 struct EndSetup {
   EndCondition condition;
-  double alpha = 0;         ///< fixed |P1 - P0| along the tangent (Curvature ends, or a retry)
+  double alpha = 0;  ///< fixed |P1 - P0| along the tangent (Curvature ends, or a retry)
   bool alpha_fixed = false;
-  bool curvature = false;   ///< write the curvature condition (needs alpha_fixed)
+  bool curvature = false;  ///< write the curvature condition (needs alpha_fixed)
 };
 
 int fixed_count(const EndCondition& e) {
   switch (e.kind) {
-    case EndKind::Point: return 1;
-    case EndKind::Tangent: return 2;
-    case EndKind::Curvature: return 3;
+    case EndKind::Point:
+      return 1;
+    case EndKind::Tangent:
+      return 2;
+    case EndKind::Curvature:
+      return 3;
   }
   return 0;
 }
@@ -102,7 +105,8 @@ PointMap build_map(const BSplineBasis& basis, bool periodic, const EndSetup& s, 
   if (periodic) {
     const int m = n - p;
     for (int i = 0; i < m; ++i) free_point(i);
-    for (int i = m; i < n; ++i) map.terms[static_cast<size_t>(i)] = map.terms[static_cast<size_t>(i - m)];
+    for (int i = m; i < n; ++i)
+      map.terms[static_cast<size_t>(i)] = map.terms[static_cast<size_t>(i - m)];
     return map;
   }
   const int fs = fixed_count(s.condition);
@@ -115,7 +119,8 @@ PointMap build_map(const BSplineBasis& basis, bool periodic, const EndSetup& s, 
     const int i0 = at_start ? 0 : n - 1;
     const int i1 = at_start ? 1 : n - 2;
     const int i2 = at_start ? 2 : n - 3;
-    const double sign = at_start ? 1.0 : -1.0;  // P1 = A + alpha T at the start, B - alpha T at the end
+    const double sign =
+        at_start ? 1.0 : -1.0;  // P1 = A + alpha T at the start, B - alpha T at the end
     map.constant[static_cast<size_t>(i0)] = c.point;
     if (c.kind == EndKind::Point) return;
     if (!end.alpha_fixed) {
@@ -138,7 +143,8 @@ PointMap build_map(const BSplineBasis& basis, bool periodic, const EndSetup& s, 
     const double d20 = nd[static_cast<size_t>(2 * w + j0)];
     const double d21 = nd[static_cast<size_t>(2 * w + j1)];
     const double d22 = nd[static_cast<size_t>(2 * w + j2)];
-    map.constant[static_cast<size_t>(i2)] = (mu * mu * c.curvature - d20 * c.point - d21 * p1) / d22;
+    map.constant[static_cast<size_t>(i2)] =
+        (mu * mu * c.curvature - d20 * c.point - d21 * p1) / d22;
     map.terms[static_cast<size_t>(i2)].push_back({map.variables++, c.tangent / d22});
   };
   constrain(s, true);
@@ -173,7 +179,8 @@ Normal assemble(const BSplineBasis& basis, const Points3& data, const std::vecto
       const int i = span - p + a;
       const double wa = nd[static_cast<size_t>(a)];
       h.rhs.row(i) += wa * data.row(k);
-      for (int b = 0; b <= p; ++b) h.band(i, span - p + b - i + p) += wa * nd[static_cast<size_t>(b)];
+      for (int b = 0; b <= p; ++b)
+        h.band(i, span - p + b - i + p) += wa * nd[static_cast<size_t>(b)];
     }
   }
   // Bending energy, exact: N_i'' N_j'' has degree 2p - 4 on a span, the rule has p >= p - 1 nodes.
@@ -262,7 +269,8 @@ std::optional<Points3> solve_ends(const Normal& h, const BSplineBasis& basis, bo
   const int vs = constrained(s.condition) ? alpha_variable(map, 1) : -1;
   const int ve = constrained(e.condition) ? alpha_variable(map, n - 2) : -1;
   // A control leg is about (domain / spans / p) x |C'|; |C'| is about the data's size.
-  const double size = count > 1 ? (pr.data.colwise().maxCoeff() - pr.data.colwise().minCoeff()).norm() : 1.0;
+  const double size =
+      count > 1 ? (pr.data.colwise().maxCoeff() - pr.data.colwise().minCoeff()).norm() : 1.0;
   const double floor = 0.1 * std::max(size, 1e-9) / (p * std::max(1, n - p));
   bool again = false;
   auto settle = [&](EndSetup& end, int variable) {
@@ -359,7 +367,8 @@ PieceResult fit_piece(const PieceProblem& pr) {
     std::vector<double> sorted = out.params;
     std::sort(sorted.begin(), sorted.end());
     for (int j = 1; j < first_spans; ++j) {
-      double q = sorted[static_cast<size_t>(std::min<Eigen::Index>(count - 1, count * j / first_spans))];
+      double q =
+          sorted[static_cast<size_t>(std::min<Eigen::Index>(count - 1, count * j / first_spans))];
       if (!(q > breaks.back() + 1e-9 && q < 1.0 - 1e-9)) q = double(j) / first_spans;
       breaks.push_back(q);
     }
@@ -400,7 +409,8 @@ PieceResult fit_piece(const PieceProblem& pr) {
       double moved = 0;
       for (Eigen::Index k = 0; k < count; ++k) {
         double& tk = out.params[static_cast<size_t>(k)];
-        const double tn = surface::project_normal(curve, pr.data.row(k).transpose(), tk, periodic).t;
+        const double tn =
+            surface::project_normal(curve, pr.data.row(k).transpose(), tk, periodic).t;
         moved = std::max(moved, periodic ? std::min(std::abs(tn - tk), 1.0 - std::abs(tn - tk))
                                          : std::abs(tn - tk));
         tk = tn;
@@ -410,7 +420,8 @@ PieceResult fit_piece(const PieceProblem& pr) {
     // Residuals at the foot points and their moving average (the systematic part).
     Points3 res(count, 3);
     for (Eigen::Index k = 0; k < count; ++k) {
-      res.row(k) = pr.data.row(k) - surface::evaluate(curve, out.params[static_cast<size_t>(k)]).transpose();
+      res.row(k) =
+          pr.data.row(k) - surface::evaluate(curve, out.params[static_cast<size_t>(k)]).transpose();
       dist[k] = res.row(k).norm();
     }
     Eigen::VectorXd score = dist;
@@ -453,7 +464,8 @@ PieceResult fit_piece(const PieceProblem& pr) {
     std::vector<std::vector<double>> span_params(static_cast<size_t>(m));
     for (Eigen::Index k = 0; k < count; ++k) {
       const double tk = out.params[static_cast<size_t>(k)];
-      int j = static_cast<int>(std::upper_bound(breaks.begin(), breaks.end(), tk) - breaks.begin()) - 1;
+      int j =
+          static_cast<int>(std::upper_bound(breaks.begin(), breaks.end(), tk) - breaks.begin()) - 1;
       j = std::clamp(j, 0, m - 1);
       span_score[static_cast<size_t>(j)] = std::max(span_score[static_cast<size_t>(j)], score[k]);
       span_params[static_cast<size_t>(j)].push_back(tk);
@@ -461,7 +473,8 @@ PieceResult fit_piece(const PieceProblem& pr) {
     int best = -1;
     for (int j = 0; j < m; ++j) {
       if (span_params[static_cast<size_t>(j)].size() < 2) continue;  // nothing to split
-      if (best < 0 || span_score[static_cast<size_t>(j)] > span_score[static_cast<size_t>(best)]) best = j;
+      if (best < 0 || span_score[static_cast<size_t>(j)] > span_score[static_cast<size_t>(best)])
+        best = j;
     }
     const int n_now = m + (periodic ? 0 : p);
     bool refined = false;
@@ -469,7 +482,8 @@ PieceResult fit_piece(const PieceProblem& pr) {
       auto& ts = span_params[static_cast<size_t>(best)];
       std::sort(ts.begin(), ts.end());
       const double knot = 0.5 * (ts[ts.size() / 2 - 1] + ts[ts.size() / 2]);
-      const double lo = breaks[static_cast<size_t>(best)], hi = breaks[static_cast<size_t>(best + 1)];
+      const double lo = breaks[static_cast<size_t>(best)],
+                   hi = breaks[static_cast<size_t>(best + 1)];
       const double gap = 1e-6 * (hi - lo) + 1e-12;
       if (knot > lo + gap && knot < hi - gap) {
         breaks.insert(breaks.begin() + best + 1, knot);
@@ -497,8 +511,9 @@ PieceResult fit_piece(const PieceProblem& pr) {
   out.iterations = it;
   std::ostringstream msg;
   msg.precision(3);
-  msg << why << " (" << curve.points.rows() << " control points, max deviation " << out.max_deviation
-      << " mm for tolerance " << pr.tolerance << " mm, fairness " << alpha << ")";
+  msg << why << " (" << curve.points.rows() << " control points, max deviation "
+      << out.max_deviation << " mm for tolerance " << pr.tolerance << " mm, fairness " << alpha
+      << ")";
   out.summary.message = msg.str();
   out.summary.iterations = it;
   out.summary.final_residual = out.max_deviation;

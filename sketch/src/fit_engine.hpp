@@ -32,10 +32,10 @@ struct PieceProblem {
   std::vector<double> params;  ///< one per data row; in [0, 1) when periodic
   bool periodic = false;       ///< closed piece: unclamped periodic knots, C^(p-1) everywhere
   int degree = 3;
-  EndCondition start, end;     ///< ignored when periodic
-  double tolerance = 0.1;      ///< mm, max point-to-curve distance sought
-  double fairness = 1e-8;      ///< alpha: lambda = alpha * points on the unit domain
-  int fairness_reductions = 6; ///< times alpha may be divided by 10
+  EndCondition start, end;      ///< ignored when periodic
+  double tolerance = 0.1;       ///< mm, max point-to-curve distance sought
+  double fairness = 1e-8;       ///< alpha: lambda = alpha * points on the unit domain
+  int fairness_reductions = 6;  ///< times alpha may be divided by 10
   int max_control_points = 100;
   int max_iterations = 200;
 };
@@ -47,9 +47,9 @@ struct PieceResult {
   Eigen::VectorXd distances;    ///< data point to foot point (mm)
   double max_deviation = 0;
   double rms_deviation = 0;
-  double fairness = 0;          ///< alpha in use at the end
-  double noise = 0;             ///< estimated noise of the data per coordinate (mm)
-  int iterations = 0;           ///< refinement iterations (each: solve + parameter correction)
+  double fairness = 0;  ///< alpha in use at the end
+  double noise = 0;     ///< estimated noise of the data per coordinate (mm)
+  int iterations = 0;   ///< refinement iterations (each: solve + parameter correction)
   Summary summary;
 };
 

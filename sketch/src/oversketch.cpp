@@ -1,11 +1,11 @@
 #include <clay/sketch/oversketch.hpp>
 
 #include <clay/error.hpp>
-#include <clay/surface/projection.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
-#include <clay/internal/checks.hpp>
+#include <clay/surface/projection.hpp>
 
 #include <Eigen/Geometry>
 
@@ -29,15 +29,17 @@ std::vector<std::string> OversketchOptions::problems() const {
   }
   if (continuity != Continuity::G1 && continuity != Continuity::G2)
     out.push_back(
-                "OversketchOptions::continuity = " + std::to_string(static_cast<int>(continuity)) +
-                    " must be Continuity::G1 or Continuity::G2");
+        "OversketchOptions::continuity = " + std::to_string(static_cast<int>(continuity)) +
+        " must be Continuity::G1 or Continuity::G2");
   FitOptions f = fit;
   f.degree = 3;  // not used: the curve's degree is
   internal::append(out, f.problems());
   return out;
 }
 
-void OversketchOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void OversketchOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 namespace {
 
@@ -152,12 +154,13 @@ OversketchResult oversketch(const BSplineCurve& curve, const Stroke& stroke,
   const bool over_start = polyline_distance(pts, curve_start) <= cap;
   const bool over_end = polyline_distance(pts, curve_end) <= cap;
   auto refuse = [&](const char* which, const End& e) {
-    throw Error(ErrorCategory::InvalidArgument,
-                std::string("oversketch: the stroke's ") + which + " point is " +
-                    distance_text(e.distance) + " mm from the curve, beyond the capture distance " +
-                    distance_text(cap) +
-                    " mm; start and end the stroke on the curve (or draw it over one of the curve's "
-                    "ends), or raise OversketchOptions::capture_distance");
+    throw Error(
+        ErrorCategory::InvalidArgument,
+        std::string("oversketch: the stroke's ") + which + " point is " +
+            distance_text(e.distance) + " mm from the curve, beyond the capture distance " +
+            distance_text(cap) +
+            " mm; start and end the stroke on the curve (or draw it over one of the curve's "
+            "ends), or raise OversketchOptions::capture_distance");
   };
   auto locate = [&](Eigen::Index row, const char* which) {
     const Eigen::Vector3d q = pts.row(row).transpose();
@@ -183,7 +186,8 @@ OversketchResult oversketch(const BSplineCurve& curve, const Stroke& stroke,
   };
   End first_end = locate(0, "first");
   End last_end = locate(pts.rows() - 1, "last");
-  if (first_end.past != Past::None && last_end.past != Past::None && first_end.past != last_end.past)
+  if (first_end.past != Past::None && last_end.past != Past::None &&
+      first_end.past != last_end.past)
     throw Error(ErrorCategory::InvalidArgument,
                 "oversketch: the stroke covers the whole curve (it runs over both of the curve's "
                 "ends); fit it with fit_stroke instead");

@@ -13,9 +13,12 @@ namespace clay::sketch {
 std::vector<std::string> problems(const SketchPlane& plane, std::string_view name) {
   std::vector<std::string> found;
   auto say = [&](const std::string& what) { found.push_back(std::string(name) + ": " + what); };
-  if (!internal::all_finite(plane.origin)) say("origin has a non-finite coordinate; give a finite origin");
-  if (!internal::all_finite(plane.x_axis)) say("x axis has a non-finite coordinate; give a finite unit vector");
-  if (!internal::all_finite(plane.y_axis)) say("y axis has a non-finite coordinate; give a finite unit vector");
+  if (!internal::all_finite(plane.origin))
+    say("origin has a non-finite coordinate; give a finite origin");
+  if (!internal::all_finite(plane.x_axis))
+    say("x axis has a non-finite coordinate; give a finite unit vector");
+  if (!internal::all_finite(plane.y_axis))
+    say("y axis has a non-finite coordinate; give a finite unit vector");
   if (!found.empty()) return found;
   std::ostringstream s;
   s.precision(17);
@@ -48,14 +51,17 @@ SketchPlane make_plane(const Eigen::Vector3d& origin, const Eigen::Vector3d& nor
   auto bad = [](const std::string& what) {
     throw Error(ErrorCategory::InvalidArgument, "make_plane: " + what);
   };
-  if (!internal::all_finite(origin)) bad("origin has a non-finite coordinate; give a finite origin");
-  if (!internal::all_finite(normal)) bad("normal has a non-finite coordinate; give a finite normal");
+  if (!internal::all_finite(origin))
+    bad("origin has a non-finite coordinate; give a finite origin");
+  if (!internal::all_finite(normal))
+    bad("normal has a non-finite coordinate; give a finite normal");
   const double ln = normal.norm();
   if (!(ln > 0.0)) bad("normal has zero length; give the plane's normal direction");
   const Eigen::Vector3d n = normal / ln;
   Eigen::Vector3d x;
   if (x_direction) {
-    if (!internal::all_finite(*x_direction)) bad("x direction has a non-finite coordinate; give a finite vector");
+    if (!internal::all_finite(*x_direction))
+      bad("x direction has a non-finite coordinate; give a finite vector");
     const double lx = x_direction->norm();
     if (!(lx > 0.0)) bad("x direction has zero length; give a direction in the plane");
     x = *x_direction / lx;

@@ -16,8 +16,9 @@ BSplineCurve circular_arc(const Eigen::Vector3d& center, const Eigen::Vector3d& 
   auto bad = [](const std::string& what) {
     throw Error(ErrorCategory::InvalidArgument, "circular_arc: " + what);
   };
-  if (!internal::all_finite(center) || !internal::all_finite(x_axis) || !internal::all_finite(y_axis) || !std::isfinite(radius) ||
-      !std::isfinite(start) || !std::isfinite(end))
+  if (!internal::all_finite(center) || !internal::all_finite(x_axis) ||
+      !internal::all_finite(y_axis) || !std::isfinite(radius) || !std::isfinite(start) ||
+      !std::isfinite(end))
     bad("non-finite input; give finite center, axes, radius and angles");
   if (!(radius >= 0.0)) bad("radius " + std::to_string(radius) + " is negative; give radius >= 0");
   if (!(sweep > 0.0) || sweep > two_pi * (1.0 + 1e-14))

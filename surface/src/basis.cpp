@@ -67,15 +67,17 @@ std::vector<std::string> problems(const BSplineBasis& basis, std::string_view na
   // Multiplicity runs: interior values at most p, end values at most p + 1.
   for (int i = 0; i < m;) {
     int j = i;
-    while (j + 1 < m && basis.knots[static_cast<size_t>(j + 1)] == basis.knots[static_cast<size_t>(i)]) ++j;
+    while (j + 1 < m &&
+           basis.knots[static_cast<size_t>(j + 1)] == basis.knots[static_cast<size_t>(i)])
+      ++j;
     const int mult = j - i + 1;
     const bool end = (i == 0 || j == m - 1);
     const int limit = end ? p + 1 : p;
     if (mult > limit) {
       std::ostringstream s;
       s.precision(17);
-      s << "knot " << basis.knots[static_cast<size_t>(i)] << " has multiplicity " << mult << ", above "
-        << limit << (end ? " (degree + 1 at an end)" : " (the degree, inside)")
+      s << "knot " << basis.knots[static_cast<size_t>(i)] << " has multiplicity " << mult
+        << ", above " << limit << (end ? " (degree + 1 at an end)" : " (the degree, inside)")
         << "; remove repeated knots";
       say(s.str());
     }
@@ -92,7 +94,9 @@ bool is_clamped(const BSplineBasis& basis) noexcept {
   const auto& k = basis.knots;
   if (static_cast<int>(k.size()) < 2 * (basis.degree + 1)) return false;
   for (int i = 1; i <= basis.degree; ++i) {
-    if (k[static_cast<size_t>(i)] != k.front() || k[k.size() - 1 - static_cast<size_t>(i)] != k.back()) return false;
+    if (k[static_cast<size_t>(i)] != k.front() ||
+        k[k.size() - 1 - static_cast<size_t>(i)] != k.back())
+      return false;
   }
   return true;
 }
@@ -118,7 +122,8 @@ std::vector<double> span_samples(const BSplineBasis& basis, int per_span) {
   const auto breaks = breakpoints(basis);
   std::vector<double> out;
   for (size_t k = 0; k + 1 < breaks.size(); ++k)
-    for (int i = 0; i < per_span; ++i) out.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * i / per_span);
+    for (int i = 0; i < per_span; ++i)
+      out.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * i / per_span);
   out.push_back(breaks.back());
   return out;
 }

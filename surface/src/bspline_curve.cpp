@@ -34,9 +34,9 @@ std::vector<std::string> problems(const BSplineCurve& curve, std::string_view na
                     " (knots - degree - 1)");
     return found;
   }
-  detail::check_net(curve.points, curve.weights, name, [&](Eigen::Index r) {
-    return "control point " + std::to_string(r);
-  }, found);
+  detail::check_net(
+      curve.points, curve.weights, name,
+      [&](Eigen::Index r) { return "control point " + std::to_string(r); }, found);
   return found;
 }
 

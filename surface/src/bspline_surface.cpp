@@ -32,9 +32,12 @@ std::vector<std::string> problems(const BSplineSurface& surface, std::string_vie
                     " (knots - degree - 1 in each direction)");
     return found;
   }
-  detail::check_net(surface.points, surface.weights, name, [&](Eigen::Index r) {
-    return "control point (" + std::to_string(r / nv) + ", " + std::to_string(r % nv) + ")";
-  }, found);
+  detail::check_net(
+      surface.points, surface.weights, name,
+      [&](Eigen::Index r) {
+        return "control point (" + std::to_string(r / nv) + ", " + std::to_string(r % nv) + ")";
+      },
+      found);
   return found;
 }
 

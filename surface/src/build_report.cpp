@@ -6,10 +6,11 @@ namespace clay::surface {
 
 std::string BuildReport::brief() const {
   char buffer[256];
-  std::snprintf(buffer, sizeof buffer,
-                "%s: degree (%d, %d), %d x %d control points, %s, %s (max deviation %.2g mm on %d samples)",
-                method.c_str(), degree_u, degree_v, count_u, count_v, rational ? "rational" : "polynomial",
-                exact ? "exact" : "approximated", max_deviation_mm, samples);
+  std::snprintf(
+      buffer, sizeof buffer,
+      "%s: degree (%d, %d), %d x %d control points, %s, %s (max deviation %.2g mm on %d samples)",
+      method.c_str(), degree_u, degree_v, count_u, count_v, rational ? "rational" : "polynomial",
+      exact ? "exact" : "approximated", max_deviation_mm, samples);
   return buffer;
 }
 

@@ -1,11 +1,11 @@
 #pragma once
-// Small curve helpers shared by the surface builders (loft.cpp, sweep.cpp, revolve.cpp, occt/fill.cpp) and
-// the self-intersection search; internal.
+// Small curve helpers shared by the surface builders (loft.cpp, sweep.cpp, revolve.cpp,
+// occt/fill.cpp) and the self-intersection search; internal.
 #include <clay/error.hpp>
+#include <clay/internal/format.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/self_intersection.hpp>
-#include <clay/internal/format.hpp>
 
 #include <Eigen/Core>
 

@@ -1,8 +1,8 @@
 #include <clay/surface/degree_elevation.hpp>
 
+#include <algorithm>
 #include <clay/error.hpp>
 #include <clay/internal/math.hpp>
-#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -110,7 +110,8 @@ void elevate_degree(Strip& strip, int t) {
     for (int ii = lbz; ii <= ph; ++ii) {  // degree-elevate the Bézier segment
       ebpts.row(ii).setZero();
       const int mpi = std::min(p, ii);
-      for (int j = std::max(0, ii - t); j <= mpi; ++j) ebpts.row(ii) += bezalfs(ii, j) * bpts.row(j);
+      for (int j = std::max(0, ii - t); j <= mpi; ++j)
+        ebpts.row(ii) += bezalfs(ii, j) * bpts.row(j);
     }
     if (oldr > 1) {  // remove knot ua oldr times
       int first = kind - 2, last = kind;
@@ -120,7 +121,8 @@ void elevate_degree(Strip& strip, int t) {
         int ii = first, j = last, kj = j - kind + 1;
         while (j - ii > tr) {
           if (ii < cind) {
-            const double alf = (ub - Uh[static_cast<size_t>(ii)]) / (ua - Uh[static_cast<size_t>(ii)]);
+            const double alf =
+                (ub - Uh[static_cast<size_t>(ii)]) / (ua - Uh[static_cast<size_t>(ii)]);
             Qw.row(ii) = alf * Qw.row(ii) + (1.0 - alf) * Qw.row(ii - 1);
           }
           if (j >= lbz) {
@@ -154,8 +156,9 @@ void elevate_degree(Strip& strip, int t) {
   }
   const int nh = mh - ph - 1;  // last control point index
   if (nh + 1 != new_count || cind != new_count)
-    throw Error(ErrorCategory::Internal, "elevate_degree: control point count " + std::to_string(nh + 1) +
-                                             " differs from the expected " + std::to_string(new_count));
+    throw Error(ErrorCategory::Internal,
+                "elevate_degree: control point count " + std::to_string(nh + 1) +
+                    " differs from the expected " + std::to_string(new_count));
   strip.basis.degree = ph;
   strip.basis.knots = std::move(Uh);
   strip.rows = std::move(Qw);
@@ -169,9 +172,9 @@ void check_elevation(int degree, int times, const char* what) {
   if (times < 0 || degree + times > max_kernel_degree)
     throw Error(ErrorCategory::InvalidArgument,
                 std::string(what) + ": cannot raise degree " + std::to_string(degree) + " by " +
-                    std::to_string(times) + "; give 0 <= times <= " +
-                    std::to_string(max_kernel_degree - degree) + " (kernel limit " +
-                    std::to_string(max_kernel_degree) + ")");
+                    std::to_string(times) +
+                    "; give 0 <= times <= " + std::to_string(max_kernel_degree - degree) +
+                    " (kernel limit " + std::to_string(max_kernel_degree) + ")");
 }
 
 }  // namespace
@@ -210,9 +213,11 @@ BSplineSurface clamp(const BSplineSurface& surface) {
   validate(surface);
   BSplineSurface out = surface;  // directions already clamped are kept bit for bit
   if (!is_clamped(out.u))
-    out = detail::apply_in_direction(out, detail::Direction::U, [](detail::Strip& s) { detail::clamp(s); });
+    out = detail::apply_in_direction(out, detail::Direction::U,
+                                     [](detail::Strip& s) { detail::clamp(s); });
   if (!is_clamped(out.v))
-    out = detail::apply_in_direction(out, detail::Direction::V, [](detail::Strip& s) { detail::clamp(s); });
+    out = detail::apply_in_direction(out, detail::Direction::V,
+                                     [](detail::Strip& s) { detail::clamp(s); });
   return out;
 }
 

@@ -14,7 +14,8 @@
 // The grid kernel is compiled for AVX-512, AVX2+FMA and baseline x86-64 and picked at load time
 // (GCC target_clones), as the FFD kernels of clay_deform are.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define CLAY_SURFACE_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#define CLAY_SURFACE_CLONES \
+  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define CLAY_SURFACE_CLONES
 #endif
@@ -24,13 +25,14 @@ namespace {
 
 void check_order(int order) {
   if (order < 0 || order > 2)
-    throw Error(ErrorCategory::InvalidArgument,
-                "derivative order " + std::to_string(order) + " is outside [0, 2]; ask for 0, 1 or 2");
+    throw Error(ErrorCategory::InvalidArgument, "derivative order " + std::to_string(order) +
+                                                    " is outside [0, 2]; ask for 0, 1 or 2");
 }
 
 void check_shape(const BSplineCurve& c) {
-  if (c.basis.degree < 1 || c.basis.degree > max_kernel_degree || c.basis.count() < c.basis.degree + 1 ||
-      c.points.rows() != c.basis.count() || c.weights.size() != c.points.rows())
+  if (c.basis.degree < 1 || c.basis.degree > max_kernel_degree ||
+      c.basis.count() < c.basis.degree + 1 || c.points.rows() != c.basis.count() ||
+      c.weights.size() != c.points.rows())
     throw Error(ErrorCategory::InvalidGeometry,
                 "curve: degree, knot count, control point count and weight count disagree; "
                 "call validate(curve) for details");
@@ -40,7 +42,8 @@ void check_shape(const BSplineSurface& s) {
   const auto ok = [](const BSplineBasis& b) {
     return b.degree >= 1 && b.degree <= max_kernel_degree && b.count() >= b.degree + 1;
   };
-  if (!ok(s.u) || !ok(s.v) || s.points.rows() != static_cast<Eigen::Index>(s.u.count()) * s.v.count() ||
+  if (!ok(s.u) || !ok(s.v) ||
+      s.points.rows() != static_cast<Eigen::Index>(s.u.count()) * s.v.count() ||
       s.weights.size() != s.points.rows())
     throw Error(ErrorCategory::InvalidGeometry,
                 "surface: degrees, knot counts, control point count and weight count disagree; "
@@ -62,11 +65,13 @@ CurveDerivatives derivatives(const BSplineCurve& curve, double t, int order) {
   else
     basis_derivatives(curve.basis, span, t, order, nd);
   // Homogeneous derivatives A^(k) (x w, y w, z w, w).
-  Eigen::Vector4d a[3] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
+  Eigen::Vector4d a[3] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(),
+                          Eigen::Vector4d::Zero()};
   for (int j = 0; j <= p; ++j) {
     const Eigen::Index r = span - p + j;
     const double w = curve.weights[r];
-    const Eigen::Vector4d pw(curve.points(r, 0) * w, curve.points(r, 1) * w, curve.points(r, 2) * w, w);
+    const Eigen::Vector4d pw(curve.points(r, 0) * w, curve.points(r, 1) * w, curve.points(r, 2) * w,
+                             w);
     for (int k = 0; k <= order; ++k) a[k] += nd[static_cast<size_t>(k * (p + 1) + j)] * pw;
   }
   // Quotient rule (The NURBS Book A4.2).
@@ -78,7 +83,9 @@ CurveDerivatives derivatives(const BSplineCurve& curve, double t, int order) {
   return out;
 }
 
-Eigen::Vector3d evaluate(const BSplineCurve& curve, double t) { return derivatives(curve, t, 0).point; }
+Eigen::Vector3d evaluate(const BSplineCurve& curve, double t) {
+  return derivatives(curve, t, 0).point;
+}
 
 SurfaceDerivatives derivatives(const BSplineSurface& surface, double u, double v, int order) {
   check_order(order);
@@ -101,7 +108,8 @@ SurfaceDerivatives derivatives(const BSplineSurface& surface, double u, double v
   for (auto& row : a)
     for (auto& e : row) e.setZero();
   for (int i = 0; i <= p; ++i) {
-    Eigen::Vector4d temp[3] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero()};
+    Eigen::Vector4d temp[3] = {Eigen::Vector4d::Zero(), Eigen::Vector4d::Zero(),
+                               Eigen::Vector4d::Zero()};
     for (int j = 0; j <= q; ++j) {
       const Eigen::Index r = surface.index(su - p + i, sv - q + j);
       const double w = surface.weights[r];
@@ -155,7 +163,8 @@ Eigen::Vector3d unit_normal(const BSplineSurface& surface, double u, double v) {
 Points3 evaluate_many(const BSplineCurve& curve, std::span<const double> ts) {
   validate(curve);
   Points3 out(static_cast<Eigen::Index>(ts.size()), 3);
-  for (size_t k = 0; k < ts.size(); ++k) out.row(static_cast<Eigen::Index>(k)) = evaluate(curve, ts[k]).transpose();
+  for (size_t k = 0; k < ts.size(); ++k)
+    out.row(static_cast<Eigen::Index>(k)) = evaluate(curve, ts[k]).transpose();
   return out;
 }
 
@@ -167,8 +176,8 @@ struct GridPlan {
   int p = 0, q = 0, cv = 0, coords = 3;
   size_t nvs = 0;
   const double* net[4] = {nullptr, nullptr, nullptr, nullptr};  // x w, y w, z w, w; row-major net
-  const double* bv = nullptr;                    // bv[j * nvs + k] = N_{span-q+j}(v_k)
-  const std::array<size_t, 3>* runs = nullptr;   // {first, end, span}
+  const double* bv = nullptr;                   // bv[j * nvs + k] = N_{span-q+j}(v_k)
+  const std::array<size_t, 3>* runs = nullptr;  // {first, end, span}
   size_t run_count = 0;
 };
 
@@ -191,7 +200,8 @@ inline void contract_runs(const GridPlan& g, const double* col, double* a) {
 /// Grid row S(u, v_k) for all k into dst (3 per point): the net contracted in u with the basis
 /// `bu` of span `su`, then in v run by run, each a loop over the parameters that vectorizes.
 CLAY_SURFACE_CLONES
-void grid_row(const GridPlan& g, int su, const double* bu, double* column, double* acc, double* dst) {
+void grid_row(const GridPlan& g, int su, const double* bu, double* column, double* acc,
+              double* dst) {
   const size_t nvs = g.nvs;
   for (int c = 0; c < g.coords; ++c) {
     double* col = column + static_cast<size_t>(c) * static_cast<size_t>(g.cv);
@@ -203,9 +213,15 @@ void grid_row(const GridPlan& g, int su, const double* bu, double* column, doubl
     }
     double* a = acc + static_cast<size_t>(c) * nvs;
     switch (g.q) {  // the usual degrees with the v sum unrolled: one store per point
-      case 1: contract_runs<1>(g, col, a); break;
-      case 2: contract_runs<2>(g, col, a); break;
-      case 3: contract_runs<3>(g, col, a); break;
+      case 1:
+        contract_runs<1>(g, col, a);
+        break;
+      case 2:
+        contract_runs<2>(g, col, a);
+        break;
+      case 3:
+        contract_runs<3>(g, col, a);
+        break;
       default:
         for (size_t r = 0; r < g.run_count; ++r) {
           const size_t first = g.runs[r][0], end = g.runs[r][1], span = g.runs[r][2];
@@ -256,8 +272,10 @@ Points3 evaluate_grid(const BSplineSurface& surface, std::span<const double> us,
     const int span = find_span(surface.v, vs[k]);
     basis_functions(surface.v, span, vs[k], b);
     for (int j = 0; j <= g.q; ++j) bv[static_cast<size_t>(j) * nvs + k] = b[static_cast<size_t>(j)];
-    if (runs.empty() || runs.back()[2] != static_cast<size_t>(span)) runs.push_back({k, k + 1, static_cast<size_t>(span)});
-    else runs.back()[1] = k + 1;
+    if (runs.empty() || runs.back()[2] != static_cast<size_t>(span))
+      runs.push_back({k, k + 1, static_cast<size_t>(span)});
+    else
+      runs.back()[1] = k + 1;
   }
   // Homogeneous net by coordinate: x w, y w, z w, w.
   const Eigen::Index rows = surface.points.rows();
@@ -267,7 +285,8 @@ Points3 evaluate_grid(const BSplineSurface& surface, std::span<const double> us,
     for (int c = 0; c < 3; ++c) net[static_cast<size_t>(c * rows + r)] = surface.points(r, c) * w;
     net[static_cast<size_t>(3 * rows + r)] = w;
   }
-  for (int c = 0; c < 4; ++c) g.net[c] = net.data() + static_cast<size_t>(c) * static_cast<size_t>(rows);
+  for (int c = 0; c < 4; ++c)
+    g.net[c] = net.data() + static_cast<size_t>(c) * static_cast<size_t>(rows);
   g.bv = bv.data();
   g.runs = runs.data();
   g.run_count = runs.size();
@@ -288,7 +307,8 @@ std::vector<double> linspace(double first, double last, int count) {
     throw Error(ErrorCategory::InvalidArgument,
                 "linspace: needs count >= 2 and finite ends, got count " + std::to_string(count));
   std::vector<double> out(static_cast<size_t>(count));
-  for (int k = 0; k < count; ++k) out[static_cast<size_t>(k)] = first + (last - first) * k / (count - 1);
+  for (int k = 0; k < count; ++k)
+    out[static_cast<size_t>(k)] = first + (last - first) * k / (count - 1);
   out.back() = last;
   return out;
 }
@@ -297,11 +317,13 @@ std::vector<double> linspace(double first, double last, int count) {
 /// the basis functions and their derivatives of each parameter computed once (The NURBS Book A2.3)
 /// and the homogeneous net contracted in u first, row by row, so a point costs 6 (q+1) 4-vector
 /// multiply-adds instead of (p+1)(q+1) (A3.6); then the rational quotient rule (A4.4).
-std::vector<SurfaceDerivatives> derivatives_grid(const BSplineSurface& s, std::span<const double> us,
+std::vector<SurfaceDerivatives> derivatives_grid(const BSplineSurface& s,
+                                                 std::span<const double> us,
                                                  std::span<const double> vs) {
   validate(s);
   const int p = s.u.degree, q = s.v.degree, cu = s.count_u(), cv = s.count_v();
-  const std::size_t nv = vs.size(), wq = static_cast<std::size_t>(q + 1), wp = static_cast<std::size_t>(p + 1);
+  const std::size_t nv = vs.size(), wq = static_cast<std::size_t>(q + 1),
+                    wp = static_cast<std::size_t>(p + 1);
   std::vector<int> span_v(nv);
   std::vector<double> bv(nv * 3 * wq);
   for (std::size_t k = 0; k < nv; ++k) {
@@ -311,11 +333,13 @@ std::vector<SurfaceDerivatives> derivatives_grid(const BSplineSurface& s, std::s
   std::vector<Eigen::Vector4d> net(static_cast<std::size_t>(cu) * static_cast<std::size_t>(cv));
   for (Eigen::Index r = 0; r < s.points.rows(); ++r) {
     const double w = s.weights[r];
-    net[static_cast<std::size_t>(r)] = Eigen::Vector4d(s.points(r, 0) * w, s.points(r, 1) * w, s.points(r, 2) * w, w);
+    net[static_cast<std::size_t>(r)] =
+        Eigen::Vector4d(s.points(r, 0) * w, s.points(r, 1) * w, s.points(r, 2) * w, w);
   }
   std::vector<SurfaceDerivatives> out(us.size() * nv);
   std::vector<double> bu(3 * wp);
-  std::vector<Eigen::Vector4d> t(3 * static_cast<std::size_t>(cv));  // row contractions, u-derivative a at a * cv + j
+  std::vector<Eigen::Vector4d> t(
+      3 * static_cast<std::size_t>(cv));  // row contractions, u-derivative a at a * cv + j
   for (std::size_t iu = 0; iu < us.size(); ++iu) {
     const int su = find_span(s.u, us[iu]);
     basis_derivatives(s.u, su, us[iu], 2, bu);
@@ -323,7 +347,9 @@ std::vector<SurfaceDerivatives> derivatives_grid(const BSplineSurface& s, std::s
     for (int i = 0; i <= p; ++i)
       for (int j = 0; j < cv; ++j) {
         const Eigen::Vector4d& pw = net[static_cast<std::size_t>(s.index(su - p + i, j))];
-        for (std::size_t a = 0; a < 3; ++a) t[a * static_cast<std::size_t>(cv) + static_cast<std::size_t>(j)] += bu[a * wp + static_cast<std::size_t>(i)] * pw;
+        for (std::size_t a = 0; a < 3; ++a)
+          t[a * static_cast<std::size_t>(cv) + static_cast<std::size_t>(j)] +=
+              bu[a * wp + static_cast<std::size_t>(i)] * pw;
       }
     for (std::size_t iv = 0; iv < nv; ++iv) {
       const double* b = bv.data() + iv * 3 * wq;
@@ -333,7 +359,9 @@ std::vector<SurfaceDerivatives> derivatives_grid(const BSplineSurface& s, std::s
       for (int j = 0; j <= q; ++j) {
         const std::size_t col = static_cast<std::size_t>(span_v[iv] - q + j);
         for (std::size_t a = 0; a < 3; ++a)
-          for (std::size_t c = 0; a + c < 3; ++c) A[a][c] += b[c * wq + static_cast<std::size_t>(j)] * t[a * static_cast<std::size_t>(cv) + col];
+          for (std::size_t c = 0; a + c < 3; ++c)
+            A[a][c] +=
+                b[c * wq + static_cast<std::size_t>(j)] * t[a * static_cast<std::size_t>(cv) + col];
       }
       const auto P = [&](int a, int c) { return Eigen::Vector3d(A[a][c].head<3>()); };
       const auto W = [&](int a, int c) { return A[a][c][3]; };
@@ -349,6 +377,5 @@ std::vector<SurfaceDerivatives> derivatives_grid(const BSplineSurface& s, std::s
   }
   return out;
 }
-
 
 }  // namespace clay::surface

@@ -39,12 +39,13 @@ std::string bad_number(std::string_view token) {
   return {};
 }
 
-[[noreturn]] void fail(std::string_view caller, const fs::path& file, int line, const std::string& where,
-                       const std::string& what) {
-  throw Error(ErrorCategory::Exchange, std::string(caller) + ": '" + file.string() + "' line " +
-                                           std::to_string(line) + (where.empty() ? "" : ", " + where) + ": " +
-                                           what + "; the file is malformed (it is refused before OpenCASCADE, "
-                                           "which may crash or hang on such files): export it again or repair it");
+[[noreturn]] void fail(std::string_view caller, const fs::path& file, int line,
+                       const std::string& where, const std::string& what) {
+  throw Error(ErrorCategory::Exchange,
+              std::string(caller) + ": '" + file.string() + "' line " + std::to_string(line) +
+                  (where.empty() ? "" : ", " + where) + ": " + what +
+                  "; the file is malformed (it is refused before OpenCASCADE, "
+                  "which may crash or hang on such files): export it again or repair it");
 }
 
 // ---- STEP -------------------------------------------------------------------------------------
@@ -100,11 +101,13 @@ class StepTokens {
         while (std::isdigit(in_.peek())) t.text += static_cast<char>(get());
       } else if (c == '.' && std::isalpha(in_.peek())) {  // .T., .UNSPECIFIED.
         t.kind = Token::Enum;
-        while (in_.peek() != EOF && in_.peek() != '.' && in_.peek() != '\n') t.text += static_cast<char>(get());
+        while (in_.peek() != EOF && in_.peek() != '.' && in_.peek() != '\n')
+          t.text += static_cast<char>(get());
         if (in_.peek() == '.') get();
       } else if (std::isalpha(c) || c == '_' || c == '!') {
         t.kind = Token::Word;
-        while (std::isalnum(in_.peek()) || in_.peek() == '_' || in_.peek() == '-') t.text += static_cast<char>(get());
+        while (std::isalnum(in_.peek()) || in_.peek() == '_' || in_.peek() == '-')
+          t.text += static_cast<char>(get());
       } else if (std::isdigit(c) || c == '+' || c == '-' || c == '.') {
         t.kind = Token::Number;  // greedy, so that "1E999", "-nan" and "1.2.3" are one token
         for (int prev = c;;) {
@@ -144,9 +147,11 @@ int degree_count(const std::string& word, bool complex) {
   if (word == "B_SPLINE_SURFACE") return 2;
   if (word == "B_SPLINE_CURVE") return 1;
   if (complex) return 0;
-  for (const char* s : {"B_SPLINE_SURFACE_WITH_KNOTS", "BEZIER_SURFACE", "UNIFORM_SURFACE", "QUASI_UNIFORM_SURFACE"})
+  for (const char* s : {"B_SPLINE_SURFACE_WITH_KNOTS", "BEZIER_SURFACE", "UNIFORM_SURFACE",
+                        "QUASI_UNIFORM_SURFACE"})
     if (word == s) return 2;
-  for (const char* c : {"B_SPLINE_CURVE_WITH_KNOTS", "BEZIER_CURVE", "UNIFORM_CURVE", "QUASI_UNIFORM_CURVE"})
+  for (const char* c :
+       {"B_SPLINE_CURVE_WITH_KNOTS", "BEZIER_CURVE", "UNIFORM_CURVE", "QUASI_UNIFORM_CURVE"})
     if (word == c) return 1;
   return 0;
 }
@@ -156,7 +161,9 @@ int degree_count(const std::string& word, bool complex) {
 void precheck_step(const fs::path& file, std::string_view caller, int max_degree) {
   const internal::FpTrapsHeld traps_held;  // bad_number's strtod
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(ErrorCategory::Io, std::string(caller) + ": '" + file.string() + "' cannot be opened");
+  if (!in)
+    throw Error(ErrorCategory::Io,
+                std::string(caller) + ": '" + file.string() + "' cannot be opened");
   StepTokens tokens(in);
   std::unordered_set<std::string> defined;
   struct Use {
@@ -181,7 +188,8 @@ void precheck_step(const fs::path& file, std::string_view caller, int max_degree
     } else if (!data) {
       // the HEADER section holds no geometry
     } else if (t.kind == Token::Ref) {
-      if (t.text.empty() || t.text.size() > 18) fail(caller, file, t.line, where(), "'#" + t.text + "' is not an entity number");
+      if (t.text.empty() || t.text.size() > 18)
+        fail(caller, file, t.line, where(), "'#" + t.text + "' is not an entity number");
       if (depth == 0 && after.kind == Token::Symbol && after.text == "=") {
         entity = "#" + t.text;
         defined.insert(t.text);
@@ -192,14 +200,16 @@ void precheck_step(const fs::path& file, std::string_view caller, int max_degree
       // Inside parameters a word is an entity name (or a typed value) followed by "(": a bare
       // word such as NaN or INF is no STEP value.
       if (depth > 0 && !call)
-        fail(caller, file, t.line, where(), "'" + t.text + "' is not a STEP value (numbers must be finite)");
+        fail(caller, file, t.line, where(),
+             "'" + t.text + "' is not a STEP value (numbers must be finite)");
       if (const int n = call ? degree_count(t.text, depth > 0) : 0; n > 0) {
         degrees_left = n;
         degree_depth = depth + 1;
         degree_entity = t.text;
       }
     } else if (t.kind == Token::Number && depth > 0) {
-      if (const std::string why = bad_number(t.text); !why.empty()) fail(caller, file, t.line, where(), why);
+      if (const std::string why = bad_number(t.text); !why.empty())
+        fail(caller, file, t.line, where(), why);
     } else if (t.kind == Token::Symbol) {
       if (t.text == "(") ++depth;
       if (t.text == ")" && --depth < 0) fail(caller, file, t.line, where(), "a ')' closes no '('");
@@ -211,10 +221,12 @@ void precheck_step(const fs::path& file, std::string_view caller, int max_degree
       const long d = std::strtol(t.text.c_str(), &end, 10);
       if (*end != '\0' || d < 1 || d > max_degree)
         fail(caller, file, t.line, where(),
-             degree_entity + " has degree " + t.text + "; degrees are integers in [1, " + std::to_string(max_degree) + "]");
+             degree_entity + " has degree " + t.text + "; degrees are integers in [1, " +
+                 std::to_string(max_degree) + "]");
       --degrees_left;
-    } else if (expecting && !(depth == degree_depth && (t.kind == Token::String || t.kind == Token::Symbol) &&
-                                     (t.kind == Token::String || t.text == "," || t.text == "("))) {
+    } else if (expecting &&
+               !(depth == degree_depth && (t.kind == Token::String || t.kind == Token::Symbol) &&
+                 (t.kind == Token::String || t.text == "," || t.text == "("))) {
       degrees_left = 0;  // no degrees where they belong: OpenCASCADE reports such a file itself
     }
     t = after;
@@ -259,7 +271,8 @@ std::vector<std::string> split_parameters(const std::string& text, char delimite
       continue;
     }
     if ((c == 'H' || c == 'h') && !trimmed(current).empty() &&
-        std::all_of(trimmed(current).begin(), trimmed(current).end(), [](char d) { return std::isdigit(static_cast<unsigned char>(d)); })) {
+        std::all_of(trimmed(current).begin(), trimmed(current).end(),
+                    [](char d) { return std::isdigit(static_cast<unsigned char>(d)); })) {
       const std::size_t n = std::strtoul(trimmed(current).c_str(), nullptr, 10);
       i += std::min(n, text.size() - i - 1);
       current = "H";
@@ -270,14 +283,15 @@ std::vector<std::string> split_parameters(const std::string& text, char delimite
   return out;
 }
 
-long integer_parameter(const IgesRecord& r, std::size_t k, std::string_view caller, const fs::path& file,
-                       const std::string& where, const char* name) {
+long integer_parameter(const IgesRecord& r, std::size_t k, std::string_view caller,
+                       const fs::path& file, const std::string& where, const char* name) {
   if (k >= r.parameters.size())
     fail(caller, file, r.line, where, std::string("the record ends before its ") + name);
   char* end = nullptr;
   const std::string& p = r.parameters[k];
   const long v = std::strtol(p.c_str(), &end, 10);
-  if (p.empty() || *end != '\0') fail(caller, file, r.line, where, std::string(name) + " '" + p + "' is not an integer");
+  if (p.empty() || *end != '\0')
+    fail(caller, file, r.line, where, std::string(name) + " '" + p + "' is not an integer");
   return v;
 }
 
@@ -291,15 +305,17 @@ void check_bspline(const IgesRecord& r, int type, std::string_view caller, const
     const long m = integer_parameter(r, k, caller, file, where, name);
     if (m < 1 || m > max_degree)
       fail(caller, file, r.line, where,
-           std::string(name) + " " + std::to_string(m) + " is outside [1, " + std::to_string(max_degree) + "]");
+           std::string(name) + " " + std::to_string(m) + " is outside [1, " +
+               std::to_string(max_degree) + "]");
     return m;
   };
   auto upper = [&](std::size_t k, long m, const char* name) {
     const long u = integer_parameter(r, k, caller, file, where, name);
     if (u < m || u > most)
       fail(caller, file, r.line, where,
-           std::string(name) + " " + std::to_string(u) + " is inconsistent (below the degree " + std::to_string(m) +
-               " or beyond the " + std::to_string(most) + " parameters of the record)");
+           std::string(name) + " " + std::to_string(u) + " is inconsistent (below the degree " +
+               std::to_string(m) + " or beyond the " + std::to_string(most) +
+               " parameters of the record)");
     return u;
   };
   long needed = 0;
@@ -315,7 +331,8 @@ void check_bspline(const IgesRecord& r, int type, std::string_view caller, const
   }
   if (most < needed)
     fail(caller, file, r.line, where,
-         "the record holds " + std::to_string(most) + " parameters but its counts need " + std::to_string(needed));
+         "the record holds " + std::to_string(most) + " parameters but its counts need " +
+             std::to_string(needed));
 }
 
 }  // namespace
@@ -323,7 +340,9 @@ void check_bspline(const IgesRecord& r, int type, std::string_view caller, const
 void precheck_iges(const fs::path& file, std::string_view caller, int max_degree) {
   const internal::FpTrapsHeld traps_held;  // bad_number's strtod
   std::ifstream in(file, std::ios::binary);
-  if (!in) throw Error(ErrorCategory::Io, std::string(caller) + ": '" + file.string() + "' cannot be opened");
+  if (!in)
+    throw Error(ErrorCategory::Io,
+                std::string(caller) + ": '" + file.string() + "' cannot be opened");
   char delimiter = ',', end = ';';
   std::string global;
   IgesRecord record;
@@ -332,16 +351,19 @@ void precheck_iges(const fs::path& file, std::string_view caller, int max_degree
     if (text.empty()) return;
     record.parameters = split_parameters(text, delimiter, end);
     text.clear();
-    const std::string where = "entity " + (record.parameters.empty() ? std::string("?") : record.parameters[0]) +
-                              " (directory entry " + record.directory_entry + ")";
+    const std::string where =
+        "entity " + (record.parameters.empty() ? std::string("?") : record.parameters[0]) +
+        " (directory entry " + record.directory_entry + ")";
     for (std::size_t k = 0; k < record.parameters.size(); ++k) {
       const std::string& p = record.parameters[k];
       if (p.empty() || p == "H") continue;  // a default value or a string
       if (const std::string why = bad_number(p); !why.empty())
         fail(caller, file, record.line, where, "parameter " + std::to_string(k + 1) + " " + why);
     }
-    if (!record.parameters.empty() && (record.parameters[0] == "126" || record.parameters[0] == "128"))
-      check_bspline(record, record.parameters[0] == "126" ? 126 : 128, caller, file, where, max_degree);
+    if (!record.parameters.empty() &&
+        (record.parameters[0] == "126" || record.parameters[0] == "128"))
+      check_bspline(record, record.parameters[0] == "126" ? 126 : 128, caller, file, where,
+                    max_degree);
   };
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {

@@ -7,8 +7,8 @@
 #include <clay/internal/checks.hpp>
 
 #include <algorithm>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -22,7 +22,8 @@ namespace {
 /// direction each).
 double block_norm(const Eigen::Ref<const Eigen::RowVectorXd>& row) {
   double worst = 0;
-  for (Eigen::Index c = 0; c + 3 < row.size(); c += 4) worst = std::max(worst, row.segment<4>(c).norm());
+  for (Eigen::Index c = 0; c + 3 < row.size(); c += 4)
+    worst = std::max(worst, row.segment<4>(c).norm());
   return worst;
 }
 
@@ -37,7 +38,8 @@ double remove_knot_once(Strip& strip, int r, int s, double tolerance) {
   const Rows& P = strip.rows;
   Rows t(last - off + 2, P.cols());
   auto alpha = [&](int i) {
-    return (u - U[static_cast<size_t>(i)]) / (U[static_cast<size_t>(i + p + 1)] - U[static_cast<size_t>(i)]);
+    return (u - U[static_cast<size_t>(i)]) /
+           (U[static_cast<size_t>(i + p + 1)] - U[static_cast<size_t>(i)]);
   };
   t.row(0) = P.row(off);
   t.row(last + 1 - off) = P.row(last + 1);
@@ -91,7 +93,8 @@ int remove_knots(Strip& strip, double tolerance) {
       const auto lo = std::lower_bound(K.begin(), K.end(), value);
       const int s = static_cast<int>(hi - lo);
       if (s == 0) break;
-      const double gap = remove_knot_once(strip, static_cast<int>(hi - K.begin()) - 1, s, tolerance - spent);
+      const double gap =
+          remove_knot_once(strip, static_cast<int>(hi - K.begin()) - 1, s, tolerance - spent);
       if (gap < 0) break;
       spent += gap;
       ++removed;
@@ -112,14 +115,13 @@ void check_tolerance(double tolerance_mm, const char* who) {
                     "the knots whose removal is exact up to rounding)");
 }
 
-SurfaceKnotRemoval remove_in(const BSplineSurface& surface, detail::Direction d, double tolerance_mm,
-                             const char* who) {
+SurfaceKnotRemoval remove_in(const BSplineSurface& surface, detail::Direction d,
+                             double tolerance_mm, const char* who) {
   validate(surface);
   check_tolerance(tolerance_mm, who);
   SurfaceKnotRemoval out;
-  out.surface = detail::apply_in_direction(surface, d, [&](detail::Strip& s) {
-    out.removed = detail::remove_knots(s, tolerance_mm);
-  });
+  out.surface = detail::apply_in_direction(
+      surface, d, [&](detail::Strip& s) { out.removed = detail::remove_knots(s, tolerance_mm); });
   return out;
 }
 
@@ -148,7 +150,8 @@ SurfaceKnotRemoval remove_knots(const BSplineSurface& surface, double tolerance_
   const Eigen::Index nu = in_u.rows.rows(), nv = in_u.rows.cols() / 4;
   detail::Strip in_v{surface.v, detail::Rows(nv, 4 * nu), in_u.polynomial};
   for (Eigen::Index i = 0; i < nu; ++i)
-    for (Eigen::Index j = 0; j < nv; ++j) in_v.rows.block<1, 4>(j, 4 * i) = in_u.rows.block<1, 4>(i, 4 * j);
+    for (Eigen::Index j = 0; j < nv; ++j)
+      in_v.rows.block<1, 4>(j, 4 * i) = in_u.rows.block<1, 4>(i, 4 * j);
   in_u.rows.resize(0, 0);
   out.removed += detail::remove_knots(in_v, tolerance_mm);
   out.surface = detail::surface_from_strip(std::move(in_v), in_u.basis, detail::Direction::V);

@@ -121,10 +121,11 @@ std::vector<double> checked_knots(const BSplineBasis& basis, std::span<const dou
     const int now = multiplicity(basis, t);
     if (now + added > limit)
       throw Error(ErrorCategory::InvalidArgument,
-                  std::string(what) + ": inserting knot " + number(t) + " " + std::to_string(added) +
-                      " time(s) gives multiplicity " + std::to_string(now + added) + ", above " +
-                      std::to_string(limit) + " (degree " + std::to_string(basis.degree) +
-                      "); insert it at most " + std::to_string(std::max(0, limit - now)) + " time(s)");
+                  std::string(what) + ": inserting knot " + number(t) + " " +
+                      std::to_string(added) + " time(s) gives multiplicity " +
+                      std::to_string(now + added) + ", above " + std::to_string(limit) +
+                      " (degree " + std::to_string(basis.degree) + "); insert it at most " +
+                      std::to_string(std::max(0, limit - now)) + " time(s)");
     k = e;
   }
   return sorted;
@@ -132,25 +133,27 @@ std::vector<double> checked_knots(const BSplineBasis& basis, std::span<const dou
 
 void check_times(int times, std::string_view what) {
   if (times < 0)
-    throw Error(ErrorCategory::InvalidArgument,
-                std::string(what) + ": times = " + std::to_string(times) + " is negative; give times >= 0");
+    throw Error(
+        ErrorCategory::InvalidArgument,
+        std::string(what) + ": times = " + std::to_string(times) + " is negative; give times >= 0");
 }
 
-BSplineSurface insert_in(const BSplineSurface& s, Direction d, double t, int times, const char* what) {
+BSplineSurface insert_in(const BSplineSurface& s, Direction d, double t, int times,
+                         const char* what) {
   validate(s);
   check_times(times, what);
   const std::vector<double> request(static_cast<size_t>(times), t);
   checked_knots(d == Direction::U ? s.u : s.v, request, what);
-  return detail::apply_in_direction(s, d, [&](detail::Strip& strip) { detail::insert_knot(strip, t, times); });
+  return detail::apply_in_direction(
+      s, d, [&](detail::Strip& strip) { detail::insert_knot(strip, t, times); });
 }
 
 BSplineSurface refine_in(const BSplineSurface& s, Direction d, std::span<const double> knots,
                          const char* what) {
   validate(s);
   auto sorted = checked_knots(d == Direction::U ? s.u : s.v, knots, what);
-  return detail::apply_in_direction(s, d, [&](detail::Strip& strip) {
-    detail::refine_knots(strip, std::move(sorted));
-  });
+  return detail::apply_in_direction(
+      s, d, [&](detail::Strip& strip) { detail::refine_knots(strip, std::move(sorted)); });
 }
 
 /// Rows k-p..k of the Bézier-refined strip for each span, with the span's clamped basis.

@@ -2,13 +2,13 @@
 #include <clay/surface/skin.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/math.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/tolerance.hpp>
-#include <clay/internal/math.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
@@ -34,7 +34,9 @@ using detail::polygon_length;
 
 std::string num(double x) { return detail::short_number(x); }
 
-std::string name(const char* what, size_t k) { return std::string(what) + " #" + std::to_string(k); }
+std::string name(const char* what, size_t k) {
+  return std::string(what) + " #" + std::to_string(k);
+}
 
 // ---- Loft ----
 
@@ -51,7 +53,8 @@ std::vector<double> section_parameters(const std::vector<BSplineCurve>& c,
   std::vector<double> v(count, 0.0);
   v.back() = 1.0;
   if (kind == LoftParametrization::Uniform) {
-    for (size_t k = 1; k + 1 < count; ++k) v[k] = static_cast<double>(k) / static_cast<double>(count - 1);
+    for (size_t k = 1; k + 1 < count; ++k)
+      v[k] = static_cast<double>(k) / static_cast<double>(count - 1);
     return v;
   }
   // Per column i of control points: cumulative (chord or centripetal) length across the sections,
@@ -83,9 +86,9 @@ std::vector<double> section_parameters(const std::vector<BSplineCurve>& c,
 PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftOptions& options) {
   options.validate();
   if (sections.size() < 2)
-    throw Error(ErrorCategory::InvalidArgument,
-                "loft: needs at least 2 sections, got " + std::to_string(sections.size()) +
-                    "; give two or more section curves");
+    throw Error(ErrorCategory::InvalidArgument, "loft: needs at least 2 sections, got " +
+                                                    std::to_string(sections.size()) +
+                                                    "; give two or more section curves");
   std::vector<const BSplineCurve*> all;
   for (size_t k = 0; k < sections.size(); ++k) {
     validate(sections[k], name("loft section", k));
@@ -97,8 +100,9 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
     const double length = polygon_length(sections[k]);
     if (!(length > tol))
       throw Error(ErrorCategory::InvalidGeometry,
-                  "loft: section #" + std::to_string(k) + " is degenerate: its control polygon is " +
-                      num(length) + " mm long (tolerance " + num(tol) +
+                  "loft: section #" + std::to_string(k) +
+                      " is degenerate: its control polygon is " + num(length) +
+                      " mm long (tolerance " + num(tol) +
                       " mm); a loft needs curves, not points: remove it or give a curve");
   }
   for (size_t k = 0; k < sections.size(); ++k)
@@ -132,7 +136,8 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
       out.reversed[k] = true;
       largest = 0;
       for (double t : ts)
-        largest = std::max(largest, (evaluate(oriented[k], t) - evaluate(oriented[k - 1], t)).norm());
+        largest =
+            std::max(largest, (evaluate(oriented[k], t) - evaluate(oriented[k - 1], t)).norm());
     }
     if (!(largest > tol))
       throw Error(ErrorCategory::InvalidGeometry,
@@ -144,9 +149,10 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
   out.v = section_parameters(out.compatible, options.parametrization);
   for (size_t k = 1; k < out.v.size(); ++k)
     if (!(out.v[k] > out.v[k - 1]))
-      throw Error(ErrorCategory::InvalidGeometry,
-                  "loft: sections #" + std::to_string(k - 1) + " and #" + std::to_string(k) +
-                      " get the same parameter (their control points coincide); remove one of them");
+      throw Error(
+          ErrorCategory::InvalidGeometry,
+          "loft: sections #" + std::to_string(k - 1) + " and #" + std::to_string(k) +
+              " get the same parameter (their control points coincide); remove one of them");
   out.degree = std::min(options.degree, static_cast<int>(sections.size()) - 1);
   return out;
 }
@@ -156,20 +162,21 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
 std::vector<std::string> LoftOptions::problems() const {
   std::vector<std::string> out;
   if (degree < 1 || degree > max_kernel_degree)
-    out.push_back(
-                "LoftOptions::degree is " + std::to_string(degree) + "; it must be in [1, " +
-                    std::to_string(max_kernel_degree) + "]");
+    out.push_back("LoftOptions::degree is " + std::to_string(degree) + "; it must be in [1, " +
+                  std::to_string(max_kernel_degree) + "]");
   if (!(tolerance > 0.0 && tolerance <= 1e-2))
-    out.push_back(
-                "LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
+    out.push_back("LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
   return out;
 }
 
-void LoftOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void LoftOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves) {
   if (curves.empty())
-    throw Error(ErrorCategory::InvalidArgument, "make_compatible: no curves given; give at least one");
+    throw Error(ErrorCategory::InvalidArgument,
+                "make_compatible: no curves given; give at least one");
   std::vector<BSplineCurve> out;
   int degree = 1;
   for (size_t k = 0; k < curves.size(); ++k) {
@@ -246,7 +253,9 @@ BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& 
     for (size_t i = 0; i < us.size(); ++i) {
       const double t = prepared.reversed[k] ? b - us[i] * (b - a) : a + us[i] * (b - a);
       const Eigen::Vector3d expected = evaluate(sections[k], std::clamp(t, a, b));
-      worst = std::max(worst, (grid.row(static_cast<Eigen::Index>(i * count + k)).transpose() - expected).norm());
+      worst = std::max(
+          worst,
+          (grid.row(static_cast<Eigen::Index>(i * count + k)).transpose() - expected).norm());
     }
   }
   std::string method = "loft of " + std::to_string(count) + " sections";
@@ -260,6 +269,5 @@ BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& 
   built.report.samples = static_cast<int>(us.size() * count);
   return built;
 }
-
 
 }  // namespace clay::surface

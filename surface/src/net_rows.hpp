@@ -1,8 +1,8 @@
 #pragma once
 // A control net seen as a "curve" of wide points (internal). Algorithms written once for curves of
-// D-dimensional homogeneous points (knot insertion, refinement, degree elevation) apply to a surface
-// direction by treating each row of control points across the other direction as one point of
-// dimension 4 * count_other.
+// D-dimensional homogeneous points (knot insertion, refinement, degree elevation) apply to a
+// surface direction by treating each row of control points across the other direction as one point
+// of dimension 4 * count_other.
 #include <clay/surface/bspline_surface.hpp>
 
 #include <Eigen/Core>

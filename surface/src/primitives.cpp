@@ -1,9 +1,9 @@
 #include <clay/surface/primitives.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -25,13 +25,16 @@ std::vector<std::string> SuperquadricOptions::problems() const {
     m << "SuperquadricOptions::" << field << " = " << value << " " << rule;
     out.push_back(m.str());
   };
-  if (!(std::isfinite(tolerance) && tolerance > 0.0)) bad("tolerance", tolerance, "must be a positive length in mm");
+  if (!(std::isfinite(tolerance) && tolerance > 0.0))
+    bad("tolerance", tolerance, "must be a positive length in mm");
   if (degree < 2 || degree > 7) bad("degree", degree, "must be in [2, 7]");
   if (max_spans < 8) bad("max_spans", max_spans, "must be >= 8");
   return out;
 }
 
-void SuperquadricOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void SuperquadricOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 namespace {
 
@@ -72,19 +75,20 @@ using Planar = std::function<Eigen::Vector2d(const Angle&)>;
 
 /// A planar curve standing for the analytic curve f on [t0, t1].
 struct Profile {
-  BSplineCurve curve;                 // z = 0
-  Planar f;                           // the analytic curve
+  BSplineCurve curve;                                                       // z = 0
+  Planar f;                                                                 // the analytic curve
   std::function<Angle(double, const Eigen::Vector3d&)> analytic_parameter;  // angle of curve(s)
   bool exact = false;
-  double error = 0;                   // max |curve(s) - f(t(s))| on the check sample
+  double error = 0;  // max |curve(s) - f(t(s))| on the check sample
   Eigen::Vector2d magnitude = Eigen::Vector2d::Zero();  // max |f_x|, |f_y| on the sample
-  std::vector<double> samples;        // curve parameters of the check sample
+  std::vector<double> samples;                          // curve parameters of the check sample
 };
 
 /// Curve parameters at fixed fractions of every span, ends included; singular ends of power
 /// functions make the error largest near span ends, so those are sampled closely.
 std::vector<double> check_samples(const BSplineBasis& basis) {
-  static constexpr double fractions[] = {0.0, 0.005, 0.02, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9, 0.98, 0.995};
+  static constexpr double fractions[] = {0.0, 0.005, 0.02, 0.1, 0.25, 0.4,
+                                         0.5, 0.6,   0.75, 0.9, 0.98, 0.995};
   const auto breaks = breakpoints(basis);
   std::vector<double> out;
   for (size_t k = 0; k + 1 < breaks.size(); ++k)
@@ -125,7 +129,8 @@ Angle stretched_angle(double s, const std::vector<double>& breaks, double m) {
 /// (multiplicity p) at the segment ends and spans bisected where the error exceeds `tol`, until it
 /// holds everywhere.
 Profile interpolate(const Planar& f_of_angle, const std::vector<double>& angle_breaks, double e,
-                    bool closed, double tol, const SuperquadricOptions& o, const std::string& what) {
+                    bool closed, double tol, const SuperquadricOptions& o,
+                    const std::string& what) {
   const int p = o.degree;
   const double stretch = std::max(1.0, 1.0 / e);
   const std::function<Eigen::Vector2d(double)> f = [f_of_angle, angle_breaks, stretch](double s) {
@@ -163,7 +168,8 @@ Profile interpolate(const Planar& f_of_angle, const std::vector<double>& angle_b
       const int span = find_span(c.basis, tau);
       basis_functions(c.basis, span, tau, values);
       for (int i = 0; i <= p; ++i)
-        if (values[static_cast<size_t>(i)] != 0.0) entries.emplace_back(k, span - p + i, values[static_cast<size_t>(i)]);
+        if (values[static_cast<size_t>(i)] != 0.0)
+          entries.emplace_back(k, span - p + i, values[static_cast<size_t>(i)]);
       rhs.row(k) = f(tau).transpose();
     }
     Eigen::SparseMatrix<double> a(n, n);
@@ -182,7 +188,8 @@ Profile interpolate(const Planar& f_of_angle, const std::vector<double>& angle_b
     std::vector<double> next = {cuts.front()};
     bool all_good = true;
     double worst = 0;
-    static constexpr double fractions[] = {0.005, 0.02, 0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9, 0.98, 0.995};
+    static constexpr double fractions[] = {0.005, 0.02, 0.1, 0.25, 0.4,  0.5,
+                                           0.6,   0.75, 0.9, 0.98, 0.995};
     for (size_t k = 0; k + 1 < cuts.size(); ++k) {
       double err = 0;
       for (double fr : fractions) {
@@ -200,7 +207,8 @@ Profile interpolate(const Planar& f_of_angle, const std::vector<double>& angle_b
     if (static_cast<int>(next.size()) - 1 > o.max_spans) {
       std::ostringstream m;
       m << what << ": could not reach " << tol << " (relative to the radii) with " << o.max_spans
-        << " spans (error " << worst << "); loosen SuperquadricOptions::tolerance, raise max_spans, "
+        << " spans (error " << worst
+        << "); loosen SuperquadricOptions::tolerance, raise max_spans, "
         << "or use exponents further from 0";
       throw Error(ErrorCategory::InvalidArgument, m.str());
     }
@@ -214,8 +222,8 @@ Profile interpolate(const Planar& f_of_angle, const std::vector<double>& angle_b
 Profile circle_profile(const Eigen::Vector2d& center, double t0, double t1) {
   Profile profile;
   profile.exact = true;
-  profile.curve = circular_arc(Eigen::Vector3d(center.x(), center.y(), 0.0), Eigen::Vector3d::UnitX(),
-                               Eigen::Vector3d::UnitY(), 1.0, t0, t1);
+  profile.curve = circular_arc(Eigen::Vector3d(center.x(), center.y(), 0.0),
+                               Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 1.0, t0, t1);
   profile.f = [center](const Angle& t) {
     const auto cs = cos_sin(t);
     return Eigen::Vector2d(center.x() + cs[0], center.y() + cs[1]);
@@ -240,7 +248,9 @@ Profile hyperbola_profile(double limit) {
     const auto cs = cos_sin(t);
     return Eigen::Vector2d(1.0 / cs[0], cs[1] / cs[0]);
   };
-  profile.analytic_parameter = [](double, const Eigen::Vector3d& p) { return Angle{std::asin(p.y() / p.x()), 0.0}; };
+  profile.analytic_parameter = [](double, const Eigen::Vector3d& p) {
+    return Angle{std::asin(p.y() / p.x()), 0.0};
+  };
   measure(profile);
   return profile;
 }
@@ -258,8 +268,9 @@ void check_shape(const Eigen::Vector3d& radii, double e1, double e2, const char*
 
 /// The primitive from its two profiles, scaled by the radii, with its measured deviation.
 /// Approximated profiles are tightened until the surface error bound holds.
-BuiltSurface assemble(const std::function<Profile(double)>& make_m, const std::function<Profile(double)>& make_h,
-                      const Eigen::Vector3d& radii, const SuperquadricOptions& o, const std::string& method) {
+BuiltSurface assemble(const std::function<Profile(double)>& make_m,
+                      const std::function<Profile(double)>& make_h, const Eigen::Vector3d& radii,
+                      const SuperquadricOptions& o, const std::string& method) {
   // Per-profile tolerance (relative to unit radii) from |S - x| <= a (|dm||H| + |m||dh|).
   double share = o.tolerance / (4.0 * radii.maxCoeff());
   Profile m, h;
@@ -273,7 +284,8 @@ BuiltSurface assemble(const std::function<Profile(double)>& make_m, const std::f
     share *= 0.25;
   }
   BSplineSurface s = spherical_product(m.curve, h.curve);
-  for (Eigen::Index r = 0; r < s.points.rows(); ++r) s.points.row(r) = s.points.row(r).cwiseProduct(radii.transpose());
+  for (Eigen::Index r = 0; r < s.points.rows(); ++r)
+    s.points.row(r) = s.points.row(r).cwiseProduct(radii.transpose());
   // Measured deviation at matching analytic parameters on a sample of both profiles' samples.
   auto thin = [](const std::vector<double>& v) {
     if (v.size() <= 160) return v;
@@ -286,11 +298,15 @@ BuiltSurface assemble(const std::function<Profile(double)>& make_m, const std::f
   const Points3 mp = evaluate_many(m.curve, ss), hp = evaluate_many(h.curve, ts);
   double worst = 0;
   for (size_t i = 0; i < ss.size(); ++i) {
-    const Eigen::Vector2d fm = m.f(m.analytic_parameter(ss[i], mp.row(static_cast<Eigen::Index>(i)).transpose()));
+    const Eigen::Vector2d fm =
+        m.f(m.analytic_parameter(ss[i], mp.row(static_cast<Eigen::Index>(i)).transpose()));
     for (size_t j = 0; j < ts.size(); ++j) {
-      const Eigen::Vector2d fh = h.f(h.analytic_parameter(ts[j], hp.row(static_cast<Eigen::Index>(j)).transpose()));
-      const Eigen::Vector3d x(radii.x() * fm.x() * fh.x(), radii.y() * fm.x() * fh.y(), radii.z() * fm.y());
-      worst = std::max(worst, (grid.row(static_cast<Eigen::Index>(i * ts.size() + j)).transpose() - x).norm());
+      const Eigen::Vector2d fh =
+          h.f(h.analytic_parameter(ts[j], hp.row(static_cast<Eigen::Index>(j)).transpose()));
+      const Eigen::Vector3d x(radii.x() * fm.x() * fh.x(), radii.y() * fm.x() * fh.y(),
+                              radii.z() * fm.y());
+      worst = std::max(
+          worst, (grid.row(static_cast<Eigen::Index>(i * ts.size() + j)).transpose() - x).norm());
     }
   }
   BuiltSurface out{s, describe(s, method)};
@@ -307,23 +323,34 @@ std::string name_of(const char* kind, double e1, double e2) {
 }
 
 /// The east–west profile (C^e, S^e), omega in [-pi, pi]: exact circle when e = 1.
-Profile around_profile(double e, double tol, const SuperquadricOptions& o, const std::string& what) {
+Profile around_profile(double e, double tol, const SuperquadricOptions& o,
+                       const std::string& what) {
   if (e == 1.0) return circle_profile(Eigen::Vector2d::Zero(), -pi, pi);
-  return interpolate([e](const Angle& t) { const auto cs = cos_sin(t); return Eigen::Vector2d(signed_pow(cs[0], e), signed_pow(cs[1], e)); },
-                     {-pi, -half_pi, 0.0, half_pi, pi}, e, true, tol, o, what);
+  return interpolate(
+      [e](const Angle& t) {
+        const auto cs = cos_sin(t);
+        return Eigen::Vector2d(signed_pow(cs[0], e), signed_pow(cs[1], e));
+      },
+      {-pi, -half_pi, 0.0, half_pi, pi}, e, true, tol, o, what);
 }
 
 /// (sec^e, tan^e) on [-limit, limit]: exact hyperbola arc when e = 1.
-Profile hyperbolic_profile(double e, double limit, double tol, const SuperquadricOptions& o, const std::string& what) {
+Profile hyperbolic_profile(double e, double limit, double tol, const SuperquadricOptions& o,
+                           const std::string& what) {
   if (e == 1.0) return hyperbola_profile(limit);
-  return interpolate([e](const Angle& t) { const auto cs = cos_sin(t); return Eigen::Vector2d(signed_pow(1.0 / cs[0], e), signed_pow(cs[1] / cs[0], e)); },
-                     {-limit, 0.0, limit}, e, false, tol, o, what);
+  return interpolate(
+      [e](const Angle& t) {
+        const auto cs = cos_sin(t);
+        return Eigen::Vector2d(signed_pow(1.0 / cs[0], e), signed_pow(cs[1] / cs[0], e));
+      },
+      {-limit, 0.0, limit}, e, false, tol, o, what);
 }
 
 void check_limit(double limit, const char* field, const char* what) {
   if (!(std::isfinite(limit) && limit > 0.0 && limit < half_pi - 1e-6)) {
     std::ostringstream m;
-    m << what << ": " << field << " = " << limit << " rad is outside (0, pi/2); the surface is unbounded at pi/2";
+    m << what << ": " << field << " = " << limit
+      << " rad is outside (0, pi/2); the surface is unbounded at pi/2";
     throw Error(ErrorCategory::InvalidArgument, m.str());
   }
 }
@@ -358,10 +385,15 @@ BuiltSurface superellipsoid(const Superellipsoid& shape, const SuperquadricOptio
   return assemble(
       [&](double tol) {
         if (e1 == 1.0) return circle_profile(Eigen::Vector2d::Zero(), -half_pi, half_pi);
-        return interpolate([e1](const Angle& t) { const auto cs = cos_sin(t); return Eigen::Vector2d(signed_pow(cs[0], e1), signed_pow(cs[1], e1)); },
-                           {-half_pi, 0.0, half_pi}, e1, false, tol, options, method);
+        return interpolate(
+            [e1](const Angle& t) {
+              const auto cs = cos_sin(t);
+              return Eigen::Vector2d(signed_pow(cs[0], e1), signed_pow(cs[1], e1));
+            },
+            {-half_pi, 0.0, half_pi}, e1, false, tol, options, method);
       },
-      [&](double tol) { return around_profile(e2, tol, options, method); }, shape.radii, options, method);
+      [&](double tol) { return around_profile(e2, tol, options, method); }, shape.radii, options,
+      method);
 }
 
 BuiltSurface supertoroid(const Supertoroid& shape, const SuperquadricOptions& options) {
@@ -369,36 +401,52 @@ BuiltSurface supertoroid(const Supertoroid& shape, const SuperquadricOptions& op
   check_shape(shape.radii, shape.e1, shape.e2, "supertoroid");
   if (!(std::isfinite(shape.hole) && shape.hole > 1.0))
     throw Error(ErrorCategory::InvalidArgument,
-                "supertoroid: hole = " + std::to_string(shape.hole) + " must be > 1 (else the tube crosses the axis)");
+                "supertoroid: hole = " + std::to_string(shape.hole) +
+                    " must be > 1 (else the tube crosses the axis)");
   const double e1 = shape.e1, e2 = shape.e2, a4 = shape.hole;
   const std::string method = name_of("supertoroid", e1, e2);
   return assemble(
       [&](double tol) {
         if (e1 == 1.0) return circle_profile(Eigen::Vector2d(a4, 0.0), -pi, pi);
-        return interpolate([e1, a4](const Angle& t) { const auto cs = cos_sin(t); return Eigen::Vector2d(a4 + signed_pow(cs[0], e1), signed_pow(cs[1], e1)); },
-                           {-pi, -half_pi, 0.0, half_pi, pi}, e1, true, tol, options, method);
+        return interpolate(
+            [e1, a4](const Angle& t) {
+              const auto cs = cos_sin(t);
+              return Eigen::Vector2d(a4 + signed_pow(cs[0], e1), signed_pow(cs[1], e1));
+            },
+            {-pi, -half_pi, 0.0, half_pi, pi}, e1, true, tol, options, method);
       },
-      [&](double tol) { return around_profile(e2, tol, options, method); }, shape.radii, options, method);
+      [&](double tol) { return around_profile(e2, tol, options, method); }, shape.radii, options,
+      method);
 }
 
-BuiltSurface superhyperboloid_one_sheet(const Superhyperboloid& shape, const SuperquadricOptions& options) {
+BuiltSurface superhyperboloid_one_sheet(const Superhyperboloid& shape,
+                                        const SuperquadricOptions& options) {
   options.validate();
   check_shape(shape.radii, shape.e1, shape.e2, "superhyperboloid of one sheet");
   check_limit(shape.eta_limit, "eta_limit", "superhyperboloid of one sheet");
   const std::string method = name_of("superhyperboloid of one sheet", shape.e1, shape.e2);
-  return assemble([&](double tol) { return hyperbolic_profile(shape.e1, shape.eta_limit, tol, options, method); },
-                  [&](double tol) { return around_profile(shape.e2, tol, options, method); }, shape.radii, options, method);
+  return assemble(
+      [&](double tol) {
+        return hyperbolic_profile(shape.e1, shape.eta_limit, tol, options, method);
+      },
+      [&](double tol) { return around_profile(shape.e2, tol, options, method); }, shape.radii,
+      options, method);
 }
 
-std::vector<BuiltSurface> superhyperboloid_two_sheets(const Superhyperboloid& shape, const SuperquadricOptions& options) {
+std::vector<BuiltSurface> superhyperboloid_two_sheets(const Superhyperboloid& shape,
+                                                      const SuperquadricOptions& options) {
   options.validate();
   check_shape(shape.radii, shape.e1, shape.e2, "superhyperboloid of two sheets");
   check_limit(shape.eta_limit, "eta_limit", "superhyperboloid of two sheets");
   check_limit(shape.omega_limit, "omega_limit", "superhyperboloid of two sheets");
   const std::string method = name_of("superhyperboloid of two sheets", shape.e1, shape.e2);
   BuiltSurface first = assemble(
-      [&](double tol) { return hyperbolic_profile(shape.e1, shape.eta_limit, tol, options, method); },
-      [&](double tol) { return hyperbolic_profile(shape.e2, shape.omega_limit, tol, options, method); },
+      [&](double tol) {
+        return hyperbolic_profile(shape.e1, shape.eta_limit, tol, options, method);
+      },
+      [&](double tol) {
+        return hyperbolic_profile(shape.e2, shape.omega_limit, tol, options, method);
+      },
       shape.radii, options, method);
   // The second sheet is omega = pi + phi: sec(pi + phi) = -sec(phi), tan(pi + phi) = tan(phi),
   // so it is the first sheet mirrored in the yz plane (exact: negate x).

@@ -1,9 +1,9 @@
 #include <clay/surface/projection.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Dense>
 
@@ -21,24 +21,29 @@ std::vector<std::string> ProjectionOptions::problems() const {
   auto bad = [&out](const std::string& field, const std::string& rule) {
     out.push_back("ProjectionOptions::" + field + " " + rule);
   };
-  if (max_iterations < 1) bad("max_iterations", "= " + std::to_string(max_iterations) + " must be >= 1");
+  if (max_iterations < 1)
+    bad("max_iterations", "= " + std::to_string(max_iterations) + " must be >= 1");
   if (!(parametric_tolerance > 0.0 && parametric_tolerance < 1.0))
     bad("parametric_tolerance", "= " + std::to_string(parametric_tolerance) + " must be in (0, 1)");
   if (!(cosine_tolerance > 0.0 && cosine_tolerance < 1.0))
     bad("cosine_tolerance", "= " + std::to_string(cosine_tolerance) + " must be in (0, 1)");
-  if (samples_per_span < 1) bad("samples_per_span", "= " + std::to_string(samples_per_span) + " must be >= 1");
+  if (samples_per_span < 1)
+    bad("samples_per_span", "= " + std::to_string(samples_per_span) + " must be >= 1");
   if (starts < 1) bad("starts", "= " + std::to_string(starts) + " must be >= 1");
   return out;
 }
 
-void ProjectionOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void ProjectionOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 namespace {
 
 void check_point(const Eigen::Vector3d& p) {
   if (!internal::all_finite(p))
-    throw Error(ErrorCategory::InvalidGeometry,
-                "projection: the point to project has a non-finite coordinate; give a finite point");
+    throw Error(
+        ErrorCategory::InvalidGeometry,
+        "projection: the point to project has a non-finite coordinate; give a finite point");
 }
 
 /// Diagonal of the control box: the scale of "P is on S" in newton().
@@ -52,7 +57,8 @@ SurfaceProjection newton(const BSplineSurface& s, double size, const Eigen::Vect
   const auto [ua, ub] = s.u.domain();
   const auto [va, vb] = s.v.domain();
   const double lo[2] = {ua, va}, hi[2] = {ub, vb};
-  const double step_tol[2] = {o.parametric_tolerance * (ub - ua), o.parametric_tolerance * (vb - va)};
+  const double step_tol[2] = {o.parametric_tolerance * (ub - ua),
+                              o.parametric_tolerance * (vb - va)};
   double x[2] = {u0, v0};
   SurfaceProjection out;
   SurfaceDerivatives d = derivatives(s, x[0], x[1], 2);
@@ -71,7 +77,8 @@ SurfaceProjection newton(const BSplineSurface& s, double size, const Eigen::Vect
     H << su.dot(su) + d.duu.dot(r), su.dot(sv) + d.duv.dot(r), su.dot(sv) + d.duv.dot(r),
         sv.dot(sv) + d.dvv.dot(r);
     // Active bounds: at a domain edge with the descent direction pointing outside.
-    for (int k = 0; k < 2; ++k) active[k] = (x[k] <= lo[k] && g[k] > 0.0) || (x[k] >= hi[k] && g[k] < 0.0);
+    for (int k = 0; k < 2; ++k)
+      active[k] = (x[k] <= lo[k] && g[k] > 0.0) || (x[k] >= hi[k] && g[k] < 0.0);
     // Stationary for every free coordinate: S - P is normal to S_u (resp. S_v), or P is on S.
     const double rn = r.norm();
     bool stationary = rn <= 1e-15 * scale;
@@ -97,7 +104,8 @@ SurfaceProjection newton(const BSplineSurface& s, double size, const Eigen::Vect
     // A direction whose tangent vanishes (a collapsed edge, a pole) cannot move the point at first
     // order: it is held for this step and Newton runs on the other one.
     const double tangent_floor = 1e-24 * (G(0, 0) + G(1, 1));
-    const bool held[2] = {active[0] || !(G(0, 0) > tangent_floor), active[1] || !(G(1, 1) > tangent_floor)};
+    const bool held[2] = {active[0] || !(G(0, 0) > tangent_floor),
+                          active[1] || !(G(1, 1) > tangent_floor)};
     auto solve_free = [&](const Eigen::Matrix2d& M) -> bool {
       if (!held[0] && !held[1]) {
         if (!(M(0, 0) > 0.0 && M.determinant() > 0.0)) return false;
@@ -138,7 +146,8 @@ SurfaceProjection newton(const BSplineSurface& s, double size, const Eigen::Vect
       }
       t *= 0.5;
     }
-    const bool tiny = std::abs(xn[0] - x[0]) <= step_tol[0] && std::abs(xn[1] - x[1]) <= step_tol[1];
+    const bool tiny =
+        std::abs(xn[0] - x[0]) <= step_tol[0] && std::abs(xn[1] - x[1]) <= step_tol[1];
     if (!accepted || tiny) {
       if (accepted) {
         x[0] = xn[0];
@@ -233,13 +242,15 @@ SurfaceProjection SurfaceProjector::closest_point(const Eigen::Vector3d& point) 
   check_point(point);
   const StartGrid& grid = start_grid();
   // Newton from the `starts` grid samples nearest to the point; the nearest result wins.
-  const size_t starts = std::min(static_cast<size_t>(grid.points.rows()), static_cast<size_t>(options_.starts));
+  const size_t starts =
+      std::min(static_cast<size_t>(grid.points.rows()), static_cast<size_t>(options_.starts));
   std::vector<std::pair<double, Eigen::Index>> best_samples;  // (squared distance, row), sorted
   best_samples.reserve(starts + 1);
   for (Eigen::Index r = 0; r < grid.points.rows(); ++r) {
     const double d2 = (grid.points.row(r) - point.transpose()).squaredNorm();
     if (best_samples.size() == starts && d2 >= best_samples.back().first) continue;
-    const auto at = std::upper_bound(best_samples.begin(), best_samples.end(), std::make_pair(d2, r));
+    const auto at =
+        std::upper_bound(best_samples.begin(), best_samples.end(), std::make_pair(d2, r));
     best_samples.insert(at, {d2, r});
     if (best_samples.size() > starts) best_samples.pop_back();
   }
@@ -320,27 +331,32 @@ CurveProjection curve_projection(const BSplineCurve& curve, const Eigen::Vector3
 void check_curve_input(const BSplineCurve& curve, const Eigen::Vector3d& q, const char* who) {
   validate(curve, "curve to project onto");
   if (!(std::isfinite(q.x()) && std::isfinite(q.y()) && std::isfinite(q.z())))
-    throw Error(ErrorCategory::InvalidGeometry, std::string(who) + ": the point to project is not finite");
+    throw Error(ErrorCategory::InvalidGeometry,
+                std::string(who) + ": the point to project is not finite");
 }
 
 }  // namespace
 
-CurveProjection project_normal(const BSplineCurve& curve, const Eigen::Vector3d& point, double t0, bool periodic) {
+CurveProjection project_normal(const BSplineCurve& curve, const Eigen::Vector3d& point, double t0,
+                               bool periodic) {
   check_curve_input(curve, point, "project_normal");
   return curve_projection(curve, point, curve_foot(curve, point, t0, periodic));
 }
 
-CurveProjection closest_point(const BSplineCurve& curve, const Eigen::Vector3d& point, int samples_per_span) {
+CurveProjection closest_point(const BSplineCurve& curve, const Eigen::Vector3d& point,
+                              int samples_per_span) {
   check_curve_input(curve, point, "closest_point");
   if (samples_per_span < 1)
-    throw Error(ErrorCategory::InvalidArgument,
-                "closest_point: samples_per_span = " + std::to_string(samples_per_span) + " must be >= 1");
+    throw Error(
+        ErrorCategory::InvalidArgument,
+        "closest_point: samples_per_span = " + std::to_string(samples_per_span) + " must be >= 1");
   const auto ts = span_samples(curve.basis, samples_per_span);
   std::vector<std::pair<double, double>> ranked;  // squared distance, parameter
   ranked.reserve(ts.size());
   for (double t : ts) ranked.emplace_back((evaluate(curve, t) - point).squaredNorm(), t);
   const std::size_t keep = std::min<std::size_t>(3, ranked.size());
-  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
+  std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep),
+                    ranked.end());
   double best_t = ranked.front().second, best = ranked.front().first;
   for (std::size_t k = 0; k < keep; ++k) {
     const double t = curve_foot(curve, point, ranked[k].second, false);

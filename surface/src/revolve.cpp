@@ -1,10 +1,10 @@
 #include <clay/surface/revolve.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/tolerance.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 
@@ -38,8 +38,8 @@ void check_profile_against_axis(const BSplineCurve& profile, const Eigen::Vector
     largest = std::max(largest, radial(profile.points.row(j).transpose()).norm());
   if (largest <= touch)
     throw Error(ErrorCategory::InvalidGeometry,
-                "revolve: the profile lies on the axis (all control points within " + number(touch) +
-                    " mm of it); revolving it gives no surface");
+                "revolve: the profile lies on the axis (all control points within " +
+                    number(touch) + " mm of it); revolving it gives no surface");
   const auto ts = span_samples(profile.basis, 32);
   const Points3 pts = evaluate_many(profile, ts);
   Eigen::Vector3d previous = radial(pts.row(0).transpose());
@@ -48,8 +48,8 @@ void check_profile_against_axis(const BSplineCurve& profile, const Eigen::Vector
     const bool interior = k + 1 < ts.size();
     if (interior && r.norm() <= touch)
       throw Error(ErrorCategory::InvalidGeometry,
-                  "revolve: the profile touches the axis at t = " + number(ts[k]) +
-                      " (distance " + number(r.norm()) +
+                  "revolve: the profile touches the axis at t = " + number(ts[k]) + " (distance " +
+                      number(r.norm()) +
                       " mm); the revolved surface would pinch there. Only the profile's ends may "
                       "lie on the axis");
     if (r.dot(previous) < 0.0)
@@ -70,14 +70,15 @@ BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle
     throw Error(ErrorCategory::InvalidArgument, "revolve: the axis has a non-finite coordinate");
   const double length = axis.direction.norm();
   if (!(length > 1e-12))
-    throw Error(ErrorCategory::InvalidArgument,
-                "revolve: the axis direction has length " + number(length) +
-                    "; give a non-zero direction vector");
+    throw Error(ErrorCategory::InvalidArgument, "revolve: the axis direction has length " +
+                                                    number(length) +
+                                                    "; give a non-zero direction vector");
   if (!(std::isfinite(angle_degrees) && angle_degrees > 0.0 && angle_degrees <= 360.0))
     throw Error(ErrorCategory::InvalidArgument,
                 "revolve: angle " + number(angle_degrees) + " degrees is outside (0, 360]");
   const Eigen::Vector3d a = axis.direction / length;
-  const Eigen::Vector3d lo = profile.points.colwise().minCoeff(), hi = profile.points.colwise().maxCoeff();
+  const Eigen::Vector3d lo = profile.points.colwise().minCoeff(),
+                        hi = profile.points.colwise().maxCoeff();
   const double size = (hi - lo).norm() + (0.5 * (hi + lo) - axis.point).norm();
   check_profile_against_axis(profile, axis.point, a, size);
   detail::reject_self_intersection(profile, tolerance::exact_relative * size,
@@ -85,7 +86,8 @@ BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle
                                    "the revolved surface would intersect itself: give a profile "
                                    "that does not cross or touch itself");
 
-  const double sweep = angle_degrees == 360.0 ? 2.0 * std::numbers::pi : angle_degrees * std::numbers::pi / 180.0;
+  const double sweep =
+      angle_degrees == 360.0 ? 2.0 * std::numbers::pi : angle_degrees * std::numbers::pi / 180.0;
   const int nv = profile.basis.count();
   BSplineSurface s;
   s.v = profile.basis;
@@ -128,7 +130,8 @@ BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis, double angle
     const Eigen::Vector3d c = prof.row(static_cast<Eigen::Index>(jv)).transpose() - axis.point;
     const double hc = c.dot(a), rc = (c - hc * a).norm();
     for (size_t iu = 0; iu < us.size(); ++iu) {
-      const Eigen::Vector3d q = grid.row(static_cast<Eigen::Index>(iu * vs.size() + jv)).transpose() - axis.point;
+      const Eigen::Vector3d q =
+          grid.row(static_cast<Eigen::Index>(iu * vs.size() + jv)).transpose() - axis.point;
       const double hq = q.dot(a), rq = (q - hq * a).norm();
       worst = std::max({worst, std::abs(hq - hc), std::abs(rq - rc)});
     }

@@ -3,13 +3,13 @@
 #include "section_interpolation.hpp"
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/math.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/tolerance.hpp>
-#include <clay/internal/math.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
@@ -50,9 +50,9 @@ BSplineSurface interpolate_sections(const std::vector<BSplineCurve>& sections,
   const int n = sections.front().basis.count();
   const int q = basis_v.degree;
   if (basis_v.count() != count)
-    throw Error(ErrorCategory::Internal,
-                "loft: " + std::to_string(basis_v.count()) + " basis functions across " +
-                    std::to_string(count) + " sections (please report this input)");
+    throw Error(ErrorCategory::Internal, "loft: " + std::to_string(basis_v.count()) +
+                                             " basis functions across " + std::to_string(count) +
+                                             " sections (please report this input)");
   const bool rational = std::any_of(sections.begin(), sections.end(),
                                     [](const BSplineCurve& c) { return c.is_rational(); });
 
@@ -81,7 +81,8 @@ BSplineSurface interpolate_sections(const std::vector<BSplineCurve>& sections,
     const BSplineCurve& c = sections[static_cast<size_t>(k)];
     for (int i = 0; i < n; ++i) {
       const double w = c.weights[i];
-      for (int d = 0; d < 3; ++d) rhs(k, width * i + d) = rational ? w * c.points(i, d) : c.points(i, d);
+      for (int d = 0; d < 3; ++d)
+        rhs(k, width * i + d) = rational ? w * c.points(i, d) : c.points(i, d);
       if (rational) rhs(k, width * i + 3) = w;
     }
   }
@@ -100,9 +101,11 @@ BSplineSurface interpolate_sections(const std::vector<BSplineCurve>& sections,
         if (!(w > 0.0))
           throw Error(ErrorCategory::InvalidGeometry,
                       "loft: the weights interpolated across the rational sections are not "
-                      "positive at control point (" + std::to_string(i) + ", " + std::to_string(j) +
-                      ") (weight " + short_number(w) + "); give sections with similar weights or lower the "
-                      "loft degree");
+                      "positive at control point (" +
+                          std::to_string(i) + ", " + std::to_string(j) + ") (weight " +
+                          short_number(w) +
+                          "); give sections with similar weights or lower the "
+                          "loft degree");
         s.weights[r] = w;
         for (int d = 0; d < 3; ++d) s.points(r, d) = x(j, width * i + d) / w;
       } else {

@@ -3,10 +3,10 @@
 #include <clay/surface/self_intersection.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/math.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
-#include <clay/internal/math.hpp>
 
 #include <Eigen/Dense>
 

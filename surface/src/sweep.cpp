@@ -3,13 +3,13 @@
 #include <clay/surface/skin.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/math.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/tolerance.hpp>
-#include <clay/internal/math.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
@@ -48,7 +48,8 @@ class PathTable {
     const int spans = static_cast<int>(bp.size()) - 1;
     const int steps = std::max(8, (512 + spans - 1) / spans);
     for (int k = 0; k < spans; ++k) {
-      const std::vector<double> ts = linspace(bp[static_cast<size_t>(k)], bp[static_cast<size_t>(k + 1)], steps + 1);
+      const std::vector<double> ts =
+          linspace(bp[static_cast<size_t>(k)], bp[static_cast<size_t>(k + 1)], steps + 1);
       for (size_t i = k == 0 ? 0 : 1; i < ts.size(); ++i) t_.push_back(ts[i]);
     }
     const double domain = bp.back() - bp.front();
@@ -96,13 +97,17 @@ class PathTable {
   double parameter(double s) const {
     if (s <= 0.0) return t_.front();
     if (s >= s_.back()) return t_.back();
-    const size_t j = static_cast<size_t>(std::upper_bound(s_.begin(), s_.end(), s) - s_.begin()) - 1;
+    const size_t j =
+        static_cast<size_t>(std::upper_bound(s_.begin(), s_.end(), s) - s_.begin()) - 1;
     double lo = t_[j], hi = t_[j + 1];
     double t = lo + (hi - lo) * (s - s_[j]) / (s_[j + 1] - s_[j]);
     for (int it = 0; it < 60; ++it) {
       const double f = s_[j] + arc(t_[j], t) - s;
       if (std::abs(f) <= 1e-15 * s_.back()) break;
-      if (f > 0) hi = t; else lo = t;
+      if (f > 0)
+        hi = t;
+      else
+        lo = t;
       double next = t - f / derivatives(path_, t, 1).d1.norm();
       if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
       if (next == t) break;
@@ -155,7 +160,7 @@ class PathTable {
   double arc(double a, double b) const {
     if (b <= a) return 0.0;
     return internal::gauss_legendre_8(a, b,
-                                    [&](double t) { return derivatives(path_, t, 1).d1.norm(); });
+                                      [&](double t) { return derivatives(path_, t, 1).d1.norm(); });
   }
 
   const BSplineCurve& path_;
@@ -166,8 +171,7 @@ class PathTable {
 /// The rigid motions of the sweep: start frame to frame at t, with the twist.
 class SweepMotion {
  public:
-  SweepMotion(const PathTable& table, double twist_radians)
-      : table_(table), twist_(twist_radians) {
+  SweepMotion(const PathTable& table, double twist_radians) : table_(table), twist_(twist_radians) {
     Eigen::Vector3d t0, r0;
     table_.frame(table_.first(), x0_, t0, r0);
     f0_ = frame_matrix(t0, r0, 0.0);
@@ -246,8 +250,11 @@ void check_fold(const PathTable& table, const SweepMotion& motion, const BSpline
                   ": the path's radius of curvature there is " + radius +
                   " mm but the profile reaches " + reach +
                   " mm from the path toward the centre of curvature; use a smaller profile "
-                  "(reaching less than " + radius + " mm toward the centre) or a gentler path "
-                  "(radius of curvature above " + reach + " mm there)");
+                  "(reaching less than " +
+                  radius +
+                  " mm toward the centre) or a gentler path "
+                  "(radius of curvature above " +
+                  reach + " mm there)");
 }
 
 /// True when every control point of the path lies on the chord from its first to its last one and
@@ -273,7 +280,8 @@ void check_corners(const BSplineCurve& path, double tolerance) {
   for (size_t k = 0; k + 1 < segments.size(); ++k) {
     const double t = segments[k].basis.domain().second;
     const Eigen::Vector3d a = derivatives(segments[k], t, 1).d1;
-    const Eigen::Vector3d b = derivatives(segments[k + 1], segments[k + 1].basis.domain().first, 1).d1;
+    const Eigen::Vector3d b =
+        derivatives(segments[k + 1], segments[k + 1].basis.domain().first, 1).d1;
     if (!(a.norm() > 0 && b.norm() > 0))
       throw Error(ErrorCategory::InvalidGeometry,
                   "sweep: path has a zero tangent at its knot t = " + num(t) +
@@ -297,7 +305,8 @@ struct Join {
 
 /// Curvature vector dT/ds of a segment at t, and its arc-length derivative by a one-sided
 /// second-order difference into the segment (direction +1 or -1).
-std::pair<Eigen::Vector3d, Eigen::Vector3d> curvature(const BSplineCurve& segment, double t, double direction) {
+std::pair<Eigen::Vector3d, Eigen::Vector3d> curvature(const BSplineCurve& segment, double t,
+                                                      double direction) {
   auto k = [&](double x) {
     const CurveDerivatives d = derivatives(segment, x, 2);
     const double speed = d.d1.norm();
@@ -328,7 +337,8 @@ std::vector<Join> sweep_joins(const BSplineCurve& path, double size) {
 
 /// `total` section intervals spread over the pieces in proportion to their arc length, at least 3
 /// each when there is room (else all in the first entry: the caller then ignores the joins).
-void distribute_intervals(int total, const std::vector<double>& sigma, std::vector<int>& intervals) {
+void distribute_intervals(int total, const std::vector<double>& sigma,
+                          std::vector<int>& intervals) {
   const size_t pieces = intervals.size();
   if (total < 3 * static_cast<int>(pieces)) {
     std::fill(intervals.begin(), intervals.end(), 0);
@@ -344,8 +354,9 @@ void distribute_intervals(int total, const std::vector<double>& sigma, std::vect
   while (used != total) {
     size_t pick = 0;
     for (size_t k = 1; k < pieces; ++k)
-      if ((used > total) ? intervals[k] > intervals[pick] : (sigma[k + 1] - sigma[k]) / intervals[k] >
-                                                              (sigma[pick + 1] - sigma[pick]) / intervals[pick])
+      if ((used > total) ? intervals[k] > intervals[pick]
+                         : (sigma[k + 1] - sigma[k]) / intervals[k] >
+                               (sigma[pick + 1] - sigma[pick]) / intervals[pick])
         pick = k;
     intervals[pick] += used > total ? -1 : 1;
     used += used > total ? -1 : 1;
@@ -370,7 +381,9 @@ BSplineBasis joined_basis(const std::vector<double>& v, const std::vector<int>& 
       basis.knots.push_back(multiplicity[k] == 3 ? at : v[static_cast<size_t>(first + 1)]);
     }
     for (int i = first + 1; i + 2 <= last - 1; ++i)
-      basis.knots.push_back((v[static_cast<size_t>(i)] + v[static_cast<size_t>(i + 1)] + v[static_cast<size_t>(i + 2)]) / 3.0);
+      basis.knots.push_back((v[static_cast<size_t>(i)] + v[static_cast<size_t>(i + 1)] +
+                             v[static_cast<size_t>(i + 2)]) /
+                            3.0);
   }
   basis.knots.insert(basis.knots.end(), 4, 1.0);
   return basis;
@@ -381,24 +394,24 @@ BSplineBasis joined_basis(const std::vector<double>& v, const std::vector<int>& 
 std::vector<std::string> SweepOptions::problems() const {
   std::vector<std::string> out;
   if (!std::isfinite(twist_degrees))
-    out.push_back(
-                "SweepOptions::twist_degrees is " + num(twist_degrees) + "; it must be finite");
+    out.push_back("SweepOptions::twist_degrees is " + num(twist_degrees) + "; it must be finite");
   if (sections != 0 && sections < 2)
-    out.push_back(
-                "SweepOptions::sections is " + std::to_string(sections) +
-                    "; it must be 0 (adaptive) or >= 2");
+    out.push_back("SweepOptions::sections is " + std::to_string(sections) +
+                  "; it must be 0 (adaptive) or >= 2");
   if (!(tolerance > 0.0 && tolerance <= 1e-1))
-    out.push_back(
-                "SweepOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-1]");
+    out.push_back("SweepOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-1]");
   if (max_sections < 2)
-    out.push_back(
-                "SweepOptions::max_sections is " + std::to_string(max_sections) + "; it must be >= 2");
+    out.push_back("SweepOptions::max_sections is " + std::to_string(max_sections) +
+                  "; it must be >= 2");
   return out;
 }
 
-void SweepOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void SweepOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
-BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const SweepOptions& options) {
+BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
+                   const SweepOptions& options) {
   options.validate();
   validate(profile, "sweep profile");
   validate(path, "sweep path");
@@ -406,8 +419,9 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
   const double exact_tol = tolerance::exact_relative * size;
   if (!(polygon_length(profile) > exact_tol))
     throw Error(ErrorCategory::InvalidGeometry,
-                "sweep: profile is degenerate: its control polygon is " + num(polygon_length(profile)) +
-                    " mm long (tolerance " + num(exact_tol) + " mm); give a curve, not a point");
+                "sweep: profile is degenerate: its control polygon is " +
+                    num(polygon_length(profile)) + " mm long (tolerance " + num(exact_tol) +
+                    " mm); give a curve, not a point");
   if (!(polygon_length(path) > exact_tol))
     throw Error(ErrorCategory::InvalidGeometry,
                 "sweep: path has zero length (its control polygon is " + num(polygon_length(path)) +
@@ -423,8 +437,9 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
   check_corners(track, options.tolerance);
   const PathTable table(track, size);
   if (!(table.length() > exact_tol))
-    throw Error(ErrorCategory::InvalidGeometry,
-                "sweep: path has zero length (" + num(table.length()) + " mm); give a path that moves");
+    throw Error(
+        ErrorCategory::InvalidGeometry,
+        "sweep: path has zero length (" + num(table.length()) + " mm); give a path that moves");
   const double twist = options.twist_degrees * std::numbers::pi / 180.0;
   const SweepMotion motion(table, twist);
   check_fold(table, motion, shape);
@@ -445,11 +460,13 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
     const Points3 grid = evaluate_grid(s, us, vs);
     per_interval.assign(sites.size() - 1, 0.0);
     for (size_t j = 0; j < vs.size(); ++j) {
-      const Points3 expected = motion.moved(profile_samples, table.parameter(vs[j] * table.length()));
+      const Points3 expected =
+          motion.moved(profile_samples, table.parameter(vs[j] * table.length()));
       double& worst = per_interval[j / 3];
       for (size_t i = 0; i < us.size(); ++i)
         worst = std::max(worst, (grid.row(static_cast<Eigen::Index>(i * vs.size() + j)) -
-                                 expected.row(static_cast<Eigen::Index>(i))).norm());
+                                 expected.row(static_cast<Eigen::Index>(i)))
+                                    .norm());
     }
     samples = static_cast<int>(vs.size() * us.size());
     return *std::max_element(per_interval.begin(), per_interval.end());
@@ -512,7 +529,8 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
     for (int m : intervals) total += m;
     const bool use_joins = pieces > 1 && *std::min_element(intervals.begin(), intervals.end()) >= 3;
     // Without joins: one piece over the whole path.
-    const std::vector<double> pt = use_joins ? piece_t : std::vector<double>{table.first(), table.last()};
+    const std::vector<double> pt =
+        use_joins ? piece_t : std::vector<double>{table.first(), table.last()};
     const std::vector<double> ps = use_joins ? piece_sigma : std::vector<double>{0.0, 1.0};
     const std::vector<int> pm = use_joins ? intervals : std::vector<int>{total};
     std::vector<BSplineCurve> copies;
@@ -526,7 +544,8 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
         if (k == 0 && i == 0)
           copies.push_back(shape);  // the start frame maps the profile to itself, exactly
         else
-          copies.push_back(motion.moved(shape, i == 0 ? pt[k] : table.parameter(sigma * table.length())));
+          copies.push_back(
+              motion.moved(shape, i == 0 ? pt[k] : table.parameter(sigma * table.length())));
       }
     }
     v.push_back(1.0);
@@ -553,11 +572,14 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path, const 
   // degrees used to come back as a wild surface whose export then ran for minutes (issue #18).
   if (options.sections == 0 && worst > target)
     throw Error(ErrorCategory::InvalidArgument,
-                "sweep: the deviation " + num(worst) + " mm is still above the tolerance " + num(target) +
-                    " mm with " + std::to_string(count) + " sections, the most SweepOptions::max_sections = " +
+                "sweep: the deviation " + num(worst) + " mm is still above the tolerance " +
+                    num(target) + " mm with " + std::to_string(count) +
+                    " sections, the most SweepOptions::max_sections = " +
                     std::to_string(options.max_sections) +
-                    " allows; loosen SweepOptions::tolerance, reduce SweepOptions::twist_degrees or smooth the path");
-  const std::string method = "sweep with rotation-minimizing frames, " + std::to_string(count) + " sections";
+                    " allows; loosen SweepOptions::tolerance, reduce SweepOptions::twist_degrees "
+                    "or smooth the path");
+  const std::string method =
+      "sweep with rotation-minimizing frames, " + std::to_string(count) + " sections";
   built.report = describe(built.surface, method);
   built.report.exact = false;
   built.report.max_deviation_mm = worst;

@@ -1,9 +1,9 @@
 // The grid tessellator and the surface area by quadrature (tessellate.hpp).
 #include <clay/error.hpp>
+#include <clay/internal/math.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/tessellate.hpp>
-#include <clay/internal/math.hpp>
 
 #include <Eigen/Geometry>
 
@@ -14,12 +14,14 @@
 
 namespace clay::surface {
 
-std::vector<double> tessellation_parameters(const BSplineBasis& basis, int per_span, int max_samples) {
+std::vector<double> tessellation_parameters(const BSplineBasis& basis, int per_span,
+                                            int max_samples) {
   constexpr int min_samples = 17;
   if (per_span < 1 || max_samples < min_samples)
     throw Error(ErrorCategory::InvalidArgument,
-                "tessellation_parameters: per_span = " + std::to_string(per_span) + " and max_samples = " +
-                    std::to_string(max_samples) + " must be >= 1 and >= 17");
+                "tessellation_parameters: per_span = " + std::to_string(per_span) +
+                    " and max_samples = " + std::to_string(max_samples) +
+                    " must be >= 1 and >= 17");
   const auto breaks = breakpoints(basis);
   const int spans = static_cast<int>(breaks.size()) - 1;
   const auto [t0, t1] = basis.domain();
@@ -30,7 +32,8 @@ std::vector<double> tessellation_parameters(const BSplineBasis& basis, int per_s
 }
 
 std::array<std::array<int, 3>, 2> cell_triangles(const GridMesh& m, int i, int j) {
-  const int a = i * m.cols + j, b = a + 1, c = a + m.cols, d = c + 1;  // (i,j) (i,j+1) (i+1,j) (i+1,j+1)
+  const int a = i * m.cols + j, b = a + 1, c = a + m.cols,
+            d = c + 1;  // (i,j) (i,j+1) (i+1,j) (i+1,j+1)
   const double ad = (m.positions.row(d) - m.positions.row(a)).squaredNorm();
   const double bc = (m.positions.row(c) - m.positions.row(b)).squaredNorm();
   // Counter-clockwise in (u, v), so the triangles face along S_u x S_v.
@@ -53,25 +56,31 @@ GridMesh tessellate(const BSplineSurface& s, int per_span, int max_samples) {
     max_u = std::max(max_u, e.du.norm());
     max_v = std::max(max_v, e.dv.norm());
   }
-  auto point = [&](int i, int j) -> Eigen::Vector3d { return m.positions.row(i * m.cols + j).transpose(); };
+  auto point = [&](int i, int j) -> Eigen::Vector3d {
+    return m.positions.row(i * m.cols + j).transpose();
+  };
   // The cells around a point, each by its diagonals (a cell with one collapsed edge still has a
   // proper normal), oriented like S_u x S_v: the reference for the orientation at a pole.
   auto cell_normal = [&](int i, int j) -> Eigen::Vector3d {
     if (i < 0 || j < 0 || i >= m.rows - 1 || j >= m.cols - 1) return Eigen::Vector3d::Zero();
-    const Eigen::Vector3d n = (point(i + 1, j + 1) - point(i, j)).cross(point(i, j + 1) - point(i + 1, j));
+    const Eigen::Vector3d n =
+        (point(i + 1, j + 1) - point(i, j)).cross(point(i, j + 1) - point(i + 1, j));
     const double len = n.norm();
     return len > 0 ? Eigen::Vector3d(n / len) : Eigen::Vector3d::Zero();
   };
   for (int i = 0; i < m.rows; ++i)
     for (int j = 0; j < m.cols; ++j) {
       const SurfaceDerivatives& e = d[static_cast<std::size_t>(i * m.cols + j)];
-      Eigen::Vector3d cells = cell_normal(i - 1, j - 1) + cell_normal(i - 1, j) + cell_normal(i, j - 1) + cell_normal(i, j);
+      Eigen::Vector3d cells = cell_normal(i - 1, j - 1) + cell_normal(i - 1, j) +
+                              cell_normal(i, j - 1) + cell_normal(i, j);
       if (cells.norm() > 0) cells.normalize();
       // Trusted when it exists and is within 60 degrees of the cells around it.
       auto trusted = [&](const Eigen::Vector3d& n, double scale) {
-        return std::isfinite(n.norm()) && n.norm() > 1e-9 * scale && (cells.norm() == 0 || n.normalized().dot(cells) > 0.5);
+        return std::isfinite(n.norm()) && n.norm() > 1e-9 * scale &&
+               (cells.norm() == 0 || n.normalized().dot(cells) > 0.5);
       };
-      const double lu = max_u > 0 ? e.du.norm() / max_u : 0, lv = max_v > 0 ? e.dv.norm() / max_v : 0;
+      const double lu = max_u > 0 ? e.du.norm() / max_u : 0,
+                   lv = max_v > 0 ? e.dv.norm() / max_v : 0;
       Eigen::Vector3d n = e.du.cross(e.dv);
       if (lu < 1e-8 || lv < 1e-8 || !trusted(n, e.du.norm() * e.dv.norm())) {
         // A pole (S_v ~ 0 along an edge u = a, exactly or nearly, as after a refit): near it
@@ -92,7 +101,8 @@ double mesh_area(const GridMesh& m) {
   for (int i = 0; i + 1 < m.rows; ++i)
     for (int j = 0; j + 1 < m.cols; ++j)
       for (const auto& t : cell_triangles(m, i, j)) {
-        const Eigen::Vector3d a = m.positions.row(t[0]).transpose(), b = m.positions.row(t[1]).transpose(),
+        const Eigen::Vector3d a = m.positions.row(t[0]).transpose(),
+                              b = m.positions.row(t[1]).transpose(),
                               c = m.positions.row(t[2]).transpose();
         area += 0.5 * (b - a).cross(c - a).norm();
       }
@@ -109,7 +119,8 @@ double surface_area(const BSplineSurface& s, int refine) {
     std::vector<double> out;
     const int parts = 1 << refine;
     for (size_t k = 0; k + 1 < breaks.size(); ++k)
-      for (int p = 0; p < parts; ++p) out.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * p / parts);
+      for (int p = 0; p < parts; ++p)
+        out.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * p / parts);
     out.push_back(breaks.back());
     return out;
   };
@@ -129,10 +140,12 @@ double surface_area(const BSplineSurface& s, int refine) {
 GridMesh tessellate_to_area(const BSplineSurface& s, double relative_area, int max_samples) {
   if (!(relative_area > 0 && relative_area < 0.5))
     throw Error(ErrorCategory::InvalidArgument,
-                "tessellate_to_area: relative_area = " + std::to_string(relative_area) + " must be in (0, 0.5)");
+                "tessellate_to_area: relative_area = " + std::to_string(relative_area) +
+                    " must be in (0, 0.5)");
   if (max_samples < 17 || max_samples > 4097)
     throw Error(ErrorCategory::InvalidArgument,
-                "tessellate_to_area: max_samples = " + std::to_string(max_samples) + " must be in [17, 4097]");
+                "tessellate_to_area: max_samples = " + std::to_string(max_samples) +
+                    " must be in [17, 4097]");
   const double exact = surface_area(s, 2);
   // First the viewer's grid, then twice as many samples per span each round, until the area is
   // met or both directions are at max_samples.
@@ -149,9 +162,11 @@ GridMesh tessellate_to_area(const BSplineSurface& s, double relative_area, int m
   const double got = mesh_area(m);
   char buffer[240];
   std::snprintf(buffer, sizeof buffer,
-                "tessellate_to_area: the finest grid allowed (%d x %d samples) has area %.6g mm^2, the surface "
+                "tessellate_to_area: the finest grid allowed (%d x %d samples) has area %.6g mm^2, "
+                "the surface "
                 "%.6g mm^2: off by %.3g %%, more than %.3g %%",
-                m.rows, m.cols, got, exact, 100 * std::abs(got - exact) / exact, 100 * relative_area);
+                m.rows, m.cols, got, exact, 100 * std::abs(got - exact) / exact,
+                100 * relative_area);
   throw Error(ErrorCategory::ToleranceNotMet, buffer);
 }
 

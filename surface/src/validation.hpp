@@ -1,8 +1,8 @@
 #pragma once
 // Shared checks of control nets (internal).
+#include <Eigen/Core>
 #include <clay/error.hpp>
 #include <clay/internal/checks.hpp>
-#include <Eigen/Core>
 
 #include <cmath>
 #include <string>
@@ -18,8 +18,8 @@ void check_net(const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>& 
                const Eigen::VectorXd& weights, std::string_view name, Label label,
                std::vector<std::string>& found) {
   if (weights.size() != points.rows()) {
-    found.push_back(std::string(name) + ": has " + std::to_string(weights.size()) + " weights for " +
-                    std::to_string(points.rows()) +
+    found.push_back(std::string(name) + ": has " + std::to_string(weights.size()) +
+                    " weights for " + std::to_string(points.rows()) +
                     " control points; give one weight per control point (all 1 when polynomial)");
     return;
   }

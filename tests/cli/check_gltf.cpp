@@ -28,14 +28,18 @@ int main(int argc, char** argv) {
       const auto [v0, v1] = s.v.domain();
       const auto dense = clay::surface::evaluate_grid(s, clay::surface::linspace(u0, u1, 401),
                                                       clay::surface::linspace(v0, v1, 401));
-      for (Eigen::Index r = 0; r < dense.rows(); ++r) box.extend(Eigen::Vector3d(dense.row(r).transpose()));
+      for (Eigen::Index r = 0; r < dense.rows(); ++r)
+        box.extend(Eigen::Vector3d(dense.row(r).transpose()));
     }
     const Eigen::AlignedBox3d got = mesh.box();
     const double size = box.diagonal().norm();
     const double area_error = std::abs(mesh.area() - area) / area;
-    const double box_error = std::max((got.min() - box.min()).norm(), (got.max() - box.max()).norm()) / size;
-    std::printf("%s: %zu triangles, area %.6g mm^2 (NURBS %.6g mm^2, off %.3g %%), bounding box off %.3g of the size\n",
-                argv[1], mesh.triangles.size(), mesh.area(), area, 100 * area_error, box_error);
+    const double box_error =
+        std::max((got.min() - box.min()).norm(), (got.max() - box.max()).norm()) / size;
+    std::printf(
+        "%s: %zu triangles, area %.6g mm^2 (NURBS %.6g mm^2, off %.3g %%), bounding box off %.3g "
+        "of the size\n",
+        argv[1], mesh.triangles.size(), mesh.area(), area, 100 * area_error, box_error);
     const bool ok = !mesh.triangles.empty() && area_error <= 0.01 && box_error <= 1e-3;
     if (!ok) std::printf("FAILED: the preview does not cover its surfaces\n");
     return ok ? 0 : 1;

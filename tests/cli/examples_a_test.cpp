@@ -21,9 +21,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <tuple>
 #include <random>
 #include <string>
+#include <tuple>
 
 using namespace clay::recipe;
 namespace surface = clay::surface;
@@ -34,14 +34,18 @@ using Json = nlohmann::json;
 
 namespace {
 
-fs::path recipe_file(const std::string& name) { return fs::path(CLAY_EXAMPLES_DIR) / "recipes" / (name + ".json"); }
+fs::path recipe_file(const std::string& name) {
+  return fs::path(CLAY_EXAMPLES_DIR) / "recipes" / (name + ".json");
+}
 
 Json recipe_json(const std::string& name) {
   std::ifstream in(recipe_file(name));
   return Json::parse(in);
 }
 
-RunResult run_example(const std::string& name) { return run_recipe(load_recipe(recipe_file(name))); }
+RunResult run_example(const std::string& name) {
+  return run_recipe(load_recipe(recipe_file(name)));
+}
 
 const StepReport& step(const RunResult& r, const std::string& path) {
   for (const auto& s : r.steps)
@@ -61,7 +65,9 @@ T figure(const StepReport& s, const std::string& key) {
   return T{};
 }
 
-Eigen::Vector3d vec(const Json& j) { return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()}; }
+Eigen::Vector3d vec(const Json& j) {
+  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
 
 deform::Frame frame_of(const Json& f) {
   deform::Frame frame;
@@ -72,7 +78,9 @@ deform::Frame frame_of(const Json& f) {
   return frame;
 }
 
-std::array<int, 3> ints3(const Json& j) { return {j.at(0).get<int>(), j.at(1).get<int>(), j.at(2).get<int>()}; }
+std::array<int, 3> ints3(const Json& j) {
+  return {j.at(0).get<int>(), j.at(1).get<int>(), j.at(2).get<int>()};
+}
 
 /// docs/recipe.md "moves": start from the undisplaced lattice, then set ("to") or shift ("by").
 template <class Lattice>
@@ -88,15 +96,16 @@ void apply_moves(Lattice& lattice, const Json& moves) {
 }
 
 deform::BezierLattice bezier_lattice_of(const Json& step) {
-  deform::BezierLattice l = deform::make_bezier_lattice(frame_of(step.at("frame")), ints3(step.at("degrees")));
+  deform::BezierLattice l =
+      deform::make_bezier_lattice(frame_of(step.at("frame")), ints3(step.at("degrees")));
   apply_moves(l, step.at("moves"));
   return l;
 }
 
 deform::BSplineLattice bspline_lattice_of(const Json& step) {
   REQUIRE(step.at("knots") == "clamped");
-  deform::BSplineLattice l =
-      deform::make_bspline_lattice(frame_of(step.at("frame")), ints3(step.at("degrees")), ints3(step.at("cells")));
+  deform::BSplineLattice l = deform::make_bspline_lattice(
+      frame_of(step.at("frame")), ints3(step.at("degrees")), ints3(step.at("cells")));
   if (step.contains("moves")) apply_moves(l, step.at("moves"));
   return l;
 }
@@ -108,8 +117,9 @@ double diagonal(const surface::BSplineSurface& s) {
 
 /// Largest |result(u, v) - map(parent(u, v))| over `n` random parameters.
 template <class Map>
-double max_pointwise_gap(const surface::BSplineSurface& parent, const surface::BSplineSurface& result, Map&& map,
-                         int n = 400, unsigned seed = 8) {
+double max_pointwise_gap(const surface::BSplineSurface& parent,
+                         const surface::BSplineSurface& result, Map&& map, int n = 400,
+                         unsigned seed = 8) {
   std::mt19937 rng(seed);
   const auto [u0, u1] = parent.u.domain();
   const auto [v0, v1] = parent.v.domain();
@@ -117,7 +127,8 @@ double max_pointwise_gap(const surface::BSplineSurface& parent, const surface::B
   double gap = 0;
   for (int i = 0; i < n; ++i) {
     const double u = du(rng), v = dv(rng);
-    gap = std::max(gap, (surface::evaluate(result, u, v) - map(surface::evaluate(parent, u, v))).norm());
+    gap = std::max(gap,
+                   (surface::evaluate(result, u, v) - map(surface::evaluate(parent, u, v))).norm());
   }
   return gap;
 }
@@ -132,7 +143,8 @@ void check_exact_composition(const StepReport& s) {
 
 }  // namespace
 
-TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow composed exactly", "[examples]") {
+TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow composed exactly",
+          "[examples]") {
   const RunResult r = run_example("sail");
   const Json j = recipe_json("sail");
   const auto& flat = r.surface("flat_sail");
@@ -155,18 +167,21 @@ TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow c
   INFO("pointwise gap " << gap << " mm on a " << size << " mm sail");
   CHECK(gap <= 1e-12 * size);
 
-  // The report: exact composition, deviation at rounding level; the style step meets its key points.
+  // The report: exact composition, deviation at rounding level; the style step meets its key
+  // points.
   const StepReport& lattice_step = step(r, "surfaces.sail.steps[1]");
   check_exact_composition(lattice_step);
   CHECK(figure<long long>(lattice_step, "degree_u") == 12);  // 3 x (2 + 1 + 1)
   CHECK(figure<long long>(lattice_step, "degree_v") == 12);
-  CHECK_THAT(figure<double>(lattice_step, "volume_ratio_min"), WithinAbs(1.0, 1e-12));  // a pure shear
+  CHECK_THAT(figure<double>(lattice_step, "volume_ratio_min"),
+             WithinAbs(1.0, 1e-12));  // a pure shear
   const StepReport& style_step = step(r, "surfaces.sail.steps[0]");
   CHECK(figure<std::string>(style_step, "mode") == "exact");
   CHECK(figure<double>(style_step, "locality") == 0.0);
   CHECK(figure<long long>(style_step, "key_points") == styled.report.m);
   for (const auto& k : styled.report.key_points)
-    if (k.influenced) CHECK(surface::closest_point(styled.surface, k.point).distance <= 1e-9 * size);
+    if (k.influenced)
+      CHECK(surface::closest_point(styled.surface, k.point).distance <= 1e-9 * size);
   // Below and above the bound (an ellipse over z = 500 .. 4100 mm) the style step changed nothing.
   int away = 0;
   for (double u : surface::linspace(0, 1, 41))
@@ -178,14 +193,16 @@ TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow c
     }
   CHECK(away > 50);
 
-  // The luff lies on the lattice face s = 0 whose control points stay: it stays on the mast (x = y = 0).
+  // The luff lies on the lattice face s = 0 whose control points stay: it stays on the mast (x = y
+  // = 0).
   for (double u : surface::linspace(0, 1, 21)) {
     const Eigen::Vector3d p = surface::evaluate(sail, u, 0.0);
     CHECK_THAT(p.x(), WithinAbs(0.0, 1e-9 * size));
     CHECK_THAT(p.y(), WithinAbs(0.0, 1e-9 * size));
   }
   // The billow is there: the middle of the sail moved about 100 mm to leeward.
-  const Eigen::Vector3d mid = surface::evaluate(sail, 0.6, 0.5) - surface::evaluate(styled.surface, 0.6, 0.5);
+  const Eigen::Vector3d mid =
+      surface::evaluate(sail, 0.6, 0.5) - surface::evaluate(styled.surface, 0.6, 0.5);
   CHECK(mid.y() > 50.0);
 
   // A replay gives the same surface bit for bit (the ctest "recipe: sail" also compares the STEP
@@ -193,7 +210,8 @@ TEST_CASE("example sail: fill of three curves, exact style step, Bezier billow c
   CHECK(surface::identical(run_example("sail").surface("sail"), sail));
 }
 
-TEST_CASE("example car hood: skinned hood, crease by bound and target, paper and exact modes", "[examples]") {
+TEST_CASE("example car hood: skinned hood, crease by bound and target, paper and exact modes",
+          "[examples]") {
   const RunResult r = run_example("car_hood");
   const auto& hood = r.surface("hood");
   const auto& exact = r.surface("hood_exact");
@@ -205,7 +223,8 @@ TEST_CASE("example car hood: skinned hood, crease by bound and target, paper and
   // Key points found independently on the parent: the exact mode passes through every
   // influenced one, the paper's forces only approach them.
   deform::StyleOptions options;
-  const deform::InfluenceRegion region = deform::influence_factors(hood, r.curve("crease_bound"), options);
+  const deform::InfluenceRegion region =
+      deform::influence_factors(hood, r.curve("crease_bound"), options);
   const deform::KeyPoints keys = deform::key_points(hood, region, r.curve("crease"), options);
   REQUIRE(keys.points.size() >= 2);
   double paper_miss = 0;
@@ -224,8 +243,8 @@ TEST_CASE("example car hood: skinned hood, crease by bound and target, paper and
       if (std::hypot(p.x() / 350.0, p.y() / 250.0) < 1.8) continue;
       CHECK((surface::evaluate(exact, u, v) - p).norm() <= 1e-9 * size);
     }
-  // The paper mode moves only the vertices whose Greville point lies inside the bound (eq. 2): every
-  // other control point keeps its coordinates bit for bit (same knots).
+  // The paper mode moves only the vertices whose Greville point lies inside the bound (eq. 2):
+  // every other control point keeps its coordinates bit for bit (same knots).
   REQUIRE(paper.u.knots == hood.u.knots);
   REQUIRE(paper.v.knots == hood.v.knots);
   const auto xi = surface::greville_abscissae(hood.u), eta = surface::greville_abscissae(hood.v);
@@ -251,7 +270,8 @@ TEST_CASE("example car hood: skinned hood, crease by bound and target, paper and
   CHECK(figure<double>(e, "boundary_tangent_angle") <= 0.5);
 }
 
-TEST_CASE("example bump: direct manipulation to a flat top, B-spline lattice composed exactly", "[examples]") {
+TEST_CASE("example bump: direct manipulation to a flat top, B-spline lattice composed exactly",
+          "[examples]") {
   const RunResult r = run_example("bump");
   const Json j = recipe_json("bump");
   const auto& sheet = r.surface("sheet");
@@ -261,7 +281,8 @@ TEST_CASE("example bump: direct manipulation to a flat top, B-spline lattice com
 
   // Every selected point of the sheet went where it was asked, 40 mm up.
   for (const auto& m : dm.at("moves")) {
-    const double u = m.at("surface_point").at(0).get<double>(), v = m.at("surface_point").at(1).get<double>();
+    const double u = m.at("surface_point").at(0).get<double>(),
+                 v = m.at("surface_point").at(1).get<double>();
     const Eigen::Vector3d p = surface::evaluate(bump, u, v);
     CHECK((p - vec(m.at("to"))).norm() <= 1e-10);
     CHECK_THAT(p.z(), WithinAbs(40.0, 1e-10));
@@ -296,8 +317,10 @@ TEST_CASE("example bump: direct manipulation to a flat top, B-spline lattice com
 
   // The border planes are locked: the sheet's edges stay where they were.
   for (double t : surface::linspace(0, 1, 11))
-    for (const auto& [u, v] : {std::pair{t, 0.0}, std::pair{t, 1.0}, std::pair{0.0, t}, std::pair{1.0, t}})
-      CHECK((surface::evaluate(bump, u, v) - surface::evaluate(sheet, u, v)).norm() <= 1e-12 * size);
+    for (const auto& [u, v] :
+         {std::pair{t, 0.0}, std::pair{t, 1.0}, std::pair{0.0, t}, std::pair{1.0, t}})
+      CHECK((surface::evaluate(bump, u, v) - surface::evaluate(sheet, u, v)).norm() <=
+            1e-12 * size);
 
   const StepReport& s = step(r, "surfaces.bump.steps[0]");
   CHECK(figure<bool>(s, "feasible"));
@@ -307,7 +330,8 @@ TEST_CASE("example bump: direct manipulation to a flat top, B-spline lattice com
   CHECK(figure<long long>(s, "degree_u") == 3);  // an axis-aligned sheet: 3 x 1
 }
 
-TEST_CASE("example bottle: revolved body pinched by a Bezier lattice stays rational and round", "[examples]") {
+TEST_CASE("example bottle: revolved body pinched by a Bezier lattice stays rational and round",
+          "[examples]") {
   const RunResult r = run_example("bottle");
   const Json j = recipe_json("bottle");
   const auto& body = r.surface("body");
@@ -330,8 +354,8 @@ TEST_CASE("example bottle: revolved body pinched by a Bezier lattice stays ratio
     const double w = (x.z() - 60.0) / 110.0;
     double scale = 0;
     for (int k = 0; k <= n; ++k)
-      scale += std::tgamma(n + 1.0) / (std::tgamma(k + 1.0) * std::tgamma(n - k + 1.0)) * std::pow(w, k) *
-               std::pow(1 - w, n - k) * f[static_cast<std::size_t>(k)];
+      scale += std::tgamma(n + 1.0) / (std::tgamma(k + 1.0) * std::tgamma(n - k + 1.0)) *
+               std::pow(w, k) * std::pow(1 - w, n - k) * f[static_cast<std::size_t>(k)];
     return Eigen::Vector3d(scale * x.x(), scale * x.y(), x.z());
   };
   const double gap = max_pointwise_gap(body, waist, radial);
@@ -339,11 +363,13 @@ TEST_CASE("example bottle: revolved body pinched by a Bezier lattice stays ratio
   CHECK(gap <= 1e-12 * size);
   // And against the lattice rebuilt from the recipe, pointwise.
   const deform::BezierLattice lattice = bezier_lattice_of(pinch);
-  CHECK(max_pointwise_gap(body, waist, [&](const Eigen::Vector3d& x) { return deform::deform_point(lattice, x); }) <=
-        1e-12 * size);
+  CHECK(max_pointwise_gap(body, waist, [&](const Eigen::Vector3d& x) {
+          return deform::deform_point(lattice, x);
+        }) <= 1e-12 * size);
   // The waist is pinched: radius 33 mm -> 33 f(1/2) at mid-height.
   const Eigen::Vector3d mid = surface::evaluate(waist, 0.3, 0.5);
-  CHECK_THAT(std::hypot(mid.x(), mid.y()), WithinAbs(radial(surface::evaluate(body, 0.3, 0.5)).head<2>().norm(), 1e-9));
+  CHECK_THAT(std::hypot(mid.x(), mid.y()),
+             WithinAbs(radial(surface::evaluate(body, 0.3, 0.5)).head<2>().norm(), 1e-9));
   CHECK(std::hypot(mid.x(), mid.y()) < 30.0);
 
   // Base and neck lie outside the lattice and are exported untouched; the pinched body still meets
@@ -351,8 +377,10 @@ TEST_CASE("example bottle: revolved body pinched by a Bezier lattice stays ratio
   const auto& base = r.surface("base");
   const auto& neck = r.surface("neck");
   for (double u : surface::linspace(0, 1, 17)) {
-    const auto b = surface::derivatives(base, u, 1.0, 1), w0 = surface::derivatives(waist, u, 0.0, 1);
-    const auto w1 = surface::derivatives(waist, u, 1.0, 1), k = surface::derivatives(neck, u, 0.0, 1);
+    const auto b = surface::derivatives(base, u, 1.0, 1),
+               w0 = surface::derivatives(waist, u, 0.0, 1);
+    const auto w1 = surface::derivatives(waist, u, 1.0, 1),
+               k = surface::derivatives(neck, u, 0.0, 1);
     CHECK((b.point - w0.point).norm() <= 1e-12 * size);
     CHECK((w1.point - k.point).norm() <= 1e-12 * size);
     CHECK((b.dv.normalized() - w0.dv.normalized()).norm() <= 1e-9);
@@ -375,12 +403,14 @@ TEST_CASE("example tongue: one lattice over two C1 bicubic patches keeps them C1
 
   // The parents are C1 across x = 300 (the recipe's premise).
   for (double v : surface::linspace(0, 1, 9)) {
-    const auto a = surface::derivatives(left, 1.0, v, 1), b = surface::derivatives(right, 0.0, v, 1);
+    const auto a = surface::derivatives(left, 1.0, v, 1),
+               b = surface::derivatives(right, 0.0, v, 1);
     REQUIRE((a.point - b.point).norm() <= 1e-12 * size);
     REQUIRE((a.du - b.du).norm() <= 1e-12 * a.du.norm());
   }
   // Each deformed patch is the rebuilt lattice applied pointwise to its parent.
-  const deform::BSplineLattice lattice = bspline_lattice_of(j.at("deformations").at("tongue").at(0));
+  const deform::BSplineLattice lattice =
+      bspline_lattice_of(j.at("deformations").at("tongue").at(0));
   const auto map = [&](const Eigen::Vector3d& x) { return deform::deform_point(lattice, x); };
   CHECK(max_pointwise_gap(left, lt, map) <= 1e-12 * size);
   CHECK(max_pointwise_gap(right, rt, map) <= 1e-12 * size);
@@ -393,7 +423,8 @@ TEST_CASE("example tongue: one lattice over two C1 bicubic patches keeps them C1
     position = std::max(position, (a.point - b.point).norm());
     tangent = std::max(tangent, (a.du - b.du).norm() / a.du.norm());
   }
-  INFO("edge: position gap " << position << " mm, cross-derivative gap " << tangent << " (relative)");
+  INFO("edge: position gap " << position << " mm, cross-derivative gap " << tangent
+                             << " (relative)");
   CHECK(position <= 1e-9 * size);
   CHECK(tangent <= 1e-9);
   // The tongue is there, straddling the edge: the middle of the edge rose by more than 60 mm.
@@ -414,13 +445,14 @@ TEST_CASE("example sail: a bound close around the target no longer blows the net
   for (const auto& [c, a, b] : {std::tuple{Eigen::Vector3d(650, 600, 2300), 650.0, 1500.0},
                                 std::tuple{Eigen::Vector3d(600, 600, 2300), 500.0, 1300.0}}) {
     nlohmann::ordered_json pts = nlohmann::ordered_json::array();
-    for (const auto& [s, t] : std::vector<std::pair<double, double>>{{1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0},
-                                                                      {-1, -1}, {0, -1}, {1, -1}, {1, 0}})
+    for (const auto& [s, t] : std::vector<std::pair<double, double>>{
+             {1, 0}, {1, 1}, {0, 1}, {-1, 1}, {-1, 0}, {-1, -1}, {0, -1}, {1, -1}, {1, 0}})
       pts.push_back({c.x() + s * a, c.y(), c.z() + t * b});
-    r["curves"]["draft_bound"] = {{"bspline", {{"degree", 2},
-                                               {"knots", {0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1}},
-                                               {"points", pts},
-                                               {"weights", {1, w, 1, w, 1, w, 1, w, 1}}}}};
+    r["curves"]["draft_bound"] = {{"bspline",
+                                   {{"degree", 2},
+                                    {"knots", {0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1}},
+                                    {"points", pts},
+                                    {"weights", {1, w, 1, w, 1, w, 1, w, 1}}}}};
     r["deformations"]["shape"][0]["key_points_per_row"] = 1;
     const auto result = clay::recipe::run_recipe(clay::recipe::parse_recipe(r.dump()));
     double displacement = -1, target = -1, locality = -1;
@@ -454,12 +486,14 @@ TEST_CASE("example sail: key points added along the target do not wind the net u
   const auto& before = result.stages[0].before;
   const auto& after = result.stages[0].after;
   // The size the tolerance is relative to: the diagonal of the parent's control-point box.
-  const double size = (before.points.colwise().maxCoeff() - before.points.colwise().minCoeff()).norm();
+  const double size =
+      (before.points.colwise().maxCoeff() - before.points.colwise().minCoeff()).norm();
   // The surface moves by the order of the draft line's distance from the flat sail (~330 mm).
   double moved = 0;
   for (double u : surface::linspace(0, 1, 61))
     for (double v : surface::linspace(0, 1, 61))
-      moved = std::max(moved, (surface::evaluate(after, u, v) - surface::evaluate(before, u, v)).norm());
+      moved = std::max(moved,
+                       (surface::evaluate(after, u, v) - surface::evaluate(before, u, v)).norm());
   INFO("largest move of the surface " << moved << " mm");
   CHECK(moved < 500);
   // Every sample of the draft line is on the styled sail within curve_tolerance x size (λ = 1,
@@ -468,6 +502,7 @@ TEST_CASE("example sail: key points added along the target do not wind the net u
   double miss = 0;
   for (double t : surface::linspace(0, 1, 101))
     miss = std::max(miss, surface::closest_point(after, surface::evaluate(line, t)).distance);
-  INFO("draft line missed by " << miss << " mm (" << miss / size << " of the size " << size << " mm)");
+  INFO("draft line missed by " << miss << " mm (" << miss / size << " of the size " << size
+                               << " mm)");
   CHECK(miss <= 1e-3 * size);
 }

@@ -27,9 +27,9 @@
 #include "error_of.hpp"
 
 using namespace clay::recipe;
+using Catch::Matchers::Contains;
 using clay::ErrorCategory;
 using clay::test::error_of;
-using Catch::Matchers::Contains;
 namespace surface = clay::surface;
 namespace deform = clay::deform;
 namespace fs = std::filesystem;
@@ -45,7 +45,8 @@ std::string num(double x) {
 std::string points_json(const surface::Points3& p) {
   std::string s = "[";
   for (Eigen::Index i = 0; i < p.rows(); ++i)
-    s += std::string(i ? "," : "") + "[" + num(p(i, 0)) + "," + num(p(i, 1)) + "," + num(p(i, 2)) + "]";
+    s += std::string(i ? "," : "") + "[" + num(p(i, 0)) + "," + num(p(i, 1)) + "," + num(p(i, 2)) +
+         "]";
   return s + "]";
 }
 
@@ -70,15 +71,17 @@ surface::BSplineSurface dome() {
 
 std::string surface_json(const surface::BSplineSurface& s) {
   std::vector<double> w(s.weights.data(), s.weights.data() + s.weights.size());
-  return "{\"bspline\": {\"degrees\": [" + std::to_string(s.u.degree) + ", " + std::to_string(s.v.degree) +
-         "], \"knots_u\": " + numbers_json(s.u.knots) + ", \"knots_v\": " + numbers_json(s.v.knots) +
-         ", \"points\": " + points_json(s.points) + ", \"weights\": " + numbers_json(w) + "}}";
+  return "{\"bspline\": {\"degrees\": [" + std::to_string(s.u.degree) + ", " +
+         std::to_string(s.v.degree) + "], \"knots_u\": " + numbers_json(s.u.knots) +
+         ", \"knots_v\": " + numbers_json(s.v.knots) + ", \"points\": " + points_json(s.points) +
+         ", \"weights\": " + numbers_json(w) + "}}";
 }
 
 /// A recipe with the dome and the given extra sections (JSON members, comma-separated).
 std::string recipe_with(const std::string& surfaces_extra, const std::string& rest) {
   return R"({"format": "clayform.recipe", "version": 1, "name": "test",
-    "surfaces": {"dome": )" + surface_json(dome()) + surfaces_extra + "}" + (rest.empty() ? "" : ", " + rest) + "}";
+    "surfaces": {"dome": )" +
+         surface_json(dome()) + surfaces_extra + "}" + (rest.empty() ? "" : ", " + rest) + "}";
 }
 
 const char* lattice_step = R"({"kind": "bezier_lattice", "name": "bulge",
@@ -112,7 +115,8 @@ double max_gap(const surface::BSplineSurface& result, F&& expected, int samples 
   return worst;
 }
 
-bool mentions(const std::vector<Problem>& problems, const std::string& path, const std::string& words) {
+bool mentions(const std::vector<Problem>& problems, const std::string& path,
+              const std::string& words) {
   for (const auto& p : problems)
     if (p.path == path && p.message.find(words) != std::string::npos) return true;
   return false;
@@ -139,9 +143,11 @@ TEST_CASE("an inline surface is read bit for bit", "[recipe]") {
   CHECK(result.steps[0].path == "surfaces.dome");
 }
 
-TEST_CASE("a Bezier lattice step with moves equals the lattice applied pointwise, exactly", "[recipe]") {
-  const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
-                                       std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
+TEST_CASE("a Bezier lattice step with moves equals the lattice applied pointwise, exactly",
+          "[recipe]") {
+  const std::string text =
+      recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                  std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
   const auto result = run_recipe(parse_recipe(text));
   const auto parent = dome();
   const auto lattice = bulge();
@@ -171,11 +177,14 @@ TEST_CASE("a Bezier lattice step with moves equals the lattice applied pointwise
 }
 
 TEST_CASE("a twist needs the refit mode, and the refit is within its tolerance", "[recipe]") {
-  const std::string twist = R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.01]})";
-  const std::string exact = recipe_with(R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin"}})",
-                                        R"("deformations": {"spin": [)" + twist + "]}");
+  const std::string twist =
+      R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.01]})";
+  const std::string exact =
+      recipe_with(R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin"}})",
+                  R"("deformations": {"spin": [)" + twist + "]}");
   // refused by the check already, naming the surface, the step and the fix
-  CHECK(mentions(check_recipe(exact), "surfaces.spun.deform.deformation", "deformations.spin[0] is a twist"));
+  CHECK(mentions(check_recipe(exact), "surfaces.spun.deform.deformation",
+                 "deformations.spin[0] is a twist"));
   CHECK(mentions(check_recipe(exact), "surfaces.spun.deform.deformation", "\"mode\": \"refit\""));
 
   const std::string refit = recipe_with(
@@ -210,7 +219,9 @@ TEST_CASE("curves: line, polyline, arc and reversed match their closed forms", "
     CHECK((surface::evaluate(result.curve("r"), 1.0 - t) - x).norm() < 1e-12);
   }
   const double pi = std::acos(-1.0);
-  CHECK((surface::evaluate(result.curve("a"), 0.0) - Eigen::Vector3d(1 + 7 * std::cos(pi / 6), 1 + 7 * std::sin(pi / 6), 0)).norm() < 1e-12);
+  CHECK((surface::evaluate(result.curve("a"), 0.0) -
+         Eigen::Vector3d(1 + 7 * std::cos(pi / 6), 1 + 7 * std::sin(pi / 6), 0))
+            .norm() < 1e-12);
 }
 
 TEST_CASE("a stroke is fitted within its tolerance", "[recipe]") {
@@ -221,7 +232,8 @@ TEST_CASE("a stroke is fitted within its tolerance", "[recipe]") {
   }
   pts += "]";
   const std::string text = R"({"format": "clayform.recipe", "version": 1,
-    "strokes": {"s": {"points": )" + pts + R"(, "tolerance": 0.05}}})";
+    "strokes": {"s": {"points": )" +
+                           pts + R"(, "tolerance": 0.05}}})";
   const auto result = run_recipe(parse_recipe(text));
   const auto& c = result.curve("s");
   // every stroke point is within the tolerance of the curve (dense sampling of the curve)
@@ -230,7 +242,8 @@ TEST_CASE("a stroke is fitted within its tolerance", "[recipe]") {
     const double t = i / 60.0;
     const Eigen::Vector3d q(100 * t, 20 * std::sin(3 * t), 0);
     double best = 1e300;
-    for (int k = 0; k <= 4000; ++k) best = std::min(best, (surface::evaluate(c, k / 4000.0) - q).norm());
+    for (int k = 0; k <= 4000; ++k)
+      best = std::min(best, (surface::evaluate(c, k / 4000.0) - q).norm());
     worst = std::max(worst, best);
   }
   CHECK(worst <= 0.05 + 1e-3);  // + the sampling's chord error
@@ -301,8 +314,9 @@ TEST_CASE("direct manipulation moves the surface points exactly onto their targe
      "moves": [{"surface_point": [0.4, 0.6], "to": [)" +
                            num(p.x()) + "," + num(p.y()) + "," + num(p.z() + 12) + R"(]},
                {"surface_point": [0.7, 0.2], "to": [70, 20, 5]}]})";
-  const std::string text = recipe_with(R"(, "pulled": {"deform": {"surface": "dome", "deformation": "pull"}})",
-                                       R"("deformations": {"pull": [)" + step + "]}");
+  const std::string text =
+      recipe_with(R"(, "pulled": {"deform": {"surface": "dome", "deformation": "pull"}})",
+                  R"("deformations": {"pull": [)" + step + "]}");
   const auto result = run_recipe(parse_recipe(text));
   const auto& s = result.surface("pulled");
   CHECK((surface::evaluate(s, 0.4, 0.6) - (p + Eigen::Vector3d(0, 0, 12))).norm() < 1e-10);
@@ -310,9 +324,9 @@ TEST_CASE("direct manipulation moves the surface points exactly onto their targe
 }
 
 TEST_CASE("a style step leaves every control vertex outside the bound untouched", "[recipe]") {
-  const std::string text = recipe_with(
-      R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
-      R"("curves": {
+  const std::string text =
+      recipe_with(R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
+                  R"("curves": {
            "bound": {"arc": {"center": [50, 50, 25], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0], "radius": 30, "start": 0, "end": 360}},
            "target": {"line": {"from": [35, 50, 30], "to": [65, 50, 30]}}},
          "deformations": {"crease": [{"kind": "style", "bound": "bound", "target": "target", "mode": "paper"}]})");
@@ -336,16 +350,19 @@ TEST_CASE("a style step leaves every control vertex outside the bound untouched"
 }
 
 TEST_CASE("a replay gives bit-identical surfaces", "[recipe]") {
-  const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
-                                       std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
+  const std::string text =
+      recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                  std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
   const auto a = run_recipe(parse_recipe(text));
   const auto b = run_recipe(parse_recipe(text));
   CHECK(surface::identical(a.surface("bulged"), b.surface("bulged")));
 }
 
-TEST_CASE("deform_surfaces applies a recipe's stack to other surfaces, as the recipe does", "[recipe]") {
-  const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
-                                       std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
+TEST_CASE("deform_surfaces applies a recipe's stack to other surfaces, as the recipe does",
+          "[recipe]") {
+  const std::string text =
+      recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                  std::string(R"("deformations": {"shape": [)") + lattice_step + "]}");
   const Recipe recipe = parse_recipe(text);
   const auto own = run_recipe(recipe);
   const auto other = deform_surfaces(recipe, {dome(), dome()}, "part");
@@ -354,15 +371,18 @@ TEST_CASE("deform_surfaces applies a recipe's stack to other surfaces, as the re
   CHECK(surface::identical(other.surfaces[0].second, own.surface("bulged")));
   REQUIRE(other.exports.size() == 1);
   CHECK(other.exports[0].surfaces.size() == 2);
-  const auto [category, message] = error_of([&] { deform_surfaces(recipe, {dome()}, "x", "nope"); });
+  const auto [category, message] =
+      error_of([&] { deform_surfaces(recipe, {dome()}, "x", "nope"); });
   CHECK(category == ErrorCategory::InvalidArgument);
   CHECK_THAT(message, Contains("shape"));
 }
 
-TEST_CASE("outputs are written whole, read back identical, and a failure leaves nothing", "[recipe]") {
-  const std::string text = recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
-                                       std::string(R"("deformations": {"shape": [)") + lattice_step +
-                                           R"(]}, "exports": {"part": {"surfaces": ["bulged", "dome"]}})");
+TEST_CASE("outputs are written whole, read back identical, and a failure leaves nothing",
+          "[recipe]") {
+  const std::string text =
+      recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                  std::string(R"("deformations": {"shape": [)") + lattice_step +
+                      R"(]}, "exports": {"part": {"surfaces": ["bulged", "dome"]}})");
   auto result = run_recipe(parse_recipe(text));
   const fs::path out = output_dir("write");
   const auto files = write_outputs(result, out);
@@ -406,7 +426,8 @@ TEST_CASE("an imported STEP surface is read bit for bit", "[recipe]") {
 }
 
 TEST_CASE("check_recipe reports every problem at once, each with its path", "[recipe]") {
-  const std::string text = R"({"format": "clayform.recipe", "version": 2, "units": "inch", "colour": 1,
+  const std::string text =
+      R"({"format": "clayform.recipe", "version": 2, "units": "inch", "colour": 1,
     "curves": {
       "a": {"line": {"from": [0, 0, 0], "to": [1, 0]}},
       "b": {"reversed": "zzz"},
@@ -451,9 +472,11 @@ TEST_CASE("check_recipe reports every problem at once, each with its path", "[re
   CHECK_THAT(message, Contains("problems:"));
 }
 
-TEST_CASE("syntax errors come with their line and column, repeated keys with their path", "[recipe]") {
+TEST_CASE("syntax errors come with their line and column, repeated keys with their path",
+          "[recipe]") {
   // line 3 lacks the comma after the "version" member: the parser stops at "name" (line 4, col 3)
-  const std::string text = "{\n  \"format\": \"clayform.recipe\",\n  \"version\": 1\n  \"name\": \"x\"\n}\n";
+  const std::string text =
+      "{\n  \"format\": \"clayform.recipe\",\n  \"version\": 1\n  \"name\": \"x\"\n}\n";
   const auto problems = check_recipe(text);
   REQUIRE(problems.size() == 1);
   CHECK(problems[0].line == 4);
@@ -463,16 +486,19 @@ TEST_CASE("syntax errors come with their line and column, repeated keys with the
   const std::string twice = R"({"format": "clayform.recipe", "version": 1,
     "curves": {"a": {"line": {"from": [0, 0, 0], "to": [1, 0, 0]}}, "a": {"line": {"from": [0, 0, 0], "to": [2, 0, 0]}}}})";
   CHECK(mentions(check_recipe(twice), "curves.a", "appears twice"));
-  CHECK(mentions(check_recipe(R"({"format": "clayform.recipe", "version": 1, "name": 1e999})"), "name", "finite"));
+  CHECK(mentions(check_recipe(R"({"format": "clayform.recipe", "version": 1, "name": 1e999})"),
+                 "name", "finite"));
 }
 
-TEST_CASE("a text that ends inside a number or literal is placed without reading past its end", "[recipe]") {
+TEST_CASE("a text that ends inside a number or literal is placed without reading past its end",
+          "[recipe]") {
   // Found by fuzz_recipe (issue #19): the parser reports the end of input one past the last byte,
   // and the search for the token's start read that byte. The text lies in a buffer of exactly its
   // size, so AddressSanitizer (scripts/test.sh's sanitize part) sees any read past it.
-  for (const std::string& text : std::vector<std::string>{R"({"format": "clayform.recipe", "version": 1)",
-                                                           R"({"format": "clayform.recipe", "version": tru)",
-                                 std::string("{\n  \"version\": 1.5e")}) {
+  for (const std::string& text :
+       std::vector<std::string>{R"({"format": "clayform.recipe", "version": 1)",
+                                R"({"format": "clayform.recipe", "version": tru)",
+                                std::string("{\n  \"version\": 1.5e")}) {
     const std::vector<char> exact(text.begin(), text.end());
     const auto problems = check_recipe(std::string_view(exact.data(), exact.size()));
     REQUIRE(problems.size() == 1);
@@ -483,7 +509,8 @@ TEST_CASE("a text that ends inside a number or literal is placed without reading
   }
 }
 
-TEST_CASE("a number beyond a double leaves the caller's floating-point environment as it was", "[recipe]") {
+TEST_CASE("a number beyond a double leaves the caller's floating-point environment as it was",
+          "[recipe]") {
   // strtod reports 1e999 by raising overflow; a host trapping overflow (the Debug tests do) died of
   // it inside check_recipe (issue #19). The parser runs with the traps held, the flags restored.
   std::feclearexcept(FE_ALL_EXCEPT);
@@ -492,7 +519,8 @@ TEST_CASE("a number beyond a double leaves the caller's floating-point environme
 #endif
   const auto problems = check_recipe(R"({"format": "clayform.recipe", "version": 1, "name": "x",
     "curves": {"a": {"line": {"from": [0, 0, 0], "to": [1e999, 0, 0]}}}})");
-  CHECK(mentions(problems, "curves.a.line.to[0]", "number overflow parsing '1e999'; give finite numbers"));
+  CHECK(mentions(problems, "curves.a.line.to[0]",
+                 "number overflow parsing '1e999'; give finite numbers"));
   CHECK(std::fetestexcept(FE_OVERFLOW | FE_INVALID | FE_DIVBYZERO) == 0);
 #if defined(__GLIBC__)
   CHECK(fegetexcept() == traps);
@@ -538,9 +566,12 @@ TEST_CASE("a taper composes exactly and a cylindrical extended lattice is refitt
   spec.sectors = 8;
   auto lattice = deform::make_cylindrical_lattice(spec);
   lattice.points.row(deform::cylindrical_index(spec, 1, 2, 2)) += Eigen::RowVector3d(0, 0, 12);
-  const double gap = max_gap(result.surface("dented"), [&](double u, double v) {
-    return deform::deform_point(lattice, surface::evaluate(parent, u, v));
-  }, 100);
+  const double gap = max_gap(
+      result.surface("dented"),
+      [&](double u, double v) {
+        return deform::deform_point(lattice, surface::evaluate(parent, u, v));
+      },
+      100);
   CHECK(gap <= 0.2);
   // the dent is there: the lattice moves the surface by about 1 mm (its control point by 12)
   double moved = 0;
@@ -554,9 +585,11 @@ TEST_CASE("a taper composes exactly and a cylindrical extended lattice is refitt
 
 TEST_CASE("a step failing at run time is named by its path, with its category", "[recipe]") {
   // the lattice covers only half of the dome: exact composition refuses a surface leaving it
-  const std::string small = R"({"kind": "bezier_lattice", "frame": {"origin": [-10, -10, -20], "s": [60, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]}, "degrees": [1, 1, 1]})";
-  const std::string text = recipe_with(R"(, "cut": {"deform": {"surface": "dome", "deformation": "half"}})",
-                                       R"("deformations": {"half": [)" + small + "]}");
+  const std::string small =
+      R"({"kind": "bezier_lattice", "frame": {"origin": [-10, -10, -20], "s": [60, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]}, "degrees": [1, 1, 1]})";
+  const std::string text =
+      recipe_with(R"(, "cut": {"deform": {"surface": "dome", "deformation": "half"}})",
+                  R"("deformations": {"half": [)" + small + "]}");
   REQUIRE(check_recipe(text).empty());
   const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
   CHECK(category == ErrorCategory::OutOfDomain);
@@ -594,13 +627,16 @@ TEST_CASE("a prismatic lattice's control points can be moved by index", "[recipe
       ++found;
     }
   REQUIRE(found == 1);
-  for (const Eigen::Vector3d& x : {Eigen::Vector3d(20, 10, 15), Eigen::Vector3d(12, 17, 15), Eigen::Vector3d(25, 5, 15)})
+  for (const Eigen::Vector3d& x :
+       {Eigen::Vector3d(20, 10, 15), Eigen::Vector3d(12, 17, 15), Eigen::Vector3d(25, 5, 15)})
     CHECK((result.stages[0].map(x) - deform::deform_point(lattice, x)).norm() < 1e-12);
   // closed form at (20, 10, 15) = parameters (1/3, 2/3, 1/2) of the linear rest lattice: the move
   // times B_1^3(1/3) B_2^3(2/3) B_1^3(1/2) = (4/9)(4/9)(3/8)
   const Eigen::Vector3d x(20, 10, 15);
-  CHECK_THAT((result.stages[0].map(x) - x).z(), Catch::Matchers::WithinAbs(-6.0 * 4 / 9 * 4 / 9 * 3 / 8, 1e-12));
-  const std::string both = R"({"format": "clayform.recipe", "version": 1, "deformations": {"d": [{"kind": "extended_lattice",
+  CHECK_THAT((result.stages[0].map(x) - x).z(),
+             Catch::Matchers::WithinAbs(-6.0 * 4 / 9 * 4 / 9 * 3 / 8, 1e-12));
+  const std::string both =
+      R"({"format": "clayform.recipe", "version": 1, "deformations": {"d": [{"kind": "extended_lattice",
       "generator": {"prism": {"sections": [[[0, 0], [10, 0], [20, 0], [30, 0]], [[0, 30], [10, 30], [20, 30], [30, 30]]]}},
       "moves": [{"index": [1, 2, 1], "row": 3, "by": [0, 0, 1]}, {"index": [4, 0, 0], "by": [0, 0, 1]}]}]}})";
   const auto problems = check_recipe(both);
@@ -608,7 +644,8 @@ TEST_CASE("a prismatic lattice's control points can be moved by index", "[recipe
   CHECK(mentions(problems, "deformations.d[0].moves[1].index[0]", "[0, 3]"));
   // sections that are all malformed are reported, not read past the end (a review found the
   // checker taking the first of no sections)
-  const std::string no_sections = R"({"format": "clayform.recipe", "version": 1, "deformations": {"d": [{"kind": "extended_lattice",
+  const std::string no_sections =
+      R"({"format": "clayform.recipe", "version": 1, "deformations": {"d": [{"kind": "extended_lattice",
       "generator": {"prism": {"sections": [1, 2]}}}]}})";
   const auto bad = check_recipe(no_sections);
   CHECK(mentions(bad, "deformations.d[0].generator.prism.sections[0]", "expected"));
@@ -640,7 +677,7 @@ TEST_CASE("B-spline curves in a sketch are joined G2 by the solver", "[recipe]")
   const auto& b = result.curve("s.right");
   const auto da = surface::derivatives(a, 1.0), db = surface::derivatives(b, 0.0);
   CHECK((da.point - db.point).norm() < 1e-8);
-  CHECK((surface::evaluate(a, 0.0) - Eigen::Vector3d(0, 0, 0)).norm() < 1e-9);   // fixed
+  CHECK((surface::evaluate(a, 0.0) - Eigen::Vector3d(0, 0, 0)).norm() < 1e-9);    // fixed
   CHECK((surface::evaluate(b, 1.0) - Eigen::Vector3d(120, 0, 0)).norm() < 1e-9);  // fixed
   // tangent directions equal, curvatures |C' x C''| / |C'|^3 (signed in the plane) equal
   CHECK((da.d1.normalized() - db.d1.normalized()).norm() < 1e-8);
@@ -654,7 +691,8 @@ TEST_CASE("B-spline curves in a sketch are joined G2 by the solver", "[recipe]")
       "points": {"c": [0, 0]},
       "entities": {"o": {"circle": {"center": "c", "radius": 5}}},
       "constraints": [{"type": "fixed", "point": "o.start"}]}}})";
-  CHECK(mentions(check_recipe(bad), "sketches.s.constraints[0].point", "circle, which has no end points"));
+  CHECK(mentions(check_recipe(bad), "sketches.s.constraints[0].point",
+                 "circle, which has no end points"));
   // a stroke drawn 5 mm off the sketch's plane passes the check (its curve is not known yet) and
   // is refused when the sketch is built with it, naming the sketch
   const std::string off = R"({"format": "clayform.recipe", "version": 1,
@@ -665,7 +703,8 @@ TEST_CASE("B-spline curves in a sketch are joined G2 by the solver", "[recipe]")
   const auto [category, message] = error_of([&] { run_recipe(parse_recipe(off)); });
   CHECK(category == ErrorCategory::InvalidGeometry);
   CHECK_THAT(message, Contains("sketches.s (sketch): with the run's curves the sketch has"));
-  CHECK_THAT(message, Contains("sketches.s.entities.f.curve: add_curve (curve \"f\"): control point 0 is 5 mm off plane"));
+  CHECK_THAT(message, Contains("sketches.s.entities.f.curve: add_curve (curve \"f\"): control "
+                               "point 0 is 5 mm off plane"));
   // the constraint on "f.start" adds no follow-on problem: the entity's own is the one reported
   CHECK_THAT(message, Contains("the sketch has 1 problem:"));
   CHECK_THAT(message, !Contains("no point named"));
@@ -686,7 +725,8 @@ TEST_CASE("B-spline curves in a sketch are joined G2 by the solver", "[recipe]")
     "sketches": {"s": {"plane": {"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]},
       "points": {"q": [40, 0]}, "entities": {},
       "constraints": [{"type": "fixed", "point": "f.start"}]}}})";
-  CHECK(mentions(check_recipe(typo), "sketches.s.constraints[0].point", "no point named \"f.start\""));
+  CHECK(mentions(check_recipe(typo), "sketches.s.constraints[0].point",
+                 "no point named \"f.start\""));
 }
 
 TEST_CASE("a fitted stroke joins a sketch, built when the recipe runs", "[recipe]") {
@@ -694,13 +734,16 @@ TEST_CASE("a fitted stroke joins a sketch, built when the recipe runs", "[recipe
   std::string pts = "[";
   for (int i = 0; i <= 40; ++i) {
     const double t = i / 40.0;
-    pts += std::string(i ? "," : "") + "[" + num(60 * t) + "," + num(12 * std::sin(2.5 * t)) + ",0]";
+    pts +=
+        std::string(i ? "," : "") + "[" + num(60 * t) + "," + num(12 * std::sin(2.5 * t)) + ",0]";
   }
   pts += "]";
   const std::string plane = R"({"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]})";
   const std::string text = R"({"format": "clayform.recipe", "version": 1,
-    "strokes": {"swoosh": {"points": )" + pts + R"(, "plane": )" + plane + R"(, "tolerance": 0.05}},
-    "sketches": {"s": {"plane": )" + plane + R"(,
+    "strokes": {"swoosh": {"points": )" +
+                           pts + R"(, "plane": )" + plane + R"(, "tolerance": 0.05}},
+    "sketches": {"s": {"plane": )" +
+                           plane + R"(,
       "points": {"q": [100, 20]},
       "entities": {"swoosh": {"curve": "swoosh"}, "run": {"line": ["swoosh.end", "q"]}},
       "constraints": [
@@ -718,13 +761,15 @@ TEST_CASE("a fitted stroke joins a sketch, built when the recipe runs", "[recipe
   const auto end = surface::derivatives(solved, 1.0);
   CHECK((end.point - surface::evaluate(line, 0.0)).norm() < 1e-8);
   CHECK((surface::evaluate(line, 1.0) - Eigen::Vector3d(100, 20, 0)).norm() < 1e-9);
-  const Eigen::Vector3d along = (surface::evaluate(line, 1.0) - surface::evaluate(line, 0.0)).normalized();
+  const Eigen::Vector3d along =
+      (surface::evaluate(line, 1.0) - surface::evaluate(line, 0.0)).normalized();
   CHECK((end.d1.normalized() - along).norm() < 1e-8);
 }
 
 // ---- issue #18: outside-check defects --------------------------------------------------------
 
-TEST_CASE("an under-constrained recipe sketch converges; messages use the recipe's names", "[recipe]") {
+TEST_CASE("an under-constrained recipe sketch converges; messages use the recipe's names",
+          "[recipe]") {
   // The smallest case of the outside check: a fixed start, a length of 10, the end drawn at
   // (0.02, 10.5): 1 DOF, nothing conflicts. It stopped after 101 iterations at residual 0.508.
   const std::string free_end = R"({"format": "clayform.recipe", "version": 1,
@@ -736,7 +781,8 @@ TEST_CASE("an under-constrained recipe sketch converges; messages use the recipe
     "surfaces": {}})";
   const auto result = run_recipe(parse_recipe(free_end));
   const auto& mast = result.curve("s.mast");
-  CHECK(std::abs((surface::evaluate(mast, 1.0) - surface::evaluate(mast, 0.0)).norm() - 10) < 1e-10);
+  CHECK(std::abs((surface::evaluate(mast, 1.0) - surface::evaluate(mast, 0.0)).norm() - 10) <
+        1e-10);
   const StepReport* sketch_step = nullptr;
   for (const auto& s : result.steps)
     if (s.path == "sketches.s") sketch_step = &s;
@@ -755,7 +801,9 @@ TEST_CASE("an under-constrained recipe sketch converges; messages use the recipe
     "surfaces": {}})";
   const auto [category, message] = error_of([&] { run_recipe(parse_recipe(conflict)); });
   CHECK(category == ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Contains("sketches.s.constraints[2] (distance 12 mm between point \"a\" and point \"b\")"));
+  CHECK_THAT(
+      message,
+      Contains("sketches.s.constraints[2] (distance 12 mm between point \"a\" and point \"b\")"));
   CHECK_THAT(message, !Contains("point #") && !Contains("constraint #"));
   const auto first = message.find("conflicting:");
   REQUIRE(first != std::string::npos);
@@ -784,15 +832,18 @@ TEST_CASE("every redundant set of a recipe sketch is in its report", "[recipe]")
   }
   REQUIRE(count == 2);
   REQUIRE(sets.size() == 2);
-  CHECK_THAT(sets[0] + sets[1], Contains("horizontal line \"low\"") && Contains("horizontal line \"high\""));
+  CHECK_THAT(sets[0] + sets[1],
+             Contains("horizontal line \"low\"") && Contains("horizontal line \"high\""));
   const std::string report = report_json(result);
   CHECK_THAT(report, Contains("redundant[1]"));
 }
 
-TEST_CASE("a refit of a torn lattice fails the run before refitting, naming the cause", "[recipe]") {
+TEST_CASE("a refit of a torn lattice fails the run before refitting, naming the cause",
+          "[recipe]") {
   // The outside check's case: the surface lies partly outside a lattice whose every control point
   // is displaced, so the map jumps where the surface crosses the face; tolerance 1e-4.
-  const std::string torn = R"({"kind": "bezier_lattice", "frame": {"origin": [-10, -10, -20], "s": [70, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
+  const std::string torn =
+      R"({"kind": "bezier_lattice", "frame": {"origin": [-10, -10, -20], "s": [70, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
      "degrees": [1, 1, 1], "moves": [{"index": [0, 0, 0], "by": [0, 0, 5]}, {"index": [1, 0, 0], "by": [0, 0, 5]},
        {"index": [0, 1, 0], "by": [0, 0, 5]}, {"index": [1, 1, 0], "by": [0, 0, 5]}, {"index": [0, 0, 1], "by": [0, 0, 5]},
        {"index": [1, 0, 1], "by": [0, 0, 5]}, {"index": [0, 1, 1], "by": [0, 0, 5]}, {"index": [1, 1, 1], "by": [0, 0, 5]}]})";
@@ -803,8 +854,9 @@ TEST_CASE("a refit of a torn lattice fails the run before refitting, naming the 
   REQUIRE(check_recipe(text).empty());
   const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
   CHECK(category == ErrorCategory::ToleranceNotMet);
-  CHECK_THAT(message, Contains("surfaces.cut.steps[0] (bezier_lattice)") && Contains("discontinuous") &&
-                          Contains("lattice face s = 1") && Contains("jumps by 5 mm"));
+  CHECK_THAT(message, Contains("surfaces.cut.steps[0] (bezier_lattice)") &&
+                          Contains("discontinuous") && Contains("lattice face s = 1") &&
+                          Contains("jumps by 5 mm"));
   CHECK_THAT(message, !Contains("Options::") && !Contains("deform_surface"));  // no C++ names
   // The explicit opt-in keeps the result (with a warning in the report) when the refit runs out.
   // A tolerance just above half the jump (2.5 mm) is not refused up front; a net of at most 400
@@ -824,20 +876,24 @@ TEST_CASE("a refit of a torn lattice fails the run before refitting, naming the 
   CHECK(warned);
 }
 
-TEST_CASE("a style step that misses its target fails, unless accepted out of tolerance", "[recipe]") {
+TEST_CASE("a style step that misses its target fails, unless accepted out of tolerance",
+          "[recipe]") {
   // The target lies outside the bound: nothing may move (over-constrained).
   const std::string curves = R"("curves": {
            "bound": {"arc": {"center": [50, 50, 25], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0], "radius": 15, "start": 0, "end": 360}},
            "target": {"line": {"from": [80, 80, 30], "to": [95, 80, 30]}}})";
   auto recipe = [&](const std::string& extra) {
-    return recipe_with(R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
-                       curves + R"(, "deformations": {"crease": [{"kind": "style", "bound": "bound", "target": "target")" +
-                           extra + "}]}");
+    return recipe_with(
+        R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
+        curves +
+            R"(, "deformations": {"crease": [{"kind": "style", "bound": "bound", "target": "target")" +
+            extra + "}]}");
   };
   REQUIRE(check_recipe(recipe("")).empty());
   const auto [category, message] = error_of([&] { run_recipe(parse_recipe(recipe(""))); });
   CHECK(category == ErrorCategory::ToleranceNotMet);
-  CHECK_THAT(message, Contains("surfaces.styled.steps[0] (style)") && Contains("outside the bound") &&
+  CHECK_THAT(message, Contains("surfaces.styled.steps[0] (style)") &&
+                          Contains("outside the bound") &&
                           Contains("\"accept_out_of_tolerance\": true"));
   const auto kept = run_recipe(parse_recipe(recipe(R"(, "accept_out_of_tolerance": true)")));
   bool warned = false;
@@ -846,10 +902,11 @@ TEST_CASE("a style step that misses its target fails, unless accepted out of tol
   CHECK(warned);
 }
 
-TEST_CASE("validate knows an inline bound curve is open, and the style's refinement keys", "[recipe]") {
-  const std::string text = recipe_with(
-      R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
-      R"("curves": {
+TEST_CASE("validate knows an inline bound curve is open, and the style's refinement keys",
+          "[recipe]") {
+  const std::string text =
+      recipe_with(R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
+                  R"("curves": {
            "bound": {"arc": {"center": [50, 50, 25], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0], "radius": 30, "start": 0, "end": 300}},
            "target": {"line": {"from": [35, 50, 30], "to": [65, 50, 30]}}},
          "deformations": {"crease": [{"kind": "style", "bound": "bound", "target": "target", "mode": "exact",
@@ -868,10 +925,12 @@ const char* recipe_head = R"({"format": "clayform.recipe", "version": 1, )";
 
 /// check_recipe must refuse `text` quickly — it used to accept each of
 /// these, or crash — with a problem at `path` whose message holds every one of `words` (the limit).
-void refused_quickly(const std::string& text, const std::string& path, std::initializer_list<std::string> words) {
+void refused_quickly(const std::string& text, const std::string& path,
+                     std::initializer_list<std::string> words) {
   const auto start = std::chrono::steady_clock::now();
   const auto problems = check_recipe(text);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   INFO(dump(problems));
   // The cases took a minute or more (and gigabytes) before the limits; refused, they take
   // milliseconds. The bound only separates the two: speed itself is measured in bench/, and this
@@ -894,13 +953,16 @@ std::string repeated(const std::string& item, std::size_t n, const char* separat
   return s;
 }
 
-const char* frame_json = R"("frame": {"origin": [0, 0, 0], "s": [100, 0, 0], "t": [0, 100, 0], "u": [0, 0, 100]})";
+const char* frame_json =
+    R"("frame": {"origin": [0, 0, 0], "s": [100, 0, 0], "t": [0, 100, 0], "u": [0, 0, 100]})";
 
 }  // namespace
 
-TEST_CASE("a recipe nested 100,000 deep is refused at its line and column, without a crash", "[recipe][limits]") {
+TEST_CASE("a recipe nested 100,000 deep is refused at its line and column, without a crash",
+          "[recipe][limits]") {
   // nlohmann's parser recursed ~87,000 frames on this and overflowed the stack (SIGSEGV).
-  const std::string text = std::string(recipe_head) + "\n\"description\": " + std::string(100000, '[') +
+  const std::string text = std::string(recipe_head) +
+                           "\n\"description\": " + std::string(100000, '[') +
                            std::string(100000, ']') + ", \"x\": 1}";
   refused_quickly(text, "description", {"deeper than 64 levels"});
   const auto problems = check_recipe(text);
@@ -909,51 +971,68 @@ TEST_CASE("a recipe nested 100,000 deep is refused at its line and column, witho
   CHECK(problems[0].column == 16 + 63);  // the 64th bracket: level 65 with the recipe's own object
   CHECK_THAT(to_string(problems[0]), Contains("line 2, column 79: description: "));
   // 64 levels are allowed (the check only counts; the parser then reports the wrong type)
-  const std::string deep64 = std::string(recipe_head) + "\"description\": " + std::string(63, '[') + std::string(63, ']') + "}";
+  const std::string deep64 = std::string(recipe_head) + "\"description\": " + std::string(63, '[') +
+                             std::string(63, ']') + "}";
   CHECK(mentions(check_recipe(deep64), "description", "expected a string"));
   // brackets inside strings do not count
-  const std::string in_string = std::string(recipe_head) + "\"description\": \"" + std::string(1000, '[') + "\"}";
+  const std::string in_string =
+      std::string(recipe_head) + "\"description\": \"" + std::string(1000, '[') + "\"}";
   CHECK(check_recipe(in_string).empty());
 }
 
-TEST_CASE("validate refuses an export listing one surface 100,000 times, or twice", "[recipe][limits]") {
+TEST_CASE("validate refuses an export listing one surface 100,000 times, or twice",
+          "[recipe][limits]") {
   // was: over 60 s and 4.2 GB at run time
-  refused_quickly(recipe_with("", R"("exports": {"e": {"surfaces": [)" + repeated("\"dome\"", 100000) + "]}}"),
-                  "exports.e.surfaces", {"100000 surface names", "at most 1000"});
-  refused_quickly(recipe_with("", R"("exports": {"e": {"surfaces": ["dome", "dome"]}})"), "exports.e.surfaces[1]",
-                  {"already listed at [0]", "list each surface once"});
+  refused_quickly(
+      recipe_with("", R"("exports": {"e": {"surfaces": [)" + repeated("\"dome\"", 100000) + "]}}"),
+      "exports.e.surfaces", {"100000 surface names", "at most 1000"});
+  refused_quickly(recipe_with("", R"("exports": {"e": {"surfaces": ["dome", "dome"]}})"),
+                  "exports.e.surfaces[1]", {"already listed at [0]", "list each surface once"});
 }
 
-TEST_CASE("validate refuses a B-spline lattice of 200^3 cells, and one of too many control points", "[recipe][limits]") {
+TEST_CASE("validate refuses a B-spline lattice of 200^3 cells, and one of too many control points",
+          "[recipe][limits]") {
   // was: over 4.4 GB in 32 s at run time
   auto stack = [](const std::string& cells, const std::string& degrees) {
-    return std::string(recipe_head) + R"("deformations": {"big": [{"kind": "bspline_lattice", )" + frame_json +
-           R"(, "cells": )" + cells + R"(, "degrees": )" + degrees + "}]}}";
+    return std::string(recipe_head) + R"("deformations": {"big": [{"kind": "bspline_lattice", )" +
+           frame_json + R"(, "cells": )" + cells + R"(, "degrees": )" + degrees + "}]}}";
   };
-  refused_quickly(stack("[200, 200, 200]", "[3, 3, 3]"), "deformations.big[0].cells[0]", {"[1, 64]", "found the number 200"});
+  refused_quickly(stack("[200, 200, 200]", "[3, 3, 3]"), "deformations.big[0].cells[0]",
+                  {"[1, 64]", "found the number 200"});
   refused_quickly(stack("[64, 64, 64]", "[3, 3, 3]"), "deformations.big[0]",
                   {"67 x 67 x 67 = 300763 control points", "at most 100000"});
   CHECK(check_recipe(stack("[8, 8, 8]", "[3, 3, 3]")).empty());
-  const std::string bezier = std::string(recipe_head) + R"("deformations": {"big": [{"kind": "bezier_lattice", )" +
+  const std::string bezier = std::string(recipe_head) +
+                             R"("deformations": {"big": [{"kind": "bezier_lattice", )" +
                              frame_json + R"(, "degrees": [63, 63, 63]}]}})";
-  refused_quickly(bezier, "deformations.big[0].degrees", {"64 x 64 x 64 = 262144 control points", "at most 100000"});
+  refused_quickly(bezier, "deformations.big[0].degrees",
+                  {"64 x 64 x 64 = 262144 control points", "at most 100000"});
 }
 
-TEST_CASE("validate refuses a twist of 1e6 degrees, a bend of 10 rad/mm and a taper scaling by 1e4", "[recipe][limits]") {
+TEST_CASE("validate refuses a twist of 1e6 degrees, a bend of 10 rad/mm and a taper scaling by 1e4",
+          "[recipe][limits]") {
   // was: over 4.4 GB in refit mode (the post of superellipsoid_taper_twist.json turned 1e6
   // degrees over its 120 mm: 145 rad/mm)
-  const std::string axis = R"("frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]})";
-  const std::string twist = std::string(recipe_head) +
-                            R"("composition": {"mode": "refit"}, "surfaces": {"post": {"superellipsoid": {"radii": [25, 25, 60]}},
+  const std::string axis =
+      R"("frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]})";
+  const std::string twist =
+      std::string(recipe_head) +
+      R"("composition": {"mode": "refit"}, "surfaces": {"post": {"superellipsoid": {"radii": [25, 25, 60]}},
       "twisted": {"deform": {"surface": "post", "deformation": "wring"}}},
-      "deformations": {"wring": [{"kind": "twist", )" + axis + R"(, "angle": [0, 145.44]}]}})";
-  refused_quickly(twist, "deformations.wring[0].angle", {"at most 36000 degrees (100 turns)", "radians per mm^k"});
-  const std::string fine = std::string(recipe_head) + R"("deformations": {"w": [{"kind": "twist", )" + axis +
+      "deformations": {"wring": [{"kind": "twist", )" +
+      axis + R"(, "angle": [0, 145.44]}]}})";
+  refused_quickly(twist, "deformations.wring[0].angle",
+                  {"at most 36000 degrees (100 turns)", "radians per mm^k"});
+  const std::string fine = std::string(recipe_head) +
+                           R"("deformations": {"w": [{"kind": "twist", )" + axis +
                            R"(, "angle": [0, 0.0131]}]}})";
   CHECK(check_recipe(fine).empty());
-  const std::string bend = std::string(recipe_head) + R"("deformations": {"b": [{"kind": "bend", "frame": {"origin": [0, 0, 0], "axis": [0, 1, 0], "reference": [0, 0, 1]}, "y_min": -10, "y_max": 10, "center": 0, "rate": 10}]}})";
+  const std::string bend =
+      std::string(recipe_head) +
+      R"("deformations": {"b": [{"kind": "bend", "frame": {"origin": [0, 0, 0], "axis": [0, 1, 0], "reference": [0, 0, 1]}, "y_min": -10, "y_max": 10, "center": 0, "rate": 10}]}})";
   refused_quickly(bend, "deformations.b[0].rate", {"10 rad/mm", "1 rad/mm"});
-  const std::string taper = std::string(recipe_head) + R"("deformations": {"t": [{"kind": "taper", )" + axis +
+  const std::string taper = std::string(recipe_head) +
+                            R"("deformations": {"t": [{"kind": "taper", )" + axis +
                             R"(, "profile": [1, 10]}]}})";
   refused_quickly(taper, "deformations.t[0].profile", {"10001", "at most 1000"});
 }
@@ -963,69 +1042,96 @@ TEST_CASE("validate refuses a sweep twisted 1e300 degrees", "[recipe][limits]") 
   const std::string text = std::string(recipe_head) + R"("curves": {
       "a": {"line": {"from": [0, -5, 0], "to": [0, 5, 0]}}, "b": {"line": {"from": [0, 0, 0], "to": [0, 0, 100]}}},
     "surfaces": {"s": {"sweep": {"profile": "a", "path": "b", "twist_degrees": 1e300}}}})";
-  refused_quickly(text, "surfaces.s.sweep.twist_degrees", {"1e+300 is out of range", "[-3600, 3600]"});
+  refused_quickly(text, "surfaces.s.sweep.twist_degrees",
+                  {"1e+300 is out of range", "[-3600, 3600]"});
 }
 
-TEST_CASE("validate refuses a prism lattice with a coordinate of 2^31 mm or 100,000 sections", "[recipe][limits]") {
+TEST_CASE("validate refuses a prism lattice with a coordinate of 2^31 mm or 100,000 sections",
+          "[recipe][limits]") {
   auto prism = [](const std::string& sections) {
-    return std::string(recipe_head) + R"("deformations": {"p": [{"kind": "extended_lattice", "generator": {"prism": {
-        "sections": )" + sections + R"(, "extrusion": [0, 0, 30]}}}]}})";
+    return std::string(recipe_head) +
+           R"("deformations": {"p": [{"kind": "extended_lattice", "generator": {"prism": {
+        "sections": )" +
+           sections + R"(, "extrusion": [0, 0, 30]}}}]}})";
   };
   // was: over 60 s at run time
-  refused_quickly(prism("[[[0, 0], [10, 0], [20, 0], [2147483648, 0]], [[0, 30], [10, 30], [20, 30], [30, 30]]]"),
-                  "deformations.p[0].generator.prism.sections[0][3][0]",
-                  {"2147483648 is out of range", "[-1e+06, 1e+06]", "limited to ±1e+06"});
+  refused_quickly(
+      prism(
+          "[[[0, 0], [10, 0], [20, 0], [2147483648, 0]], [[0, 30], [10, 30], [20, 30], [30, 30]]]"),
+      "deformations.p[0].generator.prism.sections[0][3][0]",
+      {"2147483648 is out of range", "[-1e+06, 1e+06]", "limited to ±1e+06"});
   // was: validate itself over 60 s and 2.7 GB
   refused_quickly(prism("[" + repeated("[[0, 0], [10, 0], [20, 0], [30, 0]]", 100000) + "]"),
                   "deformations.p[0].generator.prism.sections", {"100000 sections", "at most 65"});
 }
 
-TEST_CASE("validate refuses weights of 1e300 (a bottle's neck that read back invalid)", "[recipe][limits]") {
-  const std::string text = std::string(recipe_head) + R"("curves": {"neck": {"bspline": {"degree": 2,
+TEST_CASE("validate refuses weights of 1e300 (a bottle's neck that read back invalid)",
+          "[recipe][limits]") {
+  const std::string text =
+      std::string(recipe_head) + R"("curves": {"neck": {"bspline": {"degree": 2,
       "knots": [0, 0, 0, 1, 1, 1], "points": [[30, 0, 0], [30, 0, 10], [10, 0, 20]], "weights": [1, 1e300, 1]}}}})";
-  refused_quickly(text, "curves.neck.bspline.weights[1]", {"1e+300 is out of range", "[1e-06, 1e+06]"});
+  refused_quickly(text, "curves.neck.bspline.weights[1]",
+                  {"1e+300 is out of range", "[1e-06, 1e+06]"});
 }
 
-TEST_CASE("every count and magnitude of a recipe has a limit that validate names", "[recipe][limits]") {
-  refused_quickly(std::string(recipe_head) + R"("strokes": {"s": {"points": [)" + repeated("[0, 0, 0]", 10001) + "]}}}",
+TEST_CASE("every count and magnitude of a recipe has a limit that validate names",
+          "[recipe][limits]") {
+  refused_quickly(std::string(recipe_head) + R"("strokes": {"s": {"points": [)" +
+                      repeated("[0, 0, 0]", 10001) + "]}}}",
                   "strokes.s.points", {"10001 points", "at most 10000"});
-  refused_quickly(std::string(recipe_head) + R"("curves": {"p": {"polyline": {"points": [)" + repeated("[0, 0, 0]", 10001) + "]}}}}",
+  refused_quickly(std::string(recipe_head) + R"("curves": {"p": {"polyline": {"points": [)" +
+                      repeated("[0, 0, 0]", 10001) + "]}}}}",
                   "curves.p.polyline.points", {"at most 10000"});
-  refused_quickly(std::string(recipe_head) + R"("curves": {"a": {"arc": {"center": [0, 0, 0], "x_axis": [1, 0, 0],
+  refused_quickly(std::string(recipe_head) +
+                      R"("curves": {"a": {"arc": {"center": [0, 0, 0], "x_axis": [1, 0, 0],
       "y_axis": [0, 1, 0], "radius": 5, "start": 100000, "end": 100090}}}})",
                   "curves.a.arc.start", {"[-720, 720]"});
   std::string many = std::string(recipe_head) + R"("curves": {)";
   for (int k = 0; k <= 1000; ++k)
-    many += (k ? ", " : "") + std::string("\"c") + std::to_string(k) + R"(": {"line": {"from": [0, 0, 0], "to": [1, 0, 0]}})";
+    many += (k ? ", " : "") + std::string("\"c") + std::to_string(k) +
+            R"(": {"line": {"from": [0, 0, 0], "to": [1, 0, 0]}})";
   refused_quickly(many + "}}", "curves", {"1001 entries", "at most 1000"});
-  const std::string step = R"({"kind": "taper", "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": [1]})";
-  refused_quickly(std::string(recipe_head) + R"("deformations": {"d": [)" + repeated(step, 101) + "]}}", "deformations.d",
-                  {"101 steps", "at most 100"});
-  refused_quickly(std::string(recipe_head) + R"("deformations": {"c": [{"kind": "extended_lattice", "generator": {"cylinder": {
+  const std::string step =
+      R"({"kind": "taper", "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": [1]})";
+  refused_quickly(
+      std::string(recipe_head) + R"("deformations": {"d": [)" + repeated(step, 101) + "]}}",
+      "deformations.d", {"101 steps", "at most 100"});
+  refused_quickly(
+      std::string(recipe_head) +
+          R"("deformations": {"c": [{"kind": "extended_lattice", "generator": {"cylinder": {
       "sectors": 1000}}}]}})",
-                  "deformations.c[0].generator.cylinder.sectors", {"[3, 256]"});
-  refused_quickly(std::string(recipe_head) + R"("deformations": {"c": [{"kind": "extended_lattice", "generator": {"cylinder": {
+      "deformations.c[0].generator.cylinder.sectors", {"[3, 256]"});
+  refused_quickly(
+      std::string(recipe_head) +
+          R"("deformations": {"c": [{"kind": "extended_lattice", "generator": {"cylinder": {
       "sectors": 256, "rings": 64, "layers": 64}}}]}})",
-                  "deformations.c[0].generator.cylinder", {"1048576 chunks", "at most 4096"});
-  refused_quickly(std::string(recipe_head) + R"("composition": {"mode": "refit", "tolerance": 1e-12}})", "composition.tolerance",
-                  {"[1e-09, 1e+06]"});
-  refused_quickly(std::string(recipe_head) + R"("composition": {"mode": "refit", "max_control_points": 100000}})",
+      "deformations.c[0].generator.cylinder", {"1048576 chunks", "at most 4096"});
+  refused_quickly(
+      std::string(recipe_head) + R"("composition": {"mode": "refit", "tolerance": 1e-12}})",
+      "composition.tolerance", {"[1e-09, 1e+06]"});
+  refused_quickly(std::string(recipe_head) +
+                      R"("composition": {"mode": "refit", "max_control_points": 100000}})",
                   "composition.max_control_points", {"[16, 40000]"});
-  refused_quickly(recipe_with(R"(, "big": {"superellipsoid": {"radii": [1e7, 1, 1]}})", ""), "surfaces.big.superellipsoid.radii[0]",
+  refused_quickly(recipe_with(R"(, "big": {"superellipsoid": {"radii": [1e7, 1, 1]}})", ""),
+                  "surfaces.big.superellipsoid.radii[0]",
                   {"1e+07 is out of range", "limited to ±1e+06"});
-  refused_quickly(std::string(recipe_head) + std::string(64u << 20, ' ') + "}", "(top level)", {"at most 67108864"});
+  refused_quickly(std::string(recipe_head) + std::string(64u << 20, ' ') + "}", "(top level)",
+                  {"at most 67108864"});
 }
 
-TEST_CASE("a refit that misses its tolerance at the refit's caps fails the run, naming the cap", "[recipe][limits]") {
+TEST_CASE("a refit that misses its tolerance at the refit's caps fails the run, naming the cap",
+          "[recipe][limits]") {
   // Tighter than the refit can certify within its iteration and control-point limits: a failure,
   // not a warning (DESIGN.md), with the cap named and the recipe keys to change.
-  const std::string twist = R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.05]})";
+  const std::string twist =
+      R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.05]})";
   const std::string text = recipe_with(
       R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 1e-9, "max_control_points": 400}}})",
       R"("deformations": {"spin": [)" + twist + "]}");
   const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
   CHECK(category == ErrorCategory::ToleranceNotMet);
-  CHECK_THAT(message, Contains("surfaces.spun.steps[0] (twist): ") && Contains("misses its tolerance"));
+  CHECK_THAT(message,
+             Contains("surfaces.spun.steps[0] (twist): ") && Contains("misses its tolerance"));
   CHECK_THAT(message, Contains("control point limit 400 reached"));
   CHECK_THAT(message, Contains("raise the composition's \"max_control_points\" (at most 40,000)"));
   CHECK_THAT(message, Contains("\"accept_out_of_tolerance\": true"));

@@ -14,23 +14,25 @@
 #include "error_of.hpp"
 
 using namespace clay::render;
+using Catch::Matchers::Contains;
 using clay::ErrorCategory;
 using clay::test::error_of;
-using Catch::Matchers::Contains;
 namespace surface = clay::surface;
 namespace fs = std::filesystem;
 
 namespace {
 
 /// The plane patch [x0, x1] x [y0, y1] at height z, degree p in both directions with its control
-/// points at the Greville abscissae: by linear precision S(u, v) = (x0 + u (x1 - x0), y0 + v (y1 - y0), z).
+/// points at the Greville abscissae: by linear precision S(u, v) = (x0 + u (x1 - x0), y0 + v (y1 -
+/// y0), z).
 surface::BSplineSurface plate(double x0, double x1, double y0, double y1, double z, int p = 1) {
   const auto b = surface::clamped_uniform_basis(p, p + 1);
   const auto xi = surface::greville_abscissae(b);
   surface::Points3 pts((p + 1) * (p + 1), 3);
   for (int i = 0; i <= p; ++i)
     for (int j = 0; j <= p; ++j)
-      pts.row(i * (p + 1) + j) << x0 + xi[static_cast<size_t>(i)] * (x1 - x0), y0 + xi[static_cast<size_t>(j)] * (y1 - y0), z;
+      pts.row(i * (p + 1) + j) << x0 + xi[static_cast<size_t>(i)] * (x1 - x0),
+          y0 + xi[static_cast<size_t>(j)] * (y1 - y0), z;
   return surface::make_surface(b, b, pts);
 }
 
@@ -50,7 +52,8 @@ bool same(const Rgb& a, const Rgb& b) { return a == b; }
 
 }  // namespace
 
-TEST_CASE("render: a plate facing the camera covers the rectangle of the orthographic fit", "[render]") {
+TEST_CASE("render: a plate facing the camera covers the rectangle of the orthographic fit",
+          "[render]") {
   for (const bool supersample : {false, true})
     for (const int degree : {1, 3}) {
       CAPTURE(supersample, degree);
@@ -69,7 +72,8 @@ TEST_CASE("render: a plate facing the camera covers the rectangle of the orthogr
         for (int x = 0; x < 240; ++x) {
           const bool covered = x >= 40 && x < 200 && y >= 10 && y < 90;
           const Rgb expected = covered ? inside : o.background;
-          if (!same(img.pixel(x, y), expected)) FAIL("pixel " << x << ", " << y << (covered ? " inside" : " outside"));
+          if (!same(img.pixel(x, y), expected))
+            FAIL("pixel " << x << ", " << y << (covered ? " inside" : " outside"));
         }
       // A plane under a directional light, seen orthographically, is one colour: base * diffuse +
       // a grey highlight, so the channel differences keep the base's ratios 100 : 50.
@@ -80,12 +84,15 @@ TEST_CASE("render: a plate facing the camera covers the rectangle of the orthogr
     }
 }
 
-TEST_CASE("render: the whole model is visible, centred, and touches the margin on one axis", "[render]") {
+TEST_CASE("render: the whole model is visible, centred, and touches the margin on one axis",
+          "[render]") {
   // A bicubic dome 4 x 4 control points, seen obliquely.
   const auto b = surface::clamped_uniform_basis(3, 4);
   surface::Points3 pts(16, 3);
   for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 4; ++j) pts.row(i * 4 + j) << 30.0 * i, 20.0 * j, (i == 1 || i == 2) && (j == 1 || j == 2) ? 25.0 : 0.0;
+    for (int j = 0; j < 4; ++j)
+      pts.row(i * 4 + j) << 30.0 * i, 20.0 * j,
+          (i == 1 || i == 2) && (j == 1 || j == 2) ? 25.0 : 0.0;
   RenderOptions o;
   o.width = 300;
   o.height = 200;
@@ -134,11 +141,13 @@ TEST_CASE("render: a surface behind another is hidden, whatever the drawing orde
   }
 }
 
-TEST_CASE("render: a collapsed or nearly collapsed edge is shaded like the rest of its plane", "[render]") {
+TEST_CASE("render: a collapsed or nearly collapsed edge is shaded like the rest of its plane",
+          "[render]") {
   // S(u, v) = (u, u v, 0): S_u x S_v = (0, 0, u) vanishes on the edge u = 0 (a pole), where the
   // normal is the limit S_u x S_uv = (0, 0, 1). Then the same with the pole split by 1e-6 (as a
-  // refit leaves it): S_u x S_v there is (3e-6 v, -3e-6, 1e-6), 70 degrees off, and must not be used.
-  // Both surfaces are planar to 3e-6, so every fully covered pixel has the colour of the plane.
+  // refit leaves it): S_u x S_v there is (3e-6 v, -3e-6, 1e-6), 70 degrees off, and must not be
+  // used. Both surfaces are planar to 3e-6, so every fully covered pixel has the colour of the
+  // plane.
   const auto b = surface::clamped_uniform_basis(1, 2);
   for (const double split : {0.0, 1e-6}) {
     CAPTURE(split);
@@ -152,7 +161,8 @@ TEST_CASE("render: a collapsed or nearly collapsed edge is shaded like the rest 
     std::vector<Rgb> colours;
     for (int y = 1; y + 1 < img.height; ++y)
       for (int x = 1; x + 1 < img.width; ++x)
-        if (covered(x, y) && covered(x - 1, y) && covered(x + 1, y) && covered(x, y - 1) && covered(x, y + 1))
+        if (covered(x, y) && covered(x - 1, y) && covered(x + 1, y) && covered(x, y - 1) &&
+            covered(x, y + 1))
           colours.push_back(img.pixel(x, y));
     REQUIRE(colours.size() > 1200);  // of the triangle's 80 x 80 / 2 pixels, foreshortened
     int off = 0;
@@ -175,8 +185,11 @@ TEST_CASE("render: the control net is drawn along its lines only", "[render]") {
   o.control_net = true;
   const Image net = render({s}, o);
   auto near_line = [](int x, int y) {
-    auto close = [](int a, int line) { return std::abs(2 * a + 1 - 2 * line) <= 4; };  // centre within 2 px
-    return close(x, 40) || close(x, 120) || close(x, 200) || close(y, 10) || close(y, 50) || close(y, 90);
+    auto close = [](int a, int line) {
+      return std::abs(2 * a + 1 - 2 * line) <= 4;
+    };  // centre within 2 px
+    return close(x, 40) || close(x, 120) || close(x, 200) || close(y, 10) || close(y, 50) ||
+           close(y, 90);
   };
   int changed = 0;
   for (int y = 0; y < 100; ++y)
@@ -192,7 +205,8 @@ TEST_CASE("render: the control net is drawn along its lines only", "[render]") {
   CHECK(darkest < 150);
 }
 
-TEST_CASE("render: write_png writes the pixels that libpng reads back, and no temporary file", "[render]") {
+TEST_CASE("render: write_png writes the pixels that libpng reads back, and no temporary file",
+          "[render]") {
   const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "render";
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -216,7 +230,8 @@ TEST_CASE("render: write_png writes the pixels that libpng reads back, and no te
   CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
 }
 
-TEST_CASE("render: bad options, no surfaces, bad images and unwritable files are named", "[render]") {
+TEST_CASE("render: bad options, no surfaces, bad images and unwritable files are named",
+          "[render]") {
   const std::vector<surface::BSplineSurface> one{plate(0, 1, 0, 1, 0)};
   auto with = [&](auto change) {
     RenderOptions o;
@@ -248,10 +263,14 @@ TEST_CASE("render: bad options, no surfaces, bad images and unwritable files are
   CHECK_THAT(m7, Contains("surface #1"));
 
   const fs::path missing = fs::path(CLAY_TEST_OUTPUT_DIR) / "no such folder" / "p.png";
-  auto [c8, m8] = error_of([&] { write_png(Image{16, 16, std::vector<std::uint8_t>(3 * 16 * 16)}, missing); });
+  auto [c8, m8] = error_of([&] {
+    write_png(Image{16, 16, std::vector<std::uint8_t>(3 * 16 * 16)}, missing);
+  });
   CHECK(c8 == ErrorCategory::Io);
   CHECK_THAT(m8, Contains(missing.string()));
-  auto [c9, m9] = error_of([&] { write_png(Image{16, 16, std::vector<std::uint8_t>(10)}, "x.png"); });
+  auto [c9, m9] = error_of([&] {
+    write_png(Image{16, 16, std::vector<std::uint8_t>(10)}, "x.png");
+  });
   CHECK(c9 == ErrorCategory::InvalidArgument);
   CHECK_THAT(m9, Contains("16 x 16") && Contains("768 bytes") && Contains("it has 10"));
 }

@@ -20,7 +20,8 @@ TEST_CASE("the umbrella header compiles alone and the version is the project's",
   CHECK(surface::evaluate(line, 1.0).norm() == 5);
   sketch::Sketch s;
   const auto a = s.add_point(Eigen::Vector3d(0, 0, 0)), b = s.add_point(Eigen::Vector3d(1, 0, 0));
-  CHECK(constraints::solve(s, {constraints::fixed(a), constraints::distance(a, b, 2)}).report.summary.converged());
+  CHECK(constraints::solve(s, {constraints::fixed(a), constraints::distance(a, b, 2)})
+            .report.summary.converged());
   CHECK(deform::kind_name(deform::Deformation{deform::Taper{}}) == std::string_view("taper"));
   CHECK(recipe::check_recipe(R"({"format": "clayform.recipe", "version": 1})").empty());
 }

@@ -6,16 +6,16 @@
 
 #include <clay/deform/regular.hpp>
 #include <clay/recipe/recipe.hpp>
+#include <clay/recipe/view.hpp>
 #include <clay/serve.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/tessellate.hpp>
-#include <clay/recipe/view.hpp>
 
-#include <Eigen/Geometry>
 #include <httplib.h>
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -29,10 +29,10 @@
 #include "error_of.hpp"
 
 using namespace clay::recipe;
-using clay::ErrorCategory;
-using clay::test::error_of;
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
+using clay::ErrorCategory;
+using clay::test::error_of;
 namespace surface = clay::surface;
 namespace deform = clay::deform;
 namespace fs = std::filesystem;
@@ -65,15 +65,18 @@ std::vector<float> read_floats(const fs::path& file) {
   std::vector<float> f(bytes.size() / 4);
   for (std::size_t k = 0; k < f.size(); ++k) {  // little-endian float32, whatever the host
     std::uint32_t b = 0;
-    for (int c = 3; c >= 0; --c) b = (b << 8) | static_cast<unsigned char>(bytes[4 * k + static_cast<std::size_t>(c)]);
+    for (int c = 3; c >= 0; --c)
+      b = (b << 8) | static_cast<unsigned char>(bytes[4 * k + static_cast<std::size_t>(c)]);
     std::memcpy(&f[k], &b, 4);
   }
   return f;
 }
 
-/// A full sphere of radius r about c: an exact rational revolve of a half circle (poles at v = 0, 1).
+/// A full sphere of radius r about c: an exact rational revolve of a half circle (poles at v = 0,
+/// 1).
 surface::BSplineSurface sphere(const Vector3d& c, double r) {
-  const auto half = surface::circular_arc(c, Vector3d::UnitX(), Vector3d::UnitZ(), r, -pi / 2, pi / 2);
+  const auto half =
+      surface::circular_arc(c, Vector3d::UnitX(), Vector3d::UnitZ(), r, -pi / 2, pi / 2);
   surface::Axis axis;
   axis.point = c;
   return surface::revolve(half, axis, 360.0).surface;
@@ -97,7 +100,8 @@ std::string dome_json() {
              num(20 * std::sin(0.031 * x) * std::sin(0.029 * y) + 1.0 / 3.0) + "]";
     }
   return R"({"bspline": {"degrees": [3, 3], "knots_u": [0, 0, 0, 0, 0.3, 0.55, 1, 1, 1, 1],
-            "knots_v": [0, 0, 0, 0, 0.3, 0.55, 1, 1, 1, 1], "points": [)" + pts + "]}}";
+            "knots_v": [0, 0, 0, 0, 0.3, 0.55, 1, 1, 1, 1], "points": [)" +
+         pts + "]}}";
 }
 
 /// dome, a Bezier-lattice bulge (exact), a twist (refit within 0.01 mm), a style step (curves).
@@ -107,7 +111,8 @@ std::string stages_recipe() {
       "bound": {"arc": {"center": [50, 50, 25], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0], "radius": 30, "start": 0, "end": 360}},
       "target": {"line": {"from": [35, 50, 30], "to": [65, 50, 30]}}},
     "surfaces": {
-      "dome": )" + dome_json() + R"(,
+      "dome": )" +
+         dome_json() + R"(,
       "bulged": {"deform": {"surface": "dome", "deformation": "shape"}},
       "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 0.01, "relative": false}}},
       "styled": {"deform": {"surface": "dome", "deformation": "crease"}}},
@@ -136,12 +141,14 @@ TEST_CASE("view parameters follow the knots, 8 per span, 17 to 161 in all", "[vi
   CHECK(t[16] == 0.55);
   CHECK(t.front() == 0.0);
   CHECK(t.back() == 1.0);
-  CHECK(view_parameters(surface::BSplineBasis{1, {0, 0, 1, 1}}).size() == 17);  // one span: at least 17
+  CHECK(view_parameters(surface::BSplineBasis{1, {0, 0, 1, 1}}).size() ==
+        17);  // one span: at least 17
   CHECK(view_parameters(surface::clamped_uniform_basis(3, 43)).size() == 161);  // 40 spans x 4 + 1
   CHECK(view_parameters(surface::clamped_uniform_basis(3, 400)).size() == 161);
 }
 
-TEST_CASE("a sphere's mesh has K = 1 over r squared and a mean curvature of size 1 over r", "[view]") {
+TEST_CASE("a sphere's mesh has K = 1 over r squared and a mean curvature of size 1 over r",
+          "[view]") {
   const Vector3d c(3, -2, 5);
   const double r = 40;
   const auto s = sphere(c, r);
@@ -153,7 +160,8 @@ TEST_CASE("a sphere's mesh has K = 1 over r squared and a mean curvature of size
   for (std::size_t k = 0; k < m.position.size(); ++k) {
     const Vector3d radial = (m.position[k] - c) / r;
     CHECK_THAT(radial.norm(), WithinAbs(1.0, 1e-13));
-    // the revolve's S_u x S_v points outwards here: H is then negative (it bends away from the normal)
+    // the revolve's S_u x S_v points outwards here: H is then negative (it bends away from the
+    // normal)
     worst_k = std::max(worst_k, std::abs(m.gaussian[k] - 1 / (r * r)) * r * r);
     worst_h = std::max(worst_h, std::abs(m.mean[k] + 1 / r) * r);
     CHECK_THAT(m.normal[k].norm(), WithinAbs(1.0, 1e-14));
@@ -174,7 +182,9 @@ TEST_CASE("a sphere's mesh has K = 1 over r squared and a mean curvature of size
   CHECK(worst_pole < 1e-12);
 }
 
-TEST_CASE("the view mesh is the kernel tessellator's: same grid, positions and normals, poles included", "[view]") {
+TEST_CASE(
+    "the view mesh is the kernel tessellator's: same grid, positions and normals, poles included",
+    "[view]") {
   // One tessellator (issue #19): the viewer, the PNG renderer and the glTF preview shade alike.
   for (const auto& s : {sphere(Vector3d(3, -2, 5), 40), sphere(Vector3d(0, 0, 0), 0.5)}) {
     const ViewMesh m = view_mesh(s);
@@ -194,7 +204,8 @@ TEST_CASE("the view mesh is the kernel tessellator's: same grid, positions and n
   }
 }
 
-TEST_CASE("a pole opened into a tiny ring, as a refit leaves it, is treated as degenerate", "[view]") {
+TEST_CASE("a pole opened into a tiny ring, as a refit leaves it, is treated as degenerate",
+          "[view]") {
   const Vector3d c(0, 0, 0);
   const double r = 40;
   auto s = sphere(c, r);
@@ -235,7 +246,8 @@ TEST_CASE("a cylinder's mesh has K = 0 and a mean curvature of size 1 over 2r", 
 
 TEST_CASE("a plane's mesh has K = H = 0 and the plane's normal", "[view]") {
   // a bicubic patch in the plane through o spanned by a, b, with a wavy in-plane parametrization
-  const Vector3d o(10, 20, 30), a = Vector3d(1, 2, 0.5).normalized(), b = Vector3d(-2, 1, 0).normalized();
+  const Vector3d o(10, 20, 30), a = Vector3d(1, 2, 0.5).normalized(),
+                                b = Vector3d(-2, 1, 0).normalized();
   const Vector3d n = a.cross(b).normalized();
   const auto basis = surface::clamped_uniform_basis(3, 6);
   surface::Points3 p(36, 3);
@@ -253,7 +265,8 @@ TEST_CASE("a plane's mesh has K = H = 0 and the plane's normal", "[view]") {
   }
 }
 
-TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equal the surfaces", "[view]") {
+TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equal the surfaces",
+          "[view]") {
   RunResult result = stages_run();
   const fs::path out = output_dir("view");
   write_outputs(result, out);
@@ -274,7 +287,8 @@ TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equa
   Vector3d lo = Vector3d::Constant(1e300), hi = -lo;
   // Every mesh: 36 R C bytes, positions equal to the surface evaluated at the view parameters,
   // unit normals.
-  const auto check_mesh = [&](const nlohmann::json& mesh, const surface::BSplineSurface& s, bool box) {
+  const auto check_mesh = [&](const nlohmann::json& mesh, const surface::BSplineSurface& s,
+                              bool box) {
     const auto file = mesh["file"].get<std::string>();
     referenced.insert(file);
     const int rows = mesh["rows"], cols = mesh["cols"];
@@ -289,7 +303,8 @@ TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equa
     for (int i = 0; i < rows; ++i)
       for (int jj = 0; jj < cols; ++jj) {
         const std::size_t k = static_cast<std::size_t>(i * cols + jj);
-        const Vector3d x = surface::evaluate(s, us[static_cast<std::size_t>(i)], vs[static_cast<std::size_t>(jj)]);
+        const Vector3d x =
+            surface::evaluate(s, us[static_cast<std::size_t>(i)], vs[static_cast<std::size_t>(jj)]);
         const Vector3d p(f[3 * k], f[3 * k + 1], f[3 * k + 2]);
         const Vector3d nn(f[3 * n + 3 * k], f[3 * n + 3 * k + 1], f[3 * n + 3 * k + 2]);
         worst = std::max(worst, (p - x).norm());
@@ -314,7 +329,9 @@ TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equa
     REQUIRE(x["net"]["rows"] == s.count_u());
     REQUIRE(x["net"]["cols"] == s.count_v());
     for (Eigen::Index r = 0; r < s.points.rows(); ++r)
-      for (int c = 0; c < 3; ++c) CHECK(x["net"]["points"][static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] == s.points(r, c));
+      for (int c = 0; c < 3; ++c)
+        CHECK(x["net"]["points"][static_cast<std::size_t>(r)][static_cast<std::size_t>(c)] ==
+              s.points(r, c));
   }
   // dome: a parent, no stages, its build step's figures
   CHECK(j["surfaces"][3]["stages"].empty());
@@ -330,11 +347,14 @@ TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equa
   CHECK(st0["figures"]["composition"] == "exact");
   CHECK(bulged["figures"] == st0["figures"]);
   CHECK(st0["curves"].empty());
-  for (float d : deviation_of(check_mesh(st0["after"], result.surface("bulged"), false))) CHECK(d == 0.0f);
-  for (float d : deviation_of(check_mesh(st0["before"], result.surface("dome"), false))) CHECK(d == 0.0f);
+  for (float d : deviation_of(check_mesh(st0["after"], result.surface("bulged"), false)))
+    CHECK(d == 0.0f);
+  for (float d : deviation_of(check_mesh(st0["before"], result.surface("dome"), false)))
+    CHECK(d == 0.0f);
   CHECK(st0["net_before"]["points"].size() == 36);
 
-  // spun: a refitted twist; the deviation is |fit - twist(dome)|, within the refit's tolerance and > 0
+  // spun: a refitted twist; the deviation is |fit - twist(dome)|, within the refit's tolerance and
+  // > 0
   const auto& spun = j["surfaces"][1];
   REQUIRE(spun["stages"].size() == 1);
   const auto& st1 = spun["stages"][0];
@@ -354,7 +374,9 @@ TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equa
     for (std::size_t jj = 0; jj < vs.size(); ++jj) {
       const std::size_t k = i * vs.size() + jj;
       const double expected =
-          (surface::evaluate(fit, us[i], vs[jj]) - deform::deform_point(twist, surface::evaluate(parent, us[i], vs[jj]))).norm();
+          (surface::evaluate(fit, us[i], vs[jj]) -
+           deform::deform_point(twist, surface::evaluate(parent, us[i], vs[jj])))
+              .norm();
       worst = std::max(worst, std::abs(dev[k] - expected));
       most = std::max(most, dev[k]);
     }
@@ -381,7 +403,8 @@ TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equa
       CHECK((Vector3d(p[0], p[1], p[2]) - x).norm() < 1e-12);
     }
   }
-  for (float d : deviation_of(check_mesh(st2["after"], result.surface("styled"), false))) CHECK(d == 0.0f);
+  for (float d : deviation_of(check_mesh(st2["after"], result.surface("styled"), false)))
+    CHECK(d == 0.0f);
 
   // the box of every final mesh
   for (int c = 0; c < 3; ++c) {
@@ -393,8 +416,10 @@ TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equa
   for (const auto& e : fs::directory_iterator(out / "view"))
     if (e.path().extension() == ".bin") files.insert(e.path().filename().string());
   CHECK(files == referenced);
-  RunResult parent_only = run_recipe(parse_recipe(R"({"format": "clayform.recipe", "version": 1, "name": "p",
-      "surfaces": {"dome": )" + dome_json() + R"(}, "exports": {"d": {"surfaces": ["dome"], "formats": ["step"]}}})"));
+  RunResult parent_only = run_recipe(parse_recipe(
+      R"({"format": "clayform.recipe", "version": 1, "name": "p",
+      "surfaces": {"dome": )" +
+      dome_json() + R"(}, "exports": {"d": {"surfaces": ["dome"], "formats": ["step"]}}})"));
   write_outputs(parent_only, out);
   int bins = 0;
   for (const auto& e : fs::directory_iterator(out / "view")) bins += e.path().extension() == ".bin";
@@ -411,7 +436,8 @@ struct ServedFolders {
     const fs::path base = output_dir("serve");
     run = base / "run";
     dist = base / "dist";
-    write_text(run / "view" / "manifest.json", R"({"format": "clayform.view", "version": 1})" "\n");
+    write_text(run / "view" / "manifest.json", R"({"format": "clayform.view", "version": 1})"
+                                               "\n");
     write_text(run / "view" / "000.bin", std::string("\x00\x01\x02\xff", 4));
     write_text(run / "part.glb", "glTF");
     write_text(base / "secret.txt", "not served");
@@ -423,7 +449,8 @@ struct ServedFolders {
 
 }  // namespace
 
-TEST_CASE("the view server serves the front end at the root and the run folder under run", "[view]") {
+TEST_CASE("the view server serves the front end at the root and the run folder under run",
+          "[view]") {
   const ServedFolders f;
   ServeOptions o;
   o.port = 0;
@@ -433,7 +460,8 @@ TEST_CASE("the view server serves the front end at the root and the run folder u
   CHECK(server.url() == "http://127.0.0.1:" + std::to_string(server.port()) + "/");
   server.start();
   httplib::Client client("127.0.0.1", server.port());
-  const auto get = [&](const std::string& path, int status, const std::string& type, const std::string& body) {
+  const auto get = [&](const std::string& path, int status, const std::string& type,
+                       const std::string& body) {
     INFO(path);
     auto res = client.Get(path.c_str());
     REQUIRE(res);
@@ -441,7 +469,8 @@ TEST_CASE("the view server serves the front end at the root and the run folder u
     if (!type.empty()) CHECK(res->get_header_value("Content-Type") == type);
     if (!body.empty()) CHECK(res->body == body);
   };
-  get("/run/view/manifest.json", 200, "application/json", read_text(f.run / "view" / "manifest.json"));
+  get("/run/view/manifest.json", 200, "application/json",
+      read_text(f.run / "view" / "manifest.json"));
   get("/run/view/000.bin", 200, "application/octet-stream", std::string("\x00\x01\x02\xff", 4));
   get("/run/part.glb", 200, "model/gltf-binary", "glTF");
   get("/", 200, "text/html; charset=utf-8", read_text(f.dist / "index.html"));
@@ -485,5 +514,6 @@ TEST_CASE("the view server and snapshot name the fix for what is missing", "[vie
   CHECK_THAT(message, Contains("zebra"));
   s.mode = "zebra";
   s.width = 4;
-  CHECK(error_of([&] { snapshot(f.run, f.run / "x.png", s); }).first == ErrorCategory::InvalidArgument);
+  CHECK(error_of([&] { snapshot(f.run, f.run / "x.png", s); }).first ==
+        ErrorCategory::InvalidArgument);
 }

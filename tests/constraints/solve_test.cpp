@@ -12,11 +12,11 @@
 #include "error_of.hpp"
 
 using namespace clay::constraints;
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinAbs;
 using clay::ErrorCategory;
 using clay::sketch::Sketch;
 using clay::test::error_of;
-using Catch::Matchers::Contains;
-using Catch::Matchers::WithinAbs;
 
 namespace {
 
@@ -43,13 +43,15 @@ struct Rectangle {
 Rectangle crooked_rectangle(double width = 40, double height = 25, bool fix = true) {
   Rectangle r;
   const PlaneId plane = r.sketch.add_plane({});
-  const std::vector<Eigen::Vector2d> drawn = {{0.3, -0.2}, {41.0, 0.8},  {39.5, 0.4},  {40.6, 26.1},
+  const std::vector<Eigen::Vector2d> drawn = {{0.3, -0.2},  {41.0, 0.8},  {39.5, 0.4}, {40.6, 26.1},
                                               {40.2, 24.3}, {-0.7, 25.9}, {0.5, 24.6}, {-0.4, 0.6}};
   for (const Eigen::Vector2d& p : drawn) r.corners.push_back(r.sketch.add_point(plane, p));
   for (int k = 0; k < 4; ++k)
-    r.sides.push_back(r.sketch.add_line(r.corners[static_cast<size_t>(2 * k)], r.corners[static_cast<size_t>(2 * k + 1)]));
+    r.sides.push_back(r.sketch.add_line(r.corners[static_cast<size_t>(2 * k)],
+                                        r.corners[static_cast<size_t>(2 * k + 1)]));
   for (int k = 0; k < 4; ++k)
-    r.constraints.push_back(coincident(r.corners[static_cast<size_t>(2 * k + 1)], r.corners[static_cast<size_t>((2 * k + 2) % 8)]));
+    r.constraints.push_back(coincident(r.corners[static_cast<size_t>(2 * k + 1)],
+                                       r.corners[static_cast<size_t>((2 * k + 2) % 8)]));
   r.constraints.push_back(horizontal(r.sides[0]));
   r.constraints.push_back(vertical(r.sides[1]));
   r.constraints.push_back(horizontal(r.sides[2]));
@@ -62,7 +64,9 @@ Rectangle crooked_rectangle(double width = 40, double height = 25, bool fix = tr
 
 }  // namespace
 
-TEST_CASE("a rectangle with horizontal, vertical and distance constraints has 0 DOF and exact sizes", "[constraints]") {
+TEST_CASE(
+    "a rectangle with horizontal, vertical and distance constraints has 0 DOF and exact sizes",
+    "[constraints]") {
   const Rectangle r = crooked_rectangle();
   const SolveResult result = solve(r.sketch, r.constraints);
   const SolveReport& rep = result.report;
@@ -84,7 +88,9 @@ TEST_CASE("a rectangle with horizontal, vertical and distance constraints has 0 
   CHECK_THAT(std::abs((c - b).x()), WithinAbs(0, 1e-12));
   CHECK_THAT(std::abs((d - c).y()), WithinAbs(0, 1e-12));
   for (int k = 0; k < 4; ++k)  // joints coincide exactly (substituted)
-    CHECK((at(s, r.corners[static_cast<size_t>(2 * k + 1)]) - at(s, r.corners[static_cast<size_t>((2 * k + 2) % 8)])).norm() == 0);
+    CHECK((at(s, r.corners[static_cast<size_t>(2 * k + 1)]) -
+           at(s, r.corners[static_cast<size_t>((2 * k + 2) % 8)]))
+              .norm() == 0);
   CHECK(rep.substituted > 0);
   CHECK(rep.components == 1);
 }
@@ -96,7 +102,8 @@ TEST_CASE("degrees of freedom count what is left to move", "[constraints]") {
   CHECK(solve(r.sketch, r.constraints).report.degrees_of_freedom == 3);
   Sketch free_line;
   const PlaneId plane = free_line.add_plane({});
-  const EntityId l = free_line.add_line(free_line.add_point(plane, {0, 0}), free_line.add_point(plane, {3, 1}));
+  const EntityId l =
+      free_line.add_line(free_line.add_point(plane, {0, 0}), free_line.add_point(plane, {3, 1}));
   CHECK(solve(free_line, {}).report.degrees_of_freedom == 4);
   CHECK(solve(free_line, {horizontal(l)}).report.degrees_of_freedom == 3);
   Sketch space;  // free 3D points: 3 unknowns each
@@ -104,13 +111,16 @@ TEST_CASE("degrees of freedom count what is left to move", "[constraints]") {
   CHECK(solve(space, {distance(p, q, 5)}).report.degrees_of_freedom == 5);
 }
 
-TEST_CASE("a triangle whose three angles do not sum to 180 degrees is conflicting, naming them", "[constraints]") {
+TEST_CASE("a triangle whose three angles do not sum to 180 degrees is conflicting, naming them",
+          "[constraints]") {
   Sketch s;
   const PlaneId plane = s.add_plane({});
-  const PointId a = s.add_point(plane, {0, 0}), b = s.add_point(plane, {10, 0}), c = s.add_point(plane, {4, 7});
+  const PointId a = s.add_point(plane, {0, 0}), b = s.add_point(plane, {10, 0}),
+                c = s.add_point(plane, {4, 7});
   const EntityId ab = s.add_line(a, b), bc = s.add_line(b, c), ca = s.add_line(c, a);
-  std::vector<Constraint> cs = {fixed(a), distance(a, b, 10), horizontal(ab), angle(ab, bc, 120),
-                                angle(bc, ca, 130), angle(ca, ab, 120)};  // turns sum to 370, not 360
+  std::vector<Constraint> cs = {
+      fixed(a),           distance(a, b, 10), horizontal(ab),
+      angle(ab, bc, 120), angle(bc, ca, 130), angle(ca, ab, 120)};  // turns sum to 370, not 360
   const SolveResult result = solve(s, cs);
   const SolveReport& rep = result.report;
   INFO(rep.summary.brief());
@@ -134,7 +144,8 @@ TEST_CASE("a triangle whose three angles do not sum to 180 degrees is conflictin
   CHECK_THAT(turn(at(t, c) - at(t, b), at(t, a) - at(t, c)), WithinAbs(130, 1e-8));
 }
 
-TEST_CASE("a redundant dimension is named redundant, a contradicting one conflicting", "[constraints]") {
+TEST_CASE("a redundant dimension is named redundant, a contradicting one conflicting",
+          "[constraints]") {
   Rectangle r = crooked_rectangle();
   r.constraints.push_back(distance(r.corners[4], r.corners[5], 40));  // top width again: consistent
   SolveResult result = solve(r.sketch, r.constraints);
@@ -175,7 +186,8 @@ TEST_CASE("G1 and G2 joints between B-spline curves hold to 1e-9", "[constraints
   const auto& cp2 = std::get<clay::sketch::Curve>(s.entities[1]).control_points;
   for (int joint = 1; joint <= 2; ++joint) {
     std::vector<Constraint> cs = {fixed(cp1[0]), fixed(cp1[1]), fixed(cp2.back())};
-    cs.push_back(joint == 1 ? tangent(end_of(c1), start_of(c2)) : curvature(end_of(c1), start_of(c2)));
+    cs.push_back(joint == 1 ? tangent(end_of(c1), start_of(c2))
+                            : curvature(end_of(c1), start_of(c2)));
     const SolveResult result = solve(s, cs);
     INFO(result.report.summary.brief());
     REQUIRE(result.report.summary.converged());
@@ -197,7 +209,8 @@ TEST_CASE("G1 and G2 joints between B-spline curves hold to 1e-9", "[constraints
   }
 }
 
-TEST_CASE("a line tangent to an arc, an arc of given radius and a curve end along a direction", "[constraints]") {
+TEST_CASE("a line tangent to an arc, an arc of given radius and a curve end along a direction",
+          "[constraints]") {
   Sketch s;
   const PlaneId plane = s.add_plane({});
   const PointId center = s.add_point(plane, {0, 0});
@@ -205,8 +218,8 @@ TEST_CASE("a line tangent to an arc, an arc of given radius and a curve end alon
   const EntityId arc = s.add_arc(center, a0, a1, plane);
   const PointId l0 = s.add_point(plane, {0.3, 5.2}), l1 = s.add_point(plane, {-10, 6});
   const EntityId line = s.add_line(l0, l1);
-  const SolveResult result =
-      solve(s, {fixed(center), fixed(a0), tangent(end_of(arc), start_of(line)), distance(l0, l1, 10)});
+  const SolveResult result = solve(
+      s, {fixed(center), fixed(a0), tangent(end_of(arc), start_of(line)), distance(l0, l1, 10)});
   INFO(result.report.summary.brief());
   REQUIRE(result.report.summary.converged());
   CHECK(result.report.redundant.empty());
@@ -225,7 +238,8 @@ TEST_CASE("a line tangent to an arc, an arc of given radius and a curve end alon
   const EntityId curve = sp.add_curve(clay::surface::make_curve(3, {0, 0, 0, 0, 1, 1, 1, 1}, p));
   const auto& cps = std::get<clay::sketch::Curve>(sp.entities[0]).control_points;
   const Eigen::Vector3d dir(1, 2, 2);
-  const SolveResult r2 = solve(sp, {fixed(cps[0]), fixed(cps[2]), fixed(cps[3]), end_tangent(start_of(curve), dir)});
+  const SolveResult r2 =
+      solve(sp, {fixed(cps[0]), fixed(cps[2]), fixed(cps[3]), end_tangent(start_of(curve), dir)});
   REQUIRE(r2.report.summary.converged());
   const auto d = clay::surface::derivatives(clay::sketch::curve_of(r2.sketch, curve), 0.0, 1);
   CHECK(d.d1.normalized().dot(dir.normalized()) >= 1 - 1e-15);
@@ -235,8 +249,8 @@ TEST_CASE("each planar constraint holds in an independent measurement", "[constr
   Sketch s;
   const PlaneId plane = s.add_plane(clay::sketch::make_plane({1, 2, 3}, {0, 1, 1}));
   auto pt = [&](double x, double y) { return s.add_point(plane, {x, y}); };
-  const PointId a = pt(0, 0), b = pt(10, 1), c = pt(1, 5), d = pt(9, 9), m = pt(4, 1), p = pt(3, -4),
-                q = pt(6, 7), on = pt(12, 3);
+  const PointId a = pt(0, 0), b = pt(10, 1), c = pt(1, 5), d = pt(9, 9), m = pt(4, 1),
+                p = pt(3, -4), q = pt(6, 7), on = pt(12, 3);
   const EntityId ab = s.add_line(a, b), cd = s.add_line(c, d);
   const PointId e = pt(2, 8), f = pt(2.5, 14);
   const EntityId ef = s.add_line(e, f);
@@ -245,11 +259,21 @@ TEST_CASE("each planar constraint holds in an independent measurement", "[constr
   const PointId oc = pt(24, 1);
   const PointId ac = pt(-10, 0), as = pt(-5, 0), ae = pt(-10, 5);
   const EntityId arc = s.add_arc(ac, as, ae, plane);
-  const std::vector<Constraint> cs = {
-      fixed(a), fixed(b), parallel(ab, cd), distance(c, ab, 6), equal_length(ab, cd),
-      perpendicular(ab, ef), midpoint(m, ab), symmetric(p, q, ab), point_on(on, ab),
-      fixed(cc), radius(circle, 4), point_on(oc, circle), distance(e, c, 2),
-      fixed(ac), radius(arc, 7)};
+  const std::vector<Constraint> cs = {fixed(a),
+                                      fixed(b),
+                                      parallel(ab, cd),
+                                      distance(c, ab, 6),
+                                      equal_length(ab, cd),
+                                      perpendicular(ab, ef),
+                                      midpoint(m, ab),
+                                      symmetric(p, q, ab),
+                                      point_on(on, ab),
+                                      fixed(cc),
+                                      radius(circle, 4),
+                                      point_on(oc, circle),
+                                      distance(e, c, 2),
+                                      fixed(ac),
+                                      radius(arc, 7)};
   const SolveResult result = solve(s, cs);
   INFO(result.report.summary.brief());
   REQUIRE(result.report.summary.converged());
@@ -259,10 +283,11 @@ TEST_CASE("each planar constraint holds in an independent measurement", "[constr
     const Eigen::Vector2d x = clay::sketch::to_plane(pl, at(t, id));
     return Eigen::Vector3d(x.x(), x.y(), 0);
   };
-  for (size_t i = 0; i < t.points.size(); ++i) CHECK(std::abs(clay::sketch::signed_distance(pl, t.points[i].position)) < 1e-12);
+  for (size_t i = 0; i < t.points.size(); ++i)
+    CHECK(std::abs(clay::sketch::signed_distance(pl, t.points[i].position)) < 1e-12);
   const Eigen::Vector3d u = uv(b) - uv(a), v = uv(d) - uv(c), w = uv(f) - uv(e);
   CHECK(std::abs(u.cross(v).z()) / (u.norm() * v.norm()) < 1e-10);
-  CHECK(u.dot(v) > 0);  // kept its sense
+  CHECK(u.dot(v) > 0);                                                     // kept its sense
   CHECK_THAT(u.cross(uv(c) - uv(a)).z() / u.norm(), WithinAbs(6, 1e-10));  // on the side it started
   CHECK_THAT(u.norm() - v.norm(), WithinAbs(0, 1e-10));
   CHECK(std::abs(u.dot(w)) / (u.norm() * w.norm()) < 1e-10);
@@ -303,9 +328,10 @@ TEST_CASE("a solution that turns a joint into a cusp is reported as flipped", "[
   const PointId c = s.add_point(plane, {10, 0.5}), d = s.add_point(plane, {5, 1});
   const EntityId first = s.add_line(a, b), second = s.add_line(c, d);
   // The second line starts drawn back over the first: the nearest G1 solution points backwards.
-  const SolveResult result = solve(s, {fixed(a), fixed(b), tangent(end_of(first), start_of(second)), distance(c, d, 5)});
+  const SolveResult result =
+      solve(s, {fixed(a), fixed(b), tangent(end_of(first), start_of(second)), distance(c, d, 5)});
   INFO(result.report.summary.brief());
-  REQUIRE(result.report.summary.converged());  // the equations hold ...
+  REQUIRE(result.report.summary.converged());                              // the equations hold ...
   CHECK((at(result.sketch, d) - Eigen::Vector3d(5, 0, 0)).norm() < 1e-9);  // ... as a cusp
   CHECK(result.report.flipped == std::vector<int>{2});
   CHECK_THAT(result.report.summary.message, Contains("orientation flipped for constraint #2"));
@@ -319,7 +345,8 @@ TEST_CASE("independent rectangles are separate components", "[constraints]") {
     const Rectangle r = crooked_rectangle();
     const int offset = static_cast<int>(s.points.size());
     const int eoffset = static_cast<int>(s.entities.size());
-    for (const auto& p : r.sketch.points) s.add_point(plane, {p.position.x() + 50 * k, p.position.y()});
+    for (const auto& p : r.sketch.points)
+      s.add_point(plane, {p.position.x() + 50 * k, p.position.y()});
     for (const auto& e : r.sketch.entities) {
       const auto& l = std::get<clay::sketch::Line>(e);
       s.add_line({l.start.index + offset}, {l.end.index + offset});
@@ -327,11 +354,16 @@ TEST_CASE("independent rectangles are separate components", "[constraints]") {
     for (Constraint c : r.constraints) {
       if (c.kind() == ConstraintKind::Fixed) continue;
       // The rectangle's constraints, moved to its copy's points and lines (typed alternatives).
-      if (auto* q = std::get_if<Coincident>(&c.requirement)) q->a.index += offset, q->b.index += offset;
-      else if (auto* h = std::get_if<Horizontal>(&c.requirement)) h->line.index += eoffset;
-      else if (auto* v = std::get_if<Vertical>(&c.requirement)) v->line.index += eoffset;
-      else if (auto* d = std::get_if<Distance>(&c.requirement)) d->a.index += offset, d->b.index += offset;
-      else FAIL("the rectangle uses a constraint kind this test does not move");
+      if (auto* q = std::get_if<Coincident>(&c.requirement))
+        q->a.index += offset, q->b.index += offset;
+      else if (auto* h = std::get_if<Horizontal>(&c.requirement))
+        h->line.index += eoffset;
+      else if (auto* v = std::get_if<Vertical>(&c.requirement))
+        v->line.index += eoffset;
+      else if (auto* d = std::get_if<Distance>(&c.requirement))
+        d->a.index += offset, d->b.index += offset;
+      else
+        FAIL("the rectangle uses a constraint kind this test does not move");
       cs.push_back(c);
     }
   }
@@ -354,8 +386,10 @@ TEST_CASE("bad constraints raise clay::Error naming the constraint", "[constrain
     CHECK(category == ErrorCategory::InvalidArgument);
     CHECK_THAT(message, Contains(text));
   };
-  category_and({fixed(a), distance(a, PointId{9}, 1)}, "constraint #1: refers to point #9, which does not exist");
-  category_and({horizontal(EntityId{7})}, "constraint #0: refers to entity #7, which does not exist");
+  category_and({fixed(a), distance(a, PointId{9}, 1)},
+               "constraint #1: refers to point #9, which does not exist");
+  category_and({horizontal(EntityId{7})},
+               "constraint #0: refers to entity #7, which does not exist");
   category_and({horizontal(circle)}, "circle #1 is not a line");
   category_and({horizontal(slanted)}, "needs its points in one sketch plane");
   category_and({distance(a, b, 0)}, "must be positive; use coincident");
@@ -372,33 +406,45 @@ TEST_CASE("bad constraints raise clay::Error naming the constraint", "[constrain
   CHECK_THAT(message, Contains("SolveOptions::tolerance"));
 }
 
-TEST_CASE("points on curves and arcs, equal radii, and joints across planes and 3D", "[constraints]") {
+TEST_CASE("points on curves and arcs, equal radii, and joints across planes and 3D",
+          "[constraints]") {
   Sketch s;
   const PlaneId xy = s.add_plane({});
   const PlaneId tilted = s.add_plane(clay::sketch::make_plane({0, 0, 10}, {1, 0, 1}));
   // A free 3D cubic and a point that must lie on it.
   clay::surface::Points3 cp(5, 3);
   cp << 0, 0, 0, 5, 8, 2, 12, -3, 4, 18, 6, -2, 25, 0, 1;
-  const EntityId curve = s.add_curve(clay::surface::make_curve(3, {0, 0, 0, 0, 0.4, 1, 1, 1, 1}, cp));
+  const EntityId curve =
+      s.add_curve(clay::surface::make_curve(3, {0, 0, 0, 0, 0.4, 1, 1, 1, 1}, cp));
   const std::vector<PointId> cps = std::get<clay::sketch::Curve>(s.entities[0]).control_points;
   const PointId near = s.add_point({11, 3, 5});
   // A circle and an arc of equal radius in the xy plane, a point on the arc's circle.
   const PointId cc = s.add_point(xy, {40, 0});
   const EntityId circle = s.add_circle(cc, 3, xy);
-  const PointId ac = s.add_point(xy, {60, 0}), as = s.add_point(xy, {65, 0}), ae = s.add_point(xy, {60, 5});
+  const PointId ac = s.add_point(xy, {60, 0}), as = s.add_point(xy, {65, 0}),
+                ae = s.add_point(xy, {60, 5});
   const EntityId arc = s.add_arc(ac, as, ae, xy);
   const PointId on_arc = s.add_point(xy, {57, -3});
   // A point of the tilted plane made coincident with a free point (a world-frame equation).
   const Eigen::Vector3d spot = clay::sketch::to_world(s.planes[1], {3, -1});
-  const PointId in_plane = s.add_point(tilted, {1, 1}), loose = s.add_point(spot + Eigen::Vector3d(0.5, 0.2, -0.3));
+  const PointId in_plane = s.add_point(tilted, {1, 1}),
+                loose = s.add_point(spot + Eigen::Vector3d(0.5, 0.2, -0.3));
   // A line of the tilted plane joined G1 to the 3D curve's end.
   const PointId l0 = s.add_point(tilted, {2, 2}), l1 = s.add_point(tilted, {8, 3});
   const EntityId line = s.add_line(l0, l1);
-  std::vector<Constraint> cs = {fixed(cps[0]), fixed(cps[1]), fixed(cps[2]),
-                                point_on(near, curve), fixed(cc), fixed(ac), radius(circle, 4),
-                                equal_radius(circle, arc), point_on(on_arc, arc),
-                                coincident(in_plane, loose), distance(loose, l0, 3),
-                                tangent(end_of(line), end_of(curve)), distance(l0, l1, 6)};
+  std::vector<Constraint> cs = {fixed(cps[0]),
+                                fixed(cps[1]),
+                                fixed(cps[2]),
+                                point_on(near, curve),
+                                fixed(cc),
+                                fixed(ac),
+                                radius(circle, 4),
+                                equal_radius(circle, arc),
+                                point_on(on_arc, arc),
+                                coincident(in_plane, loose),
+                                distance(loose, l0, 3),
+                                tangent(end_of(line), end_of(curve)),
+                                distance(l0, l1, 6)};
   const SolveResult result = solve(s, cs);
   INFO(result.report.summary.brief());
   REQUIRE(result.report.summary.converged());
@@ -435,7 +481,9 @@ TEST_CASE("points on curves and arcs, equal radii, and joints across planes and 
   CHECK(std::atan2(d_line.d1.cross(-d_curve.d1).norm(), d_line.d1.dot(-d_curve.d1)) < 1e-9);
   for (size_t i = 0; i < t.points.size(); ++i)
     if (!t.points[i].plane.free())
-      CHECK(std::abs(clay::sketch::signed_distance(t.planes[static_cast<size_t>(t.points[i].plane.index)], t.points[i].position)) < 1e-12);
+      CHECK(std::abs(clay::sketch::signed_distance(
+                t.planes[static_cast<size_t>(t.points[i].plane.index)], t.points[i].position)) <
+            1e-12);
 }
 
 // Issue #18: under-constrained sketches (the normal state while a stylist draws) must converge.
@@ -458,7 +506,8 @@ Sketch free_end_line(const Eigen::Vector2d& end, std::vector<Constraint>& constr
 /// A horizontal/vertical staircase of n segments (own end points, coincident joints, a length
 /// each, first point fixed) drawn off by up to ±1 mm, with the last `free` vertical constraints
 /// removed: `free` degrees of freedom.
-Sketch staircase_with_freedom(int n, int free, std::vector<Constraint>& constraints, double drawn_off = 1.0) {
+Sketch staircase_with_freedom(int n, int free, std::vector<Constraint>& constraints,
+                              double drawn_off = 1.0) {
   Sketch s;
   const PlaneId plane = s.add_plane({});
   Eigen::Vector2d corner(0, 0);
@@ -472,25 +521,34 @@ Sketch staircase_with_freedom(int n, int free, std::vector<Constraint>& constrai
   std::vector<int> verticals;
   for (int k = 0; k < n; ++k) {
     const double length = 10 + k % 3;
-    const Eigen::Vector2d next = corner + (k % 2 == 0 ? Eigen::Vector2d(length, 0) : Eigen::Vector2d(0, length));
+    const Eigen::Vector2d next =
+        corner + (k % 2 == 0 ? Eigen::Vector2d(length, 0) : Eigen::Vector2d(0, length));
     const PointId a = s.add_point(plane, corner + Eigen::Vector2d(jitter(), jitter()));
     const PointId b = s.add_point(plane, next + Eigen::Vector2d(jitter(), jitter()));
     const EntityId line = s.add_line(a, b);
-    if (k > 0) constraints.push_back(coincident(ends.back(), a));
-    else constraints.push_back(fixed(a));
+    if (k > 0)
+      constraints.push_back(coincident(ends.back(), a));
+    else
+      constraints.push_back(fixed(a));
     ends.push_back(b);
     constraints.push_back(distance(a, b, length));
-    if (k % 2 == 0) constraints.push_back(horizontal(line));
-    else verticals.push_back(static_cast<int>(constraints.size())), constraints.push_back(vertical(line));
+    if (k % 2 == 0)
+      constraints.push_back(horizontal(line));
+    else
+      verticals.push_back(static_cast<int>(constraints.size())),
+          constraints.push_back(vertical(line));
     corner = next;
   }
-  for (int k = 0; k < free; ++k) constraints.erase(constraints.begin() + verticals[verticals.size() - 1 - static_cast<size_t>(k)]);
+  for (int k = 0; k < free; ++k)
+    constraints.erase(constraints.begin() +
+                      verticals[verticals.size() - 1 - static_cast<size_t>(k)]);
   return s;
 }
 
 }  // namespace
 
-TEST_CASE("a line with a fixed start and a length converges whatever direction its free end takes", "[constraints]") {
+TEST_CASE("a line with a fixed start and a length converges whatever direction its free end takes",
+          "[constraints]") {
   // Every free-DOF direction around the circle, and ends a hair off vertical and horizontal, each
   // drawn 5 % too long or too short.
   std::vector<Eigen::Vector2d> ends;
@@ -524,32 +582,36 @@ TEST_CASE("a line with a fixed start and a length converges whatever direction i
     CHECK((at(r.sketch, PointId{1}).normalized() - drawn.normalized()).norm() < 1e-9);
     worst_iterations = std::max(worst_iterations, r.report.summary.iterations);
   }
-  CHECK(worst_iterations <= 20);  // 5 for ends drawn near the circle, 17 for one drawn 20 times too short
+  CHECK(worst_iterations <=
+        20);  // 5 for ends drawn near the circle, 17 for one drawn 20 times too short
 }
 
-TEST_CASE("staircases of up to 1,000 segments with 1 to 10 free verticals converge in few iterations", "[constraints]") {
+TEST_CASE(
+    "staircases of up to 1,000 segments with 1 to 10 free verticals converge in few iterations",
+    "[constraints]") {
   int worst_iterations = 0;
   // Drawn off by up to 1 mm, and nearly exactly (0.02 mm: the free ends then start nearly
   // vertical, where Marquardt's damping swung them).
   for (double drawn_off : {1.0, 0.02})
-  for (int n : {10, 100, 1000})
-    for (int free : {1, 2, 5, 10}) {
-      if (free > n / 2) continue;  // only the odd segments are vertical
-      std::vector<Constraint> c;
-      const Sketch s = staircase_with_freedom(n, free, c, drawn_off);
-      const SolveResult r = solve(s, c);
-      INFO(n << " segments, " << free << " DOF: " << r.report.summary.brief());
-      REQUIRE(r.report.summary.termination == clay::Termination::Converged);
-      REQUIRE(r.report.max_residual <= 1e-10);
-      CHECK(r.report.degrees_of_freedom == free);
-      // Independent check of the chain: each segment's length, joints closed.
-      for (int k = 0; k < n; ++k) {
-        const Eigen::Vector3d a = at(r.sketch, PointId{2 * k}), b = at(r.sketch, PointId{2 * k + 1});
-        CHECK_THAT((b - a).norm(), WithinAbs(10 + k % 3, 1e-10));
-        if (k > 0) CHECK((a - at(r.sketch, PointId{2 * k - 1})).norm() < 1e-10);
+    for (int n : {10, 100, 1000})
+      for (int free : {1, 2, 5, 10}) {
+        if (free > n / 2) continue;  // only the odd segments are vertical
+        std::vector<Constraint> c;
+        const Sketch s = staircase_with_freedom(n, free, c, drawn_off);
+        const SolveResult r = solve(s, c);
+        INFO(n << " segments, " << free << " DOF: " << r.report.summary.brief());
+        REQUIRE(r.report.summary.termination == clay::Termination::Converged);
+        REQUIRE(r.report.max_residual <= 1e-10);
+        CHECK(r.report.degrees_of_freedom == free);
+        // Independent check of the chain: each segment's length, joints closed.
+        for (int k = 0; k < n; ++k) {
+          const Eigen::Vector3d a = at(r.sketch, PointId{2 * k}),
+                                b = at(r.sketch, PointId{2 * k + 1});
+          CHECK_THAT((b - a).norm(), WithinAbs(10 + k % 3, 1e-10));
+          if (k > 0) CHECK((a - at(r.sketch, PointId{2 * k - 1})).norm() < 1e-10);
+        }
+        worst_iterations = std::max(worst_iterations, r.report.summary.iterations);
       }
-      worst_iterations = std::max(worst_iterations, r.report.summary.iterations);
-    }
   CHECK(worst_iterations <= 25);
 }
 
@@ -562,7 +624,8 @@ TEST_CASE("SolveOptions lists every bad field", "[solve]") {
   CHECK_THROWS_AS(o.validate(), clay::Error);
 }
 
-TEST_CASE("a constraint is a typed requirement; the factories and the structs build the same", "[constraints]") {
+TEST_CASE("a constraint is a typed requirement; the factories and the structs build the same",
+          "[constraints]") {
   const PointId a{0}, b{1};
   const Constraint made = distance(a, b, 12.5);
   const Constraint typed{Distance{a, b, 12.5}, "rig.constraints[0]"};
@@ -575,7 +638,8 @@ TEST_CASE("a constraint is a typed requirement; the factories and the structs bu
   CHECK(constraint_name(typed, 4) == "rig.constraints[0]");
   CHECK(constraint_name(made, 4) == "constraint #4");
   // Every kind is an alternative at its enum's index.
-  CHECK(static_cast<int>(end_tangent(clay::constraints::CurveEnd{}, Eigen::Vector3d::UnitX()).kind()) ==
+  CHECK(static_cast<int>(
+            end_tangent(clay::constraints::CurveEnd{}, Eigen::Vector3d::UnitX()).kind()) ==
         static_cast<int>(std::variant_size_v<Requirement>) - 1);
   CHECK(std::holds_alternative<Tangent>(tangent({}, {}).requirement));
 }

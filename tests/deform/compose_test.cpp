@@ -18,12 +18,12 @@
 #include "fixtures.hpp"
 
 using namespace clay::deform;
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinAbs;
 using clay::ErrorCategory;
 using clay::surface::BSplineBasis;
 using clay::surface::BSplineSurface;
 using clay::test::error_of;
-using Catch::Matchers::Contains;
-using Catch::Matchers::WithinAbs;
 namespace fs = std::filesystem;
 
 namespace {
@@ -66,8 +66,8 @@ BSplineSurface random_surface_in(const Frame& frame, int p, int q, int cu, int c
 /// Largest distance between the composed surface and the pointwise deformation of the original
 /// at `n` random parameters.
 template <class Map>
-double deviation(const BSplineSurface& original, const BSplineSurface& composed, const Map& map, int n,
-                 std::mt19937& rng) {
+double deviation(const BSplineSurface& original, const BSplineSurface& composed, const Map& map,
+                 int n, std::mt19937& rng) {
   const auto [u0, u1] = original.u.domain();
   const auto [v0, v1] = original.v.domain();
   std::uniform_real_distribution<double> cu(u0, u1), cv(v0, v1);
@@ -120,7 +120,8 @@ TEST_CASE("compose_exact matches the pointwise Bezier FFD on random surfaces and
     const BezierLattice lattice = clay::test::displaced(make_bezier_lattice(frame, ld), rng);
     const int p = degree(rng), q = degree(rng);
     const bool rational = c % 2 == 1;
-    const BSplineSurface s = random_surface_in(frame, p, q, p + 1 + extra(rng), q + 1 + extra(rng), rational, rng);
+    const BSplineSurface s =
+        random_surface_in(frame, p, q, p + 1 + extra(rng), q + 1 + extra(rng), rational, rng);
     const ComposeResult r = compose_exact(lattice, s);
     const double size = clay::test::size_of(lattice.points);
     const auto map = [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); };
@@ -144,7 +145,8 @@ TEST_CASE("compose_exact matches the pointwise Bezier FFD on random surfaces and
       require_round_trips(r.surface, folder, "case" + std::to_string(c));
       const auto back = clay::surface::read_step(folder / ("case" + std::to_string(c) + ".step"));
       CHECK(deviation(s, back[0], map, 100, rng) <= 1e-12 * size);
-      const auto back_iges = clay::surface::read_iges(folder / ("case" + std::to_string(c) + ".igs"));
+      const auto back_iges =
+          clay::surface::read_iges(folder / ("case" + std::to_string(c) + ".igs"));
       CHECK(deviation(s, back_iges[0], map, 100, rng) <= 1e-12 * size);
     }
   }
@@ -162,8 +164,9 @@ TEST_CASE("compose_exact degrees follow the per-direction rule") {
   SECTION("planar bicubic parallel to a lattice face: u constant, s and t general") {
     // u = 0.4 everywhere: d(u) = 0, d(s) = d(t) = 3 in both directions -> 3*3 + 3*3 + 3*0 = 18.
     for (bool rational : {false, true}) {
-      const BSplineSurface s = surface_in(frame, 3, 3, 5, 4, rational, rng,
-                                          [&](int, int) { return Eigen::Vector3d(c(rng), c(rng), 0.4); });
+      const BSplineSurface s = surface_in(frame, 3, 3, 5, 4, rational, rng, [&](int, int) {
+        return Eigen::Vector3d(c(rng), c(rng), 0.4);
+      });
       const ComposeResult r = compose_exact(tricubic, s);
       CHECK(r.report.degree_u == 18);
       CHECK(r.report.degree_v == 18);
@@ -174,8 +177,9 @@ TEST_CASE("compose_exact degrees follow the per-direction rule") {
     // s = x_i (cubic in the first parameter, constant in the second), t = y_j, u = 0.3:
     // first direction 3*3, second 3*3 -> 9 x 9.
     std::vector<double> x{0.1, 0.35, 0.4, 0.7, 0.9}, y{0.2, 0.3, 0.6, 0.8};
-    const BSplineSurface s = surface_in(frame, 3, 3, 5, 4, false, rng,
-                                        [&](int i, int j) { return Eigen::Vector3d(x[size_t(i)], y[size_t(j)], 0.3); });
+    const BSplineSurface s = surface_in(frame, 3, 3, 5, 4, false, rng, [&](int i, int j) {
+      return Eigen::Vector3d(x[size_t(i)], y[size_t(j)], 0.3);
+    });
     const ComposeResult r = compose_exact(tricubic, s);
     CHECK(r.report.degree_u == 9);
     CHECK(r.report.degree_v == 9);
@@ -186,7 +190,8 @@ TEST_CASE("compose_exact degrees follow the per-direction rule") {
     // (a, b), degree 1 in each parameter -> 3 + 3 + 3 = 9 in both directions.
     BSplineSurface s = surface_in(frame, 3, 3, 4, 4, false, rng, [&](int i, int j) {
       const double a = i / 3.0, b = j / 3.0;
-      return Eigen::Vector3d(0.1 + 0.6 * a + 0.2 * b, 0.1 + 0.2 * a + 0.6 * b, 0.2 + 0.1 * a + 0.1 * b);
+      return Eigen::Vector3d(0.1 + 0.6 * a + 0.2 * b, 0.1 + 0.2 * a + 0.6 * b,
+                             0.2 + 0.1 * a + 0.1 * b);
     });
     s.u = clay::surface::clamped_uniform_basis(3, 4);  // one Bézier patch: Greville = i/3
     s.v = clay::surface::clamped_uniform_basis(3, 4);
@@ -203,8 +208,9 @@ TEST_CASE("compose_exact degrees follow the per-direction rule") {
       const int expected = 3 * (ld[0] + ld[1] + ld[2]);
       CHECK(r.report.degree_u == expected);
       CHECK(r.report.degree_v == expected);
-      CHECK(deviation(s, r.surface, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); }, 300, rng) <=
-            1e-12 * clay::test::size_of(lattice.points));
+      CHECK(deviation(
+                s, r.surface, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); },
+                300, rng) <= 1e-12 * clay::test::size_of(lattice.points));
     }
   }
 }
@@ -227,8 +233,9 @@ TEST_CASE("compose_exact keeps a revolved rational surface exact") {
   const ComposeResult r = compose_exact(lattice, s);
   const double size = clay::test::size_of(lattice.points);
   INFO(r.report.brief());
-  CHECK(deviation(s, r.surface, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); }, 1000, rng) <=
-        1e-12 * size);
+  CHECK(deviation(
+            s, r.surface, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); }, 1000,
+            rng) <= 1e-12 * size);
   CHECK(r.surface.is_rational());
   // u around the axis (degree 2, homogeneous), v the polynomial cubic profile: s and t have
   // homogeneous degree (2, 3), u (height) depends on v only but is rational in u: (2, 3) too.
@@ -268,7 +275,8 @@ TEST_CASE("compose_exact removes knots down to the continuity of the input") {
 TEST_CASE("compose_exact with a B-spline lattice splits at knot planes met along iso-lines") {
   std::mt19937 rng(17);
   const Frame frame = clay::test::random_frame(rng);
-  const BSplineLattice lattice = clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
+  const BSplineLattice lattice =
+      clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
   const auto map = [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); };
   const double size = clay::test::size_of(lattice.points);
 
@@ -281,7 +289,8 @@ TEST_CASE("compose_exact with a B-spline lattice splits at knot planes met along
       });
       if (rational)  // product weights a_i b_j: s = Σ a_i N_i x_i / Σ a_i N_i stays a function of u
         for (int i = 0; i < 5; ++i)
-          for (int j = 0; j < 4; ++j) s.weights(s.index(i, j)) = (1.0 + 0.3 * i) * (1.5 - 0.1 * j * j);
+          for (int j = 0; j < 4; ++j)
+            s.weights(s.index(i, j)) = (1.0 + 0.3 * i) * (1.5 - 0.1 * j * j);
       const ComposeResult r = compose_exact(lattice, s);
       INFO(r.report.brief());
       CHECK(r.report.splits > 0);
@@ -312,10 +321,12 @@ TEST_CASE("compose_exact with a B-spline lattice splits at knot planes met along
 
 // Issue #18: touching a knot plane is not crossing it, and crossings closer together than any
 // sampling step are still found. The lattice has 2 cells in t: the knot plane t = 0.5.
-TEST_CASE("compose_exact with a B-spline lattice: a surface tangent to a knot plane composes exactly") {
+TEST_CASE(
+    "compose_exact with a B-spline lattice: a surface tangent to a knot plane composes exactly") {
   std::mt19937 rng(29);
   const Frame frame = clay::test::random_frame(rng);
-  const BSplineLattice lattice = clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
+  const BSplineLattice lattice =
+      clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
   const auto map = [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); };
   const double size = clay::test::size_of(lattice.points);
   // t(u, v) = base + sign 0.3 (4u(1-u)) (4v(1-v)): Bernstein coefficients of 4x(1-x) are 0, 2, 0.
@@ -335,10 +346,12 @@ TEST_CASE("compose_exact with a B-spline lattice: a surface tangent to a knot pl
     CHECK(deviation(s, r.surface, map, 1000, rng) <= 1e-12 * size);
     // The touching point itself: the lattice's two cells meet there with C^2 continuity, so both
     // sides give the same point; the composed surface must too.
-    CHECK((clay::surface::evaluate(r.surface, 0.5, 0.5) - map(clay::surface::evaluate(s, 0.5, 0.5))).norm() <=
-          1e-12 * size);
+    CHECK((clay::surface::evaluate(r.surface, 0.5, 0.5) - map(clay::surface::evaluate(s, 0.5, 0.5)))
+              .norm() <= 1e-12 * size);
   }
-  SECTION("lifted by 1e-6 the same surface crosses the plane in a tiny region: refused, with the true value") {
+  SECTION(
+      "lifted by 1e-6 the same surface crosses the plane in a tiny region: refused, with the true "
+      "value") {
     const BSplineSurface s = surface_in(frame, 2, 2, 3, 3, false, rng, [&](int i, int j) {
       return Eigen::Vector3d(0.4 + 0.05 * i, 0.2 + 1e-6 + 0.3 * f[i] * f[j], 0.3 + 0.1 * j);
     });
@@ -346,16 +359,20 @@ TEST_CASE("compose_exact with a B-spline lattice: a surface tangent to a knot pl
     CHECK(category == ErrorCategory::InvalidArgument);
     // The value is the surface's own (1e-6 above the plane), at the top of the bump.
     CHECK_THAT(what, Contains("knot plane t = 0.5") &&
-                         Catch::Matchers::Matches(".*\\(t = 0\\.50000(09|1)[0-9]* at parameter "
-                                                  "\\((0\\.5|0\\.4999)[0-9]*, (0\\.5|0\\.4999)[0-9]*\\).*"));
+                         Catch::Matchers::Matches(
+                             ".*\\(t = 0\\.50000(09|1)[0-9]* at parameter "
+                             "\\((0\\.5|0\\.4999)[0-9]*, (0\\.5|0\\.4999)[0-9]*\\).*"));
     CHECK_THAT(what, !Contains("bound"));
   }
 }
 
-TEST_CASE("compose_exact with a B-spline lattice splits at two crossings of a knot plane inside one sampling step") {
+TEST_CASE(
+    "compose_exact with a B-spline lattice splits at two crossings of a knot plane inside one "
+    "sampling step") {
   std::mt19937 rng(31);
   const Frame frame = clay::test::random_frame(rng);
-  const BSplineLattice lattice = clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
+  const BSplineLattice lattice =
+      clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
   const auto map = [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); };
   const double size = clay::test::size_of(lattice.points);
   // t(u) = 0.5 + e - k (u - m)^2 crosses t = 0.5 at m -+ 0.003, between the samples 0.5 and
@@ -372,7 +389,8 @@ TEST_CASE("compose_exact with a B-spline lattice splits at two crossings of a kn
   // Both crossings are knots of the result, within rounding of the closed form m -+ sqrt(e / k).
   const std::vector<double> breaks = clay::surface::breakpoints(r.surface.u);
   for (double root : {m - std::sqrt(e / k), m + std::sqrt(e / k)})
-    CHECK(std::any_of(breaks.begin(), breaks.end(), [&](double b) { return std::abs(b - root) < 1e-9; }));
+    CHECK(std::any_of(breaks.begin(), breaks.end(),
+                      [&](double b) { return std::abs(b - root) < 1e-9; }));
   CHECK(deviation(s, r.surface, map, 2000, rng) <= 1e-12 * size);
 }
 
@@ -398,7 +416,8 @@ TEST_CASE("compose_exact composes a polynomial taper exactly") {
   }
   // A plane perpendicular to the axis: z constant, r(z) constant, the degrees stay (3, 2).
   const Eigen::Vector3d ez = taper.frame.axis.normalized();
-  const Eigen::Vector3d ex = (Eigen::Vector3d(1, 0, 0.1) - Eigen::Vector3d(1, 0, 0.1).dot(ez) * ez).normalized();
+  const Eigen::Vector3d ex =
+      (Eigen::Vector3d(1, 0, 0.1) - Eigen::Vector3d(1, 0, 0.1).dot(ez) * ez).normalized();
   const Eigen::Vector3d ey = ez.cross(ex);
   Frame flat;
   flat.origin = taper.frame.origin + 7 * ez;
@@ -457,8 +476,9 @@ TEST_CASE("compose_exact errors name the problem and the fix") {
     CHECK(error_of([&] { compose_exact(broken, inside); }).first == ErrorCategory::InvalidGeometry);
     BSplineSurface nan = inside;
     nan.points(0, 0) = std::nan("");
-    CHECK(error_of([&] { compose_exact(make_bezier_lattice(frame, {1, 1, 1}), nan); }).first ==
-          ErrorCategory::InvalidGeometry);
+    CHECK(error_of([&] {
+            compose_exact(make_bezier_lattice(frame, {1, 1, 1}), nan);
+          }).first == ErrorCategory::InvalidGeometry);
     Taper taper;
     taper.profile.clear();
     CHECK(error_of([&] { compose_exact(taper, inside); }).first == ErrorCategory::InvalidGeometry);
@@ -477,7 +497,8 @@ TEST_CASE("ComposeReport brief states the figures") {
   CHECK(r.report.degree_u == 6);
   CHECK_THAT(r.report.brief(), Contains("degree 6 x 6") && Contains("1 patches"));
   std::mt19937 rng2(4);
-  CHECK(deviation(s, r.surface, [](const Eigen::Vector3d& p) { return p; }, 200, rng2) <= 1e-12 * 100);
+  CHECK(deviation(
+            s, r.surface, [](const Eigen::Vector3d& p) { return p; }, 200, rng2) <= 1e-12 * 100);
 }
 
 TEST_CASE("compose_exact finds lower degrees: an axis-aligned affine sheet") {
@@ -495,11 +516,13 @@ TEST_CASE("compose_exact finds lower degrees: an axis-aligned affine sheet") {
   const ComposeResult r = compose_exact(lattice, s);
   CHECK(r.report.degree_u == 6);
   CHECK(r.report.degree_v == 3);
-  CHECK(deviation(s, r.surface, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); }, 300, rng) <=
-        1e-12 * clay::test::size_of(lattice.points));
+  CHECK(deviation(
+            s, r.surface, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); }, 300,
+            rng) <= 1e-12 * clay::test::size_of(lattice.points));
 }
 
-TEST_CASE("Exact composition keeps a closed side closed and a pole a point, bit for bit", "[compose]") {
+TEST_CASE("Exact composition keeps a closed side closed and a pole a point, bit for bit",
+          "[compose]") {
   // A full revolution of a half circle whose ends lie exactly on the axis: closed in u, its
   // first and last columns collapsed to the poles.
   clay::surface::Points3 p(5, 3);
@@ -507,7 +530,8 @@ TEST_CASE("Exact composition keeps a closed side closed and a pole a point, bit 
   Eigen::VectorXd w(5);
   w << 1, std::sqrt(0.5), 1, std::sqrt(0.5), 1;
   const auto sphere =
-      clay::surface::revolve(clay::surface::make_curve(2, {0, 0, 0, 0.5, 0.5, 1, 1, 1}, p, w), {{0, 0, 0}, {0, 0, 1}}, 360)
+      clay::surface::revolve(clay::surface::make_curve(2, {0, 0, 0, 0.5, 0.5, 1, 1, 1}, p, w),
+                             {{0, 0, 0}, {0, 0, 1}}, 360)
           .surface;
   Frame f;
   f.origin = {-40, -40, -40};
@@ -524,7 +548,8 @@ TEST_CASE("Exact composition keeps a closed side closed and a pole a point, bit 
     CHECK(s.points.row(s.index(0, j)) == s.points.row(s.index(mu - 1, j)));
     CHECK(s.weights[s.index(0, j)] == s.weights[s.index(mu - 1, j)]);
   }
-  const Eigen::RowVector3d south = deform_point(lattice, sphere.points.row(0).transpose()).transpose();
+  const Eigen::RowVector3d south =
+      deform_point(lattice, sphere.points.row(0).transpose()).transpose();
   const Eigen::RowVector3d north =
       deform_point(lattice, sphere.points.row(sphere.count_v() - 1).transpose()).transpose();
   for (int i = 0; i < mu; ++i) {

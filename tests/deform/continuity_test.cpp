@@ -14,7 +14,9 @@ using clay::test::random_frame;
 
 namespace {
 
-int count_locked(const std::vector<bool>& v) { return static_cast<int>(std::count(v.begin(), v.end(), true)); }
+int count_locked(const std::vector<bool>& v) {
+  return static_cast<int>(std::count(v.begin(), v.end(), true));
+}
 
 /// Largest |dX_fd/dX − I| over points on the face s = 0 (analytic derivative), and over the same
 /// points by central differences straddling the face (identity outside, lattice inside).
@@ -29,7 +31,8 @@ std::pair<double, double> derivative_jump_on_s_min(const Lattice& L, std::mt1993
     const Eigen::Vector3d x = L.frame.point(0.0, c(rng), c(rng));
     analytic = std::max(analytic, (jacobian_matrix(L, x) - Eigen::Matrix3d::Identity()).norm());
     // Across the face: the derivative along the face normal, from both sides at once.
-    const Eigen::Vector3d d = (deform_point(L, x + h * normal) - deform_point(L, x - h * normal)) / (2 * h);
+    const Eigen::Vector3d d =
+        (deform_point(L, x + h * normal) - deform_point(L, x - h * normal)) / (2 * h);
     differences = std::max(differences, (d - normal).norm());
   }
   return {analytic, differences};
@@ -53,7 +56,8 @@ TEST_CASE("locked planes: face plane and k more for Bezier and clamped lattices"
   const FaceContinuity t2[] = {{Face::TMax, 2}};
   CHECK(count_locked(locked_control_points(S, t2)) == 3 * 49);
   // Unclamped uniform knots: every function of the first span touches the face, so p planes.
-  const BSplineLattice U = make_bspline_lattice(random_frame(rng), {3, 3, 3}, {4, 4, 4}, LatticeKnots::Uniform);
+  const BSplineLattice U =
+      make_bspline_lattice(random_frame(rng), {3, 3, 3}, {4, 4, 4}, LatticeKnots::Uniform);
   const FaceContinuity u0[] = {{Face::UMin, 0}};
   CHECK(count_locked(locked_control_points(U, u0)) == 3 * 49);
 }
@@ -62,7 +66,8 @@ TEST_CASE("local C1 deformation matches the undeformed space across the fixed fa
   std::mt19937 rng(12);
   const FaceContinuity faces[] = {{Face::SMin, 1}, {Face::TMax, 1}};
   {
-    const BezierLattice free = clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 3, 3}), rng, 0.2);
+    const BezierLattice free =
+        clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 3, 3}), rng, 0.2);
     const BezierLattice local = with_continuity(free, faces);
     const auto [analytic, differences] = derivative_jump_on_s_min(local, rng);
     INFO("Bezier: analytic " << analytic << ", differences " << differences);
@@ -72,8 +77,8 @@ TEST_CASE("local C1 deformation matches the undeformed space across the fixed fa
     CHECK(derivative_jump_on_s_min(free, rng).first > 1e-3);
   }
   for (LatticeKnots knots : {LatticeKnots::Clamped, LatticeKnots::Uniform}) {
-    const BSplineLattice free =
-        clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 2, 3}, {3, 4, 2}, knots), rng, 0.2);
+    const BSplineLattice free = clay::test::displaced(
+        make_bspline_lattice(random_frame(rng), {3, 2, 3}, {3, 4, 2}, knots), rng, 0.2);
     const BSplineLattice local = with_continuity(free, faces);
     const auto [analytic, differences] = derivative_jump_on_s_min(local, rng);
     INFO("B-spline: analytic " << analytic << ", differences " << differences);
@@ -86,8 +91,8 @@ TEST_CASE("local C1 deformation matches the undeformed space across the fixed fa
 TEST_CASE("C0 keeps positions but not derivatives on the face", "[deform]") {
   std::mt19937 rng(13);
   const FaceContinuity c0[] = {{Face::UMin, 0}};
-  const BezierLattice L =
-      with_continuity(clay::test::displaced(make_bezier_lattice(random_frame(rng), {2, 2, 3}), rng, 0.2), c0);
+  const BezierLattice L = with_continuity(
+      clay::test::displaced(make_bezier_lattice(random_frame(rng), {2, 2, 3}), rng, 0.2), c0);
   std::uniform_real_distribution<double> c(0.0, 1.0);
   double jump = 0;
   for (int n = 0; n < 30; ++n) {

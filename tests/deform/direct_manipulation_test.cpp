@@ -79,7 +79,8 @@ void check_minimal_norm(const Lattice& lattice, std::mt19937& rng, int count) {
   const Points3 x = sample_points(lattice.frame, rng, count, 0.1, 0.9);
   std::uniform_real_distribution<double> c(-5.0, 5.0);
   Points3 targets = images_of(lattice, x);
-  for (Eigen::Index i = 0; i < targets.rows(); ++i) targets.row(i) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
+  for (Eigen::Index i = 0; i < targets.rows(); ++i)
+    targets.row(i) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
   const auto moves = moves_of(x, targets);
   const auto result = manipulate(lattice, moves);
   INFO(result.report.brief());
@@ -111,7 +112,8 @@ void check_minimal_norm(const Lattice& lattice, std::mt19937& rng, int count) {
 
 }  // namespace
 
-TEST_CASE("influence matrix equals the unit-displacement construction and sums to one", "[deform]") {
+TEST_CASE("influence matrix equals the unit-displacement construction and sums to one",
+          "[deform]") {
   std::mt19937 rng(41);
   const BSplineLattice s = make_bspline_lattice(random_frame(rng), {3, 2, 3}, {2, 3, 2});
   const Points3 x = sample_points(s.frame, rng, 7);
@@ -124,7 +126,8 @@ TEST_CASE("influence matrix equals the unit-displacement construction and sums t
 
   const BezierLattice z = make_bezier_lattice(random_frame(rng), {2, 3, 1});
   const Points3 y = sample_points(z.frame, rng, 5);
-  CHECK((Eigen::MatrixXd(influence_matrix(z, y)) - dense_influence(z, y)).cwiseAbs().maxCoeff() < 1e-14);
+  CHECK((Eigen::MatrixXd(influence_matrix(z, y)) - dense_influence(z, y)).cwiseAbs().maxCoeff() <
+        1e-14);
 }
 
 TEST_CASE("one point moves by the closed form of eq. 4", "[deform]") {
@@ -138,7 +141,8 @@ TEST_CASE("one point moves by the closed form of eq. 4", "[deform]") {
   // Hsu eq. (4): B⁺ = Bᵀ / |B|², so ΔP = Bᵀ Δq / |B|².
   const Eigen::VectorXd b = dense_influence(lattice, x).row(0).transpose();
   const Eigen::MatrixXd expected = b * Eigen::RowVector3d(3.0, -2.0, 4.0) / b.squaredNorm();
-  CHECK((Eigen::MatrixXd(result.lattice.points - lattice.points) - expected).cwiseAbs().maxCoeff() < 1e-12);
+  CHECK((Eigen::MatrixXd(result.lattice.points - lattice.points) - expected).cwiseAbs().maxCoeff() <
+        1e-12);
   CHECK((deform_point(result.lattice, move.point) - move.target).norm() < 1e-10);
   CHECK_THAT(result.report.displacement_norm, WithinAbs(std::sqrt(29.0) / b.norm(), 1e-10));
 }
@@ -146,17 +150,20 @@ TEST_CASE("one point moves by the closed form of eq. 4", "[deform]") {
 TEST_CASE("feasible requests reach their targets with the least displacement", "[deform]") {
   std::mt19937 rng(43);
   SECTION("B-spline lattice, 9 points") {
-    check_minimal_norm(clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 2}, {2, 3, 2}), rng),
-                       rng, 9);
+    check_minimal_norm(
+        clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 2}, {2, 3, 2}), rng),
+        rng, 9);
   }
   SECTION("uniform-knot B-spline lattice, 5 points") {
-    check_minimal_norm(clay::test::displaced(make_bspline_lattice(random_frame(rng, true), {2, 2, 2}, {3, 2, 3},
-                                                                  LatticeKnots::Uniform),
-                                             rng),
-                       rng, 5);
+    check_minimal_norm(
+        clay::test::displaced(make_bspline_lattice(random_frame(rng, true), {2, 2, 2}, {3, 2, 3},
+                                                   LatticeKnots::Uniform),
+                              rng),
+        rng, 5);
   }
   SECTION("Bezier lattice, 6 points") {
-    check_minimal_norm(clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 2, 3}), rng), rng, 6);
+    check_minimal_norm(
+        clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 2, 3}), rng), rng, 6);
   }
 }
 
@@ -194,13 +201,16 @@ TEST_CASE("the same point pulled to two targets gets the least-squares compromis
   CHECK((repeated.lattice.points - single.lattice.points).cwiseAbs().maxCoeff() < 1e-10);
 }
 
-TEST_CASE("an over-determined request reports the least-squares residual of a dense solve", "[deform]") {
+TEST_CASE("an over-determined request reports the least-squares residual of a dense solve",
+          "[deform]") {
   std::mt19937 rng(45);
-  const BezierLattice lattice = clay::test::displaced(make_bezier_lattice(random_frame(rng), {1, 1, 1}), rng);
+  const BezierLattice lattice =
+      clay::test::displaced(make_bezier_lattice(random_frame(rng), {1, 1, 1}), rng);
   const Points3 x = sample_points(lattice.frame, rng, 12, 0.05, 0.95);
   std::uniform_real_distribution<double> c(-3.0, 3.0);
   Points3 targets = images_of(lattice, x);
-  for (Eigen::Index i = 0; i < targets.rows(); ++i) targets.row(i) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
+  for (Eigen::Index i = 0; i < targets.rows(); ++i)
+    targets.row(i) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
   const auto result = manipulate(lattice, moves_of(x, targets));
   CHECK(result.report.rank == 8);
   CHECK(result.report.unknowns == 8);
@@ -209,7 +219,8 @@ TEST_CASE("an over-determined request reports the least-squares residual of a de
   const Eigen::MatrixXd dq = targets - images_of(lattice, x);
   const Eigen::MatrixXd dp = svd_solve(b, dq);
   CHECK_THAT(result.report.residual, WithinAbs((b * dp - dq).norm(), 1e-10));
-  CHECK((Eigen::MatrixXd(result.lattice.points - lattice.points) - dp).cwiseAbs().maxCoeff() < 1e-10);
+  CHECK((Eigen::MatrixXd(result.lattice.points - lattice.points) - dp).cwiseAbs().maxCoeff() <
+        1e-10);
   const Eigen::MatrixXd reached = images_of(lattice, x) + b * dp;
   CHECK((Eigen::MatrixXd(images_of(result.lattice, x)) - reached).cwiseAbs().maxCoeff() < 1e-10);
   CHECK_THAT(result.report.achieved_max_error,
@@ -248,14 +259,16 @@ TEST_CASE("locked control points keep their positions bit for bit", "[deform]") 
   for (size_t k = 0; k < free.size(); ++k) bf.col(static_cast<Eigen::Index>(k)) = b.col(free[k]);
   const Eigen::MatrixXd dp = svd_solve(bf, Eigen::MatrixXd(targets - images_of(lattice, x)));
   for (size_t k = 0; k < free.size(); ++k)
-    CHECK((result.lattice.points.row(free[k]) - lattice.points.row(free[k]) - dp.row(static_cast<Eigen::Index>(k)))
+    CHECK((result.lattice.points.row(free[k]) - lattice.points.row(free[k]) -
+           dp.row(static_cast<Eigen::Index>(k)))
               .norm() < 1e-10);
 
   SECTION("a point moved only by locked control points stays, and says so") {
     // On the face s = 0 only the face plane acts (clamped knots), and it is locked; eq. (1)
     // rounds s to about 1e-17, so the free plane i = 2 acts with weights ~s² (not a 1e34 move).
-    const PointMove on_face{lattice.frame.point(0.0, 0.5, 0.5),
-                            deform_point(lattice, lattice.frame.point(0.0, 0.5, 0.5)) + Eigen::Vector3d(1, 0, 0)};
+    const PointMove on_face{
+        lattice.frame.point(0.0, 0.5, 0.5),
+        deform_point(lattice, lattice.frame.point(0.0, 0.5, 0.5)) + Eigen::Vector3d(1, 0, 0)};
     const auto stuck = manipulate(lattice, std::span(&on_face, 1), options);
     CHECK(stuck.report.rank == 0);
     CHECK_FALSE(stuck.report.feasible);
@@ -287,7 +300,8 @@ TEST_CASE("tied control points move together, minimal norm over B S", "[deform]"
   CHECK(worst_miss(result.lattice, x, targets) < 1e-10);
   const Points3 dp = result.lattice.points - lattice.points;
   for (size_t g = 0; g < 2; ++g)
-    for (const Eigen::Index r : options.tied[g]) CHECK((dp.row(r) - dp.row(options.tied[g][0])).norm() < 1e-12);
+    for (const Eigen::Index r : options.tied[g])
+      CHECK((dp.row(r) - dp.row(options.tied[g][0])).norm() < 1e-12);
   CHECK(dp.row(lattice.index(0, 0, 0)).norm() == 0.0);
   CHECK(dp.row(lattice.index(1, 2, 2)).norm() == 0.0);
   CHECK(dp.row(lattice.index(2, 2, 2)).norm() > 0.0);
@@ -303,13 +317,15 @@ TEST_CASE("tied control points move together, minimal norm over B S", "[deform]"
   for (size_t c = 0; c < unknowns.size(); ++c)
     for (const Eigen::Index r : unknowns[c]) s(r, static_cast<Eigen::Index>(c)) = 1.0;
   const Eigen::MatrixXd b = dense_influence(lattice, x);
-  const Eigen::MatrixXd expected = s * svd_solve(b * s, Eigen::MatrixXd(targets - images_of(lattice, x)));
+  const Eigen::MatrixXd expected =
+      s * svd_solve(b * s, Eigen::MatrixXd(targets - images_of(lattice, x)));
   CHECK((Eigen::MatrixXd(dp) - expected).cwiseAbs().maxCoeff() < 1e-10);
 }
 
 TEST_CASE("a manipulator factorizes once and follows dragged targets", "[deform]") {
   std::mt19937 rng(48);
-  const BezierLattice lattice = clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 3, 3}), rng);
+  const BezierLattice lattice =
+      clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 3, 3}), rng);
   const Points3 x = sample_points(lattice.frame, rng, 4, 0.1, 0.9);
   const DirectManipulator<BezierLattice> drag(lattice, x);
   CHECK(drag.rank() == 4);
@@ -332,7 +348,9 @@ TEST_CASE("a manipulator factorizes once and follows dragged targets", "[deform]
   copy.reset();
   Points3 targets = drag.images();
   targets.col(0).array() -= 0.75;
-  CHECK((second.move(targets).lattice.points - drag.move(targets).lattice.points).cwiseAbs().maxCoeff() == 0.0);
+  CHECK((second.move(targets).lattice.points - drag.move(targets).lattice.points)
+            .cwiseAbs()
+            .maxCoeff() == 0.0);
   CHECK(second.rank() == drag.rank());
 }
 
@@ -350,7 +368,8 @@ TEST_CASE("direct manipulation rejects bad requests naming the culprit", "[defor
     auto [category, what] = error_of([&] { manipulate(lattice, bad_point); });
     CHECK(category == ErrorCategory::InvalidArgument);
     CHECK_THAT(what, Contains("selected point #0") && Contains("not finite"));
-    const PointMove bad_target[] = {{{0.5, 0.5, 0.5}, {0.5, 0.5, 0.6}}, {{0.4, 0.5, 0.5}, {0.5, nan, 0.6}}};
+    const PointMove bad_target[] = {{{0.5, 0.5, 0.5}, {0.5, 0.5, 0.6}},
+                                    {{0.4, 0.5, 0.5}, {0.5, nan, 0.6}}};
     CHECK_THAT(error_of([&] { manipulate(lattice, bad_target); }).second,
                Contains("target #1") && Contains("not finite"));
   }
@@ -379,7 +398,8 @@ TEST_CASE("direct manipulation rejects bad requests naming the culprit", "[defor
     o.tied = {{3}};
     CHECK_THAT(error_of([&] { o.validate(); }).second, Contains("tied[0] has 1 control point"));
     o.tied = {{3, 4}, {5, 4}};
-    CHECK_THAT(error_of([&] { o.validate(); }).second, Contains("tied[1] holds the row 4") && Contains("already tied"));
+    CHECK_THAT(error_of([&] { o.validate(); }).second,
+               Contains("tied[1] holds the row 4") && Contains("already tied"));
     o.tied = {{3, -1}};
     CHECK_THAT(error_of([&] { o.validate(); }).second, Contains("row -1"));
     o.tied = {{3, 64}};
@@ -406,8 +426,9 @@ TEST_CASE("docs snippet: lift one point and pin another with the bottom kept C1"
   const FaceContinuity keep[] = {{Face::UMin, 1}};
   DirectManipulationOptions options;
   options.locked = locked_control_points(lattice, keep);
-  const PointMove moves[] = {{frame.point(0.5, 0.5, 0.9), frame.point(0.5, 0.5, 0.9) + Eigen::Vector3d(0, 0, 12)},
-                             {frame.point(0.3, 0.7, 0.9), frame.point(0.3, 0.7, 0.9)}};
+  const PointMove moves[] = {
+      {frame.point(0.5, 0.5, 0.9), frame.point(0.5, 0.5, 0.9) + Eigen::Vector3d(0, 0, 12)},
+      {frame.point(0.3, 0.7, 0.9), frame.point(0.3, 0.7, 0.9)}};
   const auto [moved, report] = manipulate(lattice, moves, options);
   INFO(report.brief());
   CHECK(report.feasible);
@@ -416,6 +437,7 @@ TEST_CASE("docs snippet: lift one point and pin another with the bottom kept C1"
   for (size_t r = 0; r < options.locked.size(); ++r)
     if (options.locked[r])
       CHECK((moved.points.row(static_cast<Eigen::Index>(r)).array() ==
-             lattice.points.row(static_cast<Eigen::Index>(r)).array()).all());
+             lattice.points.row(static_cast<Eigen::Index>(r)).array())
+                .all());
   CHECK_THAT(report.brief(), Contains("feasible: 2 points, rank 2"));
 }

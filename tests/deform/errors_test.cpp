@@ -9,9 +9,9 @@
 #include "error_of.hpp"
 
 using namespace clay::deform;
+using Catch::Matchers::Contains;
 using clay::ErrorCategory;
 using clay::test::error_of;
-using Catch::Matchers::Contains;
 
 TEST_CASE("a zero-volume frame is rejected", "[deform]") {
   Frame f;
@@ -19,7 +19,9 @@ TEST_CASE("a zero-volume frame is rejected", "[deform]") {
   const auto [category, what] = error_of([&] { make_bezier_lattice(f, {2, 2, 2}); });
   CHECK(category == ErrorCategory::InvalidGeometry);
   CHECK_THAT(what, Contains("coplanar") && Contains("zero volume") && Contains("independent edge"));
-  CHECK(error_of([&] { make_bspline_lattice(f, {3, 3, 3}, {2, 2, 2}); }).first == ErrorCategory::InvalidGeometry);
+  CHECK(error_of([&] {
+          make_bspline_lattice(f, {3, 3, 3}, {2, 2, 2});
+        }).first == ErrorCategory::InvalidGeometry);
 }
 
 TEST_CASE("a degree below one is rejected", "[deform]") {
@@ -39,7 +41,8 @@ TEST_CASE("a wrong control point count is rejected", "[deform]") {
   CHECK_THAT(what, Contains("124 control points") && Contains("5 x 5 x 5 = 125"));
 }
 
-TEST_CASE("non-finite values are rejected naming the control point or the frame vector", "[deform]") {
+TEST_CASE("non-finite values are rejected naming the control point or the frame vector",
+          "[deform]") {
   BezierLattice L = make_bezier_lattice(Frame{}, {2, 3, 1});
   L.points(L.index(1, 2, 0), 1) = std::numeric_limits<double>::quiet_NaN();
   const auto [category, what] = error_of([&] { jacobian_bounds(L); });
@@ -56,7 +59,9 @@ TEST_CASE("bad options and arguments are rejected naming the field", "[deform]")
   const auto [category, what] = error_of([&] { deform_points(L, p, DeformOptions{-1}); });
   CHECK(category == ErrorCategory::InvalidArgument);
   CHECK_THAT(what, Contains("DeformOptions::threads = -1") && Contains("0 <= threads"));
-  CHECK_THAT(error_of([] { make_bspline_lattice(Frame{}, {3, 3, 3}, {2, 0, 2}); }).second,
+  CHECK_THAT(error_of([] {
+               make_bspline_lattice(Frame{}, {3, 3, 3}, {2, 0, 2});
+             }).second,
              Contains("cells along t = 0"));
   const FaceContinuity too_smooth[] = {{Face::TMin, 4}};
   CHECK_THAT(error_of([&] { locked_control_points(L, too_smooth); }).second,
@@ -90,7 +95,8 @@ TEST_CASE("Options structs list every bad field, not only the first", "[deform][
   CHECK_THAT(list[2], Contains("certificate_share = 2"));
   const auto [category, what] = error_of([&] { refit.validate(); });
   CHECK(category == ErrorCategory::InvalidArgument);
-  CHECK_THAT(what, Contains("degree = 0") && Contains("tolerance = -1") && Contains("certificate_share = 2"));
+  CHECK_THAT(what, Contains("degree = 0") && Contains("tolerance = -1") &&
+                       Contains("certificate_share = 2"));
   CHECK(RefitOptions{}.problems().empty());
 
   // Nested options: the parts' problems are gathered too.

@@ -13,9 +13,9 @@
 #include "error_of.hpp"
 
 using namespace clay::deform;
+using Catch::Matchers::Contains;
 using clay::ErrorCategory;
 using clay::test::error_of;
-using Catch::Matchers::Contains;
 using Vec3 = Eigen::Vector3d;
 
 static_assert(PointDeformation<ExtendedLattice>);
@@ -34,9 +34,11 @@ Vec3 de_casteljau(const Points3& control, const Chunk& chunk, const Vec3& uvw) {
     return a[0];
   };
   std::array<Vec3, 16> w;
-  for (int ij = 0; ij < 16; ++ij) w[static_cast<size_t>(ij)] = reduce(&p[static_cast<size_t>(ij * 4)], 1, uvw[2]);
+  for (int ij = 0; ij < 16; ++ij)
+    w[static_cast<size_t>(ij)] = reduce(&p[static_cast<size_t>(ij * 4)], 1, uvw[2]);
   std::array<Vec3, 4> v;
-  for (int i = 0; i < 4; ++i) v[static_cast<size_t>(i)] = reduce(&w[static_cast<size_t>(i * 4)], 1, uvw[1]);
+  for (int i = 0; i < 4; ++i)
+    v[static_cast<size_t>(i)] = reduce(&w[static_cast<size_t>(i * 4)], 1, uvw[1]);
   return reduce(v.data(), 1, uvw[0]);
 }
 
@@ -75,14 +77,18 @@ Points3 cylinder_points(const CylinderSpec& s, std::mt19937& rng, int random_cou
   std::uniform_real_distribution<double> unit(0, 1);
   std::vector<Vec3> p;
   for (int n = 0; n < random_count; ++n)
-    p.push_back(c.at(s.radius * std::sqrt(unit(rng)), 2 * std::numbers::pi * unit(rng), s.height * unit(rng)));
-  for (int n = 0; n <= 40; ++n) p.push_back(c.at(0, 0, s.height * n / 40));           // axis
-  for (int n = 0; n <= 40; ++n) p.push_back(c.at(s.radius * unit(rng), 0, s.height * unit(rng)));  // seam
-  for (int n = 0; n < 60; ++n)                                                        // sector faces
-    p.push_back(c.at(s.radius * unit(rng), 2 * std::numbers::pi * (n % s.sectors) / s.sectors, s.height * unit(rng)));
-  for (int n = 0; n < 40; ++n)                                                        // end discs
-    p.push_back(c.at(s.radius * std::sqrt(unit(rng)), 2 * std::numbers::pi * unit(rng), n % 2 ? s.height : 0.0));
-  for (int n = 0; n < 40; ++n)                                                        // mantle
+    p.push_back(c.at(s.radius * std::sqrt(unit(rng)), 2 * std::numbers::pi * unit(rng),
+                     s.height * unit(rng)));
+  for (int n = 0; n <= 40; ++n) p.push_back(c.at(0, 0, s.height * n / 40));  // axis
+  for (int n = 0; n <= 40; ++n)
+    p.push_back(c.at(s.radius * unit(rng), 0, s.height * unit(rng)));  // seam
+  for (int n = 0; n < 60; ++n)                                         // sector faces
+    p.push_back(c.at(s.radius * unit(rng), 2 * std::numbers::pi * (n % s.sectors) / s.sectors,
+                     s.height * unit(rng)));
+  for (int n = 0; n < 40; ++n)  // end discs
+    p.push_back(c.at(s.radius * std::sqrt(unit(rng)), 2 * std::numbers::pi * unit(rng),
+                     n % 2 ? s.height : 0.0));
+  for (int n = 0; n < 40; ++n)  // mantle
     p.push_back(c.at(s.radius, 2 * std::numbers::pi * unit(rng), s.height * unit(rng)));
   p.push_back(c.at(1e-9, 0.3, 10));  // a hair off the axis
   Points3 out(static_cast<Eigen::Index>(p.size()), 3);
@@ -90,7 +96,9 @@ Points3 cylinder_points(const CylinderSpec& s, std::mt19937& rng, int random_cou
   return out;
 }
 
-double size_of(const Points3& p) { return (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm(); }
+double size_of(const Points3& p) {
+  return (p.colwise().maxCoeff() - p.colwise().minCoeff()).norm();
+}
 
 /// One chunk whose control point (i, j, k) is f(i / 3, j / 3, k / 3).
 template <class F>
@@ -111,7 +119,9 @@ Points3 rest_samples(const ExtendedLattice& L, std::mt19937& rng, int n) {
   std::uniform_real_distribution<double> unit(0, 1);
   std::uniform_int_distribution<size_t> pick(0, L.chunks.size() - 1);
   Points3 p(n, 3);
-  for (int r = 0; r < n; ++r) p.row(r) = de_casteljau(L.rest, L.chunks[pick(rng)], Vec3(unit(rng), unit(rng), unit(rng))).transpose();
+  for (int r = 0; r < n; ++r)
+    p.row(r) = de_casteljau(L.rest, L.chunks[pick(rng)], Vec3(unit(rng), unit(rng), unit(rng)))
+                   .transpose();
   return p;
 }
 
@@ -128,9 +138,12 @@ Identity identity_errors(const ExtendedLattice& L, const Points3& p, const Froze
     const FrozenPoint& q = f.points[static_cast<size_t>(r)];
     REQUIRE(q.chunk >= 0);
     const Vec3 x = p.row(r).transpose();
-    id.rest_map = std::max(id.rest_map, (de_casteljau(L.rest, L.chunks[static_cast<size_t>(q.chunk)], q.uvw) - x).norm());
+    id.rest_map =
+        std::max(id.rest_map,
+                 (de_casteljau(L.rest, L.chunks[static_cast<size_t>(q.chunk)], q.uvw) - x).norm());
     id.evaluated = std::max(id.evaluated, (back.row(r) - p.row(r)).norm());
-    for (int d = 0; d < 3; ++d) id.outside_cube = std::max({id.outside_cube, -q.uvw[d], q.uvw[d] - 1});
+    for (int d = 0; d < 3; ++d)
+      id.outside_cube = std::max({id.outside_cube, -q.uvw[d], q.uvw[d] - 1});
   }
   return id;
 }
@@ -138,7 +151,8 @@ Identity identity_errors(const ExtendedLattice& L, const Points3& p, const Froze
 /// Every control point moved by up to `amount` mm at random.
 ExtendedLattice displaced(ExtendedLattice L, std::mt19937& rng, double amount) {
   std::uniform_real_distribution<double> c(-amount, amount);
-  for (Eigen::Index r = 0; r < L.points.rows(); ++r) L.points.row(r) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
+  for (Eigen::Index r = 0; r < L.points.rows(); ++r)
+    L.points.row(r) += Eigen::RowVector3d(c(rng), c(rng), c(rng));
   return L;
 }
 
@@ -168,14 +182,17 @@ TEST_CASE("a cylindrical lattice welds its seam and merges its axis points", "[d
   const Chunk& last = L.chunks[static_cast<size_t>((0 * s.sectors + s.sectors - 1) * s.layers)];
   const Chunk& first = L.chunks[0];
   for (int i = 0; i < 4; ++i)
-    for (int k = 0; k < 4; ++k) CHECK(last[static_cast<size_t>((i * 4 + 3) * 4 + k)] == first[static_cast<size_t>((i * 4 + 0) * 4 + k)]);
+    for (int k = 0; k < 4; ++k)
+      CHECK(last[static_cast<size_t>((i * 4 + 3) * 4 + k)] ==
+            first[static_cast<size_t>((i * 4 + 0) * 4 + k)]);
   // A tube (inner radius > 0) merges nothing.
   CylinderSpec tube = s;
   tube.inner_radius = 10;
   CHECK(make_cylindrical_lattice(tube).rest.rows() == nI * nJ * nK);
 }
 
-TEST_CASE("freezing then re-evaluating an undisplaced cylindrical lattice returns every point", "[deform]") {
+TEST_CASE("freezing then re-evaluating an undisplaced cylindrical lattice returns every point",
+          "[deform]") {
   std::mt19937 rng(61);
   const CylinderSpec s = cylinder();
   const ExtendedLattice L = make_cylindrical_lattice(s);
@@ -206,7 +223,8 @@ TEST_CASE("freezing then re-evaluating an undisplaced cylindrical lattice return
   }
 }
 
-TEST_CASE("a displaced extended lattice deforms like de Casteljau at the frozen parameters", "[deform]") {
+TEST_CASE("a displaced extended lattice deforms like de Casteljau at the frozen parameters",
+          "[deform]") {
   std::mt19937 rng(62);
   const CylinderSpec s = cylinder();
   const ExtendedLattice L = displaced(make_cylindrical_lattice(s), rng, 4.0);
@@ -217,23 +235,29 @@ TEST_CASE("a displaced extended lattice deforms like de Casteljau at the frozen 
   for (Eigen::Index r = 0; r < p.rows(); ++r) {
     const FrozenPoint& q = f.points[static_cast<size_t>(r)];
     REQUIRE(q.chunk >= 0);
-    worst = std::max(worst, (moved.row(r).transpose() - de_casteljau(L.points, L.chunks[static_cast<size_t>(q.chunk)], q.uvw)).norm());
+    worst = std::max(worst, (moved.row(r).transpose() -
+                             de_casteljau(L.points, L.chunks[static_cast<size_t>(q.chunk)], q.uvw))
+                                .norm());
   }
   INFO("largest difference to de Casteljau " << worst << " mm");
   CHECK(worst < 1e-12 * size_of(L.points));
   // The one-off functions freeze and evaluate the same way.
   CHECK(deform_points(L, p, DeformOptions{2}) == moved);
   CHECK(deform_points(L, p, DeformOptions{1}) == moved);
-  for (Eigen::Index r = 0; r < 20; ++r) CHECK(deform_point(L, p.row(r).transpose()) == moved.row(r).transpose());
+  for (Eigen::Index r = 0; r < 20; ++r)
+    CHECK(deform_point(L, p.row(r).transpose()) == moved.row(r).transpose());
   // C0 by construction: the displaced seam and axis agree between the chunks that share them.
   std::uniform_real_distribution<double> unit(0, 1);
   for (int n = 0; n < 50; ++n) {
     const double u = unit(rng), w = unit(rng), v = unit(rng);
     const Chunk& first = L.chunks[0];
     const Chunk& last = L.chunks[static_cast<size_t>((s.sectors - 1) * s.layers)];
-    CHECK((chunk_point(L.points, first, Vec3(u, 0, w)) - chunk_point(L.points, last, Vec3(u, 1, w))).norm() < 1e-12);
+    CHECK((chunk_point(L.points, first, Vec3(u, 0, w)) - chunk_point(L.points, last, Vec3(u, 1, w)))
+              .norm() < 1e-12);
     const Chunk& other = L.chunks[static_cast<size_t>(5 * s.layers)];
-    CHECK((chunk_point(L.points, first, Vec3(0, v, w)) - chunk_point(L.points, other, Vec3(0, unit(rng), w))).norm() < 1e-12);
+    CHECK((chunk_point(L.points, first, Vec3(0, v, w)) -
+           chunk_point(L.points, other, Vec3(0, unit(rng), w)))
+              .norm() < 1e-12);
   }
 }
 
@@ -246,9 +270,13 @@ TEST_CASE("points outside an extended lattice come back bit-identical", "[deform
   Points3 p(300, 3);
   for (Eigen::Index r = 0; r < 300; ++r) {
     const double angle = 2 * std::numbers::pi * unit(rng);
-    if (r % 3 == 0) p.row(r) = c.at(s.radius * (1.001 + unit(rng)), angle, s.height * unit(rng)).transpose();
-    else if (r % 3 == 1) p.row(r) = c.at(s.radius * unit(rng), angle, -1e-6 - 20 * unit(rng)).transpose();
-    else p.row(r) = c.at(s.radius * unit(rng), angle, s.height * (1 + 1e-7) + 20 * unit(rng)).transpose();
+    if (r % 3 == 0)
+      p.row(r) = c.at(s.radius * (1.001 + unit(rng)), angle, s.height * unit(rng)).transpose();
+    else if (r % 3 == 1)
+      p.row(r) = c.at(s.radius * unit(rng), angle, -1e-6 - 20 * unit(rng)).transpose();
+    else
+      p.row(r) =
+          c.at(s.radius * unit(rng), angle, s.height * (1 + 1e-7) + 20 * unit(rng)).transpose();
   }
   p.row(0) << 1e6, -1e6, 3e5;  // far away, outside the candidate grid
   const FrozenPoints f = freeze(L, p);
@@ -259,7 +287,8 @@ TEST_CASE("points outside an extended lattice come back bit-identical", "[deform
   CHECK(deform_points(L, p) == p);
 }
 
-TEST_CASE("a prismatic lattice lofted from planar curves is the identity when undisplaced", "[deform]") {
+TEST_CASE("a prismatic lattice lofted from planar curves is the identity when undisplaced",
+          "[deform]") {
   std::mt19937 rng(64);
   PrismSpec s;
   s.origin = Vec3(-30, 12, 200);
@@ -269,7 +298,8 @@ TEST_CASE("a prismatic lattice lofted from planar curves is the identity when un
   s.layers = 2;
   // An S-like middle curve (two cubic segments) and two offsets (Coquillart's "S" lattice: a
   // loft on three curves, two of them offsets of the middle one).
-  const std::vector<Eigen::Vector2d> middle = {{0, 0}, {10, 8}, {20, 8}, {30, 0}, {40, -8}, {50, -8}, {60, 0}};
+  const std::vector<Eigen::Vector2d> middle = {{0, 0},   {10, 8},  {20, 8}, {30, 0},
+                                               {40, -8}, {50, -8}, {60, 0}};
   for (double offset : {-6.0, 0.0, 6.0}) {
     std::vector<Eigen::Vector2d> c = middle;
     for (auto& q : c) q.y() += offset;
@@ -297,8 +327,10 @@ TEST_CASE("a prismatic lattice lofted from planar curves is the identity when un
     for (int q = 0; q < 4; ++q) {
       const double a = q * std::numbers::pi / 2, b = a + std::numbers::pi / 2;
       c.push_back(radius * Eigen::Vector2d(std::cos(a), std::sin(a)));
-      c.push_back(radius * (Eigen::Vector2d(std::cos(a), std::sin(a)) + kappa * Eigen::Vector2d(-std::sin(a), std::cos(a))));
-      c.push_back(radius * (Eigen::Vector2d(std::cos(b), std::sin(b)) - kappa * Eigen::Vector2d(-std::sin(b), std::cos(b))));
+      c.push_back(radius * (Eigen::Vector2d(std::cos(a), std::sin(a)) +
+                            kappa * Eigen::Vector2d(-std::sin(a), std::cos(a))));
+      c.push_back(radius * (Eigen::Vector2d(std::cos(b), std::sin(b)) -
+                            kappa * Eigen::Vector2d(-std::sin(b), std::cos(b))));
     }
     c.push_back(c.front());
     ring.sections.push_back(c);
@@ -332,7 +364,8 @@ TEST_CASE("degenerate chunks do not crash and use the pseudo-inverse", "[deform]
 
   // A flat chunk (zero thickness along w): points of its plane are found (w is then arbitrary),
   // points off it are outside.
-  const ExtendedLattice F = one_chunk([](double a, double b, double) { return Vec3(10 * a + b * b, 8 * b, 0); });
+  const ExtendedLattice F =
+      one_chunk([](double a, double b, double) { return Vec3(10 * a + b * b, 8 * b, 0); });
   Points3 q(4, 3);
   q << 5, 4, 0, 2, 7, 0, 5, 4, 1e-3, 5, 4, -2;
   const FrozenPoints g = freeze(F, q);
@@ -386,7 +419,8 @@ TEST_CASE("a strongly twisted chunk needs subdivision and the report counts it",
 TEST_CASE("welding coincident points joins two chunks into a composite lattice", "[deform]") {
   // Two unit boxes side by side, built separately: 128 rows, 16 of them duplicated.
   auto box = [](double x0) {
-    return one_chunk([x0](double a, double b, double c) { return Vec3(x0 + 10 * a, 10 * b, 10 * c); });
+    return one_chunk(
+        [x0](double a, double b, double c) { return Vec3(x0 + 10 * a, 10 * b, 10 * c); });
   };
   ExtendedLattice A = box(0), B = box(10);
   ExtendedLattice C;
@@ -399,14 +433,18 @@ TEST_CASE("welding coincident points joins two chunks into a composite lattice",
   CHECK(W.rest.rows() == 112);
   for (int j = 0; j < 4; ++j)
     for (int k = 0; k < 4; ++k)
-      CHECK(W.chunks[0][static_cast<size_t>((3 * 4 + j) * 4 + k)] == W.chunks[1][static_cast<size_t>((0 * 4 + j) * 4 + k)]);
+      CHECK(W.chunks[0][static_cast<size_t>((3 * 4 + j) * 4 + k)] ==
+            W.chunks[1][static_cast<size_t>((0 * 4 + j) * 4 + k)]);
   for (size_t c = 0; c < 2; ++c)
     for (int e = 0; e < 64; ++e)
-      CHECK(W.rest.row(W.chunks[c][static_cast<size_t>(e)]) == C.rest.row(C.chunks[c][static_cast<size_t>(e)]));
+      CHECK(W.rest.row(W.chunks[c][static_cast<size_t>(e)]) ==
+            C.rest.row(C.chunks[c][static_cast<size_t>(e)]));
   // Moving a welded point moves both chunks' shared face alike.
   ExtendedLattice M = W;
   M.points.row(W.chunks[0][(3 * 4 + 1) * 4 + 2]) += Eigen::RowVector3d(1, 2, 3);
-  CHECK((chunk_point(M.points, M.chunks[0], Vec3(1, 0.4, 0.6)) - chunk_point(M.points, M.chunks[1], Vec3(0, 0.4, 0.6))).norm() < 1e-14);
+  CHECK((chunk_point(M.points, M.chunks[0], Vec3(1, 0.4, 0.6)) -
+         chunk_point(M.points, M.chunks[1], Vec3(0, 0.4, 0.6)))
+            .norm() < 1e-14);
   CHECK(merge_coincident_points(C, 0).rest.rows() == 112);  // exact duplicates
 }
 
@@ -425,10 +463,12 @@ TEST_CASE("extended lattice errors name the culprit and the fix", "[deform]") {
   {
     ExtendedLattice L = good;
     L.rest(7, 1) = std::numeric_limits<double>::quiet_NaN();
-    CHECK_THAT(error_of([&] { evaluate(L, FrozenPoints{}); }).second, Contains("rest control point row 7"));
+    CHECK_THAT(error_of([&] { evaluate(L, FrozenPoints{}); }).second,
+               Contains("rest control point row 7"));
     L = good;
     L.points(9, 2) = std::numeric_limits<double>::infinity();
-    CHECK_THAT(error_of([&] { deform_points(L, p); }).second, Contains("current control point row 9"));
+    CHECK_THAT(error_of([&] { deform_points(L, p); }).second,
+               Contains("current control point row 9"));
     L = good;
     L.points.conservativeResize(L.points.rows() - 1, 3);
     CHECK_THAT(error_of([&] { validate(L); }).second, Contains("current ones"));
@@ -460,15 +500,21 @@ TEST_CASE("extended lattice errors name the culprit and the fix", "[deform]") {
       set(o);
       return error_of([&] { freeze(good, p, o); });
     };
-    CHECK_THAT(option([](FreezeOptions& o) { o.newton_tolerance = 0; }).second, Contains("FreezeOptions::newton_tolerance = 0"));
-    CHECK_THAT(option([](FreezeOptions& o) { o.parameter_tolerance = -1; }).second, Contains("parameter_tolerance = -1"));
-    CHECK_THAT(option([](FreezeOptions& o) { o.pseudo_inverse_threshold = 0.5; }).second, Contains("pseudo_inverse_threshold = 0.5"));
-    CHECK_THAT(option([](FreezeOptions& o) { o.max_iterations = 0; }).second, Contains("max_iterations = 0"));
-    CHECK_THAT(option([](FreezeOptions& o) { o.max_subdivision_depth = 11; }).second, Contains("max_subdivision_depth = 11"));
+    CHECK_THAT(option([](FreezeOptions& o) { o.newton_tolerance = 0; }).second,
+               Contains("FreezeOptions::newton_tolerance = 0"));
+    CHECK_THAT(option([](FreezeOptions& o) { o.parameter_tolerance = -1; }).second,
+               Contains("parameter_tolerance = -1"));
+    CHECK_THAT(option([](FreezeOptions& o) { o.pseudo_inverse_threshold = 0.5; }).second,
+               Contains("pseudo_inverse_threshold = 0.5"));
+    CHECK_THAT(option([](FreezeOptions& o) { o.max_iterations = 0; }).second,
+               Contains("max_iterations = 0"));
+    CHECK_THAT(option([](FreezeOptions& o) { o.max_subdivision_depth = 11; }).second,
+               Contains("max_subdivision_depth = 11"));
     const auto [category, what] = option([](FreezeOptions& o) { o.threads = -2; });
     CHECK(category == ErrorCategory::InvalidArgument);
     CHECK_THAT(what, Contains("FreezeOptions::threads = -2"));
-    CHECK_THAT(error_of([&] { evaluate(good, freeze(good, p), DeformOptions{-1}); }).second, Contains("DeformOptions::threads = -1"));
+    CHECK_THAT(error_of([&] { evaluate(good, freeze(good, p), DeformOptions{-1}); }).second,
+               Contains("DeformOptions::threads = -1"));
   }
   {
     auto spec = [](auto set) {
@@ -479,15 +525,23 @@ TEST_CASE("extended lattice errors name the culprit and the fix", "[deform]") {
     const auto [category, what] = spec([](CylinderSpec& s) { s.sectors = 2; });
     CHECK(category == ErrorCategory::InvalidArgument);
     CHECK_THAT(what, Contains("CylinderSpec::sectors = 2") && Contains("3 <= sectors"));
-    CHECK_THAT(spec([](CylinderSpec& s) { s.radius = 0; }).second, Contains("CylinderSpec::radius = 0"));
-    CHECK_THAT(spec([](CylinderSpec& s) { s.inner_radius = 30; }).second, Contains("inner_radius < radius"));
-    CHECK_THAT(spec([](CylinderSpec& s) { s.height = -1; }).second, Contains("CylinderSpec::height = -1"));
-    CHECK_THAT(spec([](CylinderSpec& s) { s.axis = Vec3::Zero(); }).second, Contains("CylinderSpec::axis"));
-    CHECK_THAT(spec([](CylinderSpec& s) { s.reference = s.axis; }).second, Contains("not parallel to the axis"));
-    CHECK_THAT(spec([](CylinderSpec& s) { s.rings = 0; }).second, Contains("CylinderSpec::rings = 0"));
+    CHECK_THAT(spec([](CylinderSpec& s) { s.radius = 0; }).second,
+               Contains("CylinderSpec::radius = 0"));
+    CHECK_THAT(spec([](CylinderSpec& s) { s.inner_radius = 30; }).second,
+               Contains("inner_radius < radius"));
+    CHECK_THAT(spec([](CylinderSpec& s) { s.height = -1; }).second,
+               Contains("CylinderSpec::height = -1"));
+    CHECK_THAT(spec([](CylinderSpec& s) { s.axis = Vec3::Zero(); }).second,
+               Contains("CylinderSpec::axis"));
+    CHECK_THAT(spec([](CylinderSpec& s) { s.reference = s.axis; }).second,
+               Contains("not parallel to the axis"));
+    CHECK_THAT(spec([](CylinderSpec& s) { s.rings = 0; }).second,
+               Contains("CylinderSpec::rings = 0"));
     CHECK_THAT(spec([](CylinderSpec& s) { s.layers = 2000; }).second, Contains("layers <= 1024"));
-    CHECK_THAT(spec([](CylinderSpec& s) { s.sectors = s.rings = s.layers = 1000; }).second, Contains("1000000 chunks"));
-    CHECK_THAT(spec([](CylinderSpec& s) { s.origin.x() = std::nan(""); }).second, Contains("CylinderSpec::origin"));
+    CHECK_THAT(spec([](CylinderSpec& s) { s.sectors = s.rings = s.layers = 1000; }).second,
+               Contains("1000000 chunks"));
+    CHECK_THAT(spec([](CylinderSpec& s) { s.origin.x() = std::nan(""); }).second,
+               Contains("CylinderSpec::origin"));
     const auto [c2, w2] = error_of([] { cylindrical_index(cylinder(), 7, 0, 0); });
     CHECK(c2 == ErrorCategory::OutOfDomain);
     CHECK_THAT(w2, Contains("radial <= 6"));
@@ -501,17 +555,28 @@ TEST_CASE("extended lattice errors name the culprit and the fix", "[deform]") {
       set(t);
       return error_of([&] { make_prismatic_lattice(t); });
     };
-    CHECK_THAT(spec([](PrismSpec& t) { t.sections.pop_back(); }).second, Contains("sections.size() = 1"));
-    CHECK_THAT(spec([](PrismSpec& t) { t.sections[1].pop_back(); }).second, Contains("sections[1].size() = 3"));
-    CHECK_THAT(spec([](PrismSpec& t) { t.sections[1].push_back({4, 1}); t.sections[1].push_back({5, 1}); t.sections[1].push_back({6, 1}); }).second,
+    CHECK_THAT(spec([](PrismSpec& t) { t.sections.pop_back(); }).second,
+               Contains("sections.size() = 1"));
+    CHECK_THAT(spec([](PrismSpec& t) { t.sections[1].pop_back(); }).second,
+               Contains("sections[1].size() = 3"));
+    CHECK_THAT(spec([](PrismSpec& t) {
+                 t.sections[1].push_back({4, 1});
+                 t.sections[1].push_back({5, 1});
+                 t.sections[1].push_back({6, 1});
+               }).second,
                Contains("every section alike"));
-    CHECK_THAT(spec([](PrismSpec& t) { t.sections[0][2].y() = std::nan(""); }).second, Contains("sections[0][2]"));
-    CHECK_THAT(spec([](PrismSpec& t) { t.extrusion = Vec3(1, 1, 0); }).second, Contains("off the plane"));
-    CHECK_THAT(spec([](PrismSpec& t) { t.y_axis = 2 * t.x_axis; }).second, Contains("not parallel to x_axis"));
-    CHECK_THAT(spec([](PrismSpec& t) { t.x_axis = Vec3::Zero(); }).second, Contains("PrismSpec::x_axis"));
+    CHECK_THAT(spec([](PrismSpec& t) { t.sections[0][2].y() = std::nan(""); }).second,
+               Contains("sections[0][2]"));
+    CHECK_THAT(spec([](PrismSpec& t) { t.extrusion = Vec3(1, 1, 0); }).second,
+               Contains("off the plane"));
+    CHECK_THAT(spec([](PrismSpec& t) { t.y_axis = 2 * t.x_axis; }).second,
+               Contains("not parallel to x_axis"));
+    CHECK_THAT(spec([](PrismSpec& t) { t.x_axis = Vec3::Zero(); }).second,
+               Contains("PrismSpec::x_axis"));
     CHECK_THAT(spec([](PrismSpec& t) { t.layers = 0; }).second, Contains("PrismSpec::layers = 0"));
   }
-  CHECK_THAT(error_of([&] { merge_coincident_points(good, -1); }).second, Contains("tolerance = -1"));
+  CHECK_THAT(error_of([&] { merge_coincident_points(good, -1); }).second,
+             Contains("tolerance = -1"));
 }
 
 TEST_CASE("the docs snippet pushes the axis of a cylindrical lattice up", "[deform]") {
@@ -525,7 +590,8 @@ TEST_CASE("the docs snippet pushes the axis of a cylindrical lattice up", "[defo
   Points3 points(3, 3);
   points << 0, 0, 10, 29.9, 0, 0, 40, 0, 10;  // on the axis, at the rim's foot, outside
   const FrozenPoints frozen = freeze(lattice, points);
-  for (int k = 0; k <= 3; ++k) lattice.points.row(cylindrical_index(spec, 0, 0, k)) += Eigen::RowVector3d(0, 0, 8);
+  for (int k = 0; k <= 3; ++k)
+    lattice.points.row(cylindrical_index(spec, 0, 0, k)) += Eigen::RowVector3d(0, 0, 8);
   const Points3 out = evaluate(lattice, frozen);
   // The axis moves by 8 (all its control points did: partition of unity in w); the rim's outer
   // ring of control points did not move and the point outside stays.

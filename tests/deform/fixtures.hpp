@@ -35,7 +35,8 @@ inline double size_of(const surface::Points3& points) {
 template <class Lattice>
 Lattice displaced(Lattice lattice, std::mt19937& rng, double amount = 0.15) {
   std::uniform_real_distribution<double> c(-1.0, 1.0);
-  const double edge = std::min({lattice.frame.s.norm(), lattice.frame.t.norm(), lattice.frame.u.norm()});
+  const double edge =
+      std::min({lattice.frame.s.norm(), lattice.frame.t.norm(), lattice.frame.u.norm()});
   for (Eigen::Index r = 0; r < lattice.points.rows(); ++r)
     lattice.points.row(r) += amount * edge * Eigen::RowVector3d(c(rng), c(rng), c(rng));
   return lattice;

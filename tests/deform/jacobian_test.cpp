@@ -71,8 +71,8 @@ TEST_CASE("Jacobian bounds enclose sampled determinants", "[deform]") {
       CHECK_THAT(evaluate(J, stu[0], stu[1], stu[2]), Catch::Matchers::WithinAbs(analytic, 1e-12));
     }
   }
-  const BSplineLattice S =
-      clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 2}, {3, 2, 4}), rng, 0.2);
+  const BSplineLattice S = clay::test::displaced(
+      make_bspline_lattice(random_frame(rng), {3, 3, 2}, {3, 2, 4}), rng, 0.2);
   const JacobianBounds b = jacobian_bounds(S);
   std::uniform_real_distribution<double> c(0.01, 0.99);
   for (int n = 0; n < 200; ++n) {

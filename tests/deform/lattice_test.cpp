@@ -67,7 +67,8 @@ TEST_CASE("undisplaced Bezier lattices are the identity", "[deform]") {
       const BezierLattice L = make_bezier_lattice(random_frame(rng, left), degrees);
       const double size = size_of(L.points);
       const auto points = sample_points(L.frame, rng, 200);
-      const double worst = worst_difference(points, size, [&](const Eigen::Vector3d& x) { return deform_point(L, x); }, same);
+      const double worst = worst_difference(
+          points, size, [&](const Eigen::Vector3d& x) { return deform_point(L, x); }, same);
       INFO("degrees " << degrees[0] << degrees[1] << degrees[2] << " relative error " << worst);
       CHECK(worst < 1e-12);
     }
@@ -86,7 +87,8 @@ TEST_CASE("undisplaced B-spline lattices are the identity, clamped, uniform and 
       const BSplineLattice L = make_bspline_lattice(random_frame(rng), c.degrees, c.cells, knots);
       const double size = size_of(L.points);
       const auto points = sample_points(L.frame, rng, 200);
-      const double worst = worst_difference(points, size, [&](const Eigen::Vector3d& x) { return deform_point(L, x); }, same);
+      const double worst = worst_difference(
+          points, size, [&](const Eigen::Vector3d& x) { return deform_point(L, x); }, same);
       INFO("relative error " << worst);
       CHECK(worst < 1e-12);
     }
@@ -95,7 +97,8 @@ TEST_CASE("undisplaced B-spline lattices are the identity, clamped, uniform and 
   for (int n = 0; n < 4; ++n) {
     std::array<clay::surface::BSplineBasis, 3> bases;
     for (int d = 0; d < 3; ++d)
-      bases[static_cast<size_t>(d)] = clay::test::random_basis(rng, 1 + (n + d) % 3, 6 + d, n % 2 == 0, 2);
+      bases[static_cast<size_t>(d)] =
+          clay::test::random_basis(rng, 1 + (n + d) % 3, 6 + d, n % 2 == 0, 2);
     const BSplineLattice L = make_bspline_lattice(random_frame(rng), bases);
     const double size = size_of(L.points);
     const auto points = sample_points(L.frame, rng, 200);
@@ -108,7 +111,8 @@ TEST_CASE("undisplaced B-spline lattices are the identity, clamped, uniform and 
 
 TEST_CASE("points outside the lattice are left unchanged", "[deform]") {
   std::mt19937 rng(5);
-  const BezierLattice B = clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 2, 3}), rng);
+  const BezierLattice B =
+      clay::test::displaced(make_bezier_lattice(random_frame(rng), {3, 2, 3}), rng);
   const BSplineLattice S =
       clay::test::displaced(make_bspline_lattice(random_frame(rng), {3, 3, 3}, {4, 4, 4}), rng);
   for (int r = 0; r < 100; ++r) {
@@ -134,8 +138,9 @@ TEST_CASE("a Bezier lattice equals the one-cell clamped B-spline lattice", "[def
     S.points = B.points;  // same storage order, same control points
     const double size = size_of(B.points);
     const auto points = sample_points(f, rng, 300);
-    const double worst = worst_difference(points, size, [&](const Eigen::Vector3d& x) { return deform_point(B, x); },
-                                          [&](const Eigen::Vector3d& x) { return deform_point(S, x); });
+    const double worst = worst_difference(
+        points, size, [&](const Eigen::Vector3d& x) { return deform_point(B, x); },
+        [&](const Eigen::Vector3d& x) { return deform_point(S, x); });
     INFO("relative difference " << worst);
     CHECK(worst < 1e-12);
   }
@@ -165,7 +170,9 @@ TEST_CASE("Bezier cells reproduce the B-spline lattice pointwise", "[deform]") {
       std::array<int, 3> c{};
       for (int d = 0; d < 3; ++d) {
         const auto& br = cells.breaks[static_cast<size_t>(d)];
-        c[static_cast<size_t>(d)] = static_cast<int>(std::upper_bound(br.begin() + 1, br.end() - 1, stu[d]) - br.begin()) - 1;
+        c[static_cast<size_t>(d)] =
+            static_cast<int>(std::upper_bound(br.begin() + 1, br.end() - 1, stu[d]) - br.begin()) -
+            1;
       }
       const Eigen::Vector3d from_cell = deform_point(cells.cell(c[0], c[1], c[2]), x);
       worst = std::max(worst, (from_cell - deform_point(L, x)).norm() / size);

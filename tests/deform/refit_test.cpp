@@ -21,11 +21,11 @@
 #include "fixtures.hpp"
 
 using namespace clay::deform;
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinRel;
 using clay::ErrorCategory;
 using clay::Termination;
 using clay::test::error_of;
-using Catch::Matchers::Contains;
-using Catch::Matchers::WithinRel;
 namespace surface = clay::surface;
 
 namespace {
@@ -104,7 +104,8 @@ TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independentl
   // size: the deformed surface's box from a dense grid, computed here
   const auto us = surface::linspace(0, 1, 60), vs = surface::linspace(0, 1, 60);
   surface::Points3 grid = surface::evaluate_grid(loft, us, vs);
-  for (Eigen::Index k = 0; k < grid.rows(); ++k) grid.row(k) = rotate(grid.row(k).transpose()).transpose();
+  for (Eigen::Index k = 0; k < grid.rows(); ++k)
+    grid.row(k) = rotate(grid.row(k).transpose()).transpose();
   const double size = (grid.colwise().maxCoeff() - grid.colwise().minCoeff()).norm();
   CHECK_THAT(rep.tolerance, WithinRel(1e-4 * size, 0.02));
 
@@ -119,8 +120,7 @@ TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independentl
 TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor", "[refit]") {
   std::mt19937 rng(5);
   const Frame f = clay::test::random_frame(rng);
-  const BezierLattice lattice =
-      clay::test::displaced(make_bezier_lattice(f, {2, 2, 2}), rng, 0.12);
+  const BezierLattice lattice = clay::test::displaced(make_bezier_lattice(f, {2, 2, 2}), rng, 0.12);
   const surface::BSplineSurface sheet = sheet_in(f, 0.1, 0.9, 0.2);
   RefitOptions options;
   options.tolerance = 1e-5;
@@ -130,7 +130,8 @@ TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor",
   REQUIRE(r.report.certified);
   CHECK(r.report.crossings.empty());  // inside the lattice
   const double check = random_deviation(
-      sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, 4000, 3);
+      sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, 4000,
+      3);
   INFO("independent check " << check);
   CHECK(check <= r.report.certified_bound);
   CHECK(r.report.certified_bound <= 10 * check);
@@ -181,7 +182,8 @@ TEST_CASE("B-spline lattice knot planes crossed by the surface are detected and 
   CHECK(crossed >= 4);  // s and t planes at least
 
   const double check = random_deviation(
-      sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, 3000, 4);
+      sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, 3000,
+      4);
   INFO("independent check " << check);
   CHECK(check <= r.report.certified_bound);
 }
@@ -418,7 +420,8 @@ TEST_CASE("Refit keeps a closed side closed and a pole a point, bit for bit", "[
   const auto fit = refit_deformed(twist, sphere, options);
   const auto& s = fit.surface;
   const int mu = s.count_u(), mv = s.count_v();
-  for (int j = 0; j < mv; ++j) CHECK(s.points.row(s.index(0, j)) == s.points.row(s.index(mu - 1, j)));
+  for (int j = 0; j < mv; ++j)
+    CHECK(s.points.row(s.index(0, j)) == s.points.row(s.index(mu - 1, j)));
   const Eigen::RowVector3d south = deform_point(twist, Eigen::Vector3d(0, 0, -30)).transpose();
   const Eigen::RowVector3d north = deform_point(twist, Eigen::Vector3d(0, 0, 30)).transpose();
   for (int i = 0; i < mu; ++i) {

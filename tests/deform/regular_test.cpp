@@ -14,10 +14,10 @@
 #include "error_of.hpp"
 
 using namespace clay::deform;
-using clay::ErrorCategory;
-using clay::test::error_of;
 using Catch::Matchers::Contains;
 using Catch::Matchers::WithinAbs;
+using clay::ErrorCategory;
+using clay::test::error_of;
 
 static_assert(PointDeformation<Taper>);
 static_assert(PointDeformation<Twist>);
@@ -39,8 +39,10 @@ Eigen::Vector3d random_point(std::mt19937& rng, double scale) {
 /// An axis frame: origin far off, axis and reference from rotation q applied to the canonical
 /// directions, the reference tilted towards the axis and both scaled (the library normalises).
 AxisFrame rotated_frame(const Eigen::Matrix3d& q, const Eigen::Vector3d& origin,
-                        const Eigen::Vector3d& canonical_axis, const Eigen::Vector3d& canonical_ref) {
-  return {origin, 3.5 * (q * canonical_axis), 0.4 * (q * canonical_ref) + 0.25 * (q * canonical_axis)};
+                        const Eigen::Vector3d& canonical_axis,
+                        const Eigen::Vector3d& canonical_ref) {
+  return {origin, 3.5 * (q * canonical_axis),
+          0.4 * (q * canonical_ref) + 0.25 * (q * canonical_axis)};
 }
 
 template <class D>
@@ -66,7 +68,8 @@ TEST_CASE("a taper scales the radial offset by r(z) about any axis", "[deform][r
   std::mt19937 rng(11);
   for (int trial = 0; trial < 5; ++trial) {
     const Eigen::Matrix3d q = random_rotation(rng);
-    Taper taper{rotated_frame(q, random_point(rng, 200), Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()),
+    Taper taper{rotated_frame(q, random_point(rng, 200), Eigen::Vector3d::UnitZ(),
+                              Eigen::Vector3d::UnitX()),
                 {0.9, 0.004, -3e-5, 2e-7}};
     const Eigen::Vector3d a = taper.frame.axis.normalized();
     double worst = 0;
@@ -88,7 +91,8 @@ TEST_CASE("a twist rotates about the axis by exactly theta of z", "[deform][regu
   std::mt19937 rng(12);
   for (int trial = 0; trial < 5; ++trial) {
     const Eigen::Matrix3d q = random_rotation(rng);
-    Twist twist{rotated_frame(q, random_point(rng, 200), Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()),
+    Twist twist{rotated_frame(q, random_point(rng, 200), Eigen::Vector3d::UnitZ(),
+                              Eigen::Vector3d::UnitX()),
                 {0.3, 0.02, 1e-4}};
     const Eigen::Vector3d a = twist.frame.axis.normalized();
     for (int i = 0; i < 100; ++i) {
@@ -125,12 +129,14 @@ TEST_CASE("a bend follows the paper's formula with 1 over k", "[deform][regular]
     const double yh = y <= bend.y_min ? bend.y_min : (y >= bend.y_max ? bend.y_max : y);
     const double th = k * (yh - y0), C = std::cos(th), S = std::sin(th);
     // Güdükbay–Özgüç §3.1.3 (Barr): with 1/k, as printed.
-    const Eigen::Vector3d expected(x, -S * (z - 1 / k) + y0 + C * (y - yh), C * (z - 1 / k) + 1 / k + S * (y - yh));
+    const Eigen::Vector3d expected(x, -S * (z - 1 / k) + y0 + C * (y - yh),
+                                   C * (z - 1 / k) + 1 / k + S * (y - yh));
     CHECK((deform_point(bend, {x, y, z}) - expected).norm() < 1e-12);
   }
 }
 
-TEST_CASE("a bend maps the centreline onto an arc of radius 1 over k and keeps its length", "[deform][regular]") {
+TEST_CASE("a bend maps the centreline onto an arc of radius 1 over k and keeps its length",
+          "[deform][regular]") {
   Bend bend;
   bend.y_min = -30;
   bend.y_max = 50;
@@ -159,19 +165,22 @@ TEST_CASE("a bend maps the centreline onto an arc of radius 1 over k and keeps i
   const Eigen::Vector3d b = deform_point(bend, {0, bend.y_max, 0}) - centre;
   CHECK_THAT(std::atan2(a.cross(b).norm(), a.dot(b)), WithinAbs(2.0, 1e-13));
   // The centre of the bend stays put; beyond the region the parts move rigidly: distances kept.
-  CHECK((deform_point(bend, {0, bend.center, 0}) - Eigen::Vector3d(0, bend.center, 0)).norm() < 1e-15);
+  CHECK((deform_point(bend, {0, bend.center, 0}) - Eigen::Vector3d(0, bend.center, 0)).norm() <
+        1e-15);
   std::mt19937 rng(14);
-  std::uniform_real_distribution<double> above(bend.y_max, bend.y_max + 40), below(bend.y_min - 40, bend.y_min),
-      xz(-10, 10);
+  std::uniform_real_distribution<double> above(bend.y_max, bend.y_max + 40),
+      below(bend.y_min - 40, bend.y_min), xz(-10, 10);
   for (int i = 0; i < 50; ++i) {
     for (auto* side : {&above, &below}) {
       const Eigen::Vector3d p(xz(rng), (*side)(rng), xz(rng)), q(xz(rng), (*side)(rng), xz(rng));
-      CHECK_THAT((deform_point(bend, p) - deform_point(bend, q)).norm(), WithinAbs((p - q).norm(), 1e-12));
+      CHECK_THAT((deform_point(bend, p) - deform_point(bend, q)).norm(),
+                 WithinAbs((p - q).norm(), 1e-12));
     }
   }
 }
 
-TEST_CASE("a bend is continuous across y_min and y_max and C1 on the neutral plane", "[deform][regular]") {
+TEST_CASE("a bend is continuous across y_min and y_max and C1 on the neutral plane",
+          "[deform][regular]") {
   Bend bend;
   bend.y_min = -10;
   bend.y_max = 25;
@@ -195,41 +204,53 @@ TEST_CASE("a bend is continuous across y_min and y_max and C1 on the neutral pla
   }
 }
 
-TEST_CASE("analytic Jacobians of taper, twist and bend match central differences", "[deform][regular]") {
+TEST_CASE("analytic Jacobians of taper, twist and bend match central differences",
+          "[deform][regular]") {
   std::mt19937 rng(15);
   const Eigen::Matrix3d q = random_rotation(rng);
   const Eigen::Vector3d o = random_point(rng, 100);
-  const Taper taper{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), {1.1, -0.01, 2e-4}};
-  const Twist twist{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), {0.2, 0.03, -4e-4}};
-  Bend bend{rotated_frame(q, o, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()), -15, 20, 2, 0.05};
+  const Taper taper{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()),
+                    {1.1, -0.01, 2e-4}};
+  const Twist twist{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()),
+                    {0.2, 0.03, -4e-4}};
+  Bend bend{rotated_frame(q, o, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()), -15, 20, 2,
+            0.05};
   const Eigen::Vector3d ey = bend.frame.axis.normalized();
   double worst[3] = {0, 0, 0};
   for (int i = 0; i < 60; ++i) {
     const Eigen::Vector3d x = o + random_point(rng, 30);
-    worst[0] = std::max(worst[0], (jacobian_matrix(taper, x) - central_differences(taper, x, 1e-5)).norm());
-    worst[1] = std::max(worst[1], (jacobian_matrix(twist, x) - central_differences(twist, x, 1e-5)).norm());
+    worst[0] = std::max(worst[0],
+                        (jacobian_matrix(taper, x) - central_differences(taper, x, 1e-5)).norm());
+    worst[1] = std::max(worst[1],
+                        (jacobian_matrix(twist, x) - central_differences(twist, x, 1e-5)).norm());
     const double y = (x - o).dot(ey);
     if (std::abs(y - bend.y_min) > 1e-3 && std::abs(y - bend.y_max) > 1e-3)  // not across a kink
-      worst[2] = std::max(worst[2], (jacobian_matrix(bend, x) - central_differences(bend, x, 1e-5)).norm());
+      worst[2] = std::max(worst[2],
+                          (jacobian_matrix(bend, x) - central_differences(bend, x, 1e-5)).norm());
     CHECK_THAT(jacobian_matrix(twist, x).determinant(), WithinAbs(1, 1e-13));  // volume kept
     const double z = (x - o).dot(taper.frame.axis.normalized());
-    CHECK_THAT(jacobian_matrix(taper, x).determinant(), WithinAbs(std::pow(poly(taper.profile, z), 2), 1e-13));
+    CHECK_THAT(jacobian_matrix(taper, x).determinant(),
+               WithinAbs(std::pow(poly(taper.profile, z), 2), 1e-13));
   }
   CHECK(worst[0] < 1e-8);
   CHECK(worst[1] < 1e-8);
   CHECK(worst[2] < 1e-8);
 }
 
-TEST_CASE("an arbitrary frame equals the canonical deformation in rotated coordinates", "[deform][regular]") {
+TEST_CASE("an arbitrary frame equals the canonical deformation in rotated coordinates",
+          "[deform][regular]") {
   std::mt19937 rng(16);
   for (int trial = 0; trial < 4; ++trial) {
     const Eigen::Matrix3d q = random_rotation(rng);
     const Eigen::Vector3d o = random_point(rng, 300);
     const std::vector<double> profile{1.2, -0.008, 5e-5}, angle{-0.4, 0.015};
-    const Taper t0{AxisFrame{}, profile}, t1{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), profile};
-    const Twist w0{AxisFrame{}, angle}, w1{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), angle};
+    const Taper t0{AxisFrame{}, profile},
+        t1{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), profile};
+    const Twist w0{AxisFrame{}, angle},
+        w1{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), angle};
     const Bend b0{Bend{}.frame, -12, 30, 4, 0.03};
-    const Bend b1{rotated_frame(q, o, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()), -12, 30, 4, 0.03};
+    const Bend b1{rotated_frame(q, o, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()), -12, 30,
+                  4, 0.03};
     double worst = 0, worst_j = 0;
     for (int i = 0; i < 100; ++i) {
       const Eigen::Vector3d local = random_point(rng, 40);
@@ -238,9 +259,11 @@ TEST_CASE("an arbitrary frame equals the canonical deformation in rotated coordi
                         (deform_point(w1, x) - (o + q * deform_point(w0, local))).norm(),
                         (deform_point(b1, x) - (o + q * deform_point(b0, local))).norm()});
       // Jacobians transform as q J q^T.
-      worst_j = std::max({worst_j, (jacobian_matrix(t1, x) - q * jacobian_matrix(t0, local) * q.transpose()).norm(),
-                          (jacobian_matrix(w1, x) - q * jacobian_matrix(w0, local) * q.transpose()).norm(),
-                          (jacobian_matrix(b1, x) - q * jacobian_matrix(b0, local) * q.transpose()).norm()});
+      worst_j = std::max(
+          {worst_j,
+           (jacobian_matrix(t1, x) - q * jacobian_matrix(t0, local) * q.transpose()).norm(),
+           (jacobian_matrix(w1, x) - q * jacobian_matrix(w0, local) * q.transpose()).norm(),
+           (jacobian_matrix(b1, x) - q * jacobian_matrix(b0, local) * q.transpose()).norm()});
     }
     CHECK(worst < 1e-12);  // points ~350 mm from the world origin
     CHECK(worst_j < 1e-13);
@@ -249,9 +272,9 @@ TEST_CASE("an arbitrary frame equals the canonical deformation in rotated coordi
 
 TEST_CASE("rate 0 and r identically 1 are the identity", "[deform][regular]") {
   std::mt19937 rng(17);
-  const Taper taper;        // profile {1}
-  const Twist twist;        // angle {0}
-  const Bend bend;          // rate 0
+  const Taper taper;  // profile {1}
+  const Twist twist;  // angle {0}
+  const Bend bend;    // rate 0
   for (int i = 0; i < 100; ++i) {
     const Eigen::Vector3d x = random_point(rng, 500);
     CHECK((deform_point(taper, x).array() == x.array()).all());  // bit for bit
@@ -262,12 +285,15 @@ TEST_CASE("rate 0 and r identically 1 are the identity", "[deform][regular]") {
   // Any frame: rounding of the rotation only.
   const Eigen::Matrix3d q = random_rotation(rng);
   const Eigen::Vector3d o = random_point(rng, 100);
-  const Taper t1{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), {1.0, 0.0}};
-  const Twist w1{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), {0.0, 0.0}};
+  const Taper t1{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()),
+                 {1.0, 0.0}};
+  const Twist w1{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()),
+                 {0.0, 0.0}};
   double worst = 0;
   for (int i = 0; i < 100; ++i) {
     const Eigen::Vector3d x = o + random_point(rng, 50);
-    worst = std::max({worst, (deform_point(t1, x) - x).norm() / x.norm(), (deform_point(w1, x) - x).norm() / x.norm()});
+    worst = std::max({worst, (deform_point(t1, x) - x).norm() / x.norm(),
+                      (deform_point(w1, x) - x).norm() / x.norm()});
   }
   CHECK(worst < 2e-15);
   // A tiny rate is accurate (no 1/k cancellation): the bend of the centreline stays on the arc.
@@ -275,17 +301,21 @@ TEST_CASE("rate 0 and r identically 1 are the identity", "[deform][regular]") {
   tiny.rate = 1e-9;
   tiny.y_max = 10;
   const Eigen::Vector3d p = deform_point(tiny, {0, 10, 0});
-  CHECK_THAT(p.y(), WithinAbs(10, 1e-14));  // sin(kL) / k = L (1 − (kL)² / 6)
+  CHECK_THAT(p.y(), WithinAbs(10, 1e-14));            // sin(kL) / k = L (1 − (kL)² / 6)
   CHECK_THAT(p.z(), WithinAbs(0.5e-9 * 100, 1e-20));  // z = (1 − cos kL)/k ≈ k L² / 2
 }
 
-TEST_CASE("bulk regular deformations equal deform_point bit for bit, in place too", "[deform][regular]") {
+TEST_CASE("bulk regular deformations equal deform_point bit for bit, in place too",
+          "[deform][regular]") {
   std::mt19937 rng(18);
   const Eigen::Matrix3d q = random_rotation(rng);
   const Eigen::Vector3d o = random_point(rng, 100);
-  const Taper taper{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), {1, 0.01}};
-  const Twist twist{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()), {0, 0.02}};
-  const Bend bend{rotated_frame(q, o, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()), -20, 20, 0, 0.03};
+  const Taper taper{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()),
+                    {1, 0.01}};
+  const Twist twist{rotated_frame(q, o, Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX()),
+                    {0, 0.02}};
+  const Bend bend{rotated_frame(q, o, Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ()), -20, 20,
+                  0, 0.03};
   const int n = 40000;  // more than 2 x 16,384: two workers
   Points3 points(n, 3);
   for (int r = 0; r < n; ++r) points.row(r) = (o + random_point(rng, 60)).transpose();
@@ -294,7 +324,10 @@ TEST_CASE("bulk regular deformations equal deform_point bit for bit, in place to
     Points3 in_place = points;
     deform_points(d, in_place, in_place, DeformOptions{2});
     bool equal = out.rows() == n && (out.array() == in_place.array()).all();
-    for (int r = 0; r < n; r += 7) equal = equal && (deform_point(d, points.row(r).transpose()).transpose().array() == out.row(r).array()).all();
+    for (int r = 0; r < n; r += 7)
+      equal = equal &&
+              (deform_point(d, points.row(r).transpose()).transpose().array() == out.row(r).array())
+                  .all();
     return equal;
   };
   CHECK(same(taper));
@@ -304,26 +337,31 @@ TEST_CASE("bulk regular deformations equal deform_point bit for bit, in place to
   CHECK(deform_points(twist, Points3(0, 3)).rows() == 0);
 }
 
-TEST_CASE("bad regular deformations are rejected naming the field and the fix", "[deform][regular]") {
+TEST_CASE("bad regular deformations are rejected naming the field and the fix",
+          "[deform][regular]") {
   Taper taper;
   taper.frame.axis.setZero();
   auto [category, what] = error_of([&] { validate(taper); });
   CHECK(category == ErrorCategory::InvalidGeometry);
-  CHECK_THAT(what, Contains("taper frame: axis (0, 0, 0) has zero length") && Contains("non-zero direction"));
+  CHECK_THAT(what, Contains("taper frame: axis (0, 0, 0) has zero length") &&
+                       Contains("non-zero direction"));
 
   Twist twist;
   twist.frame.reference = {0, 0, -2};  // parallel to the axis
   CHECK_THAT(error_of([&] { deform_points(twist, Points3::Zero(3, 3)); }).second,
-             Contains("twist frame: reference (0, 0, -2) is parallel to the axis") && Contains("across the axis"));
+             Contains("twist frame: reference (0, 0, -2) is parallel to the axis") &&
+                 Contains("across the axis"));
   twist = Twist{};
   twist.frame.origin.x() = std::numeric_limits<double>::infinity();
-  CHECK_THAT(error_of([&] { validate(twist); }).second, Contains("origin (inf, 0, 0) is not finite"));
+  CHECK_THAT(error_of([&] { validate(twist); }).second,
+             Contains("origin (inf, 0, 0) is not finite"));
   twist = Twist{};
   twist.angle = {0, std::numeric_limits<double>::quiet_NaN()};
   CHECK_THAT(error_of([&] { validate(twist); }).second, Contains("angle[1] = nan is not finite"));
   taper = Taper{};
   taper.profile.clear();
-  CHECK_THAT(error_of([&] { validate(taper); }).second, Contains("profile is empty") && Contains("constant"));
+  CHECK_THAT(error_of([&] { validate(taper); }).second,
+             Contains("profile is empty") && Contains("constant"));
   taper.profile.assign(65, 0.0);
   CHECK_THAT(error_of([&] { validate(taper); }).second, Contains("65 coefficients, more than 64"));
 
@@ -338,8 +376,11 @@ TEST_CASE("bad regular deformations are rejected naming the field and the fix", 
   CHECK_THAT(error_of([&] { validate(bend, "hood bend"); }).second,
              Contains("hood bend: y_min = 5 > y_max = 1") && Contains("give y_min <= y_max"));
   CHECK(problems(Bend{}).empty());  // rate 0 is valid: the identity
-  CHECK_THAT(error_of([&] { deform_points(Twist{}, Points3::Zero(2, 3), DeformOptions{-3}); }).second,
-             Contains("DeformOptions::threads = -3"));
-  CHECK_THAT(error_of([&] { validate(AxisFrame{{0, 0, 0}, {1, 0, 0}, {0, 0, 0}}); }).second,
+  CHECK_THAT(
+      error_of([&] { deform_points(Twist{}, Points3::Zero(2, 3), DeformOptions{-3}); }).second,
+      Contains("DeformOptions::threads = -3"));
+  CHECK_THAT(error_of([&] {
+               validate(AxisFrame{{0, 0, 0}, {1, 0, 0}, {0, 0, 0}});
+             }).second,
              Contains("axis frame: reference (0, 0, 0) has zero length"));
 }

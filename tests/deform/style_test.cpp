@@ -18,10 +18,10 @@
 #include "error_of.hpp"
 
 using namespace clay::deform;
+using Catch::Matchers::WithinAbs;
 using clay::surface::BSplineCurve;
 using clay::surface::BSplineSurface;
 using clay::surface::Points3;
-using Catch::Matchers::WithinAbs;
 
 namespace {
 
@@ -50,7 +50,8 @@ BSplineSurface flat(int n = 15) {
 BSplineSurface hood(int nu = 12, int nv = 12) {
   return net_surface(nu, nv, [](double u, double v) {
     const double x = -600 + 1200 * u, y = -400 + 800 * v;
-    return Eigen::Vector3d(x, y, 80 * (1 - (x / 700) * (x / 700)) * (1 - (y / 500) * (y / 500)) + 0.05 * x);
+    return Eigen::Vector3d(
+        x, y, 80 * (1 - (x / 700) * (x / 700)) * (1 - (y / 500) * (y / 500)) + 0.05 * x);
   });
 }
 
@@ -107,7 +108,8 @@ double size_of(const BSplineSurface& s) {
 }
 
 // Largest angle (degrees) between the normals of a and b at the bound curve's closest points on a.
-double normal_jump_along(const BSplineSurface& a, const BSplineSurface& b, const BSplineCurve& bound) {
+double normal_jump_along(const BSplineSurface& a, const BSplineSurface& b,
+                         const BSplineCurve& bound) {
   double worst = 0;
   for (double t : clay::surface::linspace(0, 1, 97)) {
     const auto p = clay::surface::closest_point(a, clay::surface::evaluate(bound, t));
@@ -120,13 +122,15 @@ double normal_jump_along(const BSplineSurface& a, const BSplineSurface& b, const
 
 }  // namespace
 
-TEST_CASE("influence factors: Greville points inside the projected bound (Han et al. eq. 2)", "[style]") {
+TEST_CASE("influence factors: Greville points inside the projected bound (Han et al. eq. 2)",
+          "[style]") {
   const BSplineSurface s = flat();
   const Eigen::Vector3d c(48, 53, 0);
   const double radius = 31;
   const auto xu = clay::surface::greville_abscissae(s.u);
   for (double lift : {0.0, 12.0}) {  // drawn on the surface or above it: the projection is the same
-    const InfluenceRegion region = influence_factors(s, ellipse(c + Eigen::Vector3d(0, 0, lift), radius, radius));
+    const InfluenceRegion region =
+        influence_factors(s, ellipse(c + Eigen::Vector3d(0, 0, lift), radius, radius));
     REQUIRE(region.factors.size() == 225u);
     int checked = 0;
     for (int i = 0; i < 15; ++i)
@@ -142,7 +146,8 @@ TEST_CASE("influence factors: Greville points inside the projected bound (Han et
   }
 }
 
-TEST_CASE("influence from the target marks the vertices supporting its projection (Han et al. 5)", "[style]") {
+TEST_CASE("influence from the target marks the vertices supporting its projection (Han et al. 5)",
+          "[style]") {
   const BSplineSurface s = flat();
   const BSplineCurve target = bezier({20.3, 40.1, 5}, {40, 45, 9}, {60, 45, 9}, {80.7, 40.2, 5});
   StyleOptions options;
@@ -172,12 +177,14 @@ TEST_CASE("influence from the target marks the vertices supporting its projectio
     for (int j = 0; j < 15; ++j) {
       bool near = false;
       for (int a = std::max(0, i - 2); a <= std::min(14, i + 2); ++a)
-        for (int b = std::max(0, j - 2); b <= std::min(14, j + 2); ++b) near = near || expected[static_cast<size_t>(a * 15 + b)];
+        for (int b = std::max(0, j - 2); b <= std::min(14, j + 2); ++b)
+          near = near || expected[static_cast<size_t>(a * 15 + b)];
       CHECK(wide.inside(i, j) == near);
     }
 }
 
-TEST_CASE("key points lie on the target where it crosses the control-net rows (Han et al. eq. 8)", "[style]") {
+TEST_CASE("key points lie on the target where it crosses the control-net rows (Han et al. eq. 8)",
+          "[style]") {
   const BSplineSurface s = flat();
   const double h = 7;
   const Eigen::Vector3d a(12, 30, h), b(83, 60, h);
@@ -189,7 +196,8 @@ TEST_CASE("key points lie on the target where it crosses the control-net rows (H
   const auto xu = clay::surface::greville_abscissae(s.u);
   std::vector<int> rows;
   for (int r = 0; r < 15; ++r)
-    if (100 * xu[static_cast<size_t>(r)] >= 12 && 100 * xu[static_cast<size_t>(r)] <= 83) rows.push_back(r);
+    if (100 * xu[static_cast<size_t>(r)] >= 12 && 100 * xu[static_cast<size_t>(r)] <= 83)
+      rows.push_back(r);
   REQUIRE(keys.points.size() == rows.size());
   for (size_t k = 0; k < rows.size(); ++k) {
     const KeyPoint& p = keys.points[k];
@@ -203,7 +211,8 @@ TEST_CASE("key points lie on the target where it crosses the control-net rows (H
   }
 }
 
-TEST_CASE("paper mode: forces along the normal, peak and symmetric fall-off (eqs. 3-13)", "[style]") {
+TEST_CASE("paper mode: forces along the normal, peak and symmetric fall-off (eqs. 3-13)",
+          "[style]") {
   const BSplineSurface s = flat();
   const auto xv = clay::surface::greville_abscissae(s.v);
   const double y7 = 100 * xv[7];  // the target runs exactly over column 7
@@ -226,7 +235,8 @@ TEST_CASE("paper mode: forces along the normal, peak and symmetric fall-off (eqs
     CHECK(d.z() <= options.lambda * h + 1e-12);
   }
   for (const KeyPoint& k : r.report.key_points) {
-    // The peak vertex under the key point moves by exactly λ D (eq. 9), its neighbours symmetrically.
+    // The peak vertex under the key point moves by exactly λ D (eq. 9), its neighbours
+    // symmetrically.
     const auto z = [&](int j) { return r.surface.points(k.row * 15 + j, 2); };
     CHECK_THAT(z(7), WithinAbs(options.lambda * h, 1e-12));
     for (int d = 1; d <= 7; ++d) CHECK_THAT(z(7 - d), WithinAbs(z(7 + d), 1e-12));
@@ -270,7 +280,8 @@ TEST_CASE("locality: vertices outside the bound are bit-identical, in both modes
       CHECK(r.report.knots_inserted > 0);  // the ends of the target need a finer net here
       for (double u : clay::surface::linspace(0, 1, 9))  // knot insertion is exact
         for (double v : clay::surface::linspace(0, 1, 9))
-          CHECK((clay::surface::evaluate(before, u, v) - clay::surface::evaluate(s, u, v)).norm() <= 1e-12 * size);
+          CHECK((clay::surface::evaluate(before, u, v) - clay::surface::evaluate(s, u, v)).norm() <=
+                1e-12 * size);
     }
     REQUIRE(r.surface.points.rows() == before.points.rows());
     CHECK(r.surface.u.knots == before.u.knots);
@@ -279,7 +290,8 @@ TEST_CASE("locality: vertices outside the bound are bit-identical, in both modes
     CHECK(region.inside_count() > 10);
     CHECK(r.report.moved_vertices > 0);
     for (Eigen::Index row = 0; row < before.points.rows(); ++row)
-      if (region.factors[static_cast<size_t>(row)] == 0) CHECK(rows_identical(r.surface.points, before.points, row));
+      if (region.factors[static_cast<size_t>(row)] == 0)
+        CHECK(rows_identical(r.surface.points, before.points, row));
     CHECK(r.report.locality == 0.0);
   }
 }
@@ -294,13 +306,15 @@ TEST_CASE("lambda = 0 and the over-constrained class leave the surface bit-ident
     CHECK(clay::surface::identical(zero.surface, s));
     options.lambda = 1;
     // A target beside the bound, completely outside it.
-    const BSplineCurve outside = bezier({450, -150, 60}, {480, -50, 80}, {480, 50, 80}, {450, 150, 60});
+    const BSplineCurve outside =
+        bezier({450, -150, 60}, {480, -50, 80}, {480, 50, 80}, {450, 150, 60});
     const StyleResult over = style_deform(s, hood_bound(), outside, options);
     CHECK(over.report.constraint_class == ConstraintClass::OverConstrained);
     CHECK(clay::surface::identical(over.surface, s));
     CHECK(over.report.message.find("over-constrained") != std::string::npos);
     // Half in, half out.
-    const BSplineCurve partly = bezier({-60, -380, 60}, {-40, -200, 150}, {-40, 0, 150}, {-60, 100, 120});
+    const BSplineCurve partly =
+        bezier({-60, -380, 60}, {-40, -200, 150}, {-40, 0, 150}, {-60, 100, 120});
     CHECK(style_deform(s, hood_bound(), partly, options).report.constraint_class ==
           ConstraintClass::UnderConstrained);
   }
@@ -318,7 +332,8 @@ TEST_CASE("mirror-symmetric input gives a mirror-symmetric result to 1e-12", "[s
       CHECK(r.report.direction == KeyDirection::V);
       // The exact mode refines this net: mirror-symmetrically too.
       const auto& kv = r.surface.v.knots;
-      for (size_t k = 0; k < kv.size(); ++k) CHECK_THAT(kv[k] + kv[kv.size() - 1 - k], WithinAbs(1.0, 1e-15));
+      for (size_t k = 0; k < kv.size(); ++k)
+        CHECK_THAT(kv[k] + kv[kv.size() - 1 - k], WithinAbs(1.0, 1e-15));
       const int nu = r.surface.count_u(), nv = r.surface.count_v();
       double worst = 0;
       for (int i = 0; i < nu; ++i)
@@ -337,7 +352,8 @@ TEST_CASE("mirror-symmetric input gives a mirror-symmetric result to 1e-12", "[s
   }
 }
 
-TEST_CASE("exact mode: the hood passes through every key point and joins the parent with G1", "[style]") {
+TEST_CASE("exact mode: the hood passes through every key point and joins the parent with G1",
+          "[style]") {
   const BSplineSurface s = hood(16, 16);
   const double size = size_of(s);
   StyleOptions options;
@@ -362,10 +378,12 @@ TEST_CASE("exact mode: the hood passes through every key point and joins the par
   CHECK(r.report.locality == 0.0);
   // The paper's mode only approximates: its key-point deviation is far larger.
   options.mode = StyleMode::Paper;
-  CHECK(style_deform(s, hood_bound(), hood_target(), options).report.target_deviation > 1e-3 * size);
+  CHECK(style_deform(s, hood_bound(), hood_target(), options).report.target_deviation >
+        1e-3 * size);
 }
 
-TEST_CASE("exact mode: the displacement is the least thin-plate energy that meets the key points", "[style]") {
+TEST_CASE("exact mode: the displacement is the least thin-plate energy that meets the key points",
+          "[style]") {
   // First-order optimality, checked from the definitions alone: with E(d) the thin-plate energy of
   // the displacement net (docs/deform.md) and B the key-point rows, any move z of the moved
   // vertices with B z = 0 leaves the key points met, so the gradient of E must be orthogonal to
@@ -395,10 +413,16 @@ TEST_CASE("exact mode: the displacement is the least thin-plate energy that meet
     const double twist = std::sqrt(2.0);
     for (int i = 0; i < nu; ++i)
       for (int j = 0; j < nv; ++j) {
-        if (i > 0 && i + 1 < nu) stencil({{net.index(i - 1, j), 1.0}, {net.index(i, j), -2.0}, {net.index(i + 1, j), 1.0}});
-        if (j > 0 && j + 1 < nv) stencil({{net.index(i, j - 1), 1.0}, {net.index(i, j), -2.0}, {net.index(i, j + 1), 1.0}});
+        if (i > 0 && i + 1 < nu)
+          stencil(
+              {{net.index(i - 1, j), 1.0}, {net.index(i, j), -2.0}, {net.index(i + 1, j), 1.0}});
+        if (j > 0 && j + 1 < nv)
+          stencil(
+              {{net.index(i, j - 1), 1.0}, {net.index(i, j), -2.0}, {net.index(i, j + 1), 1.0}});
         if (i + 1 < nu && j + 1 < nv)
-          stencil({{net.index(i, j), twist}, {net.index(i + 1, j), -twist}, {net.index(i, j + 1), -twist},
+          stencil({{net.index(i, j), twist},
+                   {net.index(i + 1, j), -twist},
+                   {net.index(i, j + 1), -twist},
                    {net.index(i + 1, j + 1), twist}});
       }
     return Eigen::MatrixXd(grad(moved, Eigen::all));
@@ -406,14 +430,17 @@ TEST_CASE("exact mode: the displacement is the least thin-plate energy that meet
   std::vector<const KeyPoint*> keys;
   for (const KeyPoint& k : r.report.key_points)
     if (k.influenced) keys.push_back(&k);
-  const Eigen::Index nk = static_cast<Eigen::Index>(keys.size()), nm = static_cast<Eigen::Index>(moved.size());
+  const Eigen::Index nk = static_cast<Eigen::Index>(keys.size()),
+                     nm = static_cast<Eigen::Index>(moved.size());
   Eigen::MatrixXd B(nk, nm);
   for (Eigen::Index c = 0; c < nm; ++c) {
     BSplineSurface unit = net;
     unit.points.row(moved[static_cast<size_t>(c)]).x() += 1.0;
     for (Eigen::Index k = 0; k < nk; ++k) {
       const KeyPoint& kp = *keys[static_cast<size_t>(k)];
-      B(k, c) = (clay::surface::evaluate(unit, kp.u, kp.v) - clay::surface::evaluate(net, kp.u, kp.v)).x();
+      B(k, c) =
+          (clay::surface::evaluate(unit, kp.u, kp.v) - clay::surface::evaluate(net, kp.u, kp.v))
+              .x();
     }
   }
   // The projection onto null(B): g - B^T (B B^T)^-1 B g.
@@ -435,18 +462,21 @@ TEST_CASE("exact mode on a sail with uneven knots, with and without a bound curv
   const BSplineSurface s = sail();
   const double size = size_of(s);
   // A target across the sail at mid height, 80-150 mm off its camber.
-  const BSplineCurve target = bezier({500, 2200, 380}, {800, 2500, 450}, {1100, 2500, 450}, {1300, 2300, 300});
+  const BSplineCurve target =
+      bezier({500, 2200, 380}, {800, 2500, 450}, {1100, 2500, 450}, {1300, 2300, 300});
   const BSplineCurve bound = ellipse({900, 2400, 600}, 750, 900);
   StyleOptions options;
   options.mode = StyleMode::Exact;
   for (bool with_bound : {true, false}) {
-    const StyleResult r = with_bound ? style_deform(s, bound, target, options) : style_deform(s, target, options);
+    const StyleResult r =
+        with_bound ? style_deform(s, bound, target, options) : style_deform(s, target, options);
     INFO((with_bound ? "with bound: " : "without: ") << r.report.message);
     REQUIRE(r.report.m >= 2);
     CHECK(r.report.constraint_class != ConstraintClass::OverConstrained);
     for (const KeyPoint& k : r.report.key_points)
       if (k.influenced) {
-        INFO((clay::surface::evaluate(r.surface, k.u, k.v) - k.point).norm() << " at " << k.u << " " << k.v << " D " << k.distance);
+        INFO((clay::surface::evaluate(r.surface, k.u, k.v) - k.point).norm()
+             << " at " << k.u << " " << k.v << " D " << k.distance);
         CHECK(clay::surface::closest_point(r.surface, k.point).distance <= 1e-6 * size);
       }
     CHECK(r.report.target_deviation <= 1e-6 * size);
@@ -456,7 +486,8 @@ TEST_CASE("exact mode on a sail with uneven knots, with and without a bound curv
   }
 }
 
-TEST_CASE("exact mode refines a coarse net by knot insertion and reports conflicts without it", "[style]") {
+TEST_CASE("exact mode refines a coarse net by knot insertion and reports conflicts without it",
+          "[style]") {
   const BSplineSurface s = hood(6, 6);
   const double size = size_of(s);
   StyleOptions options;
@@ -473,7 +504,8 @@ TEST_CASE("exact mode refines a coarse net by knot insertion and reports conflic
   // The refinement is exact: away from the bound the result equals the parent.
   for (double u : {0.02, 0.98})
     for (double v : {0.03, 0.5, 0.97})
-      CHECK((clay::surface::evaluate(r.surface, u, v) - clay::surface::evaluate(s, u, v)).norm() <= 1e-12 * size);
+      CHECK((clay::surface::evaluate(r.surface, u, v) - clay::surface::evaluate(s, u, v)).norm() <=
+            1e-12 * size);
 
   options.max_refinements = 0;
   const StyleResult coarse = style_deform(s, hood_bound(), hood_target(), options);
@@ -488,14 +520,17 @@ TEST_CASE("style deformation errors name the object and the fix", "[style]") {
   using clay::test::error_of;
   const BSplineSurface s = hood();
   // An open bound curve.
-  const BSplineCurve open = bezier({-300, -200, 150}, {0, -300, 150}, {300, -200, 150}, {300, 200, 150});
+  const BSplineCurve open =
+      bezier({-300, -200, 150}, {0, -300, 150}, {300, -200, 150}, {300, 200, 150});
   auto [c1, m1] = error_of([&] { influence_factors(s, open); });
   CHECK(c1 == ErrorCategory::InvalidGeometry);
   CHECK(m1.find("closed") != std::string::npos);
   // A figure-eight bound crossing itself.
   Points3 p(7, 3);
-  p << -300, 0, 150, -300, 250, 150, 300, -250, 150, 300, 250, 150, -300, -250, 150, -300, 0, 150, -300, 0, 150;
-  const BSplineCurve eight = clay::surface::make_curve(3, {0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1}, p);
+  p << -300, 0, 150, -300, 250, 150, 300, -250, 150, 300, 250, 150, -300, -250, 150, -300, 0, 150,
+      -300, 0, 150;
+  const BSplineCurve eight =
+      clay::surface::make_curve(3, {0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1}, p);
   auto [c2, m2] = error_of([&] { influence_factors(s, eight); });
   CHECK(c2 == ErrorCategory::InvalidGeometry);
   CHECK(m2.find("crosses itself") != std::string::npos);
@@ -524,7 +559,8 @@ TEST_CASE("style deformation errors name the object and the fix", "[style]") {
   CHECK(m5.find("target curve") != std::string::npos);
 }
 
-TEST_CASE("StyleEditor: drags give the one-off results and reuse the exact factorization", "[style]") {
+TEST_CASE("StyleEditor: drags give the one-off results and reuse the exact factorization",
+          "[style]") {
   const BSplineSurface s = hood(16, 16);
   const double size = size_of(s);
   for (StyleMode mode : {StyleMode::Paper, StyleMode::Exact}) {
@@ -551,7 +587,8 @@ TEST_CASE("StyleEditor: drags give the one-off results and reuse the exact facto
   CHECK_THROWS_AS(StyleEditor(hood(8, 8), influence_factors(s, hood_bound())), clay::Error);
 }
 
-TEST_CASE("report_curves off leaves the sampled figures unmeasured (NaN), the rest identical", "[style]") {
+TEST_CASE("report_curves off leaves the sampled figures unmeasured (NaN), the rest identical",
+          "[style]") {
   const BSplineSurface s = hood(16, 16);
   StyleOptions options;
   const StyleResult full = style_deform(s, hood_bound(), hood_target(), options);

@@ -16,9 +16,9 @@
 #include "error_of.hpp"
 
 using namespace clay::deform;
+using Catch::Matchers::Contains;
 using clay::ErrorCategory;
 using clay::test::error_of;
-using Catch::Matchers::Contains;
 namespace surface = clay::surface;
 
 namespace {
@@ -66,7 +66,8 @@ Twist spin() {
 }
 
 /// Largest |result(u, v) - deform_point(stack, S(u, v))| at n random parameters.
-double worst_against_pointwise(const DeformationStack& stack, const surface::BSplineSurface& original,
+double worst_against_pointwise(const DeformationStack& stack,
+                               const surface::BSplineSurface& original,
                                const surface::BSplineSurface& result, int n) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -106,7 +107,8 @@ TEST_CASE("deform_surface: a stack of exact steps stays an exact NURBS", "[surfa
   CHECK(r.report.control_points == r.surface.points.rows());
 }
 
-TEST_CASE("deform_surface: a twist is refitted with a certified bound that holds", "[surface_deformation]") {
+TEST_CASE("deform_surface: a twist is refitted with a certified bound that holds",
+          "[surface_deformation]") {
   const surface::BSplineSurface s = dome();
   DeformationStack stack;
   stack.steps.push_back({bulge(), "bulge", true});
@@ -132,12 +134,14 @@ TEST_CASE("deform_surface: a twist is refitted with a certified bound that holds
   CHECK_THAT(message, Contains("refit"));
 }
 
-TEST_CASE("deform_surface: above the degree limit, a refit when allowed, the DegreeLimit error otherwise",
-          "[surface_deformation]") {
+TEST_CASE(
+    "deform_surface: above the degree limit, a refit when allowed, the DegreeLimit error otherwise",
+    "[surface_deformation]") {
   const surface::BSplineSurface s = dome();
   // A frame turned against the dome: every local coordinate is bicubic, so the exact result
   // would have degree 3 x 3 + 3 x 3 + 3 x 3 = 27 > 25 in each direction.
-  const Eigen::Vector3d a(std::cos(0.35), std::sin(0.35), 0.1), b(-std::sin(0.35), std::cos(0.35), 0.1);
+  const Eigen::Vector3d a(std::cos(0.35), std::sin(0.35), 0.1),
+      b(-std::sin(0.35), std::cos(0.35), 0.1);
   Frame turned;
   turned.s = 170 * a;
   turned.t = 170 * b;
@@ -158,7 +162,8 @@ TEST_CASE("deform_surface: above the degree limit, a refit when allowed, the Deg
   CHECK(r.surface.u.degree == 3);
   DeformationStack one;
   one.steps.push_back({heavy, {}, true});
-  CHECK(worst_against_pointwise(one, s, r.surface, 1000) <= r.report.steps[0].refit.certified_bound + 1e-9);
+  CHECK(worst_against_pointwise(one, s, r.surface, 1000) <=
+        r.report.steps[0].refit.certified_bound + 1e-9);
 }
 
 TEST_CASE("deform_surface: bad input", "[surface_deformation][errors]") {
@@ -170,26 +175,32 @@ TEST_CASE("deform_surface: bad input", "[surface_deformation][errors]") {
   CHECK(error_of([&] { deform_surface(bad, s); }).first == ErrorCategory::InvalidGeometry);
   SurfaceDeformationOptions options;
   options.compose.check_samples = -1;
-  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, s, options); }).first == ErrorCategory::InvalidArgument);
+  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, s, options); }).first ==
+        ErrorCategory::InvalidArgument);
   options = {};
   options.refit = RefitOptions{};
   options.refit->degree = 0;
-  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, s, options); }).first == ErrorCategory::InvalidArgument);
+  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, s, options); }).first ==
+        ErrorCategory::InvalidArgument);
   surface::BSplineSurface nan_surface = s;
   nan_surface.points(3, 1) = std::nan("");
-  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, nan_surface); }).first == ErrorCategory::InvalidGeometry);
+  CHECK(error_of([&] { deform_surface(Deformation{bulge()}, nan_surface); }).first ==
+        ErrorCategory::InvalidGeometry);
 }
 
 // Issue #18: a refit that misses its tolerance is a failure, not a warning.
-TEST_CASE("deform_surface: a lattice torn where the surface leaves it is refused at once, naming the jump",
-          "[surface_deformation][errors]") {
+TEST_CASE(
+    "deform_surface: a lattice torn where the surface leaves it is refused at once, naming the "
+    "jump",
+    "[surface_deformation][errors]") {
   const surface::BSplineSurface s = dome();  // x, y in [0, 100]
   // The lattice covers x in [-10, 60] only: the dome crosses its face s = 1 along x = 60, and
   // every control point is displaced, that face's too.
   Frame half = box_frame();
   half.s = {70, 0, 0};
   BezierLattice torn = make_bezier_lattice(half, {2, 2, 1});
-  for (Eigen::Index r = 0; r < torn.points.rows(); ++r) torn.points.row(r) += Eigen::RowVector3d(0, 0, 6 + r % 3);
+  for (Eigen::Index r = 0; r < torn.points.rows(); ++r)
+    torn.points.row(r) += Eigen::RowVector3d(0, 0, 6 + r % 3);
   const Deformation d = torn;
   // The independent figure: at the crossing x = 60 the face s = 1 is moved by P(1, t, u) − X,
   // here straight up by 6..8 mm, while the surface outside stays put.
@@ -201,7 +212,8 @@ TEST_CASE("deform_surface: a lattice torn where the surface leaves it is refused
   options.refit->tolerance = 1e-4;
   const auto [category, message] = error_of([&] { deform_surface(d, s, options); });
   CHECK(category == ErrorCategory::ToleranceNotMet);
-  CHECK_THAT(message, Contains("steps[0]") && Contains("discontinuous") && Contains("lattice face s = 1") &&
+  CHECK_THAT(message, Contains("steps[0]") && Contains("discontinuous") &&
+                          Contains("lattice face s = 1") &&
                           Contains("no refit can come closer than half the jump") &&
                           Contains("Enlarge the lattice"));
   // The figure in the message is the map's jump, measured where the surface crosses the face.
@@ -230,7 +242,8 @@ TEST_CASE("deform_surface: a refit that cannot meet a too tight tolerance within
   const auto [category, message] = error_of([&] { deform_surface(stack, s, options); });
   CHECK(category == ErrorCategory::ToleranceNotMet);
   CHECK_THAT(message, Contains("steps[0] (twist 'spin') misses its tolerance") &&
-                          Contains("iteration limit 2 reached") && Contains("accept_out_of_tolerance"));
+                          Contains("iteration limit 2 reached") &&
+                          Contains("accept_out_of_tolerance"));
   // With the opt-in the result comes back, with its figures.
   options.accept_out_of_tolerance = true;
   const SurfaceDeformationResult r = deform_surface(stack, s, options);

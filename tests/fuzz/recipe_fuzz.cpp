@@ -1,7 +1,7 @@
-// libFuzzer target: clay::recipe::check_recipe on arbitrary bytes. Its contract (clay/recipe/recipe.hpp):
-// every problem of the text at once, and never a throw for bad text. So an exception escaping it
-// is a finding, and so is a sanitizer report, a failed assertion, a floating-point trap (invalid,
-// divide by zero, overflow) and a problem without a message.
+// libFuzzer target: clay::recipe::check_recipe on arbitrary bytes. Its contract
+// (clay/recipe/recipe.hpp): every problem of the text at once, and never a throw for bad text. So
+// an exception escaping it is a finding, and so is a sanitizer report, a failed assertion, a
+// floating-point trap (invalid, divide by zero, overflow) and a problem without a message.
 #include <clay/recipe/recipe.hpp>
 
 #include <cstdint>
@@ -22,7 +22,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     for (const auto& problem : clay::recipe::check_recipe(text, CLAY_FUZZ_BASE_DIR)) {
       if (problem.message.empty()) {
-        std::fprintf(stderr, "check_recipe reported a problem without a message at \"%s\"\n", problem.path.c_str());
+        std::fprintf(stderr, "check_recipe reported a problem without a message at \"%s\"\n",
+                     problem.path.c_str());
         std::abort();
       }
       (void)clay::recipe::to_string(problem);

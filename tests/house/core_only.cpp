@@ -13,7 +13,8 @@ int main() {
   using namespace clay::surface;
   Points3 p(4, 3);
   p << 0, 0, 0, 0, 10, 0, 10, 0, 0, 10, 10, 5;
-  const BSplineSurface s = make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
+  const BSplineSurface s =
+      make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
   const double z = evaluate(s, 0.5, 0.5).z();  // bilinear: 5 u v
   const double area = mesh_area(tessellate(insert_knot_u(s, 0.5, 1)));
   std::printf("z(0.5, 0.5) = %.17g, mesh area %.6g mm^2\n", z, area);

@@ -13,19 +13,19 @@
 #include "sketch/sketch_geometry.hpp"
 
 using namespace clay::sketch;
+using Catch::Matchers::WithinAbs;
 using clay::surface::BSplineCurve;
 using clay::surface::Points3;
-using Catch::Matchers::WithinAbs;
 
 namespace {
 
 /// A fair nonplanar clamped cubic about 125 mm long (the "known smooth curve" of the noisy tests).
 BSplineCurve true_curve() {
   Points3 p(6, 3);
-  p << 0, 0, 0,  //
-      25, 25, 10,  //
-      50, 35, -5,  //
-      70, 5, 15,  //
+  p << 0, 0, 0,     //
+      25, 25, 10,   //
+      50, 35, -5,   //
+      70, 5, 15,    //
       85, -15, 20,  //
       105, 5, 5;
   return clay::surface::make_curve(3, {0, 0, 0, 0, 0.35, 0.65, 1, 1, 1, 1}, p);
@@ -64,8 +64,9 @@ NoisyCase noisy_case(unsigned seed) {
   REQUIRE(out.fit.curves.size() == 1);
   const auto fitted = clay::test::analytic(out.fit.curves[0].curve);
   out.to_truth = clay::test::curve_distance(fitted, exact);
-  out.energy_ratio = clay::test::bending_energy(fitted, clay::test::unit_breaks(out.fit.curves[0].curve)) /
-                     clay::test::bending_energy(exact, clay::test::unit_breaks(truth));
+  out.energy_ratio =
+      clay::test::bending_energy(fitted, clay::test::unit_breaks(out.fit.curves[0].curve)) /
+      clay::test::bending_energy(exact, clay::test::unit_breaks(truth));
   return out;
 }
 
@@ -73,7 +74,8 @@ NoisyCase noisy_case(unsigned seed) {
 
 // OCCT's default fitter (GeomAPI_PointsToBSpline with its default settings) interpolates the
 // noise of this kind of stroke: 302 control points for 300 points. Ours looks through it.
-TEST_CASE("noisy 3D stroke: few control points, within 0.2 mm of the true curve, as fair", "[fit]") {
+TEST_CASE("noisy 3D stroke: few control points, within 0.2 mm of the true curve, as fair",
+          "[fit]") {
   const NoisyCase n = noisy_case(2024);
   CHECK_FALSE(n.fit.closed);
   CHECK(n.fit.corners.empty());
@@ -176,13 +178,15 @@ TEST_CASE("a closed noisy stroke gives one closed curve, G1 (indeed C2) at the s
   // A tilted ellipse, 40 x 25 mm, drawn once round; the pen stops short of the start.
   clay::test::Gaussian g(11);
   const double sigma = 0.1;
-  const Eigen::Matrix3d tilt = Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+  const Eigen::Matrix3d tilt =
+      Eigen::AngleAxisd(0.4, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
   Stroke s;
   const int n = 250;
   s.points.resize(n, 3);
   for (int i = 0; i < n; ++i) {
     const double a = 2 * std::numbers::pi * i / n;
-    s.points.row(i) = (tilt * Eigen::Vector3d(40 * std::cos(a), 25 * std::sin(a), 0)).transpose() + g.vector(sigma);
+    s.points.row(i) = (tilt * Eigen::Vector3d(40 * std::cos(a), 25 * std::sin(a), 0)).transpose() +
+                      g.vector(sigma);
   }
   FitOptions o;
   o.tolerance = 3 * sigma;
@@ -215,13 +219,14 @@ TEST_CASE("a closed noisy stroke gives one closed curve, G1 (indeed C2) at the s
   const Points3 dense = clay::test::polyline(ellipse, 4000);
   double worst = 0;
   for (double t : clay::surface::linspace(t0, t1, 400))
-    worst = std::max(worst, clay::test::distance_to_polyline(clay::surface::evaluate(c.curve, t), dense));
+    worst = std::max(worst,
+                     clay::test::distance_to_polyline(clay::surface::evaluate(c.curve, t), dense));
   CHECK(worst <= 0.15);
 }
 
 TEST_CASE("strokes on a sketch plane give curves lying in the plane", "[fit]") {
-  const SketchPlane plane = make_plane(Eigen::Vector3d(10, -20, 30), Eigen::Vector3d(1, -2, 3),
-                                       Eigen::Vector3d(1, 0, 0));
+  const SketchPlane plane =
+      make_plane(Eigen::Vector3d(10, -20, 30), Eigen::Vector3d(1, -2, 3), Eigen::Vector3d(1, 0, 0));
   clay::test::Gaussian g(5);
   auto drawn = [&](auto shape, int n) {
     Stroke s;
@@ -230,8 +235,9 @@ TEST_CASE("strokes on a sketch plane give curves lying in the plane", "[fit]") {
     for (int i = 0; i < n; ++i) {
       const Eigen::Vector2d xy = shape(double(i) / n);
       // Drawn a little off the plane (a hand in the air): 0.5 mm along the normal, and noise.
-      s.points.row(i) = (to_world(plane, xy) + 0.5 * std::sin(9.0 * i / n) * plane.normal()).transpose() +
-                        g.vector(0.05);
+      s.points.row(i) =
+          (to_world(plane, xy) + 0.5 * std::sin(9.0 * i / n) * plane.normal()).transpose() +
+          g.vector(0.05);
     }
     return s;
   };
@@ -240,7 +246,8 @@ TEST_CASE("strokes on a sketch plane give curves lying in the plane", "[fit]") {
     return f < 0.5 ? Eigen::Vector2d(0, 60 * (1 - 2 * f)) : Eigen::Vector2d(60 * (2 * f - 1), 0);
   };
   const auto circle = [](double f) {
-    return Eigen::Vector2d(30 * std::cos(2 * std::numbers::pi * f), 30 * std::sin(2 * std::numbers::pi * f));
+    return Eigen::Vector2d(30 * std::cos(2 * std::numbers::pi * f),
+                           30 * std::sin(2 * std::numbers::pi * f));
   };
   FitOptions o;
   o.tolerance = 0.15;
@@ -293,7 +300,8 @@ TEST_CASE("a closed stroke with corners gives a closed chain of curves", "[fit]"
     CHECK_FALSE(fit.curves[k].closed);
     // Each joint is at a vertex of the triangle.
     double nearest = 1e9;
-    for (const auto& vertex : v) nearest = std::min(nearest, (b.points.row(0).transpose() - vertex).norm());
+    for (const auto& vertex : v)
+      nearest = std::min(nearest, (b.points.row(0).transpose() - vertex).norm());
     CHECK(nearest <= o.tolerance);
   }
 }

@@ -15,25 +15,26 @@
 #include "sketch/sketch_geometry.hpp"
 
 using namespace clay::sketch;
+using Catch::Matchers::Contains;
 using clay::surface::BSplineCurve;
 using clay::surface::Points3;
-using Catch::Matchers::Contains;
 
 namespace {
 
 /// A nonplanar clamped cubic, about 170 mm long, 9 control points.
 BSplineCurve old_curve() {
   Points3 p(9, 3);
-  p << 0, 0, 0,  //
-      20, 15, 5,  //
-      40, 25, 10,  //
-      60, 20, 15,  //
-      80, 5, 10,  //
-      100, -5, 5,  //
-      120, 0, 0,  //
+  p << 0, 0, 0,     //
+      20, 15, 5,    //
+      40, 25, 10,   //
+      60, 20, 15,   //
+      80, 5, 10,    //
+      100, -5, 5,   //
+      120, 0, 0,    //
       140, 15, -5,  //
       160, 20, 0;
-  return clay::surface::make_curve(3, {0, 0, 0, 0, 1. / 6, 2. / 6, 3. / 6, 4. / 6, 5. / 6, 1, 1, 1, 1}, p);
+  return clay::surface::make_curve(
+      3, {0, 0, 0, 0, 1. / 6, 2. / 6, 3. / 6, 4. / 6, 5. / 6, 1, 1, 1, 1}, p);
 }
 
 /// Points of the old curve on [a, b] pushed out by a smooth bump height * sin^2 (zero value and
@@ -45,7 +46,8 @@ Points3 bumped(const BSplineCurve& c, double a, double b, double height, int cou
   for (int i = 0; i < count; ++i) {
     const double u = double(i) / (count - 1);
     const double bump = height * std::pow(std::sin(std::numbers::pi * u), 2);
-    out.row(i) = (clay::surface::evaluate(c, a + (b - a) * u) + bump * Eigen::Vector3d(0, 0.6, 0.8)).transpose() +
+    out.row(i) = (clay::surface::evaluate(c, a + (b - a) * u) + bump * Eigen::Vector3d(0, 0.6, 0.8))
+                     .transpose() +
                  g.vector(sigma);
   }
   return out;
@@ -87,13 +89,15 @@ double stroke_to_curve(const Points3& stroke, const BSplineCurve& c) {
 double unchanged(const BSplineCurve& old, const BSplineCurve& now, double a, double b) {
   double worst = 0;
   for (double t : clay::surface::linspace(a, b, 200))
-    worst = std::max(worst, (clay::surface::evaluate(old, t) - clay::surface::evaluate(now, t)).norm());
+    worst =
+        std::max(worst, (clay::surface::evaluate(old, t) - clay::surface::evaluate(now, t)).norm());
   return worst;
 }
 
 }  // namespace
 
-TEST_CASE("oversketch G1: joints exact, kept parts unchanged, new part follows the stroke", "[oversketch]") {
+TEST_CASE("oversketch G1: joints exact, kept parts unchanged, new part follows the stroke",
+          "[oversketch]") {
   const BSplineCurve old = old_curve();
   const Stroke stroke{bumped(old, 0.3, 0.7, 6.0, 160, 0.01, 3), std::nullopt};
   OversketchOptions o;
@@ -180,7 +184,8 @@ TEST_CASE("oversketch over the curve's end replaces its tail", "[oversketch]") {
   stroke.points.resize(along + past, 3);
   for (int i = 0; i < along; ++i) {
     const double u = double(i) / along;
-    stroke.points.row(i) = (clay::surface::evaluate(old, 0.6 + 0.4 * u) + 4.0 * u * u * (3 - 2 * u) * up).transpose();
+    stroke.points.row(i) =
+        (clay::surface::evaluate(old, 0.6 + 0.4 * u) + 4.0 * u * u * (3 - 2 * u) * up).transpose();
   }
   for (int i = 0; i < past; ++i)
     stroke.points.row(along + i) = (end + 4.0 * up + 25.0 * (i + 1.0) / past * tangent).transpose();
@@ -197,15 +202,16 @@ TEST_CASE("oversketch over the curve's end replaces its tail", "[oversketch]") {
   CHECK(angle(sides(r.curve, r.cut_start).left.d1, sides(r.curve, r.cut_start).right.d1) <= 1e-9);
   CHECK(unchanged(old, r.curve, 0.0, r.cut_start) <= 1e-12 * 170);
   // The new tail ends at the stroke's end.
-  CHECK((clay::surface::evaluate(r.curve, 1.0) - stroke.points.row(along + past - 1).transpose()).norm() <=
-        o.fit.tolerance);
+  CHECK((clay::surface::evaluate(r.curve, 1.0) - stroke.points.row(along + past - 1).transpose())
+            .norm() <= o.fit.tolerance);
   CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance + 1e-4);
 }
 
 TEST_CASE("oversketch keeps a rational curve's kept parts exact", "[oversketch]") {
   // A rational quadratic half circle, radius 50; the stroke flattens its middle.
-  const BSplineCurve old = clay::surface::circular_arc(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(),
-                                                       Eigen::Vector3d::UnitY(), 50.0, 0.0, std::numbers::pi);
+  const BSplineCurve old =
+      clay::surface::circular_arc(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(),
+                                  Eigen::Vector3d::UnitY(), 50.0, 0.0, std::numbers::pi);
   REQUIRE(old.is_rational());
   Stroke stroke;
   stroke.points.resize(100, 3);
@@ -231,7 +237,8 @@ TEST_CASE("oversketch keeps a rational curve's kept parts exact", "[oversketch]"
     CHECK(std::abs(clay::surface::evaluate(r.curve, t).norm() - 50.0) <= 1e-12 * 50);
 }
 
-TEST_CASE("oversketch refuses a stroke end beyond the capture distance, naming it", "[oversketch]") {
+TEST_CASE("oversketch refuses a stroke end beyond the capture distance, naming it",
+          "[oversketch]") {
   const BSplineCurve old = old_curve();
   Stroke stroke{bumped(old, 0.3, 0.7, 6.0, 100, 0.0, 1), std::nullopt};
   stroke.points.row(99) += Eigen::RowVector3d(0, 0, 30);
@@ -261,8 +268,9 @@ TEST_CASE("oversketch refuses a stroke whose ends meet the curve at one point", 
   stroke.points.resize(40, 3);
   for (int i = 0; i < 40; ++i) {
     const double a = 2 * std::numbers::pi * i / 39;
-    stroke.points.row(i) = (at + Eigen::Vector3d(0, 0, 5 * (1 - std::cos(a))) +
-                            Eigen::Vector3d(0, 4 * std::sin(a), 0)).transpose();
+    stroke.points.row(i) =
+        (at + Eigen::Vector3d(0, 0, 5 * (1 - std::cos(a))) + Eigen::Vector3d(0, 4 * std::sin(a), 0))
+            .transpose();
   }
   stroke.points.row(39) = at.transpose();
   const auto [category, what] = clay::test::error_of([&] { oversketch(old, stroke); });
@@ -279,11 +287,13 @@ TEST_CASE("oversketch refuses a stroke covering the whole curve", "[oversketch]"
   stroke.points.resize(120, 3);
   const Eigen::Vector3d lift(0, 0, 2);
   for (int i = 0; i < 10; ++i)
-    stroke.points.row(i) = (clay::surface::evaluate(old, 0.0) + lift - 2.0 * (10 - i) * t0).transpose();
+    stroke.points.row(i) =
+        (clay::surface::evaluate(old, 0.0) + lift - 2.0 * (10 - i) * t0).transpose();
   for (int i = 0; i < 100; ++i)
     stroke.points.row(10 + i) = (clay::surface::evaluate(old, i / 99.0) + lift).transpose();
   for (int i = 0; i < 10; ++i)
-    stroke.points.row(110 + i) = (clay::surface::evaluate(old, 1.0) + lift + 2.0 * (i + 1) * t1).transpose();
+    stroke.points.row(110 + i) =
+        (clay::surface::evaluate(old, 1.0) + lift + 2.0 * (i + 1) * t1).transpose();
   const auto [category, what] = clay::test::error_of([&] { oversketch(old, stroke); });
   CHECK(category == clay::ErrorCategory::InvalidArgument);
   CHECK_THAT(what, Contains("covers the whole curve"));

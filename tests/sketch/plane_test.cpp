@@ -29,7 +29,8 @@ TEST_CASE("make_plane: orthonormal right-handed axes around the given normal", "
   }
 }
 
-TEST_CASE("make_plane: the x axis follows the given direction, projected into the plane", "[plane]") {
+TEST_CASE("make_plane: the x axis follows the given direction, projected into the plane",
+          "[plane]") {
   const SketchPlane plane =
       make_plane(Eigen::Vector3d(1, 2, 3), Eigen::Vector3d(0, 0, 2), Eigen::Vector3d(1, 1, 5));
   CHECK((plane.x_axis - Eigen::Vector3d(1, 1, 0).normalized()).norm() < 1e-15);
@@ -37,9 +38,10 @@ TEST_CASE("make_plane: the x axis follows the given direction, projected into th
   CHECK((plane.normal() - Eigen::Vector3d::UnitZ()).norm() < 1e-15);
 }
 
-TEST_CASE("to_plane and to_world: coordinates along the axes, projection along the normal", "[plane]") {
-  const SketchPlane plane = make_plane(Eigen::Vector3d(10, -20, 5), Eigen::Vector3d(1, 2, 2),
-                                       Eigen::Vector3d(2, -1, 0));
+TEST_CASE("to_plane and to_world: coordinates along the axes, projection along the normal",
+          "[plane]") {
+  const SketchPlane plane =
+      make_plane(Eigen::Vector3d(10, -20, 5), Eigen::Vector3d(1, 2, 2), Eigen::Vector3d(2, -1, 0));
   const Eigen::Vector2d xy(12.5, -7.25);
   const Eigen::Vector3d in_plane = to_world(plane, xy);
   CHECK((to_plane(plane, in_plane) - xy).norm() < 1e-13);
@@ -71,7 +73,8 @@ TEST_CASE("sketch plane validation names the plane and the broken rule", "[plane
 }
 
 TEST_CASE("make_plane refuses a zero normal and an x direction along the normal", "[plane]") {
-  auto [c1, w1] = clay::test::error_of([] { make_plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()); });
+  auto [c1, w1] =
+      clay::test::error_of([] { make_plane(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()); });
   CHECK(c1 == clay::ErrorCategory::InvalidArgument);
   CHECK_THAT(w1, Contains("normal has zero length"));
   auto [c2, w2] = clay::test::error_of([] {

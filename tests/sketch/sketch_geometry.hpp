@@ -53,9 +53,10 @@ struct Analytic {
 inline Analytic analytic(const surface::BSplineCurve& c) {
   const double a = c.basis.domain().first;  // not a structured binding: Clang 14 cannot capture one
   const double s = c.basis.domain().second - a;
-  return {[=](double t) { return surface::evaluate(c, a + s * t); },
-          [=](double t) { return Eigen::Vector3d(s * surface::derivatives(c, a + s * t, 1).d1); },
-          [=](double t) { return Eigen::Vector3d(s * s * surface::derivatives(c, a + s * t, 2).d2); }};
+  return {
+      [=](double t) { return surface::evaluate(c, a + s * t); },
+      [=](double t) { return Eigen::Vector3d(s * surface::derivatives(c, a + s * t, 1).d1); },
+      [=](double t) { return Eigen::Vector3d(s * s * surface::derivatives(c, a + s * t, 2).d2); }};
 }
 
 /// `count` points along the curve at evenly spaced t in [0, 1], plus noise of `sigma` per

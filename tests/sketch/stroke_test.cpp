@@ -66,7 +66,8 @@ TEST_CASE("an infinite coordinate is refused, naming the point", "[stroke]") {
   CHECK_THAT(what, Contains("point 19 has a non-finite coordinate"));
 }
 
-TEST_CASE("repeated consecutive points are refused, naming them, unless dropped on request", "[stroke]") {
+TEST_CASE("repeated consecutive points are refused, naming them, unless dropped on request",
+          "[stroke]") {
   Stroke s = arc(20);
   s.points.row(5) = s.points.row(4);
   const auto [category, what] = fit_error(s);
@@ -81,11 +82,12 @@ TEST_CASE("repeated consecutive points are refused, naming them, unless dropped 
   CHECK(fit.curves[0].last_point == 18);  // 19 distinct points
 }
 
-TEST_CASE("points that project onto one point of the stroke's plane are repeated points", "[stroke]") {
+TEST_CASE("points that project onto one point of the stroke's plane are repeated points",
+          "[stroke]") {
   Stroke s = arc(10);
-  s.plane = SketchPlane{};                 // the xy plane
+  s.plane = SketchPlane{};  // the xy plane
   s.points.row(3) = s.points.row(2);
-  s.points(3, 2) += 5.0;                   // straight above point 2
+  s.points(3, 2) += 5.0;  // straight above point 2
   const auto [category, what] = fit_error(s);
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
   CHECK_THAT(what, Contains("points 2 and 3 project onto the same place of its plane"));
@@ -115,7 +117,8 @@ TEST_CASE("a stroke with an invalid plane is refused, naming the plane", "[strok
 
 TEST_CASE("bad fit options are refused, naming the field, its value and the rule", "[stroke]") {
   const std::vector<std::pair<std::string, std::function<void(FitOptions&)>>> cases = {
-      {"FitOptions::tolerance = 0 must be a positive distance", [](FitOptions& o) { o.tolerance = 0; }},
+      {"FitOptions::tolerance = 0 must be a positive distance",
+       [](FitOptions& o) { o.tolerance = 0; }},
       {"FitOptions::tolerance = nan", [](FitOptions& o) { o.tolerance = std::nan(""); }},
       {"FitOptions::degree = 1 must be in [2, 9]", [](FitOptions& o) { o.degree = 1; }},
       {"FitOptions::degree = 10", [](FitOptions& o) { o.degree = 10; }},
@@ -124,10 +127,12 @@ TEST_CASE("bad fit options are refused, naming the field, its value and the rule
       {"FitOptions::max_control_points = 5 must be >= 2 * degree (6)",
        [](FitOptions& o) { o.max_control_points = 5; }},
       {"FitOptions::max_iterations = 0 must be >= 1", [](FitOptions& o) { o.max_iterations = 0; }},
-      {"FitOptions::corner_angle = 0 must be in (0, 180]", [](FitOptions& o) { o.corner_angle = 0; }},
+      {"FitOptions::corner_angle = 0 must be in (0, 180]",
+       [](FitOptions& o) { o.corner_angle = 0; }},
       {"FitOptions::corner_angle = 181", [](FitOptions& o) { o.corner_angle = 181; }},
       {"FitOptions::corner_window = -1", [](FitOptions& o) { o.corner_window = -1; }},
-      {"FitOptions::closing_ratio = 0.7 must be in [0, 0.5]", [](FitOptions& o) { o.closing_ratio = 0.7; }},
+      {"FitOptions::closing_ratio = 0.7 must be in [0, 0.5]",
+       [](FitOptions& o) { o.closing_ratio = 0.7; }},
       {"FitOptions::end_samples = 0 must be >= 1", [](FitOptions& o) { o.end_samples = 0; }},
   };
   const Stroke s = arc(20);

@@ -75,10 +75,12 @@ TEST_CASE("basis derivatives match central differences and vanish above the degr
         CHECK_THAT(d[static_cast<size_t>(j)], WithinAbs(mid[static_cast<size_t>(j)], 1e-14));
         const double fd1 = (hi[static_cast<size_t>(j)] - lo[static_cast<size_t>(j)]) / (2 * h);
         CHECK_THAT(d[static_cast<size_t>(p + 1 + j)], WithinAbs(fd1, 1e-5 * (1 + std::abs(fd1))));
-        const double fd2 =
-            (hi[static_cast<size_t>(j)] - 2 * mid[static_cast<size_t>(j)] + lo[static_cast<size_t>(j)]) / (h * h);
+        const double fd2 = (hi[static_cast<size_t>(j)] - 2 * mid[static_cast<size_t>(j)] +
+                            lo[static_cast<size_t>(j)]) /
+                           (h * h);
         if (p >= 2)
-          CHECK_THAT(d[static_cast<size_t>(2 * (p + 1) + j)], WithinAbs(fd2, 1e-2 * (1 + std::abs(fd2))));
+          CHECK_THAT(d[static_cast<size_t>(2 * (p + 1) + j)],
+                     WithinAbs(fd2, 1e-2 * (1 + std::abs(fd2))));
         else
           CHECK(d[static_cast<size_t>(2 * (p + 1) + j)] == 0.0);
       }
@@ -94,9 +96,12 @@ TEST_CASE("basis validation names each broken invariant", "[basis][errors]") {
   };
   CHECK_THAT(first(BSplineBasis{0, {0, 1}}), Catch::Contains("degree 0"));
   CHECK_THAT(first(BSplineBasis{3, {0, 0, 0, 1, 1, 1}}), Catch::Contains("needs at least 8"));
-  CHECK_THAT(first(BSplineBasis{2, {0, 0, 0, 0.7, 0.5, 1, 1, 1}}), Catch::Contains("decrease at index 4"));
-  CHECK_THAT(first(BSplineBasis{2, {0, 0, 0, std::nan(""), 1, 1, 1}}), Catch::Contains("not finite"));
-  CHECK_THAT(first(BSplineBasis{2, {0, 0, 0, 0.5, 0.5, 0.5, 1, 1, 1}}), Catch::Contains("multiplicity 3"));
+  CHECK_THAT(first(BSplineBasis{2, {0, 0, 0, 0.7, 0.5, 1, 1, 1}}),
+             Catch::Contains("decrease at index 4"));
+  CHECK_THAT(first(BSplineBasis{2, {0, 0, 0, std::nan(""), 1, 1, 1}}),
+             Catch::Contains("not finite"));
+  CHECK_THAT(first(BSplineBasis{2, {0, 0, 0, 0.5, 0.5, 0.5, 1, 1, 1}}),
+             Catch::Contains("multiplicity 3"));
   CHECK_THAT(first(BSplineBasis{2, {0, 0, 0, 0, 1, 1, 1}}), Catch::Contains("multiplicity 4"));
   CHECK_THAT(first(BSplineBasis{1, {1, 1, 1, 1}}), Catch::Contains("domain"));
   try {
@@ -104,7 +109,8 @@ TEST_CASE("basis validation names each broken invariant", "[basis][errors]") {
     FAIL("validate did not throw");
   } catch (const clay::Error& e) {
     CHECK(e.category() == clay::ErrorCategory::InvalidGeometry);
-    CHECK_THAT(e.what(), Catch::Contains("hood u basis") && Catch::Contains("sort the knot vector"));
+    CHECK_THAT(e.what(),
+               Catch::Contains("hood u basis") && Catch::Contains("sort the knot vector"));
   }
 }
 
@@ -118,7 +124,8 @@ TEST_CASE("clamped_uniform_basis, breakpoints, multiplicity", "[basis]") {
   CHECK_THROWS_AS(clamped_uniform_basis(2, 5, 1.0, 1.0), clay::Error);
 }
 
-TEST_CASE("greville_abscissae average degree-many knots and reproduce linear functions", "[basis]") {
+TEST_CASE("greville_abscissae average degree-many knots and reproduce linear functions",
+          "[basis]") {
   const BSplineBasis b{3, {0, 0, 0, 0, 1, 3, 4, 4, 4, 4}};
   const auto xi = greville_abscissae(b);
   REQUIRE(xi.size() == 6);
@@ -134,7 +141,8 @@ TEST_CASE("greville_abscissae average degree-many knots and reproduce linear fun
     const int k = find_span(b, t);
     basis_functions(b, k, t, N);
     double sum = 0;
-    for (int r = 0; r <= 3; ++r) sum += N[static_cast<size_t>(r)] * xi[static_cast<size_t>(k - 3 + r)];
+    for (int r = 0; r <= 3; ++r)
+      sum += N[static_cast<size_t>(r)] * xi[static_cast<size_t>(k - 3 + r)];
     CHECK_THAT(sum, WithinAbs(t, 1e-14));
   }
 }

@@ -37,7 +37,8 @@ TEST_CASE("a valid surface and curve pass validation", "[bspline]") {
   CHECK_NOTHROW(validate(good_surface()));
   std::mt19937 rng(4);
   CHECK(problems(clay::test::random_curve(rng, 3, 6, true, false)).empty());
-  const BSplineCurve line = make_curve(1, {0, 0, 1, 1}, (Points3(2, 3) << 0, 0, 0, 1, 2, 3).finished());
+  const BSplineCurve line =
+      make_curve(1, {0, 0, 1, 1}, (Points3(2, 3) << 0, 0, 0, 1, 2, 3).finished());
   CHECK_FALSE(line.is_rational());
   CHECK(line.weights.size() == 2);
 }
@@ -54,13 +55,15 @@ TEST_CASE("surface invariant: control point count matches degree and knots", "[b
   BSplineSurface s = good_surface();
   s.points.conservativeResize(s.points.rows() - 1, 3);  // one control point short
   s.weights.conservativeResize(s.weights.rows() - 1);
-  CHECK_THAT(error_of(s), Catch::Contains("has 19 control points") && Catch::Contains("4 x 5 = 20"));
+  CHECK_THAT(error_of(s),
+             Catch::Contains("has 19 control points") && Catch::Contains("4 x 5 = 20"));
 }
 
 TEST_CASE("surface invariant: weights positive", "[bspline][errors]") {
   BSplineSurface s = good_surface();
   s.weights[7] = 0.0;
-  CHECK_THAT(error_of(s), Catch::Contains("weight of control point (1, 2)") && Catch::Contains("positive"));
+  CHECK_THAT(error_of(s),
+             Catch::Contains("weight of control point (1, 2)") && Catch::Contains("positive"));
   s.weights[7] = -2.0;
   CHECK_THAT(error_of(s), Catch::Contains("-2"));
 }
@@ -121,7 +124,8 @@ TEST_CASE("reversed runs a curve backwards on the same domain", "[bspline]") {
     const BSplineCurve r = reversed(c);
     const auto [a, b] = c.basis.domain();
     CHECK(r.basis.domain() == c.basis.domain());
-    for (double t : linspace(a, b, 41)) CHECK((evaluate(r, a + b - t) - evaluate(c, t)).norm() < 1e-12);
+    for (double t : linspace(a, b, 41))
+      CHECK((evaluate(r, a + b - t) - evaluate(c, t)).norm() < 1e-12);
     // Twice reversed: the same control net bit for bit; knots a + b - (a + b - k) up to rounding.
     const BSplineCurve rr = reversed(r);
     CHECK(rr.points == c.points);

@@ -12,7 +12,8 @@
 using namespace clay::surface;
 using clay::test::relative_deviation;
 
-TEST_CASE("degree elevation keeps curves unchanged and adds one multiplicity per breakpoint", "[elevate]") {
+TEST_CASE("degree elevation keeps curves unchanged and adds one multiplicity per breakpoint",
+          "[elevate]") {
   std::mt19937 rng(41);
   for (int p = 1; p <= 8; ++p) {
     for (int t : {1, 2, 5}) {
@@ -35,7 +36,8 @@ TEST_CASE("degree elevation keeps curves unchanged and adds one multiplicity per
 TEST_CASE("degree elevation of surfaces in u and v", "[elevate]") {
   std::mt19937 rng(42);
   for (int p = 1; p <= 4; ++p) {
-    const BSplineSurface s = clay::test::random_surface(rng, p, 5 - p, p + 4, 8 - p, true, p % 2 == 1, 2);
+    const BSplineSurface s =
+        clay::test::random_surface(rng, p, 5 - p, p + 4, 8 - p, true, p % 2 == 1, 2);
     const BSplineSurface eu = elevate_degree_u(s, 2);
     const BSplineSurface ev = elevate_degree_v(s, 1);
     CHECK(eu.u.degree == p + 2);
@@ -48,7 +50,8 @@ TEST_CASE("degree elevation of surfaces in u and v", "[elevate]") {
   }
   // Elevating a Bézier patch gives the classical count (p + t + 1) and keeps the corners exactly.
   std::mt19937 rng2(43);
-  const BSplineSurface bez = extract_bezier(clay::test::random_surface(rng2, 3, 3, 4, 4, false)).patch(0, 0);
+  const BSplineSurface bez =
+      extract_bezier(clay::test::random_surface(rng2, 3, 3, 4, 4, false)).patch(0, 0);
   const BSplineSurface e = elevate_degree_u(bez, 3);
   CHECK(e.count_u() == 7);
   CHECK(e.points.row(0) == bez.points.row(0));
@@ -85,7 +88,8 @@ TEST_CASE("clamp makes an unclamped curve clamped on the same domain", "[elevate
   }
 }
 
-TEST_CASE("polynomial objects stay polynomial through knot and degree operations", "[elevate][knots]") {
+TEST_CASE("polynomial objects stay polynomial through knot and degree operations",
+          "[elevate][knots]") {
   std::mt19937 rng(46);
   for (int p = 1; p <= 6; ++p) {
     const BSplineCurve c = clay::test::random_curve(rng, p, p + 5, false, p % 2 == 0);

@@ -40,14 +40,17 @@ TEST_CASE("BuildReport describes a surface in one line", "[error]") {
   using namespace clay::surface;
   Points3 p(4, 3);
   p << 0, 0, 0, 0, 1, 0, 1, 0, 0, 1, 1, 0;
-  const BSplineSurface s = make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
+  const BSplineSurface s =
+      make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
   BuildReport r = describe(s, "bilinear");
   r.exact = true;
   r.max_deviation_mm = 0.0;
   r.samples = 9;
   CHECK(r.count_u == 2);
   CHECK_FALSE(r.rational);
-  CHECK(r.brief() == "bilinear: degree (1, 1), 2 x 2 control points, polynomial, exact (max deviation 0 mm on 9 samples)");
+  CHECK(r.brief() ==
+        "bilinear: degree (1, 1), 2 x 2 control points, polynomial, exact (max deviation 0 mm on 9 "
+        "samples)");
 }
 
 TEST_CASE("surface Options structs list every bad field, not only the first") {

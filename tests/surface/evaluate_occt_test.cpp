@@ -24,7 +24,8 @@ TEST_CASE("surface points and derivatives agree with OpenCASCADE D2 to 1e-12", "
   for (int p = 1; p <= 7; ++p) {
     for (int q : {1, 3, 7}) {
       for (bool clamped : {true, false}) {
-        const BSplineSurface s = clay::test::random_surface(rng, p, q, p + 4, q + 3, true, clamped, 2);
+        const BSplineSurface s =
+            clay::test::random_surface(rng, p, q, p + 4, q + 3, true, clamped, 2);
         const auto [ua, ub] = s.u.domain();
         const auto [va, vb] = s.v.domain();
         std::uniform_real_distribution<double> U(ua, ub), V(va, vb);
@@ -45,8 +46,9 @@ TEST_CASE("surface points and derivatives agree with OpenCASCADE D2 to 1e-12", "
       }
     }
   }
-  INFO("relative differences: S " << worst[0] << ", Su " << worst[1] << ", Sv " << worst[2] << ", Suu "
-                                   << worst[3] << ", Suv " << worst[4] << ", Svv " << worst[5]);
+  INFO("relative differences: S " << worst[0] << ", Su " << worst[1] << ", Sv " << worst[2]
+                                  << ", Suu " << worst[3] << ", Suv " << worst[4] << ", Svv "
+                                  << worst[5]);
   for (double w : worst) CHECK(w < 1e-12);
 }
 

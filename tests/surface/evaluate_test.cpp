@@ -41,17 +41,20 @@ TEST_CASE("rational circle: exact radius, tangent orthogonal, curvature 1/r", "[
   }
 }
 
-TEST_CASE("surface derivatives match central differences on random rational surfaces", "[evaluate]") {
+TEST_CASE("surface derivatives match central differences on random rational surfaces",
+          "[evaluate]") {
   std::mt19937 rng(21);
   for (int p = 1; p <= 5; ++p) {
-    const BSplineSurface s = clay::test::random_surface(rng, p, 6 - p, p + 4, 9 - p, true, p % 2 == 0);
+    const BSplineSurface s =
+        clay::test::random_surface(rng, p, 6 - p, p + 4, 9 - p, true, p % 2 == 0);
     const auto [ua, ub] = s.u.domain();
     const auto [va, vb] = s.v.domain();
     for (int k = 0; k < 25; ++k) {
       const double u = ua + (ub - ua) * (0.05 + 0.9 * ((k * 7) % 25) / 25.0);
       const double v = va + (vb - va) * (0.05 + 0.9 * ((k * 11) % 25) / 25.0);
       const double hu = 1e-5 * (ub - ua), hv = 1e-5 * (vb - va);
-      if (find_span(s.u, u - hu) != find_span(s.u, u + hu) || find_span(s.v, v - hv) != find_span(s.v, v + hv))
+      if (find_span(s.u, u - hu) != find_span(s.u, u + hu) ||
+          find_span(s.v, v - hv) != find_span(s.v, v + hv))
         continue;
       const SurfaceDerivatives d = derivatives(s, u, v);
       const SurfaceDerivatives pu = derivatives(s, u + hu, v, 1), mu = derivatives(s, u - hu, v, 1);
@@ -72,14 +75,17 @@ TEST_CASE("surface derivatives match central differences on random rational surf
 TEST_CASE("bilinear patch evaluates to its closed form", "[evaluate]") {
   Points3 p(4, 3);
   p << 0, 0, 0, 0, 10, 1, 20, 0, 2, 20, 10, 7;  // (i, j) = i * 2 + j
-  const BSplineSurface s = make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
+  const BSplineSurface s =
+      make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
   for (double u : {0.0, 0.25, 0.5, 1.0})
     for (double v : {0.0, 0.3, 1.0}) {
-      const Eigen::Vector3d expect = (1 - u) * (1 - v) * p.row(0).transpose() + (1 - u) * v * p.row(1).transpose() +
-                                     u * (1 - v) * p.row(2).transpose() + u * v * p.row(3).transpose();
+      const Eigen::Vector3d expect =
+          (1 - u) * (1 - v) * p.row(0).transpose() + (1 - u) * v * p.row(1).transpose() +
+          u * (1 - v) * p.row(2).transpose() + u * v * p.row(3).transpose();
       CHECK((evaluate(s, u, v) - expect).norm() < 1e-14);
       const SurfaceDerivatives d = derivatives(s, u, v);
-      const Eigen::Vector3d duv = p.row(0).transpose() - p.row(1).transpose() - p.row(2).transpose() + p.row(3).transpose();
+      const Eigen::Vector3d duv =
+          p.row(0).transpose() - p.row(1).transpose() - p.row(2).transpose() + p.row(3).transpose();
       CHECK((d.duv - duv).norm() < 1e-13);
       CHECK(d.duu.norm() == 0.0);
     }
@@ -101,12 +107,15 @@ TEST_CASE("grid evaluation equals pointwise evaluation", "[evaluate]") {
     double worst = 0;
     for (size_t i = 0; i < us.size(); ++i)
       for (size_t j = 0; j < vs.size(); ++j)
-        worst = std::max(worst, (g.row(static_cast<Eigen::Index>(i * vs.size() + j)).transpose() - evaluate(s, us[i], vs[j])).norm());
+        worst = std::max(worst, (g.row(static_cast<Eigen::Index>(i * vs.size() + j)).transpose() -
+                                 evaluate(s, us[i], vs[j]))
+                                    .norm());
     CHECK(worst < 1e-12);
   }
 }
 
-TEST_CASE("evaluation errors: parameter outside the domain, bad order, degenerate normal", "[evaluate][errors]") {
+TEST_CASE("evaluation errors: parameter outside the domain, bad order, degenerate normal",
+          "[evaluate][errors]") {
   std::mt19937 rng(9);
   const BSplineSurface s = clay::test::random_surface(rng, 2, 2, 4, 4, true);
   try {
@@ -121,7 +130,8 @@ TEST_CASE("evaluation errors: parameter outside the domain, bad order, degenerat
   // A surface collapsed to a point along u = 0 has no normal there.
   Points3 p(4, 3);
   p << 0, 0, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0;
-  const BSplineSurface tri = make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
+  const BSplineSurface tri =
+      make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
   CHECK_THROWS_AS(unit_normal(tri, 0.0, 0.5), clay::Error);
   BSplineSurface broken = s;
   broken.weights.resize(2);
@@ -143,7 +153,8 @@ TEST_CASE("evaluate_many equals pointwise evaluation of a curve", "[evaluate]") 
   CHECK_THROWS_AS(evaluate_many(c, std::vector<double>{a, b + 1.0}), clay::Error);
 }
 
-TEST_CASE("derivatives_grid equals pointwise derivatives on random rational surfaces", "[evaluate]") {
+TEST_CASE("derivatives_grid equals pointwise derivatives on random rational surfaces",
+          "[evaluate]") {
   std::mt19937 rng(808);
   for (bool rational : {false, true}) {
     const BSplineSurface s = clay::test::random_surface(rng, 3, 2, 7, 6, rational);
@@ -156,8 +167,12 @@ TEST_CASE("derivatives_grid equals pointwise derivatives on random rational surf
     for (size_t i = 0; i < us.size(); ++i)
       for (size_t j = 0; j < vs.size(); ++j) {
         const SurfaceDerivatives a = grid[i * vs.size() + j], b = derivatives(s, us[i], vs[j], 2);
-        for (const auto& [x, y] : {std::pair{a.point, b.point}, {a.du, b.du}, {a.dv, b.dv}, {a.duu, b.duu},
-                                   {a.duv, b.duv}, {a.dvv, b.dvv}}) {
+        for (const auto& [x, y] : {std::pair{a.point, b.point},
+                                   {a.du, b.du},
+                                   {a.dv, b.dv},
+                                   {a.duu, b.duu},
+                                   {a.duv, b.duv},
+                                   {a.dvv, b.dvv}}) {
           worst = std::max(worst, (x - y).norm());
           scale = std::max(scale, y.norm());
         }

@@ -15,8 +15,8 @@
 #include <cfenv>
 #include <chrono>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <limits>
 #include <numbers>
@@ -42,7 +42,8 @@ fs::path fresh_folder(const std::string& name) {
 
 std::vector<std::string> names_in(const fs::path& folder) {
   std::vector<std::string> out;
-  for (const auto& entry : fs::directory_iterator(folder)) out.push_back(entry.path().filename().string());
+  for (const auto& entry : fs::directory_iterator(folder))
+    out.push_back(entry.path().filename().string());
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -59,11 +60,11 @@ std::vector<BSplineSurface> mixed_surfaces(std::mt19937& rng) {
   std::vector<BSplineSurface> out;
   out.push_back(test::random_surface(rng, 3, 3, 6, 7, false));
   out.push_back(test::random_surface(rng, 2, 3, 5, 6, true, true, 2));
-  out.push_back(test::random_surface(rng, 5, 4, 11, 9, true, true, 4));   // C0 knots
-  out.push_back(test::random_surface(rng, 4, 6, 8, 9, true, false));       // unclamped
-  out.push_back(test::random_surface(rng, 25, 25, 30, 30, true, false));   // degree (25, 25)
-  out.push_back(test::random_surface(rng, 25, 3, 29, 8, false, false, 2)); // degree (25, 3)
-  out.push_back(test::random_surface(rng, 1, 1, 2, 2, false));             // bilinear
+  out.push_back(test::random_surface(rng, 5, 4, 11, 9, true, true, 4));     // C0 knots
+  out.push_back(test::random_surface(rng, 4, 6, 8, 9, true, false));        // unclamped
+  out.push_back(test::random_surface(rng, 25, 25, 30, 30, true, false));    // degree (25, 25)
+  out.push_back(test::random_surface(rng, 25, 3, 29, 8, false, false, 2));  // degree (25, 3)
+  out.push_back(test::random_surface(rng, 1, 1, 2, 2, false));              // bilinear
   return out;
 }
 
@@ -108,7 +109,8 @@ ErrorCategory category_of(const std::function<void()>& call) {
 
 }  // namespace
 
-TEST_CASE("STEP AP214 round trip is bit-identical and faces are valid at 1e-7", "[exchange][step]") {
+TEST_CASE("STEP AP214 round trip is bit-identical and faces are valid at 1e-7",
+          "[exchange][step]") {
   std::mt19937 rng(214);
   const auto surfaces = mixed_surfaces(rng);
   const fs::path file = fresh_folder("step214") / "surfaces.step";
@@ -120,7 +122,8 @@ TEST_CASE("STEP AP214 round trip is bit-identical and faces are valid at 1e-7", 
   const std::string text = read_text(file);
   REQUIRE_THAT(text, Catch::Matchers::StartsWith("ISO-10303-21;"));
   REQUIRE_THAT(text, Catch::Matchers::Contains("FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214"));
-  REQUIRE_THAT(text, Catch::Matchers::Contains("LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.)"));
+  REQUIRE_THAT(text,
+               Catch::Matchers::Contains("LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.)"));
   REQUIRE_THAT(text, Catch::Matchers::Contains("PRODUCT('clayform','clayform'"));
   REQUIRE_THAT(text, Catch::Matchers::Contains("RATIONAL_B_SPLINE_SURFACE"));
   REQUIRE(names_in(file.parent_path()) == std::vector<std::string>{"surfaces.step"});
@@ -184,9 +187,11 @@ TEST_CASE("Closed surfaces come back as written although the readers make them p
   }
   BSplineSurface closed_both = test::random_surface(rng, 4, 2, 8, 5, false);
   for (int j = 0; j < 5; ++j)
-    closed_both.points.row(closed_both.index(7, j)) = closed_both.points.row(closed_both.index(0, j));
+    closed_both.points.row(closed_both.index(7, j)) =
+        closed_both.points.row(closed_both.index(0, j));
   for (int i = 0; i < 8; ++i)
-    closed_both.points.row(closed_both.index(i, 4)) = closed_both.points.row(closed_both.index(i, 0));
+    closed_both.points.row(closed_both.index(i, 4)) =
+        closed_both.points.row(closed_both.index(i, 0));
   BSplineSurface pole = test::random_surface(rng, 3, 3, 6, 6, true);  // degenerate side
   for (int i = 0; i < 6; ++i) pole.points.row(pole.index(i, 0)) = pole.points.row(pole.index(0, 0));
   const std::vector<BSplineSurface> surfaces{closed_u, closed_both, pole};
@@ -214,8 +219,10 @@ TEST_CASE("Bezier-like degree-25 patches: exact file, honest BRepCheck verdict",
                                        Catch::Matchers::Contains("exact iso-curves") &&
                                        Catch::Matchers::Contains("cached power-basis"));
   // brief() names the verdict and the first problem
-  REQUIRE_THAT(report.brief(), Catch::Matchers::Equals("1 face, max degree 25, 676 control points, NOT valid "
-                                                       "(BRepCheck at 1e-07 mm): 1 problem: " + report.problems[0]));
+  REQUIRE_THAT(report.brief(),
+               Catch::Matchers::Equals("1 face, max degree 25, 676 control points, NOT valid "
+                                       "(BRepCheck at 1e-07 mm): 1 problem: " +
+                                       report.problems[0]));
   const fs::path file = fresh_folder("bezier25") / "patch.igs";
   const ExchangeReport written = write_iges(surfaces, file);
   REQUIRE_FALSE(written.valid);
@@ -224,14 +231,14 @@ TEST_CASE("Bezier-like degree-25 patches: exact file, honest BRepCheck verdict",
 
 TEST_CASE("check_faces reports sizes and validity without writing", "[exchange][validity]") {
   std::mt19937 rng(3);
-  const std::vector<BSplineSurface> surfaces{
-      test::random_surface(rng, 20, 22, 40, 41, true, false),
-      test::random_surface(rng, 24, 2, 45, 3, false, false),
-      test::random_surface(rng, 3, 3, 4, 4, true)};
+  const std::vector<BSplineSurface> surfaces{test::random_surface(rng, 20, 22, 40, 41, true, false),
+                                             test::random_surface(rng, 24, 2, 45, 3, false, false),
+                                             test::random_surface(rng, 3, 3, 4, 4, true)};
   const ExchangeReport report = check_faces(surfaces);
   require_report(report, surfaces);
   // 40 x 41 + 45 x 3 + 4 x 4 control points, the largest degree 24
-  CHECK(report.brief() == "3 faces, max degree 24, 1791 control points, valid (BRepCheck at 1e-07 mm)");
+  CHECK(report.brief() ==
+        "3 faces, max degree 24, 1791 control points, valid (BRepCheck at 1e-07 mm)");
 }
 
 TEST_CASE("Failed writes throw clay::Error and leave no file behind", "[exchange][errors]") {
@@ -276,8 +283,8 @@ TEST_CASE("Failed writes throw clay::Error and leave no file behind", "[exchange
       FAIL("no exception");
     } catch (const Error& e) {
       REQUIRE(e.category() == ErrorCategory::DegreeLimit);
-      REQUIRE_THAT(e.message(), Catch::Matchers::Contains("surface #1") &&
-                                    Catch::Matchers::Contains("26"));
+      REQUIRE_THAT(e.message(),
+                   Catch::Matchers::Contains("surface #1") && Catch::Matchers::Contains("26"));
     }
     REQUIRE(category_of([&] { write_step(high, folder / "high.step"); }) ==
             ErrorCategory::DegreeLimit);
@@ -375,7 +382,8 @@ TEST_CASE("Concurrent STEP and IGES round trips from 4 threads", "[exchange][thr
     INFO("thread " << t);
     REQUIRE(failures[t].empty());
     REQUIRE(read_back[t].size() == 2 * rounds);
-    for (size_t r = 0; r < read_back[t].size(); ++r) require_identical(read_back[t][r], written[t][r]);
+    for (size_t r = 0; r < read_back[t].size(); ++r)
+      require_identical(read_back[t][r], written[t][r]);
   }
   REQUIRE(names_in(folder).size() == 2 * threads * rounds);
 }
@@ -410,7 +418,8 @@ TEST_CASE("glTF preview is a binary glTF file", "[exchange][gltf]") {
     const auto [u0, u1] = s.u.domain();
     const auto [v0, v1] = s.v.domain();
     const Points3 dense = evaluate_grid(s, linspace(u0, u1, 401), linspace(v0, v1, 401));
-    for (Eigen::Index r = 0; r < dense.rows(); ++r) box.extend(Eigen::Vector3d(dense.row(r).transpose()));
+    for (Eigen::Index r = 0; r < dense.rows(); ++r)
+      box.extend(Eigen::Vector3d(dense.row(r).transpose()));
   }
   CHECK(back.triangles.size() > 1000);
   CHECK(std::abs(back.area() - area) <= 0.01 * area);
@@ -419,7 +428,8 @@ TEST_CASE("glTF preview is a binary glTF file", "[exchange][gltf]") {
   CHECK((back.box().max() - box.max()).norm() <= 1e-3 * size);
 }
 
-TEST_CASE("glTF previews of surfaces with poles and collapsed edges are not empty", "[exchange][gltf]") {
+TEST_CASE("glTF previews of surfaces with poles and collapsed edges are not empty",
+          "[exchange][gltf]") {
   // A sphere of revolution (a pole at each end of every meridian) and a cone with its apex
   // collapsed: OpenCASCADE's mesher once gave such faces zero-area meshes.
   // The half circle x^2 + z^2 = 100, x >= 0, as two rational quadratic quarter circles.
@@ -464,8 +474,8 @@ std::string replaced(std::string text, const std::string& from, const std::strin
 
 /// An IGES file's lines with the data columns 1-64 of the line starting with `prefix` (offset
 /// `down` lines below it) edited, padded back to 64 columns so the fixed format stays intact.
-std::string iges_edited(const std::string& text, const std::string& prefix, int down, const std::string& from,
-                        const std::string& to) {
+std::string iges_edited(const std::string& text, const std::string& prefix, int down,
+                        const std::string& from, const std::string& to) {
   std::vector<std::string> lines;
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) lines.push_back(line);
@@ -527,7 +537,9 @@ std::vector<std::pair<std::string, std::string>> write_mutated_files(const fs::p
       {"iges-infinite-coordinate.igs", "'1.0D999' is beyond the range of a double"},
       {"iges-denormal-coordinate.igs", "'4.9D-324' is denormal"},
   };
-  auto write = [&](const std::string& name, const std::string& text) { std::ofstream(folder / name, std::ios::binary) << text; };
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(folder / name, std::ios::binary) << text;
+  };
   write(files[0].first, replaced(step, axis, replaced(axis, first_ref + ",", "#999999,")));
   write(files[1].first, replaced(step, axis, replaced(axis, "," + second_ref + ",", ",#999998,")));
   write(files[2].first, coordinate("NaN"));
@@ -571,7 +583,8 @@ std::vector<BSplineSurface> read_any(const fs::path& file, const ReadOptions& op
 
 }  // namespace
 
-TEST_CASE("The pre-check refuses malformed STEP and IGES files, naming the entity and line", "[exchange][malformed]") {
+TEST_CASE("The pre-check refuses malformed STEP and IGES files, naming the entity and line",
+          "[exchange][malformed]") {
   const fs::path folder = fresh_folder("malformed");
   const auto files = write_mutated_files(folder);
   REQUIRE(read_step(folder / "valid.step").size() == 2);  // the originals pass
@@ -584,12 +597,16 @@ TEST_CASE("The pre-check refuses malformed STEP and IGES files, naming the entit
     CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 5.0);
     CHECK_THAT(m, Catch::Matchers::Contains(why));
     CHECK_THAT(m, Catch::Matchers::Contains(name + "' line "));
-    CHECK_THAT(m, Catch::Matchers::Contains(name.rfind("step", 0) == 0 ? ", entity #" : ", entity 128 (directory entry "));
+    CHECK_THAT(m, Catch::Matchers::Contains(name.rfind("step", 0) == 0
+                                                ? ", entity #"
+                                                : ", entity 128 (directory entry "));
   }
   // A copy for the fuzzers' corpus (tests/fuzz/corpus/exchange/) is made from these files.
 }
 
-TEST_CASE("The pre-check's refusal of 1.0E999 leaves the caller's floating-point environment as it was", "[exchange][malformed]") {
+TEST_CASE(
+    "The pre-check's refusal of 1.0E999 leaves the caller's floating-point environment as it was",
+    "[exchange][malformed]") {
   // strtod reports 1.0E999 by raising overflow; a host trapping overflow (the Debug tests do) died
   // of it in the pre-check (issue #19). The scan runs with the traps held, the flags restored.
   const fs::path folder = fresh_folder("malformed-fenv");
@@ -601,7 +618,8 @@ TEST_CASE("The pre-check's refusal of 1.0E999 leaves the caller's floating-point
     const int traps = fegetexcept();
 #endif
     const fs::path file = folder / name;
-    CHECK_THAT(message_of([&] { (void)read_any(file, {}); }), Catch::Matchers::Contains("is beyond the range of a double"));
+    CHECK_THAT(message_of([&] { (void)read_any(file, {}); }),
+               Catch::Matchers::Contains("is beyond the range of a double"));
     CHECK(std::fetestexcept(FE_OVERFLOW | FE_INVALID | FE_DIVBYZERO) == 0);
 #if defined(__GLIBC__)
     CHECK(fegetexcept() == traps);
@@ -609,7 +627,8 @@ TEST_CASE("The pre-check's refusal of 1.0E999 leaves the caller's floating-point
   }
 }
 
-TEST_CASE("An isolated read survives what crashes OpenCASCADE, and stops at its limits", "[exchange][malformed]") {
+TEST_CASE("An isolated read survives what crashes OpenCASCADE, and stops at its limits",
+          "[exchange][malformed]") {
   const fs::path folder = fresh_folder("isolated");
   (void)write_mutated_files(folder);
   ReadOptions isolated;
@@ -649,8 +668,10 @@ TEST_CASE("An isolated read survives what crashes OpenCASCADE, and stops at its 
   // Bad options.
   ReadOptions bad;
   bad.time_limit_seconds = 0;
-  REQUIRE(category_of([&] { (void)read_step(folder / "valid.step", bad); }) == ErrorCategory::InvalidArgument);
+  REQUIRE(category_of([&] { (void)read_step(folder / "valid.step", bad); }) ==
+          ErrorCategory::InvalidArgument);
   bad = {};
   bad.memory_limit_mb = 0;
-  REQUIRE(category_of([&] { (void)read_iges(folder / "valid.igs", bad); }) == ErrorCategory::InvalidArgument);
+  REQUIRE(category_of([&] { (void)read_iges(folder / "valid.igs", bad); }) ==
+          ErrorCategory::InvalidArgument);
 }

@@ -17,9 +17,9 @@
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
+using Catch::Matchers::WithinAbs;
 using clay::test::error_of;
 using clay::test::polyline;
-using Catch::Matchers::WithinAbs;
 
 namespace {
 
@@ -61,7 +61,8 @@ double edge_error(const BSplineSurface& s, const BSplineCurve& c) {
         const double g = back ? 1 - f : f;
         const double u = edge == 0 ? ua : edge == 1 ? ub : ua + g * (ub - ua);
         const double v = edge == 2 ? va : edge == 3 ? vb : va + g * (vb - va);
-        worst = std::max(worst, (evaluate(s, u, v) - evaluate(c, std::clamp(a + f * (b - a), a, b))).norm());
+        worst = std::max(
+            worst, (evaluate(s, u, v) - evaluate(c, std::clamp(a + f * (b - a), a, b))).norm());
       }
       best = std::min(best, worst);
     }
@@ -84,7 +85,8 @@ std::vector<BSplineCurve> quad_boundary(std::mt19937& rng, bool rational = false
 double distance_to(const BSplineSurface& s, const BSplineCurve& c) {
   const auto [a, b] = c.basis.domain();
   double worst = 0;
-  for (double t : linspace(a, b, 65)) worst = std::max(worst, closest_point(s, evaluate(c, t)).distance);
+  for (double t : linspace(a, b, 65))
+    worst = std::max(worst, closest_point(s, evaluate(c, t)).distance);
   return worst;
 }
 
@@ -120,7 +122,8 @@ TEST_CASE("fill of 4 curves interpolates them exactly in every style", "[fill]")
 TEST_CASE("fill of 4 curves in shuffled order and directions", "[fill]") {
   std::mt19937 rng(402);
   const std::vector<BSplineCurve> quad = quad_boundary(rng);
-  const std::vector<BSplineCurve> shuffled = {reversed(quad[2]), quad[0], reversed(quad[3]), quad[1]};
+  const std::vector<BSplineCurve> shuffled = {reversed(quad[2]), quad[0], reversed(quad[3]),
+                                              quad[1]};
   for (FillStyle style : all_styles) check_fill(shuffled, style);
   const BuiltSurface built = fill(shuffled);
   CHECK_THAT(built.report.method, Catch::Contains("reversed"));
@@ -188,7 +191,8 @@ TEST_CASE("Coons fill of straight sides raises them to degree 3", "[fill]") {
   CHECK(built.surface.v.degree == 3);
   for (const BSplineCurve& c : sides) CHECK(edge_error(built.surface, c) < 1e-12 * 200);
   // Four coplanar lines: every style stays in their plane.
-  const std::vector<BSplineCurve> flat = {line(p0, p1), line(p1, {100, 100, 0}), line({100, 100, 0}, p3), line(p3, p0)};
+  const std::vector<BSplineCurve> flat = {line(p0, p1), line(p1, {100, 100, 0}),
+                                          line({100, 100, 0}, p3), line(p3, p0)};
   for (FillStyle style : all_styles) {
     FillOptions o;
     o.style = style;
@@ -215,7 +219,9 @@ TEST_CASE("fill rejects a boundary with a gap, naming the curves and the gap", "
   quad[2].points(0, 0) += 0.25;
   const auto [category, message] = error_of([&] { fill(quad); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("curve #1 end and curve #2 start are 0.25 mm apart (tolerance 1e-07 mm)"));
+  CHECK_THAT(
+      message,
+      Catch::Contains("curve #1 end and curve #2 start are 0.25 mm apart (tolerance 1e-07 mm)"));
   // Reversed curve: its start becomes the trailing end.
   quad[1] = reversed(quad[1]);
   CHECK_THAT(error_of([&] { fill(quad); }).second,
@@ -251,7 +257,6 @@ TEST_CASE("fill rejects an invalid curve, naming it", "[fill][errors]") {
   CHECK_THAT(message, Catch::Contains("curve #1"));
 }
 
-
 TEST_CASE("fill rejects a boundary curve that crosses itself", "[fill][errors]") {
   std::mt19937 rng(412);
   std::vector<BSplineCurve> quad = quad_boundary(rng);
@@ -261,25 +266,35 @@ TEST_CASE("fill rejects a boundary curve that crosses itself", "[fill][errors]")
   quad[2] = polyline({p2, p3 + d, p2 + d, p3});
   const auto [category, message] = error_of([&] { fill(quad); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("fill: curve #2 crosses itself at t = 0.5 and t = 2.5 (point (52.5, 85, 7.5)") &&
-                          Catch::Contains("must not cross or touch itself"));
+  CHECK_THAT(message,
+             Catch::Contains(
+                 "fill: curve #2 crosses itself at t = 0.5 and t = 2.5 (point (52.5, 85, 7.5)") &&
+                 Catch::Contains("must not cross or touch itself"));
   // The same curve reversed and given first: its parameters are still its own.
   std::vector<BSplineCurve> turned = {reversed(quad[2]), quad[0], quad[1], quad[3]};
-  CHECK_THAT(error_of([&] { fill(turned); }).second, Catch::Contains("curve #0 crosses itself at t = 0.5 and t = 2.5"));
+  CHECK_THAT(error_of([&] { fill(turned); }).second,
+             Catch::Contains("curve #0 crosses itself at t = 0.5 and t = 2.5"));
   // Two curves of a ruled fill: each is checked on its own.
   const BSplineCurve zee = polyline({{0, 0, 0}, {100, 30, 0}, {100, 0, 0}, {0, 30, 0}});
   const BSplineCurve far = curve_between(rng, 3, 5, {0, 80, 20}, {100, 80, 0}, 5.0);
-  CHECK_THAT(error_of([&] { fill({far, zee}); }).second,
-             Catch::Contains("fill: curve #1 crosses itself at t = 0.5 and t = 2.5 (point (50, 15, 0)"));
+  CHECK_THAT(
+      error_of([&] {
+        fill({far, zee});
+      }).second,
+      Catch::Contains("fill: curve #1 crosses itself at t = 0.5 and t = 2.5 (point (50, 15, 0)"));
 }
 
 TEST_CASE("fill rejects boundary curves that cross each other", "[fill][errors]") {
-  // A bow tie: (0,0) -> (100,0) -> (0,100) -> (100,100) -> (0,0); curves #1 and #3 cross at (50, 50).
+  // A bow tie: (0,0) -> (100,0) -> (0,100) -> (100,100) -> (0,0); curves #1 and #3 cross at (50,
+  // 50).
   auto line = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return polyline({a, b}); };
   const Eigen::Vector3d p0(0, 0, 0), p1(100, 0, 0), p2(0, 100, 0), p3(100, 100, 0);
-  const auto [category, message] = error_of([&] { fill({line(p0, p1), line(p1, p2), line(p2, p3), line(p3, p0)}); });
+  const auto [category, message] = error_of([&] {
+    fill({line(p0, p1), line(p1, p2), line(p2, p3), line(p3, p0)});
+  });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("fill: the boundary crosses itself: curve #1 at t = 0.5 and curve #3 at t = 0.5 meet at point (50, 50, 0)") &&
+  CHECK_THAT(message, Catch::Contains("fill: the boundary crosses itself: curve #1 at t = 0.5 and "
+                                      "curve #3 at t = 0.5 meet at point (50, 50, 0)") &&
                           Catch::Contains("must form a simple loop"));
 }
 
@@ -297,7 +312,8 @@ TEST_CASE("curved fill of 2 curves needs a shared corner", "[fill][errors]") {
 TEST_CASE("fill options are validated", "[fill][errors]") {
   FillOptions o;
   o.gap_tolerance = 0;
-  CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("FillOptions::gap_tolerance is 0"));
+  CHECK_THAT(error_of([&] { o.validate(); }).second,
+             Catch::Contains("FillOptions::gap_tolerance is 0"));
   o.gap_tolerance = 1e-7;
   o.style = static_cast<FillStyle>(7);
   CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("FillOptions::style is 7"));
@@ -320,7 +336,8 @@ BSplineCurve lifted(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     const double t = k / 3.0;
     const Eigen::Vector2d q = (1 - t) * a + t * b;
     z[k] = dome(q.x(), q.y());
-    bernstein.row(k) << std::pow(1 - t, 3), 3 * t * std::pow(1 - t, 2), 3 * t * t * (1 - t), std::pow(t, 3);
+    bernstein.row(k) << std::pow(1 - t, 3), 3 * t * std::pow(1 - t, 2), 3 * t * t * (1 - t),
+        std::pow(t, 3);
   }
   const Eigen::Vector4d ordinates = bernstein.fullPivLu().solve(z);
   Points3 p(4, 3);
@@ -344,7 +361,8 @@ std::vector<BSplineCurve> pentagon_on_dome() {
 
 }  // namespace
 
-TEST_CASE("n-sided fill of a 5-sided dome with an interior curve reports a measured deviation", "[fill][nsided]") {
+TEST_CASE("n-sided fill of a 5-sided dome with an interior curve reports a measured deviation",
+          "[fill][nsided]") {
   std::vector<BSplineCurve> sides = pentagon_on_dome();
   // Shuffle and reverse some: the loop is found regardless.
   std::swap(sides[1], sides[3]);
@@ -363,7 +381,8 @@ TEST_CASE("n-sided fill of a 5-sided dome with an interior curve reports a measu
   // Independent measurement: closest points of 4x denser samples, each against its reported value.
   for (size_t k = 0; k < all.size(); ++k) {
     double worst = 0;
-    for (double t : linspace(0, 1, 257)) worst = std::max(worst, closest_point(result.built.surface, evaluate(all[k], t)).distance);
+    for (double t : linspace(0, 1, 257))
+      worst = std::max(worst, closest_point(result.built.surface, evaluate(all[k], t)).distance);
     INFO("curve " << k << ": reported " << result.curve_deviations[k] << ", independent " << worst);
     CHECK(worst >= 0.8 * result.curve_deviations[k]);
     CHECK(worst <= 1.25 * result.curve_deviations[k] + 1e-9 * size);
@@ -381,15 +400,20 @@ TEST_CASE("n-sided fill rejects an open boundary, naming the gap", "[fill][nside
   CHECK_THAT(message, Catch::Contains("curve #3 end and curve #4 start are 0.5 mm apart"));
 }
 
-TEST_CASE("n-sided fill rejects fewer than 3 boundary curves and bad options", "[fill][nsided][errors]") {
+TEST_CASE("n-sided fill rejects fewer than 3 boundary curves and bad options",
+          "[fill][nsided][errors]") {
   const std::vector<BSplineCurve> sides = pentagon_on_dome();
-  CHECK(error_of([&] { fill_n_sided({sides[0], sides[1]}); }).first == clay::ErrorCategory::InvalidArgument);
+  CHECK(error_of([&] {
+          fill_n_sided({sides[0], sides[1]});
+        }).first == clay::ErrorCategory::InvalidArgument);
   NSidedFillOptions o;
   o.max_degree = 30;
-  CHECK_THAT(error_of([&] { fill_n_sided(sides, {}, o); }).second, Catch::Contains("NSidedFillOptions::max_degree is 30"));
+  CHECK_THAT(error_of([&] { fill_n_sided(sides, {}, o); }).second,
+             Catch::Contains("NSidedFillOptions::max_degree is 30"));
   o = {};
   o.tolerance_3d = -1;
-  CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("NSidedFillOptions::tolerance_3d"));
+  CHECK_THAT(error_of([&] { o.validate(); }).second,
+             Catch::Contains("NSidedFillOptions::tolerance_3d"));
 }
 
 TEST_CASE("n-sided fill rejects a degenerate interior curve", "[fill][nsided][errors]") {
@@ -409,7 +433,8 @@ TEST_CASE("n-sided fill rejects a star-shaped (self-crossing) boundary", "[fill]
     corners.emplace_back(80 * std::cos(a), 80 * std::sin(a));
   }
   std::vector<BSplineCurve> star;
-  for (int k = 0; k < 5; ++k) star.push_back(lifted(corners[(2 * k) % 5], corners[(2 * k + 2) % 5]));
+  for (int k = 0; k < 5; ++k)
+    star.push_back(lifted(corners[(2 * k) % 5], corners[(2 * k + 2) % 5]));
   double first = 2, other_t = 0;
   int other = -1;
   const Eigen::Vector2d a0 = corners[0], a1 = corners[2];
@@ -424,8 +449,10 @@ TEST_CASE("n-sided fill rejects a star-shaped (self-crossing) boundary", "[fill]
   }
   REQUIRE(other > 0);
   char expected[160];
-  std::snprintf(expected, sizeof expected, "curve #0 at t = %.4g and curve #%d at t = %.4g meet", first, other, other_t);
+  std::snprintf(expected, sizeof expected, "curve #0 at t = %.4g and curve #%d at t = %.4g meet",
+                first, other, other_t);
   const auto [category, message] = error_of([&] { fill_n_sided(star); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("fill_n_sided: the boundary crosses itself") && Catch::Contains(expected));
+  CHECK_THAT(message, Catch::Contains("fill_n_sided: the boundary crosses itself") &&
+                          Catch::Contains(expected));
 }

@@ -38,12 +38,14 @@ TEST_CASE("binomial: Pascal's rows against the product formula and the row sums 
   CHECK(std::abs(internal::binomial(180, 90) / static_cast<double>(c) - 1) < 1e-13);
 }
 
-TEST_CASE("gauss_legendre: n points integrate x^k exactly for k <= 2n - 1; the 8-point constants agree") {
+TEST_CASE(
+    "gauss_legendre: n points integrate x^k exactly for k <= 2n - 1; the 8-point constants agree") {
   for (int n = 1; n <= 20; ++n) {
     const internal::GaussRule rule = internal::gauss_legendre(n);
     for (int k = 0; k <= 2 * n - 1; ++k) {
       double sum = 0;
-      for (size_t i = 0; i < rule.nodes.size(); ++i) sum += rule.weights[i] * std::pow(rule.nodes[i], k);
+      for (size_t i = 0; i < rule.nodes.size(); ++i)
+        sum += rule.weights[i] * std::pow(rule.nodes[i], k);
       const double exact = k % 2 ? 0.0 : 2.0 / (k + 1);  // ∫_{-1}^{1} x^k dx
       CHECK(std::abs(sum - exact) < 1e-14);
     }
@@ -54,7 +56,8 @@ TEST_CASE("gauss_legendre: n points integrate x^k exactly for k <= 2n - 1; the 8
     CHECK(std::abs(eight.weights[i] - internal::gauss8_weights[i]) < 1e-15);
   }
   // ∫_1^3 x^15 dx = (3^16 - 1) / 16, exact for the 8-point rule.
-  const double integral = internal::gauss_legendre_8(1.0, 3.0, [](double x) { return std::pow(x, 15); });
+  const double integral =
+      internal::gauss_legendre_8(1.0, 3.0, [](double x) { return std::pow(x, 15); });
   CHECK(std::abs(integral / ((std::pow(3.0, 16) - 1) / 16) - 1) < 1e-14);
 }
 
@@ -86,7 +89,8 @@ TEST_CASE("part_count: requested parts, capped by the work, at least one") {
   CHECK(internal::part_count(4, 10, 1000) == 1);
   CHECK(internal::part_count(0, 0, 1000) == 1);
   // 0 asks for one part per hardware thread.
-  CHECK(internal::part_count(0, std::size_t{1} << 40, 1) == std::max(1u, std::thread::hardware_concurrency()));
+  CHECK(internal::part_count(0, std::size_t{1} << 40, 1) ==
+        std::max(1u, std::thread::hardware_concurrency()));
 }
 
 TEST_CASE("run_on_threads runs every part once and rethrows a task's exception after all ended") {

@@ -32,7 +32,8 @@ TEST_CASE("knot insertion keeps curves unchanged", "[knots]") {
       CHECK(relative_deviation(c, full) < 1e-12);
       // At an existing knot and at the domain ends.
       const double k = c.basis.knots[static_cast<size_t>(p + 1)];
-      if (k < b && multiplicity(c.basis, k) < p) CHECK(relative_deviation(c, insert_knot(c, k)) < 1e-12);
+      if (k < b && multiplicity(c.basis, k) < p)
+        CHECK(relative_deviation(c, insert_knot(c, k)) < 1e-12);
       if (!clamped && p > 1) {  // unclamped ends are simple knots: room for p - 1 more
         CHECK(relative_deviation(c, insert_knot(c, a)) < 1e-12);
         CHECK(relative_deviation(c, insert_knot(c, b, p - 1)) < 1e-12);
@@ -44,7 +45,8 @@ TEST_CASE("knot insertion keeps curves unchanged", "[knots]") {
 TEST_CASE("knot insertion in u and v keeps surfaces unchanged", "[knots]") {
   std::mt19937 rng(32);
   for (int p = 1; p <= 5; ++p) {
-    const BSplineSurface s = clay::test::random_surface(rng, p, 6 - p, p + 3, 9 - p, true, p != 3, 2);
+    const BSplineSurface s =
+        clay::test::random_surface(rng, p, 6 - p, p + 3, 9 - p, true, p != 3, 2);
     const BSplineSurface su = insert_knot_u(s, 0.41, 2 > p ? p : 2);
     const BSplineSurface sv = insert_knot_v(s, 0.77);
     CHECK(su.count_u() == s.count_u() + (2 > p ? p : 2));
@@ -98,8 +100,10 @@ TEST_CASE("Bézier extraction: patches evaluate like the surface on their spans"
         CHECK(patch.count_u() == 4);
         CHECK(patch.count_v() == 3);
         CHECK(is_clamped(patch.u));
-        for (double u : linspace(bez.breaks_u[static_cast<size_t>(i)], bez.breaks_u[static_cast<size_t>(i + 1)], 7))
-          for (double v : linspace(bez.breaks_v[static_cast<size_t>(j)], bez.breaks_v[static_cast<size_t>(j + 1)], 7))
+        for (double u : linspace(bez.breaks_u[static_cast<size_t>(i)],
+                                 bez.breaks_u[static_cast<size_t>(i + 1)], 7))
+          for (double v : linspace(bez.breaks_v[static_cast<size_t>(j)],
+                                   bez.breaks_v[static_cast<size_t>(j + 1)], 7))
             worst = std::max(worst, (evaluate(patch, u, v) - evaluate(s, u, v)).norm());
       }
     CHECK(worst / size < 1e-12);
@@ -168,7 +172,8 @@ TEST_CASE("remove_knots undoes knot refinement and keeps the knots a shape needs
     const BSplineSurface s = clay::test::random_surface(rng, 3, 2, 7, 6, rational);
     const BezierPatches bp = extract_bezier(s);  // the breaks
     std::vector<double> extra_u, extra_v;
-    for (size_t i = 1; i + 1 < bp.breaks_u.size(); ++i) extra_u.insert(extra_u.end(), 2, bp.breaks_u[i]);
+    for (size_t i = 1; i + 1 < bp.breaks_u.size(); ++i)
+      extra_u.insert(extra_u.end(), 2, bp.breaks_u[i]);
     for (size_t j = 1; j + 1 < bp.breaks_v.size(); ++j) extra_v.push_back(bp.breaks_v[j]);
     const BSplineSurface refined = refine_knots_v(refine_knots_u(s, extra_u), extra_v);
     const SurfaceKnotRemoval in_u = remove_knots_u(refined, 1e-9);
@@ -188,7 +193,10 @@ TEST_CASE("remove_knots undoes knot refinement and keeps the knots a shape needs
   }
 }
 
-TEST_CASE("join_bezier_patches undoes extract_bezier: C0 joined, then remove_knots gives the surface back", "[knots]") {
+TEST_CASE(
+    "join_bezier_patches undoes extract_bezier: C0 joined, then remove_knots gives the surface "
+    "back",
+    "[knots]") {
   std::mt19937 rng(41);
   for (bool rational : {false, true}) {
     const BSplineSurface s = clay::test::random_surface(rng, 3, 2, 7, 6, rational);
@@ -200,8 +208,10 @@ TEST_CASE("join_bezier_patches undoes extract_bezier: C0 joined, then remove_kno
     CHECK(joined.v.degree == 3);
     CHECK(joined.is_rational() == rational);
     // C0: every interior break has multiplicity = degree
-    for (std::size_t i = 1; i + 1 < bp.breaks_u.size(); ++i) CHECK(multiplicity(joined.u, bp.breaks_u[i]) == 5);
-    CHECK(joined.points.rows() == static_cast<Eigen::Index>((bp.count_u() * 5 + 1) * (bp.count_v() * 3 + 1)));
+    for (std::size_t i = 1; i + 1 < bp.breaks_u.size(); ++i)
+      CHECK(multiplicity(joined.u, bp.breaks_u[i]) == 5);
+    CHECK(joined.points.rows() ==
+          static_cast<Eigen::Index>((bp.count_u() * 5 + 1) * (bp.count_v() * 3 + 1)));
     CHECK(relative_deviation(s, joined) < 1e-13);
     // Without the elevated patch, removal gives the original knots and net back.
     const BSplineSurface plain = join_bezier_patches(extract_bezier(s));
@@ -213,7 +223,8 @@ TEST_CASE("join_bezier_patches undoes extract_bezier: C0 joined, then remove_kno
   }
 }
 
-TEST_CASE("join_bezier_patches refuses patches that do not match their breaks or do not meet", "[knots][errors]") {
+TEST_CASE("join_bezier_patches refuses patches that do not match their breaks or do not meet",
+          "[knots][errors]") {
   std::mt19937 rng(43);
   const BSplineSurface s = clay::test::random_surface(rng, 2, 2, 5, 4, true);
   const BezierPatches good = extract_bezier(s);
@@ -230,7 +241,8 @@ TEST_CASE("join_bezier_patches refuses patches that do not match their breaks or
   CHECK(category == clay::ErrorCategory::InvalidArgument);
   CHECK_THAT(what, Catch::Matchers::Contains("patch (0, 0) is not one clamped Bézier span"));
   BezierPatches torn = good;
-  torn.patches[3].points.row(0) += Eigen::RowVector3d(0, 0, 1);  // patch (1, 1)'s corner leaves (1, 0)'s edge
+  torn.patches[3].points.row(0) +=
+      Eigen::RowVector3d(0, 0, 1);  // patch (1, 1)'s corner leaves (1, 0)'s edge
   std::tie(category, what) = clay::test::error_of([&] { (void)join_bezier_patches(torn); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
   CHECK_THAT(what, Catch::Matchers::Contains("neighbouring patches do not meet"));
@@ -250,7 +262,10 @@ TEST_CASE("remove_knots refuses a negative or non-finite tolerance", "[knots]") 
   }
 }
 
-TEST_CASE("bezier_extraction: each span's operator maps the control points to a Bézier piece that evaluates like the curve", "[knots]") {
+TEST_CASE(
+    "bezier_extraction: each span's operator maps the control points to a Bézier piece that "
+    "evaluates like the curve",
+    "[knots]") {
   std::mt19937 rng(5);
   for (int p = 1; p <= 5; ++p)
     for (bool clamped : {true, false}) {

@@ -46,7 +46,8 @@ Reference evaluate_by_basis(const BSplineSurface& surface, double u, double v) {
       const Eigen::Vector3d pw = wij * surface.points.row(r).transpose();
       for (int m = 0; m < 3; ++m)
         for (int n = 0; m + n < 3; ++n) {
-          const double b = du[static_cast<size_t>(m * (p + 1) + i)] * dv[static_cast<size_t>(n * (q + 1) + j)];
+          const double b =
+              du[static_cast<size_t>(m * (p + 1) + i)] * dv[static_cast<size_t>(n * (q + 1) + j)];
           a[m][n] += b * pw;
           w[m][n] += b * wij;
         }
@@ -129,8 +130,8 @@ TEST_CASE("OCCT evaluates the converted surface as our control net says", "[occt
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (int k = 0; k < 8; ++k) {
     const int degree_u = 1 + k % 4, degree_v = 2 + (k * 3) % 5;
-    const BSplineSurface surface = test::random_surface(
-        rng, degree_u, degree_v, degree_u + 3, degree_v + 2, k % 2 == 1, k % 3 != 0, 2);
+    const BSplineSurface surface = test::random_surface(rng, degree_u, degree_v, degree_u + 3,
+                                                        degree_v + 2, k % 2 == 1, k % 3 != 0, 2);
     const auto [u0, u1] = surface.u.domain();
     const auto [v0, v1] = surface.v.domain();
     for (int sample = 0; sample < 20; ++sample) {
@@ -187,8 +188,7 @@ TEST_CASE("OCCT conversion refuses degree 26 and invalid data", "[occt][convert]
     FAIL("no exception for degree 26");
   } catch (const Error& e) {
     REQUIRE(e.category() == ErrorCategory::DegreeLimit);
-    REQUIRE_THAT(e.message(), Catch::Matchers::Contains("26") &&
-                                  Catch::Matchers::Contains("25"));
+    REQUIRE_THAT(e.message(), Catch::Matchers::Contains("26") && Catch::Matchers::Contains("25"));
   }
   const BSplineSurface high_v = test::random_surface(rng, 2, 26, 3, 27, true);
   REQUIRE_THROWS_MATCHES(occt_reference::round_trip(high_v), Error,

@@ -32,7 +32,8 @@ BSplineSurface quarter_cylinder(double r, double h) {
 
 }  // namespace
 
-TEST_CASE("closest point on an exact cylinder: distance |rho - r| and the radial foot", "[projection]") {
+TEST_CASE("closest point on an exact cylinder: distance |rho - r| and the radial foot",
+          "[projection]") {
   const double r = 50.0, h = 80.0;
   const BSplineSurface s = quarter_cylinder(r, h);
   std::mt19937 rng(51);
@@ -57,10 +58,12 @@ TEST_CASE("closest point beyond the domain edge lands on the edge", "[projection
   CHECK_THAT(above.distance, WithinAbs(std::hypot(40.0, 50.0 - std::hypot(30.0, 30.0)), 1e-9));
 }
 
-TEST_CASE("normal projection recovers the foot point of offset points on random surfaces", "[projection]") {
+TEST_CASE("normal projection recovers the foot point of offset points on random surfaces",
+          "[projection]") {
   std::mt19937 rng(52);
   for (int p = 2; p <= 4; ++p) {
-    // Mild surfaces (small z relief over a regular xy grid) so that the offset foot point is unique.
+    // Mild surfaces (small z relief over a regular xy grid) so that the offset foot point is
+    // unique.
     BSplineSurface s = clay::test::random_surface(rng, p, p, p + 3, p + 3, true, true, 1, 10.0);
     for (int i = 0; i < s.count_u(); ++i)
       for (int j = 0; j < s.count_v(); ++j) {
@@ -73,7 +76,8 @@ TEST_CASE("normal projection recovers the foot point of offset points on random 
       const double u = ua + (ub - ua) * k / 10.0, v = va + (vb - va) * (10 - k) / 10.0;
       const Eigen::Vector3d foot = evaluate(s, u, v);
       const Eigen::Vector3d p_off = foot + 3.0 * unit_normal(s, u, v);
-      const SurfaceProjection proj = project_normal(s, p_off, std::min(ub, u + 0.03 * (ub - ua)), v);
+      const SurfaceProjection proj =
+          project_normal(s, p_off, std::min(ub, u + 0.03 * (ub - ua)), v);
       REQUIRE(proj.summary.converged());
       CHECK_THAT(proj.distance, WithinAbs(3.0, 1e-9));
       CHECK((proj.point - foot).norm() < 1e-8);
@@ -115,11 +119,13 @@ TEST_CASE("closest point near a collapsed edge (a triangular patch)", "[projecti
       const double r = 30.0 * i, a = 0.5 * j;  // a fan from the apex
       p.row(i * 4 + j) << r * std::cos(a), r * std::sin(a), 0.0;
     }
-  const BSplineSurface s = make_surface(clamped_uniform_basis(3, 4), clamped_uniform_basis(3, 4), p);
+  const BSplineSurface s =
+      make_surface(clamped_uniform_basis(3, 4), clamped_uniform_basis(3, 4), p);
   // Points of the surface near and at the apex project onto themselves.
   for (double u : {0.0, 1e-6, 0.01, 0.2})
     for (double v : {0.0, 0.4, 1.0}) {
-      const Eigen::Vector3d x = evaluate(s, u, v) + Eigen::Vector3d(0, 0, 2.0);  // 2 mm above the plane
+      const Eigen::Vector3d x =
+          evaluate(s, u, v) + Eigen::Vector3d(0, 0, 2.0);  // 2 mm above the plane
       const SurfaceProjection proj = closest_point(s, x);
       INFO("u " << u << ", v " << v << ": " << proj.summary.brief());
       CHECK(proj.summary.termination != clay::Termination::Failed);
@@ -127,7 +133,8 @@ TEST_CASE("closest point near a collapsed edge (a triangular patch)", "[projecti
     }
 }
 
-TEST_CASE("SurfaceProjector: the cylinder's closed-form distance, and the free functions' results", "[projection]") {
+TEST_CASE("SurfaceProjector: the cylinder's closed-form distance, and the free functions' results",
+          "[projection]") {
   const double r = 50.0, h = 80.0;
   const BSplineSurface s = quarter_cylinder(r, h);
   const SurfaceProjector projector(s);
@@ -150,14 +157,16 @@ TEST_CASE("SurfaceProjector: the cylinder's closed-form distance, and the free f
     CHECK(n.distance == free_n.distance);
   }
   CHECK_THROWS_AS(SurfaceProjector(BSplineSurface{}), clay::Error);
-  CHECK_THROWS_AS(projector.project_normal(Eigen::Vector3d(0, 0, std::nan("")), 0.5, 0.5), clay::Error);
+  CHECK_THROWS_AS(projector.project_normal(Eigen::Vector3d(0, 0, std::nan("")), 0.5, 0.5),
+                  clay::Error);
   CHECK_THROWS_AS(projector.project_normal(Eigen::Vector3d::Zero(), 2.0, 0.5), clay::Error);
   ProjectionOptions bad;
   bad.starts = 0;
   CHECK_THROWS_AS(SurfaceProjector(s, bad), clay::Error);
 }
 
-TEST_CASE("SurfaceProjector: the start grid is evaluated once, shared by copies and threads", "[projection]") {
+TEST_CASE("SurfaceProjector: the start grid is evaluated once, shared by copies and threads",
+          "[projection]") {
   // The grid is built on the first closest_point; threads racing for it, on the projector and on
   // a copy made before it existed, get the cylinder's closed-form distance and the same
   // parameters.
@@ -197,9 +206,11 @@ TEST_CASE("SurfaceProjector: the start grid is evaluated once, shared by copies 
 TEST_CASE("curve projection: closed forms on a circle and a segment", "[projection]") {
   // A full circle of radius 5 about (1, 2, 0) in the xy plane, as rational quadratic arcs.
   const Eigen::Vector3d c(1, 2, 0);
-  const BSplineCurve circle = circular_arc(c, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 5, 0, 2 * std::numbers::pi);
+  const BSplineCurve circle = circular_arc(c, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 5,
+                                           0, 2 * std::numbers::pi);
   for (double angle : {0.3, 1.9, 3.0, 4.4, 6.1}) {
-    const Eigen::Vector3d q = c + 8 * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) + Eigen::Vector3d(0, 0, 3);
+    const Eigen::Vector3d q =
+        c + 8 * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0) + Eigen::Vector3d(0, 0, 3);
     const CurveProjection p = closest_point(circle, q);
     // The closest point of a circle: the foot in the direction of q's projection on its plane.
     const Eigen::Vector3d foot = c + 5 * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0);
@@ -208,7 +219,8 @@ TEST_CASE("curve projection: closed forms on a circle and a segment", "[projecti
     CHECK((evaluate(circle, p.t) - p.point).norm() == 0);
   }
   // A segment: inside, the perpendicular foot; beyond an end, the end (no silent overshoot).
-  const BSplineCurve segment = make_curve(1, {0, 0, 1, 1}, (Points3(2, 3) << 0, 0, 0, 10, 0, 0).finished());
+  const BSplineCurve segment =
+      make_curve(1, {0, 0, 1, 1}, (Points3(2, 3) << 0, 0, 0, 10, 0, 0).finished());
   CHECK(std::abs(closest_point(segment, Eigen::Vector3d(4, 3, 0)).t - 0.4) < 1e-14);
   CHECK(closest_point(segment, Eigen::Vector3d(14, 3, 0)).t == 1.0);
   CHECK(project_normal(segment, Eigen::Vector3d(-4, 3, 0), 0.5).t == 0.0);
@@ -216,7 +228,8 @@ TEST_CASE("curve projection: closed forms on a circle and a segment", "[projecti
   const auto [t0, t1] = circle.basis.domain();
   const Eigen::Vector3d near_seam = c + 6 * Eigen::Vector3d(std::cos(-0.2), std::sin(-0.2), 0);
   const CurveProjection wrapped = project_normal(circle, near_seam, t0 + 0.01 * (t1 - t0), true);
-  CHECK((wrapped.point - (c + 5 * Eigen::Vector3d(std::cos(-0.2), std::sin(-0.2), 0))).norm() < 1e-12);
+  CHECK((wrapped.point - (c + 5 * Eigen::Vector3d(std::cos(-0.2), std::sin(-0.2), 0))).norm() <
+        1e-12);
   CHECK_THROWS_AS(closest_point(segment, Eigen::Vector3d(std::nan(""), 0, 0)), clay::Error);
   CHECK_THROWS_AS(closest_point(segment, Eigen::Vector3d(1, 0, 0), 0), clay::Error);
 }

@@ -81,7 +81,6 @@ double nodal_gap(double c, double* t_star = nullptr) {
   return 2.0 * t * std::sqrt((t * t - 1) * (t * t - 1) + c * c);
 }
 
-
 /// A hairpin: a straight leg along y = -r, a semicircle of radius r about the origin on the left,
 /// and a leg back along y = +r (exact rational quadratic, legs `length` long).
 BSplineCurve hairpin(double r, double length) {

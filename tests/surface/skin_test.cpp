@@ -18,9 +18,9 @@
 #include "random_geometry.hpp"
 
 using namespace clay::surface;
+using Catch::Matchers::WithinAbs;
 using clay::test::error_of;
 using clay::test::polyline;
-using Catch::Matchers::WithinAbs;
 
 namespace {
 
@@ -85,7 +85,6 @@ BSplineCurve quarter_circle(double r, double z) {
   return make_curve(2, {0, 0, 0, 1, 1, 1}, p, w);
 }
 
-
 /// A "Z" at height z: (x0, y0) -> (x1, y1) -> (x1, y0) -> (x0, y1), whose first and last segments
 /// cross at the centre, at t = 0.5 and t = 2.5.
 BSplineCurve z_shape(double x0, double y0, double x1, double y1, double z) {
@@ -99,7 +98,8 @@ BSplineCurve cubic_curve(const std::function<Eigen::Vector3d(double)>& f, double
   Eigen::Matrix<double, 4, 3> values;
   for (int k = 0; k < 4; ++k) {
     const double s = k / 3.0;
-    bernstein.row(k) << std::pow(1 - s, 3), 3 * s * std::pow(1 - s, 2), 3 * s * s * (1 - s), std::pow(s, 3);
+    bernstein.row(k) << std::pow(1 - s, 3), 3 * s * std::pow(1 - s, 2), 3 * s * s * (1 - s),
+        std::pow(s, 3);
     values.row(k) = f(a + s * (b - a)).transpose();
   }
   const Points3 p = bernstein.fullPivLu().solve(values);
@@ -156,7 +156,8 @@ TEST_CASE("loft degree across the sections is min(degree, sections - 1)", "[skin
   linear.degree = 1;
   const BuiltSurface ruled = loft(five, linear);
   CHECK(ruled.surface.v.degree == 1);
-  CHECK(section_error(ruled.surface, five, loft_parameters(five, linear)) < 1e-9 * box_size(ruled.surface));
+  CHECK(section_error(ruled.surface, five, loft_parameters(five, linear)) <
+        1e-9 * box_size(ruled.surface));
   LoftOptions quintic;
   quintic.degree = 5;
   CHECK(loft(five, quintic).surface.v.degree == 4);
@@ -170,7 +171,8 @@ TEST_CASE("loft parameters: chord length, centripetal and uniform spacing", "[sk
   LoftOptions o;
   CHECK_THAT(loft_parameters(s, o)[1], WithinAbs(1.0 / 3.0, 1e-15));
   o.parametrization = LoftParametrization::Centripetal;
-  CHECK_THAT(loft_parameters(s, o)[1], WithinAbs(std::sqrt(10.0) / (std::sqrt(10.0) + std::sqrt(20.0)), 1e-15));
+  CHECK_THAT(loft_parameters(s, o)[1],
+             WithinAbs(std::sqrt(10.0) / (std::sqrt(10.0) + std::sqrt(20.0)), 1e-15));
   o.parametrization = LoftParametrization::Uniform;
   CHECK_THAT(loft_parameters(s, o)[1], WithinAbs(0.5, 0.0));
   // Three translated copies with chord-length spacing: the loft is the exact extrusion, S(u, v) =
@@ -179,7 +181,9 @@ TEST_CASE("loft parameters: chord length, centripetal and uniform spacing", "[sk
   double worst = 0;
   for (double u : linspace(0, 1, 21))
     for (double v : linspace(0, 1, 21))
-      worst = std::max(worst, (evaluate(built.surface, u, v) - evaluate(c, u) - Eigen::Vector3d(0, 0, 30 * v)).norm());
+      worst = std::max(
+          worst,
+          (evaluate(built.surface, u, v) - evaluate(c, u) - Eigen::Vector3d(0, 0, 30 * v)).norm());
   CHECK(worst < 1e-12 * box_size(built.surface));
 }
 
@@ -202,7 +206,8 @@ TEST_CASE("loft turns a section that runs against its neighbour", "[skin][loft]"
 
 TEST_CASE("loft rejects too few sections", "[skin][loft][errors]") {
   std::mt19937 rng(307);
-  const auto [category, message] = error_of([&] { loft({clay::test::random_curve(rng, 3, 5, false)}); });
+  const auto [category, message] =
+      error_of([&] { loft({clay::test::random_curve(rng, 3, 5, false)}); });
   CHECK(category == clay::ErrorCategory::InvalidArgument);
   CHECK_THAT(message, Catch::Contains("at least 2 sections, got 1"));
 }
@@ -234,28 +239,35 @@ TEST_CASE("loft rejects an invalid section, naming it", "[skin][loft][errors]") 
   CHECK_THAT(message, Catch::Contains("section #1") && Catch::Contains("non-finite"));
 }
 
-TEST_CASE("loft rejects rational sections whose interpolated weights turn negative", "[skin][loft][errors]") {
+TEST_CASE("loft rejects rational sections whose interpolated weights turn negative",
+          "[skin][loft][errors]") {
   const BSplineCurve a = quarter_circle(100, 0);
-  BSplineCurve b = quarter_circle(100, 10), c = quarter_circle(100, 20), d = quarter_circle(100, 30);
+  BSplineCurve b = quarter_circle(100, 10), c = quarter_circle(100, 20),
+               d = quarter_circle(100, 30);
   // Same circles, weights scaled by wildly different factors (each curve is unchanged).
   b.weights *= 40.0;
   d.weights *= 40.0;
   const auto [category, message] = error_of([&] { loft({a, b, c, d}); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("weights interpolated across the rational sections are not positive"));
+  CHECK_THAT(message,
+             Catch::Contains("weights interpolated across the rational sections are not positive"));
 }
 
-TEST_CASE("loft rejects a section that crosses itself, naming it, the parameters and the point", "[skin][loft][errors]") {
+TEST_CASE("loft rejects a section that crosses itself, naming it, the parameters and the point",
+          "[skin][loft][errors]") {
   std::mt19937 rng(312);
   std::vector<BSplineCurve> sections = random_sections(rng, false);
   sections[2] = z_shape(0, 0, 40, 30, 200);  // crosses at (20, 15, 200), t = 0.5 and 2.5
   const auto [category, message] = error_of([&] { loft(sections); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("loft: section #2 crosses itself at t = 0.5 and t = 2.5 (point (20, 15, 200)") &&
-                          Catch::Contains("move the section's control points"));
+  CHECK_THAT(message,
+             Catch::Contains(
+                 "loft: section #2 crosses itself at t = 0.5 and t = 2.5 (point (20, 15, 200)") &&
+                 Catch::Contains("move the section's control points"));
   // The same section running back over itself instead.
   sections[2] = polyline({{0, 0, 200}, {40, 0, 200}, {10, 0, 200}});
-  CHECK_THAT(error_of([&] { loft(sections); }).second, Catch::Contains("section #2 doubles back onto itself"));
+  CHECK_THAT(error_of([&] { loft(sections); }).second,
+             Catch::Contains("section #2 doubles back onto itself"));
 }
 
 TEST_CASE("loft options are validated", "[skin][loft][errors]") {
@@ -287,7 +299,8 @@ double revolution_error(const BSplineSurface& s, const BSplineCurve& profile) {
   for (double v : linspace(0, 1, 61)) {
     const Eigen::Vector3d s_ref = evaluate(s, u_ref, v);
     const double angle = std::atan2(s_ref.y(), s_ref.x()) - std::atan2(x_ref.y(), x_ref.x());
-    const Eigen::Matrix3d rot = Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3d rot =
+        Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     for (double u : linspace(0, 1, 41))
       worst = std::max(worst, (evaluate(s, u, v) - rot * evaluate(profile, u)).norm());
   }
@@ -301,7 +314,8 @@ TEST_CASE("sweep along a straight path is the exact extrusion", "[skin][sweep]")
   BSplineCurve profile = clay::test::random_curve(rng, 3, 7, true, true, 1, 50.0);
   profile.points.col(2).setZero();
   // Control points advancing along x: the profile cannot cross itself (a sweep would refuse it).
-  for (Eigen::Index i = 0; i < profile.points.rows(); ++i) profile.points(i, 0) = -50.0 + 100.0 * i / 6.0;
+  for (Eigen::Index i = 0; i < profile.points.rows(); ++i)
+    profile.points(i, 0) = -50.0 + 100.0 * i / 6.0;
   // Straight path along z, unevenly parametrized (control points 0, 10, 60, 100).
   Points3 p(4, 3);
   p << 0, 0, 0, 0, 0, 10, 0, 0, 60, 0, 0, 100;
@@ -315,11 +329,14 @@ TEST_CASE("sweep along a straight path is the exact extrusion", "[skin][sweep]")
   const auto [a, b] = profile.basis.domain();
   for (double u : linspace(a, b, 41))
     for (double v : linspace(0, 1, 21))
-      worst = std::max(worst, (evaluate(built.surface, u, v) - evaluate(profile, u) - Eigen::Vector3d(0, 0, 100 * v)).norm());
+      worst = std::max(worst, (evaluate(built.surface, u, v) - evaluate(profile, u) -
+                               Eigen::Vector3d(0, 0, 100 * v))
+                                  .norm());
   CHECK(worst < 1e-12 * size);
 }
 
-TEST_CASE("sweep along a quarter circle is the surface of revolution within tolerance", "[skin][sweep]") {
+TEST_CASE("sweep along a quarter circle is the surface of revolution within tolerance",
+          "[skin][sweep]") {
   const BSplineCurve profile = upright_profile();
   const BSplineCurve path = quarter_circle(100.0, 0.0);
   const BuiltSurface built = sweep(profile, path);
@@ -331,24 +348,29 @@ TEST_CASE("sweep along a quarter circle is the surface of revolution within tole
   CHECK(err <= 1e-6 * size);
   // The first section is the profile itself and the last one the profile turned by 90 degrees
   // (sections are interpolated exactly; on a planar path the frames are exact rotations).
-  const Eigen::Matrix3d quarter = Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d quarter =
+      Eigen::AngleAxisd(std::numbers::pi / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   double ends = 0;
   for (double u : linspace(0, 1, 41)) {
     ends = std::max(ends, (evaluate(built.surface, u, 0.0) - evaluate(profile, u)).norm());
-    ends = std::max(ends, (evaluate(built.surface, u, 1.0) - quarter * evaluate(profile, u)).norm());
+    ends =
+        std::max(ends, (evaluate(built.surface, u, 1.0) - quarter * evaluate(profile, u)).norm());
   }
   CHECK(ends < 1e-9 * size);
 }
 
-TEST_CASE("sweep of a rational circle along a quarter circle is a torus within tolerance", "[skin][sweep]") {
+TEST_CASE("sweep of a rational circle along a quarter circle is a torus within tolerance",
+          "[skin][sweep]") {
   // Full circle of radius 10 about the path start (100, 0, 0) in the plane y = 0, as four
   // rational quadratic quarters.
   const double w = std::sqrt(0.5);
   Points3 p(9, 3);
-  p << 110, 0, 0, 110, 0, 10, 100, 0, 10, 90, 0, 10, 90, 0, 0, 90, 0, -10, 100, 0, -10, 110, 0, -10, 110, 0, 0;
+  p << 110, 0, 0, 110, 0, 10, 100, 0, 10, 90, 0, 10, 90, 0, 0, 90, 0, -10, 100, 0, -10, 110, 0, -10,
+      110, 0, 0;
   Eigen::VectorXd wt(9);
   wt << 1, w, 1, w, 1, w, 1, w, 1;
-  const BSplineCurve circle = make_curve(2, {0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1}, p, wt);
+  const BSplineCurve circle =
+      make_curve(2, {0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1}, p, wt);
   const BuiltSurface built = sweep(circle, quarter_circle(100.0, 0.0));
   const double size = box_size(built.surface);
   double worst = 0;
@@ -363,7 +385,8 @@ TEST_CASE("sweep of a rational circle along a quarter circle is a torus within t
   CHECK(worst <= 1e-6 * size);
 }
 
-TEST_CASE("sweep along a planar path does not twist: the plane-normal offset is kept", "[skin][sweep]") {
+TEST_CASE("sweep along a planar path does not twist: the plane-normal offset is kept",
+          "[skin][sweep]") {
   // An S-shaped cubic path in the plane z = 7, profile in a plane normal to its start tangent.
   Points3 p(5, 3);
   p << 0, 0, 7, 60, 10, 7, 100, 80, 7, 160, 60, 7, 220, 120, 7;
@@ -373,7 +396,8 @@ TEST_CASE("sweep along a planar path does not twist: the plane-normal offset is 
   Points3 q(4, 3);
   for (int i = 0; i < 4; ++i) {
     const double a = -15.0 + 10.0 * i;
-    q.row(i) = (Eigen::Vector3d(0, 0, 7) + a * side + Eigen::Vector3d(0, 0, 0.3 * a * a - 20)).transpose();
+    q.row(i) =
+        (Eigen::Vector3d(0, 0, 7) + a * side + Eigen::Vector3d(0, 0, 0.3 * a * a - 20)).transpose();
   }
   const BSplineCurve profile = make_curve(3, {0, 0, 0, 0, 1, 1, 1, 1}, q);
   const BuiltSurface built = sweep(profile, path);
@@ -385,12 +409,14 @@ TEST_CASE("sweep along a planar path does not twist: the plane-normal offset is 
   double worst = 0;
   for (double u : linspace(0, 1, 31))
     for (double v : linspace(0, 1, 51))
-      worst = std::max(worst, std::abs(evaluate(built.surface, u, v).z() - evaluate(profile, u).z()));
+      worst =
+          std::max(worst, std::abs(evaluate(built.surface, u, v).z() - evaluate(profile, u).z()));
   CHECK(worst < 1e-9 * size);
   // And the profile keeps its in-plane distances: each section is a rigid copy (width checked).
   const double width0 = (evaluate(profile, 0.0) - evaluate(profile, 1.0)).norm();
   for (double v : linspace(0, 1, 11))
-    CHECK_THAT((evaluate(built.surface, 0.0, v) - evaluate(built.surface, 1.0, v)).norm(), WithinAbs(width0, 1e-6 * size));
+    CHECK_THAT((evaluate(built.surface, 0.0, v) - evaluate(built.surface, 1.0, v)).norm(),
+               WithinAbs(width0, 1e-6 * size));
 }
 
 namespace {
@@ -406,7 +432,9 @@ struct OdeFrames {
     const Eigen::Vector3d tt = d.d1 / speed;
     return (d.d2 - tt.dot(d.d2) * tt) / speed;
   }
-  Eigen::Vector3d rhs(double t, const Eigen::Vector3d& r) const { return -(r.dot(dtangent(t))) * tangent(t); }
+  Eigen::Vector3d rhs(double t, const Eigen::Vector3d& r) const {
+    return -(r.dot(dtangent(t))) * tangent(t);
+  }
   /// r at t1 from r0 at t0.
   Eigen::Vector3d transport(Eigen::Vector3d r, double t0, double t1, int steps) const {
     const double h = (t1 - t0) / steps;
@@ -444,7 +472,8 @@ double parameter_at_fraction(const BSplineCurve& c, double f) {
 
 }  // namespace
 
-TEST_CASE("sweep along a space curve follows independently integrated rotation-minimizing frames", "[skin][sweep]") {
+TEST_CASE("sweep along a space curve follows independently integrated rotation-minimizing frames",
+          "[skin][sweep]") {
   // A non-planar cubic path (a loose helix-like curve) and a small profile at its start.
   Points3 p(6, 3);
   p << 100, 0, 0, 100, 60, 20, 30, 110, 40, -50, 90, 60, -100, 20, 80, -90, -50, 100;
@@ -482,7 +511,8 @@ TEST_CASE("sweep along a space curve follows independently integrated rotation-m
   CHECK(worst <= 2e-6 * size);
 }
 
-TEST_CASE("sweep along a line continued by a tangent arc (curvature jump) keeps its accuracy", "[skin][sweep]") {
+TEST_CASE("sweep along a line continued by a tangent arc (curvature jump) keeps its accuracy",
+          "[skin][sweep]") {
   // One rational quadratic path: a straight segment (0,0,0)-(50,0,0), then the quarter circle
   // about (50, 50, 0) to (100, 50, 0). Tangent-continuous, the curvature jumps from 0 to 1/50.
   Points3 p(5, 3);
@@ -515,7 +545,8 @@ TEST_CASE("sweep along a line continued by a tangent arc (curvature jump) keeps 
       } else {
         const double angle = (s - 50.0) / 50.0;
         const Eigen::Vector3d c(50, 50, 0);
-        expected = c + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()) * (x + Eigen::Vector3d(50, 0, 0) - c);
+        expected = c + Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()) *
+                           (x + Eigen::Vector3d(50, 0, 0) - c);
       }
       worst = std::max(worst, (evaluate(built.surface, u, v) - expected).norm());
     }
@@ -538,10 +569,12 @@ TEST_CASE("sweep with twist turns the profile about the path", "[skin][sweep]") 
   CHECK(built.report.max_deviation_mm <= 1e-6 * size);
   const Eigen::Vector3d axis_point(100, 0, 0);
   for (double v : {0.25, 0.5, 1.0}) {
-    const Eigen::Matrix3d rot = Eigen::AngleAxisd(v * std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const Eigen::Matrix3d rot =
+        Eigen::AngleAxisd(v * std::numbers::pi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
     double worst = 0;
     for (double u : linspace(0, 1, 31)) {
-      const Eigen::Vector3d expected = axis_point + Eigen::Vector3d(0, 200 * v, 0) + rot * (evaluate(profile, u) - axis_point);
+      const Eigen::Vector3d expected =
+          axis_point + Eigen::Vector3d(0, 200 * v, 0) + rot * (evaluate(profile, u) - axis_point);
       worst = std::max(worst, (evaluate(built.surface, u, v) - expected).norm());
     }
     CHECK(worst <= (v == 1.0 ? 1e-9 : 1e-6) * size);
@@ -566,7 +599,9 @@ TEST_CASE("sweep with a fixed number of sections reports its deviation", "[skin]
 TEST_CASE("sweep rejects a path of zero length", "[skin][sweep][errors]") {
   Points3 p(3, 3);
   p << 5, 5, 5, 5, 5, 5, 5, 5, 5;
-  const auto [category, message] = error_of([&] { sweep(upright_profile(), make_curve(2, {0, 0, 0, 1, 1, 1}, p)); });
+  const auto [category, message] = error_of([&] {
+    sweep(upright_profile(), make_curve(2, {0, 0, 0, 1, 1, 1}, p));
+  });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
   CHECK_THAT(message, Catch::Contains("path has zero length"));
 }
@@ -582,9 +617,12 @@ TEST_CASE("sweep rejects a degenerate profile", "[skin][sweep][errors]") {
 TEST_CASE("sweep rejects a path with a corner", "[skin][sweep][errors]") {
   Points3 p(3, 3);
   p << 100, 0, 0, 100, 50, 0, 150, 50, 0;
-  const auto [category, message] = error_of([&] { sweep(upright_profile(), make_curve(1, {0, 0, 0.5, 1, 1}, p)); });
+  const auto [category, message] = error_of([&] {
+    sweep(upright_profile(), make_curve(1, {0, 0, 0.5, 1, 1}, p));
+  });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("path has a corner at t = 0.5") && Catch::Contains("90 degrees"));
+  CHECK_THAT(message,
+             Catch::Contains("path has a corner at t = 0.5") && Catch::Contains("90 degrees"));
 }
 
 TEST_CASE("sweep rejects a profile that crosses itself", "[skin][sweep][errors]") {
@@ -592,17 +630,22 @@ TEST_CASE("sweep rejects a profile that crosses itself", "[skin][sweep][errors]"
   const BSplineCurve profile = polyline({{90, 0, -10}, {110, 0, 10}, {110, 0, -10}, {90, 0, 10}});
   const auto [category, message] = error_of([&] { sweep(profile, quarter_circle(100, 0)); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("sweep: profile crosses itself at t = 0.5 and t = 2.5 (point (100, 0, 0)"));
+  CHECK_THAT(
+      message,
+      Catch::Contains("sweep: profile crosses itself at t = 0.5 and t = 2.5 (point (100, 0, 0)"));
 }
 
 TEST_CASE("sweep rejects a path that crosses itself", "[skin][sweep][errors]") {
   // The nodal cubic 50 (t^2 - 1, t^3 - t, 0) on [-1.5, 1.5]: its loop closes at the origin, t = -1
   // and t = 1.
-  const BSplineCurve path = cubic_curve([](double t) { return Eigen::Vector3d(50 * (t * t - 1), 50 * (t * t * t - t), 0); }, -1.5, 1.5);
+  const BSplineCurve path = cubic_curve(
+      [](double t) { return Eigen::Vector3d(50 * (t * t - 1), 50 * (t * t * t - t), 0); }, -1.5,
+      1.5);
   const auto [category, message] = error_of([&] { sweep(upright_profile(), path); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("sweep: path crosses itself at t = -1 and t = 1 (point (0, 0, 0)") &&
-                          Catch::Contains("tangents 90 degrees apart"));
+  CHECK_THAT(message,
+             Catch::Contains("sweep: path crosses itself at t = -1 and t = 1 (point (0, 0, 0)") &&
+                 Catch::Contains("tangents 90 degrees apart"));
 }
 
 namespace {
@@ -610,16 +653,21 @@ namespace {
 /// A circle of radius `r` about the start (R, 0, 0) of quarter_circle(R, 0), in the plane y = 0
 /// normal to the path there: the sweep is a torus.
 BSplineCurve tube_profile(double big_r, double r) {
-  return circular_arc({big_r, 0, 0}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(), r, 0.0, 2 * std::numbers::pi);
+  return circular_arc({big_r, 0, 0}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitZ(), r, 0.0,
+                      2 * std::numbers::pi);
 }
 
 }  // namespace
 
-TEST_CASE("sweep rejects a profile reaching past the path's centre of curvature (the surface would fold)", "[skin][sweep][errors]") {
+TEST_CASE(
+    "sweep rejects a profile reaching past the path's centre of curvature (the surface would fold)",
+    "[skin][sweep][errors]") {
   // Profile radius 10 along an arc of radius 5: it reaches 10 mm toward the centre, 5 mm away.
-  const auto [category, message] = error_of([&] { sweep(tube_profile(5, 10), quarter_circle(5, 0)); });
+  const auto [category, message] =
+      error_of([&] { sweep(tube_profile(5, 10), quarter_circle(5, 0)); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
-  CHECK_THAT(message, Catch::Contains("fold through itself") && Catch::Contains("radius of curvature there is 5 mm") &&
+  CHECK_THAT(message, Catch::Contains("fold through itself") &&
+                          Catch::Contains("radius of curvature there is 5 mm") &&
                           Catch::Contains("the profile reaches 10 mm"));
   // Just past the centre (reach / radius 1.05) is refused, just short of it (0.95) is not.
   CHECK_THAT(error_of([&] { sweep(tube_profile(9.5, 10), quarter_circle(9.5, 0)); }).second,
@@ -647,30 +695,36 @@ TEST_CASE("sweep rejects an invalid path, naming it", "[skin][sweep][errors]") {
 TEST_CASE("sweep options are validated", "[skin][sweep][errors]") {
   SweepOptions o;
   o.sections = 1;
-  CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("SweepOptions::sections is 1"));
+  CHECK_THAT(error_of([&] { o.validate(); }).second,
+             Catch::Contains("SweepOptions::sections is 1"));
   o = {};
   o.tolerance = 0;
   CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("SweepOptions::tolerance"));
   o = {};
   o.twist_degrees = std::nan("");
-  CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("SweepOptions::twist_degrees"));
+  CHECK_THAT(error_of([&] { o.validate(); }).second,
+             Catch::Contains("SweepOptions::twist_degrees"));
   o = {};
   o.max_sections = 1;
   CHECK_THAT(error_of([&] { sweep(upright_profile(), quarter_circle(100, 0), o); }).second,
              Catch::Contains("SweepOptions::max_sections"));
 }
 
-TEST_CASE("An adaptive sweep that misses its tolerance at max_sections is an error, not a result", "[sweep][errors]") {
+TEST_CASE("An adaptive sweep that misses its tolerance at max_sections is an error, not a result",
+          "[sweep][errors]") {
   // Issue #18: a twist of 1e300 degrees came back as a wild surface (a note in the method only),
   // whose export then ran for minutes. Now the cap is an error with the figures.
   SweepOptions o;
   o.twist_degrees = 1e300;
   o.max_sections = 9;
-  const auto [category, message] = error_of([&] { sweep(upright_profile(), quarter_circle(100, 0), o); });
+  const auto [category, message] =
+      error_of([&] { sweep(upright_profile(), quarter_circle(100, 0), o); });
   CHECK(category == clay::ErrorCategory::InvalidArgument);
   CHECK_THAT(message, Catch::Contains("is still above the tolerance"));
-  CHECK_THAT(message, Catch::Contains("with 9 sections, the most SweepOptions::max_sections = 9 allows"));
+  CHECK_THAT(message,
+             Catch::Contains("with 9 sections, the most SweepOptions::max_sections = 9 allows"));
   o.twist_degrees = 90;  // within reach: a result
   o.max_sections = 1025;
-  CHECK(sweep(upright_profile(), quarter_circle(100, 0), o).report.max_deviation_mm <= o.tolerance * 200);
+  CHECK(sweep(upright_profile(), quarter_circle(100, 0), o).report.max_deviation_mm <=
+        o.tolerance * 200);
 }

@@ -34,12 +34,15 @@ TEST_CASE("surface_area matches closed forms", "[tessellate]") {
   // A bilinear 30 x 20 rectangle, tilted: area 600.
   Points3 p(4, 3);
   p << 0, 0, 0, 0, 20, 0, 30, 0, 30 * 0.0, 30, 20, 0;
-  const BSplineSurface flat = make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
+  const BSplineSurface flat =
+      make_surface(clamped_uniform_basis(1, 2), clamped_uniform_basis(1, 2), p);
   CHECK_THAT(surface_area(flat, 0), WithinRel(600.0, 1e-13));
   CHECK_THAT(surface_area(sphere(7), 2), WithinRel(4 * std::numbers::pi * 49, 1e-9));
   // A cylinder r = 5, height 12: the side area 2 pi r h.
-  const BSplineCurve line = make_curve(1, {0, 0, 1, 1}, (Points3(2, 3) << 5, 0, 0, 5, 0, 12).finished());
-  CHECK_THAT(surface_area(revolve(line, Axis{}).surface, 1), WithinRel(2 * std::numbers::pi * 5 * 12, 1e-9));
+  const BSplineCurve line =
+      make_curve(1, {0, 0, 1, 1}, (Points3(2, 3) << 5, 0, 0, 5, 0, 12).finished());
+  CHECK_THAT(surface_area(revolve(line, Axis{}).surface, 1),
+             WithinRel(2 * std::numbers::pi * 5 * 12, 1e-9));
   CHECK_THROWS_AS(surface_area(flat, -1), clay::Error);
 }
 
@@ -51,8 +54,8 @@ TEST_CASE("tessellate: vertices on the surface, exact normals, the viewer's grid
   CHECK(m.rows == static_cast<int>(m.us.size()));
   CHECK(m.rows >= 17);
   CHECK(m.rows <= 161);
-  CHECK(tessellation_parameters(clamped_uniform_basis(3, 4)).size() == 17);            // 1 span: 16 + 1
-  CHECK(tessellation_parameters(clamped_uniform_basis(3, 500)).size() == 161);          // capped
+  CHECK(tessellation_parameters(clamped_uniform_basis(3, 4)).size() == 17);     // 1 span: 16 + 1
+  CHECK(tessellation_parameters(clamped_uniform_basis(3, 500)).size() == 161);  // capped
   CHECK(tessellation_parameters(clamped_uniform_basis(3, 8), 8).size() == 5 * 8 + 1);  // 5 spans
   double worst_point = 0, worst_normal = 0;
   // The side S_u x S_v points to, read at a regular point (the equator): every normal, the poles'
@@ -62,7 +65,8 @@ TEST_CASE("tessellate: vertices on the surface, exact normals, the viewer's grid
   for (int i = 0; i < m.rows; ++i)
     for (int j = 0; j < m.cols; ++j) {
       const Eigen::Vector3d x = m.positions.row(i * m.cols + j).transpose();
-      worst_point = std::max(worst_point, (x - evaluate(s, m.us[size_t(i)], m.vs[size_t(j)])).norm());
+      worst_point =
+          std::max(worst_point, (x - evaluate(s, m.us[size_t(i)], m.vs[size_t(j)])).norm());
       // On a sphere about the origin the normal is side x / |x|, also at the poles, where
       // S_u x S_v vanishes and the neighbouring triangles decide.
       const Eigen::Vector3d n = m.normals.row(i * m.cols + j).transpose();
@@ -72,7 +76,8 @@ TEST_CASE("tessellate: vertices on the surface, exact normals, the viewer's grid
   for (int i = 0; i + 1 < m.rows; ++i)
     for (int j = 0; j + 1 < m.cols; ++j)
       for (const auto& t : cell_triangles(m, i, j)) {
-        const Eigen::Vector3d a = m.positions.row(t[0]).transpose(), b = m.positions.row(t[1]).transpose(),
+        const Eigen::Vector3d a = m.positions.row(t[0]).transpose(),
+                              b = m.positions.row(t[1]).transpose(),
                               c = m.positions.row(t[2]).transpose();
         const Eigen::Vector3d n = (b - a).cross(c - a);
         if (n.norm() > 1e-12 && side * n.dot(a + b + c) < 0) ++against;
@@ -98,7 +103,8 @@ TEST_CASE("tessellate_to_area refines a wavy single patch past the viewer's grid
   const int n = 16;
   Points3 p(n * 2, 3);
   for (int i = 0; i < n; ++i)
-    for (int j = 0; j < 2; ++j) p.row(i * 2 + j) << 100.0 * i / (n - 1), 30.0 * j, (i % 2 ? 40.0 : -40.0);
+    for (int j = 0; j < 2; ++j)
+      p.row(i * 2 + j) << 100.0 * i / (n - 1), 30.0 * j, (i % 2 ? 40.0 : -40.0);
   std::vector<double> ku(static_cast<size_t>(2 * n), 0.0);
   for (int k = n; k < 2 * n; ++k) ku[static_cast<size_t>(k)] = 1;
   const BSplineSurface s = make_surface(BSplineBasis{n - 1, ku}, clamped_uniform_basis(1, 2), p);
@@ -106,7 +112,8 @@ TEST_CASE("tessellate_to_area refines a wavy single patch past the viewer's grid
   CHECK_THAT(surface_area(s, 2), WithinRel(exact, 1e-4));  // the quadrature tessellate_to_area uses
   const GridMesh coarse = tessellate(s);
   const double coarse_error = std::abs(mesh_area(coarse) - exact) / exact;
-  INFO("the viewer's grid (" << coarse.rows << " x " << coarse.cols << ") is off by " << 100 * coarse_error << " %");
+  INFO("the viewer's grid (" << coarse.rows << " x " << coarse.cols << ") is off by "
+                             << 100 * coarse_error << " %");
   const GridMesh m = tessellate_to_area(s, 0.001);
   CHECK(std::abs(mesh_area(m) - exact) <= 0.001 * exact);
   CHECK(m.rows > coarse.rows);

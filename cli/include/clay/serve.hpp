@@ -16,8 +16,8 @@ std::filesystem::path viewer_dir();
 /// Settings of ViewServer.
 struct ServeOptions {
   std::string host = "127.0.0.1";
-  int port = 8765;                      ///< 0: any free port (see ViewServer::port)
-  std::filesystem::path viewer;         ///< the built front end; empty: viewer_dir()
+  int port = 8765;               ///< 0: any free port (see ViewServer::port)
+  std::filesystem::path viewer;  ///< the built front end; empty: viewer_dir()
 };
 
 /// An HTTP server (cpp-httplib) of one run folder: `/` and static files from the front end,
@@ -45,13 +45,13 @@ class ViewServer {
 
 /// Settings of snapshot.
 struct SnapshotOptions {
-  int width = 1280;                                    ///< picture width in pixels [16, 8192]
-  int height = 800;                                    ///< picture height in pixels [16, 8192]
-  std::string mode = "shaded";                         ///< shaded, zebra, gaussian, mean or deviation
-  bool bare = false;                                   ///< the picture alone: no toolbar, no panels (?ui=0)
-  std::filesystem::path viewer;                        ///< the built front end; empty: viewer_dir()
+  int width = 1280;              ///< picture width in pixels [16, 8192]
+  int height = 800;              ///< picture height in pixels [16, 8192]
+  std::string mode = "shaded";   ///< shaded, zebra, gaussian, mean or deviation
+  bool bare = false;             ///< the picture alone: no toolbar, no panels (?ui=0)
+  std::filesystem::path viewer;  ///< the built front end; empty: viewer_dir()
   std::filesystem::path chromium = "/usr/bin/chromium";  ///< Debian's chromium
-  int timeout_seconds = 60;                            ///< chromium is killed after this
+  int timeout_seconds = 60;                              ///< chromium is killed after this
 };
 
 /// A PNG picture of the viewer's page on the run folder: serves it on a free port of 127.0.0.1,
@@ -59,8 +59,7 @@ struct SnapshotOptions {
 /// `/?mode=MODE`, waits for it (killed after the timeout), checks `png` was written.
 /// Throws clay::Error: InvalidArgument for a bad mode or size, Io when chromium is missing (naming
 /// the Debian package), fails, times out or writes no picture.
-void snapshot(const std::filesystem::path& run_dir,
-                              const std::filesystem::path& png,
-                              const SnapshotOptions& options = {});
+void snapshot(const std::filesystem::path& run_dir, const std::filesystem::path& png,
+              const SnapshotOptions& options = {});
 
 }  // namespace clay::recipe

@@ -7,7 +7,6 @@
 /// deformation by bound and target curves (Han–De Amicis–Conti 2007), the exact composition of
 /// lattices and polynomial tapers with NURBS surfaces (Sederberg–Parry §2.1) and the certified
 /// refit of deformed surfaces that are not polynomial.
-#include <clay/surface.hpp>
 #include <clay/deform/compose.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
@@ -21,3 +20,4 @@
 #include <clay/deform/stack.hpp>
 #include <clay/deform/style.hpp>
 #include <clay/deform/surface_deformation.hpp>
+#include <clay/surface.hpp>

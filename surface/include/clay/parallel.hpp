@@ -19,6 +19,7 @@ using Executor =
 
 /// The default Executor: parts − 1 new std::threads plus the calling thread. Every task runs to
 /// its end; the first exception thrown by a task is rethrown on the calling thread afterwards.
-CLAY_SURFACE_API void run_on_threads(std::size_t parts, const std::function<void(std::size_t part)>& task);
+CLAY_SURFACE_API void run_on_threads(std::size_t parts,
+                                     const std::function<void(std::size_t part)>& task);
 
 }  // namespace clay

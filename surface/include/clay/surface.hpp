@@ -4,12 +4,11 @@
 /// revolve, primitives) and STEP/IGES/glTF exchange.
 #include <clay/error.hpp>
 #include <clay/summary.hpp>
-#include <clay/tolerance.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
-#include <clay/surface/build_report.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/build_report.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/exchange.hpp>
@@ -21,3 +20,4 @@
 #include <clay/surface/self_intersection.hpp>
 #include <clay/surface/skin.hpp>
 #include <clay/surface/tessellate.hpp>
+#include <clay/tolerance.hpp>

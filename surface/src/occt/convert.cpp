@@ -15,7 +15,8 @@
 namespace clay::surface::occt {
 namespace {
 
-constexpr int occt_max_degree = 25;  // Geom_BSplineSurface::MaxDegree() == Geom_BSplineCurve::MaxDegree()
+constexpr int occt_max_degree =
+    25;  // Geom_BSplineSurface::MaxDegree() == Geom_BSplineCurve::MaxDegree()
 
 /// OCCT's distinct knots and multiplicities (1-based) of a flat knot vector, by exact equality.
 struct KnotsAndMults {
@@ -104,23 +105,21 @@ DirectionPlan clamp_ends(const TColStd_Array1OfReal& knots, const TColStd_Array1
 
 [[noreturn]] void refused(std::string_view name, const Standard_Failure& failure) {
   throw Error(ErrorCategory::Exchange,
-              std::string(name) + ": OpenCASCADE refused the B-spline data: " +
-                  describe(failure) +
+              std::string(name) + ": OpenCASCADE refused the B-spline data: " + describe(failure) +
                   "; check for knots closer than one unit in the last place or weights near 0");
 }
 
 void check_degree(std::string_view name, int degree_u, int degree_v, bool surface) {
   if (degree_u <= occt_max_degree && degree_v <= occt_max_degree) return;
-  std::string degrees = surface ? "(" + std::to_string(degree_u) + ", " +
-                                      std::to_string(degree_v) + ")"
-                                : std::to_string(degree_u);
-  throw Error(ErrorCategory::DegreeLimit,
-              std::string(name) + ": degree " + degrees + " exceeds " +
-                  std::to_string(occt_max_degree) +
-                  ", the largest degree OpenCASCADE (and so STEP/IGES export) accepts; reduce "
-                  "the degree or refit the " +
-                  (surface ? "surface" : "curve") + " with degree <= " +
-                  std::to_string(occt_max_degree));
+  std::string degrees = surface
+                            ? "(" + std::to_string(degree_u) + ", " + std::to_string(degree_v) + ")"
+                            : std::to_string(degree_u);
+  throw Error(
+      ErrorCategory::DegreeLimit,
+      std::string(name) + ": degree " + degrees + " exceeds " + std::to_string(occt_max_degree) +
+          ", the largest degree OpenCASCADE (and so STEP/IGES export) accepts; reduce "
+          "the degree or refit the " +
+          (surface ? "surface" : "curve") + " with degree <= " + std::to_string(occt_max_degree));
 }
 
 }  // namespace
@@ -153,9 +152,10 @@ Handle(Geom_BSplineCurve) to_occt(const BSplineCurve& curve, std::string_view na
   }
 }
 
-BSplineCurve from_occt(const Handle(Geom_BSplineCurve)& input, std::string_view name) {
+BSplineCurve from_occt(const Handle(Geom_BSplineCurve) & input, std::string_view name) {
   if (input.IsNull())
-    throw Error(ErrorCategory::Exchange, std::string(name) + ": no OpenCASCADE curve (null handle)");
+    throw Error(ErrorCategory::Exchange,
+                std::string(name) + ": no OpenCASCADE curve (null handle)");
   BSplineCurve curve;
   try {
     Handle(Geom_BSplineCurve) c = input;
@@ -212,7 +212,8 @@ Handle(Geom_BSplineSurface) to_occt(const BSplineSurface& surface, std::string_v
                                      surface.u.degree, surface.v.degree, false, false);
     TColStd_Array2OfReal weights(1, nu, 1, nv);
     for (int i = 0; i < nu; ++i)
-      for (int j = 0; j < nv; ++j) weights.SetValue(i + 1, j + 1, surface.weights[surface.index(i, j)]);
+      for (int j = 0; j < nv; ++j)
+        weights.SetValue(i + 1, j + 1, surface.weights[surface.index(i, j)]);
     return new Geom_BSplineSurface(poles, weights, ku.knots, kv.knots, ku.mults, kv.mults,
                                    surface.u.degree, surface.v.degree, false, false);
   } catch (const Standard_Failure& failure) {
@@ -220,7 +221,7 @@ Handle(Geom_BSplineSurface) to_occt(const BSplineSurface& surface, std::string_v
   }
 }
 
-BSplineSurface from_occt(const Handle(Geom_BSplineSurface)& input, std::string_view name) {
+BSplineSurface from_occt(const Handle(Geom_BSplineSurface) & input, std::string_view name) {
   if (input.IsNull())
     throw Error(ErrorCategory::Exchange,
                 std::string(name) + ": no OpenCASCADE surface (null handle)");
@@ -246,11 +247,11 @@ BSplineSurface from_occt(const Handle(Geom_BSplineSurface)& input, std::string_v
       }
     }
     const DirectionPlan pu =
-        u_inexact ? clamp_ends(s->UKnots(), s->UMultiplicities(), p)
+        u_inexact          ? clamp_ends(s->UKnots(), s->UMultiplicities(), p)
         : s->IsUPeriodic() ? unperiodize_exact(s->UKnots(), s->UMultiplicities(), p, s->NbUPoles())
                            : keep_all(s->UKnots(), s->UMultiplicities(), s->NbUPoles());
     const DirectionPlan pv =
-        v_inexact ? clamp_ends(s->VKnots(), s->VMultiplicities(), q)
+        v_inexact          ? clamp_ends(s->VKnots(), s->VMultiplicities(), q)
         : s->IsVPeriodic() ? unperiodize_exact(s->VKnots(), s->VMultiplicities(), q, s->NbVPoles())
                            : keep_all(s->VKnots(), s->VMultiplicities(), s->NbVPoles());
     const int nu = static_cast<int>(pu.source.size()), nv = static_cast<int>(pv.source.size());

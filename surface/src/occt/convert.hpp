@@ -48,18 +48,18 @@ Handle(Geom_BSplineCurve) to_occt(const BSplineCurve& curve, std::string_view na
 /// >= degree, which is the case for a closed clamped curve that OCCT made periodic, so such a
 /// curve comes back as it was written; otherwise after OCCT knot insertion (not bit-exact).
 /// Throws clay::Error(Exchange) for a null handle; the result is validated (InvalidGeometry).
-BSplineCurve from_occt(const Handle(Geom_BSplineCurve)& curve, std::string_view name = "curve");
+BSplineCurve from_occt(const Handle(Geom_BSplineCurve) & curve, std::string_view name = "curve");
 
 /// Builds the OCCT surface; control point (i, j) becomes pole (i + 1, j + 1). Throws as the curve
 /// overload (DegreeLimit when either degree exceeds 25).
-Handle(Geom_BSplineSurface) to_occt(const BSplineSurface& surface,
-                                    std::string_view name = "surface");
+Handle(Geom_BSplineSurface)
+    to_occt(const BSplineSurface& surface, std::string_view name = "surface");
 
 /// Reads an OCCT surface: periodic directions are made non-periodic and clamped as for curves
 /// (the STEP and IGES readers make every closed clamped surface periodic; this undoes it
 /// exactly); weights are read when IsURational() || IsVRational(), else all 1. Throws as the
 /// curve overload.
-BSplineSurface from_occt(const Handle(Geom_BSplineSurface)& surface,
+BSplineSurface from_occt(const Handle(Geom_BSplineSurface) & surface,
                          std::string_view name = "surface");
 
 }  // namespace clay::surface::occt

@@ -12,9 +12,9 @@
 #include <clay/surface/exchange.hpp>
 
 #include <clay/error.hpp>
-#include <clay/surface/tessellate.hpp>
 #include <clay/internal/checks.hpp>
 #include <clay/internal/fenv.hpp>
+#include <clay/surface/tessellate.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -57,21 +57,21 @@
 #include <GeomConvert.hxx>
 #include <Geom_OffsetSurface.hxx>
 #include <Geom_RectangularTrimmedSurface.hxx>
+#include <IFSelect_ReturnStatus.hxx>
 #include <IGESControl_Controller.hxx>
 #include <IGESControl_Reader.hxx>
 #include <IGESControl_Writer.hxx>
 #include <IGESData_IGESModel.hxx>
 #include <IGESData_IGESWriter.hxx>
 #include <IGESSelect_WorkLibrary.hxx>
-#include <IFSelect_ReturnStatus.hxx>
 #include <Interface_Static.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_Printer.hxx>
 #include <Message_ProgressRange.hxx>
-#include <Precision.hxx>
 #include <Poly_Triangle.hxx>
 #include <Poly_Triangulation.hxx>
+#include <Precision.hxx>
 #include <RWGltf_CafWriter.hxx>
 #include <STEPControl_Controller.hxx>
 #include <STEPControl_Reader.hxx>
@@ -88,9 +88,9 @@
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
-#include <TopoDS_Shell.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
+#include <TopoDS_Shell.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
@@ -169,7 +169,7 @@ std::vector<Handle(Geom_BSplineSurface)> convert_all(const std::vector<BSplineSu
   return out;
 }
 
-TopoDS_Face make_face(const Handle(Geom_BSplineSurface)& surface, const std::string& name) {
+TopoDS_Face make_face(const Handle(Geom_BSplineSurface) & surface, const std::string& name) {
   try {
     // Natural bounds: edges are the exact iso-curves UIso/VIso with Geom2d_Line pcurves.
     BRepBuilderAPI_MakeFace maker(surface, face_tolerance);
@@ -186,14 +186,15 @@ TopoDS_Face make_face(const Handle(Geom_BSplineSurface)& surface, const std::str
 
 /// Every BRepCheck status found on `face` and its sub-shapes, in words ("edge 2:
 /// BRepCheck_InvalidCurveOnSurface"), without repeats.
-std::vector<std::string> check_statuses(const TopoDS_Face& face, const BRepCheck_Analyzer& analyzer) {
+std::vector<std::string> check_statuses(const TopoDS_Face& face,
+                                        const BRepCheck_Analyzer& analyzer) {
   std::vector<std::string> found;
   auto add = [&](const char* kind, int index, BRepCheck_Status status) {
     if (status == BRepCheck_NoError) return;
     std::ostringstream text;
     BRepCheck::Print(status, text);
-    std::string line = std::string(kind) + (index >= 0 ? " " + std::to_string(index) : "") + ": " +
-                       text.str();
+    std::string line =
+        std::string(kind) + (index >= 0 ? " " + std::to_string(index) : "") + ": " + text.str();
     while (!line.empty() && (line.back() == '\n' || line.back() == ' ')) line.pop_back();
     for (const auto& f : found)
       if (f == line) return;
@@ -221,7 +222,7 @@ std::vector<std::string> check_statuses(const TopoDS_Face& face, const BRepCheck
 
 /// Largest gap between each edge's 3D curve and the surface along its pcurve, both evaluated
 /// exactly (Geom_*::D0, de Boor), at 101 parameters per edge.
-double exact_edge_gap(const TopoDS_Face& face, const Handle(Geom_BSplineSurface)& surface) {
+double exact_edge_gap(const TopoDS_Face& face, const Handle(Geom_BSplineSurface) & surface) {
   double gap = 0.0;
   for (TopExp_Explorer e(face, TopAbs_EDGE); e.More(); e.Next()) {
     const TopoDS_Edge& edge = TopoDS::Edge(e.Current());
@@ -242,7 +243,7 @@ double exact_edge_gap(const TopoDS_Face& face, const Handle(Geom_BSplineSurface)
 /// Largest gap between OpenCASCADE's cached evaluation (GeomAdaptor_Surface, a power basis per
 /// span, used by BRepCheck) and exact evaluation, on a grid of up to 8 steps per knot span and
 /// about 64 parameters per direction (the error is largest near span ends, which are sampled).
-double cached_evaluation_error(const Handle(Geom_BSplineSurface)& surface) {
+double cached_evaluation_error(const Handle(Geom_BSplineSurface) & surface) {
   GeomAdaptor_Surface adaptor(surface);
   auto parameters = [](const TColStd_Array1OfReal& knots, int first, int last) {
     const int steps = std::clamp(64 / std::max(1, last - first), 1, 8);
@@ -253,8 +254,10 @@ double cached_evaluation_error(const Handle(Geom_BSplineSurface)& surface) {
     out.push_back(knots(last));
     return out;
   };
-  const auto us = parameters(surface->UKnots(), surface->FirstUKnotIndex(), surface->LastUKnotIndex());
-  const auto vs = parameters(surface->VKnots(), surface->FirstVKnotIndex(), surface->LastVKnotIndex());
+  const auto us =
+      parameters(surface->UKnots(), surface->FirstUKnotIndex(), surface->LastUKnotIndex());
+  const auto vs =
+      parameters(surface->VKnots(), surface->FirstVKnotIndex(), surface->LastVKnotIndex());
   double error = 0.0;
   for (double u : us)
     for (double v : vs) error = std::max(error, adaptor.Value(u, v).Distance(surface->Value(u, v)));
@@ -332,10 +335,10 @@ void check_target(const fs::path& file, std::string_view caller) {
 std::string random_suffix() {
   static std::atomic<unsigned long> counter{0};
   std::random_device device;
-  std::mt19937_64 rng((static_cast<unsigned long long>(device()) << 32) ^
-                      static_cast<unsigned long long>(
-                          std::chrono::steady_clock::now().time_since_epoch().count()) ^
-                      counter.fetch_add(1));
+  std::mt19937_64 rng(
+      (static_cast<unsigned long long>(device()) << 32) ^
+      static_cast<unsigned long long>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
+      counter.fetch_add(1));
   std::ostringstream out;
   out << std::hex << rng();
   return out.str();
@@ -384,8 +387,8 @@ void write_stream(const fs::path& temp, std::string_view caller,
 void check_readable(const fs::path& file, std::string_view caller) {
   std::error_code ec;
   if (!fs::exists(file, ec))
-    throw Error(ErrorCategory::Io, std::string(caller) + ": " + quoted(file) +
-                                       " does not exist; check the path");
+    throw Error(ErrorCategory::Io,
+                std::string(caller) + ": " + quoted(file) + " does not exist; check the path");
   if (!fs::is_regular_file(file, ec))
     throw Error(ErrorCategory::Io,
                 std::string(caller) + ": " + quoted(file) + " is not a regular file");
@@ -414,8 +417,7 @@ void set_static(const char* name, int value) {
 /// (restricted to the face's parameter box when they are infinite).
 BSplineSurface surface_of_face(const TopoDS_Face& face, const std::string& name) {
   Handle(Geom_Surface) surface = BRep_Tool::Surface(face);  // the face's location applied
-  if (surface.IsNull())
-    throw Error(ErrorCategory::Exchange, name + ": the face has no surface");
+  if (surface.IsNull()) throw Error(ErrorCategory::Exchange, name + ": the face has no surface");
   bool trimmed = false;
   double tu0 = 0, tu1 = 0, tv0 = 0, tv1 = 0;
   for (;;) {
@@ -445,8 +447,7 @@ BSplineSurface surface_of_face(const TopoDS_Face& face, const std::string& name)
     if (trimmed && !bspline->IsUPeriodic() && !bspline->IsVPeriodic() &&
         (tu0 > u0 + eps || tu1 < u1 - eps || tv0 > v0 + eps || tv1 < v1 - eps)) {
       bspline = Handle(Geom_BSplineSurface)::DownCast(bspline->Copy());
-      bspline->Segment(std::max(tu0, u0), std::min(tu1, u1), std::max(tv0, v0),
-                       std::min(tv1, v1));
+      bspline->Segment(std::max(tu0, u0), std::min(tu1, u1), std::max(tv0, v0), std::min(tv1, v1));
     }
     return occt::from_occt(bspline, name);
   }
@@ -518,7 +519,12 @@ std::vector<BSplineSurface> read_iges_locked(const fs::path& file) {
 
 using Reader = std::vector<BSplineSurface> (*)(const fs::path&);
 
-enum ChildStatus : int { child_read = 0, child_error = 2, child_out_of_memory = 3, child_unknown = 4 };
+enum ChildStatus : int {
+  child_read = 0,
+  child_error = 2,
+  child_out_of_memory = 3,
+  child_unknown = 4
+};
 
 template <class T>
 void put(std::string& out, const T& x) {
@@ -537,7 +543,8 @@ std::string serialize(const std::vector<BSplineSurface>& surfaces) {
     put(out, static_cast<std::int32_t>(s.v.degree));
     put_doubles(out, s.u.knots.data(), s.u.knots.size());
     put_doubles(out, s.v.knots.data(), s.v.knots.size());
-    put_doubles(out, s.points.data(), static_cast<std::size_t>(s.points.size()));  // row-major x y z
+    put_doubles(out, s.points.data(),
+                static_cast<std::size_t>(s.points.size()));  // row-major x y z
     put_doubles(out, s.weights.data(), static_cast<std::size_t>(s.weights.size()));
   }
   return out;
@@ -582,8 +589,10 @@ std::vector<BSplineSurface> deserialize(const std::string& bytes) {
     s.u.knots = in.doubles();
     s.v.knots = in.doubles();
     const std::vector<double> points = in.doubles(), weights = in.doubles();
-    s.points = Eigen::Map<const Points3>(points.data(), static_cast<Eigen::Index>(points.size() / 3), 3);
-    s.weights = Eigen::Map<const Eigen::VectorXd>(weights.data(), static_cast<Eigen::Index>(weights.size()));
+    s.points =
+        Eigen::Map<const Points3>(points.data(), static_cast<Eigen::Index>(points.size() / 3), 3);
+    s.weights = Eigen::Map<const Eigen::VectorXd>(weights.data(),
+                                                  static_cast<Eigen::Index>(weights.size()));
   }
   return out;
 }
@@ -621,18 +630,21 @@ unsigned long long peak_mapped_bytes() {
 /// In the child: read, answer, exit. Never returns, and nothing escapes it (noexcept: whatever
 /// might would otherwise unwind into the caller's copy of its own stack and run on as a second
 /// process); never runs the parent's atexit handlers or flushes its stdio buffers (_exit).
-[[noreturn]] void answer_in_child(int fd, const fs::path& file, const ReadOptions& options, Reader read) noexcept {
+[[noreturn]] void answer_in_child(int fd, const fs::path& file, const ReadOptions& options,
+                                  Reader read) noexcept {
   int status = child_unknown;
   try {
     // Die of a crash, so the parent sees the signal: the caller's handlers (a test framework's,
     // a crash reporter's) must not run in the child.
     struct sigaction by_default {};
     by_default.sa_handler = SIG_DFL;
-    for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL}) ::sigaction(sig, &by_default, nullptr);
+    for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL})
+      ::sigaction(sig, &by_default, nullptr);
     // The limit counts what is mapped already (shared libraries, the parent's heap).
     rlimit limit{};
     ::getrlimit(RLIMIT_AS, &limit);
-    const unsigned long long allowance = static_cast<unsigned long long>(options.memory_limit_mb) * 1024 * 1024;
+    const unsigned long long allowance =
+        static_cast<unsigned long long>(options.memory_limit_mb) * 1024 * 1024;
     const unsigned long long start = mapped_bytes();
     const rlim_t wanted = static_cast<rlim_t>(start + allowance);
     if (limit.rlim_max == RLIM_INFINITY || wanted < limit.rlim_max) limit.rlim_cur = wanted;
@@ -645,7 +657,8 @@ unsigned long long peak_mapped_bytes() {
       // OpenCASCADE's parsers catch a failed allocation and report the file as unreadable: a
       // failure after using more than half the allowance is the memory limit's doing.
       const unsigned long long peak = peak_mapped_bytes();
-      if (e.message().find("Standard_OutOfMemory") != std::string::npos || (peak > start && peak - start > allowance / 2)) {
+      if (e.message().find("Standard_OutOfMemory") != std::string::npos ||
+          (peak > start && peak - start > allowance / 2)) {
         status = child_out_of_memory;
       } else {
         put(payload, static_cast<std::int32_t>(e.category()));
@@ -664,24 +677,32 @@ unsigned long long peak_mapped_bytes() {
 
 std::string signal_name(int sig) {
   switch (sig) {
-    case SIGSEGV: return "SIGSEGV";
-    case SIGBUS: return "SIGBUS";
-    case SIGABRT: return "SIGABRT";
-    case SIGFPE: return "SIGFPE";
-    case SIGILL: return "SIGILL";
-    case SIGKILL: return "SIGKILL";
-    default: return "signal " + std::to_string(sig);
+    case SIGSEGV:
+      return "SIGSEGV";
+    case SIGBUS:
+      return "SIGBUS";
+    case SIGABRT:
+      return "SIGABRT";
+    case SIGFPE:
+      return "SIGFPE";
+    case SIGILL:
+      return "SIGILL";
+    case SIGKILL:
+      return "SIGKILL";
+    default:
+      return "signal " + std::to_string(sig);
   }
 }
 
 /// `read(file)` in a forked child process with options' time and memory limits. The caller holds
 /// the exchange session across the fork, so no other thread of this process is inside
 /// OpenCASCADE while the child's copy of it starts; the child calls `read` without locking.
-std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOptions& options, std::string_view caller,
-                                          Reader read) {
+std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOptions& options,
+                                          std::string_view caller, Reader read) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0)
-    throw Error(ErrorCategory::Io, std::string(caller) + ": cannot create a pipe: " + std::strerror(errno));
+    throw Error(ErrorCategory::Io,
+                std::string(caller) + ": cannot create a pipe: " + std::strerror(errno));
   // The child would otherwise write out a copy of whatever the caller has buffered.
   std::fflush(nullptr);
   const pid_t pid = ::fork();
@@ -689,8 +710,8 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
     const int e = errno;
     ::close(fds[0]);
     ::close(fds[1]);
-    throw Error(ErrorCategory::Io, std::string(caller) + ": cannot start a process to read " + quoted(file) + ": " +
-                                       std::strerror(e));
+    throw Error(ErrorCategory::Io, std::string(caller) + ": cannot start a process to read " +
+                                       quoted(file) + ": " + std::strerror(e));
   }
   if (pid == 0) {
     ::close(fds[0]);
@@ -712,11 +733,14 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
       }
     }
   } child{pid, fds[0]};
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.time_limit_seconds);
-  auto left_ms = [&] {  // poll's timeout is an int: wait at most ~16 minutes at a time, then look again
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    return static_cast<int>(std::clamp<long long>(left.count(), 0, 1000000));
-  };
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(options.time_limit_seconds);
+  auto left_ms =
+      [&] {  // poll's timeout is an int: wait at most ~16 minutes at a time, then look again
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+            deadline - std::chrono::steady_clock::now());
+        return static_cast<int>(std::clamp<long long>(left.count(), 0, 1000000));
+      };
   auto past_deadline = [&] { return std::chrono::steady_clock::now() >= deadline; };
   std::string bytes;
   bool timed_out = false;
@@ -750,7 +774,8 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
       if (got < 0)  // ECHILD: reaped elsewhere (SIGCHLD ignored, or a waitpid(-1) in the host)
         throw Error(ErrorCategory::Exchange,
                     std::string(caller) + ": the process reading " + quoted(file) +
-                        " ended, but its exit status is lost to this process (is SIGCHLD ignored, or are children "
+                        " ended, but its exit status is lost to this process (is SIGCHLD ignored, "
+                        "or are children "
                         "reaped elsewhere?); read the file without isolation to see its outcome");
       if (past_deadline()) {
         timed_out = true;
@@ -762,45 +787,55 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
   if (timed_out) {
     char limit[32];
     std::snprintf(limit, sizeof limit, "%g", options.time_limit_seconds);
-    throw Error(ErrorCategory::Exchange, std::string(caller) + ": reading " + quoted(file) + " took longer than " +
-                                             limit + " s, the time limit, so it was stopped; the file is "
-                                             "probably malformed (OpenCASCADE hangs on NaN coordinates and absurd degrees)");
+    throw Error(ErrorCategory::Exchange,
+                std::string(caller) + ": reading " + quoted(file) + " took longer than " + limit +
+                    " s, the time limit, so it was stopped; the file is "
+                    "probably malformed (OpenCASCADE hangs on NaN coordinates and absurd degrees)");
   }
   const std::string memory = std::to_string(options.memory_limit_mb) + " MB";
   if (WIFSIGNALED(status))
-    throw Error(ErrorCategory::Exchange, std::string(caller) + ": OpenCASCADE crashed (" + signal_name(WTERMSIG(status)) +
-                                             ") while reading " + quoted(file) +
-                                             "; the file is malformed (or it needed more than " + memory +
-                                             "): export it again or repair it");
+    throw Error(ErrorCategory::Exchange, std::string(caller) + ": OpenCASCADE crashed (" +
+                                             signal_name(WTERMSIG(status)) + ") while reading " +
+                                             quoted(file) +
+                                             "; the file is malformed (or it needed more than " +
+                                             memory + "): export it again or repair it");
   switch (WIFEXITED(status) ? WEXITSTATUS(status) : child_unknown) {
-    case child_read: return deserialize(bytes);
+    case child_read:
+      return deserialize(bytes);
     case child_error: {
       Unpacker in(bytes);
       const auto category = static_cast<ErrorCategory>(in.take<std::int32_t>());
       throw Error(category, bytes.substr(sizeof(std::int32_t)));
     }
     case child_out_of_memory:
-      throw Error(ErrorCategory::Exchange, std::string(caller) + ": reading " + quoted(file) + " needed more than " +
-                                               memory + ", the memory limit, so it was stopped");
+      throw Error(ErrorCategory::Exchange, std::string(caller) + ": reading " + quoted(file) +
+                                               " needed more than " + memory +
+                                               ", the memory limit, so it was stopped");
     default:
-      throw Error(ErrorCategory::Exchange, std::string(caller) + ": the process reading " + quoted(file) +
-                                               " failed without an answer (exit status " +
-                                               std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+      throw Error(ErrorCategory::Exchange,
+                  std::string(caller) + ": the process reading " + quoted(file) +
+                      " failed without an answer (exit status " +
+                      std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
   }
 }
 
 /// The checks and the read every public read goes through.
-std::vector<BSplineSurface> read_guarded(const fs::path& file, const ReadOptions& options, std::string_view caller,
-                                         void (*precheck)(const fs::path&, std::string_view, int), Reader read) {
+std::vector<BSplineSurface> read_guarded(const fs::path& file, const ReadOptions& options,
+                                         std::string_view caller,
+                                         void (*precheck)(const fs::path&, std::string_view, int),
+                                         Reader read) {
   options.validate();
   check_readable(file, caller);
   if (options.precheck) precheck(file, caller, max_exchange_degree);
   ExchangeSession session;
-  std::vector<BSplineSurface> surfaces = options.isolate ? read_in_child(file, options, caller, read) : read(file);
+  std::vector<BSplineSurface> surfaces =
+      options.isolate ? read_in_child(file, options, caller, read) : read(file);
   // What came through the pipe is checked again here: a surface the child's OpenCASCADE accepted
   // must still be one this kernel can use.
   for (std::size_t k = 0; k < surfaces.size(); ++k)
-    if (const auto list = surface::problems(surfaces[k], quoted(file) + " face #" + std::to_string(k)); !list.empty())
+    if (const auto list =
+            surface::problems(surfaces[k], quoted(file) + " face #" + std::to_string(k));
+        !list.empty())
       throw Error(ErrorCategory::Exchange, std::string(caller) + ": " + list.front());
   return surfaces;
 }
@@ -811,12 +846,14 @@ std::vector<BSplineSurface> read_guarded(const fs::path& file, const ReadOptions
 
 std::string ExchangeReport::brief() const {
   char head[160];
-  std::snprintf(head, sizeof head, "%d face%s, max degree %d, %ld control points, %s (BRepCheck at %.0e mm)",
-                faces, faces == 1 ? "" : "s", max_degree, control_points, valid ? "valid" : "NOT valid", tolerance);
+  std::snprintf(head, sizeof head,
+                "%d face%s, max degree %d, %ld control points, %s (BRepCheck at %.0e mm)", faces,
+                faces == 1 ? "" : "s", max_degree, control_points, valid ? "valid" : "NOT valid",
+                tolerance);
   std::string line = head;
   if (!problems.empty())
-    line += ": " + std::to_string(problems.size()) + (problems.size() == 1 ? " problem: " : " problems, the first: ") +
-            problems.front();
+    line += ": " + std::to_string(problems.size()) +
+            (problems.size() == 1 ? " problem: " : " problems, the first: ") + problems.front();
   return line;
 }
 
@@ -899,9 +936,7 @@ ExchangeReport write_iges(const std::vector<BSplineSurface>& surfaces, const fs:
 
 std::vector<std::string> ReadOptions::problems() const {
   std::vector<std::string> out;
-  auto fail = [&out](const std::string& what) {
-    out.push_back("ReadOptions::" + what);
-  };
+  auto fail = [&out](const std::string& what) { out.push_back("ReadOptions::" + what); };
   if (!(time_limit_seconds > 0 && time_limit_seconds <= 86400))
     fail("time_limit_seconds = " + std::to_string(time_limit_seconds) + ": must be in (0, 86400]");
   if (memory_limit_mb < 1 || memory_limit_mb > 1048576)
@@ -909,7 +944,9 @@ std::vector<std::string> ReadOptions::problems() const {
   return out;
 }
 
-void ReadOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void ReadOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 std::vector<BSplineSurface> read_step(const fs::path& file, const ReadOptions& options) {
   return read_guarded(file, options, "read_step", &detail::precheck_step, &read_step_locked);
@@ -930,7 +967,9 @@ std::vector<std::string> GltfWriteOptions::problems() const {
   return out;
 }
 
-void GltfWriteOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void GltfWriteOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& file,
                 const GltfWriteOptions& options) {
@@ -940,17 +979,21 @@ void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& fil
   // mesher gave zero-area meshes on surfaces with poles (the handset, the bent superellipsoid),
   // and only the writer is needed from it.
   const auto bad = options.problems();
-  if (!bad.empty()) throw Error(ErrorCategory::InvalidArgument, "write_gltf: " + internal::join_problems(bad));
+  if (!bad.empty())
+    throw Error(ErrorCategory::InvalidArgument, "write_gltf: " + internal::join_problems(bad));
   for (size_t k = 0; k < surfaces.size(); ++k) validate(surfaces[k], surface_name(k));
   const long share = options.max_vertices / std::max<long>(1, static_cast<long>(surfaces.size()));
-  const int max_samples = static_cast<int>(std::clamp<long>(static_cast<long>(std::sqrt(static_cast<double>(share))), 17, 1025));
+  const int max_samples = static_cast<int>(
+      std::clamp<long>(static_cast<long>(std::sqrt(static_cast<double>(share))), 17, 1025));
   std::vector<GridMesh> meshes;
   meshes.reserve(surfaces.size());
   for (size_t k = 0; k < surfaces.size(); ++k) {
     try {
       meshes.push_back(tessellate_to_area(surfaces[k], options.relative_area, max_samples));
-    } catch (const Error& e) {  // say which surface and which file, not only the tessellator's figures
-      throw Error(e.category(), "write_gltf: the preview of " + surface_name(k) + " for " + quoted(file) +
+    } catch (
+        const Error& e) {  // say which surface and which file, not only the tessellator's figures
+      throw Error(e.category(), "write_gltf: the preview of " + surface_name(k) + " for " +
+                                    quoted(file) +
                                     " cannot be meshed within its area tolerance: " + e.message() +
                                     "; raise GltfWriteOptions::max_vertices or relative_area");
     }
@@ -969,9 +1012,11 @@ void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& fil
       Handle(Poly_Triangulation) triangulation =
           new Poly_Triangulation(m.rows * m.cols, 2 * cells, Standard_False, Standard_True);
       for (int v = 0; v < m.rows * m.cols; ++v) {
-        triangulation->SetNode(v + 1, gp_Pnt(m.positions(v, 0), m.positions(v, 1), m.positions(v, 2)));
+        triangulation->SetNode(v + 1,
+                               gp_Pnt(m.positions(v, 0), m.positions(v, 1), m.positions(v, 2)));
         const Eigen::Vector3d n = m.normals.row(v).transpose();
-        triangulation->SetNormal(v + 1, n.squaredNorm() > 0 ? gp_Dir(n.x(), n.y(), n.z()) : gp_Dir(0, 0, 1));
+        triangulation->SetNormal(
+            v + 1, n.squaredNorm() > 0 ? gp_Dir(n.x(), n.y(), n.z()) : gp_Dir(0, 0, 1));
       }
       int t = 0;
       for (int i = 0; i + 1 < m.rows; ++i)

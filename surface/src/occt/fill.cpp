@@ -5,13 +5,13 @@
 #include <clay/surface/fill.hpp>
 
 #include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
 #include <clay/surface/self_intersection.hpp>
 #include <clay/surface/skin.hpp>
 #include <clay/tolerance.hpp>
-#include <clay/internal/checks.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -65,10 +65,10 @@ void check_curves(const std::vector<BSplineCurve>& curves, const char* what, dou
     validate(curves[k], std::string(what) + " #" + std::to_string(k));
     const double length = detail::polygon_length(curves[k]);
     if (!(length > 1e-12 * size))
-      throw Error(ErrorCategory::InvalidGeometry,
-                  std::string(what) + " #" + std::to_string(k) +
-                      " is degenerate: its control polygon is " + num(length) +
-                      " mm long; give a curve, not a point");
+      throw Error(ErrorCategory::InvalidGeometry, std::string(what) + " #" + std::to_string(k) +
+                                                      " is degenerate: its control polygon is " +
+                                                      num(length) +
+                                                      " mm long; give a curve, not a point");
   }
 }
 
@@ -115,8 +115,8 @@ std::vector<LoopCurve> closed_loop(const std::vector<BSplineCurve>& curves, doub
       if (to_end < best) best = to_end, best_k = k, best_reversed = true;
     }
     used[best_k] = true;
-    loop.push_back({best_k, best_reversed,
-                    best_reversed ? reversed(clamped[best_k]) : clamped[best_k], 1.0});
+    loop.push_back(
+        {best_k, best_reversed, best_reversed ? reversed(clamped[best_k]) : clamped[best_k], 1.0});
     gaps.push_back(best);
   }
   gaps.push_back((first_point(loop.front().curve) - last_point(loop.back().curve)).norm());
@@ -128,8 +128,8 @@ std::vector<LoopCurve> closed_loop(const std::vector<BSplineCurve>& curves, doub
     const LoopCurve& b = loop[(k + 1) % n];
     problems += (problems.empty() ? "" : "; ") + curve_name(a.input) +
                 (a.reversed ? " start" : " end") + " and " + curve_name(b.input) +
-                (b.reversed ? " end" : " start") + " are " + num(gaps[k]) + " mm apart (tolerance " +
-                num(tolerance) + " mm)";
+                (b.reversed ? " end" : " start") + " are " + num(gaps[k]) +
+                " mm apart (tolerance " + num(tolerance) + " mm)";
   }
   if (!problems.empty())
     throw Error(ErrorCategory::InvalidGeometry,
@@ -227,11 +227,12 @@ struct Side {
   bool at_end = false;                  // the constant is the domain end (else start)
   bool edge_reversed = false;           // the edge runs against its surface parameter
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
-  double alpha = 1;                     // edge parameter f is curve parameter alpha f / (alpha f + 1 - f)
+  double alpha = 1;  // edge parameter f is curve parameter alpha f / (alpha f + 1 - f)
 };
 
 /// Largest distance between each side's input curve and the surface edge, at `count` samples.
-double side_deviation(const BSplineSurface& s, const std::vector<Side>& sides, int count, int& samples) {
+double side_deviation(const BSplineSurface& s, const std::vector<Side>& sides, int count,
+                      int& samples) {
   const auto [ua, ub] = s.u.domain();
   const auto [va, vb] = s.v.domain();
   double worst = 0;
@@ -244,11 +245,13 @@ double side_deviation(const BSplineSurface& s, const std::vector<Side>& sides, i
       Eigen::Vector3d expected = side.point;
       if (side.input) {
         const auto [a, b] = side.input->basis.domain();
-        const double m = side.alpha == 1.0 ? f : std::min(1.0, side.alpha * f / (side.alpha * f + 1.0 - f));
+        const double m =
+            side.alpha == 1.0 ? f : std::min(1.0, side.alpha * f / (side.alpha * f + 1.0 - f));
         const double t = side.input_reversed ? b - m * (b - a) : a + m * (b - a);
         expected = evaluate(*side.input, std::clamp(t, a, b));
       }
-      worst = std::max(worst, (evaluate(s, std::clamp(u, ua, ub), std::clamp(v, va, vb)) - expected).norm());
+      worst = std::max(
+          worst, (evaluate(s, std::clamp(u, ua, ub), std::clamp(v, va, vb)) - expected).norm());
       ++samples;
     }
   }
@@ -319,9 +322,10 @@ TColStd_Array1OfReal occt_weights(const BSplineCurve& c) {
 /// 0) and u1 (v = 1) along u, v0 (u = 0) and v1 (u = 1) along v. GeomFill_BSplineCurves calls
 /// GeomFill_Coons(P1, P4, P3, P2, W1, W4, W3, W2), whose Init gives the u = 0 column the poles of
 /// its 2nd argument but the weights of its 8th: the side weights of u = 0 and u = 1 end up swapped
-/// (OpenCASCADE 7.6.3) and the edges are not the curves. Passing the weights in pole order fixes it.
-BSplineSurface rational_coons(const BSplineCurve& u0, const BSplineCurve& v1, const BSplineCurve& u1,
-                              const BSplineCurve& v0) {
+/// (OpenCASCADE 7.6.3) and the edges are not the curves. Passing the weights in pole order fixes
+/// it.
+BSplineSurface rational_coons(const BSplineCurve& u0, const BSplineCurve& v1,
+                              const BSplineCurve& u1, const BSplineCurve& v0) {
   GeomFill_Coons coons(occt_points(u0), occt_points(v0), occt_points(u1), occt_points(v1),
                        occt_weights(u0), occt_weights(v1), occt_weights(u1), occt_weights(v0));
   return surface_from_filling(coons, u0.basis, v1.basis);
@@ -329,18 +333,24 @@ BSplineSurface rational_coons(const BSplineCurve& u0, const BSplineCurve& v1, co
 
 GeomFill_FillingStyle occt_style(FillStyle style) {
   switch (style) {
-    case FillStyle::Stretch: return GeomFill_StretchStyle;
-    case FillStyle::Coons: return GeomFill_CoonsStyle;
-    case FillStyle::Curved: return GeomFill_CurvedStyle;
+    case FillStyle::Stretch:
+      return GeomFill_StretchStyle;
+    case FillStyle::Coons:
+      return GeomFill_CoonsStyle;
+    case FillStyle::Curved:
+      return GeomFill_CurvedStyle;
   }
   return GeomFill_CoonsStyle;
 }
 
 const char* style_name(FillStyle style) {
   switch (style) {
-    case FillStyle::Stretch: return "stretch";
-    case FillStyle::Coons: return "coons";
-    case FillStyle::Curved: return "curved";
+    case FillStyle::Stretch:
+      return "stretch";
+    case FillStyle::Coons:
+      return "coons";
+    case FillStyle::Curved:
+      return "curved";
   }
   return "coons";
 }
@@ -378,16 +388,17 @@ auto with_occt(const char* what, F f) {
 std::vector<std::string> FillOptions::problems() const {
   std::vector<std::string> out;
   if (!(gap_tolerance > 0.0 && std::isfinite(gap_tolerance)))
-    out.push_back(
-                "FillOptions::gap_tolerance is " + num(gap_tolerance) + "; it must be > 0 and finite");
+    out.push_back("FillOptions::gap_tolerance is " + num(gap_tolerance) +
+                  "; it must be > 0 and finite");
   if (style != FillStyle::Stretch && style != FillStyle::Coons && style != FillStyle::Curved)
-    out.push_back(
-                "FillOptions::style is " + std::to_string(static_cast<int>(style)) +
-                    "; it must be Stretch, Coons or Curved");
+    out.push_back("FillOptions::style is " + std::to_string(static_cast<int>(style)) +
+                  "; it must be Stretch, Coons or Curved");
   return out;
 }
 
-void FillOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void FillOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& options) {
   options.validate();
@@ -417,8 +428,10 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
   if (n == 2) {
     BSplineCurve a = normalized(boundary[0]);
     BSplineCurve b = normalized(boundary[1]);
-    const double sa = (first_point(a) - first_point(b)).norm(), ea = (last_point(a) - last_point(b)).norm();
-    const double sr = (first_point(a) - last_point(b)).norm(), er = (last_point(a) - first_point(b)).norm();
+    const double sa = (first_point(a) - first_point(b)).norm(),
+                 ea = (last_point(a) - last_point(b)).norm();
+    const double sr = (first_point(a) - last_point(b)).norm(),
+                 er = (last_point(a) - first_point(b)).norm();
     if (options.style != FillStyle::Curved) {
       // Ruled surface: turn curve #1 to run like curve #0 (ends paired by distance).
       const bool turn = sr + er < sa + ea;
@@ -429,7 +442,8 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
       BSplineCurve ca, cb;
       std::tie(ca, cb) = compatible_pair(a, b, false, "", note);
       result = with_occt("fill", [&] {
-        GeomFill_BSplineCurves filler(occt::to_occt(ca, "curve #0"), occt::to_occt(cb, "curve #1"), style);
+        GeomFill_BSplineCurves filler(occt::to_occt(ca, "curve #0"), occt::to_occt(cb, "curve #1"),
+                                      style);
         return filler.Surface();
       });
       sides.push_back({&boundary[0], false, false, false, false, {}});
@@ -442,8 +456,8 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
         throw Error(ErrorCategory::InvalidGeometry,
                     "fill: a curved fill of 2 curves needs them to share a corner, but curve #0 " +
                         std::string(best >= 2 ? "end" : "start") + " and curve #1 " +
-                        (best % 2 ? "end" : "start") + " (the nearest ends) are " + num(gaps[best]) +
-                        " mm apart (tolerance " + num(options.gap_tolerance) +
+                        (best % 2 ? "end" : "start") + " (the nearest ends) are " +
+                        num(gaps[best]) + " mm apart (tolerance " + num(options.gap_tolerance) +
                         " mm); join them, or use Stretch or Coons for the ruled surface");
       const bool turn_a = best >= 2, turn_b = best % 2 == 1;
       if (turn_a) a = reversed(a);
@@ -458,9 +472,12 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
       b.points.row(0) = corner.transpose();
       if (turn_a) note = "curve #0 reversed";
       if (turn_b) note += std::string(note.empty() ? "" : "; ") + "curve #1 reversed";
-      if (moved > 0) note += std::string(note.empty() ? "" : "; ") + "corner joined (ends moved " + num(moved) + " mm)";
+      if (moved > 0)
+        note += std::string(note.empty() ? "" : "; ") + "corner joined (ends moved " + num(moved) +
+                " mm)";
       result = with_occt("fill", [&] {
-        GeomFill_BSplineCurves filler(occt::to_occt(a, "curve #0"), occt::to_occt(b, "curve #1"), style);
+        GeomFill_BSplineCurves filler(occt::to_occt(a, "curve #0"), occt::to_occt(b, "curve #1"),
+                                      style);
         return filler.Surface();
       });
       sides.push_back({&boundary[0], turn_a, false, false, false, {}, alpha_a});
@@ -477,8 +494,11 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
       reparametrized = reparametrized || c.alpha != 1.0;
     }
     for (const LoopCurve& c : loop)
-      if (c.reversed) note += std::string(note.empty() ? "" : "; ") + curve_name(c.input) + " reversed";
-    if (joined > 0) note += std::string(note.empty() ? "" : "; ") + "corners joined (ends moved up to " + num(joined) + " mm)";
+      if (c.reversed)
+        note += std::string(note.empty() ? "" : "; ") + curve_name(c.input) + " reversed";
+    if (joined > 0)
+      note += std::string(note.empty() ? "" : "; ") + "corners joined (ends moved up to " +
+              num(joined) + " mm)";
     // GeomFill_BSplineCurves arranges C1 (v = 0, along u), C2 (u = 1), C3 reversed (v = 1),
     // C4 reversed (u = 0); its arrangement finds our loop order unchanged because our corners
     // coincide exactly. Opposite sides are made compatible in surface direction.
@@ -497,7 +517,8 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
         const int from = single.basis.degree;
         single = elevate_degree(single, 3 - from);
         note += std::string(note.empty() ? "" : "; ") + curve_name(loop[1].input) +
-                " raised from degree " + std::to_string(from) + " to 3 (Coons needs 4 control points per side)";
+                " raised from degree " + std::to_string(from) +
+                " to 3 (Coons needs 4 control points per side)";
       }
       v1 = single;
       v0 = point_curve(single, first_point(c1));
@@ -508,19 +529,24 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
               "rational Coons built by GeomFill_Coons with corrected side weights";
     } else {
       result = with_occt("fill", [&] {
-        GeomFill_BSplineCurves filler(occt::to_occt(u0, curve_name(loop[0].input)),
-                                      occt::to_occt(v1, curve_name(loop[1].input)),
-                                      occt::to_occt(reversed(u1), curve_name(loop[2].input)),
-                                      occt::to_occt(reversed(v0), n == 4 ? curve_name(loop[3].input) : "collapsed side"),
-                                      style);
+        GeomFill_BSplineCurves filler(
+            occt::to_occt(u0, curve_name(loop[0].input)),
+            occt::to_occt(v1, curve_name(loop[1].input)),
+            occt::to_occt(reversed(u1), curve_name(loop[2].input)),
+            occt::to_occt(reversed(v0), n == 4 ? curve_name(loop[3].input) : "collapsed side"),
+            style);
         return filler.Surface();
       });
     }
-    sides.push_back({&boundary[loop[0].input], loop[0].reversed, false, false, false, {}, loop[0].alpha});
-    sides.push_back({&boundary[loop[1].input], loop[1].reversed, true, true, false, {}, loop[1].alpha});
-    sides.push_back({&boundary[loop[2].input], loop[2].reversed, false, true, true, {}, loop[2].alpha});
+    sides.push_back(
+        {&boundary[loop[0].input], loop[0].reversed, false, false, false, {}, loop[0].alpha});
+    sides.push_back(
+        {&boundary[loop[1].input], loop[1].reversed, true, true, false, {}, loop[1].alpha});
+    sides.push_back(
+        {&boundary[loop[2].input], loop[2].reversed, false, true, true, {}, loop[2].alpha});
     if (n == 4)
-      sides.push_back({&boundary[loop[3].input], loop[3].reversed, true, false, true, {}, loop[3].alpha});
+      sides.push_back(
+          {&boundary[loop[3].input], loop[3].reversed, true, false, true, {}, loop[3].alpha});
     else
       sides.push_back({nullptr, false, true, false, true, first_point(c1)});
   }
@@ -533,7 +559,8 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
   int samples = 0;
   const int spans = std::max(built.surface.u.count(), built.surface.v.count());
   const double worst = side_deviation(built.surface, sides, std::max(101, 8 * spans + 1), samples);
-  std::string method = std::string(style_name(options.style)) + " fill of " + std::to_string(n) + " curves";
+  std::string method =
+      std::string(style_name(options.style)) + " fill of " + std::to_string(n) + " curves";
   if (!note.empty()) method += " (" + note + ")";
   built.report = describe(built.surface, method);
   built.report.exact = true;
@@ -545,20 +572,24 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
 std::vector<std::string> NSidedFillOptions::problems() const {
   std::vector<std::string> out;
   auto bad = [&out](const char* field, const std::string& value, const char* rule) {
-    out.push_back(
-                std::string("NSidedFillOptions::") + field + " is " + value + "; it must be " + rule);
+    out.push_back(std::string("NSidedFillOptions::") + field + " is " + value + "; it must be " +
+                  rule);
   };
   if (degree < 2 || degree > 14) bad("degree", std::to_string(degree), "in [2, 14]");
   if (points_on_curve < 2 || points_on_curve > 1000)
     bad("points_on_curve", std::to_string(points_on_curve), "in [2, 1000]");
-  if (iterations < 1 || iterations > 50) bad("iterations", std::to_string(iterations), "in [1, 50]");
-  if (!(tolerance_2d > 0 && std::isfinite(tolerance_2d))) bad("tolerance_2d", num(tolerance_2d), "> 0 and finite");
-  if (!(tolerance_3d > 0 && std::isfinite(tolerance_3d))) bad("tolerance_3d", num(tolerance_3d), "> 0 and finite");
+  if (iterations < 1 || iterations > 50)
+    bad("iterations", std::to_string(iterations), "in [1, 50]");
+  if (!(tolerance_2d > 0 && std::isfinite(tolerance_2d)))
+    bad("tolerance_2d", num(tolerance_2d), "> 0 and finite");
+  if (!(tolerance_3d > 0 && std::isfinite(tolerance_3d)))
+    bad("tolerance_3d", num(tolerance_3d), "> 0 and finite");
   if (!(angular_tolerance > 0 && std::isfinite(angular_tolerance)))
     bad("angular_tolerance", num(angular_tolerance), "> 0 and finite");
   if (!(curvature_tolerance > 0 && std::isfinite(curvature_tolerance)))
     bad("curvature_tolerance", num(curvature_tolerance), "> 0 and finite");
-  if (max_degree < 3 || max_degree > 25) bad("max_degree", std::to_string(max_degree), "in [3, 25]");
+  if (max_degree < 3 || max_degree > 25)
+    bad("max_degree", std::to_string(max_degree), "in [3, 25]");
   if (max_segments < 1 || max_segments > 1000)
     bad("max_segments", std::to_string(max_segments), "in [1, 1000]");
   if (!(gap_tolerance > 0 && std::isfinite(gap_tolerance)))
@@ -567,10 +598,13 @@ std::vector<std::string> NSidedFillOptions::problems() const {
   return out;
 }
 
-void NSidedFillOptions::validate() const { internal::throw_if(ErrorCategory::InvalidArgument, problems()); }
+void NSidedFillOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
 
 NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
-                        const std::vector<BSplineCurve>& interior, const NSidedFillOptions& options) {
+                        const std::vector<BSplineCurve>& interior,
+                        const NSidedFillOptions& options) {
   options.validate();
   if (boundary.size() < 3)
     throw Error(ErrorCategory::InvalidArgument,
@@ -600,23 +634,27 @@ NSidedFill fill_n_sided(const std::vector<BSplineCurve>& boundary,
       BRepBuilderAPI_MakeEdge edge(occt::to_occt(loop[k].curve, curve_name(loop[k].input)),
                                    corners[k], corners[(k + 1) % n]);
       if (!edge.IsDone())
-        throw Error(ErrorCategory::InvalidGeometry,
-                    "fill_n_sided: OpenCASCADE could not make an edge of " + curve_name(loop[k].input));
+        throw Error(
+            ErrorCategory::InvalidGeometry,
+            "fill_n_sided: OpenCASCADE could not make an edge of " + curve_name(loop[k].input));
       filler.Add(edge.Edge(), GeomAbs_C0, Standard_True);
     }
     for (size_t k = 0; k < interior.size(); ++k) {
-      BRepBuilderAPI_MakeEdge edge(occt::to_occt(interior[k], "interior curve #" + std::to_string(k)));
+      BRepBuilderAPI_MakeEdge edge(
+          occt::to_occt(interior[k], "interior curve #" + std::to_string(k)));
       if (!edge.IsDone())
         throw Error(ErrorCategory::InvalidGeometry,
-                    "fill_n_sided: OpenCASCADE could not make an edge of interior curve #" + std::to_string(k));
+                    "fill_n_sided: OpenCASCADE could not make an edge of interior curve #" +
+                        std::to_string(k));
       filler.Add(edge.Edge(), GeomAbs_C0, Standard_False);
     }
     filler.Build();
     if (!filler.IsDone())
-      throw Error(ErrorCategory::InvalidGeometry,
-                  "fill_n_sided: OpenCASCADE's plate filling (BRepOffsetAPI_MakeFilling) failed for "
-                  "these curves; check that the boundary is a simple loop and the interior curves "
-                  "lie inside it");
+      throw Error(
+          ErrorCategory::InvalidGeometry,
+          "fill_n_sided: OpenCASCADE's plate filling (BRepOffsetAPI_MakeFilling) failed for "
+          "these curves; check that the boundary is a simple loop and the interior curves "
+          "lie inside it");
     occt_g0 = filler.G0Error();
     const TopoDS_Face face = TopoDS::Face(filler.Shape());
     const Handle(Geom_Surface) surface = BRep_Tool::Surface(face);

@@ -44,9 +44,7 @@ BSplineSurface round_trip(const BSplineSurface& surface) {
   return occt::from_occt(occt::to_occt(surface));
 }
 
-BSplineCurve round_trip(const BSplineCurve& curve) {
-  return occt::from_occt(occt::to_occt(curve));
-}
+BSplineCurve round_trip(const BSplineCurve& curve) { return occt::from_occt(occt::to_occt(curve)); }
 
 struct GridEvaluator::Impl {
   Handle(Geom_BSplineSurface) surface;

@@ -68,11 +68,11 @@ using Figure = std::variant<bool, long long, double, std::string>;
 
 /// What one step of a run did.
 struct StepReport {
-  std::string path;     ///< "strokes.leech", "surfaces.sail", "surfaces.sail.steps[1]", "exports.sail"
-  std::string kind;     ///< "stroke", "bspline", "fill", "bezier_lattice", "style", "step", ...
-  double seconds = 0;   ///< wall time of the step
-  bool warning = false; ///< produced its result but an outcome fell short (see message)
-  std::string message;  ///< what happened, in words
+  std::string path;  ///< "strokes.leech", "surfaces.sail", "surfaces.sail.steps[1]", "exports.sail"
+  std::string kind;  ///< "stroke", "bspline", "fill", "bezier_lattice", "style", "step", ...
+  double seconds = 0;    ///< wall time of the step
+  bool warning = false;  ///< produced its result but an outcome fell short (see message)
+  std::string message;   ///< what happened, in words
   std::vector<std::pair<std::string, Figure>> figures;  ///< in a fixed order per kind
 };
 
@@ -84,11 +84,11 @@ struct RunOptions {
 
 /// One export: the surfaces written together and what the exchange layer reported.
 struct ExportResult {
-  std::string name;                                ///< the export's name (file stem)
-  std::vector<std::string> surface_names;          ///< in the recipe's order
-  std::vector<surface::BSplineSurface> surfaces;   ///< what is written
-  std::vector<std::string> formats;                ///< "step", "iges", "glb"
-  std::string schema = "AP214";                    ///< STEP schema
+  std::string name;                               ///< the export's name (file stem)
+  std::vector<std::string> surface_names;         ///< in the recipe's order
+  std::vector<surface::BSplineSurface> surfaces;  ///< what is written
+  std::vector<std::string> formats;               ///< "step", "iges", "glb"
+  std::string schema = "AP214";                   ///< STEP schema
   // Filled in by write_outputs:
   std::vector<std::string> files;     ///< file names written (in out_dir)
   bool checked = false;               ///< the STEP (or IGES) file was read back and checked
@@ -113,13 +113,13 @@ struct Stage {
 
 /// Everything a run computed, in memory. Nothing is written until write_outputs.
 struct CLAY_RECIPE_API RunResult {
-  std::string recipe;  ///< the recipe's name
+  std::string recipe;                                                     ///< the recipe's name
   std::vector<std::pair<std::string, surface::BSplineCurve>> curves;      ///< every named curve
   std::vector<std::pair<std::string, surface::BSplineSurface>> surfaces;  ///< every named surface
-  std::vector<ExportResult> exports;  ///< in document order
-  std::vector<StepReport> steps;      ///< every step in order of execution
-  std::vector<Stage> stages;          ///< every enabled deformation step, in order of execution
-  double seconds = 0;                 ///< wall time of the whole run
+  std::vector<ExportResult> exports;                                      ///< in document order
+  std::vector<StepReport> steps;  ///< every step in order of execution
+  std::vector<Stage> stages;      ///< every enabled deformation step, in order of execution
+  double seconds = 0;             ///< wall time of the whole run
   /// The named surface. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
   const surface::BSplineSurface& surface(std::string_view name) const;
   /// The named curve. Throws clay::Error(InvalidArgument) naming the defined ones when absent.

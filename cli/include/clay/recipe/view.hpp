@@ -3,8 +3,8 @@
 /// deformation stage's before/after, with exact normals, Gaussian and mean curvature and the
 /// refit deviation, written as `view/manifest.json` and `view/NNN.bin` for the browser viewer
 /// (`clayform view`, docs/recipe.md "Viewing a run").
-#include <clay/recipe/recipe.hpp>
 #include <clay/recipe/export.hpp>
+#include <clay/recipe/recipe.hpp>
 
 #include <Eigen/Core>
 
@@ -20,11 +20,13 @@ struct ViewMesh {
   int rows = 0, cols = 0;
   std::vector<double> us, vs;
   std::vector<Eigen::Vector3d> position;  ///< S(u, v), mm
-  std::vector<Eigen::Vector3d> normal;    ///< surface::tessellate's: unit S_u x S_v, the limit normal at a pole
-  std::vector<double> gaussian;           ///< K, 1/mm^2
-  std::vector<double> mean;               ///< H, 1/mm, positive when the surface bends towards its normal
-  std::vector<double> deviation;          ///< mm; 0 unless set by set_deviation
-  std::vector<char> degenerate;           ///< 1 where S_u x S_v vanishes (curvatures are the neighbours' average)
+  std::vector<Eigen::Vector3d>
+      normal;  ///< surface::tessellate's: unit S_u x S_v, the limit normal at a pole
+  std::vector<double> gaussian;   ///< K, 1/mm^2
+  std::vector<double> mean;       ///< H, 1/mm, positive when the surface bends towards its normal
+  std::vector<double> deviation;  ///< mm; 0 unless set by set_deviation
+  std::vector<char>
+      degenerate;  ///< 1 where S_u x S_v vanishes (curvatures are the neighbours' average)
 };
 
 /// The grid parameters of one direction: about 8 samples per knot span following the knots, at

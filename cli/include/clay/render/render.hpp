@@ -30,11 +30,11 @@ struct CLAY_RENDER_API RenderOptions {
   /// 400 triangle rows per direction: fewer per span when a surface has many spans, and evenly
   /// spaced parameters when it has more than 400 spans.
   int samples_per_span = 8;
-  double margin = 0.05;         ///< free border on each side, fraction of width/height, in [0, 0.4]
-  bool control_net = false;     ///< draw each control net (lines and points) over the surfaces
-  bool supersample = true;      ///< 2 x 2 samples per pixel, averaged (anti-aliasing)
+  double margin = 0.05;      ///< free border on each side, fraction of width/height, in [0, 0.4]
+  bool control_net = false;  ///< draw each control net (lines and points) over the surfaces
+  bool supersample = true;   ///< 2 x 2 samples per pixel, averaged (anti-aliasing)
   Rgb background{255, 255, 255};
-  Rgb net_colour{40, 40, 40};   ///< colour of the control net
+  Rgb net_colour{40, 40, 40};  ///< colour of the control net
   /// Base colour of surface k is colours[k % colours.size()]; empty: a palette with a distinct hue
   /// per surface (golden-angle hue steps from blue).
   std::vector<Rgb> colours;

@@ -54,39 +54,81 @@ enum class ConstraintKind {
 // ---- one value type per kind (the alternatives of Requirement, in ConstraintKind's order) ----
 
 /// The point stays where it is.
-struct Fixed { PointId point; };
+struct Fixed {
+  PointId point;
+};
 /// Two points at the same place.
-struct Coincident { PointId a, b; };
+struct Coincident {
+  PointId a, b;
+};
 /// A point on a curve entity (a line counts as its infinite line, an arc as its circle).
-struct PointOnCurve { PointId point; EntityId curve; };
+struct PointOnCurve {
+  PointId point;
+  EntityId curve;
+};
 /// Planar: a line along its plane's x axis.
-struct Horizontal { EntityId line; };
+struct Horizontal {
+  EntityId line;
+};
 /// Planar: a line along its plane's y axis.
-struct Vertical { EntityId line; };
+struct Vertical {
+  EntityId line;
+};
 /// Planar: two lines parallel, keeping their sense.
-struct Parallel { EntityId a, b; };
+struct Parallel {
+  EntityId a, b;
+};
 /// Planar: two lines at 90 degrees, keeping their turn.
-struct Perpendicular { EntityId a, b; };
+struct Perpendicular {
+  EntityId a, b;
+};
 /// Two points `mm` apart (> 0).
-struct Distance { PointId a, b; double mm = 0; };
+struct Distance {
+  PointId a, b;
+  double mm = 0;
+};
 /// Planar: a point `mm` from the (infinite) line, on the side it starts on.
-struct PointLineDistance { PointId point; EntityId line; double mm = 0; };
+struct PointLineDistance {
+  PointId point;
+  EntityId line;
+  double mm = 0;
+};
 /// Planar: the angle turning line a into line b is `degrees`, in (0, 180], turn sense kept.
-struct Angle { EntityId a, b; double degrees = 0; };
+struct Angle {
+  EntityId a, b;
+  double degrees = 0;
+};
 /// A circle's or arc's radius is `mm` (> 0).
-struct Radius { EntityId circle_or_arc; double mm = 0; };
+struct Radius {
+  EntityId circle_or_arc;
+  double mm = 0;
+};
 /// Two lines of equal length.
-struct EqualLength { EntityId a, b; };
+struct EqualLength {
+  EntityId a, b;
+};
 /// Two circles/arcs of equal radius.
-struct EqualRadius { EntityId a, b; };
+struct EqualRadius {
+  EntityId a, b;
+};
 /// A point at the midpoint of a line.
-struct Midpoint { PointId point; EntityId line; };
+struct Midpoint {
+  PointId point;
+  EntityId line;
+};
 /// Planar: a and b mirror images about a line.
-struct Symmetric { PointId a, b; EntityId line; };
+struct Symmetric {
+  PointId a, b;
+  EntityId line;
+};
 /// G1 joint: ends coincide, tangents parallel with the same sense.
-struct Tangent { CurveEnd a, b; };
+struct Tangent {
+  CurveEnd a, b;
+};
 /// G2 joint: G1 and equal curvature vectors.
-struct Curvature { CurveEnd a, b; };
+struct Curvature {
+  CurveEnd a, b;
+};
 /// A curve end's tangent along `direction` (world, nonzero, same sense).
 struct EndTangent {
   CurveEnd end;
@@ -95,9 +137,10 @@ struct EndTangent {
 
 /// What a constraint requires: one typed alternative per kind (ConstraintKind is its index), so
 /// a constraint cannot hold the wrong number of points or a value it has no use for.
-using Requirement = std::variant<Fixed, Coincident, PointOnCurve, Horizontal, Vertical, Parallel, Perpendicular,
-                                 Distance, PointLineDistance, Angle, Radius, EqualLength, EqualRadius,
-                                 Midpoint, Symmetric, Tangent, Curvature, EndTangent>;
+using Requirement =
+    std::variant<Fixed, Coincident, PointOnCurve, Horizontal, Vertical, Parallel, Perpendicular,
+                 Distance, PointLineDistance, Angle, Radius, EqualLength, EqualRadius, Midpoint,
+                 Symmetric, Tangent, Curvature, EndTangent>;
 
 /// A constraint: what it requires and an optional label for reports. Make it with the functions
 /// below or from a Requirement directly (Constraint{Distance{a, b, 10}}).

@@ -28,12 +28,12 @@ struct Drag {
 
 /// Settings of solve().
 struct CLAY_CONSTRAINTS_API SolveOptions {
-  double tolerance = 1e-10;   ///< largest residual (mm, or radians for angles) of a solved
-                              ///< constraint; in (0, 1e-3]
-  int max_iterations = 100;   ///< Levenberg–Marquardt iterations, >= 1
+  double tolerance = 1e-10;      ///< largest residual (mm, or radians for angles) of a solved
+                                 ///< constraint; in (0, 1e-3]
+  int max_iterations = 100;      ///< Levenberg–Marquardt iterations, >= 1
   double rank_tolerance = 1e-9;  ///< pivot threshold of the rank-revealing QR on the normalised
                                  ///< Jacobian, in (0, 1e-2]
-  bool diagnose = true;       ///< compute degrees of freedom and dependencies after the solve
+  bool diagnose = true;          ///< compute degrees of freedom and dependencies after the solve
   /// Points pulled to targets while everything else changes as little as possible: the solve
   /// first minimises |p − target|² + 1e-8 |x − start|² + 1e4 |constraint residuals|² (the
   /// constraints as heavy equations), then solves the constraints alone from there.
@@ -56,19 +56,19 @@ struct Dependency {
 
 /// What solve() found.
 struct CLAY_CONSTRAINTS_API SolveReport {
-  Summary summary;               ///< Converged when every constraint holds within tolerance
-  double max_residual = 0;       ///< largest |residual| after the solve (mm or radians)
-  int unknowns = 0;              ///< scalar unknowns before substitution
-  int substituted = 0;           ///< unknowns removed by union-find substitution
-  int equations = 0;             ///< scalar equations left after substitution
-  int components = 0;            ///< independent parts solved together
-  int degrees_of_freedom = -1;   ///< remaining DOF (unknowns − rank); -1 when not diagnosed
-  std::vector<Dependency> redundant;    ///< redundant sets (consistent, removable)
+  Summary summary;                    ///< Converged when every constraint holds within tolerance
+  double max_residual = 0;            ///< largest |residual| after the solve (mm or radians)
+  int unknowns = 0;                   ///< scalar unknowns before substitution
+  int substituted = 0;                ///< unknowns removed by union-find substitution
+  int equations = 0;                  ///< scalar equations left after substitution
+  int components = 0;                 ///< independent parts solved together
+  int degrees_of_freedom = -1;        ///< remaining DOF (unknowns − rank); -1 when not diagnosed
+  std::vector<Dependency> redundant;  ///< redundant sets (consistent, removable)
   std::vector<Dependency> conflicting;  ///< conflicting sets (the sketch cannot satisfy them)
-  std::vector<int> flipped;      ///< constraints whose orientation (turn sense, side, arc
-                                 ///< direction) differs from the start: a different solution
-  double solve_seconds = 0;      ///< wall time of the solve
-  double diagnose_seconds = 0;   ///< wall time of the rank / dependency analysis
+  std::vector<int> flipped;             ///< constraints whose orientation (turn sense, side, arc
+                                        ///< direction) differs from the start: a different solution
+  double solve_seconds = 0;             ///< wall time of the solve
+  double diagnose_seconds = 0;          ///< wall time of the rank / dependency analysis
 
   /// One line: the summary, the largest residual, the unknowns and the degrees of freedom.
   std::string brief() const;

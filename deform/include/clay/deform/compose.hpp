@@ -41,7 +41,8 @@ struct CLAY_DEFORM_API ComposeOptions {
   /// net (dimensionless, in [0, 1e-6]). 0 keeps every patch boundary (a C0 patchwork).
   double knot_tolerance = 1e-12;
   /// Samples per patch and direction at which the result is compared with the pointwise
-  /// deformation of the original for ComposeReport::max_relative_deviation (>= 0; 0 skips the check).
+  /// deformation of the original for ComposeReport::max_relative_deviation (>= 0; 0 skips the
+  /// check).
   int check_samples = 4;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
@@ -52,19 +53,19 @@ struct CLAY_DEFORM_API ComposeOptions {
 
 /// What compose_exact built, and how closely it matches the pointwise deformation.
 struct CLAY_DEFORM_API ComposeReport {
-  int degree_u = 0;          ///< degree of the result in u
-  int degree_v = 0;          ///< degree of the result in v
-  int patches = 0;           ///< Bézier patches composed (after any splits at lattice knot planes)
-  long control_points = 0;   ///< control points of the result
-  int knots_removed = 0;     ///< interior knots removed exactly after the patches were joined
-  int splits = 0;            ///< knots inserted to split the surface at lattice knot planes
+  int degree_u = 0;         ///< degree of the result in u
+  int degree_v = 0;         ///< degree of the result in v
+  int patches = 0;          ///< Bézier patches composed (after any splits at lattice knot planes)
+  long control_points = 0;  ///< control points of the result
+  int knots_removed = 0;    ///< interior knots removed exactly after the patches were joined
+  int splits = 0;           ///< knots inserted to split the surface at lattice knot planes
   /// Largest distance between the result and the pointwise deformation (deform_point of the
   /// original surface's points) over check_samples² parameters per patch, divided by `size`
   /// (dimensionless; ~1e-15 for an exact composition). 0 when check_samples is 0.
   double max_relative_deviation = 0.0;
-  double size = 0.0;         ///< the reference length (mm): the lattice control points' box
-                             ///< diagonal, or the surface's control box diagonal for a taper
-  bool exact = true;         ///< true: the result is the composition, exact up to rounding
+  double size = 0.0;  ///< the reference length (mm): the lattice control points' box
+                      ///< diagonal, or the surface's control box diagonal for a taper
+  bool exact = true;  ///< true: the result is the composition, exact up to rounding
   /// Converged (a composition that cannot be exact throws instead); message = brief(),
   /// final_residual = max_relative_deviation.
   Summary summary;

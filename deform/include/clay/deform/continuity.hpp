@@ -19,7 +19,7 @@ enum class Face { SMin, SMax, TMin, TMax, UMin, UMax };
 /// C^order continuity with the undeformed space across one face.
 struct FaceContinuity {
   Face face = Face::SMin;  ///< the face across which the continuity holds
-  int order = 1;  ///< k of C^k, 0 <= k <= degree in the face's normal direction
+  int order = 1;           ///< k of C^k, 0 <= k <= degree in the face's normal direction
 };
 
 /// Which control points must stay undisplaced for the requested continuity: entry r is true when

@@ -70,10 +70,10 @@ struct CLAY_DEFORM_API DirectManipulationOptions {
 
 /// What a direct manipulation achieved.
 struct CLAY_DEFORM_API DirectManipulationReport {
-  int requested = 0;  ///< number of point moves N
-  int unknowns = 0;   ///< free control points and tie groups that act on some selected point (m)
-  int rank = 0;       ///< numerical rank of B S on those unknowns (<= min(N, m))
-  double residual = 0;            ///< ||B S ΔP − ΔQ||_F (mm): the least-squares residual
+  int requested = 0;    ///< number of point moves N
+  int unknowns = 0;     ///< free control points and tie groups that act on some selected point (m)
+  int rank = 0;         ///< numerical rank of B S on those unknowns (<= min(N, m))
+  double residual = 0;  ///< ||B S ΔP − ΔQ||_F (mm): the least-squares residual
   double achieved_max_error = 0;  ///< max_i |deform_point(new lattice, X_i) − target_i| (mm)
   double displacement_norm = 0;   ///< Frobenius norm of new − old lattice.points (mm)
   bool feasible = false;          ///< achieved_max_error <= tolerance × size

@@ -76,10 +76,10 @@ CLAY_DEFORM_API ExtendedLattice merge_coincident_points(const ExtendedLattice& l
 
 /// A cylinder cut into sectors (around the axis), rings (radial) and layers (along the axis).
 struct CLAY_DEFORM_API CylinderSpec {
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();     ///< centre of the bottom disc (mm)
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();      ///< axis direction (normalized)
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();      ///< centre of the bottom disc (mm)
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();       ///< axis direction (normalized)
   Eigen::Vector3d reference = Eigen::Vector3d::UnitX();  ///< angle 0 (made orthogonal to the axis)
-  double radius = 1;        ///< outer radius (mm), > 0
+  double radius = 1;                                     ///< outer radius (mm), > 0
   double inner_radius = 0;  ///< 0: a full cylinder whose axis points are merged; else a tube (mm)
   double height = 1;        ///< along the axis (mm), > 0
   int sectors = 8;          ///< chunks around the axis, 3..1024 (each arc spans 360°/sectors)
@@ -153,11 +153,11 @@ struct CLAY_DEFORM_API FreezeOptions {
   double parameter_tolerance = 1e-9;
   double pseudo_inverse_threshold = 1e-12;  ///< below this |det J| / max|column|^3 the
                                             ///< pseudo-inverse replaces the inverse, [0, 1e-3]
-  int max_iterations = 50;          ///< Newton iterations per start, 1..1000
-  int max_subdivision_depth = 4;    ///< de Casteljau halvings of a chunk when Newton fails, 0..10
-  int threads = 0;                  ///< parts the points are split into, 0 = one per hardware
-                                    ///< thread (at least 1,024 points per part), 0..1024
-  Executor executor = {};           ///< who runs the parts (clay/parallel.hpp); empty = std::threads
+  int max_iterations = 50;                  ///< Newton iterations per start, 1..1000
+  int max_subdivision_depth = 4;  ///< de Casteljau halvings of a chunk when Newton fails, 0..10
+  int threads = 0;                ///< parts the points are split into, 0 = one per hardware
+                                  ///< thread (at least 1,024 points per part), 0..1024
+  Executor executor = {};         ///< who runs the parts (clay/parallel.hpp); empty = std::threads
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -185,11 +185,11 @@ struct CLAY_DEFORM_API FreezeReport {
   /// Converged when no point is unresolved; iterations = Newton iterations over all points,
   /// final_residual = the largest |L(u,v,w) − x| over inside points (mm, rest shape).
   Summary summary;
-  Eigen::Index inside = 0;      ///< points given a chunk
-  Eigen::Index outside = 0;     ///< points in no chunk (unchanged)
-  Eigen::Index unresolved = 0;  ///< points Newton could not place (unchanged)
-  Eigen::Index subdivided = 0;  ///< inside points found only after subdividing a chunk
-  Eigen::Index splits = 0;      ///< de Casteljau splits of a (sub)chunk into eight
+  Eigen::Index inside = 0;                ///< points given a chunk
+  Eigen::Index outside = 0;               ///< points in no chunk (unchanged)
+  Eigen::Index unresolved = 0;            ///< points Newton could not place (unchanged)
+  Eigen::Index subdivided = 0;            ///< inside points found only after subdividing a chunk
+  Eigen::Index splits = 0;                ///< de Casteljau splits of a (sub)chunk into eight
   Eigen::Index pseudo_inverse_steps = 0;  ///< Newton steps taken with the pseudo-inverse
 
   /// One line: "frozen 1000 points: 990 inside, 10 outside, 0 unresolved; ...".

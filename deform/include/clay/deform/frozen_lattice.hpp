@@ -44,11 +44,11 @@ class CLAY_DEFORM_API FrozenLattice {
  private:
   friend struct FrozenLatticeAccess;  // the kernels in frozen_lattice.cpp
   Frame frame_;
-  std::array<Eigen::Vector3d, 3> dual_{};        // (T×U)/(T×U·S), (U×S)/(U×S·T), (S×T)/(S×T·U)
+  std::array<Eigen::Vector3d, 3> dual_{};  // (T×U)/(T×U·S), (U×S)/(U×S·T), (S×T)/(S×T·U)
   std::array<int, 3> degrees_{};
-  std::array<std::vector<double>, 3> breaks_;    // cell boundaries in [0, 1] per direction
+  std::array<std::vector<double>, 3> breaks_;  // cell boundaries in [0, 1] per direction
   std::array<std::vector<double>, 3> inverse_width_;
-  std::array<bool, 3> uniform_{};                // breaks equally spaced: arithmetic cell lookup
+  std::array<bool, 3> uniform_{};  // breaks equally spaced: arithmetic cell lookup
   Eigen::Vector3d center_ = Eigen::Vector3d::Zero();  // coefficients are relative to this point
   std::vector<double> coefficients_;  // per cell, per coordinate, power coefficients, s-major
 };

@@ -28,10 +28,10 @@ CLAY_DEFORM_API double evaluate(const BernsteinVolume& volume, double s, double 
 
 /// Bounds of the Jacobian from the Bernstein coefficients (convex hull property).
 struct JacobianBounds {
-  double min = 1;          ///< smallest coefficient: a lower bound of the volume ratio
-  double max = 1;          ///< largest coefficient: an upper bound of the volume ratio
-  bool fold_free = true;   ///< min > 0: no fold anywhere in the lattice (sufficient, not
-                           ///< necessary: false means a fold could not be excluded)
+  double min = 1;         ///< smallest coefficient: a lower bound of the volume ratio
+  double max = 1;         ///< largest coefficient: an upper bound of the volume ratio
+  bool fold_free = true;  ///< min > 0: no fold anywhere in the lattice (sufficient, not
+                          ///< necessary: false means a fold could not be excluded)
 };
 
 /// The Jacobian (volume ratio, see above) of a Bézier lattice as a Bernstein polynomial of degrees

@@ -181,8 +181,9 @@ CLAY_DEFORM_API Eigen::Vector3d deform_point(const BSplineLattice& lattice,
 /// BezierLattice on the sub-frame X0 + breaks S ..., edges (break width) S, ...: it deforms every
 /// point of its cell like the B-spline lattice (up to rounding).
 struct BezierCells {
-  std::array<std::vector<double>, 3> breaks;  ///< distinct knots in [0, 1] per direction, ends included
-  std::vector<BezierLattice> cells;           ///< cell (a, b, c) at (a * cells_t + b) * cells_u + c
+  std::array<std::vector<double>, 3>
+      breaks;                        ///< distinct knots in [0, 1] per direction, ends included
+  std::vector<BezierLattice> cells;  ///< cell (a, b, c) at (a * cells_t + b) * cells_u + c
 
   /// Number of cells along S, T, U.
   std::array<int, 3> counts() const noexcept {

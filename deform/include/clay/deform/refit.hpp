@@ -42,16 +42,16 @@ namespace clay::deform {
 
 /// Settings of refit_deformed().
 struct CLAY_DEFORM_API RefitOptions {
-  int degree = 3;             ///< degree of the fit in u and v, 1..25 (the exchange limit)
-  double tolerance = 1e-4;    ///< > 0: allowed deviation, relative to the size when `relative`
-  bool relative = true;       ///< true: tolerance x diagonal of the deformed surface's bounding
-                              ///< box (of a sample); false: tolerance in mm
-  int max_iterations = 12;    ///< >= 1: fit / certify / refine rounds
-  int max_control_points = 40000;  ///< >= (degree + 1)^2: no refinement beyond this net size
+  int degree = 3;           ///< degree of the fit in u and v, 1..25 (the exchange limit)
+  double tolerance = 1e-4;  ///< > 0: allowed deviation, relative to the size when `relative`
+  bool relative = true;     ///< true: tolerance x diagonal of the deformed surface's bounding
+                            ///< box (of a sample); false: tolerance in mm
+  int max_iterations = 12;  ///< >= 1: fit / certify / refine rounds
+  int max_control_points = 40000;      ///< >= (degree + 1)^2: no refinement beyond this net size
   int max_count_per_direction = 1000;  ///< >= degree + 1: no refinement beyond this many control
                                        ///< points in u or in v (the dense least squares per
                                        ///< direction take 32 count^2 bytes)
-  double certificate_share = 0.1;  ///< in (0, 1): share of the tolerance the certificate's
+  double certificate_share = 0.1;      ///< in (0, 1): share of the tolerance the certificate's
                                    ///< remainder may take when choosing each cell's sample density
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
@@ -64,11 +64,11 @@ struct CLAY_DEFORM_API RefitOptions {
 /// (where the lattice's map is only C^(degree-1), or C0 at the faces): the fit has one polynomial
 /// piece there, and these are its numbers.
 struct KnotPlaneCrossing {
-  int cell_u = 0;        ///< index of the fit's non-empty u knot span
-  int cell_v = 0;        ///< index of the fit's non-empty v knot span
-  int step = 0;          ///< index of the stack step (0 for a single lattice)
-  int axis = 0;          ///< 0 = S, 1 = T, 2 = U (lattice local axes)
-  double plane = 0;      ///< local coordinate of the plane (0 and 1 are the lattice's faces)
+  int cell_u = 0;          ///< index of the fit's non-empty u knot span
+  int cell_v = 0;          ///< index of the fit's non-empty v knot span
+  int step = 0;            ///< index of the stack step (0 for a single lattice)
+  int axis = 0;            ///< 0 = S, 1 = T, 2 = U (lattice local axes)
+  double plane = 0;        ///< local coordinate of the plane (0 and 1 are the lattice's faces)
   double sampled_max = 0;  ///< largest sampled deviation in the cell (mm)
   double bound = std::numeric_limits<double>::infinity();  ///< certified bound in the cell (mm)
 };
@@ -78,17 +78,17 @@ struct CLAY_DEFORM_API RefitReport {
   /// Converged: the certified bound (or, when not certified, the sampled maximum) is within the
   /// tolerance; NotConverged: iteration or control point limit reached first.
   Summary summary;
-  bool certified = false;    ///< certified_bound is a true upper bound of |fit − D∘S|
-  double tolerance = 0;      ///< the tolerance applied (mm)
-  double size = 0;           ///< diagonal of the deformed sample's bounding box (mm)
-  double sampled_max = 0;    ///< largest deviation at the certificate's samples (mm)
+  bool certified = false;  ///< certified_bound is a true upper bound of |fit − D∘S|
+  double tolerance = 0;    ///< the tolerance applied (mm)
+  double size = 0;         ///< diagonal of the deformed sample's bounding box (mm)
+  double sampled_max = 0;  ///< largest deviation at the certificate's samples (mm)
   double certified_bound = std::numeric_limits<double>::infinity();  ///< mm; inf if not certified
-  long samples = 0;          ///< number of points sampled by the last certificate
-  int degree_u = 0;          ///< degree of the fit in u
-  int degree_v = 0;          ///< degree of the fit in v
-  int knots_added_u = 0;     ///< knots added to the original's breakpoints in u (by refinement)
-  int knots_added_v = 0;     ///< same in v
-  int lipschitz_cells = 0;   ///< cells bounded by first derivatives only (D not C1 there)
+  long samples = 0;         ///< number of points sampled by the last certificate
+  int degree_u = 0;         ///< degree of the fit in u
+  int degree_v = 0;         ///< degree of the fit in v
+  int knots_added_u = 0;    ///< knots added to the original's breakpoints in u (by refinement)
+  int knots_added_v = 0;    ///< same in v
+  int lipschitz_cells = 0;  ///< cells bounded by first derivatives only (D not C1 there)
   std::vector<KnotPlaneCrossing> crossings;  ///< every lattice plane crossing of the final fit
 
   /// One line: "certified 3.1e-03 mm <= 1.0e-02 mm (sampled 2.2e-03 mm), 12 x 9 control points,
@@ -109,36 +109,43 @@ using PointMap = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 /// Refit of taper(S): certified. Throws clay::Error: InvalidArgument for bad options,
 /// InvalidGeometry for an invalid surface or taper, or a deformed surface of zero size with a
 /// relative tolerance.
-CLAY_DEFORM_API RefitResult refit_deformed(const Taper& taper, const surface::BSplineSurface& surface,
-                           const RefitOptions& options = {});
+CLAY_DEFORM_API RefitResult refit_deformed(const Taper& taper,
+                                           const surface::BSplineSurface& surface,
+                                           const RefitOptions& options = {});
 /// Refit of twist(S): certified. Throws as the taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const Twist& twist, const surface::BSplineSurface& surface,
-                           const RefitOptions& options = {});
+CLAY_DEFORM_API RefitResult refit_deformed(const Twist& twist,
+                                           const surface::BSplineSurface& surface,
+                                           const RefitOptions& options = {});
 /// Refit of bend(S): certified (first-derivative remainder in cells crossing y_min or y_max,
 /// where the bend is only C0 off its neutral plane). Throws as the taper overload.
 CLAY_DEFORM_API RefitResult refit_deformed(const Bend& bend, const surface::BSplineSurface& surface,
-                           const RefitOptions& options = {});
+                                           const RefitOptions& options = {});
 /// Refit of lattice(S), Sederberg–Parry eq. (2): certified; cells crossing the lattice's faces
 /// are reported in crossings. Throws as the taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const BezierLattice& lattice, const surface::BSplineSurface& surface,
-                           const RefitOptions& options = {});
+CLAY_DEFORM_API RefitResult refit_deformed(const BezierLattice& lattice,
+                                           const surface::BSplineSurface& surface,
+                                           const RefitOptions& options = {});
 /// Refit of lattice(S), Hsu–Hughes–Kaufman eq. (1): certified; every cell whose hull crosses a
 /// knot plane or face is reported in crossings with its sampled maximum and bound. Throws as the
 /// taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const BSplineLattice& lattice, const surface::BSplineSurface& surface,
-                           const RefitOptions& options = {});
+CLAY_DEFORM_API RefitResult refit_deformed(const BSplineLattice& lattice,
+                                           const surface::BSplineSurface& surface,
+                                           const RefitOptions& options = {});
 /// Refit of lattice(S) (pointwise, each point frozen alone): not certified (no derivative bounds
 /// for a Newton-frozen map); the report has the sampled maximum. Throws as the taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const ExtendedLattice& lattice, const surface::BSplineSurface& surface,
-                           const RefitOptions& options = {});
+CLAY_DEFORM_API RefitResult refit_deformed(const ExtendedLattice& lattice,
+                                           const surface::BSplineSurface& surface,
+                                           const RefitOptions& options = {});
 /// Refit of stack(S): certified when every enabled step is (derivative bounds chained through the
 /// steps), otherwise sampled only. Throws as the taper overload (invalid stack: InvalidGeometry).
-CLAY_DEFORM_API RefitResult refit_deformed(const DeformationStack& stack, const surface::BSplineSurface& surface,
-                           const RefitOptions& options = {});
+CLAY_DEFORM_API RefitResult refit_deformed(const DeformationStack& stack,
+                                           const surface::BSplineSurface& surface,
+                                           const RefitOptions& options = {});
 /// Refit of map(S) for any point map: not certified (nothing is known of its derivatives).
 /// Throws as the taper overload, and InvalidArgument for an empty map or one returning a
 /// non-finite point (naming the point).
-CLAY_DEFORM_API RefitResult refit_deformed(const PointMap& map, const surface::BSplineSurface& surface,
-                           const RefitOptions& options = {});
+CLAY_DEFORM_API RefitResult refit_deformed(const PointMap& map,
+                                           const surface::BSplineSurface& surface,
+                                           const RefitOptions& options = {});
 
 }  // namespace clay::deform

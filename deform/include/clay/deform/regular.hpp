@@ -33,9 +33,9 @@ using surface::Points3;
 /// and a reference direction fixing the other two axes (see the conventions above). Both
 /// directions are normalised internally; they must be finite, non-zero and not parallel.
 struct AxisFrame {
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();     ///< a point of the axis (mm)
-  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();      ///< the deformation axis (any length > 0)
-  Eigen::Vector3d reference = Eigen::Vector3d::UnitX(); ///< fixes the other axes (not parallel)
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();      ///< a point of the axis (mm)
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();       ///< the deformation axis (any length > 0)
+  Eigen::Vector3d reference = Eigen::Vector3d::UnitX();  ///< fixes the other axes (not parallel)
 };
 
 /// Every problem of the frame, in words naming `name`: non-finite vectors, a zero axis or
@@ -76,10 +76,10 @@ struct Twist {
 struct Bend {
   AxisFrame frame{Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitY(),
                   Eigen::Vector3d::UnitZ()};  ///< axis = Barr's y, reference = Barr's z
-  double y_min = -1;   ///< start of the bent region along the axis (mm)
-  double y_max = 1;    ///< end of the bent region (mm), >= y_min
-  double center = 0;   ///< y0: where the bend angle is zero (mm)
-  double rate = 0;     ///< k: bending rate (rad/mm); the radius of curvature is 1/k
+  double y_min = -1;                          ///< start of the bent region along the axis (mm)
+  double y_max = 1;                           ///< end of the bent region (mm), >= y_min
+  double center = 0;                          ///< y0: where the bend angle is zero (mm)
+  double rate = 0;  ///< k: bending rate (rad/mm); the radius of curvature is 1/k
 };
 
 /// Every problem of the deformation, in words naming `name`: frame problems, an empty profile

@@ -67,8 +67,8 @@ CLAY_DEFORM_API Eigen::Vector3d deform_point(const DeformationStack& stack,
 struct CLAY_DEFORM_API StackReport {
   /// The freeze of one enabled extended lattice step.
   struct Freeze {
-    std::size_t step = 0;   ///< index of the step in stack.steps
-    FreezeReport report;  ///< inside / outside / unresolved counts, Newton residuals
+    std::size_t step = 0;  ///< index of the step in stack.steps
+    FreezeReport report;   ///< inside / outside / unresolved counts, Newton residuals
   };
   std::vector<Freeze> freezes;  ///< one per enabled extended lattice step, in order of application
   /// Converged when no freeze left a point unresolved, else NotConverged (those points are left

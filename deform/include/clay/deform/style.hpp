@@ -63,18 +63,19 @@ struct CLAY_DEFORM_API StyleOptions {
                            ///< neighbouring vertices get it, by area weights (eqs. 4-5)
   int curve_samples = 0;   ///< samples of the target curve (key-point search, class, figures):
                            ///< 0 = 16 per knot span of the target, at least 32; else >= 8
-  int bound_samples = 256;  ///< samples of the bound curve (its parameter-space polygon), >= 8
+  int bound_samples = 256;     ///< samples of the bound curve (its parameter-space polygon), >= 8
   int key_points_per_row = 1;  ///< exact: key points per control-net row crossed, >= 1
-  int boundary_rows = 2;   ///< exact: layers of vertices inside the bound edge kept fixed, 0..4
-  double tolerance = 1e-9; ///< exact: key-point deviation accepted, relative to the model size
-  int max_refinements = 4; ///< exact: rounds of knot insertion allowed, >= 0
-  double curve_tolerance = 1e-4;  ///< exact: where the result misses the target curve (at its
-                                  ///< samples) by more than this, relative to the model size,
-                                  ///< key points are added at the worst samples; 0 = key points only
-  int max_key_point_rounds = 6;   ///< exact: rounds of such additions, >= 0
-  bool report_curves = true;  ///< measure target_curve_deviation and the boundary figures by
-                              ///< sampling (the cost of ~curve_samples + bound_samples
-                              ///< projections); off for interactive drags: they are then NaN
+  int boundary_rows = 2;       ///< exact: layers of vertices inside the bound edge kept fixed, 0..4
+  double tolerance = 1e-9;     ///< exact: key-point deviation accepted, relative to the model size
+  int max_refinements = 4;     ///< exact: rounds of knot insertion allowed, >= 0
+  double curve_tolerance =
+      1e-4;                      ///< exact: where the result misses the target curve (at its
+                                 ///< samples) by more than this, relative to the model size,
+                                 ///< key points are added at the worst samples; 0 = key points only
+  int max_key_point_rounds = 6;  ///< exact: rounds of such additions, >= 0
+  bool report_curves = true;     ///< measure target_curve_deviation and the boundary figures by
+                                 ///< sampling (the cost of ~curve_samples + bound_samples
+                                 ///< projections); off for interactive drags: they are then NaN
   surface::ProjectionOptions projection;  ///< projection of the curves onto the surface
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
@@ -85,8 +86,8 @@ struct CLAY_DEFORM_API StyleOptions {
 
 /// Influence factors E(Q_ij) of every control vertex (Han et al. eq. 2) and where they came from.
 struct CLAY_DEFORM_API InfluenceRegion {
-  int count_u = 0;  ///< control vertices along u of the surface they belong to
-  int count_v = 0;  ///< control vertices along v
+  int count_u = 0;                    ///< control vertices along u of the surface they belong to
+  int count_v = 0;                    ///< control vertices along v
   std::vector<std::uint8_t> factors;  ///< E(Q_ij) in {0, 1} at i * count_v + j
   /// The bound curve projected into parameter space, a closed polygon (first point not
   /// repeated); empty when the region comes from the target (no bound curve, §5).
@@ -99,7 +100,8 @@ struct CLAY_DEFORM_API InfluenceRegion {
 
   /// E(Q_ij).
   bool inside(int i, int j) const noexcept {
-    return factors[static_cast<size_t>(i) * static_cast<size_t>(count_v) + static_cast<size_t>(j)] != 0;
+    return factors[static_cast<size_t>(i) * static_cast<size_t>(count_v) +
+                   static_cast<size_t>(j)] != 0;
   }
   /// Number of vertices with E = 1.
   int inside_count() const noexcept;
@@ -131,8 +133,8 @@ struct KeyPoint {
   double u = 0, v = 0;                               ///< parameters of its projection P
   Eigen::Vector3d foot = Eigen::Vector3d::Zero();    ///< P = S(u, v) (mm)
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit normal N_i at P
-  double distance = 0;  ///< D(K_i) = (K_i - P) . N_i, signed (mm)
-  int row = 0;          ///< control-net row (direction u) or column (v) the key point drives
+  double distance = 0;                               ///< D(K_i) = (K_i - P) . N_i, signed (mm)
+  int row = 0;              ///< control-net row (direction u) or column (v) the key point drives
   bool influenced = false;  ///< E(Q_j) = 1 for the vertex Q_j nearest to P (eq. 3)
 };
 
@@ -159,12 +161,12 @@ struct CLAY_DEFORM_API StyleReport {
   StyleMode mode = StyleMode::Paper;
   ConstraintClass constraint_class = ConstraintClass::OverConstrained;
   KeyDirection direction = KeyDirection::U;
-  int m = 0;  ///< number of key points (eq. 8)
+  int m = 0;                         ///< number of key points (eq. 8)
   std::vector<KeyPoint> key_points;  ///< on the parent surface
   int influenced_vertices = 0;       ///< vertices with E = 1
   int moved_vertices = 0;            ///< vertices actually displaced
   double max_displacement = 0;       ///< largest control-vertex move
-  double target_deviation = 0;   ///< largest distance from an influenced key point to the result
+  double target_deviation = 0;  ///< largest distance from an influenced key point to the result
   double target_curve_deviation = 0;  ///< largest distance from a target sample inside the
                                       ///< region to the result
   double locality = 0;  ///< largest move of a control vertex with E = 0 (0 by construction)
@@ -172,13 +174,13 @@ struct CLAY_DEFORM_API StyleReport {
   double boundary_tangent_angle = 0;  ///< largest angle (degrees) between the result's and the
                                       ///< parent's normals along the region edge
   // exact mode only
-  int knots_inserted = 0;        ///< knots inserted (u and v together) before deforming
-  int added_key_points = 0;      ///< key points added where the target curve was missed
-  int degrees_of_freedom = 0;    ///< 3 (free vertices - rank of the key-point system)
-  int rank = 0;                  ///< rank of the key-point system (scalar rows)
+  int knots_inserted = 0;                   ///< knots inserted (u and v together) before deforming
+  int added_key_points = 0;                 ///< key points added where the target curve was missed
+  int degrees_of_freedom = 0;               ///< 3 (free vertices - rank of the key-point system)
+  int rank = 0;                             ///< rank of the key-point system (scalar rows)
   std::vector<int> conflicting_key_points;  ///< key points that cannot all be met (indices)
-  double model_size = 0;         ///< diagonal of the parent's control box
-  std::string message;           ///< what happened, in words
+  double model_size = 0;                    ///< diagonal of the parent's control box
+  std::string message;                      ///< what happened, in words
   /// Whether the step did what it was asked (judge_style): Converged; NotConverged when the
   /// target is missed (exact mode: a key point beyond tolerance x size, the target curve beyond
   /// curve_tolerance x size, key points that cannot be met) or a control vertex moves more than
@@ -227,7 +229,8 @@ class CLAY_DEFORM_API StyleEditor {
  public:
   /// Throws clay::Error: InvalidGeometry for an invalid parent, InvalidArgument for bad options or
   /// a region made for another control net.
-  StyleEditor(surface::BSplineSurface parent, InfluenceRegion region, const StyleOptions& options = {});
+  StyleEditor(surface::BSplineSurface parent, InfluenceRegion region,
+              const StyleOptions& options = {});
 
   /// The deformation toward `target`. Throws clay::Error(InvalidGeometry) for an invalid target.
   StyleResult update(const surface::BSplineCurve& target);
@@ -243,7 +246,7 @@ class CLAY_DEFORM_API StyleEditor {
   surface::SurfaceProjector projector_;  // of the parent
   InfluenceRegion region_;
   StyleOptions options_;
-  std::vector<Eigen::Vector2d> warm_;    // the previous target's projected samples (u, v)
+  std::vector<Eigen::Vector2d> warm_;  // the previous target's projected samples (u, v)
   std::shared_ptr<const detail::ExactCache> exact_;  // exact mode: free vertices, fairness matrix
 };
 

@@ -37,13 +37,17 @@ struct CLAY_DEFORM_API SurfaceDeformationOptions {
 
 /// What happened at one step.
 struct StepOutcome {
-  int step = 0;          ///< index in the stack
-  std::string kind;      ///< kind_name of the deformation
-  std::string name;      ///< the step's name
-  enum class Method { Skipped, Exact, Refit } method = Method::Skipped;  ///< disabled, composed, refitted
-  std::string reason;    ///< why a step was refitted (the exact composition's refusal), else empty
-  ComposeReport compose; ///< when exact
-  RefitReport refit;     ///< when refitted
+  int step = 0;      ///< index in the stack
+  std::string kind;  ///< kind_name of the deformation
+  std::string name;  ///< the step's name
+  enum class Method {
+    Skipped,
+    Exact,
+    Refit
+  } method = Method::Skipped;  ///< disabled, composed, refitted
+  std::string reason;     ///< why a step was refitted (the exact composition's refusal), else empty
+  ComposeReport compose;  ///< when exact
+  RefitReport refit;      ///< when refitted
 };
 
 /// Per-step outcomes and the result's size.

@@ -35,7 +35,8 @@ inline std::string join_problems(const std::vector<std::string>& list) {
 }
 
 /// Throws clay::Error(category) whose message lists every problem.
-[[noreturn]] inline void throw_problems(ErrorCategory category, const std::vector<std::string>& list) {
+[[noreturn]] inline void throw_problems(ErrorCategory category,
+                                        const std::vector<std::string>& list) {
   throw Error(category, join_problems(list));
 }
 

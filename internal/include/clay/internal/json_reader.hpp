@@ -61,15 +61,19 @@ inline std::string join(const std::vector<std::string>& items, std::string_view 
 
 /// An allowed interval for a number, open or closed at each end.
 struct Range {
-  double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
+  double lo = -std::numeric_limits<double>::infinity(),
+         hi = std::numeric_limits<double>::infinity();
   bool lo_open = false, hi_open = false;
-  bool contains(double x) const { return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi); }
+  bool contains(double x) const {
+    return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
+  }
   std::string text() const {
     const double inf = std::numeric_limits<double>::infinity();
     if (lo == -inf && hi == inf) return "any finite number";
     if (hi == inf) return std::string(lo_open ? "> " : ">= ") + shortest(lo);
     if (lo == -inf) return std::string(hi_open ? "< " : "<= ") + shortest(hi);
-    return std::string(lo_open ? "(" : "[") + shortest(lo) + ", " + shortest(hi) + (hi_open ? ")" : "]");
+    return std::string(lo_open ? "(" : "[") + shortest(lo) + ", " + shortest(hi) +
+           (hi_open ? ")" : "]");
   }
 };
 
@@ -88,12 +92,13 @@ class JsonReader {
 
   /// Records a problem ("(top level)" for the empty path); `wording` may rephrase the message.
   void add(std::string path, std::string message) {
-    problems.push_back({path.empty() ? "(top level)" : std::move(path), wording(std::move(message))});
+    problems.push_back(
+        {path.empty() ? "(top level)" : std::move(path), wording(std::move(message))});
   }
 
   /// True when j is an object; reports every key outside `allowed`.
-  bool object(const Json& j, const std::string& path, std::initializer_list<std::string_view> allowed,
-              std::string_view what) {
+  bool object(const Json& j, const std::string& path,
+              std::initializer_list<std::string_view> allowed, std::string_view what) {
     if (!j.is_object()) {
       add(path, "expected " + std::string(what) + " (a JSON object), found " + found(j));
       return false;
@@ -101,7 +106,8 @@ class JsonReader {
     for (const auto& [key, value] : j.items()) {
       if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
       std::vector<std::string> names(allowed.begin(), allowed.end());
-      add(key_path(path, key), "unknown key \"" + key + "\" in " + std::string(what) + "; the keys are: " + join(names));
+      add(key_path(path, key),
+          "unknown key \"" + key + "\" in " + std::string(what) + "; the keys are: " + join(names));
     }
     return true;
   }
@@ -120,7 +126,8 @@ class JsonReader {
 
   std::optional<double> number(const Json& j, const std::string& path, Range r = {}) {
     // No range of its own: the format's magnitude is the range to name.
-    if (r.lo == -std::numeric_limits<double>::infinity() && r.hi == std::numeric_limits<double>::infinity() &&
+    if (r.lo == -std::numeric_limits<double>::infinity() &&
+        r.hi == std::numeric_limits<double>::infinity() &&
         magnitude < std::numeric_limits<double>::max())
       r = Range{-magnitude, magnitude};
     if (!j.is_number()) {
@@ -146,7 +153,8 @@ class JsonReader {
 
   std::optional<int> integer(const Json& j, const std::string& path, int lo, int hi) {
     if (!j.is_number_integer() || j.get<long long>() < lo || j.get<long long>() > hi) {
-      add(path, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " + found(j));
+      add(path, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                    "], found " + found(j));
       return std::nullopt;
     }
     return static_cast<int>(j.get<long long>());
@@ -169,7 +177,8 @@ class JsonReader {
   }
 
   /// One of `choices` (the index), or nullopt.
-  std::optional<int> choice(const Json& j, const std::string& path, const std::vector<std::string>& choices) {
+  std::optional<int> choice(const Json& j, const std::string& path,
+                            const std::vector<std::string>& choices) {
     if (j.is_string()) {
       const auto s = j.get<std::string>();
       for (std::size_t k = 0; k < choices.size(); ++k)
@@ -187,7 +196,8 @@ class JsonReader {
     Eigen::Vector3d v;
     bool ok = true;
     for (int k = 0; k < 3; ++k) {
-      const auto x = number(j[static_cast<std::size_t>(k)], index_path(path, static_cast<std::size_t>(k)));
+      const auto x =
+          number(j[static_cast<std::size_t>(k)], index_path(path, static_cast<std::size_t>(k)));
       ok = ok && x.has_value();
       v[k] = x.value_or(0.0);
     }
@@ -206,11 +216,13 @@ class JsonReader {
   }
 
   /// An array of [x, y, z] with at least `min` and at most `max` rows.
-  std::optional<surface::Points3> points(const Json& j, const std::string& path, std::size_t min,
-                                         std::size_t max = std::numeric_limits<std::size_t>::max()) {
+  std::optional<surface::Points3> points(
+      const Json& j, const std::string& path, std::size_t min,
+      std::size_t max = std::numeric_limits<std::size_t>::max()) {
     if (!at_most(j, path, max, "points")) return std::nullopt;
     if (!j.is_array() || j.size() < min) {
-      add(path, "expected an array of " + (min > 0 ? "at least " + std::to_string(min) + " " : std::string()) +
+      add(path, "expected an array of " +
+                    (min > 0 ? "at least " + std::to_string(min) + " " : std::string()) +
                     "points [x, y, z], found " + found(j));
       return std::nullopt;
     }
@@ -224,12 +236,13 @@ class JsonReader {
     return ok ? std::optional(p) : std::nullopt;
   }
 
-  std::optional<std::vector<double>> numbers(const Json& j, const std::string& path, std::size_t min,
-                                             std::size_t max = std::numeric_limits<std::size_t>::max(),
-                                             Range r = {}) {
+  std::optional<std::vector<double>> numbers(
+      const Json& j, const std::string& path, std::size_t min,
+      std::size_t max = std::numeric_limits<std::size_t>::max(), Range r = {}) {
     if (!at_most(j, path, max, "numbers")) return std::nullopt;
     if (!j.is_array() || j.size() < min) {
-      add(path, "expected an array of " + (min > 0 ? "at least " + std::to_string(min) + " " : std::string()) +
+      add(path, "expected an array of " +
+                    (min > 0 ? "at least " + std::to_string(min) + " " : std::string()) +
                     "numbers, found " + found(j));
       return std::nullopt;
     }
@@ -244,11 +257,13 @@ class JsonReader {
   }
 
   // Optional members with a default: read when present, the default otherwise (or when bad).
-  double number_or(const Json& obj, const std::string& path, std::string_view key, double def, Range r = {}) {
+  double number_or(const Json& obj, const std::string& path, std::string_view key, double def,
+                   Range r = {}) {
     const Json* j = member(obj, path, key, false, "");
     return j ? number(*j, key_path(path, key), r).value_or(def) : def;
   }
-  int integer_or(const Json& obj, const std::string& path, std::string_view key, int def, int lo, int hi) {
+  int integer_or(const Json& obj, const std::string& path, std::string_view key, int def, int lo,
+                 int hi) {
     const Json* j = member(obj, path, key, false, "");
     return j ? integer(*j, key_path(path, key), lo, hi).value_or(def) : def;
   }
@@ -261,9 +276,12 @@ class JsonReader {
   /// the label they were given, which is taken off so the path is not said twice.
   void add_all(const std::string& label, const std::vector<std::string>& list) {
     for (const auto& p : list) {
-      if (p.rfind(label + ": ", 0) == 0) add(label, p.substr(label.size() + 2));
-      else if (p.rfind(label + " ", 0) == 0) add(label, p.substr(label.size() + 1));
-      else add(label, p);
+      if (p.rfind(label + ": ", 0) == 0)
+        add(label, p.substr(label.size() + 2));
+      else if (p.rfind(label + " ", 0) == 0)
+        add(label, p.substr(label.size() + 1));
+      else
+        add(label, p);
     }
   }
 

@@ -28,7 +28,8 @@ inline const std::vector<double>& binomial_row(int n) {
   }();
   // Every caller's degrees are bounded far below (lattices 3 x 63); past the table is a bug.
   if (n < 0 || n > max_binomial_row)
-    throw Error(ErrorCategory::Internal, "binomial_row(" + std::to_string(n) + "): beyond the table of rows 0.." +
+    throw Error(ErrorCategory::Internal, "binomial_row(" + std::to_string(n) +
+                                             "): beyond the table of rows 0.." +
                                              std::to_string(max_binomial_row));
   return table[static_cast<size_t>(n)];
 }

@@ -27,8 +27,10 @@ void run_parts(std::size_t parts, const Executor& executor, const Work& work) {
     return;
   }
   const std::function<void(std::size_t)> task = [&work](std::size_t part) { work(part); };
-  if (executor) executor(parts, task);
-  else run_on_threads(parts, task);
+  if (executor)
+    executor(parts, task);
+  else
+    run_on_threads(parts, task);
 }
 
 }  // namespace clay::internal

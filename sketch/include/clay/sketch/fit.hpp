@@ -47,22 +47,22 @@ namespace clay::sketch {
 
 /// Settings of fit_stroke (and of the new piece in oversketch).
 struct CLAY_SKETCH_API FitOptions {
-  double tolerance = 0.1;         ///< mm, largest distance from a stroke point to its curve
-                                  ///< (averaged over 9 neighbours for a noisy stroke); > 0
-  int degree = 3;                 ///< degree of the curves, in [2, 9]
-  double fairness = 1e-8;         ///< weight of the bending energy (see above), >= 0; its fourth
-                                  ///< root is about the smoothing length / stroke length
-  int fairness_reductions = 6;    ///< times the fairness may be divided by 10 to meet the tolerance
-  int max_control_points = 100;   ///< per curve, >= 2 * degree
-  int max_iterations = 200;       ///< refinement iterations per curve, >= 1
-  double corner_angle = 50.0;     ///< degrees in (0, 180]: turning angle that makes a corner
-                                  ///< (180 never splits)
-  double corner_window = 0.0;     ///< mm, arc length each side over which turning is measured;
-                                  ///< 0 (default) means 10 x tolerance; >= 0
-  double closing_ratio = 0.03;    ///< a stroke whose end is within closing_ratio x its length of
-                                  ///< its start is closed; in [0, 0.5], 0 never closes
-  int end_samples = 60;           ///< samples in the end-point estimate, >= 1 (1: the drawn point)
-  bool drop_duplicates = false;   ///< drop repeated consecutive points instead of refusing them
+  double tolerance = 0.1;        ///< mm, largest distance from a stroke point to its curve
+                                 ///< (averaged over 9 neighbours for a noisy stroke); > 0
+  int degree = 3;                ///< degree of the curves, in [2, 9]
+  double fairness = 1e-8;        ///< weight of the bending energy (see above), >= 0; its fourth
+                                 ///< root is about the smoothing length / stroke length
+  int fairness_reductions = 6;   ///< times the fairness may be divided by 10 to meet the tolerance
+  int max_control_points = 100;  ///< per curve, >= 2 * degree
+  int max_iterations = 200;      ///< refinement iterations per curve, >= 1
+  double corner_angle = 50.0;    ///< degrees in (0, 180]: turning angle that makes a corner
+                                 ///< (180 never splits)
+  double corner_window = 0.0;    ///< mm, arc length each side over which turning is measured;
+                                 ///< 0 (default) means 10 x tolerance; >= 0
+  double closing_ratio = 0.03;   ///< a stroke whose end is within closing_ratio x its length of
+                                 ///< its start is closed; in [0, 0.5], 0 never closes
+  int end_samples = 60;          ///< samples in the end-point estimate, >= 1 (1: the drawn point)
+  bool drop_duplicates = false;  ///< drop repeated consecutive points instead of refusing them
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -72,19 +72,19 @@ struct CLAY_SKETCH_API FitOptions {
 
 /// One fitted curve and its report.
 struct FittedCurve {
-  surface::BSplineCurve curve;  ///< clamped, polynomial, domain [0, 1]
-  bool closed = false;          ///< smooth closed curve: last control point == first, seam C^(p-1)
-  Eigen::Index first_point = 0; ///< first stroke point fitted by this curve
-  Eigen::Index last_point = 0;  ///< last stroke point fitted (inclusive; wraps past the stroke's
-                                ///< end for the last curve of a closed stroke with corners)
-  double max_deviation_mm = 0;  ///< largest distance from its stroke points to the curve,
-                                ///< measured at each point's foot point (Newton projection)
-  double rms_deviation_mm = 0;  ///< root mean square of the same distances
-  int control_points = 0;       ///< curve.points.rows()
-  int iterations = 0;           ///< refinement iterations
-  double fairness = 0;          ///< fairness weight in use at the end (after reductions)
-  double noise = 0;             ///< mm, estimated noise of its stroke points per coordinate
-  Summary summary;              ///< converged when max_deviation_mm <= tolerance
+  surface::BSplineCurve curve;   ///< clamped, polynomial, domain [0, 1]
+  bool closed = false;           ///< smooth closed curve: last control point == first, seam C^(p-1)
+  Eigen::Index first_point = 0;  ///< first stroke point fitted by this curve
+  Eigen::Index last_point = 0;   ///< last stroke point fitted (inclusive; wraps past the stroke's
+                                 ///< end for the last curve of a closed stroke with corners)
+  double max_deviation_mm = 0;   ///< largest distance from its stroke points to the curve,
+                                 ///< measured at each point's foot point (Newton projection)
+  double rms_deviation_mm = 0;   ///< root mean square of the same distances
+  int control_points = 0;        ///< curve.points.rows()
+  int iterations = 0;            ///< refinement iterations
+  double fairness = 0;           ///< fairness weight in use at the end (after reductions)
+  double noise = 0;              ///< mm, estimated noise of its stroke points per coordinate
+  Summary summary;               ///< converged when max_deviation_mm <= tolerance
 };
 
 /// The curves fitted to one stroke, in drawing order; consecutive curves share their joint point

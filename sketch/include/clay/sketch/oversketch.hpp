@@ -58,9 +58,9 @@ struct Joint {
 
 /// The redrawn curve and how it was made.
 struct OversketchResult {
-  surface::BSplineCurve curve;       ///< same domain and degree as the input curve
-  double cut_start = 0;              ///< parameter where the replaced part begins (old and new curve)
-  double cut_end = 0;                ///< parameter where it ends (a domain end for a new head/tail)
+  surface::BSplineCurve curve;  ///< same domain and degree as the input curve
+  double cut_start = 0;         ///< parameter where the replaced part begins (old and new curve)
+  double cut_end = 0;           ///< parameter where it ends (a domain end for a new head/tail)
   std::optional<Joint> start_joint;  ///< absent when the stroke replaced the curve's head
   std::optional<Joint> end_joint;    ///< absent when the stroke replaced the curve's tail
   double max_deviation_mm = 0;       ///< stroke points to the new part (foot points)
@@ -74,8 +74,8 @@ struct OversketchResult {
 /// either direction. Throws clay::Error: InvalidArgument for bad options, for a stroke end farther
 /// than capture_distance from the curve (naming the end and the distance) unless the stroke runs
 /// over an end of the curve, for a stroke whose ends meet the curve at one point or that runs over
-/// both of its ends (covering it all); InvalidGeometry for an invalid curve, a curve of degree 1, or a stroke that
-/// problems(stroke) rejects.
+/// both of its ends (covering it all); InvalidGeometry for an invalid curve, a curve of degree 1,
+/// or a stroke that problems(stroke) rejects.
 CLAY_SKETCH_API OversketchResult oversketch(const surface::BSplineCurve& curve,
                                             const Stroke& stroke,
                                             const OversketchOptions& options = {});

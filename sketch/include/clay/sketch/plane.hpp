@@ -21,9 +21,9 @@ inline constexpr double plane_axis_tolerance = 1e-9;
 
 /// An origin and two orthonormal axes. Value type: copy, compare, store freely.
 struct SketchPlane {
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< mm
-  Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX(); ///< unit
-  Eigen::Vector3d y_axis = Eigen::Vector3d::UnitY(); ///< unit, orthogonal to x_axis
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();   ///< mm
+  Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX();  ///< unit
+  Eigen::Vector3d y_axis = Eigen::Vector3d::UnitY();  ///< unit, orthogonal to x_axis
 
   /// x_axis × y_axis (unit when the plane is valid).
   Eigen::Vector3d normal() const { return x_axis.cross(y_axis); }

@@ -20,8 +20,8 @@ inline constexpr int max_kernel_degree = 63;
 
 /// Degree and knot vector of one direction of a B-spline curve or surface.
 struct BSplineBasis {
-  int degree = 0;              ///< polynomial degree p >= 1
-  std::vector<double> knots;   ///< flat knot vector, length count() + degree + 1
+  int degree = 0;             ///< polynomial degree p >= 1
+  std::vector<double> knots;  ///< flat knot vector, length count() + degree + 1
 
   /// Number of control points (basis functions) this basis spans: knots.size() - degree - 1.
   int count() const noexcept { return static_cast<int>(knots.size()) - degree - 1; }
@@ -37,9 +37,9 @@ CLAY_SURFACE_API BSplineBasis clamped_uniform_basis(int degree, int count, doubl
                                                     double last = 1.0);
 
 /// Every invariant the basis breaks, in words, each naming `name` (e.g. "surface 'hood' u basis").
-/// Empty when the basis is valid: 1 <= degree <= max_kernel_degree, finite non-decreasing knots, at least degree + 1
-/// control points, interior multiplicity <= degree, end multiplicity <= degree + 1, and a domain
-/// of positive length.
+/// Empty when the basis is valid: 1 <= degree <= max_kernel_degree, finite non-decreasing knots, at
+/// least degree + 1 control points, interior multiplicity <= degree, end multiplicity <= degree +
+/// 1, and a domain of positive length.
 CLAY_SURFACE_API std::vector<std::string> problems(const BSplineBasis& basis,
                                                    std::string_view name);
 
@@ -64,9 +64,9 @@ CLAY_SURFACE_API std::vector<double> span_samples(const BSplineBasis& basis, int
 /// itself). Strictly increasing for a valid basis. Precondition: a valid basis.
 CLAY_SURFACE_API std::vector<double> greville_abscissae(const BSplineBasis& basis);
 
-/// Index k of the knot span [knots[k], knots[k+1]) holding t, with degree <= k < count(); the domain
-/// end maps to the last non-empty span. Throws clay::Error(OutOfDomain) when t is outside the domain
-/// or not finite. (The NURBS Book A2.1.)
+/// Index k of the knot span [knots[k], knots[k+1]) holding t, with degree <= k < count(); the
+/// domain end maps to the last non-empty span. Throws clay::Error(OutOfDomain) when t is outside
+/// the domain or not finite. (The NURBS Book A2.1.)
 CLAY_SURFACE_API int find_span(const BSplineBasis& basis, double t);
 
 /// The degree + 1 non-zero basis functions N_{k-p..k}(t) on span k, written to `values`

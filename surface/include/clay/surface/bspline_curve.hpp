@@ -1,8 +1,8 @@
 #pragma once
 /// BSplineCurve — a (rational) B-spline curve as plain data.
 ///
-/// C(t) = sum_i N_{i,p}(t) w_i P_i / sum_i N_{i,p}(t) w_i. Weights are all 1 for a polynomial curve;
-/// one type serves both so that no algorithm exists twice.
+/// C(t) = sum_i N_{i,p}(t) w_i P_i / sum_i N_{i,p}(t) w_i. Weights are all 1 for a polynomial
+/// curve; one type serves both so that no algorithm exists twice.
 #include <clay/surface/basis.hpp>
 #include <clay/surface/export.hpp>
 
@@ -14,7 +14,8 @@
 
 namespace clay::surface {
 
-/// Control points, one row per point (x, y, z in millimetres), row-major so each point is contiguous.
+/// Control points, one row per point (x, y, z in millimetres), row-major so each point is
+/// contiguous.
 using Points3 = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 /// A B-spline curve: basis, control points (basis.count() rows) and weights (basis.count() entries,

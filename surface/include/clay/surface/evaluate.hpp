@@ -3,8 +3,8 @@
 ///
 /// Rational derivatives follow The NURBS Book A3.6 (homogeneous derivatives) and A4.4 (quotient
 /// rule). Every function throws clay::Error(OutOfDomain) for a parameter outside the domain and
-/// clay::Error(InvalidArgument) for a derivative order outside [0, 2]. Single-point functions assume
-/// a valid object (see validate()); batch functions validate it once.
+/// clay::Error(InvalidArgument) for a derivative order outside [0, 2]. Single-point functions
+/// assume a valid object (see validate()); batch functions validate it once.
 #include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/export.hpp>
 
@@ -52,8 +52,8 @@ CLAY_SURFACE_API Points3 evaluate_many(const BSplineCurve& curve, std::span<cons
 
 /// Points of the grid us x vs: row iu * vs.size() + iv holds S(us[iu], vs[iv]). The basis functions
 /// of each u and v are computed once and the control net is contracted a direction at a time, so a
-/// grid costs about (p+1)*count_v + (q+1) multiply-adds per point instead of (p+1)(q+1) plus a basis
-/// evaluation.
+/// grid costs about (p+1)*count_v + (q+1) multiply-adds per point instead of (p+1)(q+1) plus a
+/// basis evaluation.
 CLAY_SURFACE_API Points3 evaluate_grid(const BSplineSurface& surface, std::span<const double> us,
                                        std::span<const double> vs);
 

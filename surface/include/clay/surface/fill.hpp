@@ -36,9 +36,9 @@ struct CLAY_OCCT_API FillOptions {
 /// their midpoint. Curves are clamped and reparametrized to [0, 1], opposite sides made compatible
 /// (degree elevation and knot refinement), and, for Coons, sides with fewer than 4 control points
 /// raised to degree 3 (OpenCASCADE refuses Coons below 4). 4 curves: u runs along the first curve
-/// of the loop (v = 0), v along the second (u = 1); 3 curves: the side u = 0 collapses to the corner
-/// where the loop closes; 2 curves: Stretch and Coons give the ruled surface between them (the
-/// second curve turned to run like the first; no loop needed), Curved the patch spanned by two
+/// of the loop (v = 0), v along the second (u = 1); 3 curves: the side u = 0 collapses to the
+/// corner where the loop closes; 2 curves: Stretch and Coons give the ruled surface between them
+/// (the second curve turned to run like the first; no loop needed), Curved the patch spanned by two
 /// curves that share a corner. The report is exact; its max_deviation_mm is the largest distance
 /// between each input curve and the surface edge it became, on dense samples (rounding, plus at
 /// most half a joined gap), and its method lists what was reversed, raised or joined. Throws
@@ -65,13 +65,14 @@ struct CLAY_OCCT_API NSidedFillOptions {
   double tolerance_2d = 1e-5;  ///< parametric tolerance, > 0 (OCCT "Tol2d")
   double tolerance_3d = 1e-5;  ///< mm, > 0: distance the plate may leave the curves by (OCCT
                                ///< "Tol3d"); the measured distance can be larger, see the report
-  double angular_tolerance = 1e-2;  ///< radians, > 0 (OCCT "TolAng"; used for G1 constraints)
-  double curvature_tolerance = 0.1; ///< > 0 (OCCT "TolCurv"; used for G2 constraints)
-  int max_degree = 8;          ///< degree of the B-spline approximating the plate, 3..25 (OCCT "MaxDeg")
-  int max_segments = 20;       ///< knot spans per direction of that B-spline, 1..1000 (OCCT "MaxSegments")
-  double gap_tolerance = 1e-7; ///< mm, > 0: boundary corners must meet within this (joined at
-                               ///< their midpoint)
-  int samples_per_curve = 64;  ///< points per curve where the deviation is measured, >= 2
+  double angular_tolerance = 1e-2;   ///< radians, > 0 (OCCT "TolAng"; used for G1 constraints)
+  double curvature_tolerance = 0.1;  ///< > 0 (OCCT "TolCurv"; used for G2 constraints)
+  int max_degree = 8;  ///< degree of the B-spline approximating the plate, 3..25 (OCCT "MaxDeg")
+  int max_segments =
+      20;  ///< knot spans per direction of that B-spline, 1..1000 (OCCT "MaxSegments")
+  double gap_tolerance = 1e-7;  ///< mm, > 0: boundary corners must meet within this (joined at
+                                ///< their midpoint)
+  int samples_per_curve = 64;   ///< points per curve where the deviation is measured, >= 2
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -81,7 +82,7 @@ struct CLAY_OCCT_API NSidedFillOptions {
 
 /// What fill_n_sided() built and how far each curve is from it.
 struct NSidedFill {
-  BuiltSurface built;                  ///< the plate as one B-spline surface (report not exact)
+  BuiltSurface built;                    ///< the plate as one B-spline surface (report not exact)
   std::vector<double> curve_deviations;  ///< mm: boundary curves in input order, then interior
                                          ///< curves; each the largest closest-point distance of
                                          ///< its samples to the surface
@@ -91,8 +92,8 @@ struct NSidedFill {
 /// fill()) and optional interior curves it must pass through: OpenCASCADE's plate
 /// (BRepOffsetAPI_MakeFilling, GeomPlate: a thin-plate energy minimized under point constraints,
 /// then approximated by a B-spline), returned as that B-spline surface, untrimmed: it covers the
-/// N-sided region and extends beyond it (the boundary curves trim it). Not exact: max_deviation_mm is
-/// the largest of curve_deviations, measured with closest_point() on options.samples_per_curve
+/// N-sided region and extends beyond it (the boundary curves trim it). Not exact: max_deviation_mm
+/// is the largest of curve_deviations, measured with closest_point() on options.samples_per_curve
 /// points of every curve. Throws clay::Error: InvalidArgument for fewer than 3 boundary curves or
 /// bad options; InvalidGeometry for invalid or degenerate curves, a boundary that does not close
 /// (naming each gap as fill() does), a boundary loop that crosses, touches or doubles back onto

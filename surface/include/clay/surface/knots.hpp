@@ -43,9 +43,9 @@ CLAY_SURFACE_API std::vector<BSplineCurve> extract_bezier(const BSplineCurve& cu
 
 /// The Bézier patches of a surface, one per pair of non-empty knot spans.
 struct BezierPatches {
-  std::vector<double> breaks_u;          ///< distinct knot values of the u domain, ends included
-  std::vector<double> breaks_v;          ///< same in v
-  std::vector<BSplineSurface> patches;   ///< patch (i, j) at i * count_v() + j
+  std::vector<double> breaks_u;         ///< distinct knot values of the u domain, ends included
+  std::vector<double> breaks_v;         ///< same in v
+  std::vector<BSplineSurface> patches;  ///< patch (i, j) at i * count_v() + j
 
   int count_u() const noexcept { return static_cast<int>(breaks_u.size()) - 1; }
   int count_v() const noexcept { return static_cast<int>(breaks_v.size()) - 1; }
@@ -104,12 +104,15 @@ struct SurfaceKnotRemoval {
 /// tolerance.
 CLAY_SURFACE_API CurveKnotRemoval remove_knots(const BSplineCurve& curve, double tolerance_mm);
 /// remove_knots in the u direction: a u knot goes only when every column of the net allows it.
-CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_u(const BSplineSurface& surface, double tolerance_mm);
+CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_u(const BSplineSurface& surface,
+                                                   double tolerance_mm);
 /// remove_knots in the v direction.
-CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_v(const BSplineSurface& surface, double tolerance_mm);
+CLAY_SURFACE_API SurfaceKnotRemoval remove_knots_v(const BSplineSurface& surface,
+                                                   double tolerance_mm);
 /// remove_knots in both directions, u then v (the gaps of each direction within `tolerance_mm`):
 /// the result of remove_knots_v(remove_knots_u(s, t).surface, t), with one homogeneous net and
 /// no surface in between.
-CLAY_SURFACE_API SurfaceKnotRemoval remove_knots(const BSplineSurface& surface, double tolerance_mm);
+CLAY_SURFACE_API SurfaceKnotRemoval remove_knots(const BSplineSurface& surface,
+                                                 double tolerance_mm);
 
 }  // namespace clay::surface

@@ -41,8 +41,8 @@ struct CLAY_SURFACE_API SuperquadricOptions {
 /// Superellipsoid (eq. 2.1.1): eta in [-pi/2, pi/2], omega in [-pi, pi].
 struct Superellipsoid {
   Eigen::Vector3d radii = Eigen::Vector3d::Ones();  ///< a1, a2, a3 in mm, > 0
-  double e1 = 1.0;  ///< north–south exponent, in (0, 10]
-  double e2 = 1.0;  ///< east–west exponent, in (0, 10]
+  double e1 = 1.0;                                  ///< north–south exponent, in (0, 10]
+  double e2 = 1.0;                                  ///< east–west exponent, in (0, 10]
 };
 
 /// Supertoroid (eq. 2.1.4): x = (a1 (a4 + C^e1) C^e2, a2 (a4 + C^e1) S^e2, a3 S^e1),
@@ -57,10 +57,10 @@ struct Supertoroid {
 /// Superhyperboloids (eqs. 2.1.2, 2.1.3), cut to a finite range of their unbounded parameters.
 struct Superhyperboloid {
   Eigen::Vector3d radii = Eigen::Vector3d::Ones();  ///< a1, a2, a3 in mm, > 0
-  double e1 = 1.0;            ///< in (0, 10]
-  double e2 = 1.0;            ///< in (0, 10]
-  double eta_limit = 1.0;     ///< eta in [-eta_limit, eta_limit], radians in (0, pi/2)
-  double omega_limit = 1.0;   ///< two sheets: omega in [-omega_limit, omega_limit], in (0, pi/2)
+  double e1 = 1.0;                                  ///< in (0, 10]
+  double e2 = 1.0;                                  ///< in (0, 10]
+  double eta_limit = 1.0;    ///< eta in [-eta_limit, eta_limit], radians in (0, pi/2)
+  double omega_limit = 1.0;  ///< two sheets: omega in [-omega_limit, omega_limit], in (0, pi/2)
 };
 
 /// The spherical product of two planar curves (their x and y coordinates; z is ignored):

@@ -21,11 +21,11 @@ namespace clay::surface {
 
 /// Settings of project_normal and closest_point.
 struct CLAY_SURFACE_API ProjectionOptions {
-  int max_iterations = 50;            ///< Newton iterations per start, >= 1
-  double parametric_tolerance = 1e-14;///< step size below which Newton stops (relative to domain)
-  double cosine_tolerance = 1e-12;    ///< |cos| between S_u or S_v and S - P that counts as normal
-  int samples_per_span = 4;           ///< closest_point: start grid density per knot span, >= 1
-  int starts = 4;                     ///< closest_point: Newton runs from the best grid samples, >= 1
+  int max_iterations = 50;              ///< Newton iterations per start, >= 1
+  double parametric_tolerance = 1e-14;  ///< step size below which Newton stops (relative to domain)
+  double cosine_tolerance = 1e-12;  ///< |cos| between S_u or S_v and S - P that counts as normal
+  int samples_per_span = 4;         ///< closest_point: start grid density per knot span, >= 1
+  int starts = 4;                   ///< closest_point: Newton runs from the best grid samples, >= 1
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -82,8 +82,8 @@ class CLAY_SURFACE_API SurfaceProjector {
 
   BSplineSurface surface_;
   ProjectionOptions options_;
-  double size_ = 0;                    // diagonal of the control box
-  std::shared_ptr<StartGrid> grid_;    // evaluated once, on first use
+  double size_ = 0;                  // diagonal of the control box
+  std::shared_ptr<StartGrid> grid_;  // evaluated once, on first use
 };
 
 // ---- curves ---------------------------------------------------------------------------------

@@ -20,13 +20,13 @@ struct Axis {
 /// (same degree, knots and parameters). A full revolution closes exactly (the last row of control
 /// points copies the first). Control points on the axis stay there (poles, as on a sphere).
 ///
-/// The report is exact; its max_deviation_mm is the largest difference, over a dense sample, between
-/// a surface point's distance to the axis (and height along it) and those of the profile point it
-/// comes from. Throws clay::Error: InvalidGeometry for an invalid profile, a profile lying on the
-/// axis, a profile that touches or crosses the axis between its ends, or a profile that crosses,
-/// touches or doubles back onto itself within 1e-7 × size (find_self_intersection; the surface
-/// would intersect itself in each case); InvalidArgument for an axis of zero length or an angle
-/// outside (0, 360]. Not detected: a non-planar profile whose meridian (distance to the axis,
+/// The report is exact; its max_deviation_mm is the largest difference, over a dense sample,
+/// between a surface point's distance to the axis (and height along it) and those of the profile
+/// point it comes from. Throws clay::Error: InvalidGeometry for an invalid profile, a profile lying
+/// on the axis, a profile that touches or crosses the axis between its ends, or a profile that
+/// crosses, touches or doubles back onto itself within 1e-7 × size (find_self_intersection; the
+/// surface would intersect itself in each case); InvalidArgument for an axis of zero length or an
+/// angle outside (0, 360]. Not detected: a non-planar profile whose meridian (distance to the axis,
 /// height along it) crosses itself although the profile does not.
 CLAY_SURFACE_API BuiltSurface revolve(const BSplineCurve& profile, const Axis& axis,
                                       double angle_degrees = 360.0);

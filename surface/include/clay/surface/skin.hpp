@@ -54,10 +54,10 @@ CLAY_SURFACE_API std::vector<double> loft_parameters(const std::vector<BSplineCu
 /// rational sections work) is interpolated across the sections with degree
 /// min(options.degree, sections - 1), the averaged parameters of loft_parameters and knots by
 /// averaging (eq. 9.8). Exact: S(u, v_k) equals section k at its normalized parameter u in [0, 1];
-/// the report's max_deviation_mm measures exactly that on a dense sample (rounding, ~1e-15 of size).
-/// A section running against its predecessor is reversed when options.auto_orient (the report's
-/// method says which). Throws clay::Error: InvalidArgument for fewer than 2 sections or bad
-/// options; InvalidGeometry naming the section index (0-based) for an invalid or degenerate
+/// the report's max_deviation_mm measures exactly that on a dense sample (rounding, ~1e-15 of
+/// size). A section running against its predecessor is reversed when options.auto_orient (the
+/// report's method says which). Throws clay::Error: InvalidArgument for fewer than 2 sections or
+/// bad options; InvalidGeometry naming the section index (0-based) for an invalid or degenerate
 /// section (control polygon ~0 long, e.g. a point), a section that crosses, touches or doubles
 /// back onto itself within options.tolerance × size (find_self_intersection; the message gives
 /// both parameters and the point), two consecutive coincident sections, a reversed section when
@@ -91,18 +91,19 @@ struct CLAY_SURFACE_API SweepOptions {
 /// at equal arc-length steps (cubic across them, v = arc-length fraction, u = the profile's own
 /// clamped parameter), doubling their number until the largest distance between S(u, v) and the
 /// exactly moved profile at 1/4, 1/2, 3/4 of every interval is within tolerance (report: exact =
-/// false, max_deviation_mm, the sections used in the method). At path knots where the curvature (or its derivative) jumps, a copy
-/// sits on the knot and v gets a triple (double) knot, matching the sweep's own C0 (C1) continuity
-/// there. A straight path without twist gives the exact extrusion (degree 1 across, exact = true).
-/// Throws clay::Error(InvalidGeometry) naming "profile" or "path" for an invalid or degenerate
-/// curve (control polygon ~0 long), a profile or path that crosses, touches or doubles back onto
-/// itself within 1e-7 × size (find_self_intersection), a path with a zero tangent or a corner
-/// (tangent turning by more than tolerance radians at a knot: split the path there), and a
-/// profile that reaches as far toward the path's centre of curvature as its radius of curvature
-/// (kappa n . q >= 1 - 1e-3 for a profile offset q in the moving frame, on the path table: the
-/// surface would fold through itself; the message gives the path parameter, the radius and the
-/// reach); InvalidArgument for bad options and when the adaptive sweep still misses the tolerance
-/// with max_sections sections (the message gives the deviation and the tolerance in mm).
+/// false, max_deviation_mm, the sections used in the method). At path knots where the curvature (or
+/// its derivative) jumps, a copy sits on the knot and v gets a triple (double) knot, matching the
+/// sweep's own C0 (C1) continuity there. A straight path without twist gives the exact extrusion
+/// (degree 1 across, exact = true). Throws clay::Error(InvalidGeometry) naming "profile" or "path"
+/// for an invalid or degenerate curve (control polygon ~0 long), a profile or path that crosses,
+/// touches or doubles back onto itself within 1e-7 × size (find_self_intersection), a path with a
+/// zero tangent or a corner (tangent turning by more than tolerance radians at a knot: split the
+/// path there), and a profile that reaches as far toward the path's centre of curvature as its
+/// radius of curvature (kappa n . q >= 1 - 1e-3 for a profile offset q in the moving frame, on the
+/// path table: the surface would fold through itself; the message gives the path parameter, the
+/// radius and the reach); InvalidArgument for bad options and when the adaptive sweep still misses
+/// the tolerance with max_sections sections (the message gives the deviation and the tolerance in
+/// mm).
 CLAY_SURFACE_API BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
                                     const SweepOptions& options = {});
 

@@ -1,0 +1,37 @@
+# Checks that the C++ sources under SOURCE_DIR are formatted as .clang-format says, so the style is
+# kept, not re-applied in one large commit now and then. Usage:
+#   cmake -DSOURCE_DIR=<tree> [-DSTYLE_FILE=<.clang-format>] -P check_format.cmake
+# Each misformatted file is named with clang-format's first complaint about it. The house fixture
+# tests/house/fixtures/format/ holds one such file (the check must catch it), so the tree-wide run
+# leaves that folder out. Fix a file with: clang-format-14 -i <file>.
+find_program(CLANG_FORMAT NAMES clang-format-14 clang-format)
+if(NOT CLANG_FORMAT)
+  message(FATAL_ERROR "clang-format-14 not found: install the clang-format-14 package "
+                      "(scripts/packages.txt; scripts/test.sh installs it)")
+endif()
+if(NOT STYLE_FILE)
+  set(STYLE_FILE ${SOURCE_DIR}/.clang-format)
+endif()
+file(GLOB_RECURSE sources RELATIVE ${SOURCE_DIR}
+  ${SOURCE_DIR}/*.cpp ${SOURCE_DIR}/*.hpp ${SOURCE_DIR}/*.h)
+list(FILTER sources EXCLUDE REGEX "^(build[^/]*|viewer|\\.git)/|/node_modules/")
+if(NOT SOURCE_DIR MATCHES "fixtures/format$")
+  list(FILTER sources EXCLUDE REGEX "^tests/house/fixtures/format/")
+endif()
+list(LENGTH sources count)
+if(count EQUAL 0)
+  message(FATAL_ERROR "no C++ sources under ${SOURCE_DIR}")
+endif()
+set(bad "")
+foreach(file IN LISTS sources)
+  execute_process(COMMAND ${CLANG_FORMAT} --style=file:${STYLE_FILE} --dry-run --Werror ${file}
+    WORKING_DIRECTORY ${SOURCE_DIR} RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+  if(NOT rc EQUAL 0)
+    string(REGEX MATCH "^[^\n]*" first "${err}")
+    string(APPEND bad "\n  ${file}: ${first}")
+  endif()
+endforeach()
+if(bad)
+  message(FATAL_ERROR "not formatted as .clang-format says (run clang-format-14 -i on each):${bad}")
+endif()
+message(STATUS "${count} C++ files formatted as ${STYLE_FILE} says")
