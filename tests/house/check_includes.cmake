@@ -3,7 +3,8 @@
 #   in OCCT's include folder), Ceres headers only in .cpp files;
 # - a module includes only the clay headers of the modules it may use:
 #     surface (the core: clay/surface*, clay/error.hpp, summary.hpp, tolerance.hpp, version.hpp)
-#       <- sketch <- constraints;  surface <- deform;  cli (recipe, render, servers) uses all.
+#       <- sketch <- constraints;  surface <- brep <- deform;  cli (recipe, render, servers) uses
+#       all.
 #   The umbrella clay/clayform.hpp is exempt (it is the whole API by design).
 # - clay/internal/ (the shared helpers, never installed) only from sources, never from a public
 #   header under include/.
@@ -13,15 +14,16 @@ set(violations "")
 set(may_use_surface surface)
 set(may_use_sketch surface sketch)
 set(may_use_constraints surface sketch constraints)
-set(may_use_deform surface deform)
-set(may_use_cli surface sketch constraints deform cli)
+set(may_use_brep surface brep)
+set(may_use_deform surface brep deform)
+set(may_use_cli surface brep sketch constraints deform cli)
 # The module a clay header belongs to, or "" for a header outside the graph.
 function(module_of header out)
   if(header MATCHES "^clay/(surface(/|\\.hpp$)|error\\.hpp$|summary\\.hpp$|tolerance\\.hpp$|version\\.hpp$|parallel\\.hpp$)")
     set(${out} surface PARENT_SCOPE)
   elseif(header STREQUAL "clay/internal/deformation_json.hpp")
     set(${out} deform PARENT_SCOPE)  # the stack schema's reader, shared with the recipe
-  elseif(header MATCHES "^clay/(sketch|constraints|deform)(/|\\.hpp$)")
+  elseif(header MATCHES "^clay/(brep|sketch|constraints|deform)(/|\\.hpp$)")
     set(${out} ${CMAKE_MATCH_1} PARENT_SCOPE)
   elseif(header MATCHES "^clay/(recipe|render|serve|view)(/|\\.hpp$)")
     set(${out} cli PARENT_SCOPE)
@@ -46,7 +48,7 @@ foreach(f ${files})
       list(APPEND violations "${f}: public header includes the internal <${header}>, which is not installed")
     endif()
     set(from "")
-    if(f MATCHES "^(surface|sketch|constraints|deform|cli)/")
+    if(f MATCHES "^(surface|brep|sketch|constraints|deform|cli)/")
       set(from ${CMAKE_MATCH_1})
     endif()
     if(from AND NOT f MATCHES "/clay/clayform\\.hpp$")

@@ -1,0 +1,4 @@
+#pragma once
+/// The B-rep module (Clayform::brep): models of bodies, shells and trimmed faces with shared
+/// edges, names, colours and assemblies, as plain data (clay/brep/model.hpp).
+#include <clay/brep/model.hpp>

@@ -1,0 +1,495 @@
+// The B-rep model's counts, edge gaps and invariants (clay/brep/model.hpp).
+#include <clay/brep/model.hpp>
+#include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/format.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+namespace clay::brep {
+
+namespace {
+
+using internal::shortest;
+
+std::string face_name(const Model& m, int f) {
+  const std::string& name = m.faces[static_cast<size_t>(f)].name;
+  return "face " + std::to_string(f) + (name.empty() ? "" : " (\"" + name + "\")");
+}
+
+std::string coedge_name(const Model& m, int f, int l, int c) {
+  return face_name(m, f) + " loop " + std::to_string(l) + " coedge " + std::to_string(c);
+}
+
+bool in_range(int index, size_t size) { return index >= 0 && static_cast<size_t>(index) < size; }
+
+/// Slack for parameter comparisons: rounding of knot values, relative to the range.
+double parameter_slack(double a, double b) {
+  return 1e-12 * std::max({1.0, std::abs(a), std::abs(b)});
+}
+
+/// The parameters at which a coedge is sampled: both ends, the breakpoints of the pcurve and of
+/// the edge curve inside (t0, t1), and `per_span` points inside every piece between them.
+std::vector<double> coedge_samples(const Edge& e, const Coedge& c, int per_span) {
+  std::vector<double> breaks{e.t0, e.t1};
+  auto add_breaks = [&](const surface::BSplineBasis& basis) {
+    for (double k : surface::breakpoints(basis))
+      if (k > e.t0 && k < e.t1) breaks.push_back(k);
+  };
+  add_breaks(c.pcurve.basis);
+  if (!e.degenerate) add_breaks(e.curve.basis);
+  std::sort(breaks.begin(), breaks.end());
+  breaks.erase(std::unique(breaks.begin(), breaks.end()), breaks.end());
+  std::vector<double> ts;
+  for (size_t k = 0; k + 1 < breaks.size(); ++k) {
+    ts.push_back(breaks[k]);
+    for (int s = 1; s < per_span; ++s)
+      ts.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * s / per_span);
+  }
+  ts.push_back(breaks.back());
+  return ts;
+}
+
+/// (u, v) of a pcurve at t, clamped to the surface's domain (a pcurve leaving the domain is a
+/// problem of its own; the gap is measured at the nearest point of the domain).
+Eigen::Vector2d uv_at(const surface::BSplineSurface& s, const surface::BSplineCurve& pcurve,
+                      double t) {
+  const Eigen::Vector3d p = surface::evaluate(pcurve, t);
+  const auto [u0, u1] = s.u.domain();
+  const auto [v0, v1] = s.v.domain();
+  return {std::clamp(p.x(), u0, u1), std::clamp(p.y(), v0, v1)};
+}
+
+/// Largest |surface(pcurve(t)) - edge(t)| over the samples. Preconditions: indices and curves
+/// valid, the edge range inside both curves' domains.
+EdgeGap gap_of(const Model& m, int f, int l, int c, int per_span) {
+  const Face& face = m.faces[static_cast<size_t>(f)];
+  const Coedge& co = face.loops[static_cast<size_t>(l)].coedges[static_cast<size_t>(c)];
+  const Edge& e = m.edges[static_cast<size_t>(co.edge)];
+  EdgeGap g{f, l, c, co.edge, e.t0, 0.0};
+  for (double t : coedge_samples(e, co, per_span)) {
+    const Eigen::Vector2d uv = uv_at(face.surface, co.pcurve, t);
+    const Eigen::Vector3d on_face = surface::evaluate(face.surface, uv.x(), uv.y());
+    const Eigen::Vector3d on_edge = e.degenerate ? m.vertices[static_cast<size_t>(e.start)].point
+                                                 : surface::evaluate(e.curve, t);
+    const double d = (on_face - on_edge).norm();
+    if (d > g.gap_mm || std::isnan(d)) {
+      g.gap_mm = d;
+      g.t = t;
+    }
+  }
+  return g;
+}
+
+/// Problems of one coedge's own data; empty when edge_gaps may measure it.
+std::vector<std::string> coedge_problems(const Model& m, int f, int l, int c) {
+  std::vector<std::string> out;
+  const Face& face = m.faces[static_cast<size_t>(f)];
+  const Coedge& co = face.loops[static_cast<size_t>(l)].coedges[static_cast<size_t>(c)];
+  const std::string name = coedge_name(m, f, l, c);
+  if (!in_range(co.edge, m.edges.size())) {
+    out.push_back(name + ": edge index " + std::to_string(co.edge) + " is not one of the " +
+                  std::to_string(m.edges.size()) + " edges");
+    return out;
+  }
+  const auto pcurve = surface::problems(co.pcurve, name + "'s pcurve");
+  if (!pcurve.empty()) {
+    internal::append(out, pcurve);
+    return out;
+  }
+  if ((co.pcurve.points.col(2).array() != 0.0).any())
+    out.push_back(name +
+                  ": the pcurve leaves the plane z = 0; give its control points as (u, v, 0)");
+  const Edge& e = m.edges[static_cast<size_t>(co.edge)];
+  const auto [a, b] = co.pcurve.basis.domain();
+  const double slack = parameter_slack(e.t0, e.t1);
+  if (e.t0 < a - slack || e.t1 > b + slack)
+    out.push_back(name + ": the edge range [" + shortest(e.t0) + ", " + shortest(e.t1) +
+                  "] of edge " + std::to_string(co.edge) + " is not inside the pcurve's domain [" +
+                  shortest(a) + ", " + shortest(b) +
+                  "]; a pcurve is parametrized like its edge (same parameter)");
+  return out;
+}
+
+/// Signed area in (u, v) of the polygon through the loop's samples, in loop order.
+double signed_area(const Model& m, const Loop& loop) {
+  std::vector<Eigen::Vector2d> poly;
+  for (const Coedge& co : loop.coedges) {
+    const Edge& e = m.edges[static_cast<size_t>(co.edge)];
+    std::vector<double> ts = coedge_samples(e, co, 8);
+    if (!co.same_sense) std::reverse(ts.begin(), ts.end());
+    for (double t : ts) {
+      const Eigen::Vector3d p = surface::evaluate(co.pcurve, t);
+      poly.emplace_back(p.x(), p.y());
+    }
+  }
+  double twice = 0;
+  for (size_t k = 0; k < poly.size(); ++k) {
+    const Eigen::Vector2d& p = poly[k];
+    const Eigen::Vector2d& q = poly[(k + 1) % poly.size()];
+    twice += p.x() * q.y() - q.x() * p.y();
+  }
+  return twice / 2;
+}
+
+/// The vertex a coedge starts (or ends) at, in loop order.
+int first_vertex(const Edge& e, const Coedge& c) { return c.same_sense ? e.start : e.end; }
+int last_vertex(const Edge& e, const Coedge& c) { return c.same_sense ? e.end : e.start; }
+
+bool colour_ok(const std::optional<Colour>& c) {
+  if (!c) return true;
+  for (double x : {c->r, c->g, c->b})
+    if (!(x >= 0 && x <= 1)) return false;
+  return true;
+}
+
+std::string colour_text(const Colour& c) {
+  return "(" + shortest(c.r) + ", " + shortest(c.g) + ", " + shortest(c.b) + ")";
+}
+
+void vertex_and_edge_problems(const Model& m, std::vector<std::string>& out) {
+  for (size_t i = 0; i < m.vertices.size(); ++i) {
+    const Vertex& v = m.vertices[i];
+    if (!internal::all_finite(v.point))
+      out.push_back("vertex " + std::to_string(i) + ": its point has a non-finite coordinate");
+    if (!(std::isfinite(v.tolerance_mm) && v.tolerance_mm >= 0))
+      out.push_back("vertex " + std::to_string(i) + ": tolerance_mm = " + shortest(v.tolerance_mm) +
+                    " must be finite and >= 0");
+  }
+  for (size_t i = 0; i < m.edges.size(); ++i) {
+    const Edge& e = m.edges[i];
+    const std::string name = "edge " + std::to_string(i);
+    if (!(std::isfinite(e.tolerance_mm) && e.tolerance_mm >= 0))
+      out.push_back(name + ": tolerance_mm = " + shortest(e.tolerance_mm) +
+                    " must be finite and >= 0");
+    const bool ends_ok = in_range(e.start, m.vertices.size()) && in_range(e.end, m.vertices.size());
+    if (!ends_ok)
+      out.push_back(name + ": vertex indices (" + std::to_string(e.start) + ", " +
+                    std::to_string(e.end) + ") are not both among the " +
+                    std::to_string(m.vertices.size()) + " vertices");
+    if (!(std::isfinite(e.t0) && std::isfinite(e.t1) && e.t0 < e.t1))
+      out.push_back(name + ": its range [" + shortest(e.t0) + ", " + shortest(e.t1) +
+                    "] must be finite with t0 < t1");
+    if (e.degenerate) {
+      if (e.start != e.end)
+        out.push_back(name + ": a degenerate edge (a pole) starts and ends at one vertex, not at " +
+                      std::to_string(e.start) + " and " + std::to_string(e.end));
+      continue;
+    }
+    const auto curve = surface::problems(e.curve, name + "'s curve");
+    if (!curve.empty()) {
+      internal::append(out, curve);
+      continue;
+    }
+    const auto [a, b] = e.curve.basis.domain();
+    const double slack = parameter_slack(a, b);
+    if (e.t0 < a - slack || e.t1 > b + slack) {
+      out.push_back(name + ": its range [" + shortest(e.t0) + ", " + shortest(e.t1) +
+                    "] is not inside its curve's domain [" + shortest(a) + ", " + shortest(b) +
+                    "]");
+      continue;
+    }
+    if (!ends_ok || !(e.t0 < e.t1)) continue;
+    for (const auto& [t, vi, which] :
+         {std::tuple{e.t0, e.start, "start"}, std::tuple{e.t1, e.end, "end"}}) {
+      const Vertex& v = m.vertices[static_cast<size_t>(vi)];
+      const double d = (surface::evaluate(e.curve, t) - v.point).norm();
+      if (!(d <= e.tolerance_mm + v.tolerance_mm))
+        out.push_back(name + ": its " + which + " is " + shortest(d) + " mm from vertex " +
+                      std::to_string(vi) + ", more than the tolerances allow (" +
+                      shortest(e.tolerance_mm) + " + " + shortest(v.tolerance_mm) + " mm)");
+    }
+  }
+}
+
+/// Face, loop and coedge problems.
+void face_problems(const Model& m, std::vector<std::string>& out) {
+  for (size_t fi = 0; fi < m.faces.size(); ++fi) {
+    const int f = static_cast<int>(fi);
+    const Face& face = m.faces[fi];
+    const auto surface = surface::problems(face.surface, face_name(m, f) + "'s surface");
+    if (!surface.empty()) {
+      internal::append(out, surface);
+      continue;
+    }
+    if (!colour_ok(face.colour))
+      out.push_back(face_name(m, f) + ": colour " + colour_text(*face.colour) +
+                    " has a component outside [0, 1]");
+    const auto [u0, u1] = face.surface.u.domain();
+    const auto [v0, v1] = face.surface.v.domain();
+    const double uv_slack = 1e-9 * std::max(u1 - u0, v1 - v0);
+    for (size_t li = 0; li < face.loops.size(); ++li) {
+      const Loop& loop = face.loops[li];
+      const int l = static_cast<int>(li);
+      const std::string loop_name = face_name(m, f) + " loop " + std::to_string(l);
+      if (loop.coedges.empty()) {
+        out.push_back(loop_name + ": has no coedges");
+        continue;
+      }
+      bool loop_ok = true;
+      for (size_t ci = 0; ci < loop.coedges.size(); ++ci) {
+        const int c = static_cast<int>(ci);
+        const auto own = coedge_problems(m, f, l, c);
+        if (!own.empty()) {
+          internal::append(out, own);
+          loop_ok = false;
+          continue;
+        }
+        const Coedge& co = loop.coedges[ci];
+        const Edge& e = m.edges[static_cast<size_t>(co.edge)];
+        if (!e.degenerate && !surface::problems(e.curve).empty()) {
+          loop_ok = false;  // reported with the edge
+          continue;
+        }
+        if (!in_range(e.start, m.vertices.size()) || !in_range(e.end, m.vertices.size())) {
+          loop_ok = false;
+          continue;
+        }
+        // Inside the surface's domain, at the samples.
+        for (double t : coedge_samples(e, co, 4)) {
+          const Eigen::Vector3d p = surface::evaluate(co.pcurve, t);
+          if (p.x() < u0 - uv_slack || p.x() > u1 + uv_slack || p.y() < v0 - uv_slack ||
+              p.y() > v1 + uv_slack) {
+            out.push_back(coedge_name(m, f, l, c) + ": the pcurve leaves the surface's domain [" +
+                          shortest(u0) + ", " + shortest(u1) + "] x [" + shortest(v0) + ", " +
+                          shortest(v1) + "] at t = " + shortest(t) + " (u, v) = (" +
+                          shortest(p.x()) + ", " + shortest(p.y()) + ")");
+            break;
+          }
+        }
+        const EdgeGap g = gap_of(m, f, l, c, 16);
+        if (!(g.gap_mm <= e.tolerance_mm))
+          out.push_back(coedge_name(m, f, l, c) + ": the face is " + shortest(g.gap_mm) +
+                        " mm from edge " + std::to_string(co.edge) + " at t = " + shortest(g.t) +
+                        ", more than the edge's tolerance " + shortest(e.tolerance_mm) + " mm");
+      }
+      if (!loop_ok) continue;
+      // Closed: each coedge ends where the next one starts.
+      for (size_t ci = 0; ci < loop.coedges.size(); ++ci) {
+        const Coedge& a = loop.coedges[ci];
+        const Coedge& b = loop.coedges[(ci + 1) % loop.coedges.size()];
+        const int end = last_vertex(m.edges[static_cast<size_t>(a.edge)], a);
+        const int start = first_vertex(m.edges[static_cast<size_t>(b.edge)], b);
+        if (end != start)
+          out.push_back(loop_name + " is open: coedge " + std::to_string(ci) + " ends at vertex " +
+                        std::to_string(end) + " but coedge " +
+                        std::to_string((ci + 1) % loop.coedges.size()) + " starts at vertex " +
+                        std::to_string(start));
+      }
+      const double area = signed_area(m, loop);
+      if (l == 0 && !(area > 0))
+        out.push_back(loop_name + " (the outer loop) runs clockwise in (u, v) (signed area " +
+                      shortest(area) +
+                      "); the outer loop runs counter-clockwise, face on its left");
+      if (l > 0 && !(area < 0))
+        out.push_back(loop_name + " (a hole) runs counter-clockwise in (u, v) (signed area " +
+                      shortest(area) + "); holes run clockwise, face on their left");
+    }
+  }
+}
+
+void shell_problems(const Model& m, std::vector<std::string>& out) {
+  std::vector<int> shell_of_face(m.faces.size(), -1);
+  std::vector<int> uses(m.edges.size(), 0);
+  int shell_index = 0;
+  for (size_t bi = 0; bi < m.bodies.size(); ++bi) {
+    const Body& body = m.bodies[bi];
+    const std::string body_name =
+        "body " + std::to_string(bi) + (body.name.empty() ? "" : " (\"" + body.name + "\")");
+    if (!colour_ok(body.colour))
+      out.push_back(body_name + ": colour " + colour_text(*body.colour) +
+                    " has a component outside [0, 1]");
+    if (body.shells.empty()) out.push_back(body_name + ": has no shells");
+    for (size_t si = 0; si < body.shells.size(); ++si, ++shell_index) {
+      const Shell& shell = body.shells[si];
+      const std::string shell_name = body_name + " shell " + std::to_string(si);
+      if (shell.faces.empty()) out.push_back(shell_name + ": has no faces");
+      // Each use of an edge in this shell: the face and its direction around the outward normal.
+      std::map<int, std::vector<std::pair<int, bool>>> used;
+      for (int f : shell.faces) {
+        if (!in_range(f, m.faces.size())) {
+          out.push_back(shell_name + ": face index " + std::to_string(f) + " is not one of the " +
+                        std::to_string(m.faces.size()) + " faces");
+          continue;
+        }
+        int& owner = shell_of_face[static_cast<size_t>(f)];
+        if (owner >= 0)
+          out.push_back(shell_name + ": " + face_name(m, f) + " is already in another shell");
+        owner = shell_index;
+        const Face& face = m.faces[static_cast<size_t>(f)];
+        if (body.kind == BodyKind::Solid && face.loops.empty())
+          out.push_back(shell_name + ": " + face_name(m, f) +
+                        " has no loops; a solid's faces are bounded by edges it shares");
+        for (const Loop& loop : face.loops)
+          for (const Coedge& co : loop.coedges) {
+            if (!in_range(co.edge, m.edges.size())) continue;  // reported with the face
+            if (m.edges[static_cast<size_t>(co.edge)].degenerate) continue;
+            used[co.edge].emplace_back(f, co.same_sense != face.reversed);
+          }
+      }
+      for (const auto& [edge, list] : used) {
+        if (list.size() > 2) {
+          out.push_back(shell_name + ": edge " + std::to_string(edge) + " is used by " +
+                        std::to_string(list.size()) +
+                        " coedges; a shell is a manifold: at most two faces meet along an edge");
+        } else if (list.size() == 2 && list[0].second == list[1].second) {
+          out.push_back(shell_name + ": " + face_name(m, list[0].first) + " and " +
+                        face_name(m, list[1].first) + " both run along edge " +
+                        std::to_string(edge) +
+                        " in the same direction: their orientations disagree (reverse one face)");
+        } else if (list.size() == 1) {
+          if (body.kind == BodyKind::Solid)
+            out.push_back(shell_name + " does not close: edge " + std::to_string(edge) +
+                          " is used by " + face_name(m, list[0].first) +
+                          " only; a solid's shells are closed");
+        }
+      }
+    }
+  }
+  for (size_t f = 0; f < m.faces.size(); ++f) {
+    if (shell_of_face[f] < 0)
+      out.push_back(face_name(m, static_cast<int>(f)) + " belongs to no body; put it in a shell");
+    for (const Loop& loop : m.faces[f].loops)
+      for (const Coedge& co : loop.coedges)
+        if (in_range(co.edge, m.edges.size())) ++uses[static_cast<size_t>(co.edge)];
+  }
+  for (size_t e = 0; e < m.edges.size(); ++e)
+    if (uses[e] == 0) out.push_back("edge " + std::to_string(e) + " is dangling: no face uses it");
+}
+
+void assembly_problems(const Model& m, std::vector<std::string>& out) {
+  auto check_instance = [&](const Instance& in, const std::string& where) {
+    if (!in_range(in.part, m.parts.size()))
+      out.push_back(where + ": part index " + std::to_string(in.part) + " is not one of the " +
+                    std::to_string(m.parts.size()) + " parts");
+    if (!internal::all_finite(in.placement.matrix()))
+      out.push_back(where + ": its placement has a non-finite entry");
+  };
+  for (size_t r = 0; r < m.roots.size(); ++r)
+    check_instance(m.roots[r], "root instance " + std::to_string(r));
+  for (size_t p = 0; p < m.parts.size(); ++p) {
+    const Part& part = m.parts[p];
+    const std::string name =
+        "part " + std::to_string(p) + (part.name.empty() ? "" : " (\"" + part.name + "\")");
+    for (int b : part.bodies)
+      if (!in_range(b, m.bodies.size()))
+        out.push_back(name + ": body index " + std::to_string(b) + " is not one of the " +
+                      std::to_string(m.bodies.size()) + " bodies");
+    for (size_t k = 0; k < part.components.size(); ++k)
+      check_instance(part.components[k], name + " component " + std::to_string(k));
+    if (!colour_ok(part.colour))
+      out.push_back(name + ": colour " + colour_text(*part.colour) +
+                    " has a component outside [0, 1]");
+  }
+  // No cycle: depth-first, 0 unvisited, 1 on the path, 2 done.
+  std::vector<int> state(m.parts.size(), 0);
+  auto visit = [&](auto& self, int p) -> void {
+    state[static_cast<size_t>(p)] = 1;
+    for (const Instance& in : m.parts[static_cast<size_t>(p)].components) {
+      if (!in_range(in.part, m.parts.size())) continue;
+      const int s = state[static_cast<size_t>(in.part)];
+      if (s == 1)
+        out.push_back("part " + std::to_string(in.part) +
+                      " contains itself (an assembly cycle through part " + std::to_string(p) +
+                      ")");
+      else if (s == 0)
+        self(self, in.part);
+    }
+    state[static_cast<size_t>(p)] = 2;
+  };
+  for (size_t p = 0; p < m.parts.size(); ++p)
+    if (state[p] == 0) visit(visit, static_cast<int>(p));
+}
+
+}  // namespace
+
+Counts counts(const Model& model) {
+  Counts c;
+  c.bodies = static_cast<int>(model.bodies.size());
+  for (const Body& b : model.bodies) {
+    c.solids += b.kind == BodyKind::Solid;
+    c.shells += static_cast<int>(b.shells.size());
+  }
+  c.faces = static_cast<int>(model.faces.size());
+  for (const Face& f : model.faces) {
+    c.trimmed_faces += !f.loops.empty();
+    c.loops += static_cast<int>(f.loops.size());
+    c.inner_loops += f.loops.empty() ? 0 : static_cast<int>(f.loops.size()) - 1;
+    for (const Loop& l : f.loops) c.coedges += static_cast<int>(l.coedges.size());
+  }
+  c.edges = static_cast<int>(model.edges.size());
+  for (const Edge& e : model.edges) c.degenerate_edges += e.degenerate;
+  c.vertices = static_cast<int>(model.vertices.size());
+  c.parts = static_cast<int>(model.parts.size());
+  c.instances = static_cast<int>(model.roots.size());
+  for (const Part& p : model.parts) c.instances += static_cast<int>(p.components.size());
+  return c;
+}
+
+std::vector<EdgeGap> edge_gaps(const Model& model, int samples_per_span) {
+  if (samples_per_span < 1)
+    throw Error(ErrorCategory::InvalidArgument,
+                "edge_gaps: samples_per_span = " + std::to_string(samples_per_span) +
+                    " must be >= 1 (16 samples each knot span by default)");
+  std::vector<EdgeGap> out;
+  std::vector<std::string> bad;
+  for (size_t f = 0; f < model.faces.size(); ++f) {
+    const Face& face = model.faces[f];
+    internal::append(
+        bad, surface::problems(face.surface, face_name(model, static_cast<int>(f)) + "'s surface"));
+    if (!bad.empty()) internal::throw_problems(ErrorCategory::InvalidGeometry, bad);
+    for (size_t l = 0; l < face.loops.size(); ++l)
+      for (size_t c = 0; c < face.loops[l].coedges.size(); ++c) {
+        const int fi = static_cast<int>(f), li = static_cast<int>(l), ci = static_cast<int>(c);
+        bad = coedge_problems(model, fi, li, ci);
+        const Coedge& co = face.loops[l].coedges[c];
+        if (bad.empty()) {
+          const Edge& e = model.edges[static_cast<size_t>(co.edge)];
+          if (e.degenerate && !in_range(e.start, model.vertices.size()))
+            bad.push_back("edge " + std::to_string(co.edge) + ": a pole without a vertex");
+          if (!e.degenerate)
+            internal::append(
+                bad, surface::problems(e.curve, "edge " + std::to_string(co.edge) + "'s curve"));
+        }
+        if (!bad.empty()) internal::throw_problems(ErrorCategory::InvalidGeometry, bad);
+        out.push_back(gap_of(model, fi, li, ci, samples_per_span));
+      }
+  }
+  return out;
+}
+
+std::vector<std::string> problems(const Model& model) {
+  std::vector<std::string> out;
+  vertex_and_edge_problems(model, out);
+  face_problems(model, out);
+  shell_problems(model, out);
+  assembly_problems(model, out);
+  return out;
+}
+
+void validate(const Model& model) {
+  const auto list = problems(model);
+  if (!list.empty()) internal::throw_problems(ErrorCategory::InvalidGeometry, list);
+}
+
+std::string_view to_string(BodyKind kind) noexcept {
+  switch (kind) {
+    case BodyKind::Solid:
+      return "solid";
+    case BodyKind::Shell:
+      return "shell";
+    case BodyKind::Sheet:
+      return "sheet";
+  }
+  return "unknown";
+}
+
+}  // namespace clay::brep

@@ -1,0 +1,409 @@
+// The B-rep model (clay/brep/model.hpp): counts, edge gaps and every invariant problems() checks,
+// on models built here by hand from planar faces, whose edges, pcurves and gaps have closed forms.
+#include <catch2/catch.hpp>
+
+#include <clay/brep.hpp>
+#include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/bspline_surface.hpp>
+
+#include <algorithm>
+#include <map>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "error_of.hpp"
+
+using Catch::Matchers::Contains;
+using clay::brep::Body;
+using clay::brep::BodyKind;
+using clay::brep::Coedge;
+using clay::brep::Edge;
+using clay::brep::Face;
+using clay::brep::Loop;
+using clay::brep::Model;
+using clay::brep::Vertex;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+namespace {
+
+clay::surface::BSplineCurve line(const Vector3d& a, const Vector3d& b) {
+  clay::surface::Points3 p(2, 3);
+  p.row(0) = a;
+  p.row(1) = b;
+  return clay::surface::make_curve(1, {0, 0, 1, 1}, p);
+}
+
+/// Builds models from planar quadrilateral faces S(u, v) = o + u e1 + v e2 on [0, 1]^2, sharing
+/// vertices by position and edges by their pair of vertices.
+struct Builder {
+  Model m;
+  std::map<std::tuple<double, double, double>, int> vertex_at;
+  std::map<std::pair<int, int>, int> edge_between;
+
+  int vertex(const Vector3d& p) {
+    const auto key = std::tuple{p.x(), p.y(), p.z()};
+    if (auto it = vertex_at.find(key); it != vertex_at.end()) return it->second;
+    m.vertices.push_back({p, 1e-9});
+    return vertex_at[key] = static_cast<int>(m.vertices.size()) - 1;
+  }
+
+  /// The coedge from corner a to corner b of a face (3D points pa, pb; (u, v) at ua, ub): the edge
+  /// runs from its lower vertex index to its higher one, the pcurve with the same parameter.
+  Coedge coedge(const Vector3d& pa, const Vector3d& pb, const Vector2d& ua, const Vector2d& ub) {
+    const int a = vertex(pa), b = vertex(pb);
+    const bool forward = a < b;
+    const auto key = std::pair{std::min(a, b), std::max(a, b)};
+    int e;
+    if (auto it = edge_between.find(key); it != edge_between.end()) {
+      e = it->second;
+    } else {
+      Edge edge;
+      edge.curve = forward ? line(pa, pb) : line(pb, pa);
+      edge.start = key.first;
+      edge.end = key.second;
+      edge.tolerance_mm = 1e-9;
+      m.edges.push_back(edge);
+      e = edge_between[key] = static_cast<int>(m.edges.size()) - 1;
+    }
+    const Vector2d s = forward ? ua : ub, t = forward ? ub : ua;
+    return {e, forward, line({s.x(), s.y(), 0}, {t.x(), t.y(), 0})};
+  }
+
+  /// A loop through the given (u, v) corners of a face, in order.
+  Loop loop(const Face& f, const std::vector<Vector2d>& uv) {
+    Loop l;
+    for (size_t k = 0; k < uv.size(); ++k) {
+      const Vector2d& a = uv[k];
+      const Vector2d& b = uv[(k + 1) % uv.size()];
+      l.coedges.push_back(coedge(at(f, a), at(f, b), a, b));
+    }
+    return l;
+  }
+
+  static Vector3d at(const Face& f, const Vector2d& uv) {
+    const auto& p = f.surface.points;  // bilinear: rows (0,0), (0,1), (1,0), (1,1)
+    return (1 - uv.x()) * (1 - uv.y()) * Vector3d(p.row(0)) +
+           (1 - uv.x()) * uv.y() * Vector3d(p.row(1)) + uv.x() * (1 - uv.y()) * Vector3d(p.row(2)) +
+           uv.x() * uv.y() * Vector3d(p.row(3));
+  }
+
+  /// A planar face o + u e1 + v e2 bounded by its four sides, counter-clockwise in (u, v).
+  int quad(const Vector3d& o, const Vector3d& e1, const Vector3d& e2, std::string name = "") {
+    Face f;
+    clay::surface::Points3 p(4, 3);
+    p.row(0) = o;
+    p.row(1) = o + e2;
+    p.row(2) = o + e1;
+    p.row(3) = o + e1 + e2;
+    f.surface = clay::surface::make_surface({1, {0, 0, 1, 1}}, {1, {0, 0, 1, 1}}, p);
+    f.name = std::move(name);
+    f.loops.push_back(loop(f, {{0, 0}, {1, 0}, {1, 1}, {0, 1}}));
+    m.faces.push_back(std::move(f));
+    return static_cast<int>(m.faces.size()) - 1;
+  }
+};
+
+/// The cube [0, a]^3 as a solid: six faces with outward normals e1 × e2, 12 shared edges.
+Model cube(double a = 10) {
+  Builder b;
+  const Vector3d x(a, 0, 0), y(0, a, 0), z(0, 0, a), o = Vector3d::Zero();
+  b.quad(o, y, x, "bottom");  // y × x = -z
+  b.quad(z, x, y, "top");
+  b.quad(o, z, y, "x0");  // z × y = -x
+  b.quad(x, y, z, "x1");
+  b.quad(o, x, z, "y0");  // x × z = -y
+  b.quad(y, z, x, "y1");
+  Body body;
+  body.kind = BodyKind::Solid;
+  body.name = "cube";
+  body.shells.push_back({{0, 1, 2, 3, 4, 5}});
+  b.m.bodies.push_back(body);
+  return b.m;
+}
+
+std::string all(const std::vector<std::string>& list) {
+  std::string s;
+  for (const auto& p : list) s += p + "\n";
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("a cube built by hand is a valid closed solid with the expected counts", "[brep]") {
+  const Model m = cube();
+  INFO(all(clay::brep::problems(m)));
+  CHECK(clay::brep::problems(m).empty());
+  CHECK_NOTHROW(clay::brep::validate(m));
+  const auto c = clay::brep::counts(m);
+  CHECK(c.bodies == 1);
+  CHECK(c.solids == 1);
+  CHECK(c.shells == 1);
+  CHECK(c.faces == 6);
+  CHECK(c.trimmed_faces == 6);
+  CHECK(c.loops == 6);
+  CHECK(c.inner_loops == 0);
+  CHECK(c.coedges == 24);
+  CHECK(c.edges == 12);  // a cube's 12 edges, each shared by two faces
+  CHECK(c.degenerate_edges == 0);
+  CHECK(c.vertices == 8);
+  CHECK(c.parts == 0);
+  CHECK(c.instances == 0);
+  CHECK_FALSE(m.is_assembly());
+  CHECK(clay::brep::to_string(BodyKind::Solid) == "solid");
+  CHECK(clay::brep::to_string(BodyKind::Sheet) == "sheet");
+}
+
+TEST_CASE("edge_gaps measures the face against its edge along the pcurve", "[brep]") {
+  Model m = cube(10);
+  const auto gaps = clay::brep::edge_gaps(m);
+  REQUIRE(gaps.size() == 24);
+  for (const auto& g : gaps) CHECK(g.gap_mm < 1e-14);  // affine faces and lines: rounding only
+  // Shift one pcurve by dv along v (inside the domain): the face point moves by dv * |e2| =
+  // dv * 10 mm (closed form), the same at every t.
+  const double dv = 1e-3;
+  auto& co = m.faces[1].loops[0].coedges[2];  // top face, from (1, 1) to (0, 1)
+  co.pcurve.points.col(1).array() -= dv;
+  const auto shifted = clay::brep::edge_gaps(m, 4);
+  const auto& g = shifted[1 * 4 + 2];
+  CHECK(g.face == 1);
+  CHECK(g.loop == 0);
+  CHECK(g.coedge == 2);
+  CHECK(g.edge == co.edge);
+  CHECK(g.gap_mm == Approx(dv * 10).epsilon(1e-9));
+  const auto list = clay::brep::problems(m);
+  REQUIRE(list.size() == 1);
+  CHECK_THAT(list[0], Contains("face 1 (\"top\") loop 0 coedge 2: the face is 0.0"));
+  CHECK_THAT(list[0], Contains(" mm from edge " + std::to_string(co.edge) + " at t = "));
+  CHECK_THAT(list[0], Contains("more than the edge's tolerance 1e-09 mm"));
+}
+
+TEST_CASE("problems names a face whose orientation disagrees with its neighbours", "[brep]") {
+  Model m = cube();
+  m.faces[3].reversed = true;  // "x1" now claims its outward side points into the cube
+  // Its four edges, and nothing else.
+  const auto list = clay::brep::problems(m);
+  REQUIRE(list.size() == 4);
+  for (const auto& p : list) {
+    CHECK_THAT(p, Contains("face 3 (\"x1\")"));
+    CHECK_THAT(p,
+               Contains("in the same direction: their orientations disagree (reverse one face)"));
+  }
+  const auto [category, what] = clay::test::error_of([&] { clay::brep::validate(m); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(what, Contains("orientations disagree"));
+}
+
+TEST_CASE("problems finds a solid that does not close, a loose face and a dangling edge",
+          "[brep]") {
+  Model m = cube();
+  m.bodies[0].shells[0].faces.pop_back();  // "y1" leaves the shell
+  const std::string list = all(clay::brep::problems(m));
+  CHECK_THAT(list, Contains("body 0 (\"cube\") shell 0 does not close: edge"));
+  CHECK_THAT(list, Contains("a solid's shells are closed"));
+  CHECK_THAT(list, Contains("face 5 (\"y1\") belongs to no body; put it in a shell"));
+  // The same five faces as an open shell body: only the loose face remains a problem.
+  m.bodies[0].kind = BodyKind::Shell;
+  const auto open = clay::brep::problems(m);
+  REQUIRE(open.size() == 1);
+  CHECK_THAT(open[0], Contains("belongs to no body"));
+  m.faces.pop_back();  // y1's edges are all shared: still used
+  CHECK(clay::brep::problems(m).empty());
+  m.edges.push_back(m.edges[0]);  // a copy no face refers to
+  const auto dangling = clay::brep::problems(m);
+  REQUIRE(dangling.size() == 1);
+  CHECK(dangling[0] == "edge 12 is dangling: no face uses it");
+}
+
+TEST_CASE("problems finds an open loop, an edge off its vertex and a pcurve off the plane",
+          "[brep]") {
+  SECTION("open loop") {
+    Model m = cube();
+    auto& coedges = m.faces[0].loops[0].coedges;
+    std::swap(coedges[1], coedges[2]);
+    CHECK_THAT(all(clay::brep::problems(m)),
+               Contains("face 0 (\"bottom\") loop 0 is open: coedge 0 ends at vertex"));
+  }
+  SECTION("an edge's end away from its vertex") {
+    Model m = cube();
+    m.vertices[m.edges[0].end].point.z() += 0.5;
+    CHECK_THAT(all(clay::brep::problems(m)),
+               Contains("edge 0: its end is 0.5 mm from vertex " + std::to_string(m.edges[0].end)));
+  }
+  SECTION("a pcurve off the plane z = 0") {
+    Model m = cube();
+    m.faces[2].loops[0].coedges[0].pcurve.points(0, 2) = 1e-3;
+    CHECK_THAT(all(clay::brep::problems(m)),
+               Contains("face 2 (\"x0\") loop 0 coedge 0: the pcurve leaves the plane z = 0"));
+  }
+  SECTION("a pcurve outside the surface's domain") {
+    Model m = cube();
+    m.faces[4].loops[0].coedges[0].pcurve.points.col(1).array() -= 0.25;
+    CHECK_THAT(all(clay::brep::problems(m)),
+               Contains("face 4 (\"y0\") loop 0 coedge 0: the pcurve leaves the surface's domain "
+                        "[0, 1] x [0, 1]"));
+  }
+  SECTION("indices out of range") {
+    Model m = cube();
+    m.faces[0].loops[0].coedges[0].edge = 99;
+    m.edges[3].start = -1;
+    m.bodies[0].shells[0].faces.push_back(42);
+    const std::string list = all(clay::brep::problems(m));
+    CHECK_THAT(
+        list,
+        Contains("face 0 (\"bottom\") loop 0 coedge 0: edge index 99 is not one of the 12 edges"));
+    CHECK_THAT(list, Contains("edge 3: vertex indices (-1, "));
+    CHECK_THAT(list, Contains("face index 42 is not one of the 6 faces"));
+    const auto [category, what] = clay::test::error_of([&] { (void)clay::brep::edge_gaps(m); });
+    CHECK(category == clay::ErrorCategory::InvalidGeometry);
+    CHECK_THAT(what, Contains("edge index 99"));
+  }
+  SECTION("a bad tolerance, range and colour") {
+    Model m = cube();
+    m.edges[1].tolerance_mm = -1;
+    m.edges[2].t1 = 1.5;
+    m.faces[1].colour = clay::brep::Colour{0.2, 1.5, 0};
+    const std::string list = all(clay::brep::problems(m));
+    CHECK_THAT(list, Contains("edge 1: tolerance_mm = -1 must be finite and >= 0"));
+    CHECK_THAT(list,
+               Contains("edge 2: its range [0, 1.5] is not inside its curve's domain [0, 1]"));
+    CHECK_THAT(list,
+               Contains("face 1 (\"top\"): colour (0.2, 1.5, 0) has a component outside [0, 1]"));
+  }
+  const auto [category, what] =
+      clay::test::error_of([&] { (void)clay::brep::edge_gaps(cube(), 0); });
+  CHECK(category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(what, Contains("samples_per_span = 0 must be >= 1"));
+}
+
+TEST_CASE("a face with a hole: the outer loop counter-clockwise, the hole clockwise", "[brep]") {
+  Builder b;
+  const int f = b.quad({0, 0, 0}, {10, 0, 0}, {0, 10, 0}, "plate");
+  Face& plate = b.m.faces[static_cast<size_t>(f)];
+  plate.loops.push_back(b.loop(plate, {{0.25, 0.25}, {0.25, 0.75}, {0.75, 0.75}, {0.75, 0.25}}));
+  Body sheet;
+  sheet.kind = BodyKind::Sheet;
+  sheet.shells.push_back({{f}});
+  b.m.bodies.push_back(sheet);
+  INFO(all(clay::brep::problems(b.m)));
+  CHECK(clay::brep::problems(b.m).empty());
+  const auto c = clay::brep::counts(b.m);
+  CHECK(c.inner_loops == 1);
+  CHECK(c.edges == 8);
+  CHECK(c.vertices == 8);
+  // Each loop run the other way round: both orientation rules are broken.
+  Model flipped = b.m;
+  for (Loop& l : flipped.faces[0].loops) {
+    std::reverse(l.coedges.begin(), l.coedges.end());
+    for (Coedge& co : l.coedges) co.same_sense = !co.same_sense;
+  }
+  const std::string list = all(clay::brep::problems(flipped));
+  // Signed areas in (u, v): the unit square's -1 and the hole's +0.25 (closed forms).
+  CHECK_THAT(
+      list,
+      Contains(
+          "face 0 (\"plate\") loop 0 (the outer loop) runs clockwise in (u, v) (signed area -1)"));
+  CHECK_THAT(list, Contains("face 0 (\"plate\") loop 1 (a hole) runs counter-clockwise in (u, v) "
+                            "(signed area 0.25)"));
+}
+
+TEST_CASE("a pole: a degenerate edge stands at its vertex", "[brep]") {
+  // A triangle as a bilinear patch whose side v = 1 collapses to the apex.
+  Model m;
+  const Vector3d a(0, 0, 0), b(10, 0, 0), apex(5, 8, 0);
+  m.vertices = {{a, 1e-9}, {b, 1e-9}, {apex, 1e-9}};
+  clay::surface::Points3 p(4, 3);
+  p.row(0) = a;
+  p.row(1) = apex;
+  p.row(2) = b;
+  p.row(3) = apex;
+  Face f;
+  f.surface = clay::surface::make_surface({1, {0, 0, 1, 1}}, {1, {0, 0, 1, 1}}, p);
+  auto edge = [&](const Vector3d& from, const Vector3d& to, int s, int e) {
+    Edge E;
+    E.curve = line(from, to);
+    E.start = s;
+    E.end = e;
+    E.tolerance_mm = 1e-9;
+    m.edges.push_back(E);
+  };
+  edge(a, b, 0, 1);     // v = 0
+  edge(b, apex, 1, 2);  // u = 1
+  edge(a, apex, 0, 2);  // u = 0
+  Edge pole;
+  pole.degenerate = true;
+  pole.start = pole.end = 2;
+  pole.tolerance_mm = 1e-9;
+  m.edges.push_back(pole);
+  Loop l;
+  l.coedges.push_back({0, true, line({0, 0, 0}, {1, 0, 0})});
+  l.coedges.push_back({1, true, line({1, 0, 0}, {1, 1, 0})});
+  l.coedges.push_back({3, true, line({1, 1, 0}, {0, 1, 0})});  // along the collapsed side
+  l.coedges.push_back({2, false, line({0, 0, 0}, {0, 1, 0})});
+  f.loops.push_back(l);
+  m.faces.push_back(f);
+  Body sheet;
+  sheet.kind = BodyKind::Sheet;
+  sheet.shells.push_back({{0}});
+  m.bodies.push_back(sheet);
+  INFO(all(clay::brep::problems(m)));
+  CHECK(clay::brep::problems(m).empty());
+  CHECK(clay::brep::counts(m).degenerate_edges == 1);
+  for (const auto& g : clay::brep::edge_gaps(m)) CHECK(g.gap_mm < 1e-14);
+  // A pole that claims two vertices is refused.
+  m.edges[3].end = 1;
+  CHECK_THAT(
+      all(clay::brep::problems(m)),
+      Contains("edge 3: a degenerate edge (a pole) starts and ends at one vertex, not at 2 and 1"));
+}
+
+TEST_CASE("problems finds an edge shared by three faces", "[brep]") {
+  Builder b;
+  // Three fins on the x axis, all sharing the edge from (0,0,0) to (10,0,0).
+  const Vector3d x(10, 0, 0);
+  b.quad({0, 0, 0}, x, {0, 5, 0});
+  b.quad({0, 0, 0}, x, {0, 0, 5});
+  b.quad({0, 0, 0}, x, {0, -5, 0});
+  Body body;
+  body.kind = BodyKind::Shell;
+  body.shells.push_back({{0, 1, 2}});
+  b.m.bodies.push_back(body);
+  CHECK_THAT(all(clay::brep::problems(b.m)),
+             Contains("edge 0 is used by 3 coedges; a shell is a manifold: at most two faces meet "
+                      "along an edge"));
+}
+
+TEST_CASE("the assembly tree: instances of a part, bad references and cycles", "[brep]") {
+  Model m = cube();
+  clay::brep::Part part;
+  part.name = "cube part";
+  part.bodies = {0};
+  m.parts.push_back(part);
+  clay::brep::Part pair;
+  pair.name = "two cubes";
+  Eigen::Isometry3d moved = Eigen::Isometry3d::Identity();
+  moved.translate(Vector3d(20, 0, 0));
+  pair.components = {{0, Eigen::Isometry3d::Identity(), "left"}, {0, moved, "right"}};
+  m.parts.push_back(pair);
+  m.roots.push_back({1, Eigen::Isometry3d::Identity(), "assembly"});
+  CHECK(m.is_assembly());
+  INFO(all(clay::brep::problems(m)));
+  CHECK(clay::brep::problems(m).empty());
+  const auto c = clay::brep::counts(m);
+  CHECK(c.parts == 2);
+  CHECK(c.instances == 3);  // the root and the two cubes
+  SECTION("a cycle") {
+    m.parts[0].components.push_back({1, Eigen::Isometry3d::Identity(), "loop"});
+    CHECK_THAT(all(clay::brep::problems(m)),
+               Contains("contains itself (an assembly cycle through part"));
+  }
+  SECTION("missing parts and bodies") {
+    m.parts[0].bodies.push_back(7);
+    m.roots.push_back({5, Eigen::Isometry3d::Identity(), ""});
+    const std::string list = all(clay::brep::problems(m));
+    CHECK_THAT(list, Contains("part 0 (\"cube part\"): body index 7 is not one of the 1 bodies"));
+    CHECK_THAT(list, Contains("root instance 1: part index 5 is not one of the 2 parts"));
+  }
+}
