@@ -15,6 +15,7 @@
 #include <deque>
 #include <functional>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "bernstein_poly.hpp"
+#include "lattice_monomials.hpp"
 #include "messages.hpp"
 #include "patch_containment.hpp"
 #include "seal.hpp"
@@ -41,6 +43,7 @@ constexpr const char* coordinate_name[3] = {"s", "t", "u"};
 using detail::constant_poly;
 using detail::exact_degree;
 using detail::halve;
+using detail::LatticeMonomials;
 using detail::leaves;
 using detail::mul_add;
 using detail::multiply;
@@ -103,6 +106,7 @@ struct Factor {
   double value = 0;
   int du = 0, dv = 0;
   Poly s, v;  // scaled
+  Poly w;     // W, scaled, at its exact degrees: the powers W^k of compose_by_monomials
 };
 
 /// W's exact degrees (reduced coefficients kept positive).
@@ -125,6 +129,8 @@ bool constant_coordinate(const Poly& c, const Poly& w, double c_scale, double& c
 /// `wd`: constant, or the pair at the homogeneous degrees max(deg C, deg W) per direction.
 Factor make_factor(const Poly& c, const Poly& w, double c_scale, std::pair<int, int> wd) {
   Factor f;
+  f.w = to_degree(to_degree(w, wd.first, 0), wd.second, 1);
+  scale(f.w, false);
   double c0 = 0;
   if (constant_coordinate(c, w, c_scale, c0)) {
     f.constant = true;
@@ -215,6 +221,130 @@ ComposedPatch compose_patch(const BezierLattice& cell, const std::array<Factor, 
   out.du = out.h.du;
   out.dv = out.h.dv;
   return out;
+}
+
+// ---- the same composition monomial by monomial, at the lattice's true total degree ----------
+
+/// The exponent sum of a monomial over the coordinates that are not constant on the patch.
+int varying_exponent(const std::array<Factor, 3>& f, const std::array<int, 3>& e) {
+  int sum = 0;
+  for (size_t d = 0; d < 3; ++d)
+    if (!f[d].constant) sum += e[d];
+  return sum;
+}
+
+/// The largest varying_exponent over the monomials: the power of W in the homogeneous form.
+int varying_degree(const std::array<Factor, 3>& f, const LatticeMonomials& lm) {
+  int t = 0;
+  for (const auto& e : lm.exponents) t = std::max(t, varying_exponent(f, e));
+  return t;
+}
+
+/// Degrees of the composition written term by term: X W^T = Σ_k x_k Π_d S_d^(a_d) W^(T − Σ a_d)
+/// (constant coordinates contribute c_d^(a_d), no degree), so a term has degree Σ a_d deg S_d +
+/// (T − Σ a_d) deg W in each direction, and the composition the largest of them. Never above
+/// composed_degrees (a_d <= the lattice degree along d, deg W <= deg S_d).
+std::pair<int, int> monomial_degrees(const std::array<Factor, 3>& f, const LatticeMonomials& lm) {
+  const int t = varying_degree(f, lm);
+  int du = 0, dv = 0;
+  for (const auto& e : lm.exponents) {
+    const int rest = t - varying_exponent(f, e);
+    int tu = rest * f[0].w.du, tv = rest * f[0].w.dv;
+    for (size_t d = 0; d < 3; ++d)
+      if (!f[d].constant) tu += e[d] * f[d].du, tv += e[d] * f[d].dv;
+    du = std::max(du, tu);
+    dv = std::max(dv, tv);
+  }
+  return {du, dv};
+}
+
+/// The scaled Bernstein form of the constant 1 at degrees (du, dv): multiplying by it raises a
+/// scaled poly's degrees exactly.
+Poly scaled_one(int du, int dv) {
+  Poly one(du, dv, 1);
+  const auto& bu = internal::binomial_row(du);
+  const auto& bv = internal::binomial_row(dv);
+  for (int i = 0; i <= du; ++i)
+    for (int j = 0; j <= dv; ++j)
+      one.at(i, j) = bu[static_cast<size_t>(i)] * bv[static_cast<size_t>(j)];
+  return one;
+}
+
+/// Sederberg–Parry eq. (2) expanded in the power basis of (s, t, u), with the factors'
+/// polynomials in place of s, t, u: Σ_k x_k Π_d S_d^(a_d) W^(T − Σ a_d) over the lattice's
+/// monomials, each term raised to the common degrees. Used when the lattice's true total degree
+/// gives lower degrees than the tensor product (an affine lattice keeps the surface's degrees).
+ComposedPatch compose_by_monomials(const LatticeMonomials& lm, const std::array<Factor, 3>& f,
+                                   bool rational) {
+  const int t = varying_degree(f, lm);
+  const auto [du, dv] = monomial_degrees(f, lm);
+  std::vector<Poly> w_power{constant_poly(1)};
+  for (int k = 1; k <= t; ++k) w_power.push_back(multiply(w_power.back(), f[0].w));
+  std::array<std::vector<Poly>, 3> s_power;
+  for (size_t d = 0; d < 3; ++d) {
+    if (f[d].constant) continue;
+    s_power[d].push_back(constant_poly(1));
+    for (const auto& e : lm.exponents)
+      while (static_cast<int>(s_power[d].size()) <= e[d])
+        s_power[d].push_back(multiply(s_power[d].back(), f[d].s));
+  }
+  Poly sum(du, dv, 3);
+  for (size_t k = 0; k < lm.exponents.size(); ++k) {
+    const auto& e = lm.exponents[k];
+    double constant = 1;
+    Poly term = w_power[static_cast<size_t>(t - varying_exponent(f, e))];
+    for (size_t d = 0; d < 3; ++d) {
+      if (f[d].constant)
+        constant *= std::pow(f[d].value, e[d]);
+      else
+        term = multiply(term, s_power[d][static_cast<size_t>(e[d])]);
+    }
+    Poly vector_term(term.du, term.dv, 3);
+    for (size_t c = 0; c < term.c.size(); ++c)
+      for (size_t d = 0; d < 3; ++d)
+        vector_term.c[3 * c + d] =
+            term.c[c] * constant * lm.coefficients[k][static_cast<Eigen::Index>(d)];
+    mul_add(vector_term, scaled_one(du - term.du, dv - term.dv), sum);
+  }
+  ComposedPatch out;
+  out.h = Poly(du, dv, 4);
+  const Poly weight = multiply(
+      w_power[static_cast<size_t>(t)],
+      scaled_one(du - w_power[static_cast<size_t>(t)].du, dv - w_power[static_cast<size_t>(t)].dv));
+  for (size_t c = 0; c < weight.c.size(); ++c) {
+    for (size_t d = 0; d < 3; ++d) out.h.c[4 * c + d] = sum.c[3 * c + d];
+    out.h.c[4 * c + 3] = rational ? weight.c[c] : 0.0;  // set to 1 below
+  }
+  scale(out.h, true);
+  if (!rational)  // exactly 1, as compose_patch appends it
+    for (size_t c = 0; c < weight.c.size(); ++c) out.h.c[4 * c + 3] = 1;
+  out.du = du;
+  out.dv = dv;
+  return out;
+}
+
+/// True when the lattice's monomials give lower degrees than the tensor product on this patch
+/// (and the power basis is well enough conditioned to compose by it).
+bool by_monomials(const std::array<Factor, 3>& f, const BezierLattice& cell,
+                  const LatticeMonomials& lm) {
+  if (!lm.usable()) return false;
+  const auto tensor = composed_degrees(f, cell.degrees);
+  const auto monomial = monomial_degrees(f, lm);
+  return monomial.first < tensor.first || monomial.second < tensor.second;
+}
+
+/// The degrees of a cell's composition on a patch, by the route compose_cell takes.
+std::pair<int, int> composition_degrees(const std::array<Factor, 3>& f, const BezierLattice& cell,
+                                        const LatticeMonomials& lm) {
+  return by_monomials(f, cell, lm) ? monomial_degrees(f, lm) : composed_degrees(f, cell.degrees);
+}
+
+/// One patch composed with one cell: monomial by monomial when that lowers the degrees,
+/// otherwise the de Casteljau route.
+ComposedPatch compose_cell(const BezierLattice& cell, const LatticeMonomials& lm,
+                           const std::array<Factor, 3>& f, bool rational) {
+  return by_monomials(f, cell, lm) ? compose_by_monomials(lm, f, rational)
+                                   : compose_patch(cell, f, rational);
 }
 
 /// C and W of coordinate d as one dim-2 poly.
@@ -590,6 +720,7 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
   const bool rational = surface.is_rational();
   const auto bp = surface::extract_bezier(surface);
   const auto dual = dual_vectors(lattice.frame);
+  const LatticeMonomials monomials = detail::lattice_monomials(lattice);
   const int np = static_cast<int>(bp.patches.size());
   std::vector<std::array<Factor, 3>> factors(static_cast<size_t>(np));
   for (int a = 0; a < bp.count_u(); ++a)
@@ -600,7 +731,7 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
           throw_outside(bp, a, b, d, *v, "Bézier lattice");
       auto& f = factors[static_cast<size_t>(a * bp.count_v() + b)];
       f = cell_factors(pc, {0, 0, 0}, {1, 1, 1});
-      const auto [du, dv] = composed_degrees(f, lattice.degrees);
+      const auto [du, dv] = composition_degrees(f, lattice, monomials);
       if (std::max(du, dv) > surface::max_exchange_degree)
         throw_degree(
             du, dv,
@@ -613,7 +744,7 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
     }
   std::vector<ComposedPatch> patches(static_cast<size_t>(np));
   for (size_t k = 0; k < patches.size(); ++k)
-    patches[k] = compose_patch(lattice, factors[k], rational);
+    patches[k] = compose_cell(lattice, monomials, factors[k], rational);
   return finish(
       bp, patches, rational, surface,
       [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); },
@@ -633,6 +764,8 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
   const auto counts = cells.counts();
   std::vector<std::array<Factor, 3>> factors(static_cast<size_t>(bp.patches.size()));
   std::vector<const BezierLattice*> cell_of(bp.patches.size());
+  // Each cell's monomials, found once for all the patches in it.
+  std::map<const BezierLattice*, LatticeMonomials> monomials_of;
   for (int a = 0; a < bp.count_u(); ++a)
     for (int b = 0; b < bp.count_v(); ++b) {
       const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
@@ -696,8 +829,11 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
       }
       const size_t k = static_cast<size_t>(a * bp.count_v() + b);
       cell_of[k] = &cells.cell(index[0], index[1], index[2]);
+      auto known = monomials_of.find(cell_of[k]);
+      if (known == monomials_of.end())
+        known = monomials_of.emplace(cell_of[k], detail::lattice_monomials(*cell_of[k])).first;
       factors[k] = cell_factors(pc, lo, width);
-      const auto [du, dv] = composed_degrees(factors[k], cell_of[k]->degrees);
+      const auto [du, dv] = composition_degrees(factors[k], *cell_of[k], known->second);
       if (std::max(du, dv) > surface::max_exchange_degree)
         throw_degree(
             du, dv,
@@ -710,7 +846,7 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
     }
   std::vector<ComposedPatch> patches(bp.patches.size());
   for (size_t k = 0; k < patches.size(); ++k)
-    patches[k] = compose_patch(*cell_of[k], factors[k], rational);
+    patches[k] = compose_cell(*cell_of[k], monomials_of.at(cell_of[k]), factors[k], rational);
   return finish(
       bp, patches, rational, split,
       [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); },

@@ -435,7 +435,9 @@ TEST_CASE("compose_exact composes a polynomial taper exactly") {
 TEST_CASE("compose_exact errors name the problem and the fix") {
   std::mt19937 rng(31);
   const Frame frame = clay::test::random_frame(rng);
-  const BezierLattice lattice = make_bezier_lattice(frame, {3, 3, 3});
+  // Displaced: a general tricubic FFD, total degree 9 (an undisplaced one is affine and keeps the
+  // surface's degrees).
+  const BezierLattice lattice = clay::test::displaced(make_bezier_lattice(frame, {3, 3, 3}), rng);
   const BSplineSurface inside = random_surface_in(frame, 3, 3, 4, 4, false, rng);
 
   SECTION("degree above the exchange limit") {
@@ -493,9 +495,10 @@ TEST_CASE("ComposeReport brief states the figures") {
   const Frame frame = clay::test::random_frame(rng);
   const BSplineSurface s = random_surface_in(frame, 2, 2, 3, 3, false, rng);
   const ComposeResult r = compose_exact(make_bezier_lattice(frame, {1, 1, 1}), s);
-  // The undisplaced lattice is the identity: degree (3*2, 3*2) by the rule, the same surface.
-  CHECK(r.report.degree_u == 6);
-  CHECK_THAT(r.report.brief(), Contains("degree 6 x 6") && Contains("1 patches"));
+  // The undisplaced lattice is the identity, of total degree 1: the surface comes back with its
+  // own degrees (2, 2), not the tensor-product rule's (3*2, 3*2).
+  CHECK(r.report.degree_u == 2);
+  CHECK_THAT(r.report.brief(), Contains("degree 2 x 2") && Contains("1 patches"));
   std::mt19937 rng2(4);
   CHECK(deviation(
             s, r.surface, [](const Eigen::Vector3d& p) { return p; }, 200, rng2) <= 1e-12 * 100);
@@ -519,6 +522,81 @@ TEST_CASE("compose_exact finds lower degrees: an axis-aligned affine sheet") {
   CHECK(deviation(
             s, r.surface, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); }, 300,
             rng) <= 1e-12 * clay::test::size_of(lattice.points));
+}
+
+TEST_CASE(
+    "compose_exact composes at the lattice's true total degree: affine lattices keep the "
+    "surface's degrees") {
+  std::mt19937 rng(29);
+  const Frame frame = clay::test::random_frame(rng);
+  const auto deviation_from = [&](const auto& lattice, const BSplineSurface& s,
+                                  const BSplineSurface& composed) {
+    return deviation(
+        s, composed, [&](const Eigen::Vector3d& p) { return deform_point(lattice, p); }, 500, rng);
+  };
+  SECTION("a trilinear lattice whose top corners all move by one vector, a tricubic affine one") {
+    BezierLattice trilinear = make_bezier_lattice(frame, {1, 1, 1});
+    const Eigen::Vector3d shift(3.0, -2.0, 5.0);
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        trilinear.points.row(trilinear.index(i, j, 1)) += shift.transpose();
+    // Control points of an affine map A x + b are the map of the undisplaced ones (Bernstein
+    // polynomials reproduce linear functions).
+    BezierLattice tricubic = make_bezier_lattice(frame, {3, 3, 3});
+    Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
+    a(0, 1) = 0.3, a(2, 0) = -0.2, a(1, 1) = 1.4;
+    for (Eigen::Index r = 0; r < tricubic.points.rows(); ++r)
+      tricubic.points.row(r) =
+          (a * tricubic.points.row(r).transpose()).transpose() + Eigen::RowVector3d(1, 2, 3);
+    for (bool rational : {false, true}) {
+      const BSplineSurface s = random_surface_in(frame, 3, 3, 6, 5, rational, rng);
+      for (const BezierLattice* lattice : {&trilinear, &tricubic}) {
+        // The tensor-product rule gives 3 (1 + 1 + 1) = 9 and 3 (3 + 3 + 3) = 27 (above the
+        // exchange limit 25); an affine map of a bicubic is a bicubic.
+        const ComposeResult r = compose_exact(*lattice, s);
+        CHECK(r.report.degree_u == 3);
+        CHECK(r.report.degree_v == 3);
+        CHECK(deviation_from(*lattice, s, r.surface) <=
+              1e-12 * clay::test::size_of(lattice->points));
+        CHECK(r.report.max_relative_deviation <= 1e-12);
+      }
+    }
+  }
+  SECTION("a tricubic lattice of total degree 2") {
+    // Local displacement s + 0.2 s^2, t + 0.2 t u, u: Bernstein coefficients i/3 + 0.2 i(i-1)/6,
+    // j/3 + 0.2 (j/3)(k/3), k/3 (s^2 = Σ C(i,2)/C(3,2) B_i^3). A general bicubic (and its weights)
+    // composes to degree 2 * 3 = 6, not 27.
+    BezierLattice quadratic = make_bezier_lattice(frame, {3, 3, 3});
+    for (int i = 0; i <= 3; ++i)
+      for (int j = 0; j <= 3; ++j)
+        for (int k = 0; k <= 3; ++k)
+          quadratic.points.row(quadratic.index(i, j, k)) =
+              frame
+                  .point(i / 3.0 + 0.2 * i * (i - 1) / 6.0, j / 3.0 + 0.2 * (j / 3.0) * (k / 3.0),
+                         k / 3.0)
+                  .transpose();
+    for (bool rational : {false, true}) {
+      const BSplineSurface s = random_surface_in(frame, 3, 3, 5, 5, rational, rng);
+      const ComposeResult r = compose_exact(quadratic, s);
+      CHECK(r.report.degree_u == 6);
+      CHECK(r.report.degree_v == 6);
+      CHECK(deviation_from(quadratic, s, r.surface) <=
+            1e-12 * clay::test::size_of(quadratic.points));
+    }
+  }
+  SECTION("an undisplaced B-spline lattice: the identity, cell by cell") {
+    const BSplineLattice identity = make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1});
+    std::vector<double> x{0.05, 0.3, 0.6, 0.7, 0.95}, y{0.1, 0.4, 0.6, 0.9};
+    std::uniform_real_distribution<double> h(0.2, 0.8);
+    const BSplineSurface s = surface_in(frame, 3, 2, 5, 4, false, rng, [&](int i, int j) {
+      return Eigen::Vector3d(x[size_t(i)], y[size_t(j)], h(rng));
+    });
+    const ComposeResult r = compose_exact(identity, s);
+    CHECK(r.report.splits > 0);
+    CHECK(r.report.degree_u == 3);
+    CHECK(r.report.degree_v == 2);
+    CHECK(deviation_from(identity, s, r.surface) <= 1e-12 * clay::test::size_of(identity.points));
+  }
 }
 
 TEST_CASE("Exact composition keeps a closed side closed and a pole a point, bit for bit",

@@ -10,12 +10,17 @@
 /// - Eq. (2) is evaluated with polynomials in place of numbers (homogeneous de Casteljau:
 ///   level r = (W − S) · level r−1 [i] + S · level r−1 [i+1], exact Bernstein products), giving a
 ///   patch with weights W^(l+m+n) for a rational surface.
-/// - Degrees are the smallest exact ones: in α, l·d_α(s) + m·d_α(t) + n·d_α(u), where d_α(c) is
+/// - Degrees are the smallest exact ones: in α at most l·d_α(s) + m·d_α(t) + n·d_α(u), where d_α(c)
+/// is
 ///   0 when c is constant on the patch and otherwise the larger of the α-degrees of its
 ///   homogeneous numerator and of W (the plain degree of c for a polynomial surface). A degree is
 ///   read off the Bernstein coefficients: the polynomial has degree e < p when the form reduced
 ///   to degree e (power-basis truncation) and elevated back to p reproduces every coefficient to
 ///   1e-14 of the rounding scale of the coordinates (control points times the dual edge vectors).
+///   When the lattice's polynomial has lower total degree than l + m + n (an affine lattice has
+///   1), the patch is composed monomial by monomial and gets max over the monomials s^a t^b u^c of
+///   a·d_α(s) + b·d_α(t) + c·d_α(u) + (T − a − b − c)·d_α(W), T the largest a + b + c: an affine
+///   lattice keeps the surface's degrees (docs/deform.md, "The lattice's true total degree").
 /// - The patches are elevated to a common degree, joined into one B-spline surface with interior
 ///   knots of full multiplicity, and every interior knot whose removal is exact (The NURBS Book
 ///   A5.8 in homogeneous coordinates, ComposeOptions::knot_tolerance) is removed: the continuity
