@@ -1,6 +1,8 @@
 // The recipe checker: surfaces (recipe_checker.hpp).
 #include "recipe_checker.hpp"
 
+#include <system_error>
+
 namespace clay::recipe::check_detail {
 
 void RecipeChecker::surface(const std::string& name, const Json& j, const std::string& path) {
@@ -117,9 +119,15 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
               c_.add(key_path(p, "file"),
                      "\"" + *s +
                          "\" is not a STEP or IGES file; give a .step, .stp, .igs or .iges file");
-            else if (!fs::is_regular_file(d.file))
-              c_.add(key_path(p, "file"), "no file \"" + d.file.string() +
-                                              "\" (paths are relative to the recipe's folder)");
+            else if (std::error_code ec; !fs::is_regular_file(d.file, ec))
+              // The error_code overload: the throwing one raised filesystem_error for a name the
+              // system refuses (ENAMETOOLONG, found by fuzz_recipe), and checking never throws.
+              c_.add(key_path(p, "file"),
+                     ec && ec != std::errc::no_such_file_or_directory
+                         ? "cannot look up \"" + d.file.string() + "\": " + ec.message() +
+                               "; give the path of an existing file"
+                         : "no file \"" + d.file.string() +
+                               "\" (paths are relative to the recipe's folder)");
           }
         d.index = c_.integer_or(v, p, "index", 0, 0, 1000000);
       }

@@ -425,6 +425,22 @@ TEST_CASE("an imported STEP surface is read bit for bit", "[recipe]") {
   CHECK(mentions(problems, "surfaces.d.import.file", "no file"));
 }
 
+TEST_CASE("check_recipe reports an import path the system refuses, without throwing", "[recipe]") {
+  // A file name over NAME_MAX (255 bytes): std::filesystem's throwing lookup raised
+  // filesystem_error "File name too long" out of check_recipe (found by fuzz_recipe).
+  const std::string name = std::string(300, 'a') + ".step";
+  const std::string text = R"({"format": "clayform.recipe", "version": 1,
+    "surfaces": {"d": {"import": {"file": ")" +
+                           name + R"("}}}})";
+  const fs::path dir = output_dir("import");
+  fs::create_directories(dir);  // an existing folder: the lookup reaches the long name
+  std::vector<Problem> problems;
+  REQUIRE_NOTHROW(problems = check_recipe(text, dir));
+  INFO(dump(problems));
+  CHECK(mentions(problems, "surfaces.d.import.file", "cannot look up"));
+  CHECK(mentions(problems, "surfaces.d.import.file", "File name too long"));
+}
+
 TEST_CASE("check_recipe reports every problem at once, each with its path", "[recipe]") {
   const std::string text =
       R"({"format": "clayform.recipe", "version": 2, "units": "inch", "colour": 1,
