@@ -440,24 +440,24 @@ std::vector<EdgeGap> edge_gaps(const Model& model, int samples_per_span) {
                 "edge_gaps: samples_per_span = " + std::to_string(samples_per_span) +
                     " must be >= 1 (16 samples each knot span by default)");
   std::vector<EdgeGap> out;
-  std::vector<std::string> bad;
   for (size_t f = 0; f < model.faces.size(); ++f) {
     const Face& face = model.faces[f];
-    internal::append(
-        bad, surface::problems(face.surface, face_name(model, static_cast<int>(f)) + "'s surface"));
-    if (!bad.empty()) internal::throw_problems(ErrorCategory::InvalidGeometry, bad);
+    const int fi = static_cast<int>(f);
+    if (auto bad = surface::problems(face.surface, face_name(model, fi) + "'s surface");
+        !bad.empty())
+      internal::throw_problems(ErrorCategory::InvalidGeometry, bad);
     for (size_t l = 0; l < face.loops.size(); ++l)
       for (size_t c = 0; c < face.loops[l].coedges.size(); ++c) {
-        const int fi = static_cast<int>(f), li = static_cast<int>(l), ci = static_cast<int>(c);
-        bad = coedge_problems(model, fi, li, ci);
-        const Coedge& co = face.loops[l].coedges[c];
+        const int li = static_cast<int>(l), ci = static_cast<int>(c);
+        // What gap_of needs: the coedge's own data, then its edge's curve or pole vertex.
+        std::vector<std::string> bad = coedge_problems(model, fi, li, ci);
         if (bad.empty()) {
-          const Edge& e = model.edges[static_cast<size_t>(co.edge)];
+          const int ei = face.loops[l].coedges[c].edge;
+          const Edge& e = model.edges[static_cast<size_t>(ei)];
           if (e.degenerate && !in_range(e.start, model.vertices.size()))
-            bad.push_back("edge " + std::to_string(co.edge) + ": a pole without a vertex");
+            bad.push_back("edge " + std::to_string(ei) + ": a pole without a vertex");
           if (!e.degenerate)
-            internal::append(
-                bad, surface::problems(e.curve, "edge " + std::to_string(co.edge) + "'s curve"));
+            bad = surface::problems(e.curve, "edge " + std::to_string(ei) + "'s curve");
         }
         if (!bad.empty()) internal::throw_problems(ErrorCategory::InvalidGeometry, bad);
         out.push_back(gap_of(model, fi, li, ci, samples_per_span));
