@@ -35,6 +35,7 @@
 
 #include "exchange_precheck.hpp"
 #include "occt/convert.hpp"
+#include "occt/session.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -103,46 +104,14 @@ namespace fs = std::filesystem;
 /// Edge and vertex tolerance of every face we build (mm); never raised.
 constexpr double face_tolerance = 1e-7;
 
-/// OpenCASCADE 7.6's STEP/IGES translators (and their Interface_Static settings) are not
-/// thread-safe: every exchange call holds this lock.
-std::mutex& exchange_mutex() {
-  static std::mutex mutex;
-  return mutex;
-}
+using occt::check_readable;
+using occt::check_target;
+using occt::ExchangeSession;
+using occt::set_static;
+using occt::write_atomically;
+using occt::write_stream;
 
-/// While alive, OpenCASCADE's default messenger prints failures only (its translators otherwise
-/// print transfer banners and statistics on standard output). Restores the levels on exit.
-class QuietMessages {
- public:
-  QuietMessages() {
-    Message_SequenceOfPrinters& printers = Message::DefaultMessenger()->ChangePrinters();
-    for (Message_SequenceOfPrinters::Iterator it(printers); it.More(); it.Next()) {
-      saved_.push_back(it.Value()->GetTraceLevel());
-      it.Value()->SetTraceLevel(Message_Fail);
-    }
-  }
-  ~QuietMessages() {
-    Message_SequenceOfPrinters& printers = Message::DefaultMessenger()->ChangePrinters();
-    size_t k = 0;
-    for (Message_SequenceOfPrinters::Iterator it(printers); it.More() && k < saved_.size();
-         it.Next())
-      it.Value()->SetTraceLevel(saved_[k++]);
-  }
-  QuietMessages(const QuietMessages&) = delete;
-  QuietMessages& operator=(const QuietMessages&) = delete;
-
- private:
-  std::vector<Message_Gravity> saved_;
-};
-
-/// The exchange lock, quiet messages and non-stop floating point, for one public call.
-struct ExchangeSession {
-  std::lock_guard<std::mutex> lock{exchange_mutex()};
-  QuietMessages quiet;
-  internal::FpTrapsHeld floating_point;
-};
-
-std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+using occt::quoted;
 
 std::string surface_name(size_t k) { return "surface #" + std::to_string(k); }
 
@@ -315,99 +284,6 @@ BuiltFaces build_faces(const std::vector<BSplineSurface>& input, std::string_vie
     }
   }
   return built;
-}
-
-// ---- files ---------------------------------------------------------------------------------
-
-/// Checks that the folder of `file` exists and `file` names a file in it.
-void check_target(const fs::path& file, std::string_view caller) {
-  if (file.empty() || !file.has_filename())
-    throw Error(ErrorCategory::Io, std::string(caller) + ": " + quoted(file) +
-                                       " does not name a file; give a file path");
-  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(folder, ec))
-    throw Error(ErrorCategory::Io, std::string(caller) + ": the output folder " + quoted(folder) +
-                                       " of " + quoted(file) +
-                                       " does not exist; create it before writing");
-}
-
-std::string random_suffix() {
-  static std::atomic<unsigned long> counter{0};
-  std::random_device device;
-  std::mt19937_64 rng(
-      (static_cast<unsigned long long>(device()) << 32) ^
-      static_cast<unsigned long long>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
-      counter.fetch_add(1));
-  std::ostringstream out;
-  out << std::hex << rng();
-  return out.str();
-}
-
-/// Writes through `write(temp_path)` into a temporary file next to `file` (".NAME.tmp-<random>")
-/// and renames it onto `file`. On any failure the temporary file is removed and the error
-/// rethrown, so nothing is left behind.
-void write_atomically(const fs::path& file, std::string_view caller,
-                      const std::function<void(const fs::path&)>& write) {
-  check_target(file, caller);
-  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
-  const fs::path temp = folder / ("." + file.filename().string() + ".tmp-" + random_suffix());
-  try {
-    write(temp);
-    std::error_code ec;
-    fs::rename(temp, file, ec);
-    if (ec)
-      throw Error(ErrorCategory::Io, std::string(caller) + ": could not rename " + quoted(temp) +
-                                         " to " + quoted(file) + ": " + ec.message());
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    throw;
-  }
-}
-
-/// Opens `temp` for writing, lets `print` fill it and checks the stream.
-void write_stream(const fs::path& temp, std::string_view caller,
-                  const std::function<bool(std::ostream&)>& print) {
-  std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-  if (!out)
-    throw Error(ErrorCategory::Io, std::string(caller) + ": could not create " + quoted(temp) +
-                                       "; check that the folder is writable");
-  const bool printed = print(out);
-  out.flush();
-  if (!printed)
-    throw Error(ErrorCategory::Exchange,
-                std::string(caller) + ": OpenCASCADE could not serialize the model");
-  out.close();
-  if (!out)
-    throw Error(ErrorCategory::Io, std::string(caller) + ": writing " + quoted(temp) +
-                                       " failed (disk full or folder not writable?)");
-}
-
-void check_readable(const fs::path& file, std::string_view caller) {
-  std::error_code ec;
-  if (!fs::exists(file, ec))
-    throw Error(ErrorCategory::Io,
-                std::string(caller) + ": " + quoted(file) + " does not exist; check the path");
-  if (!fs::is_regular_file(file, ec))
-    throw Error(ErrorCategory::Io,
-                std::string(caller) + ": " + quoted(file) + " is not a regular file");
-  std::ifstream probe(file, std::ios::binary);
-  if (!probe)
-    throw Error(ErrorCategory::Io, std::string(caller) + ": " + quoted(file) +
-                                       " cannot be opened; check its permissions");
-}
-
-void set_static(const char* name, const char* value) {
-  if (!Interface_Static::SetCVal(name, value))
-    throw Error(ErrorCategory::Internal,
-                std::string("OpenCASCADE setting '") + name + "' does not accept '" + value + "'");
-}
-
-void set_static(const char* name, int value) {
-  if (!Interface_Static::SetIVal(name, value))
-    throw Error(ErrorCategory::Internal, std::string("OpenCASCADE setting '") + name +
-                                             "' does not accept " + std::to_string(value));
 }
 
 // ---- reading ---------------------------------------------------------------------------------

@@ -1,0 +1,120 @@
+// The shared exchange helpers of session.hpp.
+#include "occt/session.hpp"
+
+#include <clay/error.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <Interface_Static.hxx>
+
+namespace clay::surface::occt {
+
+namespace fs = std::filesystem;
+
+std::mutex& exchange_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+namespace {
+
+std::string random_suffix() {
+  static std::atomic<unsigned long> counter{0};
+  std::random_device device;
+  std::mt19937_64 rng(
+      (static_cast<unsigned long long>(device()) << 32) ^
+      static_cast<unsigned long long>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
+      counter.fetch_add(1));
+  std::ostringstream out;
+  out << std::hex << rng();
+  return out.str();
+}
+
+}  // namespace
+
+/// Checks that the folder of `file` exists and `file` names a file in it.
+void check_target(const fs::path& file, std::string_view caller) {
+  if (file.empty() || !file.has_filename())
+    throw Error(ErrorCategory::Io, std::string(caller) + ": " + quoted(file) +
+                                       " does not name a file; give a file path");
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec))
+    throw Error(ErrorCategory::Io, std::string(caller) + ": the output folder " + quoted(folder) +
+                                       " of " + quoted(file) +
+                                       " does not exist; create it before writing");
+}
+
+/// Writes through `write(temp_path)` into a temporary file next to `file` (".NAME.tmp-<random>")
+/// and renames it onto `file`. On any failure the temporary file is removed and the error
+/// rethrown, so nothing is left behind.
+void write_atomically(const fs::path& file, std::string_view caller,
+                      const std::function<void(const fs::path&)>& write) {
+  check_target(file, caller);
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  const fs::path temp = folder / ("." + file.filename().string() + ".tmp-" + random_suffix());
+  try {
+    write(temp);
+    std::error_code ec;
+    fs::rename(temp, file, ec);
+    if (ec)
+      throw Error(ErrorCategory::Io, std::string(caller) + ": could not rename " + quoted(temp) +
+                                         " to " + quoted(file) + ": " + ec.message());
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+    throw;
+  }
+}
+
+/// Opens `temp` for writing, lets `print` fill it and checks the stream.
+void write_stream(const fs::path& temp, std::string_view caller,
+                  const std::function<bool(std::ostream&)>& print) {
+  std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+  if (!out)
+    throw Error(ErrorCategory::Io, std::string(caller) + ": could not create " + quoted(temp) +
+                                       "; check that the folder is writable");
+  const bool printed = print(out);
+  out.flush();
+  if (!printed)
+    throw Error(ErrorCategory::Exchange,
+                std::string(caller) + ": OpenCASCADE could not serialize the model");
+  out.close();
+  if (!out)
+    throw Error(ErrorCategory::Io, std::string(caller) + ": writing " + quoted(temp) +
+                                       " failed (disk full or folder not writable?)");
+}
+
+void check_readable(const fs::path& file, std::string_view caller) {
+  std::error_code ec;
+  if (!fs::exists(file, ec))
+    throw Error(ErrorCategory::Io,
+                std::string(caller) + ": " + quoted(file) + " does not exist; check the path");
+  if (!fs::is_regular_file(file, ec))
+    throw Error(ErrorCategory::Io,
+                std::string(caller) + ": " + quoted(file) + " is not a regular file");
+  std::ifstream probe(file, std::ios::binary);
+  if (!probe)
+    throw Error(ErrorCategory::Io, std::string(caller) + ": " + quoted(file) +
+                                       " cannot be opened; check its permissions");
+}
+
+void set_static(const char* name, const char* value) {
+  if (!Interface_Static::SetCVal(name, value))
+    throw Error(ErrorCategory::Internal,
+                std::string("OpenCASCADE setting '") + name + "' does not accept '" + value + "'");
+}
+
+void set_static(const char* name, int value) {
+  if (!Interface_Static::SetIVal(name, value))
+    throw Error(ErrorCategory::Internal, std::string("OpenCASCADE setting '") + name +
+                                             "' does not accept " + std::to_string(value));
+}
+
+}  // namespace clay::surface::occt
