@@ -270,10 +270,13 @@ std::vector<std::string> split_parameters(const std::string& text, char delimite
       if (c == end) break;
       continue;
     }
-    if ((c == 'H' || c == 'h') && !trimmed(current).empty() &&
-        std::all_of(trimmed(current).begin(), trimmed(current).end(),
+    // (One trimmed copy: begin() and end() of two temporaries made a range across two strings,
+    // so every string parameter was refused as "not a number".)
+    const std::string count = trimmed(current);
+    if ((c == 'H' || c == 'h') && !count.empty() &&
+        std::all_of(count.begin(), count.end(),
                     [](char d) { return std::isdigit(static_cast<unsigned char>(d)); })) {
-      const std::size_t n = std::strtoul(trimmed(current).c_str(), nullptr, 10);
+      const std::size_t n = std::strtoul(count.c_str(), nullptr, 10);
       i += std::min(n, text.size() - i - 1);
       current = "H";
       continue;

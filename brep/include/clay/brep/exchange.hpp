@@ -1,0 +1,88 @@
+#pragma once
+/// Reading whole B-rep models (trimmed faces, shared edges, solids, assemblies, names, colours)
+/// from STEP and IGES files into a brep::Model (issue #20).
+///
+/// Implemented in the OCCT library (Clayform::occt, through OpenCASCADE's XCAF readers); this
+/// header carries no OpenCASCADE type.
+///
+/// Every face becomes a NURBS face. B-spline and Bézier faces are kept as they are, with their
+/// pcurves. Planes, linear extrusions and offsets by 0 keep their parametrization when converted,
+/// so their pcurves convert exactly. Cylinders, cones, spheres, tori and revolutions become
+/// rational B-splines whose parameter equals the angle only at knots: each of their pcurves is
+/// re-derived. It is exact where the composed parameter map is (an iso-line, or a conic on a plane
+/// converted with the same angle map as its edge); otherwise it is a cubic interpolant refined
+/// until the face along it is within 1e-10 × model size of the original face along the original
+/// pcurve. The report says how many pcurves took each path and the largest re-derivation error,
+/// and brep::edge_gaps measures the result independently.
+#include <clay/brep/model.hpp>
+#include <clay/surface/exchange.hpp>
+#include <clay/surface/exchange_export.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace clay::brep {
+
+/// Settings of read_model.
+struct CLAY_OCCT_API ModelReadOptions {
+  /// Sew loose faces (IGES 144 files, STEP shells exported face by face) into shells, and closed
+  /// shells into solids (BRepBuilderAPI_Sewing, then ShapeFix_Solid).
+  bool sew = false;
+  /// Largest gap sewing closes (mm), in (0, 1].
+  double sewing_tolerance_mm = 1e-3;
+  /// The text pre-check of surface::ReadOptions (refuses the inputs known to crash OpenCASCADE).
+  bool precheck = true;
+
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
+  void validate() const;
+};
+
+/// What a read found and did.
+struct CLAY_OCCT_API ModelReadReport {
+  Counts counts;
+  double size_mm = 0;     ///< diagonal of the model's bounding box (control points of its surfaces)
+  int faces_bspline = 0;  ///< faces whose surface was a B-spline or Bézier: kept as they were
+  int faces_affine = 0;   ///< planes, linear extrusions: converted with the same (u, v)
+  int faces_angular = 0;  ///< cylinders, cones, spheres, tori, revolutions: angle maps changed
+  int pcurves_kept = 0;   ///< pcurves converted exactly with their face's unchanged (u, v)
+  int pcurves_exact = 0;  ///< re-derived exactly (an iso-line or a shared angle map)
+  int pcurves_fitted = 0;  ///< re-derived by a refined interpolant
+  /// Largest distance between the face along a re-derived pcurve and the original face along the
+  /// original pcurve (mm); 0 when every pcurve was kept or re-derived exactly.
+  double max_rederivation_error_mm = 0;
+  /// Largest gap between an edge and a face along its pcurve, by brep::edge_gaps (mm): includes
+  /// the file's own gaps, which its edge tolerances allow.
+  double max_edge_gap_mm = 0;
+  double max_edge_tolerance_mm = 0;  ///< the largest edge tolerance the file gives
+  /// Healing done, one line each ("built 3D curves of 4 edges", "sewed 12 faces into 1 shell").
+  std::vector<std::string> healing;
+  /// brep::problems(model): invariants the model breaks (empty for a clean file). The model is
+  /// still returned, so that it can be inspected; deforming it refuses it.
+  std::vector<std::string> problems;
+
+  /// One line: "1 solid, 1 shell, 42 faces (18 trimmed, 6 holes), 104 edges, 66 vertices;
+  /// 30 faces converted; pcurves 160 kept, 40 exact, 8 fitted (<= 3e-12 mm); edge gap 1e-7 mm".
+  std::string brief() const;
+};
+
+/// A model and the report of its reading.
+struct ImportedModel {
+  Model model;
+  ModelReadReport report;
+};
+
+/// Reads a STEP (.step, .stp) or IGES (.iges, .igs) file, chosen by its extension, into a model:
+/// solids, shells and loose faces become bodies; an assembly becomes parts and instances with
+/// their placements; names and colours of parts, bodies and faces are kept. Throws
+/// clay::Error(Io) when the file is missing or cannot be opened, Exchange when it cannot be
+/// parsed, fails the pre-check, holds no face, or holds geometry that cannot be converted
+/// (naming the face or edge and what failed), InvalidGeometry for a surface or curve with
+/// non-finite coordinates or weights that no exact reparametrization makes positive (naming the
+/// face), InvalidArgument for bad options or an unknown extension.
+CLAY_OCCT_API ImportedModel read_model(const std::filesystem::path& file,
+                                       const ModelReadOptions& options = {});
+
+}  // namespace clay::brep

@@ -1,0 +1,43 @@
+#pragma once
+// Whole B-rep models built by OpenCASCADE and written as STEP or IGES, and OpenCASCADE's own
+// reading of such files, behind an OCCT-free interface (internal to tests and benchmarks, in
+// clay_occt_reference). The tests of model reading and deformation compare with these.
+#include <Eigen/Core>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace clay::surface::occt_reference {
+
+/// The test models (issue #20's "Must show").
+enum class TestModel {
+  FilletedBlock,  ///< 60 x 40 x 20 box, vertical edges filleted (r 5), two through holes, a pocket
+  Sphere,         ///< r 10: a seam and two poles
+  Torus,          ///< R 20, r 5: seams in both directions
+  Cone,           ///< r 10 to 4, height 15: a seam, a plane at each end
+  Bottle,         ///< a revolved profile (lines and an arc), hollow: a solid with a void-free shell
+  Assembly,       ///< two parts, named and coloured; the second placed twice
+  LooseFaces,     ///< a box's six faces written as loose IGES faces (144), to be sewn
+};
+
+/// Builds `model` with OpenCASCADE and writes it through XCAF (names, colours, assembly) as
+/// STEP AP214 or, for a .igs/.iges path, IGES 5.3 (BRep mode, except LooseFaces).
+void write_test_model(TestModel model, const std::filesystem::path& file);
+
+/// What OpenCASCADE itself reads from a file (STEPControl_Reader / IGESControl_Reader).
+struct ShapeFacts {
+  int solids = 0, shells = 0, faces = 0, edges = 0, vertices = 0;
+  double volume = 0;   ///< BRepGProp::VolumeProperties with Eps 1e-9 (0 without solids)
+  bool valid = false;  ///< BRepCheck_Analyzer
+};
+
+/// OpenCASCADE's counts (distinct sub-shapes), volume and validity of the shapes in `file`.
+ShapeFacts facts_of_file(const std::filesystem::path& file);
+
+/// For each face of `file` (TopExp_Explorer order) and each of its points in `points[face]`,
+/// the distance to that face's surface (GeomAPI_ProjectPointOnSurf); the largest overall.
+double max_distance_to_surfaces(const std::filesystem::path& file,
+                                const std::vector<std::vector<Eigen::Vector3d>>& points);
+
+}  // namespace clay::surface::occt_reference
