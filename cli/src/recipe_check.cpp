@@ -425,6 +425,78 @@ SketchDef rebuild_sketch(
   return std::move(rc.data.sketches.front());
 }
 
+namespace {
+
+// Hand-written scans, not std::regex: libstdc++'s regex matcher recurses once per character, so
+// a message quoting a 30,000-character recipe key overflowed the stack (found by fuzz_recipe).
+
+bool word_start(const std::string& m, std::size_t at) {
+  return at == 0 || !(std::isalnum(static_cast<unsigned char>(m[at - 1])) || m[at - 1] == '_');
+}
+
+/// The number written between `before` and `after` ("control point limit 40000 reached"), or -1.
+long number_between(const std::string& m, std::string_view before, std::string_view after) {
+  for (std::size_t at = m.find(before); at != std::string::npos; at = m.find(before, at + 1)) {
+    std::size_t end = at + before.size();
+    while (end < m.size() && std::isdigit(static_cast<unsigned char>(m[end]))) ++end;
+    const std::size_t digits = end - at - before.size();
+    if (digits > 0 && digits < 10 && m.compare(end, after.size(), after) == 0)
+      return std::stol(m.substr(at + before.size(), digits));
+  }
+  return -1;
+}
+
+/// Removes every "XxxOptions::" (a capitalized word ending in Options, at a word start).
+std::string without_options_structs(const std::string& m) {
+  static constexpr std::string_view tail = "Options::";
+  std::string out;
+  std::size_t copied = 0;
+  for (std::size_t at = m.find(tail); at != std::string::npos; at = m.find(tail, at + 1)) {
+    std::size_t start = at;
+    while (start > copied && std::isalpha(static_cast<unsigned char>(m[start - 1]))) --start;
+    if (start == at || !std::isupper(static_cast<unsigned char>(m[start])) || !word_start(m, start))
+      continue;
+    out.append(m, copied, start - copied);
+    copied = at + tail.size();
+  }
+  return out.append(m, copied, std::string::npos);
+}
+
+/// Removes "deform_surface: steps[N] (...)" (with a following ": "), "compose_exact: " and
+/// "refit_deformed: " where they start a word.
+std::string without_library_prefixes(const std::string& m) {
+  std::string out;
+  std::size_t at = 0;
+  while (at < m.size()) {
+    if (word_start(m, at)) {
+      std::size_t end = std::string::npos;
+      if (m.compare(at, 13, "compose_exact") == 0 && m.compare(at + 13, 2, ": ") == 0) {
+        end = at + 15;
+      } else if (m.compare(at, 14, "refit_deformed") == 0 && m.compare(at + 14, 2, ": ") == 0) {
+        end = at + 16;
+      } else if (m.compare(at, 22, "deform_surface: steps[") == 0) {
+        std::size_t k = at + 22;
+        while (k < m.size() && std::isdigit(static_cast<unsigned char>(m[k]))) ++k;
+        if (k > at + 22 && m.compare(k, 3, "] (") == 0) {
+          const std::size_t close = m.find(')', k + 3);
+          if (close != std::string::npos) {
+            end = close + 1;
+            if (m.compare(end, 2, ": ") == 0) end += 2;
+          }
+        }
+      }
+      if (end != std::string::npos) {
+        at = end;
+        continue;
+      }
+    }
+    out += m[at++];
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string recipe_wording(std::string m) {
   // The library's fixes, as a recipe applies them (or dropped where a recipe cannot).
   static const std::pair<std::string_view, std::string_view> phrases[] = {
@@ -448,10 +520,8 @@ std::string recipe_wording(std::string m) {
   // its 40,000 cap), not the iteration or per-direction limits.
   if (const auto at = m.find("; raise the limits, the tolerance or the degree");
       at != std::string::npos) {
-    static const std::regex net_limit("control point limit ([0-9]+) reached");
-    std::smatch hit;
-    const bool raisable = std::regex_search(m, hit, net_limit) &&
-                          std::stol(hit[1].str()) < limit::refit_control_points;
+    const long reached = number_between(m, "control point limit ", " reached");
+    const bool raisable = reached >= 0 && reached < limit::refit_control_points;
     m.replace(
         at, std::string_view("; raise the limits, the tolerance or the degree").size(),
         raisable
@@ -464,13 +534,10 @@ std::string recipe_wording(std::string m) {
       m.replace(at, from.size(), to);
   // What is left: a field of a C++ options struct in a validation message ("SweepOptions::
   // twist_degrees is ..."), which for the options a recipe sets is the recipe's own key.
-  static const std::regex options_struct("\\b[A-Z][A-Za-z]*Options::");
-  m = std::regex_replace(m, options_struct, "");
+  m = without_options_structs(m);
   // The library's own prefixes: the recipe path in front of the message already names the step
   // (and a recipe runs deform_surface one step at a time, so its "steps[0]" would mislead).
-  static const std::regex library_prefix(
-      "\\b(deform_surface: steps\\[[0-9]+\\] \\([^)]*\\)(: )?|compose_exact: |refit_deformed: )");
-  return std::regex_replace(m, library_prefix, "");
+  return without_library_prefixes(m);
 }
 
 std::string to_string(const Problem& problem) {

@@ -33,7 +33,6 @@
 #include <limits>
 #include <map>
 #include <numbers>
-#include <regex>
 #include <set>
 #include <sstream>
 

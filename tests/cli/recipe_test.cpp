@@ -617,6 +617,33 @@ TEST_CASE("a step failing at run time is named by its path, with its category", 
         "relative = false and twist_degrees is 1e300");
 }
 
+TEST_CASE("recipe_wording rewords long messages without recursing per character", "[recipe]") {
+  // std::regex recursed once per character: a message quoting a 30,000-character key crashed
+  // `clayform validate` with a stack overflow (found by fuzz_recipe; the input is in the corpus).
+  const std::string key(30000, 'L');
+  const std::string long_message = "exports." + key + ": unknown key; SweepOptions::twist";
+  CHECK(recipe_wording(long_message) == "exports." + key + ": unknown key; twist");
+  const std::string long_step = "deform_surface: steps[0] (" + key + "): too far";
+  CHECK(recipe_wording(long_step) == "too far");
+  // The same rewording as before, piece by piece.
+  CHECK(recipe_wording("deform_surface: steps[12] (bend): compose_exact: x") == "x");
+  CHECK(recipe_wording("refit_deformed: a, notdeform_surface: steps[1] (x)") ==
+        "a, notdeform_surface: steps[1] (x)");
+  CHECK(recipe_wording("Options:: stays, fooBarOptions::x stays, BarOptions::y goes") ==
+        "Options:: stays, fooBarOptions::x stays, y goes");
+  CHECK_THAT(recipe_wording("control point limit 100 reached; raise the limits, the tolerance or "
+                            "the degree"),
+             Contains("max_control_points"));
+  CHECK_THAT(recipe_wording("control point limit 40000 reached; raise the limits, the tolerance "
+                            "or the degree"),
+             !Contains("max_control_points"));
+  std::vector<Problem> problems;
+  const std::string text =
+      R"({"format": "clayform.recipe", "version": 1, "exports": {"e": {")" + key + R"(": 1}}})";
+  REQUIRE_NOTHROW(problems = check_recipe(text));
+  CHECK(!problems.empty());
+}
+
 TEST_CASE("a prismatic lattice's control points can be moved by index", "[recipe]") {
   // Two straight sections 30 mm apart, one segment, one layer: before welding, control point
   // (i, j, k) rests at (10 j, 10 i, 10 k). The test finds the moved row by that position.
