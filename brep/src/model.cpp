@@ -475,6 +475,69 @@ std::vector<std::string> problems(const Model& model) {
   return out;
 }
 
+Model flattened(const Model& model) {
+  if (!model.is_assembly()) return model;
+  {
+    std::vector<std::string> tree;
+    assembly_problems(model, tree);
+    if (!tree.empty()) internal::throw_problems(ErrorCategory::InvalidGeometry, tree);
+  }
+  Model out;
+  // One copy of a body: its faces, their edges and vertices, moved by `place`.
+  auto copy_body = [&](int b, const Eigen::Isometry3d& place, const Part& part,
+                       const std::optional<Colour>& inherited) {
+    std::map<int, int> vertex_copy, edge_copy;
+    auto vertex = [&](int v) {
+      if (auto it = vertex_copy.find(v); it != vertex_copy.end()) return it->second;
+      Vertex copy = model.vertices[static_cast<size_t>(v)];
+      copy.point = place * copy.point;
+      out.vertices.push_back(copy);
+      return vertex_copy[v] = static_cast<int>(out.vertices.size()) - 1;
+    };
+    auto moved = [&](surface::Points3 points) {
+      for (Eigen::Index r = 0; r < points.rows(); ++r)
+        points.row(r) = (place * Eigen::Vector3d(points.row(r).transpose())).transpose();
+      return points;
+    };
+    auto edge = [&](int e) {
+      if (auto it = edge_copy.find(e); it != edge_copy.end()) return it->second;
+      Edge copy = model.edges[static_cast<size_t>(e)];
+      if (!copy.degenerate) copy.curve.points = moved(copy.curve.points);
+      copy.start = vertex(copy.start);
+      copy.end = vertex(copy.end);
+      out.edges.push_back(std::move(copy));
+      return edge_copy[e] = static_cast<int>(out.edges.size()) - 1;
+    };
+    const Body& body = model.bodies[static_cast<size_t>(b)];
+    Body copy;
+    copy.kind = body.kind;
+    copy.name = body.name.empty() ? part.name : body.name;
+    copy.colour = body.colour ? body.colour : inherited;
+    for (const Shell& shell : body.shells) {
+      Shell moved_shell;
+      for (int f : shell.faces) {
+        Face face = model.faces[static_cast<size_t>(f)];
+        face.surface.points = moved(face.surface.points);
+        for (Loop& loop : face.loops)
+          for (Coedge& co : loop.coedges) co.edge = edge(co.edge);
+        out.faces.push_back(std::move(face));
+        moved_shell.faces.push_back(static_cast<int>(out.faces.size()) - 1);
+      }
+      copy.shells.push_back(std::move(moved_shell));
+    }
+    out.bodies.push_back(std::move(copy));
+  };
+  auto walk = [&](auto& self, int p, const Eigen::Isometry3d& place,
+                  std::optional<Colour> inherited) -> void {
+    const Part& part = model.parts[static_cast<size_t>(p)];
+    if (part.colour) inherited = part.colour;
+    for (int b : part.bodies) copy_body(b, place, part, inherited);
+    for (const Instance& in : part.components) self(self, in.part, place * in.placement, inherited);
+  };
+  for (const Instance& root : model.roots) walk(walk, root.part, root.placement, std::nullopt);
+  return out;
+}
+
 void validate(const Model& model) {
   const auto list = problems(model);
   if (!list.empty()) internal::throw_problems(ErrorCategory::InvalidGeometry, list);

@@ -407,3 +407,67 @@ TEST_CASE("the assembly tree: instances of a part, bad references and cycles", "
     CHECK_THAT(list, Contains("root instance 1: part index 5 is not one of the 2 parts"));
   }
 }
+
+TEST_CASE("volume_mm3 of a cube, a translated cube and a cube with a face turned inside out",
+          "[brep]") {
+  // a^3 for the cube [0, a]^3 wherever it stands (the field (0, 0, z) depends on the origin
+  // face by face, not in total).
+  CHECK(clay::brep::volume_mm3(cube(10), 0) == Approx(1000).epsilon(1e-14));
+  Model moved = cube(3);
+  for (Face& f : moved.faces) f.surface.points.rowwise() += Eigen::RowVector3d(5, -7, 11);
+  for (Vertex& v : moved.vertices) v.point += Vector3d(5, -7, 11);
+  for (Edge& e : moved.edges) e.curve.points.rowwise() += Eigen::RowVector3d(5, -7, 11);
+  CHECK(clay::brep::volume_mm3(moved) == Approx(27).epsilon(1e-14));
+  // A trimmed face: the plate with a hole, as an open sheet, integrates over the trimmed domain
+  // only. With the field (0, 0, z) and the plate at z = 4, its flux is 4 × (100 - 25).
+  Builder b;
+  const int f = b.quad({0, 0, 4}, {10, 0, 0}, {0, 10, 0}, "plate");
+  Face& plate = b.m.faces[static_cast<size_t>(f)];
+  plate.loops.push_back(b.loop(plate, {{0.25, 0.25}, {0.25, 0.75}, {0.75, 0.75}, {0.75, 0.25}}));
+  Body sheet;
+  sheet.kind = BodyKind::Sheet;
+  sheet.shells.push_back({{f}});
+  b.m.bodies.push_back(sheet);
+  CHECK(clay::brep::volume_mm3(b.m, 0) == Approx(4 * 75).epsilon(1e-14));
+  CHECK(clay::brep::volume_mm3(b.m) == 0);  // no solid
+  CHECK(clay::test::error_of([&] { (void)clay::brep::volume_mm3(b.m, 1); }).first ==
+        clay::ErrorCategory::InvalidArgument);
+}
+
+TEST_CASE("flattened places every instance of an assembly as a body of its own", "[brep]") {
+  Model m = cube(2);
+  m.bodies[0].name.clear();
+  m.parts.push_back({"block", {0}, {}, clay::brep::Colour{1, 0, 0}});
+  clay::brep::Part pair;
+  pair.name = "pair";
+  for (double x : {0.0, 10.0}) {
+    clay::brep::Instance in;
+    in.part = 0;
+    in.placement = Eigen::Translation3d(x, 0, 0) * Eigen::AngleAxisd(0.5, Vector3d::UnitZ());
+    pair.components.push_back(in);
+  }
+  m.parts.push_back(pair);
+  m.roots.push_back({1, Eigen::Isometry3d(Eigen::Translation3d(0, 0, 5)), "top"});
+  REQUIRE(clay::brep::problems(m).empty());
+  CHECK(clay::brep::volume_mm3(m) == Approx(16).epsilon(1e-14));  // two instances of 2^3
+  const Model flat = clay::brep::flattened(m);
+  INFO(all(clay::brep::problems(flat)));
+  CHECK(clay::brep::problems(flat).empty());
+  CHECK(!flat.is_assembly());
+  REQUIRE(flat.bodies.size() == 2);
+  CHECK(flat.bodies[1].name == "block");  // the part's name, the body having none
+  CHECK(flat.bodies[1].colour == clay::brep::Colour{1, 0, 0});
+  CHECK(clay::brep::counts(flat).faces == 12);
+  CHECK(clay::brep::counts(flat).vertices == 16);
+  // The second copy's corner (0, 0, 0) lands at the second placement's origin, 5 above.
+  const Eigen::Isometry3d place = Eigen::Translation3d(0, 0, 5) * Eigen::Translation3d(10, 0, 0) *
+                                  Eigen::AngleAxisd(0.5, Vector3d::UnitZ());
+  const Vector3d corner = place * m.vertices[0].point;
+  bool found = false;
+  for (const Vertex& v : flat.vertices) found = found || (v.point - corner).norm() < 1e-14;
+  CHECK(found);
+  CHECK(clay::brep::volume_mm3(flat) == Approx(16).epsilon(1e-13));
+  // Pcurves are untouched.
+  CHECK(clay::surface::identical(flat.faces[7].loops[0].coedges[0].pcurve,
+                                 m.faces[1].loops[0].coedges[0].pcurve));
+}

@@ -1,4 +1,6 @@
 #pragma once
 /// The B-rep module (Clayform::brep): models of bodies, shells and trimmed faces with shared
-/// edges, names, colours and assemblies, as plain data (clay/brep/model.hpp).
+/// edges, names, colours and assemblies, as plain data (clay/brep/model.hpp), and the volume of
+/// their solids (clay/brep/volume.hpp).
 #include <clay/brep/model.hpp>
+#include <clay/brep/volume.hpp>

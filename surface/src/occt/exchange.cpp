@@ -105,6 +105,7 @@ namespace fs = std::filesystem;
 constexpr double face_tolerance = 1e-7;
 
 using occt::check_readable;
+using occt::check_statuses;
 using occt::check_target;
 using occt::ExchangeSession;
 using occt::set_static;
@@ -151,42 +152,6 @@ TopoDS_Face make_face(const Handle(Geom_BSplineSurface) & surface, const std::st
     throw Error(ErrorCategory::Exchange,
                 name + ": OpenCASCADE failed to build its face: " + occt::describe(failure));
   }
-}
-
-/// Every BRepCheck status found on `face` and its sub-shapes, in words ("edge 2:
-/// BRepCheck_InvalidCurveOnSurface"), without repeats.
-std::vector<std::string> check_statuses(const TopoDS_Face& face,
-                                        const BRepCheck_Analyzer& analyzer) {
-  std::vector<std::string> found;
-  auto add = [&](const char* kind, int index, BRepCheck_Status status) {
-    if (status == BRepCheck_NoError) return;
-    std::ostringstream text;
-    BRepCheck::Print(status, text);
-    std::string line =
-        std::string(kind) + (index >= 0 ? " " + std::to_string(index) : "") + ": " + text.str();
-    while (!line.empty() && (line.back() == '\n' || line.back() == ' ')) line.pop_back();
-    for (const auto& f : found)
-      if (f == line) return;
-    found.push_back(line);
-  };
-  auto scan = [&](const TopoDS_Shape& shape, const char* kind, int index) {
-    const Handle(BRepCheck_Result)& result = analyzer.Result(shape);
-    if (result.IsNull()) return;
-    for (BRepCheck_ListIteratorOfListOfStatus it(result->Status()); it.More(); it.Next())
-      add(kind, index, it.Value());
-    for (result->InitContextIterator(); result->MoreShapeInContext(); result->NextShapeInContext())
-      for (BRepCheck_ListIteratorOfListOfStatus it(result->StatusOnShape()); it.More(); it.Next())
-        add(kind, index, it.Value());
-  };
-  scan(face, "face", -1);
-  int index = 0;
-  for (TopExp_Explorer e(face, TopAbs_WIRE); e.More(); e.Next()) scan(e.Current(), "wire", index++);
-  index = 0;
-  for (TopExp_Explorer e(face, TopAbs_EDGE); e.More(); e.Next()) scan(e.Current(), "edge", index++);
-  index = 0;
-  for (TopExp_Explorer e(face, TopAbs_VERTEX); e.More(); e.Next())
-    scan(e.Current(), "vertex", index++);
-  return found;
 }
 
 /// Largest gap between each edge's 3D curve and the surface along its pcurve, both evaluated

@@ -173,6 +173,15 @@ struct FaceConversion {
       v = nv;
       if (done) break;
     }
+    // The maps keep the parameters at knots: land on them exactly rather than 1e-62 away.
+    auto snap = [](double x, double lo, double hi, const TColStd_Array1OfReal& knots) {
+      const double eps = 1e-14 * (hi - lo);
+      for (int k = knots.Lower(); k <= knots.Upper(); ++k)
+        if (std::abs(x - knots.Value(k)) <= eps) return knots.Value(k);
+      return x;
+    };
+    u = snap(u, nu0, nu1, nurbs->UKnots());
+    v = snap(v, nv0, nv1, nurbs->VKnots());
     const double miss = nurbs->Value(u, v).Distance(target);
     if (!(miss <= 1e-9 * size))
       throw Error(ErrorCategory::Exchange,
@@ -267,6 +276,33 @@ std::array<double, 4> face_box(const TopoDS_Face& face, const Handle(Geom_Surfac
   return {u0, u1, v0, v1};
 }
 
+/// A converted full turn ends where it starts only to rounding (a torus's last row of poles is
+/// 1e-15 off its first). OpenCASCADE's readers make such a surface periodic and keep one row,
+/// so a written model would not read back bit for bit: the last row is set to the first when
+/// they agree within 1e-14 of the size (and their weights to 1e-15).
+void close_exactly(const Handle(Geom_BSplineSurface) & s, double size) {
+  const int nu = s->NbUPoles(), nv = s->NbVPoles();
+  auto same = [&](int i0, int j0, int i1, int j1) {
+    return s->Pole(i0, j0).Distance(s->Pole(i1, j1)) <= 1e-14 * size &&
+           std::abs(s->Weight(i0, j0) - s->Weight(i1, j1)) <= 1e-15 * s->Weight(i0, j0);
+  };
+  bool u_closed = true, v_closed = true;
+  for (int j = 1; j <= nv && u_closed; ++j) u_closed = same(1, j, nu, j);
+  for (int i = 1; i <= nu && v_closed; ++i) v_closed = same(i, 1, i, nv);
+  if (u_closed)
+    for (int j = 1; j <= nv; ++j) s->SetPole(nu, j, s->Pole(1, j), s->Weight(1, j));
+  if (v_closed)
+    for (int i = 1; i <= nu; ++i) s->SetPole(i, nv, s->Pole(i, 1), s->Weight(i, 1));
+}
+
+/// The same for a converted closed curve (a full circle).
+void close_exactly(const Handle(Geom_BSplineCurve) & c, double size) {
+  const int n = c->NbPoles();
+  if (c->Pole(1).Distance(c->Pole(n)) <= 1e-14 * size &&
+      std::abs(c->Weight(1) - c->Weight(n)) <= 1e-15 * c->Weight(1))
+    c->SetPole(n, c->Pole(1), c->Weight(1));
+}
+
 FaceConversion convert_face(const TopoDS_Face& face, double size, const std::string& name) {
   FaceConversion c;
   c.size = size;
@@ -306,6 +342,7 @@ FaceConversion convert_face(const TopoDS_Face& face, double size, const std::str
   }
   if (c.nurbs.IsNull())
     throw Error(ErrorCategory::Exchange, name + ": OpenCASCADE could not convert the surface");
+  if (c.nurbs.get() != c.old_surface.get()) close_exactly(c.nurbs, size);
   c.nurbs->Bounds(c.nu0, c.nu1, c.nv0, c.nv1);
 
   // Which directions kept their parameter: S_new(a, b) = S_old(a, b) on a grid, per direction.
@@ -403,6 +440,7 @@ EdgeConversion convert_edge(const TopoDS_Edge& edge, double size, const std::str
     c.nurbs = GeomConvert::CurveToBSplineCurve(new Geom_TrimmedCurve(c.old_curve, c.f, c.l));
   if (c.nurbs.IsNull())
     throw Error(ErrorCategory::Exchange, name + ": OpenCASCADE could not convert the curve");
+  if (c.nurbs.get() != c.old_curve.get()) close_exactly(c.nurbs, size);
   if (c.nurbs.get() == c.old_curve.get()) {
     c.s0 = c.f;
     c.s1 = c.l;
@@ -937,6 +975,84 @@ class ModelBuilder {
     return static_cast<int>(model_.edges.size()) - 1;
   }
 
+  /// A seam lies on an end of the domain of its full turn: files give it 5e-13 off (0 after the
+  /// box was snapped to one period), which OpenCASCADE's readers then shift by a period.
+  static double at_end(double x, double lo, double hi) {
+    const double eps = 1e-9 * (hi - lo);
+    return std::abs(x - lo) <= eps ? lo : std::abs(x - hi) <= eps ? hi : x;
+  }
+
+  /// A seam of an angular face (one edge used both ways by the face, along an iso-line): its
+  /// new curve is the new surface's iso-curve there, parametrized by the surface's own
+  /// parameter, so that both pcurves are exact lines and OpenCASCADE's readers, which rebuild
+  /// seams from the surface, read back the same curve. Returns the edge and whether it runs
+  /// against the old edge; nullopt when the seam is not an iso-line.
+  std::optional<std::pair<int, bool>> seam_of(const TopoDS_Edge& edge, const TopoDS_Face& face,
+                                              const FaceConversion& conversion) {
+    const int found = edges_.FindIndex(edge);
+    if (found > 0) {
+      const auto flip = seam_flipped_.find(found - 1);
+      if (flip == seam_flipped_.end()) return std::nullopt;
+      return std::pair{found - 1, flip->second};
+    }
+    const TopoDS_Edge forward = TopoDS::Edge(edge.Oriented(TopAbs_FORWARD));
+    double f = 0, l = 0;
+    const Handle(Geom2d_Curve) p = BRep_Tool::CurveOnSurface(forward, face, f, l);
+    if (p.IsNull()) return std::nullopt;
+    const gp_Pnt2d a = p->Value(f), b = p->Value(l);
+    const bool iso_u = std::abs(a.X() - b.X()) <= 1e-12 * (conversion.nu1 - conversion.nu0);
+    const bool iso_v = std::abs(a.Y() - b.Y()) <= 1e-12 * (conversion.nv1 - conversion.nv0);
+    if (iso_u == iso_v) return std::nullopt;
+    const Eigen::Vector2d na = conversion.map(a.X(), a.Y()), nb = conversion.map(b.X(), b.Y());
+    const double c = iso_u ? at_end(na.x(), conversion.nu0, conversion.nu1)
+                           : at_end(na.y(), conversion.nv0, conversion.nv1);
+    const double w0 = iso_u ? na.y() : na.x(), w1 = iso_u ? nb.y() : nb.x();
+    const bool flipped = w1 < w0;
+    Handle(Geom_BSplineCurve) iso = Handle(Geom_BSplineCurve)::DownCast(
+        iso_u ? conversion.nurbs->UIso(c) : conversion.nurbs->VIso(c));
+    if (iso.IsNull()) return std::nullopt;
+    const std::string name = edge_name(forward);
+    Edge e;
+    e.curve = checked_curve(iso, name);
+    e.t0 = std::min(w0, w1);
+    e.t1 = std::max(w0, w1);
+    e.tolerance_mm = BRep_Tool::Tolerance(forward);
+    TopoDS_Vertex first, last;
+    TopExp::Vertices(forward, first, last);
+    if (first.IsNull() || last.IsNull())
+      throw Error(ErrorCategory::Exchange, name + ": the edge has no vertex at one end");
+    e.start = vertex_of(flipped ? last : first);
+    e.end = vertex_of(flipped ? first : last);
+    edges_.Add(edge);
+    EdgeConversion identity;
+    identity.nurbs = iso;
+    identity.s0 = e.t0;
+    identity.s1 = e.t1;
+    conversions_.push_back(identity);
+    model_.edges.push_back(std::move(e));
+    const int index = static_cast<int>(model_.edges.size()) - 1;
+    seam_flipped_[index] = flipped;
+    return std::pair{index, flipped};
+  }
+
+  /// The exact line pcurve of one use of a seam made by seam_of.
+  surface::BSplineCurve seam_pcurve(const TopoDS_Edge& oriented, const TopoDS_Face& face,
+                                    const FaceConversion& conversion, const Edge& e) const {
+    double f = 0, l = 0;
+    const Handle(Geom2d_Curve) p = BRep_Tool::CurveOnSurface(oriented, face, f, l);
+    const gp_Pnt2d a = p->Value(f), b = p->Value(l);
+    const bool iso_u = std::abs(a.X() - b.X()) <= std::abs(a.Y() - b.Y());
+    const Eigen::Vector2d na = conversion.map(a.X(), a.Y());
+    const double c = iso_u ? at_end(na.x(), conversion.nu0, conversion.nu1)
+                           : at_end(na.y(), conversion.nv0, conversion.nv1);
+    surface::Points3 points(2, 3);
+    if (iso_u)
+      points << c, e.t0, 0.0, c, e.t1, 0.0;
+    else
+      points << e.t0, c, 0.0, e.t1, c, 0.0;
+    return surface::make_curve(1, {e.t0, e.t0, e.t1, e.t1}, std::move(points));
+  }
+
   int add_face(const TopoDS_Face& face,
                const std::vector<std::pair<TopoDS_Shape, Attributes>>& attributes) {
     const int index = static_cast<int>(model_.faces.size());
@@ -975,6 +1091,18 @@ class ModelBuilder {
       for (BRepTools_WireExplorer w(wire, forward); w.More(); w.Next()) {
         const TopoDS_Edge& edge = w.Current();
         Coedge coedge;
+        if (conversion.kind == FaceKind::Angular && !BRep_Tool::Degenerated(edge) &&
+            BRep_Tool::IsClosed(edge, forward)) {
+          if (const auto seam = seam_of(edge, forward, conversion)) {
+            coedge.edge = seam->first;
+            coedge.same_sense = (edge.Orientation() != TopAbs_REVERSED) != seam->second;
+            coedge.pcurve = seam_pcurve(edge, forward, conversion,
+                                        model_.edges[static_cast<std::size_t>(seam->first)]);
+            ++report_.pcurves_exact;
+            loop.coedges.push_back(std::move(coedge));
+            continue;
+          }
+        }
         coedge.edge = edge_of(edge);
         coedge.same_sense = edge.Orientation() != TopAbs_REVERSED;
         const std::string coedge_name = name + " edge #" + std::to_string(coedge.edge);
@@ -1028,6 +1156,7 @@ class ModelBuilder {
   std::vector<std::pair<TDF_Label, int>> parts_;  // few: a linear search
   TopTools_IndexedMapOfShape vertices_, edges_;
   std::vector<EdgeConversion> conversions_;
+  std::map<int, bool> seam_flipped_;  // seams made by seam_of: runs against the old edge
 };
 
 bool extension_is(const fs::path& file, std::initializer_list<const char*> list) {

@@ -9,7 +9,11 @@
 #include <random>
 #include <sstream>
 
+#include <BRepCheck.hxx>
+#include <BRepCheck_ListOfStatus.hxx>
+#include <BRepCheck_Result.hxx>
 #include <Interface_Static.hxx>
+#include <TopExp_Explorer.hxx>
 
 namespace clay::surface::occt {
 
@@ -115,6 +119,40 @@ void set_static(const char* name, int value) {
   if (!Interface_Static::SetIVal(name, value))
     throw Error(ErrorCategory::Internal, std::string("OpenCASCADE setting '") + name +
                                              "' does not accept " + std::to_string(value));
+}
+
+std::vector<std::string> check_statuses(const TopoDS_Face& face,
+                                        const BRepCheck_Analyzer& analyzer) {
+  std::vector<std::string> found;
+  auto add = [&](const char* kind, int index, BRepCheck_Status status) {
+    if (status == BRepCheck_NoError) return;
+    std::ostringstream text;
+    BRepCheck::Print(status, text);
+    std::string line =
+        std::string(kind) + (index >= 0 ? " " + std::to_string(index) : "") + ": " + text.str();
+    while (!line.empty() && (line.back() == '\n' || line.back() == ' ')) line.pop_back();
+    for (const auto& f : found)
+      if (f == line) return;
+    found.push_back(line);
+  };
+  auto scan = [&](const TopoDS_Shape& shape, const char* kind, int index) {
+    const Handle(BRepCheck_Result)& result = analyzer.Result(shape);
+    if (result.IsNull()) return;
+    for (BRepCheck_ListIteratorOfListOfStatus it(result->Status()); it.More(); it.Next())
+      add(kind, index, it.Value());
+    for (result->InitContextIterator(); result->MoreShapeInContext(); result->NextShapeInContext())
+      for (BRepCheck_ListIteratorOfListOfStatus it(result->StatusOnShape()); it.More(); it.Next())
+        add(kind, index, it.Value());
+  };
+  scan(face, "face", -1);
+  int index = 0;
+  for (TopExp_Explorer e(face, TopAbs_WIRE); e.More(); e.Next()) scan(e.Current(), "wire", index++);
+  index = 0;
+  for (TopExp_Explorer e(face, TopAbs_EDGE); e.More(); e.Next()) scan(e.Current(), "edge", index++);
+  index = 0;
+  for (TopExp_Explorer e(face, TopAbs_VERTEX); e.More(); e.Next())
+    scan(e.Current(), "vertex", index++);
+  return found;
 }
 
 }  // namespace clay::surface::occt

@@ -12,9 +12,11 @@
 #include <string_view>
 #include <vector>
 
+#include <BRepCheck_Analyzer.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_Printer.hxx>
+#include <TopoDS_Face.hxx>
 
 namespace clay::surface::occt {
 
@@ -76,5 +78,10 @@ void check_readable(const std::filesystem::path& file, std::string_view caller);
 /// Interface_Static::SetCVal / SetIVal, throwing clay::Error(Internal) when refused.
 void set_static(const char* name, const char* value);
 void set_static(const char* name, int value);
+
+/// Every BRepCheck status found on `face` and its sub-shapes, in words ("edge 2:
+/// BRepCheck_InvalidCurveOnSurface"), without repeats.
+std::vector<std::string> check_statuses(const TopoDS_Face& face,
+                                        const BRepCheck_Analyzer& analyzer);
 
 }  // namespace clay::surface::occt

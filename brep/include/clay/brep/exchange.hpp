@@ -1,6 +1,6 @@
 #pragma once
-/// Reading whole B-rep models (trimmed faces, shared edges, solids, assemblies, names, colours)
-/// from STEP and IGES files into a brep::Model (issue #20).
+/// Reading and writing whole B-rep models (trimmed faces, shared edges, solids, assemblies,
+/// names, colours) as STEP and IGES files, and OpenCASCADE's checks of them (issue #20).
 ///
 /// Implemented in the OCCT library (Clayform::occt, through OpenCASCADE's XCAF readers); this
 /// header carries no OpenCASCADE type.
@@ -84,5 +84,43 @@ struct ImportedModel {
 /// face), InvalidArgument for bad options or an unknown extension.
 CLAY_OCCT_API ImportedModel read_model(const std::filesystem::path& file,
                                        const ModelReadOptions& options = {});
+
+/// Settings of write_model.
+struct ModelWriteOptions {
+  surface::StepSchema schema = surface::StepSchema::AP214;  ///< STEP only
+};
+
+/// What OpenCASCADE makes of a model: its validity (BRepCheck_Analyzer on the shapes built from
+/// it, with the model's own tolerances) and the volume of its solids.
+struct CLAY_OCCT_API ModelCheck {
+  bool valid = false;
+  /// BRepCheck findings in words, each naming the body and face ("body 0 face 3: ...").
+  std::vector<std::string> problems;
+  /// Volume of the solids (mm^3) by brep::volume_mm3 (Green's theorem on the trimmed faces, to
+  /// about 1e-13); instances count once each.
+  double volume_mm3 = 0;
+  /// The same by OpenCASCADE (BRepGProp::VolumeProperties with precision 1e-9), for comparison:
+  /// about 2e-7 off on rational spheres and tori, 0.03 % with its default precision.
+  double occt_volume_mm3 = 0;
+  /// One line: "valid (BRepCheck), volume 45123.7 mm^3" or "NOT valid: 2 problems, the first: ...".
+  std::string brief() const;
+};
+
+/// Builds OpenCASCADE shapes from `model` (exactly: every surface, curve and pcurve copied) and
+/// checks them. Throws clay::Error(InvalidGeometry) listing problems(model) when the model
+/// breaks an invariant, DegreeLimit above degree 25.
+CLAY_OCCT_API ModelCheck check_model(const Model& model);
+
+/// Writes `model` as STEP (.step, .stp: AP214 or AP242) or IGES 5.3 (.iges, .igs: solids and
+/// shells as 186/514 B-rep entities when the model has a solid, otherwise trimmed surfaces 144),
+/// chosen by the extension, with the names, colours and assembly tree (IGES: OpenCASCADE's
+/// translator has no assemblies, so an assembly is written flattened(), each placed instance a
+/// named, coloured body). Lossless: 17 significant
+/// digits, so read_model gives the same surfaces, curves and pcurves bit for bit. Atomic: written
+/// to a temporary file and renamed, nothing is left behind on failure. Throws clay::Error as
+/// check_model, Io when the file cannot be written, InvalidArgument for an unknown extension,
+/// Exchange when OpenCASCADE refuses the model. Returns the check of the shapes written.
+CLAY_OCCT_API ModelCheck write_model(const Model& model, const std::filesystem::path& file,
+                                     const ModelWriteOptions& options = {});
 
 }  // namespace clay::brep

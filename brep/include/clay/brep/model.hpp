@@ -169,6 +169,15 @@ CLAY_BREP_API std::vector<EdgeGap> edge_gaps(const Model& model, int samples_per
 /// - the assembly tree refers to existing parts and bodies and has no cycle.
 CLAY_BREP_API std::vector<std::string> problems(const Model& model);
 
+/// The model without its assembly: every placed instance of a body becomes a body of its own in
+/// world coordinates (control points, edge curves and vertices moved by the placement, pcurves
+/// unchanged), named after the body or else its part, coloured by the body or else the nearest
+/// coloured part above it. A model without an assembly comes back as it is. A deformation of
+/// space moves each instance differently, so it deforms the flattened model. Throws
+/// clay::Error(InvalidGeometry) when the assembly tree refers to missing parts or bodies or has a
+/// cycle.
+CLAY_BREP_API Model flattened(const Model& model);
+
 /// Throws clay::Error(InvalidGeometry) listing problems(model) when there are any.
 CLAY_BREP_API void validate(const Model& model);
 

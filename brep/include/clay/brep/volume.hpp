@@ -1,0 +1,28 @@
+#pragma once
+/// The volume a model's solids enclose, integrated to near machine precision (issue #20).
+///
+/// By the divergence theorem with the field (0, 0, z), the volume is the sum over the faces of
+/// ±∬_D z (x_u y_v − x_v y_u) du dv, + for a face whose outward side is S_u × S_v. Green's
+/// theorem turns each face's double integral over its trimmed domain D into a loop integral
+/// ∮_∂D F dv with F(u, v) = ∫ z (x_u y_v − x_v y_u) du, so trims count exactly as they are:
+/// F by Gauss–Legendre (16 points per knot span of u), the loop integral by adaptive
+/// Gauss–Legendre along every pcurve until two levels agree to 1e-14 of the size cubed.
+/// OpenCASCADE's BRepGProp::VolumeProperties is 0.03 % off on B-spline faces by default and
+/// 2e-7 off with its precision at 1e-9 (rational spheres and tori); this is exact to about 1e-13.
+#include <clay/brep/export.hpp>
+#include <clay/brep/model.hpp>
+
+namespace clay::brep {
+
+/// The signed volume (mm^3) enclosed by the shells of body `body` of `model`: positive for a
+/// solid whose faces point outwards, its voids subtracted. Meaningful for closed shells (a
+/// solid); for an open shell the result depends on where the coordinate origin is. Throws
+/// clay::Error(InvalidArgument) for a body index out of range, InvalidGeometry when the model
+/// breaks an invariant (validate).
+CLAY_BREP_API double volume_mm3(const Model& model, int body);
+
+/// The volume of every solid of the model: each body once without an assembly; each placed
+/// instance once with one (rigid placements keep volumes).
+CLAY_BREP_API double volume_mm3(const Model& model);
+
+}  // namespace clay::brep
