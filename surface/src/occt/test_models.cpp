@@ -204,6 +204,15 @@ void write_test_model(TestModel model, const fs::path& file) {
       shapes->UpdateAssemblies();
       break;
     }
+    case TestModel::Separated: {
+      TopoDS_Compound both;
+      BRep_Builder builder;
+      builder.MakeCompound(both);
+      builder.Add(both, BRepPrimAPI_MakeBox(20, 20, 20).Shape());
+      builder.Add(both, BRepPrimAPI_MakeSphere(gp_Pnt(50, 10, 10), 5.0).Shape());
+      add_part(shapes, colours, both, "pair", srgb(0.4, 0.4, 0.4));
+      break;
+    }
     case TestModel::LooseFaces:
       add_part(shapes, colours, loose_box_faces(), "faces", srgb(0.6, 0.6, 0.6));
       break;

@@ -19,6 +19,7 @@ enum class TestModel {
   Bottle,         ///< a revolved profile (lines and an arc), hollow: a solid with a void-free shell
   Assembly,       ///< two parts, named and coloured; the second placed twice
   LooseFaces,     ///< a box's six faces written as loose IGES faces (144), to be sewn
+  Separated,      ///< two solids apart: a box 20^3 at the origin, a sphere r 5 at (50, 10, 10)
 };
 
 /// Builds `model` with OpenCASCADE and writes it through XCAF (names, colours, assembly) as

@@ -1,0 +1,295 @@
+// Deformation of whole B-rep models (see clay/deform/model_deformation.hpp).
+#include <clay/deform/model_deformation.hpp>
+
+#include <clay/brep/volume.hpp>
+#include <clay/error.hpp>
+#include <clay/internal/checks.hpp>
+#include <clay/internal/format.hpp>
+#include <clay/surface/bspline_curve.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+namespace clay::deform {
+namespace {
+
+using internal::shortest;
+
+/// True when every point lies strictly on the outer side of one face of the frame's box: the
+/// lattice's FFD is the identity on their convex hull.
+bool outside(const Frame& frame, const surface::Points3& points) {
+  for (int axis = 0; axis < 3; ++axis) {
+    bool below = true, above = true;
+    for (Eigen::Index r = 0; r < points.rows() && (below || above); ++r) {
+      const double c = local_coordinates(frame, points.row(r).transpose())[axis];
+      below = below && c < 0;
+      above = above && c > 1;
+    }
+    if (below || above) return true;
+  }
+  return false;
+}
+
+/// True when the step leaves every point of `points` (and their convex hull) where it is.
+bool leaves_alone(const DeformationStep& step, const surface::Points3& points) {
+  if (!step.enabled) return true;
+  return std::visit(
+      [&](const auto& d) {
+        using T = std::decay_t<decltype(d)>;
+        if constexpr (std::is_same_v<T, BezierLattice> || std::is_same_v<T, BSplineLattice>)
+          return outside(d.frame, points) || d.points == undisplaced_points(d);
+        else
+          return false;
+      },
+      step.deformation);
+}
+
+bool leaves_alone(const DeformationStack& stack, const surface::Points3& points) {
+  for (const DeformationStep& step : stack.steps)
+    if (!leaves_alone(step, points)) return false;
+  return true;
+}
+
+/// The ruled surface C(t) x [0, 1] whose every v-row is the curve: its composition's row 0 is the
+/// curve's composition on the same t.
+surface::BSplineSurface ruled(const surface::BSplineCurve& c) {
+  const Eigen::Index n = c.points.rows();
+  surface::Points3 points(2 * n, 3);
+  Eigen::VectorXd weights(2 * n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    points.row(2 * i) = c.points.row(i);
+    points.row(2 * i + 1) = c.points.row(i);
+    weights[2 * i] = weights[2 * i + 1] = c.weights[i];
+  }
+  return surface::make_surface(c.basis, {1, {0, 0, 1, 1}}, std::move(points), std::move(weights));
+}
+
+/// Row v = 0 of a surface (control points j = 0): a curve on the surface's u basis.
+surface::BSplineCurve row_zero(const surface::BSplineSurface& s) {
+  const int nu = s.count_u();
+  surface::Points3 points(nu, 3);
+  Eigen::VectorXd weights(nu);
+  for (int i = 0; i < nu; ++i) {
+    points.row(i) = s.points.row(s.index(i, 0));
+    weights[i] = s.weights[s.index(i, 0)];
+  }
+  return surface::make_curve(s.u.degree, s.u.knots, std::move(points), std::move(weights));
+}
+
+struct Outcome {
+  enum class Way { Untouched, Exact, Refit } way = Way::Untouched;
+  double bound = 0;      // certified bound of a refit (mm)
+  double deviation = 0;  // largest deviation of an exact result from the pointwise map (mm)
+};
+
+/// One surface through the stack, with the degree cap: its result and what happened.
+Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
+                   const ModelDeformationOptions& options, const std::string& name) {
+  Outcome out;
+  SurfaceDeformationResult r;
+  try {
+    r = deform_surface(stack, s, options.surface);
+  } catch (const Error& e) {
+    throw Error(e.category(), name + ": " + e.message());
+  }
+  const bool too_high = std::max(r.report.degree_u, r.report.degree_v) > options.max_degree;
+  if (too_high) {
+    if (!options.surface.refit)
+      throw Error(ErrorCategory::DegreeLimit,
+                  name + ": the exact result has degree " +
+                      std::to_string(std::max(r.report.degree_u, r.report.degree_v)) +
+                      ", above max_degree " + std::to_string(options.max_degree) +
+                      "; allow a refit (a refit tolerance) or raise max_degree");
+    RefitOptions refit = *options.surface.refit;
+    refit.degree = std::min(refit.degree, options.max_degree);
+    RefitResult fit;
+    try {
+      fit = refit_deformed(stack, s, refit);
+    } catch (const Error& e) {
+      throw Error(e.category(), name + ": " + e.message());
+    }
+    if (!fit.report.certified || !(fit.report.certified_bound <= fit.report.tolerance))
+      throw Error(ErrorCategory::ToleranceNotMet,
+                  name + ": the refit below max_degree " + std::to_string(options.max_degree) +
+                      " missed its tolerance: " + fit.report.brief());
+    s = std::move(fit.surface);
+    out.way = Outcome::Way::Refit;
+    out.bound = fit.report.certified_bound;
+    return out;
+  }
+  s = std::move(r.surface);
+  out.way = r.report.exact ? Outcome::Way::Exact : Outcome::Way::Refit;
+  for (const StepOutcome& step : r.report.steps) {
+    if (step.method == StepOutcome::Method::Exact)
+      out.deviation =
+          std::max(out.deviation, step.compose.max_relative_deviation * step.compose.size);
+    if (step.method == StepOutcome::Method::Refit)
+      out.bound += step.refit.certified ? step.refit.certified_bound
+                                        : std::numeric_limits<double>::infinity();
+  }
+  return out;
+}
+
+double size_of(const brep::Model& m) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const brep::Face& f : m.faces)
+    for (Eigen::Index r = 0; r < f.surface.points.rows(); ++r) {
+      lo = lo.cwiseMin(f.surface.points.row(r).transpose());
+      hi = hi.cwiseMax(f.surface.points.row(r).transpose());
+    }
+  return m.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
+}
+
+std::string face_name(const brep::Model& m, std::size_t f) {
+  const std::string& name = m.faces[f].name;
+  return "face " + std::to_string(f) + (name.empty() ? "" : " (\"" + name + "\")");
+}
+
+}  // namespace
+
+std::vector<std::string> ModelDeformationOptions::problems() const {
+  std::vector<std::string> out = surface.problems();
+  if (max_degree < 1 || max_degree > 25)
+    out.push_back("max_degree is " + std::to_string(max_degree) + "; it must be in [1, 25]");
+  return out;
+}
+
+void ModelDeformationOptions::validate() const {
+  internal::throw_if(ErrorCategory::InvalidArgument, problems());
+}
+
+std::string ModelDeformationReport::brief() const {
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "%d faces: %d exact, %d refit, %d untouched; %d edges: %d exact, %d refit, %d "
+                "untouched; certified bound %.2g mm; edge gap %.2g mm; volume %.10g -> %.10g mm^3",
+                counts.faces, faces_exact, faces_refit, faces_untouched, counts.edges, edges_exact,
+                edges_refit, edges_untouched, max_certified_bound_mm, max_edge_gap_mm,
+                volume_before_mm3, volume_after_mm3);
+  std::string line = text;
+  if (solids_reversed > 0)
+    line += "; " + std::to_string(solids_reversed) + " solids reversed (mirroring stack)";
+  return line;
+}
+
+ModelDeformationResult deform_model(const DeformationStack& stack, const brep::Model& input,
+                                    const ModelDeformationOptions& options) {
+  options.validate();
+  validate(stack);
+  brep::validate(input);
+  ModelDeformationResult result;
+  brep::Model& m = result.model;
+  m = brep::flattened(input);
+  ModelDeformationReport& report = result.report;
+  report.volume_before_mm3 = brep::volume_mm3(m);
+  const double size = size_of(m);
+
+  // Faces.
+  std::vector<Outcome> faces(m.faces.size());
+  std::vector<double> edge_face_bound(m.edges.size(), 0.0);
+  std::vector<bool> edge_touched(m.edges.size(), false);
+  for (std::size_t f = 0; f < m.faces.size(); ++f) {
+    brep::Face& face = m.faces[f];
+    if (leaves_alone(stack, face.surface.points)) {
+      ++report.faces_untouched;
+      continue;
+    }
+    faces[f] = deform_one(stack, face.surface, options, face_name(m, f));
+    (faces[f].way == Outcome::Way::Exact ? report.faces_exact : report.faces_refit) += 1;
+    report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, faces[f].bound);
+    report.max_deviation_mm = std::max(report.max_deviation_mm, faces[f].deviation);
+    for (const brep::Loop& loop : face.loops)
+      for (const brep::Coedge& co : loop.coedges) {
+        const auto e = static_cast<std::size_t>(co.edge);
+        edge_touched[e] = true;
+        edge_face_bound[e] = std::max(edge_face_bound[e], faces[f].bound);
+      }
+  }
+  // Edges: F∘C on the same t, when a deformed face uses them.
+  std::vector<double> edge_bound(m.edges.size(), 0.0);
+  for (std::size_t e = 0; e < m.edges.size(); ++e) {
+    brep::Edge& edge = m.edges[e];
+    if (!edge_touched[e] || edge.degenerate) {
+      if (edge_touched[e])
+        ++report.edges_exact;  // a pole: nothing to map but its vertex
+      else
+        ++report.edges_untouched;
+      continue;
+    }
+    surface::BSplineSurface strip = ruled(edge.curve);
+    const Outcome o = deform_one(stack, strip, options, "edge " + std::to_string(e));
+    edge.curve = row_zero(strip);
+    (o.way == Outcome::Way::Exact ? report.edges_exact : report.edges_refit) += 1;
+    report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, o.bound);
+    report.max_deviation_mm = std::max(report.max_deviation_mm, o.deviation);
+    edge_bound[e] = o.bound;
+    // A refit's bound, the face's and the edge's own, widens the edge's tolerance.
+    edge.tolerance_mm += o.bound + edge_face_bound[e];
+  }
+  // Vertices: the pointwise map, where a deformed edge ends.
+  std::vector<bool> vertex_touched(m.vertices.size(), false);
+  std::vector<double> vertex_widen(m.vertices.size(), 0.0);
+  for (std::size_t e = 0; e < m.edges.size(); ++e) {
+    if (!edge_touched[e]) continue;
+    for (int v : {m.edges[e].start, m.edges[e].end}) {
+      vertex_touched[static_cast<std::size_t>(v)] = true;
+      vertex_widen[static_cast<std::size_t>(v)] =
+          std::max(vertex_widen[static_cast<std::size_t>(v)], edge_bound[e] + edge_face_bound[e]);
+    }
+  }
+  for (std::size_t v = 0; v < m.vertices.size(); ++v)
+    if (vertex_touched[v]) {
+      m.vertices[v].point = deform_point(stack, m.vertices[v].point);
+      m.vertices[v].tolerance_mm += vertex_widen[v];
+    }
+  // A deformation stretches the file's own gaps with the geometry: where an exact edge's gap now
+  // exceeds its tolerance by no more than the stretch allows (10 x, or 1e-9 of the size), the
+  // tolerance follows the measured gap, as OpenCASCADE's GTransform scales tolerances.
+  for (const brep::EdgeGap& g : brep::edge_gaps(m)) {
+    brep::Edge& edge = m.edges[static_cast<std::size_t>(g.edge)];
+    const double allowed = std::max(10 * edge.tolerance_mm, 1e-9 * size);
+    if (g.gap_mm > edge.tolerance_mm && g.gap_mm <= allowed) {
+      edge.tolerance_mm = g.gap_mm * (1 + 1e-9);
+      for (int v : {edge.start, edge.end}) {
+        brep::Vertex& vertex = m.vertices[static_cast<std::size_t>(v)];
+        vertex.tolerance_mm = std::max(vertex.tolerance_mm, edge.tolerance_mm);
+      }
+    }
+  }
+  // A mirroring map turns solids inside out: reverse their faces.
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+    if (m.bodies[b].kind != brep::BodyKind::Solid) continue;
+    if (brep::volume_mm3(m, static_cast<int>(b)) < 0) {
+      for (const brep::Shell& shell : m.bodies[b].shells)
+        for (int f : shell.faces)
+          m.faces[static_cast<std::size_t>(f)].reversed =
+              !m.faces[static_cast<std::size_t>(f)].reversed;
+      ++report.solids_reversed;
+    }
+  }
+  for (const brep::EdgeGap& g : brep::edge_gaps(m))
+    report.max_edge_gap_mm = std::max(report.max_edge_gap_mm, g.gap_mm);
+  report.counts = brep::counts(m);
+  const auto broken = brep::problems(m);
+  if (!broken.empty()) {
+    std::string text = "deform_model: the deformed model breaks " + std::to_string(broken.size()) +
+                       " invariant" + (broken.size() == 1 ? "" : "s") +
+                       " (a torn model is not returned):";
+    for (std::size_t k = 0; k < std::min<std::size_t>(broken.size(), 8); ++k)
+      text += "\n  " + broken[k];
+    throw Error(ErrorCategory::ToleranceNotMet, text);
+  }
+  report.volume_after_mm3 = brep::volume_mm3(m);
+  report.summary.termination = Termination::Converged;
+  report.summary.final_residual = report.max_edge_gap_mm;
+  report.summary.message = report.brief();
+  return result;
+}
+
+}  // namespace clay::deform

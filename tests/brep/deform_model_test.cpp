@@ -1,0 +1,232 @@
+// deform_model (clay/deform/model_deformation.hpp) on whole models built by OpenCASCADE and read
+// from STEP: the deformed model is valid for brep::problems and for BRepCheck, has the same
+// counts, keeps its pcurves bit for bit, and each face equals the pointwise deformation of the
+// original inside its trims; a uniform scale changes the volume by its determinant; faces a
+// local lattice leaves alone are kept bit for bit.
+#include <catch2/catch.hpp>
+
+#include <clay/brep/exchange.hpp>
+#include <clay/brep/volume.hpp>
+#include <clay/deform/model_deformation.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "error_of.hpp"
+#include "occt/test_models.hpp"
+
+namespace fs = std::filesystem;
+using Catch::Matchers::Contains;
+using clay::brep::Model;
+using clay::deform::DeformationStack;
+using clay::surface::occt_reference::TestModel;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+namespace {
+
+fs::path output(const std::string& name) {
+  const fs::path folder = fs::path(CLAY_TEST_OUTPUT_DIR) / "brep-deform";
+  fs::create_directories(folder);
+  return folder / name;
+}
+
+Model read(TestModel model, const std::string& name) {
+  const fs::path file = output(name);
+  clay::surface::occt_reference::write_test_model(model, file);
+  return clay::brep::read_model(file).model;
+}
+
+/// The loops of a face as polygons in (u, v), 64 points per coedge.
+std::vector<std::vector<Vector2d>> polygons(const Model& m, const clay::brep::Face& face) {
+  std::vector<std::vector<Vector2d>> out;
+  for (const auto& loop : face.loops) {
+    auto& poly = out.emplace_back();
+    for (const auto& co : loop.coedges) {
+      const auto& e = m.edges[static_cast<size_t>(co.edge)];
+      for (int k = 0; k < 64; ++k) {
+        const double w = k / 64.0;
+        const double t = co.same_sense ? e.t0 + (e.t1 - e.t0) * w : e.t1 - (e.t1 - e.t0) * w;
+        poly.push_back(clay::surface::evaluate(co.pcurve, t).head<2>());
+      }
+    }
+  }
+  return out;
+}
+
+/// Even-odd rule over every loop.
+bool inside(const std::vector<std::vector<Vector2d>>& loops, const Vector2d& p) {
+  bool in = false;
+  for (const auto& poly : loops)
+    for (size_t i = 0, j = poly.size() - 1; i < poly.size(); j = i++)
+      if ((poly[i].y() > p.y()) != (poly[j].y() > p.y()) &&
+          p.x() <
+              (poly[j].x() - poly[i].x()) * (p.y() - poly[i].y()) / (poly[j].y() - poly[i].y()) +
+                  poly[i].x())
+        in = !in;
+  return in;
+}
+
+/// The largest distance, over `per_face` random parameters inside each face's trims, between
+/// the deformed face and the pointwise deformation of the original face.
+double max_pointwise_deviation(const DeformationStack& stack, const Model& before,
+                               const Model& after, int per_face, int& samples) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(0, 1);
+  double worst = 0;
+  samples = 0;
+  for (size_t f = 0; f < before.faces.size(); ++f) {
+    const auto& face = before.faces[f];
+    const auto loops = polygons(before, face);
+    const auto [u0, u1] = face.surface.u.domain();
+    const auto [v0, v1] = face.surface.v.domain();
+    for (int found = 0, tries = 0; found < per_face && tries < 100 * per_face; ++tries) {
+      const Vector2d uv(u0 + (u1 - u0) * unit(rng), v0 + (v1 - v0) * unit(rng));
+      if (!face.loops.empty() && !inside(loops, uv)) continue;
+      ++found;
+      ++samples;
+      const Vector3d expected =
+          clay::deform::deform_point(stack, clay::surface::evaluate(face.surface, uv.x(), uv.y()));
+      worst = std::max(
+          worst,
+          (clay::surface::evaluate(after.faces[f].surface, uv.x(), uv.y()) - expected).norm());
+    }
+  }
+  return worst;
+}
+
+/// A trilinear Bézier lattice around the box [lo, hi], one corner moved by `move`.
+DeformationStack trilinear(const Vector3d& lo, const Vector3d& hi, const Vector3d& move) {
+  clay::deform::Frame frame;
+  frame.origin = lo;
+  frame.s = {hi.x() - lo.x(), 0, 0};
+  frame.t = {0, hi.y() - lo.y(), 0};
+  frame.u = {0, 0, hi.z() - lo.z()};
+  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  lattice.points.row(lattice.index(1, 1, 1)) += move.transpose();
+  DeformationStack stack;
+  stack.steps.push_back({lattice, "corner", true});
+  return stack;
+}
+
+}  // namespace
+
+TEST_CASE("deform_model: a filleted block with holes through a trilinear lattice, exactly") {
+  const Model block = read(TestModel::FilletedBlock, "block.step");
+  const DeformationStack stack = trilinear({-5, -5, -5}, {65, 45, 25}, {6, 4, 5});
+  const auto result = clay::deform::deform_model(stack, block);
+  const auto& r = result.report;
+  INFO(r.brief());
+  CHECK(r.counts == clay::brep::counts(block));
+  CHECK(r.faces_exact == 17);
+  CHECK(r.faces_refit == 0);
+  CHECK(r.edges_refit == 0);
+  CHECK(r.max_certified_bound_mm == 0);
+  const double size = 75;  // the block's diagonal is 74.8 mm
+  CHECK(r.max_edge_gap_mm <= 1e-9 * size);
+  CHECK(r.max_deviation_mm <= 1e-12 * size);
+  // Pcurves kept bit for bit.
+  int kept = 0, coedges = 0;
+  for (size_t f = 0; f < block.faces.size(); ++f)
+    for (size_t l = 0; l < block.faces[f].loops.size(); ++l)
+      for (size_t c = 0; c < block.faces[f].loops[l].coedges.size(); ++c) {
+        ++coedges;
+        kept += clay::surface::identical(block.faces[f].loops[l].coedges[c].pcurve,
+                                         result.model.faces[f].loops[l].coedges[c].pcurve);
+      }
+  CHECK(kept == coedges);
+  // Each face is the pointwise deformation of the original inside its trims.
+  int samples = 0;
+  const double deviation = max_pointwise_deviation(stack, block, result.model, 1000, samples);
+  CHECK(samples >= 17 * 1000);
+  CHECK(deviation <= 1e-12 * size);
+  // OpenCASCADE finds it valid, in memory and read back from STEP, with the same counts.
+  const auto check = clay::brep::check_model(result.model);
+  INFO(check.brief());
+  CHECK(check.valid);
+  const fs::path written = output("block-deformed.step");
+  clay::brep::write_model(result.model, written);
+  const auto facts = clay::surface::occt_reference::facts_of_file(written);
+  CHECK(facts.valid);
+  CHECK(facts.solids == 1);
+  CHECK(facts.faces == 17);
+  CHECK(facts.edges == clay::brep::counts(block).edges);
+  CHECK(std::abs(facts.volume - r.volume_after_mm3) <= 1e-6 * r.volume_after_mm3);
+}
+
+TEST_CASE("deform_model: a uniform scale changes the volume by its determinant") {
+  const Model sphere = read(TestModel::Sphere, "sphere.step");
+  // The lattice [-20, 20]^3 scaled by 1.1 about the origin: an affine map of determinant 1.331.
+  clay::deform::Frame frame;
+  frame.origin = {-20, -20, -20};
+  frame.s = {40, 0, 0};
+  frame.t = {0, 40, 0};
+  frame.u = {0, 0, 40};
+  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  lattice.points *= 1.1;
+  DeformationStack stack;
+  stack.steps.push_back({lattice, "scale", true});
+  const auto result = clay::deform::deform_model(stack, sphere);
+  INFO(result.report.brief());
+  CHECK(std::abs(result.report.volume_after_mm3 / result.report.volume_before_mm3 - 1.331) <=
+        1e-9 * 1.331);
+  // An affine lattice keeps every degree.
+  for (size_t f = 0; f < sphere.faces.size(); ++f) {
+    CHECK(result.model.faces[f].surface.u.degree == sphere.faces[f].surface.u.degree);
+    CHECK(result.model.faces[f].surface.v.degree == sphere.faces[f].surface.v.degree);
+  }
+  CHECK(clay::brep::check_model(result.model).valid);
+}
+
+TEST_CASE("deform_model: faces a local lattice leaves alone are kept bit for bit") {
+  const Model pair = read(TestModel::Separated, "pair.step");
+  // Around the sphere only (centre (50, 10, 10), r 5).
+  const DeformationStack stack = trilinear({43, 3, 3}, {57, 17, 17}, {2, -1, 3});
+  const auto result = clay::deform::deform_model(stack, pair);
+  INFO(result.report.brief());
+  CHECK(result.report.faces_untouched == 6);  // the box
+  CHECK(result.report.faces_exact == 1);      // the sphere
+  int identical = 0;
+  for (size_t f = 0; f < pair.faces.size(); ++f)
+    identical += clay::surface::identical(pair.faces[f].surface, result.model.faces[f].surface);
+  CHECK(identical == 6);
+  for (size_t e = 0; e < pair.edges.size(); ++e)
+    if (!pair.edges[e].degenerate && pair.edges[e].curve.points.col(0).maxCoeff() < 30)
+      CHECK(clay::surface::identical(pair.edges[e].curve, result.model.edges[e].curve));
+  CHECK(clay::brep::check_model(result.model).valid);
+}
+
+TEST_CASE("deform_model: a mirroring lattice reverses the solid's faces") {
+  const Model sphere = read(TestModel::Sphere, "sphere-mirror.step");
+  clay::deform::Frame frame;
+  frame.origin = {-20, -20, -20};
+  frame.s = {40, 0, 0};
+  frame.t = {0, 40, 0};
+  frame.u = {0, 0, 40};
+  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  lattice.points.col(0) *= -1;  // x -> -x
+  DeformationStack stack;
+  stack.steps.push_back({lattice, "mirror", true});
+  const auto result = clay::deform::deform_model(stack, sphere);
+  CHECK(result.report.solids_reversed == 1);
+  CHECK(result.report.volume_after_mm3 == Approx(result.report.volume_before_mm3).epsilon(1e-12));
+  CHECK(clay::brep::check_model(result.model).valid);
+}
+
+TEST_CASE("deform_model: a model leaving the lattice is refused, naming the face") {
+  const Model block = read(TestModel::FilletedBlock, "block-leaves.step");
+  // The lattice holds only the left half of the block.
+  const DeformationStack stack = trilinear({-5, -5, -5}, {30, 45, 25}, {3, 0, 0});
+  auto [category, text] =
+      clay::test::error_of([&] { (void)clay::deform::deform_model(stack, block); });
+  CHECK(category == clay::ErrorCategory::OutOfDomain);
+  CHECK_THAT(text, Contains("face "));
+  clay::deform::ModelDeformationOptions options;
+  options.max_degree = 0;
+  CHECK(clay::test::error_of([&] {
+          (void)clay::deform::deform_model(stack, block, options);
+        }).first == clay::ErrorCategory::InvalidArgument);
+}
