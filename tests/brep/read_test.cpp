@@ -437,3 +437,25 @@ TEST_CASE("debug rt", "[.debug]") {
     }
   }
 }
+
+TEST_CASE("read_model: an isolated read (a child process) gives the same model and report") {
+  const fs::path file = written(TestModel::FilletedBlock, "isolated.step");
+  const auto direct = read_model(file);
+  clay::brep::ModelReadOptions options;
+  options.read.isolate = true;
+  const auto isolated = read_model(file, options);
+  check_identical(direct.model, isolated.model, false);
+  CHECK(isolated.report.brief() == direct.report.brief());
+  CHECK(isolated.model.bodies[0].name == "block");
+  CHECK(near(isolated.model.bodies[0].colour, 0.8, 0.5, 0.2));
+  // The assembly tree and placements come through the pipe too.
+  const auto tree = read_model(written(TestModel::Assembly, "isolated-assembly.step"), options);
+  REQUIRE(tree.model.is_assembly());
+  CHECK(tree.model.parts.size() == 3);
+  // A child that fails reports the failure.
+  const fs::path garbage = output("isolated-garbage.step");
+  std::ofstream(garbage) << "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\n#1=FOO(#2);\nENDSEC;\n";
+  options.read.precheck = false;  // let OpenCASCADE see it
+  CHECK(clay::test::error_of([&] { read_model(garbage, options); }).first ==
+        clay::ErrorCategory::Exchange);
+}

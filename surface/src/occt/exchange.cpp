@@ -108,7 +108,10 @@ using occt::check_readable;
 using occt::check_statuses;
 using occt::check_target;
 using occt::ExchangeSession;
+using occt::put;
+using occt::put_doubles;
 using occt::set_static;
+using occt::Unpacker;
 using occt::write_atomically;
 using occt::write_stream;
 
@@ -358,23 +361,12 @@ std::vector<BSplineSurface> read_iges_locked(const fs::path& file) {
 // the bytes with a deadline, and the child's exit status says which of the two it was, or how it
 // died. Same machine, same build: no portable format is needed.
 
-using Reader = std::vector<BSplineSurface> (*)(const fs::path&);
-
 enum ChildStatus : int {
   child_read = 0,
   child_error = 2,
   child_out_of_memory = 3,
   child_unknown = 4
 };
-
-template <class T>
-void put(std::string& out, const T& x) {
-  out.append(reinterpret_cast<const char*>(&x), sizeof x);
-}
-void put_doubles(std::string& out, const double* p, std::size_t n) {
-  put(out, static_cast<std::uint64_t>(n));
-  out.append(reinterpret_cast<const char*>(p), n * sizeof(double));
-}
 
 std::string serialize(const std::vector<BSplineSurface>& surfaces) {
   std::string out;
@@ -390,36 +382,6 @@ std::string serialize(const std::vector<BSplineSurface>& surfaces) {
   }
   return out;
 }
-
-/// Reads back what serialize wrote; throws Internal when the bytes are short.
-class Unpacker {
- public:
-  explicit Unpacker(const std::string& bytes) : bytes_(bytes) {}
-  template <class T>
-  T take() {
-    T x;
-    need(sizeof x);
-    std::memcpy(&x, bytes_.data() + at_, sizeof x);
-    at_ += sizeof x;
-    return x;
-  }
-  std::vector<double> doubles() {
-    const auto n = take<std::uint64_t>();
-    if (n > (bytes_.size() - at_) / sizeof(double)) need(bytes_.size() + 1);
-    std::vector<double> out(static_cast<std::size_t>(n));
-    std::memcpy(out.data(), bytes_.data() + at_, out.size() * sizeof(double));
-    at_ += out.size() * sizeof(double);
-    return out;
-  }
-
- private:
-  const std::string& bytes_;
-  std::size_t at_ = 0;
-  void need(std::size_t n) const {
-    if (bytes_.size() - at_ < n)
-      throw Error(ErrorCategory::Internal, "isolated read: the child's answer is truncated");
-  }
-};
 
 std::vector<BSplineSurface> deserialize(const std::string& bytes) {
   Unpacker in(bytes);
@@ -472,7 +434,7 @@ unsigned long long peak_mapped_bytes() {
 /// might would otherwise unwind into the caller's copy of its own stack and run on as a second
 /// process); never runs the parent's atexit handlers or flushes its stdio buffers (_exit).
 [[noreturn]] void answer_in_child(int fd, const fs::path& file, const ReadOptions& options,
-                                  Reader read) noexcept {
+                                  const occt::Producer& produce) noexcept {
   int status = child_unknown;
   try {
     // Die of a crash, so the parent sees the signal: the caller's handlers (a test framework's,
@@ -492,7 +454,7 @@ unsigned long long peak_mapped_bytes() {
     ::setrlimit(RLIMIT_AS, &limit);
     std::string payload;
     try {
-      payload = serialize(read(file));
+      payload = produce(file);
       status = child_read;
     } catch (const Error& e) {
       // OpenCASCADE's parsers catch a failed allocation and report the file as unreadable: a
@@ -538,8 +500,10 @@ std::string signal_name(int sig) {
 /// `read(file)` in a forked child process with options' time and memory limits. The caller holds
 /// the exchange session across the fork, so no other thread of this process is inside
 /// OpenCASCADE while the child's copy of it starts; the child calls `read` without locking.
-std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOptions& options,
-                                          std::string_view caller, Reader read) {
+}  // namespace
+
+std::string occt::read_in_child(const fs::path& file, const ReadOptions& options,
+                                std::string_view caller, const Producer& produce) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0)
     throw Error(ErrorCategory::Io,
@@ -556,7 +520,7 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
   }
   if (pid == 0) {
     ::close(fds[0]);
-    answer_in_child(fds[1], file, options, read);
+    answer_in_child(fds[1], file, options, produce);
   }
   ::close(fds[1]);
   // Whatever happens on this side (a throw included), the pipe is closed and the child reaped:
@@ -642,7 +606,7 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
                                              memory + "): export it again or repair it");
   switch (WIFEXITED(status) ? WEXITSTATUS(status) : child_unknown) {
     case child_read:
-      return deserialize(bytes);
+      return bytes;
     case child_error: {
       Unpacker in(bytes);
       const auto category = static_cast<ErrorCategory>(in.take<std::int32_t>());
@@ -660,6 +624,10 @@ std::vector<BSplineSurface> read_in_child(const fs::path& file, const ReadOption
   }
 }
 
+namespace {
+
+using Reader = std::vector<BSplineSurface> (*)(const fs::path&);
+
 /// The checks and the read every public read goes through.
 std::vector<BSplineSurface> read_guarded(const fs::path& file, const ReadOptions& options,
                                          std::string_view caller,
@@ -670,7 +638,10 @@ std::vector<BSplineSurface> read_guarded(const fs::path& file, const ReadOptions
   if (options.precheck) precheck(file, caller, max_exchange_degree);
   ExchangeSession session;
   std::vector<BSplineSurface> surfaces =
-      options.isolate ? read_in_child(file, options, caller, read) : read(file);
+      options.isolate
+          ? deserialize(occt::read_in_child(
+                file, options, caller, [read](const fs::path& f) { return serialize(read(f)); }))
+          : read(file);
   // What came through the pipe is checked again here: a surface the child's OpenCASCADE accepted
   // must still be one this kernel can use.
   for (std::size_t k = 0; k < surfaces.size(); ++k)

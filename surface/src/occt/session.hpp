@@ -2,7 +2,12 @@
 // What every OpenCASCADE exchange call shares (internal to clay_occt): the lock around
 // OpenCASCADE's translators, quiet messages, and the file checks and atomic writes of
 // surface/exchange.cpp and brep model exchange.
+#include <clay/error.hpp>
 #include <clay/internal/fenv.hpp>
+#include <clay/surface/exchange.hpp>
+
+#include <cstdint>
+#include <cstring>
 
 #include <filesystem>
 #include <functional>
@@ -78,6 +83,56 @@ void check_readable(const std::filesystem::path& file, std::string_view caller);
 /// Interface_Static::SetCVal / SetIVal, throwing clay::Error(Internal) when refused.
 void set_static(const char* name, const char* value);
 void set_static(const char* name, int value);
+
+/// Appends x's bytes (native layout: the isolated read's pipe joins two processes of one build).
+template <class T>
+void put(std::string& out, const T& x) {
+  out.append(reinterpret_cast<const char*>(&x), sizeof x);
+}
+/// Appends a count and n doubles.
+inline void put_doubles(std::string& out, const double* p, std::size_t n) {
+  put(out, static_cast<std::uint64_t>(n));
+  out.append(reinterpret_cast<const char*>(p), n * sizeof(double));
+}
+
+/// Reads back what put and put_doubles wrote; throws Internal when the bytes are short.
+class Unpacker {
+ public:
+  explicit Unpacker(const std::string& bytes) : bytes_(bytes) {}
+  template <class T>
+  T take() {
+    T x;
+    need(sizeof x);
+    std::memcpy(&x, bytes_.data() + at_, sizeof x);
+    at_ += sizeof x;
+    return x;
+  }
+  std::vector<double> doubles() {
+    const auto n = take<std::uint64_t>();
+    if (n > (bytes_.size() - at_) / sizeof(double)) need(bytes_.size() + 1);
+    std::vector<double> out(static_cast<std::size_t>(n));
+    std::memcpy(out.data(), bytes_.data() + at_, out.size() * sizeof(double));
+    at_ += out.size() * sizeof(double);
+    return out;
+  }
+
+ private:
+  const std::string& bytes_;
+  std::size_t at_ = 0;
+  void need(std::size_t n) const {
+    if (bytes_.size() - at_ < n)
+      throw Error(ErrorCategory::Internal, "isolated read: the child's answer is truncated");
+  }
+};
+
+/// What an isolated read runs in the child: reads the file and returns its answer as bytes.
+using Producer = std::function<std::string(const std::filesystem::path&)>;
+
+/// Runs produce(file) in a forked child process under options' time and memory limits and
+/// returns its bytes. A crash, hang or memory blow-up of the child becomes clay::Error(Exchange)
+/// naming the file; a clay::Error the child raised is raised again here (ReadOptions::isolate).
+std::string read_in_child(const std::filesystem::path& file, const ReadOptions& options,
+                          std::string_view caller, const Producer& produce);
 
 /// Every BRepCheck status found on `face` and its sub-shapes, in words ("edge 2:
 /// BRepCheck_InvalidCurveOnSurface"), without repeats.

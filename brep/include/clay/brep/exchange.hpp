@@ -31,8 +31,10 @@ struct CLAY_OCCT_API ModelReadOptions {
   bool sew = false;
   /// Largest gap sewing closes (mm), in (0, 1].
   double sewing_tolerance_mm = 1e-3;
-  /// The text pre-check of surface::ReadOptions (refuses the inputs known to crash OpenCASCADE).
-  bool precheck = true;
+  /// The text pre-check and the isolated read (a child process under time and memory limits)
+  /// of surface::ReadOptions: a file that crashes or hangs OpenCASCADE becomes
+  /// clay::Error(Exchange). The `clayform` command reads every model isolated.
+  surface::ReadOptions read;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
