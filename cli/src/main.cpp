@@ -1,5 +1,6 @@
 // clayform — the command-line shell over the kernel: parse, call one library function, print the
 // outcome, map error categories to exit codes (STYLE.md rule 18).
+#include <clay/brep/exchange.hpp>
 #include <clay/deform.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/render/render.hpp>
@@ -8,6 +9,7 @@
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <chrono>
@@ -78,22 +80,101 @@ std::vector<BSplineSurface> read_surfaces(const fs::path& file, const char* comm
                         "'; give a .step/.stp or .igs/.iges file");
 }
 
-/// `clayform info FILE`: lists the surfaces of a STEP or IGES file.
+/// The whole model of a STEP or IGES file (brep::read_model), read in a child process like
+/// read_surfaces.
+clay::brep::ImportedModel read_model_file(const fs::path& file, const char* command) {
+  std::string ext = file.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".step" && ext != ".stp" && ext != ".igs" && ext != ".iges")
+    throw clay::Error(clay::ErrorCategory::InvalidArgument,
+                      std::string(command) + ": '" + file.string() + "' has extension '" + ext +
+                          "'; give a .step/.stp or .igs/.iges file");
+  clay::brep::ModelReadOptions options;
+  options.read.isolate = true;
+  return clay::brep::read_model(file, options);
+}
+
+std::string quoted_name(const std::string& name) { return name.empty() ? "" : " \"" + name + "\""; }
+
+std::string colour_text(const std::optional<clay::brep::Colour>& c) {
+  if (!c) return "";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, " colour (%.3g, %.3g, %.3g)", c->r, c->g, c->b);
+  return buf;
+}
+
+/// The assembly tree, indented: each instance's name, its part's name and where it is placed.
+void print_tree(const clay::brep::Model& m, const clay::brep::Instance& in, int depth) {
+  if (depth > static_cast<int>(m.parts.size())) return;  // cycles are problems, printed apart
+  const auto& part = m.parts[static_cast<size_t>(in.part)];
+  const Eigen::Vector3d t = in.placement.translation();
+  const bool turned = !in.placement.linear().isIdentity(1e-12);
+  std::printf("  %*s%s%s at (%.6g, %.6g, %.6g)%s%s: %zu bod%s\n", 2 * depth, "",
+              part.name.empty() ? "(unnamed part)" : ("\"" + part.name + "\"").c_str(),
+              in.name.empty() || in.name == part.name ? "" : (" as \"" + in.name + "\"").c_str(),
+              t.x(), t.y(), t.z(), turned ? ", turned" : "", colour_text(part.colour).c_str(),
+              part.bodies.size(), part.bodies.size() == 1 ? "y" : "ies");
+  for (const auto& c : part.components) print_tree(m, c, depth + 1);
+}
+
+/// `clayform info FILE`: the topology of a STEP or IGES file (bodies, shells, trimmed faces and
+/// holes, the assembly tree with names), OpenCASCADE's verdict, and each face's surface.
 int info(const fs::path& file) {
-  const std::vector<BSplineSurface> surfaces = read_surfaces(file, "info");
-  const ExchangeReport check = check_faces(surfaces);
-  std::printf("%s: %s\n", file.string().c_str(), check.brief().c_str());
-  for (size_t k = 0; k < surfaces.size(); ++k) {
-    const BSplineSurface& s = surfaces[k];
+  const clay::brep::ImportedModel read = read_model_file(file, "info");
+  const clay::brep::Model& m = read.model;
+  int max_degree = 0;
+  long control_points = 0;
+  for (const auto& f : m.faces) {
+    max_degree = std::max({max_degree, f.surface.u.degree, f.surface.v.degree});
+    control_points += static_cast<long>(f.surface.points.rows());
+  }
+  const bool broken = !read.report.problems.empty();
+  clay::brep::ModelCheck check;
+  if (!broken) check = clay::brep::check_model(m);
+  std::printf("%s: %zu face%s, max degree %d, %ld control points, %s\n", file.string().c_str(),
+              m.faces.size(), m.faces.size() == 1 ? "" : "s", max_degree, control_points,
+              broken ? "NOT valid (broken invariants)" : check.brief().c_str());
+  std::printf("  read: %s\n", read.report.brief().c_str());
+  for (size_t b = 0; b < m.bodies.size(); ++b) {
+    const auto& body = m.bodies[b];
+    int faces = 0, trimmed = 0, holes = 0;
+    for (const auto& shell : body.shells)
+      for (int f : shell.faces) {
+        const auto& face = m.faces[static_cast<size_t>(f)];
+        ++faces;
+        trimmed += !face.loops.empty();
+        holes += face.loops.empty() ? 0 : static_cast<int>(face.loops.size()) - 1;
+      }
+    std::printf("  body %zu: %s%s%s, %zu shell%s, %d face%s (%d trimmed, %d hole%s)\n", b,
+                std::string(clay::brep::to_string(body.kind)).c_str(),
+                quoted_name(body.name).c_str(), colour_text(body.colour).c_str(),
+                body.shells.size(), body.shells.size() == 1 ? "" : "s", faces,
+                faces == 1 ? "" : "s", trimmed, holes, holes == 1 ? "" : "s");
+  }
+  if (m.is_assembly()) {
+    std::printf("  assembly:\n");
+    for (const auto& root : m.roots) print_tree(m, root, 0);
+  }
+  for (size_t k = 0; k < m.faces.size(); ++k) {
+    const auto& face = m.faces[k];
+    const BSplineSurface& s = face.surface;
     const auto [lo, hi] = control_box(s);
-    std::printf("  #%zu degree (%d, %d), %d x %d control points, %s\n", k, s.u.degree, s.v.degree,
-                s.count_u(), s.count_v(), s.is_rational() ? "rational" : "polynomial");
+    std::printf("  #%zu degree (%d, %d), %d x %d control points, %s%s%s, %s\n", k, s.u.degree,
+                s.v.degree, s.count_u(), s.count_v(), s.is_rational() ? "rational" : "polynomial",
+                quoted_name(face.name).c_str(), colour_text(face.colour).c_str(),
+                face.loops.empty()       ? "untrimmed"
+                : face.loops.size() == 1 ? "trimmed"
+                                         : ("trimmed, " + std::to_string(face.loops.size() - 1) +
+                                            " hole" + (face.loops.size() == 2 ? "" : "s"))
+                                               .c_str());
     std::printf("     u knots %s\n     v knots %s\n", knots_summary(s.u).c_str(),
                 knots_summary(s.v).c_str());
     std::printf("     control box [%.6g, %.6g, %.6g] .. [%.6g, %.6g, %.6g] mm\n", lo.x(), lo.y(),
                 lo.z(), hi.x(), hi.y(), hi.z());
   }
+  for (const auto& p : read.report.problems) std::printf("  problem: %s\n", p.c_str());
   for (const auto& p : check.problems) std::printf("  problem: %s\n", p.c_str());
+  if (broken) return exit_code(clay::ErrorCategory::InvalidGeometry);
   return check.valid ? 0 : exit_code(clay::ErrorCategory::Exchange);
 }
 
@@ -166,6 +247,35 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
   return 0;
 }
 
+/// `clayform deform FILE --recipe R --out DIR`: the whole model of a STEP or IGES file (trimmed
+/// faces, solids, assembly) through the recipe's deformation stack, written as a valid model.
+int deform_model_file(const fs::path& file, const fs::path& recipe_file,
+                      const std::string& deformation, const fs::path& out, bool show) {
+  const auto recipe = clay::recipe::load_recipe(recipe_file);
+  const auto start = std::chrono::steady_clock::now();
+  const clay::brep::ImportedModel read = read_model_file(file, "deform");
+  if (show) std::printf("read %s: %s\n", file.string().c_str(), read.report.brief().c_str());
+  if (!read.report.problems.empty()) {
+    std::string m = "deform: the model of '" + file.string() + "' breaks " +
+                    std::to_string(read.report.problems.size()) +
+                    " invariant(s), so it is not deformed:";
+    for (const auto& p : read.report.problems) m += "\n  " + p;
+    throw clay::Error(clay::ErrorCategory::InvalidGeometry, m);
+  }
+  const auto result = clay::recipe::deform_model(recipe, read.model, deformation);
+  if (show)
+    std::printf("deformed by %s: %s\n", result.deformation.c_str(), result.report.brief().c_str());
+  const auto files = clay::recipe::write_model_outputs(result, out, file.stem().string());
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%s: %s in %.2f s\n", file.string().c_str(), result.report.brief().c_str(), seconds);
+  if (!result.fold_free)
+    std::printf("  WARNING: a lattice may fold (a Jacobian bound <= 0): check the result\n");
+  std::printf("outputs in %s (read back valid, BRepCheck):\n", out.string().c_str());
+  for (const auto& f : files) std::printf("  %s\n", f.string().c_str());
+  return 0;
+}
+
 /// `clayform validate RECIPE`: every problem, with its location.
 int validate(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -228,10 +338,12 @@ int main(int argc, char** argv) {
       "Check a recipe without running it: every problem at once, with its JSON path (and "
       "line and column for syntax errors)");
   validate_cmd->add_option("RECIPE", recipe_file, "a recipe (.json)")->required();
-  auto* deform_cmd = app.add_subcommand(
-      "deform",
-      "Apply a recipe's deformation stack to every surface of a STEP or IGES file; writes "
-      "STEM.step/.igs/.glb and report.json into --out");
+  auto* deform_cmd =
+      app.add_subcommand("deform",
+                         "Deform the whole model of a STEP or IGES file (trimmed faces, solids, "
+                         "assembly) by a recipe's deformation stack; writes "
+                         "STEM.step/.igs (as the recipe's first export says) and report.json into "
+                         "--out, each read back and checked");
   deform_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
   deform_cmd->add_option("--recipe", recipe_file, "the recipe holding the deformation stack")
       ->required();
@@ -332,13 +444,7 @@ int main(int argc, char** argv) {
       auto result = clay::recipe::run_recipe(recipe, run_options(show));
       return finish(result, out_dir);
     }
-    if (*deform_cmd) {
-      const auto recipe = clay::recipe::load_recipe(recipe_file);
-      const auto surfaces = read_surfaces(file, "deform");
-      auto result = clay::recipe::deform_surfaces(recipe, surfaces, fs::path(file).stem().string(),
-                                                  deformation, run_options(show));
-      return finish(result, out_dir);
-    }
+    if (*deform_cmd) return deform_model_file(file, recipe_file, deformation, out_dir, show);
   } catch (const clay::Error& e) {
     std::fprintf(stderr, "clayform: %s\n", e.what());
     return exit_code(e.category());

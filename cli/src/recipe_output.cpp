@@ -1,5 +1,6 @@
 // The outputs of a run: STEP, IGES and glTF per export, read back and checked, and report.json —
 // written into a temporary folder and moved into place only when everything succeeded.
+#include <clay/brep/exchange.hpp>
 #include <clay/error.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/recipe/view.hpp>
@@ -85,25 +86,67 @@ std::string report_json(const RunResult& result) {
   return j.dump(2) + "\n";
 }
 
-std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) {
+namespace {
+
+/// The output folder and its temporary sibling, where everything is written first.
+struct Staging {
+  fs::path target, tmp;
+};
+
+Staging stage(const fs::path& out_dir, std::string_view caller) {
   if (out_dir.empty())
-    throw Error(ErrorCategory::InvalidArgument, "write_outputs: give an output folder");
-  const fs::path target = fs::absolute(out_dir).lexically_normal();
+    throw Error(ErrorCategory::InvalidArgument, std::string(caller) + ": give an output folder");
+  Staging s;
+  s.target = fs::absolute(out_dir).lexically_normal();
   const fs::path parent =
-      target.has_filename() ? target.parent_path() : target.parent_path().parent_path();
-  const std::string leaf =
-      target.has_filename() ? target.filename().string() : target.parent_path().filename().string();
+      s.target.has_filename() ? s.target.parent_path() : s.target.parent_path().parent_path();
+  const std::string leaf = s.target.has_filename() ? s.target.filename().string()
+                                                   : s.target.parent_path().filename().string();
   std::error_code ec;
   fs::create_directories(parent, ec);
   if (ec)
     throw Error(ErrorCategory::Io, "cannot create the folder \"" + parent.string() +
                                        "\": " + ec.message() + "; check the path and permissions");
-  const fs::path tmp = parent / ("." + leaf + ".clayform-" + std::to_string(::getpid()));
-  fs::remove_all(tmp, ec);
-  fs::create_directory(tmp, ec);
+  s.tmp = parent / ("." + leaf + ".clayform-" + std::to_string(::getpid()));
+  fs::remove_all(s.tmp, ec);
+  fs::create_directory(s.tmp, ec);
   if (ec)
     throw Error(ErrorCategory::Io,
-                "cannot create the temporary folder \"" + tmp.string() + "\": " + ec.message());
+                "cannot create the temporary folder \"" + s.tmp.string() + "\": " + ec.message());
+  return s;
+}
+
+/// Moves the named files from the temporary folder into the target (created when missing).
+std::vector<fs::path> move_in(const Staging& s, const std::vector<std::string>& names) {
+  std::error_code ec;
+  fs::create_directories(s.target, ec);
+  if (ec)
+    throw Error(ErrorCategory::Io,
+                "cannot create the output folder \"" + s.target.string() + "\": " + ec.message());
+  std::vector<fs::path> written;
+  for (const auto& n : names) {
+    fs::rename(s.tmp / n, s.target / n, ec);  // same file system: atomic per file
+    if (ec)
+      throw Error(ErrorCategory::Io,
+                  "cannot move \"" + n + "\" into \"" + s.target.string() + "\": " + ec.message());
+    written.push_back(s.target / n);
+  }
+  return written;
+}
+
+void write_text(const fs::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + file.string() + "\"");
+}
+
+}  // namespace
+
+std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) {
+  const Staging staging = stage(out_dir, "write_outputs");
+  const fs::path& target = staging.target;
+  const fs::path& tmp = staging.tmp;
+  std::error_code ec;
   std::vector<std::string> names;
   try {
     for (auto& e : result.exports) {
@@ -153,26 +196,10 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
         }
       }
     }
-    {
-      std::ofstream out(tmp / "report.json", std::ios::binary);
-      out << report_json(result);
-      if (!out)
-        throw Error(ErrorCategory::Io, "cannot write \"" + (tmp / "report.json").string() + "\"");
-    }
+    write_text(tmp / "report.json", report_json(result));
     names.push_back("report.json");
     write_view_data(result, tmp);  // view/manifest.json and view/NNN.bin (clay/recipe/view.hpp)
-    fs::create_directories(target, ec);
-    if (ec)
-      throw Error(ErrorCategory::Io,
-                  "cannot create the output folder \"" + target.string() + "\": " + ec.message());
-    std::vector<fs::path> written;
-    for (const auto& n : names) {
-      fs::rename(tmp / n, target / n, ec);  // same file system: atomic per file
-      if (ec)
-        throw Error(ErrorCategory::Io,
-                    "cannot move \"" + n + "\" into \"" + target.string() + "\": " + ec.message());
-      written.push_back(target / n);
-    }
+    std::vector<fs::path> written = move_in(staging, names);
     // The view folder as a whole: a previous run's meshes go, this run's come in one rename.
     fs::remove_all(target / "view", ec);
     if (ec)
@@ -187,6 +214,99 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
     return written;
   } catch (...) {
     fs::remove_all(tmp, ec);
+    throw;
+  }
+}
+
+namespace {
+
+Json model_report_json(const ModelRunResult& r, const brep::Counts& c, const Json& exports) {
+  const auto& m = r.report;
+  Json j = Json::object();
+  j["format"] = "clayform.report";
+  j["version"] = 1;
+  j["recipe"] = r.recipe;
+#ifdef CLAYFORM_VERSION
+  j["clayform"] = CLAYFORM_VERSION;
+#endif
+  j["ok"] = true;
+  j["seconds"] = r.seconds;
+  j["deformation"] = r.deformation;
+  Json model = Json::object();
+  model["bodies"] = c.bodies;
+  model["solids"] = c.solids;
+  model["shells"] = c.shells;
+  model["faces"] = c.faces;
+  model["trimmed_faces"] = c.trimmed_faces;
+  model["inner_loops"] = c.inner_loops;
+  model["edges"] = c.edges;
+  model["vertices"] = c.vertices;
+  model["faces_exact"] = m.faces_exact;
+  model["faces_refit"] = m.faces_refit;
+  model["faces_untouched"] = m.faces_untouched;
+  model["edges_exact"] = m.edges_exact;
+  model["edges_refit"] = m.edges_refit;
+  model["edges_untouched"] = m.edges_untouched;
+  model["max_certified_bound_mm"] = m.max_certified_bound_mm;
+  model["max_edge_gap_mm"] = m.max_edge_gap_mm;
+  model["max_deviation_mm"] = m.max_deviation_mm;
+  model["volume_before_mm3"] = m.volume_before_mm3;
+  model["volume_after_mm3"] = m.volume_after_mm3;
+  model["solids_reversed"] = m.solids_reversed;
+  model["fold_free"] = r.fold_free;
+  model["message"] = m.brief();
+  j["model"] = std::move(model);
+  j["exports"] = exports;
+  return j;
+}
+
+}  // namespace
+
+std::vector<fs::path> write_model_outputs(const ModelRunResult& result, const fs::path& out_dir,
+                                          std::string_view stem) {
+  const Staging staging = stage(out_dir, "write_model_outputs");
+  std::error_code ec;
+  try {
+    std::vector<std::string> names;
+    Json exports = Json::array();
+    const brep::Counts counts = brep::counts(result.model);
+    for (const auto& format : result.formats) {
+      const std::string file = std::string(stem) + (format == "step" ? ".step" : ".igs");
+      brep::ModelWriteOptions o;
+      o.schema = result.schema == "AP242" ? surface::StepSchema::AP242 : surface::StepSchema::AP214;
+      const brep::ModelCheck written = brep::write_model(result.model, staging.tmp / file, o);
+      // Read back as a CAD system would, and checked before anything moves into out_dir.
+      const brep::ImportedModel back = brep::read_model(staging.tmp / file);
+      const bool same = back.report.counts.faces == counts.faces &&
+                        back.report.counts.edges == counts.edges &&
+                        back.report.counts.solids == counts.solids &&
+                        back.report.counts.vertices == counts.vertices;
+      if (!written.valid || !back.report.problems.empty() || !same) {
+        std::string m = file + " reads back " +
+                        (!written.valid ? std::string("INVALID (BRepCheck)")
+                         : !same        ? "with other counts (" + back.report.brief() + ")"
+                                        : "broken") +
+                        ", so nothing was written to \"" + staging.target.string() + "\"";
+        for (const auto& p : written.problems) m += "\n  problem: " + p;
+        for (const auto& p : back.report.problems) m += "\n  problem: " + p;
+        throw Error(ErrorCategory::Exchange, m);
+      }
+      Json x = Json::object();
+      x["name"] = std::string(stem);
+      x["file"] = file;
+      x["valid"] = written.valid;
+      x["volume_mm3"] = written.volume_mm3;
+      x["read_back"] = back.report.brief();
+      exports.push_back(std::move(x));
+      names.push_back(file);
+    }
+    write_text(staging.tmp / "report.json", model_report_json(result, counts, exports).dump(2));
+    names.push_back("report.json");
+    std::vector<fs::path> written = move_in(staging, names);
+    fs::remove_all(staging.tmp, ec);
+    return written;
+  } catch (...) {
+    fs::remove_all(staging.tmp, ec);
     throw;
   }
 }

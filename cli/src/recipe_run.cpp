@@ -4,6 +4,7 @@
 
 #include <clay/constraints/solve.hpp>
 #include <clay/deform/jacobian.hpp>
+#include <clay/deform/model_deformation.hpp>
 #include <clay/deform/surface_deformation.hpp>
 #include <clay/error.hpp>
 #include <clay/sketch/entities.hpp>
@@ -349,6 +350,8 @@ class Runner {
 
   // ---- deformation steps --------------------------------------------------------------------
 
+ public:
+  /// The composition's settings as deform_surface's (deform_model uses them too).
   static deform::SurfaceDeformationOptions deformation_options(const Composition& c) {
     deform::SurfaceDeformationOptions o;
     o.compose.check_samples = c.check_samples;
@@ -364,6 +367,7 @@ class Runner {
     return o;
   }
 
+ private:
   static void lattice_figures(const deform::Deformation& d, StepReport& rep) {
     std::optional<deform::JacobianBounds> j;
     if (const auto* b = std::get_if<deform::BezierLattice>(&d)) j = deform::jacobian_bounds(*b);
@@ -568,6 +572,28 @@ RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
   return result;
 }
 
+namespace {
+
+/// The recipe's deformation stack named `deformation`, or its only one when the name is empty.
+const StackDef& pick_stack(const RecipeData& d, std::string_view deformation) {
+  std::string names;
+  for (const auto& s : d.stacks) names += (names.empty() ? "" : ", ") + s.name;
+  if (deformation.empty()) {
+    if (d.stacks.size() != 1)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "the recipe has " + std::to_string(d.stacks.size()) + " deformation stacks (" +
+                      names + "); name one with --deformation");
+    return d.stacks.front();
+  }
+  for (const auto& s : d.stacks)
+    if (s.name == deformation) return s;
+  throw Error(ErrorCategory::InvalidArgument, "the recipe has no deformation stack '" +
+                                                  std::string(deformation) +
+                                                  "'; its stacks: " + names);
+}
+
+}  // namespace
+
 RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface>& surfaces,
                           std::string_view stem, std::string_view deformation,
                           const RunOptions& options) {
@@ -575,23 +601,7 @@ RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface
     throw Error(ErrorCategory::InvalidArgument,
                 "deform_surfaces: empty recipe; load or parse one first");
   const RecipeData& d = *recipe.data;
-  std::string names;
-  for (const auto& s : d.stacks) names += (names.empty() ? "" : ", ") + s.name;
-  const StackDef* stack = nullptr;
-  if (deformation.empty()) {
-    if (d.stacks.size() != 1)
-      throw Error(ErrorCategory::InvalidArgument,
-                  "the recipe has " + std::to_string(d.stacks.size()) + " deformation stacks (" +
-                      names + "); name one with --deformation");
-    stack = &d.stacks.front();
-  } else {
-    for (const auto& s : d.stacks)
-      if (s.name == deformation) stack = &s;
-    if (!stack)
-      throw Error(ErrorCategory::InvalidArgument, "the recipe has no deformation stack '" +
-                                                      std::string(deformation) +
-                                                      "'; its stacks: " + names);
-  }
+  const StackDef* stack = &pick_stack(d, deformation);
   if (surfaces.empty())
     throw Error(ErrorCategory::InvalidArgument, "deform_surfaces: no surfaces given");
   const auto t0 = Clock::now();
@@ -613,6 +623,87 @@ RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface
     x.surfaces.push_back(std::move(s));
   }
   result.exports.push_back(std::move(x));
+  result.seconds = seconds_since(t0);
+  return result;
+}
+
+ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
+                            std::string_view deformation) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "deform_model: empty recipe; load or parse one first");
+  const RecipeData& d = *recipe.data;
+  const StackDef& def = pick_stack(d, deformation);
+  const auto t0 = Clock::now();
+  ModelRunResult result;
+  result.recipe = d.name;
+  result.deformation = def.name;
+  deform::DeformationStack stack;
+  for (std::size_t i = 0; i < def.steps.size(); ++i) {
+    const StepDef& step = def.steps[i];
+    const std::string where = def.path + ".steps[" + std::to_string(i) + "] (" + step.kind + ")";
+    deform::Deformation lattice = std::visit(
+        [&](const auto& k) -> deform::Deformation {
+          using T = std::decay_t<decltype(k)>;
+          if constexpr (std::is_same_v<T, deform::Deformation>) {
+            return k;
+          } else if constexpr (std::is_same_v<T, DirectDef>) {
+            std::vector<deform::PointMove> moves;
+            for (const auto& m : k.moves) {
+              if (m.on_surface)
+                throw Error(ErrorCategory::InvalidArgument,
+                            where +
+                                ": a move from a \"surface_point\" needs one surface; to "
+                                "deform a model, give the move's \"point\" in space");
+              moves.push_back({m.point, m.to});
+            }
+            deform::Deformation solved;
+            bool feasible = true;
+            std::string message;
+            std::visit(
+                [&](const auto& lat) {
+                  auto r = deform::manipulate(lat, moves, k.options);
+                  feasible = r.report.feasible;
+                  message = r.report.summary.message;
+                  solved = std::move(r.lattice);
+                },
+                k.lattice);
+            if (!feasible && !k.accept_out_of_tolerance)
+              throw Error(ErrorCategory::ToleranceNotMet,
+                          where + ": the lattice cannot meet every move (" + message +
+                              "); free more control points, use a finer lattice or ask for "
+                              "fewer moves");
+            return solved;
+          } else {
+            throw Error(ErrorCategory::InvalidArgument,
+                        where +
+                            ": a style step shapes one surface by its control points; a "
+                            "model deforms through lattices, direct manipulation and "
+                            "regular deformations (taper, twist, bend)");
+          }
+        },
+        step.step);
+    if (const auto* b = std::get_if<deform::BezierLattice>(&lattice))
+      result.fold_free = result.fold_free && deform::jacobian_bounds(*b).fold_free;
+    if (const auto* b = std::get_if<deform::BSplineLattice>(&lattice))
+      result.fold_free = result.fold_free && deform::jacobian_bounds(*b).fold_free;
+    stack.steps.push_back({std::move(lattice), step.name, step.enabled});
+  }
+  deform::ModelDeformationOptions options;
+  options.surface = Runner::deformation_options(d.composition);
+  try {
+    auto r = deform::deform_model(stack, model, options);
+    result.model = std::move(r.model);
+    result.report = std::move(r.report);
+  } catch (const Error& e) {
+    throw Error(e.category(), def.path + ": " + recipe_wording(e.message()));
+  }
+  result.formats =
+      d.exports.empty() ? std::vector<std::string>{"step", "iges"} : d.exports.front().formats;
+  result.formats.erase(std::remove(result.formats.begin(), result.formats.end(), "glb"),
+                       result.formats.end());
+  if (result.formats.empty()) result.formats = {"step"};
+  result.schema = d.exports.empty() ? "AP214" : d.exports.front().schema;
   result.seconds = seconds_since(t0);
   return result;
 }

@@ -168,11 +168,15 @@ std::string ModelDeformationReport::brief() const {
   char text[400];
   std::snprintf(text, sizeof text,
                 "%d faces: %d exact, %d refit, %d untouched; %d edges: %d exact, %d refit, %d "
-                "untouched; certified bound %.2g mm; edge gap %.2g mm; volume %.10g -> %.10g mm^3",
+                "untouched; certified bound %.2g mm; edge gap %.2g mm",
                 counts.faces, faces_exact, faces_refit, faces_untouched, counts.edges, edges_exact,
-                edges_refit, edges_untouched, max_certified_bound_mm, max_edge_gap_mm,
-                volume_before_mm3, volume_after_mm3);
+                edges_refit, edges_untouched, max_certified_bound_mm, max_edge_gap_mm);
   std::string line = text;
+  if (volume_before_mm3 != 0 || volume_after_mm3 != 0) {  // solids only
+    std::snprintf(text, sizeof text, "; volume %.10g -> %.10g mm^3", volume_before_mm3,
+                  volume_after_mm3);
+    line += text;
+  }
   if (solids_reversed > 0)
     line += "; " + std::to_string(solids_reversed) + " solids reversed (mirroring stack)";
   return line;

@@ -677,7 +677,10 @@ std::string name_of(const TDF_Label& label) {
   Handle(TDataStd_Name) attribute;
   if (label.IsNull() || !label.FindAttribute(TDataStd_Name::GetID(), attribute)) return {};
   // Without a replacement character the conversion is to UTF-8.
-  return TCollection_AsciiString(attribute->Get()).ToCString();
+  std::string name = TCollection_AsciiString(attribute->Get()).ToCString();
+  // XCAF names unnamed references after their target's label entry ("=>[0:1:1:2]"): no name.
+  if (name.rfind("=>[", 0) == 0) name.clear();
+  return name;
 }
 
 std::optional<Colour> colour_of(const Handle(XCAFDoc_ColorTool) & tool, const TDF_Label& label) {
@@ -1427,14 +1430,15 @@ void ModelReadOptions::validate() const {
 std::string ModelReadReport::brief() const {
   char text[512];
   std::snprintf(text, sizeof text,
-                "%d bod%s (%d solid%s), %d shell%s, %d faces (%d trimmed, %d holes), %d edges, "
+                "%d bod%s (%d solid%s), %d shell%s, %d face%s (%d trimmed, %d holes), %d edges, "
                 "%d vertices; faces %d B-spline, %d affine, %d angular; pcurves %d kept, %d "
                 "exact, %d fitted (<= %.1e mm); edge gap %.1e mm",
                 counts.bodies, counts.bodies == 1 ? "y" : "ies", counts.solids,
                 counts.solids == 1 ? "" : "s", counts.shells, counts.shells == 1 ? "" : "s",
-                counts.faces, counts.trimmed_faces, counts.inner_loops, counts.edges,
-                counts.vertices, faces_bspline, faces_affine, faces_angular, pcurves_kept,
-                pcurves_exact, pcurves_fitted, max_rederivation_error_mm, max_edge_gap_mm);
+                counts.faces, counts.faces == 1 ? "" : "s", counts.trimmed_faces,
+                counts.inner_loops, counts.edges, counts.vertices, faces_bspline, faces_affine,
+                faces_angular, pcurves_kept, pcurves_exact, pcurves_fitted,
+                max_rederivation_error_mm, max_edge_gap_mm);
   std::string line = text;
   if (!healing.empty()) line += "; healed: " + healing.front();
   if (!problems.empty())

@@ -393,8 +393,8 @@ bool extension_is(const fs::path& file, std::initializer_list<const char*> list)
 }  // namespace
 
 std::string ModelCheck::brief() const {
-  char text[96];
-  std::snprintf(text, sizeof text, ", volume %.6g mm^3", volume_mm3);
+  char text[96] = "";
+  if (volume_mm3 != 0) std::snprintf(text, sizeof text, ", volume %.10g mm^3", volume_mm3);
   if (valid) return "valid (BRepCheck)" + std::string(text);
   return "NOT valid (BRepCheck)" + std::string(text) + ": " + std::to_string(problems.size()) +
          (problems.size() == 1 ? " problem: " : " problems, the first: ") +

@@ -4,6 +4,8 @@
 /// composition mode and the exports — checked with every problem at once, replayed bit for bit,
 /// and applied to other surfaces (Coquillart's recording operator). The `clayform` command is a
 /// shell over these functions.
+#include <clay/brep/model.hpp>
+#include <clay/deform/model_deformation.hpp>
 #include <clay/recipe/export.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
@@ -141,6 +143,33 @@ CLAY_RECIPE_API RunResult deform_surfaces(const Recipe& recipe,
                                           const std::vector<surface::BSplineSurface>& surfaces,
                                           std::string_view stem, std::string_view deformation = {},
                                           const RunOptions& options = {});
+
+/// A whole model deformed by a recipe's deformation stack (the "clayform deform" use).
+struct ModelRunResult {
+  std::string recipe;       ///< the recipe's name
+  std::string deformation;  ///< the stack's name
+  brep::Model model;        ///< the deformed model (flattened when it was an assembly)
+  deform::ModelDeformationReport report;
+  bool fold_free = true;             ///< every lattice step's Jacobian bounds are positive
+  std::vector<std::string> formats;  ///< "step", "iges": the recipe's first export's (glb aside)
+  std::string schema = "AP214";      ///< STEP schema
+  double seconds = 0;                ///< wall time
+};
+
+/// Deforms `model` by the recipe's deformation stack `deformation` (may be empty when the recipe
+/// has exactly one) with the recipe's composition mode (deform::deform_model). Lattices, regular
+/// deformations and direct manipulation with moves given in space apply; a style step, or a move
+/// from a surface point, is refused (InvalidArgument naming the step): they shape one surface.
+/// Throws the deformation's clay::Error in the recipe's words, naming the stack.
+CLAY_RECIPE_API ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
+                                            std::string_view deformation = {});
+
+/// Writes STEM.step and/or STEM.igs (result.formats) and report.json into `out_dir`, through a
+/// temporary folder as write_outputs does: each file is read back (read_model) and checked
+/// (BRepCheck, the same counts) before anything is moved into `out_dir`. Returns the paths
+/// written. Throws clay::Error (Io, Exchange) naming the file.
+CLAY_RECIPE_API std::vector<std::filesystem::path> write_model_outputs(
+    const ModelRunResult& result, const std::filesystem::path& out_dir, std::string_view stem);
 
 /// The report of a run as JSON text (schema "clayform.report", version 1, docs/recipe.md):
 /// per step its path, kind, seconds, warning, message and figures; per export its files and
