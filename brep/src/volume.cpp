@@ -14,28 +14,33 @@
 namespace clay::brep {
 namespace {
 
-const internal::GaussRule& rule16() {
-  static const internal::GaussRule rule = internal::gauss_legendre(16);
-  return rule;
+/// The n-point Gauss–Legendre rule, n in [1, 16], computed once.
+const internal::GaussRule& rule(int n) {
+  static const std::vector<internal::GaussRule> rules = [] {
+    std::vector<internal::GaussRule> all;
+    for (int k = 0; k <= 16; ++k) all.push_back(internal::gauss_legendre(std::max(k, 1)));
+    return all;
+  }();
+  return rules[static_cast<std::size_t>(n)];
 }
 
-/// The integral of f over [a, b] by 16-point Gauss–Legendre.
+/// The integral of f over [a, b] by n-point Gauss–Legendre (exact for degree 2n - 1).
 template <class F>
-double gauss16(double a, double b, F&& f) {
-  const auto& r = rule16();
+double gauss(int n, double a, double b, F&& f) {
+  const auto& r = rule(n);
   double sum = 0;
   for (std::size_t g = 0; g < r.nodes.size(); ++g)
     sum += r.weights[g] * f(0.5 * (a + b) + 0.5 * (b - a) * r.nodes[g]);
   return 0.5 * (b - a) * sum;
 }
 
-/// Adaptive: accepts [a, b] when one rule and the two halves agree to `tol` (absolute).
+/// Adaptive: accepts [a, b] when the 16- and 10-point rules agree to `tol` (absolute; both exact
+/// to degree 19, so agreement means the integrand is resolved), else halves the interval.
 template <class F>
 double adaptive(double a, double b, F&& f, double tol, int depth = 0) {
-  const double whole = gauss16(a, b, f);
+  const double fine = gauss(16, a, b, f);
+  if (std::abs(fine - gauss(10, a, b, f)) <= tol || depth >= 40) return fine;
   const double m = 0.5 * (a + b);
-  const double halves = gauss16(a, m, f) + gauss16(m, b, f);
-  if (std::abs(whole - halves) <= tol || depth >= 40) return halves;
   return adaptive(a, m, f, 0.5 * tol, depth + 1) + adaptive(m, b, f, 0.5 * tol, depth + 1);
 }
 
@@ -48,14 +53,17 @@ std::vector<double> breaks(const surface::BSplineBasis& basis, double a, double 
   return out;
 }
 
-/// F(u, v) = ∫_a^u z (x_u y_v − x_v y_u) ds, per knot span of u.
+/// F(u, v) = ∫_a^u z (x_u y_v − x_v y_u) ds, per knot span of u. On a polynomial surface of
+/// degree p in u the integrand has degree 3p - 1 there, so ceil(3p / 2) points are exact; a
+/// rational one gets 16.
 double inner(const surface::BSplineSurface& s, double a, double u, double v) {
   const double lo = std::min(a, u), hi = std::max(a, u);
   if (hi == lo) return 0;
+  const int n = s.is_rational() ? 16 : std::clamp((3 * s.u.degree + 1) / 2, 1, 16);
   const auto spans = breaks(s.u, lo, hi);
   double sum = 0;
   for (std::size_t k = 0; k + 1 < spans.size(); ++k)
-    sum += gauss16(spans[k], spans[k + 1], [&](double x) {
+    sum += gauss(n, spans[k], spans[k + 1], [&](double x) {
       const surface::SurfaceDerivatives d = surface::derivatives(s, x, v, 1);
       return d.point.z() * (d.du.x() * d.dv.y() - d.dv.x() * d.du.y());
     });

@@ -393,6 +393,7 @@ bool extension_is(const fs::path& file, std::initializer_list<const char*> list)
 }  // namespace
 
 std::string ModelCheck::brief() const {
+  if (!checked) return "not checked";
   char text[96] = "";
   if (volume_mm3 != 0) std::snprintf(text, sizeof text, ", volume %.10g mm^3", volume_mm3);
   if (valid) return "valid (BRepCheck)" + std::string(text);
@@ -423,7 +424,11 @@ ModelCheck write_model(const Model& model, const fs::path& file, const ModelWrit
   const Shapes shapes = build_shapes(m);
   surface::occt::ExchangeSession session;
   return surface::occt::guarded(ErrorCategory::Exchange, caller, [&] {
-    ModelCheck check = check_shapes(m, shapes);
+    ModelCheck check;
+    if (options.check)
+      check = check_shapes(m, shapes);
+    else
+      check.checked = false;
     Handle(TDocStd_Document) document;
     XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
     DocumentWriter(m, shapes, XCAFDoc_DocumentTool::ShapeTool(document->Main()),

@@ -7,6 +7,7 @@
 #include <string>
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_GTransform.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
@@ -48,6 +49,7 @@
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Ax2.hxx>
+#include <gp_GTrsf.hxx>
 #include <gp_Pnt.hxx>
 #include <gp_Trsf.hxx>
 
@@ -213,6 +215,28 @@ void write_test_model(TestModel model, const fs::path& file) {
       add_part(shapes, colours, both, "pair", srgb(0.4, 0.4, 0.4));
       break;
     }
+    case TestModel::HolePlate: {
+      TopoDS_Shape plate = BRepPrimAPI_MakeBox(200, 200, 10).Shape();
+      BRepFilletAPI_MakeFillet fillet(plate);
+      for (TopExp_Explorer e(plate, TopAbs_EDGE); e.More(); e.Next()) {
+        TopoDS_Vertex a, b;
+        TopExp::Vertices(TopoDS::Edge(e.Current()), a, b);
+        const gp_Pnt pa = BRep_Tool::Pnt(a), pb = BRep_Tool::Pnt(b);
+        if (std::abs(pa.X() - pb.X()) < 1e-9 && std::abs(pa.Y() - pb.Y()) < 1e-9)
+          fillet.Add(8.0, TopoDS::Edge(e.Current()));
+      }
+      TopoDS_Compound holes;
+      BRep_Builder builder;
+      builder.MakeCompound(holes);
+      for (int i = 0; i < 19; ++i)
+        for (int j = 0; j < 10; ++j)
+          builder.Add(holes, BRepPrimAPI_MakeCylinder(
+                                 gp_Ax2(gp_Pnt(10 + 10 * i, 19 + 18 * j, -1), gp::DZ()), 3.0, 12.0)
+                                 .Shape());
+      add_part(shapes, colours, BRepAlgoAPI_Cut(fillet.Shape(), holes).Shape(), "plate",
+               srgb(0.7, 0.7, 0.75));
+      break;
+    }
     case TestModel::LooseFaces:
       add_part(shapes, colours, loose_box_faces(), "faces", srgb(0.6, 0.6, 0.6));
       break;
@@ -279,6 +303,24 @@ double max_distance_to_surfaces(const fs::path& file,
   }
   if (k != points.size()) return std::numeric_limits<double>::infinity();
   return worst;
+}
+
+struct GTransformReference::Impl {
+  TopoDS_Shape shape;
+};
+
+GTransformReference::GTransformReference(const fs::path& file) : impl_(std::make_unique<Impl>()) {
+  impl_->shape = read_shape(file);
+}
+
+GTransformReference::~GTransformReference() = default;
+
+int GTransformReference::transform(const Eigen::Matrix<double, 3, 4>& a) const {
+  gp_GTrsf map;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) map.SetValue(i + 1, j + 1, a(i, j));
+  BRepBuilderAPI_GTransform transform(impl_->shape, map, true);
+  return count(transform.Shape(), TopAbs_FACE);
 }
 
 }  // namespace clay::surface::occt_reference

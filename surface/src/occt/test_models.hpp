@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@ enum class TestModel {
   Assembly,       ///< two parts, named and coloured; the second placed twice
   LooseFaces,     ///< a box's six faces written as loose IGES faces (144), to be sewn
   Separated,      ///< two solids apart: a box 20^3 at the origin, a sphere r 5 at (50, 10, 10)
+  HolePlate,      ///< 200 faces: a 200 x 200 x 10 plate, vertical edges filleted (r 8), 190 holes
 };
 
 /// Builds `model` with OpenCASCADE and writes it through XCAF (names, colours, assembly) as
@@ -40,5 +42,22 @@ ShapeFacts facts_of_file(const std::filesystem::path& file);
 /// the distance to that face's surface (GeomAPI_ProjectPointOnSurf); the largest overall.
 double max_distance_to_surfaces(const std::filesystem::path& file,
                                 const std::vector<std::vector<Eigen::Vector3d>>& points);
+
+/// OpenCASCADE's own affine map of a whole shape, the reference of bench/model_bench.cpp: the
+/// file's shape is read once (STEPControl_Reader); transform() runs BRepBuilderAPI_GTransform.
+class GTransformReference {
+ public:
+  explicit GTransformReference(const std::filesystem::path& file);
+  ~GTransformReference();
+  GTransformReference(const GTransformReference&) = delete;
+  GTransformReference& operator=(const GTransformReference&) = delete;
+  /// The shape mapped by x -> A x + b (`affine` = [A | b]) with copies of its geometry; returns
+  /// the face count of the result.
+  int transform(const Eigen::Matrix<double, 3, 4>& affine) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace clay::surface::occt_reference

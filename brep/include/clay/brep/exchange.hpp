@@ -90,11 +90,15 @@ CLAY_OCCT_API ImportedModel read_model(const std::filesystem::path& file,
 /// Settings of write_model.
 struct ModelWriteOptions {
   surface::StepSchema schema = surface::StepSchema::AP214;  ///< STEP only
+  /// Run check_model's BRepCheck and volumes on the shapes written (about half the time of a
+  /// write of a 200-face solid); false: the returned check says it was not run.
+  bool check = true;
 };
 
 /// What OpenCASCADE makes of a model: its validity (BRepCheck_Analyzer on the shapes built from
 /// it, with the model's own tolerances) and the volume of its solids.
 struct CLAY_OCCT_API ModelCheck {
+  bool checked = true;  ///< false: write_model was asked not to check (the rest is empty)
   bool valid = false;
   /// BRepCheck findings in words, each naming the body and face ("body 0 face 3: ...").
   std::vector<std::string> problems;

@@ -5,8 +5,9 @@
 /// ±∬_D z (x_u y_v − x_v y_u) du dv, + for a face whose outward side is S_u × S_v. Green's
 /// theorem turns each face's double integral over its trimmed domain D into a loop integral
 /// ∮_∂D F dv with F(u, v) = ∫ z (x_u y_v − x_v y_u) du, so trims count exactly as they are:
-/// F by Gauss–Legendre (16 points per knot span of u), the loop integral by adaptive
-/// Gauss–Legendre along every pcurve until two levels agree to 1e-14 of the size cubed.
+/// F by Gauss–Legendre per knot span of u (exact for polynomial surfaces, 16 points for rational
+/// ones), the loop integral by adaptive Gauss–Legendre along every pcurve until the 16- and
+/// 10-point rules agree to 1e-14 of the size cubed.
 /// OpenCASCADE's BRepGProp::VolumeProperties is 0.03 % off on B-spline faces by default and
 /// 2e-7 off with its precision at 1e-9 (rational spheres and tori); this is exact to about 1e-13.
 #include <clay/brep/export.hpp>

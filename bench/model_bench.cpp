@@ -1,0 +1,162 @@
+// Whole models (issue #20): read, deform exactly, validate and write a 200-face solid (a plate
+// 200 x 200 x 10 with filleted corners and 190 through holes, built by OpenCASCADE and written as
+// STEP), phase by phase and as one pipeline (read, deform, brep::validate, write without
+// BRepCheck; target: under 1 s on 2 cores). The reference, in the
+// same run: OpenCASCADE's own affine map of the same solid, BRepBuilderAPI_GTransform (with
+// geometry copies), against deform_model with an affine lattice.
+#include <clay/brep/exchange.hpp>
+#include <clay/brep/volume.hpp>
+#include <clay/deform/model_deformation.hpp>
+
+#include <benchmark/benchmark.h>
+
+#include <filesystem>
+#include <string>
+
+#include "occt/test_models.hpp"
+
+namespace fs = std::filesystem;
+using namespace clay;
+
+namespace {
+
+const fs::path& plate_file() {
+  static const fs::path file = [] {
+    const fs::path f = fs::temp_directory_path() / "clayform-bench-plate.step";
+    surface::occt_reference::write_test_model(surface::occt_reference::TestModel::HolePlate, f);
+    return f;
+  }();
+  return file;
+}
+
+const brep::Model& plate() {
+  static const brep::Model m = brep::read_model(plate_file()).model;
+  return m;
+}
+
+deform::Frame around_plate() {
+  deform::Frame f;
+  f.origin = {-5, -5, -5};
+  f.s = {210, 0, 0};
+  f.t = {0, 210, 0};
+  f.u = {0, 0, 20};
+  return f;
+}
+
+/// A trilinear lattice with one top corner raised: not affine (total degree 3).
+deform::DeformationStack bent_stack() {
+  auto lattice = deform::make_bezier_lattice(around_plate(), {1, 1, 1});
+  lattice.points.row(lattice.index(1, 1, 1)) += Eigen::RowVector3d(4, 6, 12);
+  deform::DeformationStack stack;
+  stack.steps.push_back({lattice, "raise a corner", true});
+  return stack;
+}
+
+/// The affine map x -> A x + b as a trilinear lattice, and as the matrix [A | b].
+const Eigen::Matrix<double, 3, 4>& affine_map() {
+  static const Eigen::Matrix<double, 3, 4> a = [] {
+    Eigen::Matrix<double, 3, 4> m;
+    m << 1.05, 0.02, 0.0, 1.0, 0.0, 0.97, 0.01, -2.0, 0.03, 0.0, 1.1, 0.5;
+    return m;
+  }();
+  return a;
+}
+
+deform::DeformationStack affine_stack() {
+  auto lattice = deform::make_bezier_lattice(around_plate(), {1, 1, 1});
+  for (Eigen::Index r = 0; r < lattice.points.rows(); ++r)
+    lattice.points.row(r) =
+        (affine_map().leftCols<3>() * lattice.points.row(r).transpose() + affine_map().col(3))
+            .transpose();
+  deform::DeformationStack stack;
+  stack.steps.push_back({lattice, "affine", true});
+  return stack;
+}
+
+void faces_counter(benchmark::State& state) {
+  state.counters["faces"] = static_cast<double>(brep::counts(plate()).faces);
+  state.counters["edges"] = static_cast<double>(brep::counts(plate()).edges);
+}
+
+void BM_Read(benchmark::State& state) {
+  plate_file();  // built once, outside the timing
+  for (auto _ : state) benchmark::DoNotOptimize(brep::read_model(plate_file()));
+  faces_counter(state);
+}
+
+void BM_DeformExact(benchmark::State& state) {
+  plate();  // read once, outside the timing
+  const auto stack = bent_stack();
+  for (auto _ : state) benchmark::DoNotOptimize(deform::deform_model(stack, plate()));
+  const auto r = deform::deform_model(stack, plate()).report;
+  state.counters["faces_exact"] = r.faces_exact;
+  state.counters["max_edge_gap_mm"] = r.max_edge_gap_mm;
+  faces_counter(state);
+}
+
+void BM_DeformAffine(benchmark::State& state) {
+  plate();  // read once, outside the timing
+  const auto stack = affine_stack();
+  for (auto _ : state) benchmark::DoNotOptimize(deform::deform_model(stack, plate()));
+  faces_counter(state);
+}
+
+void BM_OcctGTransformAffine(benchmark::State& state) {
+  plate();
+  const surface::occt_reference::GTransformReference reference(plate_file());
+  for (auto _ : state) benchmark::DoNotOptimize(reference.transform(affine_map()));
+  faces_counter(state);
+}
+
+void BM_ValidateInvariants(benchmark::State& state) {
+  plate();  // read once, outside the timing
+  const auto deformed = deform::deform_model(bent_stack(), plate()).model;
+  for (auto _ : state) benchmark::DoNotOptimize(brep::problems(deformed));
+  faces_counter(state);
+}
+
+void BM_ValidateBRepCheck(benchmark::State& state) {
+  plate();  // read once, outside the timing
+  const auto deformed = deform::deform_model(bent_stack(), plate()).model;
+  for (auto _ : state) benchmark::DoNotOptimize(brep::check_model(deformed));
+  faces_counter(state);
+}
+
+/// Writing with and without write_model's own check (BRepCheck and volumes).
+void BM_Write(benchmark::State& state) {
+  plate();  // read once, outside the timing
+  const auto deformed = deform::deform_model(bent_stack(), plate()).model;
+  const fs::path out = fs::temp_directory_path() / "clayform-bench-plate-out.step";
+  brep::ModelWriteOptions options;
+  options.check = state.range(0) != 0;
+  for (auto _ : state) benchmark::DoNotOptimize(brep::write_model(deformed, out, options));
+  faces_counter(state);
+}
+
+/// The whole job: read, deform exactly, validate (invariants), write.
+void BM_Pipeline(benchmark::State& state) {
+  plate_file();
+  const auto stack = bent_stack();
+  const fs::path out = fs::temp_directory_path() / "clayform-bench-plate-pipeline.step";
+  for (auto _ : state) {
+    const auto read = brep::read_model(plate_file());
+    const auto deformed = deform::deform_model(stack, read.model);
+    brep::validate(deformed.model);
+    brep::ModelWriteOptions options;
+    options.check = false;  // validated above
+    benchmark::DoNotOptimize(brep::write_model(deformed.model, out, options));
+  }
+  faces_counter(state);
+}
+
+}  // namespace
+
+BENCHMARK(BM_Read)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DeformExact)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DeformAffine)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OcctGTransformAffine)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ValidateInvariants)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ValidateBRepCheck)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Write)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Pipeline)->Unit(benchmark::kMillisecond);
+BENCHMARK_MAIN();
