@@ -230,3 +230,55 @@ TEST_CASE("deform_model: a model leaving the lattice is refused, naming the face
           (void)clay::deform::deform_model(stack, block, options);
         }).first == clay::ErrorCategory::InvalidArgument);
 }
+
+TEST_CASE("deform_model: a bend refits every face and edge, certified, and stays valid") {
+  const Model block = read(TestModel::FilletedBlock, "block-bend.step");
+  clay::deform::Bend bend;
+  bend.frame.origin = {30, 20, 10};
+  bend.frame.axis = {1, 0, 0};  // bend along the block's length
+  bend.frame.reference = {0, 0, 1};
+  bend.y_min = -40;  // the whole block inside the bent region, where the bend is smooth
+  bend.y_max = 40;
+  bend.center = 0;
+  bend.rate = 0.01;  // radius 100 mm
+  DeformationStack stack;
+  stack.steps.push_back({bend, "arch", true});
+  clay::deform::ModelDeformationOptions options;
+  clay::deform::RefitOptions refit;
+  refit.tolerance = 1e-3;
+  refit.relative = false;  // 1 micrometre
+  options.surface.refit = refit;
+  const auto result = clay::deform::deform_model(stack, block, options);
+  const auto& r = result.report;
+  INFO(r.brief());
+  CHECK(r.faces_refit == 17);
+  CHECK(r.max_certified_bound_mm > 0);
+  CHECK(r.max_certified_bound_mm <= 1e-3);
+  // Every edge gap within its tolerance, and the tolerances within what the bounds allow.
+  for (const auto& g : clay::brep::edge_gaps(result.model)) {
+    const auto& e = result.model.edges[static_cast<size_t>(g.edge)];
+    CHECK(g.gap_mm <= e.tolerance_mm);
+    CHECK(e.tolerance_mm <= block.edges[static_cast<size_t>(g.edge)].tolerance_mm +
+                                2 * r.max_certified_bound_mm + 1e-9 * 75);
+  }
+  // Each face within the certified bound of the pointwise bend inside its trims.
+  int samples = 0;
+  CHECK(max_pointwise_deviation(stack, block, result.model, 200, samples) <=
+        r.max_certified_bound_mm);
+  CHECK(clay::brep::check_model(result.model).valid);
+  // Without a refit tolerance the bend is refused, naming the face.
+  auto [category, text] =
+      clay::test::error_of([&] { (void)clay::deform::deform_model(stack, block); });
+  CHECK(category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(text, Contains("face 0"));
+}
+
+TEST_CASE("deform_model: an open shell in a solid is refused, naming the shell") {
+  Model block = read(TestModel::FilletedBlock, "block-open.step");
+  block.bodies[0].shells[0].faces.pop_back();  // a hole in the solid
+  const DeformationStack stack = trilinear({-5, -5, -5}, {65, 45, 25}, {6, 4, 5});
+  auto [category, text] =
+      clay::test::error_of([&] { (void)clay::deform::deform_model(stack, block); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(text, Contains("shell 0"));
+}

@@ -459,3 +459,25 @@ TEST_CASE("read_model: an isolated read (a child process) gives the same model a
   CHECK(clay::test::error_of([&] { read_model(garbage, options); }).first ==
         clay::ErrorCategory::Exchange);
 }
+
+TEST_CASE("read_model: entities OpenCASCADE does not know are named in the report") {
+  const fs::path whole = written(TestModel::Sphere, "known.step");
+  std::string text;
+  {
+    std::ifstream in(whole, std::ios::binary);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t end = text.find("ENDSEC;", text.find("DATA;"));
+  REQUIRE(end != std::string::npos);
+  text.insert(end,
+              "#99001 = CLAYFORM_UNKNOWN_THING('x', 1.5);\n"
+              "#99002 = CLAYFORM_UNKNOWN_THING('y', 2.5);\n");
+  const fs::path odd = output("unknown-entities.step");
+  std::ofstream(odd, std::ios::binary) << text;
+  const auto read = read_model(odd);
+  CHECK(clay::brep::counts(read.model).faces == 1);  // the sphere is still read
+  REQUIRE(read.report.ignored.size() == 1);
+  CHECK_THAT(read.report.ignored.front(), Contains("CLAYFORM_UNKNOWN_THING x 2"));
+  CHECK_THAT(read.report.ignored.front(), Contains("#99001"));
+  CHECK_THAT(read.report.brief(), Contains("ignored 1 unknown entity type"));
+}

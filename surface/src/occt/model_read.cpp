@@ -80,6 +80,8 @@
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESControl_Controller.hxx>
+#include <IGESData_IGESModel.hxx>
+#include <IGESData_UndefinedEntity.hxx>
 #include <Precision.hxx>
 #include <Quantity_Color.hxx>
 #include <STEPCAFControl_Controller.hxx>
@@ -87,6 +89,8 @@
 #include <STEPControl_Controller.hxx>
 #include <ShapeFix_Solid.hxx>
 #include <Standard_Failure.hxx>
+#include <StepData_StepModel.hxx>
+#include <StepData_UndefinedEntity.hxx>
 #include <TColStd_Array1OfInteger.hxx>
 #include <TColStd_Array1OfReal.hxx>
 #include <TColStd_HArray1OfReal.hxx>
@@ -1324,6 +1328,8 @@ std::string serialize(const ImportedModel& x) {
   put(out, r.max_edge_tolerance_mm);
   put(out, static_cast<std::uint64_t>(r.healing.size()));
   for (const auto& h : r.healing) put_string(out, h);
+  put(out, static_cast<std::uint64_t>(r.ignored.size()));
+  for (const auto& h : r.ignored) put_string(out, h);
   return out;
 }
 
@@ -1400,6 +1406,8 @@ ImportedModel deserialize(const std::string& bytes) {
   r.max_edge_tolerance_mm = in.take<double>();
   r.healing.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
   for (auto& h : r.healing) h = take_string(in);
+  r.ignored.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
+  for (auto& h : r.ignored) h = take_string(in);
   return x;
 }
 
@@ -1441,6 +1449,9 @@ std::string ModelReadReport::brief() const {
                 max_rederivation_error_mm, max_edge_gap_mm);
   std::string line = text;
   if (!healing.empty()) line += "; healed: " + healing.front();
+  if (!ignored.empty())
+    line += "; ignored " + std::to_string(ignored.size()) + " unknown entity type" +
+            (ignored.size() == 1 ? "" : "s") + ": " + ignored.front();
   if (!problems.empty())
     line += "; " + std::to_string(problems.size()) + " problems, the first: " + problems.front();
   return line;
@@ -1448,12 +1459,32 @@ std::string ModelReadReport::brief() const {
 
 namespace {
 
+/// The entities of a file OpenCASCADE does not know, per type, for the report.
+struct UnknownEntities {
+  std::vector<std::pair<std::string, std::pair<int, std::string>>> types;  // count, first
+  void add(const std::string& type, const std::string& where) {
+    for (auto& [t, seen] : types)
+      if (t == type) {
+        ++seen.first;
+        return;
+      }
+    types.push_back({type, {1, where}});
+  }
+  std::vector<std::string> lines() const {
+    std::vector<std::string> out;
+    for (const auto& [t, seen] : types)
+      out.push_back(t + " x " + std::to_string(seen.first) + " (the first " + seen.second + ")");
+    return out;
+  }
+};
+
 /// read_model's work; the caller holds the exchange session.
 ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options, bool step) {
   return surface::occt::guarded(ErrorCategory::Exchange, "read_model", [&] {
     Handle(TDocStd_Document) document;
     XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
     bool read = false;
+    UnknownEntities unknown;
     if (step) {
       STEPCAFControl_Controller::Init();
       surface::occt::set_static("xstep.cascade.unit", "MM");
@@ -1465,6 +1496,10 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
       if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
         throw Error(ErrorCategory::Exchange,
                     "read_model: " + quoted(file) + " could not be parsed as a STEP file");
+      const Handle(StepData_StepModel) model = reader.Reader().StepModel();
+      for (int i = 1; !model.IsNull() && i <= model->NbEntities(); ++i)
+        if (auto u = Handle(StepData_UndefinedEntity)::DownCast(model->Value(i)); !u.IsNull())
+          unknown.add(u->StepType(), "#" + std::to_string(model->IdentLabel(u)));
       read = reader.Transfer(document);
     } else {
       IGESControl_Controller::Init();
@@ -1477,6 +1512,11 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
       if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
         throw Error(ErrorCategory::Exchange,
                     "read_model: " + quoted(file) + " could not be parsed as an IGES file");
+      const Handle(IGESData_IGESModel) model = reader.IGESModel();
+      for (int i = 1; !model.IsNull() && i <= model->NbEntities(); ++i)
+        if (auto u = Handle(IGESData_UndefinedEntity)::DownCast(model->Value(i)); !u.IsNull())
+          unknown.add("entity type " + std::to_string(u->TypeNumber()),
+                      "D" + std::to_string(2 * i - 1));
       read = reader.Transfer(document);
     }
     if (!read)
@@ -1485,6 +1525,7 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
     ModelBuilder builder(file, options, XCAFDoc_DocumentTool::ShapeTool(document->Main()),
                          XCAFDoc_DocumentTool::ColorTool(document->Main()));
     ImportedModel out = builder.build();
+    out.report.ignored = unknown.lines();
     XCAFApp_Application::GetApplication()->Close(document);
     if (out.model.faces.empty())
       throw Error(ErrorCategory::Exchange,

@@ -61,6 +61,9 @@ struct CLAY_OCCT_API ModelReadReport {
   double max_edge_tolerance_mm = 0;  ///< the largest edge tolerance the file gives
   /// Healing done, one line each ("built 3D curves of 4 edges", "sewed 12 faces into 1 shell").
   std::vector<std::string> healing;
+  /// Entities of the file OpenCASCADE does not know and ignored, one line per type:
+  /// "FOO_BAR x 3 (the first #999)" (STEP) or "entity type 999 x 2 (the first D17)" (IGES).
+  std::vector<std::string> ignored;
   /// brep::problems(model): invariants the model breaks (empty for a clean file). The model is
   /// still returned, so that it can be inspected; deforming it refuses it.
   std::vector<std::string> problems;
