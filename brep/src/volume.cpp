@@ -72,8 +72,9 @@ double inner(const surface::BSplineSurface& s, double a, double u, double v) {
 
 double face_volume(const Model& m, const Face& face, double tol) {
   const surface::BSplineSurface& s = face.surface;
-  const auto [u0, u1] = s.u.domain();
-  const auto [v0, v1] = s.v.domain();
+  // Plain copies, not structured bindings: lambdas below capture them (Clang 14 refuses).
+  const double u0 = s.u.domain().first, u1 = s.u.domain().second;
+  const double v0 = s.v.domain().first, v1 = s.v.domain().second;
   double sum = 0;
   if (face.loops.empty()) {
     // The whole domain: along its right side (the left one has F = 0, the others dv = 0).
