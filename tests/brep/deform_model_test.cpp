@@ -112,6 +112,16 @@ DeformationStack trilinear(const Vector3d& lo, const Vector3d& hi, const Vector3
   return stack;
 }
 
+/// The undisplaced trilinear lattice on [-20, 20]^3.
+clay::deform::BezierLattice around_origin() {
+  clay::deform::Frame frame;
+  frame.origin = {-20, -20, -20};
+  frame.s = {40, 0, 0};
+  frame.t = {0, 40, 0};
+  frame.u = {0, 0, 40};
+  return clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+}
+
 }  // namespace
 
 TEST_CASE("deform_model: a filleted block with holes through a trilinear lattice, exactly") {
@@ -160,12 +170,7 @@ TEST_CASE("deform_model: a filleted block with holes through a trilinear lattice
 TEST_CASE("deform_model: a uniform scale changes the volume by its determinant") {
   const Model sphere = read(TestModel::Sphere, "sphere.step");
   // The lattice [-20, 20]^3 scaled by 1.1 about the origin: an affine map of determinant 1.331.
-  clay::deform::Frame frame;
-  frame.origin = {-20, -20, -20};
-  frame.s = {40, 0, 0};
-  frame.t = {0, 40, 0};
-  frame.u = {0, 0, 40};
-  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  auto lattice = around_origin();
   lattice.points *= 1.1;
   DeformationStack stack;
   stack.steps.push_back({lattice, "scale", true});
@@ -201,12 +206,7 @@ TEST_CASE("deform_model: faces a local lattice leaves alone are kept bit for bit
 
 TEST_CASE("deform_model: a mirroring lattice reverses the solid's faces") {
   const Model sphere = read(TestModel::Sphere, "sphere-mirror.step");
-  clay::deform::Frame frame;
-  frame.origin = {-20, -20, -20};
-  frame.s = {40, 0, 0};
-  frame.t = {0, 40, 0};
-  frame.u = {0, 0, 40};
-  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  auto lattice = around_origin();
   lattice.points.col(0) *= -1;  // x -> -x
   DeformationStack stack;
   stack.steps.push_back({lattice, "mirror", true});
@@ -281,4 +281,30 @@ TEST_CASE("deform_model: an open shell in a solid is refused, naming the shell")
       clay::test::error_of([&] { (void)clay::deform::deform_model(stack, block); });
   CHECK(category == clay::ErrorCategory::InvalidGeometry);
   CHECK_THAT(text, Contains("shell 0"));
+}
+
+TEST_CASE("deform_model: max_degree refits exact results above it, certified") {
+  const Model block = read(TestModel::FilletedBlock, "block-degree.step");
+  const DeformationStack stack = trilinear({-5, -5, -5}, {65, 45, 25}, {6, 4, 5});
+  clay::deform::ModelDeformationOptions options;
+  options.max_degree = 2;  // the trilinear lattice (total degree 3) gives degree 3 and more
+  auto [category, text] =
+      clay::test::error_of([&] { (void)clay::deform::deform_model(stack, block, options); });
+  CHECK(category == clay::ErrorCategory::DegreeLimit);
+  CHECK_THAT(text, Contains("above max_degree 2"));
+  clay::deform::RefitOptions refit;
+  refit.tolerance = 1e-3;
+  refit.relative = false;
+  options.surface.refit = refit;
+  const auto result = clay::deform::deform_model(stack, block, options);
+  INFO(result.report.brief());
+  CHECK(result.report.faces_refit > 0);
+  CHECK(result.report.max_certified_bound_mm <= 1e-3);
+  for (const auto& face : result.model.faces) {
+    CHECK(face.surface.u.degree <= 2);
+    CHECK(face.surface.v.degree <= 2);
+  }
+  for (const auto& edge : result.model.edges)
+    if (!edge.degenerate) CHECK(edge.curve.basis.degree <= 2);
+  CHECK(clay::brep::check_model(result.model).valid);
 }

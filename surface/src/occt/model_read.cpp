@@ -126,6 +126,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using internal::shortest;
+using surface::occt::extension_is;
 using surface::occt::quoted;
 
 /// Accepted as exact: the face along a re-derived pcurve agrees with the original to rounding.
@@ -1164,15 +1165,6 @@ class ModelBuilder {
   std::vector<EdgeConversion> conversions_;
   std::map<int, bool> seam_flipped_;  // seams made by seam_of: runs against the old edge
 };
-
-bool extension_is(const fs::path& file, std::initializer_list<const char*> list) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-  for (const char* e : list)
-    if (ext == e) return true;
-  return false;
-}
 
 }  // namespace
 

@@ -68,6 +68,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using internal::shortest;
+using surface::occt::extension_is;
 using surface::occt::quoted;
 
 /// A 2D OCCT curve from a pcurve (control points (u, v, 0)), copied exactly.
@@ -380,15 +381,6 @@ class DocumentWriter {
   Handle(XCAFDoc_ColorTool) colours_;
   std::vector<TDF_Label> part_labels_;
 };
-
-bool extension_is(const fs::path& file, std::initializer_list<const char*> list) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-  for (const char* e : list)
-    if (ext == e) return true;
-  return false;
-}
 
 }  // namespace
 

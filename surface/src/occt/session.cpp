@@ -3,7 +3,9 @@
 
 #include <clay/error.hpp>
 
+#include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <fstream>
 #include <random>
@@ -25,6 +27,15 @@ std::mutex& exchange_mutex() {
 }
 
 std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+bool extension_is(const fs::path& file, std::initializer_list<const char*> list) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  for (const char* e : list)
+    if (ext == e) return true;
+  return false;
+}
 
 namespace {
 

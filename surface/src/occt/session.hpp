@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <mutex>
 #include <ostream>
 #include <string>
@@ -63,6 +64,9 @@ struct ExchangeSession {
 
 /// 'path', for messages.
 std::string quoted(const std::filesystem::path& path);
+
+/// True when the file's extension, in lower case, is one of `list` (".step", ".igs", ...).
+bool extension_is(const std::filesystem::path& file, std::initializer_list<const char*> list);
 
 /// Checks that the folder of `file` exists and `file` names a file in it (clay::Error(Io)).
 void check_target(const std::filesystem::path& file, std::string_view caller);
