@@ -58,11 +58,18 @@ std::vector<double> coedge_samples(const Edge& e, const Coedge& c, int per_span)
   return ts;
 }
 
+/// t clamped to a curve's domain: problems() lets an edge range end within a rounding slack past
+/// it (a range read from a file), and evaluation refuses parameters outside.
+double within(const surface::BSplineCurve& c, double t) {
+  const auto [a, b] = c.basis.domain();
+  return std::clamp(t, a, b);
+}
+
 /// (u, v) of a pcurve at t, clamped to the surface's domain (a pcurve leaving the domain is a
 /// problem of its own; the gap is measured at the nearest point of the domain).
 Eigen::Vector2d uv_at(const surface::BSplineSurface& s, const surface::BSplineCurve& pcurve,
                       double t) {
-  const Eigen::Vector3d p = surface::evaluate(pcurve, t);
+  const Eigen::Vector3d p = surface::evaluate(pcurve, within(pcurve, t));
   const auto [u0, u1] = s.u.domain();
   const auto [v0, v1] = s.v.domain();
   return {std::clamp(p.x(), u0, u1), std::clamp(p.y(), v0, v1)};
@@ -79,7 +86,7 @@ EdgeGap gap_of(const Model& m, int f, int l, int c, int per_span) {
     const Eigen::Vector2d uv = uv_at(face.surface, co.pcurve, t);
     const Eigen::Vector3d on_face = surface::evaluate(face.surface, uv.x(), uv.y());
     const Eigen::Vector3d on_edge = e.degenerate ? m.vertices[static_cast<size_t>(e.start)].point
-                                                 : surface::evaluate(e.curve, t);
+                                                 : surface::evaluate(e.curve, within(e.curve, t));
     const double d = (on_face - on_edge).norm();
     if (d > g.gap_mm || std::isnan(d)) {
       g.gap_mm = d;
@@ -127,7 +134,7 @@ double signed_area(const Model& m, const Loop& loop) {
     std::vector<double> ts = coedge_samples(e, co, 8);
     if (!co.same_sense) std::reverse(ts.begin(), ts.end());
     for (double t : ts) {
-      const Eigen::Vector3d p = surface::evaluate(co.pcurve, t);
+      const Eigen::Vector3d p = surface::evaluate(co.pcurve, within(co.pcurve, t));
       poly.emplace_back(p.x(), p.y());
     }
   }
@@ -201,7 +208,7 @@ void vertex_and_edge_problems(const Model& m, std::vector<std::string>& out) {
     for (const auto& [t, vi, which] :
          {std::tuple{e.t0, e.start, "start"}, std::tuple{e.t1, e.end, "end"}}) {
       const Vertex& v = m.vertices[static_cast<size_t>(vi)];
-      const double d = (surface::evaluate(e.curve, t) - v.point).norm();
+      const double d = (surface::evaluate(e.curve, within(e.curve, t)) - v.point).norm();
       if (!(d <= e.tolerance_mm + v.tolerance_mm))
         out.push_back(name + ": its " + which + " is " + shortest(d) + " mm from vertex " +
                       std::to_string(vi) + ", more than the tolerances allow (" +
@@ -255,7 +262,7 @@ void face_problems(const Model& m, std::vector<std::string>& out) {
         }
         // Inside the surface's domain, at the samples.
         for (double t : coedge_samples(e, co, 4)) {
-          const Eigen::Vector3d p = surface::evaluate(co.pcurve, t);
+          const Eigen::Vector3d p = surface::evaluate(co.pcurve, within(co.pcurve, t));
           if (p.x() < u0 - uv_slack || p.x() > u1 + uv_slack || p.y() < v0 - uv_slack ||
               p.y() > v1 + uv_slack) {
             out.push_back(coedge_name(m, f, l, c) + ": the pcurve leaves the surface's domain [" +

@@ -57,6 +57,10 @@ std::vector<double> breaks(const surface::BSplineBasis& basis, double a, double 
 /// degree p in u the integrand has degree 3p - 1 there, so ceil(3p / 2) points are exact; a
 /// rational one gets 16.
 double inner(const surface::BSplineSurface& s, double a, double u, double v) {
+  // A pcurve may stand a rounding error outside the surface's domain (problems() allows it):
+  // evaluate on its boundary there.
+  u = std::clamp(u, s.u.domain().first, s.u.domain().second);
+  v = std::clamp(v, s.v.domain().first, s.v.domain().second);
   const double lo = std::min(a, u), hi = std::max(a, u);
   if (hi == lo) return 0;
   const int n = s.is_rational() ? 16 : std::clamp((3 * s.u.degree + 1) / 2, 1, 16);
@@ -87,8 +91,12 @@ double face_volume(const Model& m, const Face& face, double tol) {
     for (const Loop& loop : face.loops)
       for (const Coedge& c : loop.coedges) {
         const Edge& e = m.edges[static_cast<std::size_t>(c.edge)];
+        // problems() lets an edge range end a rounding error past its pcurve's domain (a range
+        // read from a file, 30.773502691896002 against 30.773502691895999): evaluate inside.
+        const double d0 = c.pcurve.basis.domain().first, d1 = c.pcurve.basis.domain().second;
         auto integrand = [&](double t) {
-          const surface::CurveDerivatives q = surface::derivatives(c.pcurve, t, 1);
+          const surface::CurveDerivatives q =
+              surface::derivatives(c.pcurve, std::clamp(t, d0, d1), 1);
           return q.d1.y() == 0.0 ? 0.0 : inner(s, a, q.point.x(), q.point.y()) * q.d1.y();
         };
         const auto pieces = breaks(c.pcurve.basis, e.t0, e.t1);

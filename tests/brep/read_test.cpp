@@ -130,6 +130,25 @@ TEST_CASE("read_model: a torus, a cone and a revolved bottle") {
   }
 }
 
+TEST_CASE(
+    "read_model: an oblique cut of a cylinder needs fitted pcurves, within 1e-10 of the size") {
+  // The ellipse where the plane cuts the cylinder is a sine curve in the cylinder's angle: no
+  // line and no shared conic rule maps it onto the rational parameter, so it is fitted.
+  const fs::path file = written(TestModel::ObliqueCut, "oblique.step");
+  const auto read = read_model(file);
+  check_against_occt(file, read);
+  CHECK(read.report.pcurves_fitted >= 1);
+  CHECK(read.report.max_rederivation_error_mm > 0);
+  CHECK(read.report.max_rederivation_error_mm <= 1e-10 * read.report.size_mm);
+  // The edge gap includes the file's own: OpenCASCADE's intersection curve (its Boolean
+  // approximates the ellipse) within its edge tolerance.
+  CHECK(read.report.max_edge_gap_mm <= read.report.max_edge_tolerance_mm);
+  // The fitted pcurves write and read back like the others.
+  const fs::path copy = output("oblique-copy.step");
+  CHECK(clay::brep::write_model(read.model, copy).valid);
+  CHECK(read_model(copy).report.problems.empty());
+}
+
 TEST_CASE("read_model: STEP and IGES of the same solid give the same topology") {
   const fs::path step = written(TestModel::FilletedBlock, "block-same.step");
   const fs::path iges = written(TestModel::FilletedBlock, "block-same.igs");

@@ -237,6 +237,19 @@ void write_test_model(TestModel model, const fs::path& file) {
                srgb(0.7, 0.7, 0.75));
       break;
     }
+    case TestModel::ObliqueCut: {
+      const TopoDS_Shape cylinder =
+          BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp::DZ()), 10.0, 40.0).Shape();
+      // A box above the plane z = 25 + x tan(30 deg), turned about the y axis.
+      gp_Trsf turn;
+      turn.SetRotation(gp_Ax1(gp_Pnt(0, 0, 25), gp::DY()), -std::atan(1.0) * 4 / 6);
+      const TopoDS_Shape cutter = BRepPrimAPI_MakeBox(gp_Pnt(-50, -50, 25), 100, 100, 50)
+                                      .Shape()
+                                      .Moved(TopLoc_Location(turn));
+      add_part(shapes, colours, BRepAlgoAPI_Cut(cylinder, cutter).Shape(), "cut cylinder",
+               srgb(0.6, 0.3, 0.3));
+      break;
+    }
     case TestModel::LooseFaces:
       add_part(shapes, colours, loose_box_faces(), "faces", srgb(0.6, 0.6, 0.6));
       break;

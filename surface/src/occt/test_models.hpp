@@ -22,6 +22,7 @@ enum class TestModel {
   LooseFaces,     ///< a box's six faces written as loose IGES faces (144), to be sewn
   Separated,      ///< two solids apart: a box 20^3 at the origin, a sphere r 5 at (50, 10, 10)
   HolePlate,      ///< 200 faces: a 200 x 200 x 10 plate, vertical edges filleted (r 8), 190 holes
+  ObliqueCut,     ///< a cylinder r 10 cut by a plane at 30 degrees: an ellipse across the angles
 };
 
 /// Builds `model` with OpenCASCADE and writes it through XCAF (names, colours, assembly) as
