@@ -36,25 +36,37 @@ bool outside(const Frame& frame, const surface::Points3& points) {
   return false;
 }
 
-/// True when the step leaves every point of `points` (and their convex hull) where it is.
-bool leaves_alone(const DeformationStep& step, const surface::Points3& points) {
-  if (!step.enabled) return true;
-  return std::visit(
-      [&](const auto& d) {
-        using T = std::decay_t<decltype(d)>;
-        if constexpr (std::is_same_v<T, BezierLattice> || std::is_same_v<T, BSplineLattice>)
-          return outside(d.frame, points) || d.points == undisplaced_points(d);
-        else
-          return false;
-      },
-      step.deformation);
-}
+/// Per enabled step, what makes it leave a face alone: a lattice whose points are all undisplaced
+/// (worked out once per step, not per face), or a face outside the lattice's box.
+struct Leaves {
+  std::vector<const Frame*> frames;  // one per enabled step; null: the step moves everything
+  std::vector<bool> identity;        // the step's lattice is undisplaced
 
-bool leaves_alone(const DeformationStack& stack, const surface::Points3& points) {
-  for (const DeformationStep& step : stack.steps)
-    if (!leaves_alone(step, points)) return false;
-  return true;
-}
+  explicit Leaves(const DeformationStack& stack) {
+    for (const DeformationStep& step : stack.steps) {
+      if (!step.enabled) continue;
+      std::visit(
+          [&](const auto& d) {
+            using T = std::decay_t<decltype(d)>;
+            if constexpr (std::is_same_v<T, BezierLattice> || std::is_same_v<T, BSplineLattice>) {
+              frames.push_back(&d.frame);
+              identity.push_back(d.points == undisplaced_points(d));
+            } else {
+              frames.push_back(nullptr);
+              identity.push_back(false);
+            }
+          },
+          step.deformation);
+    }
+  }
+
+  /// True when every enabled step leaves `points` (and their convex hull) where they are.
+  bool alone(const surface::Points3& points) const {
+    for (std::size_t k = 0; k < frames.size(); ++k)
+      if (!identity[k] && (frames[k] == nullptr || !outside(*frames[k], points))) return false;
+    return true;
+  }
+};
 
 /// The ruled surface C(t) x [0, 1] whose every v-row is the curve: its composition's row 0 is the
 /// curve's composition on the same t.
@@ -198,9 +210,10 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   std::vector<Outcome> faces(m.faces.size());
   std::vector<double> edge_face_bound(m.edges.size(), 0.0);
   std::vector<bool> edge_touched(m.edges.size(), false);
+  const Leaves leaves(stack);
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     brep::Face& face = m.faces[f];
-    if (leaves_alone(stack, face.surface.points)) {
+    if (leaves.alone(face.surface.points)) {
       ++report.faces_untouched;
       continue;
     }
