@@ -124,6 +124,18 @@ Model cube(double a = 10) {
   return b.m;
 }
 
+/// A sheet: the square [0, 10]^2 at height z with a square hole [2.5, 7.5]^2 (the hole's loop
+/// clockwise in (u, v)).
+void plate_with_hole(Builder& b, double z) {
+  const int f = b.quad({0, 0, z}, {10, 0, 0}, {0, 10, 0}, "plate");
+  Face& plate = b.m.faces[static_cast<size_t>(f)];
+  plate.loops.push_back(b.loop(plate, {{0.25, 0.25}, {0.25, 0.75}, {0.75, 0.75}, {0.75, 0.25}}));
+  Body sheet;
+  sheet.kind = BodyKind::Sheet;
+  sheet.shells.push_back({{f}});
+  b.m.bodies.push_back(sheet);
+}
+
 std::string all(const std::vector<std::string>& list) {
   std::string s;
   for (const auto& p : list) s += p + "\n";
@@ -280,13 +292,7 @@ TEST_CASE("problems finds an open loop, an edge off its vertex and a pcurve off 
 
 TEST_CASE("a face with a hole: the outer loop counter-clockwise, the hole clockwise", "[brep]") {
   Builder b;
-  const int f = b.quad({0, 0, 0}, {10, 0, 0}, {0, 10, 0}, "plate");
-  Face& plate = b.m.faces[static_cast<size_t>(f)];
-  plate.loops.push_back(b.loop(plate, {{0.25, 0.25}, {0.25, 0.75}, {0.75, 0.75}, {0.75, 0.25}}));
-  Body sheet;
-  sheet.kind = BodyKind::Sheet;
-  sheet.shells.push_back({{f}});
-  b.m.bodies.push_back(sheet);
+  plate_with_hole(b, 0);
   INFO(all(clay::brep::problems(b.m)));
   CHECK(clay::brep::problems(b.m).empty());
   const auto c = clay::brep::counts(b.m);
@@ -421,13 +427,7 @@ TEST_CASE("volume_mm3 of a cube, a translated cube and a cube with a face turned
   // A trimmed face: the plate with a hole, as an open sheet, integrates over the trimmed domain
   // only. With the field (0, 0, z) and the plate at z = 4, its flux is 4 × (100 - 25).
   Builder b;
-  const int f = b.quad({0, 0, 4}, {10, 0, 0}, {0, 10, 0}, "plate");
-  Face& plate = b.m.faces[static_cast<size_t>(f)];
-  plate.loops.push_back(b.loop(plate, {{0.25, 0.25}, {0.25, 0.75}, {0.75, 0.75}, {0.75, 0.25}}));
-  Body sheet;
-  sheet.kind = BodyKind::Sheet;
-  sheet.shells.push_back({{f}});
-  b.m.bodies.push_back(sheet);
+  plate_with_hole(b, 4);
   CHECK(clay::brep::volume_mm3(b.m, 0) == Approx(4 * 75).epsilon(1e-14));
   CHECK(clay::brep::volume_mm3(b.m) == 0);  // no solid
   CHECK(clay::test::error_of([&] { (void)clay::brep::volume_mm3(b.m, 1); }).first ==
