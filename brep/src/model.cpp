@@ -217,6 +217,55 @@ void vertex_and_edge_problems(const Model& m, std::vector<std::string>& out) {
   }
 }
 
+/// Whether a face's analytic surface is well formed and is the surface its NURBS represents:
+/// every control net node's point of the NURBS (a 9 x 9 grid of its domain) lies on it, and for a
+/// plane at the same (u, v), within 1e-9 of the face's size (or 1e-12 mm).
+void elementary_problems(const Model& m, int f, std::vector<std::string>& out) {
+  const Face& face = m.faces[static_cast<size_t>(f)];
+  const Elementary& e = *face.elementary;
+  const std::string name = face_name(m, f) + "'s " + std::string(to_string(e.kind));
+  const size_t before = out.size();
+  if (!internal::all_finite(e.origin) || !internal::all_finite(e.x_axis) ||
+      !internal::all_finite(e.y_axis) || !internal::all_finite(e.z_axis))
+    out.push_back(name + ": its frame has a non-finite coordinate");
+  const Eigen::Matrix3d frame = (Eigen::Matrix3d() << e.x_axis, e.y_axis, e.z_axis).finished();
+  if (!((frame.transpose() * frame - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= 1e-12))
+    out.push_back(name + ": its axes are not orthonormal (give unit x, y, z at right angles)");
+  const bool round = e.kind != ElementaryKind::Plane;
+  if (round && !(std::isfinite(e.radius) && e.radius >= 0 &&
+                 (e.radius > 0 || e.kind == ElementaryKind::Cone)))
+    out.push_back(name + ": radius = " + shortest(e.radius) + " must be finite and > 0");
+  if (e.kind == ElementaryKind::Torus && !(std::isfinite(e.minor_radius) && e.minor_radius > 0))
+    out.push_back(name + ": minor_radius = " + shortest(e.minor_radius) +
+                  " must be finite and > 0");
+  if (e.kind == ElementaryKind::Cone &&
+      !(std::abs(e.semi_angle) < std::acos(0.0) && e.semi_angle != 0))
+    out.push_back(name + ": semi_angle = " + shortest(e.semi_angle) +
+                  " must be in (-pi/2, pi/2) and not 0");
+  if (out.size() != before) return;
+  const auto [u0, u1] = face.surface.u.domain();
+  const auto [v0, v1] = face.surface.v.domain();
+  Eigen::AlignedBox3d box;
+  for (Eigen::Index r = 0; r < face.surface.points.rows(); ++r)
+    box.extend(Eigen::Vector3d(face.surface.points.row(r).transpose()));
+  const double tolerance = std::max(1e-12, 1e-9 * box.diagonal().norm());
+  double worst = 0;
+  constexpr int n = 8;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const double u = std::min(u1, u0 + (u1 - u0) * i / n),
+                   v = std::min(v1, v0 + (v1 - v0) * j / n);
+      const Eigen::Vector3d p = surface::evaluate(face.surface, u, v);
+      const double d =
+          e.kind == ElementaryKind::Plane ? (p - point(e, u, v)).norm() : distance(e, p);
+      worst = std::max(worst, std::isnan(d) ? INFINITY : d);
+    }
+  if (!(worst <= tolerance))
+    out.push_back(name + ": the face's NURBS surface is " + shortest(worst) + " mm off it (" +
+                  (e.kind == ElementaryKind::Plane ? "at the same (u, v), " : "") + "more than " +
+                  shortest(tolerance) + " mm); drop `elementary` when the surface is changed");
+}
+
 /// Face, loop and coedge problems.
 void face_problems(const Model& m, std::vector<std::string>& out) {
   for (size_t fi = 0; fi < m.faces.size(); ++fi) {
@@ -230,6 +279,7 @@ void face_problems(const Model& m, std::vector<std::string>& out) {
     if (!colour_ok(face.colour))
       out.push_back(face_name(m, f) + ": colour " + colour_text(*face.colour) +
                     " has a component outside [0, 1]");
+    if (face.elementary) elementary_problems(m, f, out);
     const auto [u0, u1] = face.surface.u.domain();
     const auto [v0, v1] = face.surface.v.domain();
     const double uv_slack = 1e-9 * std::max(u1 - u0, v1 - v0);
@@ -418,6 +468,55 @@ void assembly_problems(const Model& m, std::vector<std::string>& out) {
 
 }  // namespace
 
+Eigen::Vector3d point(const Elementary& e, double u, double v) {
+  const Eigen::Vector3d radial = std::cos(u) * e.x_axis + std::sin(u) * e.y_axis;
+  switch (e.kind) {
+    case ElementaryKind::Plane:
+      return e.origin + u * e.x_axis + v * e.y_axis;
+    case ElementaryKind::Cylinder:
+      return e.origin + e.radius * radial + v * e.z_axis;
+    case ElementaryKind::Cone:
+      return e.origin + (e.radius + v * std::sin(e.semi_angle)) * radial +
+             v * std::cos(e.semi_angle) * e.z_axis;
+    case ElementaryKind::Sphere:
+      return e.origin + e.radius * (std::cos(v) * radial + std::sin(v) * e.z_axis);
+    case ElementaryKind::Torus:
+      return e.origin + (e.radius + e.minor_radius * std::cos(v)) * radial +
+             e.minor_radius * std::sin(v) * e.z_axis;
+  }
+  return e.origin;
+}
+
+double distance(const Elementary& e, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d d = p - e.origin;
+  const double axial = d.dot(e.z_axis);
+  const double radial = (d - axial * e.z_axis).norm();  // distance from the axis
+  switch (e.kind) {
+    case ElementaryKind::Plane:
+      return std::abs(axial);
+    case ElementaryKind::Cylinder:
+      return std::abs(radial - e.radius);
+    case ElementaryKind::Cone: {
+      // In the half-plane through the axis and p, the cone (both nappes: the radius changes sign
+      // at the apex) is two rays from the apex, mirror images across the axis.
+      const double s = std::sin(e.semi_angle), c = std::cos(e.semi_angle);
+      const Eigen::Vector2d apex(0.0, -e.radius * c / s), q(radial, axial);
+      double nearest = INFINITY;
+      for (double side : {1.0, -1.0}) {
+        const Eigen::Vector2d ray(std::abs(s), side * c);
+        const double t = std::max(0.0, (q - apex).dot(ray));
+        nearest = std::min(nearest, (q - apex - t * ray).norm());
+      }
+      return nearest;
+    }
+    case ElementaryKind::Sphere:
+      return std::abs(d.norm() - e.radius);
+    case ElementaryKind::Torus:
+      return std::abs(std::hypot(radial - e.radius, axial) - e.minor_radius);
+  }
+  return INFINITY;
+}
+
 Counts counts(const Model& model) {
   Counts c;
   c.bodies = static_cast<int>(model.bodies.size());
@@ -525,6 +624,13 @@ Model flattened(const Model& model) {
       for (int f : shell.faces) {
         Face face = model.faces[static_cast<size_t>(f)];
         face.surface.points = moved(face.surface.points);
+        if (face.elementary) {
+          Elementary& e = *face.elementary;
+          e.origin = place * e.origin;
+          e.x_axis = place.linear() * e.x_axis;
+          e.y_axis = place.linear() * e.y_axis;
+          e.z_axis = place.linear() * e.z_axis;
+        }
         for (Loop& loop : face.loops)
           for (Coedge& co : loop.coedges) co.edge = edge(co.edge);
         out.faces.push_back(std::move(face));
@@ -548,6 +654,22 @@ Model flattened(const Model& model) {
 void validate(const Model& model) {
   const auto list = problems(model);
   if (!list.empty()) internal::throw_problems(ErrorCategory::InvalidGeometry, list);
+}
+
+std::string_view to_string(ElementaryKind kind) noexcept {
+  switch (kind) {
+    case ElementaryKind::Plane:
+      return "plane";
+    case ElementaryKind::Cylinder:
+      return "cylinder";
+    case ElementaryKind::Cone:
+      return "cone";
+    case ElementaryKind::Sphere:
+      return "sphere";
+    case ElementaryKind::Torus:
+      return "torus";
+  }
+  return "unknown";
 }
 
 std::string_view to_string(BodyKind kind) noexcept {

@@ -218,6 +218,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       continue;
     }
     faces[f] = deform_one(stack, face.surface, options, face_name(m, f));
+    face.elementary.reset();  // no longer a plane, cylinder, ...: only untouched faces keep it
     (faces[f].way == Outcome::Way::Exact ? report.faces_exact : report.faces_refit) += 1;
     report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, faces[f].bound);
     report.max_deviation_mm = std::max(report.max_deviation_mm, faces[f].deviation);

@@ -202,6 +202,20 @@ TEST_CASE("deform_model: faces a local lattice leaves alone are kept bit for bit
     if (!pair.edges[e].degenerate && pair.edges[e].curve.points.col(0).maxCoeff() < 30)
       CHECK(clay::surface::identical(pair.edges[e].curve, result.model.edges[e].curve));
   CHECK(clay::brep::check_model(result.model).valid);
+  // ... and keep their type: the box's faces are still planes, in the model and in the file;
+  // the deformed sphere is a sphere no more.
+  int planes = 0, spheres = 0;
+  for (const auto& face : result.model.faces) {
+    planes += face.elementary && face.elementary->kind == clay::brep::ElementaryKind::Plane;
+    spheres += face.elementary && face.elementary->kind == clay::brep::ElementaryKind::Sphere;
+  }
+  CHECK(planes == 6);
+  CHECK(spheres == 0);
+  const fs::path file = output("pair-deformed.step");
+  CHECK(clay::brep::write_model(result.model, file).valid);
+  const auto facts = clay::surface::occt_reference::facts_of_file(file);
+  CHECK(facts.planes == 6);
+  CHECK(facts.other_surfaces == 1);
 }
 
 TEST_CASE("deform_model: a mirroring lattice reverses the solid's faces") {

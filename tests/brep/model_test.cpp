@@ -471,3 +471,98 @@ TEST_CASE("flattened places every instance of an assembly as a body of its own",
   CHECK(clay::surface::identical(flat.faces[7].loops[0].coedges[0].pcurve,
                                  m.faces[1].loops[0].coedges[0].pcurve));
 }
+
+TEST_CASE("elementary surfaces: points in closed form and distances along the normal", "[brep]") {
+  using clay::brep::Elementary;
+  using clay::brep::ElementaryKind;
+  const Eigen::Matrix3d turn = (Eigen::AngleAxisd(0.7, Vector3d(1, 2, 3).normalized()) *
+                                Eigen::AngleAxisd(-0.3, Vector3d::UnitX()))
+                                   .toRotationMatrix();
+  for (const ElementaryKind kind :
+       {ElementaryKind::Plane, ElementaryKind::Cylinder, ElementaryKind::Cone,
+        ElementaryKind::Sphere, ElementaryKind::Torus}) {
+    for (const bool left_handed : {false, true}) {
+      INFO(clay::brep::to_string(kind) << (left_handed ? " left-handed" : ""));
+      Elementary e;
+      e.kind = kind;
+      e.origin = Vector3d(3, -2, 5);
+      e.x_axis = turn.col(0);
+      e.y_axis = left_handed ? Vector3d(-turn.col(1)) : Vector3d(turn.col(1));
+      e.z_axis = turn.col(2);
+      e.radius = kind == ElementaryKind::Torus ? 20 : 6;
+      e.minor_radius = 5;
+      e.semi_angle = 0.4;
+      for (double u : {0.0, 0.9, 2.5, 4.0})
+        for (double v : {-0.6, 0.3, 1.1}) {
+          const Vector3d radial = std::cos(u) * e.x_axis + std::sin(u) * e.y_axis;
+          // The outward unit normal in closed form, and the point by the formulas of the header.
+          Vector3d normal = e.z_axis;
+          Vector3d expected = e.origin + u * e.x_axis + v * e.y_axis;
+          if (kind == ElementaryKind::Cylinder) {
+            normal = radial;
+            expected = e.origin + 6 * radial + v * e.z_axis;
+          } else if (kind == ElementaryKind::Cone) {
+            normal = std::cos(0.4) * radial - std::sin(0.4) * e.z_axis;
+            expected = e.origin + (6 + v * std::sin(0.4)) * radial + v * std::cos(0.4) * e.z_axis;
+          } else if (kind == ElementaryKind::Sphere) {
+            normal = std::cos(v) * radial + std::sin(v) * e.z_axis;
+            expected = e.origin + 6 * normal;
+          } else if (kind == ElementaryKind::Torus) {
+            normal = std::cos(v) * radial + std::sin(v) * e.z_axis;
+            expected = e.origin + 20 * radial + 5 * normal;
+          }
+          const Vector3d p = clay::brep::point(e, u, v);
+          CHECK((p - expected).norm() <= 1e-13);
+          CHECK(clay::brep::distance(e, p) <= 1e-13);
+          for (double d : {0.25, -0.5})
+            CHECK(clay::brep::distance(e, p + d * normal) == Approx(std::abs(d)).margin(1e-13));
+        }
+    }
+  }
+}
+
+TEST_CASE("problems checks a face's elementary surface against its NURBS", "[brep]") {
+  using clay::brep::Elementary;
+  using clay::brep::ElementaryKind;
+  Model m = cube(1);  // the unit cube: its faces have the plane's own parameters
+  Elementary top;
+  top.kind = ElementaryKind::Plane;
+  top.origin = Vector3d(0, 0, 1);  // the top face is (0, 0, 1) + u x + v y
+  m.faces[1].elementary = top;
+  CHECK(clay::brep::problems(m).empty());
+  // A parallel plane is not the face.
+  Model wrong = m;
+  wrong.faces[1].elementary->origin.z() = 1.5;
+  CHECK_THAT(all(clay::brep::problems(wrong)),
+             Contains("face 1 (\"top\")'s plane: the face's NURBS surface is 0.5 mm off it"));
+  wrong = m;
+  wrong.faces[1].elementary->y_axis = Vector3d(0.1, 1, 0);
+  CHECK_THAT(all(clay::brep::problems(wrong)), Contains("its axes are not orthonormal"));
+  wrong = m;
+  wrong.faces[1].elementary->kind = ElementaryKind::Cone;
+  wrong.faces[1].elementary->radius = 1;
+  CHECK_THAT(all(clay::brep::problems(wrong)),
+             Contains("cone: semi_angle = 0 must be in (-pi/2, pi/2) and not 0"));
+  wrong = m;
+  wrong.faces[1].elementary->kind = ElementaryKind::Sphere;
+  CHECK_THAT(all(clay::brep::problems(wrong)),
+             Contains("sphere: radius = 0 must be finite and > 0"));
+  // A sphere through the face's four corners is not the face either.
+  wrong = m;
+  wrong.faces[1].elementary->kind = ElementaryKind::Sphere;
+  wrong.faces[1].elementary->origin = Vector3d(0.5, 0.5, 0);
+  wrong.faces[1].elementary->radius = std::sqrt(1.5);
+  CHECK_THAT(all(clay::brep::problems(wrong)), Contains("'s sphere: the face's NURBS surface is"));
+
+  // flattened moves the frame with the instance.
+  m.parts.push_back({"cube", {0}, {}, std::nullopt});
+  const Eigen::Isometry3d place(Eigen::Translation3d(4, 0, 0) *
+                                Eigen::AngleAxisd(0.5, Vector3d::UnitY()));
+  m.roots.push_back({0, place, "placed"});
+  const Model flat = clay::brep::flattened(m);
+  INFO(all(clay::brep::problems(flat)));
+  CHECK(clay::brep::problems(flat).empty());
+  REQUIRE(flat.faces[1].elementary);
+  CHECK((flat.faces[1].elementary->origin - place * Vector3d(0, 0, 1)).norm() <= 1e-15);
+  CHECK((flat.faces[1].elementary->z_axis - place.linear() * Vector3d::UnitZ()).norm() <= 1e-15);
+}

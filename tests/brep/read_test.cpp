@@ -10,6 +10,7 @@
 #include <clay/brep/volume.hpp>
 #include <clay/surface/evaluate.hpp>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -59,6 +60,14 @@ std::vector<std::vector<Eigen::Vector3d>> surface_samples(const Model& m, int pe
   return out;
 }
 
+/// How many faces are planes, cylinders, cones, spheres and tori (Face::elementary).
+std::array<int, 5> elementary_counts(const Model& m) {
+  std::array<int, 5> out{};
+  for (const auto& face : m.faces)
+    if (face.elementary) ++out[static_cast<std::size_t>(face.elementary->kind)];
+  return out;
+}
+
 /// The checks every clean model passes: OpenCASCADE's counts, no broken invariant, every face
 /// on the original surface to 1e-12 of the size, re-derived pcurves within 1e-9 of the size.
 void check_against_occt(const fs::path& file, const clay::brep::ImportedModel& read) {
@@ -71,6 +80,13 @@ void check_against_occt(const fs::path& file, const clay::brep::ImportedModel& r
   CHECK(c.edges == facts.edges);
   CHECK(c.vertices == facts.vertices);
   CHECK(read.report.counts == c);
+  // Every analytic face keeps its type (problems() below checks its NURBS lies on it).
+  const auto kinds = elementary_counts(read.model);
+  CHECK(kinds[0] == facts.planes);
+  CHECK(kinds[1] == facts.cylinders);
+  CHECK(kinds[2] == facts.cones);
+  CHECK(kinds[3] == facts.spheres);
+  CHECK(kinds[4] == facts.tori);
   for (const auto& problem : read.report.problems) UNSCOPED_INFO(problem);
   CHECK(read.report.problems.empty());
   CHECK(read.report.size_mm > 0);
@@ -106,6 +122,22 @@ TEST_CASE("read_model: a filleted block with holes and a pocket is one valid sol
       CHECK(near(face.colour, 0.1, 0.3, 0.9));
     }
   CHECK(named == 1);
+  // The top is the plane z = 20, the holes cylinders of radius 4, the fillets of radius 5.
+  int holes = 0, fillets = 0;
+  for (const auto& face : read.model.faces) {
+    if (face.name == "top") {
+      REQUIRE(face.elementary);
+      CHECK(face.elementary->kind == clay::brep::ElementaryKind::Plane);
+      CHECK(face.elementary->origin.z() == 20);
+      CHECK(std::abs(face.elementary->z_axis.z()) == 1);
+    }
+    if (face.elementary && face.elementary->kind == clay::brep::ElementaryKind::Cylinder) {
+      holes += face.elementary->radius == 4;
+      fillets += face.elementary->radius == 5;
+    }
+  }
+  CHECK(holes == 2);
+  CHECK(fillets == 4);
 }
 
 TEST_CASE("read_model: a sphere keeps its seam and its two poles") {
@@ -359,6 +391,17 @@ TEST_CASE("write_model: STEP and IGES round trips are bit-identical and valid") 
       CHECK(copy_facts.faces == facts.faces);
       CHECK(copy_facts.edges == facts.edges);
       CHECK(copy_facts.vertices == facts.vertices);
+      // Planes are written as planes and read back as the same plane; cylinders, cones, spheres
+      // and tori are written as their NURBS (see model_write.cpp) and come back as B-splines.
+      CHECK(copy_facts.planes == facts.planes);
+      CHECK(copy_facts.planes + copy_facts.other_surfaces == facts.faces);
+      for (std::size_t f = 0; f < read.model.faces.size(); ++f) {
+        const auto& was = read.model.faces[f].elementary;
+        if (was && was->kind == clay::brep::ElementaryKind::Plane)
+          CHECK(again.model.faces[f].elementary == was);
+        else
+          CHECK(!again.model.faces[f].elementary);
+      }
     }
   }
 }

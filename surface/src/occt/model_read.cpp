@@ -70,12 +70,18 @@
 #include <Geom_BezierCurve.hxx>
 #include <Geom_BezierSurface.hxx>
 #include <Geom_Circle.hxx>
+#include <Geom_ConicalSurface.hxx>
+#include <Geom_CylindricalSurface.hxx>
+#include <Geom_ElementarySurface.hxx>
 #include <Geom_Ellipse.hxx>
 #include <Geom_Hyperbola.hxx>
 #include <Geom_OffsetCurve.hxx>
 #include <Geom_OffsetSurface.hxx>
 #include <Geom_Parabola.hxx>
+#include <Geom_Plane.hxx>
 #include <Geom_RectangularTrimmedSurface.hxx>
+#include <Geom_SphericalSurface.hxx>
+#include <Geom_ToroidalSurface.hxx>
 #include <Geom_TrimmedCurve.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
@@ -382,6 +388,68 @@ FaceConversion convert_face(const TopoDS_Face& face, double size, const std::str
   return c;
 }
 
+/// The analytic surface a face's (unwrapped, located) surface is, if it is one.
+std::optional<Elementary> elementary_of(const Handle(Geom_Surface) & s) {
+  const auto elementary = Handle(Geom_ElementarySurface)::DownCast(s);
+  if (elementary.IsNull()) return std::nullopt;
+  Elementary e;
+  const gp_Ax3& frame = elementary->Position();
+  auto vec = [](const auto& xyz) { return Eigen::Vector3d(xyz.X(), xyz.Y(), xyz.Z()); };
+  e.origin = vec(frame.Location());
+  e.x_axis = vec(frame.XDirection());
+  e.y_axis = vec(frame.YDirection());
+  e.z_axis = vec(frame.Direction());
+  if (!Handle(Geom_Plane)::DownCast(s).IsNull()) {
+    e.kind = ElementaryKind::Plane;
+  } else if (auto c = Handle(Geom_CylindricalSurface)::DownCast(s); !c.IsNull()) {
+    e.kind = ElementaryKind::Cylinder;
+    e.radius = c->Radius();
+  } else if (auto k = Handle(Geom_ConicalSurface)::DownCast(s); !k.IsNull()) {
+    e.kind = ElementaryKind::Cone;
+    e.radius = k->RefRadius();
+    e.semi_angle = k->SemiAngle();
+  } else if (auto b = Handle(Geom_SphericalSurface)::DownCast(s); !b.IsNull()) {
+    e.kind = ElementaryKind::Sphere;
+    e.radius = b->Radius();
+  } else if (auto t = Handle(Geom_ToroidalSurface)::DownCast(s); !t.IsNull()) {
+    e.kind = ElementaryKind::Torus;
+    e.radius = t->MajorRadius();
+    e.minor_radius = t->MinorRadius();
+  } else {
+    return std::nullopt;
+  }
+  return e;
+}
+
+/// A plane face's NURBS: the plane, in its own parameters, over the box of its pcurves' control
+/// points (which holds the pcurves), widened a little. Not over BRepTools::UVBounds: that box
+/// depends on how the file gave the pcurves (a circle, or the rational B-spline we write for it),
+/// and a written plane must read back as the same NURBS bit for bit.
+surface::BSplineSurface plane_over_pcurves(const Elementary& e, const std::vector<Loop>& loops) {
+  double u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
+  for (const Loop& loop : loops)
+    for (const Coedge& c : loop.coedges)
+      for (Eigen::Index r = 0; r < c.pcurve.points.rows(); ++r) {
+        u0 = std::min(u0, c.pcurve.points(r, 0));
+        u1 = std::max(u1, c.pcurve.points(r, 0));
+        v0 = std::min(v0, c.pcurve.points(r, 1));
+        v1 = std::max(v1, c.pcurve.points(r, 1));
+      }
+  // Widened by 1e-9 of its size: a pcurve evaluates to rounding outside its control points' box.
+  const double du = 1e-9 * (u1 - u0 + std::abs(u0) + std::abs(u1)),
+               dv = 1e-9 * (v1 - v0 + std::abs(v0) + std::abs(v1));
+  u0 -= du;
+  u1 += du;
+  v0 -= dv;
+  v1 += dv;
+  surface::Points3 corners(4, 3);
+  int row = 0;
+  for (double u : {u0, u1})
+    for (double v : {v0, v1}) corners.row(row++) = point(e, u, v).transpose();
+  return surface::make_surface(surface::BSplineBasis{1, {u0, u0, u1, u1}},
+                               surface::BSplineBasis{1, {v0, v0, v1, v1}}, std::move(corners));
+}
+
 // ---- converted edges ------------------------------------------------------------------------
 
 struct EdgeConversion {
@@ -475,7 +543,8 @@ surface::BSplineCurve checked_curve(Handle(Geom_BSplineCurve) b, const std::stri
   return surface::occt::from_occt(b, name);
 }
 
-/// Our pcurve (points (u, v, 0)) of a 2D OCCT B-spline, unperiodized exactly when periodic.
+/// Our pcurve (points (u, v, 0)) of a 2D OCCT B-spline, unperiodized exactly when periodic, and
+/// closed exactly when it closes to rounding.
 surface::BSplineCurve pcurve_of(const Handle(Geom2d_BSplineCurve) & b, const std::string& name) {
   const int n = b->NbPoles();
   TColgp_Array1OfPnt poles(1, n);
@@ -492,6 +561,11 @@ surface::BSplineCurve pcurve_of(const Handle(Geom2d_BSplineCurve) & b, const std
   } else {
     c = new Geom_BSplineCurve(poles, knots, mults, b->Degree(), b->IsPeriodic());
   }
+  // A converted full circle ends where it starts only to rounding; OpenCASCADE's readers close
+  // it exactly (a pcurve on a plane, rebuilt from its edge), so close it here too.
+  Bnd_Box extent;
+  for (int i = 1; i <= n; ++i) extent.Add(poles.Value(i));
+  if (!c->IsPeriodic()) close_exactly(c, std::sqrt(extent.SquareExtent()));
   return checked_curve(c, name);
 }
 
@@ -1137,6 +1211,9 @@ class ModelBuilder {
       }
       if (!loop.coedges.empty()) out.loops.push_back(std::move(loop));
     }
+    out.elementary = elementary_of(conversion.old_surface);
+    if (out.elementary && out.elementary->kind == ElementaryKind::Plane && !out.loops.empty())
+      out.surface = plane_over_pcurves(*out.elementary, out.loops);
     model_.faces.push_back(std::move(out));
     return index;
   }
@@ -1292,6 +1369,16 @@ std::string serialize(const ImportedModel& x) {
     }
     put_string(out, f.name);
     put_colour(out, f.colour);
+    put(out, static_cast<std::int8_t>(f.elementary.has_value()));
+    if (f.elementary) {
+      const Elementary& e = *f.elementary;
+      put(out, static_cast<std::int32_t>(e.kind));
+      for (const Eigen::Vector3d* v : {&e.origin, &e.x_axis, &e.y_axis, &e.z_axis})
+        put_doubles(out, v->data(), 3);
+      put(out, e.radius);
+      put(out, e.minor_radius);
+      put(out, e.semi_angle);
+    }
   }
   put(out, static_cast<std::uint64_t>(m.bodies.size()));
   for (const Body& b : m.bodies) {
@@ -1370,6 +1457,18 @@ ImportedModel deserialize(const std::string& bytes) {
     }
     f.name = take_string(in);
     f.colour = take_colour(in);
+    if (in.take<std::int8_t>()) {
+      Elementary e;
+      e.kind = static_cast<ElementaryKind>(in.take<std::int32_t>());
+      for (Eigen::Vector3d* v : {&e.origin, &e.x_axis, &e.y_axis, &e.z_axis}) {
+        const std::vector<double> xyz = in.doubles();
+        if (xyz.size() == 3) *v = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+      }
+      e.radius = in.take<double>();
+      e.minor_radius = in.take<double>();
+      e.semi_angle = in.take<double>();
+      f.elementary = e;
+    }
   }
   m.bodies.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
   for (Body& b : m.bodies) {

@@ -5,6 +5,8 @@
 // 3D curve and pcurve is copied through the bit-exact adapter (convert.hpp), edges are created
 // once and shared by their faces, ranges and tolerances are the model's, and the edges are
 // declared same-parameter and same-range (brep::problems has checked it by sampling before).
+// A face read as a plane is written as a plane (Face::elementary): the only surface rebuilt
+// rather than copied, from its frame, which the file stores as it is.
 #include <clay/brep/exchange.hpp>
 #include <clay/brep/volume.hpp>
 
@@ -26,6 +28,7 @@
 #include <BRep_Tool.hxx>
 #include <GProp_GProps.hxx>
 #include <Geom2d_BSplineCurve.hxx>
+#include <Geom_Plane.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Writer.hxx>
 #include <IGESControl_Controller.hxx>
@@ -98,6 +101,22 @@ Handle(Geom2d_BSplineCurve) pcurve_to_occt(const surface::BSplineCurve& c) {
   return new Geom2d_BSplineCurve(poles, weights, knots, mults, c.basis.degree);
 }
 
+/// A face's surface for the file: a plane as a plane (its NURBS has the plane's parameters, so the
+/// pcurves serve both, and the reader rebuilds the same NURBS from them), anything else as its
+/// NURBS. Cylinders, cones, spheres and tori are written as NURBS: their NURBS parameter is not
+/// the angle, and an angle-space pcurve of the same edge parameter is not a B-spline.
+Handle(Geom_Surface) surface_to_occt(const Face& face, const std::string& name) {
+  if (face.elementary && face.elementary->kind == ElementaryKind::Plane && !face.loops.empty()) {
+    const Elementary& e = *face.elementary;
+    auto pnt = [](const Eigen::Vector3d& p) { return gp_Pnt(p.x(), p.y(), p.z()); };
+    auto dir = [](const Eigen::Vector3d& d) { return gp_Dir(d.x(), d.y(), d.z()); };
+    gp_Ax3 frame(pnt(e.origin), dir(e.z_axis), dir(e.x_axis));
+    if (e.y_axis.dot(e.z_axis.cross(e.x_axis)) < 0) frame.YReverse();  // a left-handed frame
+    return new Geom_Plane(frame);
+  }
+  return surface::occt::to_occt(face.surface, name);
+}
+
 /// The OCCT shapes of a model: vertices, edges and faces shared as in the model, one shape per
 /// body (a solid, a shell or a compound of shells, a compound of loose faces).
 struct Shapes {
@@ -139,7 +158,7 @@ Shapes build_shapes(const Model& m) {
       for (const Coedge& c : loop.coedges)
         tolerance = std::min(tolerance, m.edges[static_cast<std::size_t>(c.edge)].tolerance_mm);
     TopoDS_Face out;
-    b.MakeFace(out, surface::occt::to_occt(face.surface, "face " + std::to_string(f)), tolerance);
+    b.MakeFace(out, surface_to_occt(face, "face " + std::to_string(f)), tolerance);
     // Pcurves per edge and sense: a seam (one edge used both ways by the face) needs both at once.
     std::map<int, std::array<Handle(Geom2d_BSplineCurve), 2>> pcurves;
     for (const Loop& loop : face.loops)

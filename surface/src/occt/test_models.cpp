@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include <BRepAdaptor_Surface.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_GTransform.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
@@ -298,6 +299,29 @@ ShapeFacts facts_of_file(const fs::path& file) {
     facts.volume += props.Mass();
   }
   facts.valid = BRepCheck_Analyzer(shape).IsValid();
+  TopTools_IndexedMapOfShape faces;
+  TopExp::MapShapes(shape, TopAbs_FACE, faces);
+  for (int i = 1; i <= faces.Extent(); ++i) {
+    switch (BRepAdaptor_Surface(TopoDS::Face(faces(i)), false).GetType()) {
+      case GeomAbs_Plane:
+        ++facts.planes;
+        break;
+      case GeomAbs_Cylinder:
+        ++facts.cylinders;
+        break;
+      case GeomAbs_Cone:
+        ++facts.cones;
+        break;
+      case GeomAbs_Sphere:
+        ++facts.spheres;
+        break;
+      case GeomAbs_Torus:
+        ++facts.tori;
+        break;
+      default:
+        ++facts.other_surfaces;
+    }
+  }
   return facts;
 }
 

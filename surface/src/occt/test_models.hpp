@@ -34,6 +34,8 @@ struct ShapeFacts {
   int solids = 0, shells = 0, faces = 0, edges = 0, vertices = 0;
   double volume = 0;   ///< BRepGProp::VolumeProperties with Eps 1e-9 (0 without solids)
   bool valid = false;  ///< BRepCheck_Analyzer
+  /// Faces per surface type (BRepAdaptor_Surface::GetType), distinct faces.
+  int planes = 0, cylinders = 0, cones = 0, spheres = 0, tori = 0, other_surfaces = 0;
 };
 
 /// OpenCASCADE's counts (distinct sub-shapes), volume and validity of the shapes in `file`.

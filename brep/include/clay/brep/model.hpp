@@ -70,9 +70,42 @@ struct Loop {
   std::vector<Coedge> coedges;
 };
 
+/// The kinds of analytic surface a face can be read as and written back as.
+enum class ElementaryKind { Plane, Cylinder, Cone, Sphere, Torus };
+
+/// An analytic surface in OpenCASCADE's (and STEP's) parametrization, in a frame whose axes are
+/// orthonormal; y is ±(z × x), so a left-handed frame is kept as it came. With
+/// e(u) = cos u x + sin u y:
+/// - plane:    origin + u x + v y;
+/// - cylinder: origin + radius e(u) + v z;
+/// - cone:     origin + (radius + v sin semi_angle) e(u) + v cos semi_angle z;
+/// - sphere:   origin + radius (cos v e(u) + sin v z);
+/// - torus:    origin + (radius + minor_radius cos v) e(u) + minor_radius sin v z.
+struct Elementary {
+  ElementaryKind kind = ElementaryKind::Plane;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x_axis = Eigen::Vector3d::UnitX(), y_axis = Eigen::Vector3d::UnitY(),
+                  z_axis = Eigen::Vector3d::UnitZ();
+  double radius = 0;        ///< cylinder, cone (at v = 0), sphere; a torus's major radius
+  double minor_radius = 0;  ///< torus
+  double semi_angle = 0;    ///< cone, in radians, in (-pi/2, pi/2) and not 0
+  friend bool operator==(const Elementary&, const Elementary&) = default;
+};
+
+/// The point of `e` at (u, v), by the formulas of Elementary.
+CLAY_BREP_API Eigen::Vector3d point(const Elementary& e, double u, double v);
+
+/// The distance from `p` to the whole (unbounded) surface `e`, in closed form.
+CLAY_BREP_API double distance(const Elementary& e, const Eigen::Vector3d& p);
+
 /// A bounded piece of a NURBS surface.
 struct Face {
   surface::BSplineSurface surface;
+  /// The analytic surface `surface` represents exactly, when the face was read as one: kept by
+  /// every operation that leaves the face's geometry as it is (flattened, an untouched face of
+  /// deform_model), dropped by any that changes it. For a plane, `surface` has the plane's own
+  /// parameters, so the pcurves serve both and write_model writes the face as a plane.
+  std::optional<Elementary> elementary;
   bool reversed = false;    ///< outward side is -(S_u × S_v)
   std::vector<Loop> loops;  ///< loops[0] the outer loop, the others holes; empty: untrimmed
   std::string name;         ///< "" when unnamed
@@ -180,6 +213,9 @@ CLAY_BREP_API Model flattened(const Model& model);
 
 /// Throws clay::Error(InvalidGeometry) listing problems(model) when there are any.
 CLAY_BREP_API void validate(const Model& model);
+
+/// The name of an elementary kind: "plane", "cylinder", "cone", "sphere", "torus".
+CLAY_BREP_API std::string_view to_string(ElementaryKind kind) noexcept;
 
 /// The name of a body kind: "solid", "shell", "sheet".
 CLAY_BREP_API std::string_view to_string(BodyKind kind) noexcept;

@@ -9,7 +9,8 @@
 /// S(pcurve(t)) = C(t). Vertices are mapped by the stack's pointwise deformation.
 /// - A face whose control points all lie on the outer side of one face of every enabled
 ///   lattice's box, or whose lattices are undisplaced, is untouched: kept bit for bit (the FFD
-///   is the identity outside its lattice). So are the edges and vertices only untouched faces use.
+///   is the identity outside its lattice), and keeps its type (Face::elementary: a plane is still
+///   written as a plane). So are the edges and vertices only untouched faces use.
 /// - Where exact composition is impossible (a face crossing a lattice's boundary or a knot plane
 ///   off its iso-lines, twist, bend, extended lattices, a degree above max_degree), the face and
 ///   its edges are refitted on the same (u, v) and t with a certified bound when
