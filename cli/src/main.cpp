@@ -159,14 +159,17 @@ int info(const fs::path& file) {
     const auto& face = m.faces[k];
     const BSplineSurface& s = face.surface;
     const auto [lo, hi] = control_box(s);
-    std::printf("  #%zu degree (%d, %d), %d x %d control points, %s%s%s, %s\n", k, s.u.degree,
-                s.v.degree, s.count_u(), s.count_v(), s.is_rational() ? "rational" : "polynomial",
-                quoted_name(face.name).c_str(), colour_text(face.colour).c_str(),
-                face.loops.empty()       ? "untrimmed"
-                : face.loops.size() == 1 ? "trimmed"
-                                         : ("trimmed, " + std::to_string(face.loops.size() - 1) +
-                                            " hole" + (face.loops.size() == 2 ? "" : "s"))
-                                               .c_str());
+    std::printf(
+        "  #%zu %sdegree (%d, %d), %d x %d control points, %s%s%s, %s\n", k,
+        face.elementary ? (std::string(to_string(face.elementary->kind)) + ", ").c_str() : "",
+        s.u.degree, s.v.degree, s.count_u(), s.count_v(),
+        s.is_rational() ? "rational" : "polynomial", quoted_name(face.name).c_str(),
+        colour_text(face.colour).c_str(),
+        face.loops.empty()       ? "untrimmed"
+        : face.loops.size() == 1 ? "trimmed"
+                                 : ("trimmed, " + std::to_string(face.loops.size() - 1) + " hole" +
+                                    (face.loops.size() == 2 ? "" : "s"))
+                                       .c_str());
     std::printf("     u knots %s\n     v knots %s\n", knots_summary(s.u).c_str(),
                 knots_summary(s.v).c_str());
     std::printf("     control box [%.6g, %.6g, %.6g] .. [%.6g, %.6g, %.6g] mm\n", lo.x(), lo.y(),
