@@ -20,6 +20,7 @@
 #include <string>
 
 #include "occt/convert.hpp"
+#include "occt/model_shapes.hpp"
 #include "occt/session.hpp"
 
 #include <BRepCheck_Analyzer.hxx>
@@ -117,14 +118,7 @@ Handle(Geom_Surface) surface_to_occt(const Face& face, const std::string& name) 
   return surface::occt::to_occt(face.surface, name);
 }
 
-/// The OCCT shapes of a model: vertices, edges and faces shared as in the model, one shape per
-/// body (a solid, a shell or a compound of shells, a compound of loose faces).
-struct Shapes {
-  std::vector<TopoDS_Vertex> vertices;
-  std::vector<TopoDS_Edge> edges;
-  std::vector<TopoDS_Face> faces;  // forward
-  std::vector<TopoDS_Shape> bodies;
-};
+}  // namespace
 
 Shapes build_shapes(const Model& m) {
   validate(m);
@@ -236,6 +230,8 @@ Shapes build_shapes(const Model& m) {
   }
   return s;
 }
+
+namespace {
 
 /// BRepCheck of every body, and the volume of the solids (each instance once).
 ModelCheck check_shapes(const Model& m, const Shapes& s) {
@@ -403,6 +399,12 @@ class DocumentWriter {
 
 }  // namespace
 
+void fill_document(const Model& m, const Shapes& s, const Handle(TDocStd_Document) & document) {
+  DocumentWriter(m, s, XCAFDoc_DocumentTool::ShapeTool(document->Main()),
+                 XCAFDoc_DocumentTool::ColorTool(document->Main()))
+      .fill();
+}
+
 std::string ModelCheck::brief() const {
   if (!checked) return "not checked";
   char text[96] = "";
@@ -424,10 +426,12 @@ ModelCheck write_model(const Model& model, const fs::path& file, const ModelWrit
   constexpr std::string_view caller = "write_model";
   const bool step = extension_is(file, {".step", ".stp"});
   const bool iges = extension_is(file, {".iges", ".igs"});
-  if (!step && !iges)
+  const bool glb = extension_is(file, {".glb"});
+  if (!step && !iges && !glb)
     throw Error(ErrorCategory::InvalidArgument,
                 "write_model: " + quoted(file) +
-                    " has an unknown extension; name a .step, .stp, .iges or .igs file");
+                    " has an unknown extension; name a .step, .stp, .iges, .igs or .glb file");
+  if (glb) options.mesh.validate();
   surface::occt::check_target(file, caller);
   // OpenCASCADE's IGES translator has no assemblies: each placed instance becomes a body.
   const Model flat = iges && model.is_assembly() ? flattened(model) : Model();
@@ -442,10 +446,10 @@ ModelCheck write_model(const Model& model, const fs::path& file, const ModelWrit
       check.checked = false;
     Handle(TDocStd_Document) document;
     XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
-    DocumentWriter(m, shapes, XCAFDoc_DocumentTool::ShapeTool(document->Main()),
-                   XCAFDoc_DocumentTool::ColorTool(document->Main()))
-        .fill();
-    if (step) {
+    fill_document(m, shapes, document);
+    if (glb) {
+      write_glb(m, shapes, file, options.mesh, document);
+    } else if (step) {
       // Settings go after Init() and before the writer is constructed (OCCT-NOTES).
       STEPCAFControl_Controller::Init();
       surface::occt::set_static("write.step.schema", options.schema == surface::StepSchema::AP242

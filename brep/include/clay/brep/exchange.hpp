@@ -18,7 +18,11 @@
 #include <clay/surface/exchange.hpp>
 #include <clay/surface/exchange_export.hpp>
 
+#include <Eigen/Core>
+
+#include <array>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -90,9 +94,48 @@ struct ImportedModel {
 CLAY_OCCT_API ImportedModel read_model(const std::filesystem::path& file,
                                        const ModelReadOptions& options = {});
 
+/// How finely tessellate() and a .glb preview mesh a model's faces. Checked by validate().
+struct CLAY_OCCT_API MeshOptions {
+  /// The largest distance from a triangle to its face OpenCASCADE's mesher aims at, as a fraction
+  /// of the model's size (the diagonal of the box of its control points), in [1e-6, 0.1].
+  double relative_deflection = 5e-4;
+  /// The largest angle, in radians, between the normals at a triangle's corners on a curved face,
+  /// in [0.01, 1].
+  double angular_deflection_rad = 0.35;
+
+  /// Every bad field, naming it, its value and the range; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems().
+  void validate() const;
+};
+
+/// Triangles of a model's trimmed faces: holes are holes. Faces are those of flattened(model)
+/// (the model's own when it has no assembly), in world coordinates.
+struct ModelMesh {
+  std::vector<Eigen::Vector3d> positions;     ///< nodes, mm
+  std::vector<Eigen::Vector3d> normals;       ///< unit outward normal at each node
+  std::vector<std::array<int, 3>> triangles;  ///< node indices, counter-clockwise from outside
+  std::vector<int> triangle_face;             ///< the face each triangle lies on
+  std::vector<int> face_body;                 ///< the body of each face (-1: in no body)
+  /// The colour of each face: its own, else its body's; nullopt when neither has one.
+  std::vector<std::optional<Colour>> face_colours;
+  /// The largest distance from a triangle's centroid to its face (the NURBS at the mean of the
+  /// corners' (u, v)), measured over every triangle: how far the mesh strays from the model.
+  double max_deflection_mm = 0;
+};
+
+/// Meshes every face of `model` within its loops by OpenCASCADE's mesher (BRepMesh_Incremental
+/// Mesh) on the shapes check_model builds, shared edges discretized once, so neighbouring faces
+/// meet without cracks. Normals are the faces' exact normals (S_u × S_v of the NURBS at each
+/// node's (u, v), turned for reversed faces; at a pole, the mean of the triangles around it).
+/// Throws clay::Error as check_model, InvalidArgument for bad options, Exchange naming the face
+/// when the mesher leaves a face without triangles.
+CLAY_OCCT_API ModelMesh tessellate(const Model& model, const MeshOptions& options = {});
+
 /// Settings of write_model.
 struct ModelWriteOptions {
   surface::StepSchema schema = surface::StepSchema::AP214;  ///< STEP only
+  MeshOptions mesh;  ///< .glb only: how finely the faces are meshed
   /// Run check_model's BRepCheck and volumes on the shapes written (about half the time of a
   /// write of a 200-face solid); false: the returned check says it was not run.
   bool check = true;
@@ -120,11 +163,13 @@ struct CLAY_OCCT_API ModelCheck {
 /// breaks an invariant, DegreeLimit above degree 25.
 CLAY_OCCT_API ModelCheck check_model(const Model& model);
 
-/// Writes `model` as STEP (.step, .stp: AP214 or AP242) or IGES 5.3 (.iges, .igs: solids and
+/// Writes `model` as STEP (.step, .stp: AP214 or AP242), IGES 5.3 (.iges, .igs: solids and
 /// shells as 186/514 B-rep entities when the model has a solid, otherwise trimmed surfaces 144),
 /// chosen by the extension, with the names, colours and assembly tree (IGES: OpenCASCADE's
 /// translator has no assemblies, so an assembly is written flattened(), each placed instance a
-/// named, coloured body). Lossless: 17 significant
+/// named, coloured body), or a binary glTF preview (.glb: the faces meshed as by tessellate(),
+/// holes are holes, with the names, colours and assembly tree; in metres, y up, as glTF wants).
+/// STEP and IGES are lossless: 17 significant
 /// digits, so read_model gives the same surfaces, curves and pcurves bit for bit. Atomic: written
 /// to a temporary file and renamed, nothing is left behind on failure. Throws clay::Error as
 /// check_model, Io when the file cannot be written, InvalidArgument for an unknown extension,
