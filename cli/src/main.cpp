@@ -65,23 +65,9 @@ std::string knots_summary(const BSplineBasis& b) {
   return out;
 }
 
-/// The surfaces of a STEP or IGES file, chosen by its extension. Read in a child process
+/// The whole model of a STEP or IGES file (brep::read_model), read in a child process
 /// (ReadOptions::isolate): a file that crashes or hangs OpenCASCADE ends in exit code 6 and a
 /// message, never in a signal.
-std::vector<BSplineSurface> read_surfaces(const fs::path& file, const char* command) {
-  std::string ext = file.extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  ReadOptions guard;
-  guard.isolate = true;
-  if (ext == ".step" || ext == ".stp") return read_step(file, guard);
-  if (ext == ".igs" || ext == ".iges") return read_iges(file, guard);
-  throw clay::Error(clay::ErrorCategory::InvalidArgument,
-                    std::string(command) + ": '" + file.string() + "' has extension '" + ext +
-                        "'; give a .step/.stp or .igs/.iges file");
-}
-
-/// The whole model of a STEP or IGES file (brep::read_model), read in a child process like
-/// read_surfaces.
 clay::brep::ImportedModel read_model_file(const fs::path& file, const char* command) {
   std::string ext = file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -301,17 +287,23 @@ int validate(const fs::path& file) {
 
 // ---- clayform render (clay/render/render.hpp) ----
 
-/// `clayform render FILE --png OUT.png`: a picture of the surfaces of a STEP or IGES file.
+/// `clayform render FILE --png OUT.png`: a picture of the model of a STEP or IGES file, its faces
+/// trimmed (holes are holes), coloured as the file colours them.
 int render_picture(const fs::path& file, const fs::path& png,
                    const clay::render::RenderOptions& options) {
-  const std::vector<BSplineSurface> surfaces = read_surfaces(file, "render");
+  const clay::brep::ImportedModel read = read_model_file(file, "render");
   const auto start = std::chrono::steady_clock::now();
-  const clay::render::Image image = clay::render::render(surfaces, options);
+  const clay::brep::ModelMesh mesh = clay::brep::tessellate(read.model);
+  std::vector<BSplineSurface> nets;
+  if (options.control_net)
+    for (const auto& face : clay::brep::flattened(read.model).faces) nets.push_back(face.surface);
+  const clay::render::Image image = clay::render::render_mesh(mesh, options, nets);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   clay::render::write_png(image, png);
-  std::printf("%s: %zu surface(s) -> %s (%d x %d, %.0f ms)\n", file.string().c_str(),
-              surfaces.size(), png.string().c_str(), image.width, image.height, ms);
+  std::printf("%s: %zu face(s), %zu triangles -> %s (%d x %d, %.0f ms)\n", file.string().c_str(),
+              read.model.faces.size(), mesh.triangles.size(), png.string().c_str(), image.width,
+              image.height, ms);
   return 0;
 }
 

@@ -1,4 +1,5 @@
 // Software rendering of surfaces into an RGB picture and a PNG writer (clay/render/render.hpp).
+#include <clay/brep/exchange.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/checks.hpp>
 #include <clay/render/render.hpp>
@@ -190,13 +191,19 @@ Rgb Image::pixel(int x, int y) const noexcept {
   return {rgb[k], rgb[k + 1], rgb[k + 2]};
 }
 
-Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderOptions& options) {
-  options.validate();
-  if (surfaces.empty())
-    throw Error(ErrorCategory::InvalidArgument, "render: no surfaces; give at least one");
-  for (size_t k = 0; k < surfaces.size(); ++k)
-    surface::validate(surfaces[k], "render: surface #" + std::to_string(k));
+namespace {
 
+/// Triangles to draw: points, unit normals at them, and a base colour per triangle.
+struct Batch {
+  std::vector<Vector3d> points, normals;
+  std::vector<std::array<int, 3>> triangles;
+  std::vector<Rgb> colours;
+};
+
+/// The picture of `batches` (and of the control nets of `nets` when asked): the camera fitted to
+/// everything drawn, z-buffered Phong shading, supersamples averaged.
+Image draw(const std::vector<Batch>& batches, const std::vector<surface::BSplineSurface>& nets,
+           const RenderOptions& options) {
   const int f = options.supersample ? 2 : 1;
   Canvas cv{f * options.width,
             f * options.height,
@@ -210,23 +217,19 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
             1,
             {},
             {}};
-  std::vector<Mesh> meshes;
-  for (const auto& s : surfaces)
-    meshes.push_back(tessellate_for_render(s, options.samples_per_span));
 
   // Fit: the box of everything drawn, in camera coordinates.
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  auto grow = [&](const surface::Points3& pts) {
-    for (Eigen::Index i = 0; i < pts.rows(); ++i) {
-      const Vector3d p = pts.row(i).transpose();
-      const Vector3d q{p.dot(cv.cam.right), p.dot(cv.cam.up), p.dot(cv.cam.eye)};
-      lo = lo.cwiseMin(q);
-      hi = hi.cwiseMax(q);
-    }
+  auto grow = [&](const Vector3d& p) {
+    const Vector3d q{p.dot(cv.cam.right), p.dot(cv.cam.up), p.dot(cv.cam.eye)};
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
   };
-  for (const auto& m : meshes) grow(m.grid.positions);
+  for (const Batch& b : batches)
+    for (const Vector3d& p : b.points) grow(p);
   if (options.control_net)
-    for (const auto& s : surfaces) grow(s.points);
+    for (const auto& s : nets)
+      for (Eigen::Index i = 0; i < s.points.rows(); ++i) grow(s.points.row(i).transpose());
   const Vector3d extent = hi - lo;
   const double room = 1 - 2 * options.margin;
   const double sx =
@@ -248,26 +251,20 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
     std::copy(options.background.begin(), options.background.end(),
               cv.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(k));
 
-  for (size_t k = 0; k < meshes.size(); ++k) {
-    const Mesh& m = meshes[k];
-    const Rgb base =
-        options.colours.empty() ? palette(k) : options.colours[k % options.colours.size()];
-    std::vector<Vector3d> screen(m.normals.size());
-    for (int i = 0; i < m.nu(); ++i)
-      for (int j = 0; j < m.nv(); ++j)
-        screen[static_cast<size_t>(i * m.nv() + j)] = cv.project(m.point(i, j));
-    for (int i = 0; i + 1 < m.nu(); ++i)
-      for (int j = 0; j + 1 < m.nv(); ++j) {
-        const size_t a = static_cast<size_t>(i * m.nv() + j), b = a + static_cast<size_t>(m.nv()),
-                     c = b + 1, d = a + 1;
-        cv.triangle(screen[a], screen[b], screen[c], m.normals[a], m.normals[b], m.normals[c],
-                    base);
-        cv.triangle(screen[a], screen[c], screen[d], m.normals[a], m.normals[c], m.normals[d],
-                    base);
-      }
+  for (const Batch& b : batches) {
+    std::vector<Vector3d> screen;
+    screen.reserve(b.points.size());
+    for (const Vector3d& p : b.points) screen.push_back(cv.project(p));
+    for (size_t k = 0; k < b.triangles.size(); ++k) {
+      const auto [i, j, l] = b.triangles[k];
+      cv.triangle(screen[static_cast<size_t>(i)], screen[static_cast<size_t>(j)],
+                  screen[static_cast<size_t>(l)], b.normals[static_cast<size_t>(i)],
+                  b.normals[static_cast<size_t>(j)], b.normals[static_cast<size_t>(l)],
+                  b.colours[k]);
+    }
   }
   if (options.control_net)
-    for (const auto& s : surfaces) {
+    for (const auto& s : nets) {
       auto at = [&](int i, int j) { return cv.project(s.points.row(s.index(i, j)).transpose()); };
       for (int i = 0; i < s.count_u(); ++i)
         for (int j = 0; j < s.count_v(); ++j) {
@@ -295,6 +292,79 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
                   static_cast<size_t>(c)] = static_cast<std::uint8_t>((sum + f * f / 2) / (f * f));
       }
   return image;
+}
+
+Rgb byte_colour(const brep::Colour& c) {
+  auto byte = [](double x) {
+    return static_cast<std::uint8_t>(std::lround(255 * std::clamp(x, 0.0, 1.0)));
+  };
+  return {byte(c.r), byte(c.g), byte(c.b)};
+}
+
+}  // namespace
+
+Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderOptions& options) {
+  options.validate();
+  if (surfaces.empty())
+    throw Error(ErrorCategory::InvalidArgument, "render: no surfaces; give at least one");
+  for (size_t k = 0; k < surfaces.size(); ++k)
+    surface::validate(surfaces[k], "render: surface #" + std::to_string(k));
+  std::vector<Batch> batches;
+  for (size_t k = 0; k < surfaces.size(); ++k) {
+    const Mesh m = tessellate_for_render(surfaces[k], options.samples_per_span);
+    const Rgb base =
+        options.colours.empty() ? palette(k) : options.colours[k % options.colours.size()];
+    Batch& b = batches.emplace_back();
+    for (int i = 0; i < m.nu(); ++i)
+      for (int j = 0; j < m.nv(); ++j) b.points.push_back(m.point(i, j));
+    b.normals = m.normals;
+    for (int i = 0; i + 1 < m.nu(); ++i)
+      for (int j = 0; j + 1 < m.nv(); ++j) {
+        const int a = i * m.nv() + j, c = a + m.nv() + 1, d = a + 1;
+        b.triangles.push_back({a, a + m.nv(), c});
+        b.triangles.push_back({a, c, d});
+      }
+    b.colours.assign(b.triangles.size(), base);
+  }
+  return draw(batches, surfaces, options);
+}
+
+Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options,
+                  const std::vector<surface::BSplineSurface>& control_nets) {
+  options.validate();
+  if (mesh.triangles.empty())
+    throw Error(ErrorCategory::InvalidArgument, "render: the mesh has no triangles");
+  const size_t nodes = mesh.positions.size();
+  if (mesh.normals.size() != nodes || mesh.triangle_face.size() != mesh.triangles.size() ||
+      mesh.face_body.size() != mesh.face_colours.size())
+    throw Error(ErrorCategory::InvalidArgument,
+                "render: the mesh's arrays disagree in size (" + std::to_string(nodes) +
+                    " positions, " + std::to_string(mesh.normals.size()) + " normals, " +
+                    std::to_string(mesh.triangles.size()) + " triangles, " +
+                    std::to_string(mesh.triangle_face.size()) +
+                    " triangle faces); give a mesh from brep::tessellate");
+  Batch b;
+  b.points = mesh.positions;
+  b.normals = mesh.normals;
+  b.triangles = mesh.triangles;
+  for (size_t k = 0; k < mesh.triangles.size(); ++k) {
+    for (int corner : mesh.triangles[k])
+      if (corner < 0 || static_cast<size_t>(corner) >= nodes)
+        throw Error(ErrorCategory::InvalidArgument,
+                    "render: triangle " + std::to_string(k) + " refers to node " +
+                        std::to_string(corner) + " of " + std::to_string(nodes));
+    const int f = mesh.triangle_face[k];
+    if (f < 0 || static_cast<size_t>(f) >= mesh.face_colours.size())
+      throw Error(ErrorCategory::InvalidArgument, "render: triangle " + std::to_string(k) +
+                                                      " lies on face " + std::to_string(f) +
+                                                      ", which the mesh has no colour entry for");
+    const auto& own = mesh.face_colours[static_cast<size_t>(f)];
+    const size_t body = static_cast<size_t>(std::max(0, mesh.face_body[static_cast<size_t>(f)]));
+    b.colours.push_back(!options.colours.empty() ? options.colours[body % options.colours.size()]
+                        : own                    ? byte_colour(*own)
+                                                 : palette(body));
+  }
+  return draw({b}, control_nets, options);
 }
 
 void write_png(const Image& image, const fs::path& file) {

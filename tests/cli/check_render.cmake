@@ -1,4 +1,5 @@
-# Runs `clayform render` on example 01's STEP and IGES files and checks the pictures: exit 0, a PNG
+# Runs `clayform render` on example 01's STEP and IGES files (read as models, meshed by
+# brep::tessellate) and checks the pictures: exit 0, a PNG
 # signature and the requested size in the IHDR chunk; then the exit codes for a file of the wrong
 # kind (2, invalid argument) and a picture in a missing folder (5, i/o).
 foreach(file sample.step sample.igs)
@@ -6,7 +7,7 @@ foreach(file sample.step sample.igs)
   file(REMOVE ${png})
   execute_process(COMMAND ${CLAYFORM} render ${DIR}/${file} --png ${png} --width 320 --height 200 --net
     OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
-  if(NOT rc EQUAL 0 OR NOT out MATCHES "2 surface\\(s\\) -> .*\\(320 x 200, [0-9]+ ms\\)")
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "2 face\\(s\\), [0-9]+ triangles -> .*\\(320 x 200, [0-9]+ ms\\)")
     message(FATAL_ERROR "clayform render ${file} exited ${rc}: ${out}${err}")
   endif()
   if(NOT EXISTS ${png})

@@ -8,6 +8,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 
@@ -82,6 +83,54 @@ TEST_CASE("render: a plate facing the camera covers the rectangle of the orthogr
       CHECK(g > b);
       CHECK_THAT(r - g, Catch::Matchers::WithinAbs(2 * (g - b), 2.0));
     }
+}
+
+TEST_CASE("render_mesh: a trimmed plate's hole shows the background, in the face's colour",
+          "[render]") {
+  // The plate [0, 2] x [0, 1] with the hole [0.5, 1.5] x [0.25, 0.75], as four trapezoids of two
+  // triangles each; with top_view() x maps to columns 40 + 80 x and y to rows 90 - 80 y.
+  clay::brep::ModelMesh mesh;
+  const std::array<Eigen::Vector2d, 8> corners{
+      Eigen::Vector2d(0, 0),      Eigen::Vector2d(2, 0),      Eigen::Vector2d(2, 1),
+      Eigen::Vector2d(0, 1),      Eigen::Vector2d(0.5, 0.25), Eigen::Vector2d(1.5, 0.25),
+      Eigen::Vector2d(1.5, 0.75), Eigen::Vector2d(0.5, 0.75)};
+  for (const auto& c : corners) {
+    mesh.positions.emplace_back(c.x(), c.y(), 0);
+    mesh.normals.emplace_back(0, 0, 1);
+  }
+  for (int k = 0; k < 4; ++k) {
+    const int a = k, b = (k + 1) % 4, c = 4 + (k + 1) % 4, d = 4 + k;
+    mesh.triangles.push_back({a, b, c});
+    mesh.triangles.push_back({a, c, d});
+  }
+  mesh.triangle_face.assign(8, 0);
+  mesh.face_body = {0};
+  mesh.face_colours = {clay::brep::Colour{0.9, 0.1, 0.1}};
+  RenderOptions o = top_view();
+  o.background = {10, 20, 30};
+  const Image img = render_mesh(mesh, o);
+  CHECK(same(img.pixel(120, 50), o.background));  // the hole's centre (1, 0.5)
+  const Rgb frame = img.pixel(60, 50);            // (0.25, 0.5), on the plate
+  CHECK(!same(frame, o.background));
+  CHECK(frame[0] > 2 * frame[1]);  // red, the face's colour
+  CHECK(frame[1] == frame[2]);
+  for (int x = 82; x < 158; ++x)  // across the hole, away from its rims
+    CHECK(same(img.pixel(x, 50), o.background));
+  // Options' colours win over the model's.
+  o.colours = {{20, 200, 20}};
+  const Rgb green = render_mesh(mesh, o).pixel(60, 50);
+  CHECK(green[1] > 2 * green[0]);
+  // A mesh whose arrays disagree is refused.
+  clay::brep::ModelMesh broken = mesh;
+  broken.normals.pop_back();
+  auto [c1, m1] = error_of([&] { render_mesh(broken, o); });
+  CHECK(c1 == ErrorCategory::InvalidArgument);
+  CHECK_THAT(m1, Contains("the mesh's arrays disagree in size"));
+  broken = mesh;
+  broken.triangles[3][1] = 99;
+  auto [c2, m2] = error_of([&] { render_mesh(broken, o); });
+  CHECK(c2 == ErrorCategory::InvalidArgument);
+  CHECK_THAT(m2, Contains("triangle 3 refers to node 99 of 8"));
 }
 
 TEST_CASE("render: the whole model is visible, centred, and touches the margin on one axis",

@@ -1,7 +1,9 @@
 #pragma once
 /// Pictures of surfaces: a small software renderer (orthographic camera, z-buffer, Lambert and a
 /// soft specular highlight) and a PNG writer, for README figures and `clayform render`. No GPU,
-/// no window, no OpenCASCADE: the surfaces are tessellated with surface::evaluate_grid.
+/// no window, no OpenCASCADE: the surfaces are tessellated with surface::evaluate_grid, whole
+/// models by brep::tessellate.
+#include <clay/brep/exchange.hpp>
 #include <clay/render/export.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
@@ -76,6 +78,15 @@ struct CLAY_RENDER_API Image {
 /// invalid surface (surface::validate).
 CLAY_RENDER_API Image render(const std::vector<surface::BSplineSurface>& surfaces,
                              const RenderOptions& options = {});
+
+/// Pictures a whole model's mesh (brep::tessellate: trimmed faces, holes are holes) with the
+/// same camera, fit and shading as render(). Each triangle's base colour is
+/// options.colours[body % size] when colours are given, else its face's colour from the model
+/// (its own or its body's), else the palette's colour of its body. The control nets of
+/// `control_nets` are drawn over it when options.control_net is set. Throws clay::Error
+/// (InvalidArgument) for bad options or a mesh whose arrays disagree.
+CLAY_RENDER_API Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options = {},
+                                  const std::vector<surface::BSplineSurface>& control_nets = {});
 
 /// Writes `image` as an 8-bit RGB PNG (libpng), atomically: into a temporary file next to `file`,
 /// then renamed over it. Throws clay::Error: InvalidArgument when the image's size and pixel count
