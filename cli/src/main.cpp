@@ -290,10 +290,11 @@ int validate(const fs::path& file) {
 /// `clayform render FILE --png OUT.png`: a picture of the model of a STEP or IGES file, its faces
 /// trimmed (holes are holes), coloured as the file colours them.
 int render_picture(const fs::path& file, const fs::path& png,
-                   const clay::render::RenderOptions& options) {
+                   const clay::render::RenderOptions& options,
+                   const clay::brep::MeshOptions& mesh_options) {
   const clay::brep::ImportedModel read = read_model_file(file, "render");
   const auto start = std::chrono::steady_clock::now();
-  const clay::brep::ModelMesh mesh = clay::brep::tessellate(read.model);
+  const clay::brep::ModelMesh mesh = clay::brep::tessellate(read.model, mesh_options);
   std::vector<BSplineSurface> nets;
   if (options.control_net)
     for (const auto& face : clay::brep::flattened(read.model).faces) nets.push_back(face.surface);
@@ -353,8 +354,9 @@ int main(int argc, char** argv) {
   clay::render::RenderOptions render_options;
   auto* render_cmd = app.add_subcommand(
       "render",
-      "Write a PNG picture of the surfaces of a STEP or IGES file: orthographic view fitted "
-      "to the model, one hue per surface, shading with a soft highlight");
+      "Write a PNG picture of the model of a STEP or IGES file: trimmed faces (holes are "
+      "holes) in the file's colours, orthographic view fitted to the model, shading with a soft "
+      "highlight");
   render_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
   render_cmd->add_option("--png", png_file, "the picture to write (.png)")->required();
   render_cmd->add_option("--width", render_options.width, "picture width in pixels [16, 4096]")
@@ -365,9 +367,11 @@ int main(int argc, char** argv) {
       ->add_option("--eye", eye,
                    "direction from the model towards the eye, X Y Z (default -1 -1.2 0.9)")
       ->expected(3);
+  clay::brep::MeshOptions mesh_options;
   render_cmd
-      ->add_option("--samples", render_options.samples_per_span,
-                   "tessellation: samples per knot span [1, 64]")
+      ->add_option("--deflection", mesh_options.relative_deflection,
+                   "mesh: largest distance from a triangle to its face, as a fraction of the "
+                   "model's size [1e-6, 0.1]")
       ->capture_default_str();
   render_cmd->add_flag("--net", render_options.control_net, "draw the control nets");
   // clayform view / snapshot (clay/serve.hpp)
@@ -410,7 +414,7 @@ int main(int argc, char** argv) {
     if (*info_cmd) return info(file);
     if (*render_cmd) {
       if (!eye.empty()) render_options.eye_direction = {eye[0], eye[1], eye[2]};
-      return render_picture(file, png_file, render_options);
+      return render_picture(file, png_file, render_options, mesh_options);
     }
     if (*view_cmd) {
       clay::recipe::ServeOptions o;

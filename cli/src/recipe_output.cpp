@@ -271,9 +271,22 @@ std::vector<fs::path> write_model_outputs(const ModelRunResult& result, const fs
     Json exports = Json::array();
     const brep::Counts counts = brep::counts(result.model);
     for (const auto& format : result.formats) {
-      const std::string file = std::string(stem) + (format == "step" ? ".step" : ".igs");
+      const std::string file = std::string(stem) + (format == "step"   ? ".step"
+                                                    : format == "iges" ? ".igs"
+                                                                       : ".glb");
       brep::ModelWriteOptions o;
       o.schema = result.schema == "AP242" ? surface::StepSchema::AP242 : surface::StepSchema::AP214;
+      if (format == "glb") {  // a preview: the same shapes, meshed; nothing to read back
+        o.check = false;
+        brep::write_model(result.model, staging.tmp / file, o);
+        Json x = Json::object();
+        x["name"] = std::string(stem);
+        x["file"] = file;
+        x["preview"] = true;
+        exports.push_back(std::move(x));
+        names.push_back(file);
+        continue;
+      }
       const brep::ModelCheck written = brep::write_model(result.model, staging.tmp / file, o);
       // Read back as a CAD system would, and checked before anything moves into out_dir.
       const brep::ImportedModel back = brep::read_model(staging.tmp / file);

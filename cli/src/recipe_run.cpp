@@ -698,11 +698,8 @@ ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
   } catch (const Error& e) {
     throw Error(e.category(), def.path + ": " + recipe_wording(e.message()));
   }
-  result.formats =
-      d.exports.empty() ? std::vector<std::string>{"step", "iges"} : d.exports.front().formats;
-  result.formats.erase(std::remove(result.formats.begin(), result.formats.end(), "glb"),
-                       result.formats.end());
-  if (result.formats.empty()) result.formats = {"step"};
+  result.formats = d.exports.empty() ? std::vector<std::string>{"step", "iges", "glb"}
+                                     : d.exports.front().formats;
   result.schema = d.exports.empty() ? "AP214" : d.exports.front().schema;
   result.seconds = seconds_since(t0);
   return result;

@@ -1,6 +1,6 @@
 # `clayform deform` on example 01's STEP file (2 faces: a bicubic hood and a rational torus
 # patch) with the taper of tests/cli/recipes/flare.json: the whole model (faces, edges, vertices)
-# deformed exactly and written as STEP and IGES; and the --help of every command.
+# deformed exactly and written as STEP, IGES and a .glb preview; and the --help of every command.
 # Arguments: -DCLAYFORM=... -DDIR=<example 01 output> -DRECIPE=... -DWORK=...
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${CLAYFORM} deform ${DIR}/sample.step --recipe ${RECIPE} --out ${WORK}/out
@@ -22,7 +22,7 @@ foreach(expect "read [^\n]*sample.step: 2 bodies" "deformed by flare: 2 faces: 2
     message(FATAL_ERROR "clayform deform: expected '${expect}' in the progress lines:\n${out}")
   endif()
 endforeach()
-foreach(file sample.step sample.igs report.json)
+foreach(file sample.step sample.igs sample.glb report.json)
   if(NOT EXISTS ${WORK}/out/${file})
     message(FATAL_ERROR "clayform deform: ${file} missing in ${WORK}/out")
   endif()

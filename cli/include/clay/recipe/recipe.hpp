@@ -151,7 +151,7 @@ struct ModelRunResult {
   brep::Model model;        ///< the deformed model (flattened when it was an assembly)
   deform::ModelDeformationReport report;
   bool fold_free = true;             ///< every lattice step's Jacobian bounds are positive
-  std::vector<std::string> formats;  ///< "step", "iges": the recipe's first export's (glb aside)
+  std::vector<std::string> formats;  ///< the recipe's first export's (all three when none)
   std::string schema = "AP214";      ///< STEP schema
   double seconds = 0;                ///< wall time
 };
@@ -164,10 +164,11 @@ struct ModelRunResult {
 CLAY_RECIPE_API ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
                                             std::string_view deformation = {});
 
-/// Writes STEM.step and/or STEM.igs (result.formats) and report.json into `out_dir`, through a
-/// temporary folder as write_outputs does: each file is read back (read_model) and checked
-/// (BRepCheck, the same counts) before anything is moved into `out_dir`. Returns the paths
-/// written. Throws clay::Error (Io, Exchange) naming the file.
+/// Writes STEM.step, STEM.igs and STEM.glb (result.formats; the .glb a preview of the trimmed
+/// faces, brep::write_model) and report.json into `out_dir`, through a temporary folder as
+/// write_outputs does: each STEP and IGES file is read back (read_model) and checked (BRepCheck,
+/// the same counts) before anything is moved into `out_dir`. Returns the paths written. Throws
+/// clay::Error (Io, Exchange) naming the file.
 CLAY_RECIPE_API std::vector<std::filesystem::path> write_model_outputs(
     const ModelRunResult& result, const std::filesystem::path& out_dir, std::string_view stem);
 
