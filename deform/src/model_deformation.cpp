@@ -203,7 +203,9 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   brep::Model& m = result.model;
   m = brep::flattened(input);
   ModelDeformationReport& report = result.report;
-  report.volume_before_mm3 = brep::volume_mm3(m);
+  const std::vector<double> before = brep::body_volumes_mm3(m);
+  for (std::size_t b = 0; b < m.bodies.size(); ++b)
+    if (m.bodies[b].kind == brep::BodyKind::Solid) report.volume_before_mm3 += before[b];
   const double size = size_of(m);
 
   // Faces.
@@ -269,7 +271,9 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   // A deformation stretches the file's own gaps with the geometry: where an exact edge's gap now
   // exceeds its tolerance by no more than the stretch allows (10 x, or 1e-9 of the size), the
   // tolerance follows the measured gap, as OpenCASCADE's GTransform scales tolerances.
+  // The gaps measured once: widening tolerances and reversing faces below do not move them.
   for (const brep::EdgeGap& g : brep::edge_gaps(m)) {
+    report.max_edge_gap_mm = std::max(report.max_edge_gap_mm, g.gap_mm);
     brep::Edge& edge = m.edges[static_cast<std::size_t>(g.edge)];
     const double allowed = std::max(10 * edge.tolerance_mm, 1e-9 * size);
     if (g.gap_mm > edge.tolerance_mm && g.gap_mm <= allowed) {
@@ -280,19 +284,6 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       }
     }
   }
-  // A mirroring map turns solids inside out: reverse their faces.
-  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
-    if (m.bodies[b].kind != brep::BodyKind::Solid) continue;
-    if (brep::volume_mm3(m, static_cast<int>(b)) < 0) {
-      for (const brep::Shell& shell : m.bodies[b].shells)
-        for (int f : shell.faces)
-          m.faces[static_cast<std::size_t>(f)].reversed =
-              !m.faces[static_cast<std::size_t>(f)].reversed;
-      ++report.solids_reversed;
-    }
-  }
-  for (const brep::EdgeGap& g : brep::edge_gaps(m))
-    report.max_edge_gap_mm = std::max(report.max_edge_gap_mm, g.gap_mm);
   report.counts = brep::counts(m);
   const auto broken = brep::problems(m);
   if (!broken.empty()) {
@@ -303,7 +294,20 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       text += "\n  " + broken[k];
     throw Error(ErrorCategory::ToleranceNotMet, text);
   }
-  report.volume_after_mm3 = brep::volume_mm3(m);
+  // A mirroring map turns solids inside out: reverse their faces, which negates their volume
+  // (and breaks no invariant: a shell's orientation stays consistent).
+  const std::vector<double> after = brep::body_volumes_mm3(m);
+  for (std::size_t b = 0; b < m.bodies.size(); ++b) {
+    if (m.bodies[b].kind != brep::BodyKind::Solid) continue;
+    if (after[b] < 0) {
+      for (const brep::Shell& shell : m.bodies[b].shells)
+        for (int f : shell.faces)
+          m.faces[static_cast<std::size_t>(f)].reversed =
+              !m.faces[static_cast<std::size_t>(f)].reversed;
+      ++report.solids_reversed;
+    }
+    report.volume_after_mm3 += std::abs(after[b]);
+  }
   report.summary.termination = Termination::Converged;
   report.summary.final_residual = report.max_edge_gap_mm;
   report.summary.message = report.brief();

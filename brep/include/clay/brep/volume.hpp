@@ -13,6 +13,8 @@
 #include <clay/brep/export.hpp>
 #include <clay/brep/model.hpp>
 
+#include <vector>
+
 namespace clay::brep {
 
 /// The signed volume (mm^3) enclosed by the shells of body `body` of `model`: positive for a
@@ -21,6 +23,11 @@ namespace clay::brep {
 /// clay::Error(InvalidArgument) for a body index out of range, InvalidGeometry when the model
 /// breaks an invariant (validate).
 CLAY_BREP_API double volume_mm3(const Model& model, int body);
+
+/// The signed volume of every body (indexed like model.bodies; meaningful for solids), the faces
+/// integrated on the hardware's threads (the result does not depend on them). Throws
+/// clay::Error(InvalidGeometry) when the model breaks an invariant (validate).
+CLAY_BREP_API std::vector<double> body_volumes_mm3(const Model& model);
 
 /// The volume of every solid of the model: each body once without an assembly; each placed
 /// instance once with one (rigid placements keep volumes).
