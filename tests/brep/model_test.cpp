@@ -432,6 +432,15 @@ TEST_CASE("volume_mm3 of a cube, a translated cube and a cube with a face turned
   CHECK(clay::brep::volume_mm3(b.m) == 0);  // no solid
   CHECK(clay::test::error_of([&] { (void)clay::brep::volume_mm3(b.m, 1); }).first ==
         clay::ErrorCategory::InvalidArgument);
+  // Every body at once: the cube's a^3, and the sheet's signed flux, as one at a time.
+  const std::vector<double> one = clay::brep::body_volumes_mm3(cube(10));
+  REQUIRE(one.size() == 1);
+  CHECK(one[0] == Approx(1000).epsilon(1e-14));
+  CHECK(clay::brep::body_volumes_mm3(b.m) == std::vector<double>{clay::brep::volume_mm3(b.m, 0)});
+  Model turned = cube(10);
+  turned.faces[1].reversed = true;  // inside out: refused, like volume_mm3
+  CHECK(clay::test::error_of([&] { (void)clay::brep::body_volumes_mm3(turned); }).first ==
+        clay::ErrorCategory::InvalidGeometry);
 }
 
 TEST_CASE("flattened places every instance of an assembly as a body of its own", "[brep]") {
