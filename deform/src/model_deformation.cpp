@@ -6,6 +6,7 @@
 #include <clay/internal/checks.hpp>
 #include <clay/internal/format.hpp>
 #include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/evaluate.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -213,9 +214,19 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   std::vector<double> edge_face_bound(m.edges.size(), 0.0);
   std::vector<bool> edge_touched(m.edges.size(), false);
   const Leaves leaves(stack);
+  std::vector<bool> chosen(m.faces.size(), options.faces.empty());
+  for (int f : options.faces) {
+    if (f < 0 || static_cast<std::size_t>(f) >= m.faces.size())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "deform_model: ModelDeformationOptions::faces names face " + std::to_string(f) +
+                      ", but the model has " + std::to_string(m.faces.size()) +
+                      " faces (flattened); give indices in [0, " + std::to_string(m.faces.size()) +
+                      ")");
+    chosen[static_cast<std::size_t>(f)] = true;
+  }
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     brep::Face& face = m.faces[f];
-    if (leaves.alone(face.surface.points)) {
+    if (!chosen[f] || leaves.alone(face.surface.points)) {
       ++report.faces_untouched;
       continue;
     }
@@ -230,6 +241,33 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
         edge_touched[e] = true;
         edge_face_bound[e] = std::max(edge_face_bound[e], faces[f].bound);
       }
+  }
+  // An edge a deformed face shares with a kept one must stay where it is (within its tolerance).
+  if (!options.faces.empty()) {
+    std::vector<int> kept_user(m.edges.size(), -1), deformed_user(m.edges.size(), -1);
+    for (std::size_t f = 0; f < m.faces.size(); ++f)
+      for (const brep::Loop& loop : m.faces[f].loops)
+        for (const brep::Coedge& co : loop.coedges)
+          (faces[f].way == Outcome::Way::Untouched
+               ? kept_user
+               : deformed_user)[static_cast<std::size_t>(co.edge)] = static_cast<int>(f);
+    for (std::size_t e = 0; e < m.edges.size(); ++e) {
+      if (kept_user[e] < 0 || deformed_user[e] < 0 || m.edges[e].degenerate) continue;
+      const brep::Edge& edge = m.edges[e];
+      double moved = 0;
+      for (int k = 0; k <= 32; ++k) {
+        const double t = edge.t0 + (edge.t1 - edge.t0) * k / 32;
+        const Eigen::Vector3d p = surface::evaluate(edge.curve, t);
+        moved = std::max(moved, (deform_point(stack, p) - p).norm());
+      }
+      if (moved > edge.tolerance_mm)
+        throw Error(ErrorCategory::InvalidArgument,
+                    "deform_model: " + face_name(m, static_cast<std::size_t>(deformed_user[e])) +
+                        " is deformed but " + face_name(m, static_cast<std::size_t>(kept_user[e])) +
+                        " is not, and the stack moves their shared edge " + std::to_string(e) +
+                        " by " + internal::shortest(moved) +
+                        " mm: choose both faces, or keep the deformation off that edge");
+    }
   }
   // Edges: F∘C on the same t, when a deformed face uses them.
   std::vector<double> edge_bound(m.edges.size(), 0.0);

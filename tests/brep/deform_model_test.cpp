@@ -322,3 +322,59 @@ TEST_CASE("deform_model: max_degree refits exact results above it, certified") {
     if (!edge.degenerate) CHECK(edge.curve.basis.degree <= 2);
   CHECK(clay::brep::check_model(result.model).valid);
 }
+
+TEST_CASE("deform_model: only the chosen faces deform; a shared edge that would tear is refused") {
+  // The pair: a box [0, 20]^3 (faces 0-5) and a sphere at (50, 10, 10). A lattice over both,
+  // with only the sphere chosen: the box stays bit for bit.
+  const Model pair = read(TestModel::Separated, "pair-chosen.step");
+  int sphere = -1;
+  for (size_t f = 0; f < pair.faces.size(); ++f)
+    if (pair.faces[f].elementary &&
+        pair.faces[f].elementary->kind == clay::brep::ElementaryKind::Sphere)
+      sphere = static_cast<int>(f);
+  REQUIRE(sphere >= 0);
+  const DeformationStack stack = trilinear({-5, -5, -5}, {60, 25, 25}, {3, 2, 4});
+  clay::deform::ModelDeformationOptions options;
+  options.faces = {sphere};
+  const auto result = clay::deform::deform_model(stack, pair, options);
+  INFO(result.report.brief());
+  CHECK(result.report.faces_exact == 1);
+  CHECK(result.report.faces_untouched == 6);
+  for (size_t f = 0; f < pair.faces.size(); ++f)
+    CHECK(clay::surface::identical(pair.faces[f].surface, result.model.faces[f].surface) ==
+          (static_cast<int>(f) != sphere));
+  // The sphere is the pointwise deformation of the original.
+  const auto& before = pair.faces[static_cast<size_t>(sphere)].surface;
+  const auto& after = result.model.faces[static_cast<size_t>(sphere)].surface;
+  for (double u : {0.3, 2.0, 4.1})
+    for (double v : {-1.0, 0.2, 1.2}) {
+      const auto [u0, u1] = before.u.domain();
+      const auto [v0, v1] = before.v.domain();
+      const double a = u0 + (u1 - u0) * u / 6.3, b = v0 + (v1 - v0) * (v + 1.6) / 3.2;
+      CHECK((clay::surface::evaluate(after, a, b) -
+             clay::deform::deform_point(stack, clay::surface::evaluate(before, a, b)))
+                .norm() <= 1e-12 * 60);
+    }
+  CHECK(clay::brep::check_model(result.model).valid);
+
+  // The block's top alone under a lattice that lifts its rim: the rim is shared with the sides.
+  const Model block = read(TestModel::FilletedBlock, "block-chosen.step");
+  int top = -1;
+  for (size_t f = 0; f < block.faces.size(); ++f)
+    if (block.faces[f].name == "top") top = static_cast<int>(f);
+  REQUIRE(top >= 0);
+  clay::deform::ModelDeformationOptions only_top;
+  only_top.faces = {top};
+  const auto [category, message] = clay::test::error_of([&] {
+    clay::deform::deform_model(trilinear({-5, -5, -5}, {65, 45, 25}, {6, 4, 5}), block, only_top);
+  });
+  CHECK(category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("(\"top\") is deformed but face") &&
+                          Contains("is not, and the stack moves their shared edge") &&
+                          Contains("choose both faces"));
+  only_top.faces = {99};
+  const auto [c2, m2] =
+      clay::test::error_of([&] { clay::deform::deform_model(stack, block, only_top); });
+  CHECK(c2 == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(m2, Contains("names face 99, but the model has 17 faces"));
+}

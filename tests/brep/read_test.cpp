@@ -150,10 +150,11 @@ TEST_CASE("read_model: a sphere keeps its seam and its two poles") {
   CHECK(c.coedges == 4);  // the seam twice, the two poles
 }
 
-TEST_CASE("read_model: a torus, a cone and a revolved bottle") {
+TEST_CASE("read_model: a torus, a cone and two revolved bottles") {
   for (const auto& [model, name] :
        {std::pair{TestModel::Torus, "torus.step"}, std::pair{TestModel::Cone, "cone.step"},
-        std::pair{TestModel::Bottle, "bottle.step"}}) {
+        std::pair{TestModel::Bottle, "bottle.step"},
+        std::pair{TestModel::LabelBottle, "label-bottle.step"}}) {
     INFO(name);
     const fs::path file = written(model, name);
     const auto read = read_model(file);

@@ -103,6 +103,23 @@ TopoDS_Shape bottle() {
   return BRepPrimAPI_MakeRevol(profile, gp::OZ()).Shape();
 }
 
+/// The bottle with an embossed label band: the body's cylinder r 15 rises by 45-degree cones to a
+/// band r 16 for z in [14, 30].
+TopoDS_Shape label_bottle() {
+  const std::vector<gp_Pnt> points{{0, 0, 0},  {15, 0, 0},  {15, 0, 13}, {16, 0, 14},
+                                   {16, 0, 30}, {15, 0, 31}, {15, 0, 40}};
+  BRepBuilderAPI_MakeWire wire;
+  for (std::size_t k = 0; k + 1 < points.size(); ++k)
+    wire.Add(BRepBuilderAPI_MakeEdge(points[k], points[k + 1]).Edge());
+  const gp_Pnt mid(12.5, 0, 50), p3(8, 0, 55), p4(8, 0, 65), p5(0, 0, 65);
+  wire.Add(BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(points.back(), mid, p3).Value()).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(p3, p4).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(p4, p5).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(p5, points.front()).Edge());
+  const TopoDS_Face profile = BRepBuilderAPI_MakeFace(wire.Wire(), true).Face();
+  return BRepPrimAPI_MakeRevol(profile, gp::OZ()).Shape();
+}
+
 TopoDS_Shape loose_box_faces() {
   const TopoDS_Shape box = BRepPrimAPI_MakeBox(30, 20, 10).Shape();
   TopoDS_Compound faces;
@@ -188,6 +205,19 @@ void write_test_model(TestModel model, const fs::path& file) {
     case TestModel::Bottle:
       add_part(shapes, colours, bottle(), "bottle", srgb(0.3, 0.6, 0.9));
       break;
+    case TestModel::LabelBottle: {
+      const TopoDS_Shape shape = label_bottle();
+      const TDF_Label label = add_part(shapes, colours, shape, "bottle", srgb(0.3, 0.6, 0.9));
+      // The band (the cylinder of radius 16) is the label: named and coloured.
+      for (TopExp_Explorer e(shape, TopAbs_FACE); e.More(); e.Next()) {
+        BRepAdaptor_Surface surface(TopoDS::Face(e.Current()));
+        if (surface.GetType() != GeomAbs_Cylinder || surface.Cylinder().Radius() != 16) continue;
+        const TDF_Label face = shapes->AddSubShape(label, e.Current());
+        TDataStd_Name::Set(face, "label");
+        colours->SetColor(face, srgb(0.95, 0.85, 0.2), XCAFDoc_ColorSurf);
+      }
+      break;
+    }
     case TestModel::Assembly: {
       const TDF_Label assembly = shapes->NewShape();
       TDataStd_Name::Set(assembly, "bracket assembly");

@@ -18,6 +18,7 @@ enum class TestModel {
   Torus,          ///< R 20, r 5: seams in both directions
   Cone,           ///< r 10 to 4, height 15: a seam, a plane at each end
   Bottle,         ///< a revolved profile (lines and an arc), hollow: a solid with a void-free shell
+  LabelBottle,    ///< the bottle with an embossed label band (r 16, z 14..30, named "label")
   Assembly,       ///< two parts, named and coloured; the second placed twice
   LooseFaces,     ///< a box's six faces written as loose IGES faces (144), to be sewn
   Separated,      ///< two solids apart: a box 20^3 at the origin, a sphere r 5 at (50, 10, 10)

@@ -37,6 +37,11 @@ struct CLAY_DEFORM_API ModelDeformationOptions {
   /// Largest degree of a result (1 to 25, the exchange limit). An exact face or edge above it is
   /// refitted (certified) when surface.refit is given, else refused (DegreeLimit) naming it.
   int max_degree = 25;
+  /// The faces to deform, as indices into flattened(model).faces (the model's own faces when it
+  /// has no assembly); empty: every face. The others are kept as they are, so an edge a chosen
+  /// face shares with a kept one must stay where it is: a stack that moves it by more than its
+  /// tolerance is refused (InvalidArgument naming both faces and the edge).
+  std::vector<int> faces;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
