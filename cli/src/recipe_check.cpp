@@ -15,7 +15,7 @@ void RecipeChecker::rebuild(const std::string& name, const Json& j, const std::s
 void RecipeChecker::run(const Json& root) {
   if (!c_.object(root, "",
                  {"format", "version", "name", "description", "units", "composition", "strokes",
-                  "curves", "sketches", "surfaces", "deformations", "exports"},
+                  "curves", "sketches", "surfaces", "deformations", "exports", "models"},
                  "a recipe {\"format\": \"clayform.recipe\", \"version\": 1, ...}"))
     return;
   const Json* format = c_.member(root, "", "format", true, "\"format\": \"clayform.recipe\"");
@@ -54,6 +54,8 @@ void RecipeChecker::run(const Json& root) {
           [&](const std::string& n, const Json& j, const std::string& p) { surface(n, j, p); });
   section(root, "exports",
           [&](const std::string& n, const Json& j, const std::string& p) { exporting(n, j, p); });
+  section(root, "models",
+          [&](const std::string& n, const Json& j, const std::string& p) { modelling(n, j, p); });
 }
 
 void RecipeChecker::declare(const Json& root) {
@@ -190,26 +192,122 @@ void RecipeChecker::exporting(const std::string& name, const Json& j, const std:
       }
     }
   }
-  if (const Json* f = c_.member(j, path, "formats", false, "")) {
-    const std::string fp = key_path(path, "formats");
-    def.formats.clear();
-    if (!f->is_array() || f->empty()) {
-      c_.add(fp, "expected a non-empty array of \"step\", \"iges\", \"glb\", found " + found(*f));
-    } else {
-      for (std::size_t i = 0; i < f->size(); ++i)
-        if (const auto k = c_.choice((*f)[i], index_path(fp, i), {"step", "iges", "glb"})) {
-          const std::string fmt = (*f)[i].get<std::string>();
-          if (std::find(def.formats.begin(), def.formats.end(), fmt) != def.formats.end())
-            c_.add(index_path(fp, i), "\"" + fmt + "\" is listed twice; list each format once");
-          else
-            def.formats.push_back(fmt);
-        }
-    }
-  }
+  if (const Json* f = c_.member(j, path, "formats", false, ""))
+    def.formats = formats(*f, key_path(path, "formats"));
   if (const Json* s = c_.member(j, path, "schema", false, ""))
     if (const auto k = c_.choice(*s, key_path(path, "schema"), {"AP214", "AP242"}))
       def.schema = *k == 0 ? "AP214" : "AP242";
   if (c_.problems.size() == before) data.exports.push_back(std::move(def));
+}
+
+std::vector<std::string> RecipeChecker::formats(const Json& f, const std::string& fp) {
+  std::vector<std::string> out;
+  if (!f.is_array() || f.empty()) {
+    c_.add(fp, "expected a non-empty array of \"step\", \"iges\", \"glb\", found " + found(f));
+    return out;
+  }
+  for (std::size_t i = 0; i < f.size(); ++i)
+    if (const auto k = c_.choice(f[i], index_path(fp, i), {"step", "iges", "glb"})) {
+      const std::string fmt = f[i].get<std::string>();
+      if (std::find(out.begin(), out.end(), fmt) != out.end())
+        c_.add(index_path(fp, i), "\"" + fmt + "\" is listed twice; list each format once");
+      else
+        out.push_back(fmt);
+    }
+  return out;
+}
+
+std::optional<fs::path> RecipeChecker::exchange_file(const Json& f, const std::string& path) {
+  const auto s = c_.string(f, path);
+  if (!s) return std::nullopt;
+  const fs::path file = fs::path(*s).is_absolute() ? fs::path(*s) : base_ / *s;
+  std::string ext = file.extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext != ".step" && ext != ".stp" && ext != ".igs" && ext != ".iges") {
+    c_.add(path,
+           "\"" + *s + "\" is not a STEP or IGES file; give a .step, .stp, .igs or .iges file");
+    return std::nullopt;
+  }
+  if (std::error_code ec; !fs::is_regular_file(file, ec)) {
+    // The error_code overload: the throwing one raised filesystem_error for a name the system
+    // refuses (ENAMETOOLONG, found by fuzz_recipe), and checking never throws.
+    c_.add(path,
+           ec && ec != std::errc::no_such_file_or_directory
+               ? "cannot look up \"" + file.string() + "\": " + ec.message() +
+                     "; give the path of an existing file"
+               : "no file \"" + file.string() + "\" (paths are relative to the recipe's folder)");
+    return std::nullopt;
+  }
+  return file;
+}
+
+void RecipeChecker::modelling(const std::string& name, const Json& j, const std::string& path) {
+  if (!c_.object(j, path, {"import", "sew", "deformation", "bodies", "faces", "formats", "schema"},
+                 "a model {import, deformation, bodies, faces, formats, schema, sew}"))
+    return;
+  const std::size_t before = c_.problems.size();
+  ModelDef def;
+  def.name = name;
+  def.path = path;
+  for (const ExportDef& e : data.exports)
+    if (e.name == name)
+      c_.add(path, "the export \"" + name + "\" writes files of the same names (" + name +
+                       ".step, ...); rename the model or the export");
+  if (const Json* f =
+          c_.member(j, path, "import", true, "the path of a .step/.stp/.igs/.iges file"))
+    if (const auto file = exchange_file(*f, key_path(path, "import"))) def.file = *file;
+  def.sew = c_.boolean_or(j, path, "sew", def.sew);
+  if (const Json* d = c_.member(j, path, "deformation", false, "")) {
+    const std::string dp = key_path(path, "deformation");
+    if (const auto n = c_.string(*d, dp)) {
+      const auto stack = std::find_if(data.stacks.begin(), data.stacks.end(),
+                                      [&](const StackDef& s) { return s.name == *n; });
+      if (stack == data.stacks.end()) {
+        c_.add(dp, "no deformation stack named \"" + *n + "\"; " + listing(names_.stacks));
+      } else {
+        def.deformation = *n;
+        // What a model cannot take: a style step (it shapes one surface by its control points)
+        // and a direct move from a surface point (it needs one surface).
+        for (const StepDef& step : stack->steps) {
+          if (std::holds_alternative<StyleDef>(step.step))
+            c_.add(dp, "the stack \"" + *n + "\" has a style step (" + step.path +
+                           "), which shapes one surface by its control points; a model deforms "
+                           "through lattices, direct manipulation and taper, twist, bend");
+          if (const auto* direct = std::get_if<DirectDef>(&step.step))
+            for (const DirectMove& m : direct->moves)
+              if (m.on_surface) {
+                c_.add(dp, "the stack \"" + *n + "\" moves a \"surface_point\" (" + step.path +
+                               "), which needs one surface; give the move's \"point\" in space");
+                break;
+              }
+        }
+      }
+    }
+  }
+  for (const auto& [key, out] :
+       {std::pair{"bodies", &def.bodies}, std::pair{"faces", &def.faces}}) {
+    const Json* list = c_.member(j, path, key, false, "");
+    if (!list) continue;
+    const std::string lp = key_path(path, key);
+    if (!list->is_array() || list->empty()) {
+      c_.add(lp,
+             std::string("expected a non-empty array of ") + key + " names, found " + found(*list));
+      continue;
+    }
+    if (!c_.at_most(*list, lp, limit::entries, "names")) continue;
+    for (std::size_t i = 0; i < list->size(); ++i)
+      if (const auto n = c_.string((*list)[i], index_path(lp, i))) out->push_back(*n);
+  }
+  if ((!def.bodies.empty() || !def.faces.empty()) && def.deformation.empty())
+    c_.add(path,
+           "\"bodies\" and \"faces\" choose what a deformation deforms; name one with "
+           "\"deformation\"");
+  if (const Json* f = c_.member(j, path, "formats", false, ""))
+    def.formats = formats(*f, key_path(path, "formats"));
+  if (const Json* s = c_.member(j, path, "schema", false, ""))
+    if (const auto k = c_.choice(*s, key_path(path, "schema"), {"AP214", "AP242"}))
+      def.schema = *k == 0 ? "AP214" : "AP242";
+  if (c_.problems.size() == before) data.models.push_back(std::move(def));
 }
 
 }  // namespace check_detail

@@ -110,25 +110,7 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
       if (c_.object(v, p, {"file", "index"}, "an import {file, index}")) {
         if (const Json* f =
                 c_.member(v, p, "file", true, "the path of a .step/.stp/.igs/.iges file"))
-          if (const auto s = c_.string(*f, key_path(p, "file"))) {
-            d.file = fs::path(*s).is_absolute() ? fs::path(*s) : base_ / *s;
-            std::string ext = d.file.extension().string();
-            for (char& ch : ext)
-              ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-            if (ext != ".step" && ext != ".stp" && ext != ".igs" && ext != ".iges")
-              c_.add(key_path(p, "file"),
-                     "\"" + *s +
-                         "\" is not a STEP or IGES file; give a .step, .stp, .igs or .iges file");
-            else if (std::error_code ec; !fs::is_regular_file(d.file, ec))
-              // The error_code overload: the throwing one raised filesystem_error for a name the
-              // system refuses (ENAMETOOLONG, found by fuzz_recipe), and checking never throws.
-              c_.add(key_path(p, "file"),
-                     ec && ec != std::errc::no_such_file_or_directory
-                         ? "cannot look up \"" + d.file.string() + "\": " + ec.message() +
-                               "; give the path of an existing file"
-                         : "no file \"" + d.file.string() +
-                               "\" (paths are relative to the recipe's folder)");
-          }
+          if (const auto file = exchange_file(*f, key_path(p, "file"))) d.file = *file;
         d.index = c_.integer_or(v, p, "index", 0, 0, 1000000);
       }
       def.build = d;

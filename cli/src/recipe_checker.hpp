@@ -556,6 +556,11 @@ class RecipeChecker {
   // ---- exports ----------------------------------------------------------------------------
 
   void exporting(const std::string& name, const Json& j, const std::string& path);
+  void modelling(const std::string& name, const Json& j, const std::string& path);
+  /// The path of an existing STEP or IGES file `j` names, relative to the recipe's folder.
+  std::optional<fs::path> exchange_file(const Json& j, const std::string& path);
+  /// A "formats" array of "step", "iges", "glb", each once; `fallback` when it has problems.
+  std::vector<std::string> formats(const Json& j, const std::string& path);
 };
 
 }  // namespace clay::recipe::check_detail

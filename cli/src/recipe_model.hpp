@@ -144,6 +144,17 @@ struct ExportDef {
   std::string schema = "AP214";
 };
 
+/// A whole model imported from a STEP or IGES file and, optionally, deformed by a stack.
+struct ModelDef {
+  std::string name, path;
+  std::filesystem::path file;
+  bool sew = false;                        ///< sew loose faces into shells and solids
+  std::string deformation;                 ///< "" when the model is written as read
+  std::vector<std::string> bodies, faces;  ///< names chosen to deform; both empty: every face
+  std::vector<std::string> formats{"step", "iges", "glb"};
+  std::string schema = "AP214";
+};
+
 struct RecipeData {
   std::string name, description;
   Composition composition;
@@ -153,6 +164,7 @@ struct RecipeData {
   std::vector<SurfaceDef> surfaces;
   std::vector<StackDef> stacks;
   std::vector<ExportDef> exports;
+  std::vector<ModelDef> models;
 };
 
 /// The checked model, or problems (then the model is incomplete and must not be run).

@@ -24,6 +24,8 @@ Json figure_json(const Figure& f) {
   return std::visit([](const auto& x) { return Json(x); }, f);
 }
 
+Json model_figures(const ModelRunResult& r);
+
 }  // namespace
 
 std::string report_json(const RunResult& result) {
@@ -83,6 +85,23 @@ std::string report_json(const RunResult& result) {
     exports.push_back(std::move(x));
   }
   j["exports"] = std::move(exports);
+  if (!result.models.empty()) {
+    Json models = Json::array();
+    for (const auto& m : result.models) {
+      Json x = Json::object();
+      x["name"] = m.name;
+      x["import"] = m.source;
+      x["deformation"] = m.deformation;
+      x["bodies"] = m.bodies;
+      x["faces"] = m.faces;
+      x["files"] = m.files;
+      if (!m.files.empty()) x["valid"] = m.valid;
+      x["seconds"] = m.seconds;
+      x["model"] = model_figures(m);
+      models.push_back(std::move(x));
+    }
+    j["models"] = std::move(models);
+  }
   return j.dump(2) + "\n";
 }
 
@@ -140,6 +159,9 @@ void write_text(const fs::path& file, const std::string& text) {
   if (!out) throw Error(ErrorCategory::Io, "cannot write \"" + file.string() + "\"");
 }
 
+Json write_model_files(const ModelRunResult& result, const Staging& staging, std::string_view stem,
+                       std::vector<std::string>& names);
+
 }  // namespace
 
 std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) {
@@ -196,6 +218,13 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
         }
       }
     }
+    for (auto& m : result.models) {
+      std::vector<std::string> files;
+      write_model_files(m, staging, m.name, files);
+      m.files = files;
+      m.valid = true;  // write_model_files refuses a file that does not read back valid
+      names.insert(names.end(), files.begin(), files.end());
+    }
     write_text(tmp / "report.json", report_json(result));
     names.push_back("report.json");
     write_view_data(result, tmp);  // view/manifest.json and view/NNN.bin (clay/recipe/view.hpp)
@@ -220,18 +249,10 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
 
 namespace {
 
-Json model_report_json(const ModelRunResult& r, const brep::Counts& c, const Json& exports) {
+/// A model run's figures: its topology and what the deformation did (report.json "model").
+Json model_figures(const ModelRunResult& r) {
   const auto& m = r.report;
-  Json j = Json::object();
-  j["format"] = "clayform.report";
-  j["version"] = 1;
-  j["recipe"] = r.recipe;
-#ifdef CLAYFORM_VERSION
-  j["clayform"] = CLAYFORM_VERSION;
-#endif
-  j["ok"] = true;
-  j["seconds"] = r.seconds;
-  j["deformation"] = r.deformation;
+  const brep::Counts& c = m.counts;
   Json model = Json::object();
   model["bodies"] = c.bodies;
   model["solids"] = c.solids;
@@ -255,9 +276,78 @@ Json model_report_json(const ModelRunResult& r, const brep::Counts& c, const Jso
   model["solids_reversed"] = m.solids_reversed;
   model["fold_free"] = r.fold_free;
   model["message"] = m.brief();
-  j["model"] = std::move(model);
+  return model;
+}
+
+Json model_report_json(const ModelRunResult& r, const Json& exports) {
+  Json j = Json::object();
+  j["format"] = "clayform.report";
+  j["version"] = 1;
+  j["recipe"] = r.recipe;
+#ifdef CLAYFORM_VERSION
+  j["clayform"] = CLAYFORM_VERSION;
+#endif
+  j["ok"] = true;
+  j["seconds"] = r.seconds;
+  j["deformation"] = r.deformation;
+  j["model"] = model_figures(r);
   j["exports"] = exports;
   return j;
+}
+
+/// Writes the model's files (STEM.step, STEM.igs, STEM.glb per result.formats) into the staging
+/// folder, each
+/// STEP and IGES file read back (read_model) and checked (BRepCheck, the same counts) first;
+/// appends their names to `names` and returns what the report says of each.
+Json write_model_files(const ModelRunResult& result, const Staging& staging, std::string_view stem,
+                       std::vector<std::string>& names) {
+  const fs::path& tmp = staging.tmp;
+  Json exports = Json::array();
+  const brep::Counts counts = brep::counts(result.model);
+  for (const auto& format : result.formats) {
+    const std::string file = std::string(stem) + (format == "step"   ? ".step"
+                                                  : format == "iges" ? ".igs"
+                                                                     : ".glb");
+    brep::ModelWriteOptions o;
+    o.schema = result.schema == "AP242" ? surface::StepSchema::AP242 : surface::StepSchema::AP214;
+    if (format == "glb") {  // a preview: the same shapes, meshed; nothing to read back
+      o.check = false;
+      brep::write_model(result.model, tmp / file, o);
+      Json x = Json::object();
+      x["name"] = std::string(stem);
+      x["file"] = file;
+      x["preview"] = true;
+      exports.push_back(std::move(x));
+      names.push_back(file);
+      continue;
+    }
+    const brep::ModelCheck written = brep::write_model(result.model, tmp / file, o);
+    // Read back as a CAD system would, and checked before anything moves into out_dir.
+    const brep::ImportedModel back = brep::read_model(tmp / file);
+    const bool same = back.report.counts.faces == counts.faces &&
+                      back.report.counts.edges == counts.edges &&
+                      back.report.counts.solids == counts.solids &&
+                      back.report.counts.vertices == counts.vertices;
+    if (!written.valid || !back.report.problems.empty() || !same) {
+      std::string m = file + " reads back " +
+                      (!written.valid ? std::string("INVALID (BRepCheck)")
+                       : !same        ? "with other counts (" + back.report.brief() + ")"
+                                      : "broken") +
+                      ", so nothing was written to \"" + staging.target.string() + "\"";
+      for (const auto& p : written.problems) m += "\n  problem: " + p;
+      for (const auto& p : back.report.problems) m += "\n  problem: " + p;
+      throw Error(ErrorCategory::Exchange, m);
+    }
+    Json x = Json::object();
+    x["name"] = std::string(stem);
+    x["file"] = file;
+    x["valid"] = written.valid;
+    x["volume_mm3"] = written.volume_mm3;
+    x["read_back"] = back.report.brief();
+    exports.push_back(std::move(x));
+    names.push_back(file);
+  }
+  return exports;
 }
 
 }  // namespace
@@ -268,52 +358,8 @@ std::vector<fs::path> write_model_outputs(const ModelRunResult& result, const fs
   std::error_code ec;
   try {
     std::vector<std::string> names;
-    Json exports = Json::array();
-    const brep::Counts counts = brep::counts(result.model);
-    for (const auto& format : result.formats) {
-      const std::string file = std::string(stem) + (format == "step"   ? ".step"
-                                                    : format == "iges" ? ".igs"
-                                                                       : ".glb");
-      brep::ModelWriteOptions o;
-      o.schema = result.schema == "AP242" ? surface::StepSchema::AP242 : surface::StepSchema::AP214;
-      if (format == "glb") {  // a preview: the same shapes, meshed; nothing to read back
-        o.check = false;
-        brep::write_model(result.model, staging.tmp / file, o);
-        Json x = Json::object();
-        x["name"] = std::string(stem);
-        x["file"] = file;
-        x["preview"] = true;
-        exports.push_back(std::move(x));
-        names.push_back(file);
-        continue;
-      }
-      const brep::ModelCheck written = brep::write_model(result.model, staging.tmp / file, o);
-      // Read back as a CAD system would, and checked before anything moves into out_dir.
-      const brep::ImportedModel back = brep::read_model(staging.tmp / file);
-      const bool same = back.report.counts.faces == counts.faces &&
-                        back.report.counts.edges == counts.edges &&
-                        back.report.counts.solids == counts.solids &&
-                        back.report.counts.vertices == counts.vertices;
-      if (!written.valid || !back.report.problems.empty() || !same) {
-        std::string m = file + " reads back " +
-                        (!written.valid ? std::string("INVALID (BRepCheck)")
-                         : !same        ? "with other counts (" + back.report.brief() + ")"
-                                        : "broken") +
-                        ", so nothing was written to \"" + staging.target.string() + "\"";
-        for (const auto& p : written.problems) m += "\n  problem: " + p;
-        for (const auto& p : back.report.problems) m += "\n  problem: " + p;
-        throw Error(ErrorCategory::Exchange, m);
-      }
-      Json x = Json::object();
-      x["name"] = std::string(stem);
-      x["file"] = file;
-      x["valid"] = written.valid;
-      x["volume_mm3"] = written.volume_mm3;
-      x["read_back"] = back.report.brief();
-      exports.push_back(std::move(x));
-      names.push_back(file);
-    }
-    write_text(staging.tmp / "report.json", model_report_json(result, counts, exports).dump(2));
+    const Json exports = write_model_files(result, staging, stem, names);
+    write_text(staging.tmp / "report.json", model_report_json(result, exports).dump(2));
     names.push_back("report.json");
     std::vector<fs::path> written = move_in(staging, names);
     fs::remove_all(staging.tmp, ec);

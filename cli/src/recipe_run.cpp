@@ -2,6 +2,8 @@
 // quality figures of DESIGN.md; a failing step is rethrown with its path first.
 #include "recipe_model.hpp"
 
+#include <clay/brep/exchange.hpp>
+#include <clay/brep/volume.hpp>
 #include <clay/constraints/solve.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/model_deformation.hpp>
@@ -54,6 +56,10 @@ auto in_recipe_words(const Words& words, F&& build) {
 }
 
 /// The run's state: named results so far, and the reports.
+/// One of the recipe's models: imported, flattened, and deformed when it names a stack
+/// (defined after the Runner).
+ModelRunResult run_model(const RecipeData& d, const ModelDef& def);
+
 class Runner {
  public:
   Runner(const RecipeData& d, const RunOptions& o, RunResult& r)
@@ -101,6 +107,28 @@ class Runner {
                        {"degree", static_cast<long long>(degree)}};
         rep.message = std::to_string(x.surfaces.size()) + " surface(s) for " + e.name;
         result_.exports.push_back(std::move(x));
+      });
+  }
+
+  /// Every imported model, deformed when it names a stack.
+  void models() {
+    for (const auto& m : data_.models)
+      timed(m.path, "model", [&](StepReport& rep) {
+        result_.models.push_back(run_model(data_, m));
+        const ModelRunResult& r = result_.models.back();
+        const deform::ModelDeformationReport& x = r.report;
+        rep.figures = {{"faces", static_cast<long long>(x.counts.faces)},
+                       {"faces_exact", static_cast<long long>(x.faces_exact)},
+                       {"faces_refit", static_cast<long long>(x.faces_refit)},
+                       {"faces_untouched", static_cast<long long>(x.faces_untouched)},
+                       {"max_certified_bound_mm", x.max_certified_bound_mm},
+                       {"max_edge_gap_mm", x.max_edge_gap_mm},
+                       {"volume_before_mm3", x.volume_before_mm3},
+                       {"volume_after_mm3", x.volume_after_mm3},
+                       {"fold_free", r.fold_free}};
+        rep.message =
+            (r.deformation.empty() ? "read as it is: " : "deformed by " + r.deformation + ": ") +
+            x.brief();
       });
   }
 
@@ -568,6 +596,7 @@ RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
   runner.curves();
   runner.surfaces();
   runner.exports();
+  runner.models();
   result.seconds = seconds_since(t0);
   return result;
 }
@@ -590,6 +619,144 @@ const StackDef& pick_stack(const RecipeData& d, std::string_view deformation) {
   throw Error(ErrorCategory::InvalidArgument, "the recipe has no deformation stack '" +
                                                   std::string(deformation) +
                                                   "'; its stacks: " + names);
+}
+
+/// A stack for a whole model: lattices and regular deformations as they are, direct
+/// manipulation solved from moves in space; a style step or a move from a surface point is
+/// refused, naming the step. `fold_free` is cleared when a lattice's Jacobian bounds are not
+/// positive.
+deform::DeformationStack model_stack(const StackDef& def, bool& fold_free) {
+  deform::DeformationStack stack;
+  for (std::size_t i = 0; i < def.steps.size(); ++i) {
+    const StepDef& step = def.steps[i];
+    const std::string where = def.path + ".steps[" + std::to_string(i) + "] (" + step.kind + ")";
+    deform::Deformation lattice = std::visit(
+        [&](const auto& k) -> deform::Deformation {
+          using T = std::decay_t<decltype(k)>;
+          if constexpr (std::is_same_v<T, deform::Deformation>) {
+            return k;
+          } else if constexpr (std::is_same_v<T, DirectDef>) {
+            std::vector<deform::PointMove> moves;
+            for (const auto& m : k.moves) {
+              if (m.on_surface)
+                throw Error(ErrorCategory::InvalidArgument,
+                            where +
+                                ": a move from a \"surface_point\" needs one surface; to "
+                                "deform a model, give the move's \"point\" in space");
+              moves.push_back({m.point, m.to});
+            }
+            deform::Deformation solved;
+            bool feasible = true;
+            std::string message;
+            std::visit(
+                [&](const auto& lat) {
+                  auto r = deform::manipulate(lat, moves, k.options);
+                  feasible = r.report.feasible;
+                  message = r.report.summary.message;
+                  solved = std::move(r.lattice);
+                },
+                k.lattice);
+            if (!feasible && !k.accept_out_of_tolerance)
+              throw Error(ErrorCategory::ToleranceNotMet,
+                          where + ": the lattice cannot meet every move (" + message +
+                              "); free more control points, use a finer lattice or ask for "
+                              "fewer moves");
+            return solved;
+          } else {
+            throw Error(ErrorCategory::InvalidArgument,
+                        where +
+                            ": a style step shapes one surface by its control points; a "
+                            "model deforms through lattices, direct manipulation and "
+                            "regular deformations (taper, twist, bend)");
+          }
+        },
+        step.step);
+    if (const auto* b = std::get_if<deform::BezierLattice>(&lattice))
+      fold_free = fold_free && deform::jacobian_bounds(*b).fold_free;
+    if (const auto* b = std::get_if<deform::BSplineLattice>(&lattice))
+      fold_free = fold_free && deform::jacobian_bounds(*b).fold_free;
+    stack.steps.push_back({std::move(lattice), step.name, step.enabled});
+  }
+  return stack;
+}
+
+/// The faces of `flat` the model's "bodies" and "faces" name (every face when both are empty);
+/// a name that matches nothing is refused, listing the names the model has.
+std::vector<int> chosen_faces(const brep::Model& flat, const ModelDef& def) {
+  std::vector<int> out;
+  if (def.bodies.empty() && def.faces.empty()) return out;
+  std::vector<bool> chosen(flat.faces.size(), false);
+  auto known = [](const auto& items) {
+    std::vector<std::string> names;
+    for (const auto& x : items)
+      if (!x.name.empty() && std::find(names.begin(), names.end(), x.name) == names.end())
+        names.push_back(x.name);
+    std::string text;
+    for (const auto& n : names) text += (text.empty() ? "\"" : ", \"") + n + "\"";
+    return text.empty() ? std::string("none is named") : text;
+  };
+  for (std::size_t i = 0; i < def.bodies.size(); ++i) {
+    bool found = false;
+    for (const brep::Body& body : flat.bodies)
+      if (body.name == def.bodies[i]) {
+        found = true;
+        for (const brep::Shell& shell : body.shells)
+          for (int f : shell.faces) chosen[static_cast<std::size_t>(f)] = true;
+      }
+    if (!found)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "bodies[" + std::to_string(i) + "]: the model has no body named \"" +
+                      def.bodies[i] + "\"; its bodies: " + known(flat.bodies));
+  }
+  for (std::size_t i = 0; i < def.faces.size(); ++i) {
+    bool found = false;
+    for (std::size_t f = 0; f < flat.faces.size(); ++f)
+      if (flat.faces[f].name == def.faces[i]) found = chosen[f] = true;
+    if (!found)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "faces[" + std::to_string(i) + "]: the model has no face named \"" +
+                      def.faces[i] + "\"; its named faces: " + known(flat.faces));
+  }
+  for (std::size_t f = 0; f < chosen.size(); ++f)
+    if (chosen[f]) out.push_back(static_cast<int>(f));
+  return out;
+}
+
+ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
+  const auto t0 = Clock::now();
+  ModelRunResult out;
+  out.recipe = d.name;
+  out.name = def.name;
+  out.source = def.file.string();
+  out.deformation = def.deformation;
+  out.bodies = def.bodies;
+  out.faces = def.faces;
+  out.formats = def.formats;
+  out.schema = def.schema;
+  brep::ModelReadOptions read_options;
+  read_options.sew = def.sew;
+  read_options.read.isolate = true;  // a file that crashes OpenCASCADE fails the run, not clayform
+  const brep::Model flat = brep::flattened(brep::read_model(def.file, read_options).model);
+  if (def.deformation.empty()) {
+    out.model = flat;
+    out.report.counts = brep::counts(flat);
+    out.report.faces_untouched = out.report.counts.faces;
+    out.report.edges_untouched = out.report.counts.edges;
+    for (const brep::EdgeGap& g : brep::edge_gaps(flat))
+      out.report.max_edge_gap_mm = std::max(out.report.max_edge_gap_mm, g.gap_mm);
+    out.report.volume_before_mm3 = out.report.volume_after_mm3 = brep::volume_mm3(flat);
+  } else {
+    const StackDef& stack_def = pick_stack(d, def.deformation);
+    const deform::DeformationStack stack = model_stack(stack_def, out.fold_free);
+    deform::ModelDeformationOptions options;
+    options.surface = Runner::deformation_options(d.composition);
+    options.faces = chosen_faces(flat, def);
+    auto r = deform::deform_model(stack, flat, options);
+    out.model = std::move(r.model);
+    out.report = std::move(r.report);
+  }
+  out.seconds = seconds_since(t0);
+  return out;
 }
 
 }  // namespace
@@ -638,57 +805,7 @@ ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
   ModelRunResult result;
   result.recipe = d.name;
   result.deformation = def.name;
-  deform::DeformationStack stack;
-  for (std::size_t i = 0; i < def.steps.size(); ++i) {
-    const StepDef& step = def.steps[i];
-    const std::string where = def.path + ".steps[" + std::to_string(i) + "] (" + step.kind + ")";
-    deform::Deformation lattice = std::visit(
-        [&](const auto& k) -> deform::Deformation {
-          using T = std::decay_t<decltype(k)>;
-          if constexpr (std::is_same_v<T, deform::Deformation>) {
-            return k;
-          } else if constexpr (std::is_same_v<T, DirectDef>) {
-            std::vector<deform::PointMove> moves;
-            for (const auto& m : k.moves) {
-              if (m.on_surface)
-                throw Error(ErrorCategory::InvalidArgument,
-                            where +
-                                ": a move from a \"surface_point\" needs one surface; to "
-                                "deform a model, give the move's \"point\" in space");
-              moves.push_back({m.point, m.to});
-            }
-            deform::Deformation solved;
-            bool feasible = true;
-            std::string message;
-            std::visit(
-                [&](const auto& lat) {
-                  auto r = deform::manipulate(lat, moves, k.options);
-                  feasible = r.report.feasible;
-                  message = r.report.summary.message;
-                  solved = std::move(r.lattice);
-                },
-                k.lattice);
-            if (!feasible && !k.accept_out_of_tolerance)
-              throw Error(ErrorCategory::ToleranceNotMet,
-                          where + ": the lattice cannot meet every move (" + message +
-                              "); free more control points, use a finer lattice or ask for "
-                              "fewer moves");
-            return solved;
-          } else {
-            throw Error(ErrorCategory::InvalidArgument,
-                        where +
-                            ": a style step shapes one surface by its control points; a "
-                            "model deforms through lattices, direct manipulation and "
-                            "regular deformations (taper, twist, bend)");
-          }
-        },
-        step.step);
-    if (const auto* b = std::get_if<deform::BezierLattice>(&lattice))
-      result.fold_free = result.fold_free && deform::jacobian_bounds(*b).fold_free;
-    if (const auto* b = std::get_if<deform::BSplineLattice>(&lattice))
-      result.fold_free = result.fold_free && deform::jacobian_bounds(*b).fold_free;
-    stack.steps.push_back({std::move(lattice), step.name, step.enabled});
-  }
+  const deform::DeformationStack stack = model_stack(def, result.fold_free);
   deform::ModelDeformationOptions options;
   options.surface = Runner::deformation_options(d.composition);
   try {

@@ -4,6 +4,7 @@
 // lattice built here from the same numbers), closed forms, the exchange read-back.
 #include <catch2/catch.hpp>
 
+#include <clay/brep/exchange.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
@@ -1179,4 +1180,62 @@ TEST_CASE("a refit that misses its tolerance at the refit's caps fails the run, 
   CHECK_THAT(message, Contains("raise the composition's \"max_control_points\" (at most 40,000)"));
   CHECK_THAT(message, Contains("\"accept_out_of_tolerance\": true"));
   CHECK_THAT(message, !Contains("Options"));
+}
+
+TEST_CASE(
+    "recipe models: the assembly's pins lean by name, exactly; the plate stays; a bend refits",
+    "[recipe]") {
+  const fs::path file = fs::path(CLAY_EXAMPLES_DIR) / "recipes" / "assembly_model.json";
+  const Recipe recipe = load_recipe(file);
+  const RunResult run = run_recipe(recipe);
+  REQUIRE(run.models.size() == 2);
+  const ModelRunResult& lean = run.models[0];
+  CHECK(lean.name == "pins_leaning");
+  CHECK(lean.bodies == std::vector<std::string>{"pin"});
+  // The model as read, flattened: the plate and the two placed pins.
+  const clay::brep::Model read = clay::brep::flattened(
+      clay::brep::read_model(fs::path(CLAY_EXAMPLES_DIR) / "models" / "assembly.step").model);
+  REQUIRE(read.faces.size() == lean.model.faces.size());
+  // The lattice moves its top corners by (4, 0, 0): the shear x += 4 (z - 4) / 14 (closed form).
+  int pins = 0, plate = 0;
+  for (std::size_t b = 0; b < read.bodies.size(); ++b)
+    for (const auto& shell : read.bodies[b].shells)
+      for (int f : shell.faces) {
+        const auto& before = read.faces[static_cast<std::size_t>(f)].surface;
+        const auto& after = lean.model.faces[static_cast<std::size_t>(f)].surface;
+        if (read.bodies[b].name != "pin") {
+          CHECK(surface::identical(before, after));
+          ++plate;
+          continue;
+        }
+        ++pins;
+        const auto [u0, u1] = before.u.domain();
+        const auto [v0, v1] = before.v.domain();
+        for (int i = 0; i <= 4; ++i)
+          for (int j = 0; j <= 4; ++j) {
+            const double u = std::min(u1, u0 + (u1 - u0) * i / 4),
+                         v = std::min(v1, v0 + (v1 - v0) * j / 4);
+            const Eigen::Vector3d p = surface::evaluate(before, u, v);
+            const Eigen::Vector3d sheared = p + Eigen::Vector3d(4 * (p.z() - 4) / 14, 0, 0);
+            CHECK((surface::evaluate(after, u, v) - sheared).norm() <= 1e-12 * 60);
+          }
+      }
+  CHECK(plate == 6);
+  CHECK(pins == 6);  // two pins of three faces
+  CHECK(lean.report.faces_exact == 6);
+  CHECK(lean.report.faces_untouched == 6);
+  // The bend: every face refitted, every edge within its tolerance, the tolerances within the
+  // certified bound, and a valid solid for OpenCASCADE.
+  const ModelRunResult& bent = run.models[1];
+  CHECK(bent.report.faces_refit == 12);
+  CHECK(bent.report.max_certified_bound_mm > 0);
+  for (const auto& g : clay::brep::edge_gaps(bent.model)) {
+    const auto& edge = bent.model.edges[static_cast<std::size_t>(g.edge)];
+    CHECK(g.gap_mm <= edge.tolerance_mm);
+  }
+  CHECK(clay::brep::check_model(bent.model).valid);
+  // The report lists both models with their figures.
+  const std::string report = report_json(run);
+  CHECK_THAT(report, Contains("\"name\": \"pins_leaning\"") && Contains("\"faces_untouched\": 6") &&
+                         Contains("\"bodies\": [\n"));
 }

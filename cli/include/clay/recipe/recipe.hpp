@@ -113,15 +113,37 @@ struct Stage {
   std::function<Eigen::Vector3d(const Eigen::Vector3d&)> map;
 };
 
+/// A whole model deformed by a recipe's deformation stack (the "clayform deform" use, and each
+/// entry of a recipe's "models").
+struct ModelRunResult {
+  std::string recipe;       ///< the recipe's name
+  std::string name;         ///< the recipe's name for the model (file stem of its outputs)
+  std::string source;       ///< the file it was imported from
+  std::string deformation;  ///< the stack's name ("" when the model is written as read)
+  /// The bodies and faces the recipe chose to deform, by name (both empty: every face).
+  std::vector<std::string> bodies, faces;
+  brep::Model model;  ///< the deformed model (flattened when it was an assembly)
+  deform::ModelDeformationReport report;
+  bool fold_free = true;             ///< every lattice step's Jacobian bounds are positive
+  std::vector<std::string> formats;  ///< "step", "iges", "glb" (the model's, or for `clayform
+                                     ///< deform` the recipe's first export's; all three when none)
+  std::string schema = "AP214";      ///< STEP schema
+  double seconds = 0;                ///< wall time
+  // Filled in by write_outputs:
+  std::vector<std::string> files;  ///< file names written (in out_dir)
+  bool valid = false;              ///< BRepCheck of every STEP/IGES file written, read back
+};
+
 /// Everything a run computed, in memory. Nothing is written until write_outputs.
 struct CLAY_RECIPE_API RunResult {
   std::string recipe;                                                     ///< the recipe's name
   std::vector<std::pair<std::string, surface::BSplineCurve>> curves;      ///< every named curve
   std::vector<std::pair<std::string, surface::BSplineSurface>> surfaces;  ///< every named surface
   std::vector<ExportResult> exports;                                      ///< in document order
-  std::vector<StepReport> steps;  ///< every step in order of execution
-  std::vector<Stage> stages;      ///< every enabled deformation step, in order of execution
-  double seconds = 0;             ///< wall time of the whole run
+  std::vector<ModelRunResult> models;  ///< the recipe's imported models, in document order
+  std::vector<StepReport> steps;       ///< every step in order of execution
+  std::vector<Stage> stages;           ///< every enabled deformation step, in order of execution
+  double seconds = 0;                  ///< wall time of the whole run
   /// The named surface. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
   const surface::BSplineSurface& surface(std::string_view name) const;
   /// The named curve. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
@@ -143,18 +165,6 @@ CLAY_RECIPE_API RunResult deform_surfaces(const Recipe& recipe,
                                           const std::vector<surface::BSplineSurface>& surfaces,
                                           std::string_view stem, std::string_view deformation = {},
                                           const RunOptions& options = {});
-
-/// A whole model deformed by a recipe's deformation stack (the "clayform deform" use).
-struct ModelRunResult {
-  std::string recipe;       ///< the recipe's name
-  std::string deformation;  ///< the stack's name
-  brep::Model model;        ///< the deformed model (flattened when it was an assembly)
-  deform::ModelDeformationReport report;
-  bool fold_free = true;             ///< every lattice step's Jacobian bounds are positive
-  std::vector<std::string> formats;  ///< the recipe's first export's (all three when none)
-  std::string schema = "AP214";      ///< STEP schema
-  double seconds = 0;                ///< wall time
-};
 
 /// Deforms `model` by the recipe's deformation stack `deformation` (may be empty when the recipe
 /// has exactly one) with the recipe's composition mode (deform::deform_model). Lattices, regular
