@@ -274,6 +274,10 @@ Json model_figures(const ModelRunResult& r) {
   model["volume_before_mm3"] = m.volume_before_mm3;
   model["volume_after_mm3"] = m.volume_after_mm3;
   model["solids_reversed"] = m.solids_reversed;
+  if (m.volume_ratio_bounded) {
+    model["volume_ratio_min"] = m.volume_ratio_min;
+    model["volume_ratio_max"] = m.volume_ratio_max;
+  }
   model["fold_free"] = r.fold_free;
   model["message"] = m.brief();
   return model;

@@ -1,6 +1,8 @@
 // Deformation of whole B-rep models (see clay/deform/model_deformation.hpp).
 #include <clay/deform/model_deformation.hpp>
 
+#include <clay/deform/jacobian.hpp>
+
 #include <clay/brep/volume.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/checks.hpp>
@@ -190,6 +192,12 @@ std::string ModelDeformationReport::brief() const {
                   volume_after_mm3);
     line += text;
   }
+  if (volume_ratio_bounded && (volume_before_mm3 != 0 || volume_after_mm3 != 0)) {
+    std::snprintf(text, sizeof text, " (ratio %.6g, Jacobian bounds [%.6g, %.6g])",
+                  volume_before_mm3 != 0 ? volume_after_mm3 / volume_before_mm3 : 0.0,
+                  volume_ratio_min, volume_ratio_max);
+    line += text;
+  }
   if (solids_reversed > 0)
     line += "; " + std::to_string(solids_reversed) + " solids reversed (mirroring stack)";
   return line;
@@ -346,6 +354,25 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
     }
     report.volume_after_mm3 += std::abs(after[b]);
   }
+  // The Jacobian's volume bounds (lattices only: a twist or bend has no coefficient bounds).
+  report.volume_ratio_bounded = options.faces.empty();
+  for (const DeformationStep& step : stack.steps) {
+    if (!step.enabled) continue;
+    std::visit(
+        [&](const auto& d) {
+          using T = std::decay_t<decltype(d)>;
+          if constexpr (std::is_same_v<T, BezierLattice> || std::is_same_v<T, BSplineLattice>) {
+            const JacobianBounds b = jacobian_bounds(d);
+            report.volume_ratio_bounded = report.volume_ratio_bounded && b.fold_free;
+            report.volume_ratio_min *= std::min(b.min, 1.0);
+            report.volume_ratio_max *= std::max(b.max, 1.0);
+          } else {
+            report.volume_ratio_bounded = false;
+          }
+        },
+        step.deformation);
+  }
+  if (!report.volume_ratio_bounded) report.volume_ratio_min = report.volume_ratio_max = 1;
   report.summary.termination = Termination::Converged;
   report.summary.final_residual = report.max_edge_gap_mm;
   report.summary.message = report.brief();

@@ -135,7 +135,13 @@ TEST_CASE("deform_model: a filleted block with holes through a trilinear lattice
   CHECK(r.faces_refit == 0);
   CHECK(r.edges_refit == 0);
   CHECK(r.max_certified_bound_mm == 0);
-  const double size = 75;  // the block's diagonal is 74.8 mm
+  // Green's-theorem volumes against the Jacobian's coefficient bounds (independent computations).
+  REQUIRE(r.volume_ratio_bounded);
+  const double ratio = r.volume_after_mm3 / r.volume_before_mm3;
+  CHECK(ratio >= r.volume_ratio_min);
+  CHECK(ratio <= r.volume_ratio_max);
+  CHECK(r.volume_ratio_max > 1);  // the raised corner grows the block
+  const double size = 75;         // the block's diagonal is 74.8 mm
   CHECK(r.max_edge_gap_mm <= 1e-9 * size);
   CHECK(r.max_deviation_mm <= 1e-12 * size);
   // Pcurves kept bit for bit.
@@ -178,6 +184,10 @@ TEST_CASE("deform_model: a uniform scale changes the volume by its determinant")
   INFO(result.report.brief());
   CHECK(std::abs(result.report.volume_after_mm3 / result.report.volume_before_mm3 - 1.331) <=
         1e-9 * 1.331);
+  // The Jacobian's bounds are the determinant itself (a constant), widened to 1 outside.
+  CHECK(result.report.volume_ratio_bounded);
+  CHECK(result.report.volume_ratio_min == 1);
+  CHECK(std::abs(result.report.volume_ratio_max - 1.331) <= 1e-12);
   // An affine lattice keeps every degree.
   for (size_t f = 0; f < sphere.faces.size(); ++f) {
     CHECK(result.model.faces[f].surface.u.degree == sphere.faces[f].surface.u.degree);

@@ -65,6 +65,13 @@ struct CLAY_DEFORM_API ModelDeformationReport {
   double volume_before_mm3 = 0;  ///< brep::volume_mm3 of the solids
   double volume_after_mm3 = 0;
   int solids_reversed = 0;  ///< solids turned inside out by a mirroring stack, faces reversed
+  /// When every enabled step is a fold-free Bézier or B-spline lattice and every face was free to
+  /// deform: bounds on the volume ratio det DF from the lattices' Jacobian coefficients
+  /// (Sederberg–Parry §4), multiplied over the steps and widened to 1 (the FFD is the identity
+  /// outside its lattice). volume_after / volume_before of each solid then lies within them
+  /// (exactly for exact results; within the refits' bounds otherwise).
+  bool volume_ratio_bounded = false;
+  double volume_ratio_min = 1, volume_ratio_max = 1;
   /// Converged, or Failed with the problems of the result; message = brief().
   Summary summary;
   /// One line: "42 faces: 30 exact, 0 refit, 12 untouched; 104 edges ...; edge gap 2e-12 mm;
