@@ -106,7 +106,7 @@ TopoDS_Shape bottle() {
 /// The bottle with an embossed label band: the body's cylinder r 15 rises by 45-degree cones to a
 /// band r 16 for z in [14, 30].
 TopoDS_Shape label_bottle() {
-  const std::vector<gp_Pnt> points{{0, 0, 0},  {15, 0, 0},  {15, 0, 13}, {16, 0, 14},
+  const std::vector<gp_Pnt> points{{0, 0, 0},   {15, 0, 0},  {15, 0, 13}, {16, 0, 14},
                                    {16, 0, 30}, {15, 0, 31}, {15, 0, 40}};
   BRepBuilderAPI_MakeWire wire;
   for (std::size_t k = 0; k + 1 < points.size(); ++k)
