@@ -1,5 +1,6 @@
 // The view data of a run: grid meshes with exact normals and curvatures, the refit deviation, and
 // the manifest the browser viewer reads (docs/recipe.md "Viewing a run").
+#include <clay/brep/exchange.hpp>
 #include <clay/error.hpp>
 #include <clay/recipe/view.hpp>
 #include <clay/surface/basis.hpp>
@@ -83,6 +84,36 @@ bool is_refit(const StepReport* step) {
     if (name == "composition")
       return std::holds_alternative<std::string>(value) && std::get<std::string>(value) == "refit";
   return false;
+}
+
+/// Writes a .bin mesh file: the floats, then the triangles' node indices (uint32), both
+/// little-endian.
+void write_mesh_file(const fs::path& file, std::vector<float> f,
+                     const std::vector<std::array<int, 3>>& triangles) {
+  std::vector<std::uint32_t> index;
+  index.reserve(3 * triangles.size());
+  for (const auto& t : triangles)
+    for (int k : t) index.push_back(static_cast<std::uint32_t>(k));
+  if constexpr (std::endian::native == std::endian::big) {
+    auto swap = [](std::uint32_t b) {
+      return ((b & 0xFFu) << 24) | ((b & 0xFF00u) << 8) | ((b >> 8) & 0xFF00u) | (b >> 24);
+    };
+    for (float& x : f) {
+      std::uint32_t b;
+      std::memcpy(&b, &x, 4);
+      b = swap(b);
+      std::memcpy(&x, &b, 4);
+    }
+    for (std::uint32_t& k : index) k = swap(k);
+  }
+  std::ofstream out(file, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(f.data()),
+            static_cast<std::streamsize>(f.size() * sizeof(float)));
+  out.write(reinterpret_cast<const char*>(index.data()),
+            static_cast<std::streamsize>(index.size() * sizeof(std::uint32_t)));
+  if (!out)
+    throw Error(ErrorCategory::Io,
+                "cannot write \"" + file.string() + "\"; check the space and permissions");
 }
 
 }  // namespace
@@ -180,6 +211,56 @@ ViewMesh view_mesh(const surface::BSplineSurface& s) {
   return m;
 }
 
+ViewMesh view_mesh(const brep::Model& model) {
+  const brep::Model flat = brep::flattened(model);
+  const brep::ModelMesh mesh = brep::tessellate(flat);
+  ViewMesh m;
+  m.triangles = mesh.triangles;
+  m.position = mesh.positions;
+  m.normal = mesh.normals;
+  const std::size_t n = mesh.positions.size();
+  m.gaussian.assign(n, 0.0);
+  m.mean.assign(n, 0.0);
+  m.deviation.assign(n, 0.0);
+  m.degenerate.assign(n, 0);
+  for (std::size_t k = 0; k < n; ++k) {
+    const surface::BSplineSurface& s =
+        flat.faces[static_cast<std::size_t>(mesh.node_face[k])].surface;
+    const surface::SurfaceDerivatives x = surface::derivatives(s, mesh.uv[k].x(), mesh.uv[k].y());
+    const Vector3d c = x.du.cross(x.dv);
+    const double cn = c.norm(), nu = x.du.norm(), nv = x.dv.norm();
+    if (!(cn > 1e-8 * nu * nv) || !std::isfinite(cn)) {  // a pole, or S_u parallel to S_v
+      m.degenerate[k] = 1;
+      continue;
+    }
+    // The outward normal of the mesh gives the sign of H (it bends towards the normal shown).
+    const Vector3d normal = (c.dot(mesh.normals[k]) < 0 ? -1.0 : 1.0) * c / cn;
+    const double E = x.du.dot(x.du), F = x.du.dot(x.dv), G = x.dv.dot(x.dv);
+    const double L = x.duu.dot(normal), M = x.duv.dot(normal), N = x.dvv.dot(normal);
+    const double det = cn * cn;
+    m.gaussian[k] = (L * N - M * M) / det;
+    m.mean[k] = (E * N - 2 * F * M + G * L) / (2 * det);
+  }
+  // Degenerate nodes: the mean of their non-degenerate neighbours along the triangles.
+  std::vector<double> K(n, 0.0), H(n, 0.0);
+  std::vector<int> count(n, 0);
+  for (const auto& t : m.triangles)
+    for (int a : t)
+      for (int b : t) {
+        const auto i = static_cast<std::size_t>(a), j = static_cast<std::size_t>(b);
+        if (!m.degenerate[i] || m.degenerate[j]) continue;
+        K[i] += m.gaussian[j];
+        H[i] += m.mean[j];
+        ++count[i];
+      }
+  for (std::size_t k = 0; k < n; ++k)
+    if (m.degenerate[k] && count[k] > 0) {
+      m.gaussian[k] = K[k] / count[k];
+      m.mean[k] = H[k] / count[k];
+    }
+  return m;
+}
+
 void set_deviation(ViewMesh& mesh, const surface::BSplineSurface& before,
                    const std::function<Vector3d(const Vector3d&)>& map) {
   if (!map || mesh.us.empty() || mesh.vs.empty()) return;
@@ -232,6 +313,7 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
     Vector3d lo, hi;  // of the mesh's vertices
   };
   std::vector<Written> written;
+  std::size_t models_written = 0;
   Vector3d lo = Vector3d::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   const auto mesh = [&](const surface::BSplineSurface& s, int source, bool boxed) -> Json {
     for (const auto& w : written)
@@ -258,20 +340,7 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
     }
     char name[32];
     std::snprintf(name, sizeof name, "%03zu.bin", written.size());
-    std::vector<float> f = view_floats(m);
-    if constexpr (std::endian::native == std::endian::big)
-      for (float& x : f) {
-        std::uint32_t b;
-        std::memcpy(&b, &x, 4);
-        b = ((b & 0xFFu) << 24) | ((b & 0xFF00u) << 8) | ((b >> 8) & 0xFF00u) | (b >> 24);
-        std::memcpy(&x, &b, 4);
-      }
-    std::ofstream out(view / name, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(f.data()),
-              static_cast<std::streamsize>(f.size() * sizeof(float)));
-    if (!out)
-      throw Error(ErrorCategory::Io, "cannot write \"" + (view / name).string() +
-                                         "\"; check the space and permissions");
+    write_mesh_file(view / name, view_floats(m), {});
     written.push_back({&s, source, name, m.rows, m.cols, mlo, mhi});
     return Json{{"file", name}, {"rows", m.rows}, {"cols", m.cols}};
   };
@@ -329,6 +398,32 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
       x["stages"] = std::move(stages);
       surfaces.push_back(std::move(x));
     }
+
+  // Whole models: one triangle mesh each, all faces trimmed (holes are holes).
+  for (const auto& model : result.models) {
+    const ViewMesh m = view_mesh(model.model);
+    for (const auto& p : m.position) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    char name[32];
+    std::snprintf(name, sizeof name, "%03zu.bin", written.size() + models_written++);
+    write_mesh_file(view / name, view_floats(m), m.triangles);
+    Json figures = Json::object();
+    for (const auto& step : result.steps)
+      if (step.path == "models." + model.name)
+        for (const auto& [n, value] : step.figures) figures[n] = figure_json(value);
+    Json x = Json::object();
+    x["name"] = model.name;
+    x["export"] = model.name;
+    x["kind"] = "model";
+    x["figures"] = std::move(figures);
+    x["mesh"] =
+        Json{{"file", name}, {"vertices", m.position.size()}, {"triangles", m.triangles.size()}};
+    x["net"] = nullptr;
+    x["stages"] = Json::array();
+    surfaces.push_back(std::move(x));
+  }
 
   Json j = Json::object();
   j["format"] = "clayform.view";

@@ -4,6 +4,7 @@
 // `clayform view` exercised with cpp-httplib's client.
 #include <catch2/catch.hpp>
 
+#include <clay/brep/exchange.hpp>
 #include <clay/deform/regular.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/recipe/view.hpp>
@@ -263,6 +264,45 @@ TEST_CASE("a plane's mesh has K = H = 0 and the plane's normal", "[view]") {
     CHECK(std::abs(m.mean[k]) < 1e-12);
     CHECK((m.normal[k] - n).norm() < 1e-12);
   }
+}
+
+TEST_CASE("a whole model's view mesh: trimmed triangles, the cylinder's and the plane's curvature",
+          "[view]") {
+  // The label bottle: a cylinder r 15 for z in [0, 13] and [31, 40], a band r 16 for z in
+  // [14, 30], a flat bottom at z = 0. With the outward normal, H = -1 / (2 r) on a cylinder.
+  const clay::brep::Model bottle =
+      clay::brep::read_model(fs::path(CLAY_EXAMPLES_DIR) / "models" / "label_bottle.step").model;
+  const ViewMesh m = view_mesh(bottle);
+  REQUIRE(m.rows == 0);
+  REQUIRE(!m.triangles.empty());
+  REQUIRE(m.gaussian.size() == m.position.size());
+  REQUIRE(m.normal.size() == m.position.size());
+  // Which face each node lies on, from the same (deterministic) mesh, and what that face is:
+  // OpenCASCADE's mesher puts a cylinder's nodes on its rims, so nodes are told by their face.
+  const clay::brep::Model flat = clay::brep::flattened(bottle);
+  const clay::brep::ModelMesh mesh = clay::brep::tessellate(flat);
+  REQUIRE(mesh.positions.size() == m.position.size());
+  int cylinders = 0, planes = 0;
+  for (std::size_t k = 0; k < m.position.size(); ++k) {
+    CHECK(mesh.positions[k] == m.position[k]);
+    const auto& e = flat.faces[static_cast<std::size_t>(mesh.node_face[k])].elementary;
+    if (!e) continue;
+    if (e->kind == clay::brep::ElementaryKind::Cylinder) {
+      ++cylinders;
+      CHECK(std::abs(m.gaussian[k]) <= 1e-9);
+      CHECK(m.mean[k] == Approx(-1.0 / (2 * e->radius)).epsilon(1e-9));
+      CHECK(std::abs(std::hypot(m.position[k].x(), m.position[k].y()) - e->radius) <= 1e-9);
+    } else if (e->kind == clay::brep::ElementaryKind::Plane) {
+      ++planes;
+      CHECK(m.gaussian[k] == 0);
+      CHECK(m.mean[k] == 0);
+      CHECK(std::abs(m.normal[k].z()) == Approx(1));
+    }
+  }
+  CHECK(cylinders > 40);
+  CHECK(planes > 10);
+  // view_floats then the triangles: what write_view_data writes for a model.
+  CHECK(view_floats(m).size() == 9 * m.position.size());
 }
 
 TEST_CASE("write_outputs writes the view folder: manifest, meshes read back equal the surfaces",

@@ -55,10 +55,13 @@ const BACKGROUND = [0x30, 0x34, 0x3a];
 // ------------------------------------------------------------------ the run, read independently
 const manifest = JSON.parse(readFileSync(join(runDir, 'view', 'manifest.json'), 'utf8'));
 const ATTR_OFFSET = { gaussian: 6, mean: 7, deviation: 8 }; // in units of R*C floats
+/** Vertices of a MESH: rows x cols for a grid, `vertices` for a model's triangle mesh. */
+const vertexCount = (mesh) => (mesh.triangles !== undefined ? mesh.vertices : mesh.rows * mesh.cols);
 function readAttr(mesh, attr) {
   const buf = readFileSync(join(runDir, 'view', mesh.file));
-  const n = mesh.rows * mesh.cols;
-  if (buf.length !== 36 * n) throw new Error(`${mesh.file}: ${buf.length} bytes, expected ${36 * n}`);
+  const n = vertexCount(mesh);
+  const bytes = 36 * n + 12 * (mesh.triangles || 0); // a model's file ends with its uint32 triangles
+  if (buf.length !== bytes) throw new Error(`${mesh.file}: ${buf.length} bytes, expected ${bytes}`);
   const out = new Float64Array(n);
   for (let k = 0; k < n; k++) out[k] = buf.readFloatLE(4 * (ATTR_OFFSET[attr] * n + k));
   return out;
@@ -80,7 +83,7 @@ function expectedRange(meshes, attr) {
 }
 const finals = manifest.surfaces.map((s) => s.mesh);
 const befores = manifest.surfaces.map((s) => (s.stages && s.stages.length ? s.stages[0].before : s.mesh));
-const vertices = (meshes) => meshes.reduce((n, m) => n + m.rows * m.cols, 0);
+const vertices = (meshes) => meshes.reduce((n, m) => n + vertexCount(m), 0);
 const hasStages = manifest.surfaces.some((s) => s.stages && s.stages.length);
 const empty = manifest.surfaces.length === 0; // a run with no surface: nothing to compare in pictures
 

@@ -1,5 +1,6 @@
 // Reading the view folder a run writes (docs/viewer.md, "The view folder"): manifest.json and the
-// MESH .bin files (little-endian float32, attribute after attribute, vertex (i, j) at i*cols + j).
+// MESH .bin files (little-endian float32, attribute after attribute, vertex (i, j) at i*cols + j;
+// a whole model's triangle mesh then has its uint32 triangle indices).
 import * as THREE from 'three';
 
 /** The attributes of a MESH file, in file order, with their float count per vertex. */
@@ -25,7 +26,11 @@ export function checkManifest(manifest) {
   if (!Array.isArray(manifest.surfaces)) throw new Error('manifest: no "surfaces" array');
   const checkMesh = (mesh, where) => {
     if (!mesh || typeof mesh.file !== 'string') throw new Error(`${where}: no mesh file`);
-    if (!(mesh.rows >= 2 && mesh.cols >= 2)) throw new Error(`${where}: rows and cols must be at least 2`);
+    if (isTriangleMesh(mesh)) {
+      if (!(mesh.vertices >= 3 && mesh.triangles >= 1)) throw new Error(`${where}: a triangle mesh needs vertices >= 3 and triangles >= 1`);
+    } else if (!(mesh.rows >= 2 && mesh.cols >= 2)) {
+      throw new Error(`${where}: rows and cols must be at least 2`);
+    }
   };
   manifest.surfaces.forEach((s, i) => {
     const where = `surfaces[${i}]`;
@@ -38,22 +43,50 @@ export function checkManifest(manifest) {
   return manifest;
 }
 
-/** Splits a MESH file's bytes into its attributes (Float32Array views, no copy on little-endian). */
-export function parseMesh(buffer, rows, cols, name = 'mesh') {
-  const n = rows * cols;
-  const expected = 4 * FLOATS_PER_VERTEX * n;
+/** A whole model's MESH: a triangle mesh (vertices, triangles) instead of a grid (rows, cols). */
+export function isTriangleMesh(mesh) {
+  return mesh && mesh.triangles !== undefined;
+}
+
+/** The number of vertices of a MESH entry of the manifest. */
+export function vertexCount(mesh) {
+  return isTriangleMesh(mesh) ? mesh.vertices : mesh.rows * mesh.cols;
+}
+
+/**
+ * Splits a MESH file's bytes into its attributes (Float32Array views, no copy on little-endian).
+ * `shape` is the manifest's entry: {rows, cols} for a grid, {vertices, triangles} for a model's
+ * triangle mesh, whose file then holds 3 uint32 node indices per triangle after the floats.
+ */
+export function parseMesh(buffer, shape, name = 'mesh') {
+  const triangles = isTriangleMesh(shape) ? shape.triangles : 0;
+  const n = vertexCount(shape);
+  const expected = 4 * FLOATS_PER_VERTEX * n + 12 * triangles;
   if (buffer.byteLength !== expected) {
-    throw new Error(`${name}: ${buffer.byteLength} bytes, expected ${expected} for ${rows} x ${cols} vertices`);
+    const what = triangles ? `${n} vertices and ${triangles} triangles` : `${shape.rows} x ${shape.cols} vertices`;
+    throw new Error(`${name}: ${buffer.byteLength} bytes, expected ${expected} for ${what}`);
   }
+  const littleEndian = new Uint8Array(new Uint16Array([1]).buffer)[0] === 1;
   let floats;
-  if (new Uint8Array(new Uint16Array([1]).buffer)[0] === 1) {
-    floats = new Float32Array(buffer);
+  if (littleEndian) {
+    floats = new Float32Array(buffer, 0, FLOATS_PER_VERTEX * n);
   } else {
     const view = new DataView(buffer);
     floats = new Float32Array(FLOATS_PER_VERTEX * n);
     for (let i = 0; i < floats.length; i++) floats[i] = view.getFloat32(4 * i, true);
   }
-  const mesh = { rows, cols };
+  const mesh = { rows: shape.rows, cols: shape.cols, vertices: n };
+  if (triangles) {
+    const offset = 4 * FLOATS_PER_VERTEX * n;
+    if (littleEndian) {
+      mesh.index = new Uint32Array(buffer, offset, 3 * triangles);
+    } else {
+      const view = new DataView(buffer);
+      mesh.index = new Uint32Array(3 * triangles);
+      for (let i = 0; i < mesh.index.length; i++) mesh.index[i] = view.getUint32(offset + 4 * i, true);
+    }
+    for (const k of mesh.index) if (k >= n) throw new Error(`${name}: a triangle refers to vertex ${k} of ${n}`);
+  }
   let offset = 0;
   for (const [attr, k] of MESH_ATTRIBUTES) {
     mesh[attr] = floats.subarray(offset, offset + k * n);
@@ -88,7 +121,7 @@ export function gridIndex(rows, cols) {
 
 export function meshGeometry(mesh) {
   const g = new THREE.BufferGeometry();
-  g.setIndex(gridIndex(mesh.rows, mesh.cols));
+  g.setIndex(mesh.index ? new THREE.BufferAttribute(mesh.index, 1) : gridIndex(mesh.rows, mesh.cols));
   for (const [attr, k] of MESH_ATTRIBUTES) g.setAttribute(attr, new THREE.BufferAttribute(mesh[attr], k));
   g.computeBoundingBox();
   g.computeBoundingSphere();
@@ -114,7 +147,7 @@ export class MeshStore {
           return r.arrayBuffer();
         })
         .then((buf) => {
-          const m = parseMesh(buf, mesh.rows, mesh.cols, mesh.file);
+          const m = parseMesh(buf, mesh, mesh.file);
           m.geometry = meshGeometry(m);
           return m;
         });

@@ -192,7 +192,7 @@ async function applyStates() {
     s.curves = buildCurves(curvesOf(s));
     s.group.add(s.net, s.curves);
   });
-  body.dataset.vertices = String(surfaces.reduce((n, s) => n + s.data.rows * s.data.cols, 0));
+  body.dataset.vertices = String(surfaces.reduce((n, s) => n + s.data.vertices, 0));
   const anyBefore = surfaces.some((s) => s.state.side === 'before');
   body.dataset.stage = anyBefore ? 'before' : 'after';
   const global = document.getElementById('toggle-before-after');

@@ -65,9 +65,12 @@ export function surfacePanel(surface, index, actions) {
     stats,
     figuresTable(surface.figures),
   );
-  meta.textContent = `${surface.mesh.rows} × ${surface.mesh.cols} samples · net ${
-    surface.net ? `${surface.net.rows} × ${surface.net.cols}` : '—'
-  }`;
+  meta.textContent =
+    surface.mesh.triangles !== undefined
+      ? `whole model: ${surface.mesh.triangles} triangles (trimmed faces) · ${surface.mesh.vertices} vertices`
+      : `${surface.mesh.rows} × ${surface.mesh.cols} samples · net ${
+          surface.net ? `${surface.net.rows} × ${surface.net.cols}` : '—'
+        }`;
 
   const toggles = [];
   const stages = surface.stages || [];

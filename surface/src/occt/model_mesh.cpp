@@ -123,6 +123,8 @@ ModelMesh tessellate(const Model& model, const MeshOptions& options) {
         const gp_Pnt2d q = t->UVNode(i);
         uv.emplace_back(std::clamp(q.X(), u0, u1), std::clamp(q.Y(), v0, v1));
         out.positions.emplace_back(p.X(), p.Y(), p.Z());
+        out.uv.push_back(uv.back());
+        out.node_face.push_back(static_cast<int>(f));
         out.normals.push_back((face.reversed ? -1.0 : 1.0) *
                               node_normal(face.surface, uv.back().x(), uv.back().y()));
       }

@@ -114,6 +114,8 @@ struct CLAY_OCCT_API MeshOptions {
 struct ModelMesh {
   std::vector<Eigen::Vector3d> positions;     ///< nodes, mm
   std::vector<Eigen::Vector3d> normals;       ///< unit outward normal at each node
+  std::vector<Eigen::Vector2d> uv;            ///< each node's (u, v) on its face's NURBS
+  std::vector<int> node_face;                 ///< the face each node lies on
   std::vector<std::array<int, 3>> triangles;  ///< node indices, counter-clockwise from outside
   std::vector<int> triangle_face;             ///< the face each triangle lies on
   std::vector<int> face_body;                 ///< the body of each face (-1: in no body)

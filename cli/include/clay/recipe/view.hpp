@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <vector>
@@ -15,9 +16,11 @@
 namespace clay::recipe {
 
 /// A grid tessellation: rows x cols vertices, vertex (i, j) at index i * cols + j, u along rows
-/// (parameter us[i]) and v along columns (vs[j]).
+/// (parameter us[i]) and v along columns (vs[j]); or, for a whole model's trimmed faces, a
+/// triangle mesh (rows = cols = 0, `triangles` not empty).
 struct ViewMesh {
   int rows = 0, cols = 0;
+  std::vector<std::array<int, 3>> triangles;  ///< a model's mesh; empty for a grid
   std::vector<double> us, vs;
   std::vector<Eigen::Vector3d> position;  ///< S(u, v), mm
   std::vector<Eigen::Vector3d>
@@ -43,6 +46,12 @@ CLAY_RECIPE_API std::vector<double> view_parameters(const surface::BSplineBasis&
 /// S_v — K and H are the average of the non-degenerate neighbouring vertices'. Deviation all 0.
 CLAY_RECIPE_API ViewMesh view_mesh(const surface::BSplineSurface& surface);
 
+/// A whole model's trimmed faces as a triangle mesh (brep::tessellate of `model`, holes are
+/// holes) with the exact normals and, at every node, the Gaussian and mean curvature of its face's
+/// NURBS at the node's (u, v), by the formulas of view_mesh (a degenerate node takes the mean of
+/// its non-degenerate neighbours'). Deviation all 0. Throws what brep::tessellate throws.
+CLAY_RECIPE_API ViewMesh view_mesh(const brep::Model& model);
+
 /// Sets mesh.deviation to |S(u, v) - map(B(u, v))| at every vertex, with S the tessellated
 /// surface (the refit) and B the surface before the step, its domain mapped affinely onto S's.
 CLAY_RECIPE_API void set_deviation(
@@ -50,7 +59,9 @@ CLAY_RECIPE_API void set_deviation(
     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map);
 
 /// The .bin layout: little-endian float32, attribute after attribute (position 3, normal 3,
-/// gaussian 1, mean 1, deviation 1 floats per vertex), rows * cols * 9 floats.
+/// gaussian 1, mean 1, deviation 1 floats per vertex), 9 floats per vertex; a triangle mesh's file
+/// then holds its triangles as little-endian uint32 node indices (3 per triangle, written by
+/// write_view_data after these floats).
 CLAY_RECIPE_API std::vector<float> view_floats(const ViewMesh& mesh);
 
 /// Writes `dir/view/manifest.json` (format "clayform.view", version 1) and the meshes
