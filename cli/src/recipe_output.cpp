@@ -153,6 +153,21 @@ std::vector<fs::path> move_in(const Staging& s, const std::vector<std::string>& 
   return written;
 }
 
+/// Moves the view folder from the temporary folder into the target as a whole: a previous run's
+/// meshes go, this run's come in one rename. Returns its path.
+fs::path move_view_in(const Staging& s) {
+  std::error_code ec;
+  fs::remove_all(s.target / "view", ec);
+  if (ec)
+    throw Error(ErrorCategory::Io,
+                "cannot replace \"" + (s.target / "view").string() + "\": " + ec.message());
+  fs::rename(s.tmp / "view", s.target / "view", ec);
+  if (ec)
+    throw Error(ErrorCategory::Io,
+                "cannot move \"view\" into \"" + s.target.string() + "\": " + ec.message());
+  return s.target / "view";
+}
+
 void write_text(const fs::path& file, const std::string& text) {
   std::ofstream out(file, std::ios::binary);
   out << text;
@@ -229,16 +244,7 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
     names.push_back("report.json");
     write_view_data(result, tmp);  // view/manifest.json and view/NNN.bin (clay/recipe/view.hpp)
     std::vector<fs::path> written = move_in(staging, names);
-    // The view folder as a whole: a previous run's meshes go, this run's come in one rename.
-    fs::remove_all(target / "view", ec);
-    if (ec)
-      throw Error(ErrorCategory::Io,
-                  "cannot replace \"" + (target / "view").string() + "\": " + ec.message());
-    fs::rename(tmp / "view", target / "view", ec);
-    if (ec)
-      throw Error(ErrorCategory::Io,
-                  "cannot move \"view\" into \"" + target.string() + "\": " + ec.message());
-    written.push_back(target / "view");
+    written.push_back(move_view_in(staging));
     fs::remove_all(tmp, ec);
     return written;
   } catch (...) {
@@ -365,7 +371,14 @@ std::vector<fs::path> write_model_outputs(const ModelRunResult& result, const fs
     const Json exports = write_model_files(result, staging, stem, names);
     write_text(staging.tmp / "report.json", model_report_json(result, exports).dump(2));
     names.push_back("report.json");
+    // The view folder (clayform view): the model as the one entry of a run's models.
+    RunResult run;
+    run.recipe = result.recipe;
+    run.models.push_back(result);
+    run.models.back().name = std::string(stem);
+    write_view_data(run, staging.tmp);
     std::vector<fs::path> written = move_in(staging, names);
+    written.push_back(move_view_in(staging));
     fs::remove_all(staging.tmp, ec);
     return written;
   } catch (...) {

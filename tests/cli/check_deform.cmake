@@ -22,7 +22,7 @@ foreach(expect "read [^\n]*sample.step: 2 bodies" "deformed by flare: 2 faces: 2
     message(FATAL_ERROR "clayform deform: expected '${expect}' in the progress lines:\n${out}")
   endif()
 endforeach()
-foreach(file sample.step sample.igs sample.glb report.json)
+foreach(file sample.step sample.igs sample.glb report.json view/manifest.json)
   if(NOT EXISTS ${WORK}/out/${file})
     message(FATAL_ERROR "clayform deform: ${file} missing in ${WORK}/out")
   endif()

@@ -175,7 +175,8 @@ CLAY_RECIPE_API ModelRunResult deform_model(const Recipe& recipe, const brep::Mo
                                             std::string_view deformation = {});
 
 /// Writes STEM.step, STEM.igs and STEM.glb (result.formats; the .glb a preview of the trimmed
-/// faces, brep::write_model) and report.json into `out_dir`, through a temporary folder as
+/// faces, brep::write_model), report.json and the view folder (the model's trimmed mesh, for
+/// `clayform view`) into `out_dir`, through a temporary folder as
 /// write_outputs does: each STEP and IGES file is read back (read_model) and checked (BRepCheck,
 /// the same counts) before anything is moved into `out_dir`. Returns the paths written. Throws
 /// clay::Error (Io, Exchange) naming the file.
