@@ -26,16 +26,22 @@ Json figure_json(const Figure& f) {
 
 Json model_figures(const ModelRunResult& r);
 
-}  // namespace
-
-std::string report_json(const RunResult& result) {
+/// The first keys of every report: format, version, recipe and the clayform that wrote it.
+Json report_header(const std::string& recipe) {
   Json j = Json::object();
   j["format"] = "clayform.report";
   j["version"] = 1;
-  j["recipe"] = result.recipe;
+  j["recipe"] = recipe;
 #ifdef CLAYFORM_VERSION
   j["clayform"] = CLAYFORM_VERSION;
 #endif
+  return j;
+}
+
+}  // namespace
+
+std::string report_json(const RunResult& result) {
+  Json j = report_header(result.recipe);
   bool warnings = false;
   Json steps = Json::array();
   for (const auto& s : result.steps) {
@@ -290,13 +296,7 @@ Json model_figures(const ModelRunResult& r) {
 }
 
 Json model_report_json(const ModelRunResult& r, const Json& exports) {
-  Json j = Json::object();
-  j["format"] = "clayform.report";
-  j["version"] = 1;
-  j["recipe"] = r.recipe;
-#ifdef CLAYFORM_VERSION
-  j["clayform"] = CLAYFORM_VERSION;
-#endif
+  Json j = report_header(r.recipe);
   j["ok"] = true;
   j["seconds"] = r.seconds;
   j["deformation"] = r.deformation;

@@ -39,6 +39,25 @@ bool outside(const Frame& frame, const surface::Points3& points) {
   return false;
 }
 
+/// Calls on_lattice(lattice) for each enabled Bézier or B-spline lattice step of `stack` and
+/// on_other() for each other enabled step, in order.
+template <class OnLattice, class OnOther>
+void for_each_enabled_step(const DeformationStack& stack, OnLattice&& on_lattice,
+                           OnOther&& on_other) {
+  for (const DeformationStep& step : stack.steps) {
+    if (!step.enabled) continue;
+    std::visit(
+        [&](const auto& d) {
+          using T = std::decay_t<decltype(d)>;
+          if constexpr (std::is_same_v<T, BezierLattice> || std::is_same_v<T, BSplineLattice>)
+            on_lattice(d);
+          else
+            on_other();
+        },
+        step.deformation);
+  }
+}
+
 /// Per enabled step, what makes it leave a face alone: a lattice whose points are all undisplaced
 /// (worked out once per step, not per face), or a face outside the lattice's box.
 struct Leaves {
@@ -46,21 +65,16 @@ struct Leaves {
   std::vector<bool> identity;        // the step's lattice is undisplaced
 
   explicit Leaves(const DeformationStack& stack) {
-    for (const DeformationStep& step : stack.steps) {
-      if (!step.enabled) continue;
-      std::visit(
-          [&](const auto& d) {
-            using T = std::decay_t<decltype(d)>;
-            if constexpr (std::is_same_v<T, BezierLattice> || std::is_same_v<T, BSplineLattice>) {
-              frames.push_back(&d.frame);
-              identity.push_back(d.points == undisplaced_points(d));
-            } else {
-              frames.push_back(nullptr);
-              identity.push_back(false);
-            }
-          },
-          step.deformation);
-    }
+    for_each_enabled_step(
+        stack,
+        [&](const auto& lattice) {
+          frames.push_back(&lattice.frame);
+          identity.push_back(lattice.points == undisplaced_points(lattice));
+        },
+        [&] {
+          frames.push_back(nullptr);
+          identity.push_back(false);
+        });
   }
 
   /// True when every enabled step leaves `points` (and their convex hull) where they are.
@@ -356,22 +370,15 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   }
   // The Jacobian's volume bounds (lattices only: a twist or bend has no coefficient bounds).
   report.volume_ratio_bounded = options.faces.empty();
-  for (const DeformationStep& step : stack.steps) {
-    if (!step.enabled) continue;
-    std::visit(
-        [&](const auto& d) {
-          using T = std::decay_t<decltype(d)>;
-          if constexpr (std::is_same_v<T, BezierLattice> || std::is_same_v<T, BSplineLattice>) {
-            const JacobianBounds b = jacobian_bounds(d);
-            report.volume_ratio_bounded = report.volume_ratio_bounded && b.fold_free;
-            report.volume_ratio_min *= std::min(b.min, 1.0);
-            report.volume_ratio_max *= std::max(b.max, 1.0);
-          } else {
-            report.volume_ratio_bounded = false;
-          }
-        },
-        step.deformation);
-  }
+  for_each_enabled_step(
+      stack,
+      [&](const auto& lattice) {
+        const JacobianBounds b = jacobian_bounds(lattice);
+        report.volume_ratio_bounded = report.volume_ratio_bounded && b.fold_free;
+        report.volume_ratio_min *= std::min(b.min, 1.0);
+        report.volume_ratio_max *= std::max(b.max, 1.0);
+      },
+      [&] { report.volume_ratio_bounded = false; });
   if (!report.volume_ratio_bounded) report.volume_ratio_min = report.volume_ratio_max = 1;
   report.summary.termination = Termination::Converged;
   report.summary.final_residual = report.max_edge_gap_mm;

@@ -17,6 +17,7 @@
 
 #include "error_of.hpp"
 #include "occt/test_models.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
@@ -28,16 +29,10 @@ using Eigen::Vector3d;
 
 namespace {
 
-fs::path output(const std::string& name) {
-  const fs::path folder = fs::path(CLAY_TEST_OUTPUT_DIR) / "brep-deform";
-  fs::create_directories(folder);
-  return folder / name;
-}
+fs::path output(const std::string& name) { return clay::test::test_output("brep-deform", name); }
 
 Model read(TestModel model, const std::string& name) {
-  const fs::path file = output(name);
-  clay::surface::occt_reference::write_test_model(model, file);
-  return clay::brep::read_model(file).model;
+  return clay::test::read_test_model(model, output(name));
 }
 
 /// The loops of a face as polygons in (u, v), 64 points per coedge.

@@ -16,6 +16,7 @@
 #include "error_of.hpp"
 #include "gltf_reader.hpp"
 #include "occt/test_models.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
@@ -27,16 +28,10 @@ using Eigen::Vector3d;
 
 namespace {
 
-fs::path output(const std::string& name) {
-  const fs::path folder = fs::path(CLAY_TEST_OUTPUT_DIR) / "brep-mesh";
-  fs::create_directories(folder);
-  return folder / name;
-}
+fs::path output(const std::string& name) { return clay::test::test_output("brep-mesh", name); }
 
 Model read(TestModel model, const std::string& name) {
-  const fs::path file = output(name);
-  clay::surface::occt_reference::write_test_model(model, file);
-  return clay::brep::read_model(file).model;
+  return clay::test::read_test_model(model, output(name));
 }
 
 /// The volume the triangles enclose (divergence theorem: each triangle's tetrahedron with the
