@@ -182,6 +182,29 @@ TEST_CASE(
   CHECK(read_model(copy).report.problems.empty());
 }
 
+TEST_CASE("read_model: an offset face is approximated on its own (u, v), measured, edges widened") {
+  const fs::path file = written(TestModel::OffsetSheet, "offset.step");
+  const auto read = read_model(file);
+  INFO(read.report.brief());
+  for (const auto& problem : read.report.problems) UNSCOPED_INFO(problem);
+  CHECK(read.report.problems.empty());
+  REQUIRE(read.model.faces.size() == 1);
+  CHECK(read.report.faces_approximated == 1);
+  const double size = read.report.size_mm;
+  CHECK(read.report.max_approximation_error_mm > 0);
+  CHECK(read.report.max_approximation_error_mm <= 1e-6 * size);
+  // Independently: OpenCASCADE's own offset surface is within the reported error of our face.
+  const double distance = clay::surface::occt_reference::max_distance_to_surfaces(
+      file, surface_samples(read.model, 400));
+  CHECK(distance <= read.report.max_approximation_error_mm * (1 + 1e-6) + 1e-12 * size);
+  // The edges, on the offset surface, are within their (widened) tolerances of the face.
+  for (const auto& g : clay::brep::edge_gaps(read.model))
+    CHECK(g.gap_mm <= read.model.edges[static_cast<std::size_t>(g.edge)].tolerance_mm);
+  // And it writes back valid.
+  const auto check = clay::brep::write_model(read.model, output("offset-copy.step"));
+  CHECK(check.valid);
+}
+
 TEST_CASE("read_model: STEP and IGES of the same solid give the same topology") {
   const fs::path step = written(TestModel::FilletedBlock, "block-same.step");
   const fs::path iges = written(TestModel::FilletedBlock, "block-same.igs");

@@ -68,6 +68,7 @@
 #include <Geom2d_Parabola.hxx>
 #include <Geom2d_TrimmedCurve.hxx>
 #include <GeomConvert.hxx>
+#include <GeomConvert_ApproxSurface.hxx>
 #include <Geom_BSplineCurve.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_BezierCurve.hxx>
@@ -140,6 +141,10 @@ using surface::occt::quoted;
 
 /// Accepted as exact: the face along a re-derived pcurve agrees with the original to rounding.
 constexpr double exact_relative = 1e-13;
+/// An offset surface with no exact NURBS form is approximated to this fraction of the model size
+/// (OpenCASCADE's GeomConvert_ApproxSurface, C2, degree <= 9).
+constexpr double offset_relative = 1e-7;
+
 /// Gaps up to this fraction of the model size raise an edge's tolerance on reading (see
 /// ModelBuilder::raise_tolerances_to_gaps).
 constexpr double tolerant_edge_relative = 1e-4;
@@ -150,7 +155,7 @@ constexpr double fit_relative = 1e-10;
 
 // ---- converted faces ------------------------------------------------------------------------
 
-enum class FaceKind { BSpline, Affine, Angular };
+enum class FaceKind { BSpline, Affine, Angular, Approximated };
 
 /// A face's surface before and after conversion, and the parameter maps between them.
 struct FaceConversion {
@@ -161,6 +166,7 @@ struct FaceConversion {
   double u_mid = 0, v_mid = 0;  // old parameters of the reference iso-lines of the maps
   double nu0 = 0, nu1 = 0, nv0 = 0, nv1 = 0;  // the new surface's domain
   double size = 1;                            // the model's size, for tolerances
+  double approximation_error = 0;             // an approximated offset's measured error (mm)
   std::string name;
 
   /// (u, v) on the new surface where it meets the old surface at (a, b): Gauss–Newton from the
@@ -345,6 +351,39 @@ FaceConversion convert_face(const TopoDS_Face& face, double size, const std::str
     if (inside) {
       c.nurbs = bspline;  // kept as it is (a periodic one is unperiodized exactly by from_occt)
     }
+  }
+  if (const auto offset = Handle(Geom_OffsetSurface)::DownCast(c.old_surface); !offset.IsNull()) {
+    // An offset by d != 0 of a surface whose offset is not elementary: its NURBS form is not
+    // exact, so it is approximated on the same (u, v), measured, and the pcurves are kept.
+    const double tolerance = offset_relative * size;
+    Handle(Geom_Surface) trimmed =
+        new Geom_RectangularTrimmedSurface(c.old_surface, box[0], box[1], box[2], box[3]);
+    GeomConvert_ApproxSurface approximation(trimmed, tolerance, GeomAbs_C2, GeomAbs_C2, 9, 9, 400,
+                                            1);
+    if (!approximation.HasResult() || approximation.Surface().IsNull())
+      throw Error(ErrorCategory::Exchange, name + ": its offset surface (distance " +
+                                               shortest(offset->Offset()) +
+                                               " mm) could not be approximated by a NURBS within " +
+                                               shortest(tolerance) + " mm");
+    c.nurbs = approximation.Surface();
+    c.nurbs->Bounds(c.nu0, c.nu1, c.nv0, c.nv1);
+    constexpr int n = 48;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; j <= n; ++j) {
+        const double a = box[0] + (box[1] - box[0]) * i / n, b = box[2] + (box[3] - box[2]) * j / n;
+        c.approximation_error =
+            std::max(c.approximation_error,
+                     c.nurbs->Value(std::clamp(a, c.nu0, c.nu1), std::clamp(b, c.nv0, c.nv1))
+                         .Distance(c.old_surface->Value(a, b)));
+      }
+    c.approximation_error = std::max(c.approximation_error, approximation.MaxError());
+    if (!(c.approximation_error <= 10 * tolerance))
+      throw Error(ErrorCategory::Exchange,
+                  name + ": its offset surface (distance " + shortest(offset->Offset()) +
+                      " mm) was approximated only within " + shortest(c.approximation_error) +
+                      " mm (asked " + shortest(tolerance) + " mm)");
+    c.kind = FaceKind::Approximated;
+    return c;
   }
   if (c.nurbs.IsNull()) {
     try {
@@ -659,7 +698,8 @@ surface::BSplineCurve joined(const std::vector<Handle(Geom2d_BSplineCurve)>& pie
 /// The new pcurve of one coedge: see the file comment for the four ways.
 Rederived rederive(const FaceConversion& face, const EdgeConversion& edge,
                    const Handle(Geom2d_Curve) & old_pcurve, const std::string& name) {
-  const double exact_tol = exact_relative * face.size;
+  // An approximated face is within its approximation error of the original, not closer.
+  const double exact_tol = exact_relative * face.size + face.approximation_error;
   const double s0 = edge.s0, s1 = edge.s1;
   auto target = [&](double s) {
     const gp_Pnt2d p = old_pcurve->Value(edge.old_parameter(s));
@@ -733,7 +773,7 @@ Rederived rederive(const FaceConversion& face, const EdgeConversion& edge,
       if (b - breaks.back() > 1e-9 * (s1 - s0) && s1 - b > 1e-9 * (s1 - s0)) breaks.push_back(b);
     breaks.push_back(s1);
   }
-  const double fit_tol = fit_relative * face.size;
+  const double fit_tol = fit_relative * face.size + face.approximation_error;
   std::vector<Handle(Geom2d_BSplineCurve)> pieces;
   double worst = 0;
   for (std::size_t k = 0; k + 1 < breaks.size(); ++k) {
@@ -1216,6 +1256,11 @@ class ModelBuilder {
       case FaceKind::Angular:
         ++report_.faces_angular;
         break;
+      case FaceKind::Approximated:
+        ++report_.faces_approximated;
+        report_.max_approximation_error_mm =
+            std::max(report_.max_approximation_error_mm, conversion.approximation_error);
+        break;
     }
     // Loops: the outer wire first, each walked in order on the forward face.
     const TopoDS_Wire outer = BRepTools::OuterWire(forward);
@@ -1268,6 +1313,19 @@ class ModelBuilder {
       }
       if (!loop.coedges.empty()) out.loops.push_back(std::move(loop));
     }
+    // The edges lie on the offset surface; the approximated face is off it by up to its error.
+    if (conversion.kind == FaceKind::Approximated)
+      for (const Loop& loop : out.loops)
+        for (const Coedge& co : loop.coedges) {
+          Edge& e = model_.edges[static_cast<std::size_t>(co.edge)];
+          double& applied = widened_[co.edge];  // once per edge: the larger of its faces' errors
+          if (conversion.approximation_error <= applied) continue;
+          e.tolerance_mm += conversion.approximation_error - applied;
+          applied = conversion.approximation_error;
+          for (int v : {e.start, e.end})
+            model_.vertices[static_cast<std::size_t>(v)].tolerance_mm =
+                std::max(model_.vertices[static_cast<std::size_t>(v)].tolerance_mm, e.tolerance_mm);
+        }
     out.elementary = elementary_of(conversion.old_surface);
     if (out.elementary && out.elementary->kind == ElementaryKind::Plane && !out.loops.empty())
       out.surface = plane_over_pcurves(*out.elementary, out.loops, model_.edges);
@@ -1297,7 +1355,9 @@ class ModelBuilder {
   std::vector<std::pair<TDF_Label, int>> parts_;  // few: a linear search
   TopTools_IndexedMapOfShape vertices_, edges_;
   std::vector<EdgeConversion> conversions_;
-  std::map<int, bool> seam_flipped_;  // seams made by seam_of: runs against the old edge
+  std::map<int, bool> seam_flipped_;
+  std::map<int, double> widened_;  // edges widened for approximated faces, by how much  // seams
+                                   // made by seam_of: runs against the old edge
 };
 
 }  // namespace
@@ -1457,9 +1517,10 @@ std::string serialize(const ImportedModel& x) {
   for (const Instance& i : m.roots) put_instance(out, i);
   const ModelReadReport& r = x.report;
   put(out, r.size_mm);
-  for (int v : {r.faces_bspline, r.faces_affine, r.faces_angular, r.pcurves_kept, r.pcurves_exact,
-                r.pcurves_fitted})
+  for (int v : {r.faces_bspline, r.faces_affine, r.faces_angular, r.faces_approximated,
+                r.pcurves_kept, r.pcurves_exact, r.pcurves_fitted})
     put(out, static_cast<std::int32_t>(v));
+  put(out, r.max_approximation_error_mm);
   put(out, r.max_rederivation_error_mm);
   put(out, r.max_edge_tolerance_mm);
   put(out, static_cast<std::uint64_t>(r.healing.size()));
@@ -1547,9 +1608,10 @@ ImportedModel deserialize(const std::string& bytes) {
   for (Instance& i : m.roots) i = take_instance(in);
   ModelReadReport& r = x.report;
   r.size_mm = in.take<double>();
-  for (int* v : {&r.faces_bspline, &r.faces_affine, &r.faces_angular, &r.pcurves_kept,
-                 &r.pcurves_exact, &r.pcurves_fitted})
+  for (int* v : {&r.faces_bspline, &r.faces_affine, &r.faces_angular, &r.faces_approximated,
+                 &r.pcurves_kept, &r.pcurves_exact, &r.pcurves_fitted})
     *v = in.take<std::int32_t>();
+  r.max_approximation_error_mm = in.take<double>();
   r.max_rederivation_error_mm = in.take<double>();
   r.max_edge_tolerance_mm = in.take<double>();
   r.healing.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
@@ -1596,6 +1658,12 @@ std::string ModelReadReport::brief() const {
                 faces_angular, pcurves_kept, pcurves_exact, pcurves_fitted,
                 max_rederivation_error_mm, max_edge_gap_mm);
   std::string line = text;
+  if (faces_approximated > 0) {
+    std::snprintf(text, sizeof text, "; %d offset face%s approximated (<= %.1e mm)",
+                  faces_approximated, faces_approximated == 1 ? "" : "s",
+                  max_approximation_error_mm);
+    line += text;
+  }
   if (!healing.empty()) line += "; healed: " + healing.front();
   if (!ignored.empty())
     line += "; ignored " + std::to_string(ignored.size()) + " unknown entity type" +

@@ -26,6 +26,8 @@
 #include <GC_MakeArcOfCircle.hxx>
 #include <GProp_GProps.hxx>
 #include <GeomAPI_ProjectPointOnSurf.hxx>
+#include <Geom_BSplineSurface.hxx>
+#include <Geom_OffsetSurface.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Writer.hxx>
 #include <IGESControl_Controller.hxx>
@@ -35,6 +37,9 @@
 #include <STEPCAFControl_Controller.hxx>
 #include <STEPCAFControl_Writer.hxx>
 #include <STEPControl_Reader.hxx>
+#include <TColStd_Array1OfInteger.hxx>
+#include <TColStd_Array1OfReal.hxx>
+#include <TColgp_Array2OfPnt.hxx>
 #include <TDF_Label.hxx>
 #include <TDataStd_Name.hxx>
 #include <TDocStd_Document.hxx>
@@ -216,6 +221,27 @@ void write_test_model(TestModel model, const fs::path& file) {
         TDataStd_Name::Set(face, "label");
         colours->SetColor(face, srgb(0.95, 0.85, 0.2), XCAFDoc_ColorSurf);
       }
+      break;
+    }
+    case TestModel::OffsetSheet: {
+      // A bicubic bump over [0, 40] x [0, 30] (4 x 4 poles, the middle ones raised), offset by 2.
+      TColgp_Array2OfPnt poles(1, 4, 1, 4);
+      for (int i = 1; i <= 4; ++i)
+        for (int j = 1; j <= 4; ++j)
+          poles.SetValue(i, j,
+                         gp_Pnt(40.0 * (i - 1) / 3, 30.0 * (j - 1) / 3,
+                                (i == 2 || i == 3) && (j == 2 || j == 3) ? 8.0 : 0.0));
+      TColStd_Array1OfReal knots(1, 2);
+      knots.SetValue(1, 0);
+      knots.SetValue(2, 1);
+      TColStd_Array1OfInteger mults(1, 2);
+      mults.SetValue(1, 4);
+      mults.SetValue(2, 4);
+      Handle(Geom_BSplineSurface) bump =
+          new Geom_BSplineSurface(poles, knots, knots, mults, mults, 3, 3);
+      Handle(Geom_OffsetSurface) offset = new Geom_OffsetSurface(bump, 2.0);
+      add_part(shapes, colours, BRepBuilderAPI_MakeFace(offset, 0, 1, 0, 1, 1e-7).Face(),
+               "offset sheet", srgb(0.6, 0.6, 0.8));
       break;
     }
     case TestModel::Assembly: {

@@ -24,6 +24,7 @@ enum class TestModel {
   Separated,      ///< two solids apart: a box 20^3 at the origin, a sphere r 5 at (50, 10, 10)
   HolePlate,      ///< 200 faces: a 200 x 200 x 10 plate, vertical edges filleted (r 8), 190 holes
   ObliqueCut,     ///< a cylinder r 10 cut by a plane at 30 degrees: an ellipse across the angles
+  OffsetSheet,    ///< one face: a bicubic bump 40 x 30 offset by 2 mm (STEP offset_surface)
 };
 
 /// Builds `model` with OpenCASCADE and writes it through XCAF (names, colours, assembly) as

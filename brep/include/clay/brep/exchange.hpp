@@ -53,8 +53,14 @@ struct CLAY_OCCT_API ModelReadReport {
   int faces_bspline = 0;  ///< faces whose surface was a B-spline or Bézier: kept as they were
   int faces_affine = 0;   ///< planes, linear extrusions: converted with the same (u, v)
   int faces_angular = 0;  ///< cylinders, cones, spheres, tori, revolutions: angle maps changed
-  int pcurves_kept = 0;   ///< pcurves converted exactly with their face's unchanged (u, v)
-  int pcurves_exact = 0;  ///< re-derived exactly (an iso-line or a shared angle map)
+  /// Offsets (by a distance other than 0) of surfaces with no exact NURBS form: approximated on
+  /// their own (u, v), the edges' tolerances widened by the approximation's measured error.
+  int faces_approximated = 0;
+  /// Largest distance between an approximated face and its offset surface, measured on a dense
+  /// grid of the face's parameter box (mm); 0 when no face was approximated.
+  double max_approximation_error_mm = 0;
+  int pcurves_kept = 0;    ///< pcurves converted exactly with their face's unchanged (u, v)
+  int pcurves_exact = 0;   ///< re-derived exactly (an iso-line or a shared angle map)
   int pcurves_fitted = 0;  ///< re-derived by a refined interpolant
   /// Largest distance between the face along a re-derived pcurve and the original face along the
   /// original pcurve (mm); 0 when every pcurve was kept or re-derived exactly.
