@@ -234,7 +234,8 @@ void elementary_problems(const Model& m, int f, std::vector<std::string>& out) {
   const bool round = e.kind != ElementaryKind::Plane;
   if (round && !(std::isfinite(e.radius) && e.radius >= 0 &&
                  (e.radius > 0 || e.kind == ElementaryKind::Cone)))
-    out.push_back(name + ": radius = " + shortest(e.radius) + " must be finite and > 0");
+    out.push_back(name + ": radius = " + shortest(e.radius) + " must be finite and " +
+                  (e.kind == ElementaryKind::Cone ? ">= 0" : "> 0"));
   if (e.kind == ElementaryKind::Torus && !(std::isfinite(e.minor_radius) && e.minor_radius > 0))
     out.push_back(name + ": minor_radius = " + shortest(e.minor_radius) +
                   " must be finite and > 0");

@@ -99,6 +99,7 @@ void RecipeChecker::declare(const Json& root) {
   each("deformations",
        [&](const std::string& n, const Json&, const std::string&) { names_.stacks.push_back(n); });
   each("exports", [&](const std::string&, const Json&, const std::string&) {});
+  each("models", [&](const std::string&, const Json&, const std::string&) {});  // file stems
 }
 
 std::optional<std::string> RecipeChecker::curve_ref(const Json& j, const std::string& path) {

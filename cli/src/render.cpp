@@ -333,16 +333,18 @@ Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options,
                   const std::vector<surface::BSplineSurface>& control_nets) {
   options.validate();
   if (mesh.triangles.empty())
-    throw Error(ErrorCategory::InvalidArgument, "render: the mesh has no triangles");
+    throw Error(ErrorCategory::InvalidArgument, "render_mesh: the mesh has no triangles");
   const size_t nodes = mesh.positions.size();
   if (mesh.normals.size() != nodes || mesh.triangle_face.size() != mesh.triangles.size() ||
       mesh.face_body.size() != mesh.face_colours.size())
     throw Error(ErrorCategory::InvalidArgument,
-                "render: the mesh's arrays disagree in size (" + std::to_string(nodes) +
+                "render_mesh: the mesh's arrays disagree in size (" + std::to_string(nodes) +
                     " positions, " + std::to_string(mesh.normals.size()) + " normals, " +
                     std::to_string(mesh.triangles.size()) + " triangles, " +
-                    std::to_string(mesh.triangle_face.size()) +
-                    " triangle faces); give a mesh from brep::tessellate");
+                    std::to_string(mesh.triangle_face.size()) + " triangle faces, " +
+                    std::to_string(mesh.face_body.size()) + " face bodies, " +
+                    std::to_string(mesh.face_colours.size()) +
+                    " face colours); give a mesh from brep::tessellate");
   Batch b;
   b.points = mesh.positions;
   b.normals = mesh.normals;
@@ -351,11 +353,11 @@ Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options,
     for (int corner : mesh.triangles[k])
       if (corner < 0 || static_cast<size_t>(corner) >= nodes)
         throw Error(ErrorCategory::InvalidArgument,
-                    "render: triangle " + std::to_string(k) + " refers to node " +
+                    "render_mesh: triangle " + std::to_string(k) + " refers to node " +
                         std::to_string(corner) + " of " + std::to_string(nodes));
     const int f = mesh.triangle_face[k];
     if (f < 0 || static_cast<size_t>(f) >= mesh.face_colours.size())
-      throw Error(ErrorCategory::InvalidArgument, "render: triangle " + std::to_string(k) +
+      throw Error(ErrorCategory::InvalidArgument, "render_mesh: triangle " + std::to_string(k) +
                                                       " lies on face " + std::to_string(f) +
                                                       ", which the mesh has no colour entry for");
     const auto& own = mesh.face_colours[static_cast<size_t>(f)];

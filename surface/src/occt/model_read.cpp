@@ -447,6 +447,9 @@ std::optional<Elementary> elementary_of(const Handle(Geom_Surface) & s) {
   e.z_axis = vec(frame.Direction());
   if (!Handle(Geom_Plane)::DownCast(s).IsNull()) {
     e.kind = ElementaryKind::Plane;
+    // A plane's parameters depend on x and y only: its frame is taken right-handed (z = x × y),
+    // as STEP's axis2_placement_3d can only hold it, so a written plane reads back the same.
+    e.z_axis = e.x_axis.cross(e.y_axis);
   } else if (auto c = Handle(Geom_CylindricalSurface)::DownCast(s); !c.IsNull()) {
     e.kind = ElementaryKind::Cylinder;
     e.radius = c->Radius();
@@ -919,16 +922,19 @@ class ModelBuilder {
     } catch (const Error&) {
       return;  // a broken coedge: problems() names it
     }
+    // The largest gap per edge first, then one decision against the file's tolerance.
+    std::map<int, double> widest;
+    for (const EdgeGap& g : gaps) widest[g.edge] = std::max(widest[g.edge], g.gap_mm);
     std::set<int> raised;
     double largest = 0;
-    for (const EdgeGap& g : gaps) {
-      Edge& e = model_.edges[static_cast<std::size_t>(g.edge)];
-      if (!(g.gap_mm > e.tolerance_mm) ||
-          !(g.gap_mm <= std::max(1.5 * e.tolerance_mm, tolerant_edge_relative * size_)))
+    for (const auto& [edge, gap] : widest) {
+      Edge& e = model_.edges[static_cast<std::size_t>(edge)];
+      if (!(gap > e.tolerance_mm) ||
+          !(gap <= std::max(1.5 * e.tolerance_mm, tolerant_edge_relative * size_)))
         continue;
-      raised.insert(g.edge);
-      largest = std::max(largest, g.gap_mm - e.tolerance_mm);
-      e.tolerance_mm = g.gap_mm * (1 + 1e-9);
+      raised.insert(edge);
+      largest = std::max(largest, gap - e.tolerance_mm);
+      e.tolerance_mm = gap * (1 + 1e-9);
       for (int v : {e.start, e.end})
         if (v >= 0 && static_cast<std::size_t>(v) < model_.vertices.size())
           model_.vertices[static_cast<std::size_t>(v)].tolerance_mm =
@@ -1323,8 +1329,9 @@ class ModelBuilder {
           e.tolerance_mm += conversion.approximation_error - applied;
           applied = conversion.approximation_error;
           for (int v : {e.start, e.end})
-            model_.vertices[static_cast<std::size_t>(v)].tolerance_mm =
-                std::max(model_.vertices[static_cast<std::size_t>(v)].tolerance_mm, e.tolerance_mm);
+            if (v >= 0 && static_cast<std::size_t>(v) < model_.vertices.size())
+              model_.vertices[static_cast<std::size_t>(v)].tolerance_mm = std::max(
+                  model_.vertices[static_cast<std::size_t>(v)].tolerance_mm, e.tolerance_mm);
         }
     out.elementary = elementary_of(conversion.old_surface);
     if (out.elementary && out.elementary->kind == ElementaryKind::Plane && !out.loops.empty())
@@ -1355,9 +1362,8 @@ class ModelBuilder {
   std::vector<std::pair<TDF_Label, int>> parts_;  // few: a linear search
   TopTools_IndexedMapOfShape vertices_, edges_;
   std::vector<EdgeConversion> conversions_;
-  std::map<int, bool> seam_flipped_;
-  std::map<int, double> widened_;  // edges widened for approximated faces, by how much  // seams
-                                   // made by seam_of: runs against the old edge
+  std::map<int, bool> seam_flipped_;  // seams made by seam_of: runs against the old edge
+  std::map<int, double> widened_;     // edges widened for approximated faces, by how much
 };
 
 }  // namespace

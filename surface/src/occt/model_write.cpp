@@ -111,9 +111,10 @@ Handle(Geom_Surface) surface_to_occt(const Face& face, const std::string& name) 
     const Elementary& e = *face.elementary;
     auto pnt = [](const Eigen::Vector3d& p) { return gp_Pnt(p.x(), p.y(), p.z()); };
     auto dir = [](const Eigen::Vector3d& d) { return gp_Dir(d.x(), d.y(), d.z()); };
-    gp_Ax3 frame(pnt(e.origin), dir(e.z_axis), dir(e.x_axis));
-    if (e.y_axis.dot(e.z_axis.cross(e.x_axis)) < 0) frame.YReverse();  // a left-handed frame
-    return new Geom_Plane(frame);
+    // The right-handed frame with the same x and y (z = x × y): the same parameters, and the
+    // only kind of frame STEP's axis2_placement_3d holds (a mirrored instance's plane is
+    // left-handed in the model).
+    return new Geom_Plane(gp_Ax3(pnt(e.origin), dir(e.x_axis.cross(e.y_axis)), dir(e.x_axis)));
   }
   return surface::occt::to_occt(face.surface, name);
 }

@@ -68,7 +68,9 @@ struct CLAY_OCCT_API ModelReadReport {
   /// Largest gap between an edge and a face along its pcurve, by brep::edge_gaps (mm): includes
   /// the file's own gaps, which its edge tolerances allow.
   double max_edge_gap_mm = 0;
-  double max_edge_tolerance_mm = 0;  ///< the largest edge tolerance the file gives
+  /// The largest edge tolerance of the model read: the file's, widened for approximated offset
+  /// faces and raised to measured gaps where `healing` says so.
+  double max_edge_tolerance_mm = 0;
   /// Healing done, one line each ("built 3D curves of 4 edges", "sewed 12 faces into 1 shell").
   std::vector<std::string> healing;
   /// Entities of the file OpenCASCADE does not know and ignored, one line per type:

@@ -74,7 +74,8 @@ struct Loop {
 enum class ElementaryKind { Plane, Cylinder, Cone, Sphere, Torus };
 
 /// An analytic surface in OpenCASCADE's (and STEP's) parametrization, in a frame whose axes are
-/// orthonormal; y is ±(z × x), so a left-handed frame is kept as it came. With
+/// orthonormal; y is ±(z × x), so a left-handed frame is kept as it came (read_model gives a
+/// plane's frame right-handed: its parameters depend on x and y only). With
 /// e(u) = cos u x + sin u y:
 /// - plane:    origin + u x + v y;
 /// - cylinder: origin + radius e(u) + v z;
