@@ -472,6 +472,54 @@ TEST_CASE("write_model: an assembly keeps its tree, names, colours and placement
   }
 }
 
+TEST_CASE("write_model: a mirrored block's planes (left-handed frames) are written and read back") {
+  // The block mirrored in x = 0 as a placed instance, flattened: its planes' frames become
+  // left-handed; the faces are reversed so that the solid points outwards again.
+  Model m = read_model(written(TestModel::FilletedBlock, "mirror-block.step")).model;
+  m.parts.push_back({"block", {0}, {}, std::nullopt});
+  Eigen::Isometry3d mirror = Eigen::Isometry3d::Identity();
+  mirror.linear() = Eigen::Vector3d(-1, 1, 1).asDiagonal();
+  m.roots.push_back({0, mirror, "mirrored"});
+  Model flat = clay::brep::flattened(m);
+  for (auto& face : flat.faces) face.reversed = !face.reversed;
+  REQUIRE(clay::brep::problems(flat).empty());
+  int left_handed = 0;
+  for (const auto& face : flat.faces)
+    if (face.elementary && face.elementary->kind == clay::brep::ElementaryKind::Plane)
+      left_handed +=
+          face.elementary->y_axis.dot(face.elementary->z_axis.cross(face.elementary->x_axis)) < 0;
+  CHECK(left_handed == 11);
+  const fs::path copy = output("mirror-block-copy.step");
+  const auto check = clay::brep::write_model(flat, copy);
+  CHECK(check.valid);
+  CHECK(check.volume_mm3 > 0);
+  const auto again = read_model(copy);
+  INFO(again.report.brief());
+  CHECK(again.report.problems.empty());
+  REQUIRE(again.model.faces.size() == flat.faces.size());
+  const double size = 75;
+  for (std::size_t f = 0; f < flat.faces.size(); ++f) {
+    const auto& was = flat.faces[f];
+    const auto& now = again.model.faces[f];
+    REQUIRE(static_cast<bool>(now.elementary) ==
+            static_cast<bool>(was.elementary &&
+                              was.elementary->kind == clay::brep::ElementaryKind::Plane));
+    if (!now.elementary) continue;
+    // The same plane, in the same parameters, now with the right-handed frame z = x × y.
+    CHECK((now.elementary->x_axis - was.elementary->x_axis).norm() <= 1e-15);
+    CHECK((now.elementary->y_axis - was.elementary->y_axis).norm() <= 1e-15);
+    for (const auto& loop : was.loops)
+      for (const auto& co : loop.coedges)
+        for (double t : {0.0, 0.3, 0.7, 1.0}) {
+          const auto& e = flat.edges[static_cast<std::size_t>(co.edge)];
+          const Eigen::Vector3d uv = clay::surface::evaluate(co.pcurve, e.t0 + (e.t1 - e.t0) * t);
+          CHECK((clay::brep::point(*now.elementary, uv.x(), uv.y()) -
+                 clay::brep::point(*was.elementary, uv.x(), uv.y()))
+                    .norm() <= 1e-12 * size);
+        }
+  }
+}
+
 TEST_CASE("write_model: bad models and paths raise clay::Error and write nothing") {
   using clay::ErrorCategory;
   using clay::test::error_of;
