@@ -58,6 +58,17 @@ double remove_knot_once(Strip& strip, int r, int s, double tolerance) {
     gap = block_norm(P.row(i) - (ai * t.row(ii + 1) + (1 - ai) * t.row(ii - 1)));
   }
   if (!(gap <= tolerance)) return -1;
+  // The gap is a homogeneous norm, so a removal can meet it and still leave a weight at zero or
+  // below: an I-DEAS cone whose apex row carries weights unlike its base row gave a weight of
+  // -1e-17 after composition, which made the surface invalid. Such a removal is refused.
+  if (!strip.polynomial) {
+    double largest = 0;
+    for (Eigen::Index r0 = off; r0 <= last + 1; ++r0)
+      for (Eigen::Index c = 3; c < P.cols(); c += 4) largest = std::max(largest, P(r0, c));
+    for (int a = first, b = last; b - a > 0; ++a, --b)  // the rows the removal writes
+      for (Eigen::Index c = 3; c < t.cols(); c += 4)
+        if (!(t(a - off, c) > 1e-12 * largest) || !(t(b - off, c) > 1e-12 * largest)) return -1;
+  }
   i = first, j = last;
   while (j - i > 0) {
     strip.rows.row(i) = t.row(i - off);

@@ -249,6 +249,26 @@ TEST_CASE("join_bezier_patches refuses patches that do not match their breaks or
   CHECK_THROWS_AS(join_bezier_patches(good, -1.0), clay::Error);
 }
 
+TEST_CASE("remove_knots keeps a knot whose exact removal would leave a weight <= 0", "[knots]") {
+  // The Bézier arc with weights (1, -0.5, 1) has a positive weight function, 0.25 at t = 0.5;
+  // inserting t = 0.5 gives positive weights (1, 0.25, 0.25, 1) and a valid NURBS. Removing the
+  // knot again is exact in homogeneous space (gap 0) but brings back the weight -0.5, so it must
+  // be refused: the curve comes back unchanged.
+  clay::surface::Points3 points(4, 3);
+  points << 0, 0, 0, -1, -1, 0, 3, -1, 0, 2, 0, 0;
+  Eigen::VectorXd weights(4);
+  weights << 1, 0.25, 0.25, 1;
+  const BSplineCurve c =
+      clay::surface::make_curve(2, {0, 0, 0, 0.5, 1, 1, 1}, std::move(points), weights);
+  // Independent check of the premise: the homogeneous points are the split of the arc.
+  const Eigen::Vector3d mid = clay::surface::evaluate(c, 0.5);
+  CHECK((mid - Eigen::Vector3d(1, -1, 0)).norm() <= 1e-15);  // (0.25, -0.25, 0) / 0.25
+  const auto removal = remove_knots(c, 1e-9);
+  CHECK(removal.removed == 0);
+  CHECK(clay::surface::identical(removal.curve, c));
+  CHECK(clay::surface::problems(removal.curve).empty());
+}
+
 TEST_CASE("remove_knots refuses a negative or non-finite tolerance", "[knots]") {
   std::mt19937 rng(3);
   const BSplineCurve c = clay::test::random_curve(rng, 3, 6, false);
