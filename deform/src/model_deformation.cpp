@@ -344,6 +344,35 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       }
     }
   }
+  // The same for the vertices: the file's distance from a vertex to the ends of its edges (3D,
+  // and each face along its pcurve) is stretched too, and OpenCASCADE's BRepCheck then finds the
+  // vertex off its curve (CATIA's as1 assembly, 10 % stretch: BRepCheck_InvalidPointOnCurve).
+  auto widen_vertex = [&](int v, const Eigen::Vector3d& end) {
+    if (!vertex_touched[static_cast<std::size_t>(v)]) return;
+    brep::Vertex& vertex = m.vertices[static_cast<std::size_t>(v)];
+    const double distance = (vertex.point - end).norm();
+    if (distance > vertex.tolerance_mm &&
+        distance <= std::max(10 * vertex.tolerance_mm, 1e-9 * size))
+      vertex.tolerance_mm = distance * (1 + 1e-9);
+  };
+  for (const brep::Edge& edge : m.edges) {
+    if (edge.degenerate) continue;
+    widen_vertex(edge.start, surface::evaluate(edge.curve, edge.t0));
+    widen_vertex(edge.end, surface::evaluate(edge.curve, edge.t1));
+  }
+  for (const brep::Face& face : m.faces)
+    for (const brep::Loop& loop : face.loops)
+      for (const brep::Coedge& c : loop.coedges) {
+        const brep::Edge& edge = m.edges[static_cast<std::size_t>(c.edge)];
+        const auto [d0, d1] = c.pcurve.basis.domain();
+        for (const auto& [v, t] : {std::pair{edge.start, edge.t0}, std::pair{edge.end, edge.t1}}) {
+          const Eigen::Vector3d uv = surface::evaluate(c.pcurve, std::clamp(t, d0, d1));
+          const auto [u0, u1] = face.surface.u.domain();
+          const auto [v0, v1] = face.surface.v.domain();
+          widen_vertex(v, surface::evaluate(face.surface, std::clamp(uv.x(), u0, u1),
+                                            std::clamp(uv.y(), v0, v1)));
+        }
+      }
   report.counts = brep::counts(m);
   const auto broken = brep::problems(m);
   if (!broken.empty()) {

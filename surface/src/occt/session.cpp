@@ -147,7 +147,14 @@ std::vector<std::string> check_statuses(const TopoDS_Face& face,
     found.push_back(line);
   };
   auto scan = [&](const TopoDS_Shape& shape, const char* kind, int index) {
-    const Handle(BRepCheck_Result)& result = analyzer.Result(shape);
+    // Result() throws Standard_NoSuchObject for a shape the analyzer did not reach (an edge of a
+    // face it stopped at); such a shape has no status to report.
+    Handle(BRepCheck_Result) result;
+    try {
+      result = analyzer.Result(shape);
+    } catch (const Standard_NoSuchObject&) {
+      return;
+    }
     if (result.IsNull()) return;
     for (BRepCheck_ListIteratorOfListOfStatus it(result->Status()); it.More(); it.Next())
       add(kind, index, it.Value());
