@@ -33,6 +33,7 @@
 #include <clay/internal/format.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/surface/projection.hpp>
 
 #include <algorithm>
 #include <array>
@@ -165,15 +166,19 @@ struct FaceConversion {
   bool u_identity = true, v_identity = true;
   double u_mid = 0, v_mid = 0;  // old parameters of the reference iso-lines of the maps
   double nu0 = 0, nu1 = 0, nv0 = 0, nv1 = 0;  // the new surface's domain
-  double size = 1;                            // the model's size, for tolerances
-  double approximation_error = 0;             // an approximated offset's measured error (mm)
+  // Whole periods GeomConvert moved a periodic direction's domain by: a cylinder trimmed to
+  // [-pi, pi] comes back on [pi, 3 pi] (an Autodesk file). Newton starts from the shifted angle,
+  // not from the clamped one (half a turn away, where the gradient vanishes).
+  double u_shift = 0, v_shift = 0;
+  double size = 1;                 // the model's size, for tolerances
+  double approximation_error = 0;  // an approximated offset's measured error (mm)
   std::string name;
 
   /// (u, v) on the new surface where it meets the old surface at (a, b): Gauss–Newton from the
   /// old parameters, which the conversions keep at their knots.
   Eigen::Vector2d solve(double a, double b) const {
     const gp_Pnt target = old_surface->Value(a, b);
-    double u = std::clamp(a, nu0, nu1), v = std::clamp(b, nv0, nv1);
+    double u = std::clamp(a + u_shift, nu0, nu1), v = std::clamp(b + v_shift, nv0, nv1);
     for (int iteration = 0; iteration < 50; ++iteration) {
       gp_Pnt p;
       gp_Vec su, sv;
@@ -402,6 +407,13 @@ FaceConversion convert_face(const TopoDS_Face& face, double size, const std::str
     throw Error(ErrorCategory::Exchange, name + ": OpenCASCADE could not convert the surface");
   if (c.nurbs.get() != c.old_surface.get()) close_exactly(c.nurbs, size);
   c.nurbs->Bounds(c.nu0, c.nu1, c.nv0, c.nv1);
+  auto whole_periods = [](double from, double to, bool periodic, double period) {
+    return periodic ? std::round((to - from) / period) * period : 0.0;
+  };
+  c.u_shift = whole_periods(box[0], c.nu0, c.old_surface->IsUPeriodic(),
+                            c.old_surface->IsUPeriodic() ? c.old_surface->UPeriod() : 1.0);
+  c.v_shift = whole_periods(box[2], c.nv0, c.old_surface->IsVPeriodic(),
+                            c.old_surface->IsVPeriodic() ? c.old_surface->VPeriod() : 1.0);
 
   // Which directions kept their parameter: S_new(a, b) = S_old(a, b) on a grid, per direction.
   auto differs = [&](double a, double b) {
@@ -922,6 +934,13 @@ class ModelBuilder {
     } catch (const Error&) {
       return;  // a broken coedge: problems() names it
     }
+    if (rederive_pcurves_from_edges(gaps)) {
+      try {
+        gaps = edge_gaps(model_);
+      } catch (const Error&) {
+        return;
+      }
+    }
     // The largest gap per edge first, then one decision against the file's tolerance.
     std::map<int, double> widest;
     for (const EdgeGap& g : gaps) widest[g.edge] = std::max(widest[g.edge], g.gap_mm);
@@ -934,7 +953,9 @@ class ModelBuilder {
         continue;
       raised.insert(edge);
       largest = std::max(largest, gap - e.tolerance_mm);
-      e.tolerance_mm = gap * (1 + 1e-9);
+      // A margin of rounding at the model's size too: a placed instance, rotated when an
+      // assembly is flattened, measures the same gap 3e-15 mm wider (CATIA's as1 assembly).
+      e.tolerance_mm = gap * (1 + 1e-9) + 1e-12 * size_;
       for (int v : {e.start, e.end})
         if (v >= 0 && static_cast<std::size_t>(v) < model_.vertices.size())
           model_.vertices[static_cast<std::size_t>(v)].tolerance_mm =
@@ -945,6 +966,142 @@ class ModelBuilder {
                                 " edge" + (raised.size() == 1 ? "" : "s") +
                                 " to the gaps measured densely (by at most " + shortest(largest) +
                                 " mm)");
+  }
+
+  /// A pcurve parametrized unlike its edge, though the edge lies on the face: an I-DEAS IGES
+  /// solid gives a circle's 3D curve as a 120-degree rational B-spline and its pcurve as a line
+  /// across a 90-degree rational cone, declared same-parameter, so at equal parameters the face
+  /// is 0.12 mm from the edge (BRepCheck samples 23 points and misses it). Each coedge whose gap
+  /// is beyond what raise_tolerances_to_gaps accepts gets a pcurve re-derived from its edge: the
+  /// edge's points projected onto the face by Newton from the old pcurve's point at the same
+  /// parameter, interpolated by cubics piece by piece (between the edge's knots) until the face
+  /// along it is within fit_relative of the size from the edge. Only where every projected point
+  /// lies on the face within the accepted gap: the edge and face must share the curve. Returns
+  /// whether any pcurve was replaced (the report says how many).
+  bool rederive_pcurves_from_edges(const std::vector<EdgeGap>& gaps) {
+    int replaced = 0;
+    double worst_before = 0, worst_fit = 0;
+    for (const EdgeGap& g : gaps) {
+      Edge& edge = model_.edges[static_cast<std::size_t>(g.edge)];
+      const double accepted = std::max(1.5 * edge.tolerance_mm, tolerant_edge_relative * size_);
+      if (edge.degenerate || !(g.gap_mm > accepted)) continue;
+      Face& face = model_.faces[static_cast<std::size_t>(g.face)];
+      Coedge& coedge =
+          face.loops[static_cast<std::size_t>(g.loop)].coedges[static_cast<std::size_t>(g.coedge)];
+      if (auto fitted = pcurve_from_edge(face.surface, edge, coedge.pcurve, accepted)) {
+        coedge.pcurve = std::move(fitted->first);
+        worst_fit = std::max(worst_fit, fitted->second);
+        worst_before = std::max(worst_before, g.gap_mm);
+        ++replaced;
+      }
+    }
+    if (replaced > 0)
+      report_.healing.push_back(
+          "re-derived " + std::to_string(replaced) +
+          (replaced == 1 ? " pcurve from its edge" : " pcurves from their edges") +
+          " (parametrized unlike their edges: gaps up to " + shortest(worst_before) +
+          " mm at equal parameters, " + shortest(worst_fit) + " mm after)");
+    return replaced > 0;
+  }
+
+  /// The pcurve of `edge` on `surface` by projection (see rederive_pcurves_from_edges), with its
+  /// largest measured gap; nullopt when the edge leaves the face by more than `accepted` or no
+  /// fit within fit_relative of the size is found.
+  std::optional<std::pair<surface::BSplineCurve, double>> pcurve_from_edge(
+      const surface::BSplineSurface& surface, const Edge& edge, const surface::BSplineCurve& old,
+      double accepted) const {
+    const double fit_tol = fit_relative * size_;
+    std::vector<double> breaks{edge.t0};
+    for (double k : edge.curve.basis.knots)
+      if (k - breaks.back() > 1e-9 * (edge.t1 - edge.t0) &&
+          edge.t1 - k > 1e-9 * (edge.t1 - edge.t0))
+        breaks.push_back(k);
+    breaks.push_back(edge.t1);
+    bool off_face = false;
+    // Plain copies: Clang 14 refuses structured bindings captured by lambdas.
+    const double u0 = surface.u.domain().first, u1 = surface.u.domain().second;
+    const double v0 = surface.v.domain().first, v1 = surface.v.domain().second;
+    auto foot = [&](double t) {
+      const Eigen::Vector3d point = surface::evaluate(edge.curve, t);
+      const Eigen::Vector3d start = surface::evaluate(old, t);
+      // Pcurves reach rounding outside the domain (v = -1e-20 on the I-DEAS cone).
+      const auto p = surface::project_normal(surface, point, std::clamp(start.x(), u0, u1),
+                                             std::clamp(start.y(), v0, v1));
+      off_face = off_face || !(p.distance <= accepted);
+      return gp_Pnt2d(p.u, p.v);
+    };
+    std::vector<Handle(Geom2d_BSplineCurve)> pieces;
+    double worst = 0;
+    try {
+      // Breaks also where the foot crosses a knot line of the surface (bisected between scan
+      // samples): the parameter map is only C1 there, which cubics would chase for ever.
+      auto span_of = [&](double t) {
+        const gp_Pnt2d uv = foot(t);
+        const auto& ku = surface.u.knots;
+        const auto& kv = surface.v.knots;
+        return std::pair<long, long>(std::upper_bound(ku.begin(), ku.end(), uv.X()) - ku.begin(),
+                                     std::upper_bound(kv.begin(), kv.end(), uv.Y()) - kv.begin());
+      };
+      std::vector<double> crossings;
+      constexpr int scan = 64;
+      auto previous = span_of(edge.t0);
+      double previous_t = edge.t0;
+      for (int i = 1; i < scan; ++i) {
+        const double t = edge.t0 + (edge.t1 - edge.t0) * i / scan;
+        const auto now = span_of(t);
+        if (now != previous) {
+          double lo = previous_t, hi = t;
+          for (int k = 0; k < 60; ++k) {
+            const double mid = 0.5 * (lo + hi);
+            (span_of(mid) == previous ? lo : hi) = mid;
+          }
+          crossings.push_back(0.5 * (lo + hi));
+        }
+        previous = now;
+        previous_t = t;
+      }
+      breaks.insert(breaks.end() - 1, crossings.begin(), crossings.end());
+      std::sort(breaks.begin(), breaks.end());
+      breaks.erase(
+          std::unique(breaks.begin(), breaks.end(),
+                      [&](double x, double y) { return y - x <= 1e-9 * (edge.t1 - edge.t0); }),
+          breaks.end());
+      breaks.back() = edge.t1;
+      for (std::size_t k = 0; k + 1 < breaks.size(); ++k) {
+        const double a = breaks[k], b = breaks[k + 1];
+        Handle(Geom2d_BSplineCurve) piece;
+        double error = 0;
+        for (int samples = 8;; samples *= 2) {
+          if (samples > 1024 || off_face) return std::nullopt;
+          Handle(TColgp_HArray1OfPnt2d) points = new TColgp_HArray1OfPnt2d(1, samples + 1);
+          Handle(TColStd_HArray1OfReal) parameters = new TColStd_HArray1OfReal(1, samples + 1);
+          for (int i = 0; i <= samples; ++i) {
+            const double t = i == samples ? b : a + (b - a) * i / samples;
+            points->SetValue(i + 1, foot(t));
+            parameters->SetValue(i + 1, t);
+          }
+          Geom2dAPI_Interpolate interpolate(points, parameters, false, 1e-15);
+          interpolate.Perform();
+          if (!interpolate.IsDone()) continue;
+          piece = interpolate.Curve();
+          error = 0;
+          for (int i = 0; i <= 4 * samples; ++i) {
+            const double t = a + (b - a) * i / (4 * samples);
+            const gp_Pnt2d uv = piece->Value(t);  // within rounding of the domain
+            error = std::max(error, (surface::evaluate(surface, std::clamp(uv.X(), u0, u1),
+                                                       std::clamp(uv.Y(), v0, v1)) -
+                                     surface::evaluate(edge.curve, t))
+                                        .norm());
+          }
+          if (error <= fit_tol) break;
+        }
+        worst = std::max(worst, error);
+        pieces.push_back(piece);
+      }
+    } catch (const Error&) {
+      return std::nullopt;  // a projection outside the domain: left for problems() to name
+    }
+    return std::pair{joined(pieces), worst};
   }
 
   /// The part of a label (a simple shape or an assembly), converted once.

@@ -307,20 +307,9 @@ class DocumentWriter {
       if (m_.bodies.size() == 1) {
         body_label(0);
       } else {
-        // One compound: a reader finds one free shape with its bodies, as it was read.
-        TopoDS_Compound all;
-        BRep_Builder b;
-        b.MakeCompound(all);
-        for (const TopoDS_Shape& body : s_.bodies) b.Add(all, body);
-        const TDF_Label label = shapes_->AddShape(all, false);
-        for (std::size_t bi = 0; bi < m_.bodies.size(); ++bi) {
-          const Body& body = m_.bodies[bi];
-          if (!body.name.empty() || body.colour) {
-            const TDF_Label sub = shapes_->AddSubShape(label, s_.bodies[bi]);
-            if (!sub.IsNull()) attribute(sub, body.name, body.colour, XCAFDoc_ColorGen);
-          }
-          face_labels(label, bi);
-        }
+        std::vector<int> all(m_.bodies.size());
+        for (std::size_t bi = 0; bi < all.size(); ++bi) all[bi] = static_cast<int>(bi);
+        bodies_label(all);
       }
     } else {
       part_labels_.assign(m_.parts.size(), TDF_Label());
@@ -356,6 +345,25 @@ class DocumentWriter {
       }
   }
 
+  /// Several bodies as one compound: a reader finds one shape with its bodies, as it was read
+  /// (a part of several bodies stays one part, not an assembly of one part per body).
+  TDF_Label bodies_label(const std::vector<int>& bodies) {
+    TopoDS_Compound all;
+    BRep_Builder b;
+    b.MakeCompound(all);
+    for (int bi : bodies) b.Add(all, s_.bodies[static_cast<std::size_t>(bi)]);
+    const TDF_Label label = shapes_->AddShape(all, false);
+    for (int bi : bodies) {
+      const Body& body = m_.bodies[static_cast<std::size_t>(bi)];
+      if (!body.name.empty() || body.colour) {
+        const TDF_Label sub = shapes_->AddSubShape(label, s_.bodies[static_cast<std::size_t>(bi)]);
+        if (!sub.IsNull()) attribute(sub, body.name, body.colour, XCAFDoc_ColorGen);
+      }
+      face_labels(label, static_cast<std::size_t>(bi));
+    }
+    return label;
+  }
+
   TDF_Label body_label(std::size_t body) {
     const TDF_Label label = shapes_->AddShape(s_.bodies[body], false);
     attribute(label, m_.bodies[body].name, m_.bodies[body].colour, XCAFDoc_ColorGen);
@@ -375,6 +383,8 @@ class DocumentWriter {
         known = label;
         return label;
       }
+    } else if (part.components.empty() && part.bodies.size() > 1) {
+      label = bodies_label(part.bodies);
     } else {
       label = shapes_->NewShape();
       for (int bi : part.bodies)
