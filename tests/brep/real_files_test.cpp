@@ -1,0 +1,173 @@
+// Reading files written by other CAD systems (tests/data/cad, sources in its README): Autodesk
+// Inventor and its translation framework, CATIA V4 and V5, I-DEAS, Pro/ENGINEER, Rhino,
+// SolidWorks and Unigraphics; STEP AP203/AP214 and IGES 144/186. Each is read whole and checked
+// against independent figures: OpenCASCADE's own reading of the same file (counts, BRepCheck,
+// BRepGProp volume), closed forms where the part is one (the cube, the cone, the spheres) and
+// the volume the sending system wrote into the file (CATIA's validation property). Then each
+// goes through the rest of the pipeline: written as STEP and read back with the same geometry,
+// and deformed exactly by a lattice around it into a model that is still valid.
+#include <catch2/catch.hpp>
+
+#include <clay/brep/exchange.hpp>
+#include <clay/brep/volume.hpp>
+#include <clay/deform/model_deformation.hpp>
+#include <clay/surface/bspline_surface.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <optional>
+#include <string>
+
+#include "error_of.hpp"
+#include "occt/test_models.hpp"
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+using Catch::Matchers::Contains;
+using clay::brep::Model;
+
+namespace {
+
+fs::path cad_file(const std::string& name) { return fs::path(CLAY_TEST_CAD_DIR) / name; }
+
+/// One real file and what is known of it independently of our reader.
+struct RealFile {
+  std::string name;
+  int bodies, faces;
+  std::optional<double> volume_mm3;  ///< a closed form or the sending system's own figure
+  double volume_relative = 1e-9;     ///< how closely that figure is expected
+  std::string healing;               ///< a healing the report must name ("" for none)
+};
+
+RealFile real(std::string name, int bodies, int faces, std::optional<double> volume = {},
+              double relative = 1e-9, std::string healing = {}) {
+  return {std::move(name), bodies, faces, volume, relative, std::move(healing)};
+}
+
+/// The lattice box around every control point of the model's placed instances, 5 % larger
+/// each way, one corner raised.
+clay::deform::DeformationStack corner_raised_around(const Model& model) {
+  const Model m = clay::brep::flattened(model);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const auto& f : m.faces)
+    for (Eigen::Index i = 0; i < f.surface.points.rows(); ++i) {
+      lo = lo.cwiseMin(f.surface.points.row(i).transpose());
+      hi = hi.cwiseMax(f.surface.points.row(i).transpose());
+    }
+  const Eigen::Vector3d pad = 0.05 * (hi - lo) + Eigen::Vector3d::Constant(1.0);
+  lo -= pad;
+  hi += pad;
+  clay::deform::Frame frame;
+  frame.origin = lo;
+  frame.s = {hi.x() - lo.x(), 0, 0};
+  frame.t = {0, hi.y() - lo.y(), 0};
+  frame.u = {0, 0, hi.z() - lo.z()};
+  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  lattice.points.row(lattice.index(1, 1, 1)) += (0.1 * (hi - lo)).transpose();
+  clay::deform::DeformationStack stack;
+  stack.steps.push_back({lattice, "corner", true});
+  return stack;
+}
+
+}  // namespace
+
+TEST_CASE("real files from other CAD systems read whole, valid, with their volumes") {
+  const double cone = std::numbers::pi * 35 * 35 * 100 / 3;  // I-DEAS: r 35, height 100
+  const double spheres = 2 * 4 * std::numbers::pi / 3;       // SolidWorks: 2 instances of r 1
+  const RealFile file = GENERATE_COPY(
+      real("inventor2019_cube10_ap214.stp", 1, 6, 1000.0),
+      real("inventor2019_cube10_msbo.igs", 1, 6, 1000.0),
+      real("autodesk_atf_conical_surface_ap214.step", 1, 5),
+      real("unigraphics16_io1_ap214.stp", 1, 17),
+      // CATIA's own validation property; the file's B-spline edges are within 5e-5 mm.
+      real("catia_v5r13_xr2_bolt_ap214.stp", 1, 7, 3200.49751584, 1e-6),
+      real("catia_v4_pr1_box_sphere_torus_cone_cc2.stp", 4, 15),
+      real("catia_v5r19_as1_assembly_ap203.stp", 3, 39),
+      real("catia_v5r14_cone_trimmed144.igs", 3, 3),
+      real("ideas11_cone_msbo186.igs", 1, 2, cone, 1e-9, "re-derived 1 pcurve from its edge"),
+      real("proe1999_t4m_surfaces_ap203.stp", 3, 11),
+      real("solidworks2013_spheres_asm_ap214.STEP", 1, 1, spheres),
+      real("rhino7_bspline_surface.igs", 1, 1));
+  INFO(file.name);
+  const fs::path path = cad_file(file.name);
+  const auto imported = clay::brep::read_model(path);
+  const Model& m = imported.model;
+  INFO(imported.report.brief());
+  CHECK(m.bodies.size() == static_cast<std::size_t>(file.bodies));
+  CHECK(m.faces.size() == static_cast<std::size_t>(file.faces));
+  CHECK(clay::brep::problems(m).empty());
+  const double size = imported.report.size_mm;
+  CHECK(imported.report.max_rederivation_error_mm <= 1e-9 * size);
+  if (!file.healing.empty()) {
+    bool named = false;
+    for (const auto& h : imported.report.healing) named = named || h.find(file.healing) == 0;
+    CHECK(named);
+  }
+
+  // OpenCASCADE's own reading of the same file: the same counts (instances placed), and the
+  // same volume within its integration's accuracy.
+  const auto facts = clay::surface::occt_reference::facts_of_file(path);
+  const auto placed = clay::brep::counts(clay::brep::flattened(m));
+  CHECK(placed.faces == facts.faces);
+  CHECK(placed.edges == facts.edges);
+  const auto check = clay::brep::check_model(m);
+  INFO(check.brief());
+  CHECK(check.valid);
+  if (facts.solids > 0) {
+    CHECK(std::abs(check.volume_mm3 - facts.volume) <= 1e-6 * std::abs(facts.volume));
+  }
+  if (file.volume_mm3) {
+    CHECK(std::abs(check.volume_mm3 - *file.volume_mm3) <= file.volume_relative * *file.volume_mm3);
+  }
+
+  // Written as STEP and read back: the same counts, every surface bit-identical, except planes
+  // some of whose pcurves OpenCASCADE's STEP reader rebuilds (it re-derives pcurves of circles
+  // on planes): their NURBS box then moves by rounding. Those are counted and bounded.
+  const fs::path out =
+      clay::test::test_output("real", fs::path(file.name).stem().string() + ".step");
+  clay::brep::write_model(m, out);
+  const Model again = clay::brep::read_model(out).model;
+  CHECK(clay::brep::counts(again) == clay::brep::counts(m));
+  int identical = 0, planes_at_rounding = 0;
+  for (std::size_t f = 0; f < m.faces.size() && f < again.faces.size(); ++f) {
+    const auto& a = m.faces[f].surface;
+    const auto& b = again.faces[f].surface;
+    if (clay::surface::identical(a, b)) {
+      ++identical;
+      continue;
+    }
+    INFO("face " << f);
+    REQUIRE(m.faces[f].elementary);
+    CHECK(m.faces[f].elementary->kind == clay::brep::ElementaryKind::Plane);
+    REQUIRE(a.points.rows() == b.points.rows());
+    REQUIRE(a.u.knots.size() == b.u.knots.size());
+    REQUIRE(a.v.knots.size() == b.v.knots.size());
+    double moved = (a.points - b.points).cwiseAbs().maxCoeff();
+    for (std::size_t k = 0; k < a.u.knots.size(); ++k)
+      moved = std::max(moved, std::abs(a.u.knots[k] - b.u.knots[k]));
+    for (std::size_t k = 0; k < a.v.knots.size(); ++k)
+      moved = std::max(moved, std::abs(a.v.knots[k] - b.v.knots[k]));
+    CHECK(moved <= 1e-13 * size);
+    ++planes_at_rounding;
+  }
+  CHECK(identical + planes_at_rounding == static_cast<int>(m.faces.size()));
+  CHECK(planes_at_rounding <= 1);
+
+  // Deformed exactly by a trilinear lattice with a raised corner: still valid, every face exact.
+  const auto deformed = clay::deform::deform_model(corner_raised_around(m), m);
+  INFO(deformed.report.brief());
+  CHECK(deformed.report.faces_exact == clay::brep::counts(clay::brep::flattened(m)).faces);
+  CHECK(clay::brep::problems(deformed.model).empty());
+  const auto deformed_check = clay::brep::check_model(deformed.model);
+  INFO(deformed_check.brief());
+  CHECK(deformed_check.valid);
+}
+
+TEST_CASE("a real file with no face (Rhino wireframe) is refused, naming the file") {
+  const fs::path path = cad_file("rhino_stdev14_wireframe_line_ap214.stp");
+  const auto [category, message] = clay::test::error_of([&] { clay::brep::read_model(path); });
+  CHECK(category == clay::ErrorCategory::Exchange);
+  CHECK_THAT(message,
+             Contains("rhino_stdev14_wireframe_line_ap214.stp") && Contains("holds no face"));
+}
