@@ -168,6 +168,49 @@ TEST_CASE("deform_model: a filleted block with holes through a trilinear lattice
   CHECK(std::abs(facts.volume - r.volume_after_mm3) <= 1e-6 * r.volume_after_mm3);
 }
 
+TEST_CASE("deform_model: a loft with trimmed holes (B-spline faces) through a lattice, exactly") {
+  const fs::path file = output("loft.step");
+  const Model loft = clay::test::read_test_model(TestModel::LoftWithHoles, file);
+  // Read as OpenCASCADE reads it: one solid, a B-spline side face holding four holes.
+  const auto facts = clay::surface::occt_reference::facts_of_file(file);
+  const auto counts = clay::brep::counts(loft);
+  CHECK(counts.solids == 1);
+  CHECK(counts.faces == facts.faces);
+  CHECK(counts.edges == facts.edges);
+  CHECK(counts.inner_loops >= 4);
+  CHECK(clay::brep::problems(loft).empty());
+  CHECK(std::abs(clay::brep::volume_mm3(loft) - facts.volume) <= 1e-6 * facts.volume);
+  const DeformationStack stack = trilinear({-40, -25, -5}, {40, 25, 65}, {5, -4, 6});
+  const auto result = clay::deform::deform_model(stack, loft);
+  const auto& r = result.report;
+  INFO(r.brief());
+  CHECK(r.counts == counts);
+  CHECK(r.faces_exact == counts.faces);
+  CHECK(r.faces_refit == 0);
+  const double size = 100;  // the loft's box is 60 x 30 x 60 mm (diagonal 90)
+  CHECK(r.max_deviation_mm <= 1e-12 * size);
+  int samples = 0;
+  const double deviation = max_pointwise_deviation(stack, loft, result.model, 1000, samples);
+  CHECK(samples >= counts.faces * 1000);
+  CHECK(deviation <= 1e-12 * size);
+  CHECK(clay::brep::problems(result.model).empty());
+  REQUIRE(r.volume_ratio_bounded);
+  const double ratio = r.volume_after_mm3 / r.volume_before_mm3;
+  CHECK(ratio >= r.volume_ratio_min);
+  CHECK(ratio <= r.volume_ratio_max);
+  const auto check = clay::brep::check_model(result.model);
+  INFO(check.brief());
+  CHECK(check.valid);
+  // Written and read back by OpenCASCADE: valid, the same counts, its volume agrees with ours.
+  const fs::path written = output("loft-deformed.step");
+  clay::brep::write_model(result.model, written);
+  const auto after = clay::surface::occt_reference::facts_of_file(written);
+  CHECK(after.valid);
+  CHECK(after.faces == counts.faces);
+  CHECK(after.edges == counts.edges);
+  CHECK(std::abs(after.volume - r.volume_after_mm3) <= 1e-6 * r.volume_after_mm3);
+}
+
 TEST_CASE("deform_model: a uniform scale changes the volume by its determinant") {
   const Model sphere = read(TestModel::Sphere, "sphere.step");
   // The lattice [-20, 20]^3 scaled by 1.1 about the origin: an affine map of determinant 1.331.

@@ -538,39 +538,6 @@ TEST_CASE("write_model: bad models and paths raise clay::Error and write nothing
           clay::brep::write_model(read.model, output("missing/dir/x.step"));
         }).first == ErrorCategory::Io);
 }
-TEST_CASE("debug rt", "[.debug]") {
-  for (const char* name : {"rt-torus", "rt-sphere"}) {
-    const auto a = read_model(output(std::string(name) + ".step")).model;
-    const auto b = read_model(output(std::string(name) + "-copy.step")).model;
-    auto show = [](const char* what, const clay::surface::BSplineBasis& x,
-                   const clay::surface::BSplineBasis& y) {
-      std::printf("%s degree %d/%d knots %zu/%zu:", what, x.degree, y.degree, x.knots.size(),
-                  y.knots.size());
-      for (size_t i = 0; i < std::min(x.knots.size(), y.knots.size()); ++i)
-        if (x.knots[i] != y.knots[i])
-          std::printf(" [%zu] %.17g vs %.17g", i, x.knots[i], y.knots[i]);
-      std::printf("\n");
-    };
-    show("u", a.faces[0].surface.u, b.faces[0].surface.u);
-    show("v", a.faces[0].surface.v, b.faces[0].surface.v);
-    for (Eigen::Index r = 0; r < a.faces[0].surface.points.rows(); ++r)
-      for (int k = 0; k < 3; ++k)
-        if (a.faces[0].surface.points(r, k) != b.faces[0].surface.points(r, k))
-          std::printf("  pt %ld/%ld.%d %.17g vs %.17g\n", (long)r,
-                      (long)a.faces[0].surface.count_v(), k, a.faces[0].surface.points(r, k),
-                      b.faces[0].surface.points(r, k));
-    std::printf("points max diff %g weights %g\n",
-                (a.faces[0].surface.points - b.faces[0].surface.points).cwiseAbs().maxCoeff(),
-                (a.faces[0].surface.weights - b.faces[0].surface.weights).cwiseAbs().maxCoeff());
-    for (size_t e = 0; e < a.edges.size(); ++e) {
-      std::printf("edge %zu deg %d t %g %g / %g %g\n", e, (int)a.edges[e].degenerate, a.edges[e].t0,
-                  a.edges[e].t1, b.edges[e].t0, b.edges[e].t1);
-      if (!a.edges[e].degenerate) {
-        show(" c", a.edges[e].curve.basis, b.edges[e].curve.basis);
-      }
-    }
-  }
-}
 
 TEST_CASE("read_model: an isolated read (a child process) gives the same model and report") {
   const fs::path file = written(TestModel::FilletedBlock, "isolated.step");

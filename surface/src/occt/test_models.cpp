@@ -15,6 +15,7 @@
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepGProp.hxx>
+#include <BRepOffsetAPI_ThruSections.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCone.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
@@ -25,6 +26,7 @@
 #include <BRep_Tool.hxx>
 #include <GC_MakeArcOfCircle.hxx>
 #include <GProp_GProps.hxx>
+#include <GeomAPI_Interpolate.hxx>
 #include <GeomAPI_ProjectPointOnSurf.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_OffsetSurface.hxx>
@@ -39,7 +41,9 @@
 #include <STEPControl_Reader.hxx>
 #include <TColStd_Array1OfInteger.hxx>
 #include <TColStd_Array1OfReal.hxx>
+#include <TColStd_HArray1OfReal.hxx>
 #include <TColgp_Array2OfPnt.hxx>
+#include <TColgp_HArray1OfPnt.hxx>
 #include <TDF_Label.hxx>
 #include <TDataStd_Name.hxx>
 #include <TDocStd_Document.hxx>
@@ -55,6 +59,8 @@
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Ax2.hxx>
+#include <gp_Circ.hxx>
+#include <gp_Elips.hxx>
 #include <gp_GTrsf.hxx>
 #include <gp_Pnt.hxx>
 #include <gp_Trsf.hxx>
@@ -123,6 +129,42 @@ TopoDS_Shape label_bottle() {
   wire.Add(BRepBuilderAPI_MakeEdge(p5, points.front()).Edge());
   const TopoDS_Face profile = BRepBuilderAPI_MakeFace(wire.Wire(), true).Face();
   return BRepPrimAPI_MakeRevol(profile, gp::OZ()).Shape();
+}
+
+/// The loft of TestModel::LoftWithHoles: BRepOffsetAPI_ThruSections, ruled, through three closed
+/// sections (closed cubic B-splines through 12 points of a circle or an ellipse, on the same
+/// parameters, so the loft keeps them: bicubic-by-linear side faces, two planar caps), then two
+/// cylinders cut across it at 45 degrees to the seam (each makes two holes, away from the seam).
+TopoDS_Shape loft_with_holes() {
+  // Closed, not periodic (ThruSections refuses periodic sections): 13 points, the last the first.
+  auto section = [](double a, double b, double z) {
+    constexpr int n = 12;
+    Handle(TColgp_HArray1OfPnt) points = new TColgp_HArray1OfPnt(1, n + 1);
+    Handle(TColStd_HArray1OfReal) parameters = new TColStd_HArray1OfReal(1, n + 1);
+    for (int k = 0; k <= n; ++k) {
+      const double t = 2 * M_PI * k / n;
+      points->SetValue(k + 1, gp_Pnt(a * std::cos(t), b * std::sin(t), z));
+      parameters->SetValue(k + 1, t);
+    }
+    points->SetValue(n + 1, points->Value(1));
+    GeomAPI_Interpolate interpolate(points, parameters, false, 1e-9);
+    interpolate.Perform();
+    return BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(interpolate.Curve()).Edge()).Wire();
+  };
+  BRepOffsetAPI_ThruSections loft(true, true);
+  loft.AddWire(section(20, 20, 0));
+  loft.AddWire(section(30, 15, 30));
+  loft.AddWire(section(12, 12, 60));
+  loft.Build();
+  TopoDS_Shape shape = loft.Shape();
+  for (const auto& [z, direction] :
+       {std::pair{15.0, gp_Dir(1, 1, 0)}, std::pair{45.0, gp_Dir(1, -1, 0)}}) {
+    const gp_Pnt start = gp_Pnt(0, 0, z).Translated(-40 * gp_Vec(direction));
+    shape = BRepAlgoAPI_Cut(shape,
+                            BRepPrimAPI_MakeCylinder(gp_Ax2(start, direction), 4.0, 80.0).Shape())
+                .Shape();
+  }
+  return shape;
 }
 
 TopoDS_Shape loose_box_faces() {
@@ -309,6 +351,9 @@ void write_test_model(TestModel model, const fs::path& file) {
     }
     case TestModel::LooseFaces:
       add_part(shapes, colours, loose_box_faces(), "faces", srgb(0.6, 0.6, 0.6));
+      break;
+    case TestModel::LoftWithHoles:
+      add_part(shapes, colours, loft_with_holes(), "loft", srgb(0.4, 0.7, 0.7));
       break;
   }
   write_document(document, file, model == TestModel::LooseFaces);

@@ -25,6 +25,9 @@ enum class TestModel {
   HolePlate,      ///< 200 faces: a 200 x 200 x 10 plate, vertical edges filleted (r 8), 190 holes
   ObliqueCut,     ///< a cylinder r 10 cut by a plane at 30 degrees: an ellipse across the angles
   OffsetSheet,    ///< one face: a bicubic bump 40 x 30 offset by 2 mm (STEP offset_surface)
+  LoftWithHoles,  ///< a ruled loft through a circle r 20 (z 0), an ellipse 30 x 15 (z 30) and a
+                  ///< circle r 12 (z 60), cut by two cylinders r 4 across it at 45 degrees (z 15
+                  ///< and 45): B-spline side faces with four trimmed holes (Boolean rims)
 };
 
 /// Builds `model` with OpenCASCADE and writes it through XCAF (names, colours, assembly) as
