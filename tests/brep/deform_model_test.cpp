@@ -24,6 +24,7 @@ using Catch::Matchers::Contains;
 using clay::brep::Model;
 using clay::deform::DeformationStack;
 using clay::surface::occt_reference::TestModel;
+using clay::test::trilinear;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
@@ -91,20 +92,6 @@ double max_pointwise_deviation(const DeformationStack& stack, const Model& befor
     }
   }
   return worst;
-}
-
-/// A trilinear Bézier lattice around the box [lo, hi], one corner moved by `move`.
-DeformationStack trilinear(const Vector3d& lo, const Vector3d& hi, const Vector3d& move) {
-  clay::deform::Frame frame;
-  frame.origin = lo;
-  frame.s = {hi.x() - lo.x(), 0, 0};
-  frame.t = {0, hi.y() - lo.y(), 0};
-  frame.u = {0, 0, hi.z() - lo.z()};
-  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
-  lattice.points.row(lattice.index(1, 1, 1)) += move.transpose();
-  DeformationStack stack;
-  stack.steps.push_back({lattice, "corner", true});
-  return stack;
 }
 
 /// The undisplaced trilinear lattice on [-20, 20]^3.

@@ -45,8 +45,8 @@ RealFile real(std::string name, int bodies, int faces, std::optional<double> vol
   return {std::move(name), bodies, faces, volume, relative, std::move(healing)};
 }
 
-/// The lattice box around every control point of the model's placed instances, 5 % larger
-/// each way, one corner raised.
+/// A trilinear lattice around every control point of the model's placed instances, 5 % larger
+/// each way, one corner raised by a tenth of the box.
 clay::deform::DeformationStack corner_raised_around(const Model& model) {
   const Model m = clay::brep::flattened(model);
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
@@ -56,18 +56,7 @@ clay::deform::DeformationStack corner_raised_around(const Model& model) {
       hi = hi.cwiseMax(f.surface.points.row(i).transpose());
     }
   const Eigen::Vector3d pad = 0.05 * (hi - lo) + Eigen::Vector3d::Constant(1.0);
-  lo -= pad;
-  hi += pad;
-  clay::deform::Frame frame;
-  frame.origin = lo;
-  frame.s = {hi.x() - lo.x(), 0, 0};
-  frame.t = {0, hi.y() - lo.y(), 0};
-  frame.u = {0, 0, hi.z() - lo.z()};
-  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
-  lattice.points.row(lattice.index(1, 1, 1)) += (0.1 * (hi - lo)).transpose();
-  clay::deform::DeformationStack stack;
-  stack.steps.push_back({lattice, "corner", true});
-  return stack;
+  return clay::test::trilinear(lo - pad, hi + pad, 0.1 * (hi - lo + 2 * pad));
 }
 
 }  // namespace

@@ -710,6 +710,32 @@ surface::BSplineCurve joined(const std::vector<Handle(Geom2d_BSplineCurve)>& pie
   return surface::make_curve(3, std::move(knots), std::move(points));
 }
 
+/// Where a parameter map crosses a knot line: `span_of(s)` names the knot spans (u, v) the map
+/// is in at s; each change between 64 samples of [s0, s1] is bisected to rounding. The maps are
+/// only C1 there, so the fitted pieces break at these parameters.
+std::vector<double> span_changes(const std::function<std::pair<long, long>(double)>& span_of,
+                                 double s0, double s1) {
+  constexpr int scan = 64;
+  std::vector<double> out;
+  auto previous = span_of(s0);
+  double previous_s = s0;
+  for (int i = 1; i < scan; ++i) {
+    const double s = s0 + (s1 - s0) * i / scan;
+    const auto now = span_of(s);
+    if (now != previous) {
+      double lo = previous_s, hi = s;
+      for (int k = 0; k < 60; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (span_of(mid) == previous ? lo : hi) = mid;
+      }
+      out.push_back(0.5 * (lo + hi));
+    }
+    previous = now;
+    previous_s = s;
+  }
+  return out;
+}
+
 /// The new pcurve of one coedge: see the file comment for the four ways.
 Rederived rederive(const FaceConversion& face, const EdgeConversion& edge,
                    const Handle(Geom2d_Curve) & old_pcurve, const std::string& name) {
@@ -758,31 +784,17 @@ Rederived rederive(const FaceConversion& face, const EdgeConversion& edge,
       for (int i = 1; i <= edge.nurbs->NbKnots(); ++i)
         if (edge.nurbs->Knot(i) > s0 && edge.nurbs->Knot(i) < s1)
           candidates.push_back(edge.nurbs->Knot(i));
-    // Where the pcurve crosses a knot line of the new surface (by bisection between samples).
-    auto span_of = [&](double s) {
-      const Eigen::Vector2d uv = target(s);
-      int iu = 0, iv = 0;
-      for (int k = 1; k <= face.nurbs->NbUKnots(); ++k) iu += face.nurbs->UKnot(k) <= uv.x();
-      for (int k = 1; k <= face.nurbs->NbVKnots(); ++k) iv += face.nurbs->VKnot(k) <= uv.y();
-      return std::pair<int, int>(iu, iv);
-    };
-    constexpr int scan = 64;
-    auto previous = span_of(s0);
-    double previous_s = s0;
-    for (int i = 1; i <= scan; ++i) {
-      const double s = s0 + (s1 - s0) * i / scan;
-      const auto now = span_of(s);
-      if (now != previous && i < scan) {
-        double lo = previous_s, hi = s;
-        for (int k = 0; k < 60; ++k) {
-          const double mid = 0.5 * (lo + hi);
-          (span_of(mid) == previous ? lo : hi) = mid;
-        }
-        candidates.push_back(0.5 * (lo + hi));
-      }
-      previous = now;
-      previous_s = s;
-    }
+    // Where the pcurve crosses a knot line of the new surface.
+    const auto crossings = span_changes(
+        [&](double s) {
+          const Eigen::Vector2d uv = target(s);
+          long iu = 0, iv = 0;
+          for (int k = 1; k <= face.nurbs->NbUKnots(); ++k) iu += face.nurbs->UKnot(k) <= uv.x();
+          for (int k = 1; k <= face.nurbs->NbVKnots(); ++k) iv += face.nurbs->VKnot(k) <= uv.y();
+          return std::pair<long, long>(iu, iv);
+        },
+        s0, s1);
+    candidates.insert(candidates.end(), crossings.begin(), crossings.end());
     std::sort(candidates.begin(), candidates.end());
     for (double b : candidates)
       if (b - breaks.back() > 1e-9 * (s1 - s0) && s1 - b > 1e-9 * (s1 - s0)) breaks.push_back(b);
@@ -1033,33 +1045,17 @@ class ModelBuilder {
     std::vector<Handle(Geom2d_BSplineCurve)> pieces;
     double worst = 0;
     try {
-      // Breaks also where the foot crosses a knot line of the surface (bisected between scan
-      // samples): the parameter map is only C1 there, which cubics would chase for ever.
-      auto span_of = [&](double t) {
-        const gp_Pnt2d uv = foot(t);
-        const auto& ku = surface.u.knots;
-        const auto& kv = surface.v.knots;
-        return std::pair<long, long>(std::upper_bound(ku.begin(), ku.end(), uv.X()) - ku.begin(),
-                                     std::upper_bound(kv.begin(), kv.end(), uv.Y()) - kv.begin());
-      };
-      std::vector<double> crossings;
-      constexpr int scan = 64;
-      auto previous = span_of(edge.t0);
-      double previous_t = edge.t0;
-      for (int i = 1; i < scan; ++i) {
-        const double t = edge.t0 + (edge.t1 - edge.t0) * i / scan;
-        const auto now = span_of(t);
-        if (now != previous) {
-          double lo = previous_t, hi = t;
-          for (int k = 0; k < 60; ++k) {
-            const double mid = 0.5 * (lo + hi);
-            (span_of(mid) == previous ? lo : hi) = mid;
-          }
-          crossings.push_back(0.5 * (lo + hi));
-        }
-        previous = now;
-        previous_t = t;
-      }
+      // Breaks also where the foot crosses a knot line of the surface (span_changes).
+      const auto crossings = span_changes(
+          [&](double t) {
+            const gp_Pnt2d uv = foot(t);
+            const auto& ku = surface.u.knots;
+            const auto& kv = surface.v.knots;
+            return std::pair<long, long>(
+                std::upper_bound(ku.begin(), ku.end(), uv.X()) - ku.begin(),
+                std::upper_bound(kv.begin(), kv.end(), uv.Y()) - kv.begin());
+          },
+          edge.t0, edge.t1);
       breaks.insert(breaks.end() - 1, crossings.begin(), crossings.end());
       std::sort(breaks.begin(), breaks.end());
       breaks.erase(
