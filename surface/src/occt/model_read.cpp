@@ -484,10 +484,11 @@ std::optional<Elementary> elementary_of(const Handle(Geom_Surface) & s) {
 
 /// A plane face's NURBS: the plane, in its own parameters, over the box of its pcurves (32
 /// samples per knot span of each, widened by 1e-3 of the box, which holds the arcs between the
-/// samples). Not over BRepTools::UVBounds: that box depends on how the file gave the pcurves (a
-/// circle, or the rational B-spline we write for it), and a written plane must read back as the
-/// same NURBS bit for bit; nor over the pcurves' control points, which reach far outside a
-/// circle (a lattice around the face would then not hold its NURBS).
+/// samples, and rounded outward to 2^-20 of it). Not over BRepTools::UVBounds: that box depends on
+/// how the file gave the pcurves (a circle, or the rational B-spline we write for it), and a
+/// written plane must read back as the same NURBS bit for bit; nor over the pcurves' control
+/// points, which reach far outside a circle (a lattice around the face would then not hold its
+/// NURBS).
 surface::BSplineSurface plane_over_pcurves(const Elementary& e, const std::vector<Loop>& loops,
                                            const std::vector<Edge>& edges) {
   double u0 = INFINITY, u1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY;
@@ -510,10 +511,14 @@ surface::BSplineSurface plane_over_pcurves(const Elementary& e, const std::vecto
         }
     }
   const double margin = 1e-3 * std::max(u1 - u0, v1 - v0);
-  u0 -= margin;
-  u1 += margin;
-  v0 -= margin;
-  v1 += margin;
+  // Outward to a grid of 2^-20 of the box: OpenCASCADE's STEP reader re-derives some pcurves on
+  // planes (circles of an Autodesk part, a CATIA hole), which then differ from ours by rounding,
+  // and the box must not follow them for a written plane to read back bit for bit.
+  const double step = std::exp2(std::floor(std::log2(std::max(u1 - u0, v1 - v0))) - 20);
+  u0 = std::floor((u0 - margin) / step) * step;
+  u1 = std::ceil((u1 + margin) / step) * step;
+  v0 = std::floor((v0 - margin) / step) * step;
+  v1 = std::ceil((v1 + margin) / step) * step;
   surface::Points3 corners(4, 3);
   int row = 0;
   for (double u : {u0, u1})
