@@ -58,16 +58,18 @@ using detail::Plane;
 
 // ---- surfaces: bases, fit, derivative bounds of Bézier patches --------------------------------
 
-/// The fit's basis in one direction: the original's breakpoints, degree p_fit, and at each
+/// The fit's basis in one direction: the original's breakpoints (or, without keep_breakpoints,
+/// those where the original is less smooth than C^p_fit), degree p_fit, and at each
 /// interior breakpoint the multiplicity that keeps the original's continuity C^(p − m) there
 /// (at least 1, at most p_fit).
-BSplineBasis initial_basis(const BSplineBasis& original, int degree) {
+BSplineBasis initial_basis(const BSplineBasis& original, int degree, bool keep_breakpoints) {
   const std::vector<double> breaks = surface::breakpoints(original);
   BSplineBasis b;
   b.degree = degree;
   b.knots.assign(static_cast<std::size_t>(degree + 1), breaks.front());
   for (std::size_t k = 1; k + 1 < breaks.size(); ++k) {
     const int continuity = original.degree - surface::multiplicity(original, breaks[k]);
+    if (!keep_breakpoints && continuity >= degree) continue;  // smoother than a fit's join
     const int m = std::clamp(degree - continuity, 1, degree);
     b.knots.insert(b.knots.end(), static_cast<std::size_t>(m), breaks[k]);
   }
@@ -211,6 +213,8 @@ struct CellResult {
 struct Certificate {
   std::vector<CellResult> cells;  // (iu, iv) at iu * cells_v + iv
   int cells_u = 0, cells_v = 0;
+  std::vector<int> span_u, span_v;  // the fit's non-empty span holding each cell
+  int spans_u = 0, spans_v = 0;     // the fit's non-empty spans
   double sampled = 0, bound = 0;
   long samples = 0;
   bool certified = true;
@@ -221,14 +225,23 @@ struct Certificate {
 /// max|e(grid)| + remainder + rounding allowance.
 Certificate certify(const BSplineSurface& original, const BSplineSurface& fit, const Certifier& d,
                     int base, double budget, double rounding) {
-  const surface::BezierPatches fit_patches = surface::extract_bezier(fit);
-  const std::vector<double> added_u =
-      added_breaks(fit_patches.breaks_u, surface::breakpoints(original.u));
-  const std::vector<double> added_v =
-      added_breaks(fit_patches.breaks_v, surface::breakpoints(original.v));
-  BSplineSurface refined = original;
-  if (!added_u.empty()) refined = surface::refine_knots_u(refined, added_u);
-  if (!added_v.empty()) refined = surface::refine_knots_v(refined, added_v);
+  // Cells: the union of both surfaces' breakpoints, each refined to it (the same surfaces), so
+  // both are one polynomial per cell. The fit's breakpoints hold the original's unless it was
+  // started from fewer (RefitOptions::keep_breakpoints); its cells are then split.
+  const std::vector<double> fit_u = surface::breakpoints(fit.u),
+                            fit_v = surface::breakpoints(fit.v);
+  const std::vector<double> original_u = surface::breakpoints(original.u),
+                            original_v = surface::breakpoints(original.v);
+  BSplineSurface refined = original, refined_fit = fit;
+  if (const auto a = added_breaks(fit_u, original_u); !a.empty())
+    refined = surface::refine_knots_u(refined, a);
+  if (const auto a = added_breaks(fit_v, original_v); !a.empty())
+    refined = surface::refine_knots_v(refined, a);
+  if (const auto a = added_breaks(original_u, fit_u); !a.empty())
+    refined_fit = surface::refine_knots_u(refined_fit, a);
+  if (const auto a = added_breaks(original_v, fit_v); !a.empty())
+    refined_fit = surface::refine_knots_v(refined_fit, a);
+  const surface::BezierPatches fit_patches = surface::extract_bezier(refined_fit);
   const surface::BezierPatches s_patches = surface::extract_bezier(refined);
   if (s_patches.count_u() != fit_patches.count_u() || s_patches.count_v() != fit_patches.count_v())
     throw Error(ErrorCategory::Internal,
@@ -237,6 +250,18 @@ Certificate certify(const BSplineSurface& original, const BSplineSurface& fit, c
   const int cap = std::max(base, 64);
   Certificate out;
   out.cells_u = fit_patches.count_u(), out.cells_v = fit_patches.count_v();
+  auto spans_of = [](const std::vector<double>& cells, const std::vector<double>& spans) {
+    std::vector<int> owner;
+    for (std::size_t k = 0; k + 1 < cells.size(); ++k)
+      owner.push_back(static_cast<int>(
+          std::upper_bound(spans.begin(), spans.end(), 0.5 * (cells[k] + cells[k + 1])) -
+          spans.begin() - 1));
+    return owner;
+  };
+  out.span_u = spans_of(fit_patches.breaks_u, fit_u);
+  out.span_v = spans_of(fit_patches.breaks_v, fit_v);
+  out.spans_u = static_cast<int>(fit_u.size()) - 1;
+  out.spans_v = static_cast<int>(fit_v.size()) - 1;
   out.certified = static_cast<bool>(d.info);
   for (int iu = 0; iu < out.cells_u; ++iu)
     for (int iv = 0; iv < out.cells_v; ++iv) {
@@ -340,7 +365,8 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
   report.tolerance = tolerance;
   report.size = size;
   report.degree_u = report.degree_v = p;
-  BSplineBasis bu = initial_basis(surface.u, p), bv = initial_basis(surface.v, p);
+  BSplineBasis bu = initial_basis(surface.u, p, options.keep_breakpoints),
+               bv = initial_basis(surface.v, p, options.keep_breakpoints);
   const std::size_t initial_u = bu.knots.size(), initial_v = bv.knots.size();
   std::string limit;
   for (int iteration = 1;; ++iteration) {
@@ -363,17 +389,20 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     report.knots_added_v = static_cast<int>(bv.knots.size() - initial_v);
     report.lipschitz_cells = 0;
     report.crossings.clear();
-    std::vector<char> mark_u(static_cast<std::size_t>(cert.cells_u), 0);
-    std::vector<char> mark_v(static_cast<std::size_t>(cert.cells_v), 0);
+    std::vector<char> mark_u(static_cast<std::size_t>(cert.spans_u), 0);
+    std::vector<char> mark_v(static_cast<std::size_t>(cert.spans_v), 0);
     for (int iu = 0; iu < cert.cells_u; ++iu)
       for (int iv = 0; iv < cert.cells_v; ++iv) {
         const CellResult& c = cert.cells[static_cast<std::size_t>(iu * cert.cells_v + iv)];
+        const int span_u = cert.span_u[static_cast<std::size_t>(iu)];
+        const int span_v = cert.span_v[static_cast<std::size_t>(iv)];
         if (c.lipschitz) ++report.lipschitz_cells;
         for (const Plane& pl : c.planes)
-          report.crossings.push_back({iu, iv, pl.step, pl.axis, pl.value, c.sampled, c.bound});
+          report.crossings.push_back(
+              {span_u, span_v, pl.step, pl.axis, pl.value, c.sampled, c.bound});
         const double measure = cert.certified ? c.bound : c.sampled;
         if (measure > tolerance)
-          mark_u[static_cast<std::size_t>(iu)] = mark_v[static_cast<std::size_t>(iv)] = 1;
+          mark_u[static_cast<std::size_t>(span_u)] = mark_v[static_cast<std::size_t>(span_v)] = 1;
       }
     const double measure = cert.certified ? cert.bound : cert.sampled;
     if (iteration == 1) report.summary.initial_residual = measure;
@@ -489,6 +518,19 @@ RefitResult refit_validated(const BSplineSurface& surface, const D& deformation,
 }
 
 }  // namespace
+
+RefitResult refit_surface(const BSplineSurface& surface, const RefitOptions& options) {
+  // The identity: |D'| = 1, D'' = 0 everywhere, so the certificate's Taylor remainder holds.
+  Certifier identity{"identity map",
+                     [](const Eigen::Vector3d& x) { return x; },
+                     [](const Points3&) {
+                       HullInfo info;
+                       info.bounds = {1.0, 0.0};
+                       return info;
+                     },
+                     {}};
+  return refit(surface, identity, options);
+}
 
 RefitResult refit_deformed(const Taper& taper, const BSplineSurface& surface,
                            const RefitOptions& options) {

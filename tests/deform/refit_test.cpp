@@ -7,7 +7,9 @@
 
 #include <clay/deform.hpp>
 #include <clay/surface/basis.hpp>
+#include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/surface/knots.hpp>
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/skin.hpp>
 
@@ -115,6 +117,59 @@ TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independentl
   CHECK(check <= 1e-4 * size);
   CHECK(rep.certified_bound <= 10 * check);  // the bound is not wildly pessimistic
   CHECK(check <= rep.sampled_max * 1.5);     // the sampled figure is representative
+}
+
+TEST_CASE("refit_surface makes a small certified bicubic copy of a dense high-degree surface",
+          "[refit]") {
+  // What exact composition and style refinement make: the loft (bicubic, C2 joins at 1/3 and 2/3)
+  // elevated to degree 6 x 5 and given 24 more knots per direction (C5 and C4 joins there), then
+  // moved by a displaced trilinear lattice, exactly. Its editable copy drops the smooth knots.
+  std::mt19937 rng(21);
+  surface::BSplineSurface dense =
+      surface::elevate_degree_v(surface::elevate_degree_u(loft_surface(), 3), 2);
+  std::vector<double> extra;
+  for (int k = 1; k <= 24; ++k) extra.push_back((k - 0.5) / 24.0 + 0.003);
+  dense = surface::refine_knots_v(surface::refine_knots_u(dense, extra), extra);
+  Frame f;
+  f.origin = {-60, -50, -10};
+  f.s = {120, 0, 0};
+  f.t = {0, 100, 0};
+  f.u = {0, 0, 140};
+  const BezierLattice lattice = clay::test::displaced(make_bezier_lattice(f, {1, 1, 1}), rng, 0.1);
+  const surface::BSplineSurface exact = compose_exact(lattice, dense).surface;
+  INFO("exact: degree " << exact.u.degree << " x " << exact.v.degree << ", " << exact.points.rows()
+                        << " control points");
+  REQUIRE(exact.u.degree > 3);
+  RefitOptions options;  // bicubic, 1e-4 of the size
+  options.keep_breakpoints = false;
+  const RefitResult editable = refit_surface(exact, options);
+  INFO(editable.report.brief());
+  REQUIRE(editable.report.summary.converged());
+  REQUIRE(editable.report.certified);
+  CHECK(editable.surface.u.degree == 3);
+  CHECK(editable.surface.v.degree == 3);
+  CHECK(editable.report.certified_bound <= editable.report.tolerance);
+  // The bound holds against the exact surface at parameters the refit never sampled.
+  const double check = random_deviation(
+      exact, editable.surface, [](const Eigen::Vector3d& x) { return x; }, 4000, 5);
+  INFO("independent check " << check << " mm");
+  CHECK(check <= editable.report.certified_bound);
+  // A small net: far fewer control points than the exact result, and than a refit that keeps
+  // every breakpoint.
+  options.keep_breakpoints = true;
+  const RefitResult kept = refit_surface(exact, options);
+  INFO(kept.report.brief());
+  REQUIRE(kept.report.summary.converged());
+  CHECK(4 * editable.surface.points.rows() < exact.points.rows());
+  CHECK(2 * editable.surface.points.rows() < kept.surface.points.rows());
+  // The loft's C2 joins (a cubic cannot follow their third derivatives) are kept.
+  CHECK(surface::multiplicity(editable.surface.u, 1.0 / 3) >= 1);
+  // A crease (a C0 breakpoint) is kept with multiplicity 3.
+  const std::vector<double> crease(static_cast<std::size_t>(exact.u.degree), 0.5);
+  options.keep_breakpoints = false;
+  const RefitResult copy = refit_surface(surface::refine_knots_u(exact, crease), options);
+  REQUIRE(copy.report.summary.converged());
+  CHECK(surface::multiplicity(copy.surface.u, 0.5) == 3);
 }
 
 TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor", "[refit]") {

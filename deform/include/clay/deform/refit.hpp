@@ -53,6 +53,13 @@ struct CLAY_DEFORM_API RefitOptions {
                                        ///< direction take 32 count^2 bytes)
   double certificate_share = 0.1;      ///< in (0, 1): share of the tolerance the certificate's
                                    ///< remainder may take when choosing each cell's sample density
+  /// true: the fit starts from every breakpoint of the original, with its continuity; false:
+  /// only from those where the original is C^(degree - 1) or rougher (creases, C1 and C2 joins
+  /// for a cubic fit: a cubic cannot follow a jump of the third derivative without a knot
+  /// there), adding knots only where the tolerance needs them. An exact result of degree 12
+  /// with hundreds of smooth knots then refits to a small, editable net (the recipes'
+  /// "editable" output uses false).
+  bool keep_breakpoints = true;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -105,6 +112,12 @@ struct RefitResult {
 
 /// Any map of space, point by point (mm to mm).
 using PointMap = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
+
+/// Certified refit of the surface itself (the identity map): an exchange-friendly, lower-degree
+/// copy of an exact result, within options.tolerance everywhere on its domain. Throws as the
+/// taper overload.
+CLAY_DEFORM_API RefitResult refit_surface(const surface::BSplineSurface& surface,
+                                          const RefitOptions& options = {});
 
 /// Refit of taper(S): certified. Throws clay::Error: InvalidArgument for bad options,
 /// InvalidGeometry for an invalid surface or taper, or a deformed surface of zero size with a
