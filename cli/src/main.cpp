@@ -226,7 +226,13 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
       std::printf("  %s (%s): %s composition, max deviation %.2g of the size (%.2g mm)\n",
                   step.path.c_str(), step.kind.c_str(), std::get<std::string>(*mode).c_str(),
                   relative, mm);
+    if (step.kind == "editable") std::printf("  %s: %s\n", step.path.c_str(), step.message.c_str());
   }
+  // Warnings reach the user whether or not progress is shown (a script's run has no terminal).
+  for (const auto& step : result.steps)
+    if (step.warning)
+      std::fprintf(stderr, "clayform: warning: %s (%s): %s\n", step.path.c_str(), step.kind.c_str(),
+                   step.message.c_str());
   for (const auto& e : result.exports)
     if (e.checked)
       std::printf("  export %s: %zu surface(s), read back valid (BRepCheck)%s\n", e.name.c_str(),

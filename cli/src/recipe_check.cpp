@@ -149,7 +149,7 @@ std::vector<std::string> RecipeChecker::curve_refs(const Json& obj, const std::s
 Composition RecipeChecker::composition(const Json& j, const std::string& path, Composition c) {
   if (!c_.object(j, path,
                  {"mode", "tolerance", "relative", "degree", "check_samples", "max_control_points",
-                  "accept_out_of_tolerance"},
+                  "accept_out_of_tolerance", "editable"},
                  "a composition {\"mode\": \"exact\"|\"refit\", ...}"))
     return c;
   if (const Json* m = c_.member(j, path, "mode", false, ""))
@@ -165,6 +165,25 @@ Composition RecipeChecker::composition(const Json& j, const std::string& path, C
   c.max_control_points =
       c_.integer_or(j, path, "max_control_points", c.max_control_points,
                     (c.degree + 1) * (c.degree + 1), limit::refit_control_points);
+  // Exchange-friendly output: surfaces above these limits are refitted at `degree` (bicubic by
+  // default), certified within `tolerance`, into at most max_control_points.
+  if (const Json* e = c_.member(j, path, "editable", false, "")) {
+    const std::string ep = key_path(path, "editable");
+    if (c_.object(*e, ep, {"max_degree", "max_control_points"},
+                  "an editable output {\"max_degree\": 9, \"max_control_points\": 10000}")) {
+      Editable ed;
+      ed.max_degree = c_.integer_or(*e, ep, "max_degree", ed.max_degree, 1, 25);
+      ed.max_control_points =
+          c_.integer_or(*e, ep, "max_control_points", ed.max_control_points,
+                        (c.degree + 1) * (c.degree + 1), limit::refit_control_points);
+      if (c.degree > ed.max_degree)
+        c_.add(key_path(ep, "max_degree"),
+               "is " + std::to_string(ed.max_degree) + ", below the composition's \"degree\" " +
+                   std::to_string(c.degree) +
+                   " that editable surfaces are refitted at; raise it or lower \"degree\"");
+      c.editable = ed;
+    }
+  }
   return c;
 }
 

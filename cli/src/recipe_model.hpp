@@ -24,6 +24,13 @@
 namespace clay::recipe {
 
 /// The composition mode of deform surfaces.
+/// "editable": a deformed surface above these limits is refitted (certified, at the
+/// composition's degree and tolerance) into a net a surfacing tool can edit.
+struct Editable {
+  int max_degree = 9;
+  int max_control_points = 10000;
+};
+
 struct Composition {
   bool refit = false;  ///< "refit": steps that cannot be exact are refitted
   double tolerance = 1e-4;
@@ -32,6 +39,7 @@ struct Composition {
   int check_samples = 4;
   bool accept_out_of_tolerance = false;  ///< "accept_out_of_tolerance": keep a refit that misses
   int max_control_points = 40000;        // refit: the net may not grow beyond this (RefitOptions)
+  std::optional<Editable> editable;      ///< "editable": exchange-friendly output on request
 };
 
 struct StrokeDef {

@@ -79,6 +79,10 @@ class Runner {
     for (const auto& s : data_.surfaces) build_surface(s);
   }
 
+  /// Above these an exported surface gets a warning: few surfacing tools edit more.
+  static constexpr int editable_degree = 9;
+  static constexpr long editable_control_points = 10000;
+
   void exports() {
     for (const auto& e : data_.exports)
       timed(e.path, "export", [&](StepReport& rep) {
@@ -106,6 +110,21 @@ class Runner {
                        {"control_points", static_cast<long long>(points)},
                        {"degree", static_cast<long long>(degree)}};
         rep.message = std::to_string(x.surfaces.size()) + " surface(s) for " + e.name;
+        // Exact results can be far beyond what surfacing tools edit: say so, per surface.
+        for (std::size_t k = 0; k < x.surfaces.size(); ++k) {
+          const BSplineSurface& f = x.surfaces[k];
+          if (std::max(f.u.degree, f.v.degree) <= editable_degree &&
+              f.points.rows() <= editable_control_points)
+            continue;
+          rep.warning = true;
+          rep.message +=
+              "; surface '" + e.surfaces[k] + "' has degree " + std::to_string(f.u.degree) + " x " +
+              std::to_string(f.v.degree) + " and " + std::to_string(f.points.rows()) +
+              " control points, more than most surfacing tools edit (degree " +
+              std::to_string(editable_degree) + ", " + std::to_string(editable_control_points) +
+              " control points): ask for \"composition\": {\"editable\": {}} to "
+              "export a certified bicubic copy";
+        }
         result_.exports.push_back(std::move(x));
       });
   }
@@ -155,7 +174,55 @@ class Runner {
         result_.stages.push_back(std::move(stage));
       });
     }
+    if (c.editable && (std::max(s.u.degree, s.v.degree) > c.editable->max_degree ||
+                       s.points.rows() > c.editable->max_control_points))
+      timed(path + ".composition.editable", "editable",
+            [&](StepReport& rep) { s = editable(s, c, name, rep); });
     return s;
+  }
+
+  /// The exchange-friendly copy of a deformed surface above the "editable" limits: refitted at
+  /// the composition's degree, certified within its tolerance, starting from the surface's rough
+  /// breakpoints only (deform::refit_surface), into at most max_control_points.
+  static BSplineSurface editable(const BSplineSurface& s, const Composition& c,
+                                 const std::string& name, StepReport& rep) {
+    deform::RefitOptions o;
+    o.degree = c.degree;
+    o.tolerance = c.tolerance;
+    o.relative = c.relative;
+    o.max_control_points = c.editable->max_control_points;
+    o.keep_breakpoints = false;
+    const deform::RefitResult r = deform::refit_surface(s, o);
+    const auto& f = r.report;
+    rep.figures = {{"exact_degree_u", static_cast<long long>(s.u.degree)},
+                   {"exact_degree_v", static_cast<long long>(s.v.degree)},
+                   {"exact_control_points", static_cast<long long>(s.points.rows())},
+                   {"degree_u", static_cast<long long>(r.surface.u.degree)},
+                   {"degree_v", static_cast<long long>(r.surface.v.degree)},
+                   {"control_points", static_cast<long long>(r.surface.points.rows())},
+                   {"certified", f.certified},
+                   {"max_deviation_mm", f.certified ? f.certified_bound : f.sampled_max},
+                   {"sampled_max_mm", f.sampled_max},
+                   {"tolerance_mm", f.tolerance},
+                   {"size", f.size}};
+    rep.message = "surface '" + name + "' made editable: degree " + std::to_string(s.u.degree) +
+                  " x " + std::to_string(s.v.degree) + ", " + std::to_string(s.points.rows()) +
+                  " control points -> degree " + std::to_string(r.surface.u.degree) + " x " +
+                  std::to_string(r.surface.v.degree) + ", " +
+                  std::to_string(r.surface.points.rows()) + " control points, " + f.brief();
+    // An editable copy that misses its tolerance is a failure, unless the composition accepts
+    // refits out of tolerance: then it carries a warning, as a refitted step does.
+    if (!f.summary.converged()) {
+      if (!c.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    "the editable copy of surface '" + name +
+                        "' misses its tolerance: " + f.summary.message +
+                        "; raise \"editable\": {\"max_control_points\"} or the composition's "
+                        "\"tolerance\", or raise \"max_degree\" to keep the exact surface");
+      rep.warning = true;
+      rep.message += "; accepted out of tolerance (\"accept_out_of_tolerance\": true)";
+    }
+    return r.surface;
   }
 
   const BSplineSurface& surface_of(const std::string& name) const {

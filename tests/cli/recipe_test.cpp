@@ -1239,3 +1239,71 @@ TEST_CASE(
   CHECK_THAT(report, Contains("\"name\": \"pins_leaning\"") && Contains("\"faces_untouched\": 6") &&
                          Contains("\"bodies\": [\n"));
 }
+
+TEST_CASE("an editable composition refits a high-degree exact result, certified; the export warns",
+          "[recipe]") {
+  // The dome through a lattice of degrees (3, 3, 3) with inner points moved: an exact result of
+  // degree above 9, beyond what surfacing tools edit.
+  const std::string lattice = R"({"kind": "bezier_lattice", "name": "swell",
+     "frame": {"origin": [-10, -10, -20], "s": [120, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
+     "degrees": [3, 3, 3],
+     "moves": [{"index": [1, 1, 1], "by": [3, -2, 15]}, {"index": [2, 2, 1], "by": [-4, 3, 9]},
+               {"index": [1, 2, 2], "by": [2, 2, -6]}]})";
+  auto recipe = [&](const std::string& composition) {
+    return recipe_with(
+        R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape")" + composition + "}}",
+        R"("deformations": {"shape": [)" + lattice +
+            R"(]}, "exports": {"part": {"surfaces": ["bulged"], "formats": ["step"]}})");
+  };
+  const auto exact = run_recipe(parse_recipe(recipe("")));
+  const surface::BSplineSurface& high = exact.surface("bulged");
+  REQUIRE(std::max(high.u.degree, high.v.degree) > 9);
+  const StepReport& exported = exact.steps.back();
+  REQUIRE(exported.kind == "export");
+  CHECK(exported.warning);
+  CHECK_THAT(exported.message, Contains("surface 'bulged' has degree") &&
+                                   Contains("\"composition\": {\"editable\": {}}"));
+
+  const auto editable = run_recipe(parse_recipe(recipe(R"(, "composition": {"editable": {}})")));
+  const surface::BSplineSurface& low = editable.surface("bulged");
+  CHECK(low.u.degree == 3);
+  CHECK(low.v.degree == 3);
+  CHECK(low.points.rows() <= 10000);
+  const StepReport* step = nullptr;
+  for (const auto& s : editable.steps)
+    if (s.kind == "editable") step = &s;
+  REQUIRE(step != nullptr);
+  CHECK(step->path == "surfaces.bulged.composition.editable");
+  auto figure = [&](const std::string& name) {
+    for (const auto& [n, v] : step->figures)
+      if (n == name) return v;
+    FAIL("no figure " << name);
+    return Figure{};
+  };
+  CHECK(std::get<long long>(figure("exact_degree_u")) == high.u.degree);
+  CHECK(std::get<long long>(figure("exact_control_points")) == high.points.rows());
+  CHECK(std::get<long long>(figure("control_points")) == low.points.rows());
+  CHECK(std::get<bool>(figure("certified")));
+  const double bound = std::get<double>(figure("max_deviation_mm"));
+  CHECK(bound <= std::get<double>(figure("tolerance_mm")));
+  // The bound holds against the exact result, independently sampled.
+  const double gap = max_gap(
+      low, [&](double u, double v) { return surface::evaluate(high, u, v); }, 2000);
+  INFO("independent check " << gap << " mm, certified " << bound << " mm");
+  CHECK(gap <= bound);
+  CHECK(!editable.steps.back().warning);  // the export of the editable copy does not warn
+
+  // Too few control points for the tolerance: the run fails, naming the surface and the fix.
+  const auto [category, message] = error_of([&] {
+    run_recipe(parse_recipe(
+        recipe(R"(, "composition": {"tolerance": 1e-9, "editable": {"max_control_points": 16}})")));
+  });
+  CHECK(category == ErrorCategory::ToleranceNotMet);
+  CHECK_THAT(message, Contains("surfaces.bulged.composition.editable") &&
+                          Contains("the editable copy of surface 'bulged' misses its tolerance"));
+  // validate names a max_degree below the degree the copy would have.
+  const auto problems = check_recipe(recipe(R"(, "composition": {"editable": {"max_degree": 2}})"));
+  INFO(dump(problems));
+  CHECK(mentions(problems, "surfaces.bulged.deform.composition.editable.max_degree",
+                 "below the composition's \"degree\" 3"));
+}
