@@ -3,6 +3,8 @@
 #include <clay/error.hpp>
 #include <clay/internal/checks.hpp>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -60,6 +62,32 @@ BSplineCurve circular_arc(const Eigen::Vector3d& center, const Eigen::Vector3d& 
     c.weights[2 * i] = 1.0;
   }
   if (full) c.points.row(n - 1) = c.points.row(0);
+  return c;
+}
+
+BSplineCurve arc_through(const Eigen::Vector3d& start, const Eigen::Vector3d& through,
+                         const Eigen::Vector3d& end) {
+  if (!internal::all_finite(start) || !internal::all_finite(through) || !internal::all_finite(end))
+    throw Error(ErrorCategory::InvalidArgument,
+                "arc_through: a point is not finite; give three finite points");
+  // Circumcentre of the triangle (start, through, end): with u = through - start, v = end - start
+  // and w = u x v, c = start + (|u|^2 (v x w) + |v|^2 (w x u)) / (2 |w|^2).
+  const Eigen::Vector3d u = through - start, v = end - start, w = u.cross(v);
+  if (!(w.norm() > 1e-12 * u.norm() * v.norm()))
+    throw Error(ErrorCategory::InvalidArgument,
+                "arc_through: the three points are on one line (or two are the same); an arc "
+                "needs its middle point off the line from start to end");
+  const Eigen::Vector3d center =
+      start + (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u)) / (2 * w.squaredNorm());
+  const double radius = (start - center).norm();
+  // Counter-clockwise about w runs start -> through -> end.
+  const Eigen::Vector3d x = (start - center) / radius;
+  const Eigen::Vector3d y = w.normalized().cross(x);
+  double sweep = std::atan2((end - center).dot(y), (end - center).dot(x));
+  if (sweep <= 0) sweep += 2 * std::numbers::pi;
+  BSplineCurve c = circular_arc(center, x, y, radius, 0.0, sweep);
+  c.points.row(0) = start.transpose();
+  c.points.row(c.points.rows() - 1) = end.transpose();
   return c;
 }
 

@@ -1,10 +1,15 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/surface/arc.hpp>
 #include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/evaluate.hpp>
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
 #include <cmath>
+#include <numbers>
 #include <random>
 
 #include "random_geometry.hpp"
@@ -133,4 +138,78 @@ TEST_CASE("reversed runs a curve backwards on the same domain", "[bspline]") {
     for (size_t k = 0; k < c.basis.knots.size(); ++k)
       CHECK(std::abs(rr.basis.knots[k] - c.basis.knots[k]) <= 4e-16 * (std::abs(a) + std::abs(b)));
   }
+}
+
+TEST_CASE("mirrored reflects a curve at every parameter, and twice gives it back", "[bspline]") {
+  std::mt19937 rng(8);
+  const BSplineCurve c = clay::test::random_curve(rng, 3, 8, true);
+  const Eigen::Vector3d origin(1, -2, 3), normal(0.3, -1.1, 0.7);  // any length
+  const Eigen::Vector3d n = normal.normalized();
+  const BSplineCurve m = mirrored(c, origin, normal);
+  const auto [a, b] = c.basis.domain();
+  for (double t : linspace(a, b, 41)) {
+    const Eigen::Vector3d p = evaluate(c, t);
+    const Eigen::Vector3d reflected = p - 2 * (p - origin).dot(n) * n;  // independent
+    CHECK((evaluate(m, t) - reflected).norm() <= 1e-12 * (1 + p.norm()));
+  }
+  CHECK(m.basis.knots == c.basis.knots);
+  CHECK(m.weights == c.weights);
+  const BSplineCurve back = mirrored(m, origin, normal);
+  CHECK((back.points - c.points).cwiseAbs().maxCoeff() <= 1e-12 * c.points.cwiseAbs().maxCoeff());
+  CHECK_THROWS_AS(mirrored(c, origin, Eigen::Vector3d::Zero()), clay::Error);
+}
+
+TEST_CASE("mirrored reflects a surface with u reversed, so its normal is the mirror image",
+          "[bspline]") {
+  const BSplineSurface s = good_surface();  // rational
+  const Eigen::Vector3d origin(0, 0, 1), n(1, 0, 0);
+  const BSplineSurface m = mirrored(s, origin, 2 * n);
+  CHECK(problems(m).empty());
+  const auto [a, b] = s.u.domain();
+  const auto [c, d] = s.v.domain();
+  for (double u : linspace(a, b, 9))
+    for (double v : linspace(c, d, 9)) {
+      const SurfaceDerivatives x = derivatives(s, a + b - u, v, 1);
+      const SurfaceDerivatives y = derivatives(m, u, v, 1);
+      const Eigen::Vector3d reflected = x.point - 2 * (x.point - origin).dot(n) * n;
+      CHECK((y.point - reflected).norm() <= 1e-12 * (1 + x.point.norm()));
+      // The normal: the reflection of the original's normal.
+      const Eigen::Vector3d nx = x.du.cross(x.dv).normalized(), ny = y.du.cross(y.dv).normalized();
+      const Eigen::Vector3d nx_reflected = nx - 2 * nx.dot(n) * n;
+      CHECK(ny.dot(nx_reflected) >= 1 - 1e-9);
+    }
+}
+
+TEST_CASE("arc_through is the circle through its three points, ends exact", "[bspline]") {
+  const Eigen::Vector3d p0(10, 0, 5), p1(3, 7, 6), p2(-8, 2, 4);
+  const BSplineCurve arc = arc_through(p0, p1, p2);
+  // The circumcentre, independently: on the points' plane, equidistant from all three.
+  const Eigen::Vector3d w = (p1 - p0).cross(p2 - p0);
+  Eigen::Matrix3d m;
+  Eigen::Vector3d rhs;
+  m.row(0) = 2 * (p1 - p0).transpose();
+  m.row(1) = 2 * (p2 - p0).transpose();
+  m.row(2) = w.transpose();
+  rhs << p1.squaredNorm() - p0.squaredNorm(), p2.squaredNorm() - p0.squaredNorm(), w.dot(p0);
+  const Eigen::Vector3d center = m.fullPivLu().solve(rhs);
+  const double r = (p0 - center).norm();
+  const auto [t0, t1] = arc.basis.domain();
+  double nearest_through = 1e300;
+  for (double t : linspace(t0, t1, 2001)) {
+    const Eigen::Vector3d q = evaluate(arc, t);
+    CHECK(std::abs((q - center).norm() - r) <= 1e-12 * r);
+    CHECK(std::abs((q - center).dot(w.normalized())) <= 1e-12 * r);
+    nearest_through = std::min(nearest_through, (q - p1).norm());
+  }
+  CHECK(nearest_through <= 1e-2 * r);  // it passes `through` (sampled at 2,001 points)
+  CHECK(Eigen::Vector3d(arc.points.row(0).transpose()) == p0);
+  CHECK(Eigen::Vector3d(arc.points.row(arc.points.rows() - 1).transpose()) == p2);
+  // More than half a turn when `through` lies on the far side: the sweep follows it.
+  const BSplineCurve major =
+      arc_through(Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, -1, 0));
+  CHECK(major.points.rows() == 7);  // three 90-degree segments: 270 degrees
+  CHECK((evaluate(major, 2.0 / 3) - Eigen::Vector3d(-1, 0, 0)).norm() <= 1e-15);
+  CHECK((evaluate(major, 1.0 / 3) - Eigen::Vector3d(0, 1, 0)).norm() <= 1e-15);
+  CHECK_THROWS_AS(arc_through(p0, 0.5 * (p0 + p2), p2), clay::Error);  // on one line
+  CHECK_THROWS_AS(arc_through(p0, p0, p2), clay::Error);
 }

@@ -18,4 +18,13 @@ CLAY_SURFACE_API BSplineCurve circular_arc(const Eigen::Vector3d& center,
                                            const Eigen::Vector3d& y_axis, double radius,
                                            double start, double end);
 
+/// The arc from `start` through `through` to `end`: the circle through the three points (its
+/// circumcentre, in their plane), run from start to end the way that passes `through`, exact as
+/// circular_arc gives it, with its end control points exactly `start` and `end` (so curves
+/// snapped to them meet bit for bit). Throws clay::Error(InvalidArgument) naming the points when
+/// they are not finite, or lie on one line (two of them the same included).
+CLAY_SURFACE_API BSplineCurve arc_through(const Eigen::Vector3d& start,
+                                          const Eigen::Vector3d& through,
+                                          const Eigen::Vector3d& end);
+
 }  // namespace clay::surface

@@ -48,4 +48,11 @@ CLAY_SURFACE_API bool identical(const BSplineCurve& a, const BSplineCurve& b) no
 /// are mirrored, control points and weights reversed (exact up to the rounding of a + b - t).
 CLAY_SURFACE_API BSplineCurve reversed(const BSplineCurve& curve);
 
+/// The curve mirrored in the plane through `origin` with normal `normal` (any length): control
+/// points reflected, p - 2 ((p - origin) . n) n, knots and weights kept, so the mirrored curve
+/// is the reflection of the curve at every parameter (up to the rounding of the reflection).
+/// Throws clay::Error(InvalidArgument) for a zero or non-finite normal or origin.
+CLAY_SURFACE_API BSplineCurve mirrored(const BSplineCurve& curve, const Eigen::Vector3d& origin,
+                                       const Eigen::Vector3d& normal);
+
 }  // namespace clay::surface

@@ -50,6 +50,15 @@ CLAY_SURFACE_API void validate(const BSplineSurface& surface, std::string_view n
 /// True when degrees, knots, control points and weights are equal bit for bit.
 CLAY_SURFACE_API bool identical(const BSplineSurface& a, const BSplineSurface& b) noexcept;
 
+/// The surface mirrored in the plane through `origin` with normal `normal` (any length), with
+/// its u direction reversed so that its normal is the mirror image of the original's (a mirrored
+/// half of a symmetric body faces outward as the original does): mirrored(s)(u, v) is the
+/// reflection of s(a + b - u, v) on the same domain [a, b] x [c, d]; v, weights and degrees
+/// kept. Throws clay::Error(InvalidArgument) for a zero or non-finite normal or origin.
+CLAY_SURFACE_API BSplineSurface mirrored(const BSplineSurface& surface,
+                                         const Eigen::Vector3d& origin,
+                                         const Eigen::Vector3d& normal);
+
 /// Axis-aligned box of the control points {min, max} (it contains the surface).
 CLAY_SURFACE_API std::pair<Eigen::Vector3d, Eigen::Vector3d> control_box(
     const BSplineSurface& surface);
