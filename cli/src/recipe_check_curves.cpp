@@ -70,9 +70,13 @@ std::optional<surface::BSplineCurve> RecipeChecker::inline_curve(const Json& j,
 }
 
 void RecipeChecker::curve(const std::string& name, const Json& j, const std::string& path) {
-  CurveDef def{name, path, "", std::nullopt, ""};
-  const bool ok =
-      one_of(j, path, {"bspline", "line", "arc", "polyline", "reversed"}, "a curve", def.kind);
+  CurveDef def;
+  def.name = name;
+  def.path = path;
+  const bool ok = one_of(
+      j, path,
+      {"bspline", "line", "arc", "arc_through", "arc_radius", "polyline", "reversed", "mirror"},
+      "a curve", def.kind);
   const std::string p = key_path(path, def.kind);
   if (ok) {
     const Json& v = j.at(def.kind);
@@ -99,12 +103,112 @@ void RecipeChecker::curve(const std::string& name, const Json& j, const std::str
       }
     } else if (def.kind == "arc") {
       def.curve = arc(v, p);
+    } else if (def.kind == "arc_through") {
+      def.curve = arc_through(v, p);
+    } else if (def.kind == "arc_radius") {
+      def.curve = arc_radius(v, p);
+    } else if (def.kind == "mirror") {
+      if (c_.object(v, p, {"curve", "plane"}, "a mirror {curve, plane: {origin, normal}}")) {
+        std::optional<std::string> source;
+        if (const Json* m = c_.member(v, p, "curve", true, "the name of a curve"))
+          source = curve_ref(*m, key_path(p, "curve"));
+        const auto plane = mirror_plane(v, p);
+        if (source && plane) {
+          def.mirror_of = *source;
+          def.plane = *plane;
+        }
+      }
     } else {  // reversed
       if (const auto n = curve_ref(v, p)) def.reversed_of = *n;
     }
   }
   names_.curves.push_back(name);
-  if (def.curve || !def.reversed_of.empty()) data.curves.push_back(std::move(def));
+  if (def.curve || !def.reversed_of.empty() || !def.mirror_of.empty())
+    data.curves.push_back(std::move(def));
+}
+
+std::optional<MirrorPlane> RecipeChecker::mirror_plane(const Json& v, const std::string& p) {
+  const Json* m = c_.member(v, p, "plane", true, "a plane {origin, normal}");
+  if (!m) return std::nullopt;
+  const std::string pp = key_path(p, "plane");
+  if (!c_.object(*m, pp, {"origin", "normal"}, "a mirror plane {origin, normal}"))
+    return std::nullopt;
+  const Json* o = c_.member(*m, pp, "origin", true, "[x, y, z]");
+  const Json* n = c_.member(*m, pp, "normal", true, "[x, y, z]");
+  const auto origin = o ? c_.vec3(*o, key_path(pp, "origin")) : std::nullopt;
+  const auto normal = n ? c_.vec3(*n, key_path(pp, "normal")) : std::nullopt;
+  if (!origin || !normal) return std::nullopt;
+  if (!(normal->norm() > 0)) {
+    c_.add(key_path(pp, "normal"), "is [0, 0, 0]; give the plane's normal, of any length");
+    return std::nullopt;
+  }
+  return MirrorPlane{*origin, normal->normalized()};
+}
+
+std::optional<surface::BSplineCurve> RecipeChecker::arc_through(const Json& v,
+                                                                const std::string& p) {
+  if (!c_.object(v, p, {"start", "through", "end"},
+                 "an arc through three points {start, through, end}"))
+    return std::nullopt;
+  std::array<std::optional<Eigen::Vector3d>, 3> pts;
+  int k = 0;
+  for (const char* key : {"start", "through", "end"}) {
+    const Json* m = c_.member(v, p, key, true, "[x, y, z]");
+    pts[static_cast<std::size_t>(k++)] = m ? c_.vec3(*m, key_path(p, key)) : std::nullopt;
+  }
+  if (!pts[0] || !pts[1] || !pts[2]) return std::nullopt;
+  std::optional<surface::BSplineCurve> out;
+  c_.attempt(p, [&] { out = surface::arc_through(*pts[0], *pts[1], *pts[2]); });
+  return out;
+}
+
+std::optional<surface::BSplineCurve> RecipeChecker::arc_radius(const Json& v,
+                                                               const std::string& p) {
+  if (!c_.object(v, p, {"start", "end", "radius", "normal", "side"},
+                 "an arc {start, end, radius, normal, side}"))
+    return std::nullopt;
+  std::array<std::optional<Eigen::Vector3d>, 3> vs;
+  int k = 0;
+  for (const char* key : {"start", "end", "normal"}) {
+    const Json* m = c_.member(v, p, key, true, "[x, y, z]");
+    vs[static_cast<std::size_t>(k++)] = m ? c_.vec3(*m, key_path(p, key)) : std::nullopt;
+  }
+  const Json* r = c_.member(v, p, "radius", true, "the radius in mm");
+  const auto radius = r ? c_.number(*r, key_path(p, "radius"), positive) : std::nullopt;
+  std::optional<std::size_t> side;
+  if (const Json* s = c_.member(v, p, "side", true, "\"left\" or \"right\""))
+    side = c_.choice(*s, key_path(p, "side"), {"left", "right"});
+  if (!vs[0] || !vs[1] || !vs[2] || !radius || !side) return std::nullopt;
+  const Eigen::Vector3d a = *vs[0], b = *vs[1];
+  const Eigen::Vector3d chord = b - a;
+  // In the plane through the chord normal to `normal` (its part across the chord): `left` is
+  // normal x chord, seen from the normal's tip.
+  const Eigen::Vector3d n = *vs[2] - vs[2]->dot(chord) / chord.squaredNorm() * chord;
+  const double half = 0.5 * chord.norm();
+  if (!(half > 0)) {
+    c_.add(key_path(p, "end"), "is the start point; an arc needs two different ends");
+    return std::nullopt;
+  }
+  if (!(n.norm() > 1e-9 * vs[2]->norm())) {
+    c_.add(key_path(p, "normal"),
+           "lies along the chord from start to end; give the normal of "
+           "the arc's plane");
+    return std::nullopt;
+  }
+  if (!(*radius >= half)) {
+    c_.add(key_path(p, "radius"), "is " + shortest(*radius) +
+                                      " mm, less than half the chord from start to end (" +
+                                      shortest(half) + " mm); give at least that");
+    return std::nullopt;
+  }
+  // The minor arc, bulging to `side` of the chord: its middle point is the chord's middle moved
+  // sideways by the sagitta r - sqrt(r^2 - (c/2)^2).
+  const Eigen::Vector3d left = n.normalized().cross(chord).normalized();
+  const double sagitta = *radius - std::sqrt(std::max(0.0, *radius * *radius - half * half));
+  const Eigen::Vector3d middle = 0.5 * (a + b) + (*side == 0 ? 1.0 : -1.0) * sagitta * left;
+  std::optional<surface::BSplineCurve> out;
+  c_.attempt(p, [&] { out = surface::arc_through(a, middle, b); });
+  return out;
 }
 
 std::optional<surface::BSplineCurve> RecipeChecker::polyline_curve(const Points3& pts,

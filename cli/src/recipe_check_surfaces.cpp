@@ -10,7 +10,7 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
   const std::size_t before = c_.problems.size();
   if (one_of(j, path,
              {"bspline", "fill", "skin", "sweep", "revolve", "superellipsoid", "supertoroid",
-              "import", "deform"},
+              "import", "deform", "mirror"},
              "a surface", def.kind)) {
     const Json& v = j.at(def.kind);
     const std::string p = key_path(path, def.kind);
@@ -112,6 +112,14 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
                 c_.member(v, p, "file", true, "the path of a .step/.stp/.igs/.iges file"))
           if (const auto file = exchange_file(*f, key_path(p, "file"))) d.file = *file;
         d.index = c_.integer_or(v, p, "index", 0, 0, 1000000);
+      }
+      def.build = d;
+    } else if (def.kind == "mirror") {
+      MirrorDef d;
+      if (c_.object(v, p, {"surface", "plane"}, "a mirror {surface, plane: {origin, normal}}")) {
+        if (const Json* m = c_.member(v, p, "surface", true, "the name of an earlier surface"))
+          d.surface = surface_ref(*m, key_path(p, "surface")).value_or("");
+        if (const auto plane = mirror_plane(v, p)) d.plane = *plane;
       }
       def.build = d;
     } else {  // deform

@@ -278,6 +278,10 @@ class RecipeChecker {
   std::optional<surface::BSplineCurve> polyline_curve(const Points3& pts, const std::string& path);
 
   std::optional<surface::BSplineCurve> arc(const Json& v, const std::string& p);
+  std::optional<surface::BSplineCurve> arc_through(const Json& v, const std::string& p);
+  std::optional<surface::BSplineCurve> arc_radius(const Json& v, const std::string& p);
+  /// The "plane" member {origin, normal} of a mirror at path p (normal made unit).
+  std::optional<MirrorPlane> mirror_plane(const Json& v, const std::string& p);
 
   /// Exactly one of `kinds` is a key of j: true and `kind` set; else the problem is recorded.
   bool one_of(const Json& j, const std::string& path, std::initializer_list<std::string_view> kinds,

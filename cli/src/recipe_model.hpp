@@ -50,10 +50,19 @@ struct StrokeDef {
 };
 
 /// A curve given inline (already built) or the reverse of another named curve.
+/// A mirror plane: through `origin`, normal `normal` (unit).
+struct MirrorPlane {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();
+};
+
 struct CurveDef {
-  std::string name, path, kind;  // kind: bspline, line, arc, polyline, reversed
+  std::string name, path, kind;  // kind: bspline, line, arc, arc_through, arc_radius, polyline,
+                                 // reversed, mirror
   std::optional<surface::BSplineCurve> curve;
   std::string reversed_of;
+  std::string mirror_of;  ///< mirror: the curve mirrored in `plane`
+  MirrorPlane plane;
 };
 
 struct SketchDef {
@@ -107,11 +116,15 @@ struct DeformDef {
   std::string surface, deformation;
   Composition composition;
 };
+struct MirrorDef {
+  std::string surface;
+  MirrorPlane plane;
+};
 
 struct SurfaceDef {
   std::string name, path, kind;
   std::variant<surface::BSplineSurface, FillDef, SkinDef, SweepDef, RevolveDef, SuperellipsoidDef,
-               SupertoroidDef, ImportDef, DeformDef>
+               SupertoroidDef, ImportDef, DeformDef, MirrorDef>
       build;
 };
 

@@ -291,7 +291,10 @@ class Runner {
   }
 
   void curve(const CurveDef& c, StepReport& rep) {
-    BSplineCurve out = c.curve ? *c.curve : surface::reversed(curve_of(c.reversed_of));
+    BSplineCurve out = c.curve                ? *c.curve
+                       : !c.mirror_of.empty() ? surface::mirrored(curve_of(c.mirror_of),
+                                                                  c.plane.origin, c.plane.normal)
+                                              : surface::reversed(curve_of(c.reversed_of));
     rep.figures = {{"degree", static_cast<long long>(out.basis.degree)},
                    {"control_points", static_cast<long long>(out.points.rows())},
                    {"rational", out.is_rational()}};
@@ -434,6 +437,15 @@ class Runner {
               build_figures(surface::describe(all[static_cast<std::size_t>(b.index)], "import"),
                             rep);
               return std::move(all[static_cast<std::size_t>(b.index)]);
+            } else if constexpr (std::is_same_v<T, MirrorDef>) {
+              BSplineSurface m =
+                  surface::mirrored(surface_of(b.surface), b.plane.origin, b.plane.normal);
+              build_figures(surface::describe(m,
+                                              "mirror of "
+                                              " + b.surface + "
+                                              ""),
+                            rep);
+              return m;
             } else {
               throw Error(ErrorCategory::Internal, "recipe run: deform handled above");
             }

@@ -1307,3 +1307,57 @@ TEST_CASE("an editable composition refits a high-degree exact result, certified;
   CHECK(mentions(problems, "surfaces.bulged.deform.composition.editable.max_degree",
                  "below the composition's \"degree\" 3"));
 }
+
+TEST_CASE("arcs by three points and by radius and side; mirrored curves and surfaces", "[recipe]") {
+  const std::string text = recipe_with(
+      R"(, "other_half": {"mirror": {"surface": "dome", "plane": {"origin": [0, 0, 0], "normal": [3, 0, 0]}}})",
+      R"("curves": {
+        "a3": {"arc_through": {"start": [0, 0, 0], "through": [10, 10, 0], "end": [20, 0, 0]}},
+        "ar": {"arc_radius": {"start": [0, 0, 0], "end": [20, 0, 0], "radius": 25,
+                              "normal": [0, 0, 1], "side": "left"}},
+        "m": {"mirror": {"curve": "a3", "plane": {"origin": [0, 0, 5], "normal": [0, 0, 2]}}}})");
+  INFO(dump(check_recipe(text)));
+  const auto result = run_recipe(parse_recipe(text));
+  auto curve = [&](const char* name) -> const surface::BSplineCurve& { return result.curve(name); };
+  // a3: the circle of centre (10, 0, 0) and radius 10; ar: radius 25 about (10, -sqrt(525), 0),
+  // bulging to +y (left of the chord seen from +z) by its sagitta 25 - sqrt(525).
+  const Eigen::Vector3d c3(10, 0, 0), cr(10, -std::sqrt(525.0), 0);
+  double top3 = 0, topr = -1e300;
+  for (double t : surface::linspace(0, 1, 201)) {
+    const Eigen::Vector3d p = surface::evaluate(curve("a3"), t),
+                          q = surface::evaluate(curve("ar"), t);
+    CHECK(std::abs((p - c3).norm() - 10) <= 1e-12 * 10);
+    CHECK(std::abs((q - cr).norm() - 25) <= 1e-12 * 25);
+    top3 = std::max(top3, p.y());
+    topr = std::max(topr, q.y());
+    // m: a3 mirrored in z = 5, so at z = 10
+    const Eigen::Vector3d mp = surface::evaluate(curve("m"), t);
+    CHECK((mp - Eigen::Vector3d(p.x(), p.y(), 10 - p.z())).norm() <= 1e-12 * 20);
+  }
+  CHECK(std::abs(top3 - 10) <= 1e-6);
+  CHECK(std::abs(topr - (25 - std::sqrt(525.0))) <= 1e-9);
+  // The mirrored dome: the reflection of dome(1 - u, v) in x = 0.
+  const auto parent = dome();
+  const double gap = max_gap(result.surface("other_half"), [&](double u, double v) {
+    const Eigen::Vector3d p = surface::evaluate(parent, 1 - u, v);
+    return Eigen::Vector3d(-p.x(), p.y(), p.z());
+  });
+  CHECK(gap <= 1e-12 * 100);
+  // Problems named at their paths.
+  const std::string bad = recipe_with("", R"("curves": {
+      "line3": {"arc_through": {"start": [0, 0, 0], "through": [1, 1, 1], "end": [2, 2, 2]}},
+      "small": {"arc_radius": {"start": [0, 0, 0], "end": [20, 0, 0], "radius": 5,
+                               "normal": [0, 0, 1], "side": "up"}},
+      "flat": {"mirror": {"curve": "nothing", "plane": {"origin": [0, 0, 0], "normal": [0, 0, 0]}}}})");
+  const auto problems = check_recipe(bad);
+  INFO(dump(problems));
+  CHECK(mentions(problems, "curves.line3.arc_through", "on one line"));
+  CHECK(mentions(problems, "curves.small.arc_radius.side", "left"));
+  CHECK(mentions(problems, "curves.flat.mirror.curve", "nothing"));
+  CHECK(mentions(problems, "curves.flat.mirror.plane.normal", "[0, 0, 0]"));
+  const std::string too_small = recipe_with("", R"("curves": {
+      "small": {"arc_radius": {"start": [0, 0, 0], "end": [20, 0, 0], "radius": 5,
+                               "normal": [0, 0, 1], "side": "right"}}})");
+  CHECK(mentions(check_recipe(too_small), "curves.small.arc_radius.radius",
+                 "less than half the chord"));
+}
