@@ -77,7 +77,11 @@ TEST_CASE("real files from other CAD systems read whole, valid, with their volum
       real("ideas11_cone_msbo186.igs", 1, 2, cone, 1e-9, "re-derived 1 pcurve from its edge"),
       real("proe1999_t4m_surfaces_ap203.stp", 3, 11),
       real("solidworks2013_spheres_asm_ap214.STEP", 1, 1, spheres),
-      real("rhino7_bspline_surface.igs", 1, 1));
+      real("rhino7_bspline_surface.igs", 1, 1),
+      real("solidworks2013_featuretype_holes_fillets_ap214.STEP", 1, 96),
+      real("solidworks2018_base_interface_plate_holes_ap214.STEP", 1, 30),
+      // A degree 12 x 12 Bézier torus patch trimmed across its seam.
+      real("harmonyware_torus_bspline_trimmed144.igs", 1, 1));
   INFO(file.name);
   const fs::path path = cad_file(file.name);
   const auto imported = clay::brep::read_model(path);
@@ -121,10 +125,19 @@ TEST_CASE("real files from other CAD systems read whole, valid, with their volum
     identical += clay::surface::identical(m.faces[f].surface, again.faces[f].surface);
   CHECK(identical == static_cast<int>(m.faces.size()));
 
-  // Deformed exactly by a trilinear lattice with a raised corner: still valid, every face exact.
-  const auto deformed = clay::deform::deform_model(corner_raised_around(m), m);
+  // Deformed by a trilinear lattice with a raised corner: still valid. Every face is exact but
+  // where the composition's degree would pass 25 (a face of degree above 8: the torus patch of
+  // degree 12), which is refitted, certified.
+  const Model placed_model = clay::brep::flattened(m);
+  int too_high = 0;
+  for (const auto& f : placed_model.faces)
+    too_high += std::max(f.surface.u.degree, f.surface.v.degree) > 8;
+  clay::deform::ModelDeformationOptions options;
+  options.surface.refit = clay::deform::RefitOptions{};
+  const auto deformed = clay::deform::deform_model(corner_raised_around(m), m, options);
   INFO(deformed.report.brief());
-  CHECK(deformed.report.faces_exact == clay::brep::counts(clay::brep::flattened(m)).faces);
+  CHECK(deformed.report.faces_refit == too_high);
+  CHECK(deformed.report.faces_exact == static_cast<int>(placed_model.faces.size()) - too_high);
   CHECK(clay::brep::problems(deformed.model).empty());
   const auto deformed_check = clay::brep::check_model(deformed.model);
   INFO(deformed_check.brief());
@@ -137,4 +150,44 @@ TEST_CASE("a real file with no face (Rhino wireframe) is refused, naming the fil
   CHECK(category == clay::ErrorCategory::Exchange);
   CHECK_THAT(message,
              Contains("rhino_stdev14_wireframe_line_ap214.stp") && Contains("holds no face"));
+}
+
+TEST_CASE("a file OpenCASCADE's XCAF reader crashes on is read by its plain reader, and says so") {
+  // C3D Converter's IGES: solids placed by subfigures nested in subfigures. XCAF (IGESCAFControl)
+  // dies of SIGSEGV on it in OpenCASCADE 7.6; the isolated read survives, reads it again
+  // without XCAF and reports what that loses.
+  const fs::path path = cad_file("c3d_converter_plates_msbo186_subfigures.igs");
+  clay::brep::ModelReadOptions options;
+  options.read.isolate = true;
+  const auto imported = clay::brep::read_model(path, options);
+  INFO(imported.report.brief());
+  bool said = false;
+  for (const auto& h : imported.report.healing)
+    said = said || h.find("XCAF reader crashed") != std::string::npos;
+  CHECK(said);
+  CHECK(clay::brep::problems(imported.model).empty());
+  const auto facts = clay::surface::occt_reference::facts_of_file(path);
+  const auto placed = clay::brep::counts(clay::brep::flattened(imported.model));
+  CHECK(placed.faces == facts.faces);
+  CHECK(placed.edges == facts.edges);
+  CHECK(clay::brep::check_model(imported.model).valid);
+}
+
+TEST_CASE("a face that encloses no area is kept, and a file's open loops are listed, not hidden") {
+  // PCB Libraries' FPX Expert pin: directions written with 4 digits, a sliver face whose loop
+  // runs along one line, and loops whose ends do not share vertices.
+  const fs::path path = cad_file("pcblibraries_fpx2013_header_pin_lowprec_ap214.stp");
+  const auto imported = clay::brep::read_model(path);
+  INFO(imported.report.brief());
+  bool kept = false;
+  for (const auto& h : imported.report.healing)
+    kept = kept || h.find("kept 1 face that encloses no area") == 0;
+  CHECK(kept);
+  CHECK(imported.model.faces.size() == 16);
+  // The file's own defects are in the report, each naming its face and loop.
+  CHECK(!imported.report.problems.empty());
+  CHECK(imported.report.problems == clay::brep::problems(imported.model));
+  // Deforming it is refused, naming a problem, rather than writing a torn model.
+  CHECK_THROWS_AS(clay::deform::deform_model(corner_raised_around(imported.model), imported.model),
+                  clay::Error);
 }

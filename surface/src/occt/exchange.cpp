@@ -599,11 +599,11 @@ std::string occt::read_in_child(const fs::path& file, const ReadOptions& options
   }
   const std::string memory = std::to_string(options.memory_limit_mb) + " MB";
   if (WIFSIGNALED(status))
-    throw Error(ErrorCategory::Exchange, std::string(caller) + ": OpenCASCADE crashed (" +
-                                             signal_name(WTERMSIG(status)) + ") while reading " +
-                                             quoted(file) +
-                                             "; the file is malformed (or it needed more than " +
-                                             memory + "): export it again or repair it");
+    throw ChildCrashed(ErrorCategory::Exchange,
+                       std::string(caller) + ": OpenCASCADE crashed (" +
+                           signal_name(WTERMSIG(status)) + ") while reading " + quoted(file) +
+                           "; the file is malformed (or it needed more than " + memory +
+                           "): export it again or repair it");
   switch (WIFEXITED(status) ? WEXITSTATUS(status) : child_unknown) {
     case child_read:
       return bytes;

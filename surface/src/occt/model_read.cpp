@@ -91,6 +91,7 @@
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESControl_Controller.hxx>
+#include <IGESControl_Reader.hxx>
 #include <IGESData_IGESModel.hxx>
 #include <IGESData_UndefinedEntity.hxx>
 #include <Precision.hxx>
@@ -98,6 +99,7 @@
 #include <STEPCAFControl_Controller.hxx>
 #include <STEPCAFControl_Reader.hxx>
 #include <STEPControl_Controller.hxx>
+#include <STEPControl_Reader.hxx>
 #include <ShapeFix_Solid.hxx>
 #include <Standard_Failure.hxx>
 #include <StepData_StepModel.hxx>
@@ -172,6 +174,7 @@ struct FaceConversion {
   double u_shift = 0, v_shift = 0;
   double size = 1;                 // the model's size, for tolerances
   double approximation_error = 0;  // an approximated offset's measured error (mm)
+  bool encloses_nothing = false;   // its loop runs along a line (face_box)
   std::string name;
 
   /// (u, v) on the new surface where it meets the old surface at (a, b): Gauss–Newton from the
@@ -269,13 +272,28 @@ Handle(Geom_Surface) unwrapped(Handle(Geom_Surface) s) {
 /// The parameter box of `face` (its pcurves' extent) fitted to the surface's bounds: clamped to
 /// a bounded direction, at most one period long in a periodic one.
 std::array<double, 4> face_box(const TopoDS_Face& face, const Handle(Geom_Surface) & s,
-                               const std::string& name) {
+                               const std::string& name, bool& encloses_nothing) {
   double u0 = 0, u1 = 0, v0 = 0, v1 = 0;
   BRepTools::UVBounds(face, u0, u1, v0, v1);
-  if (!(u1 > u0) || !(v1 > v0) || Precision::IsInfinite(u0) || Precision::IsInfinite(u1) ||
-      Precision::IsInfinite(v0) || Precision::IsInfinite(v1))
+  if (Precision::IsInfinite(u0) || Precision::IsInfinite(u1) || Precision::IsInfinite(v0) ||
+      Precision::IsInfinite(v1) || !(u1 >= u0) || !(v1 >= v0) || (u1 == u0 && v1 == v0))
     throw Error(ErrorCategory::Exchange,
                 name + ": the face has no bounded parameter box (no boundary loops?)");
+  // A face whose loop runs along one line encloses no area (a PCB library's header pin, written
+  // with 4-digit directions, has such a sliver between two planes): its box is flat in one
+  // direction. The face is kept, on its surface widened across the line by 1e-3 of the box, so
+  // its neighbours keep their shared edges and the shell stays closed.
+  encloses_nothing = !(u1 > u0) || !(v1 > v0);
+  if (!(u1 > u0)) {
+    const double w = 1e-3 * (v1 - v0);
+    u0 -= w;
+    u1 += w;
+  }
+  if (!(v1 > v0)) {
+    const double w = 1e-3 * (u1 - u0);
+    v0 -= w;
+    v1 += w;
+  }
   double su0 = 0, su1 = 0, sv0 = 0, sv1 = 0;
   s->Bounds(su0, su1, sv0, sv1);
   // A full turn is taken as exactly one period from the multiple of the period nearest its start
@@ -340,7 +358,7 @@ FaceConversion convert_face(const TopoDS_Face& face, double size, const std::str
   const Handle(Geom_Surface) located = BRep_Tool::Surface(face);  // the location applied
   if (located.IsNull()) throw Error(ErrorCategory::Exchange, name + ": the face has no surface");
   c.old_surface = unwrapped(located);
-  const auto box = face_box(face, c.old_surface, name);
+  const auto box = face_box(face, c.old_surface, name, c.encloses_nothing);
   c.u_mid = 0.5 * (box[0] + box[1]);
   c.v_mid = 0.5 * (box[2] + box[3]);
 
@@ -923,6 +941,11 @@ class ModelBuilder {
       }
     }
     raise_tolerances_to_gaps();
+    if (faces_enclosing_nothing_ > 0)
+      report_.healing.push_back(
+          "kept " + std::to_string(faces_enclosing_nothing_) +
+          (faces_enclosing_nothing_ == 1 ? " face that encloses" : " faces that enclose") +
+          " no area (a loop along one line), on a surface widened across that line");
     ImportedModel out;
     out.report = report_;
     out.report.size_mm = size_;
@@ -1403,6 +1426,7 @@ class ModelBuilder {
     const FaceConversion conversion = convert_face(forward, size_, name);
     Face out;
     out.surface = checked_surface(conversion.nurbs, name);
+    if (conversion.encloses_nothing) ++faces_enclosing_nothing_;
     out.reversed = face.Orientation() == TopAbs_REVERSED;
     if (const Attributes* a = find(attributes, face)) {
       out.name = a->name;
@@ -1522,6 +1546,7 @@ class ModelBuilder {
   std::vector<EdgeConversion> conversions_;
   std::map<int, bool> seam_flipped_;  // seams made by seam_of: runs against the old edge
   std::map<int, double> widened_;     // edges widened for approximated faces, by how much
+  int faces_enclosing_nothing_ = 0;   // kept on a widened box (face_box)
 };
 
 }  // namespace
@@ -1858,14 +1883,47 @@ struct UnknownEntities {
   }
 };
 
-/// read_model's work; the caller holds the exchange session.
-ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options, bool step) {
+/// The shapes of `file` by OpenCASCADE's plain reader (no XCAF: no names, colours or assembly),
+/// as one free shape of `document`; whether the transfer gave a shape.
+bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) & document) {
+  TopoDS_Shape shape;
+  if (step) {
+    STEPControl_Controller::Init();
+    surface::occt::set_static("xstep.cascade.unit", "MM");  // after Init (OCCT-NOTES)
+    STEPControl_Reader reader;
+    if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
+      throw Error(ErrorCategory::Exchange,
+                  "read_model: " + quoted(file) + " could not be parsed as a STEP file");
+    reader.TransferRoots();
+    shape = reader.OneShape();
+  } else {
+    IGESControl_Controller::Init();
+    surface::occt::set_static("xstep.cascade.unit", "MM");
+    surface::occt::set_static("read.iges.bspline.continuity", 0);
+    IGESControl_Reader reader;
+    if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
+      throw Error(ErrorCategory::Exchange,
+                  "read_model: " + quoted(file) + " could not be parsed as an IGES file");
+    reader.TransferRoots();
+    shape = reader.OneShape();
+  }
+  if (shape.IsNull()) return false;
+  XCAFDoc_DocumentTool::ShapeTool(document->Main())->AddShape(shape, false);
+  return true;
+}
+
+/// read_model's work; the caller holds the exchange session. `plain`: read_plain instead of
+/// the XCAF readers.
+ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options, bool step,
+                          bool plain = false) {
   return surface::occt::guarded(ErrorCategory::Exchange, "read_model", [&] {
     Handle(TDocStd_Document) document;
     XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
     bool read = false;
     UnknownEntities unknown;
-    if (step) {
+    if (plain) {
+      read = read_plain(file, step, document);
+    } else if (step) {
       STEPCAFControl_Controller::Init();
       surface::occt::set_static("xstep.cascade.unit", "MM");
       surface::occt::set_static("read.stepcaf.subshapes.name", 1);  // names of faces and solids
@@ -1934,10 +1992,23 @@ ImportedModel read_model(const fs::path& file, const ModelReadOptions& options) 
   }
   surface::occt::ExchangeSession session;
   if (!options.read.isolate) return read_locked(file, options, step);
-  ImportedModel out =
-      deserialize(surface::occt::read_in_child(file, options.read, caller, [&](const fs::path& f) {
-        return serialize(read_locked(f, options, step));
-      }));
+  auto isolated = [&](bool plain) {
+    return deserialize(surface::occt::read_in_child(
+        file, options.read, caller,
+        [&](const fs::path& f) { return serialize(read_locked(f, options, step, plain)); }));
+  };
+  ImportedModel out;
+  try {
+    out = isolated(false);
+  } catch (const surface::occt::ChildCrashed& crash) {
+    // OpenCASCADE's XCAF readers crash on some files its plain readers read (IGES subfigures
+    // nested in subfigures, from C3D Converter): the shapes again without XCAF, and said so. A
+    // second crash is the file's.
+    out = isolated(true);
+    out.report.healing.push_back(
+        "OpenCASCADE's XCAF reader crashed on this file, so its plain reader read it: the "
+        "shapes are whole, but names, colours and the assembly tree are not read");
+  }
   // What came through the pipe is checked again here, as the surface reader does.
   for (std::size_t k = 0; k < out.model.faces.size(); ++k)
     if (const auto list = surface::problems(out.model.faces[k].surface,

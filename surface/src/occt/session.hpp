@@ -129,6 +129,13 @@ class Unpacker {
   }
 };
 
+/// What read_in_child throws when the child died of a signal (OpenCASCADE crashed): a
+/// clay::Error(Exchange), typed so that a caller can try another way of reading the file.
+class ChildCrashed : public Error {
+ public:
+  using Error::Error;
+};
+
 /// What an isolated read runs in the child: reads the file and returns its answer as bytes.
 using Producer = std::function<std::string(const std::filesystem::path&)>;
 
