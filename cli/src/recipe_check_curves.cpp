@@ -150,12 +150,7 @@ std::optional<surface::BSplineCurve> RecipeChecker::arc_through(const Json& v,
   if (!c_.object(v, p, {"start", "through", "end"},
                  "an arc through three points {start, through, end}"))
     return std::nullopt;
-  std::array<std::optional<Eigen::Vector3d>, 3> pts;
-  int k = 0;
-  for (const char* key : {"start", "through", "end"}) {
-    const Json* m = c_.member(v, p, key, true, "[x, y, z]");
-    pts[static_cast<std::size_t>(k++)] = m ? c_.vec3(*m, key_path(p, key)) : std::nullopt;
-  }
+  const auto pts = points3(v, p, {"start", "through", "end"});
   if (!pts[0] || !pts[1] || !pts[2]) return std::nullopt;
   std::optional<surface::BSplineCurve> out;
   c_.attempt(p, [&] { out = surface::arc_through(*pts[0], *pts[1], *pts[2]); });
@@ -167,12 +162,7 @@ std::optional<surface::BSplineCurve> RecipeChecker::arc_radius(const Json& v,
   if (!c_.object(v, p, {"start", "end", "radius", "normal", "side"},
                  "an arc {start, end, radius, normal, side}"))
     return std::nullopt;
-  std::array<std::optional<Eigen::Vector3d>, 3> vs;
-  int k = 0;
-  for (const char* key : {"start", "end", "normal"}) {
-    const Json* m = c_.member(v, p, key, true, "[x, y, z]");
-    vs[static_cast<std::size_t>(k++)] = m ? c_.vec3(*m, key_path(p, key)) : std::nullopt;
-  }
+  const auto vs = points3(v, p, {"start", "end", "normal"});
   const Json* r = c_.member(v, p, "radius", true, "the radius in mm");
   const auto radius = r ? c_.number(*r, key_path(p, "radius"), positive) : std::nullopt;
   std::optional<std::size_t> side;
@@ -233,16 +223,21 @@ std::optional<surface::BSplineCurve> RecipeChecker::polyline_curve(const Points3
   return c;
 }
 
+std::array<std::optional<Eigen::Vector3d>, 3> RecipeChecker::points3(
+    const Json& v, const std::string& p, const std::array<const char*, 3>& keys) {
+  std::array<std::optional<Eigen::Vector3d>, 3> out;
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    const Json* m = c_.member(v, p, keys[k], true, "[x, y, z]");
+    out[k] = m ? c_.vec3(*m, key_path(p, keys[k])) : std::nullopt;
+  }
+  return out;
+}
+
 std::optional<surface::BSplineCurve> RecipeChecker::arc(const Json& v, const std::string& p) {
   if (!c_.object(v, p, {"center", "x_axis", "y_axis", "radius", "start", "end"},
                  "an arc {center, x_axis, y_axis, radius, start, end}"))
     return std::nullopt;
-  std::array<std::optional<Eigen::Vector3d>, 3> vs;
-  int k = 0;
-  for (const char* key : {"center", "x_axis", "y_axis"}) {
-    const Json* m = c_.member(v, p, key, true, "[x, y, z]");
-    vs[static_cast<std::size_t>(k++)] = m ? c_.vec3(*m, key_path(p, key)) : std::nullopt;
-  }
+  const auto vs = points3(v, p, {"center", "x_axis", "y_axis"});
   const Json* r = c_.member(v, p, "radius", true, "the radius in mm");
   const Json* s = c_.member(v, p, "start", true, "the start angle in degrees");
   const Json* e = c_.member(v, p, "end", true, "the end angle in degrees");

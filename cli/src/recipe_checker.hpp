@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -277,6 +278,10 @@ class RecipeChecker {
 
   std::optional<surface::BSplineCurve> polyline_curve(const Points3& pts, const std::string& path);
 
+  /// The three required [x, y, z] members `keys` of the object v at path p (each nullopt when
+  /// missing or malformed, reported).
+  std::array<std::optional<Eigen::Vector3d>, 3> points3(const Json& v, const std::string& p,
+                                                        const std::array<const char*, 3>& keys);
   std::optional<surface::BSplineCurve> arc(const Json& v, const std::string& p);
   std::optional<surface::BSplineCurve> arc_through(const Json& v, const std::string& p);
   std::optional<surface::BSplineCurve> arc_radius(const Json& v, const std::string& p);

@@ -37,7 +37,9 @@ struct CLAY_OCCT_API ModelReadOptions {
   double sewing_tolerance_mm = 1e-3;
   /// The text pre-check and the isolated read (a child process under time and memory limits)
   /// of surface::ReadOptions: a file that crashes or hangs OpenCASCADE becomes
-  /// clay::Error(Exchange). The `clayform` command reads every model isolated.
+  /// clay::Error(Exchange). When only OpenCASCADE's XCAF reader crashes, an isolated read tries
+  /// its plain reader in a second child (no names, colours or assembly tree; the report's
+  /// healing says so). The `clayform` command reads every model isolated.
   surface::ReadOptions read;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
