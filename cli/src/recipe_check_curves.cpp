@@ -4,8 +4,29 @@
 namespace clay::recipe::check_detail {
 
 std::optional<sketch::SketchPlane> RecipeChecker::plane(const Json& j, const std::string& path) {
-  if (!c_.object(j, path, {"origin", "x_axis", "y_axis"}, "a plane {origin, x_axis, y_axis}"))
+  if (!c_.object(j, path, {"origin", "x_axis", "y_axis", "normal"},
+                 "a plane {origin, x_axis, y_axis} or {origin, normal}"))
     return std::nullopt;
+  if (j.contains("normal")) {
+    // By origin and normal (sketch::make_plane): the x axis is the given x_axis made orthogonal
+    // to the normal, or the world axis least aligned with it.
+    if (j.contains("y_axis")) {
+      c_.add(key_path(path, "y_axis"),
+             "a plane given by its normal takes no y_axis (it is normal x x_axis); give "
+             "{origin, normal} or {origin, x_axis, y_axis}");
+      return std::nullopt;
+    }
+    Eigen::Vector3d origin, normal, x_axis;
+    if (!c_.vec3_members(j, path, {{"origin", &origin}, {"normal", &normal}})) return std::nullopt;
+    std::optional<Eigen::Vector3d> x;
+    if (j.contains("x_axis")) {
+      if (!c_.vec3_members(j, path, {{"x_axis", &x_axis}})) return std::nullopt;
+      x = x_axis;
+    }
+    std::optional<sketch::SketchPlane> out;
+    c_.attempt(path, [&] { out = sketch::make_plane(origin, normal, x); });
+    return out;
+  }
   sketch::SketchPlane pl;
   if (!c_.vec3_members(j, path,
                        {{"origin", &pl.origin}, {"x_axis", &pl.x_axis}, {"y_axis", &pl.y_axis}}))

@@ -1361,3 +1361,38 @@ TEST_CASE("arcs by three points and by radius and side; mirrored curves and surf
   CHECK(mentions(check_recipe(too_small), "curves.small.arc_radius.radius",
                  "less than half the chord"));
 }
+
+TEST_CASE("a plane may be given by origin and normal", "[recipe]") {
+  // A stroke drawn along the plane through (0, 0, 5) with normal (0, 1, 1), every other point
+  // 0.01 mm off it: fitted in that plane, the curve lies in it.
+  const Eigen::Vector3d origin(0, 0, 5), normal = Eigen::Vector3d(0, 1, 1).normalized();
+  std::string pts = "[";
+  for (int i = 0; i <= 40; ++i) {
+    const double t = i / 40.0;
+    const Eigen::Vector3d in_plane = origin + 80 * t * Eigen::Vector3d::UnitX() +
+                                     10 * std::sin(3 * t) * Eigen::Vector3d(0, 1, -1).normalized() +
+                                     0.01 * (i % 2) * normal;
+    pts += std::string(i ? "," : "") + "[" + num(in_plane.x()) + "," + num(in_plane.y()) + "," +
+           num(in_plane.z()) + "]";
+  }
+  pts += "]";
+  auto recipe = [&](const std::string& plane) {
+    return R"({"format": "clayform.recipe", "version": 1, "strokes": {"s": {"points": )" + pts +
+           R"(, "tolerance": 0.05, "plane": )" + plane + "}}}";
+  };
+  const auto result =
+      run_recipe(parse_recipe(recipe(R"({"origin": [0, 0, 5], "normal": [0, 3, 3]})")));
+  const auto& c = result.curve("s");
+  for (int k = 0; k <= 200; ++k)
+    CHECK(std::abs((surface::evaluate(c, k / 200.0) - origin).dot(normal)) <= 1e-9);
+  // The same plane with an x axis given; a y axis beside a normal, or a zero normal, is named.
+  CHECK(check_recipe(recipe(R"({"origin": [0, 0, 5], "normal": [0, 1, 1], "x_axis": [1, 0, 0]})"))
+            .empty());
+  const auto both =
+      check_recipe(recipe(R"({"origin": [0, 0, 5], "normal": [0, 1, 1], "y_axis": [0, 1, 0]})"));
+  INFO(dump(both));
+  CHECK(mentions(both, "strokes.s.plane.y_axis", "takes no y_axis"));
+  const auto zero = check_recipe(recipe(R"({"origin": [0, 0, 5], "normal": [0, 0, 0]})"));
+  INFO(dump(zero));
+  CHECK(mentions(zero, "strokes.s.plane", "normal"));
+}
