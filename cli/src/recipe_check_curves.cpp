@@ -194,12 +194,16 @@ std::optional<surface::BSplineCurve> RecipeChecker::arc_radius(const Json& v,
   const Eigen::Vector3d chord = b - a;
   // In the plane through the chord normal to `normal` (its part across the chord): `left` is
   // normal x chord, seen from the normal's tip.
-  const Eigen::Vector3d n = *vs[2] - vs[2]->dot(chord) / chord.squaredNorm() * chord;
   const double half = 0.5 * chord.norm();
   if (!(half > 0)) {
     c_.add(key_path(p, "end"), "is the start point; an arc needs two different ends");
     return std::nullopt;
   }
+  if (!(vs[2]->norm() > 0)) {
+    c_.add(key_path(p, "normal"), "is [0, 0, 0]; give the normal of the arc's plane");
+    return std::nullopt;
+  }
+  const Eigen::Vector3d n = *vs[2] - vs[2]->dot(chord) / chord.squaredNorm() * chord;
   if (!(n.norm() > 1e-9 * vs[2]->norm())) {
     c_.add(key_path(p, "normal"),
            "lies along the chord from start to end; give the normal of "

@@ -1360,6 +1360,10 @@ TEST_CASE("arcs by three points and by radius and side; mirrored curves and surf
                                "normal": [0, 0, 1], "side": "right"}}})");
   CHECK(mentions(check_recipe(too_small), "curves.small.arc_radius.radius",
                  "less than half the chord"));
+  const std::string no_normal = recipe_with("", R"("curves": {
+      "flat": {"arc_radius": {"start": [0, 0, 0], "end": [20, 0, 0], "radius": 15,
+                              "normal": [0, 0, 0], "side": "left"}}})");
+  CHECK(mentions(check_recipe(no_normal), "curves.flat.arc_radius.normal", "[0, 0, 0]"));
 }
 
 TEST_CASE("a plane may be given by origin and normal", "[recipe]") {

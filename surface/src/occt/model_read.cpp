@@ -1061,12 +1061,13 @@ class ModelBuilder {
     // Plain copies: Clang 14 refuses structured bindings captured by lambdas.
     const double u0 = surface.u.domain().first, u1 = surface.u.domain().second;
     const double v0 = surface.v.domain().first, v1 = surface.v.domain().second;
+    const surface::SurfaceProjector projector(surface);  // validated once, not per point
     auto foot = [&](double t) {
       const Eigen::Vector3d point = surface::evaluate(edge.curve, t);
       const Eigen::Vector3d start = surface::evaluate(old, t);
       // Pcurves reach rounding outside the domain (v = -1e-20 on the I-DEAS cone).
-      const auto p = surface::project_normal(surface, point, std::clamp(start.x(), u0, u1),
-                                             std::clamp(start.y(), v0, v1));
+      const auto p = projector.project_normal(point, std::clamp(start.x(), u0, u1),
+                                              std::clamp(start.y(), v0, v1));
       off_face = off_face || !(p.distance <= accepted);
       return gp_Pnt2d(p.u, p.v);
     };
