@@ -468,12 +468,12 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
 }
 
 std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p) {
-  if (!c_.object(
-          j, p,
-          {"kind", "name", "enabled", "target", "bound", "mode", "lambda", "relaxation",
-           "smoothing", "key_points_per_row", "boundary_rows", "tolerance", "curve_tolerance",
-           "max_refinements", "max_key_point_rounds", "accept_out_of_tolerance"},
-          "a style step"))
+  if (!c_.object(j, p,
+                 {"kind", "name", "enabled", "target", "bound", "mode", "lambda", "relaxation",
+                  "smoothing", "key_points_per_row", "boundary_rows", "tolerance",
+                  "curve_tolerance", "max_refinements", "max_key_point_rounds", "continuity",
+                  "net_convergence", "accept_out_of_tolerance"},
+                 "a style step"))
     return std::nullopt;
   StyleDef d;
   const std::size_t before = c_.problems.size();
@@ -513,7 +513,11 @@ std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p
   o.boundary_rows = c_.integer_or(j, p, "boundary_rows", o.boundary_rows, 0, 4);
   o.tolerance = c_.number_or(j, p, "tolerance", o.tolerance, positive);
   o.curve_tolerance = c_.number_or(j, p, "curve_tolerance", o.curve_tolerance, positive);
-  o.max_refinements = c_.integer_or(j, p, "max_refinements", o.max_refinements, 0, 8);
+  o.max_refinements = c_.integer_or(j, p, "max_refinements", o.max_refinements, 0, 10);
+  if (const Json* m = c_.member(j, p, "continuity", false, ""))
+    if (const auto k = c_.choice(*m, key_path(p, "continuity"), {"G1", "G2"}))
+      o.continuity = *k == 0 ? deform::BoundContinuity::G1 : deform::BoundContinuity::G2;
+  o.net_convergence = c_.number_or(j, p, "net_convergence", o.net_convergence, Range{0, 0.5});
   o.max_key_point_rounds =
       c_.integer_or(j, p, "max_key_point_rounds", o.max_key_point_rounds, 0, 16);
   d.accept_out_of_tolerance =

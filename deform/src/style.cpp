@@ -35,6 +35,10 @@ std::string_view to_string(ConstraintClass c) noexcept {
   return "?";
 }
 
+std::string_view to_string(BoundContinuity c) noexcept {
+  return c == BoundContinuity::G2 ? "G2" : "G1";
+}
+
 std::vector<std::string> StyleOptions::problems() const {
   std::vector<std::string> out;
   auto fail = [&out](const std::string& what) { out.push_back("style options: " + what); };
@@ -50,8 +54,14 @@ std::vector<std::string> StyleOptions::problems() const {
   if (!(tolerance > 0 && tolerance <= 1e-3))
     fail("tolerance = " + std::to_string(tolerance) +
          " must lie in (0, 1e-3] (relative to the model size)");
-  if (max_refinements < 0)
-    fail("max_refinements = " + std::to_string(max_refinements) + " must be >= 0");
+  if (max_refinements < 0 || max_refinements > 10)
+    fail("max_refinements = " + std::to_string(max_refinements) +
+         " must lie in [0, 10] (each round halves the spans over the region)");
+  if (!(net_convergence >= 0 && net_convergence <= 0.5))
+    fail("net_convergence = " + std::to_string(net_convergence) +
+         " must lie in [0, 0.5] (a fraction of the largest displacement; 0 = no such rounds)");
+  if (continuity != BoundContinuity::G1 && continuity != BoundContinuity::G2)
+    fail("continuity = " + std::to_string(static_cast<int>(continuity)) + " must be G1 or G2");
   if (!(curve_tolerance >= 0 && curve_tolerance <= 1e-1))
     fail("curve_tolerance = " + std::to_string(curve_tolerance) +
          " must lie in [0, 0.1] (relative to the model size; 0 = key points only)");
@@ -392,10 +402,30 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
   return out;
 }
 
+// The parameter box of the region: the bound polygon's, else that of the influenced vertices'
+// Greville points widened by one Greville interval.
+Eigen::AlignedBox2d region_box(const BSplineSurface& s, const InfluenceRegion& reg) {
+  Eigen::AlignedBox2d box;
+  if (!reg.polygon.empty()) {
+    for (const auto& p : reg.polygon) box.extend(p);
+    return box;
+  }
+  const auto xu = surface::greville_abscissae(s.u), xv = surface::greville_abscissae(s.v);
+  for (int i = 0; i < s.count_u(); ++i)
+    for (int j = 0; j < s.count_v(); ++j)
+      if (reg.inside(i, j)) {
+        const size_t a = static_cast<size_t>(i), b = static_cast<size_t>(j);
+        box.extend(Eigen::Vector2d(xu[a > 0 ? a - 1 : a], xv[b > 0 ? b - 1 : b]));
+        box.extend(Eigen::Vector2d(xu[std::min(a + 1, xu.size() - 1)],
+                                   xv[std::min(b + 1, xv.size() - 1)]));
+      }
+  return box;
+}
+
 void measure(const BSplineSurface& parent, const BSplineSurface& result,
              const std::vector<std::uint8_t>& factors, const InfluenceRegion& region,
-             const std::vector<TraceSample>& samples, const StyleOptions& options,
-             StyleReport& report) {
+             const BSplineCurve& target, const std::vector<TraceSample>& samples,
+             const StyleOptions& options, StyleReport& report) {
   report.model_size = model_size(parent);
   report.locality = 0;
   report.moved_vertices = 0;
@@ -418,25 +448,80 @@ void measure(const BSplineSurface& parent, const BSplineSurface& result,
   }
   const double nan = std::numeric_limits<double>::quiet_NaN();
   report.target_curve_deviation = nan;
+  report.target_curve_distance = nan;
+  report.mean_curvature_min = nan;
+  report.mean_curvature_max = nan;
   report.boundary_position_jump = nan;
   report.boundary_tangent_angle = nan;
   if (!options.report_curves) return;
+  const RegionTest inside(region, parent);
+
+  // The target curve against the result, independently of the trace and its Newton continuation:
+  // 4 times as many samples, each foot found by a global closest point on the parent (is it in
+  // the region? where does λ put the wanted point?) and on the result (the distance).
+  if (!samples.empty()) {
+    const surface::SurfaceProjector on_parent(parent, options.projection);
+    const int n = 4 * (static_cast<int>(samples.size()) - 1) + 1;
+    const double t0 = samples.front().t, t1 = samples.back().t;
+    double worst = -1;
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector3d c = surface::evaluate(target, t0 + (t1 - t0) * k / (n - 1));
+      const auto foot = on_parent.closest_point(c);
+      if (!inside(foot.u, foot.v)) continue;
+      const Eigen::Vector3d wanted = foot.point + options.lambda * (c - foot.point);
+      worst = std::max(worst, projector.closest_point(wanted).distance);
+    }
+    if (worst >= 0) report.target_curve_distance = worst;
+  }
+
+  // Mean curvature H = (E N - 2 F M + G L) / (2 (E G - F^2)) of the result on a 41 x 41 grid over
+  // the region's box, at the points inside the region.
+  {
+    constexpr int n = 41;
+    const Eigen::AlignedBox2d box = region_box(parent, region);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) {
+        const Eigen::Vector2d uv =
+            box.min() + Eigen::Vector2d(a, b).cwiseProduct(box.sizes()) / (n - 1);
+        if (!inside(uv.x(), uv.y())) continue;
+        const auto d = surface::derivatives(result, uv.x(), uv.y(), 2);
+        const Eigen::Vector3d cross = d.du.cross(d.dv);
+        const double E = d.du.dot(d.du), F = d.du.dot(d.dv), G = d.dv.dot(d.dv);
+        const double det = E * G - F * F;
+        if (!(cross.norm() > 1e-12 * std::sqrt(E * G)) || !(det > 0)) continue;  // degenerate
+        const Eigen::Vector3d normal = cross.normalized();
+        const double L = d.duu.dot(normal), M = d.duv.dot(normal), N = d.dvv.dot(normal);
+        const double h = (E * N - 2 * F * M + G * L) / (2 * det);
+        lo = std::min(lo, h);
+        hi = std::max(hi, h);
+      }
+    if (lo <= hi) {
+      report.mean_curvature_min = lo;
+      report.mean_curvature_max = hi;
+    }
+  }
   report.target_curve_deviation = samples.empty() ? nan : 0.0;
-  const RegionTest sample_inside(region, parent);
   for (const TraceSample& t : samples) {
-    if (!sample_inside(t.u, t.v)) continue;
+    if (!inside(t.u, t.v)) continue;
     const auto p = project_from(projector, t.point, t.u, t.v);
     report.target_curve_deviation = std::max(report.target_curve_deviation, p.distance);
   }
 
+  measure_boundary(parent, factors, region, parent, result, report);
+}
+
+void measure_boundary(const BSplineSurface& net, const std::vector<std::uint8_t>& factors,
+                      const InfluenceRegion& region, const BSplineSurface& parent,
+                      const BSplineSurface& result, StyleReport& report) {
   // The region edge: the bound polygon, or (region from the target) the midpoints between each
   // influenced vertex's Greville point and those of its non-influenced neighbours.
   std::vector<Eigen::Vector2d> edge = region.polygon;
   if (edge.empty()) {
-    const auto xu = surface::greville_abscissae(parent.u);
-    const auto xv = surface::greville_abscissae(parent.v);
-    const int nu = parent.count_u(), nv = parent.count_v();
-    auto e = [&](int i, int j) { return factors[static_cast<size_t>(parent.index(i, j))] != 0; };
+    const auto xu = surface::greville_abscissae(net.u);
+    const auto xv = surface::greville_abscissae(net.v);
+    const int nu = net.count_u(), nv = net.count_v();
+    auto e = [&](int i, int j) { return factors[static_cast<size_t>(net.index(i, j))] != 0; };
     for (int i = 0; i < nu; ++i)
       for (int j = 0; j < nv; ++j) {
         if (!e(i, j)) continue;
@@ -635,12 +720,25 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
       m << "a key point is missed by " << report.target_deviation
         << " mm, more than tolerance x size = " << options.tolerance * size
         << " mm; allow more max_refinements";
-    } else if (options.curve_tolerance > 0 && std::isfinite(report.target_curve_deviation) &&
-               report.target_curve_deviation > options.curve_tolerance * size) {
+    } else if (const double miss = std::max(
+                   std::isfinite(report.target_curve_deviation) ? report.target_curve_deviation
+                                                                : 0.0,
+                   std::isfinite(report.target_curve_distance) ? report.target_curve_distance
+                                                               : 0.0);
+               options.curve_tolerance > 0 && miss > options.curve_tolerance * size) {
       s.termination = Termination::NotConverged;
-      m << "the target curve is missed by " << report.target_curve_deviation
+      m << "the target curve is missed by " << miss
         << " mm, more than curve_tolerance x size = " << options.curve_tolerance * size
         << " mm; allow more max_key_point_rounds or max_refinements, or a larger curve_tolerance";
+    } else if (options.net_convergence > 0 && !(report.net_change <= options.net_convergence)) {
+      s.termination = Termination::NotConverged;
+      if (std::isnan(report.net_change))
+        m << "the net could not be halved to check that the shape has converged";
+      else
+        m << "the shape still changes by " << 100 * report.net_change
+          << " % of its largest displacement when the net is halved, more than net_convergence = "
+          << 100 * options.net_convergence << " %";
+      m << "; allow more max_refinements, or a larger net_convergence";
     }
     s.message = m.str();
   }
@@ -673,7 +771,7 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
   StyleResult out{parent, parent, {}};
   StyleReport& report = out.report;
   if (begin_report(keys, options, StyleMode::Paper, report)) {
-    detail::measure(parent, out.surface, region.factors, region, trace, options, report);
+    detail::measure(parent, out.surface, region.factors, region, target, trace, options, report);
     return out;
   }
 
@@ -757,7 +855,7 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
     if (region.factors[static_cast<size_t>(r)] != 0 && !delta.row(r).isZero(0))
       out.surface.points.row(r) += delta.row(r);
 
-  detail::measure(parent, out.surface, region.factors, region, trace, options, report);
+  detail::measure(parent, out.surface, region.factors, region, target, trace, options, report);
   std::ostringstream msg;
   msg << to_string(report.constraint_class) << ", m = " << report.m << " key points along "
       << (along_u ? "u" : "v") << ", " << report.moved_vertices << " of "

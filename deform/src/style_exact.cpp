@@ -9,6 +9,7 @@
 // the `boundary_rows` layers inside its edge are fixed, so the surface near the bound curve is
 // untouched. Where the key-point system is rank deficient (the net is too coarse there), the knot
 // spans holding key points are halved (exact knot insertion) and the solve is repeated.
+#include "fairness.hpp"
 #include "style_internal.hpp"
 
 #include <clay/error.hpp>
@@ -23,6 +24,8 @@
 
 #include <algorithm>
 #include <deque>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 namespace clay::deform::detail {
@@ -46,6 +49,9 @@ constexpr double max_amplification = 1 / min_free_share;
 constexpr double range_space_accuracy = 1e-3;
 // ... and when H d = B^T μ holds to this fraction of |B^T μ| (rounding on the hood: ~1e-11).
 constexpr double range_space_stationarity = 1e-8;
+// Dependent key points on nets of more free vertices than this are solved through the net's
+// factorization (the dense null space would take nf^2 doubles: 20 GB at 50,000).
+constexpr Eigen::Index dependent_dense_limit = 2048;
 // Nets with up to this many free vertices keep H^-1 (dense, 2 MB at the limit).
 constexpr Eigen::Index dense_inverse_limit = 512;
 
@@ -107,27 +113,61 @@ std::vector<double> halving_knots(const surface::BSplineBasis& basis, double lo,
   return knots;
 }
 
-// The parameter box of the region: the bound polygon's, else that of the influenced vertices'
-// Greville points widened by one Greville interval.
-Eigen::AlignedBox2d region_box(const BSplineSurface& s, const InfluenceRegion& reg) {
-  Eigen::AlignedBox2d box;
-  if (!reg.polygon.empty()) {
-    for (const auto& p : reg.polygon) box.extend(p);
-    return box;
-  }
-  const auto xu = surface::greville_abscissae(s.u), xv = surface::greville_abscissae(s.v);
-  for (int i = 0; i < s.count_u(); ++i)
-    for (int j = 0; j < s.count_v(); ++j)
-      if (reg.inside(i, j)) {
-        const size_t a = static_cast<size_t>(i), b = static_cast<size_t>(j);
-        box.extend(Eigen::Vector2d(xu[a > 0 ? a - 1 : a], xv[b > 0 ? b - 1 : b]));
-        box.extend(Eigen::Vector2d(xu[std::min(a + 1, xu.size() - 1)],
-                                   xv[std::min(b + 1, xv.size() - 1)]));
-      }
-  return box;
-}
-
 }  // namespace
+
+// Where the displacement may be non-zero, fixed in parameter space for every net the solve is
+// refined to: the union of the supports of the vertices that are influenced and more than
+// `fixed_rows` layers inside the region's edge on the *region net* (the parent with its spans
+// over the region halved until the region's box covers at least region_spans of them in each
+// direction). A vertex of any net is free when it is influenced and its support lies in this
+// area. The spaces of displacements are then nested as the net is halved (a spline supported in
+// the area is one on the finer net), so the solves are Galerkin approximations of one problem
+// on one domain and converge; with free vertices chosen by layers on each net instead, the
+// domain itself grew by a layer's width per halving and the shape changed by ~1/2 of its last
+// change each time (the hood: 18 %, 7 %, 3 %).
+struct FreeArea {
+  BSplineSurface net;          // the region net
+  InfluenceRegion region;      // the region on it (factors of its vertices)
+  std::vector<double> bu, bv;  // breakpoints of the region net
+  std::vector<int> sum;        // prefix sums of the cells in the area, (cu + 1) x (cv + 1)
+  int cells_v = 0;
+
+  int count(int a0, int a1, int b0, int b1) const {  // cells [a0, a1) x [b0, b1) in the area
+    const auto at = [&](int a, int b) { return sum[static_cast<size_t>(a * (cells_v + 1) + b)]; };
+    return at(a1, b1) - at(a0, b1) - at(a1, b0) + at(a0, b0);
+  }
+  // Cells of breakpoints `b` overlapping the open interval (lo, hi): [first, last).
+  static std::pair<int, int> cells(const std::vector<double>& b, double lo, double hi) {
+    const int first = static_cast<int>(std::upper_bound(b.begin(), b.end(), lo) - b.begin()) - 1;
+    const int last = static_cast<int>(std::lower_bound(b.begin(), b.end(), hi) - b.begin());
+    return {std::max(first, 0), std::min(last, static_cast<int>(b.size()) - 1)};
+  }
+  // True when the cells around (u, v) (both sides of a breakpoint it lies on) and their
+  // neighbours lie in the area: a key point elsewhere cannot be met on any net, or only where the
+  // displacement fades out towards the area's edge, by a net wound up around it. (Key points of
+  // eq. 8 lie on rows, and a uniform cubic's rows are its knots.)
+  bool holds(double u, double v) const {
+    if (sum.empty()) return false;
+    const double eu = 1e-9 * (bu.back() - bu.front()), ev = 1e-9 * (bv.back() - bv.front());
+    auto [a0, a1] = cells(bu, u - eu, u + eu);
+    auto [b0, b1] = cells(bv, v - ev, v + ev);
+    a0 -= 1;
+    b0 -= 1;
+    a1 += 1;
+    b1 += 1;
+    const int cu = static_cast<int>(bu.size()) - 1, cv = static_cast<int>(bv.size()) - 1;
+    if (a0 < 0 || b0 < 0 || a1 > cu || b1 > cv) return false;
+    return count(a0, a1, b0, b1) == (a1 - a0) * (b1 - b0);
+  }
+  // True when the rectangle [u0, u1] x [v0, v1] lies in the area.
+  bool contains(double u0, double u1, double v0, double v1) const {
+    if (sum.empty()) return false;
+    const auto [a0, a1] = cells(bu, u0, u1);
+    const auto [b0, b1] = cells(bv, v0, v1);
+    if (a1 <= a0 || b1 <= b0) return false;
+    return count(a0, a1, b0, b1) == (a1 - a0) * (b1 - b0);
+  }
+};
 
 // The free vertices of one net (knot vectors) and the fairness matrix over them.
 struct NetCache {
@@ -146,54 +186,41 @@ struct NetCache {
 
 namespace {
 
-// Free vertices of `s` (influenced, more than boundary_rows layers inside the region's edge) and
-// the factorized thin-plate fairness of their displacements (fixed vertices have d = 0).
+// Free vertices of `s` (influenced, their support in the free area) and the factorized fairness
+// energy of order `order` of their displacements (fixed vertices have d = 0).
 std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s,
                                             const std::vector<std::uint8_t>& factors,
-                                            int boundary_rows) {
+                                            const FreeArea& area, int order) {
   auto cache = std::make_shared<NetCache>();
   cache->knots_u = s.u.knots;
   cache->knots_v = s.v.knots;
-  const auto dist = distance_to_outside(s, factors);
   cache->free_index.assign(factors.size(), -1);
-  for (size_t r = 0; r < factors.size(); ++r)
-    if (factors[r] != 0 && dist[r] > boundary_rows) {
+  const int p = s.u.degree, q = s.v.degree;
+  for (int i = 0; i < s.count_u(); ++i)
+    for (int j = 0; j < s.count_v(); ++j) {
+      const size_t r = static_cast<size_t>(s.index(i, j));
+      const auto& tu = s.u.knots;
+      const auto& tv = s.v.knots;
+      if (factors[r] == 0 ||
+          !area.contains(tu[static_cast<size_t>(i)], tu[static_cast<size_t>(i + p + 1)],
+                         tv[static_cast<size_t>(j)], tv[static_cast<size_t>(j + q + 1)]))
+        continue;
       cache->free_index[r] = static_cast<Eigen::Index>(cache->free_rows.size());
       cache->free_rows.push_back(static_cast<Eigen::Index>(r));
     }
   const Eigen::Index nf = static_cast<Eigen::Index>(cache->free_rows.size());
   if (nf == 0) return cache;
 
-  std::vector<Eigen::Triplet<double>> stencil;
-  Eigen::Index stencil_rows = 0;
-  const int nu = s.count_u(), nv = s.count_v();
-  const auto& free_index = cache->free_index;
-  auto add_stencil = [&](std::initializer_list<std::tuple<int, int, double>> terms) {
-    bool any = false;
-    for (const auto& [i, j, c] : terms)
-      any = any || free_index[static_cast<size_t>(s.index(i, j))] >= 0;
-    if (!any) return;
-    for (const auto& [i, j, c] : terms) {
-      const Eigen::Index f = free_index[static_cast<size_t>(s.index(i, j))];
-      if (f >= 0) stencil.emplace_back(stencil_rows, f, c);
-    }
-    ++stencil_rows;
-  };
-  const double twist = std::sqrt(2.0);
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      if (i > 0 && i + 1 < nu) add_stencil({{i - 1, j, 1.0}, {i, j, -2.0}, {i + 1, j, 1.0}});
-      if (j > 0 && j + 1 < nv) add_stencil({{i, j - 1, 1.0}, {i, j, -2.0}, {i, j + 1, 1.0}});
-      if (i + 1 < nu && j + 1 < nv)
-        add_stencil({{i, j, twist}, {i + 1, j, -twist}, {i, j + 1, -twist}, {i + 1, j + 1, twist}});
-    }
-  Eigen::SparseMatrix<double> L(stencil_rows, nf);
-  L.setFromTriplets(stencil.begin(), stencil.end());
-  Eigen::SparseMatrix<double> H = L.transpose() * L;
+  // The fairness energy's Galerkin matrix (fairness.hpp), scaled to a unit largest diagonal so
+  // that the KKT system's blocks are of like size (the energy is reported unscaled).
+  Eigen::SparseMatrix<double> H = fairness_matrix(s, cache->free_index, nf, order);
   double max_diag = 0;
   for (Eigen::Index c = 0; c < nf; ++c) max_diag = std::max(max_diag, H.coeff(c, c));
+  if (!(max_diag > 0) || !std::isfinite(max_diag))
+    throw Error(ErrorCategory::Internal, "style deformation: the fairness energy vanishes");
+  H /= max_diag;
   // A tiny ridge keeps H definite where the free vertices reach the border of the net.
-  for (Eigen::Index c = 0; c < nf; ++c) H.coeffRef(c, c) += 1e-12 * std::max(max_diag, 1.0);
+  for (Eigen::Index c = 0; c < nf; ++c) H.coeffRef(c, c) += 1e-12;
   cache->H = std::move(H);
   cache->energy.compute(cache->H);
   cache->factorized = cache->energy.info() == Eigen::Success;
@@ -235,11 +262,192 @@ Eigen::MatrixXd kkt_solve(const Eigen::SparseMatrix<double>& H, const Eigen::Mat
 
 }  // namespace
 
+namespace {
+
+// Parameter points over the region where net convergence compares shapes, and the parent there.
+struct ShapeGrid {
+  std::vector<Eigen::Vector2d> uv;
+  std::vector<Eigen::Vector3d> parent;
+};
+
+template <class Inside>
+ShapeGrid shape_grid(const BSplineSurface& parent, const InfluenceRegion& region, Inside&& inside) {
+  constexpr int n = 41;
+  ShapeGrid grid;
+  const Eigen::AlignedBox2d box = region_box(parent, region);
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b) {
+      const Eigen::Vector2d uv =
+          box.min() + Eigen::Vector2d(a, b).cwiseProduct(box.sizes()) / (n - 1);
+      TraceSample t;
+      t.u = uv.x();
+      t.v = uv.y();
+      if (!inside(t)) continue;
+      grid.uv.push_back(uv);
+      grid.parent.push_back(surface::evaluate(parent, uv.x(), uv.y()));
+    }
+  return grid;
+}
+
+// max |S_new - S_old| / max |S_new - parent| over the grid (0 where nothing moved).
+double shape_change(const ShapeGrid& grid, const BSplineSurface& old_shape,
+                    const BSplineSurface& new_shape) {
+  double change = 0, moved = 0;
+  for (size_t k = 0; k < grid.uv.size(); ++k) {
+    const Eigen::Vector3d a = surface::evaluate(old_shape, grid.uv[k].x(), grid.uv[k].y());
+    const Eigen::Vector3d b = surface::evaluate(new_shape, grid.uv[k].x(), grid.uv[k].y());
+    change = std::max(change, (b - a).norm());
+    moved = std::max(moved, (b - grid.parent[k]).norm());
+  }
+  return moved > 0 ? change / moved : 0.0;
+}
+
+}  // namespace
+
 // What the exact mode keeps between drags: one NetCache per net it has solved on (the parent's
 // and its refinements), never modified once shared.
 struct ExactCache {
+  std::shared_ptr<const FreeArea> area;
   std::vector<std::shared_ptr<const NetCache>> nets;
 };
+
+namespace {
+
+// The region net's knot spans over the box in each direction at least this many (halving the
+// parent's at most max_region_halvings times): the resolution of the free area's edge.
+constexpr int region_spans = 32;
+constexpr int max_region_halvings = 5;
+
+int spans_over(const surface::BSplineBasis& b, double lo, double hi) {
+  const auto breaks = surface::breakpoints(b);
+  int n = 0;
+  for (size_t k = 0; k + 1 < breaks.size(); ++k) n += breaks[k + 1] > lo && breaks[k] < hi;
+  return n;
+}
+
+// The exact mode holds the target's own ends too (where they lie in the region): the rows of eq. 8
+// stop up to a row's spacing short of them, and that shortfall changed with every halving of the
+// net, so the shape near the ends never settled (the hood: 4 % after five halvings, all of it
+// past the crease's ends). A row key point within a quarter of the mean spacing of an end gives
+// way to it (two nearly equal rows would make the system ill-conditioned).
+template <class Inside>
+void hold_target_ends(const BSplineSurface& s, const InfluenceRegion& region,
+                      const std::vector<TraceSample>& trace, KeyDirection direction,
+                      Inside&& inside, std::vector<KeyPoint>& points) {
+  if (trace.size() < 2) return;
+  const double span = trace.back().t - trace.front().t;
+  const double spacing = span / static_cast<double>(std::max<size_t>(points.size(), 1));
+  for (const TraceSample* end : {&trace.front(), &trace.back()}) {
+    if (!inside(*end)) continue;
+    std::erase_if(points, [&](const KeyPoint& k) {
+      return std::abs(k.curve_parameter - end->t) < 0.25 * spacing;
+    });
+    KeyPoint k = make_key_point(s, region, end->point, end->t, end->u, end->v, direction);
+    points.insert(end == &trace.front() ? points.begin() : points.end(), k);
+  }
+}
+
+// The trace with 3 more samples between each two, uniform in the curve's parameter, each
+// projected by Newton from the sample before it.
+std::vector<TraceSample> densify(const surface::SurfaceProjector& projector,
+                                 const BSplineCurve& target,
+                                 const std::vector<TraceSample>& trace) {
+  std::vector<TraceSample> fine;
+  for (size_t k = 0; k < trace.size(); ++k) {
+    fine.push_back(trace[k]);
+    if (k + 1 == trace.size()) break;
+    for (int j = 1; j < 4; ++j) {
+      TraceSample x;
+      x.t = trace[k].t + (trace[k + 1].t - trace[k].t) * j / 4;
+      x.point = surface::evaluate(target, x.t);
+      const auto p = project_from(projector, x.point, fine.back().u, fine.back().v);
+      x.u = p.u;
+      x.v = p.v;
+      fine.push_back(x);
+    }
+  }
+  return fine;
+}
+
+FreeArea make_free_area(const BSplineSurface& parent, const InfluenceRegion& region,
+                        const Eigen::AlignedBox2d& box, int fixed_rows) {
+  BSplineSurface s = parent;
+  for (int h = 0; h < max_region_halvings; ++h) {
+    const bool u = spans_over(s.u, box.min().x(), box.max().x()) < region_spans;
+    const bool v = spans_over(s.v, box.min().y(), box.max().y()) < region_spans;
+    if (!u && !v) break;
+    if (u) s = surface::refine_knots_u(s, halving_knots(s.u, box.min().x(), box.max().x()));
+    if (v) s = surface::refine_knots_v(s, halving_knots(s.v, box.min().y(), box.max().y()));
+  }
+  const auto factors = region_factors(s, region.polygon, region.target_trace, region.margin);
+  const auto dist = distance_to_outside(s, factors);
+  FreeArea area;
+  area.region = region;
+  area.region.count_u = s.count_u();
+  area.region.count_v = s.count_v();
+  area.region.factors = factors;
+  area.bu = surface::breakpoints(s.u);
+  area.bv = surface::breakpoints(s.v);
+  const int cu = static_cast<int>(area.bu.size()) - 1, cv = static_cast<int>(area.bv.size()) - 1;
+  area.cells_v = cv;
+  std::vector<std::uint8_t> in(static_cast<size_t>(cu * cv), 0);
+  const int p = s.u.degree, q = s.v.degree;
+  for (int i = 0; i < s.count_u(); ++i)
+    for (int j = 0; j < s.count_v(); ++j) {
+      const size_t r = static_cast<size_t>(s.index(i, j));
+      // The surface's own edges are held like the bound: they are where it meets its neighbours.
+      const int to_edge = std::min({i, s.count_u() - 1 - i, j, s.count_v() - 1 - j}) + 1;
+      if (factors[r] == 0 || std::min(dist[r], to_edge) <= fixed_rows) continue;
+      const auto [a0, a1] = FreeArea::cells(area.bu, s.u.knots[static_cast<size_t>(i)],
+                                            s.u.knots[static_cast<size_t>(i + p + 1)]);
+      const auto [b0, b1] = FreeArea::cells(area.bv, s.v.knots[static_cast<size_t>(j)],
+                                            s.v.knots[static_cast<size_t>(j + q + 1)]);
+      for (int a = a0; a < a1; ++a)
+        for (int b = b0; b < b1; ++b) in[static_cast<size_t>(a * cv + b)] = 1;
+    }
+  // Not the cells along the surface's own edges: a free vertex whose support reaches an edge
+  // would move the edge itself (the bound of a sail drawn past its leech).
+  for (int a = 0; a < cu; ++a)
+    in[static_cast<size_t>(a * cv)] = in[static_cast<size_t>(a * cv + cv - 1)] = 0;
+  for (int b = 0; b < cv; ++b)
+    in[static_cast<size_t>(b)] = in[static_cast<size_t>((cu - 1) * cv + b)] = 0;
+  // Only cells inside the region (corners and edge midpoints): a support whose Greville
+  // neighbours all lie inside may still reach across a curved bound between them. Without a
+  // bound, inside means between influenced vertices of the parent's net: the four whose Greville
+  // points surround the sample have E = 1.
+  const PolygonLocator bound(region.polygon, parameter_tolerance(parent));
+  const auto xu = surface::greville_abscissae(parent.u), xv = surface::greville_abscissae(parent.v);
+  auto inside = [&](double u, double v) {
+    if (!region.polygon.empty()) return bound.inside({u, v});
+    const int i = static_cast<int>(continuous_index(xu, u)),
+              j = static_cast<int>(continuous_index(xv, v));
+    for (int a = i; a <= std::min(i + 1, parent.count_u() - 1); ++a)
+      for (int b = j; b <= std::min(j + 1, parent.count_v() - 1); ++b)
+        if (!region.inside(a, b)) return false;
+    return true;
+  };
+  for (int a = 0; a < cu; ++a)
+    for (int b = 0; b < cv; ++b) {
+      auto& cell = in[static_cast<size_t>(a * cv + b)];
+      const double u0 = area.bu[static_cast<size_t>(a)], u1 = area.bu[static_cast<size_t>(a + 1)];
+      const double v0 = area.bv[static_cast<size_t>(b)], v1 = area.bv[static_cast<size_t>(b + 1)];
+      for (int x = 0; x <= 2 && cell != 0; ++x)
+        for (int y = 0; y <= 2 && cell != 0; ++y)
+          if (!inside(u0 + 0.5 * x * (u1 - u0), v0 + 0.5 * y * (v1 - v0))) cell = 0;
+    }
+  area.sum.assign(static_cast<size_t>((cu + 1) * (cv + 1)), 0);
+  for (int a = 0; a < cu; ++a)
+    for (int b = 0; b < cv; ++b)
+      area.sum[static_cast<size_t>((a + 1) * (cv + 1) + b + 1)] =
+          in[static_cast<size_t>(a * cv + b)] +
+          area.sum[static_cast<size_t>(a * (cv + 1) + b + 1)] +
+          area.sum[static_cast<size_t>((a + 1) * (cv + 1) + b)] -
+          area.sum[static_cast<size_t>(a * (cv + 1) + b)];
+  area.net = std::move(s);
+  return area;
+}
+
+}  // namespace
 
 StyleResult style_exact(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
                         const BSplineCurve& target, const std::vector<TraceSample>& trace,
@@ -247,18 +455,44 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   const BSplineSurface& parent = projector.surface();
   const double size = model_size(parent);
   const double tol = options.tolerance * size;
+  const int order = options.continuity == BoundContinuity::G2 ? 3 : 2;
+  const int fixed_rows = options.boundary_rows + (order - 2);
+  if (parent.u.degree < order || parent.v.degree < order)
+    throw Error(ErrorCategory::InvalidArgument,
+                "style deformation (exact mode): the parent surface has degree (" +
+                    std::to_string(parent.u.degree) + ", " + std::to_string(parent.v.degree) +
+                    "), and continuity " + std::string(to_string(options.continuity)) +
+                    " minimises derivatives of order " + std::to_string(order) +
+                    ", which vanish inside its spans: elevate the parent to degree >= " +
+                    std::to_string(order) + " in u and v (surface::elevate_degree)" +
+                    (order == 3 ? ", or ask for G1" : ", or use the paper mode"));
 
   BSplineSurface s = parent;
   InfluenceRegion reg = region;
   StyleResult out{parent, parent, {}};
   StyleReport& report = out.report;
 
-  // The key points are those of the parent's net (eq. 8): refinement adds freedom, not
-  // constraints. Key points are added where the result still misses the target curve.
+  // Every refinement halves the spans over the parent's region box, so the nets are nested.
+  const Eigen::AlignedBox2d refine_box = region_box(parent, region);
+  if (!cache || !cache->area) {
+    auto fresh = std::make_shared<ExactCache>();
+    if (cache) fresh->nets = cache->nets;
+    fresh->area =
+        std::make_shared<const FreeArea>(make_free_area(parent, region, refine_box, fixed_rows));
+    cache = std::move(fresh);
+  }
+  const std::shared_ptr<const FreeArea> area = cache->area;
+
+  // The key points are those of eq. 8 on the region net, not on the net being solved: they are
+  // the same on every net the solve is refined to, so the refined solves approximate one
+  // problem (with the key points of each net, rows twice as dense at every halving, the shape
+  // never settled near the target's ends). The target's ends are held too. Key points are added
+  // where the result still misses the target curve.
+  const surface::SurfaceProjector on_region_net(area->net, options.projection);
   const KeyPoints keys =
-      find_key_points(projector, region, target, trace, options.key_points_per_row);
+      find_key_points(on_region_net, area->region, target, trace, options.key_points_per_row);
   if (begin_report(keys, options, StyleMode::Exact, report)) {
-    measure(parent, parent, region.factors, region, trace, options, report);
+    measure(parent, parent, region.factors, region, target, trace, options, report);
     return out;
   }
   std::vector<KeyPoint> points = keys.points;
@@ -266,8 +500,18 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   auto in_region = [&](const TraceSample& t) {
     return region.polygon.empty() || bound.inside({t.u, t.v});
   };
+  hold_target_ends(area->net, area->region, trace, keys.direction, in_region, points);
+  // Key points where no free vertex of any net reaches (in the fixed band inside the bound) are
+  // not influenced: they cannot be met (under-constrained targets cross that band).
+  for (KeyPoint& k : points) k.influenced = k.influenced && area->holds(k.u, k.v);
   int refinements = 0, additions = 0;
   std::size_t accepted_points = points.size();  // key points before the last round of additions
+  const std::size_t base_points = points.size();
+  std::vector<TraceSample> fine;  // the trace 4 times as dense, made when first needed
+  // Net convergence: the result on the previous (coarser) net, compared on a grid over the region.
+  std::optional<BSplineSurface> previous;
+  const ShapeGrid grid = shape_grid(parent, region, in_region);
+  report.net_change = std::numeric_limits<double>::quiet_NaN();
   double amplification = 0;
 
   for (;;) {
@@ -276,9 +520,10 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       for (const auto& n : cache->nets)
         if (n->knots_u == s.u.knots && n->knots_v == s.v.knots) net = n;
     if (!net) {
-      net = build_cache(s, reg.factors, options.boundary_rows);
+      net = build_cache(s, reg.factors, *area, order);
       auto grown = std::make_shared<ExactCache>();
-      if (cache) grown->nets = cache->nets;
+      grown->area = area;
+      grown->nets = cache->nets;
       if (grown->nets.size() >= 16) grown->nets.erase(grown->nets.begin());  // bounded memory
       grown->nets.push_back(net);
       cache = std::move(grown);
@@ -314,7 +559,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     // fixed edge layers get thinner, the free vertices more numerous). The region's box is
     // mirror-symmetric when the region is, and so is the refinement.
     auto refine = [&] {
-      const Eigen::AlignedBox2d box = region_box(s, reg);
+      const Eigen::AlignedBox2d& box = refine_box;
       const auto ku = halving_knots(s.u, box.min().x(), box.max().x());
       const auto kv = halving_knots(s.v, box.min().y(), box.max().y());
       s = surface::refine_knots_u(s, ku);
@@ -380,6 +625,15 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
           }
         }
         if (!solved) d = kkt_solve(net->H, B, rhs);
+      } else if (nf > dependent_dense_limit && net->factorized) {
+        // Too many free vertices for the dense null space below (Q is nf x nf): the same
+        // compromise as the limit of the penalty min d^T H d + |B d - r|^2 / ε, by the range
+        // space with a ridge on the Schur complement, d = Y (B Y + ε I)^-1 r, Y = H^-1 B^T.
+        const Eigen::MatrixXd Y = net->energy.solve(Eigen::MatrixXd(B.transpose()));
+        Eigen::MatrixXd S = B * Y;
+        const double ridge = 1e-10 * std::max(S.trace() / static_cast<double>(nk), 1e-300);
+        S.diagonal().array() += ridge;
+        d = Y * S.ldlt().solve(rhs);
       } else {
         Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(B);
         cod.setThreshold(1e-10);
@@ -407,7 +661,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     }
     if (wound && points.size() > accepted_points) {
       points.resize(accepted_points);
-      report.added_key_points = static_cast<int>(accepted_points - keys.points.size());
+      report.added_key_points = static_cast<int>(accepted_points - base_points);
       additions = options.max_key_point_rounds;  // no more rounds
       continue;
     }
@@ -418,40 +672,41 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
         out.surface.points.row(free_rows[static_cast<size_t>(f)]) += d.row(f);
 
     // Where the result still misses the target by more than curve_tolerance, add key points at
-    // the local maxima of the miss along the target's samples and solve again.
+    // the local maxima of the miss along the target's samples (4 times as dense as the trace: the
+    // dense measure of the report found misses between the trace's samples) and solve again.
     if (!missed && options.curve_tolerance > 0 && additions < options.max_key_point_rounds) {
       const double limit = options.curve_tolerance * size;
-      std::vector<double> miss(trace.size(), 0.0);
+      if (fine.empty()) fine = densify(projector, target, trace);
+      std::vector<double> miss(fine.size(), 0.0);
       const surface::SurfaceProjector result(out.surface, options.projection);  // validated once
-      for (size_t k = 0; k < trace.size(); ++k) {
-        if (!in_region(trace[k])) continue;
+      for (size_t k = 0; k < fine.size(); ++k) {
+        if (!in_region(fine[k]) || !area->holds(fine[k].u, fine[k].v)) continue;
         // The distance from the wanted point (λ scales the move as for key points) to the result;
         // the miss at the sample's own parameters bounds it from above and spares most
         // projections.
-        const Eigen::Vector3d foot = surface::evaluate(s, trace[k].u, trace[k].v);
-        const Eigen::Vector3d wanted = foot + options.lambda * (trace[k].point - foot);
-        miss[k] = (surface::evaluate(out.surface, trace[k].u, trace[k].v) - wanted).norm();
-        if (miss[k] > limit)
-          miss[k] = project_from(result, wanted, trace[k].u, trace[k].v).distance;
+        const Eigen::Vector3d foot = surface::evaluate(s, fine[k].u, fine[k].v);
+        const Eigen::Vector3d wanted = foot + options.lambda * (fine[k].point - foot);
+        miss[k] = (surface::evaluate(out.surface, fine[k].u, fine[k].v) - wanted).norm();
+        if (miss[k] > limit) miss[k] = project_from(result, wanted, fine[k].u, fine[k].v).distance;
       }
       size_t added = 0;
-      for (size_t k = 0; k < trace.size(); ++k) {
+      for (size_t k = 0; k < fine.size(); ++k) {
         // Local maxima, with a relative slack so that a plateau of two equal misses (a symmetric
         // target) adds both samples, not whichever rounding favours.
         const double floor = miss[k] * (1 - 1e-6);
         const bool peak = miss[k] > limit && (k == 0 || floor >= miss[k - 1]) &&
-                          (k + 1 == trace.size() || floor >= miss[k + 1]);
+                          (k + 1 == fine.size() || floor >= miss[k + 1]);
         if (!peak) continue;
         // Not next to a key point already there (nearly equal rows would make the system
         // ill-conditioned): at least half a sample step away along the curve.
         const double gap =
-            0.5 * (trace.back().t - trace.front().t) / static_cast<double>(trace.size() - 1);
+            0.5 * (fine.back().t - fine.front().t) / static_cast<double>(fine.size() - 1);
         bool crowded = false;
         for (const KeyPoint& p : points)
-          crowded = crowded || std::abs(p.curve_parameter - trace[k].t) < gap;
+          crowded = crowded || std::abs(p.curve_parameter - fine[k].t) < gap;
         if (crowded) continue;
-        points.push_back(make_key_point(s, reg, trace[k].point, trace[k].t, trace[k].u, trace[k].v,
-                                        keys.direction));
+        points.push_back(
+            make_key_point(s, reg, fine[k].point, fine[k].t, fine[k].u, fine[k].v, keys.direction));
         ++added;
       }
       if (added > 0) {
@@ -462,14 +717,39 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       }
     }
 
+    // The shape is the curves', not the net's: halve the net over the region and solve again
+    // until one more halving moves the surface by less than net_convergence of its largest
+    // displacement (the energy is a Galerkin discretization of one functional, so the results
+    // converge as the net is refined).
+    if (options.net_convergence > 0) {
+      if (previous) report.net_change = shape_change(grid, *previous, out.surface);
+      const bool settled = previous && report.net_change <= options.net_convergence;
+      if (!settled && refinements < options.max_refinements) {
+        previous = out.surface;
+        refine();
+        accepted_points = points.size();
+        additions = 0;
+        continue;
+      }
+    }
+
     report.m = static_cast<int>(points.size());
+    {
+      const surface::Points3 displacement = out.surface.points - s.points;
+      report.fairness_energy = fairness_energy(s, displacement, order);
+    }
     report.key_points = points;
     report.rank = rank;
     report.degrees_of_freedom = 3 * (static_cast<int>(nf) - rank);
     for (Eigen::Index k = 0; k < nk; ++k)
       if (achieved.row(k).norm() > tol)
         report.conflicting_key_points.push_back(active[static_cast<size_t>(k)]);
-    measure(s, out.surface, reg.factors, reg, trace, options, report);
+    measure(s, out.surface, reg.factors, reg, target, trace, options, report);
+    // The edge of a region without a bound is that of the parent's influenced vertices (the
+    // free area is made from them), not of those of the refined net, a band narrower by the
+    // refinement.
+    if (options.report_curves && region.polygon.empty())
+      measure_boundary(parent, region.factors, region, s, out.surface, report);
     std::ostringstream msg;
     msg << to_string(report.constraint_class) << ", m = " << report.m << " key points (" << nk
         << " influenced";

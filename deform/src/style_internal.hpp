@@ -5,6 +5,7 @@
 #include <clay/surface/projection.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <memory>
 #include <vector>
@@ -86,13 +87,25 @@ KeyPoints find_key_points(const surface::SurfaceProjector& projector, const Infl
 surface::SurfaceProjection project_from(const surface::SurfaceProjector& projector,
                                         const Eigen::Vector3d& x, double u, double v);
 
+/// The parameter box of the region: the bound polygon's, else that of the influenced vertices'
+/// Greville points widened by one Greville interval.
+Eigen::AlignedBox2d region_box(const surface::BSplineSurface& s, const InfluenceRegion& region);
+
 /// Fills the quality figures of `report` that compare `result` with `parent` on the region:
 /// locality, boundary jumps, target deviations (key points and, when `samples` is not empty, the
-/// target samples inside the region). `factors` are those of `parent`'s net.
+/// target samples inside the region), the dense target-curve distance and the mean-curvature
+/// range. `factors` are those of `parent`'s net.
 void measure(const surface::BSplineSurface& parent, const surface::BSplineSurface& result,
              const std::vector<std::uint8_t>& factors, const InfluenceRegion& region,
-             const std::vector<TraceSample>& samples, const StyleOptions& options,
-             StyleReport& report);
+             const surface::BSplineCurve& target, const std::vector<TraceSample>& samples,
+             const StyleOptions& options, StyleReport& report);
+
+/// The boundary figures of `report` (position jump, tangent angle) along the region's edge: the
+/// bound polygon, or without one the midpoints between influenced and other vertices of `net`
+/// (whose vertices `factors` describes), comparing `result` with `parent` there.
+void measure_boundary(const surface::BSplineSurface& net, const std::vector<std::uint8_t>& factors,
+                      const InfluenceRegion& region, const surface::BSplineSurface& parent,
+                      const surface::BSplineSurface& result, StyleReport& report);
 
 /// Paper mode on a traced target (style.cpp).
 StyleResult style_paper(const surface::SurfaceProjector& projector, const InfluenceRegion& region,

@@ -961,6 +961,36 @@ TEST_CASE("validate knows an inline bound curve is open, and the style's refinem
   CHECK(mentions(problems, "deformations.crease[0].bound", "is open: its ends are 30 mm apart"));
 }
 
+TEST_CASE("a style step's continuity and net_convergence: read, and bad values named at their path",
+          "[recipe]") {
+  auto text = [](const std::string& extra) {
+    return recipe_with(R"(, "styled": {"deform": {"surface": "dome", "deformation": "crease"}})",
+                       R"("curves": {
+           "target": {"line": {"from": [35, 50, 30], "to": [65, 50, 30]}}},
+         "deformations": {"crease": [{"kind": "style", "target": "target", "mode": "exact")" +
+                           extra + "}]}");
+  };
+  CHECK(check_recipe(text(R"(, "continuity": "G2", "net_convergence": 0.01)")).empty());
+  const auto bad = check_recipe(text(R"(, "continuity": "G3", "net_convergence": 0.9)"));
+  INFO(dump(bad));
+  CHECK(mentions(bad, "deformations.crease[0].continuity", "G1"));
+  CHECK(mentions(bad, "deformations.crease[0].net_convergence", "0.5"));
+  // The options reach the step: asked for, the convergence figure is measured (without it, NaN).
+  auto net_change = [&](const std::string& extra) {
+    const auto run = run_recipe(parse_recipe(text(extra + R"(, "accept_out_of_tolerance": true)")));
+    double figure = -1;
+    for (const auto& step : run.steps)
+      if (step.path == "surfaces.styled.steps[0]")
+        for (const auto& [name, value] : step.figures)
+          if (name == "net_change") figure = std::get<double>(value);
+    return figure;
+  };
+  CHECK(std::isnan(net_change("")));
+  const double asked = net_change(R"(, "continuity": "G2", "net_convergence": 0.5)");
+  CHECK(asked >= 0);
+  CHECK(std::isfinite(asked));
+}
+
 // ---- limits (issue #18: recipes a fuzz campaign found that crashed or blew up) ----------------
 
 namespace {

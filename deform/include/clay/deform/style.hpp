@@ -38,6 +38,16 @@ enum class StyleMode {
   Exact,  ///< fair least-norm displacements through the key points (beyond the paper)
 };
 
+/// Exact mode: how the styled region joins the untouched surface at the region's edge, in the
+/// limit of a fine net (docs/deform.md, "Fairness energy").
+enum class BoundContinuity {
+  G1,  ///< thin-plate energy (second derivatives): position and tangent plane held
+  G2,  ///< third-derivative energy and one more fixed layer: curvature held too; degree >= 3
+};
+
+/// Name of a continuity ("G1", "G2").
+CLAY_DEFORM_API std::string_view to_string(BoundContinuity c) noexcept;
+
 /// How the target curve relates to the bound (Han et al. §4.3).
 enum class ConstraintClass {
   OverConstrained,   ///< the target lies completely outside the bound: the surface is unchanged
@@ -67,7 +77,13 @@ struct CLAY_DEFORM_API StyleOptions {
   int key_points_per_row = 1;  ///< exact: key points per control-net row crossed, >= 1
   int boundary_rows = 2;       ///< exact: layers of vertices inside the bound edge kept fixed, 0..4
   double tolerance = 1e-9;     ///< exact: key-point deviation accepted, relative to the model size
-  int max_refinements = 4;     ///< exact: rounds of knot insertion allowed, >= 0
+  int max_refinements = 6;     ///< exact: rounds of knot insertion allowed, 0..10
+  BoundContinuity continuity = BoundContinuity::G1;  ///< exact: the energy, and the join at the
+                                                     ///< bound in the limit of a fine net
+  double net_convergence = 0;  ///< exact: the net is halved over the region until one more
+                               ///< halving changes the styled shape by less than this fraction
+                               ///< of its largest displacement (0 = no such rounds; see
+                               ///< docs/deform.md for what convergence costs)
   double curve_tolerance =
       1e-4;                      ///< exact: where the result misses the target curve (at its
                                  ///< samples) by more than this, relative to the model size,
@@ -179,8 +195,19 @@ struct CLAY_DEFORM_API StyleReport {
   int degrees_of_freedom = 0;               ///< 3 (free vertices - rank of the key-point system)
   int rank = 0;                             ///< rank of the key-point system (scalar rows)
   std::vector<int> conflicting_key_points;  ///< key points that cannot all be met (indices)
-  double model_size = 0;                    ///< diagonal of the parent's control box
-  std::string message;                      ///< what happened, in words
+  double net_change = 0;  ///< exact: the largest change of the shape made by the last halving of
+                          ///< the net, relative to the largest displacement of the surface (NaN
+                          ///< when net_convergence = 0 or the net could not be halved)
+  double fairness_energy = 0;  ///< exact: E_k of the displacement (dimensionless; fairness.hpp)
+  // both modes, sampled on a grid over the region (NaN with report_curves off)
+  double target_curve_distance = 0;  ///< largest distance from the target curve (inside the
+                                     ///< region) to the result, sampled 4 times as densely as the
+                                     ///< key-point search, each by a global closest point
+  double mean_curvature_min = 0;     ///< smallest mean curvature of the result inside the region
+                                     ///< (1/mm, sign along the surface normal)
+  double mean_curvature_max = 0;     ///< largest mean curvature of the result inside the region
+  double model_size = 0;             ///< diagonal of the parent's control box
+  std::string message;               ///< what happened, in words
   /// Whether the step did what it was asked (judge_style): Converged; NotConverged when the
   /// target is missed (exact mode: a key point beyond tolerance x size, the target curve beyond
   /// curve_tolerance x size, key points that cannot be met) or a control vertex moves more than
