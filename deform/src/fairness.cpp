@@ -135,8 +135,10 @@ void for_each_point(const BSplineSurface& s, int order, Wanted&& wanted, Visit&&
           const double area = std::max(su.cross(sv).norm(), 1e-3 * a * b);
           for (int i = 0; i <= order; ++i) {
             Term& t = terms[static_cast<size_t>(i)];
-            t.weight = binomial(order, i) / (std::pow(a, 2 * i) * std::pow(b, 2 * (order - i))) *
-                       area * jacobian;
+            double metric = 1;  // a^(2i) b^(2(order - i))
+            for (int r = 0; r < i; ++r) metric *= a * a;
+            for (int r = i; r < order; ++r) metric *= b * b;
+            t.weight = binomial(order, i) / metric * area * jacobian;
             for (int l = 0; l < nb; ++l) t.values[static_cast<size_t>(l)] = r_at(i, order - i, l);
           }
           visit(rows, terms, gi == 0 && gj == 0);
@@ -185,26 +187,6 @@ Eigen::SparseMatrix<double> fairness_matrix(const BSplineSurface& s,
   Eigen::SparseMatrix<double> H(free_count, free_count);
   H.setFromTriplets(triplets.begin(), triplets.end());
   return H;
-}
-
-double fairness_energy(const BSplineSurface& s, const surface::Points3& d, int order) {
-  double energy = 0;
-  const int nb = (s.u.degree + 1) * (s.v.degree + 1);
-  for_each_point(
-      s, order,
-      [&](const std::vector<Eigen::Index>& rows) {
-        return std::any_of(rows.begin(), rows.end(),
-                           [&](Eigen::Index r) { return !d.row(r).isZero(0); });
-      },
-      [&](const std::vector<Eigen::Index>& rows, const std::vector<Term>& terms, bool) {
-        for (const Term& t : terms) {
-          Eigen::RowVector3d g = Eigen::RowVector3d::Zero();
-          for (int l = 0; l < nb; ++l)
-            g += t.values[static_cast<size_t>(l)] * d.row(rows[static_cast<size_t>(l)]);
-          energy += t.weight * g.squaredNorm();
-        }
-      });
-  return energy;
 }
 
 }  // namespace clay::deform::detail

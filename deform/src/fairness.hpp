@@ -21,14 +21,12 @@
 
 namespace clay::deform::detail {
 
-/// The energy's matrix H over the free vertices, E_k = sum over x, y, z of d^T H d:
+/// The energy's matrix H over the free vertices, E_k = sum over x, y, z of d^T H d (style_exact
+/// reports E_k of its result this way):
 /// free_index[r] is the unknown of vertex r or -1 for a fixed one (d = 0). Needs degree >= order
 /// in u and v (else the order-k derivatives vanish inside the spans and H is singular).
 Eigen::SparseMatrix<double> fairness_matrix(const surface::BSplineSurface& s,
                                             const std::vector<Eigen::Index>& free_index,
                                             Eigen::Index free_count, int order);
-
-/// E_k of the displacement net `d` (rows as s.points) on the net of `s`.
-double fairness_energy(const surface::BSplineSurface& s, const surface::Points3& d, int order);
 
 }  // namespace clay::deform::detail

@@ -52,6 +52,8 @@ constexpr double range_space_stationarity = 1e-8;
 // Dependent key points on nets of more free vertices than this are solved through the net's
 // factorization (the dense null space would take nf^2 doubles: 20 GB at 50,000).
 constexpr Eigen::Index dependent_dense_limit = 2048;
+// The ridge added to the scaled energy's diagonal.
+constexpr double energy_ridge = 1e-12;
 // Nets with up to this many free vertices keep H^-1 (dense, 2 MB at the limit).
 constexpr Eigen::Index dense_inverse_limit = 512;
 
@@ -174,7 +176,8 @@ struct NetCache {
   std::vector<double> knots_u, knots_v;  // the net it was built for
   std::vector<Eigen::Index> free_index;  // per vertex: its unknown, or -1 when fixed
   std::vector<Eigen::Index> free_rows;   // per unknown: its vertex
-  Eigen::SparseMatrix<double> H;         // thin-plate energy L^T L + ridge, free vertices
+  Eigen::SparseMatrix<double> H;  // the fairness energy over the free vertices / scale + ridge
+  double scale = 1;               // E_k(d) = scale * sum over x, y, z of d^T (H - ridge) d
   // H = P^T L D L^T P, factorized once per net: every drag on the net reuses it (only the
   // key-point rows B change), so a solve costs nk triangular solves instead of a KKT factorization.
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> energy;
@@ -219,8 +222,9 @@ std::shared_ptr<const NetCache> build_cache(const BSplineSurface& s,
   if (!(max_diag > 0) || !std::isfinite(max_diag))
     throw Error(ErrorCategory::Internal, "style deformation: the fairness energy vanishes");
   H /= max_diag;
+  cache->scale = max_diag;
   // A tiny ridge keeps H definite where the free vertices reach the border of the net.
-  for (Eigen::Index c = 0; c < nf; ++c) H.coeffRef(c, c) += 1e-12;
+  for (Eigen::Index c = 0; c < nf; ++c) H.coeffRef(c, c) += energy_ridge;
   cache->H = std::move(H);
   cache->energy.compute(cache->H);
   cache->factorized = cache->energy.info() == Eigen::Success;
@@ -510,7 +514,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   std::vector<TraceSample> fine;  // the trace 4 times as dense, made when first needed
   // Net convergence: the result on the previous (coarser) net, compared on a grid over the region.
   std::optional<BSplineSurface> previous;
-  const ShapeGrid grid = shape_grid(parent, region, in_region);
+  const ShapeGrid grid =
+      options.net_convergence > 0 ? shape_grid(parent, region, in_region) : ShapeGrid{};
   report.net_change = std::numeric_limits<double>::quiet_NaN();
   double amplification = 0;
 
@@ -734,10 +739,11 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     }
 
     report.m = static_cast<int>(points.size());
-    {
-      const surface::Points3 displacement = out.surface.points - s.points;
-      report.fairness_energy = fairness_energy(s, displacement, order);
-    }
+    // E_k(d) from the net's own matrix (fixed vertices have d = 0), without the ridge.
+    report.fairness_energy =
+        nf > 0
+            ? net->scale * ((d.transpose() * (net->H * d)).trace() - energy_ridge * d.squaredNorm())
+            : 0.0;
     report.key_points = points;
     report.rank = rank;
     report.degrees_of_freedom = 3 * (static_cast<int>(nf) - rank);
