@@ -557,3 +557,23 @@ TEST_CASE("the view server and snapshot name the fix for what is missing", "[vie
   CHECK(error_of([&] { snapshot(f.run, f.run / "x.png", s); }).first ==
         ErrorCategory::InvalidArgument);
 }
+
+TEST_CASE("the view leaves out a net too dense to draw: the sail's exact composition", "[view]") {
+  // The sail's lattice step composes exactly at degree 9 x 9 (104,610 control points, more than
+  // the 20,000 a view draws); its editable copy and the style step's net are drawn.
+  RunResult result = run_recipe(load_recipe(fs::path(CLAY_EXAMPLES_DIR) / "recipes" / "sail.json"));
+  const fs::path out = output_dir("view_sail");
+  write_outputs(result, out);
+  const auto j = nlohmann::json::parse(read_text(out / "view" / "manifest.json"));
+  const auto& sail = j["surfaces"][0];
+  REQUIRE(sail["name"] == "sail");
+  REQUIRE(sail["stages"].size() == 2);
+  const auto& style = sail["stages"][0];
+  const auto& lattice = sail["stages"][1];
+  CHECK(lattice["net_after"].is_null());
+  CHECK(lattice["net_before"]["points"].size() ==
+        static_cast<std::size_t>(style["net_after"]["rows"].get<int>() *
+                                 style["net_after"]["cols"].get<int>()));
+  CHECK(sail["net"]["points"].size() < 20000);
+  CHECK(fs::file_size(out / "view" / "manifest.json") < 2'000'000);
+}

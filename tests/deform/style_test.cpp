@@ -752,3 +752,25 @@ TEST_CASE("exact mode with G2 at the bound: third-derivative energy, one more fi
   CHECK(what.find("elevate") != std::string::npos);
   CHECK(what.find("G2") != std::string::npos);
 }
+
+TEST_CASE("exact mode inserts only simple knots: the styled area stays curvature-continuous",
+          "[style]") {
+  // Inside the bound no knot of multiplicity above degree - 2 is introduced (a cubic stays C2 in
+  // its parametrization), with and without net convergence.
+  const BSplineSurface s = hood(16, 16);
+  StyleOptions options;
+  options.mode = StyleMode::Exact;
+  for (double convergence : {0.0, 0.02}) {
+    options.net_convergence = convergence;
+    const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
+    REQUIRE(r.report.knots_inserted > 0);
+    for (const auto* pair : {&r.surface.u, &r.surface.v}) {
+      const auto& parent = pair == &r.surface.u ? s.u : s.v;
+      for (double t : clay::surface::breakpoints(*pair)) {
+        if (t <= pair->knots.front() || t >= pair->knots.back()) continue;
+        if (clay::surface::multiplicity(parent, t) > 0) continue;  // the parent's own
+        CHECK(clay::surface::multiplicity(*pair, t) <= pair->degree - 2);
+      }
+    }
+  }
+}
