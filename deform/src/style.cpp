@@ -770,6 +770,7 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
   KeyPoints keys = find_key_points(projector, region, target, trace, 1);
   StyleResult out{parent, parent, {}};
   StyleReport& report = out.report;
+  report.fairness_energy = std::numeric_limits<double>::quiet_NaN();  // exact mode only
   if (begin_report(keys, options, StyleMode::Paper, report)) {
     detail::measure(parent, out.surface, region.factors, region, target, trace, options, report);
     return out;

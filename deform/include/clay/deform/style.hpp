@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -195,10 +196,12 @@ struct CLAY_DEFORM_API StyleReport {
   int degrees_of_freedom = 0;               ///< 3 (free vertices - rank of the key-point system)
   int rank = 0;                             ///< rank of the key-point system (scalar rows)
   std::vector<int> conflicting_key_points;  ///< key points that cannot all be met (indices)
-  double net_change = 0;  ///< exact: the largest change of the shape made by the last halving of
-                          ///< the net, relative to the largest displacement of the surface (NaN
-                          ///< when net_convergence = 0 or the net could not be halved)
-  double fairness_energy = 0;  ///< exact: E_k of the displacement (dimensionless; fairness.hpp)
+  /// exact: the largest change of the shape made by the last halving of the net, relative to the
+  /// largest displacement of the surface; NaN when not measured (net_convergence = 0, the net
+  /// could not be halved, or paper mode)
+  double net_change = std::numeric_limits<double>::quiet_NaN();
+  double fairness_energy =
+      0;  ///< exact: E_k of the displacement (dimensionless); NaN in paper mode
   // both modes, sampled on a grid over the region (NaN with report_curves off)
   double target_curve_distance = 0;  ///< largest distance from the target curve (inside the
                                      ///< region) to the result, sampled 4 times as densely as the
