@@ -295,12 +295,13 @@ int validate(const fs::path& file) {
 
 /// `clayform render FILE --png OUT.png`: a picture of the model of a STEP or IGES file, its faces
 /// trimmed (holes are holes), coloured as the file colours them.
-int render_picture(const fs::path& file, const fs::path& png,
-                   const clay::render::RenderOptions& options,
-                   const clay::brep::MeshOptions& mesh_options) {
+int render_picture(const fs::path& file, const fs::path& png, clay::render::RenderOptions options,
+                   bool eye_given, const clay::brep::MeshOptions& mesh_options) {
   const clay::brep::ImportedModel read = read_model_file(file, "render");
   const auto start = std::chrono::steady_clock::now();
   const clay::brep::ModelMesh mesh = clay::brep::tessellate(read.model, mesh_options);
+  // Without --eye, an open panel is pictured from its front, not from behind.
+  if (!eye_given) options.eye_direction = clay::render::facing_eye(mesh, options.eye_direction);
   std::vector<BSplineSurface> nets;
   if (options.control_net)
     for (const auto& face : clay::brep::flattened(read.model).faces) nets.push_back(face.surface);
@@ -370,8 +371,10 @@ int main(int argc, char** argv) {
   render_cmd->add_option("--height", render_options.height, "picture height in pixels [16, 4096]")
       ->capture_default_str();
   render_cmd
-      ->add_option("--eye", eye,
-                   "direction from the model towards the eye, X Y Z (default -1 -1.2 0.9)")
+      ->add_option(
+          "--eye", eye,
+          "direction from the model towards the eye, X Y Z (default -1 -1.2 0.9, turned to "
+          "face an open panel's front)")
       ->expected(3);
   clay::brep::MeshOptions mesh_options;
   render_cmd
@@ -420,7 +423,7 @@ int main(int argc, char** argv) {
     if (*info_cmd) return info(file);
     if (*render_cmd) {
       if (!eye.empty()) render_options.eye_direction = {eye[0], eye[1], eye[2]};
-      return render_picture(file, png_file, render_options, mesh_options);
+      return render_picture(file, png_file, render_options, !eye.empty(), mesh_options);
     }
     if (*view_cmd) {
       clay::recipe::ServeOptions o;

@@ -329,6 +329,35 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
   return draw(batches, surfaces, options);
 }
 
+Vector3d facing_eye(const brep::ModelMesh& mesh, const Vector3d& eye) {
+  if (!internal::all_finite(eye) || !(eye.norm() > 0))
+    throw Error(ErrorCategory::InvalidArgument,
+                "facing_eye: the eye direction must be finite and non-zero");
+  Vector3d e = eye.normalized();
+  Vector3d sum = Vector3d::Zero();  // twice the area-weighted mean normal
+  double area = 0;                  // twice the area
+  for (const auto& t : mesh.triangles) {
+    const auto at = [&](int k) {
+      return mesh.positions[static_cast<size_t>(t[static_cast<size_t>(k)])];
+    };
+    const Vector3d n = (at(1) - at(0)).cross(at(2) - at(0));
+    sum += n;
+    area += n.norm();
+  }
+  if (!(area > 0) || sum.norm() < 0.2 * area) return e;  // closed: every side is a front
+  const Vector3d n = sum.normalized();
+  if (e.dot(n) < 0) e -= 2 * e.dot(n) * n;  // the back faces the eye: mirror it to the front
+  // At least 25 degrees above the sheet (the default eye is 30 degrees above the xy plane).
+  const double min_sine = std::sin(25.0 * 3.14159265358979323846 / 180.0);
+  if (e.dot(n) < min_sine) {
+    const Vector3d along = e - e.dot(n) * n;
+    e = along.norm() > 0
+            ? Vector3d(std::sqrt(1 - min_sine * min_sine) * along.normalized() + min_sine * n)
+            : n;
+  }
+  return e.normalized();
+}
+
 Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options,
                   const std::vector<surface::BSplineSurface>& control_nets) {
   options.validate();

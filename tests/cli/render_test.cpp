@@ -323,3 +323,38 @@ TEST_CASE("render: bad options, no surfaces, bad images and unwritable files are
   CHECK(c9 == ErrorCategory::InvalidArgument);
   CHECK_THAT(m9, Contains("16 x 16") && Contains("768 bytes") && Contains("it has 10"));
 }
+
+TEST_CASE("facing_eye: an open panel is pictured from its front, a closed model as asked",
+          "[render]") {
+  const Eigen::Vector3d eye(-1, -1.2, 0.9);
+  // A square panel in z = 0 whose outward normal points down (-z): the default eye sees its back.
+  clay::brep::ModelMesh panel;
+  for (const auto& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 1, 0),
+                        Eigen::Vector3d(1, 1, 0), Eigen::Vector3d(1, 0, 0)}) {
+    panel.positions.push_back(p);
+    panel.normals.emplace_back(0, 0, -1);
+  }
+  panel.triangles = {{0, 1, 2}, {0, 2, 3}};  // counter-clockwise seen from -z
+  const Eigen::Vector3d front = facing_eye(panel, eye);
+  CHECK_THAT(front.norm(), Catch::Matchers::WithinAbs(1.0, 1e-15));
+  CHECK(front.z() < 0);  // from below, where the normal points
+  // The mirror image of the default: same x and y, z flipped.
+  CHECK_THAT(front.x(), Catch::Matchers::WithinAbs(eye.normalized().x(), 1e-15));
+  CHECK_THAT(front.z(), Catch::Matchers::WithinAbs(-eye.normalized().z(), 1e-15));
+  // Seen nearly edge on, the eye is raised to 25 degrees above the panel.
+  const Eigen::Vector3d low = facing_eye(panel, Eigen::Vector3d(1, 0, 0.01));
+  CHECK_THAT(-low.z(),
+             Catch::Matchers::WithinAbs(std::sin(25 * 3.14159265358979323846 / 180), 1e-12));
+  // A closed tetrahedron (outward normals): every side is a front, the eye stays.
+  clay::brep::ModelMesh solid;
+  for (const auto& p : {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0),
+                        Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 0, 1)}) {
+    solid.positions.push_back(p);
+    solid.normals.push_back(p);
+  }
+  solid.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  CHECK((facing_eye(solid, eye) - eye.normalized()).norm() <= 1e-15);
+  auto [category, message] = error_of([&] { facing_eye(panel, Eigen::Vector3d::Zero()); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("non-zero"));
+}

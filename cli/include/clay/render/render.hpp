@@ -88,6 +88,14 @@ CLAY_RENDER_API Image render(const std::vector<surface::BSplineSurface>& surface
 CLAY_RENDER_API Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options = {},
                                   const std::vector<surface::BSplineSurface>& control_nets = {});
 
+/// The direction to picture `mesh` from so that an open sheet shows its front: `eye` itself for a
+/// closed or nearly closed model (the area-weighted sum of its triangles' outward normals below a
+/// fifth of its area), else `eye` mirrored in the sheet's mean plane when it looks at the back
+/// (a stylist's panel exported with its normal away from the default view), and raised to at
+/// least 25° above that plane so the sheet is not seen edge on. Unit length. Throws
+/// clay::Error(InvalidArgument) for a zero or non-finite `eye`.
+CLAY_RENDER_API Eigen::Vector3d facing_eye(const brep::ModelMesh& mesh, const Eigen::Vector3d& eye);
+
 /// Writes `image` as an 8-bit RGB PNG (libpng), atomically: into a temporary file next to `file`,
 /// then renamed over it. Throws clay::Error: InvalidArgument when the image's size and pixel count
 /// disagree, Io naming the file when it cannot be written.
