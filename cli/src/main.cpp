@@ -409,6 +409,16 @@ int main(int argc, char** argv) {
   snapshot_cmd
       ->add_option("--mode", snapshot_options.mode, "shaded, zebra, gaussian, mean or deviation")
       ->capture_default_str();
+  snapshot_cmd
+      ->add_option("--eye", snapshot_options.eye,
+                   "direction from the model towards the eye, X Y Z (default: the viewer's)")
+      ->expected(3);
+  snapshot_cmd->add_option("--hide", snapshot_options.hide,
+                           "a surface not to show, by name (repeat for more)");
+  snapshot_cmd
+      ->add_option("--stage", snapshot_options.stage,
+                   "after, or before: the surfaces before their first deformation step")
+      ->capture_default_str();
   app.footer(
       "Exit codes: 0 success, 1 usage, 2 invalid argument, 3 invalid geometry or out of domain, "
       "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 8 tolerance not met, "

@@ -7,11 +7,15 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -187,6 +191,52 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
                     std::to_string(options.height) + " is out of range; give 16..8192 pixels");
   if (png.empty())
     throw Error(ErrorCategory::InvalidArgument, "snapshot: give the picture to write (--png FILE)");
+  if (!options.eye.empty() &&
+      (options.eye.size() != 3 ||
+       !std::all_of(options.eye.begin(), options.eye.end(),
+                    [](double x) { return std::isfinite(x); }) ||
+       std::all_of(options.eye.begin(), options.eye.end(), [](double x) { return x == 0; })))
+    throw Error(ErrorCategory::InvalidArgument,
+                "snapshot: the eye direction must be 3 finite numbers, not all 0 (--eye X Y Z)");
+  if (options.stage != "after" && options.stage != "before")
+    throw Error(ErrorCategory::InvalidArgument,
+                "snapshot: unknown stage '" + options.stage + "'; give after or before");
+  // The surfaces to hide must be the run's: the manifest (written by write_outputs, compact, in
+  // insertion order) opens each surface with {"name":"NAME","export":" (a curve's name is
+  // followed by its points instead). Recipe names are identifiers, safe in a URL.
+  std::string query = "?mode=" + options.mode + (options.bare ? "&ui=0" : "");
+  if (!options.hide.empty()) {
+    std::ifstream in(run_dir / "view" / "manifest.json", std::ios::binary);
+    const std::string manifest((std::istreambuf_iterator<char>(in)), {});
+    const std::string open = "{\"name\":\"", close = "\",\"export\":\"";
+    std::string names, unknown;
+    for (std::size_t at = manifest.find(open); at != std::string::npos;
+         at = manifest.find(open, at + 1)) {
+      const std::size_t from = at + open.size(), to = manifest.find('"', from);
+      if (manifest.compare(to, close.size(), close) == 0)
+        names += (names.empty() ? "" : ", ") + manifest.substr(from, to - from);
+    }
+    for (const std::string& h : options.hide) {
+      const bool plain = !h.empty() && std::all_of(h.begin(), h.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
+      });
+      if (!plain || manifest.find(open + h + close) == std::string::npos)
+        unknown += (unknown.empty() ? "" : ", ") + ("'" + h + "'");
+    }
+    if (in && !unknown.empty())  // (no manifest: the view server below says what is missing)
+      throw Error(ErrorCategory::InvalidArgument, "snapshot: no surface " + unknown + " in " +
+                                                      run_dir.string() +
+                                                      " to hide; its surfaces are " + names);
+    query += "&hide=";
+    for (std::size_t k = 0; k < options.hide.size(); ++k) query += (k ? "," : "") + options.hide[k];
+  }
+  if (!options.eye.empty()) {
+    char eye[96];
+    std::snprintf(eye, sizeof eye, "&eye=%.9g,%.9g,%.9g", options.eye[0], options.eye[1],
+                  options.eye[2]);
+    query += eye;
+  }
+  if (options.stage == "before") query += "&stage=before";
   if (::access(options.chromium.c_str(), X_OK) != 0)
     throw Error(ErrorCategory::Io,
                 "snapshot needs chromium at \"" + options.chromium.string() +
@@ -195,6 +245,7 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
   so.port = 0;
   so.viewer = options.viewer;
   ViewServer server(run_dir, so);  // checks the view data and the front end first
+
   const fs::path out = fs::absolute(png).lexically_normal();
   std::error_code ec;
   fs::remove(out, ec);  // so that a picture found afterwards is this run's
@@ -217,7 +268,7 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
       "--window-size=" + std::to_string(options.width) + "," + std::to_string(options.height),
       "--virtual-time-budget=10000",
       "--screenshot=" + out.string(),
-      server.url() + "?mode=" + options.mode + (options.bare ? "&ui=0" : "")};
+      server.url() + query};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

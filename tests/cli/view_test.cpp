@@ -556,6 +556,28 @@ TEST_CASE("the view server and snapshot name the fix for what is missing", "[vie
   s.width = 4;
   CHECK(error_of([&] { snapshot(f.run, f.run / "x.png", s); }).first ==
         ErrorCategory::InvalidArgument);
+  s.width = 640;
+  // The camera, the stage and the surfaces to hide are checked before chromium is looked for.
+  s.eye = {0, 0, 0};
+  std::tie(category, message) = error_of([&] { snapshot(f.run, f.run / "x.png", s); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("--eye X Y Z"));
+  s.eye = {0, 0, 1};
+  s.stage = "middle";
+  std::tie(category, message) = error_of([&] { snapshot(f.run, f.run / "x.png", s); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("after or before"));
+  s.stage = "before";
+  write_text(
+      f.run / "view" / "manifest.json",
+      R"({"format":"clayform.view","version":1,"surfaces":[{"name":"hood","export":"a",)"
+      R"("stages":[{"curves":[{"name":"bound","points":[]}]}]},{"name":"lid","export":"b"}]})");
+  s.hide = {"bound", "lid"};  // "bound" is a curve, not a surface
+  std::tie(category, message) = error_of([&] { snapshot(f.run, f.run / "x.png", s); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("no surface 'bound'") && Contains("its surfaces are hood, lid"));
+  s.hide = {"lid"};  // known: on to chromium, which is missing here
+  CHECK(error_of([&] { snapshot(f.run, f.run / "x.png", s); }).first == ErrorCategory::Io);
 }
 
 TEST_CASE("the view leaves out a net too dense to draw: the sail's exact composition", "[view]") {

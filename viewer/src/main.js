@@ -113,13 +113,21 @@ function resize() {
 }
 new ResizeObserver(resize).observe(document.getElementById('stage'));
 
+// ?eye=x,y,z: the direction from the model towards the eye (clayform snapshot --eye); ?hide=a,b:
+// surfaces not shown at start (--hide).
+const eyeParam = (() => {
+  const v = (params.get('eye') || '').split(',').map(Number);
+  return v.length === 3 && v.every(Number.isFinite) && v.some((x) => x !== 0) ? new THREE.Vector3(...v).normalize() : null;
+})();
+const hiddenAtStart = new Set((params.get('hide') || '').split(',').filter(Boolean));
+
 function fitCamera(box) {
   const center = box.getCenter(new THREE.Vector3());
   const radius = Math.max(1e-6, 0.5 * box.getSize(new THREE.Vector3()).length());
   const fov = THREE.MathUtils.degToRad(camera.fov);
   const fit = Math.min(fov, 2 * Math.atan(Math.tan(fov / 2) * camera.aspect));
   const distance = (1.08 * radius) / Math.sin(fit / 2);
-  const dir = new THREE.Vector3(0.9, -1.5, 1.1).normalize();
+  const dir = eyeParam || new THREE.Vector3(0.9, -1.5, 1.1).normalize();
   camera.position.copy(center).addScaledVector(dir, distance);
   camera.near = Math.max(distance / 1000, distance - 4 * radius);
   camera.far = distance + 4 * radius;
@@ -400,6 +408,11 @@ async function start() {
     const panel = surfacePanel(entry, index, { onToggle: toggleStage, onFocus: focusSurface, onVisible: showSurface });
     panels.append(panel.root);
     surfaces.push({ entry, state, group, mesh, net, curves, panel, data: null });
+    if (hiddenAtStart.has(entry.name)) {
+      group.visible = false;
+      const box = panel.root.querySelector('.surface-visible');
+      if (box) box.checked = false;
+    }
   });
   body.dataset.surfaces = String(surfaces.length);
   const netPoints = surfaces.reduce((n, s) => n + ((netOf(s) && netOf(s).points) || []).length, 0);
@@ -411,7 +424,10 @@ async function start() {
   loadReport();
   await applyStates();
   const b = manifest.box;
-  if (b && b.min && b.max) sceneBox = new THREE.Box3(new THREE.Vector3(...b.min), new THREE.Vector3(...b.max));
+  if (hiddenAtStart.size && surfaces.some((s) => s.group.visible)) {
+    sceneBox = new THREE.Box3();  // fitted to what is shown
+    surfaces.forEach((s) => s.group.visible && s.mesh.geometry.boundingBox && sceneBox.union(s.mesh.geometry.boundingBox));
+  } else if (b && b.min && b.max) sceneBox = new THREE.Box3(new THREE.Vector3(...b.min), new THREE.Vector3(...b.max));
   else {
     sceneBox = new THREE.Box3();
     surfaces.forEach((s) => sceneBox.union(s.mesh.geometry.boundingBox));

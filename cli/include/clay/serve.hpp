@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace clay::recipe {
 
@@ -45,20 +46,26 @@ class ViewServer {
 
 /// Settings of snapshot.
 struct SnapshotOptions {
-  int width = 1280;              ///< picture width in pixels [16, 8192]
-  int height = 800;              ///< picture height in pixels [16, 8192]
-  std::string mode = "shaded";   ///< shaded, zebra, gaussian, mean or deviation
-  bool bare = false;             ///< the picture alone: no toolbar, no panels (?ui=0)
-  std::filesystem::path viewer;  ///< the built front end; empty: viewer_dir()
+  int width = 1280;               ///< picture width in pixels [16, 8192]
+  int height = 800;               ///< picture height in pixels [16, 8192]
+  std::string mode = "shaded";    ///< shaded, zebra, gaussian, mean or deviation
+  bool bare = false;              ///< the picture alone: no toolbar, no panels (?ui=0)
+  std::vector<double> eye;        ///< direction from the model towards the eye, 3 numbers, finite
+                                  ///< and not all 0; empty: the viewer's default view (?eye=x,y,z)
+  std::vector<std::string> hide;  ///< surfaces (by name) not to show (?hide=a,b)
+  std::string stage = "after";    ///< after, or before: the surfaces before their first
+                                  ///< deformation step (?stage=before)
+  std::filesystem::path viewer;   ///< the built front end; empty: viewer_dir()
   std::filesystem::path chromium = "/usr/bin/chromium";  ///< Debian's chromium
   int timeout_seconds = 60;                              ///< chromium is killed after this
 };
 
 /// A PNG picture of the viewer's page on the run folder: serves it on a free port of 127.0.0.1,
 /// runs chromium headless (--screenshot, a temporary profile removed afterwards) on
-/// `/?mode=MODE`, waits for it (killed after the timeout), checks `png` was written.
-/// Throws clay::Error: InvalidArgument for a bad mode or size, Io when chromium is missing (naming
-/// the Debian package), fails, times out or writes no picture.
+/// `/?mode=MODE` (and eye, hide, stage when given), waits for it (killed after the timeout),
+/// checks `png` was written. Throws clay::Error: InvalidArgument for a bad mode, size, eye or
+/// stage, or a hidden surface the run does not have (naming the ones it has); Io when chromium is
+/// missing (naming the Debian package), fails, times out or writes no picture.
 void snapshot(const std::filesystem::path& run_dir, const std::filesystem::path& png,
               const SnapshotOptions& options = {});
 
