@@ -18,12 +18,20 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
       if (auto s = inline_surface(v, p)) def.build = std::move(*s);
     } else if (def.kind == "fill") {
       FillDef f;
-      if (c_.object(v, p, {"curves", "style", "gap_tolerance"},
-                    "a fill {curves, style, gap_tolerance}")) {
+      if (c_.object(v, p, {"curves", "style", "join", "gap_tolerance"},
+                    "a fill {curves, style, join, gap_tolerance}")) {
         f.curves = curve_refs(v, p, "curves", 2, 4);
         if (const Json* s = c_.member(v, p, "style", false, ""))
           if (const auto k = c_.choice(*s, key_path(p, "style"), {"stretch", "coons", "curved"}))
             f.options.style = static_cast<surface::FillStyle>(*k);
+        if (const Json* s = c_.member(v, p, "join", false, ""))
+          if (const auto k = c_.choice(*s, key_path(p, "join"), {"exact", "snap"}))
+            f.snap = *k == 1;
+        // Snapping moves the strokes' ends, so how far is stated, not defaulted.
+        if (f.snap && !v.contains("gap_tolerance"))
+          c_.add(key_path(p, "join"),
+                 "\"join\": \"snap\" needs \"gap_tolerance\": the largest gap between curve ends "
+                 "to close, in mm (e.g. \"gap_tolerance\": 2)");
         f.options.gap_tolerance =
             c_.number_or(v, p, "gap_tolerance", f.options.gap_tolerance, positive);
         c_.attempt(p, [&] { f.options.validate(); });

@@ -86,6 +86,7 @@ SketchDef rebuild_sketch(
 struct FillDef {
   std::vector<std::string> curves;
   surface::FillOptions options;
+  bool snap = false;  ///< "join": "snap": ends within gap_tolerance (stated) are moved together
 };
 struct SkinDef {
   std::vector<std::string> sections;

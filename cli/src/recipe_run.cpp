@@ -386,10 +386,29 @@ class Runner {
               build_figures(surface::describe(b, "inline B-spline surface"), rep);
               return b;
             } else if constexpr (std::is_same_v<T, FillDef>) {
-              auto built = by_names(b.curves, "curve", [&] {
-                return surface::fill(curves_named(b.curves), b.options);
-              });
+              const std::vector<BSplineCurve> boundary = curves_named(b.curves);
+              auto built =
+                  by_names(b.curves, "curve", [&] { return surface::fill(boundary, b.options); });
               build_figures(built.report, rep);
+              if (b.snap) {
+                // How far the ends moved: each curve end to the nearest end of another curve,
+                // halved (the fill joins each corner at the midpoint of its two ends).
+                double snapped = 0;
+                for (std::size_t k = 0; k < boundary.size(); ++k)
+                  for (const double tk :
+                       {boundary[k].basis.domain().first, boundary[k].basis.domain().second}) {
+                    double nearest = std::numeric_limits<double>::infinity();
+                    for (std::size_t m = 0; m < boundary.size(); ++m)
+                      if (m != k)
+                        for (const double tm :
+                             {boundary[m].basis.domain().first, boundary[m].basis.domain().second})
+                          nearest = std::min(nearest, (surface::evaluate(boundary[k], tk) -
+                                                       surface::evaluate(boundary[m], tm))
+                                                          .norm());
+                    if (std::isfinite(nearest)) snapped = std::max(snapped, nearest / 2);
+                  }
+                rep.figures.emplace_back("snapped_mm", snapped);
+              }
               return std::move(built.surface);
             } else if constexpr (std::is_same_v<T, SkinDef>) {
               auto built = by_names(b.sections, "section", [&] {

@@ -991,6 +991,48 @@ TEST_CASE("a style step's continuity and net_convergence: read, and bad values n
   CHECK(std::isfinite(asked));
 }
 
+TEST_CASE("a fill with \"join\": \"snap\" closes stated gaps between curve ends at their midpoints",
+          "[recipe]") {
+  // Three strokes of a triangle whose ends miss each other by 1.5 mm at every corner: the corner
+  // (0,0,0)/(1.5,0,0), (100,0,0)/(100,1.5,0) and (100,100,0)/(98.5,100,0).
+  auto text = [](const std::string& join) {
+    return std::string(R"({"format": "clayform.recipe", "version": 1, "name": "snap",
+      "curves": {"a": {"line": {"from": [1.5, 0, 0], "to": [100, 0, 0]}},
+                 "b": {"line": {"from": [100, 1.5, 0], "to": [100, 100, 0]}},
+                 "c": {"line": {"from": [98.5, 100, 0], "to": [0, 0, 0]}}},
+      "surfaces": {"patch": {"fill": {"curves": ["a", "b", "c"])") +
+           join + "}}}}";
+  };
+  // Without snapping the gaps are refused at run time, naming them.
+  CHECK_THROWS_WITH(run_recipe(parse_recipe(text(""))), Contains("apart"));
+  // Snapping must state how far: a problem at the join's path otherwise.
+  const auto problems = check_recipe(text(R"(, "join": "snap")"));
+  INFO(dump(problems));
+  CHECK(mentions(problems, "surfaces.patch.fill.join", "gap_tolerance"));
+  CHECK(mentions(check_recipe(text(R"(, "join": "glue", "gap_tolerance": 2)")),
+                 "surfaces.patch.fill.join", "snap"));
+  // Snapped within 2 mm: every end moved by half its gap, 0.75 mm, and the patch's corners are
+  // the midpoints of the ends that met.
+  const auto run = run_recipe(parse_recipe(text(R"(, "join": "snap", "gap_tolerance": 2)")));
+  double snapped = -1;
+  for (const auto& step : run.steps)
+    if (step.path == "surfaces.patch")
+      for (const auto& [name, value] : step.figures)
+        if (name == "snapped_mm") snapped = std::get<double>(value);
+  CHECK_THAT(snapped, Catch::Matchers::WithinAbs(0.75, 1e-12));
+  const surface::BSplineSurface& patch = run.surfaces.at(0).second;
+  std::vector<Eigen::Vector3d> corners;
+  for (double u : {0.0, 1.0})
+    for (double v : {0.0, 1.0}) corners.push_back(surface::evaluate(patch, u, v));
+  for (const Eigen::Vector3d& want : {Eigen::Vector3d(0.75, 0, 0), Eigen::Vector3d(100, 0.75, 0),
+                                      Eigen::Vector3d(99.25, 100, 0)}) {
+    double nearest = 1e300;
+    for (const auto& c : corners) nearest = std::min(nearest, (c - want).norm());
+    INFO(want.transpose());
+    CHECK(nearest <= 1e-9);
+  }
+}
+
 // ---- limits (issue #18: recipes a fuzz campaign found that crashed or blew up) ----------------
 
 namespace {
