@@ -8,11 +8,14 @@
 ///   normal distances (eqs. 3, 8), the force shared by area weights and distributed along the
 ///   control-net curve (eqs. 4-7) with the symmetric smoothing of eqs. 12-13, relaxation intervals
 ///   (eqs. 10-11) and the approximation scale λ (eq. 9). It approximates the target.
-/// - `StyleMode::Exact` goes beyond the paper: the displacements of the influenced vertices are
-///   solved (fairness energy on the control net, the key points as equality constraints) so the
-///   surface passes through every key point, vertices outside the bound stay fixed and the
-///   `boundary_rows` layers of vertices inside the bound edge stay fixed too, so the deformed
-///   region joins the untouched surface with (for cubics) C^2 continuity.
+/// - `StyleMode::Exact` goes beyond the paper: the displacement field is the least fairness
+///   energy *of the surface* (thin-plate for G1, third derivatives for G2; not of its control net)
+///   that passes through the key points, which are those of eq. 8 on a region net (the parent
+///   with at least 32 spans over the region) plus the target's ends, and more where the target
+///   curve is still missed: the whole target curve is met within curve_tolerance. Vertices outside
+///   the bound, a band of `boundary_rows` region-net layers inside it and the surface's own edges
+///   stay fixed, so the deformed region joins the untouched surface with (for cubics) C^2
+///   continuity. Optionally the net is refined until the shape converges (net_convergence).
 ///
 /// Both return a surface with the same degrees (and, in paper mode, the same knots): control
 /// vertices move, nothing is refitted. Exact mode may insert knots (exactly, reported) where the
@@ -76,7 +79,8 @@ struct CLAY_DEFORM_API StyleOptions {
                            ///< 0 = 16 per knot span of the target, at least 32; else >= 8
   int bound_samples = 256;     ///< samples of the bound curve (its parameter-space polygon), >= 8
   int key_points_per_row = 1;  ///< exact: key points per control-net row crossed, >= 1
-  int boundary_rows = 2;       ///< exact: layers of vertices inside the bound edge kept fixed, 0..4
+  int boundary_rows = 2;       ///< exact: layers of region-net vertices inside the bound edge kept
+                               ///< fixed, 0..4 (G2: one more)
   double tolerance = 1e-9;     ///< exact: key-point deviation accepted, relative to the model size
   int max_refinements = 6;     ///< exact: rounds of knot insertion allowed, 0..10
   BoundContinuity continuity = BoundContinuity::G1;  ///< exact: the energy, and the join at the
