@@ -128,7 +128,9 @@ std::vector<double> halving_knots(const surface::BSplineBasis& basis, double lo,
 // domain itself grew by a layer's width per halving and the shape changed by ~1/2 of its last
 // change each time (the hood: 18 %, 7 %, 3 %).
 struct FreeArea {
-  BSplineSurface net;          // the region net
+  // The region net, prepared for projection once (validated, kept across drags): the key
+  // points are found on it at every update.
+  std::shared_ptr<const surface::SurfaceProjector> net;
   InfluenceRegion region;      // the region on it (factors of its vertices)
   std::vector<double> bu, bv;  // breakpoints of the region net
   std::vector<int> sum;        // prefix sums of the cells in the area, (cu + 1) x (cv + 1)
@@ -322,13 +324,6 @@ namespace {
 constexpr int region_spans = 32;
 constexpr int max_region_halvings = 5;
 
-int spans_over(const surface::BSplineBasis& b, double lo, double hi) {
-  const auto breaks = surface::breakpoints(b);
-  int n = 0;
-  for (size_t k = 0; k + 1 < breaks.size(); ++k) n += breaks[k + 1] > lo && breaks[k] < hi;
-  return n;
-}
-
 // The exact mode holds the target's own ends too (where they lie in the region): the rows of eq. 8
 // stop up to a row's spacing short of them, and that shortfall changed with every halving of the
 // net, so the shape near the ends never settled (the hood: 4 % after five halvings, all of it
@@ -374,14 +369,18 @@ std::vector<TraceSample> densify(const surface::SurfaceProjector& projector,
 }
 
 FreeArea make_free_area(const BSplineSurface& parent, const InfluenceRegion& region,
-                        const Eigen::AlignedBox2d& box, int fixed_rows) {
+                        const Eigen::AlignedBox2d& box, int fixed_rows,
+                        const surface::ProjectionOptions& projection) {
   BSplineSurface s = parent;
   for (int h = 0; h < max_region_halvings; ++h) {
-    const bool u = spans_over(s.u, box.min().x(), box.max().x()) < region_spans;
-    const bool v = spans_over(s.v, box.min().y(), box.max().y()) < region_spans;
+    // One halving knot per span over the box: their count is the spans' count.
+    const auto ku = halving_knots(s.u, box.min().x(), box.max().x());
+    const auto kv = halving_knots(s.v, box.min().y(), box.max().y());
+    const bool u = static_cast<int>(ku.size()) < region_spans;
+    const bool v = static_cast<int>(kv.size()) < region_spans;
     if (!u && !v) break;
-    if (u) s = surface::refine_knots_u(s, halving_knots(s.u, box.min().x(), box.max().x()));
-    if (v) s = surface::refine_knots_v(s, halving_knots(s.v, box.min().y(), box.max().y()));
+    if (u) s = surface::refine_knots_u(s, ku);
+    if (v) s = surface::refine_knots_v(s, kv);
   }
   const auto factors = region_factors(s, region.polygon, region.target_trace, region.margin);
   const auto dist = distance_to_outside(s, factors);
@@ -447,7 +446,7 @@ FreeArea make_free_area(const BSplineSurface& parent, const InfluenceRegion& reg
           area.sum[static_cast<size_t>(a * (cv + 1) + b + 1)] +
           area.sum[static_cast<size_t>((a + 1) * (cv + 1) + b)] -
           area.sum[static_cast<size_t>(a * (cv + 1) + b)];
-  area.net = std::move(s);
+  area.net = std::make_shared<const surface::SurfaceProjector>(std::move(s), projection);
   return area;
 }
 
@@ -481,8 +480,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   if (!cache || !cache->area) {
     auto fresh = std::make_shared<ExactCache>();
     if (cache) fresh->nets = cache->nets;
-    fresh->area =
-        std::make_shared<const FreeArea>(make_free_area(parent, region, refine_box, fixed_rows));
+    fresh->area = std::make_shared<const FreeArea>(
+        make_free_area(parent, region, refine_box, fixed_rows, options.projection));
     cache = std::move(fresh);
   }
   const std::shared_ptr<const FreeArea> area = cache->area;
@@ -492,9 +491,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   // problem (with the key points of each net, rows twice as dense at every halving, the shape
   // never settled near the target's ends). The target's ends are held too. Key points are added
   // where the result still misses the target curve.
-  const surface::SurfaceProjector on_region_net(area->net, options.projection);
   const KeyPoints keys =
-      find_key_points(on_region_net, area->region, target, trace, options.key_points_per_row);
+      find_key_points(*area->net, area->region, target, trace, options.key_points_per_row);
   if (begin_report(keys, options, StyleMode::Exact, report)) {
     measure(parent, parent, region.factors, region, target, trace, options, report);
     return out;
@@ -504,7 +502,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   auto in_region = [&](const TraceSample& t) {
     return region.polygon.empty() || bound.inside({t.u, t.v});
   };
-  hold_target_ends(area->net, area->region, trace, keys.direction, in_region, points);
+  hold_target_ends(area->net->surface(), area->region, trace, keys.direction, in_region, points);
   // Key points where no free vertex of any net reaches (in the fixed band inside the bound) are
   // not influenced: they cannot be met (under-constrained targets cross that band).
   for (KeyPoint& k : points) k.influenced = k.influenced && area->holds(k.u, k.v);
