@@ -6,6 +6,7 @@
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/self_intersection.hpp>
+#include <clay/surface/skin.hpp>
 
 #include <Eigen/Core>
 
@@ -81,6 +82,26 @@ inline BSplineCurve normalized(const BSplineCurve& curve) {
   if (a == 0.0 && b == 1.0) return c;
   for (double& t : c.basis.knots) t = (t - a) / (b - a);  // (b - a) / (b - a) is exactly 1
   return c;
+}
+
+/// "2 knots moved to merge sliver spans of the knot union (section #1 at 0.50089 -> 0.50057,
+/// reparametrized; ...), largest deviation 3.1e-05 mm", or "" when nothing merged. `what` names
+/// the curves ("section", or "curve" with `labels` giving each merged curve's name).
+inline std::string merge_note(const CompatibleCurves& merged, const std::string& what,
+                              const std::vector<std::string>& labels = {}) {
+  if (merged.merges.empty()) return "";
+  std::string out = std::to_string(merged.merges.size()) +
+                    (merged.merges.size() == 1 ? " knot" : " knots") +
+                    " moved to merge sliver spans of the knot union (";
+  for (size_t i = 0; i < merged.merges.size(); ++i) {
+    const KnotMerge& m = merged.merges[i];
+    const auto k = static_cast<size_t>(m.curve);
+    out += (i ? "; " : "") +
+           (k < labels.size() ? labels[k] : what + " #" + std::to_string(m.curve)) + " at " +
+           short_number(m.from) + (m.removed ? " removed" : " -> " + short_number(m.to)) +
+           (m.reparametrized ? ", reparametrized" : "");
+  }
+  return out + "), largest deviation " + short_number(merged.max_deviation_mm) + " mm";
 }
 
 }  // namespace clay::surface::detail

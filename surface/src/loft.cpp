@@ -42,6 +42,7 @@ std::string name(const char* what, size_t k) {
 
 struct PreparedLoft {
   std::vector<BSplineCurve> compatible;  // oriented, compatible, on [0, 1]
+  CompatibleCurves merged;               // what merging the slivers of the knot union did
   std::vector<bool> reversed;
   std::vector<double> v;
   int degree = 1;
@@ -145,7 +146,12 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
                       " coincide (largest distance " + num(largest) + " mm, tolerance " + num(tol) +
                       " mm); remove one of them");
   }
-  out.compatible = make_compatible(oriented);
+  std::vector<std::string> names;
+  for (size_t k = 0; k < sections.size(); ++k)
+    names.push_back("loft section #" + std::to_string(k));
+  out.merged = make_compatible(
+      oriented, KnotMergeOptions{options.min_span_ratio, options.merge_tolerance * size}, names);
+  out.compatible = out.merged.curves;
   out.v = section_parameters(out.compatible, options.parametrization);
   for (size_t k = 1; k < out.v.size(); ++k)
     if (!(out.v[k] > out.v[k - 1]))
@@ -166,70 +172,17 @@ std::vector<std::string> LoftOptions::problems() const {
                   std::to_string(max_kernel_degree) + "]");
   if (!(tolerance > 0.0 && tolerance <= 1e-2))
     out.push_back("LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
+  if (!(min_span_ratio >= 0.0 && min_span_ratio < 0.5))
+    out.push_back("LoftOptions::min_span_ratio is " + num(min_span_ratio) +
+                  "; it must be in [0, 0.5) (0 keeps every span)");
+  if (!(merge_tolerance > 0.0 && merge_tolerance <= 1e-2))
+    out.push_back("LoftOptions::merge_tolerance is " + num(merge_tolerance) +
+                  "; it must be in (0, 1e-2]");
   return out;
 }
 
 void LoftOptions::validate() const {
   internal::throw_if(ErrorCategory::InvalidArgument, problems());
-}
-
-std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves) {
-  if (curves.empty())
-    throw Error(ErrorCategory::InvalidArgument,
-                "make_compatible: no curves given; give at least one");
-  std::vector<BSplineCurve> out;
-  int degree = 1;
-  for (size_t k = 0; k < curves.size(); ++k) {
-    validate(curves[k], name("curve", k));
-    out.push_back(normalized(curves[k]));
-    degree = std::max(degree, curves[k].basis.degree);
-  }
-  for (size_t k = 0; k < out.size(); ++k) {
-    BSplineCurve& c = out[k];
-    if (c.basis.degree < degree) c = elevate_degree(c, degree - c.basis.degree);
-  }
-
-  // Interior knots of every curve, clustered: values within 1e-12 (of the domain [0, 1]) are one.
-  struct Knot {
-    double value;
-    size_t curve;
-  };
-  std::vector<Knot> all;
-  for (size_t k = 0; k < out.size(); ++k)
-    for (double t : out[k].basis.knots)
-      if (t > 0.0 && t < 1.0) all.push_back({t, k});
-  std::sort(all.begin(), all.end(), [](const Knot& a, const Knot& b) { return a.value < b.value; });
-  std::vector<std::vector<double>> snapped(out.size());
-  std::vector<std::vector<double>> missing(out.size());
-  for (size_t i = 0; i < all.size();) {
-    const double representative = all[i].value;
-    size_t e = i;
-    std::vector<int> mult(out.size(), 0);
-    while (e < all.size() && all[e].value - representative <= tolerance::knot_relative) {
-      ++mult[all[e].curve];
-      ++e;
-    }
-    const int target = *std::max_element(mult.begin(), mult.end());
-    for (size_t k = 0; k < out.size(); ++k)
-      for (int r = mult[k]; r < target; ++r) missing[k].push_back(representative);
-    for (size_t j = i; j < e; ++j) snapped[all[j].curve].push_back(representative);
-    i = e;
-  }
-  for (size_t k = 0; k < out.size(); ++k) {
-    // Snap this curve's interior knots to their cluster's value (a change of at most 1e-12).
-    size_t next = 0;
-    for (double& t : out[k].basis.knots)
-      if (t > 0.0 && t < 1.0) t = snapped[k][next++];
-    validate(out[k], name("curve", k));
-    if (!missing[k].empty()) out[k] = refine_knots(out[k], missing[k]);
-    if (!curves[k].is_rational()) out[k].weights.setOnes();
-  }
-  for (size_t k = 1; k < out.size(); ++k)
-    if (out[k].basis.knots != out[0].basis.knots)
-      throw Error(ErrorCategory::Internal,
-                  "make_compatible: curve #" + std::to_string(k) +
-                      " did not reach the common knot vector (please report this input)");
-  return out;
 }
 
 std::vector<double> loft_parameters(const std::vector<BSplineCurve>& sections,
@@ -242,7 +195,8 @@ BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& 
   BuiltSurface built;
   built.surface = interpolate_sections(prepared.compatible, prepared.v, prepared.degree);
 
-  // Exactness check: S(u, v_k) against the input section k at the same (normalized) parameter.
+  // Exactness check: S(u, v_k) against the input section k at the same (normalized) parameter,
+  // or, where merging a sliver reparametrized the section, at the parameter it was moved from.
   const int spans = static_cast<int>(breakpoints(built.surface.u).size()) - 1;
   const std::vector<double> us = linspace(0.0, 1.0, std::max(65, 8 * spans + 1));
   const Points3 grid = evaluate_grid(built.surface, us, prepared.v);
@@ -251,7 +205,8 @@ BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& 
   for (size_t k = 0; k < count; ++k) {
     const auto [a, b] = sections[k].basis.domain();
     for (size_t i = 0; i < us.size(); ++i) {
-      const double t = prepared.reversed[k] ? b - us[i] * (b - a) : a + us[i] * (b - a);
+      const double f = input_parameter(prepared.merged, static_cast<int>(k), us[i]);
+      const double t = prepared.reversed[k] ? b - f * (b - a) : a + f * (b - a);
       const Eigen::Vector3d expected = evaluate(sections[k], std::clamp(t, a, b));
       worst = std::max(
           worst,
@@ -263,8 +218,10 @@ BuiltSurface loft(const std::vector<BSplineCurve>& sections, const LoftOptions& 
   for (size_t k = 0; k < count; ++k)
     if (prepared.reversed[k]) turned += (turned.empty() ? "" : ", #") + std::to_string(k);
   if (!turned.empty()) method += " (reversed: #" + turned + ")";
+  const std::string merges = detail::merge_note(prepared.merged, "section");
+  if (!merges.empty()) method += " (" + merges + ")";
   built.report = describe(built.surface, method);
-  built.report.exact = true;
+  built.report.exact = prepared.merged.merges.empty();
   built.report.max_deviation_mm = worst;
   built.report.samples = static_cast<int>(us.size() * count);
   return built;

@@ -228,6 +228,10 @@ struct Side {
   bool edge_reversed = false;           // the edge runs against its surface parameter
   Eigen::Vector3d point = Eigen::Vector3d::Zero();
   double alpha = 1;  // edge parameter f is curve parameter alpha f / (alpha f + 1 - f)
+  // When merging slivers of the knot union reparametrized the side: its compatible curve and
+  // index, so the edge at surface parameter g carries the curve's point at input_parameter(g).
+  const CompatibleCurves* merged = nullptr;
+  int index = 0;
 };
 
 /// Largest distance between each side's input curve and the surface edge, at `count` samples.
@@ -245,8 +249,13 @@ double side_deviation(const BSplineSurface& s, const std::vector<Side>& sides, i
       Eigen::Vector3d expected = side.point;
       if (side.input) {
         const auto [a, b] = side.input->basis.domain();
+        double h = f;
+        if (side.merged) {
+          const double moved = input_parameter(*side.merged, side.index, g);
+          h = side.edge_reversed ? 1.0 - moved : moved;
+        }
         const double m =
-            side.alpha == 1.0 ? f : std::min(1.0, side.alpha * f / (side.alpha * f + 1.0 - f));
+            side.alpha == 1.0 ? h : std::min(1.0, side.alpha * h / (side.alpha * h + 1.0 - h));
         const double t = side.input_reversed ? b - m * (b - a) : a + m * (b - a);
         expected = evaluate(*side.input, std::clamp(t, a, b));
       }
@@ -355,18 +364,25 @@ const char* style_name(FillStyle style) {
   return "coons";
 }
 
-/// Two curves made compatible (same degree and knots on [0, 1]); for Coons, raised to degree 3
-/// when they have fewer than 4 control points. `note` records what was raised.
+/// Two curves made compatible (same degree and knots on [0, 1]), slivers of their knot union
+/// merged within `merge` (the report in `merged`); for Coons, raised to degree 3 when they have
+/// fewer than 4 control points. `note` records what was merged and raised.
 std::pair<BSplineCurve, BSplineCurve> compatible_pair(const BSplineCurve& a, const BSplineCurve& b,
-                                                      bool coons, const std::string& names,
-                                                      std::string& note) {
-  std::vector<BSplineCurve> pair = make_compatible({a, b});
+                                                      bool coons, const KnotMergeOptions& merge,
+                                                      const std::string& name_a,
+                                                      const std::string& name_b,
+                                                      CompatibleCurves& merged, std::string& note) {
+  merged = make_compatible({a, b}, merge, {"fill: " + name_a, "fill: " + name_b});
+  std::vector<BSplineCurve> pair = merged.curves;
+  const std::string merges = detail::merge_note(merged, "curve", {name_a, name_b});
+  if (!merges.empty()) note += std::string(note.empty() ? "" : "; ") + merges;
   if (coons && pair[0].basis.count() < 4) {
     const int from = pair[0].basis.degree;
     pair[0] = elevate_degree(pair[0], 3 - from);
     pair[1] = elevate_degree(pair[1], 3 - from);
-    note += std::string(note.empty() ? "" : "; ") + names + " raised from degree " +
-            std::to_string(from) + " to 3 (Coons needs 4 control points per side)";
+    note += std::string(note.empty() ? "" : "; ") + name_a + " and " + name_b +
+            " raised from degree " + std::to_string(from) +
+            " to 3 (Coons needs 4 control points per side)";
   }
   return {pair[0], pair[1]};
 }
@@ -390,6 +406,12 @@ std::vector<std::string> FillOptions::problems() const {
   if (!(gap_tolerance > 0.0 && std::isfinite(gap_tolerance)))
     out.push_back("FillOptions::gap_tolerance is " + num(gap_tolerance) +
                   "; it must be > 0 and finite");
+  if (!(min_span_ratio >= 0.0 && min_span_ratio < 0.5))
+    out.push_back("FillOptions::min_span_ratio is " + num(min_span_ratio) +
+                  "; it must be in [0, 0.5) (0 keeps every span)");
+  if (!(merge_tolerance > 0.0 && merge_tolerance <= 1e-2))
+    out.push_back("FillOptions::merge_tolerance is " + num(merge_tolerance) +
+                  "; it must be in (0, 1e-2]");
   if (style != FillStyle::Stretch && style != FillStyle::Coons && style != FillStyle::Curved)
     out.push_back("FillOptions::style is " + std::to_string(static_cast<int>(style)) +
                   "; it must be Stretch, Coons or Curved");
@@ -419,6 +441,8 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
                                        "control points apart there");
   const bool coons = options.style == FillStyle::Coons;
   const GeomFill_FillingStyle style = occt_style(options.style);
+  const KnotMergeOptions merge{options.min_span_ratio, options.merge_tolerance * size};
+  CompatibleCurves merged02, merged13;  // slivers merged between opposite sides
   std::string note;
   std::vector<Side> sides;
   Handle(Geom_BSplineSurface) result;
@@ -440,14 +464,15 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
         note = "curve #1 reversed";
       }
       BSplineCurve ca, cb;
-      std::tie(ca, cb) = compatible_pair(a, b, false, "", note);
+      std::tie(ca, cb) =
+          compatible_pair(a, b, false, merge, curve_name(0), curve_name(1), merged02, note);
       result = with_occt("fill", [&] {
         GeomFill_BSplineCurves filler(occt::to_occt(ca, "curve #0"), occt::to_occt(cb, "curve #1"),
                                       style);
         return filler.Surface();
       });
-      sides.push_back({&boundary[0], false, false, false, false, {}});
-      sides.push_back({&boundary[1], turn, false, true, false, {}});
+      sides.push_back({&boundary[0], false, false, false, false, {}, 1.0, &merged02, 0});
+      sides.push_back({&boundary[1], turn, false, true, false, {}, 1.0, &merged02, 1});
     } else {
       // Curved with two curves: both must start at a shared corner.
       const double gaps[4] = {sa, sr, er, ea};  // start-start, start-end, end-start, end-end
@@ -505,12 +530,13 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
     const BSplineCurve& c1 = loop[0].curve;
     const BSplineCurve& c2 = loop[1].curve;
     const BSplineCurve& c3 = loop[2].curve;
-    const std::string name02 = curve_name(loop[0].input) + " and " + curve_name(loop[2].input);
     BSplineCurve u0, u1, v1, v0;
-    std::tie(u0, u1) = compatible_pair(c1, reversed(c3), coons, name02, note);
+    std::tie(u0, u1) = compatible_pair(c1, reversed(c3), coons, merge, curve_name(loop[0].input),
+                                       curve_name(loop[2].input), merged02, note);
     if (n == 4) {
-      const std::string name13 = curve_name(loop[1].input) + " and " + curve_name(loop[3].input);
-      std::tie(v1, v0) = compatible_pair(c2, reversed(loop[3].curve), coons, name13, note);
+      std::tie(v1, v0) =
+          compatible_pair(c2, reversed(loop[3].curve), coons, merge, curve_name(loop[1].input),
+                          curve_name(loop[3].input), merged13, note);
     } else {
       BSplineCurve single = make_compatible({c2})[0];
       if (coons && single.basis.count() < 4) {
@@ -538,15 +564,43 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
         return filler.Surface();
       });
     }
-    sides.push_back(
-        {&boundary[loop[0].input], loop[0].reversed, false, false, false, {}, loop[0].alpha});
-    sides.push_back(
-        {&boundary[loop[1].input], loop[1].reversed, true, true, false, {}, loop[1].alpha});
-    sides.push_back(
-        {&boundary[loop[2].input], loop[2].reversed, false, true, true, {}, loop[2].alpha});
+    sides.push_back({&boundary[loop[0].input],
+                     loop[0].reversed,
+                     false,
+                     false,
+                     false,
+                     {},
+                     loop[0].alpha,
+                     &merged02,
+                     0});
+    sides.push_back({&boundary[loop[1].input],
+                     loop[1].reversed,
+                     true,
+                     true,
+                     false,
+                     {},
+                     loop[1].alpha,
+                     n == 4 ? &merged13 : nullptr,
+                     0});
+    sides.push_back({&boundary[loop[2].input],
+                     loop[2].reversed,
+                     false,
+                     true,
+                     true,
+                     {},
+                     loop[2].alpha,
+                     &merged02,
+                     1});
     if (n == 4)
-      sides.push_back(
-          {&boundary[loop[3].input], loop[3].reversed, true, false, true, {}, loop[3].alpha});
+      sides.push_back({&boundary[loop[3].input],
+                       loop[3].reversed,
+                       true,
+                       false,
+                       true,
+                       {},
+                       loop[3].alpha,
+                       &merged13,
+                       1});
     else
       sides.push_back({nullptr, false, true, false, true, first_point(c1)});
   }
@@ -563,7 +617,7 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
       std::string(style_name(options.style)) + " fill of " + std::to_string(n) + " curves";
   if (!note.empty()) method += " (" + note + ")";
   built.report = describe(built.surface, method);
-  built.report.exact = true;
+  built.report.exact = merged02.merges.empty() && merged13.merges.empty();
   built.report.max_deviation_mm = worst;
   built.report.samples = samples;
   return built;

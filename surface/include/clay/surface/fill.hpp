@@ -21,8 +21,14 @@ enum class FillStyle {
 /// Settings of fill().
 struct CLAY_OCCT_API FillOptions {
   FillStyle style = FillStyle::Coons;  ///< interior blend
-  double gap_tolerance = 1e-7;  ///< mm, > 0 and finite: ends of consecutive boundary curves must
-                                ///< meet within this; they are then joined at their midpoint
+  double gap_tolerance = 1e-7;    ///< mm, > 0 and finite: ends of consecutive boundary curves must
+                                  ///< meet within this; they are then joined at their midpoint
+  double min_span_ratio = 0.05;   ///< in [0, 0.5): slivers of opposite sides' knot union (spans
+                                  ///< shorter than this times their longer neighbour) are merged
+                                  ///< (make_compatible with KnotMergeOptions); 0 keeps every span
+  double merge_tolerance = 1e-5;  ///< relative to the model size, in (0, 1e-2]: how far merging
+                                  ///< may move a side; the report is then not exact and its
+                                  ///< max_deviation_mm measures the edges against the curves
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -34,14 +40,18 @@ struct CLAY_OCCT_API FillOptions {
 /// come in any order and direction: from curve #0 each next curve is the one whose end is nearest,
 /// reversed when needed, until the loop closes; corners within options.gap_tolerance are joined at
 /// their midpoint. Curves are clamped and reparametrized to [0, 1], opposite sides made compatible
-/// (degree elevation and knot refinement), and, for Coons, sides with fewer than 4 control points
+/// (degree elevation and knot refinement; slivers of their knot union merged, see
+/// options.min_span_ratio), and, for Coons, sides with fewer than 4 control points
 /// raised to degree 3 (OpenCASCADE refuses Coons below 4). 4 curves: u runs along the first curve
 /// of the loop (v = 0), v along the second (u = 1); 3 curves: the side u = 0 collapses to the
 /// corner where the loop closes; 2 curves: Stretch and Coons give the ruled surface between them
 /// (the second curve turned to run like the first; no loop needed), Curved the patch spanned by two
-/// curves that share a corner. The report is exact; its max_deviation_mm is the largest distance
-/// between each input curve and the surface edge it became, on dense samples (rounding, plus at
-/// most half a joined gap), and its method lists what was reversed, raised or joined. Throws
+/// curves that share a corner. The report is exact unless a sliver was merged; its
+/// max_deviation_mm is the largest distance between each input curve and the surface edge it
+/// became, on dense samples (rounding, plus at most half a joined gap, plus what a merge moved,
+/// measured at the parameter the merge's reparametrization maps to), and its method lists what was
+/// reversed, raised, joined or merged. A sliver that cannot be merged within merge_tolerance
+/// throws InvalidGeometry naming both curves and the fix. Throws
 /// clay::Error: InvalidArgument for a count outside [2, 4] or bad options; InvalidGeometry for an
 /// invalid or degenerate curve (named "curve #k", 0-based), for curves that do not close,
 /// naming each gap, e.g. "curve #1 end and curve #2 start are 0.25 mm apart (tolerance 1e-07 mm)",

@@ -27,6 +27,12 @@ struct CLAY_SURFACE_API LoftOptions {
   double tolerance = 1e-7;  ///< relative to the model size (diagonal of the sections' control
                             ///< points): consecutive sections closer than this coincide, a section
                             ///< whose control polygon is shorter is degenerate; in (0, 1e-2]
+  double min_span_ratio = 0.05;   ///< in [0, 0.5): slivers of the sections' knot union (spans
+                                  ///< shorter than this times their longer neighbour) are merged
+                                  ///< (make_compatible with KnotMergeOptions); 0 keeps every span
+  double merge_tolerance = 1e-5;  ///< relative to the model size, in (0, 1e-2]: how far merging
+                                  ///< may move a section (the report is then not exact and gives
+                                  ///< the measured deviation)
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -40,8 +46,75 @@ struct CLAY_SURFACE_API LoftOptions {
 /// input k at a_k + t (b_k - a_k) for its domain [a_k, b_k] (up to rounding). Every result has the
 /// same degree and knot vector. Throws clay::Error(InvalidGeometry) for an invalid curve (named
 /// "curve #k", 0-based) or when the degree would exceed max_kernel_degree; InvalidArgument for an
-/// empty list.
+/// empty list. Keeps every span of the union, however short (the overload with KnotMergeOptions
+/// merges slivers).
 CLAY_SURFACE_API std::vector<BSplineCurve> make_compatible(const std::vector<BSplineCurve>& curves);
+
+/// How make_compatible merges sliver spans of the knot union.
+struct CLAY_SURFACE_API KnotMergeOptions {
+  double min_span_ratio = 0.05;  ///< in [0, 0.5): a span of the union shorter than this times its
+                                 ///< longer neighbour is a sliver and is merged away; 0 keeps all
+  double tolerance_mm = 1e-4;    ///< > 0 and finite: how far the merges may move a curve, in all
+
+  /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
+  std::vector<std::string> problems() const;
+  /// Throws clay::Error(InvalidArgument) listing problems(), if any.
+  void validate() const;
+};
+
+/// One knot of one curve moved by make_compatible to merge a sliver span.
+struct KnotMerge {
+  int curve = 0;         ///< index of the curve (0-based)
+  double from = 0;       ///< the knot's value on [0, 1] before
+  double to = 0;         ///< its value after (the neighbouring knot of the union); equal to `from`
+                         ///< when the knot was removed because the curve already had `to`
+  bool removed = false;  ///< the curve already had a knot at `to`: this one was removed
+  bool reparametrized = false;  ///< the curve was reparametrized near the knot (see below)
+  double lo = 0, hi = 0;    ///< the reparametrization's interval (the curve's neighbouring knots)
+  int knots_added = 0;      ///< knots the reparametrized fit added, halving [lo, to] and [to, hi]
+  double deviation_mm = 0;  ///< largest distance the curve moved (sampled, see below)
+};
+
+/// Curves made compatible with their sliver spans merged, and what the merging did.
+struct CompatibleCurves {
+  std::vector<BSplineCurve> curves;  ///< one degree and knot vector, on [0, 1]
+  std::vector<KnotMerge> merges;     ///< in the order made
+  double max_deviation_mm = 0;       ///< the largest sum of the deviations of one curve's merges
+};
+
+/// make_compatible, merging sliver spans of the union first. While some span of the union of the
+/// curves' breakpoints (0 and 1 included) is shorter than options.min_span_ratio times its longer
+/// neighbour (the worst first), one of its two end knots is moved onto the other in every curve
+/// that has it (removed where that curve has both); of the two directions the one that moves the
+/// curves less is taken. Per curve the move is, in order of preference:
+/// - a least-squares fit of the curve on the moved knot vector at its own parameters (end points
+///   kept): exact up to rounding when the knot is removable (The NURBS Book §5.4) and otherwise
+///   within tolerance when the knot carries little of the shape; deviation_mm is the largest
+///   |new(t) − old(t)| on 16 samples per span;
+/// - else a reparametrization: the fit of old(phi(t)), phi(t) = t + (from − to) h(t) with h the
+///   C2 quintic step (6s^5 − 15s^4 + 10s^3) rising from the curve's previous knot lo to `to` and
+///   falling to its next knot hi, so the curve's own break lands on `to`; deviation_mm is the
+///   largest |new(t) − old(phi(t))|, a bound of the distance from the old curve's points. Where
+///   that misses, [lo, to] and [to, hi] are halved (up to 3 times, while no new knot makes a
+///   sliver of the union) and the fit repeated.
+/// The merges of one curve add up within options.tolerance_mm. input_parameter() maps a parameter
+/// of a result back to its input's. Throws as make_compatible, and clay::Error(InvalidGeometry)
+/// naming both curves, the two knots, the sliver's ratio and the smallest move when a sliver
+/// cannot be merged within the tolerance (the message says to raise the tolerance, or to keep the
+/// sliver with min_span_ratio 0); InvalidArgument for bad options. `names` (optional, one per
+/// curve) replace "curve #k" in messages.
+CLAY_SURFACE_API CompatibleCurves make_compatible(const std::vector<BSplineCurve>& curves,
+                                                  const KnotMergeOptions& options,
+                                                  const std::vector<std::string>& names = {});
+
+/// The parameter of input `curve` (normalized to [0, 1]) whose point result.curves[curve] carries
+/// at `t`: t itself unless a merge reparametrized that curve, then phi of each such merge applied
+/// from the last to the first.
+CLAY_SURFACE_API double input_parameter(const CompatibleCurves& result, int curve, double t);
+
+/// The smallest ratio of a non-empty knot span of `basis` to its longer neighbour (1 for a single
+/// span): the figure make_compatible's merging keeps at or above KnotMergeOptions::min_span_ratio.
+CLAY_SURFACE_API double smallest_span_ratio(const BSplineBasis& basis);
 
 /// The v parameter at which loft(sections, options) interpolates each section (0 first, 1 last):
 /// the chord-length (or centripetal, or uniform) parameters of the compatible sections' control
