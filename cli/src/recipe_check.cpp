@@ -56,6 +56,18 @@ void RecipeChecker::run(const Json& root) {
           [&](const std::string& n, const Json& j, const std::string& p) { exporting(n, j, p); });
   section(root, "models",
           [&](const std::string& n, const Json& j, const std::string& p) { modelling(n, j, p); });
+  // Curves taken from surfaces may need surfaces that need them: report the loop, once.
+  if (const std::vector<std::string> cycle = dependency_cycle(data); !cycle.empty()) {
+    std::string loop, where;
+    for (const std::string& node : cycle) loop += (loop.empty() ? "" : " -> ") + node;
+    for (const CurveDef& c : data.curves)
+      if (where.empty() && c.from_surface() &&
+          std::find(cycle.begin(), cycle.end(), "curve " + c.name) != cycle.end())
+        where = c.path;
+    c_.add(where.empty() ? "curves" : where,
+           "definitions need each other (" + loop +
+               "): take the curve from a surface that is built without it");
+  }
 }
 
 void RecipeChecker::declare(const Json& root) {

@@ -94,10 +94,10 @@ void RecipeChecker::curve(const std::string& name, const Json& j, const std::str
   CurveDef def;
   def.name = name;
   def.path = path;
-  const bool ok = one_of(
-      j, path,
-      {"bspline", "line", "arc", "arc_through", "arc_radius", "polyline", "reversed", "mirror"},
-      "a curve", def.kind);
+  const bool ok = one_of(j, path,
+                         {"bspline", "line", "arc", "arc_through", "arc_radius", "polyline",
+                          "reversed", "mirror", "iso", "boundary", "project", "offset"},
+                         "a curve", def.kind);
   const std::string p = key_path(path, def.kind);
   if (ok) {
     const Json& v = j.at(def.kind);
@@ -139,13 +139,76 @@ void RecipeChecker::curve(const std::string& name, const Json& j, const std::str
           def.plane = *plane;
         }
       }
+    } else if (def.kind == "iso" || def.kind == "boundary" || def.kind == "project" ||
+               def.kind == "offset") {
+      from_surface(v, p, def);
     } else {  // reversed
       if (const auto n = curve_ref(v, p)) def.reversed_of = *n;
     }
   }
   names_.curves.push_back(name);
-  if (def.curve || !def.reversed_of.empty() || !def.mirror_of.empty())
+  if (def.curve || !def.reversed_of.empty() || !def.mirror_of.empty() || def.from_surface())
     data.curves.push_back(std::move(def));
+}
+
+void RecipeChecker::from_surface(const Json& v, const std::string& p, CurveDef& def) {
+  const bool ok =
+      def.kind == "iso" ? c_.object(v, p, {"surface", "u", "v"}, "an iso-curve {surface, u or v}")
+      : def.kind == "boundary" ? c_.object(v, p, {"surface", "edge"}, "a boundary {surface, edge}")
+      : def.kind == "project"  ? c_.object(v, p, {"curve", "surface", "tolerance"},
+                                           "a projection {curve, surface, tolerance}")
+                               : c_.object(v, p, {"curve", "surface", "distance", "tolerance"},
+                                           "an offset {curve, surface, distance, tolerance}");
+  if (!ok) return;
+  std::optional<std::string> surface;
+  // The surface may come later in the document: the run builds it first (the checker reports
+  // a cycle, a surface that needs this curve).
+  if (const Json* m = c_.member(v, p, "surface", true, "the name of a surface")) {
+    const std::string sp = key_path(p, "surface");
+    if (const auto n = c_.string(*m, sp)) {
+      if (names_.surfaces_declared.count(*n))
+        surface = n;
+      else
+        c_.add(sp, "no surface named \"" + *n + "\"; " +
+                       listing(std::vector<std::string>(names_.surfaces_declared.begin(),
+                                                        names_.surfaces_declared.end())));
+    }
+  }
+  std::optional<std::string> source;
+  if (def.kind == "project" || def.kind == "offset") {
+    if (const Json* m = c_.member(v, p, "curve", true, "the name of a curve"))
+      source = curve_ref(*m, key_path(p, "curve"));
+    def.fit.tolerance_mm = c_.number_or(v, p, "tolerance", 1e-3, tolerance_range);
+    if (!source) return;
+    def.source = *source;
+  }
+  if (def.kind == "offset") {
+    const Json* d = c_.member(v, p, "distance", true, "the offset in mm along the normal");
+    const auto distance = d ? c_.number(*d, key_path(p, "distance"), any) : std::nullopt;
+    if (!distance) return;
+    def.distance = *distance;
+  }
+  if (def.kind == "iso") {
+    const bool u = v.contains("u"), w = v.contains("v");
+    if (u == w) {
+      c_.add(p, u ? "gives both \"u\" and \"v\"; an iso-curve fixes one: give \"u\" or \"v\""
+                  : "needs \"u\" or \"v\": the fixed parameter, a fraction of the surface's "
+                    "domain in [0, 1] (e.g. \"v\": 0.5)");
+      return;
+    }
+    def.fixed_u = u;
+    const auto at = c_.number(v.at(u ? "u" : "v"), key_path(p, u ? "u" : "v"), Range{0, 1});
+    if (!at) return;
+    def.at = *at;
+  }
+  if (def.kind == "boundary") {
+    const Json* e = c_.member(v, p, "edge", true, "\"u0\", \"u1\", \"v0\" or \"v1\"");
+    const auto k = e ? c_.choice(*e, key_path(p, "edge"), {"u0", "u1", "v0", "v1"}) : std::nullopt;
+    if (!k) return;
+    def.fixed_u = *k < 2;
+    def.at = (*k % 2 == 1) ? 1.0 : 0.0;
+  }
+  if (surface) def.surface = *surface;
 }
 
 std::optional<MirrorPlane> RecipeChecker::mirror_plane(const Json& v, const std::string& p) {
@@ -313,7 +376,7 @@ bool RecipeChecker::one_of(const Json& j, const std::string& path,
 }
 
 void RecipeChecker::sketch(const std::string& name, const Json& j, const std::string& path) {
-  SketchDef def{name, path, {}, {}, {}, {}, {}};
+  SketchDef def{name, path, {}, {}, {}, {}, {}, {}};
   bool deferred = false;
   const auto register_entities = [&] {
     const auto e = j.is_object() ? j.find("entities") : j.end();
@@ -454,6 +517,7 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
           if (kind == "bspline") {
             curve = inline_curve(v, kp);
           } else if (const auto source = curve_ref(v, kp)) {
+            def.uses.push_back(*source);
             const auto cd = std::find_if(data.curves.begin(), data.curves.end(),
                                          [&](const CurveDef& d) { return d.name == *source; });
             if (runtime_curve) {

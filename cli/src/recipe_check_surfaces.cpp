@@ -18,8 +18,10 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
       if (auto s = inline_surface(v, p)) def.build = std::move(*s);
     } else if (def.kind == "fill") {
       FillDef f;
-      if (c_.object(v, p, {"curves", "style", "join", "gap_tolerance"},
-                    "a fill {curves, style, join, gap_tolerance}")) {
+      if (c_.object(
+              v, p,
+              {"curves", "style", "join", "gap_tolerance", "min_span_ratio", "merge_tolerance"},
+              "a fill {curves, style, join, gap_tolerance, min_span_ratio, merge_tolerance}")) {
         f.curves = curve_refs(v, p, "curves", 2, 4);
         if (const Json* s = c_.member(v, p, "style", false, ""))
           if (const auto k = c_.choice(*s, key_path(p, "style"), {"stretch", "coons", "curved"}))
@@ -34,13 +36,18 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
                  "to close, in mm (e.g. \"gap_tolerance\": 2)");
         f.options.gap_tolerance =
             c_.number_or(v, p, "gap_tolerance", f.options.gap_tolerance, positive);
+        f.options.min_span_ratio = c_.number_or(v, p, "min_span_ratio", f.options.min_span_ratio,
+                                                Range{0, 0.5, false, true});
+        f.options.merge_tolerance = c_.number_or(v, p, "merge_tolerance", f.options.merge_tolerance,
+                                                 Range{0, 1e-2, true, false});
         c_.attempt(p, [&] { f.options.validate(); });
       }
       def.build = std::move(f);
     } else if (def.kind == "skin") {
       SkinDef s;
-      if (c_.object(v, p, {"sections", "degree", "parametrization"},
-                    "a skin {sections, degree, parametrization}")) {
+      if (c_.object(
+              v, p, {"sections", "degree", "parametrization", "min_span_ratio", "merge_tolerance"},
+              "a skin {sections, degree, parametrization, min_span_ratio, merge_tolerance}")) {
         s.sections = curve_refs(v, p, "sections", 2, limit::entries);
         s.options.degree =
             c_.integer_or(v, p, "degree", s.options.degree, 1, surface::max_exchange_degree);
@@ -48,6 +55,10 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
           if (const auto k = c_.choice(*m, key_path(p, "parametrization"),
                                        {"chord_length", "centripetal", "uniform"}))
             s.options.parametrization = static_cast<surface::LoftParametrization>(*k);
+        s.options.min_span_ratio = c_.number_or(v, p, "min_span_ratio", s.options.min_span_ratio,
+                                                Range{0, 0.5, false, true});
+        s.options.merge_tolerance = c_.number_or(v, p, "merge_tolerance", s.options.merge_tolerance,
+                                                 Range{0, 1e-2, true, false});
         c_.attempt(p, [&] { s.options.validate(); });
       }
       def.build = std::move(s);

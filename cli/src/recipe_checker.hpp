@@ -256,6 +256,9 @@ class RecipeChecker {
   void declare(const Json& root);
 
   std::optional<std::string> curve_ref(const Json& j, const std::string& path);
+  /// A curve taken from a surface: iso, boundary, project or offset ("surface" may be declared
+  /// anywhere; the run builds it first).
+  void from_surface(const Json& v, const std::string& p, CurveDef& def);
 
   std::optional<std::string> surface_ref(const Json& j, const std::string& path);
 

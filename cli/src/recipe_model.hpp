@@ -14,6 +14,7 @@
 #include <clay/surface/primitives.hpp>
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/skin.hpp>
+#include <clay/surface/surface_curves.hpp>
 
 #include <functional>
 #include <optional>
@@ -58,11 +59,21 @@ struct MirrorPlane {
 
 struct CurveDef {
   std::string name, path, kind;  // kind: bspline, line, arc, arc_through, arc_radius, polyline,
-                                 // reversed, mirror
+                                 // reversed, mirror, iso, boundary, project, offset
   std::optional<surface::BSplineCurve> curve;
   std::string reversed_of;
   std::string mirror_of;  ///< mirror: the curve mirrored in `plane`
   MirrorPlane plane;
+  // Taken from a surface (iso, boundary, project, offset): built once that surface is.
+  std::string surface;           ///< the surface the curve is taken from
+  std::string source;            ///< project, offset: the curve projected or offset
+  bool fixed_u = false;          ///< iso, boundary: u is fixed (the curve runs along v)
+  double at = 0;                 ///< iso, boundary: the fixed parameter as a fraction of its domain
+  double distance = 0;           ///< offset: mm along the surface normal
+  surface::CurveFitOptions fit;  ///< project, offset
+
+  /// Taken from a surface, so built at run time in dependency order.
+  bool from_surface() const { return !surface.empty(); }
 };
 
 struct SketchDef {
@@ -74,6 +85,7 @@ struct SketchDef {
   // A sketch using curves known only when the recipe runs (strokes, reversed curves) was checked
   // with stand-ins and is built again by rebuild_sketch from its JSON with the real curves.
   std::string deferred_json;
+  std::vector<std::string> uses;  ///< the named curves its "curve" entities take
 };
 
 /// The sketch `def` (deferred) built again with the run's curves (`curve` returns nullptr for an
@@ -188,6 +200,18 @@ struct RecipeData {
   std::vector<ExportDef> exports;
   std::vector<ModelDef> models;
 };
+
+/// What a curve or surface definition needs built before it: curve and surface names.
+struct Needs {
+  std::vector<std::string> curves, surfaces;
+};
+/// The needs of the curve (stroke, curve or sketch entity) named `name`.
+Needs curve_needs(const RecipeData& d, const std::string& name);
+/// The needs of a surface definition (a deform step's style curves included).
+Needs surface_needs(const RecipeData& d, const SurfaceDef& def);
+/// A cycle of definitions that need each other ("curve edge", "surface panel", "curve edge"), or
+/// empty.
+std::vector<std::string> dependency_cycle(const RecipeData& d);
 
 /// The checked model, or problems (then the model is incomplete and must not be run).
 struct CheckOutcome {

@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cstdio>
 #include <map>
+#include <set>
 
 namespace clay::recipe {
 
@@ -65,18 +66,16 @@ class Runner {
   Runner(const RecipeData& d, const RunOptions& o, RunResult& r)
       : data_(d), options_(o), result_(r) {}
 
-  /// Strokes, curves and sketches: every named curve.
+  /// Strokes, curves and sketches: every named curve, each after what it needs (a curve taken
+  /// from a surface after that surface and the curves it is built from).
   void curves() {
-    for (const auto& s : data_.strokes)
-      timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); });
-    for (const auto& c : data_.curves)
-      timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); });
-    for (const auto& s : data_.sketches)
-      timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); });
+    for (const auto& s : data_.strokes) need_curve(s.name);
+    for (const auto& c : data_.curves) need_curve(c.name);
+    for (std::size_t k = 0; k < data_.sketches.size(); ++k) need_sketch(k);
   }
-  /// Every named surface, in document order.
+  /// Every named surface, in document order unless one needs another first.
   void surfaces() {
-    for (const auto& s : data_.surfaces) build_surface(s);
+    for (const auto& s : data_.surfaces) need_surface(s.name);
   }
 
   /// Above these an exported surface gets a warning: few surfacing tools edit more.
@@ -244,6 +243,8 @@ class Runner {
   const RunOptions& options_;
   RunResult& result_;
   std::map<std::string, std::size_t> curve_index_;
+  std::set<std::size_t> sketches_built_;  // indices into data_.sketches
+  std::set<std::string> building_;        // "curve NAME" / "surface NAME" being built
 
   template <class F>
   void timed(const std::string& path, const std::string& kind, F&& f) {
@@ -259,6 +260,54 @@ class Runner {
     rep.seconds = seconds_since(t0);
     if (options_.progress) options_.progress(rep);
     result_.steps.push_back(std::move(rep));
+  }
+
+  /// Builds the curve `name` unless built: first what it needs, then its stroke, curve or sketch.
+  void need_curve(const std::string& name) {
+    if (curve_index_.count(name)) return;
+    guard("curve " + name, [&] {
+      const Needs needs = curve_needs(data_, name);
+      for (const auto& c : needs.curves) need_curve(c);
+      for (const auto& s : needs.surfaces) need_surface(s);
+      for (const auto& s : data_.strokes)
+        if (s.name == name)
+          return timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); });
+      for (const auto& c : data_.curves)
+        if (c.name == name) return timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); });
+      for (std::size_t k = 0; k < data_.sketches.size(); ++k)
+        for (const auto& [entity, id] : data_.sketches[k].entities)
+          if (entity == name) return need_sketch(k);
+    });
+  }
+  void need_sketch(std::size_t k) {
+    if (sketches_built_.count(k)) return;
+    sketches_built_.insert(k);
+    const SketchDef& s = data_.sketches[k];
+    for (const auto& c : s.uses) need_curve(c);
+    timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); });
+  }
+  void need_surface(const std::string& name) {
+    if (std::any_of(result_.surfaces.begin(), result_.surfaces.end(),
+                    [&](const auto& s) { return s.first == name; }))
+      return;
+    guard("surface " + name, [&] {
+      for (const SurfaceDef& def : data_.surfaces)
+        if (def.name == name) {
+          const Needs needs = surface_needs(data_, def);
+          for (const auto& c : needs.curves) need_curve(c);
+          for (const auto& s : needs.surfaces) need_surface(s);
+          return build_surface(def);
+        }
+    });
+  }
+  /// Runs f for `node` once at a time: the checker reports cycles, so meeting one here is a bug.
+  template <class F>
+  void guard(const std::string& node, F&& f) {
+    if (!building_.insert(node).second)
+      throw Error(ErrorCategory::Internal,
+                  "recipe run: " + node + " needs itself (please report this recipe)");
+    f();
+    building_.erase(node);
   }
 
   void add_curve(const std::string& name, BSplineCurve c) {
@@ -291,13 +340,42 @@ class Runner {
   }
 
   void curve(const CurveDef& c, StepReport& rep) {
-    BSplineCurve out = c.curve                ? *c.curve
-                       : !c.mirror_of.empty() ? surface::mirrored(curve_of(c.mirror_of),
-                                                                  c.plane.origin, c.plane.normal)
-                                              : surface::reversed(curve_of(c.reversed_of));
+    std::optional<surface::FittedCurve> fitted;
+    BSplineCurve out;
+    if (c.curve) {
+      out = *c.curve;
+    } else if (!c.mirror_of.empty()) {
+      out = surface::mirrored(curve_of(c.mirror_of), c.plane.origin, c.plane.normal);
+    } else if (!c.reversed_of.empty()) {
+      out = surface::reversed(curve_of(c.reversed_of));
+    } else if (c.kind == "iso" || c.kind == "boundary") {
+      const BSplineSurface& s = surface_of(c.surface);
+      const auto [a, b] = c.fixed_u ? s.u.domain() : s.v.domain();
+      const double t = c.at == 1.0 ? b : a + c.at * (b - a);
+      out = c.fixed_u ? surface::iso_curve_u(s, t) : surface::iso_curve_v(s, t);
+    } else {
+      const BSplineSurface& s = surface_of(c.surface);
+      fitted = in_recipe_words({{"CurveFitOptions::tolerance_mm", "\"tolerance\""},
+                                {"max_control_points", "its limit of control points"},
+                                {"raise the tolerance", "raise \"tolerance\""}},
+                               [&] {
+                                 return c.kind == "project"
+                                            ? surface::project_curve(curve_of(c.source), s, c.fit)
+                                            : surface::offset_along_normal(curve_of(c.source), s,
+                                                                           c.distance, c.fit);
+                               });
+      out = fitted->curve;
+    }
     rep.figures = {{"degree", static_cast<long long>(out.basis.degree)},
                    {"control_points", static_cast<long long>(out.points.rows())},
                    {"rational", out.is_rational()}};
+    if (fitted) {
+      rep.figures.emplace_back("max_deviation_mm", fitted->max_deviation_mm);
+      rep.figures.emplace_back("tolerance_mm", c.fit.tolerance_mm);
+      rep.message = c.kind + " of '" + c.source + "' on '" + c.surface + "' within " +
+                    format("%.3g", fitted->max_deviation_mm) + " mm (" +
+                    std::to_string(fitted->samples) + " samples)";
+    }
     add_curve(c.name, std::move(out));
   }
 

@@ -1472,3 +1472,78 @@ TEST_CASE("a plane may be given by origin and normal", "[recipe]") {
   INFO(dump(zero));
   CHECK(mentions(zero, "strokes.s.plane", "normal"));
 }
+
+TEST_CASE("curves taken from a surface: boundary, iso, projection and normal offset", "[recipe]") {
+  // The lid is filled from the dome's boundaries: the run builds dome, then its edges, then lid.
+  const std::string text = recipe_with(R"(, "lid": {"fill": {"curves": ["e0", "e1", "e2", "e3"]}})",
+                                       R"("curves": {
+        "e0": {"boundary": {"surface": "dome", "edge": "v0"}},
+        "e1": {"boundary": {"surface": "dome", "edge": "u1"}},
+        "e2": {"boundary": {"surface": "dome", "edge": "v1"}},
+        "e3": {"boundary": {"surface": "dome", "edge": "u0"}},
+        "mid": {"iso": {"surface": "dome", "u": 0.25}},
+        "drop": {"line": {"from": [20, 30, 60], "to": [80, 65, 60]}},
+        "shadow": {"project": {"curve": "drop", "surface": "dome", "tolerance": 0.001}},
+        "lifted": {"offset": {"curve": "mid", "surface": "dome", "distance": 5,
+                              "tolerance": 0.001}}})");
+  INFO(dump(check_recipe(text)));
+  const auto result = run_recipe(parse_recipe(text));
+  const auto parent = dome();
+  auto curve = [&](const char* name) -> const surface::BSplineCurve& { return result.curve(name); };
+  double edges = 0, iso = 0, lifted = 0;
+  for (double t : surface::linspace(0, 1, 201)) {
+    edges = std::max(
+        {edges, (surface::evaluate(curve("e0"), t) - surface::evaluate(parent, t, 0)).norm(),
+         (surface::evaluate(curve("e1"), t) - surface::evaluate(parent, 1, t)).norm(),
+         (surface::evaluate(curve("e2"), t) - surface::evaluate(parent, t, 1)).norm(),
+         (surface::evaluate(curve("e3"), t) - surface::evaluate(parent, 0, t)).norm()});
+    iso = std::max(
+        iso, (surface::evaluate(curve("mid"), t) - surface::evaluate(parent, 0.25, t)).norm());
+    // Offset of a curve on the surface: the point plus 5 mm along the unit normal there.
+    const Eigen::Vector3d expected =
+        surface::evaluate(parent, 0.25, t) + 5 * surface::unit_normal(parent, 0.25, t);
+    lifted = std::max(lifted, (surface::evaluate(curve("lifted"), t) - expected).norm());
+  }
+  CHECK(edges <= 1e-12 * 100);
+  CHECK(iso <= 1e-12 * 100);
+  CHECK(lifted <= 1e-3);
+  // The lid's edges are the dome's (the fill is exact): the same corners and mid-edge points.
+  const auto& lid = result.surface("lid");
+  for (double t : {0.0, 0.37, 1.0})
+    CHECK((surface::evaluate(lid, t, 0) - surface::evaluate(parent, t, 0)).norm() <= 1e-9);
+  // The projection, against a brute-force nearest point on a 301 x 301 grid of the dome: each
+  // projected point lies on the dome and is at least as near to the line's point.
+  const std::vector<double> g = surface::linspace(0, 1, 301);
+  const surface::Points3 grid = surface::evaluate_grid(parent, g, g);
+  for (double t : surface::linspace(0, 1, 21)) {
+    const Eigen::Vector3d q = surface::evaluate(curve("drop"), t);
+    const Eigen::Vector3d p = surface::evaluate(curve("shadow"), t);
+    double nearest = 1e300;
+    for (Eigen::Index r = 0; r < grid.rows(); ++r)
+      nearest = std::min(nearest, (grid.row(r).transpose() - q).norm());
+    CHECK((q - p).norm() <= nearest + 1e-3);
+    double on = 1e300;
+    for (Eigen::Index r = 0; r < grid.rows(); ++r)
+      on = std::min(on, (grid.row(r).transpose() - p).norm());
+    CHECK(on <= 0.5);  // the grid's spacing is 0.33 mm
+  }
+  const auto* step = &result.steps.front();
+  for (const auto& s : result.steps)
+    if (s.path == "curves.shadow") step = &s;
+  CHECK(step->path == "curves.shadow");
+  // Problems at their paths: a loop of needs, a surface that does not exist, an iso without u/v.
+  const std::string loop = recipe_with(R"(, "lid": {"fill": {"curves": ["e0", "e1", "e2"]}})",
+                                       R"("curves": {
+        "e0": {"boundary": {"surface": "lid", "edge": "v0"}},
+        "e1": {"line": {"from": [100, 0, 0], "to": [50, 100, 0]}},
+        "e2": {"line": {"from": [50, 100, 0], "to": [0, 0, 0]}},
+        "nowhere": {"iso": {"surface": "roof", "v": 0.5}},
+        "both": {"iso": {"surface": "dome", "u": 0.5, "v": 0.5}},
+        "far": {"iso": {"surface": "dome", "u": 1.5}}})");
+  const auto problems = check_recipe(loop);
+  INFO(dump(problems));
+  CHECK(mentions(problems, "curves.e0", "need each other"));
+  CHECK(mentions(problems, "curves.nowhere.iso.surface", "no surface named \"roof\""));
+  CHECK(mentions(problems, "curves.both.iso", "give \"u\" or \"v\""));
+  CHECK(mentions(problems, "curves.far.iso.u", "1.5"));
+}
