@@ -5,6 +5,7 @@
 #include <clay/recipe/recipe.hpp>
 #include <clay/render/render.hpp>
 #include <clay/serve.hpp>
+#include <clay/surface/tessellate.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -315,6 +316,61 @@ int render_picture(const fs::path& file, const fs::path& png, clay::render::Rend
   return 0;
 }
 
+/// The surfaces of a run as one model mesh (a face per surface, body -1), for render_mesh and
+/// facing_eye.
+clay::brep::ModelMesh mesh_of(const std::vector<BSplineSurface>& surfaces) {
+  clay::brep::ModelMesh mesh;
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    const clay::surface::GridMesh g = clay::surface::tessellate(surfaces[k], 8, 401);
+    const int first = static_cast<int>(mesh.positions.size());
+    for (Eigen::Index r = 0; r < g.positions.rows(); ++r) {
+      mesh.positions.push_back(g.positions.row(r).transpose());
+      mesh.normals.push_back(g.normals.row(r).transpose());
+      mesh.uv.emplace_back(g.us[static_cast<std::size_t>(r / g.cols)],
+                           g.vs[static_cast<std::size_t>(r % g.cols)]);
+      mesh.node_face.push_back(static_cast<int>(k));
+    }
+    for (int i = 0; i + 1 < g.rows; ++i)
+      for (int j = 0; j + 1 < g.cols; ++j)
+        for (auto t : clay::surface::cell_triangles(g, i, j)) {
+          for (int& c : t) c += first;
+          mesh.triangles.push_back(t);
+          mesh.triangle_face.push_back(static_cast<int>(k));
+        }
+    mesh.face_body.push_back(static_cast<int>(k));  // a colour per surface
+    mesh.face_colours.emplace_back();
+  }
+  return mesh;
+}
+
+/// `clayform render RECIPE.json --png OUT.png`: runs the recipe (nothing written) and pictures
+/// its final surfaces (those no deform step takes as parent) with its named curves over them.
+int render_recipe(const fs::path& file, const fs::path& png, clay::render::RenderOptions options,
+                  bool eye_given, bool curves) {
+  const auto recipe = clay::recipe::load_recipe(file);
+  const auto result = clay::recipe::run_recipe(recipe, {});
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<std::string> names = clay::recipe::final_surfaces(recipe);
+  std::vector<BSplineSurface> surfaces;
+  for (const auto& n : names) surfaces.push_back(result.surface(n));
+  if (surfaces.empty())
+    throw clay::Error(
+        clay::ErrorCategory::InvalidArgument,
+        "render: the recipe " + file.string() + " builds no surface; add one under \"surfaces\"");
+  std::vector<clay::surface::BSplineCurve> drawn;
+  if (curves)
+    for (const auto& [n, c] : result.curves) drawn.push_back(c);
+  const clay::brep::ModelMesh mesh = mesh_of(surfaces);
+  if (!eye_given) options.eye_direction = clay::render::facing_eye(mesh, options.eye_direction);
+  const clay::render::Image image = clay::render::render_mesh(mesh, options, surfaces, drawn);
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  clay::render::write_png(image, png);
+  std::printf("%s: %zu surface(s), %zu curve(s) -> %s (%d x %d, %.0f ms)\n", file.string().c_str(),
+              surfaces.size(), drawn.size(), png.string().c_str(), image.width, image.height, ms);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -361,10 +417,13 @@ int main(int argc, char** argv) {
   clay::render::RenderOptions render_options;
   auto* render_cmd = app.add_subcommand(
       "render",
-      "Write a PNG picture of the model of a STEP or IGES file: trimmed faces (holes are "
-      "holes) in the file's colours, orthographic view fitted to the model, shading with a soft "
-      "highlight");
-  render_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
+      "Write a PNG picture of the model of a STEP or IGES file (trimmed faces, holes are "
+      "holes, in the file's colours), or of what a recipe builds with its curves drawn over "
+      "it: orthographic view fitted to the model, shading with a soft highlight");
+  render_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file, or a recipe (.json)")
+      ->required();
+  bool no_curves = false;
+  render_cmd->add_flag("--no-curves", no_curves, "a recipe: do not draw its curves");
   render_cmd->add_option("--png", png_file, "the picture to write (.png)")->required();
   render_cmd->add_option("--width", render_options.width, "picture width in pixels [16, 4096]")
       ->capture_default_str();
@@ -433,6 +492,8 @@ int main(int argc, char** argv) {
     if (*info_cmd) return info(file);
     if (*render_cmd) {
       if (!eye.empty()) render_options.eye_direction = {eye[0], eye[1], eye[2]};
+      if (fs::path(file).extension() == ".json")
+        return render_recipe(file, png_file, render_options, !eye.empty(), !no_curves);
       return render_picture(file, png_file, render_options, !eye.empty(), mesh_options);
     }
     if (*view_cmd) {

@@ -782,6 +782,19 @@ RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
   return result;
 }
 
+std::vector<std::string> final_surfaces(const Recipe& recipe) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "final_surfaces: empty recipe; load or parse one first");
+  std::set<std::string> parents;
+  for (const SurfaceDef& s : recipe.data->surfaces)
+    if (const auto* d = std::get_if<DeformDef>(&s.build)) parents.insert(d->surface);
+  std::vector<std::string> out;
+  for (const SurfaceDef& s : recipe.data->surfaces)
+    if (!parents.count(s.name)) out.push_back(s.name);
+  return out;
+}
+
 namespace {
 
 /// The recipe's deformation stack named `deformation`, or its only one when the name is empty.

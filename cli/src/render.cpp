@@ -144,8 +144,10 @@ struct Canvas {
   }
 
   /// A line `thick` samples wide, drawn over everything (a control net is seen through the
-  /// surface).
-  void line(const Vector3d& a, const Vector3d& b, int thick, const Rgb& c) {
+  /// surface), or, with a `hidden` depth margin, only where no surface lies nearer the eye by
+  /// more than that margin.
+  void line(const Vector3d& a, const Vector3d& b, int thick, const Rgb& c,
+            double hidden = std::numeric_limits<double>::infinity()) {
     const int steps =
         static_cast<int>(std::ceil(std::max(std::abs(b.x() - a.x()), std::abs(b.y() - a.y())))) + 1;
     for (int k = 0; k <= steps; ++k) {
@@ -153,7 +155,14 @@ struct Canvas {
       const int x = static_cast<int>(std::floor(p.x() - 0.5 * (thick - 1)));
       const int y = static_cast<int>(std::floor(p.y() - 0.5 * (thick - 1)));
       for (int dy = 0; dy < thick; ++dy)
-        for (int dx = 0; dx < thick; ++dx) put(x + dx, y + dy, c);
+        for (int dx = 0; dx < thick; ++dx) {
+          const int px = x + dx, py = y + dy;
+          if (px < 0 || py < 0 || px >= width || py >= height) continue;
+          if (std::isfinite(hidden) && depth[static_cast<size_t>(py) * static_cast<size_t>(width) +
+                                             static_cast<size_t>(px)] > p.z() + hidden)
+            continue;
+          put(px, py, c);
+        }
     }
   }
 };
@@ -203,7 +212,7 @@ struct Batch {
 /// The picture of `batches` (and of the control nets of `nets` when asked): the camera fitted to
 /// everything drawn, z-buffered Phong shading, supersamples averaged.
 Image draw(const std::vector<Batch>& batches, const std::vector<surface::BSplineSurface>& nets,
-           const RenderOptions& options) {
+           const std::vector<std::vector<Vector3d>>& polylines, const RenderOptions& options) {
   const int f = options.supersample ? 2 : 1;
   Canvas cv{f * options.width,
             f * options.height,
@@ -230,6 +239,8 @@ Image draw(const std::vector<Batch>& batches, const std::vector<surface::BSpline
   if (options.control_net)
     for (const auto& s : nets)
       for (Eigen::Index i = 0; i < s.points.rows(); ++i) grow(s.points.row(i).transpose());
+  for (const auto& line : polylines)
+    for (const Vector3d& p : line) grow(p);
   const Vector3d extent = hi - lo;
   const double room = 1 - 2 * options.margin;
   const double sx =
@@ -273,6 +284,9 @@ Image draw(const std::vector<Batch>& batches, const std::vector<surface::BSpline
           cv.line(at(i, j), at(i, j), 3 * f, options.net_colour);  // the control point
         }
     }
+  for (const auto& line : polylines)
+    for (size_t k = 0; k + 1 < line.size(); ++k)
+      cv.line(cv.project(line[k]), cv.project(line[k + 1]), 3 * f, options.curve_colour, 0.01);
 
   // Average f x f samples per pixel.
   Image image{options.width, options.height,
@@ -303,7 +317,21 @@ Rgb byte_colour(const brep::Colour& c) {
 
 }  // namespace
 
-Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderOptions& options) {
+/// Each curve as a polyline of 32 samples per knot span.
+std::vector<std::vector<Vector3d>> polylines_of(const std::vector<surface::BSplineCurve>& curves) {
+  std::vector<std::vector<Vector3d>> out;
+  for (size_t k = 0; k < curves.size(); ++k) {
+    surface::validate(curves[k], "render: curve #" + std::to_string(k));
+    const surface::Points3 p =
+        surface::evaluate_many(curves[k], surface::span_samples(curves[k].basis, 32));
+    auto& line = out.emplace_back();
+    for (Eigen::Index i = 0; i < p.rows(); ++i) line.push_back(p.row(i).transpose());
+  }
+  return out;
+}
+
+Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderOptions& options,
+             const std::vector<surface::BSplineCurve>& curves) {
   options.validate();
   if (surfaces.empty())
     throw Error(ErrorCategory::InvalidArgument, "render: no surfaces; give at least one");
@@ -326,7 +354,7 @@ Image render(const std::vector<surface::BSplineSurface>& surfaces, const RenderO
       }
     b.colours.assign(b.triangles.size(), base);
   }
-  return draw(batches, surfaces, options);
+  return draw(batches, surfaces, polylines_of(curves), options);
 }
 
 Vector3d facing_eye(const brep::ModelMesh& mesh, const Vector3d& eye) {
@@ -359,7 +387,8 @@ Vector3d facing_eye(const brep::ModelMesh& mesh, const Vector3d& eye) {
 }
 
 Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options,
-                  const std::vector<surface::BSplineSurface>& control_nets) {
+                  const std::vector<surface::BSplineSurface>& control_nets,
+                  const std::vector<surface::BSplineCurve>& curves) {
   options.validate();
   if (mesh.triangles.empty())
     throw Error(ErrorCategory::InvalidArgument, "render_mesh: the mesh has no triangles");
@@ -395,7 +424,7 @@ Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options,
                         : own                    ? byte_colour(*own)
                                                  : palette(body));
   }
-  return draw({b}, control_nets, options);
+  return draw({b}, control_nets, polylines_of(curves), options);
 }
 
 void write_png(const Image& image, const fs::path& file) {

@@ -19,10 +19,30 @@ foreach(file sample.step sample.igs)
     message(FATAL_ERROR "clayform render ${file}: ${png} starts with ${head}, not a 320 x 200 PNG")
   endif()
 endforeach()
+# A recipe: run, its final surface pictured with its 5 curves drawn over it.
+set(png ${DIR}/sail.png)
+file(REMOVE ${png})
+execute_process(COMMAND ${CLAYFORM} render ${RECIPE} --png ${png} --width 320 --height 200
+  OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "1 surface\\(s\\), 5 curve\\(s\\) -> .*\\(320 x 200, [0-9]+ ms\\)")
+  message(FATAL_ERROR "clayform render ${RECIPE} exited ${rc}: ${out}${err}")
+endif()
+file(READ ${png} head LIMIT 24 HEX)
+if(NOT head STREQUAL "89504e470d0a1a0a0000000d4948445200000140000000c8")
+  message(FATAL_ERROR "clayform render ${RECIPE}: ${png} starts with ${head}, not a 320 x 200 PNG")
+endif()
+# A JSON file that is not a recipe: the recipe's problem, exit 7.
 execute_process(COMMAND ${CLAYFORM} render ${DIR}/report.json --png ${DIR}/report.png
   OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+if(NOT rc EQUAL 7 OR NOT err MATCHES "format")
+  message(FATAL_ERROR "clayform render on a JSON file that is no recipe: exit ${rc}, stderr '${err}'")
+endif()
+# A file of another kind: exit 2.
+file(WRITE ${DIR}/notes.txt "not a model")
+execute_process(COMMAND ${CLAYFORM} render ${DIR}/notes.txt --png ${DIR}/notes.png
+  OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
 if(NOT rc EQUAL 2 OR NOT err MATCHES "give a .step/.stp or .igs/.iges file")
-  message(FATAL_ERROR "clayform render on a JSON file: exit ${rc}, stderr '${err}'")
+  message(FATAL_ERROR "clayform render on a text file: exit ${rc}, stderr '${err}'")
 endif()
 execute_process(COMMAND ${CLAYFORM} render ${DIR}/sample.step --png ${DIR}/missing/sample.png
   OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)

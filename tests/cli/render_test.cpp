@@ -254,6 +254,36 @@ TEST_CASE("render: the control net is drawn along its lines only", "[render]") {
   CHECK(darkest < 150);
 }
 
+TEST_CASE("render: curves are drawn over the surface along their projection, hidden behind it",
+          "[render]") {
+  // The plate [0, 2] x [0, 1] at z = 0 from above (80 px per unit, centred at column 120, row
+  // 50). A line on the plate at y = 0.5 from x = 0.25 to 1.75 (row 50, columns 60 to 180), and
+  // one under it at z = -0.2 along x = 1 (column 120): hidden by the plate.
+  RenderOptions o = top_view();
+  o.supersample = false;
+  surface::Points3 on(2, 3), under(2, 3);
+  on << 0.25, 0.5, 0, 1.75, 0.5, 0;
+  under << 1, 0.1, -0.2, 1, 0.9, -0.2;
+  const auto line = [](const surface::Points3& p) {
+    return surface::make_curve(1, {0, 0, 1, 1}, p);
+  };
+  const Image plain = render({plate(0, 2, 0, 1, 0)}, o);
+  const Image drawn = render({plate(0, 2, 0, 1, 0)}, o, {line(on), line(under)});
+  int changed = 0;
+  for (int y = 0; y < 100; ++y)
+    for (int x = 0; x < 240; ++x)
+      if (!same(plain.pixel(x, y), drawn.pixel(x, y))) {
+        ++changed;
+        CHECK(same(drawn.pixel(x, y), o.curve_colour));
+        // Only along the visible line: rows 49..51, columns 59..181.
+        if (!(y >= 48 && y <= 52 && x >= 58 && x <= 182))
+          FAIL("pixel " << x << ", " << y << " changed away from the visible curve");
+      }
+  CHECK(changed >= 3 * 118);
+  CHECK(same(drawn.pixel(120, 50), o.curve_colour));
+  CHECK(same(drawn.pixel(120, 20), plain.pixel(120, 20)));  // the hidden line's column
+}
+
 TEST_CASE("render: write_png writes the pixels that libpng reads back, and no temporary file",
           "[render]") {
   const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "render";

@@ -157,6 +157,11 @@ struct CLAY_RECIPE_API RunResult {
 /// failing step's path first ("surfaces.sail.steps[2] (twist): ...") and that step's category.
 CLAY_RECIPE_API RunResult run_recipe(const Recipe& recipe, const RunOptions& options = {});
 
+/// The recipe's surfaces that no "deform" surface takes as its parent, in document order: what
+/// a picture of the design shows (a styled hood, not also the hood before styling). Throws
+/// clay::Error(InvalidArgument) for an empty recipe.
+CLAY_RECIPE_API std::vector<std::string> final_surfaces(const Recipe& recipe);
+
 /// Applies the recipe's deformation stack `deformation` (may be empty when the recipe has
 /// exactly one) to each of `surfaces` with the recipe's composition mode: the "clayform deform"
 /// use. The result's surfaces are named "<stem>-<k>" (k from 0) and one export "<stem>" holds

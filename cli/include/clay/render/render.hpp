@@ -5,6 +5,7 @@
 /// models by brep::tessellate.
 #include <clay/brep/exchange.hpp>
 #include <clay/render/export.hpp>
+#include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
 #include <Eigen/Core>
@@ -36,7 +37,8 @@ struct CLAY_RENDER_API RenderOptions {
   bool control_net = false;  ///< draw each control net (lines and points) over the surfaces
   bool supersample = true;   ///< 2 x 2 samples per pixel, averaged (anti-aliasing)
   Rgb background{255, 255, 255};
-  Rgb net_colour{40, 40, 40};  ///< colour of the control net
+  Rgb net_colour{40, 40, 40};     ///< colour of the control net
+  Rgb curve_colour{200, 30, 30};  ///< colour of the curves drawn over the surfaces
   /// Base colour of surface k is colours[k % colours.size()]; empty: a palette with a distinct hue
   /// per surface (golden-angle hue steps from blue).
   std::vector<Rgb> colours;
@@ -74,10 +76,16 @@ struct CLAY_RENDER_API Image {
 /// plus a soft Blinn–Phong highlight of the key light (exponent 50, strength 0.35) so that the
 /// highlight bands show curvature and its breaks.
 ///
+/// `curves` are drawn over the surfaces in options.curve_colour, 3 pixels wide, as polylines of
+/// 32 samples per knot span; a curve point is hidden where a surface lies in front of it by more
+/// than 1 % of the model's depth (a curve on the surface shows, one behind it does not). They
+/// count in the fit.
+///
 /// Throws clay::Error: InvalidArgument for bad options or no surfaces, InvalidGeometry for an
-/// invalid surface (surface::validate).
+/// invalid surface (surface::validate) or curve.
 CLAY_RENDER_API Image render(const std::vector<surface::BSplineSurface>& surfaces,
-                             const RenderOptions& options = {});
+                             const RenderOptions& options = {},
+                             const std::vector<surface::BSplineCurve>& curves = {});
 
 /// Pictures a whole model's mesh (brep::tessellate: trimmed faces, holes are holes) with the
 /// same camera, fit and shading as render(). Each triangle's base colour is
@@ -85,8 +93,10 @@ CLAY_RENDER_API Image render(const std::vector<surface::BSplineSurface>& surface
 /// (its own or its body's), else the palette's colour of its body. The control nets of
 /// `control_nets` are drawn over it when options.control_net is set. Throws clay::Error
 /// (InvalidArgument) for bad options or a mesh whose arrays disagree.
+/// `curves` are drawn as by render().
 CLAY_RENDER_API Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options = {},
-                                  const std::vector<surface::BSplineSurface>& control_nets = {});
+                                  const std::vector<surface::BSplineSurface>& control_nets = {},
+                                  const std::vector<surface::BSplineCurve>& curves = {});
 
 /// The direction to picture `mesh` from so that an open sheet shows its front: `eye` itself for a
 /// closed or nearly closed model (the area-weighted sum of its triangles' outward normals below a
