@@ -10,7 +10,7 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
   const std::size_t before = c_.problems.size();
   if (one_of(j, path,
              {"bspline", "fill", "skin", "sweep", "revolve", "superellipsoid", "supertoroid",
-              "import", "deform", "mirror"},
+              "import", "deform", "mirror", "rebuild"},
              "a surface", def.kind)) {
     const Json& v = j.at(def.kind);
     const std::string p = key_path(path, def.kind);
@@ -139,6 +139,20 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
         if (const Json* m = c_.member(v, p, "surface", true, "the name of an earlier surface"))
           d.surface = surface_ref(*m, key_path(p, "surface")).value_or("");
         if (const auto plane = mirror_plane(v, p)) d.plane = *plane;
+      }
+      def.build = d;
+    } else if (def.kind == "rebuild") {
+      RebuildDef d;
+      if (c_.object(v, p, {"surface", "count_u", "count_v", "degree", "tolerance"},
+                    "a rebuild {surface, count_u, count_v, degree, tolerance}")) {
+        if (const Json* m = c_.member(v, p, "surface", true, "the name of an earlier surface"))
+          d.surface = surface_ref(*m, key_path(p, "surface")).value_or("");
+        d.degree = c_.integer_or(v, p, "degree", 3, 1, surface::max_exchange_degree);
+        for (auto [key, count] :
+             {std::pair{"count_u", &d.count_u}, std::pair{"count_v", &d.count_v}})
+          if (const Json* m = c_.member(v, p, key, true, "control points in that direction"))
+            *count = c_.integer(*m, key_path(p, key), d.degree + 1, 1000).value_or(0);
+        d.tolerance = c_.number_or(v, p, "tolerance", d.tolerance, Range{1e-9, 1e-1});
       }
       def.build = d;
     } else {  // deform

@@ -134,10 +134,17 @@ struct MirrorDef {
   MirrorPlane plane;
 };
 
+/// "rebuild": the surface refitted on a fixed, uniform net (deform::refit_surface with counts).
+struct RebuildDef {
+  std::string surface;
+  int count_u = 0, count_v = 0, degree = 3;
+  double tolerance = 1e-3;  ///< relative to the surface's size
+};
+
 struct SurfaceDef {
   std::string name, path, kind;
   std::variant<surface::BSplineSurface, FillDef, SkinDef, SweepDef, RevolveDef, SuperellipsoidDef,
-               SupertoroidDef, ImportDef, DeformDef, MirrorDef>
+               SupertoroidDef, ImportDef, DeformDef, MirrorDef, RebuildDef>
       build;
 };
 

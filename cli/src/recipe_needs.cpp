@@ -49,7 +49,7 @@ Needs surface_needs(const RecipeData& d, const SurfaceDef& def) {
           add(n.curves, b.path);
         } else if constexpr (std::is_same_v<T, RevolveDef>) {
           add(n.curves, b.profile);
-        } else if constexpr (std::is_same_v<T, MirrorDef>) {
+        } else if constexpr (std::is_same_v<T, MirrorDef> || std::is_same_v<T, RebuildDef>) {
           add(n.surfaces, b.surface);
         } else if constexpr (std::is_same_v<T, DeformDef>) {
           add(n.surfaces, b.surface);

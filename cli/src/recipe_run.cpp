@@ -534,6 +534,30 @@ class Runner {
               build_figures(surface::describe(all[static_cast<std::size_t>(b.index)], "import"),
                             rep);
               return std::move(all[static_cast<std::size_t>(b.index)]);
+            } else if constexpr (std::is_same_v<T, RebuildDef>) {
+              deform::RefitOptions o;
+              o.degree = b.degree;
+              o.count_u = b.count_u;
+              o.count_v = b.count_v;
+              o.tolerance = b.tolerance;
+              const auto fit = deform::refit_surface(surface_of(b.surface), o);
+              const auto& r = fit.report;
+              surface::BuildReport built = surface::describe(
+                  fit.surface, "rebuild of '" + b.surface + "' on " + std::to_string(b.count_u) +
+                                   " x " + std::to_string(b.count_v) + " control points");
+              built.max_deviation_mm = r.certified ? r.certified_bound : r.sampled_max;
+              built.samples = static_cast<int>(std::min<long>(r.samples, 1L << 30));
+              build_figures(built, rep);
+              rep.figures.emplace_back("certified_bound_mm", r.certified_bound);
+              rep.figures.emplace_back("sampled_max_mm", r.sampled_max);
+              rep.figures.emplace_back("tolerance_mm", r.tolerance);
+              rep.message = r.brief();
+              if (!r.summary.converged())
+                throw Error(ErrorCategory::ToleranceNotMet,
+                            "the rebuilt net misses its tolerance (" + r.summary.message +
+                                "): raise \"count_u\" and \"count_v\", \"tolerance\" or "
+                                "\"degree\"");
+              return fit.surface;
             } else if constexpr (std::is_same_v<T, MirrorDef>) {
               BSplineSurface m =
                   surface::mirrored(surface_of(b.surface), b.plane.origin, b.plane.normal);
@@ -788,7 +812,10 @@ std::vector<std::string> final_surfaces(const Recipe& recipe) {
                 "final_surfaces: empty recipe; load or parse one first");
   std::set<std::string> parents;
   for (const SurfaceDef& s : recipe.data->surfaces)
-    if (const auto* d = std::get_if<DeformDef>(&s.build)) parents.insert(d->surface);
+    if (const auto* d = std::get_if<DeformDef>(&s.build))
+      parents.insert(d->surface);
+    else if (const auto* r = std::get_if<RebuildDef>(&s.build))
+      parents.insert(r->surface);
   std::vector<std::string> out;
   for (const SurfaceDef& s : recipe.data->surfaces)
     if (!parents.count(s.name)) out.push_back(s.name);

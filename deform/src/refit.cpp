@@ -365,8 +365,15 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
   report.tolerance = tolerance;
   report.size = size;
   report.degree_u = report.degree_v = p;
-  BSplineBasis bu = initial_basis(surface.u, p, options.keep_breakpoints),
-               bv = initial_basis(surface.v, p, options.keep_breakpoints);
+  const bool fixed = options.count_u > 0;
+  BSplineBasis bu = fixed ? surface::clamped_uniform_basis(p, options.count_u,
+                                                           surface.u.domain().first,
+                                                           surface.u.domain().second)
+                          : initial_basis(surface.u, p, options.keep_breakpoints),
+               bv = fixed ? surface::clamped_uniform_basis(p, options.count_v,
+                                                           surface.v.domain().first,
+                                                           surface.v.domain().second)
+                          : initial_basis(surface.v, p, options.keep_breakpoints);
   const std::size_t initial_u = bu.knots.size(), initial_v = bv.knots.size();
   std::string limit;
   for (int iteration = 1;; ++iteration) {
@@ -411,6 +418,11 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
       report.summary.termination = Termination::Converged;
       break;
     }
+    if (fixed) {
+      limit = "the fixed net of " + std::to_string(options.count_u) + " x " +
+              std::to_string(options.count_v) + " control points (count_u, count_v)";
+      break;
+    }
     if (iteration >= options.max_iterations) {
       limit = "iteration limit " + std::to_string(options.max_iterations) + " reached";
       break;
@@ -447,7 +459,9 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
               (report.certified ? "certified bound " + short_format(report.certified_bound)
                                 : "sampled maximum " + short_format(report.sampled_max)) +
               " mm above the tolerance " + short_format(tolerance) +
-              " mm; raise the limits, the tolerance or the degree";
+              (fixed ? " mm; give more control points (count_u, count_v), a larger tolerance or a "
+                       "higher degree"
+                     : " mm; raise the limits, the tolerance or the degree");
   }
   if (!report.certified) {
     message += "; not certified: ";
@@ -481,6 +495,14 @@ std::vector<std::string> RefitOptions::problems() const {
   if (max_count_per_direction < degree + 1)
     fail("max_count_per_direction = " + std::to_string(max_count_per_direction) +
          ": must be >= degree + 1 = " + std::to_string(degree + 1));
+  if ((count_u > 0) != (count_v > 0) || count_u < 0 || count_v < 0)
+    fail("count_u = " + std::to_string(count_u) + ", count_v = " + std::to_string(count_v) +
+         ": give both (a fixed net) or neither (0, adaptive)");
+  else if (count_u > 0 && (std::min(count_u, count_v) < degree + 1 ||
+                           std::max(count_u, count_v) > max_count_per_direction))
+    fail("count_u = " + std::to_string(count_u) + ", count_v = " + std::to_string(count_v) +
+         ": each must be in [degree + 1, max_count_per_direction] = [" +
+         std::to_string(degree + 1) + ", " + std::to_string(max_count_per_direction) + "]");
   if (!(certificate_share > 0 && certificate_share < 1))
     fail("certificate_share = " + format(certificate_share) + ": must be in (0, 1), e.g. 0.1");
   return out;

@@ -1547,3 +1547,40 @@ TEST_CASE("curves taken from a surface: boundary, iso, projection and normal off
   CHECK(mentions(problems, "curves.both.iso", "give \"u\" or \"v\""));
   CHECK(mentions(problems, "curves.far.iso.u", "1.5"));
 }
+
+TEST_CASE("rebuild refits a surface on a fixed uniform net, certified", "[recipe]") {
+  const std::string text = recipe_with(
+      R"(, "even": {"rebuild": {"surface": "dome", "count_u": 9, "count_v": 7, "tolerance": 1e-3}})",
+      "");
+  INFO(dump(check_recipe(text)));
+  const auto result = run_recipe(parse_recipe(text));
+  const auto& even = result.surface("even");
+  CHECK(even.u.count() == 9);
+  CHECK(even.v.count() == 7);
+  CHECK(even.u.knots == surface::clamped_uniform_basis(3, 9).knots);
+  double bound = -1, tolerance = -1;
+  for (const auto& s : result.steps)
+    if (s.path == "surfaces.even")
+      for (const auto& [key, value] : s.figures) {
+        if (key == "certified_bound_mm") bound = std::get<double>(value);
+        if (key == "tolerance_mm") tolerance = std::get<double>(value);
+      }
+  REQUIRE(bound > 0);
+  CHECK(bound <= tolerance);
+  // The bound holds against the dome at parameters the fit did not use.
+  const auto parent = dome();
+  CHECK(max_gap(even, [&](double u, double v) { return surface::evaluate(parent, u, v); }) <=
+        bound);
+  CHECK(final_surfaces(parse_recipe(text)) == std::vector<std::string>{"even"});
+  // Too coarse for the tolerance: the step fails and names what to raise.
+  const std::string coarse = recipe_with(
+      R"(, "even": {"rebuild": {"surface": "dome", "count_u": 4, "count_v": 4, "tolerance": 1e-8}})",
+      "");
+  CHECK_THAT(error_of([&] { run_recipe(parse_recipe(coarse)); }).second,
+             Contains("surfaces.even") && Contains("count_u"));
+  const auto problems = check_recipe(
+      recipe_with(R"(, "even": {"rebuild": {"surface": "dome", "count_u": 2, "degree": 3}})", ""));
+  INFO(dump(problems));
+  CHECK(mentions(problems, "surfaces.even.rebuild.count_u", "2"));
+  CHECK(mentions(problems, "surfaces.even.rebuild.count_v", "missing"));
+}

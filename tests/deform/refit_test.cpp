@@ -172,6 +172,43 @@ TEST_CASE("refit_surface makes a small certified bicubic copy of a dense high-de
   CHECK(surface::multiplicity(copy.surface.u, 0.5) == 3);
 }
 
+TEST_CASE("refit_surface with a fixed net rebuilds on uniform knots, certified", "[refit]") {
+  // The loft (bicubic, joins at 1/3 and 2/3) rebuilt as 14 x 11 control points on uniform knots.
+  const surface::BSplineSurface parent = loft_surface();
+  RefitOptions options;
+  options.count_u = 14;
+  options.count_v = 11;
+  options.tolerance = 1e-3;
+  const RefitResult rebuilt = refit_surface(parent, options);
+  INFO(rebuilt.report.brief());
+  CHECK(rebuilt.surface.u.count() == 14);
+  CHECK(rebuilt.surface.v.count() == 11);
+  CHECK(rebuilt.surface.u.knots == surface::clamped_uniform_basis(3, 14).knots);
+  CHECK(rebuilt.report.knots_added_u == 0);
+  REQUIRE(rebuilt.report.certified);
+  // The certified bound holds at parameters the fit never sampled.
+  const double check = random_deviation(
+      parent, rebuilt.surface, [](const Eigen::Vector3d& x) { return x; }, 4000, 6);
+  INFO("independent check " << check << " mm");
+  CHECK(check <= rebuilt.report.certified_bound);
+  CHECK(rebuilt.report.summary.converged() ==
+        (rebuilt.report.certified_bound <= rebuilt.report.tolerance));
+  // Too few control points for a tight tolerance: not converged, and the message says what to
+  // raise; no knot is added to a fixed net.
+  options.count_u = options.count_v = 4;
+  options.tolerance = 1e-7;
+  const RefitResult coarse = refit_surface(parent, options);
+  CHECK(!coarse.report.summary.converged());
+  CHECK(coarse.surface.points.rows() == 16);
+  CHECK_THAT(coarse.report.summary.message, Contains("count_u, count_v"));
+  // Bad counts are named.
+  RefitOptions bad;
+  bad.count_u = 10;
+  CHECK_THAT(bad.problems().front(), Contains("give both"));
+  bad.count_v = 2;
+  CHECK_THAT(bad.problems().front(), Contains("[4, 1000]"));
+}
+
 TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor", "[refit]") {
   std::mt19937 rng(5);
   const Frame f = clay::test::random_frame(rng);

@@ -60,6 +60,12 @@ struct CLAY_DEFORM_API RefitOptions {
   /// with hundreds of smooth knots then refits to a small, editable net (the recipes'
   /// "editable" output uses false).
   bool keep_breakpoints = true;
+  /// > 0: a fixed net of count_u x count_v control points on uniform knots over the original's
+  /// domain (a rebuild: a regular, denser or lighter net), fitted once and certified, no knots
+  /// added (termination NotConverged when the bound misses the tolerance); 0: adaptive. Both or
+  /// neither, each in [degree + 1, max_count_per_direction].
+  int count_u = 0;
+  int count_v = 0;  ///< see count_u
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
