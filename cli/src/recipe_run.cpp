@@ -414,19 +414,25 @@ class Runner {
   template <class F>
   static auto by_names(const std::vector<std::string>& names, const std::string& word, F build) {
     try {
-      return build();
+      auto built = build();
+      built.report.method = named(built.report.method, names, word);
+      return built;
     } catch (const Error& e) {
-      std::string m = e.message();
-      const std::string tag = word + " #";
-      for (std::size_t at = m.find(tag); at != std::string::npos; at = m.find(tag, at + 1)) {
-        std::size_t end = at + tag.size();
-        while (end < m.size() && std::isdigit(static_cast<unsigned char>(m[end]))) ++end;
-        if (end == at + tag.size()) continue;
-        const std::size_t k = std::stoul(m.substr(at + tag.size(), end - at - tag.size()));
-        if (k < names.size()) m.replace(at, end - at, word + " \"" + names[k] + "\"");
-      }
-      throw Error(e.category(), m);
+      throw Error(e.category(), named(e.message(), names, word));
     }
+  }
+  /// `m` with every "WORD #k" replaced by WORD "names[k]".
+  static std::string named(std::string m, const std::vector<std::string>& names,
+                           const std::string& word) {
+    const std::string tag = word + " #";
+    for (std::size_t at = m.find(tag); at != std::string::npos; at = m.find(tag, at + 1)) {
+      std::size_t end = at + tag.size();
+      while (end < m.size() && std::isdigit(static_cast<unsigned char>(m[end]))) ++end;
+      if (end == at + tag.size()) continue;
+      const std::size_t k = std::stoul(m.substr(at + tag.size(), end - at - tag.size()));
+      if (k < names.size()) m.replace(at, end - at, word + " \"" + names[k] + "\"");
+    }
+    return m;
   }
 
   std::vector<BSplineCurve> curves_named(const std::vector<std::string>& names) const {

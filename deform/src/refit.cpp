@@ -58,11 +58,37 @@ using detail::Plane;
 
 // ---- surfaces: bases, fit, derivative bounds of Bézier patches --------------------------------
 
-/// The fit's basis in one direction: the original's breakpoints (or, without keep_breakpoints,
-/// those where the original is less smooth than C^p_fit), degree p_fit, and at each
+/// The largest jump of the third derivative across u = t (fixed_u) or v = t of `s`, over 9
+/// parameters of the other direction: one-sided differences of the second derivative, exact up
+/// to O(delta) inside each polynomial piece.
+double third_derivative_jump(const BSplineSurface& s, bool along_u, double t, double delta) {
+  const auto [a, b] = along_u ? s.v.domain() : s.u.domain();
+  double jump = 0;
+  for (double w : surface::linspace(a, b, 9)) {
+    auto second = [&](double x) {
+      const surface::SurfaceDerivatives d =
+          along_u ? surface::derivatives(s, x, w, 2) : surface::derivatives(s, w, x, 2);
+      return Eigen::Vector3d(along_u ? d.duu : d.dvv);
+    };
+    const Eigen::Vector3d here = second(t);
+    const Eigen::Vector3d right = (second(t + delta) - here) / delta;
+    const Eigen::Vector3d left = (here - second(t - delta)) / delta;
+    jump = std::max(jump, (right - left).norm());
+  }
+  return jump;
+}
+
+/// The fit's basis in one direction: the original's breakpoints, degree p_fit, and at each
 /// interior breakpoint the multiplicity that keeps the original's continuity C^(p − m) there
-/// (at least 1, at most p_fit).
-BSplineBasis initial_basis(const BSplineBasis& original, int degree, bool keep_breakpoints) {
+/// (at least 1, at most p_fit). Without keep_breakpoints, a breakpoint as smooth as the fit's own
+/// joins (C^(p_fit - 1) or smoother) is left out, except, for a cubic fit, a C2 join whose jump J
+/// of the third derivative a cubic without a knot there would feel: J h^3 above a tenth of the
+/// tolerance, h the shorter of its neighbouring spans (a loft's joins between few sections stay;
+/// the simple knots a style refinement or an exact composition piles up go, and the refinement
+/// adds knots only where the tolerance needs them).
+BSplineBasis initial_basis(const BSplineSurface& surface, bool along_u, int degree,
+                           bool keep_breakpoints, double tolerance) {
+  const BSplineBasis& original = along_u ? surface.u : surface.v;
   const std::vector<double> breaks = surface::breakpoints(original);
   BSplineBasis b;
   b.degree = degree;
@@ -70,6 +96,12 @@ BSplineBasis initial_basis(const BSplineBasis& original, int degree, bool keep_b
   for (std::size_t k = 1; k + 1 < breaks.size(); ++k) {
     const int continuity = original.degree - surface::multiplicity(original, breaks[k]);
     if (!keep_breakpoints && continuity >= degree) continue;  // smoother than a fit's join
+    if (!keep_breakpoints && continuity == degree - 1) {
+      if (degree != 3) continue;
+      const double h = std::min(breaks[k] - breaks[k - 1], breaks[k + 1] - breaks[k]);
+      const double jump = third_derivative_jump(surface, along_u, breaks[k], 1e-4 * h);
+      if (!(jump * h * h * h > 0.1 * tolerance)) continue;
+    }
     const int m = std::clamp(degree - continuity, 1, degree);
     b.knots.insert(b.knots.end(), static_cast<std::size_t>(m), breaks[k]);
   }
@@ -369,11 +401,11 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
   BSplineBasis bu = fixed ? surface::clamped_uniform_basis(p, options.count_u,
                                                            surface.u.domain().first,
                                                            surface.u.domain().second)
-                          : initial_basis(surface.u, p, options.keep_breakpoints),
+                          : initial_basis(surface, true, p, options.keep_breakpoints, tolerance),
                bv = fixed ? surface::clamped_uniform_basis(p, options.count_v,
                                                            surface.v.domain().first,
                                                            surface.v.domain().second)
-                          : initial_basis(surface.v, p, options.keep_breakpoints);
+                          : initial_basis(surface, false, p, options.keep_breakpoints, tolerance);
   const std::size_t initial_u = bu.knots.size(), initial_v = bv.knots.size();
   std::string limit;
   for (int iteration = 1;; ++iteration) {

@@ -272,14 +272,16 @@ namespace {
 
 // Parameter points over the region where net convergence compares shapes, and the parent there.
 struct ShapeGrid {
+  int n = 0;  // samples per direction over the region's box
   std::vector<Eigen::Vector2d> uv;
   std::vector<Eigen::Vector3d> parent;
 };
 
 template <class Inside>
 ShapeGrid shape_grid(const BSplineSurface& parent, const InfluenceRegion& region, Inside&& inside) {
-  constexpr int n = 41;
+  constexpr int n = 81;
   ShapeGrid grid;
+  grid.n = n;
   const Eigen::AlignedBox2d box = region_box(parent, region);
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) {
@@ -295,17 +297,43 @@ ShapeGrid shape_grid(const BSplineSurface& parent, const InfluenceRegion& region
   return grid;
 }
 
-// max |S_new - S_old| / max |S_new - parent| over the grid (0 where nothing moved).
-double shape_change(const ShapeGrid& grid, const BSplineSurface& old_shape,
-                    const BSplineSurface& new_shape) {
-  double change = 0, moved = 0;
+// |S_new - S_old| at every grid point, and the figure: max |S_new - S_old| / max |S_new - parent|
+// over the grid (0 where nothing moved).
+struct ShapeChange {
+  double relative = 0;
+  double moved = 0;
+  std::vector<double> at;  // per grid point, mm
+};
+ShapeChange shape_change(const ShapeGrid& grid, const BSplineSurface& old_shape,
+                         const BSplineSurface& new_shape) {
+  ShapeChange out;
+  double change = 0;
   for (size_t k = 0; k < grid.uv.size(); ++k) {
     const Eigen::Vector3d a = surface::evaluate(old_shape, grid.uv[k].x(), grid.uv[k].y());
     const Eigen::Vector3d b = surface::evaluate(new_shape, grid.uv[k].x(), grid.uv[k].y());
-    change = std::max(change, (b - a).norm());
-    moved = std::max(moved, (b - grid.parent[k]).norm());
+    out.at.push_back((b - a).norm());
+    change = std::max(change, out.at.back());
+    out.moved = std::max(out.moved, (b - grid.parent[k]).norm());
   }
-  return moved > 0 ? change / moved : 0.0;
+  out.relative = out.moved > 0 ? change / out.moved : 0.0;
+  return out;
+}
+
+// The knots that halve the spans of `basis` within `reach` of a parameter in `marked` (and inside
+// [lo, hi]): where the shape still changes, the net is refined; elsewhere it is left alone.
+std::vector<double> local_halving_knots(const surface::BSplineBasis& basis,
+                                        const std::vector<double>& marked, double reach, double lo,
+                                        double hi) {
+  std::vector<double> knots;
+  const auto breaks = surface::breakpoints(basis);
+  for (size_t k = 0; k + 1 < breaks.size(); ++k) {
+    if (!(breaks[k + 1] > lo && breaks[k] < hi)) continue;
+    const bool near = std::any_of(marked.begin(), marked.end(), [&](double t) {
+      return t + reach >= breaks[k] && t - reach <= breaks[k + 1];
+    });
+    if (near) knots.push_back(0.5 * (breaks[k] + breaks[k + 1]));
+  }
+  return knots;
 }
 
 }  // namespace
@@ -725,11 +753,39 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     // displacement (the energy is a Galerkin discretization of one functional, so the results
     // converge as the net is refined).
     if (options.net_convergence > 0) {
-      if (previous) report.net_change = shape_change(grid, *previous, out.surface);
+      ShapeChange change;
+      if (previous) {
+        change = shape_change(grid, *previous, out.surface);
+        report.net_change = change.relative;
+      }
       const bool settled = previous && report.net_change <= options.net_convergence;
       if (!settled && refinements < options.max_refinements) {
         previous = out.surface;
-        refine();
+        if (change.at.empty()) {
+          refine();  // the first comparison needs a halving everywhere
+        } else {
+          // Halve the spans near where the last halving still moved the surface by more than
+          // a quarter of net_convergence (the error concentrates at the free area's edge and
+          // the target's ends); elsewhere one more halving moves it by less.
+          const double limit = 0.25 * options.net_convergence * change.moved;
+          std::vector<double> mu, mv;
+          for (size_t k = 0; k < change.at.size(); ++k)
+            if (change.at[k] > limit) {
+              mu.push_back(grid.uv[k].x());
+              mv.push_back(grid.uv[k].y());
+            }
+          const Eigen::AlignedBox2d& box = refine_box;
+          const double du = box.sizes().x() / (grid.n - 1), dv = box.sizes().y() / (grid.n - 1);
+          const auto ku = local_halving_knots(s.u, mu, du, box.min().x(), box.max().x());
+          const auto kv = local_halving_knots(s.v, mv, dv, box.min().y(), box.max().y());
+          s = surface::refine_knots_u(s, ku);
+          s = surface::refine_knots_v(s, kv);
+          report.knots_inserted += static_cast<int>(ku.size() + kv.size());
+          ++refinements;
+          reg.count_u = s.count_u();
+          reg.count_v = s.count_v();
+          reg.factors = region_factors(s, reg.polygon, reg.target_trace, reg.margin);
+        }
         accepted_points = points.size();
         additions = 0;
         continue;

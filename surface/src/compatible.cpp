@@ -299,21 +299,39 @@ Attempt try_merge(const std::vector<BSplineCurve>& curves, const Break& from, do
           BSplineBasis refined = basis;
           std::vector<double> added;
           const int parts = 1 << level;
-          for (int j = 1; j < parts; ++j) {
-            added.push_back(r.lo + (r.to - r.lo) * j / parts);
-            added.push_back(r.to + (r.hi - r.to) * j / parts);
-          }
-          if (!added.empty()) {
-            std::vector<double> y;
-            for (double v : union_values)
-              if (std::abs(v - r.from) > tolerance::knot_relative) y.push_back(v);
-            y.insert(y.end(), added.begin(), added.end());
+          // The union without `from`: a new knot near one of its values takes that value (no new
+          // breakpoint); the others must not make a sliver with their neighbours.
+          std::vector<double> y;
+          for (double v : union_values)
+            if (std::abs(v - r.from) > tolerance::knot_relative) y.push_back(v);
+          std::vector<double> fresh;
+          for (const auto& [a, b] : {std::pair{r.lo, r.to}, std::pair{r.to, r.hi}})
+            for (int j = 1; j < parts; ++j) {
+              const double step = (b - a) / parts, t = a + step * j;
+              const auto near = std::min_element(y.begin(), y.end(), [&](double p, double q) {
+                return std::abs(p - t) < std::abs(q - t);
+              });
+              if (std::abs(*near - t) < 0.25 * step && *near > r.lo && *near < r.hi &&
+                  *near != r.to)
+                added.push_back(*near);
+              else
+                added.push_back(t), fresh.push_back(t);
+            }
+          if (!fresh.empty()) {
+            y.insert(y.end(), fresh.begin(), fresh.end());
             std::sort(y.begin(), y.end());
             const std::vector<double> ratio = span_ratios(y);
-            if (*std::min_element(ratio.begin(), ratio.end()) < min_span_ratio) break;
-            refined.knots.insert(refined.knots.end(), added.begin(), added.end());
-            std::sort(refined.knots.begin(), refined.knots.end());
+            bool sliver = false;
+            for (size_t i = 0; i < ratio.size(); ++i)
+              if (ratio[i] < min_span_ratio && (std::count(fresh.begin(), fresh.end(), y[i]) ||
+                                                std::count(fresh.begin(), fresh.end(), y[i + 1])))
+                sliver = true;
+            if (sliver) break;
           }
+          std::sort(added.begin(), added.end());
+          added.erase(std::unique(added.begin(), added.end()), added.end());
+          refined.knots.insert(refined.knots.end(), added.begin(), added.end());
+          std::sort(refined.knots.begin(), refined.knots.end());
           Fit moved = fit_on(c, refined, r);
           if (moved.deviation < fit.deviation) {
             fit = std::move(moved);

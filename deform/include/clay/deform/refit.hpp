@@ -54,10 +54,12 @@ struct CLAY_DEFORM_API RefitOptions {
   double certificate_share = 0.1;      ///< in (0, 1): share of the tolerance the certificate's
                                    ///< remainder may take when choosing each cell's sample density
   /// true: the fit starts from every breakpoint of the original, with its continuity; false:
-  /// only from those where the original is C^(degree - 1) or rougher (creases, C1 and C2 joins
-  /// for a cubic fit: a cubic cannot follow a jump of the third derivative without a knot
-  /// there), adding knots only where the tolerance needs them. An exact result of degree 12
-  /// with hundreds of smooth knots then refits to a small, editable net (the recipes'
+  /// only from those where the original is rougher than the fit's own joins, C^(degree - 1)
+  /// (creases and C1 joins for a cubic fit), and, for a cubic fit, from the C2 joins whose jump
+  /// of the third derivative a cubic would feel (J h^3 above a tenth of the tolerance, h the
+  /// shorter neighbouring span: a loft's joins between few sections), adding knots only where
+  /// the tolerance needs them. An exact result of degree 12 with hundreds of smooth knots (a
+  /// style refinement's simple knots) then refits to a small, editable net (the recipes'
   /// "editable" output uses false).
   bool keep_breakpoints = true;
   /// > 0: a fixed net of count_u x count_v control points on uniform knots over the original's
