@@ -14,6 +14,7 @@
 #include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
+#include <clay/surface/skin.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -524,4 +525,98 @@ TEST_CASE("example sail: key points added along the target do not wind the net u
   INFO("draft line missed by " << miss << " mm (" << miss / size << " of the size " << size
                                << " mm)");
   CHECK(miss <= 1e-3 * size);
+}
+
+TEST_CASE(
+    "example fender: strokes, a constrained door cut, a snapped fill, exact flare, lattice, "
+    "editable output",
+    "[examples]") {
+  const RunResult r = run_example("fender");
+  const Json j = recipe_json("fender");
+  const auto& panel = r.surface("panel");
+  const auto& fender = r.surface("fender");
+  const double size = diagonal(fender);
+
+  // The door cut: a cubic in the plane y = 0 from (1000, 0, 0) to (960, 0, 420), leaving the
+  // rocker vertically (tangent to the sill) and meeting the shoulder level (tangent to the header).
+  const auto& cut = r.curve("rear.cut");
+  for (Eigen::Index i = 0; i < cut.points.rows(); ++i) CHECK(std::abs(cut.points(i, 1)) < 1e-9);
+  CHECK((surface::evaluate(cut, 0.0) - Eigen::Vector3d(1000, 0, 0)).norm() < 1e-9);
+  CHECK((surface::evaluate(cut, 1.0) - Eigen::Vector3d(960, 0, 420)).norm() < 1e-9);
+  const Eigen::Vector3d t0 = surface::derivatives(cut, 0.0, 1).d1.normalized();
+  const Eigen::Vector3d t1 = surface::derivatives(cut, 1.0, 1).d1.normalized();
+  CHECK(std::abs(std::abs(t0.z()) - 1) < 1e-9);
+  CHECK(std::abs(std::abs(t1.x()) - 1) < 1e-9);
+
+  // The fill: the strokes' ends, up to ~2.5 mm apart, snapped to their midpoints; the sliver of the
+  // rocker's and shoulder's knot union merged; every curve within the snap of the panel.
+  const StepReport& fill = step(r, "surfaces.panel");
+  const double snapped = figure<double>(fill, "snapped_mm");
+  CHECK(snapped > 0.5);
+  CHECK(snapped <= 1.5);  // half of gap_tolerance 3
+  CHECK(surface::smallest_span_ratio(panel.u) >= 0.05);
+  CHECK(surface::smallest_span_ratio(panel.v) >= 0.05);
+  for (const char* name : {"rocker", "shoulder", "front", "rear.cut"}) {
+    double worst = 0;
+    for (double t : surface::linspace(0, 1, 101))
+      worst = std::max(worst,
+                       surface::closest_point(panel, surface::evaluate(r.curve(name), t)).distance);
+    INFO(name << " " << worst << " mm from the panel");
+    CHECK(worst <= snapped + 0.01);
+  }
+  // The bound was drawn 60 mm beside the panel and projected onto it.
+  for (double t : surface::linspace(0, 1, 201))
+    CHECK(surface::closest_point(panel, surface::evaluate(r.curve("bound"), t)).distance <= 0.01);
+
+  // The flare, recomputed with the deform library: the whole target line lies on the styled
+  // surface within curve_tolerance x size (closest points, independent of the solver), and
+  // nothing moved outside the bound.
+  const Json& flare = j.at("deformations").at("styling").at(0);
+  deform::StyleOptions options;
+  options.mode = deform::StyleMode::Exact;
+  options.curve_tolerance = flare.at("curve_tolerance").get<double>();
+  const deform::StyleResult styled =
+      deform::style_deform(panel, r.curve("bound"), r.curve("flare_line"), options);
+  const double styled_size = diagonal(styled.surface);
+  double miss = 0;
+  for (double t : surface::linspace(0, 1, 401))
+    miss = std::max(
+        miss, surface::closest_point(styled.surface, surface::evaluate(r.curve("flare_line"), t))
+                  .distance);
+  INFO("target line missed by " << miss << " mm");
+  CHECK(miss <= options.curve_tolerance * styled_size * 1.01);
+  const StepReport& style_step = step(r, "surfaces.fender.steps[0]");
+  CHECK(figure<double>(style_step, "locality") == 0.0);
+  CHECK(figure<double>(style_step, "target_curve_distance") <= miss * 1.01 + 1e-9);
+  int away = 0;
+  for (double u : surface::linspace(0, 1, 41))
+    for (double v : surface::linspace(0, 1, 11)) {
+      const Eigen::Vector3d p = surface::evaluate(panel, u, v);
+      if (p.x() > 80 && p.x() < 880 && p.z() > 20 && p.z() < 390) continue;  // near the bound
+      CHECK((surface::evaluate(styled.surface, u, v) - p).norm() <= 1e-9 * size);
+      ++away;
+    }
+  CHECK(away > 100);
+
+  // The nose lattice rebuilt from the recipe: fender(u, v) = nose(styled(u, v)) within the
+  // editable copy's certified bound.
+  const deform::BezierLattice nose = bezier_lattice_of(j.at("deformations").at("styling").at(1));
+  const double gap = max_pointwise_gap(styled.surface, fender, [&](const Eigen::Vector3d& x) {
+    return deform::deform_point(nose, x);
+  });
+  const StepReport& editable = step(r, "surfaces.fender.composition.editable");
+  const double certified = figure<double>(editable, "max_deviation_mm");
+  INFO("pointwise gap " << gap << " mm, certified " << certified << " mm");
+  CHECK(figure<bool>(editable, "certified"));
+  CHECK(figure<long long>(editable, "degree_u") == 3);
+  CHECK(figure<long long>(editable, "control_points") < 10000);
+  CHECK(figure<long long>(editable, "exact_control_points") > 10000);
+  CHECK(gap <= certified + 1e-12 * size);
+  CHECK(certified <= figure<double>(editable, "tolerance_mm"));
+  check_exact_composition(step(r, "surfaces.fender.steps[1]"));
+  // The nose is wrapped inward: the front edge moved about 25 mm to -y, the rear edge not at all.
+  CHECK((surface::evaluate(fender, 0, 0.5) - surface::evaluate(panel, 0, 0.5)).y() < -20);
+  CHECK(std::abs((surface::evaluate(fender, 1, 0.5) - surface::evaluate(panel, 1, 0.5)).y()) <
+        certified + 1.0);
+  CHECK(surface::identical(run_example("fender").surface("fender"), fender));
 }
