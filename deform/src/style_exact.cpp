@@ -589,10 +589,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     // The net is too coarse in the region for the key points: halve every knot span there (the
     // fixed edge layers get thinner, the free vertices more numerous). The region's box is
     // mirror-symmetric when the region is, and so is the refinement.
-    auto refine = [&] {
-      const Eigen::AlignedBox2d& box = refine_box;
-      const auto ku = halving_knots(s.u, box.min().x(), box.max().x());
-      const auto kv = halving_knots(s.v, box.min().y(), box.max().y());
+    auto refine_at = [&](const std::vector<double>& ku, const std::vector<double>& kv) {
       s = surface::refine_knots_u(s, ku);
       s = surface::refine_knots_v(s, kv);
       report.knots_inserted += static_cast<int>(ku.size() + kv.size());
@@ -600,6 +597,11 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       reg.count_u = s.count_u();
       reg.count_v = s.count_v();
       reg.factors = region_factors(s, reg.polygon, reg.target_trace, reg.margin);
+    };
+    auto refine = [&] {
+      const Eigen::AlignedBox2d& box = refine_box;
+      refine_at(halving_knots(s.u, box.min().x(), box.max().x()),
+                halving_knots(s.v, box.min().y(), box.max().y()));
     };
     // A key point held mostly by fixed vertices (its free share Σ_free R_ij(u_k, v_k) is small)
     // is met only by moving the free ones by about distance / share: independent in rank, yet
@@ -776,15 +778,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
             }
           const Eigen::AlignedBox2d& box = refine_box;
           const double du = box.sizes().x() / (grid.n - 1), dv = box.sizes().y() / (grid.n - 1);
-          const auto ku = local_halving_knots(s.u, mu, du, box.min().x(), box.max().x());
-          const auto kv = local_halving_knots(s.v, mv, dv, box.min().y(), box.max().y());
-          s = surface::refine_knots_u(s, ku);
-          s = surface::refine_knots_v(s, kv);
-          report.knots_inserted += static_cast<int>(ku.size() + kv.size());
-          ++refinements;
-          reg.count_u = s.count_u();
-          reg.count_v = s.count_v();
-          reg.factors = region_factors(s, reg.polygon, reg.target_trace, reg.margin);
+          refine_at(local_halving_knots(s.u, mu, du, box.min().x(), box.max().x()),
+                    local_halving_knots(s.v, mv, dv, box.min().y(), box.max().y()));
         }
         accepted_points = points.size();
         additions = 0;

@@ -11,16 +11,14 @@
 #include <clay/surface/skin.hpp>
 #include <clay/tolerance.hpp>
 
-#include <Eigen/QR>
-
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "builder_tools.hpp"
+#include "curve_fit.hpp"
 #include "homogeneous.hpp"
 
 namespace clay::surface {
@@ -193,31 +191,11 @@ Fit fit_on(const BSplineCurve& old, const BSplineBasis& basis, const KnotMerge& 
   const bool rational = old.is_rational();
   const int dims = rational ? 4 : 3;
   const std::vector<double> breaks = merged_breaks(old.basis, basis);
-  std::vector<double> t;
-  const int per = 2 * (p + 1);
-  for (size_t s = 0; s + 1 < breaks.size(); ++s)
-    for (int k = 0; k < per; ++k)
-      t.push_back(breaks[s] +
-                  (breaks[s + 1] - breaks[s]) * 0.5 * (1 - std::cos(std::numbers::pi * k / per)));
-  t.push_back(1.0);
-  const auto rows = static_cast<Eigen::Index>(t.size());
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rows, n);
-  Eigen::MatrixXd f(rows, dims);
-  std::vector<double> values(static_cast<size_t>(p + 1));
-  for (Eigen::Index r = 0; r < rows; ++r) {
-    const double tr = t[static_cast<size_t>(r)];
-    const int span = find_span(basis, tr);
-    basis_functions(basis, span, tr, values);
-    for (int j = 0; j <= p; ++j) a(r, span - p + j) = values[static_cast<size_t>(j)];
-    const Eigen::Vector4d h = homogeneous_at(old, reparametrize(m, tr));
-    f.row(r) = h.head(dims).transpose();
-  }
-  Eigen::MatrixXd net(n, dims);
-  const Eigen::Vector4d first = homogeneous_at(old, 0.0), last = homogeneous_at(old, 1.0);
-  net.row(0) = first.head(dims).transpose();
-  net.row(n - 1) = last.head(dims).transpose();
-  f -= a.col(0) * net.row(0) + a.col(n - 1) * net.row(n - 1);
-  if (n > 2) net.middleRows(1, n - 2) = a.middleCols(1, n - 2).colPivHouseholderQr().solve(f);
+  // Ends kept: the homogeneous points of the old curve at 0 and 1 (phi fixes both).
+  const Eigen::MatrixXd net =
+      detail::fit_with_ends(basis, detail::lobatto_parameters(breaks, 2 * (p + 1)), [&](double t) {
+        return Eigen::RowVectorXd(homogeneous_at(old, reparametrize(m, t)).head(dims).transpose());
+      });
   Fit out;
   out.curve.basis = basis;
   if (rational) {

@@ -7,16 +7,14 @@
 #include <clay/surface/evaluate.hpp>
 #include <clay/surface/projection.hpp>
 
-#include <Eigen/QR>
-
 #include <algorithm>
 #include <cmath>
 #include <functional>
-#include <numbers>
 #include <string>
 #include <vector>
 
 #include "builder_tools.hpp"
+#include "curve_fit.hpp"
 #include "homogeneous.hpp"
 
 namespace clay::surface {
@@ -51,18 +49,6 @@ BSplineCurve iso_curve(const BSplineSurface& s, bool fixed_u, double t) {
   return c;
 }
 
-/// Chebyshev-Lobatto parameters, `per` intervals per span of `basis`, the domain end added.
-std::vector<double> fit_parameters(const BSplineBasis& basis, int per) {
-  const std::vector<double> breaks = breakpoints(basis);
-  std::vector<double> t;
-  for (size_t s = 0; s + 1 < breaks.size(); ++s)
-    for (int k = 0; k < per; ++k)
-      t.push_back(breaks[s] +
-                  (breaks[s + 1] - breaks[s]) * 0.5 * (1 - std::cos(std::numbers::pi * k / per)));
-  t.push_back(breaks.back());
-  return t;
-}
-
 /// Least-squares fits of target(t) on a basis starting from the input's breakpoints, spans
 /// halved where 16 samples per span miss the tolerance.
 FittedCurve fit_target(const BSplineCurve& input,
@@ -82,24 +68,10 @@ FittedCurve fit_target(const BSplineCurve& input,
   basis.knots.insert(basis.knots.end(), static_cast<size_t>(p + 1), breaks.back());
   FittedCurve out;
   for (out.iterations = 1;; ++out.iterations) {
-    const std::vector<double> t = fit_parameters(basis, 2 * (p + 1));
-    const auto rows = static_cast<Eigen::Index>(t.size());
     const int n = basis.count();
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(rows, n);
-    Eigen::MatrixXd f(rows, 3);
-    std::vector<double> values(static_cast<size_t>(p + 1));
-    for (Eigen::Index r = 0; r < rows; ++r) {
-      const double tr = t[static_cast<size_t>(r)];
-      const int span = find_span(basis, tr);
-      basis_functions(basis, span, tr, values);
-      for (int j = 0; j <= p; ++j) a(r, span - p + j) = values[static_cast<size_t>(j)];
-      f.row(r) = target(tr).transpose();
-    }
-    Eigen::MatrixXd net(n, 3);
-    net.row(0) = f.row(0);
-    net.row(n - 1) = f.row(rows - 1);
-    f -= a.col(0) * net.row(0) + a.col(n - 1) * net.row(n - 1);
-    if (n > 2) net.middleRows(1, n - 2) = a.middleCols(1, n - 2).colPivHouseholderQr().solve(f);
+    const Eigen::MatrixXd net =
+        detail::fit_with_ends(basis, detail::lobatto_parameters(breakpoints(basis), 2 * (p + 1)),
+                              [&](double t) { return Eigen::RowVectorXd(target(t).transpose()); });
     out.curve.basis = basis;
     out.curve.points = net;
     out.curve.weights = Eigen::VectorXd::Ones(n);
