@@ -84,6 +84,18 @@ inline BSplineCurve normalized(const BSplineCurve& curve) {
   return c;
 }
 
+/// The problems of a builder's sliver-merging options (`owner` names the struct): min_span_ratio
+/// in [0, 0.5), merge_tolerance (relative to the model size) in (0, 1e-2].
+inline void merge_option_problems(const std::string& owner, double min_span_ratio,
+                                  double merge_tolerance, std::vector<std::string>& out) {
+  if (!(min_span_ratio >= 0.0 && min_span_ratio < 0.5))
+    out.push_back(owner + "::min_span_ratio is " + short_number(min_span_ratio) +
+                  "; it must be in [0, 0.5) (0 keeps every span)");
+  if (!(merge_tolerance > 0.0 && merge_tolerance <= 1e-2))
+    out.push_back(owner + "::merge_tolerance is " + short_number(merge_tolerance) +
+                  "; it must be in (0, 1e-2]");
+}
+
 /// "2 knots moved to merge sliver spans of the knot union (section #1 at 0.50089 -> 0.50057,
 /// reparametrized; ...), largest deviation 3.1e-05 mm", or "" when nothing merged. `what` names
 /// the curves ("section", or "curve" with `labels` giving each merged curve's name).

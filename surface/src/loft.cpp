@@ -172,12 +172,7 @@ std::vector<std::string> LoftOptions::problems() const {
                   std::to_string(max_kernel_degree) + "]");
   if (!(tolerance > 0.0 && tolerance <= 1e-2))
     out.push_back("LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
-  if (!(min_span_ratio >= 0.0 && min_span_ratio < 0.5))
-    out.push_back("LoftOptions::min_span_ratio is " + num(min_span_ratio) +
-                  "; it must be in [0, 0.5) (0 keeps every span)");
-  if (!(merge_tolerance > 0.0 && merge_tolerance <= 1e-2))
-    out.push_back("LoftOptions::merge_tolerance is " + num(merge_tolerance) +
-                  "; it must be in (0, 1e-2]");
+  detail::merge_option_problems("LoftOptions", min_span_ratio, merge_tolerance, out);
   return out;
 }
 

@@ -406,12 +406,7 @@ std::vector<std::string> FillOptions::problems() const {
   if (!(gap_tolerance > 0.0 && std::isfinite(gap_tolerance)))
     out.push_back("FillOptions::gap_tolerance is " + num(gap_tolerance) +
                   "; it must be > 0 and finite");
-  if (!(min_span_ratio >= 0.0 && min_span_ratio < 0.5))
-    out.push_back("FillOptions::min_span_ratio is " + num(min_span_ratio) +
-                  "; it must be in [0, 0.5) (0 keeps every span)");
-  if (!(merge_tolerance > 0.0 && merge_tolerance <= 1e-2))
-    out.push_back("FillOptions::merge_tolerance is " + num(merge_tolerance) +
-                  "; it must be in (0, 1e-2]");
+  detail::merge_option_problems("FillOptions", min_span_ratio, merge_tolerance, out);
   if (style != FillStyle::Stretch && style != FillStyle::Coons && style != FillStyle::Curved)
     out.push_back("FillOptions::style is " + std::to_string(static_cast<int>(style)) +
                   "; it must be Stretch, Coons or Curved");
@@ -564,45 +559,23 @@ BuiltSurface fill(const std::vector<BSplineCurve>& boundary, const FillOptions& 
         return filler.Surface();
       });
     }
-    sides.push_back({&boundary[loop[0].input],
-                     loop[0].reversed,
-                     false,
-                     false,
-                     false,
-                     {},
-                     loop[0].alpha,
-                     &merged02,
-                     0});
-    sides.push_back({&boundary[loop[1].input],
-                     loop[1].reversed,
-                     true,
-                     true,
-                     false,
-                     {},
-                     loop[1].alpha,
-                     n == 4 ? &merged13 : nullptr,
-                     0});
-    sides.push_back({&boundary[loop[2].input],
-                     loop[2].reversed,
-                     false,
-                     true,
-                     true,
-                     {},
-                     loop[2].alpha,
-                     &merged02,
-                     1});
-    if (n == 4)
-      sides.push_back({&boundary[loop[3].input],
-                       loop[3].reversed,
-                       true,
-                       false,
-                       true,
+    // Side k of the loop: which edge it became (fixed u, at the domain end, run backwards) and
+    // the compatible pair it came from (0 and 2: merged02; 1 and 3: merged13, none with 3 curves).
+    const bool fixed_u[4] = {false, true, false, true}, at_end[4] = {false, true, true, false};
+    for (size_t k = 0; k < n; ++k) {
+      const LoopCurve& c = loop[k];
+      const CompatibleCurves* pair = k % 2 == 0 ? &merged02 : (n == 4 ? &merged13 : nullptr);
+      sides.push_back({&boundary[c.input],
+                       c.reversed,
+                       fixed_u[k],
+                       at_end[k],
+                       k >= 2,
                        {},
-                       loop[3].alpha,
-                       &merged13,
-                       1});
-    else
-      sides.push_back({nullptr, false, true, false, true, first_point(c1)});
+                       c.alpha,
+                       pair,
+                       k >= 2 ? 1 : 0});
+    }
+    if (n == 3) sides.push_back({nullptr, false, true, false, true, first_point(c1)});
   }
   if (reparametrized)
     note += std::string(note.empty() ? "" : "; ") +
