@@ -3,8 +3,9 @@
 // are built from curves, so the run follows these needs rather than a fixed order of sections.
 #include "recipe_model.hpp"
 
+#include <algorithm>
+#include <functional>
 #include <map>
-#include <set>
 
 namespace clay::recipe {
 
