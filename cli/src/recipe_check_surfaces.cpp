@@ -148,10 +148,16 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
         if (const Json* m = c_.member(v, p, "surface", true, "the name of an earlier surface"))
           d.surface = surface_ref(*m, key_path(p, "surface")).value_or("");
         d.degree = c_.integer_or(v, p, "degree", 3, 1, surface::max_exchange_degree);
+        // Both counts give a fixed uniform net; neither, an adaptive net that grows only where
+        // the tolerance needs it (a "rebuild to tolerance").
         for (auto [key, count] :
              {std::pair{"count_u", &d.count_u}, std::pair{"count_v", &d.count_v}})
-          if (const Json* m = c_.member(v, p, key, true, "control points in that direction"))
+          if (const Json* m = c_.member(v, p, key, false, ""))
             *count = c_.integer(*m, key_path(p, key), d.degree + 1, 1000).value_or(0);
+        if (v.contains("count_u") != v.contains("count_v"))
+          c_.add(key_path(p, v.contains("count_u") ? "count_v" : "count_u"),
+                 "give both \"count_u\" and \"count_v\" for a fixed net, or neither for a net "
+                 "that grows to the tolerance");
         d.tolerance = c_.number_or(v, p, "tolerance", d.tolerance, Range{1e-9, 1e-1});
       }
       def.build = d;

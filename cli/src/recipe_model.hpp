@@ -216,6 +216,9 @@ struct Needs {
 Needs curve_needs(const RecipeData& d, const std::string& name);
 /// The needs of a surface definition (a deform step's style curves included).
 Needs surface_needs(const RecipeData& d, const SurfaceDef& def);
+/// True when another surface or a curve is built from the surface named `surface` (a deform,
+/// rebuild or mirror of it, a curve taken from it).
+bool built_on(const RecipeData& d, const std::string& surface);
 /// A cycle of definitions that need each other ("curve edge", "surface panel", "curve edge"), or
 /// empty.
 std::vector<std::string> dependency_cycle(const RecipeData& d);

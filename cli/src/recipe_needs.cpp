@@ -67,6 +67,16 @@ Needs surface_needs(const RecipeData& d, const SurfaceDef& def) {
   return n;
 }
 
+bool built_on(const RecipeData& d, const std::string& surface) {
+  const auto named = [&](const Needs& n) {
+    return std::find(n.surfaces.begin(), n.surfaces.end(), surface) != n.surfaces.end();
+  };
+  return std::any_of(d.surfaces.begin(), d.surfaces.end(),
+                     [&](const SurfaceDef& s) { return named(surface_needs(d, s)); }) ||
+         std::any_of(d.curves.begin(), d.curves.end(),
+                     [&](const CurveDef& c) { return c.surface == surface; });
+}
+
 std::vector<std::string> dependency_cycle(const RecipeData& d) {
   // Depth-first search over "curve NAME" and "surface NAME" nodes; a node met again while on
   // the path closes a cycle.

@@ -121,8 +121,12 @@ class Runner {
               std::to_string(f.v.degree) + " and " + std::to_string(f.points.rows()) +
               " control points, more than most surfacing tools edit (degree " +
               std::to_string(editable_degree) + ", " + std::to_string(editable_control_points) +
-              " control points): ask for \"composition\": {\"editable\": {}} to "
-              "export a certified bicubic copy";
+              " control points): " +
+              (made_editable_.count(e.surfaces[k])
+                   ? std::string("this is its editable copy; loosen the composition's "
+                                 "\"tolerance\" for a lighter one")
+                   : std::string("ask for \"composition\": {\"editable\": {}} to export a "
+                                 "certified bicubic copy"));
         }
         result_.exports.push_back(std::move(x));
       });
@@ -151,8 +155,11 @@ class Runner {
   }
 
   /// One named surface deformed by a stack (the deform command and `deform` surfaces).
+  /// `final_surface` false: another definition builds on the result, which then stays exact
+  /// (an editable copy is made only of what leaves the recipe, so tolerances do not stack).
   BSplineSurface deform(const BSplineSurface& parent, const StackDef& stack, const Composition& c,
-                        const std::string& path, const std::string& name) {
+                        const std::string& path, const std::string& name,
+                        bool final_surface = true) {
     BSplineSurface s = parent;
     for (std::size_t i = 0; i < stack.steps.size(); ++i) {
       const StepDef& step = stack.steps[i];
@@ -173,10 +180,13 @@ class Runner {
         result_.stages.push_back(std::move(stage));
       });
     }
-    if (c.editable && (std::max(s.u.degree, s.v.degree) > c.editable->max_degree ||
-                       s.points.rows() > c.editable->max_control_points))
-      timed(path + ".composition.editable", "editable",
-            [&](StepReport& rep) { s = editable(s, c, name, rep); });
+    if (c.editable && final_surface &&
+        (std::max(s.u.degree, s.v.degree) > c.editable->max_degree ||
+         s.points.rows() > c.editable->max_control_points))
+      timed(path + ".composition.editable", "editable", [&](StepReport& rep) {
+        s = editable(s, c, name, rep);
+        made_editable_.insert(name);
+      });
     return s;
   }
 
@@ -245,6 +255,7 @@ class Runner {
   std::map<std::string, std::size_t> curve_index_;
   std::set<std::size_t> sketches_built_;  // indices into data_.sketches
   std::set<std::string> building_;        // "curve NAME" / "surface NAME" being built
+  std::set<std::string> made_editable_;   // surfaces exported as their editable copy
 
   template <class F>
   void timed(const std::string& path, const std::string& kind, F&& f) {
@@ -458,7 +469,8 @@ class Runner {
       const StackDef& stack =
           *std::find_if(data_.stacks.begin(), data_.stacks.end(),
                         [&](const StackDef& s) { return s.name == d->deformation; });
-      BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name);
+      BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name,
+                                !built_on(data_, def.name));
       result_.surfaces.emplace_back(def.name, std::move(s));
       return;
     }
@@ -546,11 +558,17 @@ class Runner {
               o.count_u = b.count_u;
               o.count_v = b.count_v;
               o.tolerance = b.tolerance;
+              // Without counts the net grows only where the tolerance needs it, from the
+              // original's rough breakpoints alone, as the editable output does.
+              const bool fixed = b.count_u > 0;
+              o.keep_breakpoints = fixed;
               const auto fit = deform::refit_surface(surface_of(b.surface), o);
               const auto& r = fit.report;
               surface::BuildReport built = surface::describe(
-                  fit.surface, "rebuild of '" + b.surface + "' on " + std::to_string(b.count_u) +
-                                   " x " + std::to_string(b.count_v) + " control points");
+                  fit.surface, "rebuild of '" + b.surface + "' " +
+                                   (fixed ? "on " + std::to_string(b.count_u) + " x " +
+                                                std::to_string(b.count_v) + " control points"
+                                          : "to its tolerance"));
               built.max_deviation_mm = r.certified ? r.certified_bound : r.sampled_max;
               built.samples = static_cast<int>(std::min<long>(r.samples, 1L << 30));
               build_figures(built, rep);
@@ -561,8 +579,9 @@ class Runner {
               if (!r.summary.converged())
                 throw Error(ErrorCategory::ToleranceNotMet,
                             "the rebuilt net misses its tolerance (" + r.summary.message +
-                                "): raise \"count_u\" and \"count_v\", \"tolerance\" or "
-                                "\"degree\"");
+                                (fixed ? "): raise \"count_u\" and \"count_v\", \"tolerance\" or "
+                                         "\"degree\""
+                                       : "): raise \"tolerance\" or \"degree\""));
               return fit.surface;
             } else if constexpr (std::is_same_v<T, MirrorDef>) {
               BSplineSurface m =

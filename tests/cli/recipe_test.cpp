@@ -1582,5 +1582,34 @@ TEST_CASE("rebuild refits a surface on a fixed uniform net, certified", "[recipe
       recipe_with(R"(, "even": {"rebuild": {"surface": "dome", "count_u": 2, "degree": 3}})", ""));
   INFO(dump(problems));
   CHECK(mentions(problems, "surfaces.even.rebuild.count_u", "2"));
-  CHECK(mentions(problems, "surfaces.even.rebuild.count_v", "missing"));
+  CHECK(mentions(problems, "surfaces.even.rebuild.count_v", "give both"));
+}
+
+TEST_CASE("rebuild without counts grows its net to the tolerance, certified", "[recipe]") {
+  const std::string text =
+      recipe_with(R"(, "light": {"rebuild": {"surface": "dome", "tolerance": 1e-5}})", "");
+  INFO(dump(check_recipe(text)));
+  const auto result = run_recipe(parse_recipe(text));
+  const auto& light = result.surface("light");
+  double bound = -1, tolerance = -1;
+  for (const auto& s : result.steps)
+    if (s.path == "surfaces.light") {
+      CHECK_THAT(s.message, Contains("certified"));
+      for (const auto& [key, value] : s.figures) {
+        if (key == "certified_bound_mm") bound = std::get<double>(value);
+        if (key == "tolerance_mm") tolerance = std::get<double>(value);
+      }
+    }
+  REQUIRE(bound > 0);
+  CHECK(bound <= tolerance);
+  const auto parent = dome();
+  CHECK(max_gap(light, [&](double u, double v) { return surface::evaluate(parent, u, v); }) <=
+        bound);
+  CHECK(light.u.degree == 3);
+  CHECK(light.v.degree == 3);
+  // Missing the tolerance within the net limit: the step fails, naming what to loosen.
+  const std::string tight = recipe_with(
+      R"(, "light": {"rebuild": {"surface": "dome", "tolerance": 1e-9, "degree": 1}})", "");
+  CHECK_THAT(error_of([&] { run_recipe(parse_recipe(tight)); }).second,
+             Contains("surfaces.light") && Contains("\"tolerance\""));
 }

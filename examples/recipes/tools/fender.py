@@ -9,8 +9,10 @@ A car's front-fender side panel, about 1 m long and 420 mm high, built the way a
   fixed where the strokes end and whose ends leave square to the rocker and the shoulder;
 - a Coons fill that snaps the stroke ends that nearly meet (gap_tolerance 3 mm);
 - a style step: a closed stroke drawn beside the panel and projected onto it as bound, and the
-  flare's line drawn in space, rising 25 mm outboard, as target (exact mode; docs/styling.md gives
-  the figures with "net_convergence": 0.005 added);
+  flare's line drawn in space, rising 25 mm outboard, as target (exact mode, the net refined until
+  the shape changes by less than 0.5 % when it is halved once more);
+- the styled surface rebuilt to a tenth of a millimetre (a dense exact net, made light before the
+  next operation);
 - a Bezier lattice that wraps the nose inward;
 - exact composition, exported as its editable bicubic copy.
 
@@ -113,8 +115,9 @@ recipe = {
         "three noisy strokes and a constrained planar sketch for the door cut, a Coons fill that "
         "snaps the ends that nearly meet, a style step (Han, De Amicis & Conti 2007) with a bound "
         "drawn beside the panel and projected onto it and a flare line rising 25 mm outboard as "
-        "target, exact mode, a Bezier lattice (Sederberg & Parry 1986) that wraps "
-        "the nose, exact composition exported as a certified editable bicubic."),
+        "target, exact mode on a net refined until the shape converges, the result rebuilt to a "
+        "tenth of a millimetre, a Bezier lattice (Sederberg & Parry 1986) that wraps the nose, "
+        "exact composition exported as a certified editable bicubic."),
     "units": "mm",
     "composition": {"mode": "exact", "editable": {}},
     "strokes": {
@@ -131,12 +134,20 @@ recipe = {
     "surfaces": {
         "panel": {"fill": {"curves": ["rocker", "rear.cut", "shoulder", "front"], "style": "coons",
                            "join": "snap", "gap_tolerance": 3}},
-        "fender": {"deform": {"surface": "panel", "deformation": "styling"}},
+        "styled": {"deform": {"surface": "panel", "deformation": "flare"}},
+        # The converged style result is a dense exact bicubic (about 178,000 control points); a
+        # lattice composed with it exactly would be far denser still, so it is rebuilt to a
+        # tenth of a millimetre first, as a stylist rebuilds before the next operation.
+        "styled_net": {"rebuild": {"surface": "styled", "tolerance": 1e-4}},
+        "fender": {"deform": {"surface": "styled_net", "deformation": "nose"}},
     },
     "deformations": {
-        "styling": [
+        "flare": [
             {"kind": "style", "name": "flare", "target": "flare_line", "bound": "bound",
-             "mode": "exact", "curve_tolerance": 1e-4},
+             "mode": "exact", "curve_tolerance": 1e-4, "net_convergence": 0.005,
+             "max_refinements": 8},
+        ],
+        "nose": [
             {"kind": "bezier_lattice", "name": "nose",
              "frame": {"origin": [-40, -80, -20], "s": [1120, 0, 0], "t": [0, 240, 0],
                        "u": [0, 0, 480]},
