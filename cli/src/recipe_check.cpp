@@ -683,7 +683,8 @@ std::vector<Problem> check_recipe(std::string_view text, const fs::path& base_di
   return check(text, base_dir).problems;
 }
 
-Recipe parse_recipe(std::string_view text, const fs::path& base_dir) {
+Recipe parse_recipe(std::string_view text, const fs::path& base_dir,
+                    std::string_view default_name) {
   CheckOutcome out = check(text, base_dir);
   if (!out.problems.empty()) {
     std::string m = "the recipe has " + std::to_string(out.problems.size()) + " problem" +
@@ -691,6 +692,7 @@ Recipe parse_recipe(std::string_view text, const fs::path& base_dir) {
     for (const auto& p : out.problems) m += "\n  " + to_string(p);
     throw Error(ErrorCategory::Recipe, m);
   }
+  if (out.data.name.empty()) out.data.name = std::string(default_name);
   return Recipe{std::make_shared<const RecipeData>(std::move(out.data))};
 }
 

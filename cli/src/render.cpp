@@ -427,25 +427,59 @@ Image render_mesh(const brep::ModelMesh& mesh, const RenderOptions& options,
   return draw({b}, control_nets, polylines_of(curves), options);
 }
 
-void write_png(const Image& image, const fs::path& file) {
+namespace {
+
+void check_image(const Image& image, const char* function) {
   const size_t expected = 3 * static_cast<size_t>(std::max(image.width, 0)) *
                           static_cast<size_t>(std::max(image.height, 0));
   if (image.width <= 0 || image.height <= 0 || image.rgb.size() != expected)
     throw Error(ErrorCategory::InvalidArgument,
-                "write_png: an image of " + std::to_string(image.width) + " x " +
+                std::string(function) + ": an image of " + std::to_string(image.width) + " x " +
                     std::to_string(image.height) + " pixels needs " + std::to_string(expected) +
                     " bytes (3 per pixel, both sizes > 0), it has " +
                     std::to_string(image.rgb.size()));
-  if (!file.has_filename())
-    throw Error(ErrorCategory::InvalidArgument,
-                "write_png: \"" + file.string() + "\" names no file; give e.g. picture.png");
-  const fs::path tmp = (file.has_parent_path() ? file.parent_path() : fs::path(".")) /
-                       ("." + file.filename().string() + ".clayform-" + std::to_string(::getpid()));
+}
+
+png_image png_header(const Image& image) {
   png_image png{};
   png.version = PNG_IMAGE_VERSION;
   png.width = static_cast<png_uint_32>(image.width);
   png.height = static_cast<png_uint_32>(image.height);
   png.format = PNG_FORMAT_RGB;
+  return png;
+}
+
+}  // namespace
+
+std::vector<unsigned char> encode_png(const Image& image) {
+  check_image(image, "encode_png");
+  // libpng's simplified API: ask for the size first, then write into a buffer of that size.
+  png_image png = png_header(image);
+  png_alloc_size_t size = 0;
+  if (!png_image_write_to_memory(&png, nullptr, &size, 0, image.rgb.data(), 0, nullptr)) {
+    const std::string why = png.message;
+    png_image_free(&png);
+    throw Error(ErrorCategory::Internal, "encode_png: libpng refused the image: " + why);
+  }
+  std::vector<unsigned char> out(size);
+  png = png_header(image);
+  if (!png_image_write_to_memory(&png, out.data(), &size, 0, image.rgb.data(), 0, nullptr)) {
+    const std::string why = png.message;
+    png_image_free(&png);
+    throw Error(ErrorCategory::Internal, "encode_png: libpng refused the image: " + why);
+  }
+  out.resize(size);
+  return out;
+}
+
+void write_png(const Image& image, const fs::path& file) {
+  check_image(image, "write_png");
+  if (!file.has_filename())
+    throw Error(ErrorCategory::InvalidArgument,
+                "write_png: \"" + file.string() + "\" names no file; give e.g. picture.png");
+  const fs::path tmp = (file.has_parent_path() ? file.parent_path() : fs::path(".")) /
+                       ("." + file.filename().string() + ".clayform-" + std::to_string(::getpid()));
+  png_image png = png_header(image);
   std::error_code ec;
   if (!png_image_write_to_file(&png, tmp.c_str(), 0, image.rgb.data(), 0, nullptr)) {
     const std::string why = png.message;

@@ -688,6 +688,19 @@ void deform_points(const FrozenLattice& lattice, const Points3& points, Points3&
       true, options);
 }
 
+void deform_points(const FrozenLattice& lattice, std::span<const double> in, std::span<double> out,
+                   const DeformOptions& options) {
+  if (in.size() != out.size() || in.size() % 3 != 0)
+    throw Error(
+        ErrorCategory::InvalidArgument,
+        "deform_points: interleaved points of " + std::to_string(in.size()) + " in and " +
+            std::to_string(out.size()) +
+            " out coordinates; give x, y, z per point (a multiple of 3), as many out as in");
+  const double* i = in.data();
+  double* o = out.data();
+  run(lattice, Io{{i, i + 1, i + 2}, {o, o + 1, o + 2}}, in.size() / 3, true, options);
+}
+
 void deform_points(const FrozenLattice& lattice, PointColumns in, MutablePointColumns out,
                    const DeformOptions& options) {
   const std::size_t n = in.x.size();

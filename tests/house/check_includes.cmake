@@ -5,7 +5,7 @@
 #     surface (the core: clay/surface*, clay/error.hpp, summary.hpp, tolerance.hpp, version.hpp)
 #       <- sketch <- constraints;  surface <- brep <- deform;  the OCCT library (surface/src/occt/
 #       and the exchange pre-check, Clayform::occt) uses surface and brep; cli (recipe, render,
-#       servers) uses all.
+#       servers) uses all; python (the pybind11 module) uses all.
 #   The umbrella clay/clayform.hpp is exempt (it is the whole API by design).
 # - clay/internal/ (the shared helpers, never installed) only from sources, never from a public
 #   header under include/.
@@ -19,6 +19,7 @@ set(may_use_brep surface brep)
 set(may_use_deform surface brep deform)
 set(may_use_occt surface brep)
 set(may_use_cli surface brep sketch constraints deform cli)
+set(may_use_python surface brep sketch constraints deform cli)
 # The module a clay header belongs to, or "" for a header outside the graph.
 function(module_of header out)
   if(header MATCHES "^clay/(surface(/|\\.hpp$)|error\\.hpp$|summary\\.hpp$|tolerance\\.hpp$|version\\.hpp$|parallel\\.hpp$)")
@@ -52,7 +53,7 @@ foreach(f ${files})
     set(from "")
     if(f MATCHES "^surface/src/occt/")
       set(from occt)  # the OCCT library's sources live beside the core's
-    elseif(f MATCHES "^(surface|brep|sketch|constraints|deform|cli)/")
+    elseif(f MATCHES "^(surface|brep|sketch|constraints|deform|cli|python)/")
       set(from ${CMAKE_MATCH_1})
     endif()
     if(from AND NOT f MATCHES "/clay/clayform\\.hpp$")

@@ -57,9 +57,11 @@ CLAY_RECIPE_API std::vector<Problem> check_recipe(std::string_view text,
                                                   const std::filesystem::path& base_dir = {});
 
 /// The checked recipe. Throws clay::Error(Recipe) listing every problem of check_recipe, one per
-/// line.
+/// line. `default_name` names a recipe whose text has no "name" (load_recipe gives the file
+/// stem).
 CLAY_RECIPE_API Recipe parse_recipe(std::string_view text,
-                                    const std::filesystem::path& base_dir = {});
+                                    const std::filesystem::path& base_dir = {},
+                                    std::string_view default_name = {});
 
 /// Reads and parses a recipe file (imports resolved next to it; the name defaults to the stem).
 /// Throws clay::Error: Io when the file cannot be read, Recipe for its problems.

@@ -111,4 +111,8 @@ CLAY_RENDER_API Eigen::Vector3d facing_eye(const brep::ModelMesh& mesh, const Ei
 /// disagree, Io naming the file when it cannot be written.
 CLAY_RENDER_API void write_png(const Image& image, const std::filesystem::path& file);
 
+/// `image` encoded as an 8-bit RGB PNG in memory (libpng): a notebook's picture, a network
+/// frame. Throws clay::Error(InvalidArgument) for an image whose pixels do not match its size.
+CLAY_RENDER_API std::vector<unsigned char> encode_png(const Image& image);
+
 }  // namespace clay::render

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <span>
 #include <vector>
 
 namespace clay::deform {
@@ -71,6 +72,12 @@ CLAY_DEFORM_API void deform_points(const FrozenLattice& lattice, const Points3& 
 /// Throws clay::Error(InvalidArgument) for columns of different sizes or bad options.
 CLAY_DEFORM_API void deform_points(const FrozenLattice& lattice, PointColumns in,
                                    MutablePointColumns out, const DeformOptions& options = {});
+
+/// Interleaved form, no copy: `in` and `out` hold x, y, z of each point in turn (3 N doubles,
+/// an N x 3 row-major buffer such as a NumPy (N, 3) float64 array). `out` may be `in` itself.
+/// Throws clay::Error(InvalidArgument) for sizes that differ or are not a multiple of 3.
+CLAY_DEFORM_API void deform_points(const FrozenLattice& lattice, std::span<const double> in,
+                                   std::span<double> out, const DeformOptions& options = {});
 
 /// One-off: freezes the lattice and deforms the points (Sederberg–Parry eq. (2)).
 CLAY_DEFORM_API Points3 deform_points(const BezierLattice& lattice, const Points3& points,

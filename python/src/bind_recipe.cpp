@@ -1,0 +1,173 @@
+// Recipes: load or parse, check, run in memory (the GIL released), write the outputs; reports
+// as dicts. A recipe pickles as its text, its base folder and its name.
+#include "common.hpp"
+
+#include <clay/recipe/recipe.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace clay::python {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A checked recipe and what made it: the text, the folder its imports are resolved in, its name.
+struct PyRecipe {
+  recipe::Recipe recipe;
+  std::string text;
+  std::string base_dir;
+};
+
+PyRecipe parse(const std::string& text, const std::string& base_dir, const std::string& name) {
+  PyRecipe r;
+  r.recipe = recipe::parse_recipe(text, base_dir, name);
+  r.text = text;
+  r.base_dir = base_dir;
+  return r;
+}
+
+py::object figure(const recipe::Figure& f) {
+  return std::visit([](const auto& v) -> py::object { return py::cast(v); }, f);
+}
+
+py::object report_dict(const recipe::RunResult& r) {
+  return py::module_::import("json").attr("loads")(recipe::report_json(r));
+}
+
+}  // namespace
+
+void bind_recipe(py::module_& m) {
+  py::class_<recipe::RunResult>(m, "RunResult",
+                                "What a recipe run computed, in memory: surfaces, curves, steps "
+                                "and the report; write(out) writes the exports.")
+      .def_property_readonly("name", [](const recipe::RunResult& r) { return r.recipe; })
+      .def_property_readonly(
+          "surfaces",
+          [](const recipe::RunResult& r) {
+            py::dict d;
+            for (const auto& [name, s] : r.surfaces) d[py::str(name)] = s;
+            return d;
+          },
+          "Every named surface (copies), by name.")
+      .def_property_readonly(
+          "curves",
+          [](const recipe::RunResult& r) {
+            py::dict d;
+            for (const auto& [name, c] : r.curves) d[py::str(name)] = c;
+            return d;
+          },
+          "Every named curve (copies), by name.")
+      .def_property_readonly(
+          "steps",
+          [](const recipe::RunResult& r) {
+            py::list out;
+            for (const auto& s : r.steps) {
+              py::dict d, figures;
+              d["path"] = s.path;
+              d["kind"] = s.kind;
+              d["seconds"] = s.seconds;
+              d["warning"] = s.warning;
+              d["message"] = s.message;
+              for (const auto& [k, v] : s.figures) figures[py::str(k)] = figure(v);
+              d["figures"] = figures;
+              out.append(d);
+            }
+            return out;
+          },
+          "Every step's report: path, kind, seconds, warning, message, figures.")
+      .def_property_readonly("report", &report_dict, "The report as report.json holds it (a dict).")
+      .def_property_readonly("seconds", [](const recipe::RunResult& r) { return r.seconds; })
+      .def(
+          "write",
+          [](recipe::RunResult& r, const std::string& out) {
+            std::vector<fs::path> files;
+            {
+              py::gil_scoped_release free;
+              files = recipe::write_outputs(r, out);
+            }
+            std::vector<std::string> names;
+            for (const auto& f : files) names.push_back(f.string());
+            return names;
+          },
+          py::arg("out"),
+          "Writes every export (STEP, IGES, glTF), report.json and the view folder into out, "
+          "atomically; returns the paths written.")
+      .def("__repr__", [](const recipe::RunResult& r) {
+        return "<clayform.RunResult '" + r.recipe + "': " + std::to_string(r.surfaces.size()) +
+               " surfaces, " + std::to_string(r.steps.size()) + " steps>";
+      });
+
+  py::class_<PyRecipe>(m, "Recipe",
+                       "A checked recipe (docs/recipe.md). Recipe.load(path) or "
+                       "Recipe.parse(text); run() runs it; pickles as its text.")
+      .def_static(
+          "load",
+          [](const std::string& path) {
+            std::ifstream in(path, std::ios::binary);
+            if (!in)
+              throw Error(ErrorCategory::Io,
+                          "cannot read the recipe \"" + path + "\"; check the path");
+            std::ostringstream text;
+            text << in.rdbuf();
+            const fs::path file(path);
+            return parse(text.str(), file.parent_path().string(), file.stem().string());
+          },
+          py::arg("path"), "Reads and checks a recipe file (RecipeError lists every problem).")
+      .def_static("parse", &parse, py::arg("text"), py::arg("base_dir") = "", py::arg("name") = "",
+                  "Checks recipe text; imports are resolved in base_dir; name is used when the "
+                  "text has none.")
+      .def_static(
+          "check",
+          [](const std::string& text, const std::string& base_dir) {
+            py::list out;
+            for (const auto& p : recipe::check_recipe(text, base_dir)) {
+              py::dict d;
+              d["path"] = p.path;
+              d["message"] = p.message;
+              d["line"] = p.line;
+              d["column"] = p.column;
+              out.append(d);
+            }
+            return out;
+          },
+          py::arg("text"), py::arg("base_dir") = "",
+          "Every problem of recipe text as dicts (path, message, line, column); [] when valid.")
+      .def_property_readonly("name", [](const PyRecipe& r) { return r.recipe.name(); })
+      .def_property_readonly("text", [](const PyRecipe& r) { return r.text; })
+      .def_property_readonly("base_dir", [](const PyRecipe& r) { return r.base_dir; })
+      .def_property_readonly("deformations",
+                             [](const PyRecipe& r) { return r.recipe.deformation_names(); })
+      .def_property_readonly("final_surfaces",
+                             [](const PyRecipe& r) { return recipe::final_surfaces(r.recipe); })
+      .def(
+          "run",
+          [](const PyRecipe& r, const py::object& out) {
+            recipe::RunResult result;
+            {
+              py::gil_scoped_release free;
+              result = recipe::run_recipe(r.recipe);
+            }
+            if (!out.is_none()) {
+              const std::string dir = py::str(out);
+              py::gil_scoped_release free;
+              recipe::write_outputs(result, dir);
+            }
+            return result;
+          },
+          py::arg("out") = py::none(),
+          "Runs every step in memory (the GIL released); with out, writes the exports, "
+          "report.json and the view folder there as `clayform run --out` does.")
+      .def("__repr__",
+           [](const PyRecipe& r) { return "<clayform.Recipe '" + r.recipe.name() + "'>"; })
+      .def(py::pickle(
+          [](const PyRecipe& r) { return py::make_tuple(r.text, r.base_dir, r.recipe.name()); },
+          [](const py::tuple& t) {
+            return parse(t[0].cast<std::string>(), t[1].cast<std::string>(),
+                         t[2].cast<std::string>());
+          }));
+}
+
+}  // namespace clay::python
