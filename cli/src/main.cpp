@@ -12,9 +12,12 @@
 #include <unistd.h>
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -373,6 +376,45 @@ int render_recipe(const fs::path& file, const fs::path& png, clay::render::Rende
 
 }  // namespace
 
+/// clayform sweep: replaces this process with `python3 -m clayform.sweeps SPEC --out OUT ...`
+/// (its exit code is the command's: 0 all variants done, 1 some failed, 2 a bad description).
+int run_sweep(const std::string& spec, const std::string& out, const std::string& executor,
+              int workers, const std::string& scheduler) {
+#ifdef CLAYFORM_PYTHON_EXE
+  const fs::path build_tree = CLAYFORM_PYTHON_BUILD_DIR;
+  if (fs::exists(build_tree / "clayform" / "__init__.py")) {
+    const char* old = std::getenv("PYTHONPATH");
+    const std::string path = build_tree.string() + (old && *old ? ":" + std::string(old) : "");
+    ::setenv("PYTHONPATH", path.c_str(), 1);
+  }
+  std::vector<std::string> args = {CLAYFORM_PYTHON_EXE,
+                                   "-m",
+                                   "clayform.sweeps",
+                                   spec,
+                                   "--out",
+                                   out,
+                                   "--executor",
+                                   executor,
+                                   "--workers",
+                                   std::to_string(workers)};
+  if (!scheduler.empty()) args.insert(args.end(), {"--scheduler", scheduler});
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  ::execv(CLAYFORM_PYTHON_EXE, argv.data());
+  throw clay::Error(clay::ErrorCategory::Io,
+                    std::string("clayform sweep: cannot run ") + CLAYFORM_PYTHON_EXE + ": " +
+                        std::strerror(errno) +
+                        "; install python3 and the clayform package (scripts/demo.sh does)");
+#else
+  (void)spec, (void)out, (void)executor, (void)workers, (void)scheduler;
+  throw clay::Error(clay::ErrorCategory::InvalidArgument,
+                    "clayform sweep: this build has no Python package (CLAYFORM_BUILD_PYTHON "
+                    "was OFF); build with -DCLAYFORM_BUILD_PYTHON=ON");
+#endif
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"clayform — NURBS surface styling kernel"};
   app.set_version_flag("--version", std::string("clayform ") + CLAYFORM_VERSION);
@@ -478,6 +520,24 @@ int main(int argc, char** argv) {
       ->add_option("--stage", snapshot_options.stage,
                    "after, or before: the surfaces before their first deformation step")
       ->capture_default_str();
+  // clayform sweep: the Python package's sweeps (docs/sweeps.md), run by Debian's python3.
+  std::string sweep_spec, executor = "local", scheduler;
+  int workers = 2;
+  auto* sweep_cmd = app.add_subcommand(
+      "sweep",
+      "Run every variant of a sweep description (docs/sweeps.md): each variant's STEP, IGES, "
+      "glTF and report into OUT/<id>, OUT/index.csv and .jsonl, OUT/contact_sheet.png; a re-run "
+      "skips finished variants");
+  sweep_cmd->add_option("SPEC", sweep_spec, "a sweep description (.json)")->required();
+  sweep_cmd->add_option("--out", out_dir, "output folder (created when missing)")->required();
+  sweep_cmd->add_option("--executor", executor, "local (processes) or dask")
+      ->check(CLI::IsMember({"local", "dask"}))
+      ->capture_default_str();
+  sweep_cmd->add_option("--workers", workers, "processes, or Dask workers of a LocalCluster")
+      ->check(CLI::Range(1, 1024))
+      ->capture_default_str();
+  sweep_cmd->add_option("--scheduler", scheduler,
+                        "an existing Dask scheduler, e.g. tcp://HOST:8786 (implies dask)");
   app.footer(
       "Exit codes: 0 success, 1 usage, 2 invalid argument, 3 invalid geometry or out of domain, "
       "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 8 tolerance not met, "
@@ -490,6 +550,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (*info_cmd) return info(file);
+    if (*sweep_cmd) return run_sweep(sweep_spec, out_dir, executor, workers, scheduler);
     if (*render_cmd) {
       if (!eye.empty()) render_options.eye_direction = {eye[0], eye[1], eye[2]};
       if (fs::path(file).extension() == ".json")

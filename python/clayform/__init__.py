@@ -3,11 +3,11 @@
 Curves, surfaces and lattices are value classes whose control points are (n, 3) float64 NumPy
 views into their own storage; bulk inputs are read in place (a wrong dtype or order raises
 TypeError, never a silent copy); long calls release the GIL; surfaces, lattices and recipes
-pickle. Errors are typed (clayform.errors). Sweeps of recipe variants: clayform.sweep.
+pickle. Errors are typed (clayform.errors). Sweeps of recipe variants: clayform.sweep(spec, out) (clayform.sweeps).
 """
 from __future__ import annotations
 
-from . import errors
+from . import errors, sweeps
 from ._clayform import (
     BezierLattice,
     BSplineLattice,
@@ -41,6 +41,7 @@ from .errors import (
     RecipeError,
     ToleranceNotMetError,
 )
+from .sweeps import run as sweep
 
 __all__ = [
     "BezierLattice",
@@ -70,6 +71,8 @@ __all__ = [
     "render_png",
     "revolve",
     "style_deform",
+    "sweep",
+    "sweeps",
     "write_gltf",
     "write_iges",
     "write_step",

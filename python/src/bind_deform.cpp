@@ -31,10 +31,7 @@ Frame frame_in(const py::handle& origin, const py::handle& s, const py::handle& 
 }
 
 py::tuple frame_out(const Frame& f) {
-  const auto v = [](const Eigen::Vector3d& x) {
-    return std::array<double, 3>{x.x(), x.y(), x.z()};
-  };
-  return py::make_tuple(v(f.origin), v(f.s), v(f.t), v(f.u));
+  return py::make_tuple(tuple_of(f.origin), tuple_of(f.s), tuple_of(f.t), tuple_of(f.u));
 }
 
 /// deform_points on an (n, 3) array: into `out` (in place when it is `points`) or a new array.
@@ -125,7 +122,7 @@ void lattice_common(py::class_<Lattice>& c) {
       .def_property_readonly(
           "frame", [](const Lattice& l) { return frame_out(l.frame); },
           "(origin, s, t, u) of the parallelepiped, mm.")
-      .def_property_readonly("counts", &Lattice::counts)
+      .def_property_readonly("counts", [](const Lattice& l) { return tuple_of(l.counts()); })
       .def("index", &Lattice::index, py::arg("i"), py::arg("j"), py::arg("k"),
            "The row of P_ijk in points.")
       .def(
@@ -144,8 +141,7 @@ void lattice_common(py::class_<Lattice>& c) {
       .def(
           "deform_point",
           [](const Lattice& l, const py::handle& x) {
-            const Eigen::Vector3d p = deform::deform_point(l, vec3(x, "x"));
-            return std::array<double, 3>{p.x(), p.y(), p.z()};
+            return tuple_of(deform::deform_point(l, vec3(x, "x")));
           },
           py::arg("x"), "One point deformed (a small call).")
       .def(
@@ -188,7 +184,7 @@ void bind_deform(py::module_& m) {
            }),
            py::arg("origin"), py::arg("s"), py::arg("t"), py::arg("u"),
            py::arg("degrees") = std::array<int, 3>{3, 3, 3})
-      .def_property_readonly("degrees", [](const BezierLattice& l) { return l.degrees; })
+      .def_property_readonly("degrees", [](const BezierLattice& l) { return tuple_of(l.degrees); })
       .def("__repr__",
            [](const BezierLattice& l) {
              return "<clayform.BezierLattice degrees (" + std::to_string(l.degrees[0]) + ", " +
@@ -256,8 +252,9 @@ void bind_deform(py::module_& m) {
 
   py::class_<FrozenLattice>(m, "FrozenLattice",
                             "A lattice prepared for fast evaluation (lattice.freeze()); immutable.")
-      .def_property_readonly("degrees", &FrozenLattice::degrees)
-      .def_property_readonly("cells", &FrozenLattice::cells)
+      .def_property_readonly("degrees",
+                             [](const FrozenLattice& l) { return tuple_of(l.degrees()); })
+      .def_property_readonly("cells", [](const FrozenLattice& l) { return tuple_of(l.cells()); })
       .def(
           "deform_points",
           [](const FrozenLattice& l, const py::handle& points, const py::object& out, int threads) {
@@ -269,8 +266,7 @@ void bind_deform(py::module_& m) {
       .def(
           "deform_point",
           [](const FrozenLattice& l, const py::handle& x) {
-            const Eigen::Vector3d p = deform::deform_point(l, vec3(x, "x"));
-            return std::array<double, 3>{p.x(), p.y(), p.z()};
+            return tuple_of(deform::deform_point(l, vec3(x, "x")));
           },
           py::arg("x"));
 

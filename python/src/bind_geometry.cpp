@@ -10,6 +10,10 @@
 #include <clay/surface/skin.hpp>
 #include <clay/surface/tessellate.hpp>
 
+#include <pybind11/stl/filesystem.h>
+
+#include <cstring>
+
 namespace clay::python {
 
 using surface::BSplineCurve;
@@ -214,14 +218,11 @@ void bind_geometry(py::module_& m) {
            py::arg("degrees"), py::arg("knots_u"), py::arg("knots_v"), py::arg("points"),
            py::arg("weights") = py::none(),
            "Builds and validates a surface (points (count_u * count_v, 3), u-major; copied in).")
-      .def_property_readonly("degrees",
-                             [](const BSplineSurface& s) {
-                               return std::array<int, 2>{s.u.degree, s.v.degree};
-                             })
-      .def_property_readonly("counts",
-                             [](const BSplineSurface& s) {
-                               return std::array<int, 2>{s.u.count(), s.v.count()};
-                             })
+      .def_property_readonly(
+          "degrees", [](const BSplineSurface& s) { return py::make_tuple(s.u.degree, s.v.degree); })
+      .def_property_readonly(
+          "counts",
+          [](const BSplineSurface& s) { return py::make_tuple(s.u.count(), s.v.count()); })
       .def_property_readonly("knots_u",
                              [](const BSplineSurface& s) { return frozen_copy(s.u.knots); })
       .def_property_readonly("knots_v",
@@ -402,7 +403,7 @@ void bind_geometry(py::module_& m) {
   // Exchange. OpenCASCADE's translators are serialized inside the kernel; the GIL is released.
   m.def(
       "write_step",
-      [](const py::object& surfaces, const std::string& path, const std::string& schema) {
+      [](const py::object& surfaces, const std::filesystem::path& path, const std::string& schema) {
         surface::StepWriteOptions o;
         if (schema == "AP242")
           o.schema = surface::StepSchema::AP242;
@@ -421,7 +422,7 @@ void bind_geometry(py::module_& m) {
       "Writes surfaces as faces of a STEP file (atomic); returns the exchange report.");
   m.def(
       "write_iges",
-      [](const py::object& surfaces, const std::string& path) {
+      [](const py::object& surfaces, const std::filesystem::path& path) {
         const auto list = surfaces_in(surfaces);
         surface::ExchangeReport r;
         {
@@ -433,7 +434,7 @@ void bind_geometry(py::module_& m) {
       py::arg("surfaces"), py::arg("path"), "Writes surfaces to an IGES file (atomic).");
   m.def(
       "write_gltf",
-      [](const py::object& surfaces, const std::string& path) {
+      [](const py::object& surfaces, const std::filesystem::path& path) {
         const auto list = surfaces_in(surfaces);
         py::gil_scoped_release free;
         surface::write_gltf(list, path);
@@ -443,7 +444,7 @@ void bind_geometry(py::module_& m) {
     const bool step = std::string(name) == "read_step";
     m.def(
         name,
-        [step](const std::string& path, bool precheck, bool isolate) {
+        [step](const std::filesystem::path& path, bool precheck, bool isolate) {
           surface::ReadOptions o;
           o.precheck = precheck;
           o.isolate = isolate;

@@ -4,6 +4,8 @@
 
 #include <clay/recipe/recipe.hpp>
 
+#include <pybind11/stl/filesystem.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -82,7 +84,7 @@ void bind_recipe(py::module_& m) {
       .def_property_readonly("seconds", [](const recipe::RunResult& r) { return r.seconds; })
       .def(
           "write",
-          [](recipe::RunResult& r, const std::string& out) {
+          [](recipe::RunResult& r, const fs::path& out) {
             std::vector<fs::path> files;
             {
               py::gil_scoped_release free;
@@ -144,16 +146,15 @@ void bind_recipe(py::module_& m) {
                              [](const PyRecipe& r) { return recipe::final_surfaces(r.recipe); })
       .def(
           "run",
-          [](const PyRecipe& r, const py::object& out) {
+          [](const PyRecipe& r, const std::optional<fs::path>& out) {
             recipe::RunResult result;
             {
               py::gil_scoped_release free;
               result = recipe::run_recipe(r.recipe);
             }
-            if (!out.is_none()) {
-              const std::string dir = py::str(out);
+            if (out) {
               py::gil_scoped_release free;
-              recipe::write_outputs(result, dir);
+              recipe::write_outputs(result, *out);
             }
             return result;
           },

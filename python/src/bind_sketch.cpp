@@ -159,11 +159,8 @@ void bind_sketch(py::module_& m) {
           },
           py::arg("curve"), py::arg("plane") = -1,
           "A B-spline curve whose control points become sketch points; returns its index.")
-      .def("position",
-           [](const PySketch& s, int k) {
-             const Eigen::Vector3d p = sketch::position(s.sketch, s.point(k));
-             return std::array<double, 3>{p.x(), p.y(), p.z()};
-           })
+      .def("position", [](const PySketch& s,
+                          int k) { return tuple_of(sketch::position(s.sketch, s.point(k))); })
       .def(
           "curve", [](const PySketch& s, int k) { return sketch::curve_of(s.sketch, s.entity(k)); },
           "The entity as a B-spline curve (exact: arcs and circles rational).")

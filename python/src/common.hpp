@@ -13,6 +13,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <span>
 #include <string>
 #include <vector>
@@ -108,6 +109,15 @@ inline Eigen::Vector3d vec3(const py::handle& obj, const std::string& what) {
     throw py::value_error(what + ": expected 3 coordinates, got " + std::to_string(seq.size()));
   return {seq[0], seq[1], seq[2]};
 }
+
+/// A fixed-size array as a Python tuple (std::array alone becomes a list).
+template <class T, std::size_t N>
+py::tuple tuple_of(const std::array<T, N>& a) {
+  py::tuple t(N);
+  for (std::size_t i = 0; i < N; ++i) t[i] = py::cast(a[i]);
+  return t;
+}
+inline py::tuple tuple_of(const Eigen::Vector3d& p) { return py::make_tuple(p.x(), p.y(), p.z()); }
 
 void register_errors(py::module_& m);
 void bind_geometry(py::module_& m);
