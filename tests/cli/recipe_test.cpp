@@ -549,6 +549,11 @@ TEST_CASE("load_recipe names the file and takes the name from its stem", "[recip
   fs::create_directories(dir);
   std::ofstream(dir / "my-part.json") << R"({"format": "clayform.recipe", "version": 1})";
   CHECK(load_recipe(dir / "my-part.json").name() == "my-part");
+  // parse_recipe: the default name only when the text has none.
+  CHECK(parse_recipe(R"({"format": "clayform.recipe", "version": 1})", {}, "given").name() ==
+        "given");
+  CHECK(parse_recipe(R"({"format": "clayform.recipe", "version": 1, "name": "own"})", {}, "given")
+            .name() == "own");
   const auto [category, message] = error_of([&] { load_recipe(dir / "missing.json"); });
   CHECK(category == ErrorCategory::Io);
   CHECK_THAT(message, Contains("missing.json"));

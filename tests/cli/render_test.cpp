@@ -307,6 +307,20 @@ TEST_CASE("render: write_png writes the pixels that libpng reads back, and no te
   REQUIRE(png_image_finish_read(&png, nullptr, back.data(), 0, nullptr) != 0);
   CHECK(back == img.rgb);
   CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
+  // In memory: libpng decodes encode_png's bytes to the same pixels.
+  const std::vector<unsigned char> bytes = encode_png(img);
+  png_image mem{};
+  mem.version = PNG_IMAGE_VERSION;
+  REQUIRE(png_image_begin_read_from_memory(&mem, bytes.data(), bytes.size()) != 0);
+  CHECK(mem.width == 64u);
+  mem.format = PNG_FORMAT_RGB;
+  std::vector<std::uint8_t> decoded(PNG_IMAGE_SIZE(mem));
+  REQUIRE(png_image_finish_read(&mem, nullptr, decoded.data(), 0, nullptr) != 0);
+  CHECK(decoded == img.rgb);
+  Image bad = img;
+  bad.rgb.pop_back();
+  CHECK_THAT(error_of([&] { encode_png(bad); }).second,
+             Contains("encode_png") && Contains("9216 bytes"));
 }
 
 TEST_CASE("render: bad options, no surfaces, bad images and unwritable files are named",

@@ -4,6 +4,7 @@
 #include <clay/deform.hpp>
 
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "error_of.hpp"
@@ -71,6 +72,16 @@ TEST_CASE("bad options and arguments are rejected naming the field", "[deform]")
                deform_points(FrozenLattice(L), PointColumns{a, a, a}, MutablePointColumns{a, a, b});
              }).second,
              Contains("same size"));
+  std::vector<double> seven(7), six(6);
+  const auto interleaved = error_of([&] {
+    deform_points(FrozenLattice(L), std::span<const double>(seven), std::span<double>(seven));
+  });
+  CHECK(interleaved.first == ErrorCategory::InvalidArgument);
+  CHECK_THAT(interleaved.second, Contains("7 in") && Contains("multiple of 3"));
+  CHECK_THAT(error_of([&] {
+               deform_points(FrozenLattice(L), std::span<const double>(six), std::span<double>(a));
+             }).second,
+             Contains("6 in and 3 out"));
 }
 
 TEST_CASE("a B-spline basis whose domain is not the unit interval is rejected", "[deform]") {

@@ -85,6 +85,13 @@ void check_against_reference(const Lattice& L, std::mt19937& rng, int n) {
     deform_points(frozen, PointColumns{x, y, z}, MutablePointColumns{x, y, z},
                   DeformOptions{threads});
     CHECK((x == ox && y == oy && z == oz));
+    // Interleaved buffers (a NumPy (n, 3) array): the same numbers as the row form, and in place.
+    std::vector<double> xyz(points.data(), points.data() + points.size()), out(xyz.size());
+    deform_points(frozen, xyz, out, DeformOptions{threads});
+    Points3 interleaved = Eigen::Map<const Points3>(out.data(), n, 3);
+    CHECK(worst_relative(L, points, interleaved, size) < 1e-13);
+    deform_points(frozen, xyz, xyz, DeformOptions{threads});
+    CHECK(xyz == out);
   }
   // One point at a time through the same power form.
   for (int r = 0; r < std::min(50, n); ++r) {
