@@ -10,3 +10,10 @@ for name in "${benches[@]}"; do
     --benchmark_out_format=json "$@"
   echo "results: $CLAY_BUILD/bench/$name.json"
 done
+# The Python binding's figures (FFD of 1 M points against bench_deform in the same run, small
+# calls, the GIL, a 64-variant sweep on Dask), when the package was built.
+if [ -f "$CLAY_BUILD/python/clayform/__init__.py" ]; then
+  PYTHONPATH="$CLAY_BUILD/python" /usr/bin/python3 "$CLAY_ROOT/bench/python_bench.py" \
+    --out "$CLAY_BUILD/bench/python.json" --bench-deform "$CLAY_BUILD/bench/bench_deform"
+  echo "results: $CLAY_BUILD/bench/python.json"
+fi
