@@ -41,3 +41,18 @@ if(NOT last_output MATCHES "consumer ok")
 endif()
 run(${WORK_DIR}/prefix/bin/clayform info ${WORK_DIR}/consumer.step)
 message(STATUS "${last_output}")
+# The Python package, when built: importable from the prefix alone (its RPATH reaches the
+# installed libraries, not the build tree's), and it runs a recipe.
+if(PYTHON AND PYTHON_INSTALL_DIR)
+  set(site ${WORK_DIR}/prefix/${PYTHON_INSTALL_DIR})
+  if(NOT EXISTS ${site}/clayform/__init__.py OR NOT EXISTS ${site}/clayform/py.typed)
+    message(FATAL_ERROR "install is missing the Python package in ${site}")
+  endif()
+  # (No ";" in the code: CMake would split the argument there.)
+  run(${CMAKE_COMMAND} -E env PYTHONPATH=${site} ${PYTHON} -c
+      "import clayform as c\nassert c.__file__.startswith('${site}'), c.__file__\nprint('python', len(c.read_step('${WORK_DIR}/consumer.step')))")
+  if(NOT last_output MATCHES "python [1-9]")
+    message(FATAL_ERROR "the installed package printed: ${last_output}")
+  endif()
+  message(STATUS "installed Python package: ${last_output}")
+endif()
