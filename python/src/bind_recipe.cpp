@@ -12,6 +12,9 @@
 
 namespace clay::python {
 
+py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
+                       const std::string& deformation);  // bind_model.cpp
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -107,14 +110,13 @@ void bind_recipe(py::module_& m) {
                        "Recipe.parse(text); run() runs it; pickles as its text.")
       .def_static(
           "load",
-          [](const std::string& path) {
-            std::ifstream in(path, std::ios::binary);
+          [](const fs::path& file) {
+            std::ifstream in(file, std::ios::binary);
             if (!in)
               throw Error(ErrorCategory::Io,
-                          "cannot read the recipe \"" + path + "\"; check the path");
+                          "cannot read the recipe \"" + file.string() + "\"; check the path");
             std::ostringstream text;
             text << in.rdbuf();
-            const fs::path file(path);
             return parse(text.str(), file.parent_path().string(), file.stem().string());
           },
           py::arg("path"), "Reads and checks a recipe file (RecipeError lists every problem).")
@@ -161,6 +163,14 @@ void bind_recipe(py::module_& m) {
           py::arg("out") = py::none(),
           "Runs every step in memory (the GIL released); with out, writes the exports, "
           "report.json and the view folder there as `clayform run --out` does.")
+      .def(
+          "deform_model",
+          [](const PyRecipe& r, const brep::Model& model, const std::string& deformation) {
+            return deform_model(r.recipe, model, deformation);
+          },
+          py::arg("model"), py::arg("deformation") = "",
+          "The model deformed by the recipe's stack (the one named, or its only one), as "
+          "`clayform deform` does: (Model, report).")
       .def("__repr__",
            [](const PyRecipe& r) { return "<clayform.Recipe '" + r.recipe.name() + "'>"; })
       .def(py::pickle(

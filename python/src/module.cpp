@@ -90,5 +90,6 @@ PYBIND11_MODULE(_clayform, m) {
   clay::python::bind_geometry(m);
   clay::python::bind_deform(m);
   clay::python::bind_sketch(m);
+  clay::python::bind_model(m);
   clay::python::bind_recipe(m);
 }

@@ -77,17 +77,24 @@ def test_local_sweep_with_a_failure_and_a_crash_then_resume(examples: Path, tmp_
 
 def test_dask_local_cluster_sweep(examples: Path, tmp_path: Path) -> None:
     pytest.importorskip("distributed")
-    description = spec(examples, [0, 100, 200])
-    sets = sweeps.variants(description)
+    sets = [{BILLOW: 0, DRAFT: 0.01}, {BILLOW: 100, DRAFT: 0.01}, {BILLOW: 200, DRAFT: 0.01},
+            {BILLOW: 300, DRAFT: -1.0}]
+    description = {"format": "clayform.sweep", "version": 1,
+                   "recipe": str(examples / "recipes" / "sail.json"), "list": sets}
     crash = sweeps.variant_id(sets[2])
-    rows = cf.sweep(description, tmp_path, executor="dask", workers=2, abort=[crash], progress=lambda *a: None)
-    assert [r["status"] for r in rows] == ["ok", "ok", "crashed"]
-    first = cf.read_step(str(tmp_path / rows[0]["id"] / "sail.step"))[0]
-    second = cf.read_step(str(tmp_path / rows[1]["id"] / "sail.step"))[0]
+    rows = cf.sweep(description, tmp_path, executor="dask", workers=2, abort=[crash],
+                    progress=lambda *a: None)
+    assert [r["status"] for r in rows] == ["ok", "ok", "crashed", "failed"]
+    assert "RecipeError" in rows[3]["error"] and "SIGABRT" in rows[2]["error"]
+    first = cf.read_step(tmp_path / rows[0]["id"] / "sail.step")[0]
+    second = cf.read_step(tmp_path / rows[1]["id"] / "sail.step")[0]
     assert not first.identical(second)
-    # The billow moves the middle of the sail by the lattice move's share (a pure shear in y).
+    # The billow's move is along +y: the middle of the sail moves that way.
     u = np.array([0.5]); v = np.array([0.5])
     assert second.evaluate(u, v)[0, 1] > first.evaluate(u, v)[0, 1]
+    # Resume on the cluster: the two finished variants are skipped, the crashed one now runs.
+    again = cf.sweep(description, tmp_path, executor="dask", workers=2, progress=lambda *a: None)
+    assert [r["status"] for r in again] == ["done", "done", "ok", "failed"]
 
 
 def test_the_command_runs_a_sweep_and_resumes(examples: Path, exe: str, tmp_path: Path) -> None:

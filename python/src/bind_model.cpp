@@ -1,0 +1,207 @@
+// Whole CAD models (B-rep: trimmed faces, shells, solids, assemblies): read, inspect, mesh,
+// deform by a recipe's stack, write. A Model is a value: copies are independent.
+#include "common.hpp"
+
+#include <clay/brep/exchange.hpp>
+#include <clay/brep/model.hpp>
+#include <clay/brep/volume.hpp>
+#include <clay/recipe/recipe.hpp>
+
+#include <pybind11/stl/filesystem.h>
+
+namespace clay::python {
+
+namespace {
+
+py::dict counts_dict(const brep::Counts& c) {
+  py::dict d;
+  d["bodies"] = c.bodies;
+  d["solids"] = c.solids;
+  d["shells"] = c.shells;
+  d["faces"] = c.faces;
+  d["trimmed_faces"] = c.trimmed_faces;
+  d["loops"] = c.loops;
+  d["inner_loops"] = c.inner_loops;
+  d["edges"] = c.edges;
+  d["vertices"] = c.vertices;
+  d["parts"] = c.parts;
+  d["instances"] = c.instances;
+  return d;
+}
+
+const char* kind_name(brep::BodyKind k) {
+  switch (k) {
+    case brep::BodyKind::Solid:
+      return "solid";
+    case brep::BodyKind::Shell:
+      return "shell";
+    case brep::BodyKind::Sheet:
+      return "sheet";
+  }
+  return "sheet";
+}
+
+brep::Face& face_at(brep::Model& m, int k) {
+  if (k < 0 || k >= static_cast<int>(m.faces.size()))
+    throw Error(ErrorCategory::InvalidArgument, "model: no face " + std::to_string(k) +
+                                                    "; it has " + std::to_string(m.faces.size()) +
+                                                    " (0-based)");
+  return m.faces[static_cast<std::size_t>(k)];
+}
+
+}  // namespace
+
+/// The recipe's deformation of a whole model (bind_recipe.cpp calls it on its Recipe class).
+py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
+                       const std::string& deformation) {
+  recipe::ModelRunResult result;
+  {
+    py::gil_scoped_release free;
+    result = recipe::deform_model(r, model, deformation);
+  }
+  const auto& x = result.report;
+  py::dict d;
+  d["counts"] = counts_dict(x.counts);
+  d["faces_exact"] = x.faces_exact;
+  d["faces_refit"] = x.faces_refit;
+  d["faces_untouched"] = x.faces_untouched;
+  d["max_certified_bound_mm"] = x.max_certified_bound_mm;
+  d["max_edge_gap_mm"] = x.max_edge_gap_mm;
+  d["volume_before_mm3"] = x.volume_before_mm3;
+  d["volume_after_mm3"] = x.volume_after_mm3;
+  d["fold_free"] = result.fold_free;
+  d["message"] = x.brief();
+  return py::make_tuple(std::move(result.model), d);
+}
+
+void bind_model(py::module_& m) {
+  py::class_<brep::Model>(m, "Model",
+                          "A whole B-rep model: faces (NURBS surfaces with trimming loops), "
+                          "edges, vertices, bodies (solids, shells, sheets), an assembly tree.")
+      .def_property_readonly("counts",
+                             [](const brep::Model& x) { return counts_dict(brep::counts(x)); })
+      .def_property_readonly("is_assembly", &brep::Model::is_assembly)
+      .def_property_readonly(
+          "bodies",
+          [](const brep::Model& x) {
+            py::list out;
+            for (const auto& b : x.bodies) {
+              py::dict d;
+              d["name"] = b.name;
+              d["kind"] = kind_name(b.kind);
+              std::vector<int> faces;
+              for (const auto& s : b.shells)
+                faces.insert(faces.end(), s.faces.begin(), s.faces.end());
+              d["faces"] = faces;
+              out.append(d);
+            }
+            return out;
+          },
+          "Each body's name, kind (solid, shell, sheet) and face indices.")
+      .def_property_readonly("face_count", [](const brep::Model& x) { return x.faces.size(); })
+      .def(
+          "face_surface", [](brep::Model& x, int k) { return face_at(x, k).surface; },
+          py::arg("face"), "The face's NURBS surface (a copy; the loops trim it).")
+      .def(
+          "face_name", [](brep::Model& x, int k) { return face_at(x, k).name; }, py::arg("face"))
+      .def(
+          "volume_mm3",
+          [](const brep::Model& x) {
+            py::gil_scoped_release free;
+            return brep::volume_mm3(x);
+          },
+          "The volume of the solids (mm^3), from the exact faces.")
+      .def(
+          "problems", [](const brep::Model& x) { return brep::problems(x); },
+          "Every invariant the model breaks, in words; [] when valid.")
+      .def(
+          "flattened",
+          [](const brep::Model& x) {
+            py::gil_scoped_release free;
+            return brep::flattened(x);
+          },
+          "The model without its assembly: each placed body in world coordinates.")
+      .def(
+          "tessellate",
+          [](const brep::Model& x, double relative_deflection) {
+            brep::MeshOptions o;
+            o.relative_deflection = relative_deflection;
+            brep::ModelMesh mesh;
+            {
+              py::gil_scoped_release free;
+              mesh = brep::tessellate(x, o);
+            }
+            Points3 positions(static_cast<Eigen::Index>(mesh.positions.size()), 3);
+            for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+              positions.row(static_cast<Eigen::Index>(i)) = mesh.positions[i].transpose();
+            py::array_t<std::int32_t> triangles(
+                {static_cast<py::ssize_t>(mesh.triangles.size()), py::ssize_t{3}});
+            auto t = triangles.mutable_unchecked<2>();
+            for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+              for (int k = 0; k < 3; ++k)
+                t(static_cast<py::ssize_t>(i), k) = mesh.triangles[i][static_cast<std::size_t>(k)];
+            py::array_t<std::int32_t> face(static_cast<py::ssize_t>(mesh.triangle_face.size()));
+            std::copy(mesh.triangle_face.begin(), mesh.triangle_face.end(), face.mutable_data());
+            return py::make_tuple(owned(std::move(positions)), triangles, face);
+          },
+          py::arg("relative_deflection") = 5e-4,
+          "The trimmed faces meshed (OpenCASCADE): (vertices (n, 3), triangles (m, 3) int32, "
+          "the face of each triangle (m,)); holes are holes.")
+      .def(
+          "write",
+          [](const brep::Model& x, const std::filesystem::path& path) {
+            brep::ModelCheck c;
+            {
+              py::gil_scoped_release free;
+              c = brep::write_model(x, path);
+            }
+            py::dict d;
+            d["valid"] = c.valid;
+            d["problems"] = c.problems;
+            d["volume_mm3"] = c.volume_mm3;
+            d["message"] = c.brief();
+            return d;
+          },
+          py::arg("path"),
+          "Writes STEP (.step/.stp), IGES (.igs/.iges) or a glTF preview (.glb), atomically, read "
+          "back and checked (BRepCheck): the check as a dict.")
+      .def("__copy__", [](const brep::Model& x) { return x; })
+      .def("__deepcopy__", [](const brep::Model& x, py::dict) { return x; })
+      .def("__repr__", [](const brep::Model& x) {
+        const auto c = brep::counts(x);
+        return "<clayform.Model " + std::to_string(c.bodies) + " bodies (" +
+               std::to_string(c.solids) + " solids), " + std::to_string(c.faces) + " faces" +
+               (x.is_assembly() ? ", assembly" : "") + ">";
+      });
+
+  m.def(
+      "read_model",
+      [](const std::filesystem::path& path, bool sew, bool isolate) {
+        brep::ModelReadOptions o;
+        o.sew = sew;
+        o.read.isolate = isolate;
+        brep::ImportedModel imported;
+        {
+          py::gil_scoped_release free;
+          imported = brep::read_model(path, o);
+        }
+        const auto& r = imported.report;
+        py::dict d;
+        d["counts"] = counts_dict(r.counts);
+        d["size_mm"] = r.size_mm;
+        d["faces_bspline"] = r.faces_bspline;
+        d["faces_affine"] = r.faces_affine;
+        d["faces_angular"] = r.faces_angular;
+        d["max_edge_gap_mm"] = r.max_edge_gap_mm;
+        d["healing"] = r.healing;
+        d["problems"] = r.problems;
+        d["message"] = r.brief();
+        return py::make_tuple(std::move(imported.model), d);
+      },
+      py::arg("path"), py::arg("sew") = false, py::arg("isolate") = false,
+      "Reads a whole STEP or IGES model (trimmed faces, solids, assembly): (Model, report). "
+      "isolate=True reads in a child process, so a file that crashes OpenCASCADE raises "
+      "ExchangeError.");
+}
+
+}  // namespace clay::python
