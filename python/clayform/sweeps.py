@@ -49,6 +49,7 @@ INDEX_FIELDS = [
     "status",
     "seconds",
     "deviation_mm",
+    "volume_mm3",
     "volume_ratio_min",
     "volume_ratio_max",
     "fold_free",
@@ -125,6 +126,10 @@ def load_spec(spec: Union[str, "os.PathLike[str]", Spec]) -> Tuple[Spec, str, Pa
         base = Path.cwd()
     if document.get("format", "clayform.sweep") != "clayform.sweep" or document.get("version", 1) != 1:
         raise ValueError('sweep: expected "format": "clayform.sweep", "version": 1')
+    unknown = sorted(set(document) - {"format", "version", "description", "recipe", "grid", "list", "out"})
+    if unknown:
+        raise ValueError(f"sweep: unknown key(s) {', '.join(unknown)}; the description takes format, version, "
+                         "description, recipe, grid or list, out")
     recipe = document.get("recipe")
     if recipe is None:
         raise ValueError('sweep: "recipe" names the base recipe file')
@@ -146,6 +151,7 @@ def _figures(report: Dict[str, Any]) -> Dict[str, Any]:
     ratios: List[float] = []
     fold: Optional[bool] = None
     points = 0
+    volume: Optional[float] = None
     for step in report.get("steps", []):
         f = step.get("figures", {})
         if isinstance(f.get("max_deviation_mm"), (int, float)):
@@ -157,8 +163,11 @@ def _figures(report: Dict[str, Any]) -> Dict[str, Any]:
             fold = f["fold_free"] if fold is None else (fold and f["fold_free"])
         if step.get("kind") == "export" and isinstance(f.get("control_points"), int):
             points += f["control_points"]
+        if step.get("kind") == "model" and isinstance(f.get("volume_after_mm3"), (int, float)):
+            volume = (volume or 0.0) + float(f["volume_after_mm3"])
     return {
         "deviation_mm": deviation,
+        "volume_mm3": volume,
         "volume_ratio_min": min(ratios) if ratios else None,
         "volume_ratio_max": max(ratios) if ratios else None,
         "fold_free": fold,
@@ -310,7 +319,7 @@ def contact_sheet(out: Union[str, "os.PathLike[str]"], rows: List[Dict[str, Any]
 
 def run(
     spec: Union[str, "os.PathLike[str]", Spec],
-    out: Union[str, "os.PathLike[str]"],
+    out: Union[str, "os.PathLike[str]", None] = None,
     executor: str = "local",
     workers: int = 2,
     scheduler: Optional[str] = None,
@@ -318,11 +327,17 @@ def run(
     abort: Iterable[str] = (),
 ) -> List[Dict[str, Any]]:
     """Runs every variant of the description into OUT (see the module's doc); returns the index
-    rows in the description's order. `executor` is "local" or "dask" (`scheduler` an address of
+    rows in the description's order. Without `out`, the description's "out" (relative to its
+    folder) is used. `executor` is "local" or "dask" (`scheduler` an address of
     an existing cluster, else a LocalCluster of `workers` processes). `progress(done, total, row)`
     is called as variants finish (default: a line on stderr). `abort` lists variant ids whose
     process is made to abort (fault injection for tests)."""
     document, base_text, base_dir = load_spec(spec)
+    if out is None:
+        if "out" not in document:
+            raise ValueError('sweep: give the output folder (out=..., --out) or "out" in the description')
+        spec_dir = Path(spec).parent if isinstance(spec, (str, os.PathLike)) else Path.cwd()
+        out = spec_dir / document["out"]
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     sets = variants(document)

@@ -21,7 +21,7 @@ def spec(examples: Path, values: list) -> dict:
             "grid": {BILLOW: values}}
 
 
-def test_paths_and_variants() -> None:
+def test_paths_and_variants(examples: Path) -> None:
     assert sweeps.parse_path("a.b[2].c[0]") == ["a", "b", 2, "c", 0]
     with pytest.raises(ValueError):
         sweeps.parse_path("a..b")
@@ -33,6 +33,10 @@ def test_paths_and_variants() -> None:
     grid = sweeps.variants({"grid": {"p": [1, 2], "q": ["a", "b", "c"]}})
     assert len(grid) == 6 and {"p": 2, "q": "c"} in grid
     assert sweeps.variant_id({"p": 1, "q": 2}) == sweeps.variant_id({"q": 2, "p": 1})
+    with pytest.raises(ValueError, match="unknown key"):
+        cf.sweep({"recipe": "x.json", "grid": {"a": [1]}, "gird": {}}, "out")
+    with pytest.raises(ValueError, match="output folder"):
+        cf.sweep({"recipe": str(examples / "recipes" / "sail.json"), "grid": {BILLOW: [1]}})
 
 
 def test_local_sweep_with_a_failure_and_a_crash_then_resume(examples: Path, tmp_path: Path) -> None:
@@ -71,6 +75,7 @@ def test_local_sweep_with_a_failure_and_a_crash_then_resume(examples: Path, tmp_
     # Resume: the finished variants are skipped, the crashed one runs again (and now succeeds).
     again = cf.sweep(description, tmp_path, workers=2, progress=lambda *a: None)
     assert [r["status"] for r in again].count("done") == 3
+    assert all(r["volume_mm3"] is None for r in again)  # surfaces only: no solid, no volume
     assert again[1]["status"] == "ok"
     assert again[-1]["status"] == "failed"
 
