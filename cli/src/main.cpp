@@ -5,6 +5,7 @@
 #include <clay/recipe/recipe.hpp>
 #include <clay/render/render.hpp>
 #include <clay/serve.hpp>
+#include <clay/studio.hpp>
 #include <clay/surface/tessellate.hpp>
 
 #include <CLI/CLI.hpp>
@@ -520,6 +521,16 @@ int main(int argc, char** argv) {
       ->add_option("--stage", snapshot_options.stage,
                    "after, or before: the surfaces before their first deformation step")
       ->capture_default_str();
+  // clayform studio (clay/studio.hpp): the recipe behind a WebSocket on 127.0.0.1.
+  std::string studio_recipe;
+  int studio_port = 8770;
+  auto* studio_cmd = app.add_subcommand(
+      "studio",
+      "Serve a recipe to Clayform Studio on 127.0.0.1 and print its address: the kernel behind "
+      "one WebSocket (/ws), every edit appended to the recipe's history (docs/studio.md)");
+  studio_cmd->add_option("RECIPE", studio_recipe, "a recipe (.json); none: an empty one");
+  studio_cmd->add_option("--port", studio_port, "TCP port, 0 for any free one")
+      ->capture_default_str();
   // clayform sweep: the Python package's sweeps (docs/sweeps.md), run by Debian's python3.
   std::string sweep_spec, executor = "local", scheduler;
   int workers = 2;
@@ -551,6 +562,23 @@ int main(int argc, char** argv) {
   try {
     if (*info_cmd) return info(file);
     if (*sweep_cmd) return run_sweep(sweep_spec, out_dir, executor, workers, scheduler);
+    if (*studio_cmd) {
+      clay::recipe::StudioOptions o;
+      o.port = studio_port;
+      o.front_end = clay::recipe::viewer_dir();
+      clay::recipe::StudioServer server(
+          studio_recipe.empty()
+              ? clay::recipe::StudioSession(
+                    R"({"format": "clayform.recipe", "version": 1, "name": "untitled"})", ".",
+                    "untitled")
+              : clay::recipe::StudioSession::load(studio_recipe),
+          o);
+      std::printf("Clayform Studio at %s (WebSocket ws://127.0.0.1:%d/ws; Ctrl-C to stop)\n",
+                  server.url().c_str(), server.port());
+      std::fflush(stdout);
+      server.run();
+      return 0;
+    }
     if (*render_cmd) {
       if (!eye.empty()) render_options.eye_direction = {eye[0], eye[1], eye[2]};
       if (fs::path(file).extension() == ".json")

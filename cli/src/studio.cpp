@@ -1,0 +1,554 @@
+// Clayform Studio's kernel side (clay/studio.hpp): the session (a recipe under edits with a
+// history) and its server (Boost.Beast, Debian's libboost-dev: cpp-httplib 0.11 has no
+// WebSocket, and Beast is the well-kept header-only HTTP/WebSocket library Debian ships).
+#include <clay/error.hpp>
+#include <clay/recipe/recipe.hpp>
+#include <clay/studio.hpp>
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/websocket.hpp>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <condition_variable>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+namespace clay::recipe {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace {
+
+/// "a.b[2].c" -> JSON pointer "/a/b/2/c"; clay::Error(InvalidArgument) for a malformed path.
+Json::json_pointer pointer_of(const std::string& path) {
+  std::string out;
+  std::size_t i = 0;
+  bool expect_key = true;
+  while (i < path.size()) {
+    if (path[i] == '[') {
+      const std::size_t close = path.find(']', i);
+      const std::string index = close == std::string::npos ? "" : path.substr(i + 1, close - i - 1);
+      if (index.empty() || !std::all_of(index.begin(), index.end(), ::isdigit))
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: path \"" + path + "\" has a malformed list index; write items as [i]");
+      out += "/" + index;
+      i = close + 1;
+      expect_key = false;
+    } else if (path[i] == '.') {
+      if (expect_key)
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: path \"" + path + "\" has an empty key");
+      ++i;
+      expect_key = true;
+    } else {
+      const std::size_t end = path.find_first_of(".[", i);
+      std::string key = path.substr(i, end == std::string::npos ? std::string::npos : end - i);
+      // JSON pointer escapes: ~ as ~0, / as ~1.
+      std::string escaped;
+      for (char c : key) escaped += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+      out += "/" + escaped;
+      i = end == std::string::npos ? path.size() : end;
+      expect_key = false;
+    }
+  }
+  if (out.empty() || expect_key)
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: path \"" + path + "\" is empty or ends with \".\"");
+  return Json::json_pointer(out);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> net_frame(const std::string& name, const std::string& header_json,
+                                    const std::vector<double>& points,
+                                    const std::vector<double>& weights) {
+  (void)name;
+  // Sized once and filled with memcpy (GCC 12 misreads insert() of chars into bytes as an
+  // overflow at -O3).
+  const std::size_t header = 4 + header_json.size();
+  const std::size_t padded = (header + 7) / 8 * 8;
+  std::vector<std::uint8_t> out(padded + (points.size() + weights.size()) * sizeof(double), 0);
+  const auto length = static_cast<std::uint32_t>(header_json.size());
+  for (int k = 0; k < 4; ++k)
+    out[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(length >> (8 * k));
+  std::memcpy(out.data() + 4, header_json.data(), header_json.size());
+  std::memcpy(out.data() + padded, points.data(), points.size() * sizeof(double));  // x86-64: LE
+  std::memcpy(out.data() + padded + points.size() * sizeof(double), weights.data(),
+              weights.size() * sizeof(double));
+  return out;
+}
+
+struct StudioSession::Impl {
+  fs::path base_dir;
+  std::string name;
+  std::vector<std::pair<std::string, std::string>> history;  // (label, recipe text)
+  int position = 0;
+
+  const std::string& text() const { return history[static_cast<std::size_t>(position)].second; }
+
+  RunResult run(const std::string& recipe_text) const {
+    return run_recipe(parse_recipe(recipe_text, base_dir, name));
+  }
+
+  Json history_json() const {
+    Json h = Json::array();
+    for (const auto& [label, t] : history) h.push_back(label);
+    return Json{{"entries", h}, {"position", position}};
+  }
+
+  /// The reply of a run: its report figures per step, and a net frame per final surface.
+  Reply ran(const std::string& op, const RunResult& result) const {
+    Reply reply;
+    Json steps = Json::array();
+    for (const auto& s : result.steps) {
+      Json figures = Json::object();
+      for (const auto& [k, v] : s.figures)
+        std::visit([&, key = k](const auto& x) { figures[key] = x; }, v);
+      steps.push_back({{"path", s.path},
+                       {"kind", s.kind},
+                       {"seconds", s.seconds},
+                       {"warning", s.warning},
+                       {"message", s.message},
+                       {"figures", figures}});
+    }
+    const Recipe parsed = parse_recipe(text(), base_dir, name);
+    Json surfaces = Json::array();
+    for (const std::string& n : final_surfaces(parsed)) {
+      const auto& s = result.surface(n);
+      Json header = {{"kind", "net"},
+                     {"name", n},
+                     {"degrees", {s.u.degree, s.v.degree}},
+                     {"counts", {s.u.count(), s.v.count()}},
+                     {"knots_u", s.u.knots},
+                     {"knots_v", s.v.knots},
+                     {"rational", s.is_rational()}};
+      std::vector<double> points(s.points.data(), s.points.data() + s.points.size());
+      std::vector<double> weights(s.weights.data(), s.weights.data() + s.weights.size());
+      reply.frames.push_back(net_frame(n, header.dump(), points, weights));
+      surfaces.push_back(n);
+    }
+    reply.json = Json{{"op", op},       {"recipe", result.recipe}, {"seconds", result.seconds},
+                      {"steps", steps}, {"surfaces", surfaces},    {"history", history_json()}}
+                     .dump();
+    return reply;
+  }
+};
+
+StudioSession::StudioSession(std::string text, fs::path base_dir, std::string name)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->base_dir = std::move(base_dir);
+  impl_->name = std::move(name);
+  parse_recipe(text, impl_->base_dir, impl_->name);  // throws Recipe listing the problems
+  impl_->history.emplace_back("open", std::move(text));
+}
+
+StudioSession::~StudioSession() = default;
+StudioSession::StudioSession(StudioSession&&) noexcept = default;
+StudioSession& StudioSession::operator=(StudioSession&&) noexcept = default;
+
+StudioSession StudioSession::load(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in)
+    throw Error(ErrorCategory::Io,
+                "cannot read the recipe \"" + file.string() + "\"; check the path");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return StudioSession(text.str(), file.parent_path(), file.stem().string());
+}
+
+const std::string& StudioSession::text() const { return impl_->text(); }
+
+std::vector<std::string> StudioSession::history() const {
+  std::vector<std::string> out;
+  for (const auto& [label, t] : impl_->history) out.push_back(label);
+  return out;
+}
+
+int StudioSession::position() const { return impl_->position; }
+
+StudioSession::Reply StudioSession::handle(const std::string& command) {
+  Impl& s = *impl_;
+  try {
+    const Json c = Json::parse(command);
+    if (!c.is_object() || !c.contains("op") || !c.at("op").is_string())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: a command is a JSON object with \"op\" (hello, recipe, edit, undo, "
+                  "redo, run, save)");
+    const std::string op = c.at("op");
+    if (op == "hello") {
+      const Recipe r = parse_recipe(s.text(), s.base_dir, s.name);
+      return {Json{{"op", "hello"},
+                   {"recipe", r.name()},
+                   {"surfaces", final_surfaces(r)},
+                   {"deformations", r.deformation_names()},
+                   {"history", s.history_json()}}
+                  .dump(),
+              {}};
+    }
+    if (op == "recipe") return {Json{{"op", "recipe"}, {"text", s.text()}}.dump(), {}};
+    if (op == "run") return s.ran("run", s.run(s.text()));
+    if (op == "undo" || op == "redo") {
+      const int to = s.position + (op == "undo" ? -1 : 1);
+      if (to < 0 || to >= static_cast<int>(s.history.size()))
+        throw Error(ErrorCategory::InvalidArgument, "studio: nothing to " + op +
+                                                        " (history position " +
+                                                        std::to_string(s.position) + " of " +
+                                                        std::to_string(s.history.size()) + ")");
+      const RunResult result = s.run(s.history[static_cast<std::size_t>(to)].second);
+      s.position = to;
+      return s.ran(op, result);
+    }
+    if (op == "edit") {
+      if (!c.contains("path") || !c.at("path").is_string() || !c.contains("value"))
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: \"edit\" needs \"path\" (a JSON path of the recipe) and \"value\"");
+      const std::string path = c.at("path");
+      const bool create = c.value("create", false);
+      Json doc = Json::parse(s.text());
+      const Json::json_pointer ptr = pointer_of(path);
+      const bool exists = doc.contains(ptr);
+      if (!exists && !(create && doc.contains(ptr.parent_pointer()) &&
+                       doc.at(ptr.parent_pointer()).is_object()))
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: the recipe has no \"" + path + "\"" +
+                        (create ? " parent object" : "; to add it, send \"create\": true"));
+      doc[ptr] = c.at("value");
+      std::string next = doc.dump(1);
+      const RunResult result = s.run(next);  // a recipe the edit breaks throws: nothing changes
+      s.history.resize(static_cast<std::size_t>(s.position) + 1);  // an edit drops the redo tail
+      s.history.emplace_back(c.value("label", "edit " + path), std::move(next));
+      s.position = static_cast<int>(s.history.size()) - 1;
+      return s.ran("edit", result);
+    }
+    if (op == "save") {
+      if (!c.contains("file") || !c.at("file").is_string())
+        throw Error(ErrorCategory::InvalidArgument, "studio: \"save\" needs \"file\"");
+      const fs::path file = c.at("file").get<std::string>();
+      const fs::path tmp = file.string() + ".clayform-tmp";
+      {
+        std::ofstream out(tmp, std::ios::binary);
+        out << s.text();
+        if (!out)
+          throw Error(ErrorCategory::Io,
+                      "studio: cannot write \"" + tmp.string() + "\"; check the folder");
+      }
+      std::error_code ec;
+      fs::rename(tmp, file, ec);
+      if (ec)
+        throw Error(ErrorCategory::Io,
+                    "studio: cannot move the recipe to \"" + file.string() + "\": " + ec.message());
+      return {Json{{"op", "saved"}, {"file", file.string()}}.dump(), {}};
+    }
+    throw Error(
+        ErrorCategory::InvalidArgument,
+        "studio: unknown op \"" + op + "\"; the ops: hello, recipe, edit, undo, redo, run, save");
+  } catch (const Error& e) {
+    return {Json{{"op", "error"},
+                 {"category", std::string(to_string(e.category()))},
+                 {"message", recipe_wording(e.message())}}
+                .dump(),
+            {}};
+  } catch (const Json::exception& e) {
+    return {Json{{"op", "error"},
+                 {"category", "invalid argument"},
+                 {"message", std::string("studio: the command is not valid JSON: ") + e.what()}}
+                .dump(),
+            {}};
+  }
+}
+
+// ---- the server -----------------------------------------------------------------------------
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace http = beast::http;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+
+struct StudioServer::Impl {
+  StudioSession session;
+  StudioOptions options;
+  asio::io_context io;
+  tcp::acceptor acceptor{io};
+  int port = 0;
+  std::thread thread;
+  mutable std::mutex mutex;  // guards session between commands and `current`
+  tcp::socket* current = nullptr;
+  bool stopping = false;
+
+  explicit Impl(StudioSession s) : session(std::move(s)) {}
+
+  /// Host must be the server's own address and Origin its page: a page from elsewhere (DNS
+  /// rebinding, another site) cannot open the socket.
+  bool allowed(const http::request<http::string_body>& req) const {
+    const std::string p = std::to_string(port);
+    const std::string host(req[http::field::host]);
+    const std::string origin(req[http::field::origin]);
+    const bool host_ok =
+        host == "127.0.0.1:" + p || host == "localhost:" + p || host == options.host + ":" + p;
+    const bool origin_ok = origin == "http://127.0.0.1:" + p || origin == "http://localhost:" + p ||
+                           origin == "http://" + options.host + ":" + p;
+    return host_ok && origin_ok;
+  }
+
+  http::response<http::string_body> plain(const http::request<http::string_body>& req,
+                                          http::status status, const std::string& body) const {
+    http::response<http::string_body> res{status, req.version()};
+    res.set(http::field::content_type, "text/plain; charset=utf-8");
+    res.keep_alive(false);
+    res.body() = body;
+    res.prepare_payload();
+    return res;
+  }
+
+  void serve_file(tcp::socket& socket, const http::request<http::string_body>& req) const {
+    std::string target(req.target());
+    if (const auto q = target.find('?'); q != std::string::npos) target.resize(q);
+    if (target == "/") target = "/studio.html";
+    if (target.find("..") != std::string::npos) {
+      http::write(socket, plain(req, http::status::bad_request, "a path with \"..\" is refused\n"));
+      return;
+    }
+    const fs::path file =
+        options.front_end.empty() ? fs::path() : options.front_end / target.substr(1);
+    std::ifstream in(file, std::ios::binary);
+    if (file.empty() || !in) {
+      http::write(socket,
+                  plain(req, http::status::not_found,
+                        target == "/studio.html"
+                            ? "The studio's page is not built yet (issue #23). The kernel's "
+                              "WebSocket is at /ws: JSON commands hello, recipe, edit, undo, "
+                              "redo, run, save (docs/studio.md).\n"
+                            : "not found: " + target + "\n"));
+      return;
+    }
+    std::ostringstream body;
+    body << in.rdbuf();
+    static const std::map<std::string, std::string> types = {{".html", "text/html; charset=utf-8"},
+                                                             {".js", "text/javascript"},
+                                                             {".css", "text/css"},
+                                                             {".json", "application/json"},
+                                                             {".png", "image/png"}};
+    const auto t = types.find(file.extension().string());
+    http::response<http::string_body> res{http::status::ok, req.version()};
+    res.set(http::field::content_type, t == types.end() ? "application/octet-stream" : t->second);
+    res.keep_alive(false);
+    res.body() = body.str();
+    res.prepare_payload();
+    http::write(socket, res);
+  }
+
+  /// Queues a command; an edit replaces a queued edit of the same path in its place (a drag
+  /// sends many; the kernel answers the newest).
+  static void enqueue(std::deque<std::string>& queue, std::string command) {
+    auto edit_path = [](const std::string& text) -> std::optional<std::string> {
+      const Json c = Json::parse(text, nullptr, false);
+      if (c.is_object() && c.value("op", "") == "edit" && c.contains("path") &&
+          c.at("path").is_string())
+        return c.at("path").get<std::string>();
+      return std::nullopt;
+    };
+    if (const auto path = edit_path(command))
+      for (std::string& queued : queue)
+        if (edit_path(queued) == path) {
+          queued = std::move(command);
+          return;
+        }
+    queue.push_back(std::move(command));
+  }
+
+  /// One WebSocket client, until it closes. Reads and writes run here, as asynchronous
+  /// operations on this thread; the commands run on a worker, one at a time. Commands that
+  /// arrive while one runs wait in a queue where a newer edit of a path replaces an older one:
+  /// at most one drag update is being computed, and the newest wins.
+  void converse(websocket::stream<tcp::socket&>& ws) {
+    std::mutex queue_mutex;
+    std::condition_variable wake;
+    std::deque<std::string> queue;
+    bool closed = false;
+    std::deque<std::pair<bool, std::vector<std::uint8_t>>> out;  // (text, bytes)
+    bool writing = false;
+    beast::flat_buffer buffer;
+    io.restart();
+    std::function<void()> write_next = [&] {
+      if (writing || out.empty()) return;
+      writing = true;
+      ws.text(out.front().first);
+      ws.async_write(asio::buffer(out.front().second), [&](beast::error_code ec, std::size_t) {
+        writing = false;
+        out.pop_front();
+        if (!ec) write_next();
+      });
+    };
+    std::function<void()> read_next = [&] {
+      ws.async_read(buffer, [&](beast::error_code ec, std::size_t) {
+        {
+          std::lock_guard<std::mutex> lock(queue_mutex);
+          if (ec)
+            closed = true;
+          else
+            enqueue(queue, beast::buffers_to_string(buffer.data()));
+        }
+        wake.notify_all();
+        buffer.consume(buffer.size());
+        if (!ec) read_next();
+      });
+    };
+    std::thread worker([&] {
+      while (true) {
+        std::string command;
+        {
+          std::unique_lock<std::mutex> lock(queue_mutex);
+          wake.wait(lock, [&] { return closed || !queue.empty(); });
+          if (closed) return;
+          command = std::move(queue.front());
+          queue.pop_front();
+        }
+        auto reply = std::make_shared<StudioSession::Reply>();
+        {
+          std::lock_guard<std::mutex> lock(mutex);
+          *reply = session.handle(command);
+        }
+        asio::post(io, [&, reply] {
+          out.emplace_back(true, std::vector<std::uint8_t>(reply->json.begin(), reply->json.end()));
+          for (auto& frame : reply->frames) out.emplace_back(false, std::move(frame));
+          write_next();
+        });
+      }
+    });
+    read_next();
+    io.run();  // until the client closes (or stop() shuts the socket) and the writes are done
+    {
+      std::lock_guard<std::mutex> lock(queue_mutex);
+      closed = true;
+    }
+    wake.notify_all();
+    worker.join();
+    // What the worker posted after the reads ended runs now, while everything it refers to
+    // lives (the writes fail at once on the closed socket).
+    io.restart();
+    io.run();
+  }
+
+  void handle_connection(tcp::socket& socket) {
+    beast::flat_buffer buffer;
+    http::request<http::string_body> req;
+    http::read(socket, buffer, req);
+    if (!websocket::is_upgrade(req)) {
+      serve_file(socket, req);
+      return;
+    }
+    if (std::string(req.target()) != "/ws") {
+      http::write(socket, plain(req, http::status::not_found, "the studio's socket is /ws\n"));
+      return;
+    }
+    if (!allowed(req)) {
+      http::write(socket, plain(req, http::status::forbidden,
+                                "refused: the studio's socket takes its own page only (Host and "
+                                "Origin must be this server's address)\n"));
+      return;
+    }
+    websocket::stream<tcp::socket&> ws(socket);
+    ws.read_message_max(64 << 20);
+    ws.accept(req);
+    converse(ws);
+  }
+};
+
+StudioServer::StudioServer(StudioSession session, const StudioOptions& options)
+    : impl_(std::make_unique<Impl>(std::move(session))) {
+  impl_->options = options;
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(options.host, ec);
+  if (ec)
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: host \"" + options.host + "\" is not an address; give e.g. 127.0.0.1");
+  const tcp::endpoint at(address, static_cast<unsigned short>(options.port));
+  impl_->acceptor.open(at.protocol(), ec);
+  if (!ec) impl_->acceptor.set_option(asio::socket_base::reuse_address(true), ec);
+  if (!ec) impl_->acceptor.bind(at, ec);
+  if (!ec) impl_->acceptor.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec)
+    throw Error(ErrorCategory::Io, "studio: cannot listen on " + options.host + ":" +
+                                       std::to_string(options.port) + ": " + ec.message() +
+                                       "; choose another --port (0 for any free one)");
+  impl_->port = impl_->acceptor.local_endpoint().port();
+}
+
+StudioServer::~StudioServer() { stop(); }
+
+int StudioServer::port() const noexcept { return impl_->port; }
+
+std::string StudioServer::url() const {
+  return "http://" + impl_->options.host + ":" + std::to_string(impl_->port) + "/";
+}
+
+std::string StudioServer::recipe_text() const {
+  std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->session.text();
+}
+
+void StudioServer::run() {
+  Impl& s = *impl_;
+  while (true) {
+    tcp::socket socket(s.io);
+    boost::system::error_code ec;
+    s.acceptor.accept(socket, ec);
+    {
+      std::lock_guard<std::mutex> lock(s.mutex);
+      if (s.stopping) return;
+      s.current = &socket;
+    }
+    if (!ec) {
+      try {
+        s.handle_connection(socket);
+      } catch (const std::exception&) {
+        // A client that goes away mid-message ends its connection, not the server.
+      }
+    }
+    std::lock_guard<std::mutex> lock(s.mutex);
+    s.current = nullptr;
+    if (s.stopping) return;
+  }
+}
+
+void StudioServer::start() {
+  impl_->thread = std::thread([this] { run(); });
+}
+
+void StudioServer::stop() {
+  if (!impl_) return;
+  {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    if (impl_->stopping && !impl_->thread.joinable()) return;
+    impl_->stopping = true;
+    boost::system::error_code ec;
+    if (impl_->current) impl_->current->shutdown(tcp::socket::shutdown_both, ec);
+  }
+  // A blocking accept wakes for a connection only: make one (run() then sees `stopping`).
+  if (impl_->thread.joinable()) {
+    boost::system::error_code ec;
+    asio::io_context io;
+    tcp::socket poke(io);
+    poke.connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"),
+                               static_cast<unsigned short>(impl_->port)),
+                 ec);
+    impl_->thread.join();
+  }
+  boost::system::error_code ec;
+  impl_->acceptor.close(ec);
+}
+
+}  // namespace clay::recipe

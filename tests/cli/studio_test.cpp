@@ -1,0 +1,251 @@
+// Clayform Studio's kernel side (clay/studio.hpp): a recipe under edits with a history, its
+// geometry frames against an independent replay of the recipe, and the WebSocket server's
+// origin checks and coalescing, through a Boost.Beast client.
+#include <catch2/catch.hpp>
+
+#include <clay/recipe/recipe.hpp>
+#include <clay/studio.hpp>
+#include <clay/surface/bspline_surface.hpp>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace clay::recipe;
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const fs::path sail_file = fs::path(CLAY_EXAMPLES_DIR) / "recipes" / "sail.json";
+const std::string billow = "deformations.shape[1].moves[0].by[1]";
+
+std::string read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+/// The header and the doubles of a net frame, decoded by the documented layout.
+struct Net {
+  Json header;
+  std::vector<double> points, weights;
+};
+Net decode(const std::vector<std::uint8_t>& frame) {
+  REQUIRE(frame.size() >= 8);
+  std::uint32_t length = 0;
+  for (int k = 0; k < 4; ++k)
+    length |= std::uint32_t(frame[static_cast<std::size_t>(k)]) << (8 * k);
+  Net net;
+  net.header = Json::parse(std::string(frame.begin() + 4, frame.begin() + 4 + length));
+  const std::size_t start = (4 + length + 7) / 8 * 8;
+  const std::size_t n =
+      net.header.at("counts")[0].get<std::size_t>() * net.header.at("counts")[1].get<std::size_t>();
+  REQUIRE(frame.size() == start + 4 * n * sizeof(double));
+  net.points.resize(3 * n);
+  net.weights.resize(n);
+  std::memcpy(net.points.data(), frame.data() + start, 3 * n * sizeof(double));
+  std::memcpy(net.weights.data(), frame.data() + start + 3 * n * sizeof(double),
+              n * sizeof(double));
+  return net;
+}
+
+/// The frame's net equals the surface bit for bit.
+bool same(const Net& net, const clay::surface::BSplineSurface& s) {
+  return net.header.at("knots_u").get<std::vector<double>>() == s.u.knots &&
+         net.header.at("knots_v").get<std::vector<double>>() == s.v.knots &&
+         std::memcmp(net.points.data(), s.points.data(), net.points.size() * sizeof(double)) == 0 &&
+         std::memcmp(net.weights.data(), s.weights.data(), net.weights.size() * sizeof(double)) ==
+             0;
+}
+
+}  // namespace
+
+TEST_CASE("studio session: edits, undo, redo and save replay to identical control points",
+          "[studio]") {
+  StudioSession session = StudioSession::load(sail_file);
+  const Json hello = Json::parse(session.handle(R"({"op": "hello"})").json);
+  CHECK(hello.at("recipe") == "sail");
+  CHECK(hello.at("surfaces") == Json::array({"sail"}));
+
+  // An edit: the billow's first move from 300 to 500 mm. The frame's net is the sail of the
+  // edited recipe as run_recipe computes it on its own.
+  const auto edited = session.handle(
+      Json{{"op", "edit"}, {"path", billow}, {"value", 500}, {"label", "billow 500"}}.dump());
+  INFO(edited.json);
+  const Json reply = Json::parse(edited.json);
+  REQUIRE(reply.at("op") == "edit");
+  REQUIRE(edited.frames.size() == 1);
+  Json doc = Json::parse(read(sail_file));
+  doc["deformations"]["shape"][1]["moves"][0]["by"][1] = 500;
+  const auto replay = run_recipe(parse_recipe(doc.dump(), sail_file.parent_path(), "sail"));
+  CHECK(same(decode(edited.frames[0]), replay.surface("sail")));
+  CHECK(session.history() == std::vector<std::string>{"open", "billow 500"});
+
+  // Undo gives the original sail, redo the edited one again.
+  const auto undone = session.handle(R"({"op": "undo"})");
+  REQUIRE(undone.frames.size() == 1);
+  const auto original = run_recipe(load_recipe(sail_file));
+  CHECK(same(decode(undone.frames[0]), original.surface("sail")));
+  CHECK(session.position() == 0);
+  const auto redone = session.handle(R"({"op": "redo"})");
+  CHECK(same(decode(redone.frames[0]), replay.surface("sail")));
+
+  // Save, and replay the saved file as `clayform run` does: identical control points.
+  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio";
+  fs::create_directories(dir);
+  const fs::path saved = dir / "sail_edited.json";
+  fs::remove(saved);
+  const Json ok =
+      Json::parse(session.handle(Json{{"op", "save"}, {"file", saved.string()}}.dump()).json);
+  CHECK(ok.at("op") == "saved");
+  CHECK(same(decode(redone.frames[0]), run_recipe(load_recipe(saved)).surface("sail")));
+
+  // An edit after an undo drops the redo tail.
+  session.handle(R"({"op": "undo"})");
+  session.handle(
+      Json{{"op", "edit"}, {"path", billow}, {"value", 100}, {"label", "billow 100"}}.dump());
+  CHECK(session.history() == std::vector<std::string>{"open", "billow 100"});
+}
+
+TEST_CASE("studio session: bad commands are refused and change nothing", "[studio]") {
+  StudioSession session = StudioSession::load(sail_file);
+  const std::string before = session.text();
+  auto error = [&](const std::string& command) {
+    const Json r = Json::parse(session.handle(command).json);
+    CHECK(r.at("op") == "error");
+    return r.at("message").get<std::string>();
+  };
+  CHECK_THAT(error("not json"), Contains("not valid JSON"));
+  CHECK_THAT(error(R"({"op": "fly"})"), Contains("unknown op \"fly\""));
+  CHECK_THAT(error(R"({"op": "edit", "path": "deformations.nope", "value": 1})"),
+             Contains("no \"deformations.nope\"") && Contains("create"));
+  CHECK_THAT(error(R"({"op": "edit", "path": "a..b", "value": 1})"), Contains("empty key"));
+  // A value the recipe refuses (a negative curve tolerance): the run's error, nothing changes.
+  CHECK_THAT(
+      error(R"({"op": "edit", "path": "deformations.shape[0].curve_tolerance", "value": -1})"),
+      Contains("curve_tolerance"));
+  CHECK_THAT(error(R"({"op": "undo"})"), Contains("nothing to undo"));
+  CHECK(session.text() == before);
+  CHECK(session.history().size() == 1);
+  // create: a new key under an existing object.
+  const Json created = Json::parse(
+      session
+          .handle(
+              R"({"op": "edit", "path": "description", "value": "drawn in the studio", "create": true})")
+          .json);
+  CHECK(created.at("op") == "edit");
+  CHECK(Json::parse(session.text()).at("description") == "drawn in the studio");
+}
+
+namespace {
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+
+/// A WebSocket client of the studio at `port`, sending `origin` (and Host 127.0.0.1:port).
+struct Client {
+  asio::io_context io;
+  websocket::stream<tcp::socket> ws{io};
+  Client(int port, const std::string& origin) {
+    tcp::resolver resolver(io);
+    asio::connect(ws.next_layer(), resolver.resolve("127.0.0.1", std::to_string(port)));
+    ws.set_option(websocket::stream_base::decorator(
+        [origin](websocket::request_type& req) { req.set(beast::http::field::origin, origin); }));
+    ws.handshake("127.0.0.1:" + std::to_string(port), "/ws");
+  }
+  void send(const std::string& text) {
+    ws.text(true);
+    ws.write(asio::buffer(text));
+  }
+  /// The next message: (is text, bytes).
+  std::pair<bool, std::string> receive() {
+    beast::flat_buffer buffer;
+    ws.read(buffer);
+    return {ws.got_text(), beast::buffers_to_string(buffer.data())};
+  }
+};
+
+}  // namespace
+
+TEST_CASE("studio server: its own page's origin talks, any other is refused", "[studio]") {
+  StudioOptions options;
+  options.port = 0;
+  StudioServer server(StudioSession::load(sail_file), options);
+  server.start();
+  const int port = server.port();
+  {
+    Client client(port, "http://127.0.0.1:" + std::to_string(port));
+    client.send(R"({"op": "hello"})");
+    const auto [text, body] = client.receive();
+    CHECK(text);
+    CHECK(Json::parse(body).at("recipe") == "sail");
+    client.ws.close(websocket::close_code::normal);
+  }
+  // Another site's page (or a DNS-rebound name) cannot open the socket: 403 at the upgrade.
+  for (const std::string& origin :
+       {std::string("http://evil.example"), "http://127.0.0.1:" + std::to_string(port + 1),
+        std::string("null")}) {
+    INFO("origin " << origin);
+    CHECK_THROWS_AS(Client(port, origin), beast::system_error);
+  }
+  // The server goes on serving its own page after refusing.
+  Client again(port, "http://localhost:" + std::to_string(port));
+  again.send(R"({"op": "recipe"})");
+  CHECK(Json::parse(again.receive().second).at("op") == "recipe");
+  again.ws.close(websocket::close_code::normal);
+  server.stop();
+}
+
+TEST_CASE("studio server: a burst of edits of one path is answered for the newest", "[studio]") {
+  StudioOptions options;
+  options.port = 0;
+  StudioServer server(StudioSession::load(sail_file), options);
+  server.start();
+  Client client(server.port(), "http://127.0.0.1:" + std::to_string(server.port()));
+  const int burst = 12;
+  for (int k = 1; k <= burst; ++k)
+    client.send(
+        Json{{"op", "edit"}, {"path", billow}, {"value", 20 * k}, {"label", "drag"}}.dump());
+  client.send(R"({"op": "hello"})");
+  int edits = 0;
+  std::string last_net;
+  while (true) {
+    const auto [text, body] = client.receive();
+    if (!text) {
+      last_net = body;
+      continue;
+    }
+    const Json r = Json::parse(body);
+    if (r.at("op") == "hello") {
+      CHECK(r.at("history").at("entries").size() == static_cast<std::size_t>(edits + 1));
+      break;
+    }
+    REQUIRE(r.at("op") == "edit");
+    ++edits;
+  }
+  INFO(edits << " of " << burst << " edits answered");
+  CHECK(edits >= 1);
+  CHECK(edits <= burst);
+  // Whatever was coalesced, the newest value is what the recipe holds and the last net shows.
+  CHECK(Json::parse(server.recipe_text())["deformations"]["shape"][1]["moves"][0]["by"][1] ==
+        20 * burst);
+  Json doc = Json::parse(read(sail_file));
+  doc["deformations"]["shape"][1]["moves"][0]["by"][1] = 20 * burst;
+  const auto replay = run_recipe(parse_recipe(doc.dump(), sail_file.parent_path(), "sail"));
+  CHECK(same(decode(std::vector<std::uint8_t>(last_net.begin(), last_net.end())),
+             replay.surface("sail")));
+  client.ws.close(websocket::close_code::normal);
+  server.stop();
+}
