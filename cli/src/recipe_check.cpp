@@ -3,6 +3,8 @@
 // entry points; the readers of the other sections are in recipe_check_*.cpp (recipe_checker.hpp).
 #include "recipe_checker.hpp"
 
+#include <clay/internal/files.hpp>
+
 namespace clay::recipe {
 
 namespace check_detail {
@@ -697,13 +699,7 @@ Recipe parse_recipe(std::string_view text, const fs::path& base_dir,
 }
 
 Recipe load_recipe(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in)
-    throw Error(ErrorCategory::Io,
-                "cannot read the recipe \"" + file.string() + "\"; check the path");
-  std::ostringstream text;
-  text << in.rdbuf();
-  CheckOutcome out = check(text.str(), file.parent_path());
+  CheckOutcome out = check(internal::read_text(file, "recipe"), file.parent_path());
   if (!out.problems.empty()) {
     std::string m = file.string() + ": the recipe has " + std::to_string(out.problems.size()) +
                     " problem" + (out.problems.size() == 1 ? "" : "s") + ":";

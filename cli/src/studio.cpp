@@ -2,6 +2,7 @@
 // history) and its server (Boost.Beast, Debian's libboost-dev: cpp-httplib 0.11 has no
 // WebSocket, and Beast is the well-kept header-only HTTP/WebSocket library Debian ships).
 #include <clay/error.hpp>
+#include <clay/internal/files.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 
@@ -159,13 +160,8 @@ StudioSession::StudioSession(StudioSession&&) noexcept = default;
 StudioSession& StudioSession::operator=(StudioSession&&) noexcept = default;
 
 StudioSession StudioSession::load(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in)
-    throw Error(ErrorCategory::Io,
-                "cannot read the recipe \"" + file.string() + "\"; check the path");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return StudioSession(text.str(), file.parent_path(), file.stem().string());
+  return StudioSession(internal::read_text(file, "recipe"), file.parent_path(),
+                       file.stem().string());
 }
 
 const std::string& StudioSession::text() const { return impl_->text(); }

@@ -2,6 +2,7 @@
 // as dicts. A recipe pickles as its text, its base folder and its name.
 #include "common.hpp"
 
+#include <clay/internal/files.hpp>
 #include <clay/recipe/recipe.hpp>
 
 #include <pybind11/stl/filesystem.h>
@@ -111,13 +112,8 @@ void bind_recipe(py::module_& m) {
       .def_static(
           "load",
           [](const fs::path& file) {
-            std::ifstream in(file, std::ios::binary);
-            if (!in)
-              throw Error(ErrorCategory::Io,
-                          "cannot read the recipe \"" + file.string() + "\"; check the path");
-            std::ostringstream text;
-            text << in.rdbuf();
-            return parse(text.str(), file.parent_path().string(), file.stem().string());
+            return parse(internal::read_text(file, "recipe"), file.parent_path().string(),
+                         file.stem().string());
           },
           py::arg("path"), "Reads and checks a recipe file (RecipeError lists every problem).")
       .def_static("parse", &parse, py::arg("text"), py::arg("base_dir") = "", py::arg("name") = "",
