@@ -99,8 +99,14 @@ struct StudioSession::Impl {
 
   const std::string& text() const { return history[static_cast<std::size_t>(position)].second; }
 
-  RunResult run(const std::string& recipe_text) const {
-    return run_recipe(parse_recipe(recipe_text, base_dir, name));
+  /// A run of the recipe text, and the surfaces a picture of it shows (final_surfaces).
+  struct Run {
+    RunResult result;
+    std::vector<std::string> shown;
+  };
+  Run run(const std::string& recipe_text) const {
+    const Recipe recipe = parse_recipe(recipe_text, base_dir, name);
+    return {run_recipe(recipe), final_surfaces(recipe)};
   }
 
   Json history_json() const {
@@ -110,7 +116,8 @@ struct StudioSession::Impl {
   }
 
   /// The reply of a run: its report figures per step, and a net frame per final surface.
-  Reply ran(const std::string& op, const RunResult& result) const {
+  Reply ran(const std::string& op, const Run& run) const {
+    const RunResult& result = run.result;
     Reply reply;
     Json steps = Json::array();
     for (const auto& s : result.steps) {
@@ -124,9 +131,8 @@ struct StudioSession::Impl {
                        {"message", s.message},
                        {"figures", figures}});
     }
-    const Recipe parsed = parse_recipe(text(), base_dir, name);
     Json surfaces = Json::array();
-    for (const std::string& n : final_surfaces(parsed)) {
+    for (const std::string& n : run.shown) {
       const auto& s = result.surface(n);
       Json header = {{"kind", "net"},
                      {"name", n},
@@ -202,7 +208,7 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
                                                         " (history position " +
                                                         std::to_string(s.position) + " of " +
                                                         std::to_string(s.history.size()) + ")");
-      const RunResult result = s.run(s.history[static_cast<std::size_t>(to)].second);
+      const Impl::Run result = s.run(s.history[static_cast<std::size_t>(to)].second);
       s.position = to;
       return s.ran(op, result);
     }
@@ -222,7 +228,7 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
                         (create ? " parent object" : "; to add it, send \"create\": true"));
       doc[ptr] = c.at("value");
       std::string next = doc.dump(1);
-      const RunResult result = s.run(next);  // a recipe the edit breaks throws: nothing changes
+      const Impl::Run result = s.run(next);  // a recipe the edit breaks throws: nothing changes
       s.history.resize(static_cast<std::size_t>(s.position) + 1);  // an edit drops the redo tail
       s.history.emplace_back(c.value("label", "edit " + path), std::move(next));
       s.position = static_cast<int>(s.history.size()) - 1;
