@@ -125,5 +125,6 @@ void bind_deform(py::module_& m);
 void bind_sketch(py::module_& m);
 void bind_recipe(py::module_& m);
 void bind_model(py::module_& m);
+void bind_stack(py::module_& m);
 
 }  // namespace clay::python

@@ -90,6 +90,7 @@ PYBIND11_MODULE(_clayform, m) {
   clay::python::bind_geometry(m);
   clay::python::bind_deform(m);
   clay::python::bind_sketch(m);
+  clay::python::bind_stack(m);
   clay::python::bind_model(m);
   clay::python::bind_recipe(m);
 }
