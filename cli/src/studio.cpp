@@ -72,10 +72,9 @@ Json::json_pointer pointer_of(const std::string& path) {
 
 }  // namespace
 
-std::vector<std::uint8_t> net_frame(const std::string& name, const std::string& header_json,
+std::vector<std::uint8_t> net_frame(const std::string& header_json,
                                     const std::vector<double>& points,
                                     const std::vector<double>& weights) {
-  (void)name;
   // Sized once and filled with memcpy (GCC 12 misreads insert() of chars into bytes as an
   // overflow at -O3).
   const std::size_t header = 4 + header_json.size();
@@ -143,7 +142,7 @@ struct StudioSession::Impl {
                      {"rational", s.is_rational()}};
       std::vector<double> points(s.points.data(), s.points.data() + s.points.size());
       std::vector<double> weights(s.weights.data(), s.weights.data() + s.weights.size());
-      reply.frames.push_back(net_frame(n, header.dump(), points, weights));
+      reply.frames.push_back(net_frame(header.dump(), points, weights));
       surfaces.push_back(n);
     }
     reply.json = Json{{"op", op},       {"recipe", result.recipe}, {"seconds", result.seconds},

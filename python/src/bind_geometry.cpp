@@ -164,8 +164,16 @@ void bind_geometry(py::module_& m) {
       .def(
           "evaluate",
           [](const BSplineCurve& c, const py::array& t) {
-            return on_parameters(
-                {t}, [&](const auto& s, std::size_t i) { return surface::evaluate(c, s[0][i]); });
+            // The curve's batch evaluation (one basis per span, not per point).
+            const auto ts = values_in(t, "t");
+            Points3 p;
+            {
+              py::gil_scoped_release free;
+              p = surface::evaluate_many(c, ts);
+            }
+            std::vector<py::ssize_t> shape(t.shape(), t.shape() + t.ndim());
+            shape.push_back(3);
+            return owned(std::move(p)).attr("reshape")(shape);
           },
           py::arg("t"), "The points at the parameters of an array t: shape t.shape + (3,).")
       .def(

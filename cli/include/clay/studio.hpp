@@ -60,7 +60,7 @@ class StudioSession {
 /// ({"kind": "net", "name", "degrees": [p, q], "counts": [nu, nv], "knots_u", "knots_v",
 /// "rational"}), zero padding to a multiple of 8, then nu * nv * 3 float64 control points
 /// (u-major, x y z) and nu * nv float64 weights, little-endian. The page evaluates the net.
-std::vector<std::uint8_t> net_frame(const std::string& name, const std::string& header_json,
+std::vector<std::uint8_t> net_frame(const std::string& header_json,
                                     const std::vector<double>& points,
                                     const std::vector<double>& weights);
 
