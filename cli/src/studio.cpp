@@ -70,6 +70,48 @@ Json::json_pointer pointer_of(const std::string& path) {
   return Json::json_pointer(out);
 }
 
+/// Applies one change of an "edit" to the recipe document: {path, value, create?} sets a value
+/// (the path must exist, or with create its parent object), {path, remove: true} removes a key
+/// or a list item. `first_path` gets the first change's path (the default history label).
+void apply_change(Json& doc, const Json& change, std::string& first_path) {
+  if (!change.is_object() || !change.contains("path") || !change.at("path").is_string())
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: \"edit\" needs \"path\" (a JSON path of the recipe) and \"value\" "
+                "(or \"remove\": true)");
+  const std::string path = change.at("path");
+  if (first_path.empty()) first_path = path;
+  const Json::json_pointer ptr = pointer_of(path);
+  const bool exists = doc.contains(ptr);
+  if (change.value("remove", false)) {
+    if (!exists)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: cannot remove \"" + path + "\": the recipe has no such entry");
+    Json& parent = doc.at(ptr.parent_pointer());
+    if (parent.is_array())
+      parent.erase(static_cast<std::size_t>(std::stoul(ptr.back())));
+    else
+      parent.erase(ptr.back());
+    return;
+  }
+  if (!change.contains("value"))
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: the change of \"" + path + "\" has no \"value\" (or \"remove\": true)");
+  if (!exists) {
+    if (!change.value("create", false))
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: the recipe has no \"" + path + "\"; to add it, send \"create\": true");
+    // Created keys hang from an object: the nearest existing entry above must be one (the
+    // missing ones between, e.g. "strokes" of a recipe without strokes, are made objects).
+    Json::json_pointer above = ptr.parent_pointer();
+    while (!above.empty() && !doc.contains(above)) above = above.parent_pointer();
+    if (!doc.at(above).is_object())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: cannot create \"" + path + "\": \"" + above.to_string() +
+                      "\" is not an object; a list item is changed by its index");
+  }
+  doc[ptr] = change.at("value");
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> net_frame(const std::string& header_json,
@@ -97,6 +139,12 @@ struct StudioSession::Impl {
   int position = 0;
 
   const std::string& text() const { return history[static_cast<std::size_t>(position)].second; }
+
+  /// A file or folder the page names, relative to the recipe's folder.
+  fs::path resolve(const std::string& relative) const {
+    const fs::path p(relative);
+    return p.is_absolute() ? p : base_dir / p;
+  }
 
   /// A run of the recipe text, and the surfaces a picture of it shows (final_surfaces).
   struct Run {
@@ -145,8 +193,27 @@ struct StudioSession::Impl {
       reply.frames.push_back(net_frame(header.dump(), points, weights));
       surfaces.push_back(n);
     }
-    reply.json = Json{{"op", op},       {"recipe", result.recipe}, {"seconds", result.seconds},
-                      {"steps", steps}, {"surfaces", surfaces},    {"history", history_json()}}
+    // Every named curve too (fitted strokes, sketch entities, bounds and targets): the page
+    // draws them from their nets and picks them by name.
+    Json curves = Json::array();
+    for (const auto& [n, c] : result.curves) {
+      const Json header = {{"kind", "curve"},
+                           {"name", n},
+                           {"degree", c.basis.degree},
+                           {"knots", c.basis.knots},
+                           {"rational", c.is_rational()}};
+      std::vector<double> points(c.points.data(), c.points.data() + c.points.size());
+      std::vector<double> weights(c.weights.data(), c.weights.data() + c.weights.size());
+      reply.frames.push_back(net_frame(header.dump(), points, weights));
+      curves.push_back(n);
+    }
+    reply.json = Json{{"op", op},
+                      {"recipe", result.recipe},
+                      {"seconds", result.seconds},
+                      {"steps", steps},
+                      {"surfaces", surfaces},
+                      {"curves", curves},
+                      {"history", history_json()}}
                      .dump();
     return reply;
   }
@@ -186,7 +253,7 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
     if (!c.is_object() || !c.contains("op") || !c.at("op").is_string())
       throw Error(ErrorCategory::InvalidArgument,
                   "studio: a command is a JSON object with \"op\" (hello, recipe, edit, undo, "
-                  "redo, run, save)");
+                  "redo, run, save, export)");
     const std::string op = c.at("op");
     if (op == "hello") {
       const Recipe r = parse_recipe(s.text(), s.base_dir, s.name);
@@ -212,31 +279,62 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
       return s.ran(op, result);
     }
     if (op == "edit") {
-      if (!c.contains("path") || !c.at("path").is_string() || !c.contains("value"))
-        throw Error(ErrorCategory::InvalidArgument,
-                    "studio: \"edit\" needs \"path\" (a JSON path of the recipe) and \"value\"");
-      const std::string path = c.at("path");
-      const bool create = c.value("create", false);
+      // One change ({path, value, create?} or {path, remove: true}) or several ("changes": an
+      // array of them), applied in order as one entry of the history.
+      Json changes = Json::array();
+      if (c.contains("changes")) {
+        if (!c.at("changes").is_array() || c.at("changes").empty())
+          throw Error(ErrorCategory::InvalidArgument,
+                      "studio: \"changes\" must be a non-empty array of {path, value} or "
+                      "{path, remove: true}");
+        changes = c.at("changes");
+      } else {
+        changes.push_back(c);
+      }
       Json doc = Json::parse(s.text());
-      const Json::json_pointer ptr = pointer_of(path);
-      const bool exists = doc.contains(ptr);
-      if (!exists && !(create && doc.contains(ptr.parent_pointer()) &&
-                       doc.at(ptr.parent_pointer()).is_object()))
-        throw Error(ErrorCategory::InvalidArgument,
-                    "studio: the recipe has no \"" + path + "\"" +
-                        (create ? " parent object" : "; to add it, send \"create\": true"));
-      doc[ptr] = c.at("value");
+      std::string first_path;
+      for (const Json& change : changes) apply_change(doc, change, first_path);
       std::string next = doc.dump(1);
       const Impl::Run result = s.run(next);  // a recipe the edit breaks throws: nothing changes
       s.history.resize(static_cast<std::size_t>(s.position) + 1);  // an edit drops the redo tail
-      s.history.emplace_back(c.value("label", "edit " + path), std::move(next));
+      s.history.emplace_back(c.value("label", "edit " + first_path), std::move(next));
       s.position = static_cast<int>(s.history.size()) - 1;
       return s.ran("edit", result);
+    }
+    if (op == "export") {
+      // The final surfaces, as STEP, IGES and glTF (write_outputs: read back and checked),
+      // with the run's report, into a folder (relative to the recipe's).
+      if (!c.contains("folder") || !c.at("folder").is_string() ||
+          c.at("folder").get<std::string>().empty())
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: \"export\" needs \"folder\" (relative to the recipe's folder)");
+      const fs::path folder = s.resolve(c.at("folder").get<std::string>());
+      Impl::Run run = s.run(s.text());
+      if (run.shown.empty())
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: the recipe has no surface to export yet; build one first");
+      ExportResult e;
+      e.name = c.value("name", run.result.recipe);
+      e.formats = {"step", "iges", "glb"};
+      for (const std::string& n : run.shown) {
+        e.surface_names.push_back(n);
+        e.surfaces.push_back(run.result.surface(n));
+      }
+      run.result.exports = {e};
+      write_outputs(run.result, folder);
+      const ExportResult& written = run.result.exports.front();
+      return {Json{{"op", "exported"},
+                   {"folder", folder.string()},
+                   {"files", written.files},
+                   {"valid", written.valid},
+                   {"read_back_identical", written.read_back_identical}}
+                  .dump(),
+              {}};
     }
     if (op == "save") {
       if (!c.contains("file") || !c.at("file").is_string())
         throw Error(ErrorCategory::InvalidArgument, "studio: \"save\" needs \"file\"");
-      const fs::path file = c.at("file").get<std::string>();
+      const fs::path file = s.resolve(c.at("file").get<std::string>());
       const fs::path tmp = file.string() + ".clayform-tmp";
       {
         std::ofstream out(tmp, std::ios::binary);
@@ -252,9 +350,9 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
                     "studio: cannot move the recipe to \"" + file.string() + "\": " + ec.message());
       return {Json{{"op", "saved"}, {"file", file.string()}}.dump(), {}};
     }
-    throw Error(
-        ErrorCategory::InvalidArgument,
-        "studio: unknown op \"" + op + "\"; the ops: hello, recipe, edit, undo, redo, run, save");
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: unknown op \"" + op +
+                    "\"; the ops: hello, recipe, edit, undo, redo, run, save, export");
   } catch (const Error& e) {
     return {Json{{"op", "error"},
                  {"category", std::string(to_string(e.category()))},
@@ -354,12 +452,19 @@ struct StudioServer::Impl {
   /// Queues a command; an edit replaces a queued edit of the same path in its place (a drag
   /// sends many; the kernel answers the newest).
   static void enqueue(std::deque<std::string>& queue, std::string command) {
+    // An edit's key: its path, or its changes' paths joined.
     auto edit_path = [](const std::string& text) -> std::optional<std::string> {
       const Json c = Json::parse(text, nullptr, false);
-      if (c.is_object() && c.value("op", "") == "edit" && c.contains("path") &&
-          c.at("path").is_string())
-        return c.at("path").get<std::string>();
-      return std::nullopt;
+      if (!c.is_object() || c.value("op", "") != "edit") return std::nullopt;
+      if (c.contains("path") && c.at("path").is_string()) return c.at("path").get<std::string>();
+      if (!c.contains("changes") || !c.at("changes").is_array()) return std::nullopt;
+      std::string key;
+      for (const Json& change : c.at("changes")) {
+        if (!change.is_object() || !change.contains("path") || !change.at("path").is_string())
+          return std::nullopt;
+        key += change.at("path").get<std::string>() + "\n";
+      }
+      return key;
     };
     if (const auto path = edit_path(command))
       for (std::string& queued : queue)

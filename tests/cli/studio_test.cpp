@@ -13,9 +13,11 @@
 #include <boost/beast/websocket.hpp>
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 using namespace clay::recipe;
@@ -49,7 +51,10 @@ Net decode(const std::vector<std::uint8_t>& frame) {
   net.header = Json::parse(std::string(frame.begin() + 4, frame.begin() + 4 + length));
   const std::size_t start = (4 + length + 7) / 8 * 8;
   const std::size_t n =
-      net.header.at("counts")[0].get<std::size_t>() * net.header.at("counts")[1].get<std::size_t>();
+      net.header.at("kind") == "curve"
+          ? net.header.at("knots").size() - net.header.at("degree").get<std::size_t>() - 1
+          : net.header.at("counts")[0].get<std::size_t>() *
+                net.header.at("counts")[1].get<std::size_t>();
   REQUIRE(frame.size() == start + 4 * n * sizeof(double));
   net.points.resize(3 * n);
   net.weights.resize(n);
@@ -68,6 +73,25 @@ bool same(const Net& net, const clay::surface::BSplineSurface& s) {
              0;
 }
 
+/// The frame's curve equals the curve bit for bit.
+bool same(const Net& net, const clay::surface::BSplineCurve& c) {
+  return net.header.at("knots").get<std::vector<double>>() == c.basis.knots &&
+         net.header.at("degree") == c.basis.degree &&
+         std::memcmp(net.points.data(), c.points.data(), net.points.size() * sizeof(double)) == 0 &&
+         std::memcmp(net.weights.data(), c.weights.data(), net.weights.size() * sizeof(double)) ==
+             0;
+}
+
+/// The frames of a reply, decoded, by name.
+std::map<std::string, Net> frames_by_name(const StudioSession::Reply& reply) {
+  std::map<std::string, Net> out;
+  for (const auto& f : reply.frames) {
+    Net net = decode(f);
+    out[net.header.at("name")] = std::move(net);
+  }
+  return out;
+}
+
 }  // namespace
 
 TEST_CASE("studio session: edits, undo, redo and save replay to identical control points",
@@ -84,16 +108,25 @@ TEST_CASE("studio session: edits, undo, redo and save replay to identical contro
   INFO(edited.json);
   const Json reply = Json::parse(edited.json);
   REQUIRE(reply.at("op") == "edit");
-  REQUIRE(edited.frames.size() == 1);
   Json doc = Json::parse(read(sail_file));
   doc["deformations"]["shape"][1]["moves"][0]["by"][1] = 500;
   const auto replay = run_recipe(parse_recipe(doc.dump(), sail_file.parent_path(), "sail"));
+  // One frame per final surface (first), then one per named curve of the run.
+  REQUIRE(edited.frames.size() == 1 + replay.curves.size());
   CHECK(same(decode(edited.frames[0]), replay.surface("sail")));
+  const auto nets = frames_by_name(edited);
+  for (const auto& [name, curve] : replay.curves) {
+    INFO("curve " << name);
+    REQUIRE(nets.count(name) == 1);
+    CHECK(nets.at(name).header.at("kind") == "curve");
+    CHECK(same(nets.at(name), curve));
+  }
+  CHECK(reply.at("curves").size() == replay.curves.size());
   CHECK(session.history() == std::vector<std::string>{"open", "billow 500"});
 
   // Undo gives the original sail, redo the edited one again.
   const auto undone = session.handle(R"({"op": "undo"})");
-  REQUIRE(undone.frames.size() == 1);
+  REQUIRE(undone.frames.size() == 1 + replay.curves.size());
   const auto original = run_recipe(load_recipe(sail_file));
   CHECK(same(decode(undone.frames[0]), original.surface("sail")));
   CHECK(session.position() == 0);
@@ -145,6 +178,86 @@ TEST_CASE("studio session: bad commands are refused and change nothing", "[studi
           .json);
   CHECK(created.at("op") == "edit");
   CHECK(Json::parse(session.text()).at("description") == "drawn in the studio");
+}
+
+TEST_CASE(
+    "studio session: a stroke drawn into an empty recipe, a fill in one entry, removal, export",
+    "[studio]") {
+  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio_draw";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  StudioSession session(R"({"format": "clayform.recipe", "version": 1, "name": "drawn"})", dir,
+                        "drawn");
+  // Four strokes, edges of a 100 x 60 mm patch (the first one bowed), each a new key of
+  // "strokes", which the empty recipe does not have yet.
+  auto along = [](std::array<double, 2> a, std::array<double, 2> b, double bow) {
+    Json points = Json::array();
+    for (int k = 0; k <= 20; ++k) {
+      const double t = k / 20.0;
+      points.push_back(
+          {a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]) - bow * 4 * t * (1 - t), 0.0});
+    }
+    return points;
+  };
+  const std::vector<std::pair<std::string, Json>> edges = {{"e0", along({0, 0}, {100, 0}, 8)},
+                                                           {"e1", along({100, 0}, {100, 60}, 0)},
+                                                           {"e2", along({100, 60}, {0, 60}, 0)},
+                                                           {"e3", along({0, 60}, {0, 0}, 0)}};
+  Json expected = Json::parse(session.text());
+  for (const auto& [name, points] : edges) {
+    const Json stroke = {{"points", points}, {"tolerance", 0.01}, {"closing_ratio", 0}};
+    const auto r = session.handle(Json{
+        {"op", "edit"},
+        {"path", "strokes." + name},
+        {"value", stroke},
+        {"create", true},
+        {"label", "stroke " + name}}.dump());
+    INFO(r.json);
+    REQUIRE(Json::parse(r.json).at("op") == "edit");
+    expected["strokes"][name] = stroke;
+    const auto replay = run_recipe(parse_recipe(expected.dump(), dir, "drawn"));
+    const auto nets = frames_by_name(r);
+    REQUIRE(nets.count(name) == 1);
+    CHECK(same(nets.at(name), replay.curve(name)));
+  }
+  // A fill and its report in one history entry with a stroke removed and put back: "changes".
+  const Json fill = {{"fill", {{"curves", {"e0", "e1", "e2", "e3"}}}}};
+  const auto filled = session.handle(
+      Json{{"op", "edit"},
+           {"label", "fill"},
+           {"changes",
+            {{{"path", "surfaces.patch"}, {"value", fill}, {"create", true}},
+             {{"path", "strokes.e3"}, {"remove", true}},
+             {{"path", "strokes.e3"}, {"value", expected["strokes"]["e3"]}, {"create", true}}}}}
+          .dump());
+  INFO(filled.json);
+  REQUIRE(Json::parse(filled.json).at("op") == "edit");
+  expected["surfaces"]["patch"] = fill;
+  const auto replay = run_recipe(parse_recipe(expected.dump(), dir, "drawn"));
+  CHECK(same(frames_by_name(filled).at("patch"), replay.surface("patch")));
+  CHECK(session.history().back() == "fill");
+  CHECK(session.history().size() == 6);
+  // Removing what a surface is built from breaks the recipe: refused, nothing changes.
+  const std::string before = session.text();
+  const Json refused =
+      Json::parse(session.handle(R"({"op": "edit", "path": "strokes.e1", "remove": true})").json);
+  CHECK(refused.at("op") == "error");
+  CHECK_THAT(refused.at("message").get<std::string>(), Contains("e1"));
+  CHECK(session.text() == before);
+  CHECK_THAT(
+      Json::parse(session.handle(R"({"op": "edit", "path": "strokes.nope", "remove": true})").json)
+          .at("message")
+          .get<std::string>(),
+      Contains("no such entry"));
+  // Export: STEP, IGES and glTF of the final surfaces, read back and checked, beside the recipe.
+  const Json exported =
+      Json::parse(session.handle(R"({"op": "export", "folder": "out", "name": "patch"})").json);
+  INFO(exported.dump());
+  REQUIRE(exported.at("op") == "exported");
+  CHECK(exported.at("valid") == true);
+  CHECK(exported.at("read_back_identical") == true);
+  for (const char* f : {"patch.step", "patch.igs", "patch.glb", "report.json"})
+    CHECK(fs::exists(dir / "out" / f));
 }
 
 namespace {
@@ -224,7 +337,8 @@ TEST_CASE("studio server: a burst of edits of one path is answered for the newes
   while (true) {
     const auto [text, body] = client.receive();
     if (!text) {
-      last_net = body;
+      const Net net = decode(std::vector<std::uint8_t>(body.begin(), body.end()));
+      if (net.header.at("kind") == "net") last_net = body;
       continue;
     }
     const Json r = Json::parse(body);
