@@ -178,9 +178,7 @@ struct StudioSession::Impl {
                        {"message", s.message},
                        {"figures", figures}});
     }
-    Json surfaces = Json::array();
-    for (const std::string& n : run.shown) {
-      const auto& s = result.surface(n);
+    auto push_net = [&](const std::string& n, const surface::BSplineSurface& s, bool before) {
       Json header = {{"kind", "net"},
                      {"name", n},
                      {"degrees", {s.u.degree, s.v.degree}},
@@ -188,9 +186,14 @@ struct StudioSession::Impl {
                      {"knots_u", s.u.knots},
                      {"knots_v", s.v.knots},
                      {"rational", s.is_rational()}};
+      if (before) header["before"] = true;
       std::vector<double> points(s.points.data(), s.points.data() + s.points.size());
       std::vector<double> weights(s.weights.data(), s.weights.data() + s.weights.size());
       reply.frames.push_back(net_frame(header.dump(), points, weights));
+    };
+    Json surfaces = Json::array();
+    for (const std::string& n : run.shown) {
+      push_net(n, result.surface(n), false);
       surfaces.push_back(n);
     }
     // Every named curve too (fitted strokes, sketch entities, bounds and targets): the page
@@ -207,13 +210,19 @@ struct StudioSession::Impl {
       reply.frames.push_back(net_frame(header.dump(), points, weights));
       curves.push_back(n);
     }
-    reply.json = Json{{"op", op},
-                      {"recipe", result.recipe},
-                      {"seconds", result.seconds},
-                      {"steps", steps},
-                      {"surfaces", surfaces},
-                      {"curves", curves},
-                      {"history", history_json()}}
+    // A deformed surface's parent before its first step (the page's before/after view, and
+    // what a lattice drag is checked against).
+    Json befores = Json::array();
+    for (const std::string& n : run.shown) {
+      const auto stage = std::find_if(result.stages.begin(), result.stages.end(),
+                                      [&](const Stage& st) { return st.surface == n; });
+      if (stage == result.stages.end()) continue;
+      push_net(n, stage->before, true);
+      befores.push_back(n);
+    }
+    reply.json = Json{{"op", op},           {"recipe", result.recipe},  {"seconds", result.seconds},
+                      {"steps", steps},     {"surfaces", surfaces},     {"curves", curves},
+                      {"befores", befores}, {"history", history_json()}}
                      .dump();
     return reply;
   }

@@ -82,12 +82,12 @@ bool same(const Net& net, const clay::surface::BSplineCurve& c) {
              0;
 }
 
-/// The frames of a reply, decoded, by name.
+/// The frames of a reply, decoded, by name (the parents before their steps left out).
 std::map<std::string, Net> frames_by_name(const StudioSession::Reply& reply) {
   std::map<std::string, Net> out;
   for (const auto& f : reply.frames) {
     Net net = decode(f);
-    out[net.header.at("name")] = std::move(net);
+    if (!net.header.contains("before")) out[net.header.at("name")] = std::move(net);
   }
   return out;
 }
@@ -111,9 +111,14 @@ TEST_CASE("studio session: edits, undo, redo and save replay to identical contro
   Json doc = Json::parse(read(sail_file));
   doc["deformations"]["shape"][1]["moves"][0]["by"][1] = 500;
   const auto replay = run_recipe(parse_recipe(doc.dump(), sail_file.parent_path(), "sail"));
-  // One frame per final surface (first), then one per named curve of the run.
-  REQUIRE(edited.frames.size() == 1 + replay.curves.size());
+  // One frame per final surface (first), one per named curve of the run, then the deformed
+  // surface's parent before its first step.
+  REQUIRE(edited.frames.size() == 2 + replay.curves.size());
   CHECK(same(decode(edited.frames[0]), replay.surface("sail")));
+  const Net before = decode(edited.frames.back());
+  CHECK(before.header.at("before") == true);
+  CHECK(same(before, replay.stages.front().before));
+  CHECK(reply.at("befores") == Json::array({"sail"}));
   const auto nets = frames_by_name(edited);
   for (const auto& [name, curve] : replay.curves) {
     INFO("curve " << name);
@@ -126,7 +131,7 @@ TEST_CASE("studio session: edits, undo, redo and save replay to identical contro
 
   // Undo gives the original sail, redo the edited one again.
   const auto undone = session.handle(R"({"op": "undo"})");
-  REQUIRE(undone.frames.size() == 1 + replay.curves.size());
+  REQUIRE(undone.frames.size() == 2 + replay.curves.size());
   const auto original = run_recipe(load_recipe(sail_file));
   CHECK(same(decode(undone.frames[0]), original.surface("sail")));
   CHECK(session.position() == 0);
@@ -338,7 +343,7 @@ TEST_CASE("studio server: a burst of edits of one path is answered for the newes
     const auto [text, body] = client.receive();
     if (!text) {
       const Net net = decode(std::vector<std::uint8_t>(body.begin(), body.end()));
-      if (net.header.at("kind") == "net") last_net = body;
+      if (net.header.at("kind") == "net" && !net.header.contains("before")) last_net = body;
       continue;
     }
     const Json r = Json::parse(body);
