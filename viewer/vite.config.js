@@ -4,7 +4,10 @@
 // (e.g. CLAYFORM_RUN=../out/sail npm run dev), as `clayform view` does.
 import { defineConfig } from 'vite';
 import { createReadStream, statSync } from 'node:fs';
-import { resolve, normalize, sep, extname } from 'node:path';
+import { resolve, normalize, sep, extname, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+
+const here = dirname(fileURLToPath(import.meta.url));
 
 const TYPES = { '.json': 'application/json', '.bin': 'application/octet-stream' };
 
@@ -33,6 +36,8 @@ export default defineConfig({
   base: './',
   plugins: [serveRun()],
   build: {
+    // two pages: the viewer (index.html, clayform view) and the studio (studio.html, clayform studio)
+    rollupOptions: { input: { index: resolve(here, 'index.html'), studio: resolve(here, 'studio.html') } },
     outDir: 'dist',
     emptyOutDir: true,
     target: 'es2020',

@@ -14,11 +14,13 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <cstring>
 #include <deque>
 #include <fstream>
 #include <functional>
+#include <list>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -136,6 +138,7 @@ struct StudioSession::Impl {
   fs::path base_dir;
   std::string name;
   std::vector<std::pair<std::string, std::string>> history;  // (label, recipe text)
+  std::vector<std::string> groups;  // per entry: the "group" of the edits it holds ("" none)
   int position = 0;
 
   const std::string& text() const { return history[static_cast<std::size_t>(position)].second; }
@@ -162,7 +165,9 @@ struct StudioSession::Impl {
     return Json{{"entries", h}, {"position", position}};
   }
 
-  /// The reply of a run: its report figures per step, and a net frame per final surface.
+  /// The reply of a run: its report figures per step, the history and the recipe text; then a
+  /// net frame per final surface, a curve frame per named curve, and a net frame per deformed
+  /// final surface's parent before its first step.
   Reply ran(const std::string& op, const Run& run) const {
     const RunResult& result = run.result;
     Reply reply;
@@ -220,10 +225,11 @@ struct StudioSession::Impl {
       push_net(n, stage->before, true);
       befores.push_back(n);
     }
-    reply.json = Json{{"op", op},           {"recipe", result.recipe},  {"seconds", result.seconds},
-                      {"steps", steps},     {"surfaces", surfaces},     {"curves", curves},
-                      {"befores", befores}, {"history", history_json()}}
-                     .dump();
+    reply.json =
+        Json{{"op", op},           {"recipe", result.recipe},   {"seconds", result.seconds},
+             {"steps", steps},     {"surfaces", surfaces},      {"curves", curves},
+             {"befores", befores}, {"history", history_json()}, {"text", text()}}
+            .dump();
     return reply;
   }
 };
@@ -234,6 +240,7 @@ StudioSession::StudioSession(std::string text, fs::path base_dir, std::string na
   impl_->name = std::move(name);
   parse_recipe(text, impl_->base_dir, impl_->name);  // throws Recipe listing the problems
   impl_->history.emplace_back("open", std::move(text));
+  impl_->groups.emplace_back();
 }
 
 StudioSession::~StudioSession() = default;
@@ -305,8 +312,18 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
       for (const Json& change : changes) apply_change(doc, change, first_path);
       std::string next = doc.dump(1);
       const Impl::Run result = s.run(next);  // a recipe the edit breaks throws: nothing changes
-      s.history.resize(static_cast<std::size_t>(s.position) + 1);  // an edit drops the redo tail
+      // The updates of one drag share a "group": the latest replaces the entry an earlier one
+      // made, so the drag is one step of the history.
+      const std::string group = c.value("group", "");
+      const auto at = static_cast<std::size_t>(s.position);
+      if (!group.empty() && at + 1 == s.history.size() && s.groups[at] == group) {
+        s.history[at].second = std::move(next);
+        return s.ran("edit", result);
+      }
+      s.history.resize(at + 1);  // an edit drops the redo tail
+      s.groups.resize(at + 1);
       s.history.emplace_back(c.value("label", "edit " + first_path), std::move(next));
+      s.groups.push_back(group);
       s.position = static_cast<int>(s.history.size()) - 1;
       return s.ran("edit", result);
     }
@@ -388,13 +405,37 @@ using tcp = asio::ip::tcp;
 struct StudioServer::Impl {
   StudioSession session;
   StudioOptions options;
-  asio::io_context io;
-  tcp::acceptor acceptor{io};
+  asio::io_context accept_io;  // the acceptor's
+  tcp::acceptor acceptor{accept_io};
   int port = 0;
   std::thread thread;
-  mutable std::mutex mutex;  // guards session between commands and `current`
-  tcp::socket* current = nullptr;
+  mutable std::mutex session_mutex;  // one command at a time on the session
+
+  /// One accepted connection, served on a thread of its own (with its own io_context for the
+  /// WebSocket's asynchronous reads and writes), so the page's open socket does not hold up
+  /// another request (a file, a refused upgrade).
+  struct Connection {
+    asio::io_context io;
+    tcp::socket socket{io};
+    std::thread thread;
+    std::atomic<bool> done{false};
+  };
+  std::mutex mutex;  // guards connections, socket_open, stopping
+  std::list<std::unique_ptr<Connection>> connections;
+  bool socket_open = false;  // a page holds the WebSocket
   bool stopping = false;
+
+  /// Joins the threads of finished connections (mutex held).
+  void reap() {
+    for (auto it = connections.begin(); it != connections.end();) {
+      if ((*it)->done) {
+        (*it)->thread.join();
+        it = connections.erase(it);
+      } else {
+        ++it;
+      }
+    }
+  }
 
   explicit Impl(StudioSession s) : session(std::move(s)) {}
 
@@ -488,7 +529,7 @@ struct StudioServer::Impl {
   /// operations on this thread; the commands run on a worker, one at a time. Commands that
   /// arrive while one runs wait in a queue where a newer edit of a path replaces an older one:
   /// at most one drag update is being computed, and the newest wins.
-  void converse(websocket::stream<tcp::socket&>& ws) {
+  void converse(websocket::stream<tcp::socket&>& ws, asio::io_context& io) {
     std::mutex queue_mutex;
     std::condition_variable wake;
     std::deque<std::string> queue;
@@ -533,7 +574,7 @@ struct StudioServer::Impl {
         }
         auto reply = std::make_shared<StudioSession::Reply>();
         {
-          std::lock_guard<std::mutex> lock(mutex);
+          std::lock_guard<std::mutex> lock(session_mutex);
           *reply = session.handle(command);
         }
         asio::post(io, [&, reply] {
@@ -557,7 +598,7 @@ struct StudioServer::Impl {
     io.run();
   }
 
-  void handle_connection(tcp::socket& socket) {
+  void handle_connection(tcp::socket& socket, asio::io_context& io) {
     beast::flat_buffer buffer;
     http::request<http::string_body> req;
     http::read(socket, buffer, req);
@@ -575,10 +616,27 @@ struct StudioServer::Impl {
                                 "Origin must be this server's address)\n"));
       return;
     }
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (socket_open) {
+        http::write(socket, plain(req, http::status::conflict,
+                                  "the studio is open in another tab or window: one page edits "
+                                  "the recipe at a time; close the other one first\n"));
+        return;
+      }
+      socket_open = true;
+    }
+    struct Release {
+      Impl& s;
+      ~Release() {
+        std::lock_guard<std::mutex> lock(s.mutex);
+        s.socket_open = false;
+      }
+    } release{*this};
     websocket::stream<tcp::socket&> ws(socket);
     ws.read_message_max(64 << 20);
     ws.accept(req);
-    converse(ws);
+    converse(ws, io);
   }
 };
 
@@ -611,32 +669,41 @@ std::string StudioServer::url() const {
 }
 
 std::string StudioServer::recipe_text() const {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
+  std::lock_guard<std::mutex> lock(impl_->session_mutex);
   return impl_->session.text();
 }
 
 void StudioServer::run() {
   Impl& s = *impl_;
   while (true) {
-    tcp::socket socket(s.io);
+    auto connection = std::make_unique<Impl::Connection>();
     boost::system::error_code ec;
-    s.acceptor.accept(socket, ec);
-    {
-      std::lock_guard<std::mutex> lock(s.mutex);
-      if (s.stopping) return;
-      s.current = &socket;
-    }
-    if (!ec) {
+    s.acceptor.accept(connection->socket, ec);
+    std::lock_guard<std::mutex> lock(s.mutex);
+    if (s.stopping) break;
+    s.reap();
+    if (ec) continue;
+    Impl::Connection* c = connection.get();
+    c->thread = std::thread([&s, c] {
       try {
-        s.handle_connection(socket);
+        s.handle_connection(c->socket, c->io);
       } catch (const std::exception&) {
         // A client that goes away mid-message ends its connection, not the server.
       }
-    }
-    std::lock_guard<std::mutex> lock(s.mutex);
-    s.current = nullptr;
-    if (s.stopping) return;
+      boost::system::error_code ignored;
+      c->socket.shutdown(tcp::socket::shutdown_both, ignored);
+      c->socket.close(ignored);
+      c->done = true;
+    });
+    s.connections.push_back(std::move(connection));
   }
+  // Stopping: stop() has shut every connection's socket; their threads end.
+  std::list<std::unique_ptr<Impl::Connection>> open;
+  {
+    std::lock_guard<std::mutex> lock(s.mutex);
+    open.swap(s.connections);
+  }
+  for (auto& c : open) c->thread.join();
 }
 
 void StudioServer::start() {
@@ -650,7 +717,7 @@ void StudioServer::stop() {
     if (impl_->stopping && !impl_->thread.joinable()) return;
     impl_->stopping = true;
     boost::system::error_code ec;
-    if (impl_->current) impl_->current->shutdown(tcp::socket::shutdown_both, ec);
+    for (auto& c : impl_->connections) c->socket.shutdown(tcp::socket::shutdown_both, ec);
   }
   // A blocking accept wakes for a connection only: make one (run() then sees `stopping`).
   if (impl_->thread.joinable()) {

@@ -1,0 +1,614 @@
+#!/usr/bin/env node
+// End-to-end test of Clayform Studio (docs/studio.md) in Debian's headless Chromium, driven by
+// playwright-core with synthesized pointer events against a real `clayform studio`:
+//   strokes drawn on the XY plane, each fitted curve checked against the drawn path back-projected
+//   through the page's camera (here, not by the page); a fill of four of them; a bound and a target
+//   drawn and the style applied in exact mode, checked for locality outside the bound and for the
+//   target met; a lattice placed and one of its points dragged for 5 s, the surface checked
+//   against Sederberg–Parry's FFD evaluated pointwise here; undo and redo; the recipe saved and
+//   replayed by `clayform run`, whose STEP file must hold the page's control points bit for bit;
+//   a socket from another origin refused. Latencies and frame times come from the page's
+//   window.clayStudio hook and are reported (not asserted: they depend on the machine).
+//
+//   node e2e/studio.test.mjs --clayform PATH [--chromium PATH] [--shots DIR] [--report FILE]
+import { spawn, spawnSync } from 'node:child_process';
+import { createServer, request } from 'node:http';
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, writeFileSync } from 'node:fs';
+import { tmpdir, cpus } from 'node:os';
+import { join, resolve } from 'node:path';
+import { chromium } from 'playwright-core';
+
+const args = process.argv.slice(2);
+const opt = (name, fallback) => {
+  const i = args.indexOf(name);
+  return i >= 0 && args[i + 1] ? args[i + 1] : fallback;
+};
+const clayform = resolve(opt('--clayform', process.env.CLAYFORM || '../build/cli/clayform'));
+const executablePath = opt('--chromium', process.env.CHROMIUM || '/usr/bin/chromium');
+const shots = opt('--shots', null);
+const reportFile = opt('--report', null);
+for (const [what, path] of [['clayform (cmake --build build)', clayform], ['chromium (apt-get install chromium)', executablePath]]) {
+  if (!existsSync(path)) {
+    console.error(`missing ${what}: ${path}`);
+    process.exit(2);
+  }
+}
+
+// ------------------------------------------------------------------ independent geometry
+// Evaluated here with de Boor's algorithm (The NURBS Book A3.1 / A4.1 style, written apart from the
+// page's basis-function code), so the page's own evaluation is not what checks it.
+function deBoor(knots, degree, ctrl, t) {
+  // ctrl: array of [x, y, z, w] (homogeneous); returns the homogeneous point
+  const n = ctrl.length;
+  let k = degree;
+  if (t >= knots[n]) k = n - 1;
+  else while (k < n - 1 && !(t >= knots[k] && t < knots[k + 1])) k++;
+  const d = [];
+  for (let j = 0; j <= degree; j++) d.push(ctrl[k - degree + j].slice());
+  for (let r = 1; r <= degree; r++)
+    for (let j = degree; j >= r; j--) {
+      const i = k - degree + j;
+      const den = knots[i + degree - r + 1] - knots[i];
+      const a = den === 0 ? 0 : (t - knots[i]) / den;
+      for (let e = 0; e < 4; e++) d[j][e] = (1 - a) * d[j - 1][e] + a * d[j][e];
+    }
+  return d[degree];
+}
+const dehom = (h) => [h[0] / h[3], h[1] / h[3], h[2] / h[3]];
+function curveAt(c, t) {
+  const ctrl = c.weights.map((w, i) => [c.points[3 * i] * w, c.points[3 * i + 1] * w, c.points[3 * i + 2] * w, w]);
+  return dehom(deBoor(c.knots, c.degree, ctrl, t));
+}
+function curveDomain(c) {
+  return [c.knots[c.degree], c.knots[c.knots.length - c.degree - 1]];
+}
+function surfaceAt(s, u, v) {
+  const [p, q] = s.degrees;
+  const [nu, nv] = s.counts;
+  const rows = [];
+  for (let i = 0; i < nu; i++) {
+    const ctrl = [];
+    for (let j = 0; j < nv; j++) {
+      const k = i * nv + j;
+      const w = s.weights[k];
+      ctrl.push([s.points[3 * k] * w, s.points[3 * k + 1] * w, s.points[3 * k + 2] * w, w]);
+    }
+    rows.push(deBoor(s.knots_v, q, ctrl, v));
+  }
+  return dehom(deBoor(s.knots_u, p, rows, u));
+}
+function surfaceDomain(s) {
+  const [p, q] = s.degrees;
+  return [
+    [s.knots_u[p], s.knots_u[s.knots_u.length - p - 1]],
+    [s.knots_v[q], s.knots_v[s.knots_v.length - q - 1]],
+  ];
+}
+const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+/** Distance from a point to a curve: dense samples, then golden-section refinement. */
+function distanceToCurve(c, x) {
+  const [a, b] = curveDomain(c);
+  const n = 800;
+  let best = 0;
+  let bestD = Infinity;
+  for (let k = 0; k <= n; k++) {
+    const t = a + ((b - a) * k) / n;
+    const d = dist(curveAt(c, t), x);
+    if (d < bestD) [best, bestD] = [k, d];
+  }
+  let lo = a + ((b - a) * Math.max(0, best - 1)) / n;
+  let hi = a + ((b - a) * Math.min(n, best + 1)) / n;
+  const g = (Math.sqrt(5) - 1) / 2;
+  for (let it = 0; it < 80; it++) {
+    const m1 = hi - g * (hi - lo);
+    const m2 = lo + g * (hi - lo);
+    if (dist(curveAt(c, m1), x) < dist(curveAt(c, m2), x)) hi = m2;
+    else lo = m1;
+  }
+  return Math.min(bestD, dist(curveAt(c, (lo + hi) / 2), x));
+}
+/** Sederberg–Parry eq. (2): the trivariate Bernstein sum of the lattice's points at (s, t, u). */
+function ffd(step, points, x) {
+  const [l, m, n] = step.degrees;
+  const { origin, s: S, t: T, u: U } = step.frame;
+  // local coordinates: solve X = X0 + s S + t T + u U (Cramer's rule, eq. (1))
+  const d = [0, 1, 2].map((e) => x[e] - origin[e]);
+  const det3 = (a, b, c) => a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+  const D = det3(S, T, U);
+  const s = det3(d, T, U) / D;
+  const t = det3(S, d, U) / D;
+  const u = det3(S, T, d) / D;
+  const binom = (N, k) => {
+    let r = 1;
+    for (let i = 1; i <= k; i++) r = (r * (N - k + i)) / i;
+    return r;
+  };
+  const B = (N, i, y) => binom(N, i) * (1 - y) ** (N - i) * y ** i;
+  const out = [0, 0, 0];
+  for (let i = 0; i <= l; i++)
+    for (let j = 0; j <= m; j++)
+      for (let k = 0; k <= n; k++) {
+        const f = B(l, i, s) * B(m, j, t) * B(n, k, u);
+        const P = points[(i * (m + 1) + j) * (n + 1) + k];
+        for (let e = 0; e < 3; e++) out[e] += f * P[e];
+      }
+  return out;
+}
+function latticePoints(step) {
+  const [l, m, n] = step.degrees;
+  const { origin, s, t, u } = step.frame;
+  const out = [];
+  for (let i = 0; i <= l; i++) for (let j = 0; j <= m; j++) for (let k = 0; k <= n; k++) out.push([0, 1, 2].map((e) => origin[e] + (i / l) * s[e] + (j / m) * t[e] + (k / n) * u[e]));
+  for (const mv of step.moves || []) {
+    const at = (mv.index[0] * (m + 1) + mv.index[1]) * (n + 1) + mv.index[2];
+    out[at] = mv.to ? mv.to.slice() : out[at].map((c, e) => c + mv.by[e]);
+  }
+  return out;
+}
+function insidePolygon(poly, x, y) {
+  let inside = false;
+  for (let i = 0, j = poly.length - 1; i < poly.length; j = i++) {
+    const [xi, yi] = poly[i];
+    const [xj, yj] = poly[j];
+    if (yi > y !== yj > y && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) inside = !inside;
+  }
+  return inside;
+}
+const quantile = (values, q) => {
+  const s = [...values].sort((a, b) => a - b);
+  if (!s.length) return NaN;
+  return s[Math.min(s.length - 1, Math.floor(q * (s.length - 1) + 0.5))];
+};
+
+/** The back-projection of a screen point onto the plane z = z0 through the page's camera matrices. */
+function backProject(cam, clientX, clientY, z0) {
+  const ndc = [((clientX - cam.rect.left) / cam.rect.width) * 2 - 1, -((clientY - cam.rect.top) / cam.rect.height) * 2 + 1];
+  const apply = (m, v) => {
+    const x = m[0] * v[0] + m[4] * v[1] + m[8] * v[2] + m[12] * v[3];
+    const y = m[1] * v[0] + m[5] * v[1] + m[9] * v[2] + m[13] * v[3];
+    const z = m[2] * v[0] + m[6] * v[1] + m[10] * v[2] + m[14] * v[3];
+    const w = m[3] * v[0] + m[7] * v[1] + m[11] * v[2] + m[15] * v[3];
+    return [x / w, y / w, z / w, 1];
+  };
+  const near = apply(cam.matrixWorld, apply(cam.projectionInverse, [ndc[0], ndc[1], -1, 1]));
+  const far = apply(cam.matrixWorld, apply(cam.projectionInverse, [ndc[0], ndc[1], 1, 1]));
+  const t = (z0 - near[2]) / (far[2] - near[2]);
+  return [0, 1, 2].map((e) => near[e] + t * (far[e] - near[e]));
+}
+
+// ------------------------------------------------------------------ STEP: the surfaces' control points
+/** Every B_SPLINE_SURFACE_WITH_KNOTS of a STEP file: {degrees, points (u-major)} with the numbers as written. */
+function stepSurfaces(text) {
+  const entities = new Map();
+  for (const m of text.replace(/\r?\n/g, '').matchAll(/#(\d+)\s*=\s*([^;]*);/g)) entities.set(m[1], m[2]);
+  const out = [];
+  for (const [, body] of entities) {
+    const m = body.match(/^B_SPLINE_SURFACE_WITH_KNOTS\('[^']*',(\d+),(\d+),\((.*?)\)\),/);
+    if (!m) continue;
+    const rows = m[3].split(/\)\s*,\s*\(/).map((r) => r.replace(/[()]/g, '').split(',').map((ref) => ref.trim().slice(1)));
+    const points = [];
+    for (const row of rows)
+      for (const ref of row) {
+        const p = entities.get(ref).match(/CARTESIAN_POINT\('[^']*',\(([^)]*)\)\)/);
+        points.push(...p[1].split(',').map(Number));
+      }
+    out.push({ degrees: [Number(m[1]), Number(m[2])], counts: [rows.length, rows[0].length], points });
+  }
+  return out;
+}
+
+// ------------------------------------------------------------------ the studio
+const work = mkdtempSync(join(tmpdir(), 'clayform-studio-'));
+writeFileSync(join(work, 'drawn.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'drawn' }));
+const studio = spawn(clayform, ['studio', join(work, 'drawn.json'), '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
+const url = await new Promise((resolvePromise, reject) => {
+  let out = '';
+  studio.stdout.on('data', (d) => {
+    out += d;
+    const m = out.match(/Clayform Studio at (http:\/\/127\.0\.0\.1:\d+\/)/);
+    if (m) resolvePromise(m[1]);
+  });
+  studio.on('exit', (code) => reject(new Error(`clayform studio exited (${code}) before printing its address`)));
+  setTimeout(() => reject(new Error('clayform studio printed no address in 20 s')), 20000);
+});
+const port = Number(new URL(url).port);
+
+const results = [];
+const figures = {};
+async function check(name, fn) {
+  const t0 = Date.now();
+  try {
+    const note = await fn();
+    results.push(true);
+    console.log(`ok - ${name}${note ? ` (${note})` : ''} [${Date.now() - t0} ms]`);
+  } catch (e) {
+    results.push(false);
+    console.log(`not ok - ${name}\n    ${String(e && e.stack ? e.stack : e).split('\n').slice(0, 5).join('\n    ')}`);
+  }
+}
+function assert(cond, message) {
+  if (!cond) throw new Error(message);
+}
+
+const browser = await chromium.launch({
+  executablePath,
+  headless: true,
+  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
+});
+const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+const problems = [];
+page.on('console', (m) => m.type() === 'error' && problems.push(`console error: ${m.text()}`));
+page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
+const studioCall = (fn, arg) => page.evaluate(fn, arg);
+const idle = () => page.evaluate(() => window.clayStudio.idle());
+let shotCount = 0;
+async function shot(label) {
+  if (!shots) return;
+  mkdirSync(shots, { recursive: true });
+  await page.screenshot({ path: join(shots, `${String(++shotCount).padStart(2, '0')}-${label}.png`) });
+}
+const lastError = () => page.evaluate(() => document.body.dataset.error || '');
+
+/** Draws a stroke through world points on the plane z = z0 (screen positions from the page's camera). */
+async function draw(world, { steps = 40, z0 = 0 } = {}) {
+  const screen = await studioCall((pts) => pts.map((p) => window.clayStudio.toScreen(p)), world);
+  const path = [];
+  for (let k = 0; k < screen.length - 1; k++)
+    for (let s = 0; s < steps / (screen.length - 1); s++) {
+      const f = s / (steps / (screen.length - 1));
+      path.push([screen[k][0] + f * (screen[k + 1][0] - screen[k][0]), screen[k][1] + f * (screen[k + 1][1] - screen[k][1])]);
+    }
+  path.push(screen[screen.length - 1]);
+  await page.mouse.move(...path[0]);
+  await page.mouse.down();
+  for (const p of path.slice(1)) await page.mouse.move(...p);
+  await page.mouse.up();
+  await idle();
+  const error = await lastError();
+  if (error) throw new Error(`the stroke was refused: ${error}`);
+  const cam = await studioCall(() => window.clayStudio.camera());
+  return path.map(([x, y]) => backProject(cam, x, y, z0));
+}
+const along = (a, b, bow, n = 8) =>
+  Array.from({ length: n + 1 }, (_, k) => {
+    const t = k / n;
+    const dx = b[0] - a[0];
+    const dy = b[1] - a[1];
+    const len = Math.hypot(dx, dy);
+    return [a[0] + t * dx - (bow * 4 * t * (1 - t) * dy) / len, a[1] + t * dy + (bow * 4 * t * (1 - t) * dx) / len, 0];
+  });
+/** Checks a fitted curve against the drawn points: each within the stroke's tolerance (ends: plus how far snapping moved them). */
+async function checkStroke(name, drawn) {
+  const recipe = await studioCall(() => window.clayStudio.recipe());
+  const curves = await studioCall(() => window.clayStudio.curves());
+  const stroke = recipe.strokes[name];
+  assert(stroke && curves[name], `no stroke or curve "${name}"`);
+  const snapStart = dist(stroke.points[0], drawn[0]);
+  const snapEnd = dist(stroke.points[stroke.points.length - 1], drawn[drawn.length - 1]);
+  let worst = 0;
+  drawn.forEach((x, k) => {
+    const allowance = k === 0 ? snapStart : k === drawn.length - 1 ? snapEnd : 0;
+    const d = distanceToCurve(curves[name], x);
+    worst = Math.max(worst, d - allowance);
+  });
+  assert(worst <= stroke.tolerance * (1 + 1e-9), `curve ${name}: a drawn point is ${worst} mm from the fitted curve, tolerance ${stroke.tolerance}`);
+  return { worst, snapStart, snapEnd, control_points: curves[name].weights.length };
+}
+async function clickAt(world, shift) {
+  const [x, y] = await studioCall((p) => window.clayStudio.toScreen(p), world);
+  if (shift) await page.keyboard.down('Shift');
+  await page.mouse.click(x, y);
+  if (shift) await page.keyboard.up('Shift');
+}
+async function clickCurve(name, shift) {
+  const curves = await studioCall(() => window.clayStudio.curves());
+  const c = curves[name];
+  const [a, b] = curveDomain(c);
+  await clickAt(curveAt(c, a + 0.37 * (b - a)), shift);
+}
+
+try {
+  await page.goto(url);
+  await page.waitForFunction(() => ['1', 'error'].includes(document.body.dataset.ready), null, { timeout: 60000 });
+  assert((await page.evaluate(() => document.body.dataset.ready)) === '1', `the page did not start: ${await lastError()}`);
+  await studioCall(() => window.clayStudio.setView('top'));
+  await page.keyboard.press('s'); // the sketch tool (its key), on plane XY
+
+  const edges = {
+    s1: along([-300, -200], [300, -200], -30),
+    s2: along([300, -200], [300, 200], 0),
+    s3: along([300, 200], [-300, 200], 0),
+    s4: along([-300, 200], [-300, -200], 0),
+  };
+  const drawnEdges = {};
+  await check('strokes on the XY plane are fitted within their tolerance of the drawn path, back-projected', async () => {
+    const notes = [];
+    for (const [name, world] of Object.entries(edges)) {
+      drawnEdges[name] = await draw(world);
+      const r = await checkStroke(name, drawnEdges[name]);
+      notes.push(`${name} ${r.control_points} points, ${r.worst.toExponential(2)} mm`);
+    }
+    const stroke = await studioCall(() => window.clayStudio.metrics.stroke.map((m) => m.ms));
+    figures.stroke_to_curve_ms = { p50: quantile(stroke, 0.5), p95: quantile(stroke, 0.95), n: stroke.length };
+    return notes.join('; ');
+  });
+  await shot('strokes');
+
+  await check('a fill of the four curves, picked with the mouse', async () => {
+    await page.click('#tool-orbit');
+    await clickCurve('s1', false);
+    for (const n of ['s2', 's3', 's4']) await clickCurve(n, true);
+    const selected = await page.locator('#selection').textContent();
+    assert(['s1', 's2', 's3', 's4'].every((n) => selected.includes(`curve ${n}`)), `selection: ${selected}`);
+    await page.click('#build-fill');
+    await idle();
+    assert(!(await lastError()), await lastError());
+    const surfaces = await studioCall(() => window.clayStudio.surfaces());
+    assert(surfaces.fill1, `no surface fill1 (${Object.keys(surfaces)})`);
+    // the Coons patch's boundary lies on the curves (to the snap of their ends)
+    const curves = await studioCall(() => window.clayStudio.curves());
+    const s = surfaces.fill1;
+    const [[u0, u1], [v0, v1]] = surfaceDomain(s);
+    let worst = 0;
+    for (let k = 0; k <= 20; k++) {
+      const f = k / 20;
+      for (const [u, v] of [[u0 + f * (u1 - u0), v0], [u0 + f * (u1 - u0), v1], [u0, v0 + f * (v1 - v0)], [u1, v0 + f * (v1 - v0)]]) {
+        const x = surfaceAt(s, u, v);
+        worst = Math.max(worst, Math.min(...Object.keys(edges).map((n) => distanceToCurve(curves[n], x))));
+      }
+    }
+    const step = (await studioCall(() => window.clayStudio.reply())).steps.find((st) => st.path === 'surfaces.fill1');
+    const snapped = step.figures.snapped_mm || 0;
+    assert(worst <= snapped + 1e-6, `the fill's boundary is ${worst} mm off its curves (ends snapped by ${snapped} mm)`);
+    figures.fill = { control_points: s.counts[0] * s.counts[1], boundary_off_mm: worst, snapped_mm: snapped };
+    return `${s.counts[0]} x ${s.counts[1]} control points, boundary within ${worst.toExponential(2)} mm of the curves`;
+  });
+
+  let bound = null;
+  await check('a bound and a target drawn, style in exact mode: local, and the target met', async () => {
+    await page.click('#tool-sketch');
+    const loop = Array.from({ length: 33 }, (_, k) => [160 * Math.cos((2 * Math.PI * k) / 32), 110 * Math.sin((2 * Math.PI * k) / 32), 0]);
+    await draw(loop, { steps: 64 });
+    await page.fill('#sketch-offset', '40');
+    const drawnTarget = await draw(along([-90, -10], [90, -10], 15), { z0: 40 });
+    await checkStroke('s6', drawnTarget);
+    await page.fill('#sketch-offset', '0');
+    await page.click('#tool-orbit');
+    await clickCurve('s5', false);
+    await clickCurve('s6', true);
+    await page.click('#build-style');
+    await idle();
+    assert(!(await lastError()), await lastError());
+    const reply = await studioCall(() => window.clayStudio.reply());
+    const step = reply.steps.find((st) => st.kind === 'style');
+    assert(step, `no style step in ${reply.steps.map((s) => s.path)}`);
+    const f = step.figures;
+    assert(f.mode === 'exact' && f.outcome === 'met', `style: mode ${f.mode}, outcome ${f.outcome}: ${step.message}`);
+    assert(f.locality === 0, `style: locality ${f.locality}`);
+    const surfaces = await studioCall(() => window.clayStudio.surfaces());
+    const befores = await studioCall(() => window.clayStudio.befores());
+    const styled = surfaces.fill1_styled1;
+    const parent = befores.fill1_styled1;
+    assert(styled && parent, `no styled surface or its parent (${Object.keys(surfaces)})`);
+    // Locality, here: where every control point of the styled net (the parent's, refined by
+    // exact mode's knot insertion, then moved) that carries a surface point lies outside the
+    // bound, the point did not move.
+    const curves = await studioCall(() => window.clayStudio.curves());
+    bound = curves.s5;
+    const [ba, bb] = curveDomain(bound);
+    const polygon = Array.from({ length: 400 }, (_, k) => curveAt(bound, ba + ((bb - ba) * k) / 400));
+    const [[u0, u1], [v0, v1]] = surfaceDomain(styled);
+    const [p, q] = styled.degrees;
+    const [, nv] = styled.counts;
+    const span = (knots, deg, n, t) => {
+      let k = deg;
+      while (k < n - 1 && !(t >= knots[k] && t < knots[k + 1])) k++;
+      return k;
+    };
+    let checked = 0;
+    let moved = 0;
+    for (let a = 0; a <= 60; a++)
+      for (let b = 0; b <= 60; b++) {
+        const u = u0 + ((u1 - u0) * a) / 60;
+        const v = v0 + ((v1 - v0) * b) / 60;
+        const su = span(styled.knots_u, p, styled.counts[0], u);
+        const sv = span(styled.knots_v, q, nv, v);
+        let outside = true;
+        for (let i = su - p; i <= su && outside; i++)
+          for (let j = sv - q; j <= sv && outside; j++) {
+            const k = i * nv + j;
+            if (insidePolygon(polygon, styled.points[3 * k], styled.points[3 * k + 1])) outside = false;
+          }
+        if (!outside) continue;
+        checked++;
+        moved = Math.max(moved, dist(surfaceAt(styled, u, v), surfaceAt(parent, u, v)));
+      }
+    assert(checked > 100, `only ${checked} samples are carried by control points outside the bound`);
+    assert(moved <= 1e-9, `a point carried only by control points outside the bound moved ${moved} mm`);
+    // the target met: the styled surface passes through the target curve (within the step's
+    // curve tolerance, relative to the model's size, as reported)
+    figures.style = { key_points: f.key_points, target_deviation: f.target_deviation, target_curve_deviation: f.target_curve_deviation, locality: f.locality, moved_outside_mm: moved, samples_outside: checked, kernel_ms: 1000 * step.seconds };
+    return `${f.key_points} key points, target deviation ${f.target_deviation}, curve ${f.target_curve_deviation}; ${checked} samples outside the bound moved ${moved} mm`;
+  });
+  await shot('styled');
+
+  let beforeDrag = null;
+  let afterDrag = null;
+  await check('a lattice on the styled surface, a point dragged for 5 s: the surface is the pointwise FFD', async () => {
+    await clickAt([260, 170, 0], false);
+    const selected = await page.locator('#selection').textContent();
+    assert(selected.includes('surface fill1_styled1'), `selection: ${selected}`);
+    await page.click('#build-lattice');
+    await idle();
+    assert(!(await lastError()), await lastError());
+    beforeDrag = (await studioCall(() => window.clayStudio.surfaces())).fill1_styled1_ffd1;
+    assert(beforeDrag, 'no surface fill1_styled1_ffd1');
+    const handle = (await studioCall(() => window.clayStudio.handles())).find((h) => h.kind === 'lattice' && h.index.join() === '2,2,1');
+    assert(handle, 'no handle of lattice point [2, 2, 1]');
+    await studioCall(() => window.clayStudio.resetMetrics());
+    await page.mouse.move(...handle.screen);
+    await page.mouse.down();
+    const t0 = Date.now();
+    const n = 150;
+    for (let k = 1; k <= n; k++) {
+      const f = k / n;
+      await page.mouse.move(handle.screen[0] + 60 * f, handle.screen[1] - 45 * f);
+      const wait = t0 + (5000 * k) / n - Date.now();
+      if (wait > 0) await new Promise((r) => setTimeout(r, wait));
+    }
+    await page.mouse.up();
+    await idle();
+    assert(!(await lastError()), await lastError());
+    const recipe = await studioCall(() => window.clayStudio.recipe());
+    const step = recipe.deformations.lattice1[0];
+    const moves = step.moves;
+    assert(moves.length === 1 && moves[0].index.join() === '2,2,1', `moves: ${JSON.stringify(moves)}`);
+    const surfaces = await studioCall(() => window.clayStudio.surfaces());
+    const befores = await studioCall(() => window.clayStudio.befores());
+    afterDrag = surfaces.fill1_styled1_ffd1;
+    const parent = befores.fill1_styled1_ffd1;
+    const points = latticePoints(step);
+    const [[u0, u1], [v0, v1]] = surfaceDomain(afterDrag);
+    let worst = 0;
+    for (let a = 0; a <= 24; a++)
+      for (let b = 0; b <= 24; b++) {
+        const u = u0 + ((u1 - u0) * a) / 24;
+        const v = v0 + ((v1 - v0) * b) / 24;
+        worst = Math.max(worst, dist(surfaceAt(afterDrag, u, v), ffd(step, points, surfaceAt(parent, u, v))));
+      }
+    assert(worst <= 1e-9 * 1000, `the dragged surface is ${worst} mm off the pointwise FFD`);
+    const m = await studioCall(() => ({ drag: window.clayStudio.metrics.drag, preview: window.clayStudio.metrics.preview, frames: window.clayStudio.metrics.frames, kernel: window.clayStudio.metrics.kernel, evaluate: window.clayStudio.metrics.evaluate }));
+    // drag to redraw: the pointer move to the frame that shows it (the page's FFD of the parent's
+    // samples); drag to exact: the pointer move to the frame after the kernel's exact net for it
+    const halves = (list) => {
+      const start = list.length ? list[0].at : 0;
+      return [quantile(list.filter((d) => d.at - start < 2500).map((d) => d.ms), 0.95), quantile(list.filter((d) => d.at - start >= 2500).map((d) => d.ms), 0.95)];
+    };
+    const lat = m.preview.map((d) => d.ms);
+    const exact = m.drag.map((d) => d.ms);
+    const frameMs = m.frames.filter((x) => x > 0);
+    assert(lat.length > 0, 'no drag frame was drawn');
+    figures.drag = {
+      pointer_moves: n,
+      redraws: lat.length,
+      latency_ms: { p50: quantile(lat, 0.5), p95: quantile(lat, 0.95), max: Math.max(...lat) },
+      latency_p95_first_second_half_ms: halves(m.preview),
+      exact_updates: exact.length,
+      exact_latency_ms: { p50: quantile(exact, 0.5), p95: quantile(exact, 0.95), max: Math.max(...exact) },
+      exact_latency_p95_first_second_half_ms: halves(m.drag),
+      fps: frameMs.length ? 1000 / (frameMs.reduce((a, b) => a + b, 0) / frameMs.length) : 0,
+      kernel_ms: { p50: quantile(m.kernel, 0.5), p95: quantile(m.kernel, 0.95) },
+      page_evaluation_ms: { p50: quantile(m.evaluate, 0.5), p95: quantile(m.evaluate, 0.95) },
+      control_points: afterDrag.counts[0] * afterDrag.counts[1],
+      degrees: afterDrag.degrees,
+      ffd_deviation_mm: worst,
+    };
+    return `${n} pointer moves: ${lat.length} redraws, p95 ${figures.drag.latency_ms.p95.toFixed(0)} ms; ${exact.length} exact nets, p95 ${figures.drag.exact_latency_ms.p95.toFixed(0)} ms; ${figures.drag.fps.toFixed(0)} fps; off the FFD by ${worst.toExponential(2)} mm`;
+  });
+  await shot('lattice');
+
+  const sameNet = (a, b) => a && b && a.points.length === b.points.length && a.points.every((x, i) => x === b.points[i]) && a.knots_u.every((x, i) => x === b.knots_u[i]);
+  await check('undo takes the drag back as one step, redo puts it back', async () => {
+    const history = await studioCall(() => window.clayStudio.history());
+    assert(history.entries[history.position].startsWith('move lattice'), `history: ${history.entries}`);
+    await page.keyboard.press('Control+z');
+    await idle();
+    const undone = (await studioCall(() => window.clayStudio.surfaces())).fill1_styled1_ffd1;
+    assert(sameNet(undone, beforeDrag), 'after undo the surface is not the one before the drag');
+    await page.click('#redo');
+    await idle();
+    const redone = (await studioCall(() => window.clayStudio.surfaces())).fill1_styled1_ffd1;
+    assert(sameNet(redone, afterDrag), 'after redo the surface is not the dragged one');
+    return `${history.entries.length} entries: ${history.entries.join(' | ')}`;
+  });
+
+  await check('the saved recipe, run by clayform run, gives the same control points bit for bit', async () => {
+    await page.fill('#save-name', 'saved.json');
+    await page.click('#save');
+    await idle();
+    assert(!(await lastError()), await lastError());
+    await page.waitForFunction(() => document.getElementById('message').textContent.startsWith('saved'), null, { timeout: 10000 });
+    const out = join(work, 'replay');
+    const run = spawnSync(clayform, ['run', join(work, 'saved.json'), '--out', out, '--quiet'], { encoding: 'utf8' });
+    assert(run.status === 0, `clayform run: ${run.status} ${run.stderr}`);
+    const step = readdirSync(out).find((f) => f.endsWith('.step'));
+    assert(step, `no STEP file in ${readdirSync(out)}`);
+    const written = stepSurfaces(readFileSync(join(out, step), 'utf8'));
+    const shown = await studioCall(() => window.clayStudio.surfaces());
+    const names = Object.keys(shown);
+    assert(written.length === names.length, `${written.length} surfaces in ${step}, the page shows ${names.length}`);
+    let compared = 0;
+    names.forEach((n, i) => {
+      const a = shown[n];
+      const b = written[i];
+      assert(a.points.length === b.points.length, `${n}: ${a.points.length / 3} control points on the page, ${b.points.length / 3} in ${step}`);
+      a.points.forEach((x, k) => assert(x === b.points[k], `${n}: control point coordinate ${k}: ${x} on the page, ${b.points[k]} replayed`));
+      compared += a.points.length / 3;
+    });
+    return `${compared} control points identical`;
+  });
+
+  await check('export writes STEP, IGES and glTF, read back and checked', async () => {
+    await page.click('#export');
+    await page.waitForFunction(() => document.getElementById('message').textContent.startsWith('exported') || document.body.dataset.error, null, { timeout: 60000 });
+    assert(!(await lastError()), await lastError());
+    const files = readdirSync(join(work, 'drawn-export'));
+    for (const ext of ['.step', '.igs', '.glb']) assert(files.some((f) => f.endsWith(ext)), `no ${ext} in ${files}`);
+    return files.join(', ');
+  });
+
+  await check('a socket from another origin is refused (403), the page keeps its own', async () => {
+    const status = (origin) =>
+      new Promise((resolvePromise, reject) => {
+        const req = request({ host: '127.0.0.1', port, path: '/ws', headers: { Connection: 'Upgrade', Upgrade: 'websocket', 'Sec-WebSocket-Version': '13', 'Sec-WebSocket-Key': 'dGhlIHNhbXBsZSBub25jZQ==', Host: `127.0.0.1:${port}`, Origin: origin } });
+        req.on('response', (res) => {
+          res.resume();
+          resolvePromise(res.statusCode);
+        });
+        req.on('upgrade', (res, socket) => {
+          socket.destroy();
+          resolvePromise(101);
+        });
+        req.on('error', reject);
+        req.end();
+      });
+    const evil = await status('http://evil.example');
+    assert(evil === 403, `Origin http://evil.example: ${evil}`);
+    // a page served from another origin tries it in the browser
+    const other = createServer((req, res) => {
+      res.writeHead(200, { 'Content-Type': 'text/html' });
+      res.end('<!doctype html><title>elsewhere</title>');
+    });
+    await new Promise((r) => other.listen(0, '127.0.0.1', r));
+    const elsewhere = await browser.newPage();
+    await elsewhere.goto(`http://127.0.0.1:${other.address().port}/`);
+    const outcome = await elsewhere.evaluate(
+      (wsUrl) =>
+        new Promise((r) => {
+          const ws = new WebSocket(wsUrl);
+          ws.onopen = () => r('open');
+          ws.onerror = () => r('refused');
+        }),
+      `ws://127.0.0.1:${port}/ws`,
+    );
+    await elsewhere.close();
+    other.close();
+    assert(outcome === 'refused', `a page from another origin: ${outcome}`);
+    return `raw upgrade ${evil}, browser page elsewhere ${outcome}`;
+  });
+
+  await check('no page errors', async () => {
+    assert(problems.length === 0, problems.join('; '));
+  });
+} finally {
+  await browser.close();
+  studio.kill();
+}
+
+const machine = `${cpus().length} cores, ${cpus()[0] ? cpus()[0].model : 'unknown CPU'}, headless Chromium with software rendering`;
+console.log(`# figures (${machine}):`);
+console.log(JSON.stringify(figures, null, 1));
+if (reportFile) writeFileSync(reportFile, JSON.stringify({ machine, figures }, null, 1));
+const failed = results.filter((r) => !r).length;
+console.log(`${results.length - failed}/${results.length} passed`);
+process.exit(failed ? 1 : 0);

@@ -1,0 +1,112 @@
+// The picture of a lattice drag before the kernel answers: Sederberg–Parry's FFD (eq. (2)) of the
+// parent surface's sampled points, on the page. A deformed surface composed exactly with the
+// lattice is, at each (u, v), the lattice's map of the parent's point there, so these vertices
+// are the exact result's at the same parameters (to rounding); the normals come from the
+// tangents carried by the map's Jacobian, n = (J S_u) x (J S_v). The kernel's exact net replaces
+// the picture when it arrives.
+
+/** Bernstein polynomials of degree n at x and their derivatives: [values, derivatives]. */
+function bernstein(n, x) {
+  const b = new Float64Array(n + 1);
+  const d = new Float64Array(n + 1);
+  // values of degree n - 1 first (for the derivative), then degree n
+  const lower = new Float64Array(Math.max(n, 1));
+  lower[0] = 1;
+  for (let k = 1; k < n; k++) {
+    for (let i = k; i >= 0; i--) lower[i] = (i < k ? (1 - x) * lower[i] : 0) + (i > 0 ? x * lower[i - 1] : 0);
+  }
+  for (let i = 0; i <= n; i++) {
+    b[i] = (i < n ? (1 - x) * lower[i] : 0) + (i > 0 ? x * lower[i - 1] : 0);
+    if (n > 0) d[i] = n * ((i > 0 ? lower[i - 1] : 0) - (i < n ? lower[i] : 0));
+  }
+  if (n === 0) b[0] = 1;
+  return [b, d];
+}
+
+/** 3 x 3 inverse (row-major array of 9), for the frame's local coordinates. */
+function inverse3(m) {
+  const [a, b, c, d, e, f, g, h, i] = m;
+  const A = e * i - f * h;
+  const B = -(d * i - f * g);
+  const C = d * h - e * g;
+  const det = a * A + b * B + c * C;
+  return [A / det, -(b * i - c * h) / det, (b * f - c * e) / det, B / det, (a * i - c * g) / det, -(a * f - c * d) / det, C / det, -(a * h - b * g) / det, (a * e - b * d) / det];
+}
+
+/**
+ * What a drag of `step` (a bezier_lattice recipe step) needs of the parent's samples `grid`
+ * (surfaceGrid): each vertex's Bernstein values and derivatives in the lattice's local
+ * coordinates (s, t, u), computed once per drag (eq. (1): X = X0 + s S + t T + u U).
+ */
+export function prepareFfd(grid, step) {
+  const [l, m, n] = step.degrees;
+  const { origin, s: S, t: T, u: U } = step.frame;
+  // columns S, T, U: world = X0 + M [s t u]
+  const Minv = inverse3([S[0], T[0], U[0], S[1], T[1], U[1], S[2], T[2], U[2]]);
+  const count = grid.rows * grid.cols;
+  const basis = [];
+  for (let k = 0; k < count; k++) {
+    const d = [0, 1, 2].map((e) => grid.position[3 * k + e] - origin[e]);
+    const local = [0, 1, 2].map((r) => Minv[3 * r] * d[0] + Minv[3 * r + 1] * d[1] + Minv[3 * r + 2] * d[2]);
+    basis.push([bernstein(l, local[0]), bernstein(m, local[1]), bernstein(n, local[2])]);
+  }
+  return { grid, degrees: [l, m, n], Minv, basis };
+}
+
+/**
+ * Writes the deformed vertices and unit normals into `position` and `normal` (Float32Arrays of
+ * the grid's size) for the lattice's control points `points` (s-major, [x, y, z] each).
+ */
+export function applyFfd(prepared, points, position, normal) {
+  const { grid, degrees, Minv, basis } = prepared;
+  const [l, m, n] = degrees;
+  const count = grid.rows * grid.cols;
+  for (let k = 0; k < count; k++) {
+    const [[bs, ds], [bt, dt], [bu, du]] = basis[k];
+    let x = 0;
+    let y = 0;
+    let z = 0;
+    const J = [0, 0, 0, 0, 0, 0, 0, 0, 0]; // dX/ds, dX/dt, dX/du as columns, row-major
+    let at = 0;
+    for (let i = 0; i <= l; i++)
+      for (let j = 0; j <= m; j++)
+        for (let h = 0; h <= n; h++, at++) {
+          const P = points[at];
+          const f = bs[i] * bt[j] * bu[h];
+          const fs = ds[i] * bt[j] * bu[h];
+          const ft = bs[i] * dt[j] * bu[h];
+          const fu = bs[i] * bt[j] * du[h];
+          x += f * P[0];
+          y += f * P[1];
+          z += f * P[2];
+          for (let e = 0; e < 3; e++) {
+            J[3 * e] += fs * P[e];
+            J[3 * e + 1] += ft * P[e];
+            J[3 * e + 2] += fu * P[e];
+          }
+        }
+    position[3 * k] = x;
+    position[3 * k + 1] = y;
+    position[3 * k + 2] = z;
+    // world Jacobian J M^-1, applied to the parent's tangents
+    const a = [0, 0, 0];
+    const b = [0, 0, 0];
+    for (let e = 0; e < 3; e++) {
+      for (let c = 0; c < 3; c++) {
+        const w = J[3 * e] * Minv[c] + J[3 * e + 1] * Minv[3 + c] + J[3 * e + 2] * Minv[6 + c];
+        a[e] += w * grid.su[3 * k + c];
+        b[e] += w * grid.sv[3 * k + c];
+      }
+    }
+    let nx = a[1] * b[2] - a[2] * b[1];
+    let ny = a[2] * b[0] - a[0] * b[2];
+    let nz = a[0] * b[1] - a[1] * b[0];
+    const len = Math.hypot(nx, ny, nz) || 1;
+    nx /= len;
+    ny /= len;
+    nz /= len;
+    normal[3 * k] = nx;
+    normal[3 * k + 1] = ny;
+    normal[3 * k + 2] = nz;
+  }
+}

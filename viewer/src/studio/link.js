@@ -1,0 +1,102 @@
+// The studio's one WebSocket to the kernel (docs/studio.md): JSON commands, each answered by one
+// JSON reply and the binary net frames that follow it. A drag keeps at most one update in flight
+// and replaces a waiting one by the newest (the kernel does the same with what queues there), so
+// the picture follows the pointer without a backlog however slow a step is.
+
+/** Decodes a binary frame: {header, points: Float64Array, weights: Float64Array}. */
+export function decodeFrame(buffer) {
+  const view = new DataView(buffer);
+  const length = view.getUint32(0, true);
+  const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, length)));
+  const start = Math.ceil((4 + length) / 8) * 8;
+  const count = header.kind === 'curve' ? header.knots.length - header.degree - 1 : header.counts[0] * header.counts[1];
+  const expected = start + 32 * count;
+  if (buffer.byteLength !== expected) throw new Error(`frame "${header.name}": ${buffer.byteLength} bytes, expected ${expected}`);
+  // Float64Array needs 8-byte alignment: the frame pads its header to a multiple of 8
+  const points = new Float64Array(buffer, start, 3 * count);
+  const weights = new Float64Array(buffer, start + 24 * count, count);
+  return { header, points, weights };
+}
+
+export class Link {
+  /** `onReply(reply, frames, meta)` gets every reply; meta = {command, sentAt, inputAt}. */
+  constructor(url, onReply, onClose) {
+    this.onReply = onReply;
+    this.onClose = onClose;
+    this.inFlight = null; // {command, sentAt, inputAt, resolve, frames, reply, waiting}
+    this.queue = []; // commands waiting for the one in flight
+    this.pendingDrag = null; // the newest drag update not yet sent
+    this.socket = new WebSocket(url);
+    this.socket.binaryType = 'arraybuffer';
+    this.opened = new Promise((resolve, reject) => {
+      this.socket.onopen = () => resolve();
+      this.socket.onerror = () => reject(new Error(`cannot open the studio's socket ${url}`));
+    });
+    this.socket.onclose = () => this.onClose && this.onClose();
+    this.socket.onmessage = (event) => this.receive(event.data);
+  }
+
+  get busy() {
+    return this.inFlight !== null || this.queue.length > 0 || this.pendingDrag !== null;
+  }
+
+  /** Sends a command; resolves with {reply, frames} once its reply and frames have arrived. */
+  send(command, inputAt = performance.now()) {
+    return new Promise((resolve) => {
+      this.queue.push({ command, inputAt, resolve });
+      this.pump();
+    });
+  }
+
+  /**
+   * A drag update (a command, or a function that builds it when it is sent): sent at once when nothing is in flight, else it waits, replacing any waiting
+   * drag update (the newest wins). Resolves with the reply of the update finally sent, or null
+   * when a newer one replaced it.
+   */
+  drag(command, inputAt = performance.now()) {
+    return new Promise((resolve) => {
+      if (this.pendingDrag) this.pendingDrag.resolve(null);
+      this.pendingDrag = { command, inputAt, resolve };
+      this.pump();
+    });
+  }
+
+  pump() {
+    if (this.inFlight) return;
+    let next = this.queue.shift();
+    if (!next && this.pendingDrag) {
+      next = this.pendingDrag;
+      this.pendingDrag = null;
+    }
+    if (!next) return;
+    // a drag update may be built when it is sent, from the document as the last reply left it
+    const command = typeof next.command === 'function' ? next.command() : next.command;
+    if (!command) {
+      next.resolve(null);
+      this.pump();
+      return;
+    }
+    this.inFlight = { ...next, command, sentAt: performance.now(), reply: null, frames: [], waiting: 0 };
+    this.socket.send(JSON.stringify(command));
+  }
+
+  receive(data) {
+    const f = this.inFlight;
+    if (!f) return; // nothing asked: ignore
+    if (typeof data === 'string') {
+      f.reply = JSON.parse(data);
+      f.waiting = (f.reply.surfaces ? f.reply.surfaces.length : 0) + (f.reply.curves ? f.reply.curves.length : 0) + (f.reply.befores ? f.reply.befores.length : 0);
+      if (f.reply.op === 'error') f.waiting = 0;
+    } else {
+      f.frames.push(decodeFrame(data));
+      f.waiting--;
+    }
+    if (f.reply && f.waiting <= 0) {
+      this.inFlight = null;
+      const result = { reply: f.reply, frames: f.frames };
+      this.onReply(f.reply, f.frames, { command: f.command, sentAt: f.sentAt, inputAt: f.inputAt });
+      f.resolve(result);
+      this.pump();
+    }
+  }
+}

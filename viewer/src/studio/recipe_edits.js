@@ -1,0 +1,139 @@
+// The recipe edits the studio's actions make (docs/recipe.md): new names, a lattice around a
+// surface, a lattice control point moved, a curve's control point moved, the global taper,
+// twist and bend. Pure functions of the recipe (as JSON) and the nets the kernel sent.
+
+const SECTIONS = ['strokes', 'curves', 'sketches', 'surfaces', 'deformations', 'exports', 'models'];
+
+/** A name not used in the recipe: `base` followed by the first free number (s1, s2, ...). */
+export function free(recipe, base) {
+  const used = new Set(SECTIONS.flatMap((s) => Object.keys(recipe[s] || {})));
+  const stem = base.replace(/[^A-Za-z0-9_-]/g, '_').slice(0, 56) || 'x';
+  for (let k = 1; ; k++) if (!used.has(`${stem}${k}`)) return `${stem}${k}`;
+}
+
+/** The box of control points (a B-spline surface lies in their convex hull). */
+export function bounds(points) {
+  const lo = [Infinity, Infinity, Infinity];
+  const hi = [-Infinity, -Infinity, -Infinity];
+  for (let k = 0; k < points.length; k += 3)
+    for (let e = 0; e < 3; e++) {
+      lo[e] = Math.min(lo[e], points[k + e]);
+      hi[e] = Math.max(hi[e], points[k + e]);
+    }
+  return { lo, hi };
+}
+
+/**
+ * A lattice frame around a net's control points: their box grown by 5 % of its diagonal on every
+ * side, and at least 10 % of the diagonal thick in each direction (a flat patch gets a slab), so
+ * the surface lies inside the lattice as exact composition needs.
+ */
+export function boxFrame(points) {
+  const { lo, hi } = bounds(points);
+  const diagonal = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) || 1;
+  const origin = [];
+  const size = [];
+  for (let e = 0; e < 3; e++) {
+    const extent = Math.max(hi[e] - lo[e] + 0.1 * diagonal, 0.1 * diagonal);
+    const mid = (lo[e] + hi[e]) / 2;
+    origin.push(round(mid - extent / 2));
+    size.push(round(extent));
+  }
+  return { origin, s: [size[0], 0, 0], t: [0, size[1], 0], u: [0, 0, size[2]] };
+}
+const round = (x) => Number(x.toPrecision(6));
+
+/**
+ * A Bézier lattice step's control points, s-major ((i (m+1) + j)(n+1) + k): the undisplaced
+ * lattice P_ijk = X0 + i/l S + j/m T + k/n U (Sederberg–Parry §2), or its `points`, with its
+ * `moves` applied ("to" a position or "by" an offset).
+ */
+export function latticePoints(step) {
+  const [l, m, n] = step.degrees;
+  const { origin, s, t, u } = step.frame;
+  const out = [];
+  if (Array.isArray(step.points)) out.push(...step.points.map((p) => p.slice()));
+  else
+    for (let i = 0; i <= l; i++)
+      for (let j = 0; j <= m; j++)
+        for (let k = 0; k <= n; k++) out.push([0, 1, 2].map((e) => origin[e] + (i / l) * s[e] + (j / m) * t[e] + (k / n) * u[e]));
+  for (const move of step.moves || []) {
+    const [i, j, k] = move.index;
+    const at = (i * (m + 1) + j) * (n + 1) + k;
+    out[at] = move.to ? move.to.slice() : out[at].map((c, e) => c + move.by[e]);
+  }
+  return out;
+}
+
+/** A lattice's moves with the point at `index` moved to `to` (replacing an earlier move of it). */
+export function withMove(moves, index, to) {
+  const same = (m) => m.index.every((x, e) => x === index[e]);
+  return [...moves.filter((m) => !same(m)), { index: index.slice(), to }];
+}
+
+/**
+ * The changes that move control point `index` of the curve `name` to `to`. A curve given as a
+ * B-spline changes that point; any other (a fitted stroke, a line, an arc) becomes the B-spline
+ * the kernel built for it, bit for bit, with the point moved, under the same name (the stroke
+ * is removed), so what refers to it follows.
+ */
+export function curvePointChanges(recipe, net, name, index, to) {
+  const def = (recipe.curves || {})[name];
+  if (def && def.bspline) return [{ path: `curves.${name}.bspline.points[${index}]`, value: to }];
+  const points = [];
+  for (let i = 0; i < net.weights.length; i++) points.push(i === index ? to : [net.points[3 * i], net.points[3 * i + 1], net.points[3 * i + 2]]);
+  const bspline = { degree: net.degree, knots: Array.from(net.knots), points };
+  if (Array.from(net.weights).some((w) => w !== 1)) bspline.weights = Array.from(net.weights);
+  const changes = [];
+  if ((recipe.strokes || {})[name]) changes.push({ path: `strokes.${name}`, remove: true });
+  changes.push({ path: `curves.${name}`, value: { bspline }, create: true });
+  return changes;
+}
+
+/**
+ * Barr's taper, twist and bend about the longest direction of the net's box, through its centre:
+ * `taper` is the scale change at the ends (profile 1 + taper y / half), `twist` the angle in
+ * degrees at the ends, `bend` the whole bend angle in degrees over the box's length.
+ */
+export function globalSteps(points, taper, twist, bend) {
+  const { lo, hi } = bounds(points);
+  const extent = [0, 1, 2].map((e) => hi[e] - lo[e]);
+  const along = extent.indexOf(Math.max(...extent));
+  const axis = [0, 0, 0];
+  axis[along] = 1;
+  const reference = [0, 0, 0];
+  reference[(along + 1) % 3] = 1;
+  const origin = [0, 1, 2].map((e) => round((lo[e] + hi[e]) / 2));
+  const half = round(Math.max(extent[along] / 2, 1e-3));
+  const frame = { origin, axis, reference };
+  return withGlobal(
+    [
+      { kind: 'taper', name: 'taper', frame, profile: [1, 0] },
+      { kind: 'twist', name: 'twist', frame, angle: [0, 0] },
+      { kind: 'bend', name: 'bend', frame, y_min: -half, y_max: half, center: 0, rate: 0 },
+    ],
+    taper,
+    twist,
+    bend,
+  );
+}
+
+/** The three steps of globalSteps with new slider values (frames kept). */
+export function withGlobal(steps, taper, twist, bend) {
+  const half = steps[2].y_max;
+  const [t, w, b] = steps.map((s) => ({ ...s }));
+  t.profile = [1, taper / half];
+  w.angle = [0, (twist * Math.PI) / 180 / half];
+  b.rate = (bend * Math.PI) / 180 / (2 * half);
+  return [t, w, b];
+}
+
+/** The slider values of globalSteps' three steps. */
+export function globalValues(steps) {
+  const half = steps[2].y_max;
+  return {
+    taper: round(steps[0].profile[1] * half),
+    twist: round((steps[1].angle[1] * half * 180) / Math.PI),
+    bend: round((steps[2].rate * 2 * half * 180) / Math.PI),
+  };
+}
