@@ -7,6 +7,9 @@
 #   scripts/viewer.sh test [--run D]  build if stale, then the end-to-end test in headless Chromium
 #                                     (installs Debian's chromium when /usr/bin/chromium is missing);
 #                                     --run D tests against a run folder (clayform run ... --out D)
+#   scripts/viewer.sh studio-test --clayform PATH [--report FILE] [--shots DIR]
+#                                     build if stale, then Clayform Studio's end-to-end test against
+#                                     that clayform (e2e/studio.test.mjs)
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 VIEWER=$ROOT/viewer
@@ -41,9 +44,15 @@ else
   echo "==> viewer: dist is up to date"
 fi
 
-if [[ "${1:-}" == "test" ]]; then
+if [[ "${1:-}" == "test" || "${1:-}" == "studio-test" ]]; then
+  what=$1
   shift
   if [[ ! -x ${CHROMIUM:-/usr/bin/chromium} ]]; then apt_install chromium; fi
-  echo "==> viewer: end-to-end test"
-  node e2e/viewer.test.mjs "$@"
+  if [[ $what == test ]]; then
+    echo "==> viewer: end-to-end test"
+    node e2e/viewer.test.mjs "$@"
+  else
+    echo "==> studio: end-to-end test"
+    node e2e/studio.test.mjs "$@"
+  fi
 fi

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstring>
 #include <deque>
@@ -167,8 +168,9 @@ struct StudioSession::Impl {
 
   /// The reply of a run: its report figures per step, the history and the recipe text; then a
   /// net frame per final surface, a curve frame per named curve, and a net frame per deformed
-  /// final surface's parent before its first step.
-  Reply ran(const std::string& op, const Run& run) const {
+  /// final surface's parent before its first step. Without `nets` (a drag update the page draws
+  /// itself), no frames: the figures and the history only.
+  Reply ran(const std::string& op, const Run& run, bool nets = true) const {
     const RunResult& result = run.result;
     Reply reply;
     Json steps = Json::array();
@@ -225,11 +227,17 @@ struct StudioSession::Impl {
       push_net(n, stage->before, true);
       befores.push_back(n);
     }
-    reply.json =
-        Json{{"op", op},           {"recipe", result.recipe},   {"seconds", result.seconds},
-             {"steps", steps},     {"surfaces", surfaces},      {"curves", curves},
-             {"befores", befores}, {"history", history_json()}, {"text", text()}}
-            .dump();
+    Json out = {{"op", op},       {"recipe", result.recipe},   {"seconds", result.seconds},
+                {"steps", steps}, {"history", history_json()}, {"text", text()}};
+    if (nets) {
+      out["surfaces"] = surfaces;
+      out["curves"] = curves;
+      out["befores"] = befores;
+    } else {
+      out["nets"] = false;
+      reply.frames.clear();
+    }
+    reply.json = out.dump();
     return reply;
   }
 };
@@ -318,14 +326,14 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
       const auto at = static_cast<std::size_t>(s.position);
       if (!group.empty() && at + 1 == s.history.size() && s.groups[at] == group) {
         s.history[at].second = std::move(next);
-        return s.ran("edit", result);
+        return s.ran("edit", result, c.value("nets", true));
       }
       s.history.resize(at + 1);  // an edit drops the redo tail
       s.groups.resize(at + 1);
       s.history.emplace_back(c.value("label", "edit " + first_path), std::move(next));
       s.groups.push_back(group);
       s.position = static_cast<int>(s.history.size()) - 1;
-      return s.ran("edit", result);
+      return s.ran("edit", result, c.value("nets", true));
     }
     if (op == "export") {
       // The final surfaces, as STEP, IGES and glTF (write_outputs: read back and checked),
@@ -420,9 +428,10 @@ struct StudioServer::Impl {
     std::thread thread;
     std::atomic<bool> done{false};
   };
-  std::mutex mutex;  // guards connections, socket_open, stopping
+  std::mutex mutex;  // guards connections, socket_owner, stopping
   std::list<std::unique_ptr<Connection>> connections;
-  bool socket_open = false;  // a page holds the WebSocket
+  Connection* socket_owner = nullptr;  // the connection of the page that holds the WebSocket
+  std::condition_variable released;    // socket_owner became nullptr
   bool stopping = false;
 
   /// Joins the threads of finished connections (mutex held).
@@ -598,7 +607,9 @@ struct StudioServer::Impl {
     io.run();
   }
 
-  void handle_connection(tcp::socket& socket, asio::io_context& io) {
+  void handle_connection(Connection& connection) {
+    tcp::socket& socket = connection.socket;
+    asio::io_context& io = connection.io;
     beast::flat_buffer buffer;
     http::request<http::string_body> req;
     http::read(socket, buffer, req);
@@ -617,20 +628,31 @@ struct StudioServer::Impl {
       return;
     }
     {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (socket_open) {
-        http::write(socket, plain(req, http::status::conflict,
-                                  "the studio is open in another tab or window: one page edits "
-                                  "the recipe at a time; close the other one first\n"));
-        return;
+      // One page edits the recipe at a time: the newest (a reload, another tab) takes over, the
+      // older one's socket is closed (its page says so). A command still running there is
+      // waited for.
+      std::unique_lock<std::mutex> lock(mutex);
+      if (socket_owner) {
+        boost::system::error_code ignored;
+        socket_owner->socket.shutdown(tcp::socket::shutdown_both, ignored);
+        if (!released.wait_for(lock, std::chrono::seconds(30),
+                               [&] { return socket_owner == nullptr; })) {
+          http::write(socket, plain(req, http::status::conflict,
+                                    "the studio's other page is still busy with a command; "
+                                    "try again when it has finished\n"));
+          return;
+        }
       }
-      socket_open = true;
+      socket_owner = &connection;
     }
     struct Release {
       Impl& s;
       ~Release() {
-        std::lock_guard<std::mutex> lock(s.mutex);
-        s.socket_open = false;
+        {
+          std::lock_guard<std::mutex> lock(s.mutex);
+          s.socket_owner = nullptr;
+        }
+        s.released.notify_all();
       }
     } release{*this};
     websocket::stream<tcp::socket&> ws(socket);
@@ -686,7 +708,7 @@ void StudioServer::run() {
     Impl::Connection* c = connection.get();
     c->thread = std::thread([&s, c] {
       try {
-        s.handle_connection(c->socket, c->io);
+        s.handle_connection(*c);
       } catch (const std::exception&) {
         // A client that goes away mid-message ends its connection, not the server.
       }

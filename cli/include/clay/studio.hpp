@@ -35,7 +35,7 @@ class StudioSession {
   /// - "edit" {path, value, label, create?} or {path, remove: true} or {changes: [...], label}:
   ///   set or remove values, check and run the new recipe, one history entry (edits with the
   ///   same "group" in a row, a drag's updates, make one); a recipe the edit breaks is refused
-  ///   and nothing changes;
+  ///   and nothing changes; with "nets": false the reply has no frames (a drag the page draws);
   /// - "undo", "redo": move in the history (and run);
   /// - "run": run the current recipe;
   /// - "save" {file}: write the current recipe text (atomically; relative to the recipe's folder);
@@ -77,9 +77,10 @@ struct StudioOptions {
 /// The studio's server (Boost.Beast): static files at "/" and the WebSocket at "/ws". The
 /// upgrade is refused (403) unless its Host is the server's own address and its Origin is
 /// http://HOST:PORT (127.0.0.1 or localhost), so another site's page cannot drive the kernel.
-/// Each connection is served on a thread of its own; one page at a time holds the WebSocket (a
-/// second gets 409). Commands that arrive while one is being handled are coalesced: of several
-/// "edit" commands on the same path only the newest is handled.
+/// Each connection is served on a thread of its own; one page at a time holds the WebSocket (the
+/// newest, a reload or another tab, takes it over and the older one is closed). Commands that
+/// arrive while one is being handled are coalesced: of several "edit" commands on the same path
+/// only the newest is handled.
 class StudioServer {
  public:
   /// Binds the port (clay::Error(Io) when it cannot).

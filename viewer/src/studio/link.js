@@ -61,6 +61,12 @@ export class Link {
     });
   }
 
+  /** Drops the waiting drag update, if any (resolved with null). */
+  cancelDrag() {
+    if (this.pendingDrag) this.pendingDrag.resolve(null);
+    this.pendingDrag = null;
+  }
+
   pump() {
     if (this.inFlight) return;
     let next = this.queue.shift();

@@ -68,7 +68,7 @@ function dirty(then) {
   if (then) afterRender.push(then);
   needsRender = true;
 }
-const metrics = { drag: [], preview: [], stroke: [], frames: [], kernel: [], evaluate: [] };
+const metrics = { drag: [], dragEnd: [], preview: [], stroke: [], frames: [], kernel: [], evaluate: [] };
 let dragging = false;
 let lastFrameAt = null;
 function frame(now) {
@@ -246,6 +246,13 @@ function onReply(reply, frames, meta) {
   doc.steps = reply.steps;
   doc.history = reply.history;
   if (typeof reply.text === 'string') doc.recipe = JSON.parse(reply.text);
+  if (reply.nets === false) {
+    // a drag update the page draws itself: the kernel's figures and history only
+    metrics.drag.push({ at: performance.now(), ms: performance.now() - meta.inputAt });
+    showReport();
+    showHistory();
+    return;
+  }
   doc.surfaces = new Map();
   doc.befores = new Map();
   doc.curves = new Map();
@@ -266,6 +273,7 @@ function onReply(reply, frames, meta) {
   const kind = meta.command.kind;
   dirty((drawnAt) => {
     if (kind === 'drag') metrics.drag.push({ at: drawnAt, ms: drawnAt - meta.inputAt });
+    if (kind === 'drag-end') metrics.dragEnd.push({ at: drawnAt, ms: drawnAt - meta.inputAt });
     if (kind === 'stroke') metrics.stroke.push({ at: drawnAt, ms: drawnAt - meta.inputAt });
     body.dataset.rendered = String(Number(body.dataset.rendered || 0) + 1);
   });
@@ -289,7 +297,10 @@ function edit(changes, label, kind = 'edit', inputAt = performance.now()) {
 function dragEdit(build, inputAt) {
   return link.drag(() => {
     const b = build();
-    return b && commandOf(b.changes, b.label, 'drag', b.group);
+    if (!b) return null;
+    const command = commandOf(b.changes, b.label, 'drag', b.group);
+    if (b.nets === false) command.nets = false;
+    return command;
   }, inputAt);
 }
 // The updates of one drag (a handle, a slider) share a group: the kernel keeps them as one
@@ -679,7 +690,10 @@ function moveHandle(h, to, inputAt, final, group) {
   const build = () => {
     if (h.kind === 'lattice') {
       const moves = names.withMove(doc.recipe.deformations[h.name][0].moves || [], h.index, to);
-      return { changes: { path: `deformations.${h.name}[0].moves`, value: moves }, label: `move lattice ${h.name} [${h.index}]`, group };
+      // while the page draws the drag (previews), the kernel checks and runs each update but
+      // sends no nets; the update at the release brings them
+      const changes = { path: `deformations.${h.name}[0].moves`, value: moves };
+      return { changes, label: `move lattice ${h.name} [${h.index}]`, group, nets: !(previews.size && !final) };
     }
     // a curve's control point: a stroke becomes the B-spline it was fitted to, once
     if (!doc.curves.has(h.name)) return null;
@@ -687,7 +701,9 @@ function moveHandle(h, to, inputAt, final, group) {
   };
   if (!final) return dragEdit(build, inputAt);
   const b = build();
-  return b && edit(b.changes, b.label, 'edit', inputAt);
+  if (!b) return null;
+  const command = commandOf(b.changes, b.label, final === 'drag-end' ? 'drag-end' : 'edit', b.group);
+  return link.send(command, inputAt);
 }
 
 function showLatticePoint() {
@@ -798,6 +814,7 @@ canvas.addEventListener('pointermove', (event) => {
     if (!target) return;
     const strength = Number($('lattice-strength').value) || 1;
     const to = handleDrag.start.map((c, i) => c + strength * (target[i] - c));
+    handleDrag.last = to;
     if (handleDrag.handle.kind === 'lattice') showPreview(handleDrag.handle, to, event.timeStamp);
     moveHandle(handleDrag.handle, to, event.timeStamp, false, handleDrag.group);
   }
@@ -811,9 +828,15 @@ canvas.addEventListener('pointerup', (event) => {
     return;
   }
   if (handleDrag) {
+    // the release: the last position, with the kernel's nets, in the drag's history entry
+    const d = handleDrag;
     handleDrag = null;
     dragging = false;
     controls.enabled = true;
+    if (d.last) {
+      link.cancelDrag();
+      moveHandle(d.handle, d.last, event.timeStamp, 'drag-end', d.group);
+    }
     endPreview();
     return;
   }
