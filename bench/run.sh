@@ -3,7 +3,7 @@
 # Extra arguments go to every benchmark (e.g. --benchmark_filter=...).
 source "$(dirname "${BASH_SOURCE[0]}")/../scripts/common.sh"
 clay_ensure_packages
-benches=(evaluate constraints self_intersection deform style compose model)
+benches=(evaluate constraints self_intersection deform style compose model studio)
 clay_build --target "${benches[@]/#/bench_}"
 for name in "${benches[@]}"; do
   "$CLAY_BUILD/bench/bench_$name" --benchmark_out="$CLAY_BUILD/bench/$name.json" \
