@@ -11,12 +11,13 @@
 //   window.clayStudio hook and are reported (not asserted: they depend on the machine).
 //
 //   node e2e/studio.test.mjs --clayform PATH [--chromium PATH] [--shots DIR] [--report FILE] [--keep]
-import { spawn, spawnSync } from 'node:child_process';
+import { spawnSync } from 'node:child_process';
 import { createServer, request } from 'node:http';
 import { existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir, cpus } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
-import { chromium } from 'playwright-core';
+import { backProject, curveDomain, dist, distanceToCurve, ffd, insidePolygon, latticePoints, quantile, surfaceAt, surfaceDomain, curveAt } from './geometry.mjs';
+import { along, launchBrowser, startStudio, studioPage } from './studio_driver.mjs';
 
 const args = process.argv.slice(2);
 const opt = (name, fallback) => {
@@ -32,148 +33,6 @@ for (const [what, path] of [['clayform (cmake --build build)', clayform], ['chro
     console.error(`missing ${what}: ${path}`);
     process.exit(2);
   }
-}
-
-// ------------------------------------------------------------------ independent geometry
-// Evaluated here with de Boor's algorithm (The NURBS Book A3.1 / A4.1 style, written apart from the
-// page's basis-function code), so the page's own evaluation is not what checks it.
-function deBoor(knots, degree, ctrl, t) {
-  // ctrl: array of [x, y, z, w] (homogeneous); returns the homogeneous point
-  const n = ctrl.length;
-  let k = degree;
-  if (t >= knots[n]) k = n - 1;
-  else while (k < n - 1 && !(t >= knots[k] && t < knots[k + 1])) k++;
-  const d = [];
-  for (let j = 0; j <= degree; j++) d.push(ctrl[k - degree + j].slice());
-  for (let r = 1; r <= degree; r++)
-    for (let j = degree; j >= r; j--) {
-      const i = k - degree + j;
-      const den = knots[i + degree - r + 1] - knots[i];
-      const a = den === 0 ? 0 : (t - knots[i]) / den;
-      for (let e = 0; e < 4; e++) d[j][e] = (1 - a) * d[j - 1][e] + a * d[j][e];
-    }
-  return d[degree];
-}
-const dehom = (h) => [h[0] / h[3], h[1] / h[3], h[2] / h[3]];
-function curveAt(c, t) {
-  const ctrl = c.weights.map((w, i) => [c.points[3 * i] * w, c.points[3 * i + 1] * w, c.points[3 * i + 2] * w, w]);
-  return dehom(deBoor(c.knots, c.degree, ctrl, t));
-}
-function curveDomain(c) {
-  return [c.knots[c.degree], c.knots[c.knots.length - c.degree - 1]];
-}
-function surfaceAt(s, u, v) {
-  const [p, q] = s.degrees;
-  const [nu, nv] = s.counts;
-  const rows = [];
-  for (let i = 0; i < nu; i++) {
-    const ctrl = [];
-    for (let j = 0; j < nv; j++) {
-      const k = i * nv + j;
-      const w = s.weights[k];
-      ctrl.push([s.points[3 * k] * w, s.points[3 * k + 1] * w, s.points[3 * k + 2] * w, w]);
-    }
-    rows.push(deBoor(s.knots_v, q, ctrl, v));
-  }
-  return dehom(deBoor(s.knots_u, p, rows, u));
-}
-function surfaceDomain(s) {
-  const [p, q] = s.degrees;
-  return [
-    [s.knots_u[p], s.knots_u[s.knots_u.length - p - 1]],
-    [s.knots_v[q], s.knots_v[s.knots_v.length - q - 1]],
-  ];
-}
-const dist = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-/** Distance from a point to a curve: dense samples, then golden-section refinement. */
-function distanceToCurve(c, x) {
-  const [a, b] = curveDomain(c);
-  const n = 800;
-  let best = 0;
-  let bestD = Infinity;
-  for (let k = 0; k <= n; k++) {
-    const t = a + ((b - a) * k) / n;
-    const d = dist(curveAt(c, t), x);
-    if (d < bestD) [best, bestD] = [k, d];
-  }
-  let lo = a + ((b - a) * Math.max(0, best - 1)) / n;
-  let hi = a + ((b - a) * Math.min(n, best + 1)) / n;
-  const g = (Math.sqrt(5) - 1) / 2;
-  for (let it = 0; it < 80; it++) {
-    const m1 = hi - g * (hi - lo);
-    const m2 = lo + g * (hi - lo);
-    if (dist(curveAt(c, m1), x) < dist(curveAt(c, m2), x)) hi = m2;
-    else lo = m1;
-  }
-  return Math.min(bestD, dist(curveAt(c, (lo + hi) / 2), x));
-}
-/** Sederberg–Parry eq. (2): the trivariate Bernstein sum of the lattice's points at (s, t, u). */
-function ffd(step, points, x) {
-  const [l, m, n] = step.degrees;
-  const { origin, s: S, t: T, u: U } = step.frame;
-  // local coordinates: solve X = X0 + s S + t T + u U (Cramer's rule, eq. (1))
-  const d = [0, 1, 2].map((e) => x[e] - origin[e]);
-  const det3 = (a, b, c) => a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-  const D = det3(S, T, U);
-  const s = det3(d, T, U) / D;
-  const t = det3(S, d, U) / D;
-  const u = det3(S, T, d) / D;
-  const binom = (N, k) => {
-    let r = 1;
-    for (let i = 1; i <= k; i++) r = (r * (N - k + i)) / i;
-    return r;
-  };
-  const B = (N, i, y) => binom(N, i) * (1 - y) ** (N - i) * y ** i;
-  const out = [0, 0, 0];
-  for (let i = 0; i <= l; i++)
-    for (let j = 0; j <= m; j++)
-      for (let k = 0; k <= n; k++) {
-        const f = B(l, i, s) * B(m, j, t) * B(n, k, u);
-        const P = points[(i * (m + 1) + j) * (n + 1) + k];
-        for (let e = 0; e < 3; e++) out[e] += f * P[e];
-      }
-  return out;
-}
-function latticePoints(step) {
-  const [l, m, n] = step.degrees;
-  const { origin, s, t, u } = step.frame;
-  const out = [];
-  for (let i = 0; i <= l; i++) for (let j = 0; j <= m; j++) for (let k = 0; k <= n; k++) out.push([0, 1, 2].map((e) => origin[e] + (i / l) * s[e] + (j / m) * t[e] + (k / n) * u[e]));
-  for (const mv of step.moves || []) {
-    const at = (mv.index[0] * (m + 1) + mv.index[1]) * (n + 1) + mv.index[2];
-    out[at] = mv.to ? mv.to.slice() : out[at].map((c, e) => c + mv.by[e]);
-  }
-  return out;
-}
-function insidePolygon(poly, x, y) {
-  let inside = false;
-  for (let i = 0, j = poly.length - 1; i < poly.length; j = i++) {
-    const [xi, yi] = poly[i];
-    const [xj, yj] = poly[j];
-    if (yi > y !== yj > y && x < ((xj - xi) * (y - yi)) / (yj - yi) + xi) inside = !inside;
-  }
-  return inside;
-}
-const quantile = (values, q) => {
-  const s = [...values].sort((a, b) => a - b);
-  if (!s.length) return NaN;
-  return s[Math.min(s.length - 1, Math.floor(q * (s.length - 1) + 0.5))];
-};
-
-/** The back-projection of a screen point onto the plane z = z0 through the page's camera matrices. */
-function backProject(cam, clientX, clientY, z0) {
-  const ndc = [((clientX - cam.rect.left) / cam.rect.width) * 2 - 1, -((clientY - cam.rect.top) / cam.rect.height) * 2 + 1];
-  const apply = (m, v) => {
-    const x = m[0] * v[0] + m[4] * v[1] + m[8] * v[2] + m[12] * v[3];
-    const y = m[1] * v[0] + m[5] * v[1] + m[9] * v[2] + m[13] * v[3];
-    const z = m[2] * v[0] + m[6] * v[1] + m[10] * v[2] + m[14] * v[3];
-    const w = m[3] * v[0] + m[7] * v[1] + m[11] * v[2] + m[15] * v[3];
-    return [x / w, y / w, z / w, 1];
-  };
-  const near = apply(cam.matrixWorld, apply(cam.projectionInverse, [ndc[0], ndc[1], -1, 1]));
-  const far = apply(cam.matrixWorld, apply(cam.projectionInverse, [ndc[0], ndc[1], 1, 1]));
-  const t = (z0 - near[2]) / (far[2] - near[2]);
-  return [0, 1, 2].map((e) => near[e] + t * (far[e] - near[e]));
 }
 
 // ------------------------------------------------------------------ STEP: the surfaces' control points
@@ -200,18 +59,7 @@ function stepSurfaces(text) {
 // ------------------------------------------------------------------ the studio
 const work = mkdtempSync(join(tmpdir(), 'clayform-studio-'));
 writeFileSync(join(work, 'drawn.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'drawn' }));
-const studio = spawn(clayform, ['studio', join(work, 'drawn.json'), '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
-const url = await new Promise((resolvePromise, reject) => {
-  let out = '';
-  studio.stdout.on('data', (d) => {
-    out += d;
-    const m = out.match(/Clayform Studio at (http:\/\/127\.0\.0\.1:\d+\/)/);
-    if (m) resolvePromise(m[1]);
-  });
-  studio.on('exit', (code) => reject(new Error(`clayform studio exited (${code}) before printing its address`)));
-  setTimeout(() => reject(new Error('clayform studio printed no address in 20 s')), 20000);
-});
-const port = Number(new URL(url).port);
+const { url, port, process: studio } = await startStudio(clayform, join(work, 'drawn.json'));
 
 const results = [];
 const figures = {};
@@ -230,53 +78,27 @@ function assert(cond, message) {
   if (!cond) throw new Error(message);
 }
 
-const browser = await chromium.launch({
-  executablePath,
-  headless: true,
-  args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync'],
-});
+const browser = await launchBrowser(executablePath);
 const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });
 const problems = [];
 page.on('console', (m) => m.type() === 'error' && problems.push(`console error: ${m.text()}`));
 page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-const studioCall = (fn, arg) => page.evaluate(fn, arg);
-const idle = () => page.evaluate(() => window.clayStudio.idle());
+const driver = studioPage(page);
+const { idle, lastError, clickAt, clickCurve } = driver;
+const studioCall = driver.call;
 let shotCount = 0;
 async function shot(label) {
   if (!shots) return;
   mkdirSync(shots, { recursive: true });
   await page.screenshot({ path: join(shots, `${String(++shotCount).padStart(2, '0')}-${label}.png`) });
 }
-const lastError = () => page.evaluate(() => document.body.dataset.error || '');
 
-/** Draws a stroke through world points on the plane z = z0 (screen positions from the page's camera). */
+/** Draws a stroke through world points on the plane z = z0; the drawn path back-projected onto it, here. */
 async function draw(world, { steps = 40, z0 = 0 } = {}) {
-  const screen = await studioCall((pts) => pts.map((p) => window.clayStudio.toScreen(p)), world);
-  const path = [];
-  for (let k = 0; k < screen.length - 1; k++)
-    for (let s = 0; s < steps / (screen.length - 1); s++) {
-      const f = s / (steps / (screen.length - 1));
-      path.push([screen[k][0] + f * (screen[k + 1][0] - screen[k][0]), screen[k][1] + f * (screen[k + 1][1] - screen[k][1])]);
-    }
-  path.push(screen[screen.length - 1]);
-  await page.mouse.move(...path[0]);
-  await page.mouse.down();
-  for (const p of path.slice(1)) await page.mouse.move(...p);
-  await page.mouse.up();
-  await idle();
-  const error = await lastError();
-  if (error) throw new Error(`the stroke was refused: ${error}`);
+  const path = await driver.draw(world, { steps });
   const cam = await studioCall(() => window.clayStudio.camera());
   return path.map(([x, y]) => backProject(cam, x, y, z0));
 }
-const along = (a, b, bow, n = 8) =>
-  Array.from({ length: n + 1 }, (_, k) => {
-    const t = k / n;
-    const dx = b[0] - a[0];
-    const dy = b[1] - a[1];
-    const len = Math.hypot(dx, dy);
-    return [a[0] + t * dx - (bow * 4 * t * (1 - t) * dy) / len, a[1] + t * dy + (bow * 4 * t * (1 - t) * dx) / len, 0];
-  });
 /** Checks a fitted curve against the drawn points: each within the stroke's tolerance (ends: plus how far snapping moved them). */
 async function checkStroke(name, drawn) {
   const recipe = await studioCall(() => window.clayStudio.recipe());
@@ -294,23 +116,8 @@ async function checkStroke(name, drawn) {
   assert(worst <= stroke.tolerance * (1 + 1e-9), `curve ${name}: a drawn point is ${worst} mm from the fitted curve, tolerance ${stroke.tolerance}`);
   return { worst, snapStart, snapEnd, control_points: curves[name].weights.length };
 }
-async function clickAt(world, shift) {
-  const [x, y] = await studioCall((p) => window.clayStudio.toScreen(p), world);
-  if (shift) await page.keyboard.down('Shift');
-  await page.mouse.click(x, y);
-  if (shift) await page.keyboard.up('Shift');
-}
-async function clickCurve(name, shift) {
-  const curves = await studioCall(() => window.clayStudio.curves());
-  const c = curves[name];
-  const [a, b] = curveDomain(c);
-  await clickAt(curveAt(c, a + 0.37 * (b - a)), shift);
-}
-
 try {
-  await page.goto(url);
-  await page.waitForFunction(() => ['1', 'error'].includes(document.body.dataset.ready), null, { timeout: 60000 });
-  assert((await page.evaluate(() => document.body.dataset.ready)) === '1', `the page did not start: ${await lastError()}`);
+  await driver.open(url);
   await studioCall(() => window.clayStudio.setView('top'));
   await page.keyboard.press('s'); // the sketch tool (its key), on plane XY
 
@@ -431,6 +238,48 @@ try {
     return `${f.key_points} key points, target deviation ${f.target_deviation}, curve ${f.target_curve_deviation}; ${checked} samples outside the bound moved ${moved} mm`;
   });
   await shot('styled');
+
+  await check('the target curve dragged by a control point: the style follows, in one history entry', async () => {
+    await clickCurve('s6', false);
+    await page.click('#tool-edit');
+    const handle = (await studioCall(() => window.clayStudio.handles())).find((h) => h.kind === 'curve' && h.name === 's6' && h.index === 1);
+    assert(handle, 'no handle of the target curve s6');
+    const entries = (await studioCall(() => window.clayStudio.history())).entries.length;
+    await page.mouse.move(...handle.screen);
+    await page.mouse.down();
+    for (let k = 1; k <= 20; k++) await page.mouse.move(handle.screen[0] + k, handle.screen[1] - 2 * k);
+    await page.mouse.up();
+    await idle();
+    assert(!(await lastError()), await lastError());
+    const recipe = await studioCall(() => window.clayStudio.recipe());
+    assert(!recipe.strokes.s6 && recipe.curves.s6 && recipe.curves.s6.bspline, 'the target stroke did not become a B-spline curve');
+    const history = await studioCall(() => window.clayStudio.history());
+    assert(history.entries.length === entries + 1, `the drag made ${history.entries.length - entries} history entries`);
+    const step = (await studioCall(() => window.clayStudio.reply())).steps.find((st) => st.kind === 'style');
+    assert(step.figures.outcome === 'met' && step.figures.locality === 0, `style after the drag: ${step.figures.outcome}, locality ${step.figures.locality}`);
+    // the fitted curve's control point moved where the pointer went, in the view plane
+    const curves = await studioCall(() => window.clayStudio.curves());
+    const moved = dist(curves.s6.points.slice(3, 6), handle.p);
+    assert(moved > 1, `the control point moved ${moved} mm`);
+    await page.click('#tool-orbit');
+    return `control point moved ${moved.toFixed(1)} mm; ${step.figures.key_points} key points, target deviation ${step.figures.target_deviation}`;
+  });
+
+  await check('analysis modes: zebra and curvature maps, before and after', async () => {
+    for (const mode of ['zebra', 'mean', 'gaussian', 'shaded']) {
+      await page.click(`button[data-mode="${mode}"]`);
+      assert((await page.evaluate(() => document.body.dataset.mode)) === mode, `mode ${mode} not shown`);
+      await idle();
+      if (mode !== 'shaded') await shot(mode);
+    }
+    await page.keyboard.press('b');
+    await idle();
+    await shot('before');
+    const pressed = await page.getAttribute('#before-after', 'aria-pressed');
+    await page.keyboard.press('b');
+    await idle();
+    assert(pressed === 'true', 'the before view did not switch on');
+  });
 
   let beforeDrag = null;
   let afterDrag = null;

@@ -1089,8 +1089,9 @@ function showReport() {
       return d;
     }),
   );
-  const last = metrics.drag[metrics.drag.length - 1];
-  $('status').textContent = `kernel ${doc.reply ? (1000 * doc.reply.seconds).toFixed(0) : '-'} ms${last ? `, drag to redraw ${last.ms.toFixed(0)} ms` : ''}`;
+  const redraw = metrics.preview[metrics.preview.length - 1];
+  const kernel = metrics.drag[metrics.drag.length - 1];
+  $('status').textContent = `kernel ${doc.reply ? (1000 * doc.reply.seconds).toFixed(0) : '-'} ms${redraw ? `, drag to redraw ${redraw.ms.toFixed(0)} ms` : ''}${kernel ? `, drag to kernel answer ${kernel.ms.toFixed(0)} ms` : ''}`;
 }
 
 // keyboard
