@@ -2,7 +2,8 @@
 # Renders the README pictures: runs every example recipe (examples/recipes/*.json) with
 # `clayform run` and draws its STEP output with `clayform render` into docs/pictures/NAME.png
 # (whole-model recipes: the model as read and each deformed model, docs/pictures/model_*.png),
-# then a zebra picture of the sail through the browser viewer (`clayform snapshot --bare`).
+# then a zebra picture of the sail through the browser viewer (`clayform snapshot --bare`) and the
+# studio's walkthrough pictures (viewer/e2e/studio_walkthrough.mjs).
 # Installs missing Debian packages and builds first, like the other scripts.
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 clay_ensure_packages
@@ -34,4 +35,11 @@ done
 "$CLAY_ROOT/scripts/viewer.sh"
 "$clayform" snapshot "$CLAY_BUILD/pictures/sail" --png "$pictures/sail_zebra.png" --width 900 --height 560 \
   --mode zebra --bare
+# Clayform Studio: the docs' walkthrough (a car hood styled from scratch) played in headless
+# Chromium, a picture per step (docs/pictures/studio-*.png).
+[[ -x ${CHROMIUM:-/usr/bin/chromium} ]] || {
+  echo "scripts/pictures.sh: the studio's pictures need Debian's chromium (apt-get install chromium)" >&2
+  exit 1
+}
+(cd "$CLAY_ROOT/viewer" && node e2e/studio_walkthrough.mjs --clayform "$clayform" --out "$pictures")
 ls -la "$pictures"

@@ -357,6 +357,12 @@ function toScreen(p) {
   const v = new THREE.Vector3(...p).project(camera);
   return [rect.left + ((v.x + 1) / 2) * rect.width, rect.top + ((1 - v.y) / 2) * rect.height];
 }
+/** The size of a screen pixel, in mm, at the depth of point p. */
+function millimetresPerPixel(p) {
+  const depth = new THREE.Vector3(...p).applyMatrix4(camera.matrixWorldInverse).z;
+  const height = canvas.getBoundingClientRect().height || 1;
+  return (2 * Math.abs(depth) * Math.tan(THREE.MathUtils.degToRad(camera.fov) / 2)) / height;
+}
 const PLANE_NORMALS = { xy: [0, 0, 1], xz: [0, 1, 0], yz: [1, 0, 0] };
 const PLANE_X = { xy: [1, 0, 0], xz: [1, 0, 0], yz: [0, 1, 0] };
 /** The sketch plane chosen in the toolbar: {origin, normal, x_axis} (recipe form). */
@@ -500,20 +506,27 @@ function snapEnd(p) {
   return null;
 }
 
-/** A stroke over an existing stroke from near one of its points to near another: redrawn there. */
+/**
+ * A stroke over an existing stroke from near one of its points to near another: redrawn there.
+ * Near on the screen and in space (as near in millimetres as the snap distance in pixels is
+ * there), so a stroke drawn on another plane that only looks the same from here (sections seen
+ * end on) is a new stroke.
+ */
 function oversketchTarget(points) {
   const strokes = doc.recipe.strokes || {};
-  const a = toScreen(points[0]);
-  const b = toScreen(points[points.length - 1]);
+  const a = points[0];
+  const b = points[points.length - 1];
   for (const [name, stroke] of Object.entries(strokes)) {
     const q = stroke.points;
     if (!Array.isArray(q) || q.length < 4) continue;
-    const near = (s) => {
+    const near = (x) => {
+      const s = toScreen(x);
+      const reach = SNAP_PX * millimetresPerPixel(x);
       let best = { d: Infinity, i: -1 };
       q.forEach((p, i) => {
         const t = toScreen(p);
         const d = Math.hypot(t[0] - s[0], t[1] - s[1]);
-        if (d < best.d) best = { d, i };
+        if (d < best.d && Math.hypot(p[0] - x[0], p[1] - x[1], p[2] - x[2]) < reach) best = { d, i };
       });
       return best;
     };
@@ -552,7 +565,7 @@ function finishStroke(event) {
   if ($('snap').checked && !event.altKey) {
     for (const end of [0, points.length - 1]) {
       const s = snapEnd(points[end]);
-      if (s) points[end] = s.p;
+      if (s) names.moveEnd(points, end, s.p);
     }
   }
   const name = names.free(doc.recipe, 's');

@@ -137,3 +137,26 @@ export function globalValues(steps) {
     bend: round((steps[2].rate * 2 * half * 180) / Math.PI),
   };
 }
+
+/**
+ * Moves the stroke's end `end` (0 or the last index) to `to`, and its neighbours with it, less
+ * and less over the first fifth of the stroke's length (weight 1 - smoothstep), so a snapped end
+ * does not leave a hook the fit would have to follow. Exact at the end itself.
+ */
+export function moveEnd(points, end, to) {
+  const delta = to.map((c, e) => c - points[end][e]);
+  const order = end === 0 ? points.map((_, k) => k) : points.map((_, k) => points.length - 1 - k);
+  const lengths = [0];
+  for (let k = 1; k < order.length; k++) {
+    const a = points[order[k - 1]];
+    const b = points[order[k]];
+    lengths.push(lengths[k - 1] + Math.hypot(b[0] - a[0], b[1] - a[1], b[2] - a[2]));
+  }
+  const fade = 0.2 * lengths[lengths.length - 1];
+  order.forEach((k, i) => {
+    const x = fade > 0 ? Math.min(1, lengths[i] / fade) : 1;
+    const w = i === 0 ? 1 : 1 - x * x * (3 - 2 * x);
+    if (w > 0) points[k] = points[k].map((c, e) => c + w * delta[e]);
+  });
+  points[end] = to.slice();
+}
