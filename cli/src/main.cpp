@@ -528,7 +528,9 @@ int main(int argc, char** argv) {
       "studio",
       "Serve a recipe to Clayform Studio on 127.0.0.1 and print its address: the kernel behind "
       "one WebSocket (/ws), every edit appended to the recipe's history (docs/studio.md)");
-  studio_cmd->add_option("RECIPE", studio_recipe, "a recipe (.json); none: an empty one");
+  studio_cmd->add_option("RECIPE", studio_recipe,
+                         "a recipe (.json), or a STEP/IGES model to start one from; none: an "
+                         "empty recipe");
   studio_cmd->add_option("--port", studio_port, "TCP port, 0 for any free one")
       ->capture_default_str();
   // clayform sweep: the Python package's sweeps (docs/sweeps.md), run by Debian's python3.
@@ -571,7 +573,7 @@ int main(int argc, char** argv) {
               ? clay::recipe::StudioSession(
                     R"({"format": "clayform.recipe", "version": 1, "name": "untitled"})", ".",
                     "untitled")
-              : clay::recipe::StudioSession::load(studio_recipe),
+              : clay::recipe::StudioSession::open(studio_recipe),
           o);
       std::printf("Clayform Studio at %s (WebSocket ws://127.0.0.1:%d/ws; Ctrl-C to stop)\n",
                   server.url().c_str(), server.port());

@@ -1,6 +1,7 @@
 // Clayform Studio's kernel side (clay/studio.hpp): the session (a recipe under edits with a
 // history) and its server (Boost.Beast, Debian's libboost-dev: cpp-httplib 0.11 has no
 // WebSocket, and Beast is the well-kept header-only HTTP/WebSocket library Debian ships).
+#include <clay/brep/exchange.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/files.hpp>
 #include <clay/recipe/recipe.hpp>
@@ -15,6 +16,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <condition_variable>
 #include <cstring>
@@ -135,6 +137,38 @@ std::vector<std::uint8_t> net_frame(const std::string& header_json,
   return out;
 }
 
+namespace {
+
+/// A model's frame: the length and JSON header as in net_frame ({"kind": "mesh", "name",
+/// "vertices": n, "triangles": m}), then n * 3 float64 positions, n * 3 float64 unit normals and
+/// m * 3 uint32 node indices, little-endian.
+std::vector<std::uint8_t> mesh_frame(const std::string& header_json, const brep::ModelMesh& mesh) {
+  const std::size_t header = 4 + header_json.size();
+  const std::size_t padded = (header + 7) / 8 * 8;
+  const std::size_t n = mesh.positions.size(), m = mesh.triangles.size();
+  std::vector<std::uint8_t> out(padded + 2 * n * 3 * sizeof(double) + m * 3 * sizeof(std::uint32_t),
+                                0);
+  const auto length = static_cast<std::uint32_t>(header_json.size());
+  for (int k = 0; k < 4; ++k)
+    out[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(length >> (8 * k));
+  std::memcpy(out.data() + 4, header_json.data(), header_json.size());
+  std::uint8_t* at = out.data() + padded;
+  for (const auto* list : {&mesh.positions, &mesh.normals})
+    for (const Eigen::Vector3d& p : *list) {
+      std::memcpy(at, p.data(), 3 * sizeof(double));
+      at += 3 * sizeof(double);
+    }
+  for (const auto& t : mesh.triangles)
+    for (int corner : t) {
+      const auto index = static_cast<std::uint32_t>(corner);
+      std::memcpy(at, &index, sizeof index);
+      at += sizeof index;
+    }
+  return out;
+}
+
+}  // namespace
+
 struct StudioSession::Impl {
   fs::path base_dir;
   std::string name;
@@ -227,12 +261,26 @@ struct StudioSession::Impl {
       push_net(n, stage->before, true);
       befores.push_back(n);
     }
+    // Whole models (a recipe's "models", a STEP file opened in the studio): their trimmed faces
+    // as triangle meshes, deformed when the model has a stack.
+    Json models = Json::array();
+    if (nets)
+      for (const ModelRunResult& m : result.models) {
+        const brep::ModelMesh mesh = brep::tessellate(m.model);
+        const Json header = {{"kind", "mesh"},
+                             {"name", m.name},
+                             {"vertices", mesh.positions.size()},
+                             {"triangles", mesh.triangles.size()}};
+        reply.frames.push_back(mesh_frame(header.dump(), mesh));
+        models.push_back(m.name);
+      }
     Json out = {{"op", op},       {"recipe", result.recipe},   {"seconds", result.seconds},
                 {"steps", steps}, {"history", history_json()}, {"text", text()}};
     if (nets) {
       out["surfaces"] = surfaces;
       out["curves"] = curves;
       out["befores"] = befores;
+      out["models"] = models;
     } else {
       out["nets"] = false;
       reply.frames.clear();
@@ -258,6 +306,29 @@ StudioSession& StudioSession::operator=(StudioSession&&) noexcept = default;
 StudioSession StudioSession::load(const fs::path& file) {
   return StudioSession(internal::read_text(file, "recipe"), file.parent_path(),
                        file.stem().string());
+}
+
+StudioSession StudioSession::open(const fs::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  if (extension != ".step" && extension != ".stp" && extension != ".igs" && extension != ".iges")
+    return load(file);
+  if (!fs::exists(file))
+    throw Error(ErrorCategory::Io,
+                "studio: cannot read \"" + file.string() + "\": no such file; check the path");
+  // A model: a recipe beside it importing it whole, named after it (saved as STEM_studio.json).
+  std::string name;
+  for (char ch : file.stem().string())
+    name += std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' ? ch : '_';
+  name = name.substr(0, 50);
+  const Json recipe = {
+      {"format", "clayform.recipe"},
+      {"version", 1},
+      {"name", name + "_studio"},
+      {"description", "Opened in Clayform Studio from " + file.filename().string()},
+      {"models", {{name, {{"import", file.filename().string()}}}}}};
+  return StudioSession(recipe.dump(1), file.parent_path(), name + "_studio");
 }
 
 const std::string& StudioSession::text() const { return impl_->text(); }
@@ -344,24 +415,37 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
                     "studio: \"export\" needs \"folder\" (relative to the recipe's folder)");
       const fs::path folder = s.resolve(c.at("folder").get<std::string>());
       Impl::Run run = s.run(s.text());
-      if (run.shown.empty())
+      if (run.shown.empty() && run.result.models.empty())
         throw Error(ErrorCategory::InvalidArgument,
-                    "studio: the recipe has no surface to export yet; build one first");
-      ExportResult e;
-      e.name = c.value("name", run.result.recipe);
-      e.formats = {"step", "iges", "glb"};
-      for (const std::string& n : run.shown) {
-        e.surface_names.push_back(n);
-        e.surfaces.push_back(run.result.surface(n));
+                    "studio: the recipe has no surface or model to export yet; build one first");
+      run.result.exports.clear();
+      if (!run.shown.empty()) {
+        ExportResult e;
+        e.name = c.value("name", run.result.recipe);
+        e.formats = {"step", "iges", "glb"};
+        for (const std::string& n : run.shown) {
+          e.surface_names.push_back(n);
+          e.surfaces.push_back(run.result.surface(n));
+        }
+        run.result.exports.push_back(std::move(e));
       }
-      run.result.exports = {e};
-      write_outputs(run.result, folder);
-      const ExportResult& written = run.result.exports.front();
+      write_outputs(run.result, folder);  // the models' files too (NAME.step, .igs, .glb)
+      Json files = Json::array();
+      bool valid = true, identical = true;
+      for (const ExportResult& x : run.result.exports) {
+        for (const std::string& f : x.files) files.push_back(f);
+        valid = valid && x.valid;
+        identical = identical && x.read_back_identical;
+      }
+      for (const ModelRunResult& m : run.result.models) {
+        for (const std::string& f : m.files) files.push_back(f);
+        valid = valid && m.valid;
+      }
       return {Json{{"op", "exported"},
                    {"folder", folder.string()},
-                   {"files", written.files},
-                   {"valid", written.valid},
-                   {"read_back_identical", written.read_back_identical}}
+                   {"files", files},
+                   {"valid", valid},
+                   {"read_back_identical", identical}}
                   .dump(),
               {}};
     }

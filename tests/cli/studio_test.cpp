@@ -3,6 +3,7 @@
 // origin checks and coalescing, through a Boost.Beast client.
 #include <catch2/catch.hpp>
 
+#include <clay/brep/exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 #include <clay/surface/bspline_surface.hpp>
@@ -80,6 +81,15 @@ bool same(const Net& net, const clay::surface::BSplineCurve& c) {
          std::memcmp(net.points.data(), c.points.data(), net.points.size() * sizeof(double)) == 0 &&
          std::memcmp(net.weights.data(), c.weights.data(), net.weights.size() * sizeof(double)) ==
              0;
+}
+
+/// A mesh frame's JSON header and where its numbers start.
+std::pair<Json, std::size_t> mesh_header(const std::vector<std::uint8_t>& frame) {
+  std::uint32_t length = 0;
+  for (int k = 0; k < 4; ++k)
+    length |= std::uint32_t(frame[static_cast<std::size_t>(k)]) << (8 * k);
+  return {Json::parse(std::string(frame.begin() + 4, frame.begin() + 4 + length)),
+          (4 + length + 7) / 8 * 8};
 }
 
 /// The frames of a reply, decoded, by name (the parents before their steps left out).
@@ -287,6 +297,81 @@ TEST_CASE(
   CHECK(exported.at("read_back_identical") == true);
   for (const char* f : {"patch.step", "patch.igs", "patch.glb", "report.json"})
     CHECK(fs::exists(dir / "out" / f));
+}
+
+TEST_CASE("studio session: a STEP model opened whole, meshed, deformed by a lattice, exported",
+          "[studio]") {
+  const fs::path model_file = fs::path(CLAY_EXAMPLES_DIR) / "models" / "block.step";
+  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio_model";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(model_file, dir / "block.step");
+  StudioSession session = StudioSession::open(dir / "block.step");
+  const Json recipe = Json::parse(session.text());
+  CHECK(recipe.at("name") == "block_studio");
+  CHECK(recipe.at("models").at("block").at("import") == "block.step");
+  // The run's mesh frame: the model's trimmed faces as brep::tessellate meshes the file read on
+  // its own, node for node.
+  const auto ran = session.handle(R"({"op": "run"})");
+  INFO(ran.json);
+  REQUIRE(Json::parse(ran.json).at("models") == Json::array({"block"}));
+  REQUIRE(ran.frames.size() == 1);
+  const auto [header, start] = mesh_header(ran.frames[0]);
+  const auto& frame = ran.frames[0];
+  const auto mesh = clay::brep::tessellate(clay::brep::read_model(model_file).model);
+  REQUIRE(header.at("vertices") == mesh.positions.size());
+  REQUIRE(header.at("triangles") == mesh.triangles.size());
+  const std::size_t n = mesh.positions.size();
+  REQUIRE(frame.size() == start + 48 * n + 12 * mesh.triangles.size());
+  std::vector<double> positions(3 * n);
+  std::memcpy(positions.data(), frame.data() + start, positions.size() * sizeof(double));
+  for (std::size_t k = 0; k < n; ++k)
+    for (int e = 0; e < 3; ++e)
+      REQUIRE(positions[3 * k + static_cast<std::size_t>(e)] == mesh.positions[k][e]);
+  // A lattice around the block, its top raised 5 mm: the model is deformed (its mesh's top too).
+  Eigen::Vector3d lo = mesh.positions.front(), hi = lo;
+  for (const auto& p : mesh.positions) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  const Eigen::Vector3d size = hi - lo, origin = lo - 0.05 * size;
+  Json moves = Json::array();
+  for (int i = 0; i <= 1; ++i)
+    for (int j = 0; j <= 1; ++j) moves.push_back({{"index", {i, j, 1}}, {"by", {0, 0, 5}}});
+  const Json lattice = {{"kind", "bezier_lattice"},
+                        {"frame",
+                         {{"origin", {origin.x(), origin.y(), origin.z()}},
+                          {"s", {1.1 * size.x(), 0, 0}},
+                          {"t", {0, 1.1 * size.y(), 0}},
+                          {"u", {0, 0, 1.1 * size.z()}}}},
+                        {"degrees", {1, 1, 1}},
+                        {"moves", moves}};
+  const auto lifted = session.handle(
+      Json{{"op", "edit"},
+           {"label", "lattice on block"},
+           {"changes",
+            {{{"path", "deformations.lift"}, {"value", Json::array({lattice})}, {"create", true}},
+             {{"path", "models.block.deformation"}, {"value", "lift"}, {"create", true}}}}}
+          .dump());
+  INFO(lifted.json);
+  REQUIRE(Json::parse(lifted.json).at("op") == "edit");
+  REQUIRE(lifted.frames.size() == 1);
+  const auto [h2, start2] = mesh_header(lifted.frames[0]);
+  const std::size_t n2 = h2.at("vertices");
+  double top = -1e300;
+  for (std::size_t k = 0; k < n2; ++k) {
+    double z = 0;
+    std::memcpy(&z, lifted.frames[0].data() + start2 + (3 * k + 2) * sizeof(double), sizeof z);
+    top = std::max(top, z);
+  }
+  // the top face at u = 1/1.1 of the lattice's height, raised by that fraction of 5 mm
+  CHECK(top == Approx(hi.z() + 5 * (hi.z() - origin.z()) / (1.1 * size.z())).epsilon(1e-9));
+  // Export: the deformed model's STEP, IGES and glTF, read back and checked.
+  const Json exported = Json::parse(session.handle(R"({"op": "export", "folder": "out"})").json);
+  INFO(exported.dump());
+  REQUIRE(exported.at("op") == "exported");
+  CHECK(exported.at("valid") == true);
+  for (const char* f : {"block.step", "block.igs", "block.glb"}) CHECK(fs::exists(dir / "out" / f));
 }
 
 namespace {

@@ -13,12 +13,14 @@
 //   node e2e/studio.test.mjs --clayform PATH [--chromium PATH] [--shots DIR] [--report FILE] [--keep]
 import { spawnSync } from 'node:child_process';
 import { createServer, request } from 'node:http';
-import { existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
+import { copyFileSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdirSync, rmSync, writeFileSync } from 'node:fs';
+import { fileURLToPath } from 'node:url';
 import { tmpdir, cpus } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { backProject, curveDomain, dist, distanceToCurve, ffd, insidePolygon, latticePoints, quantile, surfaceAt, surfaceDomain, curveAt } from './geometry.mjs';
 import { along, launchBrowser, startStudio, studioPage } from './studio_driver.mjs';
 
+const here = dirname(fileURLToPath(import.meta.url));
 const args = process.argv.slice(2);
 const opt = (name, fallback) => {
   const i = args.indexOf(name);
@@ -446,6 +448,56 @@ try {
     other.close();
     assert(outcome === 'refused', `a page from another origin: ${outcome}`);
     return `raw upgrade ${evil}, browser page elsewhere ${outcome}`;
+  });
+
+  await check('a STEP model opened whole, a lattice placed around it and dragged, saved and replayed', async () => {
+    const modelDir = join(work, 'model');
+    mkdirSync(modelDir);
+    copyFileSync(join(here, '..', '..', 'examples', 'models', 'block.step'), join(modelDir, 'block.step'));
+    const second = await startStudio(clayform, join(modelDir, 'block.step'));
+    const modelPage = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    modelPage.on('pageerror', (e) => problems.push(`page error (model): ${e.message}`));
+    const m = studioPage(modelPage);
+    try {
+      await m.open(second.url);
+      const models = await m.call(() => window.clayStudio.models());
+      assert(models.block && models.block.triangles > 0, `no mesh of the model: ${Object.keys(models)}`);
+      const topBefore = Math.max(...models.block.positions.filter((_, k) => k % 3 === 2));
+      // click the model where its mesh is, then Lattice
+      const centre = [0, 1, 2].map((e) => {
+        const c = models.block.positions.filter((_, k) => k % 3 === e);
+        return (Math.min(...c) + Math.max(...c)) / 2;
+      });
+      await m.clickAt([centre[0], centre[1], topBefore], false);
+      const selected = await modelPage.locator('#selection').textContent();
+      assert(selected.includes('model block'), `selection: ${selected}`);
+      await modelPage.click('#build-lattice');
+      await m.idle();
+      assert(!(await m.lastError()), await m.lastError());
+      const handle = (await m.call(() => window.clayStudio.handles())).find((h) => h.kind === 'lattice' && h.index.join() === '1,1,1');
+      assert(handle, 'no lattice handle [1, 1, 1]');
+      await modelPage.selectOption('#lattice-lock', 'z');
+      await modelPage.mouse.move(...handle.screen);
+      await modelPage.mouse.down();
+      for (let k = 1; k <= 10; k++) await modelPage.mouse.move(handle.screen[0], handle.screen[1] - 3 * k);
+      await modelPage.mouse.up();
+      await m.idle();
+      assert(!(await m.lastError()), await m.lastError());
+      const after = await m.call(() => window.clayStudio.models());
+      const topAfter = Math.max(...after.block.positions.filter((_, k) => k % 3 === 2));
+      assert(topAfter > topBefore + 1e-6, `the model's top did not rise: ${topBefore} -> ${topAfter}`);
+      await modelPage.fill('#save-name', 'block_studio.json');
+      await modelPage.click('#save');
+      await m.idle();
+      const run = spawnSync(clayform, ['run', join(modelDir, 'block_studio.json'), '--out', join(modelDir, 'replay'), '--quiet'], { encoding: 'utf8' });
+      assert(run.status === 0, `clayform run: ${run.status} ${run.stderr}`);
+      const files = readdirSync(join(modelDir, 'replay'));
+      assert(files.includes('block.step'), `replay wrote ${files}`);
+      return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}`;
+    } finally {
+      await modelPage.close();
+      second.process.kill();
+    }
   });
 
   await check('no page errors', async () => {

@@ -27,6 +27,10 @@ class StudioSession {
 
   /// Reads a recipe file (clay::Error(Io) when it cannot, Recipe for its problems).
   static StudioSession load(const std::filesystem::path& file);
+  /// A recipe file as load does, or a STEP or IGES model (.step, .stp, .igs, .iges): a new recipe
+  /// named STEM_studio, in the model's folder, whose "models" imports it whole (trimmed faces,
+  /// solids, assemblies kept; the run's frames carry its trimmed mesh).
+  static StudioSession open(const std::filesystem::path& file);
 
   /// The command's reply (JSON text) and the geometry frames that follow it (binary, see
   /// geometry_frames). Commands, as JSON objects with "op":
@@ -59,7 +63,9 @@ class StudioSession {
   std::unique_ptr<Impl> impl_;
 };
 
-/// One binary frame per final surface of a run: a 4-byte little-endian length N, N bytes of JSON
+/// One binary frame per final surface of a run (a model's trimmed mesh has a frame of its own,
+/// {"kind": "mesh", "name", "vertices", "triangles"}: float64 positions and normals, then uint32
+/// node indices, docs/studio.md): a 4-byte little-endian length N, N bytes of JSON
 /// ({"kind": "net", "name", "degrees": [p, q], "counts": [nu, nv], "knots_u", "knots_v",
 /// "rational"}), zero padding to a multiple of 8, then nu * nv * 3 float64 control points
 /// (u-major, x y z) and nu * nv float64 weights, little-endian. The page evaluates the net.

@@ -3,12 +3,23 @@
 // and replaces a waiting one by the newest (the kernel does the same with what queues there), so
 // the picture follows the pointer without a backlog however slow a step is.
 
-/** Decodes a binary frame: {header, points: Float64Array, weights: Float64Array}. */
+/**
+ * Decodes a binary frame: {header, points, weights} (Float64Arrays) for a net or a curve,
+ * {header, positions, normals, triangles} for a model's mesh.
+ */
 export function decodeFrame(buffer) {
   const view = new DataView(buffer);
   const length = view.getUint32(0, true);
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, length)));
   const start = Math.ceil((4 + length) / 8) * 8;
+  if (header.kind === 'mesh') {
+    // a model's trimmed mesh: positions, normals (float64), then uint32 triangles
+    const n = header.vertices;
+    const m = header.triangles;
+    const expected = start + 48 * n + 12 * m;
+    if (buffer.byteLength !== expected) throw new Error(`frame "${header.name}": ${buffer.byteLength} bytes, expected ${expected}`);
+    return { header, positions: new Float64Array(buffer, start, 3 * n), normals: new Float64Array(buffer, start + 24 * n, 3 * n), triangles: new Uint32Array(buffer, start + 48 * n, 3 * m) };
+  }
   const count = header.kind === 'curve' ? header.knots.length - header.degree - 1 : header.counts[0] * header.counts[1];
   const expected = start + 32 * count;
   if (buffer.byteLength !== expected) throw new Error(`frame "${header.name}": ${buffer.byteLength} bytes, expected ${expected}`);
@@ -91,7 +102,7 @@ export class Link {
     if (!f) return; // nothing asked: ignore
     if (typeof data === 'string') {
       f.reply = JSON.parse(data);
-      f.waiting = (f.reply.surfaces ? f.reply.surfaces.length : 0) + (f.reply.curves ? f.reply.curves.length : 0) + (f.reply.befores ? f.reply.befores.length : 0);
+      f.waiting = ['surfaces', 'curves', 'befores', 'models'].reduce((n, k) => n + (f.reply[k] ? f.reply[k].length : 0), 0);
       if (f.reply.op === 'error') f.waiting = 0;
     } else {
       f.frames.push(decodeFrame(data));

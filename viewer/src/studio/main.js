@@ -101,7 +101,7 @@ new ResizeObserver(resize).observe($('stage'));
 // ------------------------------------------------------------------------------ document state
 // What the last run gave: the recipe, its final surfaces' nets (and their parents before their
 // first step), every named curve's net, the history.
-const doc = { recipe: {}, surfaces: new Map(), befores: new Map(), curves: new Map(), history: { entries: [], position: 0 }, steps: [], reply: null };
+const doc = { recipe: {}, surfaces: new Map(), befores: new Map(), curves: new Map(), models: new Map(), history: { entries: [], position: 0 }, steps: [], reply: null };
 let selection = []; // [{kind: 'curve' | 'surface' | 'lattice', name, index?}]
 let mode = 'shaded';
 let showBefore = false;
@@ -203,6 +203,20 @@ function rebuildSurfaces() {
     surfaceGroup.add(mesh);
     if ($('show-net').checked && net.points.length / 3 <= 20000) surfaceGroup.add(netLines(net));
   }
+  for (const [name, m] of doc.models) {
+    // a whole model's trimmed faces, meshed by the kernel (no curvature: zero in those modes)
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(m.positions), 3));
+    geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(m.normals), 3));
+    geometry.setAttribute('mean', new THREE.BufferAttribute(new Float32Array(m.positions.length / 3), 1));
+    geometry.setAttribute('gaussian', new THREE.BufferAttribute(new Float32Array(m.positions.length / 3), 1));
+    geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(m.triangles), 1));
+    geometry.computeBoundingSphere();
+    const mesh = new THREE.Mesh(geometry, materials.shaded);
+    mesh.name = name;
+    mesh.userData = { kind: 'model', name, selected: selection.some((s) => s.kind === 'model' && s.name === name) };
+    surfaceGroup.add(mesh);
+  }
   applyMode();
 }
 
@@ -256,12 +270,14 @@ function onReply(reply, frames, meta) {
   doc.surfaces = new Map();
   doc.befores = new Map();
   doc.curves = new Map();
+  doc.models = new Map();
   for (const f of frames) {
     const h = f.header;
-    if (h.kind === 'curve') doc.curves.set(h.name, { degree: h.degree, knots: h.knots, rational: h.rational, points: f.points, weights: f.weights });
+    if (h.kind === 'mesh') doc.models.set(h.name, f);
+    else if (h.kind === 'curve') doc.curves.set(h.name, { degree: h.degree, knots: h.knots, rational: h.rational, points: f.points, weights: f.weights });
     else (h.before ? doc.befores : doc.surfaces).set(h.name, { degrees: h.degrees, counts: h.counts, knots_u: h.knots_u, knots_v: h.knots_v, rational: h.rational, points: f.points, weights: f.weights });
   }
-  selection = selection.filter((s) => (s.kind === 'curve' ? doc.curves.has(s.name) : s.kind === 'surface' ? doc.surfaces.has(s.name) : true));
+  selection = selection.filter((s) => (s.kind === 'curve' ? doc.curves.has(s.name) : s.kind === 'surface' ? doc.surfaces.has(s.name) : s.kind === 'model' ? doc.models.has(s.name) : true));
   if (previewEnding && !link.busy) finishPreview();
   else rebuildSurfaces();
   rebuildCurves();
@@ -404,7 +420,7 @@ function pick(clientX, clientY) {
   }
   if (best) return best;
   const hit = onSurface(pointerRay(clientX, clientY));
-  return hit ? { kind: 'surface', name: hit.object.name, hit } : null;
+  return hit ? { kind: hit.object.userData.kind, name: hit.object.name, hit } : null;
 }
 function segmentDistance(p, a, b) {
   const dx = b[0] - a[0];
@@ -664,6 +680,14 @@ function latticesShown() {
       if (step.kind === 'bezier_lattice') out.push({ deformation: def.deform.deformation, stepIndex: i, step });
     });
   }
+  const models = selection.filter((s) => s.kind === 'model').map((s) => s.name);
+  for (const [name, def] of Object.entries(doc.recipe.models || {})) {
+    if (!def.deformation || (models.length && !models.includes(name)) || (chosen.length && !models.length)) continue;
+    const stack = (doc.recipe.deformations || {})[def.deformation] || [];
+    stack.forEach((step, i) => {
+      if (step.kind === 'bezier_lattice' && !out.some((o) => o.deformation === def.deformation)) out.push({ deformation: def.deformation, stepIndex: i, step });
+    });
+  }
   return out;
 }
 
@@ -914,6 +938,20 @@ $('build-style').addEventListener('click', () => {
   ).then(({ reply }) => reply.op !== 'error' && select({ kind: 'surface', name: result }));
 });
 $('build-lattice').addEventListener('click', () => {
+  const model = selected('model')[0] || (!selection.length && !doc.surfaces.size && doc.models.size === 1 ? [...doc.models.keys()][0] : null);
+  if (model) {
+    // a whole model: its recipe entry takes the stack (models.M.deformation)
+    const deformation = names.free(doc.recipe, 'lattice');
+    const step = { kind: 'bezier_lattice', name: deformation, frame: names.boxFrame(doc.models.get(model).positions), degrees: [3, 3, 1], moves: [] };
+    edit(
+      [
+        { path: `deformations.${deformation}`, value: [step], create: true },
+        { path: `models.${model}.deformation`, value: deformation, create: true },
+      ],
+      `lattice on ${model}`,
+    ).then(({ reply }) => reply.op !== 'error' && setTool('edit'));
+    return;
+  }
   const surface = targetSurface();
   if (!surface) return;
   const deformation = names.free(doc.recipe, 'lattice');
@@ -1145,6 +1183,7 @@ window.clayStudio = {
   reply: () => doc.reply,
   surfaces: () => Object.fromEntries([...doc.surfaces].map(([n, s]) => [n, plainNet(s)])),
   befores: () => Object.fromEntries([...doc.befores].map(([n, s]) => [n, plainNet(s)])),
+  models: () => Object.fromEntries([...doc.models].map(([n, m]) => [n, { vertices: m.header.vertices, triangles: m.header.triangles, positions: Array.from(m.positions) }])),
   curves: () => Object.fromEntries([...doc.curves].map(([n, c]) => [n, { degree: c.degree, knots: c.knots, points: Array.from(c.points), weights: Array.from(c.weights) }])),
   camera: () => {
     camera.updateMatrixWorld();
@@ -1188,7 +1227,7 @@ async function start() {
   $('run-title').textContent = `Clayform Studio — ${doc.recipe.name || reply.recipe || 'untitled'}`;
   $('save-name').value = `${doc.recipe.name || 'studio'}.json`;
   // a recipe with geometry is seen from the side, an empty one from the top (to sketch on XY)
-  setView(doc.surfaces.size || doc.curves.size ? 'iso' : 'top');
+  setView(doc.surfaces.size || doc.curves.size || doc.models.size ? 'iso' : 'top');
   body.dataset.ready = '1';
 }
 start();
