@@ -17,7 +17,7 @@ import { copyFileSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdir
 import { fileURLToPath } from 'node:url';
 import { tmpdir, cpus } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
-import { backProject, curveDomain, dist, distanceToCurve, ffd, insidePolygon, latticePoints, quantile, surfaceAt, surfaceDomain, curveAt } from './geometry.mjs';
+import { backProject, curveDomain, curveAt, dist, distanceToCurve, ffd, insidePolygon, latticePoints, quantile, surfaceAt, surfaceDomain } from './geometry.mjs';
 import { along, launchBrowser, startStudio, studioPage } from './studio_driver.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -497,6 +497,73 @@ try {
     } finally {
       await modelPage.close();
       second.process.kill();
+    }
+  });
+
+  await check('taper and twist from the sliders: the surface is Barr\'s taper then twist of its parent, within the refit tolerances', async () => {
+    // a studio on a recipe holding one bicubic patch, 400 x 200 mm with a bump
+    const dir = join(work, 'global');
+    mkdirSync(dir);
+    const knots = [0, 0, 0, 0, 1, 1, 1, 1];
+    const points = [];
+    for (let i = 0; i < 4; i++) for (let j = 0; j < 4; j++) points.push([-200 + (400 * i) / 3, -100 + (200 * j) / 3, (i === 1 || i === 2) && (j === 1 || j === 2) ? 30 : 0]);
+    writeFileSync(join(dir, 'patch.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'patch', surfaces: { patch: { bspline: { degrees: [3, 3], knots_u: knots, knots_v: knots, points } } } }));
+    const third = await startStudio(clayform, join(dir, 'patch.json'));
+    const globalPage = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    globalPage.on('pageerror', (e) => problems.push(`page error (global): ${e.message}`));
+    const g = studioPage(globalPage);
+    try {
+      await g.open(third.url);
+      await g.clickAt([60, 30, 17], false);
+      await globalPage.click('#build-global');
+      await g.idle();
+      assert(!(await g.lastError()), await g.lastError());
+      for (const [id, value] of [['global-taper', 0.3], ['global-twist', 30]]) {
+        await globalPage.$eval(`#${id}`, (el, v) => {
+          el.value = String(v);
+          el.dispatchEvent(new Event('input'));
+          el.dispatchEvent(new Event('change'));
+        }, value);
+        await g.idle();
+        assert(!(await g.lastError()), await g.lastError());
+      }
+      const recipe = await g.call(() => window.clayStudio.recipe());
+      const [taper, twist] = recipe.deformations.global1;
+      const surfaces = await g.call(() => window.clayStudio.surfaces());
+      const befores = await g.call(() => window.clayStudio.befores());
+      const shaped = surfaces.patch_global1;
+      const parent = befores.patch_global1;
+      // Barr (Güdükbay–Özgüç §3.1): local z along the axis, x along the reference, y = z × x;
+      // taper r = 1 + c z scales x and y, twist turns them by θ = a z
+      const { origin, axis, reference } = taper.frame;
+      const yAxis = [axis[1] * reference[2] - axis[2] * reference[1], axis[2] * reference[0] - axis[0] * reference[2], axis[0] * reference[1] - axis[1] * reference[0]];
+      const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+      const barr = (p) => {
+        const d = [0, 1, 2].map((e) => p[e] - origin[e]);
+        const x = dot(d, reference);
+        const y = dot(d, yAxis);
+        const z = dot(d, axis);
+        const r = taper.profile[0] + taper.profile[1] * z;
+        const t = twist.angle[0] + twist.angle[1] * z;
+        const X = r * x * Math.cos(t) - r * y * Math.sin(t);
+        const Y = r * x * Math.sin(t) + r * y * Math.cos(t);
+        return [0, 1, 2].map((e) => origin[e] + X * reference[e] + Y * yAxis[e] + z * axis[e]);
+      };
+      const [[u0, u1], [v0, v1]] = surfaceDomain(shaped);
+      let worst = 0;
+      for (let a = 0; a <= 20; a++)
+        for (let b = 0; b <= 20; b++) {
+          const u = u0 + ((u1 - u0) * a) / 20;
+          const v = v0 + ((v1 - v0) * b) / 20;
+          worst = Math.max(worst, dist(surfaceAt(shaped, u, v), barr(surfaceAt(parent, u, v))));
+        }
+      const steps = (await g.call(() => window.clayStudio.reply())).steps.filter((st) => st.path.startsWith('surfaces.patch_global1.steps'));
+      const allowed = steps.reduce((sum, st) => sum + (st.figures.tolerance_mm || 0), 0);
+      assert(worst <= allowed, `the surface is ${worst} mm from Barr's taper and twist of its parent; the steps' tolerances add to ${allowed} mm`);
+      return `${worst.toExponential(2)} mm from Barr's formulas (tolerances add to ${allowed.toExponential(2)} mm)`;
+    } finally {
+      await globalPage.close();
+      third.process.kill();
     }
   });
 
