@@ -14,7 +14,9 @@
 #include <clay/surface/evaluate.hpp>
 
 #include <benchmark/benchmark.h>
+
 #include <nlohmann/json.hpp>
+#include "hood.hpp"
 
 #include <cmath>
 #include <filesystem>
@@ -26,24 +28,9 @@ using Json = nlohmann::json;
 
 namespace {
 
-surface::BSplineSurface hood() {
-  const int n = 16;
-  auto b = surface::clamped_uniform_basis(3, n);
-  const auto xi = surface::greville_abscissae(b);
-  surface::Points3 p(n * n, 3);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const double x = -600 + 1200 * xi[static_cast<size_t>(i)],
-                   y = -400 + 800 * xi[static_cast<size_t>(j)];
-      p.row(i * n + j) << x, y,
-          80 * (1 - (x / 700) * (x / 700)) * (1 - (y / 500) * (y / 500)) + 0.05 * x;
-    }
-  return surface::make_surface(b, b, p);
-}
-
 void lattice_drag_step(benchmark::State& state) {
   const auto grid = surface::linspace(0, 1, 173);
-  const surface::Points3 parent = surface::evaluate_grid(hood(), grid, grid);
+  const surface::Points3 parent = surface::evaluate_grid(bench::hood(), grid, grid);
   deform::Frame frame;
   frame.origin = Eigen::Vector3d(-660, -440, -60);
   frame.s = Eigen::Vector3d(1320, 0, 0);

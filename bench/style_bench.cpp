@@ -10,6 +10,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "hood.hpp"
+
 #include <cmath>
 
 using namespace clay::deform;
@@ -20,21 +22,6 @@ using clay::surface::Points3;
 namespace {
 
 constexpr double pi = 3.14159265358979323846;
-
-BSplineSurface hood() {
-  const int n = 16;
-  auto b = clay::surface::clamped_uniform_basis(3, n);
-  const auto xi = clay::surface::greville_abscissae(b);
-  Points3 p(n * n, 3);
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const double x = -600 + 1200 * xi[static_cast<size_t>(i)],
-                   y = -400 + 800 * xi[static_cast<size_t>(j)];
-      p.row(i * n + j) << x, y,
-          80 * (1 - (x / 700) * (x / 700)) * (1 - (y / 500) * (y / 500)) + 0.05 * x;
-    }
-  return clay::surface::make_surface(b, b, p);
-}
 
 BSplineCurve bound() {
   BSplineCurve e = clay::surface::circular_arc(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX(),
@@ -55,7 +42,7 @@ BSplineCurve target(double lift) {
 // (exact mode: 0 = off, the default; 20 = refine the net until the shape changes by < 2 %, 5:
 // by < 0.5 %, the issue #21 target).
 void drag(benchmark::State& state) {
-  const BSplineSurface parent = hood();
+  const BSplineSurface parent = clay::bench::hood();
   StyleOptions options;
   options.mode = state.range(0) == 0 ? StyleMode::Paper : StyleMode::Exact;
   options.report_curves = state.range(1) != 0;
