@@ -500,7 +500,7 @@ try {
     }
   });
 
-  await check('taper and twist from the sliders: the surface is Barr\'s taper then twist of its parent, within the refit tolerances', async () => {
+  await check('taper and twist from the sliders against Barr\'s formulas; a surface point pulled by direct manipulation', async () => {
     // a studio on a recipe holding one bicubic patch, 400 x 200 mm with a bump
     const dir = join(work, 'global');
     mkdirSync(dir);
@@ -560,7 +560,33 @@ try {
       const steps = (await g.call(() => window.clayStudio.reply())).steps.filter((st) => st.path.startsWith('surfaces.patch_global1.steps'));
       const allowed = steps.reduce((sum, st) => sum + (st.figures.tolerance_mm || 0), 0);
       assert(worst <= allowed, `the surface is ${worst} mm from Barr's taper and twist of its parent; the steps' tolerances add to ${allowed} mm`);
-      return `${worst.toExponential(2)} mm from Barr's formulas (tolerances add to ${allowed.toExponential(2)} mm)`;
+      const barrNote = `${worst.toExponential(2)} mm from Barr's formulas (tolerances add to ${allowed.toExponential(2)} mm)`;
+      // Direct manipulation: Shift-drag a point of the patch up (z locked); the surface point
+      // pressed must end where the pointer took it (Hsu–Hughes–Kaufman), to the refit's tolerance.
+      await globalPage.click('#tool-edit');
+      await globalPage.selectOption('#lattice-lock', 'z');
+      const press = await g.call(() => window.clayStudio.toScreen([-60, 20, 20]));
+      await globalPage.keyboard.down('Shift');
+      await globalPage.mouse.move(...press);
+      await globalPage.mouse.down();
+      for (let k = 1; k <= 10; k++) await globalPage.mouse.move(press[0], press[1] - 3 * k);
+      await globalPage.mouse.up();
+      await globalPage.keyboard.up('Shift');
+      await g.idle();
+      assert(!(await g.lastError()), await g.lastError());
+      const after = await g.call(() => window.clayStudio.recipe());
+      const pullName = Object.keys(after.deformations).find((n) => n.startsWith('pull'));
+      assert(pullName, `no direct manipulation step: ${Object.keys(after.deformations)}`);
+      const move = after.deformations[pullName][0].moves[0];
+      const pulledName = Object.keys(after.surfaces).find((n) => after.surfaces[n].deform && after.surfaces[n].deform.deformation === pullName);
+      const pulled = (await g.call(() => window.clayStudio.surfaces()))[pulledName];
+      const reached = dist(surfaceAt(pulled, move.surface_point[0], move.surface_point[1]), move.to);
+      const pullStep = (await g.call(() => window.clayStudio.reply())).steps.find((st) => st.path === `surfaces.${pulledName}.steps[0]`);
+      const tolerance = pullStep.figures.tolerance_mm;
+      assert(reached <= tolerance, `the pulled point is ${reached} mm from where it was taken (tolerance ${tolerance} mm)`);
+      const history = await g.call(() => window.clayStudio.history());
+      assert(history.entries.filter((e) => e.startsWith('drag patch_global1')).length === 1, `history: ${history.entries}`);
+      return `${barrNote}; direct manipulation: the point pulled to within ${reached.toExponential(2)} mm of the pointer's target (tolerance ${tolerance.toExponential(2)} mm)`;
     } finally {
       await globalPage.close();
       third.process.kill();

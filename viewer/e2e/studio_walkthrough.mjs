@@ -6,7 +6,7 @@
 // (docs/pictures/studio-*.png) and fails, naming the step, when one does not work.
 //
 //   node e2e/studio_walkthrough.mjs --clayform PATH [--out DIR] [--chromium PATH]
-import { mkdirSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
 import { along, launchBrowser, startStudio, studioPage } from './studio_driver.mjs';
@@ -139,7 +139,7 @@ try {
     await page.click('#export');
     await page.waitForFunction(() => document.getElementById('message').textContent.startsWith('exported'), null, { timeout: 120000 });
     const recipe = JSON.parse(readFileSync(join(work, 'hood_styled.json'), 'utf8'));
-    console.log(`# saved ${join(work, 'hood_styled.json')}: ${Object.keys(recipe.strokes).length} strokes, surfaces ${Object.keys(recipe.surfaces).join(', ')}`);
+    console.log(`# saved hood_styled.json: ${Object.keys(recipe.strokes).length} strokes, surfaces ${Object.keys(recipe.surfaces).join(', ')}`);
   });
 } catch {
   // reported by step()
@@ -148,4 +148,6 @@ try {
   studio.process.kill();
 }
 console.log(`# pictures in ${out}`);
+if (!failed) rmSync(work, { recursive: true, force: true });
+else console.log(`# the walkthrough's folder: ${work}`);
 process.exit(failed ? 1 : 0);

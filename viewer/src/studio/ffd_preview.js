@@ -55,12 +55,16 @@ export function prepareFfd(grid, step) {
 
 /**
  * Writes the deformed vertices and unit normals into `position` and `normal` (Float32Arrays of
- * the grid's size) for the lattice's control points `points` (s-major, [x, y, z] each).
+ * the grid's size) for the lattice's control points `points` (s-major, [x, y, z] each). Returns
+ * the smallest and largest volume ratio det(dX'/dX) at the samples: where the map would fold the
+ * surface's neighbourhood (<= 0), as the drag goes.
  */
 export function applyFfd(prepared, points, position, normal) {
   const { grid, degrees, Minv, basis } = prepared;
   const [l, m, n] = degrees;
   const count = grid.rows * grid.cols;
+  let lo = Infinity;
+  let hi = -Infinity;
   for (let k = 0; k < count; k++) {
     const [[bs, ds], [bt, dt], [bu, du]] = basis[k];
     let x = 0;
@@ -91,13 +95,18 @@ export function applyFfd(prepared, points, position, normal) {
     // world Jacobian J M^-1, applied to the parent's tangents
     const a = [0, 0, 0];
     const b = [0, 0, 0];
+    const W = [0, 0, 0, 0, 0, 0, 0, 0, 0];
     for (let e = 0; e < 3; e++) {
       for (let c = 0; c < 3; c++) {
         const w = J[3 * e] * Minv[c] + J[3 * e + 1] * Minv[3 + c] + J[3 * e + 2] * Minv[6 + c];
+        W[3 * e + c] = w;
         a[e] += w * grid.su[3 * k + c];
         b[e] += w * grid.sv[3 * k + c];
       }
     }
+    const det = W[0] * (W[4] * W[8] - W[5] * W[7]) - W[1] * (W[3] * W[8] - W[5] * W[6]) + W[2] * (W[3] * W[7] - W[4] * W[6]);
+    lo = Math.min(lo, det);
+    hi = Math.max(hi, det);
     let nx = a[1] * b[2] - a[2] * b[1];
     let ny = a[2] * b[0] - a[0] * b[2];
     let nz = a[0] * b[1] - a[1] * b[0];
@@ -109,4 +118,5 @@ export function applyFfd(prepared, points, position, normal) {
     normal[3 * k + 1] = ny;
     normal[3 * k + 2] = nz;
   }
+  return [lo, hi];
 }

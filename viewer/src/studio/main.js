@@ -8,7 +8,7 @@ import '../style.css';
 import './studio.css';
 import { shadedMaterial, zebraMaterial, scalarMaterial } from '../materials.js';
 import { Link } from './link.js';
-import { curvePolyline, surfaceGrid, domain } from './nurbs.js';
+import { curvePolyline, surfaceGrid, domain, sampleParameters } from './nurbs.js';
 import * as names from './recipe_edits.js';
 import { prepareFfd, applyFfd } from './ffd_preview.js';
 
@@ -116,9 +116,35 @@ function surfaceResolution(net, direction) {
 
 function meshOf(net) {
   const t0 = performance.now();
-  const g = surfaceGrid(net, surfaceResolution(net, 0), surfaceResolution(net, 1));
+  const rows = surfaceResolution(net, 0);
+  const cols = surfaceResolution(net, 1);
+  const g = surfaceGrid(net, rows, cols);
   metrics.evaluate.push(performance.now() - t0);
-  return gridGeometry(g);
+  const geometry = gridGeometry(g);
+  // each sample's (u, v), so a pick on the surface knows its parameters (direct manipulation)
+  const us = sampleParameters(net.knots_u, net.degrees[0], rows);
+  const vs = sampleParameters(net.knots_v, net.degrees[1], cols);
+  const uv = new Float64Array(2 * rows * cols);
+  for (let r = 0; r < rows; r++)
+    for (let c = 0; c < cols; c++) {
+      uv[2 * (r * cols + c)] = us[r];
+      uv[2 * (r * cols + c) + 1] = vs[c];
+    }
+  geometry.userData.parameters = uv;
+  return geometry;
+}
+
+/** The (u, v) of a raycast hit on a surface mesh: its triangle's corners' parameters, blended. */
+function hitParameters(hit) {
+  const uv = hit.object.geometry.userData.parameters;
+  if (!uv || !hit.face) return null;
+  const { a, b, c } = hit.face;
+  const bary = new THREE.Triangle(
+    new THREE.Vector3().fromBufferAttribute(hit.object.geometry.getAttribute('position'), a),
+    new THREE.Vector3().fromBufferAttribute(hit.object.geometry.getAttribute('position'), b),
+    new THREE.Vector3().fromBufferAttribute(hit.object.geometry.getAttribute('position'), c),
+  ).getBarycoord(hit.point, new THREE.Vector3());
+  return [0, 1].map((e) => bary.x * uv[2 * a + e] + bary.y * uv[2 * b + e] + bary.z * uv[2 * c + e]);
 }
 
 function gridGeometry(g) {
@@ -782,16 +808,19 @@ function startPreview(h) {
 }
 function showPreview(h, to, inputAt) {
   if (!previews.size) return;
+  let live = [Infinity, -Infinity];
   for (const preview of previews.values()) {
     const moved = { ...preview.step, moves: names.withMove(preview.step.moves || [], h.index, to) };
     const position = preview.geometry.getAttribute('position');
     const normal = preview.geometry.getAttribute('normal');
-    applyFfd(preview.prepared, names.latticePoints(moved), position.array, normal.array);
+    const ratio = applyFfd(preview.prepared, names.latticePoints(moved), position.array, normal.array);
+    live = [Math.min(live[0], ratio[0]), Math.max(live[1], ratio[1])];
     position.needsUpdate = true;
     normal.needsUpdate = true;
     preview.geometry.computeBoundingSphere();
   }
   if (!surfaceGroup.children.some((o) => o.geometry && o.geometry.userData.preview)) rebuildSurfaces();
+  showLatticeFigures(live);
   dirty((drawnAt) => metrics.preview.push({ at: drawnAt, ms: drawnAt - inputAt }));
 }
 function endPreview() {
@@ -805,6 +834,38 @@ function finishPreview() {
   previews.clear();
   rebuildSurfaces();
   geometries.forEach((g) => g.dispose());
+}
+
+// ------------------------------------------------------------------------------ direct manipulation
+// Shift-press on a surface with the Edit tool: Hsu–Hughes–Kaufman direct manipulation. A cubic
+// B-spline lattice of 3 x 3 x 1 cells around the surface is solved so that the surface point
+// pressed goes where the pointer goes (the recipe's direct_manipulation step, refitted: a
+// B-spline lattice's knot planes cross the surface off its iso-lines).
+let surfaceDrag = null; // {surface, deformation, uv, start, group}
+function startDirectManipulation(event) {
+  const hit = onSurface(pointerRay(event.clientX, event.clientY));
+  if (!hit || hit.object.userData.kind !== 'surface') return;
+  const uv = hitParameters(hit);
+  if (!uv) return;
+  const surface = hit.object.name;
+  const start = hit.point.toArray();
+  const deformation = names.free(doc.recipe, 'pull');
+  const result = names.free(doc.recipe, `${surface}_pulled`);
+  const lattice = { kind: 'bspline_lattice', frame: names.boxFrame(doc.surfaces.get(surface).points), cells: [3, 3, 1], degrees: [3, 3, 1], knots: 'clamped' };
+  // the step, its surface and the drag's updates: one history entry (one group)
+  const group = newGroup();
+  const changes = [
+    { path: `deformations.${deformation}`, value: [{ kind: 'direct_manipulation', name: deformation, lattice, moves: [{ surface_point: uv, to: start }] }], create: true },
+    { path: `surfaces.${result}`, value: { deform: { surface, deformation, composition: { mode: 'refit', tolerance: 1e-4 } } }, create: true },
+  ];
+  link.send(commandOf(changes, `drag ${surface} at (${uv.map((x) => x.toPrecision(4))})`, 'edit', group)).then(({ reply }) => {
+    if (reply.op !== 'error') select({ kind: 'surface', name: result }, false);
+  });
+  surfaceDrag = { surface, deformation, uv, start, group };
+  dragging = true;
+  canvas.setPointerCapture(event.pointerId);
+  controls.enabled = false;
+  event.stopImmediatePropagation();
 }
 
 // ------------------------------------------------------------------------------ pointer input
@@ -826,7 +887,10 @@ canvas.addEventListener(
       event.stopImmediatePropagation();
     } else if (tool === 'edit') {
       const h = pickHandle(event.clientX, event.clientY);
-      if (!h) return;
+      if (!h) {
+        if (event.shiftKey) startDirectManipulation(event);
+        return;
+      }
       activeHandle = { ...h };
       handleDrag = { handle: h, start: h.p.slice(), group: newGroup() };
       if (h.kind === 'lattice') startPreview(h);
@@ -846,6 +910,14 @@ canvas.addEventListener('pointermove', (event) => {
       const p = inkPoint(e);
       if (p) pushInk(p);
     }
+  } else if (surfaceDrag) {
+    const target = dragTarget(surfaceDrag.start, pointerRay(event.clientX, event.clientY), $('lattice-lock').value);
+    if (!target) return;
+    const strength = Number($('lattice-strength').value) || 1;
+    const to = surfaceDrag.start.map((c, i) => c + strength * (target[i] - c));
+    surfaceDrag.last = to;
+    const d = surfaceDrag;
+    dragEdit(() => (doc.recipe.deformations && doc.recipe.deformations[d.deformation] ? { changes: { path: `deformations.${d.deformation}[0].moves[0].to`, value: to }, label: `drag ${d.surface} at (${d.uv.map((x) => x.toPrecision(4))})`, group: d.group } : null), event.timeStamp);
   } else if (handleDrag) {
     const target = dragTarget(handleDrag.start, pointerRay(event.clientX, event.clientY), $('lattice-lock').value);
     if (!target) return;
@@ -861,6 +933,12 @@ canvas.addEventListener('pointerup', (event) => {
   down = null;
   if (ink) {
     finishStroke(event);
+    controls.enabled = true;
+    return;
+  }
+  if (surfaceDrag) {
+    surfaceDrag = null;
+    dragging = false;
     controls.enabled = true;
     return;
   }
@@ -885,6 +963,7 @@ function setTool(tool) {
   body.dataset.tool = tool;
   document.querySelectorAll('[data-tool]').forEach((b) => b.setAttribute('aria-pressed', String(b.dataset.tool === tool)));
   controls.mouseButtons.LEFT = tool === 'sketch' ? null : THREE.MOUSE.ROTATE;
+  $('drag-panel').hidden = tool !== 'edit';
   rebuildHandles();
 }
 document.querySelectorAll('button[data-tool]').forEach((b) => b.addEventListener('click', () => setTool(b.dataset.tool)));
@@ -1021,7 +1100,10 @@ function showPanels() {
   }
   const lattices = latticesShown();
   $('lattice-panel').hidden = !lattices.length;
-  if (lattices.length) $('lattice-name').textContent = lattices.map((l) => l.deformation).join(', ');
+  if (lattices.length) {
+    $('lattice-name').textContent = lattices.map((l) => l.deformation).join(', ');
+    showLatticeFigures();
+  }
   const global = activeGlobal();
   $('global-panel').hidden = !global;
   if (global) {
@@ -1031,6 +1113,12 @@ function showPanels() {
     setSlider('global-twist', g.twist);
     setSlider('global-bend', g.bend);
   }
+}
+/** The lattice steps' fold-free and volume-ratio figures from the kernel's last answer (certified bounds of det J). */
+function showLatticeFigures(live) {
+  const steps = doc.steps.filter((st) => st.kind === 'bezier_lattice' && 'fold_free' in st.figures);
+  const kernel = steps.map((st) => `${st.figures.fold_free ? 'fold-free' : 'MAY FOLD'}, volume ratio ${st.figures.volume_ratio_min.toPrecision(3)} … ${st.figures.volume_ratio_max.toPrecision(3)}`).join('; ');
+  $('lattice-figures').textContent = `${kernel ? `kernel: ${kernel}` : ''}${live ? `${kernel ? '\n' : ''}live, at the surface: volume ratio ${live[0].toPrecision(3)} … ${live[1].toPrecision(3)}` : ''}`;
 }
 function setSlider(id, value) {
   if (document.activeElement === $(id)) return;
