@@ -593,6 +593,68 @@ try {
     }
   });
 
+  await check('constraints on two strokes of a plane: coincident and tangent ends, the solver\'s figures shown, a conflict refused', async () => {
+    const dir = join(work, 'sketch');
+    mkdirSync(dir);
+    writeFileSync(join(dir, 'sketch.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'sketch' }));
+    const fourth = await startStudio(clayform, join(dir, 'sketch.json'));
+    const sketchPage = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    sketchPage.on('pageerror', (e) => problems.push(`page error (sketch): ${e.message}`));
+    const k = studioPage(sketchPage);
+    try {
+      await k.open(fourth.url);
+      await sketchPage.click('#tool-sketch');
+      await sketchPage.uncheck('#snap');
+      // two strokes whose ends nearly meet at an angle
+      await k.draw(along([-300, 0], [-20, 10], 20));
+      await k.draw(along([5, 0], [300, 120], -20));
+      await sketchPage.click('#tool-orbit');
+      await k.clickCurve('s1', false);
+      await k.clickCurve('s2', true);
+      await sketchPage.click('#constrain-coincident');
+      await k.idle();
+      assert(!(await k.lastError()), await k.lastError());
+      await k.clickCurve('sketch1.s1', false);
+      await k.clickCurve('sketch1.s2', true);
+      await sketchPage.click('#constrain-tangent');
+      await k.idle();
+      assert(!(await k.lastError()), await k.lastError());
+      const curves = await k.call(() => window.clayStudio.curves());
+      const a = curves['sketch1.s1'];
+      const b = curves['sketch1.s2'];
+      assert(a && b, `no sketch curves: ${Object.keys(curves)}`);
+      // here: s1's end and s2's start meet, and their end tangents (last and first control legs) are parallel
+      const na = a.weights.length;
+      const end = a.points.slice(3 * na - 3, 3 * na);
+      const before = a.points.slice(3 * na - 6, 3 * na - 3);
+      const start = b.points.slice(0, 3);
+      const next = b.points.slice(3, 6);
+      const gap = dist(end, start);
+      const ta = [0, 1, 2].map((e) => end[e] - before[e]);
+      const tb = [0, 1, 2].map((e) => next[e] - start[e]);
+      const cross = Math.hypot(ta[1] * tb[2] - ta[2] * tb[1], ta[2] * tb[0] - ta[0] * tb[2], ta[0] * tb[1] - ta[1] * tb[0]) / (Math.hypot(...ta) * Math.hypot(...tb));
+      const same = ta[0] * tb[0] + ta[1] * tb[1] + ta[2] * tb[2] > 0;
+      assert(gap <= 1e-7 && cross <= 1e-7 && same, `after coincident and tangent: gap ${gap} mm, sin of the angle ${cross}, same direction ${same}`);
+      const figures = await sketchPage.locator('#sketch-figures').textContent();
+      const step = (await k.call(() => window.clayStudio.reply())).steps.find((st) => st.path === 'sketches.sketch1');
+      assert(figures.includes(`degrees of freedom ${step.figures.degrees_of_freedom}`), `panel: "${figures}", report: ${JSON.stringify(step.figures)}`);
+      // the distance between the joined ends set to 50 mm conflicts with coincident: refused, nothing changes
+      const text = JSON.stringify(await k.call(() => window.clayStudio.recipe()));
+      await k.clickCurve('sketch1.s1', false);
+      await k.clickCurve('sketch1.s2', true);
+      await sketchPage.fill('#constrain-value', '50');
+      await sketchPage.click('#constrain-distance');
+      await k.idle();
+      const error = await k.lastError();
+      assert(/conflict/i.test(error), `a conflicting distance was not refused as a conflict: "${error}"`);
+      assert(JSON.stringify(await k.call(() => window.clayStudio.recipe())) === text, 'the refused constraint changed the recipe');
+      return `gap ${gap.toExponential(1)} mm, tangent angle sin ${cross.toExponential(1)}; ${figures}; conflict: ${error.slice(0, 90)}…`;
+    } finally {
+      await sketchPage.close();
+      fourth.process.kill();
+    }
+  });
+
   await check('no page errors', async () => {
     assert(problems.length === 0, problems.join('; '));
   });

@@ -248,9 +248,17 @@ function rebuildSurfaces() {
 
 const CURVE_COLOUR = 0xff9b3d;
 const SELECTED_COLOUR = 0x4fd1ff;
+/** Strokes that are entities of a sketch: the sketch's solved curve ("SKETCH.NAME") is drawn instead. */
+function inSketches() {
+  const out = new Set();
+  for (const def of Object.values(doc.recipe.sketches || {})) for (const e of Object.values(def.entities || {})) if (e.curve) out.add(e.curve);
+  return out;
+}
 function rebuildCurves() {
   disposeGroup(curveGroup);
+  const hidden = inSketches();
   for (const [name, curve] of doc.curves) {
+    if (hidden.has(name)) continue;
     const samples = Math.min(400, 24 * (curve.knots.length - 2 * curve.degree) + 40);
     const line = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: selection.some((s) => s.kind === 'curve' && s.name === name) ? SELECTED_COLOUR : CURVE_COLOUR, depthTest: false }));
     line.geometry.setAttribute('position', new THREE.BufferAttribute(curvePolyline(curve, samples), 3));
@@ -1069,6 +1077,46 @@ function deleteSelected() {
   edit(changes, `delete ${curves.join(', ')}`).then(({ reply }) => reply.op !== 'error' && select(null));
 }
 
+// constraints on planar sketches: the selected strokes (or a sketch's curves) become entities of
+// a sketch on their plane, and each button appends a constraint; the solver's degrees of freedom
+// and redundant sets are shown, and a conflicting constraint is refused with the solver's report.
+function constrain(type) {
+  const curves = selected('curve');
+  if (!curves.length || curves.length > 2) return showMessage('select one or two curves drawn on one plane, then a constraint', true);
+  const target = names.sketchFor(doc.recipe, curves);
+  if (target.reason) return showMessage(target.reason, true);
+  const [a, b] = target.entities;
+  const nets = curves.map((c) => doc.curves.get(c));
+  let constraints = [];
+  if (type === 'fixed') constraints = target.entities.flatMap((e) => [`${e}.start`, `${e}.end`]).map((point) => ({ type: 'fixed', point }));
+  else if (curves.length === 1) {
+    if (type !== 'distance') return showMessage('coincident, tangent and curvature join two curves: select two', true);
+    constraints = [{ type: 'distance', points: [`${a}.start`, `${a}.end`], value: Number($('constrain-value').value) }];
+  } else {
+    const [[ea, eb]] = names.nearestEnds(nets[0], nets[1]);
+    if (type === 'coincident') constraints = [{ type: 'coincident', points: [`${a}.${ea}`, `${b}.${eb}`] }];
+    else if (type === 'distance') constraints = [{ type: 'distance', points: [`${a}.${ea}`, `${b}.${eb}`], value: Number($('constrain-value').value) }];
+    else constraints = [{ type, ends: [{ entity: a, end: ea }, { entity: b, end: eb }] }];
+  }
+  const existing = target.create ? [] : (doc.recipe.sketches[target.sketch].constraints || []);
+  const changes = [...target.changes];
+  if (target.create) changes[0].value.constraints = constraints;
+  else changes.push({ path: `sketches.${target.sketch}.constraints`, value: [...existing, ...constraints] });
+  edit(changes, `${type} ${target.entities.join(', ')}`).then(({ reply }) => {
+    if (reply.op !== 'error') select(null);
+  });
+}
+for (const type of ['coincident', 'tangent', 'curvature', 'fixed', 'distance']) $(`constrain-${type}`).addEventListener('click', () => constrain(type));
+function showSketchFigures() {
+  const curves = selected('curve');
+  const target = curves.length && curves.length <= 2 ? names.sketchFor(doc.recipe, curves) : { reason: 'none' };
+  $('constrain-panel').hidden = !!target.reason;
+  if (target.reason) return;
+  $('constrain-sketch').textContent = target.create ? '(a new sketch)' : target.sketch;
+  const step = doc.steps.find((st) => st.path === `sketches.${target.sketch}`);
+  $('sketch-figures').textContent = step ? `degrees of freedom ${step.figures.degrees_of_freedom}, ${step.figures.constraints} constraints, redundant sets ${step.figures.redundant_sets}, residual ${Number(step.figures.max_residual).toExponential(1)}` : '';
+}
+
 // style, lattice and global panels
 function activeStyle() {
   for (const s of selected('surface')) {
@@ -1087,6 +1135,7 @@ function activeGlobal() {
   return null;
 }
 function showPanels() {
+  showSketchFigures();
   const style = activeStyle();
   $('style-panel').hidden = !style;
   if (style) {

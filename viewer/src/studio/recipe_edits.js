@@ -160,3 +160,72 @@ export function moveEnd(points, end, to) {
   });
   points[end] = to.slice();
 }
+
+/**
+ * The sketch a selection of curves is constrained in (docs/recipe.md § sketches): each curve a
+ * drawn stroke with a plane (the same plane for all), or an entity of one sketch ("SKETCH.NAME").
+ * Returns {sketch, create, entities: [entity names], changes} where changes make the sketch (on
+ * the strokes' plane, each stroke a {curve} entity the solver moves) or add the missing entities;
+ * null with a reason when the curves cannot be constrained together.
+ */
+export function sketchFor(recipe, curves) {
+  const sketches = recipe.sketches || {};
+  const strokes = recipe.strokes || {};
+  let sketch = null;
+  const entities = [];
+  const missing = [];
+  let plane = null;
+  for (const c of curves) {
+    const dot = c.indexOf('.');
+    if (dot > 0 && sketches[c.slice(0, dot)]) {
+      const s = c.slice(0, dot);
+      if (sketch && sketch !== s) return { reason: 'the curves are in two sketches; constrain curves of one sketch' };
+      sketch = s;
+      entities.push(c.slice(dot + 1));
+      continue;
+    }
+    const stroke = strokes[c];
+    if (!stroke || !stroke.plane) return { reason: `"${c}" is not a stroke drawn on a plane (constraints hold on planar sketches: draw it on a plane)` };
+    if (plane && JSON.stringify(plane) !== JSON.stringify(stroke.plane)) return { reason: 'the strokes are on different planes; constrain strokes of one plane' };
+    plane = stroke.plane;
+    missing.push(c);
+    entities.push(c);
+  }
+  if (sketch && plane && JSON.stringify(sketches[sketch].plane) !== JSON.stringify(plane)) return { reason: `the strokes are not on the plane of sketch "${sketch}"` };
+  const changes = [];
+  let create = false;
+  if (!sketch) {
+    // a stroke already in a sketch is constrained there
+    for (const [name, def] of Object.entries(sketches))
+      if (missing.every((c) => def.entities && def.entities[c] && def.entities[c].curve === c)) {
+        sketch = name;
+        missing.length = 0;
+        break;
+      }
+  }
+  if (!sketch) {
+    sketch = free(recipe, 'sketch');
+    create = true;
+    changes.push({ path: `sketches.${sketch}`, value: { plane, points: {}, entities: Object.fromEntries(missing.map((c) => [c, { curve: c }])), constraints: [] }, create: true });
+  } else
+    for (const c of missing) if (!(sketches[sketch].entities || {})[c]) changes.push({ path: `sketches.${sketch}.entities.${c}`, value: { curve: c }, create: true });
+  return { sketch, create, entities, changes };
+}
+
+/** The pair of ends, one of each curve net, that lie nearest each other: [["start"|"end", ...], distance]. */
+export function nearestEnds(a, b) {
+  const end = (c, which) => {
+    const n = c.weights.length;
+    const k = which === 'start' ? 0 : n - 1;
+    return [c.points[3 * k], c.points[3 * k + 1], c.points[3 * k + 2]];
+  };
+  let best = null;
+  for (const ea of ['start', 'end'])
+    for (const eb of ['start', 'end']) {
+      const p = end(a, ea);
+      const q = end(b, eb);
+      const d = Math.hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]);
+      if (!best || d < best[1]) best = [[ea, eb], d];
+    }
+  return best;
+}
