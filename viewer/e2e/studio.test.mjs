@@ -593,7 +593,7 @@ try {
     }
   });
 
-  await check('constraints on two strokes of a plane: coincident and tangent ends, the solver\'s figures shown, a conflict refused', async () => {
+  await check('constraints on two strokes of a plane (coincident, tangent, a conflict refused); a stroke in 3D between two views', async () => {
     const dir = join(work, 'sketch');
     mkdirSync(dir);
     writeFileSync(join(dir, 'sketch.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'sketch' }));
@@ -648,7 +648,41 @@ try {
       const error = await k.lastError();
       assert(/conflict/i.test(error), `a conflicting distance was not refused as a conflict: "${error}"`);
       assert(JSON.stringify(await k.call(() => window.clayStudio.recipe())) === text, 'the refused constraint changed the recipe');
-      return `gap ${gap.toExponential(1)} mm, tangent angle sin ${cross.toExponential(1)}; ${figures}; conflict: ${error.slice(0, 90)}…`;
+      const constraintNote = `gap ${gap.toExponential(1)} mm, tangent angle sin ${cross.toExponential(1)}; ${figures}; conflict: ${error.slice(0, 60)}…`;
+      // A stroke in 3D between two views: drawn on XY from the top, then again from the front
+      // over it; the 3D curve's shadow on XY is the first curve, and it has the heights drawn.
+      await k.call(() => window.clayStudio.setView('top'));
+      await sketchPage.click('#tool-sketch');
+      await sketchPage.selectOption('#sketch-on', 'xy');
+      await k.draw(along([-250, -150], [250, -100], 40));
+      const flat = (await k.call(() => window.clayStudio.curves())).s3;
+      await sketchPage.click('#tool-orbit');
+      await k.clickCurve('s3', false);
+      await k.call(() => window.clayStudio.setView('front'));
+      await sketchPage.click('#tool-sketch');
+      await sketchPage.selectOption('#sketch-on', 'over');
+      const [t0, t1] = curveDomain(flat);
+      const height = (x) => 60 * Math.sin((Math.PI * (x + 250)) / 500);
+      const wanted = Array.from({ length: 13 }, (_, i) => {
+        const p = curveAt(flat, t0 + ((t1 - t0) * (0.02 + (0.96 * i) / 12)));
+        return [p[0], p[1], height(p[0])];
+      });
+      await k.draw(wanted, { steps: 60 });
+      const lifted = (await k.call(() => window.clayStudio.curves())).s3;
+      const stroke = (await k.call(() => window.clayStudio.recipe())).strokes.s3;
+      assert(!stroke.plane, 'the redrawn stroke still has a plane');
+      // its shadow on XY lies on the first curve, and its heights are the ones drawn
+      let shadow = 0;
+      let heights = 0;
+      const [l0, l1] = curveDomain(lifted);
+      for (let i = 0; i <= 50; i++) {
+        const p = curveAt(lifted, l0 + ((l1 - l0) * i) / 50);
+        shadow = Math.max(shadow, distanceToCurve({ ...flat, points: flat.points.map((c, e) => (e % 3 === 2 ? p[2] : c)) }, p));
+        heights = Math.max(heights, Math.abs(p[2] - height(p[0])));
+      }
+      assert(shadow <= 2 * stroke.tolerance + 1, `the 3D curve's shadow is ${shadow} mm off the first curve`);
+      assert(heights <= 2 * stroke.tolerance + 2, `the 3D curve's heights are ${heights} mm off the drawn ones`);
+      return `${constraintNote}; 3D between two views: shadow within ${shadow.toFixed(2)} mm, heights within ${heights.toFixed(2)} mm`;
     } finally {
       await sketchPage.close();
       fourth.process.kill();

@@ -501,6 +501,11 @@ function pushInk(p) {
 }
 function inkPoint(event) {
   const raycaster = pointerRay(event.clientX, event.clientY);
+  if (ink.over) {
+    const last = ink.points[ink.points.length - 1];
+    const p = onExtrusion(raycaster.ray, ink.over, last);
+    return p ? p.toArray() : null;
+  }
   if (ink.plane) {
     const p = onPlane(raycaster, ink.plane);
     return p ? p.toArray() : null;
@@ -516,6 +521,58 @@ function clearInk(command) {
   pendingInk[i].line.geometry.dispose();
   pendingInk.splice(i, 1);
   dirty();
+}
+
+/**
+ * Strokes in 3D between two views: a stroke drawn on a plane in one view is the shadow of the 3D
+ * curve along that plane's normal; drawn again from another view, each pointer ray meets the
+ * sheet swept by the first curve along the normal, and the meeting point is the 3D point. In the
+ * plane's coordinates the ray is a line: its crossing with the curve's polyline gives the curve
+ * point, and the ray's point above it the depth. Of several crossings the one nearest the
+ * previous ink point is taken (the first: nearest the eye).
+ */
+function extrusionOf(name) {
+  const stroke = (doc.recipe.strokes || {})[name];
+  const curve = doc.curves.get(name);
+  if (!stroke || !stroke.plane || !curve) return null;
+  const n = new THREE.Vector3(...(stroke.plane.normal || new THREE.Vector3(...stroke.plane.x_axis).cross(new THREE.Vector3(...stroke.plane.y_axis)).toArray())).normalize();
+  const polyline = curvePolyline(curve, 400);
+  return { name, normal: n, polyline };
+}
+function onExtrusion(ray, sheet, previous) {
+  const n = sheet.normal;
+  // plane coordinates: drop the component along n
+  const e1 = new THREE.Vector3(1, 0, 0);
+  if (Math.abs(e1.dot(n)) > 0.9) e1.set(0, 1, 0);
+  e1.sub(n.clone().multiplyScalar(e1.dot(n))).normalize();
+  const e2 = n.clone().cross(e1);
+  const flat = (v) => [v.dot(e1), v.dot(e2)];
+  const o = flat(ray.origin);
+  const d = flat(ray.direction);
+  const dd = Math.hypot(d[0], d[1]);
+  if (dd < 1e-9) return null; // looking along the sheet's normal: no depth to read
+  const hits = [];
+  const P = sheet.polyline;
+  for (let k = 0; k + 1 < P.length / 3; k++) {
+    const a = flat(new THREE.Vector3(P[3 * k], P[3 * k + 1], P[3 * k + 2]));
+    const b = flat(new THREE.Vector3(P[3 * k + 3], P[3 * k + 4], P[3 * k + 5]));
+    // o + l d = a + m (b - a)
+    const ex = b[0] - a[0];
+    const ey = b[1] - a[1];
+    const den = d[0] * -ey - d[1] * -ex;
+    if (Math.abs(den) < 1e-12) continue;
+    const rx = a[0] - o[0];
+    const ry = a[1] - o[1];
+    const l = (rx * -ey - ry * -ex) / den;
+    const m = (d[0] * ry - d[1] * rx) / den;
+    if (m < 0 || m > 1 || l <= 0) continue;
+    // the ray's parameter l is along its flattened direction: the same l on the 3D ray
+    hits.push(ray.origin.clone().addScaledVector(ray.direction, l));
+  }
+  if (!hits.length) return null;
+  if (!previous) return hits.reduce((best, h) => (h.distanceTo(ray.origin) < best.distanceTo(ray.origin) ? h : best));
+  const prev = new THREE.Vector3(...previous);
+  return hits.reduce((best, h) => (h.distanceTo(prev) < best.distanceTo(prev) ? h : best));
 }
 
 /** Every curve's two ends (for snapping). */
@@ -592,6 +649,7 @@ function finishStroke(event) {
   const points = ink.points;
   const line = ink.line;
   const plane = ink.plane;
+  const over = ink.over;
   ink = null;
   if (points.length < 3) {
     inkGroup.remove(line);
@@ -599,24 +657,31 @@ function finishStroke(event) {
     return;
   }
   const tolerance = Number($('stroke-tolerance').value) || 0.5;
-  const over = event.altKey ? null : oversketchTarget(points);
-  if (over) {
-    const q = doc.recipe.strokes[over.name].points;
-    const forward = over.from < over.to;
-    const lo = Math.min(over.from, over.to);
-    const hi = Math.max(over.from, over.to);
+  const redrawn = event.altKey || over ? null : oversketchTarget(points);
+  if (redrawn) {
+    const q = doc.recipe.strokes[redrawn.name].points;
+    const forward = redrawn.from < redrawn.to;
+    const lo = Math.min(redrawn.from, redrawn.to);
+    const hi = Math.max(redrawn.from, redrawn.to);
     const drawn = forward ? points : [...points].reverse();
     const next = [...q.slice(0, lo), ...drawn, ...q.slice(hi + 1)];
-    const label = `stroke ${over.name} (oversketch)`;
+    const label = `stroke ${redrawn.name} (oversketch)`;
     pendingInk.push({ label, line });
-    edit({ path: `strokes.${over.name}.points`, value: next }, label, 'stroke', event.timeStamp);
+    edit({ path: `strokes.${redrawn.name}.points`, value: next }, label, 'stroke', event.timeStamp);
     return;
   }
-  if ($('snap').checked && !event.altKey) {
+  if ($('snap').checked && !event.altKey && !over) {
     for (const end of [0, points.length - 1]) {
       const s = snapEnd(points[end]);
       if (s) names.moveEnd(points, end, s.p);
     }
+  }
+  if (over) {
+    // the 3D stroke takes the planar one's place (its name, so what was built from it follows)
+    const label = `stroke ${over.name} (3D)`;
+    pendingInk.push({ label, line });
+    edit({ path: `strokes.${over.name}`, value: { points, tolerance } }, label, 'stroke', event.timeStamp);
+    return;
   }
   const name = names.free(doc.recipe, 's');
   const stroke = { points, tolerance };
@@ -886,8 +951,17 @@ canvas.addEventListener(
     if (event.button !== 0) return;
     if (tool === 'sketch') {
       const on = $('sketch-on').value;
-      const plane = on === 'surface' ? null : sketchPlane();
-      ink = { points: [], plane, line: inkLine(), pointerId: event.pointerId };
+      let over = null;
+      if (on === 'over') {
+        const chosen = selected('curve');
+        over = chosen.length === 1 ? extrusionOf(chosen[0]) : null;
+        if (!over) {
+          showMessage('select one stroke drawn on a plane, then draw it again from another view to give it depth', true);
+          return;
+        }
+      }
+      const plane = on === 'surface' || on === 'over' ? null : sketchPlane();
+      ink = { points: [], plane, over, line: inkLine(), pointerId: event.pointerId };
       const p = inkPoint(event);
       if (p) pushInk(p);
       canvas.setPointerCapture(event.pointerId);
