@@ -142,3 +142,36 @@ export function backProject(cam, clientX, clientY, z0) {
   return [0, 1, 2].map((e) => near[e] + t * (far[e] - near[e]));
 }
 
+
+/** Hsu–Hughes–Kaufman eq. (1): the trivariate B-spline sum of a lattice step (cells, degrees, knots) at x. */
+export function bsplineFfd(step, points, x) {
+  const knotsOf = (cells, p, kind) => {
+    const k = [];
+    if (kind === 'uniform') for (let i = 0; i <= cells + 2 * p; i++) k.push((i - p) / cells);
+    else {
+      for (let i = 0; i <= p; i++) k.push(0);
+      for (let i = 1; i < cells; i++) k.push(i / cells);
+      for (let i = 0; i <= p; i++) k.push(1);
+    }
+    return k;
+  };
+  const { origin, s: S, t: T, u: U } = step.frame;
+  const d = [0, 1, 2].map((e) => x[e] - origin[e]);
+  const det3 = (a, b, c) => a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
+  const D = det3(S, T, U);
+  const local = [det3(d, T, U) / D, det3(S, d, U) / D, det3(S, T, d) / D];
+  const counts = [0, 1, 2].map((e) => step.cells[e] + step.degrees[e]);
+  const knots = [0, 1, 2].map((e) => knotsOf(step.cells[e], step.degrees[e], step.knots || 'clamped'));
+  const [nl, nm, nn] = counts;
+  const rows = [];
+  for (let i = 0; i < nl; i++) {
+    const cols = [];
+    for (let j = 0; j < nm; j++) {
+      const line = [];
+      for (let k = 0; k < nn; k++) line.push([...points[(i * nm + j) * nn + k], 1]);
+      cols.push(deBoor(knots[2], step.degrees[2], line, local[2]));
+    }
+    rows.push(deBoor(knots[1], step.degrees[1], cols, local[1]));
+  }
+  return dehom(deBoor(knots[0], step.degrees[0], rows, local[0]));
+}

@@ -17,7 +17,7 @@ import { copyFileSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdir
 import { fileURLToPath } from 'node:url';
 import { tmpdir, cpus } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
-import { backProject, curveDomain, curveAt, dist, distanceToCurve, ffd, insidePolygon, latticePoints, quantile, surfaceAt, surfaceDomain } from './geometry.mjs';
+import { backProject, bsplineFfd, curveDomain, curveAt, dist, distanceToCurve, ffd, insidePolygon, latticePoints, quantile, surfaceAt, surfaceDomain } from './geometry.mjs';
 import { along, launchBrowser, startStudio, studioPage } from './studio_driver.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -500,7 +500,7 @@ try {
     }
   });
 
-  await check('taper and twist from the sliders against Barr\'s formulas; a surface point pulled by direct manipulation', async () => {
+  await check('taper and twist from the sliders against Barr\'s formulas; a surface point pulled by direct manipulation; a B-spline lattice dragged', async () => {
     // a studio on a recipe holding one bicubic patch, 400 x 200 mm with a bump
     const dir = join(work, 'global');
     mkdirSync(dir);
@@ -586,14 +586,61 @@ try {
       assert(reached <= tolerance, `the pulled point is ${reached} mm from where it was taken (tolerance ${tolerance} mm)`);
       const history = await g.call(() => window.clayStudio.history());
       assert(history.entries.filter((e) => e.startsWith('drag patch_global1')).length === 1, `history: ${history.entries}`);
-      return `${barrNote}; direct manipulation: the point pulled to within ${reached.toExponential(2)} mm of the pointer's target (tolerance ${tolerance.toExponential(2)} mm)`;
+      const dmNote = `direct manipulation: the point pulled to within ${reached.toExponential(2)} mm of the pointer's target (tolerance ${tolerance.toExponential(2)} mm)`;
+      // A B-spline lattice on the pulled patch, a point dragged up: the surface is the pointwise
+      // B-spline FFD of its parent (Hsu–Hughes–Kaufman eq. 1), to the refit's tolerance.
+      await globalPage.click('#tool-orbit');
+      await g.clickAt(surfaceAt(pulled, (surfaceDomain(pulled)[0][0] + surfaceDomain(pulled)[0][1]) / 2, (surfaceDomain(pulled)[1][0] + surfaceDomain(pulled)[1][1]) / 2), false);
+      await globalPage.selectOption('#lattice-kind', 'bspline');
+      await globalPage.click('#build-lattice');
+      await g.idle();
+      assert(!(await g.lastError()), await g.lastError());
+      const lh = (await g.call(() => window.clayStudio.handles())).find((h) => h.kind === 'lattice' && h.index.join() === '3,3,1');
+      assert(lh, 'no B-spline lattice handle [3, 3, 1]');
+      await globalPage.mouse.move(...lh.screen);
+      await globalPage.mouse.down();
+      for (let k = 1; k <= 8; k++) await globalPage.mouse.move(lh.screen[0], lh.screen[1] - 3 * k);
+      await globalPage.mouse.up();
+      await g.idle();
+      assert(!(await g.lastError()), await g.lastError());
+      const r3 = await g.call(() => window.clayStudio.recipe());
+      const latName = Object.keys(r3.deformations).find((n) => r3.deformations[n][0].kind === 'bspline_lattice');
+      const latStep = r3.deformations[latName][0];
+      assert(latStep.moves.length === 1, `moves: ${JSON.stringify(latStep.moves)}`);
+      const latSurface = Object.keys(r3.surfaces).find((n) => r3.surfaces[n].deform && r3.surfaces[n].deform.deformation === latName);
+      const shapedB = (await g.call(() => window.clayStudio.surfaces()))[latSurface];
+      const parentB = (await g.call(() => window.clayStudio.befores()))[latSurface];
+      const latPoints = (() => {
+        // undisplaced at the Greville abscissae of clamped uniform knots, then the move
+        const ab = (cells, p) => {
+          const kn = [...Array(p + 1).fill(0), ...Array.from({ length: cells - 1 }, (_, i) => (i + 1) / cells), ...Array(p + 1).fill(1)];
+          return Array.from({ length: cells + p }, (_, i) => kn.slice(i + 1, i + p + 1).reduce((a, b) => a + b, 0) / p);
+        };
+        const [xs, ys, zs] = [0, 1, 2].map((e) => ab(latStep.cells[e], latStep.degrees[e]));
+        const out = [];
+        for (const a of xs) for (const b of ys) for (const c of zs) out.push([0, 1, 2].map((e) => latStep.frame.origin[e] + a * latStep.frame.s[e] + b * latStep.frame.t[e] + c * latStep.frame.u[e]));
+        const mv = latStep.moves[0];
+        out[(mv.index[0] * ys.length + mv.index[1]) * zs.length + mv.index[2]] = mv.to;
+        return out;
+      })();
+      const [[bu0, bu1], [bv0, bv1]] = surfaceDomain(shapedB);
+      let offB = 0;
+      for (let a = 0; a <= 16; a++)
+        for (let b = 0; b <= 16; b++) {
+          const u = bu0 + ((bu1 - bu0) * a) / 16;
+          const v = bv0 + ((bv1 - bv0) * b) / 16;
+          offB = Math.max(offB, dist(surfaceAt(shapedB, u, v), bsplineFfd(latStep, latPoints, surfaceAt(parentB, u, v))));
+        }
+      const latRep = (await g.call(() => window.clayStudio.reply())).steps.find((st) => st.path === `surfaces.${latSurface}.steps[0]`);
+      assert(offB <= latRep.figures.tolerance_mm, `the B-spline lattice's surface is ${offB} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm})`);
+      return `${barrNote}; ${dmNote}; B-spline lattice: ${offB.toExponential(2)} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm.toExponential(2)} mm)`;
     } finally {
       await globalPage.close();
       third.process.kill();
     }
   });
 
-  await check('constraints on two strokes of a plane (coincident, tangent, a conflict refused); a stroke in 3D between two views', async () => {
+  await check('constraints on two strokes of a plane (coincident, tangent, a conflict refused); a stroke in 3D between two views; revolve about a picked line; a plane at a picked surface point', async () => {
     const dir = join(work, 'sketch');
     mkdirSync(dir);
     writeFileSync(join(dir, 'sketch.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'sketch' }));
@@ -682,7 +729,67 @@ try {
       }
       assert(shadow <= 2 * stroke.tolerance + 1, `the 3D curve's shadow is ${shadow} mm off the first curve`);
       assert(heights <= 2 * stroke.tolerance + 2, `the 3D curve's heights are ${heights} mm off the drawn ones`);
-      return `${constraintNote}; 3D between two views: shadow within ${shadow.toFixed(2)} mm, heights within ${heights.toFixed(2)} mm`;
+      const threeDNote = `3D between two views: shadow within ${shadow.toFixed(2)} mm, heights within ${heights.toFixed(2)} mm`;
+      // Revolve about a picked line: a profile and an axis drawn on XZ (front view), both picked.
+      await sketchPage.selectOption('#sketch-on', 'xz');
+      await sketchPage.fill('#sketch-offset', '0');
+      await k.draw(along([250, -150], [250, 150], 0, 8, (x, z) => [x, 0, z]));
+      await k.draw(along([320, -120], [320, 120], 30, 8, (x, z) => [x, 0, z]));
+      await sketchPage.click('#tool-orbit');
+      await k.call(() => window.clayStudio.setView('iso'));
+      await k.clickCurve('s5', false);
+      await k.clickCurve('s4', true);
+      await sketchPage.click('#build-revolve');
+      await k.idle();
+      assert(!(await k.lastError()), await k.lastError());
+      const all = await k.call(() => window.clayStudio.curves());
+      const revolved = (await k.call(() => window.clayStudio.surfaces())).revolve1;
+      assert(revolved, 'no surface revolve1');
+      // every point of the revolved surface is a profile point turned about the axis: its
+      // (axial, radial) coordinates lie on the profile's
+      const ax = all.s4;
+      const nax = ax.weights.length;
+      const a0 = ax.points.slice(0, 3);
+      const dir = [0, 1, 2].map((e) => ax.points[3 * nax - 3 + e] - a0[e]);
+      const len = Math.hypot(...dir);
+      const unit = dir.map((x) => x / len);
+      const cyl = (q) => {
+        const d = [0, 1, 2].map((e) => q[e] - a0[e]);
+        const axial = d[0] * unit[0] + d[1] * unit[1] + d[2] * unit[2];
+        return [axial, Math.hypot(...d.map((x, e) => x - axial * unit[e]))];
+      };
+      const [p0, p1] = curveDomain(all.s5);
+      const profile = Array.from({ length: 4001 }, (_, i) => cyl(curveAt(all.s5, p0 + ((p1 - p0) * i) / 4000)));
+      const [[ru0, ru1], [rv0, rv1]] = surfaceDomain(revolved);
+      let offR = 0;
+      for (let i = 0; i <= 12; i++)
+        for (let j = 0; j <= 12; j++) {
+          const c = cyl(surfaceAt(revolved, ru0 + ((ru1 - ru0) * i) / 12, rv0 + ((rv1 - rv0) * j) / 12));
+          offR = Math.max(offR, Math.min(...profile.map((q) => Math.hypot(q[0] - c[0], q[1] - c[1]))));
+        }
+      assert(offR <= 0.1, `the revolved surface is ${offR} mm off the profile turned about the picked axis`);
+      // A plane placed at a picked point of the revolved surface; a stroke drawn on it lies in it.
+      await sketchPage.click('#tool-sketch');
+      await sketchPage.selectOption('#sketch-on', 'picked');
+      const at = surfaceAt(revolved, (ru0 + ru1) / 2, (rv0 + rv1) / 2);
+      await k.clickAt(at, false);
+      const placed = await sketchPage.locator('#message').textContent();
+      assert(placed.startsWith('plane placed'), `the plane was not placed: "${placed}"`);
+      await k.draw(along([at[0] - 40, at[2] - 40], [at[0] + 40, at[2] + 40], 0, 4, (x, z) => [x, at[1], z]));
+      const rec = await k.call(() => window.clayStudio.recipe());
+      const last = Object.keys(rec.strokes).pop();
+      const pl = rec.strokes[last].plane;
+      assert(pl && pl.normal, `stroke ${last} has no picked plane`);
+      const drawnOn = (await k.call(() => window.clayStudio.curves()))[last];
+      let offPlane = 0;
+      const nl = Math.hypot(...pl.normal);
+      for (let i = 0; i < drawnOn.weights.length; i++) offPlane = Math.max(offPlane, Math.abs([0, 1, 2].reduce((acc, e) => acc + (drawnOn.points[3 * i + e] - pl.origin[e]) * pl.normal[e], 0)) / nl);
+      assert(offPlane <= 1e-9, `the stroke on the picked plane is ${offPlane} mm off it`);
+      // the plane's origin is the point pressed on the surface (on its mesh: within the mesh's sag)
+      const o = cyl(pl.origin);
+      const onSurface = Math.min(...profile.map((q) => Math.hypot(q[0] - o[0], q[1] - o[1])));
+      assert(onSurface <= 1, `the picked plane's origin is ${onSurface} mm off the revolved surface`);
+      return `${constraintNote}; ${threeDNote}; revolve about a picked line within ${offR.toExponential(1)} mm; stroke on a picked plane ${offPlane.toExponential(1)} mm off it`;
     } finally {
       await sketchPage.close();
       fourth.process.kill();

@@ -415,9 +415,38 @@ function millimetresPerPixel(p) {
 }
 const PLANE_NORMALS = { xy: [0, 0, 1], xz: [0, 1, 0], yz: [1, 0, 0] };
 const PLANE_X = { xy: [1, 0, 0], xz: [1, 0, 0], yz: [0, 1, 0] };
+// "plane at a picked surface point": the first press on a surface places the plane there (its
+// normal the surface's), the strokes after it are drawn on it; a press off the surfaces keeps it.
+let pickedPlane = null;
+const pickedOutline = new THREE.LineLoop(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: 0x8fd0ff, depthTest: false }));
+pickedOutline.renderOrder = 3;
+pickedOutline.visible = false;
+scene.add(pickedOutline);
+function placePickedPlane(hit) {
+  const normal = hit.face.normal.clone().transformDirection(hit.object.matrixWorld).normalize();
+  pickedPlane = { origin: hit.point.toArray().map((x) => Number(x.toPrecision(12))), normal: normal.toArray().map((x) => Number(x.toPrecision(12))) };
+  // an outline square of a quarter of the scene's size, in the plane
+  const size = sceneBox().getSize(new THREE.Vector3()).length() / 8;
+  const e1 = new THREE.Vector3(1, 0, 0);
+  if (Math.abs(e1.dot(normal)) > 0.9) e1.set(0, 1, 0);
+  e1.sub(normal.clone().multiplyScalar(e1.dot(normal))).normalize();
+  const e2 = normal.clone().cross(e1);
+  const corners = [
+    [-1, -1],
+    [1, -1],
+    [1, 1],
+    [-1, 1],
+  ].map(([a, b]) => hit.point.clone().addScaledVector(e1, a * size).addScaledVector(e2, b * size));
+  pickedOutline.geometry.setFromPoints(corners);
+  pickedOutline.visible = true;
+  showMessage('plane placed at the picked point: draw on it (pick again with Shift-press on a surface)');
+  dirty();
+}
+
 /** The sketch plane chosen in the toolbar: {origin, normal, x_axis} (recipe form). */
 function sketchPlane() {
   const on = $('sketch-on').value;
+  if (on === 'picked') return pickedPlane;
   const offset = Number($('sketch-offset').value) || 0;
   if (on === 'view') {
     const normal = camera.position.clone().sub(controls.target).normalize();
@@ -726,8 +755,8 @@ function rebuildHandles() {
     }
   }
   for (const lattice of latticesShown()) {
-    const pts = names.latticePoints(lattice.step);
-    const [l, m, n] = lattice.step.degrees;
+    const pts = lattice.step.kind === 'bspline_lattice' ? names.bsplineLatticePoints(lattice.step) : names.latticePoints(lattice.step);
+    const [l, m, n] = names.latticeCounts(lattice.step).map((c) => c - 1);
     const seg = [];
     const at = (i, j, k) => pts[(i * (m + 1) + j) * (n + 1) + k];
     for (let i = 0; i <= l; i++)
@@ -776,7 +805,7 @@ function latticesShown() {
     if (chosen.length && !chosen.includes(name)) continue;
     const stack = (doc.recipe.deformations || {})[def.deform.deformation] || [];
     stack.forEach((step, i) => {
-      if (step.kind === 'bezier_lattice') out.push({ deformation: def.deform.deformation, stepIndex: i, step });
+      if (step.kind === 'bezier_lattice' || step.kind === 'bspline_lattice') out.push({ deformation: def.deform.deformation, stepIndex: i, step });
     });
   }
   const models = selection.filter((s) => s.kind === 'model').map((s) => s.name);
@@ -784,7 +813,7 @@ function latticesShown() {
     if (!def.deformation || (models.length && !models.includes(name)) || (chosen.length && !models.length)) continue;
     const stack = (doc.recipe.deformations || {})[def.deformation] || [];
     stack.forEach((step, i) => {
-      if (step.kind === 'bezier_lattice' && !out.some((o) => o.deformation === def.deformation)) out.push({ deformation: def.deformation, stepIndex: i, step });
+      if ((step.kind === 'bezier_lattice' || step.kind === 'bspline_lattice') && !out.some((o) => o.deformation === def.deformation)) out.push({ deformation: def.deformation, stepIndex: i, step });
     });
   }
   return out;
@@ -960,6 +989,13 @@ canvas.addEventListener(
           return;
         }
       }
+      if (on === 'picked' && (!pickedPlane || event.shiftKey)) {
+        const hit = onSurface(pointerRay(event.clientX, event.clientY));
+        if (hit && hit.face) placePickedPlane(hit);
+        else showMessage('press on a surface to place the plane there', true);
+        event.stopImmediatePropagation();
+        return;
+      }
       const plane = on === 'surface' || on === 'over' ? null : sketchPlane();
       ink = { points: [], plane, over, line: inkLine(), pointerId: event.pointerId };
       const p = inkPoint(event);
@@ -1078,10 +1114,20 @@ $('build-skin').addEventListener('click', () => {
 });
 $('build-revolve').addEventListener('click', () => {
   const curves = selected('curve');
-  if (curves.length !== 1) return showMessage('select one profile curve, choose the axis, then Revolve', true);
-  const direction = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] }[$('revolve-axis').value];
+  if (curves.length < 1 || curves.length > 2) return showMessage('select the profile curve (and a second curve whose chord is the axis, or choose a world axis), then Revolve', true);
+  let axis = { point: [0, 0, 0], direction: { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] }[$('revolve-axis').value] };
+  if (curves.length === 2) {
+    // the axis: the second curve's chord, from its start to its end
+    const c = doc.curves.get(curves[1]);
+    const n = c.weights.length;
+    const a = [c.points[0], c.points[1], c.points[2]];
+    const b = [c.points[3 * n - 3], c.points[3 * n - 2], c.points[3 * n - 1]];
+    const d = b.map((x, e) => x - a[e]);
+    if (Math.hypot(...d) === 0) return showMessage(`the axis curve "${curves[1]}" is closed: its chord has no direction`, true);
+    axis = { point: a, direction: d };
+  }
   const name = names.free(doc.recipe, 'revolve');
-  edit({ path: `surfaces.${name}`, value: { revolve: { profile: curves[0], axis: { point: [0, 0, 0], direction } } }, create: true }, `revolve ${name}`).then(() => select(null));
+  edit({ path: `surfaces.${name}`, value: { revolve: { profile: curves[0], axis } }, create: true }, `revolve ${name}`).then(() => select(null));
 });
 $('build-style').addEventListener('click', () => {
   const curves = selected('curve');
@@ -1117,11 +1163,16 @@ $('build-lattice').addEventListener('click', () => {
   if (!surface) return;
   const deformation = names.free(doc.recipe, 'lattice');
   const result = names.free(doc.recipe, `${surface}_ffd`);
-  const step = { kind: 'bezier_lattice', name: deformation, frame: names.boxFrame(doc.surfaces.get(surface).points), degrees: [3, 3, 1], moves: [] };
+  const frame = names.boxFrame(doc.surfaces.get(surface).points);
+  // a Bézier lattice composes exactly; a B-spline lattice's knot planes cross the surface off its
+  // iso-lines, so its result is a certified refit
+  const bspline = $('lattice-kind').value === 'bspline';
+  const step = bspline ? { kind: 'bspline_lattice', name: deformation, frame, cells: [4, 4, 1], degrees: [3, 3, 1], knots: 'clamped', moves: [] } : { kind: 'bezier_lattice', name: deformation, frame, degrees: [3, 3, 1], moves: [] };
+  const deform = bspline ? { surface, deformation, composition: { mode: 'refit', tolerance: 1e-4 } } : { surface, deformation };
   edit(
     [
       { path: `deformations.${deformation}`, value: [step], create: true },
-      { path: `surfaces.${result}`, value: { deform: { surface, deformation } }, create: true },
+      { path: `surfaces.${result}`, value: { deform }, create: true },
     ],
     `lattice on ${surface}`,
   ).then(({ reply }) => {

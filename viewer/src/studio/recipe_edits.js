@@ -65,6 +65,45 @@ export function latticePoints(step) {
   return out;
 }
 
+/**
+ * A B-spline lattice step's control points (docs/recipe.md: `cells`, `degrees`, `knots` "clamped"
+ * or "uniform"), s-major like latticePoints: the undisplaced lattice at the Greville abscissae of
+ * each direction's knots (Hsu–Hughes–Kaufman: the identity), with `moves` applied.
+ */
+export function bsplineLatticePoints(step) {
+  const abscissae = (cells, p, kind) => {
+    const n = cells + p;
+    const knots = [];
+    if (kind === 'uniform') for (let i = 0; i <= n + p; i++) knots.push((i - p) / cells);
+    else {
+      for (let i = 0; i <= p; i++) knots.push(0);
+      for (let i = 1; i < cells; i++) knots.push(i / cells);
+      for (let i = 0; i <= p; i++) knots.push(1);
+    }
+    return Array.from({ length: n }, (_, i) => {
+      let sum = 0;
+      for (let k = 1; k <= p; k++) sum += knots[i + k];
+      return sum / p;
+    });
+  };
+  const [xs, ys, zs] = [0, 1, 2].map((e) => abscissae(step.cells[e], step.degrees[e], step.knots || 'clamped'));
+  const { origin, s, t, u } = step.frame;
+  const out = [];
+  for (const a of xs) for (const b of ys) for (const c of zs) out.push([0, 1, 2].map((e) => origin[e] + a * s[e] + b * t[e] + c * u[e]));
+  const [, m, n] = [xs.length, ys.length, zs.length];
+  for (const move of step.moves || []) {
+    const [i, j, k] = move.index;
+    const at = (i * m + j) * n + k;
+    out[at] = move.to ? move.to.slice() : out[at].map((x, e) => x + move.by[e]);
+  }
+  return out;
+}
+
+/** A lattice step's control point counts per direction. */
+export function latticeCounts(step) {
+  return step.kind === 'bspline_lattice' ? [0, 1, 2].map((e) => step.cells[e] + step.degrees[e]) : step.degrees.map((d) => d + 1);
+}
+
 /** A lattice's moves with the point at `index` moved to `to` (replacing an earlier move of it). */
 export function withMove(moves, index, to) {
   const same = (m) => m.index.every((x, e) => x === index[e]);
