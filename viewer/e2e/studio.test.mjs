@@ -95,6 +95,24 @@ async function shot(label) {
   await page.screenshot({ path: join(shots, `${String(++shotCount).padStart(2, '0')}-${label}.png`) });
 }
 
+/**
+ * Runs `fn(page, driver)` on a studio of its own: `clayform studio FILE` and a page open on it
+ * (its page errors counted as the test's), closed and stopped afterwards.
+ */
+async function withStudio(file, label, fn) {
+  const studio = await startStudio(clayform, file);
+  const other = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+  other.on('pageerror', (e) => problems.push(`page error (${label}): ${e.message}`));
+  const driver = studioPage(other);
+  try {
+    await driver.open(studio.url);
+    return await fn(other, driver);
+  } finally {
+    await other.close();
+    studio.process.kill();
+  }
+}
+
 /** Draws a stroke through world points on the plane z = z0; the drawn path back-projected onto it, here. */
 async function draw(world, { steps = 40, z0 = 0 } = {}) {
   const path = await driver.draw(world, { steps });
@@ -454,12 +472,7 @@ try {
     const modelDir = join(work, 'model');
     mkdirSync(modelDir);
     copyFileSync(join(here, '..', '..', 'examples', 'models', 'block.step'), join(modelDir, 'block.step'));
-    const second = await startStudio(clayform, join(modelDir, 'block.step'));
-    const modelPage = await browser.newPage({ viewport: { width: 1100, height: 700 } });
-    modelPage.on('pageerror', (e) => problems.push(`page error (model): ${e.message}`));
-    const m = studioPage(modelPage);
-    try {
-      await m.open(second.url);
+    return withStudio(join(modelDir, 'block.step'), 'model', async (modelPage, m) => {
       const models = await m.call(() => window.clayStudio.models());
       assert(models.block && models.block.triangles > 0, `no mesh of the model: ${Object.keys(models)}`);
       const topBefore = Math.max(...models.block.positions.filter((_, k) => k % 3 === 2));
@@ -494,10 +507,7 @@ try {
       const files = readdirSync(join(modelDir, 'replay'));
       assert(files.includes('block.step'), `replay wrote ${files}`);
       return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}`;
-    } finally {
-      await modelPage.close();
-      second.process.kill();
-    }
+    });
   });
 
   await check('taper and twist from the sliders against Barr\'s formulas; a surface point pulled by direct manipulation; a B-spline lattice dragged', async () => {
@@ -508,12 +518,7 @@ try {
     const points = [];
     for (let i = 0; i < 4; i++) for (let j = 0; j < 4; j++) points.push([-200 + (400 * i) / 3, -100 + (200 * j) / 3, (i === 1 || i === 2) && (j === 1 || j === 2) ? 30 : 0]);
     writeFileSync(join(dir, 'patch.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'patch', surfaces: { patch: { bspline: { degrees: [3, 3], knots_u: knots, knots_v: knots, points } } } }));
-    const third = await startStudio(clayform, join(dir, 'patch.json'));
-    const globalPage = await browser.newPage({ viewport: { width: 1100, height: 700 } });
-    globalPage.on('pageerror', (e) => problems.push(`page error (global): ${e.message}`));
-    const g = studioPage(globalPage);
-    try {
-      await g.open(third.url);
+    return withStudio(join(dir, 'patch.json'), 'global', async (globalPage, g) => {
       await g.clickAt([60, 30, 17], false);
       await globalPage.click('#build-global');
       await g.idle();
@@ -634,22 +639,14 @@ try {
       const latRep = (await g.call(() => window.clayStudio.reply())).steps.find((st) => st.path === `surfaces.${latSurface}.steps[0]`);
       assert(offB <= latRep.figures.tolerance_mm, `the B-spline lattice's surface is ${offB} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm})`);
       return `${barrNote}; ${dmNote}; B-spline lattice: ${offB.toExponential(2)} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm.toExponential(2)} mm)`;
-    } finally {
-      await globalPage.close();
-      third.process.kill();
-    }
+    });
   });
 
   await check('constraints on two strokes of a plane (coincident, tangent, a conflict refused); a stroke in 3D between two views; revolve about a picked line; a plane at a picked surface point', async () => {
     const dir = join(work, 'sketch');
     mkdirSync(dir);
     writeFileSync(join(dir, 'sketch.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'sketch' }));
-    const fourth = await startStudio(clayform, join(dir, 'sketch.json'));
-    const sketchPage = await browser.newPage({ viewport: { width: 1100, height: 700 } });
-    sketchPage.on('pageerror', (e) => problems.push(`page error (sketch): ${e.message}`));
-    const k = studioPage(sketchPage);
-    try {
-      await k.open(fourth.url);
+    return withStudio(join(dir, 'sketch.json'), 'sketch', async (sketchPage, k) => {
       await sketchPage.click('#tool-sketch');
       await sketchPage.uncheck('#snap');
       // two strokes whose ends nearly meet at an angle
@@ -790,10 +787,7 @@ try {
       const onSurface = Math.min(...profile.map((q) => Math.hypot(q[0] - o[0], q[1] - o[1])));
       assert(onSurface <= 1, `the picked plane's origin is ${onSurface} mm off the revolved surface`);
       return `${constraintNote}; ${threeDNote}; revolve about a picked line within ${offR.toExponential(1)} mm; stroke on a picked plane ${offPlane.toExponential(1)} mm off it`;
-    } finally {
-      await sketchPage.close();
-      fourth.process.kill();
-    }
+    });
   });
 
   await check('no page errors', async () => {

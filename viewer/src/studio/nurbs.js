@@ -258,28 +258,3 @@ export function surfaceGrid(net, rows, cols) {
   }
   return { rows, cols, position, normal, gaussian, mean, su, sv };
 }
-
-/** Point of a surface net at (u, v): [x, y, z] (the same sums as surfaceGrid, no derivatives). */
-export function surfacePoint(net, u, v) {
-  const [p, q] = net.degrees;
-  const [nu, nv] = net.counts;
-  const su = findSpan(net.knots_u, p, nu, u);
-  const sv = findSpan(net.knots_v, q, nv, v);
-  const Nu = basisDerivatives(net.knots_u, p, su, u, 0)[0];
-  const Nv = basisDerivatives(net.knots_v, q, sv, v, 0)[0];
-  let x = 0;
-  let y = 0;
-  let z = 0;
-  let w = 0;
-  for (let a = 0; a <= p; a++) {
-    for (let b = 0; b <= q; b++) {
-      const idx = (su - p + a) * nv + (sv - q + b);
-      const f = Nu[a] * Nv[b] * net.weights[idx];
-      x += f * net.points[3 * idx];
-      y += f * net.points[3 * idx + 1];
-      z += f * net.points[3 * idx + 2];
-      w += f;
-    }
-  }
-  return [x / w, y / w, z / w];
-}
