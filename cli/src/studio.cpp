@@ -119,20 +119,32 @@ void apply_change(Json& doc, const Json& change, std::string& first_path) {
 
 }  // namespace
 
-std::vector<std::uint8_t> net_frame(const std::string& header_json,
-                                    const std::vector<double>& points,
-                                    const std::vector<double>& weights) {
-  // Sized once and filled with memcpy (GCC 12 misreads insert() of chars into bytes as an
-  // overflow at -O3).
-  const std::size_t header = 4 + header_json.size();
-  const std::size_t padded = (header + 7) / 8 * 8;
-  std::vector<std::uint8_t> out(padded + (points.size() + weights.size()) * sizeof(double), 0);
+namespace {
+
+/// A frame of `body_bytes` after its prefix: the 4-byte little-endian length of the JSON header,
+/// the header, zero padding to a multiple of 8. Returns the frame and where the body starts.
+/// (Sized once and filled with memcpy: GCC 12 misreads insert() of chars into bytes as an
+/// overflow at -O3.)
+std::pair<std::vector<std::uint8_t>, std::size_t> frame_with_header(const std::string& header_json,
+                                                                    std::size_t body_bytes) {
+  const std::size_t padded = (4 + header_json.size() + 7) / 8 * 8;
+  std::vector<std::uint8_t> out(padded + body_bytes, 0);
   const auto length = static_cast<std::uint32_t>(header_json.size());
   for (int k = 0; k < 4; ++k)
     out[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(length >> (8 * k));
   std::memcpy(out.data() + 4, header_json.data(), header_json.size());
-  std::memcpy(out.data() + padded, points.data(), points.size() * sizeof(double));  // x86-64: LE
-  std::memcpy(out.data() + padded + points.size() * sizeof(double), weights.data(),
+  return {std::move(out), padded};
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> net_frame(const std::string& header_json,
+                                    const std::vector<double>& points,
+                                    const std::vector<double>& weights) {
+  auto [out, at] =
+      frame_with_header(header_json, (points.size() + weights.size()) * sizeof(double));
+  std::memcpy(out.data() + at, points.data(), points.size() * sizeof(double));  // x86-64: LE
+  std::memcpy(out.data() + at + points.size() * sizeof(double), weights.data(),
               weights.size() * sizeof(double));
   return out;
 }
@@ -143,16 +155,10 @@ namespace {
 /// "vertices": n, "triangles": m}), then n * 3 float64 positions, n * 3 float64 unit normals and
 /// m * 3 uint32 node indices, little-endian.
 std::vector<std::uint8_t> mesh_frame(const std::string& header_json, const brep::ModelMesh& mesh) {
-  const std::size_t header = 4 + header_json.size();
-  const std::size_t padded = (header + 7) / 8 * 8;
   const std::size_t n = mesh.positions.size(), m = mesh.triangles.size();
-  std::vector<std::uint8_t> out(padded + 2 * n * 3 * sizeof(double) + m * 3 * sizeof(std::uint32_t),
-                                0);
-  const auto length = static_cast<std::uint32_t>(header_json.size());
-  for (int k = 0; k < 4; ++k)
-    out[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(length >> (8 * k));
-  std::memcpy(out.data() + 4, header_json.data(), header_json.size());
-  std::uint8_t* at = out.data() + padded;
+  auto [out, start] =
+      frame_with_header(header_json, 2 * n * 3 * sizeof(double) + m * 3 * sizeof(std::uint32_t));
+  std::uint8_t* at = out.data() + start;
   for (const auto* list : {&mesh.positions, &mesh.normals})
     for (const Eigen::Vector3d& p : *list) {
       std::memcpy(at, p.data(), 3 * sizeof(double));

@@ -143,18 +143,38 @@ export function backProject(cam, clientX, clientY, z0) {
 }
 
 
+/** A lattice direction's knots for `cells` cells of degree p, "clamped" or "uniform" (docs/recipe.md). */
+function latticeKnots(cells, p, kind) {
+  const k = [];
+  if (kind === 'uniform') for (let i = 0; i <= cells + 2 * p; i++) k.push((i - p) / cells);
+  else {
+    for (let i = 0; i <= p; i++) k.push(0);
+    for (let i = 1; i < cells; i++) k.push(i / cells);
+    for (let i = 0; i <= p; i++) k.push(1);
+  }
+  return k;
+}
+
+/** A B-spline lattice step's points: undisplaced at the Greville abscissae (the identity), then its moves. */
+export function bsplineLatticePoints(step) {
+  const [xs, ys, zs] = [0, 1, 2].map((e) => {
+    const p = step.degrees[e];
+    const kn = latticeKnots(step.cells[e], p, step.knots || 'clamped');
+    return Array.from({ length: step.cells[e] + p }, (_, i) => kn.slice(i + 1, i + p + 1).reduce((a, b) => a + b, 0) / p);
+  });
+  const { origin, s, t, u } = step.frame;
+  const out = [];
+  for (const a of xs) for (const b of ys) for (const c of zs) out.push([0, 1, 2].map((e) => origin[e] + a * s[e] + b * t[e] + c * u[e]));
+  for (const mv of step.moves || []) {
+    const at = (mv.index[0] * ys.length + mv.index[1]) * zs.length + mv.index[2];
+    out[at] = mv.to ? mv.to.slice() : out[at].map((x, e) => x + mv.by[e]);
+  }
+  return out;
+}
+
 /** Hsu–Hughes–Kaufman eq. (1): the trivariate B-spline sum of a lattice step (cells, degrees, knots) at x. */
 export function bsplineFfd(step, points, x) {
-  const knotsOf = (cells, p, kind) => {
-    const k = [];
-    if (kind === 'uniform') for (let i = 0; i <= cells + 2 * p; i++) k.push((i - p) / cells);
-    else {
-      for (let i = 0; i <= p; i++) k.push(0);
-      for (let i = 1; i < cells; i++) k.push(i / cells);
-      for (let i = 0; i <= p; i++) k.push(1);
-    }
-    return k;
-  };
+  const knotsOf = latticeKnots;
   const { origin, s: S, t: T, u: U } = step.frame;
   const d = [0, 1, 2].map((e) => x[e] - origin[e]);
   const det3 = (a, b, c) => a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);

@@ -17,7 +17,7 @@ import { copyFileSync, existsSync, mkdirSync, mkdtempSync, readFileSync, readdir
 import { fileURLToPath } from 'node:url';
 import { tmpdir, cpus } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
-import { backProject, bsplineFfd, curveDomain, curveAt, dist, distanceToCurve, ffd, insidePolygon, latticePoints, quantile, surfaceAt, surfaceDomain } from './geometry.mjs';
+import { backProject, bsplineFfd, bsplineLatticePoints, curveDomain, curveAt, dist, distanceToCurve, ffd, insidePolygon, latticePoints, quantile, surfaceAt, surfaceDomain } from './geometry.mjs';
 import { along, launchBrowser, startStudio, studioPage } from './studio_driver.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -615,19 +615,7 @@ try {
       const latSurface = Object.keys(r3.surfaces).find((n) => r3.surfaces[n].deform && r3.surfaces[n].deform.deformation === latName);
       const shapedB = (await g.call(() => window.clayStudio.surfaces()))[latSurface];
       const parentB = (await g.call(() => window.clayStudio.befores()))[latSurface];
-      const latPoints = (() => {
-        // undisplaced at the Greville abscissae of clamped uniform knots, then the move
-        const ab = (cells, p) => {
-          const kn = [...Array(p + 1).fill(0), ...Array.from({ length: cells - 1 }, (_, i) => (i + 1) / cells), ...Array(p + 1).fill(1)];
-          return Array.from({ length: cells + p }, (_, i) => kn.slice(i + 1, i + p + 1).reduce((a, b) => a + b, 0) / p);
-        };
-        const [xs, ys, zs] = [0, 1, 2].map((e) => ab(latStep.cells[e], latStep.degrees[e]));
-        const out = [];
-        for (const a of xs) for (const b of ys) for (const c of zs) out.push([0, 1, 2].map((e) => latStep.frame.origin[e] + a * latStep.frame.s[e] + b * latStep.frame.t[e] + c * latStep.frame.u[e]));
-        const mv = latStep.moves[0];
-        out[(mv.index[0] * ys.length + mv.index[1]) * zs.length + mv.index[2]] = mv.to;
-        return out;
-      })();
+      const latPoints = bsplineLatticePoints(latStep);
       const [[bu0, bu1], [bv0, bv1]] = surfaceDomain(shapedB);
       let offB = 0;
       for (let a = 0; a <= 16; a++)

@@ -65,12 +65,17 @@ export function applyFfd(prepared, points, position, normal) {
   const count = grid.rows * grid.cols;
   let lo = Infinity;
   let hi = -Infinity;
+  // scratch, once per call: this runs for every vertex at every pointer move
+  const J = new Float64Array(9); // dX/ds, dX/dt, dX/du as columns, row-major
+  const W = new Float64Array(9); // the world Jacobian J M^-1
+  const a = new Float64Array(3);
+  const b = new Float64Array(3);
   for (let k = 0; k < count; k++) {
     const [[bs, ds], [bt, dt], [bu, du]] = basis[k];
     let x = 0;
     let y = 0;
     let z = 0;
-    const J = [0, 0, 0, 0, 0, 0, 0, 0, 0]; // dX/ds, dX/dt, dX/du as columns, row-major
+    J.fill(0);
     let at = 0;
     for (let i = 0; i <= l; i++)
       for (let j = 0; j <= m; j++)
@@ -93,9 +98,8 @@ export function applyFfd(prepared, points, position, normal) {
     position[3 * k + 1] = y;
     position[3 * k + 2] = z;
     // world Jacobian J M^-1, applied to the parent's tangents
-    const a = [0, 0, 0];
-    const b = [0, 0, 0];
-    const W = [0, 0, 0, 0, 0, 0, 0, 0, 0];
+    a.fill(0);
+    b.fill(0);
     for (let e = 0; e < 3; e++) {
       for (let c = 0; c < 3; c++) {
         const w = J[3 * e] * Minv[c] + J[3 * e + 1] * Minv[3 + c] + J[3 * e + 2] * Minv[6 + c];

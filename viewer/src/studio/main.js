@@ -469,7 +469,7 @@ function onSurface(raycaster) {
 const PICK_PX = 8;
 function pick(clientX, clientY) {
   let best = null;
-  for (const [name, curve] of doc.curves) {
+  for (const name of doc.curves.keys()) {
     const line = curveGroup.getObjectByName(name);
     if (!line) continue;
     const pos = line.geometry.getAttribute('position').array;
@@ -479,7 +479,6 @@ function pick(clientX, clientY) {
       const d = segmentDistance([clientX, clientY], a, b);
       if (d < PICK_PX && (!best || d < best.d)) best = { d, kind: 'curve', name };
     }
-    void curve;
   }
   if (best) return best;
   const hit = onSurface(pointerRay(clientX, clientY));
