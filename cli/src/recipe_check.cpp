@@ -91,8 +91,11 @@ void RecipeChecker::declare(const Json& root) {
       f(name, value, path);
     }
   };
-  each("strokes",
-       [&](const std::string& n, const Json&, const std::string& p) { declare_curve(n, p); });
+  each("strokes", [&](const std::string& n, const Json& v, const std::string& p) {
+    const int pieces = declared_pieces(v);  // a stroke split at its corners: NAME.1 .. NAME.N
+    if (pieces == 0) declare_curve(n, p);
+    for (int k = 1; k <= pieces; ++k) declare_curve(piece_name(n, k), key_path(p, "pieces"));
+  });
   each("curves",
        [&](const std::string& n, const Json&, const std::string& p) { declare_curve(n, p); });
   each("sketches", [&](const std::string& n, const Json& v, const std::string& p) {

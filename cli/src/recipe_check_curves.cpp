@@ -35,11 +35,16 @@ std::optional<sketch::SketchPlane> RecipeChecker::plane(const Json& j, const std
 }
 
 void RecipeChecker::stroke(const std::string& name, const Json& j, const std::string& path) {
-  names_.curves.push_back(name);  // defined even when broken: one problem, not a cascade
+  // Defined even when broken: one problem, not a cascade. A stroke split at its corners defines
+  // its pieces NAME.1 .. NAME.N instead of NAME (declared_pieces reads "pieces" as declare() did).
+  const int declared = declared_pieces(j);
+  if (declared == 0) names_.curves.push_back(name);
+  for (int k = 1; k <= declared; ++k) names_.curves.push_back(piece_name(name, k));
   if (!c_.object(j, path,
-                 {"points", "plane", "tolerance", "degree", "fairness", "closing_ratio",
-                  "accept_out_of_tolerance"},
-                 "a stroke {points, plane, tolerance, degree, fairness, closing_ratio}"))
+                 {"points", "plane", "tolerance", "degree", "fairness", "closing_ratio", "pieces",
+                  "corner_angle", "accept_out_of_tolerance"},
+                 "a stroke {points, plane, tolerance, degree, fairness, closing_ratio, pieces, "
+                 "corner_angle}"))
     return;
   StrokeDef s{name, path, {}, {}};
   const Json* pts = c_.member(j, path, "points", true, "the drawn points [[x, y, z], ...]");
@@ -51,13 +56,34 @@ void RecipeChecker::stroke(const std::string& name, const Json& j, const std::st
   s.fit.degree = c_.integer_or(j, path, "degree", s.fit.degree, 2, 9);
   s.fit.fairness = c_.number_or(j, path, "fairness", s.fit.fairness, non_negative);
   s.fit.closing_ratio = c_.number_or(j, path, "closing_ratio", s.fit.closing_ratio, Range{0, 0.5});
-  s.fit.corner_angle = 180.0;  // one curve per stroke in a recipe (docs/recipe.md)
+  s.pieces = c_.integer_or(j, path, "pieces", 0, 1, limit::stroke_pieces);
+  // Without "pieces", one curve per stroke, never split (docs/recipe.md); with it, split where
+  // the stroke turns by more than corner_angle (fit_stroke's default, 50 degrees).
+  s.fit.corner_angle = 180.0;
+  if (j.contains("corner_angle")) {
+    if (s.pieces == 0)
+      c_.add(key_path(path, "corner_angle"),
+             "\"corner_angle\" splits a stroke at its corners, so it needs \"pieces\" (how many "
+             "curves the stroke gives, named " +
+                 piece_name(name, 1) + " .. " + piece_name(name, 2) + " ...); add it or drop this");
+    s.fit.corner_angle = c_.number_or(j, path, "corner_angle", 50.0, Range{0, 180, true, false});
+  } else if (s.pieces > 0) {
+    s.fit.corner_angle = sketch::FitOptions{}.corner_angle;
+  }
   s.accept_out_of_tolerance = c_.boolean_or(j, path, "accept_out_of_tolerance", false);
   if (!p) return;
   s.stroke.points = *p;
   const auto list = sketch::problems(s.stroke, path);
   if (!list.empty()) return c_.add_all(path, list);
   if (c_.attempt(path, [&] { s.fit.validate(); })) data.strokes.push_back(std::move(s));
+}
+
+int declared_pieces(const Json& stroke) {
+  if (!stroke.is_object()) return 0;
+  const auto it = stroke.find("pieces");
+  if (it == stroke.end() || !it->is_number_integer()) return 0;
+  const auto n = it->get<long long>();
+  return n >= 1 && n <= limit::stroke_pieces ? static_cast<int>(n) : 0;
 }
 
 std::optional<surface::BSplineCurve> RecipeChecker::inline_curve(const Json& j,

@@ -69,6 +69,7 @@ constexpr double magnitude = 1e6;              // |any number|: mm (1 km), degre
 constexpr std::size_t entries = 1000;  // names per section, surfaces per export, skin sections
 constexpr std::size_t curve_points = 10000;     // control points of a curve, points of a polyline
 constexpr std::size_t stroke_points = 10000;    // drawn points of a stroke
+constexpr int stroke_pieces = 100;              // curves of a stroke split at its corners
 constexpr std::size_t surface_points = 250000;  // control points of an inline surface (500 x 500)
 constexpr std::size_t sketch_items = 1000;      // points, entities, constraints of a sketch
 constexpr std::size_t steps = 100;              // steps of a deformation stack
@@ -107,6 +108,10 @@ inline bool valid_name(std::string_view s) {
            c == '-';
   });
 }
+
+/// The "pieces" of a stroke's JSON when it is a valid count (1 .. limit::stroke_pieces), else 0:
+/// the names a stroke defines (declare() and stroke() agree; a bad count is reported by stroke()).
+int declared_pieces(const Json& stroke);
 
 /// The walk: the shared path-aware reader (clay/internal/json_reader.hpp) with the recipe's
 /// limits and wording, and the recipe's own composite reads.

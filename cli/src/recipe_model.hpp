@@ -48,7 +48,16 @@ struct StrokeDef {
   sketch::Stroke stroke;
   sketch::FitOptions fit;
   bool accept_out_of_tolerance = false;  ///< keep a fit that misses its tolerance
+  /// 0: one curve named after the stroke, never split; N >= 1: split at its corners into exactly
+  /// N curves, named piece_name(name, 1) .. piece_name(name, N) (the stroke's name is no curve).
+  int pieces = 0;
 };
+
+/// The name of a stroke's k-th curve (1-based) when it is split at its corners: "NAME.k", as a
+/// sketch's entities are "SKETCH.ENTITY".
+inline std::string piece_name(const std::string& stroke, int k) {
+  return stroke + "." + std::to_string(k);
+}
 
 /// A curve given inline (already built) or the reverse of another named curve.
 /// A mirror plane: through `origin`, normal `normal` (unit).

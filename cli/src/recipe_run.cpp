@@ -69,7 +69,7 @@ class Runner {
   /// Strokes, curves and sketches: every named curve, each after what it needs (a curve taken
   /// from a surface after that surface and the curves it is built from).
   void curves() {
-    for (const auto& s : data_.strokes) need_curve(s.name);
+    for (const auto& s : data_.strokes) need_curve(s.pieces == 0 ? s.name : piece_name(s.name, 1));
     for (const auto& c : data_.curves) need_curve(c.name);
     for (std::size_t k = 0; k < data_.sketches.size(); ++k) need_sketch(k);
   }
@@ -281,7 +281,7 @@ class Runner {
       for (const auto& c : needs.curves) need_curve(c);
       for (const auto& s : needs.surfaces) need_surface(s);
       for (const auto& s : data_.strokes)
-        if (s.name == name)
+        if (defines(s, name))
           return timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); });
       for (const auto& c : data_.curves)
         if (c.name == name) return timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); });
@@ -326,17 +326,46 @@ class Runner {
     result_.curves.emplace_back(name, std::move(c));
   }
 
+  /// Whether the stroke's fit gives the curve `name`: its own name, or one of its pieces.
+  static bool defines(const StrokeDef& s, const std::string& name) {
+    if (s.pieces == 0) return s.name == name;
+    for (int k = 1; k <= s.pieces; ++k)
+      if (piece_name(s.name, k) == name) return true;
+    return false;
+  }
+
   void stroke(const StrokeDef& s, StepReport& rep) {
     const sketch::StrokeFit fit = sketch::fit_stroke(s.stroke, s.fit);
-    if (fit.curves.size() != 1)
+    const std::size_t wanted = s.pieces == 0 ? 1 : static_cast<std::size_t>(s.pieces);
+    if (fit.curves.size() != wanted) {
+      const std::string found = std::to_string(fit.curves.size());
       throw Error(ErrorCategory::InvalidGeometry,
-                  "the stroke was fitted with " + std::to_string(fit.curves.size()) +
-                      " curves; a recipe stroke must give one curve: draw it as separate strokes");
-    const auto& c = fit.curves.front();
-    rep.figures = {{"control_points", static_cast<long long>(c.control_points)},
-                   {"max_deviation_mm", c.max_deviation_mm},
-                   {"rms_deviation_mm", c.rms_deviation_mm},
-                   {"closed", c.closed}};
+                  s.pieces == 0
+                      ? "the stroke was fitted with " + found +
+                            " curves; a recipe stroke without \"pieces\" gives one curve: draw "
+                            "it as separate strokes"
+                      : "the stroke turns by more than " + format("%g", s.fit.corner_angle) +
+                            " degrees at " + std::to_string(fit.corners.size()) +
+                            " corners, so it gives " + found + " curves, not " +
+                            std::to_string(s.pieces) + ": set \"pieces\": " + found + " (curves " +
+                            piece_name(s.name, 1) + " .. " +
+                            piece_name(s.name, static_cast<int>(fit.curves.size())) +
+                            "), change \"corner_angle\", or draw it again");
+    }
+    long long control_points = 0;
+    double rms = 0;
+    for (const auto& c : fit.curves) {
+      control_points += c.control_points;
+      rms = std::max(rms, c.rms_deviation_mm);
+    }
+    rep.figures = {{"control_points", control_points},
+                   {"max_deviation_mm", fit.max_deviation_mm},
+                   {"rms_deviation_mm", rms},
+                   {"closed", fit.closed}};
+    if (s.pieces > 0) {
+      rep.figures.emplace_back("pieces", static_cast<long long>(fit.curves.size()));
+      rep.figures.emplace_back("corners", static_cast<long long>(fit.corners.size()));
+    }
     rep.message = fit.summary.brief();
     if (!fit.summary.converged()) {  // a fit that misses its tolerance is a failure unless accepted
       if (!s.accept_out_of_tolerance)
@@ -347,7 +376,9 @@ class Runner {
                         "anyway, set \"accept_out_of_tolerance\": true on the stroke");
       rep.warning = true;
     }
-    add_curve(s.name, c.curve);
+    if (s.pieces == 0) return add_curve(s.name, fit.curves.front().curve);
+    for (std::size_t k = 0; k < fit.curves.size(); ++k)
+      add_curve(piece_name(s.name, static_cast<int>(k + 1)), fit.curves[k].curve);
   }
 
   void curve(const CurveDef& c, StepReport& rep) {

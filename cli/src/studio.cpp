@@ -5,6 +5,7 @@
 #include <clay/error.hpp>
 #include <clay/internal/files.hpp>
 #include <clay/recipe/recipe.hpp>
+#include <clay/sketch/fit.hpp>
 #include <clay/studio.hpp>
 
 #include <boost/asio/ip/tcp.hpp>
@@ -152,25 +153,167 @@ std::vector<std::uint8_t> net_frame(const std::string& header_json,
 namespace {
 
 /// A model's frame: the length and JSON header as in net_frame ({"kind": "mesh", "name",
-/// "vertices": n, "triangles": m}), then n * 3 float64 positions, n * 3 float64 unit normals and
-/// m * 3 uint32 node indices, little-endian.
+/// "vertices": n, "triangles": m, "faces"}), then n * 3 float64 positions, n * 3 float64 unit
+/// normals, n * 2 float64 (u, v) on each node's face, m * 3 uint32 node indices and n uint32
+/// face indices, little-endian. The (u, v) and faces let the page move the nodes itself when only
+/// the faces' control points change (model_nets_frame).
 std::vector<std::uint8_t> mesh_frame(const std::string& header_json, const brep::ModelMesh& mesh) {
   const std::size_t n = mesh.positions.size(), m = mesh.triangles.size();
-  auto [out, start] =
-      frame_with_header(header_json, 2 * n * 3 * sizeof(double) + m * 3 * sizeof(std::uint32_t));
+  auto [out, start] = frame_with_header(
+      header_json, (2 * n * 3 + 2 * n) * sizeof(double) + (m * 3 + n) * sizeof(std::uint32_t));
   std::uint8_t* at = out.data() + start;
   for (const auto* list : {&mesh.positions, &mesh.normals})
     for (const Eigen::Vector3d& p : *list) {
       std::memcpy(at, p.data(), 3 * sizeof(double));
       at += 3 * sizeof(double);
     }
+  for (const Eigen::Vector2d& uv : mesh.uv) {
+    std::memcpy(at, uv.data(), 2 * sizeof(double));
+    at += 2 * sizeof(double);
+  }
+  auto put = [&](int index) {
+    const auto value = static_cast<std::uint32_t>(index);
+    std::memcpy(at, &value, sizeof value);
+    at += sizeof value;
+  };
   for (const auto& t : mesh.triangles)
-    for (int corner : t) {
-      const auto index = static_cast<std::uint32_t>(corner);
-      std::memcpy(at, &index, sizeof index);
-      at += sizeof index;
-    }
+    for (int corner : t) put(corner);
+  for (int face : mesh.node_face) put(face);
   return out;
+}
+
+/// A model's faces as nets, one frame: the header {"kind": "model_nets", "name", "faces": [{
+/// "degrees", "counts", "knots_u", "knots_v", "rational", "reversed"}, ...]}, then each face's
+/// points (3 float64 each) and weights in turn. Sent instead of a mesh when the model's topology
+/// is that of the mesh the page holds: the page evaluates each node at its (u, v).
+std::vector<std::uint8_t> model_nets_frame(const std::string& name, const brep::Model& model) {
+  Json faces = Json::array();
+  std::size_t doubles = 0;
+  for (const brep::Face& f : model.faces) {
+    const surface::BSplineSurface& s = f.surface;
+    faces.push_back({{"degrees", {s.u.degree, s.v.degree}},
+                     {"counts", {s.u.count(), s.v.count()}},
+                     {"knots_u", s.u.knots},
+                     {"knots_v", s.v.knots},
+                     {"rational", s.is_rational()},
+                     {"reversed", f.reversed}});
+    doubles += static_cast<std::size_t>(s.points.size() + s.weights.size());
+  }
+  const Json header = {{"kind", "model_nets"}, {"name", name}, {"faces", faces}};
+  auto [out, start] = frame_with_header(header.dump(), doubles * sizeof(double));
+  std::uint8_t* at = out.data() + start;
+  for (const brep::Face& f : model.faces) {
+    const surface::BSplineSurface& s = f.surface;
+    std::memcpy(at, s.points.data(), static_cast<std::size_t>(s.points.size()) * sizeof(double));
+    at += static_cast<std::size_t>(s.points.size()) * sizeof(double);
+    std::memcpy(at, s.weights.data(), static_cast<std::size_t>(s.weights.size()) * sizeof(double));
+    at += static_cast<std::size_t>(s.weights.size()) * sizeof(double);
+  }
+  return out;
+}
+
+/// What a model's mesh depends on besides its faces' control points: the faces, their domains,
+/// sides and loops (edges used, senses, pcurves bit for bit). Exact composition keeps (u, v), so
+/// a deformed model keeps its key and its mesh's nodes stay at their (u, v) (FNV-1a, 64 bits).
+std::uint64_t topology_key(const brep::Model& model) {
+  std::uint64_t h = 1469598103934665603ull;
+  auto mix = [&](const void* data, std::size_t bytes) {
+    const auto* b = static_cast<const std::uint8_t*>(data);
+    for (std::size_t k = 0; k < bytes; ++k) h = (h ^ b[k]) * 1099511628211ull;
+  };
+  auto mix_value = [&](auto x) { mix(&x, sizeof x); };
+  mix_value(model.faces.size());
+  for (const brep::Face& f : model.faces) {
+    const auto [u0, u1] = f.surface.u.domain();
+    const auto [v0, v1] = f.surface.v.domain();
+    for (double d : {u0, u1, v0, v1}) mix_value(d);
+    mix_value(f.reversed);
+    mix_value(f.loops.size());
+    for (const brep::Loop& loop : f.loops) {
+      mix_value(loop.coedges.size());
+      for (const brep::Coedge& c : loop.coedges) {
+        mix_value(c.edge);
+        mix_value(c.same_sense);
+        mix(c.pcurve.basis.knots.data(), c.pcurve.basis.knots.size() * sizeof(double));
+        mix(c.pcurve.points.data(),
+            static_cast<std::size_t>(c.pcurve.points.size()) * sizeof(double));
+        mix(c.pcurve.weights.data(),
+            static_cast<std::size_t>(c.pcurve.weights.size()) * sizeof(double));
+      }
+    }
+  }
+  return h;
+}
+
+}  // namespace
+
+namespace {
+
+/// A 3-vector member of a command, or an InvalidArgument naming it.
+Eigen::Vector3d command_vec3(const Json& c, const std::string& key, const std::string& what) {
+  const auto it = c.find(key);
+  if (it == c.end() || !it->is_array() || it->size() != 3 ||
+      !std::all_of(it->begin(), it->end(), [](const Json& x) { return x.is_number(); }))
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: " + what + " needs \"" + key + "\" as [x, y, z] (numbers)");
+  return {(*it)[0].get<double>(), (*it)[1].get<double>(), (*it)[2].get<double>()};
+}
+
+/// The "fit" op: the stroke {points, plane?, tolerance?, corner_angle?} fitted as a recipe stroke
+/// with "pieces" would be (fit_stroke, split where it turns by more than corner_angle), and how:
+/// the page asks before it writes the stroke, so a stroke with corners becomes one with "pieces".
+Json fit_reply(const Json& c) {
+  sketch::Stroke stroke;
+  const auto pts = c.find("points");
+  if (pts == c.end() || !pts->is_array())
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: \"fit\" needs \"points\": the drawn points [[x, y, z], ...]");
+  stroke.points.resize(static_cast<Eigen::Index>(pts->size()), 3);
+  for (std::size_t k = 0; k < pts->size(); ++k) {
+    const Json& p = (*pts)[k];
+    if (!p.is_array() || p.size() != 3 ||
+        !std::all_of(p.begin(), p.end(), [](const Json& x) { return x.is_number(); }))
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: \"fit\": point " + std::to_string(k) + " is not [x, y, z] (numbers)");
+    for (int d = 0; d < 3; ++d)
+      stroke.points(static_cast<Eigen::Index>(k), d) = p[static_cast<std::size_t>(d)].get<double>();
+  }
+  if (const auto pl = c.find("plane"); pl != c.end()) {
+    if (!pl->is_object())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: \"fit\": \"plane\" is {origin, normal, x_axis?} or {origin, x_axis, "
+                  "y_axis}");
+    const Eigen::Vector3d origin = command_vec3(*pl, "origin", "the fit's plane");
+    if (pl->contains("normal")) {
+      std::optional<Eigen::Vector3d> x;
+      if (pl->contains("x_axis")) x = command_vec3(*pl, "x_axis", "the fit's plane");
+      stroke.plane = sketch::make_plane(origin, command_vec3(*pl, "normal", "the fit's plane"), x);
+    } else {
+      stroke.plane = sketch::SketchPlane{origin, command_vec3(*pl, "x_axis", "the fit's plane"),
+                                         command_vec3(*pl, "y_axis", "the fit's plane")};
+    }
+  }
+  sketch::FitOptions options;
+  auto number_or = [&](const char* key, double fallback) {
+    const auto it = c.find(key);
+    if (it == c.end()) return fallback;
+    if (!it->is_number())
+      throw Error(ErrorCategory::InvalidArgument,
+                  std::string("studio: \"fit\": \"") + key + "\" must be a number (mm, degrees)");
+    return it->get<double>();
+  };
+  options.tolerance = number_or("tolerance", options.tolerance);
+  options.corner_angle = number_or("corner_angle", options.corner_angle);
+  options.validate();
+  sketch::validate(stroke, "the fit's stroke");
+  const sketch::StrokeFit fit = sketch::fit_stroke(stroke, options);
+  return {{"op", "fit"},
+          {"pieces", fit.curves.size()},
+          {"corners", fit.corners},
+          {"closed", fit.closed},
+          {"max_deviation_mm", fit.max_deviation_mm},
+          {"corner_angle", options.corner_angle},
+          {"converged", fit.summary.converged()}};
 }
 
 }  // namespace
@@ -181,6 +324,9 @@ struct StudioSession::Impl {
   std::vector<std::pair<std::string, std::string>> history;  // (label, recipe text)
   std::vector<std::string> groups;  // per entry: the "group" of the edits it holds ("" none)
   int position = 0;
+  /// Per model, the topology key of the mesh last sent (topology_key): while it holds, runs send
+  /// the model's nets only. "hello" and "run" (what a new page sends first) forget them.
+  mutable std::map<std::string, std::uint64_t> meshed;
 
   const std::string& text() const { return history[static_cast<std::size_t>(position)].second; }
 
@@ -268,16 +414,24 @@ struct StudioSession::Impl {
       befores.push_back(n);
     }
     // Whole models (a recipe's "models", a STEP file opened in the studio): their trimmed faces
-    // as triangle meshes, deformed when the model has a stack.
+    // as a triangle mesh when the page has none of this topology yet, else only the faces' nets
+    // (a lattice moved: the mesh's nodes keep their (u, v), the page evaluates them there).
     Json models = Json::array();
     if (nets)
       for (const ModelRunResult& m : result.models) {
-        const brep::ModelMesh mesh = brep::tessellate(m.model);
-        const Json header = {{"kind", "mesh"},
-                             {"name", m.name},
-                             {"vertices", mesh.positions.size()},
-                             {"triangles", mesh.triangles.size()}};
-        reply.frames.push_back(mesh_frame(header.dump(), mesh));
+        const std::uint64_t key = topology_key(m.model);
+        if (const auto it = meshed.find(m.name); it != meshed.end() && it->second == key) {
+          reply.frames.push_back(model_nets_frame(m.name, m.model));
+        } else {
+          const brep::ModelMesh mesh = brep::tessellate(m.model);
+          const Json header = {{"kind", "mesh"},
+                               {"name", m.name},
+                               {"vertices", mesh.positions.size()},
+                               {"triangles", mesh.triangles.size()},
+                               {"faces", m.model.faces.size()}};
+          reply.frames.push_back(mesh_frame(header.dump(), mesh));
+          meshed[m.name] = key;
+        }
         models.push_back(m.name);
       }
     Json out = {{"op", op},       {"recipe", result.recipe},   {"seconds", result.seconds},
@@ -354,9 +508,10 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
     if (!c.is_object() || !c.contains("op") || !c.at("op").is_string())
       throw Error(ErrorCategory::InvalidArgument,
                   "studio: a command is a JSON object with \"op\" (hello, recipe, edit, undo, "
-                  "redo, run, save, export)");
+                  "redo, run, save, export, fit)");
     const std::string op = c.at("op");
     if (op == "hello") {
+      s.meshed.clear();  // a new page holds no mesh yet
       const Recipe r = parse_recipe(s.text(), s.base_dir, s.name);
       return {Json{{"op", "hello"},
                    {"recipe", r.name()},
@@ -367,7 +522,11 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
               {}};
     }
     if (op == "recipe") return {Json{{"op", "recipe"}, {"text", s.text()}}.dump(), {}};
-    if (op == "run") return s.ran("run", s.run(s.text()));
+    if (op == "fit") return {fit_reply(c).dump(), {}};
+    if (op == "run") {
+      s.meshed.clear();  // "run" sends everything: the page may hold nothing (a new page)
+      return s.ran("run", s.run(s.text()));
+    }
     if (op == "undo" || op == "redo") {
       const int to = s.position + (op == "undo" ? -1 : 1);
       if (to < 0 || to >= static_cast<int>(s.history.size()))
@@ -476,7 +635,7 @@ StudioSession::Reply StudioSession::handle(const std::string& command) {
     }
     throw Error(ErrorCategory::InvalidArgument,
                 "studio: unknown op \"" + op +
-                    "\"; the ops: hello, recipe, edit, undo, redo, run, save, export");
+                    "\"; the ops: hello, recipe, edit, undo, redo, run, save, export, fit");
   } catch (const Error& e) {
     return {Json{{"op", "error"},
                  {"category", std::string(to_string(e.category()))},

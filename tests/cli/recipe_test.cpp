@@ -225,6 +225,77 @@ TEST_CASE("curves: line, polyline, arc and reversed match their closed forms", "
             .norm() < 1e-12);
 }
 
+TEST_CASE("a stroke with \"pieces\" is split at its corners into curves NAME.1 .. NAME.N",
+          "[recipe]") {
+  // A 100 x 60 rectangle drawn once round from the middle of its bottom side, every 0.5 mm.
+  const Eigen::Vector3d corner[4] = {{0, 0, 0}, {100, 0, 0}, {100, 60, 0}, {0, 60, 0}};
+  std::vector<Eigen::Vector3d> drawn;
+  const Eigen::Vector3d path[6] = {{50, 0, 0}, corner[1], corner[2],
+                                   corner[3],  corner[0], {50, 0, 0}};
+  for (int leg = 0; leg < 5; ++leg) {
+    const int steps = static_cast<int>(std::lround((path[leg + 1] - path[leg]).norm() / 0.5));
+    for (int k = 0; k < steps; ++k)
+      drawn.push_back(path[leg] + (path[leg + 1] - path[leg]) * (double(k) / steps));
+  }
+  drawn.push_back(path[5]);
+  surface::Points3 points(static_cast<Eigen::Index>(drawn.size()), 3);
+  for (std::size_t k = 0; k < drawn.size(); ++k)
+    points.row(static_cast<Eigen::Index>(k)) = drawn[k];
+  auto recipe = [&](const std::string& extra, const std::string& surfaces) {
+    return R"({"format": "clayform.recipe", "version": 1, "strokes": {"r": {"points": )" +
+           points_json(points) + R"(, "tolerance": 0.1)" + extra + "}}" + surfaces + "}";
+  };
+  const auto result = run_recipe(parse_recipe(
+      recipe(R"(, "pieces": 4)",
+             R"(, "surfaces": {"patch": {"fill": {"curves": ["r.1", "r.2", "r.3", "r.4"]}}})")));
+  CHECK_THROWS(result.curve("r"));
+  // Consecutive pieces share their joints bit for bit, round the closed chain, and each joint is
+  // a corner of the rectangle (where the lines fitted to its legs meet: exact for straight legs).
+  for (int k = 1; k <= 4; ++k) {
+    const auto& c = result.curve("r." + std::to_string(k));
+    const auto& next = result.curve("r." + std::to_string(k % 4 + 1));
+    const Eigen::Vector3d end = c.points.row(c.points.rows() - 1);
+    CHECK(end == Eigen::Vector3d(next.points.row(0)));
+    double nearest = 1e300;
+    for (const auto& q : corner) nearest = std::min(nearest, (end - q).norm());
+    CHECK(nearest < 1e-6);
+    // every point of the piece is on the rectangle's side it runs along, within the tolerance
+    double worst = 0;
+    for (int i = 0; i <= 200; ++i) {
+      const Eigen::Vector3d q = surface::evaluate(c, i / 200.0);
+      const double side =
+          std::min({std::abs(q.y()), std::abs(q.y() - 60), std::abs(q.x()), std::abs(q.x() - 100)});
+      worst = std::max(worst, side);
+    }
+    CHECK(worst <= 0.1);
+  }
+  // the fill of the four pieces meets its corners
+  const auto& patch = result.surface("patch");
+  const auto [u0, u1] = patch.u.domain();
+  const auto [v0, v1] = patch.v.domain();
+  for (double u : {u0, u1})
+    for (double v : {v0, v1}) {
+      const Eigen::Vector3d q = surface::evaluate(patch, u, v);
+      double nearest = 1e300;
+      for (const auto& c : corner) nearest = std::min(nearest, (q - c).norm());
+      CHECK(nearest < 1e-6);
+    }
+  // Another count fails the run, saying how many curves the stroke gives and how to ask for them.
+  const std::string three =
+      error_of([&] { run_recipe(parse_recipe(recipe(R"(, "pieces": 3)", ""))); }).second;
+  CHECK_THAT(three, Contains("4 curves, not 3") && Contains("\"pieces\": 4"));
+  // "corner_angle" needs "pieces", and the pieces are the stroke's only curves.
+  CHECK(mentions(check_recipe(recipe(R"(, "corner_angle": 40)", "")), "strokes.r.corner_angle",
+                 "needs \"pieces\""));
+  CHECK(mentions(
+      check_recipe(recipe(R"(, "pieces": 4)", R"(, "curves": {"back": {"reversed": "r"}})")),
+      "curves.back.reversed", "no curve named \"r\""));
+  // A smooth stroke with "pieces": 1 is one curve, r.1.
+  const auto arc = run_recipe(parse_recipe(
+      R"({"format": "clayform.recipe", "version": 1, "strokes": {"r": {"points": [[0, 0, 0], [10, 3, 0], [20, 4, 0], [30, 3, 0], [40, 0, 0]], "pieces": 1}}})"));
+  CHECK(arc.curve("r.1").points.rows() >= 2);
+}
+
 TEST_CASE("a stroke is fitted within its tolerance", "[recipe]") {
   std::string pts = "[";
   for (int i = 0; i <= 60; ++i) {

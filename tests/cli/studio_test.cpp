@@ -7,6 +7,7 @@
 #include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/evaluate.hpp>
 
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -322,7 +323,7 @@ TEST_CASE("studio session: a STEP model opened whole, meshed, deformed by a latt
   REQUIRE(header.at("vertices") == mesh.positions.size());
   REQUIRE(header.at("triangles") == mesh.triangles.size());
   const std::size_t n = mesh.positions.size();
-  REQUIRE(frame.size() == start + 48 * n + 12 * mesh.triangles.size());
+  REQUIRE(frame.size() == start + 68 * n + 12 * mesh.triangles.size());
   std::vector<double> positions(3 * n);
   std::memcpy(positions.data(), frame.data() + start, positions.size() * sizeof(double));
   for (std::size_t k = 0; k < n; ++k)
@@ -356,16 +357,56 @@ TEST_CASE("studio session: a STEP model opened whole, meshed, deformed by a latt
   INFO(lifted.json);
   REQUIRE(Json::parse(lifted.json).at("op") == "edit");
   REQUIRE(lifted.frames.size() == 1);
+  // Only positions changed (exact composition keeps each face's (u, v) and loops), so the frame
+  // is the faces' nets, not a mesh: evaluated at the first mesh's nodes' (u, v), they give the
+  // nodes raised by the lattice's closed form (the top corners moved 5 mm up: z + 5 w, where w is
+  // the node's height in the lattice's frame).
   const auto [h2, start2] = mesh_header(lifted.frames[0]);
-  const std::size_t n2 = h2.at("vertices");
-  double top = -1e300;
-  for (std::size_t k = 0; k < n2; ++k) {
-    double z = 0;
-    std::memcpy(&z, lifted.frames[0].data() + start2 + (3 * k + 2) * sizeof(double), sizeof z);
-    top = std::max(top, z);
+  REQUIRE(h2.at("kind") == "model_nets");
+  REQUIRE(h2.at("faces").size() == header.at("faces").get<std::size_t>());
+  std::vector<clay::surface::BSplineSurface> faces;
+  std::size_t offset = start2;
+  for (const Json& f : h2.at("faces")) {
+    const auto nu = f.at("counts")[0].get<Eigen::Index>(),
+               nv = f.at("counts")[1].get<Eigen::Index>();
+    clay::surface::Points3 points(nu * nv, 3);
+    Eigen::VectorXd weights(nu * nv);
+    std::memcpy(points.data(), lifted.frames[0].data() + offset,
+                static_cast<std::size_t>(points.size()) * sizeof(double));
+    offset += static_cast<std::size_t>(points.size()) * sizeof(double);
+    std::memcpy(weights.data(), lifted.frames[0].data() + offset,
+                static_cast<std::size_t>(weights.size()) * sizeof(double));
+    offset += static_cast<std::size_t>(weights.size()) * sizeof(double);
+    faces.push_back(clay::surface::make_surface(
+        {f.at("degrees")[0].get<int>(), f.at("knots_u").get<std::vector<double>>()},
+        {f.at("degrees")[1].get<int>(), f.at("knots_v").get<std::vector<double>>()},
+        std::move(points), std::move(weights)));
   }
-  // the top face at u = 1/1.1 of the lattice's height, raised by that fraction of 5 mm
+  REQUIRE(offset == lifted.frames[0].size());
+  // The first mesh's (u, v) and faces, read from its frame after the positions and normals.
+  const std::size_t m = mesh.triangles.size();
+  double worst = 0, top = -1e300;
+  for (std::size_t k = 0; k < n; ++k) {
+    double uv[2];
+    std::uint32_t face = 0;
+    std::memcpy(uv, frame.data() + start + 48 * n + 16 * k, sizeof uv);
+    std::memcpy(&face, frame.data() + start + 64 * n + 12 * m + 4 * k, sizeof face);
+    REQUIRE(face == static_cast<std::uint32_t>(mesh.node_face[k]));
+    REQUIRE(uv[0] == mesh.uv[k].x());
+    const Eigen::Vector3d p = mesh.positions[k];
+    const Eigen::Vector3d expected =
+        p + Eigen::Vector3d(0, 0, 5 * (p.z() - origin.z()) / (1.1 * size.z()));
+    const Eigen::Vector3d got = clay::surface::evaluate(faces[face], uv[0], uv[1]);
+    worst = std::max(worst, (got - expected).norm());
+    top = std::max(top, got.z());
+  }
+  CHECK(worst < 1e-9 * size.norm());
+  // the top face at w = 1/1.1 of the lattice's height, raised by that fraction of 5 mm
   CHECK(top == Approx(hi.z() + 5 * (hi.z() - origin.z()) / (1.1 * size.z())).epsilon(1e-9));
+  // A "run" (what a new page sends) gives the whole mesh again, of the lifted block.
+  const auto again = session.handle(R"({"op": "run"})");
+  REQUIRE(again.frames.size() == 1);
+  CHECK(mesh_header(again.frames[0]).first.at("kind") == "mesh");
   // Export: the deformed model's STEP, IGES and glTF, read back and checked.
   const Json exported = Json::parse(session.handle(R"({"op": "export", "folder": "out"})").json);
   INFO(exported.dump());
