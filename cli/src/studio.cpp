@@ -7,6 +7,7 @@
 #include <clay/recipe/recipe.hpp>
 #include <clay/sketch/fit.hpp>
 #include <clay/studio.hpp>
+#include <clay/surface/evaluate.hpp>
 
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/post.hpp>
@@ -212,6 +213,36 @@ std::vector<std::uint8_t> model_nets_frame(const std::string& name, const brep::
   return out;
 }
 
+/// The viewer's deviation map (docs/viewer.md) of a surface: on a rows x cols grid evenly over
+/// its domain, the distance from the surface to its last stage's pointwise deformation of the
+/// surface before it, at the same fractions of that surface's domain (exact composition: rounding;
+/// a refit: its error). A frame {"kind": "deviation", "name", "step", "rows", "cols", "max"}
+/// then rows * cols float64, row (u) by row.
+std::vector<std::uint8_t> deviation_frame(const std::string& name, const surface::BSplineSurface& s,
+                                          const Stage& stage, int rows, int cols) {
+  const auto [u0, u1] = s.u.domain();
+  const auto [v0, v1] = s.v.domain();
+  const auto [a0, a1] = stage.before.u.domain();
+  const auto [b0, b1] = stage.before.v.domain();
+  auto at = [](double first, double last, int k, int n) {
+    return k == n - 1 ? last : first + (last - first) * k / (n - 1);
+  };
+  std::vector<double> values(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols));
+  double worst = 0;
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) {
+      const Eigen::Vector3d p = surface::evaluate(s, at(u0, u1, i, rows), at(v0, v1, j, cols));
+      const Eigen::Vector3d q =
+          stage.map(surface::evaluate(stage.before, at(a0, a1, i, rows), at(b0, b1, j, cols)));
+      const double d = (p - q).norm();
+      values[static_cast<std::size_t>(i * cols + j)] = d;
+      worst = std::max(worst, d);
+    }
+  const Json header = {{"kind", "deviation"}, {"name", name}, {"step", stage.step},
+                       {"rows", rows},        {"cols", cols}, {"max", worst}};
+  return net_frame(header.dump(), values, {});
+}
+
 /// What a model's mesh depends on besides its faces' control points: the faces, their domains,
 /// sides and loops (edges used, senses, pcurves bit for bit). Exact composition keeps (u, v), so
 /// a deformed model keeps its key and its mesh's nodes stay at their (u, v) (FNV-1a, 64 bits).
@@ -384,8 +415,11 @@ struct StudioSession::Impl {
       std::vector<double> weights(s.weights.data(), s.weights.data() + s.weights.size());
       reply.frames.push_back(net_frame(header.dump(), points, weights));
     };
+    // A drag update the page draws itself ("nets": false) gets no frames: none are made.
+    const std::vector<std::string> none;
+    const std::vector<std::string>& shown = nets ? run.shown : none;
     Json surfaces = Json::array();
-    for (const std::string& n : run.shown) {
+    for (const std::string& n : shown) {
       push_net(n, result.surface(n), false);
       surfaces.push_back(n);
     }
@@ -393,6 +427,7 @@ struct StudioSession::Impl {
     // draws them from their nets and picks them by name.
     Json curves = Json::array();
     for (const auto& [n, c] : result.curves) {
+      if (!nets) break;
       const Json header = {{"kind", "curve"},
                            {"name", n},
                            {"degree", c.basis.degree},
@@ -406,12 +441,22 @@ struct StudioSession::Impl {
     // A deformed surface's parent before its first step (the page's before/after view, and
     // what a lattice drag is checked against).
     Json befores = Json::array();
-    for (const std::string& n : run.shown) {
+    for (const std::string& n : shown) {
       const auto stage = std::find_if(result.stages.begin(), result.stages.end(),
                                       [&](const Stage& st) { return st.surface == n; });
       if (stage == result.stages.end()) continue;
       push_net(n, stage->before, true);
       befores.push_back(n);
+    }
+    // The deviation map of each shown surface whose last step deforms space point by point (a
+    // lattice, taper, twist or bend; a style step moves control points and has none).
+    Json deviations = Json::array();
+    for (const std::string& n : shown) {
+      const auto stage = std::find_if(result.stages.rbegin(), result.stages.rend(),
+                                      [&](const Stage& st) { return st.surface == n; });
+      if (stage == result.stages.rend() || !stage->map) continue;
+      reply.frames.push_back(deviation_frame(n, result.surface(n), *stage, 41, 41));
+      deviations.push_back(n);
     }
     // Whole models (a recipe's "models", a STEP file opened in the studio): their trimmed faces
     // as a triangle mesh when the page has none of this topology yet, else only the faces' nets
@@ -441,9 +486,9 @@ struct StudioSession::Impl {
       out["curves"] = curves;
       out["befores"] = befores;
       out["models"] = models;
+      out["deviations"] = deviations;
     } else {
       out["nets"] = false;
-      reply.frames.clear();
     }
     reply.json = out.dump();
     return reply;

@@ -37,7 +37,8 @@ std::vector<std::string> FitOptions::problems() const {
   if (!(std::isfinite(corner_angle) && corner_angle > 0.0 && corner_angle <= 180.0))
     bad("corner_angle", corner_angle, "must be in (0, 180] degrees (180 never splits)");
   if (!(std::isfinite(corner_window) && corner_window >= 0.0))
-    bad("corner_window", corner_window, "must be finite and >= 0 mm (0: 10 x tolerance)");
+    bad("corner_window", corner_window,
+        "must be finite and >= 0 mm (0: 10 x tolerance, at least 3 point spacings)");
   if (!(std::isfinite(closing_ratio) && closing_ratio >= 0.0 && closing_ratio <= 0.5))
     bad("closing_ratio", closing_ratio, "must be in [0, 0.5] (0 never closes)");
   if (end_samples < 1) bad("end_samples", end_samples, "must be >= 1 (1: the drawn end point)");
@@ -345,8 +346,19 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
   for (Eigen::Index i = 1; i < n; ++i) total += (pts.row(i) - pts.row(i - 1)).norm();
   const double gap = (pts.row(n - 1) - pts.row(0)).norm();
   const bool closed = n >= 2 * options.degree + 2 && gap <= options.closing_ratio * total;
-  const double window =
-      options.corner_window > 0 ? options.corner_window : 10.0 * options.tolerance;
+  // Turning is measured on the stroke smoothed point by point, which rounds a corner off over a
+  // few points: a window shorter than that rounding misses corners of sparse strokes (a fast hand
+  // gives a few mm between pointer events), so the default window is also 3 spacings long.
+  double window = options.corner_window;
+  if (!(window > 0)) {
+    std::vector<double> spacing;
+    for (Eigen::Index i = 1; i < n; ++i) spacing.push_back((pts.row(i) - pts.row(i - 1)).norm());
+    std::nth_element(spacing.begin(),
+                     spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2),
+                     spacing.end());
+    const double median = spacing.empty() ? 0.0 : spacing[spacing.size() / 2];
+    window = std::max(10.0 * options.tolerance, 3.0 * median);
+  }
   std::vector<Corner> corners = detail::find_corners(pts, closed, options.corner_angle, window);
   const bool plane = stroke.plane.has_value();
   for (auto& c : corners)

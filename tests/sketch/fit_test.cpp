@@ -306,6 +306,35 @@ TEST_CASE("a closed stroke with corners gives a closed chain of curves", "[fit]"
   }
 }
 
+TEST_CASE("a sparse stroke (points farther apart than 10 x tolerance) keeps its corners", "[fit]") {
+  // A 240 x 160 rectangle drawn fast: 6 mm between points, tolerance 0.5 (window 5 mm alone would
+  // sit inside the smoothing's rounding of each corner).
+  const Eigen::Vector3d c[4] = {{-120, -80, 0}, {120, -80, 0}, {120, 80, 0}, {-120, 80, 0}};
+  const Eigen::Vector3d path[6] = {{0, -80, 0}, c[1], c[2], c[3], c[0], {0, -80, 0}};
+  std::vector<Eigen::Vector3d> pts;
+  for (int leg = 0; leg < 5; ++leg) {
+    const int steps = static_cast<int>(std::lround((path[leg + 1] - path[leg]).norm() / 6));
+    for (int k = 0; k < steps; ++k)
+      pts.push_back(path[leg] + (path[leg + 1] - path[leg]) * (double(k) / steps));
+  }
+  pts.push_back(path[5]);
+  Stroke s;
+  s.points.resize(static_cast<Eigen::Index>(pts.size()), 3);
+  for (size_t k = 0; k < pts.size(); ++k) s.points.row(static_cast<Eigen::Index>(k)) = pts[k];
+  FitOptions o;
+  o.tolerance = 0.5;
+  const StrokeFit fit = fit_stroke(s, o);
+  INFO(fit.summary.brief());
+  REQUIRE(fit.curves.size() == 4);
+  for (size_t k = 0; k < 4; ++k) {
+    const auto& a = fit.curves[k].curve;
+    double nearest = 1e9;
+    for (const auto& vertex : c)
+      nearest = std::min(nearest, (a.points.row(a.points.rows() - 1).transpose() - vertex).norm());
+    CHECK(nearest <= 1e-6);  // straight legs: their lines meet at the corner
+  }
+}
+
 TEST_CASE("FitOptions and OversketchOptions list every bad field", "[fit]") {
   FitOptions f;
   f.tolerance = 0;

@@ -114,6 +114,27 @@ async function withStudio(file, label, fn) {
 }
 
 /** Draws a stroke through world points on the plane z = z0; the drawn path back-projected onto it, here. */
+/**
+ * The kernel's deviation map of `name` (window.clayStudio.deviations()) against the distance
+ * computed here at its grid: from the surface to `map` applied to its parent, at the same
+ * fractions of each domain. Asserts they agree within 1e-9 mm; returns {max, off}.
+ */
+async function deviationAgainst(call, name, surface, parent, map) {
+  const dev = (await call(() => window.clayStudio.deviations()))[name];
+  assert(dev && dev.rows > 1 && dev.cols > 1, `no deviation map of ${name}`);
+  const [[u0, u1], [v0, v1]] = surfaceDomain(surface);
+  const [[a0, a1], [b0, b1]] = surfaceDomain(parent);
+  const at = (lo, hi, k, n) => (k === n - 1 ? hi : lo + ((hi - lo) * k) / (n - 1));
+  let off = 0;
+  for (let i = 0; i < dev.rows; i += 4)
+    for (let j = 0; j < dev.cols; j += 4) {
+      const here = dist(surfaceAt(surface, at(u0, u1, i, dev.rows), at(v0, v1, j, dev.cols)), map(surfaceAt(parent, at(a0, a1, i, dev.rows), at(b0, b1, j, dev.cols))));
+      off = Math.max(off, Math.abs(here - dev.values[i * dev.cols + j]));
+    }
+  assert(off <= 1e-9, `the deviation map of ${name} is ${off} mm from the distances computed here`);
+  return { max: dev.max, off };
+}
+
 async function draw(world, { steps = 40, z0 = 0 } = {}) {
   const path = await driver.draw(world, { steps });
   const cam = await studioCall(() => window.clayStudio.camera());
@@ -346,6 +367,16 @@ try {
         worst = Math.max(worst, dist(surfaceAt(afterDrag, u, v), ffd(step, points, surfaceAt(parent, u, v))));
       }
     assert(worst <= 1e-9 * 1000, `the dragged surface is ${worst} mm off the pointwise FFD`);
+    // The Deviation mode's map, the kernel's: at its grid, the distance computed here from the
+    // surface to the pointwise FFD of its parent.
+    const deviation = await deviationAgainst(studioCall, 'fill1_styled1_ffd1', afterDrag, parent, (x) => ffd(step, points, x));
+    assert(deviation.max <= 1e-9 * 1000, `the deviation map's largest value is ${deviation.max} mm (exact composition)`);
+    await page.click('button[data-mode="deviation"]');
+    await idle();
+    const legend = await page.locator('#legend').textContent();
+    assert(legend.includes('deviation from the pointwise deformation'), `legend: ${legend}`);
+    await shot('deviation');
+    await page.click('button[data-mode="shaded"]');
     const m = await studioCall(() => ({ dragEnd: window.clayStudio.metrics.dragEnd, drag: window.clayStudio.metrics.drag, preview: window.clayStudio.metrics.preview, frames: window.clayStudio.metrics.frames, kernel: window.clayStudio.metrics.kernel, evaluate: window.clayStudio.metrics.evaluate }));
     // drag to redraw: the pointer move to the frame that shows it (the page's FFD of the parent's
     // samples); kernel confirmation: the pointer move to the kernel's answer (the recipe checked
@@ -373,6 +404,7 @@ try {
       control_points: afterDrag.counts[0] * afterDrag.counts[1],
       degrees: afterDrag.degrees,
       ffd_deviation_mm: worst,
+      deviation_map: { max_mm: deviation.max, off_independent_mm: deviation.off },
     };
     return `${n} pointer moves: ${lat.length} redraws, p95 ${figures.drag.latency_ms.p95.toFixed(0)} ms; ${exact.length} kernel updates, p95 ${figures.drag.kernel_latency_ms.p95.toFixed(0)} ms; ${figures.drag.fps.toFixed(0)} fps; off the FFD by ${worst.toExponential(2)} mm`;
   });
@@ -499,6 +531,20 @@ try {
       const after = await m.call(() => window.clayStudio.models());
       const topAfter = Math.max(...after.block.positions.filter((_, k) => k % 3 === 2));
       assert(topAfter > topBefore + 1e-6, `the model's top did not rise: ${topBefore} -> ${topAfter}`);
+      // Only positions changed, so the kernel sent the faces' nets, not a mesh, and the page moved
+      // the nodes of the mesh it held onto them: each node is where Sederberg–Parry's FFD of the
+      // lattice in the recipe takes the node's first position.
+      assert(after.block.from === 'model_nets', `the model came as a ${after.block.from} frame after the drag`);
+      assert(after.block.triangles === models.block.triangles, 'the mesh changed its triangles');
+      const recipe = await m.call(() => window.clayStudio.recipe());
+      const step = recipe.deformations[recipe.models.block.deformation][0];
+      const lattice = latticePoints(step);
+      let worstNode = 0;
+      for (let k = 0; k < models.block.positions.length; k += 3) {
+        const want = ffd(step, lattice, models.block.positions.slice(k, k + 3));
+        worstNode = Math.max(worstNode, Math.hypot(...[0, 1, 2].map((e) => after.block.positions[k + e] - want[e])));
+      }
+      assert(worstNode < 1e-9, `a node of the model is ${worstNode} mm from the pointwise FFD`);
       await modelPage.fill('#save-name', 'block_studio.json');
       await modelPage.click('#save');
       await m.idle();
@@ -506,7 +552,7 @@ try {
       assert(run.status === 0, `clayform run: ${run.status} ${run.stderr}`);
       const files = readdirSync(join(modelDir, 'replay'));
       assert(files.includes('block.step'), `replay wrote ${files}`);
-      return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}`;
+      return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; after the drag the faces' nets only, the nodes ${worstNode.toExponential(1)} mm from the pointwise FFD; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}`;
     });
   });
 
@@ -626,7 +672,71 @@ try {
         }
       const latRep = (await g.call(() => window.clayStudio.reply())).steps.find((st) => st.path === `surfaces.${latSurface}.steps[0]`);
       assert(offB <= latRep.figures.tolerance_mm, `the B-spline lattice's surface is ${offB} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm})`);
-      return `${barrNote}; ${dmNote}; B-spline lattice: ${offB.toExponential(2)} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm.toExponential(2)} mm)`;
+      // a refit: its deviation map shows the refit's error, as computed here, within its tolerance
+      const devB = await deviationAgainst(g.call, latSurface, shapedB, parentB, (x) => bsplineFfd(latStep, latPoints, x));
+      assert(devB.max > 0 && devB.max <= latRep.figures.tolerance_mm, `the refit's deviation map: largest ${devB.max} mm (tolerance ${latRep.figures.tolerance_mm})`);
+      return `${barrNote}; ${dmNote}; B-spline lattice: ${offB.toExponential(2)} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm.toExponential(2)} mm), its deviation map up to ${devB.max.toExponential(2)} mm, ${devB.off.toExponential(1)} mm from the distances computed here`;
+    });
+  });
+
+  await check('a stroke with corners split there into pieces and filled; a stroke mirrored in the plane x = 10', async () => {
+    const dir = join(work, 'corners');
+    mkdirSync(dir);
+    writeFileSync(join(dir, 'corners.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'corners' }));
+    return withStudio(join(dir, 'corners.json'), 'corners', async (cp, k) => {
+      await cp.click('#tool-sketch');
+      await cp.uncheck('#snap');
+      // a 240 x 160 rectangle in one stroke, from the middle of its bottom side round and back
+      const corner = [[-120, -80, 0], [120, -80, 0], [120, 80, 0], [-120, 80, 0]];
+      const path = await k.draw([[0, -80, 0], corner[1], corner[2], corner[3], corner[0], [0, -80, 0]], { steps: 200 });
+      const cam = await k.call(() => window.clayStudio.camera());
+      const drawn = path.map(([x, y]) => backProject(cam, x, y, 0));
+      const recipe = await k.call(() => window.clayStudio.recipe());
+      const stroke = recipe.strokes.s1;
+      assert(stroke && stroke.pieces === 4, `the stroke was written with pieces ${stroke && stroke.pieces}`);
+      const curves = await k.call(() => window.clayStudio.curves());
+      const pieces = [1, 2, 3, 4].map((i) => curves[`s1.${i}`]);
+      assert(pieces.every(Boolean), `curves: ${Object.keys(curves)}`);
+      // consecutive pieces share their joint bit for bit, round the closed chain; each joint is a
+      // drawn corner (back-projected here), within the stroke's tolerance
+      const end = (c, last) => (last ? c.points.slice(-3) : c.points.slice(0, 3));
+      let joint = 0;
+      pieces.forEach((c, i) => {
+        const next = pieces[(i + 1) % 4];
+        assert(end(c, true).every((x, e) => x === end(next, false)[e]), `pieces s1.${i + 1} and s1.${((i + 1) % 4) + 1} do not share their joint`);
+        const drawnCorner = corner.map((q) => drawn.reduce((best, d) => (dist(d, q) < dist(best, q) ? d : best)));
+        joint = Math.max(joint, Math.min(...drawnCorner.map((q) => dist(q, end(c, true)))));
+      });
+      assert(joint <= stroke.tolerance, `a joint is ${joint} mm from the drawn corner`);
+      let off = 0;
+      for (const d of drawn) off = Math.max(off, Math.min(...pieces.map((c) => distanceToCurve(c, d))));
+      assert(off <= stroke.tolerance, `a drawn point is ${off} mm from the pieces (tolerance ${stroke.tolerance})`);
+      // the four pieces filled: the patch's corners are the joints
+      await cp.click('#tool-orbit');
+      for (let i = 1; i <= 4; i++) await k.clickCurve(`s1.${i}`, i > 1);
+      await cp.click('#build-fill');
+      await k.idle();
+      assert(!(await k.lastError()), await k.lastError());
+      const patch = Object.values(await k.call(() => window.clayStudio.surfaces()))[0];
+      assert(patch, 'no fill of the pieces');
+      const [[u0, u1], [v0, v1]] = surfaceDomain(patch);
+      let gap = 0;
+      for (const [u, v] of [[u0, v0], [u1, v0], [u0, v1], [u1, v1]]) gap = Math.max(gap, Math.min(...pieces.map((c) => dist(surfaceAt(patch, u, v), end(c, true)))));
+      assert(gap <= 1e-9, `a corner of the fill is ${gap} mm from the joints`);
+      // mirror in x = 10: the mirrored curve is the stroke's reflected, control point by control point
+      await cp.click('#tool-sketch');
+      await cp.selectOption('#mirror', 'x');
+      await cp.fill('#mirror-at', '10');
+      await k.draw(along([20, -30], [80, 30], 10));
+      const mirrored = await k.call(() => window.clayStudio.curves());
+      const s2 = mirrored.s2;
+      const m2 = mirrored.s2_mirror;
+      assert(s2 && m2, `curves: ${Object.keys(mirrored)}`);
+      let reflection = 0;
+      for (let i = 0; i < s2.points.length; i += 3) reflection = Math.max(reflection, dist([20 - s2.points[i], s2.points[i + 1], s2.points[i + 2]], m2.points.slice(i, i + 3)));
+      assert(reflection <= 1e-9, `the mirrored curve is ${reflection} mm from the reflection in x = 10`);
+      figures.corners = { pieces: 4, joint_mm: joint, off_drawn_mm: off, fill_corner_gap_mm: gap, mirror_mm: reflection };
+      return `4 pieces, joints ${joint.toExponential(1)} mm from the drawn corners, drawn points within ${off.toExponential(2)} mm; fill corners on the joints (${gap.toExponential(1)} mm); mirror in x = 10 within ${reflection.toExponential(1)} mm`;
     });
   });
 

@@ -4,8 +4,11 @@
 // the picture follows the pointer without a backlog however slow a step is.
 
 /**
- * Decodes a binary frame: {header, points, weights} (Float64Arrays) for a net or a curve,
- * {header, positions, normals, triangles} for a model's mesh.
+ * Decodes a binary frame: {header, points, weights} (Float64Arrays) for a net or a curve;
+ * {header, positions, normals, uv, triangles, nodeFace} for a model's mesh; {header, faces} for a
+ * model's nets (each face {degrees, counts, knots_u, knots_v, rational, reversed, points,
+ * weights}), sent instead of its mesh while the mesh's topology holds; {header, values} for a
+ * surface's deviation map.
  */
 export function decodeFrame(buffer) {
   const view = new DataView(buffer);
@@ -13,12 +16,36 @@ export function decodeFrame(buffer) {
   const header = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, length)));
   const start = Math.ceil((4 + length) / 8) * 8;
   if (header.kind === 'mesh') {
-    // a model's trimmed mesh: positions, normals (float64), then uint32 triangles
+    // a model's trimmed mesh: positions, normals, (u, v) (float64), then uint32 triangles and faces
     const n = header.vertices;
     const m = header.triangles;
-    const expected = start + 48 * n + 12 * m;
+    const expected = start + 68 * n + 12 * m;
     if (buffer.byteLength !== expected) throw new Error(`frame "${header.name}": ${buffer.byteLength} bytes, expected ${expected}`);
-    return { header, positions: new Float64Array(buffer, start, 3 * n), normals: new Float64Array(buffer, start + 24 * n, 3 * n), triangles: new Uint32Array(buffer, start + 48 * n, 3 * m) };
+    return {
+      header,
+      positions: new Float64Array(buffer, start, 3 * n),
+      normals: new Float64Array(buffer, start + 24 * n, 3 * n),
+      uv: new Float64Array(buffer, start + 48 * n, 2 * n),
+      triangles: new Uint32Array(buffer, start + 64 * n, 3 * m),
+      nodeFace: new Uint32Array(buffer, start + 64 * n + 12 * m, n),
+    };
+  }
+  if (header.kind === 'model_nets') {
+    let at = start;
+    const faces = header.faces.map((f) => {
+      const count = f.counts[0] * f.counts[1];
+      const face = { ...f, points: new Float64Array(buffer, at, 3 * count), weights: new Float64Array(buffer, at + 24 * count, count) };
+      at += 32 * count;
+      return face;
+    });
+    if (buffer.byteLength !== at) throw new Error(`frame "${header.name}": ${buffer.byteLength} bytes, expected ${at}`);
+    return { header, faces };
+  }
+  if (header.kind === 'deviation') {
+    // a surface's deviation from its last step's pointwise deformation: rows x cols float64
+    const expected = start + 8 * header.rows * header.cols;
+    if (buffer.byteLength !== expected) throw new Error(`frame "${header.name}": ${buffer.byteLength} bytes, expected ${expected}`);
+    return { header, values: new Float64Array(buffer, start, header.rows * header.cols) };
   }
   const count = header.kind === 'curve' ? header.knots.length - header.degree - 1 : header.counts[0] * header.counts[1];
   const expected = start + 32 * count;
@@ -102,7 +129,7 @@ export class Link {
     if (!f) return; // nothing asked: ignore
     if (typeof data === 'string') {
       f.reply = JSON.parse(data);
-      f.waiting = ['surfaces', 'curves', 'befores', 'models'].reduce((n, k) => n + (f.reply[k] ? f.reply[k].length : 0), 0);
+      f.waiting = ['surfaces', 'curves', 'befores', 'deviations', 'models'].reduce((n, k) => n + (f.reply[k] ? f.reply[k].length : 0), 0);
       if (f.reply.op === 'error') f.waiting = 0;
     } else {
       f.frames.push(decodeFrame(data));

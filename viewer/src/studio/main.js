@@ -8,7 +8,7 @@ import '../style.css';
 import './studio.css';
 import { shadedMaterial, zebraMaterial, scalarMaterial } from '../materials.js';
 import { Link } from './link.js';
-import { curvePolyline, surfaceGrid, domain, sampleParameters } from './nurbs.js';
+import { curvePolyline, surfaceGrid, domain, sampleParameters, meshOnNets } from './nurbs.js';
 import * as names from './recipe_edits.js';
 import { prepareFfd, applyFfd } from './ffd_preview.js';
 
@@ -53,6 +53,7 @@ const materials = {
   zebra: zebraMaterial(),
   mean: scalarMaterial('mean', true),
   gaussian: scalarMaterial('gaussian', true),
+  deviation: scalarMaterial('deviation', false),
 };
 const surfaceGroup = new THREE.Group();
 const curveGroup = new THREE.Group();
@@ -101,7 +102,7 @@ new ResizeObserver(resize).observe($('stage'));
 // ------------------------------------------------------------------------------ document state
 // What the last run gave: the recipe, its final surfaces' nets (and their parents before their
 // first step), every named curve's net, the history.
-const doc = { recipe: {}, surfaces: new Map(), befores: new Map(), curves: new Map(), models: new Map(), history: { entries: [], position: 0 }, steps: [], reply: null };
+const doc = { recipe: {}, surfaces: new Map(), befores: new Map(), curves: new Map(), models: new Map(), deviations: new Map(), history: { entries: [], position: 0 }, steps: [], reply: null };
 let selection = []; // [{kind: 'curve' | 'surface' | 'lattice', name, index?}]
 let mode = 'shaded';
 let showBefore = false;
@@ -114,7 +115,30 @@ function surfaceResolution(net, direction) {
   return Math.max(33, Math.min(129, 8 * spans * Math.max(1, Math.ceil(p / 3)) + 1));
 }
 
-function meshOf(net) {
+/**
+ * The kernel's deviation map of a surface (a rows x cols grid evenly over its domain), at the
+ * mesh's samples: bilinear in the samples' fractions of the domain.
+ */
+function fillDeviation(geometry, net, map, us, vs) {
+  const out = geometry.getAttribute('deviation').array;
+  const [u0, u1] = domain(net.knots_u, net.degrees[0]);
+  const [v0, v1] = domain(net.knots_v, net.degrees[1]);
+  const { rows, cols } = map.header;
+  const at = (r, c) => map.values[r * cols + c];
+  for (let r = 0; r < us.length; r++) {
+    const x = ((us[r] - u0) / (u1 - u0)) * (rows - 1);
+    const i = Math.min(rows - 2, Math.floor(x));
+    const a = x - i;
+    for (let c = 0; c < vs.length; c++) {
+      const y = ((vs[c] - v0) / (v1 - v0)) * (cols - 1);
+      const j = Math.min(cols - 2, Math.floor(y));
+      const b = y - j;
+      out[r * vs.length + c] = (1 - a) * ((1 - b) * at(i, j) + b * at(i, j + 1)) + a * ((1 - b) * at(i + 1, j) + b * at(i + 1, j + 1));
+    }
+  }
+}
+
+function meshOf(net, deviation) {
   const t0 = performance.now();
   const rows = surfaceResolution(net, 0);
   const cols = surfaceResolution(net, 1);
@@ -131,6 +155,7 @@ function meshOf(net) {
       uv[2 * (r * cols + c) + 1] = vs[c];
     }
   geometry.userData.parameters = uv;
+  if (deviation) fillDeviation(geometry, net, deviation, us, vs);
   return geometry;
 }
 
@@ -153,6 +178,7 @@ function gridGeometry(g) {
   geometry.setAttribute('normal', new THREE.BufferAttribute(g.normal, 3));
   geometry.setAttribute('mean', new THREE.BufferAttribute(g.mean, 1));
   geometry.setAttribute('gaussian', new THREE.BufferAttribute(g.gaussian, 1));
+  geometry.setAttribute('deviation', new THREE.BufferAttribute(new Float32Array(g.rows * g.cols), 1));
   const index = [];
   for (let r = 0; r + 1 < g.rows; r++)
     for (let c = 0; c + 1 < g.cols; c++) {
@@ -203,6 +229,17 @@ function applyMode() {
     material.uniforms.lo.value = lo;
     material.uniforms.hi.value = hi;
     showLegend(`${mode === 'mean' ? 'mean curvature H (1/mm)' : 'Gaussian curvature K (1/mm²)'}: ${lo.toPrecision(3)} … ${hi.toPrecision(3)}`);
+  } else if (mode === 'deviation') {
+    // sequential, from 0 to the largest deviation of the surfaces shown (the kernel's own figure)
+    const maps = [...doc.deviations.values()];
+    const hi = Math.max(0, ...maps.map((d) => d.header.max));
+    material.uniforms.lo.value = 0;
+    material.uniforms.hi.value = hi || 1;
+    showLegend(
+      maps.length
+        ? `deviation from the pointwise deformation (mm): 0 … ${hi.toPrecision(3)} (${maps.map((d) => `${d.header.name} ${d.header.max.toExponential(1)}`).join(', ')})${previews.size ? '; while a drag is drawn, the page shows the pointwise FFD itself' : ''}`
+        : 'deviation from the pointwise deformation: no surface shown has a lattice, taper, twist or bend as its last step (a style moves control points: no pointwise map)',
+    );
   } else showLegend('');
   surfaceGroup.traverse((o) => {
     if (o.isMesh) o.material = o.userData.selected && mode === 'shaded' ? selectedMaterial : material;
@@ -223,7 +260,7 @@ function rebuildSurfaces() {
   const nets = showBefore ? new Map([...doc.surfaces].map(([n, net]) => [n, doc.befores.get(n) || net])) : doc.surfaces;
   for (const [name, net] of nets) {
     const preview = previews.get(name);
-    const mesh = new THREE.Mesh(preview && !showBefore ? preview.geometry : meshOf(net), materials.shaded);
+    const mesh = new THREE.Mesh(preview && !showBefore ? preview.geometry : meshOf(net, !showBefore && doc.deviations.get(name)), materials.shaded);
     mesh.name = name;
     mesh.userData = { kind: 'surface', name, selected: selection.some((s) => s.kind === 'surface' && s.name === name) };
     surfaceGroup.add(mesh);
@@ -236,6 +273,7 @@ function rebuildSurfaces() {
     geometry.setAttribute('normal', new THREE.BufferAttribute(new Float32Array(m.normals), 3));
     geometry.setAttribute('mean', new THREE.BufferAttribute(new Float32Array(m.positions.length / 3), 1));
     geometry.setAttribute('gaussian', new THREE.BufferAttribute(new Float32Array(m.positions.length / 3), 1));
+    geometry.setAttribute('deviation', new THREE.BufferAttribute(new Float32Array(m.positions.length / 3), 1));
     geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(m.triangles), 1));
     geometry.computeBoundingSphere();
     const mesh = new THREE.Mesh(geometry, materials.shaded);
@@ -301,13 +339,24 @@ function onReply(reply, frames, meta) {
     showHistory();
     return;
   }
+  const meshes = doc.models;
   doc.surfaces = new Map();
   doc.befores = new Map();
   doc.curves = new Map();
   doc.models = new Map();
+  doc.deviations = new Map();
   for (const f of frames) {
     const h = f.header;
     if (h.kind === 'mesh') doc.models.set(h.name, f);
+    else if (h.kind === 'deviation') doc.deviations.set(h.name, f);
+    else if (h.kind === 'model_nets') {
+      // only the faces' control points changed: the mesh the page holds, evaluated on them
+      const mesh = meshes.get(h.name);
+      const t0 = performance.now();
+      if (mesh) doc.models.set(h.name, { ...mesh, ...meshOnNets(mesh, f.faces), faces: f.faces });
+      else setTimeout(() => link.send({ op: 'run' })); // no mesh to move: ask for everything
+      metrics.evaluate.push(performance.now() - t0);
+    }
     else if (h.kind === 'curve') doc.curves.set(h.name, { degree: h.degree, knots: h.knots, rational: h.rational, points: f.points, weights: f.weights });
     else (h.before ? doc.befores : doc.surfaces).set(h.name, { degrees: h.degrees, counts: h.counts, knots_u: h.knots_u, knots_v: h.knots_v, rational: h.rational, points: f.points, weights: f.weights });
   }
@@ -687,7 +736,8 @@ function finishStroke(event) {
   const tolerance = Number($('stroke-tolerance').value) || 0.5;
   const redrawn = event.altKey || over ? null : oversketchTarget(points);
   if (redrawn) {
-    const q = doc.recipe.strokes[redrawn.name].points;
+    const def = doc.recipe.strokes[redrawn.name];
+    const q = def.points;
     const forward = redrawn.from < redrawn.to;
     const lo = Math.min(redrawn.from, redrawn.to);
     const hi = Math.max(redrawn.from, redrawn.to);
@@ -695,7 +745,12 @@ function finishStroke(event) {
     const next = [...q.slice(0, lo), ...drawn, ...q.slice(hi + 1)];
     const label = `stroke ${redrawn.name} (oversketch)`;
     pendingInk.push({ label, line });
-    edit({ path: `strokes.${redrawn.name}.points`, value: next }, label, 'stroke', event.timeStamp);
+    // a redrawn stroke may gain or lose corners: the kernel's fit says into how many pieces it splits
+    piecesOf(next, def.plane, def.tolerance || tolerance).then((pieces) => {
+      const changes = [{ path: `strokes.${redrawn.name}.points`, value: next }];
+      if (pieces && (def.pieces || pieces > 1)) changes.push({ path: `strokes.${redrawn.name}.pieces`, value: pieces, create: true });
+      return edit(changes, label, 'stroke', event.timeStamp);
+    });
     return;
   }
   if ($('snap').checked && !event.altKey && !over) {
@@ -714,22 +769,52 @@ function finishStroke(event) {
   const name = names.free(doc.recipe, 's');
   const stroke = { points, tolerance };
   if (plane) stroke.plane = plane;
-  const changes = [{ path: `strokes.${name}`, value: stroke, create: true }];
-  const mirror = $('mirror').value;
-  if (mirror) {
-    const normal = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] }[mirror];
-    changes.push({ path: `curves.${name}_mirror`, value: { mirror: { curve: name, plane: { origin: [0, 0, 0], normal } } }, create: true });
-  }
   const label = `stroke ${name}`;
   pendingInk.push({ label, line });
-  edit(changes, label, 'stroke', event.timeStamp).then(({ reply }) => {
-    if (reply.op === 'error') {
-      inkGroup.remove(line);
-      const i = pendingInk.findIndex((p) => p.line === line);
-      if (i >= 0) pendingInk.splice(i, 1);
-      dirty();
+  const dropInk = () => {
+    inkGroup.remove(line);
+    const i = pendingInk.findIndex((p) => p.line === line);
+    if (i >= 0) pendingInk.splice(i, 1);
+    dirty();
+  };
+  // The kernel's fit first: a stroke that turns sharply is split at its corners into pieces
+  // NAME.1 .. NAME.N (the recipe's "pieces"), one curve each.
+  piecesOf(points, plane, tolerance).then((pieces) => {
+    if (!pieces) return dropInk();
+    if (pieces > 1) stroke.pieces = pieces;
+    const changes = [{ path: `strokes.${name}`, value: stroke, create: true }];
+    const mirror = mirrorPlane();
+    if (mirror) {
+      const curves = pieces > 1 ? Array.from({ length: pieces }, (_, k) => `${name}.${k + 1}`) : [name];
+      curves.forEach((curve, k) => changes.push({ path: `curves.${name}_mirror${pieces > 1 ? `_${k + 1}` : ''}`, value: { mirror: { curve, plane: mirror } }, create: true }));
     }
+    return edit(changes, label, 'stroke', event.timeStamp).then(({ reply }) => {
+      if (reply.op === 'error') dropInk();
+    });
   });
+}
+
+/**
+ * The plane new strokes are mirrored in, {origin, normal}, or null: x, y or z = the "at" value, or
+ * the plane placed at a picked surface point.
+ */
+function mirrorPlane() {
+  const axis = $('mirror').value;
+  if (!axis) return null;
+  if (axis === 'picked') {
+    if (!pickedPlane) showMessage('no plane is placed yet: sketch "on a plane at a picked surface point" and click a surface first', true);
+    return pickedPlane;
+  }
+  const normal = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] }[axis];
+  const at = Number($('mirror-at').value) || 0;
+  return { origin: normal.map((c) => c * at), normal };
+}
+
+/** How many curves the kernel fits to the stroke (split at its corners), or null when it cannot. */
+function piecesOf(points, plane, tolerance) {
+  const command = { op: 'fit', points, tolerance };
+  if (plane) command.plane = plane;
+  return link.send(command).then(({ reply }) => (reply.op === 'fit' ? reply.pieces : null));
 }
 
 // ------------------------------------------------------------------------------ handles (Edit)
@@ -861,6 +946,10 @@ function moveHandle(h, to, inputAt, final, group) {
     }
     // a curve's control point: a stroke becomes the B-spline it was fitted to, once
     if (!doc.curves.has(h.name)) return null;
+    if (names.strokeOf(doc.recipe, h.name) && names.strokeOf(doc.recipe, h.name) !== h.name) {
+      showMessage(`${h.name} is a piece of stroke ${names.strokeOf(doc.recipe, h.name)} (split at its corners): redraw it over itself to change it`, true);
+      return null;
+    }
     return { changes: names.curvePointChanges(doc.recipe, doc.curves.get(h.name), h.name, h.index, to), label: `move ${h.name} point ${h.index}`, group };
   };
   if (!final) return dragEdit(build, inputAt);
@@ -1197,7 +1286,9 @@ $('delete').addEventListener('click', deleteSelected);
 function deleteSelected() {
   const curves = selected('curve');
   if (!curves.length) return showMessage('select a curve to delete', true);
-  const changes = curves.map((n) => ({ path: `${(doc.recipe.strokes || {})[n] ? 'strokes' : 'curves'}.${n}`, remove: true }));
+  // a piece of a stroke split at its corners goes with its stroke
+  const paths = new Set(curves.map((n) => (names.strokeOf(doc.recipe, n) ? `strokes.${names.strokeOf(doc.recipe, n)}` : `curves.${n}`)));
+  const changes = [...paths].map((path) => ({ path, remove: true }));
   edit(changes, `delete ${curves.join(', ')}`).then(({ reply }) => reply.op !== 'error' && select(null));
 }
 
@@ -1444,7 +1535,8 @@ window.clayStudio = {
   reply: () => doc.reply,
   surfaces: () => Object.fromEntries([...doc.surfaces].map(([n, s]) => [n, plainNet(s)])),
   befores: () => Object.fromEntries([...doc.befores].map(([n, s]) => [n, plainNet(s)])),
-  models: () => Object.fromEntries([...doc.models].map(([n, m]) => [n, { vertices: m.header.vertices, triangles: m.header.triangles, positions: Array.from(m.positions) }])),
+  deviations: () => Object.fromEntries([...doc.deviations].map(([n, d]) => [n, { ...d.header, values: Array.from(d.values) }])),
+  models: () => Object.fromEntries([...doc.models].map(([n, m]) => [n, { vertices: m.header.vertices, triangles: m.header.triangles, positions: Array.from(m.positions), from: m.faces ? 'model_nets' : 'mesh' }])),
   curves: () => Object.fromEntries([...doc.curves].map(([n, c]) => [n, { degree: c.degree, knots: c.knots, points: Array.from(c.points), weights: Array.from(c.weights) }])),
   camera: () => {
     camera.updateMatrixWorld();

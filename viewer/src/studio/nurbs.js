@@ -258,3 +258,92 @@ export function surfaceGrid(net, rows, cols) {
   }
   return { rows, cols, position, normal, gaussian, mean, su, sv };
 }
+
+/**
+ * Point and first derivatives of a surface net at (u, v): {p, su, sv} as [x, y, z] (rational
+ * nets by eq. (4.20)). For points scattered in (u, v), such as a model's mesh nodes.
+ */
+export function surfacePoint(net, u, v) {
+  const [p, q] = net.degrees;
+  const [nu, nv] = net.counts;
+  const spanU = findSpan(net.knots_u, p, nu, u);
+  const spanV = findSpan(net.knots_v, q, nv, v);
+  const Nu = basisDerivatives(net.knots_u, p, spanU, u, 1);
+  const Nv = basisDerivatives(net.knots_v, q, spanV, v, 1);
+  // A[ku][kv] = (w x, w y, w z, w) differentiated ku times in u and kv times in v
+  const A = [new Float64Array(4), new Float64Array(4), new Float64Array(4)]; // (0,0) (1,0) (0,1)
+  for (let a = 0; a <= p; a++) {
+    const i = spanU - p + a;
+    for (let b = 0; b <= q; b++) {
+      const k = i * nv + spanV - q + b;
+      const w = net.weights[k];
+      const P = [net.points[3 * k] * w, net.points[3 * k + 1] * w, net.points[3 * k + 2] * w, w];
+      const f00 = Nu[0][a] * Nv[0][b];
+      const f10 = Nu[1][a] * Nv[0][b];
+      const f01 = Nu[0][a] * Nv[1][b];
+      for (let e = 0; e < 4; e++) {
+        A[0][e] += f00 * P[e];
+        A[1][e] += f10 * P[e];
+        A[2][e] += f01 * P[e];
+      }
+    }
+  }
+  const w0 = A[0][3];
+  const pt = [0, 0, 0];
+  const su = [0, 0, 0];
+  const sv = [0, 0, 0];
+  for (let e = 0; e < 3; e++) {
+    pt[e] = A[0][e] / w0;
+    su[e] = (A[1][e] - A[1][3] * pt[e]) / w0;
+    sv[e] = (A[2][e] - A[2][3] * pt[e]) / w0;
+  }
+  return { p: pt, su, sv };
+}
+
+/**
+ * A model's mesh moved onto its faces' new nets (a "model_nets" frame): each node evaluated at its
+ * (u, v) on its face, its normal S_u x S_v (turned on reversed faces). Where S_u x S_v vanishes (a
+ * pole), the node takes the mean normal of its triangles, as the kernel's mesher does.
+ * Returns {positions, normals} as Float64Arrays.
+ */
+export function meshOnNets(mesh, faces) {
+  const n = mesh.nodeFace.length;
+  const positions = new Float64Array(3 * n);
+  const normals = new Float64Array(3 * n);
+  const poles = [];
+  for (let k = 0; k < n; k++) {
+    const face = faces[mesh.nodeFace[k]];
+    const { p, su, sv } = surfacePoint(face, mesh.uv[2 * k], mesh.uv[2 * k + 1]);
+    positions.set(p, 3 * k);
+    let nx = su[1] * sv[2] - su[2] * sv[1];
+    let ny = su[2] * sv[0] - su[0] * sv[2];
+    let nz = su[0] * sv[1] - su[1] * sv[0];
+    const len = Math.hypot(nx, ny, nz);
+    const scale = Math.hypot(...su) * Math.hypot(...sv);
+    if (!(len > 1e-12 * scale) || len === 0) {
+      poles.push(k);
+      continue;
+    }
+    const sign = face.reversed ? -1 : 1;
+    normals[3 * k] = (sign * nx) / len;
+    normals[3 * k + 1] = (sign * ny) / len;
+    normals[3 * k + 2] = (sign * nz) / len;
+  }
+  if (poles.length) {
+    const pole = new Set(poles);
+    const t = mesh.triangles;
+    for (let i = 0; i < t.length; i += 3) {
+      const [a, b, c] = [t[i], t[i + 1], t[i + 2]];
+      if (!pole.has(a) && !pole.has(b) && !pole.has(c)) continue;
+      const e1 = [0, 1, 2].map((e) => positions[3 * b + e] - positions[3 * a + e]);
+      const e2 = [0, 1, 2].map((e) => positions[3 * c + e] - positions[3 * a + e]);
+      const cross = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+      for (const node of [a, b, c]) if (pole.has(node)) for (let e = 0; e < 3; e++) normals[3 * node + e] += cross[e];
+    }
+    for (const k of poles) {
+      const len = Math.hypot(normals[3 * k], normals[3 * k + 1], normals[3 * k + 2]) || 1;
+      for (let e = 0; e < 3; e++) normals[3 * k + e] /= len;
+    }
+  }
+  return { positions, normals };
+}

@@ -130,6 +130,17 @@ export function curvePointChanges(recipe, net, name, index, to) {
 }
 
 /**
+ * The stroke a curve comes from: the stroke of that name, or for a piece "NAME.k" of a stroke split
+ * at its corners ("pieces"), NAME; null for any other curve.
+ */
+export function strokeOf(recipe, curve) {
+  const strokes = recipe.strokes || {};
+  if (strokes[curve]) return curve;
+  const m = /^(.+)\.(\d+)$/.exec(curve);
+  return m && strokes[m[1]] && Number(m[2]) >= 1 && Number(m[2]) <= (strokes[m[1]].pieces || 0) ? m[1] : null;
+}
+
+/**
  * Barr's taper, twist and bend about the longest direction of the net's box, through its centre:
  * `taper` is the scale change at the ends (profile 1 + taper y / half), `twist` the angle in
  * degrees at the ends, `bend` the whole bend angle in degrees over the box's length.
@@ -223,12 +234,13 @@ export function sketchFor(recipe, curves) {
       entities.push(c.slice(dot + 1));
       continue;
     }
-    const stroke = strokes[c];
+    // a stroke, or a piece "NAME.k" of one split at its corners (entity NAME_k: no dots there)
+    const stroke = strokes[strokeOf(recipe, c)];
     if (!stroke || !stroke.plane) return { reason: `"${c}" is not a stroke drawn on a plane (constraints hold on planar sketches: draw it on a plane)` };
     if (plane && JSON.stringify(plane) !== JSON.stringify(stroke.plane)) return { reason: 'the strokes are on different planes; constrain strokes of one plane' };
     plane = stroke.plane;
-    missing.push(c);
-    entities.push(c);
+    missing.push({ entity: c.replace('.', '_'), curve: c });
+    entities.push(c.replace('.', '_'));
   }
   if (sketch && plane && JSON.stringify(sketches[sketch].plane) !== JSON.stringify(plane)) return { reason: `the strokes are not on the plane of sketch "${sketch}"` };
   const changes = [];
@@ -236,7 +248,7 @@ export function sketchFor(recipe, curves) {
   if (!sketch) {
     // a stroke already in a sketch is constrained there
     for (const [name, def] of Object.entries(sketches))
-      if (missing.every((c) => def.entities && def.entities[c] && def.entities[c].curve === c)) {
+      if (missing.every((m) => def.entities && def.entities[m.entity] && def.entities[m.entity].curve === m.curve)) {
         sketch = name;
         missing.length = 0;
         break;
@@ -245,9 +257,9 @@ export function sketchFor(recipe, curves) {
   if (!sketch) {
     sketch = free(recipe, 'sketch');
     create = true;
-    changes.push({ path: `sketches.${sketch}`, value: { plane, points: {}, entities: Object.fromEntries(missing.map((c) => [c, { curve: c }])), constraints: [] }, create: true });
+    changes.push({ path: `sketches.${sketch}`, value: { plane, points: {}, entities: Object.fromEntries(missing.map((m) => [m.entity, { curve: m.curve }])), constraints: [] }, create: true });
   } else
-    for (const c of missing) if (!(sketches[sketch].entities || {})[c]) changes.push({ path: `sketches.${sketch}.entities.${c}`, value: { curve: c }, create: true });
+    for (const m of missing) if (!(sketches[sketch].entities || {})[m.entity]) changes.push({ path: `sketches.${sketch}.entities.${m.entity}`, value: { curve: m.curve }, create: true });
   return { sketch, create, entities, changes };
 }
 

@@ -58,7 +58,8 @@ struct CLAY_SKETCH_API FitOptions {
   double corner_angle = 50.0;    ///< degrees in (0, 180]: turning angle that makes a corner
                                  ///< (180 never splits)
   double corner_window = 0.0;    ///< mm, arc length each side over which turning is measured;
-                                 ///< 0 (default) means 10 x tolerance; >= 0
+                                 ///< 0 (default) means the larger of 10 x tolerance and 3 x
+                                 ///< the stroke's median point spacing; >= 0
   double closing_ratio = 0.03;   ///< a stroke whose end is within closing_ratio x its length of
                                  ///< its start is closed; in [0, 0.5], 0 never closes
   int end_samples = 60;          ///< samples in the end-point estimate, >= 1 (1: the drawn point)
