@@ -52,6 +52,14 @@ Net decode(const std::vector<std::uint8_t>& frame) {
   Net net;
   net.header = Json::parse(std::string(frame.begin() + 4, frame.begin() + 4 + length));
   const std::size_t start = (4 + length + 7) / 8 * 8;
+  if (net.header.at("kind") == "deviation") {  // rows x cols distances, in `points`
+    const std::size_t count =
+        net.header.at("rows").get<std::size_t>() * net.header.at("cols").get<std::size_t>();
+    REQUIRE(frame.size() == start + count * sizeof(double));
+    net.points.resize(count);
+    std::memcpy(net.points.data(), frame.data() + start, count * sizeof(double));
+    return net;
+  }
   const std::size_t n =
       net.header.at("kind") == "curve"
           ? net.header.at("knots").size() - net.header.at("degree").get<std::size_t>() - 1
@@ -98,7 +106,8 @@ std::map<std::string, Net> frames_by_name(const StudioSession::Reply& reply) {
   std::map<std::string, Net> out;
   for (const auto& f : reply.frames) {
     Net net = decode(f);
-    if (!net.header.contains("before")) out[net.header.at("name")] = std::move(net);
+    if (!net.header.contains("before") && net.header.at("kind") != "deviation")
+      out[net.header.at("name")] = std::move(net);
   }
   return out;
 }
@@ -123,10 +132,11 @@ TEST_CASE("studio session: edits, undo, redo and save replay to identical contro
   doc["deformations"]["shape"][1]["moves"][0]["by"][1] = 500;
   const auto replay = run_recipe(parse_recipe(doc.dump(), sail_file.parent_path(), "sail"));
   // One frame per final surface (first), one per named curve of the run, then the deformed
-  // surface's parent before its first step.
-  REQUIRE(edited.frames.size() == 2 + replay.curves.size());
+  // surface's parent before its first step, then its deviation map.
+  REQUIRE(edited.frames.size() == 3 + replay.curves.size());
   CHECK(same(decode(edited.frames[0]), replay.surface("sail")));
-  const Net before = decode(edited.frames.back());
+  CHECK(decode(edited.frames.back()).header.at("kind") == "deviation");
+  const Net before = decode(edited.frames[edited.frames.size() - 2]);
   CHECK(before.header.at("before") == true);
   CHECK(same(before, replay.stages.front().before));
   CHECK(reply.at("befores") == Json::array({"sail"}));
@@ -142,7 +152,7 @@ TEST_CASE("studio session: edits, undo, redo and save replay to identical contro
 
   // Undo gives the original sail, redo the edited one again.
   const auto undone = session.handle(R"({"op": "undo"})");
-  REQUIRE(undone.frames.size() == 2 + replay.curves.size());
+  REQUIRE(undone.frames.size() == 3 + replay.curves.size());
   const auto original = run_recipe(load_recipe(sail_file));
   CHECK(same(decode(undone.frames[0]), original.surface("sail")));
   CHECK(session.position() == 0);
@@ -218,6 +228,129 @@ TEST_CASE("studio session: bad commands are refused and change nothing", "[studi
           .json);
   CHECK(created.at("op") == "edit");
   CHECK(Json::parse(session.text()).at("description") == "drawn in the studio");
+}
+
+TEST_CASE("studio session: \"fit\" says how a stroke splits at its corners", "[studio]") {
+  StudioSession session = StudioSession::load(sail_file);
+  const std::string before = session.text();
+  // A 100 x 60 rectangle drawn once round from the middle of its bottom side, every 3 mm.
+  Json points = Json::array();
+  const std::array<std::array<double, 2>, 6> path = {
+      {{50, 0}, {100, 0}, {100, 60}, {0, 60}, {0, 0}, {50, 0}}};
+  for (std::size_t leg = 0; leg + 1 < path.size(); ++leg) {
+    const double dx = path[leg + 1][0] - path[leg][0], dy = path[leg + 1][1] - path[leg][1];
+    const int steps = static_cast<int>(std::lround(std::hypot(dx, dy) / 3));
+    for (int k = 0; k < steps; ++k)
+      points.push_back({path[leg][0] + dx * k / steps, path[leg][1] + dy * k / steps, 0.0});
+  }
+  points.push_back({50.0, 0.0, 0.0});
+  const Json fit = Json::parse(
+      session.handle(Json{{"op", "fit"}, {"points", points}, {"tolerance", 0.5}}.dump()).json);
+  INFO(fit.dump());
+  CHECK(fit.at("op") == "fit");
+  CHECK(fit.at("pieces") == 4);
+  CHECK(fit.at("corners").size() == 4);
+  CHECK(fit.at("closed") == true);
+  CHECK(fit.at("converged") == true);
+  // with the recipe's "pieces": 4 the run gives curves NAME.1 .. NAME.4
+  const Json edited =
+      Json::parse(session
+                      .handle(Json{
+                          {"op", "edit"},
+                          {"path", "strokes.frame"},
+                          {"value", {{"points", points}, {"tolerance", 0.5}, {"pieces", 4}}},
+                          {"create",
+                           true}}.dump())
+                      .json);
+  INFO(edited.dump());
+  REQUIRE(edited.at("op") == "edit");
+  for (const char* c : {"frame.1", "frame.2", "frame.3", "frame.4"})
+    CHECK(std::find(edited.at("curves").begin(), edited.at("curves").end(), c) !=
+          edited.at("curves").end());
+  // A smooth arc on a plane: one piece.
+  Json arc = Json::array();
+  for (int k = 0; k <= 40; ++k)
+    arc.push_back({100 * std::cos(k * 0.03), 100 * std::sin(k * 0.03), 5.0});
+  const Json one =
+      Json::parse(session
+                      .handle(Json{{"op", "fit"},
+                                   {"points", arc},
+                                   {"plane", {{"origin", {0, 0, 5}}, {"normal", {0, 0, 1}}}}}
+                                  .dump())
+                      .json);
+  CHECK(one.at("pieces") == 1);
+  CHECK(one.at("closed") == false);
+  // Bad input: named, and nothing changes.
+  const std::string text = session.text();
+  auto error = [&](const Json& command) {
+    const Json r = Json::parse(session.handle(command.dump()).json);
+    CHECK(r.at("op") == "error");
+    return r.at("message").get<std::string>();
+  };
+  CHECK_THAT(error({{"op", "fit"}}), Contains("\"points\""));
+  CHECK_THAT(error({{"op", "fit"}, {"points", {{0, 0, 0}, {1, "a", 0}}}}), Contains("point 1"));
+  CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"tolerance", "fine"}}),
+             Contains("\"tolerance\" must be a number"));
+  CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"tolerance", -1}}), Contains("tolerance"));
+  CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"plane", {{"origin", {0, 0}}}}}),
+             Contains("\"origin\""));
+  CHECK(session.text() == text);
+  CHECK(before != text);
+}
+
+TEST_CASE("studio session: each run sends the deviation map of a surface its lattice deforms",
+          "[studio]") {
+  StudioSession session = StudioSession::load(sail_file);
+  const auto ran = session.handle(R"({"op": "run"})");
+  const Json reply = Json::parse(ran.json);
+  REQUIRE(reply.at("deviations") == Json::array({"sail"}));
+  // The frame: rows x cols distances from the sail to its last step's pointwise deformation of
+  // the surface before it, at the same fractions of their domains (an independent replay's).
+  const RunResult replay = run_recipe(load_recipe(sail_file));
+  const Stage* last = nullptr;
+  for (const Stage& st : replay.stages)
+    if (st.surface == "sail") last = &st;
+  REQUIRE(last);
+  REQUIRE(last->map);
+  bool found = false;
+  for (const auto& f : ran.frames) {
+    const auto [header, start] = mesh_header(f);
+    if (header.at("kind") != "deviation") continue;
+    found = true;
+    const int rows = header.at("rows"), cols = header.at("cols");
+    REQUIRE(f.size() == start + static_cast<std::size_t>(rows * cols) * sizeof(double));
+    const auto& s = replay.surface("sail");
+    const auto [u0, u1] = s.u.domain();
+    const auto [v0, v1] = s.v.domain();
+    const auto [a0, a1] = last->before.u.domain();
+    const auto [b0, b1] = last->before.v.domain();
+    double largest = 0;
+    for (int i = 0; i < rows; i += 5)
+      for (int j = 0; j < cols; j += 5) {
+        double value = 0;
+        std::memcpy(&value, f.data() + start + static_cast<std::size_t>(i * cols + j) * 8, 8);
+        const double fu = double(i) / (rows - 1), fv = double(j) / (cols - 1);
+        const Eigen::Vector3d p =
+            clay::surface::evaluate(s, u0 + fu * (u1 - u0), v0 + fv * (v1 - v0));
+        const Eigen::Vector3d q = last->map(
+            clay::surface::evaluate(last->before, a0 + fu * (a1 - a0), b0 + fv * (b1 - b0)));
+        CHECK(value == Approx((p - q).norm()).margin(1e-9));
+        largest = std::max(largest, value);
+      }
+    CHECK(header.at("max").get<double>() >= largest);
+    // The sail leaves the recipe as an editable bicubic copy of the exact result: the map shows
+    // that copy's refit error, within its certified tolerance.
+    const auto editable = std::find_if(
+        replay.steps.begin(), replay.steps.end(),
+        [](const auto& st) { return st.path == "surfaces.sail.composition.editable"; });
+    REQUIRE(editable != replay.steps.end());
+    double tolerance = -1;
+    for (const auto& [key, value] : editable->figures)
+      if (key == "tolerance_mm") tolerance = std::get<double>(value);
+    CHECK(header.at("max").get<double>() > 0);
+    CHECK(header.at("max").get<double>() <= tolerance);
+  }
+  CHECK(found);
 }
 
 TEST_CASE(
