@@ -740,7 +740,7 @@ try {
     });
   });
 
-  await check('constraints on two strokes of a plane (coincident, tangent, a conflict refused); a stroke in 3D between two views; revolve about a picked line; a plane at a picked surface point', async () => {
+  await check('constraints on two strokes of a plane (coincident, tangent, a conflict refused, horizontal); a stroke in 3D between two views; revolve about a picked line; a plane at a picked surface point', async () => {
     const dir = join(work, 'sketch');
     mkdirSync(dir);
     writeFileSync(join(dir, 'sketch.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'sketch' }));
@@ -790,7 +790,19 @@ try {
       const error = await k.lastError();
       assert(/conflict/i.test(error), `a conflicting distance was not refused as a conflict: "${error}"`);
       assert(JSON.stringify(await k.call(() => window.clayStudio.recipe())) === text, 'the refused constraint changed the recipe');
-      const constraintNote = `gap ${gap.toExponential(1)} mm, tangent angle sin ${cross.toExponential(1)}; ${figures}; conflict: ${error.slice(0, 60)}…`;
+      // horizontal: s2's chord along the plane's x axis (XY: world x), the joint kept
+      await k.clickCurve('sketch1.s2', false);
+      await sketchPage.click('#constrain-horizontal');
+      await k.idle();
+      assert(!(await k.lastError()), await k.lastError());
+      const level = await k.call(() => window.clayStudio.curves());
+      const h = level['sketch1.s2'];
+      const hn = h.weights.length;
+      const rise = Math.abs(h.points[3 * hn - 2] - h.points[1]);
+      const ha = level['sketch1.s1'];
+      const joint = dist(ha.points.slice(3 * ha.weights.length - 3), h.points.slice(0, 3));
+      assert(rise <= 1e-9 && joint <= 1e-7, `after horizontal: the chord rises ${rise} mm, the joint is ${joint} mm apart`);
+      const constraintNote = `gap ${gap.toExponential(1)} mm, tangent angle sin ${cross.toExponential(1)}; ${figures}; conflict: ${error.slice(0, 60)}…; horizontal chord rises ${rise.toExponential(1)} mm`;
       // A stroke in 3D between two views: drawn on XY from the top, then again from the front
       // over it; the 3D curve's shadow on XY is the first curve, and it has the heights drawn.
       await k.call(() => window.clayStudio.setView('top'));

@@ -289,7 +289,12 @@ const SELECTED_COLOUR = 0x4fd1ff;
 /** Strokes that are entities of a sketch: the sketch's solved curve ("SKETCH.NAME") is drawn instead. */
 function inSketches() {
   const out = new Set();
-  for (const def of Object.values(doc.recipe.sketches || {})) for (const e of Object.values(def.entities || {})) if (e.curve) out.add(e.curve);
+  for (const [sketch, def] of Object.entries(doc.recipe.sketches || {}))
+    for (const [name, e] of Object.entries(def.entities || {})) {
+      if (e.curve) out.add(e.curve);
+      // a construction chord between a curve's ends (horizontal, vertical) is not drawn
+      if (Array.isArray(e.line) && e.line.every((p) => /\.(start|end)$/.test(p))) out.add(`${sketch}.${name}`);
+    }
   return out;
 }
 function rebuildCurves() {
@@ -1303,7 +1308,21 @@ function constrain(type) {
   const [a, b] = target.entities;
   const nets = curves.map((c) => doc.curves.get(c));
   let constraints = [];
+  const changes = [...target.changes];
   if (type === 'fixed') constraints = target.entities.flatMap((e) => [`${e}.start`, `${e}.end`]).map((point) => ({ type: 'fixed', point }));
+  else if (type === 'horizontal' || type === 'vertical') {
+    // a curve's chord, a construction line from its start to its end (not drawn), along the
+    // plane's x or y axis
+    for (const e of target.entities) {
+      const chord = `${e}_chord`;
+      const entities = target.create ? changes[0].value.entities : (doc.recipe.sketches[target.sketch].entities || {});
+      if (!entities[chord]) {
+        if (target.create) entities[chord] = { line: [`${e}.start`, `${e}.end`] };
+        else changes.push({ path: `sketches.${target.sketch}.entities.${chord}`, value: { line: [`${e}.start`, `${e}.end`] }, create: true });
+      }
+      constraints.push({ type, entity: chord });
+    }
+  }
   else if (curves.length === 1) {
     if (type !== 'distance') return showMessage('coincident, tangent and curvature join two curves: select two', true);
     constraints = [{ type: 'distance', points: [`${a}.start`, `${a}.end`], value: Number($('constrain-value').value) }];
@@ -1314,14 +1333,13 @@ function constrain(type) {
     else constraints = [{ type, ends: [{ entity: a, end: ea }, { entity: b, end: eb }] }];
   }
   const existing = target.create ? [] : (doc.recipe.sketches[target.sketch].constraints || []);
-  const changes = [...target.changes];
   if (target.create) changes[0].value.constraints = constraints;
   else changes.push({ path: `sketches.${target.sketch}.constraints`, value: [...existing, ...constraints] });
   edit(changes, `${type} ${target.entities.join(', ')}`).then(({ reply }) => {
     if (reply.op !== 'error') select(null);
   });
 }
-for (const type of ['coincident', 'tangent', 'curvature', 'fixed', 'distance']) $(`constrain-${type}`).addEventListener('click', () => constrain(type));
+for (const type of ['coincident', 'tangent', 'curvature', 'fixed', 'distance', 'horizontal', 'vertical']) $(`constrain-${type}`).addEventListener('click', () => constrain(type));
 function showSketchFigures() {
   const curves = selected('curve');
   const target = curves.length && curves.length <= 2 ? names.sketchFor(doc.recipe, curves) : { reason: 'none' };
