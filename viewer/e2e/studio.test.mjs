@@ -306,6 +306,39 @@ try {
     return `control point moved ${moved.toFixed(1)} mm; ${step.figures.key_points} key points, target deviation ${step.figures.target_deviation}`;
   });
 
+  await check('a new target drawn with "restyle while drawing": the surface follows the pen, one history entry', async () => {
+    await page.click('#tool-orbit');
+    await clickAt([260, 170, 0], false);
+    const selected = await page.locator('#selection').textContent();
+    assert(selected.includes('surface fill1_styled1'), `selection: ${selected}`);
+    const recipe0 = await studioCall(() => window.clayStudio.recipe());
+    const style = recipe0.surfaces.fill1_styled1.deform.deformation;
+    const entries = (await studioCall(() => window.clayStudio.history())).entries.length;
+    await page.check('#style-live');
+    await page.fill('#sketch-offset', '40');
+    await page.click('#tool-sketch');
+    const drawn = await draw(along([-90, 20], [90, 20], -15), { steps: 80, z0: 40 });
+    await page.uncheck('#style-live');
+    await page.fill('#sketch-offset', '0');
+    await page.click('#tool-orbit');
+    assert(!(await lastError()), await lastError());
+    const live = await studioCall(() => window.clayStudio.lastLive());
+    assert(live && live.style === style && live.updates >= 3, `live updates: ${JSON.stringify(live)}`);
+    const recipe = await studioCall(() => window.clayStudio.recipe());
+    assert(recipe.deformations[style][0].target === live.name, `the style's target is ${recipe.deformations[style][0].target}, not ${live.name}`);
+    const history = await studioCall(() => window.clayStudio.history());
+    assert(history.entries.length === entries + 1, `the drawing made ${history.entries.length - entries} history entries`);
+    const { worst } = await checkStroke(live.name, drawn);
+    const step = (await studioCall(() => window.clayStudio.reply())).steps.find((st) => st.kind === 'style');
+    assert(step.figures.outcome === 'met' && step.figures.locality === 0, `style after the live target: ${step.figures.outcome}, locality ${step.figures.locality}`);
+    // undone: the surface is styled by the earlier target again (the rest of the test goes on from there)
+    await page.click('#undo');
+    await idle();
+    const back = await studioCall(() => window.clayStudio.recipe());
+    assert(back.deformations[style][0].target === recipe0.deformations[style][0].target && !back.strokes[live.name], 'undo did not take the live target back');
+    return `${live.updates} updates sent while drawing (newest wins), one history entry; the target ${live.name} within ${worst.toExponential(2)} mm of the drawn path; key points met (${step.figures.key_points}), locality 0`;
+  });
+
   await check('analysis modes: zebra and curvature maps, before and after', async () => {
     for (const mode of ['zebra', 'mean', 'gaussian', 'shaded']) {
       await page.click(`button[data-mode="${mode}"]`);

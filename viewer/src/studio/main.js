@@ -727,7 +727,9 @@ function oversketchTarget(points) {
   return null;
 }
 
+let lastLive = null; // the last stroke drawn as a live style target: {style, name, updates}
 function finishStroke(event) {
+  const live = ink.live;
   const points = ink.points;
   const line = ink.line;
   const plane = ink.plane;
@@ -739,6 +741,16 @@ function finishStroke(event) {
     return;
   }
   const tolerance = Number($('stroke-tolerance').value) || 0.5;
+  if (live) {
+    // the live target's last update: the whole stroke, in the drawing's history entry
+    link.cancelDrag();
+    lastLive = live;
+    const stroke = { points, tolerance };
+    if (plane) stroke.plane = plane;
+    const { changes, label } = liveTarget(live, stroke);
+    pendingInk.push({ label, line });
+    return link.send(commandOf(changes, label, 'stroke', live.group), event.timeStamp);
+  }
   const redrawn = event.altKey || over ? null : oversketchTarget(points);
   if (redrawn) {
     const def = doc.recipe.strokes[redrawn.name];
@@ -813,6 +825,18 @@ function mirrorPlane() {
   const normal = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] }[axis];
   const at = Number($('mirror-at').value) || 0;
   return { origin: normal.map((c) => c * at), normal };
+}
+
+/** The changes that make `stroke` the style's target under the live stroke's name (one history entry). */
+function liveTarget(live, stroke) {
+  live.updates++;
+  return {
+    changes: [
+      { path: `strokes.${live.name}`, value: stroke, create: true },
+      { path: `deformations.${live.style}[0].target`, value: live.name },
+    ],
+    label: `restyle ${live.style}: target ${live.name} drawn`,
+  };
 }
 
 /** How many curves the kernel fits to the stroke (split at its corners), or null when it cannot. */
@@ -1091,6 +1115,10 @@ canvas.addEventListener(
       }
       const plane = on === 'surface' || on === 'over' ? null : sketchPlane();
       ink = { points: [], plane, over, line: inkLine(), pointerId: event.pointerId };
+      // Restyle while drawing: the stroke is the selected style's new target from its first
+      // points on, each pointer move one drag update (newest wins), the release the last.
+      const style = !over && $('style-live').checked ? activeStyle() : null;
+      if (style) ink.live = { style, name: names.free(doc.recipe, 's'), group: newGroup(), updates: 0 };
       const p = inkPoint(event);
       if (p) pushInk(p);
       canvas.setPointerCapture(event.pointerId);
@@ -1120,6 +1148,12 @@ canvas.addEventListener('pointermove', (event) => {
     for (const e of events.length ? events : [event]) {
       const p = inkPoint(e);
       if (p) pushInk(p);
+    }
+    if (ink.live && ink.points.length >= 4) {
+      const live = ink.live;
+      const stroke = { points: ink.points.slice(), tolerance: Number($('stroke-tolerance').value) || 0.5 };
+      if (ink.plane) stroke.plane = ink.plane;
+      dragEdit(() => ({ ...liveTarget(live, stroke), group: live.group }), event.timeStamp);
     }
   } else if (surfaceDrag) {
     const target = dragTarget(surfaceDrag.start, pointerRay(event.clientX, event.clientY), $('lattice-lock').value);
@@ -1553,6 +1587,7 @@ window.clayStudio = {
   reply: () => doc.reply,
   surfaces: () => Object.fromEntries([...doc.surfaces].map(([n, s]) => [n, plainNet(s)])),
   befores: () => Object.fromEntries([...doc.befores].map(([n, s]) => [n, plainNet(s)])),
+  lastLive: () => lastLive && { ...lastLive },
   deviations: () => Object.fromEntries([...doc.deviations].map(([n, d]) => [n, { ...d.header, values: Array.from(d.values) }])),
   models: () => Object.fromEntries([...doc.models].map(([n, m]) => [n, { vertices: m.header.vertices, triangles: m.header.triangles, positions: Array.from(m.positions), from: m.faces ? 'model_nets' : 'mesh' }])),
   curves: () => Object.fromEntries([...doc.curves].map(([n, c]) => [n, { degree: c.degree, knots: c.knots, points: Array.from(c.points), weights: Array.from(c.weights) }])),
