@@ -131,6 +131,11 @@ try {
     await page.mouse.up();
     await s.idle();
     await picture('lattice');
+    // the kernel's deviation map of the lattice step: exact composition, so rounding only
+    await page.click('button[data-mode="deviation"]');
+    await s.idle();
+    await picture('deviation');
+    await page.click('button[data-mode="shaded"]');
   });
   await step('saved and exported', async () => {
     await page.fill('#save-name', 'hood_styled.json');
