@@ -684,6 +684,8 @@ try {
       await globalPage.mouse.move(...lh.screen);
       await globalPage.mouse.down();
       for (let k = 1; k <= 8; k++) await globalPage.mouse.move(lh.screen[0], lh.screen[1] - 3 * k);
+      // while the point is held, the page draws Hsu–Hughes–Kaufman's FFD of the parent's samples
+      const drawing = await g.call(() => ({ previews: window.clayStudio.previews(), recipe: window.clayStudio.recipe(), parents: window.clayStudio.befores() }));
       await globalPage.mouse.up();
       await g.idle();
       assert(!(await g.lastError()), await g.lastError());
@@ -705,10 +707,32 @@ try {
         }
       const latRep = (await g.call(() => window.clayStudio.reply())).steps.find((st) => st.path === `surfaces.${latSurface}.steps[0]`);
       assert(offB <= latRep.figures.tolerance_mm, `the B-spline lattice's surface is ${offB} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm})`);
+      // The picture drawn while the point was held: each sample the pointwise B-spline FFD of
+      // the parent's point there (float32 vertices), for the lattice as the recipe then held it.
+      const heldName = Object.keys(drawing.previews)[0];
+      assert(heldName, 'no picture was drawn while the B-spline lattice point was held');
+      const held = drawing.previews[heldName];
+      const heldParent = drawing.parents[heldName];
+      const heldStep = drawing.recipe.deformations[latName][0];
+      const [[pu0, pu1], [pv0, pv1]] = surfaceDomain(heldParent);
+      let heldOff = 0;
+      let heldScale = 0;
+      for (let r = 0; r < held.rows; r += 7)
+        for (let c = 0; c < held.cols; c += 7) {
+          const u = r === held.rows - 1 ? pu1 : pu0 + ((pu1 - pu0) * r) / (held.rows - 1);
+          const v = c === held.cols - 1 ? pv1 : pv0 + ((pv1 - pv0) * c) / (held.cols - 1);
+          const want = bsplineFfd(heldStep, held.lattice, surfaceAt(heldParent, u, v));
+          const k = r * held.cols + c;
+          heldOff = Math.max(heldOff, dist(held.positions.slice(3 * k, 3 * k + 3), want));
+          heldScale = Math.max(heldScale, ...want.map(Math.abs));
+        }
+      assert(held.lattice.length === bsplineLatticePoints(heldStep).length, 'the picture\'s lattice has another size');
+      // float32 vertices
+      assert(heldOff <= 1e-6 * heldScale, `the picture drawn while dragging is ${heldOff} mm from the pointwise B-spline FFD`);
       // a refit: its deviation map shows the refit's error, as computed here, within its tolerance
       const devB = await deviationAgainst(g.call, latSurface, shapedB, parentB, (x) => bsplineFfd(latStep, latPoints, x));
       assert(devB.max > 0 && devB.max <= latRep.figures.tolerance_mm, `the refit's deviation map: largest ${devB.max} mm (tolerance ${latRep.figures.tolerance_mm})`);
-      return `${barrNote}; ${dmNote}; B-spline lattice: ${offB.toExponential(2)} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm.toExponential(2)} mm), its deviation map up to ${devB.max.toExponential(2)} mm, ${devB.off.toExponential(1)} mm from the distances computed here`;
+      return `${barrNote}; ${dmNote}; B-spline lattice: ${offB.toExponential(2)} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm.toExponential(2)} mm), its deviation map up to ${devB.max.toExponential(2)} mm, ${devB.off.toExponential(1)} mm from the distances computed here; the picture while dragging ${heldOff.toExponential(1)} mm from the pointwise FFD`;
     });
   });
 

@@ -1,9 +1,12 @@
 // The picture of a lattice drag before the kernel answers: Sederberg–Parry's FFD (eq. (2)) of the
-// parent surface's sampled points, on the page. A deformed surface composed exactly with the
-// lattice is, at each (u, v), the lattice's map of the parent's point there, so these vertices
-// are the exact result's at the same parameters (to rounding); the normals come from the
-// tangents carried by the map's Jacobian, n = (J S_u) x (J S_v). The kernel's exact net replaces
-// the picture when it arrives.
+// parent surface's sampled points, on the page, or for a B-spline lattice Hsu–Hughes–Kaufman's
+// (eq. (1): the same sum with B-spline basis functions). A deformed surface composed exactly with
+// the lattice is, at each (u, v), the lattice's map of the parent's point there, so these
+// vertices are the exact result's at the same parameters (to rounding; a refitted one's within
+// its tolerance); the normals come from the tangents carried by the map's Jacobian,
+// n = (J S_u) x (J S_v). The kernel's net replaces the picture when it arrives.
+import { basisDerivatives, findSpan } from './nurbs.js';
+import { latticeKnots } from './recipe_edits.js';
 
 /** Bernstein polynomials of degree n at x and their derivatives: [values, derivatives]. */
 function bernstein(n, x) {
@@ -23,6 +26,22 @@ function bernstein(n, x) {
   return [b, d];
 }
 
+/**
+ * The B-spline basis functions of one lattice direction at x and their derivatives, as full-length
+ * arrays over its control points: [values, derivatives].
+ */
+function bsplineBasis(knots, p, count, x) {
+  const b = new Float64Array(count);
+  const d = new Float64Array(count);
+  const span = findSpan(knots, p, count, x);
+  const ders = basisDerivatives(knots, p, span, x, 1);
+  for (let j = 0; j <= p; j++) {
+    b[span - p + j] = ders[0][j];
+    d[span - p + j] = ders[1][j];
+  }
+  return [b, d];
+}
+
 /** 3 x 3 inverse (row-major array of 9), for the frame's local coordinates. */
 function inverse3(m) {
   const [a, b, c, d, e, f, g, h, i] = m;
@@ -34,12 +53,17 @@ function inverse3(m) {
 }
 
 /**
- * What a drag of `step` (a bezier_lattice recipe step) needs of the parent's samples `grid`
- * (surfaceGrid): each vertex's Bernstein values and derivatives in the lattice's local
- * coordinates (s, t, u), computed once per drag (eq. (1): X = X0 + s S + t T + u U).
+ * What a drag of `step` (a bezier_lattice or bspline_lattice recipe step) needs of the parent's
+ * samples `grid` (surfaceGrid): each vertex's basis values and derivatives in the lattice's local
+ * coordinates (s, t, u), computed once per drag (eq. (1): X = X0 + s S + t T + u U). The
+ * B-spline basis is stored over all control points of a direction, so one sum serves both.
  */
 export function prepareFfd(grid, step) {
-  const [l, m, n] = step.degrees;
+  const bspline = step.kind === 'bspline_lattice';
+  const counts = bspline ? [0, 1, 2].map((e) => step.cells[e] + step.degrees[e]) : step.degrees.map((d) => d + 1);
+  const knots = bspline ? [0, 1, 2].map((e) => latticeKnots(step.cells[e], step.degrees[e], step.knots || 'clamped')) : null;
+  const basisOf = (e, x) => (bspline ? bsplineBasis(knots[e], step.degrees[e], counts[e], x) : bernstein(step.degrees[e], x));
+  const [l, m, n] = counts.map((c) => c - 1);
   const { origin, s: S, t: T, u: U } = step.frame;
   // columns S, T, U: world = X0 + M [s t u]
   const Minv = inverse3([S[0], T[0], U[0], S[1], T[1], U[1], S[2], T[2], U[2]]);
@@ -48,9 +72,9 @@ export function prepareFfd(grid, step) {
   for (let k = 0; k < count; k++) {
     const d = [0, 1, 2].map((e) => grid.position[3 * k + e] - origin[e]);
     const local = [0, 1, 2].map((r) => Minv[3 * r] * d[0] + Minv[3 * r + 1] * d[1] + Minv[3 * r + 2] * d[2]);
-    basis.push([bernstein(l, local[0]), bernstein(m, local[1]), bernstein(n, local[2])]);
+    basis.push([basisOf(0, local[0]), basisOf(1, local[1]), basisOf(2, local[2])]);
   }
-  return { grid, degrees: [l, m, n], Minv, basis };
+  return { grid, last: [l, m, n], Minv, basis };
 }
 
 /**
@@ -60,8 +84,8 @@ export function prepareFfd(grid, step) {
  * surface's neighbourhood (<= 0), as the drag goes.
  */
 export function applyFfd(prepared, points, position, normal) {
-  const { grid, degrees, Minv, basis } = prepared;
-  const [l, m, n] = degrees;
+  const { grid, last, Minv, basis } = prepared;
+  const [l, m, n] = last;
   const count = grid.rows * grid.cols;
   let lo = Infinity;
   let hi = -Infinity;

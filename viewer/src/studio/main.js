@@ -1015,7 +1015,7 @@ function startPreview(h) {
   previews.clear();
   previewEnding = false;
   const stack = (doc.recipe.deformations || {})[h.name];
-  if (!stack || stack.length !== 1 || stack[0].kind !== 'bezier_lattice') return;
+  if (!stack || stack.length !== 1 || !['bezier_lattice', 'bspline_lattice'].includes(stack[0].kind)) return;
   for (const [name, def] of Object.entries(doc.recipe.surfaces || {})) {
     if (!def.deform || def.deform.deformation !== h.name || !doc.surfaces.has(name) || !doc.befores.has(name)) continue;
     const parent = doc.befores.get(name);
@@ -1032,7 +1032,9 @@ function showPreview(h, to, inputAt) {
     const moved = { ...preview.step, moves: names.withMove(preview.step.moves || [], h.index, to) };
     const position = preview.geometry.getAttribute('position');
     const normal = preview.geometry.getAttribute('normal');
-    const ratio = applyFfd(preview.prepared, names.latticePoints(moved), position.array, normal.array);
+    const points = moved.kind === 'bspline_lattice' ? names.bsplineLatticePoints(moved) : names.latticePoints(moved);
+    const ratio = applyFfd(preview.prepared, points, position.array, normal.array);
+    preview.points = points;
     live = [Math.min(live[0], ratio[0]), Math.max(live[1], ratio[1])];
     position.needsUpdate = true;
     normal.needsUpdate = true;
@@ -1588,6 +1590,8 @@ window.clayStudio = {
   surfaces: () => Object.fromEntries([...doc.surfaces].map(([n, s]) => [n, plainNet(s)])),
   befores: () => Object.fromEntries([...doc.befores].map(([n, s]) => [n, plainNet(s)])),
   lastLive: () => lastLive && { ...lastLive },
+  /** The page's pictures of a lattice drag in progress: per surface, its grid, vertices and the lattice points drawn. */
+  previews: () => Object.fromEntries([...previews].map(([n, p]) => [n, { rows: p.prepared.grid.rows, cols: p.prepared.grid.cols, positions: Array.from(p.geometry.getAttribute('position').array), lattice: p.points }])),
   deviations: () => Object.fromEntries([...doc.deviations].map(([n, d]) => [n, { ...d.header, values: Array.from(d.values) }])),
   models: () => Object.fromEntries([...doc.models].map(([n, m]) => [n, { vertices: m.header.vertices, triangles: m.header.triangles, positions: Array.from(m.positions), from: m.faces ? 'model_nets' : 'mesh' }])),
   curves: () => Object.fromEntries([...doc.curves].map(([n, c]) => [n, { degree: c.degree, knots: c.knots, points: Array.from(c.points), weights: Array.from(c.weights) }])),

@@ -73,13 +73,7 @@ export function latticePoints(step) {
 export function bsplineLatticePoints(step) {
   const abscissae = (cells, p, kind) => {
     const n = cells + p;
-    const knots = [];
-    if (kind === 'uniform') for (let i = 0; i <= n + p; i++) knots.push((i - p) / cells);
-    else {
-      for (let i = 0; i <= p; i++) knots.push(0);
-      for (let i = 1; i < cells; i++) knots.push(i / cells);
-      for (let i = 0; i <= p; i++) knots.push(1);
-    }
+    const knots = latticeKnots(cells, p, kind);
     return Array.from({ length: n }, (_, i) => {
       let sum = 0;
       for (let k = 1; k <= p; k++) sum += knots[i + k];
@@ -100,6 +94,23 @@ export function bsplineLatticePoints(step) {
 }
 
 /** A lattice step's control point counts per direction. */
+/**
+ * The knot vector of one direction of a B-spline lattice (docs/recipe.md, bspline_lattice) on its
+ * local coordinate [0, 1]: `cells` spans of degree `p`, "clamped" (end knots p + 1 times) or
+ * "uniform" (knots (i - p) / cells).
+ */
+export function latticeKnots(cells, p, kind = 'clamped') {
+  const n = cells + p;
+  const knots = [];
+  if (kind === 'uniform') for (let i = 0; i <= n + p; i++) knots.push((i - p) / cells);
+  else {
+    for (let i = 0; i <= p; i++) knots.push(0);
+    for (let i = 1; i < cells; i++) knots.push(i / cells);
+    for (let i = 0; i <= p; i++) knots.push(1);
+  }
+  return knots;
+}
+
 export function latticeCounts(step) {
   return step.kind === 'bspline_lattice' ? [0, 1, 2].map((e) => step.cells[e] + step.degrees[e]) : step.degrees.map((d) => d + 1);
 }
