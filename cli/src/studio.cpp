@@ -145,9 +145,12 @@ std::vector<std::uint8_t> net_frame(const std::string& header_json,
                                     const std::vector<double>& weights) {
   auto [out, at] =
       frame_with_header(header_json, (points.size() + weights.size()) * sizeof(double));
-  std::memcpy(out.data() + at, points.data(), points.size() * sizeof(double));  // x86-64: LE
-  std::memcpy(out.data() + at + points.size() * sizeof(double), weights.data(),
-              weights.size() * sizeof(double));
+  // x86-64: little-endian; an empty list (a deviation map has no weights) copies nothing (memcpy
+  // may not be handed its null data)
+  if (!points.empty()) std::memcpy(out.data() + at, points.data(), points.size() * sizeof(double));
+  if (!weights.empty())
+    std::memcpy(out.data() + at + points.size() * sizeof(double), weights.data(),
+                weights.size() * sizeof(double));
   return out;
 }
 
@@ -276,10 +279,6 @@ std::uint64_t topology_key(const brep::Model& model) {
   return h;
 }
 
-}  // namespace
-
-namespace {
-
 /// A 3-vector member of a command, or an InvalidArgument naming it.
 Eigen::Vector3d command_vec3(const Json& c, const std::string& key, const std::string& what) {
   const auto it = c.find(key);
@@ -299,6 +298,11 @@ Json fit_reply(const Json& c) {
   if (pts == c.end() || !pts->is_array())
     throw Error(ErrorCategory::InvalidArgument,
                 "studio: \"fit\" needs \"points\": the drawn points [[x, y, z], ...]");
+  constexpr std::size_t max_points = 10000;  // a recipe stroke's limit (docs/recipe.md)
+  if (pts->size() > max_points)
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: \"fit\": " + std::to_string(pts->size()) +
+                    " points; a stroke has at most 10000: draw it as several strokes");
   stroke.points.resize(static_cast<Eigen::Index>(pts->size()), 3);
   for (std::size_t k = 0; k < pts->size(); ++k) {
     const Json& p = (*pts)[k];
@@ -999,6 +1003,10 @@ void StudioServer::run() {
     if (s.stopping) break;
     s.reap();
     if (ec) continue;
+    // A reply is a JSON frame and then its binary frames, written one after another: with
+    // Nagle's algorithm each small write after the first waits for the page's (delayed, up to
+    // 40 ms) ACK of the one before. Interactive traffic goes out at once.
+    connection->socket.set_option(tcp::no_delay(true), ec);
     Impl::Connection* c = connection.get();
     c->thread = std::thread([&s, c] {
       try {

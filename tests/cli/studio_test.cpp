@@ -292,6 +292,9 @@ TEST_CASE("studio session: \"fit\" says how a stroke splits at its corners", "[s
   CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"tolerance", "fine"}}),
              Contains("\"tolerance\" must be a number"));
   CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"tolerance", -1}}), Contains("tolerance"));
+  Json many = Json::array();
+  for (int k = 0; k <= 10000; ++k) many.push_back({0.01 * k, 0.0, 0.0});
+  CHECK_THAT(error({{"op", "fit"}, {"points", many}}), Contains("at most 10000"));
   CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"plane", {{"origin", {0, 0}}}}}),
              Contains("\"origin\""));
   CHECK(session.text() == text);

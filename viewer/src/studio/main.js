@@ -741,6 +741,12 @@ function finishStroke(event) {
     return;
   }
   const tolerance = Number($('stroke-tolerance').value) || 0.5;
+  const dropInk = () => {
+    inkGroup.remove(line);
+    const i = pendingInk.findIndex((p) => p.line === line);
+    if (i >= 0) pendingInk.splice(i, 1);
+    dirty();
+  };
   if (live) {
     // the live target's last update: the whole stroke, in the drawing's history entry
     link.cancelDrag();
@@ -749,7 +755,7 @@ function finishStroke(event) {
     if (plane) stroke.plane = plane;
     const { changes, label } = liveTarget(live, stroke);
     pendingInk.push({ label, line });
-    return link.send(commandOf(changes, label, 'stroke', live.group), event.timeStamp);
+    return link.send(commandOf(changes, label, 'stroke', live.group), event.timeStamp).then(({ reply }) => reply.op === 'error' && dropInk());
   }
   const redrawn = event.altKey || over ? null : oversketchTarget(points);
   if (redrawn) {
@@ -788,12 +794,6 @@ function finishStroke(event) {
   if (plane) stroke.plane = plane;
   const label = `stroke ${name}`;
   pendingInk.push({ label, line });
-  const dropInk = () => {
-    inkGroup.remove(line);
-    const i = pendingInk.findIndex((p) => p.line === line);
-    if (i >= 0) pendingInk.splice(i, 1);
-    dirty();
-  };
   // The kernel's fit first: a stroke that turns sharply is split at its corners into pieces
   // NAME.1 .. NAME.N (the recipe's "pieces"), one curve each.
   piecesOf(points, plane, tolerance).then((pieces) => {
