@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 #include "hood.hpp"
+#include "step_times.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -29,26 +30,6 @@ using namespace clay;
 using Json = nlohmann::json;
 
 namespace {
-
-/// Per-step wall times: the p50 and p95 the figures ask for, as counters (ms).
-struct StepTimes {
-  std::vector<double> ms;
-  void record(std::chrono::steady_clock::time_point t0) {
-    ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  void report(benchmark::State& state) {
-    if (ms.empty()) return;
-    auto q = [&](double f) {
-      std::vector<double> v = ms;
-      const auto k = static_cast<std::ptrdiff_t>(f * static_cast<double>(v.size() - 1));
-      std::nth_element(v.begin(), v.begin() + k, v.end());
-      return v[static_cast<std::size_t>(k)];
-    };
-    state.counters["p50_ms"] = q(0.5);
-    state.counters["p95_ms"] = q(0.95);
-  }
-};
 
 void lattice_drag_step(benchmark::State& state) {
   const auto grid = surface::linspace(0, 1, 173);
@@ -63,7 +44,7 @@ void lattice_drag_step(benchmark::State& state) {
   const Eigen::RowVector3d rest = lattice.points.row(moved);
   surface::Points3 out(parent.rows(), 3);
   int step = 0;
-  StepTimes times;
+  clay::bench::StepTimes times;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     lattice.points.row(moved) = rest + Eigen::RowVector3d(0, 0, 40 * std::sin(0.1 * step++));
@@ -116,7 +97,7 @@ void session_drag_step(benchmark::State& state) {
   }
   recipe::StudioSession session(doc.dump(), file.parent_path(), "car_hood");
   int step = 0;
-  StepTimes times;
+  clay::bench::StepTimes times;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     const double value =

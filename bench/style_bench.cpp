@@ -11,6 +11,7 @@
 #include <benchmark/benchmark.h>
 
 #include "hood.hpp"
+#include "step_times.hpp"
 
 #include <cmath>
 
@@ -50,11 +51,15 @@ void drag(benchmark::State& state) {
   StyleEditor editor(parent, influence_factors(parent, bound(), options), options);
   const auto grid = clay::surface::linspace(0, 1, 173);
   int step = 0;
+  clay::bench::StepTimes times;
   for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
     const StyleResult r = editor.update(target(10 * std::sin(0.1 * step++)));
     const Points3 mesh = clay::surface::evaluate_grid(r.surface, grid, grid);
     benchmark::DoNotOptimize(mesh.data());
+    times.record(t0);
   }
+  times.report(state);
   state.SetItemsProcessed(state.iterations());
 }
 
