@@ -96,14 +96,22 @@ try {
     await s.idle();
     await picture('style');
   });
-  await step('reflection lines and mean curvature', async () => {
+  await step('reflection lines, mean and Gaussian curvature, before', async () => {
     await page.click('button[data-mode="zebra"]');
     await s.idle();
     await picture('zebra');
     await page.click('button[data-mode="mean"]');
     await s.idle();
     await picture('mean');
+    await page.click('button[data-mode="gaussian"]');
+    await s.idle();
+    await picture('gaussian');
     await page.click('button[data-mode="shaded"]');
+    await page.click('#before-after');
+    await s.idle();
+    await picture('before');
+    await page.click('#before-after');
+    await s.idle();
   });
   await step('the target dragged by its middle control point (Edit)', async () => {
     await s.clickCurve('s7', false);
