@@ -113,6 +113,21 @@ async function withStudio(file, label, fn) {
   }
 }
 
+/**
+ * withStudio on a new empty recipe NAME.json in a folder of its own, the Sketch tool chosen and
+ * snapping off: fn(page, driver).
+ */
+async function withEmptyRecipe(name, fn) {
+  const dir = join(work, name);
+  mkdirSync(dir);
+  writeFileSync(join(dir, `${name}.json`), JSON.stringify({ format: 'clayform.recipe', version: 1, name }));
+  return withStudio(join(dir, `${name}.json`), name, async (other, driver) => {
+    await other.click('#tool-sketch');
+    await other.uncheck('#snap');
+    return fn(other, driver);
+  });
+}
+
 /** Draws a stroke through world points on the plane z = z0; the drawn path back-projected onto it, here. */
 /**
  * The kernel's deviation map of `name` (window.clayStudio.deviations()) against the distance
@@ -737,12 +752,7 @@ try {
   });
 
   await check('a stroke with corners split there into pieces and filled; a stroke mirrored in the plane x = 10', async () => {
-    const dir = join(work, 'corners');
-    mkdirSync(dir);
-    writeFileSync(join(dir, 'corners.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'corners' }));
-    return withStudio(join(dir, 'corners.json'), 'corners', async (cp, k) => {
-      await cp.click('#tool-sketch');
-      await cp.uncheck('#snap');
+    return withEmptyRecipe('corners', async (cp, k) => {
       // a 240 x 160 rectangle in one stroke, from the middle of its bottom side round and back
       const corner = [[-120, -80, 0], [120, -80, 0], [120, 80, 0], [-120, 80, 0]];
       const path = await k.draw([[0, -80, 0], corner[1], corner[2], corner[3], corner[0], [0, -80, 0]], { steps: 200 });
@@ -798,26 +808,23 @@ try {
   });
 
   await check('constraints on two strokes of a plane (coincident, tangent, a conflict refused, horizontal); a stroke in 3D between two views; revolve about a picked line; a plane at a picked surface point', async () => {
-    const dir = join(work, 'sketch');
-    mkdirSync(dir);
-    writeFileSync(join(dir, 'sketch.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'sketch' }));
-    return withStudio(join(dir, 'sketch.json'), 'sketch', async (sketchPage, k) => {
-      await sketchPage.click('#tool-sketch');
-      await sketchPage.uncheck('#snap');
+    return withEmptyRecipe('sketch', async (sketchPage, k) => {
+      // a button that must be taken: pressed, the kernel's answer awaited, no error
+      const press = async (selector) => {
+        await sketchPage.click(selector);
+        await k.idle();
+        assert(!(await k.lastError()), await k.lastError());
+      };
       // two strokes whose ends nearly meet at an angle
       await k.draw(along([-300, 0], [-20, 10], 20));
       await k.draw(along([5, 0], [300, 120], -20));
       await sketchPage.click('#tool-orbit');
       await k.clickCurve('s1', false);
       await k.clickCurve('s2', true);
-      await sketchPage.click('#constrain-coincident');
-      await k.idle();
-      assert(!(await k.lastError()), await k.lastError());
+      await press('#constrain-coincident');
       await k.clickCurve('sketch1.s1', false);
       await k.clickCurve('sketch1.s2', true);
-      await sketchPage.click('#constrain-tangent');
-      await k.idle();
-      assert(!(await k.lastError()), await k.lastError());
+      await press('#constrain-tangent');
       const curves = await k.call(() => window.clayStudio.curves());
       const a = curves['sketch1.s1'];
       const b = curves['sketch1.s2'];
@@ -849,9 +856,7 @@ try {
       assert(JSON.stringify(await k.call(() => window.clayStudio.recipe())) === text, 'the refused constraint changed the recipe');
       // horizontal: s2's chord along the plane's x axis (XY: world x), the joint kept
       await k.clickCurve('sketch1.s2', false);
-      await sketchPage.click('#constrain-horizontal');
-      await k.idle();
-      assert(!(await k.lastError()), await k.lastError());
+      await press('#constrain-horizontal');
       const level = await k.call(() => window.clayStudio.curves());
       const h = level['sketch1.s2'];
       const hn = h.weights.length;
