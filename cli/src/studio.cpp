@@ -223,24 +223,26 @@ std::vector<std::uint8_t> model_nets_frame(const std::string& name, const brep::
 /// then rows * cols float64, row (u) by row.
 std::vector<std::uint8_t> deviation_frame(const std::string& name, const surface::BSplineSurface& s,
                                           const Stage& stage, int rows, int cols) {
-  const auto [u0, u1] = s.u.domain();
-  const auto [v0, v1] = s.v.domain();
-  const auto [a0, a1] = stage.before.u.domain();
-  const auto [b0, b1] = stage.before.v.domain();
-  auto at = [](double first, double last, int k, int n) {
-    return k == n - 1 ? last : first + (last - first) * k / (n - 1);
+  // The same fractions of both domains, the last one each domain's end exactly.
+  auto fractions = [](const surface::BSplineBasis& basis, int n) {
+    const auto [first, last] = basis.domain();
+    std::vector<double> t(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k)
+      t[static_cast<std::size_t>(k)] = k == n - 1 ? last : first + (last - first) * k / (n - 1);
+    return t;
   };
-  std::vector<double> values(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols));
+  const surface::Points3 after =
+      surface::evaluate_grid(s, fractions(s.u, rows), fractions(s.v, cols));
+  const surface::Points3 before = surface::evaluate_grid(
+      stage.before, fractions(stage.before.u, rows), fractions(stage.before.v, cols));
+  std::vector<double> values(static_cast<std::size_t>(after.rows()));
   double worst = 0;
-  for (int i = 0; i < rows; ++i)
-    for (int j = 0; j < cols; ++j) {
-      const Eigen::Vector3d p = surface::evaluate(s, at(u0, u1, i, rows), at(v0, v1, j, cols));
-      const Eigen::Vector3d q =
-          stage.map(surface::evaluate(stage.before, at(a0, a1, i, rows), at(b0, b1, j, cols)));
-      const double d = (p - q).norm();
-      values[static_cast<std::size_t>(i * cols + j)] = d;
-      worst = std::max(worst, d);
-    }
+  for (Eigen::Index k = 0; k < after.rows(); ++k) {
+    const Eigen::Vector3d q = stage.map(before.row(k).transpose());
+    const double d = (after.row(k).transpose() - q).norm();
+    values[static_cast<std::size_t>(k)] = d;
+    worst = std::max(worst, d);
+  }
   const Json header = {{"kind", "deviation"}, {"name", name}, {"step", stage.step},
                        {"rows", rows},        {"cols", cols}, {"max", worst}};
   return net_frame(header.dump(), values, {});
