@@ -4,6 +4,7 @@
 #include <clay/brep/exchange.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/files.hpp>
+#include <clay/internal/json_reader.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/sketch/fit.hpp>
 #include <clay/studio.hpp>
@@ -281,67 +282,44 @@ std::uint64_t topology_key(const brep::Model& model) {
   return h;
 }
 
-/// A 3-vector member of a command, or an InvalidArgument naming it.
-Eigen::Vector3d command_vec3(const Json& c, const std::string& key, const std::string& what) {
-  const auto it = c.find(key);
-  if (it == c.end() || !it->is_array() || it->size() != 3 ||
-      !std::all_of(it->begin(), it->end(), [](const Json& x) { return x.is_number(); }))
-    throw Error(ErrorCategory::InvalidArgument,
-                "studio: " + what + " needs \"" + key + "\" as [x, y, z] (numbers)");
-  return {(*it)[0].get<double>(), (*it)[1].get<double>(), (*it)[2].get<double>()};
-}
-
 /// The "fit" op: the stroke {points, plane?, tolerance?, corner_angle?} fitted as a recipe stroke
 /// with "pieces" would be (fit_stroke, split where it turns by more than corner_angle), and how:
 /// the page asks before it writes the stroke, so a stroke with corners becomes one with "pieces".
-Json fit_reply(const Json& c) {
+/// Read by the shared path-aware reader, with a recipe stroke's limits; every problem is named.
+Json fit_reply(const Json& command) {
+  const internal::Json c = internal::Json::parse(command.dump());
+  internal::JsonReader r;
+  r.limit_note = "a recipe stroke's limit: draw it as several strokes";
   sketch::Stroke stroke;
-  const auto pts = c.find("points");
-  if (pts == c.end() || !pts->is_array())
-    throw Error(ErrorCategory::InvalidArgument,
-                "studio: \"fit\" needs \"points\": the drawn points [[x, y, z], ...]");
-  constexpr std::size_t max_points = 10000;  // a recipe stroke's limit (docs/recipe.md)
-  if (pts->size() > max_points)
-    throw Error(ErrorCategory::InvalidArgument,
-                "studio: \"fit\": " + std::to_string(pts->size()) +
-                    " points; a stroke has at most 10000: draw it as several strokes");
-  stroke.points.resize(static_cast<Eigen::Index>(pts->size()), 3);
-  for (std::size_t k = 0; k < pts->size(); ++k) {
-    const Json& p = (*pts)[k];
-    if (!p.is_array() || p.size() != 3 ||
-        !std::all_of(p.begin(), p.end(), [](const Json& x) { return x.is_number(); }))
-      throw Error(ErrorCategory::InvalidArgument,
-                  "studio: \"fit\": point " + std::to_string(k) + " is not [x, y, z] (numbers)");
-    for (int d = 0; d < 3; ++d)
-      stroke.points(static_cast<Eigen::Index>(k), d) = p[static_cast<std::size_t>(d)].get<double>();
-  }
-  if (const auto pl = c.find("plane"); pl != c.end()) {
-    if (!pl->is_object())
-      throw Error(ErrorCategory::InvalidArgument,
-                  "studio: \"fit\": \"plane\" is {origin, normal, x_axis?} or {origin, x_axis, "
-                  "y_axis}");
-    const Eigen::Vector3d origin = command_vec3(*pl, "origin", "the fit's plane");
+  if (const auto* pts = r.member(c, "", "points", true, "the drawn points [[x, y, z], ...]"))
+    if (auto p = r.points(*pts, "points", 2, 10000)) stroke.points = std::move(*p);
+  if (const auto* pl = r.member(c, "", "plane", false, "");
+      pl && r.object(*pl, "plane", {"origin", "normal", "x_axis", "y_axis"},
+                     "a plane {origin, normal, x_axis?} or {origin, x_axis, y_axis}")) {
+    auto vec = [&](const char* key, bool required) -> std::optional<Eigen::Vector3d> {
+      const auto* v = r.member(*pl, "plane", key, required, "[x, y, z]");
+      return v ? r.vec3(*v, internal::key_path("plane", key)) : std::nullopt;
+    };
+    const auto origin = vec("origin", true);
     if (pl->contains("normal")) {
-      std::optional<Eigen::Vector3d> x;
-      if (pl->contains("x_axis")) x = command_vec3(*pl, "x_axis", "the fit's plane");
-      stroke.plane = sketch::make_plane(origin, command_vec3(*pl, "normal", "the fit's plane"), x);
+      const auto normal = vec("normal", true);
+      const auto x = pl->contains("x_axis") ? vec("x_axis", true) : std::nullopt;
+      if (origin && normal) stroke.plane = sketch::make_plane(*origin, *normal, x);
     } else {
-      stroke.plane = sketch::SketchPlane{origin, command_vec3(*pl, "x_axis", "the fit's plane"),
-                                         command_vec3(*pl, "y_axis", "the fit's plane")};
+      const auto x = vec("x_axis", true), y = vec("y_axis", true);
+      if (origin && x && y) stroke.plane = sketch::SketchPlane{*origin, *x, *y};
     }
   }
   sketch::FitOptions options;
-  auto number_or = [&](const char* key, double fallback) {
-    const auto it = c.find(key);
-    if (it == c.end()) return fallback;
-    if (!it->is_number())
-      throw Error(ErrorCategory::InvalidArgument,
-                  std::string("studio: \"fit\": \"") + key + "\" must be a number (mm, degrees)");
-    return it->get<double>();
-  };
-  options.tolerance = number_or("tolerance", options.tolerance);
-  options.corner_angle = number_or("corner_angle", options.corner_angle);
-  options.validate();
+  options.tolerance =
+      r.number_or(c, "", "tolerance", options.tolerance, internal::Range{0, 1e6, true});
+  options.corner_angle = r.number_or(c, "", "corner_angle", options.corner_angle,
+                                     internal::Range{0, 180, true, false});
+  if (!r.problems.empty()) {
+    std::string list;
+    for (const auto& p : r.problems) list += (list.empty() ? "" : "; ") + p.path + ": " + p.message;
+    throw Error(ErrorCategory::InvalidArgument, "studio: \"fit\": " + list);
+  }
   sketch::validate(stroke, "the fit's stroke");
   const sketch::StrokeFit fit = sketch::fit_stroke(stroke, options);
   return {{"op", "fit"},

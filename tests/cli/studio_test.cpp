@@ -287,16 +287,27 @@ TEST_CASE("studio session: \"fit\" says how a stroke splits at its corners", "[s
     CHECK(r.at("op") == "error");
     return r.at("message").get<std::string>();
   };
-  CHECK_THAT(error({{"op", "fit"}}), Contains("\"points\""));
-  CHECK_THAT(error({{"op", "fit"}, {"points", {{0, 0, 0}, {1, "a", 0}}}}), Contains("point 1"));
+  // Each problem with its path in the command, as the recipe checker words them.
+  CHECK_THAT(error({{"op", "fit"}}), Contains("points: missing"));
+  CHECK_THAT(error({{"op", "fit"}, {"points", {{0, 0, 0}, {1, "a", 0}}}}),
+             Contains("points[1][1]: expected a number"));
   CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"tolerance", "fine"}}),
-             Contains("\"tolerance\" must be a number"));
-  CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"tolerance", -1}}), Contains("tolerance"));
+             Contains("tolerance: expected a number"));
+  CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"tolerance", -1}}),
+             Contains("tolerance: -1 is out of range"));
+  CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"corner_angle", 200}}),
+             Contains("corner_angle: 200 is out of range"));
   Json many = Json::array();
   for (int k = 0; k <= 10000; ++k) many.push_back({0.01 * k, 0.0, 0.0});
   CHECK_THAT(error({{"op", "fit"}, {"points", many}}), Contains("at most 10000"));
   CHECK_THAT(error({{"op", "fit"}, {"points", arc}, {"plane", {{"origin", {0, 0}}}}}),
-             Contains("\"origin\""));
+             Contains("plane.origin: expected [x, y, z]") && Contains("plane.x_axis: missing"));
+  // a plane whose axes are not orthonormal: the stroke's own check names it
+  CHECK_THAT(
+      error({{"op", "fit"},
+             {"points", arc},
+             {"plane", {{"origin", {0, 0, 0}}, {"x_axis", {1, 0, 0}}, {"y_axis", {1, 1, 0}}}}}),
+      Contains("plane"));
   CHECK(session.text() == text);
   CHECK(before != text);
 }
