@@ -129,6 +129,19 @@ async function withEmptyRecipe(name, fn) {
 }
 
 /** Draws a stroke through world points on the plane z = z0; the drawn path back-projected onto it, here. */
+/** The largest distance from `surface` to `map` of `parent` at the same (u, v), on an (n + 1)^2 grid. */
+function offPointwise(surface, parent, map, n) {
+  const [[u0, u1], [v0, v1]] = surfaceDomain(surface);
+  let worst = 0;
+  for (let a = 0; a <= n; a++)
+    for (let b = 0; b <= n; b++) {
+      const u = u0 + ((u1 - u0) * a) / n;
+      const v = v0 + ((v1 - v0) * b) / n;
+      worst = Math.max(worst, dist(surfaceAt(surface, u, v), map(surfaceAt(parent, u, v))));
+    }
+  return worst;
+}
+
 /**
  * The kernel's deviation map of `name` (window.clayStudio.deviations()) against the distance
  * computed here at its grid: from the surface to `map` applied to its parent, at the same
@@ -406,14 +419,7 @@ try {
     afterDrag = surfaces.fill1_styled1_ffd1;
     const parent = befores.fill1_styled1_ffd1;
     const points = latticePoints(step);
-    const [[u0, u1], [v0, v1]] = surfaceDomain(afterDrag);
-    let worst = 0;
-    for (let a = 0; a <= 24; a++)
-      for (let b = 0; b <= 24; b++) {
-        const u = u0 + ((u1 - u0) * a) / 24;
-        const v = v0 + ((v1 - v0) * b) / 24;
-        worst = Math.max(worst, dist(surfaceAt(afterDrag, u, v), ffd(step, points, surfaceAt(parent, u, v))));
-      }
+    const worst = offPointwise(afterDrag, parent, (x) => ffd(step, points, x), 24);
     assert(worst <= 1e-9 * 1000, `the dragged surface is ${worst} mm off the pointwise FFD`);
     // The Deviation mode's map, the kernel's: at its grid, the distance computed here from the
     // surface to the pointwise FFD of its parent.
@@ -648,14 +654,7 @@ try {
         const Y = r * x * Math.sin(t) + r * y * Math.cos(t);
         return [0, 1, 2].map((e) => origin[e] + X * reference[e] + Y * yAxis[e] + z * axis[e]);
       };
-      const [[u0, u1], [v0, v1]] = surfaceDomain(shaped);
-      let worst = 0;
-      for (let a = 0; a <= 20; a++)
-        for (let b = 0; b <= 20; b++) {
-          const u = u0 + ((u1 - u0) * a) / 20;
-          const v = v0 + ((v1 - v0) * b) / 20;
-          worst = Math.max(worst, dist(surfaceAt(shaped, u, v), barr(surfaceAt(parent, u, v))));
-        }
+      const worst = offPointwise(shaped, parent, barr, 20);
       const steps = (await g.call(() => window.clayStudio.reply())).steps.filter((st) => st.path.startsWith('surfaces.patch_global1.steps'));
       const allowed = steps.reduce((sum, st) => sum + (st.figures.tolerance_mm || 0), 0);
       assert(worst <= allowed, `the surface is ${worst} mm from Barr's taper and twist of its parent; the steps' tolerances add to ${allowed} mm`);
@@ -712,14 +711,7 @@ try {
       const shapedB = (await g.call(() => window.clayStudio.surfaces()))[latSurface];
       const parentB = (await g.call(() => window.clayStudio.befores()))[latSurface];
       const latPoints = bsplineLatticePoints(latStep);
-      const [[bu0, bu1], [bv0, bv1]] = surfaceDomain(shapedB);
-      let offB = 0;
-      for (let a = 0; a <= 16; a++)
-        for (let b = 0; b <= 16; b++) {
-          const u = bu0 + ((bu1 - bu0) * a) / 16;
-          const v = bv0 + ((bv1 - bv0) * b) / 16;
-          offB = Math.max(offB, dist(surfaceAt(shapedB, u, v), bsplineFfd(latStep, latPoints, surfaceAt(parentB, u, v))));
-        }
+      const offB = offPointwise(shapedB, parentB, (x) => bsplineFfd(latStep, latPoints, x), 16);
       const latRep = (await g.call(() => window.clayStudio.reply())).steps.find((st) => st.path === `surfaces.${latSurface}.steps[0]`);
       assert(offB <= latRep.figures.tolerance_mm, `the B-spline lattice's surface is ${offB} mm off the pointwise FFD (tolerance ${latRep.figures.tolerance_mm})`);
       // The picture drawn while the point was held: each sample the pointwise B-spline FFD of

@@ -27,19 +27,13 @@ function bernstein(n, x) {
 }
 
 /**
- * The B-spline basis functions of one lattice direction at x and their derivatives, as full-length
- * arrays over its control points: [values, derivatives].
+ * The p + 1 B-spline basis functions of one lattice direction that do not vanish at x, their
+ * derivatives, and the index of the first: [values, derivatives, first].
  */
 function bsplineBasis(knots, p, count, x) {
-  const b = new Float64Array(count);
-  const d = new Float64Array(count);
   const span = findSpan(knots, p, count, x);
   const ders = basisDerivatives(knots, p, span, x, 1);
-  for (let j = 0; j <= p; j++) {
-    b[span - p + j] = ders[0][j];
-    d[span - p + j] = ders[1][j];
-  }
-  return [b, d];
+  return [ders[0], ders[1], span - p];
 }
 
 /** 3 x 3 inverse (row-major array of 9), for the frame's local coordinates. */
@@ -55,15 +49,15 @@ function inverse3(m) {
 /**
  * What a drag of `step` (a bezier_lattice or bspline_lattice recipe step) needs of the parent's
  * samples `grid` (surfaceGrid): each vertex's basis values and derivatives in the lattice's local
- * coordinates (s, t, u), computed once per drag (eq. (1): X = X0 + s S + t T + u U). The
- * B-spline basis is stored over all control points of a direction, so one sum serves both.
+ * coordinates (s, t, u), computed once per drag (eq. (1): X = X0 + s S + t T + u U). Each
+ * direction keeps only the functions that do not vanish there and the index of the first (0 for
+ * Bernstein's), so one sum serves both lattices and a B-spline's costs (p+1)^3 per vertex.
  */
 export function prepareFfd(grid, step) {
   const bspline = step.kind === 'bspline_lattice';
   const counts = bspline ? [0, 1, 2].map((e) => step.cells[e] + step.degrees[e]) : step.degrees.map((d) => d + 1);
   const knots = bspline ? [0, 1, 2].map((e) => latticeKnots(step.cells[e], step.degrees[e], step.knots || 'clamped')) : null;
-  const basisOf = (e, x) => (bspline ? bsplineBasis(knots[e], step.degrees[e], counts[e], x) : bernstein(step.degrees[e], x));
-  const [l, m, n] = counts.map((c) => c - 1);
+  const basisOf = (e, x) => (bspline ? bsplineBasis(knots[e], step.degrees[e], counts[e], x) : [...bernstein(step.degrees[e], x), 0]);
   const { origin, s: S, t: T, u: U } = step.frame;
   // columns S, T, U: world = X0 + M [s t u]
   const Minv = inverse3([S[0], T[0], U[0], S[1], T[1], U[1], S[2], T[2], U[2]]);
@@ -74,7 +68,7 @@ export function prepareFfd(grid, step) {
     const local = [0, 1, 2].map((r) => Minv[3 * r] * d[0] + Minv[3 * r + 1] * d[1] + Minv[3 * r + 2] * d[2]);
     basis.push([basisOf(0, local[0]), basisOf(1, local[1]), basisOf(2, local[2])]);
   }
-  return { grid, last: [l, m, n], Minv, basis };
+  return { grid, counts, Minv, basis };
 }
 
 /**
@@ -84,8 +78,8 @@ export function prepareFfd(grid, step) {
  * surface's neighbourhood (<= 0), as the drag goes.
  */
 export function applyFfd(prepared, points, position, normal) {
-  const { grid, last, Minv, basis } = prepared;
-  const [l, m, n] = last;
+  const { grid, counts, Minv, basis } = prepared;
+  const [, nt, nu] = counts;
   const count = grid.rows * grid.cols;
   let lo = Infinity;
   let hi = -Infinity;
@@ -95,16 +89,15 @@ export function applyFfd(prepared, points, position, normal) {
   const a = new Float64Array(3);
   const b = new Float64Array(3);
   for (let k = 0; k < count; k++) {
-    const [[bs, ds], [bt, dt], [bu, du]] = basis[k];
+    const [[bs, ds, s0], [bt, dt, t0], [bu, du, u0]] = basis[k];
     let x = 0;
     let y = 0;
     let z = 0;
     J.fill(0);
-    let at = 0;
-    for (let i = 0; i <= l; i++)
-      for (let j = 0; j <= m; j++)
-        for (let h = 0; h <= n; h++, at++) {
-          const P = points[at];
+    for (let i = 0; i < bs.length; i++)
+      for (let j = 0; j < bt.length; j++)
+        for (let h = 0; h < bu.length; h++) {
+          const P = points[((s0 + i) * nt + t0 + j) * nu + u0 + h];
           const f = bs[i] * bt[j] * bu[h];
           const fs = ds[i] * bt[j] * bu[h];
           const ft = bs[i] * dt[j] * bu[h];

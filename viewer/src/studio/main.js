@@ -1144,6 +1144,13 @@ canvas.addEventListener(
   },
   { capture: true },
 );
+/** Where a point grabbed at `start` goes for this pointer event: the lock's target, scaled by the strength; null off the lock. */
+function draggedTo(start, event) {
+  const target = dragTarget(start, pointerRay(event.clientX, event.clientY), $('lattice-lock').value);
+  if (!target) return null;
+  const strength = Number($('lattice-strength').value) || 1;
+  return start.map((c, i) => c + strength * (target[i] - c));
+}
 canvas.addEventListener('pointermove', (event) => {
   if (ink) {
     const events = event.getCoalescedEvents ? event.getCoalescedEvents() : [event];
@@ -1158,18 +1165,14 @@ canvas.addEventListener('pointermove', (event) => {
       dragEdit(() => ({ ...liveTarget(live, stroke), group: live.group }), event.timeStamp);
     }
   } else if (surfaceDrag) {
-    const target = dragTarget(surfaceDrag.start, pointerRay(event.clientX, event.clientY), $('lattice-lock').value);
-    if (!target) return;
-    const strength = Number($('lattice-strength').value) || 1;
-    const to = surfaceDrag.start.map((c, i) => c + strength * (target[i] - c));
+    const to = draggedTo(surfaceDrag.start, event);
+    if (!to) return;
     surfaceDrag.last = to;
     const d = surfaceDrag;
     dragEdit(() => (doc.recipe.deformations && doc.recipe.deformations[d.deformation] ? { changes: { path: `deformations.${d.deformation}[0].moves[0].to`, value: to }, label: `drag ${d.surface} at (${d.uv.map((x) => x.toPrecision(4))})`, group: d.group } : null), event.timeStamp);
   } else if (handleDrag) {
-    const target = dragTarget(handleDrag.start, pointerRay(event.clientX, event.clientY), $('lattice-lock').value);
-    if (!target) return;
-    const strength = Number($('lattice-strength').value) || 1;
-    const to = handleDrag.start.map((c, i) => c + strength * (target[i] - c));
+    const to = draggedTo(handleDrag.start, event);
+    if (!to) return;
     handleDrag.last = to;
     if (handleDrag.handle.kind === 'lattice') showPreview(handleDrag.handle, to, event.timeStamp);
     moveHandle(handleDrag.handle, to, event.timeStamp, false, handleDrag.group);
