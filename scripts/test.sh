@@ -15,7 +15,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
 CLAY_SANITIZE_BUILD=${CLAYFORM_SANITIZE_BUILD_DIR:-$CLAY_ROOT/build-sanitize}
 FUZZ_SECONDS=${CLAY_FUZZ_SECONDS:-60}
-FUZZ_TARGETS=(recipe stack)  # tests/fuzz/<name>_fuzz.cpp, seeds in tests/fuzz/corpus/<name>/
+FUZZ_TARGETS=(recipe stack studio)  # tests/fuzz/<name>_fuzz.cpp, seeds in tests/fuzz/corpus/<name>/
 
 IFS=', ' read -ra parts <<<"${CLAY_TEST_PARTS:-release,sanitize,fuzz}"
 for p in "${parts[@]}"; do

@@ -10,6 +10,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <pthread.h>
+#include <signal.h>
 #include <unistd.h>
 #include <algorithm>
 #include <cctype>
@@ -375,6 +377,59 @@ int render_recipe(const fs::path& file, const fs::path& png, clay::render::Rende
   return 0;
 }
 
+/// clayform studio: the recipe (or a STEP/IGES model, or an empty recipe) behind the studio's
+/// server until Ctrl-C. The history is autosaved beside the recipe; an autosave found there is
+/// continued (--fresh sets it aside), so a crash or Ctrl-C loses no edit.
+int studio(const std::string& recipe, int port, bool fresh) {
+  namespace rc = clay::recipe;
+  rc::StudioSession session =
+      recipe.empty() ? rc::StudioSession(
+                           R"({"format": "clayform.recipe", "version": 1, "name": "untitled"})",
+                           ".", "untitled")
+                     : rc::StudioSession::open(recipe);
+  // Beside the recipe (or the model), named after the session's recipe.
+  const fs::path autosave = rc::StudioSession::autosave_file(
+      recipe.empty() ? fs::path(".") : fs::path(recipe).parent_path(), session.name());
+  std::error_code ec;
+  if (fs::exists(autosave, ec)) {
+    if (fresh) {
+      fs::rename(autosave, autosave.string() + ".old", ec);
+      if (ec)
+        throw clay::Error(clay::ErrorCategory::Io, "cannot set the autosave \"" +
+                                                       autosave.string() +
+                                                       "\" aside: " + ec.message());
+      std::printf("Set the autosave aside as %s.old\n", autosave.string().c_str());
+    } else {
+      const std::size_t entries = session.restore(autosave);
+      std::printf("Continuing the autosave %s (%zu history entries; --fresh starts from the "
+                  "recipe file instead)\n",
+                  autosave.string().c_str(), entries);
+    }
+  }
+  session.autosave_to(autosave);
+  // Ctrl-C and SIGTERM stop the server cleanly (the autosave written): they are taken by this
+  // thread alone (sigwait), blocked before the server's threads start so they inherit the mask.
+  sigset_t stops;
+  sigemptyset(&stops);
+  sigaddset(&stops, SIGINT);
+  sigaddset(&stops, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stops, nullptr);
+  rc::StudioOptions o;
+  o.port = port;
+  o.front_end = rc::viewer_dir();
+  rc::StudioServer server(std::move(session), o);
+  std::printf("Clayform Studio at %s (open this address: it holds the session's token; "
+              "autosave %s; Ctrl-C to stop)\n",
+              server.url().c_str(), autosave.string().c_str());
+  std::fflush(stdout);
+  server.start();
+  int signal_number = 0;
+  sigwait(&stops, &signal_number);
+  server.stop();
+  std::printf("Clayform Studio stopped; the history is in %s\n", autosave.string().c_str());
+  return 0;
+}
+
 }  // namespace
 
 /// clayform sweep: replaces this process with `python3 -m clayform.sweeps SPEC --out OUT ...`
@@ -533,6 +588,10 @@ int main(int argc, char** argv) {
                          "empty recipe");
   studio_cmd->add_option("--port", studio_port, "TCP port, 0 for any free one")
       ->capture_default_str();
+  bool studio_fresh = false;
+  studio_cmd->add_flag("--fresh", studio_fresh,
+                       "start from the recipe file, setting aside its autosave (renamed to "
+                       "NAME.studio-autosave.json.old) instead of continuing it");
   // clayform sweep: the Python package's sweeps (docs/sweeps.md), run by Debian's python3.
   std::string sweep_spec, executor = "local", scheduler;
   int workers = 2;
@@ -564,23 +623,7 @@ int main(int argc, char** argv) {
   try {
     if (*info_cmd) return info(file);
     if (*sweep_cmd) return run_sweep(sweep_spec, out_dir, executor, workers, scheduler);
-    if (*studio_cmd) {
-      clay::recipe::StudioOptions o;
-      o.port = studio_port;
-      o.front_end = clay::recipe::viewer_dir();
-      clay::recipe::StudioServer server(
-          studio_recipe.empty()
-              ? clay::recipe::StudioSession(
-                    R"({"format": "clayform.recipe", "version": 1, "name": "untitled"})", ".",
-                    "untitled")
-              : clay::recipe::StudioSession::open(studio_recipe),
-          o);
-      std::printf("Clayform Studio at %s (WebSocket ws://127.0.0.1:%d/ws; Ctrl-C to stop)\n",
-                  server.url().c_str(), server.port());
-      std::fflush(stdout);
-      server.run();
-      return 0;
-    }
+    if (*studio_cmd) return studio(studio_recipe, studio_port, studio_fresh);
     if (*render_cmd) {
       if (!eye.empty()) render_options.eye_direction = {eye[0], eye[1], eye[2]};
       if (fs::path(file).extension() == ".json")

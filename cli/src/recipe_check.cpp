@@ -29,8 +29,14 @@ void RecipeChecker::run(const Json& root) {
   if (version && (!version->is_number_integer() || version->get<long long>() != format_version))
     c_.add("version", found(*version) + " is not supported: this clayform reads version " +
                           std::to_string(format_version) + "; write the recipe for version 1");
-  if (const Json* j = c_.member(root, "", "name", false, ""))
+  if (const Json* j = c_.member(root, "", "name", false, "")) {
     data.name = c_.string(*j, "name").value_or("");
+    // The name is the stem of files written for the recipe (the studio's export and autosave):
+    // a name such as "../../x" wrote outside the output folder (issue #36).
+    if (const auto problem = internal::file_name_problem(data.name); problem && j->is_string())
+      c_.add("name", "the name \"" + internal::clip_utf8(data.name, 60) + "\" is not a plain file name (" +
+                         *problem + "); give a name such as \"hood_v2\"");
+  }
   if (const Json* j = c_.member(root, "", "description", false, ""))
     data.description = c_.string(*j, "description").value_or("");
   if (const Json* j = c_.member(root, "", "units", false, "")) {
@@ -377,48 +383,20 @@ std::pair<int, int> line_column(std::string_view text, std::size_t byte) {
   return {line, static_cast<int>(end - line_start) + 1};
 }
 
-/// Where arrays and objects first nest deeper than limit::depth, found by counting brackets
-/// outside strings before any parser sees the text: nlohmann's parser, called on a recipe nested
-/// 100,000 levels deep, recursed ~87,000 frames and overflowed the stack (issue #18). The problem
-/// names the top-level key it is under (when there is one) and the bracket's line and column.
+/// Where arrays and objects first nest deeper than limit::depth (internal::nesting_too_deep),
+/// named by the top-level key it is under and the bracket's line and column.
 std::optional<Problem> too_deep(std::string_view text) {
-  int depth = 0, line = 1;
-  std::size_t line_start = 0, string_start = 0;
-  bool in_string = false;
-  std::string key, top_key;  // the last string closed at depth 1, and the key it became
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (c == '\n') {
-      ++line;
-      line_start = i + 1;
-    }
-    if (in_string) {
-      if (c == '\\') {
-        ++i;  // the escaped character cannot end the string
-      } else if (c == '"') {
-        in_string = false;
-        if (depth == 1)
-          key = std::string(text.substr(string_start, std::min<std::size_t>(i - string_start, 64)));
-      }
-      continue;
-    }
-    if (c == '"') {
-      in_string = true;
-      string_start = i + 1;
-    } else if (c == ':' && depth == 1) {
-      top_key = key;
-    } else if (c == '[' || c == '{') {
-      if (++depth > limit::depth)
-        return Problem{
-            top_key.empty() ? "(syntax)" : top_key,
-            "arrays and objects nest deeper than " + std::to_string(limit::depth) +
-                " levels here (recipe limit; a recipe needs at most 8): remove the extra brackets",
-            line, static_cast<int>(i - line_start) + 1};
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return std::nullopt;
+  const auto deep = internal::nesting_too_deep(text, limit::depth);
+  if (!deep) return std::nullopt;
+  int line = 1;
+  std::size_t line_start = 0;
+  for (std::size_t i = 0; i < deep->at; ++i)
+    if (text[i] == '\n') ++line, line_start = i + 1;
+  return Problem{deep->top_key.empty() ? "(syntax)" : deep->top_key,
+                 "arrays and objects nest deeper than " + std::to_string(limit::depth) +
+                     " levels here (recipe limit; a recipe needs at most 8): remove the extra "
+                     "brackets",
+                 line, static_cast<int>(deep->at - line_start) + 1};
 }
 
 /// Parses with a callback that reports keys repeated in one object (nlohmann would keep the last

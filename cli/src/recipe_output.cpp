@@ -2,6 +2,7 @@
 // written into a temporary folder and moved into place only when everything succeeded.
 #include <clay/brep/exchange.hpp>
 #include <clay/error.hpp>
+#include <clay/internal/files.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/recipe/view.hpp>
 #include <clay/surface/exchange.hpp>
@@ -9,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <system_error>
@@ -132,12 +135,14 @@ Staging stage(const fs::path& out_dir, std::string_view caller) {
   if (ec)
     throw Error(ErrorCategory::Io, "cannot create the folder \"" + parent.string() +
                                        "\": " + ec.message() + "; check the path and permissions");
-  s.tmp = parent / ("." + leaf + ".clayform-" + std::to_string(::getpid()));
-  fs::remove_all(s.tmp, ec);
-  fs::create_directory(s.tmp, ec);
-  if (ec)
-    throw Error(ErrorCategory::Io,
-                "cannot create the temporary folder \"" + s.tmp.string() + "\": " + ec.message());
+  // A folder of its own (mkdtemp): runs into the same folder at once, from threads or processes,
+  // never share one (they did with a name from the process id, issue #36).
+  std::string pattern = (parent / ("." + leaf + ".clayform-XXXXXX")).string();
+  if (!::mkdtemp(pattern.data()))
+    throw Error(ErrorCategory::Io, "cannot create a temporary folder beside \"" +
+                                       s.target.string() + "\": " + std::strerror(errno) +
+                                       "; check the folder's permissions and free space");
+  s.tmp = pattern;
   return s;
 }
 
@@ -192,6 +197,9 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
   std::error_code ec;
   std::vector<std::string> names;
   try {
+    // Every file stem a plain name: nothing is written outside the output folder.
+    for (const auto& e : result.exports) internal::check_file_name(e.name, "write_outputs: the export");
+    for (const auto& m : result.models) internal::check_file_name(m.name, "write_outputs: the model");
     for (auto& e : result.exports) {
       e.files.clear();
       for (const auto& format : e.formats) {

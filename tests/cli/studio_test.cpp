@@ -116,7 +116,12 @@ std::map<std::string, Net> frames_by_name(const StudioSession::Reply& reply) {
 
 TEST_CASE("studio session: edits, undo, redo and save replay to identical control points",
           "[studio]") {
-  StudioSession session = StudioSession::load(sail_file);
+  // The session works on a copy in a folder of its own: a save writes into the recipe's folder.
+  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(sail_file, dir / "sail.json");
+  StudioSession session = StudioSession::load(dir / "sail.json");
   const Json hello = Json::parse(session.handle(R"({"op": "hello"})").json);
   CHECK(hello.at("recipe") == "sail");
   CHECK(hello.at("surfaces") == Json::array({"sail"}));
@@ -160,12 +165,9 @@ TEST_CASE("studio session: edits, undo, redo and save replay to identical contro
   CHECK(same(decode(redone.frames[0]), replay.surface("sail")));
 
   // Save, and replay the saved file as `clayform run` does: identical control points.
-  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio";
-  fs::create_directories(dir);
   const fs::path saved = dir / "sail_edited.json";
-  fs::remove(saved);
   const Json ok =
-      Json::parse(session.handle(Json{{"op", "save"}, {"file", saved.string()}}.dump()).json);
+      Json::parse(session.handle(Json{{"op", "save"}, {"file", "sail_edited.json"}}.dump()).json);
   CHECK(ok.at("op") == "saved");
   CHECK(same(decode(redone.frames[0]), run_recipe(load_recipe(saved)).surface("sail")));
 
@@ -569,16 +571,17 @@ namespace beast = boost::beast;
 namespace websocket = beast::websocket;
 using tcp = asio::ip::tcp;
 
-/// A WebSocket client of the studio at `port`, sending `origin` (and Host 127.0.0.1:port).
+/// A WebSocket client of the studio at `port`, sending `origin` (and Host 127.0.0.1:port) and
+/// the session's token.
 struct Client {
   asio::io_context io;
   websocket::stream<tcp::socket> ws{io};
-  Client(int port, const std::string& origin) {
+  Client(int port, const std::string& origin, const std::string& token) {
     tcp::resolver resolver(io);
     asio::connect(ws.next_layer(), resolver.resolve("127.0.0.1", std::to_string(port)));
     ws.set_option(websocket::stream_base::decorator(
         [origin](websocket::request_type& req) { req.set(beast::http::field::origin, origin); }));
-    ws.handshake("127.0.0.1:" + std::to_string(port), "/ws");
+    ws.handshake("127.0.0.1:" + std::to_string(port), "/ws?token=" + token);
   }
   void send(const std::string& text) {
     ws.text(true);
@@ -601,7 +604,7 @@ TEST_CASE("studio server: its own page's origin talks, any other is refused", "[
   server.start();
   const int port = server.port();
   {
-    Client client(port, "http://127.0.0.1:" + std::to_string(port));
+    Client client(port, "http://127.0.0.1:" + std::to_string(port), server.token());
     client.send(R"({"op": "hello"})");
     const auto [text, body] = client.receive();
     CHECK(text);
@@ -613,7 +616,7 @@ TEST_CASE("studio server: its own page's origin talks, any other is refused", "[
           std::string("null")}) {
       INFO("origin " << origin);
       try {
-        Client refused(port, origin);
+        Client refused(port, origin, server.token());
         FAIL("the upgrade was accepted");
       } catch (const beast::system_error& e) {
         CHECK(e.code() == websocket::error::upgrade_declined);
@@ -625,10 +628,10 @@ TEST_CASE("studio server: its own page's origin talks, any other is refused", "[
   }
   // The server goes on serving its own page after refusing. A second page of its own (a
   // reload, another tab) takes the socket over; the first one's connection is closed.
-  Client again(port, "http://localhost:" + std::to_string(port));
+  Client again(port, "http://localhost:" + std::to_string(port), server.token());
   again.send(R"({"op": "recipe"})");
   CHECK(Json::parse(again.receive().second).at("op") == "recipe");
-  Client newer(port, "http://127.0.0.1:" + std::to_string(port));
+  Client newer(port, "http://127.0.0.1:" + std::to_string(port), server.token());
   newer.send(R"({"op": "hello"})");
   CHECK(Json::parse(newer.receive().second).at("op") == "hello");
   CHECK_THROWS(again.receive());
@@ -641,7 +644,8 @@ TEST_CASE("studio server: a burst of edits of one path is answered for the newes
   options.port = 0;
   StudioServer server(StudioSession::load(sail_file), options);
   server.start();
-  Client client(server.port(), "http://127.0.0.1:" + std::to_string(server.port()));
+  Client client(server.port(), "http://127.0.0.1:" + std::to_string(server.port()),
+                server.token());
   const int burst = 12;
   for (int k = 1; k <= burst; ++k)
     client.send(

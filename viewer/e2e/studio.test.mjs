@@ -62,6 +62,7 @@ function stepSurfaces(text) {
 const work = mkdtempSync(join(tmpdir(), 'clayform-studio-'));
 writeFileSync(join(work, 'drawn.json'), JSON.stringify({ format: 'clayform.recipe', version: 1, name: 'drawn' }));
 const { url, port, process: studio } = await startStudio(clayform, join(work, 'drawn.json'));
+const token = new URL(url).searchParams.get('token');
 
 const results = [];
 const figures = {};
@@ -517,7 +518,7 @@ try {
   await check('a socket from another origin is refused (403), the page keeps its own', async () => {
     const status = (origin) =>
       new Promise((resolvePromise, reject) => {
-        const req = request({ host: '127.0.0.1', port, path: '/ws', headers: { Connection: 'Upgrade', Upgrade: 'websocket', 'Sec-WebSocket-Version': '13', 'Sec-WebSocket-Key': 'dGhlIHNhbXBsZSBub25jZQ==', Host: `127.0.0.1:${port}`, Origin: origin } });
+        const req = request({ host: '127.0.0.1', port, path: `/ws?token=${token}`, headers: { Connection: 'Upgrade', Upgrade: 'websocket', 'Sec-WebSocket-Version': '13', 'Sec-WebSocket-Key': 'dGhlIHNhbXBsZSBub25jZQ==', Host: `127.0.0.1:${port}`, Origin: origin } });
         req.on('response', (res) => {
           res.resume();
           resolvePromise(res.statusCode);
@@ -546,7 +547,7 @@ try {
           ws.onopen = () => r('open');
           ws.onerror = () => r('refused');
         }),
-      `ws://127.0.0.1:${port}/ws`,
+      `ws://127.0.0.1:${port}/ws?token=${token}`,
     );
     await elsewhere.close();
     other.close();

@@ -5,14 +5,14 @@ import { spawn } from 'node:child_process';
 import { chromium } from 'playwright-core';
 import { curveAt, curveDomain } from './geometry.mjs';
 
-/** Starts `clayform studio RECIPE --port 0`; resolves with {url, port, process} once it prints its address. */
+/** Starts `clayform studio RECIPE --port 0`; resolves with {url (with the session's token), port, process} once it prints its address. */
 export function startStudio(clayform, recipe) {
   const child = spawn(clayform, ['studio', recipe, '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
   return new Promise((resolve, reject) => {
     let out = '';
     child.stdout.on('data', (d) => {
       out += d;
-      const m = out.match(/Clayform Studio at (http:\/\/127\.0\.0\.1:(\d+)\/)/);
+      const m = out.match(/Clayform Studio at (http:\/\/127\.0\.0\.1:(\d+)\/\?token=[0-9a-f]+)/);
       if (m) resolve({ url: m[1], port: Number(m[2]), process: child });
     });
     child.on('exit', (code) => reject(new Error(`clayform studio exited (${code}) before printing its address`)));

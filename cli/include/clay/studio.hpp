@@ -5,8 +5,10 @@
 ///
 /// Not installed: it lives with the command, like the viewer's server (clay/serve.hpp).
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -34,25 +36,65 @@ class StudioSession {
 
   /// The command's reply (JSON text) and the geometry frames that follow it (binary, see
   /// geometry_frames). Commands, as JSON objects with "op":
-  /// - "hello": the recipe's name, its surfaces and curves, the history;
+  /// - "hello": the recipe's name, its surfaces and curves, the history (and "restored" when the
+  ///   session continues an autosave);
   /// - "recipe": the current recipe text;
-  /// - "edit" {path, value, label, create?} or {path, remove: true} or {changes: [...], label}:
-  ///   set or remove values, check and run the new recipe, one history entry (edits with the
-  ///   same "group" in a row, a drag's updates, make one); a recipe the edit breaks is refused
-  ///   and nothing changes; with "nets": false the reply has no frames (a drag the page draws);
+  /// - "edit" {path, value, label?, create?, group?, nets?} or {path, remove: true} or
+  ///   {changes: [...], label?}: set or remove values, check and run the new recipe, one history
+  ///   entry (edits with the same "group" in a row, a drag's updates, make one); a recipe the
+  ///   edit breaks is refused and nothing changes; with "nets": false the reply has no frames (a
+  ///   drag the page draws);
   /// - "undo", "redo": move in the history (and run);
   /// - "run": run the current recipe;
-  /// - "save" {file}: write the current recipe text (atomically; relative to the recipe's folder);
-  /// - "export" {folder, name?}: STEP, IGES and glTF of the final surfaces, read back and checked.
-  /// A bad command gets {"op": "error", "message": ...}; the session is unchanged.
+  /// - "save" {file}: write the current recipe text atomically, `file` a plain file name in the
+  ///   recipe's folder;
+  /// - "export" {folder, name?}: STEP, IGES and glTF of the final surfaces, read back and
+  ///   checked, into `folder` (plain names joined by '/', inside the recipe's folder); `name` a
+  ///   plain file name.
+  /// A bad command gets {"op": "error", "category", "message"}: every field is read before
+  /// anything changes, so the session is unchanged; nothing a command holds makes this throw,
+  /// and every reply is valid UTF-8. `cancelled`, when given, is asked between the run's steps;
+  /// true ends the command with {"op": "error", "category": "cancelled"} and changes nothing.
   struct Reply {
     std::string json;
     std::vector<std::vector<std::uint8_t>> frames;
   };
-  Reply handle(const std::string& command);
+  Reply handle(const std::string& command, const std::function<bool()>& cancelled = {});
+
+  /// The largest command (bytes) and its deepest nesting of arrays and objects; beyond either a
+  /// command is refused before it is parsed.
+  static constexpr std::size_t command_bytes = 16u << 20;
+  static constexpr int command_depth = 64;
+  /// The history keeps its newest entries within this many bytes of recipe text by default
+  /// (limit_history; the current entry and the one before it always stay, history_dropped()
+  /// counts the others).
+  static constexpr std::size_t history_bytes = 256u << 20;
+  /// Entries an autosave keeps (the newest; the current one always).
+  static constexpr std::size_t autosave_entries = 50;
+
+  /// Where the studio autosaves a recipe named `name` of `recipe_folder`:
+  /// NAME.studio-autosave.json beside it.
+  static std::filesystem::path autosave_file(const std::filesystem::path& recipe_folder,
+                                             const std::string& name);
+  /// Autosaves the history into `file` from now on (atomically, written now, then after each
+  /// change at most once a second; flush_autosave writes what is pending). clay::Error(Io) when
+  /// it cannot be written.
+  void autosave_to(const std::filesystem::path& file);
+  /// Writes a pending autosave now (the server calls it when a drag's updates stop).
+  void flush_autosave();
+  /// Continues the autosave `file` (written by autosave_to): its history and position replace
+  /// this session's. Returns the number of entries. clay::Error(Recipe) naming the file when it
+  /// is not an autosave or its current recipe has problems; Io when it cannot be read.
+  std::size_t restore(const std::filesystem::path& file);
+  /// Entries dropped from the start of the history to keep it within its limit.
+  std::size_t history_dropped() const;
+  /// Keeps the history within `bytes` of recipe text from now on (default history_bytes).
+  void limit_history(std::size_t bytes);
 
   /// The current recipe text.
   const std::string& text() const;
+  /// The session's name (the recipe file's stem; STEM_studio for a model).
+  const std::string& name() const;
   /// Names of the history's entries, oldest first ("open", then each edit's label).
   std::vector<std::string> history() const;
   /// Index of the current entry in history().
@@ -78,28 +120,46 @@ struct StudioOptions {
   std::string host = "127.0.0.1";
   int port = 8770;                  ///< 0: any free port (see StudioServer::port)
   std::filesystem::path front_end;  ///< static files served at "/" (empty: none, 404)
+  /// The session's secret (letters and digits, at least 16): every request must carry it, as
+  /// ?token= or the cookie the first such request sets. Empty: 32 random hex digits.
+  std::string token;
+  int max_connections = 64;      ///< open connections; beyond, the oldest not yet upgraded closes
+  int request_seconds = 10;      ///< a request's head and body must arrive within this
+  std::size_t max_file_bytes = 64u << 20;  ///< largest static file served
+  std::size_t max_queued_bytes = 512u << 20;  ///< replies a page has not read; beyond, it closes
 };
 
-/// The studio's server (Boost.Beast): static files at "/" and the WebSocket at "/ws". The
-/// upgrade is refused (403) unless its Host is the server's own address and its Origin is
-/// http://HOST:PORT (127.0.0.1 or localhost), so another site's page cannot drive the kernel.
-/// Each connection is served on a thread of its own; one page at a time holds the WebSocket (the
-/// newest, a reload or another tab, takes it over and the older one is closed). Commands that
-/// arrive while one is being handled are coalesced: of several "edit" commands on the same path
-/// only the newest is handled.
+/// The studio's server (Boost.Beast, asynchronous on one thread; the session's commands on a
+/// worker of their own): static files at "/" and the WebSocket at "/ws". A security boundary
+/// (docs/studio.md "Security"):
+/// - every request needs the session's token (?token=TOKEN, or the cookie set when the page was
+///   opened with it) and a Host of the server's own address; the upgrade also an Origin of
+///   http://HOST:PORT (127.0.0.1 or localhost): otherwise 403, so neither another site's page
+///   (DNS rebinding) nor another local user can read files or drive the kernel;
+/// - only regular files under the front end's folder are served (no "..", no absolute or
+///   symbolic-link escape, no device or FIFO, at most max_file_bytes);
+/// - connections are capped (the oldest idle one makes room), a request must arrive within
+///   request_seconds, a full descriptor table is waited out, and no exception or message ends
+///   the server.
+/// One page at a time holds the WebSocket: the newest (a reload, another tab) takes it over at
+/// once, the older one is closed and a command it was running is cancelled at its next step.
+/// Commands that arrive while one is being handled are coalesced: of several "edit" commands on
+/// the same path only the newest is handled.
 class StudioServer {
  public:
-  /// Binds the port (clay::Error(Io) when it cannot).
+  /// Binds the port (clay::Error(Io) when it cannot; InvalidArgument for a bad host, token or
+  /// limit).
   StudioServer(StudioSession session, const StudioOptions& options = {});
   ~StudioServer();  ///< stops and joins
   StudioServer(const StudioServer&) = delete;
   StudioServer& operator=(const StudioServer&) = delete;
 
-  int port() const noexcept;  ///< the bound port
-  std::string url() const;    ///< "http://HOST:PORT/"
-  void run();                 ///< serves in this thread until stop() (from another thread)
-  void start();               ///< serves in a thread of its own
-  void stop();                ///< stops serving (and joins the thread of start)
+  int port() const noexcept;         ///< the bound port
+  const std::string& token() const;  ///< the session's secret
+  std::string url() const;           ///< "http://HOST:PORT/?token=TOKEN": the page to open
+  void run();                        ///< serves in this thread until stop() (from another thread)
+  void start();                      ///< serves in a thread of its own
+  void stop();  ///< stops serving (and joins the thread of start); a running command is cancelled
   /// The session's current recipe text (between commands).
   std::string recipe_text() const;
 

@@ -70,7 +70,7 @@ export class Link {
       this.socket.onopen = () => resolve();
       this.socket.onerror = () => reject(new Error(`cannot open the studio's socket ${url}`));
     });
-    this.socket.onclose = () => this.onClose && this.onClose();
+    this.socket.onclose = (event) => this.onClose && this.onClose(event);
     this.socket.onmessage = (event) => this.receive(event.data);
   }
 

@@ -314,7 +314,10 @@ function rebuildCurves() {
 }
 
 // ------------------------------------------------------------------------------ the kernel
-const socketUrl = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws`;
+// The session's token (docs/studio.md "Security"): from the address `clayform studio` printed;
+// the server also keeps it in a cookie, so a reload without it still connects.
+const pageToken = new URLSearchParams(location.search).get('token');
+const socketUrl = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws${pageToken ? `?token=${encodeURIComponent(pageToken)}` : ''}`;
 let link = null;
 function onReply(reply, frames, meta) {
   if (reply.op === 'error') {
@@ -1624,8 +1627,11 @@ function plainNet(s) {
 
 // ------------------------------------------------------------------------------ start
 async function start() {
-  link = new Link(socketUrl, onReply, () => {
-    showMessage('the connection to clayform studio closed; restart it and reload the page', true);
+  link = new Link(socketUrl, onReply, (event) => {
+    // A newer page (a reload, another tab) takes the session over at once: this one is told
+    // so, and a reload here takes it back; otherwise the server is gone.
+    const takenOver = event && /another page/.test(event.reason || '');
+    showMessage(takenOver ? 'another page took this studio session over; reload this page to take it back' : 'the connection to clayform studio closed; restart it and reload the page', true);
     body.dataset.ready = 'closed';
   });
   try {

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cstdio>
 #include <string>
+#include <string_view>
 
 namespace clay::internal {
 
@@ -18,6 +19,16 @@ inline std::string shortest(double x) {
   char buffer[32];
   const auto end = std::to_chars(buffer, buffer + sizeof buffer, x).ptr;
   return std::string(buffer, end);
+}
+
+/// `text` for a message: at most `bytes` bytes, cut at a UTF-8 character boundary (a cut inside
+/// a character made the message invalid UTF-8, and every JSON writer of it threw), with "..."
+/// when cut.
+inline std::string clip_utf8(std::string_view text, std::size_t bytes) {
+  if (text.size() <= bytes) return std::string(text);
+  std::size_t end = bytes;
+  while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;
+  return std::string(text.substr(0, end)) + "...";
 }
 
 }  // namespace clay::internal

@@ -38,12 +38,50 @@ inline std::string found(const Json& j) {
   if (j.is_boolean()) return j.get<bool>() ? "true" : "false";
   if (j.is_number()) return "the number " + shortest(j.get<double>());
   if (j.is_string()) {
-    std::string s = j.get<std::string>();
-    if (s.size() > 40) s = s.substr(0, 37) + "...";
-    return "the string \"" + s + "\"";
+    const std::string& s = j.get_ref<const std::string&>();
+    return "the string \"" + (s.size() > 40 ? clip_utf8(s, 37) : s) + "\"";
   }
   if (j.is_array()) return "an array of " + std::to_string(j.size());
   return "an object";
+}
+
+/// Where arrays and objects first nest deeper than `limit` in a JSON text, found by counting
+/// brackets outside strings before any parser sees it: nlohmann's parser, given a text nested
+/// 100,000 levels deep, recursed until the stack overflowed (issues #18 and #36). `at` is the
+/// byte offset of the bracket, `top_key` the top-level key it is under ("" when none).
+struct TooDeep {
+  std::size_t at = 0;
+  std::string top_key;
+};
+inline std::optional<TooDeep> nesting_too_deep(std::string_view text, int limit) {
+  int depth = 0;
+  std::size_t string_start = 0;
+  bool in_string = false;
+  std::string key, top_key;  // the last string closed at depth 1, and the key it became
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') {
+        ++i;  // the escaped character cannot end the string
+      } else if (c == '"') {
+        in_string = false;
+        if (depth == 1)
+          key = clip_utf8(text.substr(string_start, i - string_start), 64);
+      }
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+      string_start = i + 1;
+    } else if (c == ':' && depth == 1) {
+      top_key = key;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return TooDeep{i, top_key};
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return std::nullopt;
 }
 
 inline std::string key_path(const std::string& path, std::string_view key) {

@@ -1,0 +1,689 @@
+// Clayform Studio's session (clay/studio.hpp): a recipe under edits with a named history, one
+// handler per op. Every command is read whole before anything changes; every reply is valid
+// UTF-8 JSON whatever the command held; files are written only inside the recipe's folder.
+#include "studio_frames.hpp"
+
+#include <clay/brep/exchange.hpp>
+#include <clay/error.hpp>
+#include <clay/internal/files.hpp>
+#include <clay/internal/json_reader.hpp>
+#include <clay/recipe/recipe.hpp>
+#include <clay/sketch/fit.hpp>
+#include <clay/studio.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstring>
+#include <functional>
+#include <map>
+#include <optional>
+
+namespace clay::recipe {
+
+namespace fs = std::filesystem;
+// Ordered: an edit keeps the document's key order (sorted keys put a surface before the one it
+// is made from, which the recipe refuses: 5 of the 12 examples could not be edited, issue #36).
+using Json = nlohmann::ordered_json;
+
+namespace {
+
+/// Every reply's text: invalid UTF-8 (a command's bytes quoted in a message) is replaced, not
+/// thrown (a throw there ended the server, issue #36).
+std::string reply_text(const Json& reply) {
+  return reply.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+/// A command's optional field of one JSON type, read before anything changes: absent gives
+/// `fallback`, another type is an error naming the field and the type it needs.
+template <class T>
+T field(const Json& command, const char* op, const char* key, T fallback, const char* type) {
+  const auto it = command.find(key);
+  if (it == command.end()) return fallback;
+  const bool ok = std::is_same_v<T, bool>          ? it->is_boolean()
+                  : std::is_same_v<T, std::string> ? it->is_string()
+                                                   : it->is_number();
+  if (!ok)
+    throw Error(ErrorCategory::InvalidArgument, std::string("studio: \"") + op + "\": \"" + key +
+                                                    "\" must be " + type + ", not " +
+                                                    internal::found(*it));
+  return it->get<T>();
+}
+
+
+/// "a.b[2].c" -> JSON pointer "/a/b/2/c"; clay::Error(InvalidArgument) for a malformed path.
+Json::json_pointer pointer_of(const std::string& path) {
+  std::string out;
+  std::size_t i = 0;
+  bool expect_key = true;
+  while (i < path.size()) {
+    if (path[i] == '[') {
+      const std::size_t close = path.find(']', i);
+      const std::string index = close == std::string::npos ? "" : path.substr(i + 1, close - i - 1);
+      if (index.empty() || !std::all_of(index.begin(), index.end(), ::isdigit))
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: path \"" + internal::clip_utf8(path, 120) + "\" has a malformed list index; write items as [i]");
+      out += "/" + index;
+      i = close + 1;
+      expect_key = false;
+    } else if (path[i] == '.') {
+      if (expect_key)
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: path \"" + internal::clip_utf8(path, 120) + "\" has an empty key");
+      ++i;
+      expect_key = true;
+    } else {
+      const std::size_t end = path.find_first_of(".[", i);
+      std::string key = path.substr(i, end == std::string::npos ? std::string::npos : end - i);
+      // JSON pointer escapes: ~ as ~0, / as ~1.
+      std::string escaped;
+      for (char c : key) escaped += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+      out += "/" + escaped;
+      i = end == std::string::npos ? path.size() : end;
+      expect_key = false;
+    }
+  }
+  if (out.empty() || expect_key)
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: path \"" + internal::clip_utf8(path, 120) + "\" is empty or ends with \".\"");
+  return Json::json_pointer(out);
+}
+
+/// Applies one change of an "edit" to the recipe document: {path, value, create?} sets a value
+/// (the path must exist, or with create its parent object), {path, remove: true} removes a key
+/// or a list item. `first_path` gets the first change's path (the default history label).
+void apply_change(Json& doc, const Json& change, std::string& first_path) {
+  if (!change.is_object() || !change.contains("path") || !change.at("path").is_string())
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: \"edit\" needs \"path\" (a JSON path of the recipe) and \"value\" "
+                "(or \"remove\": true)");
+  const std::string path = change.at("path");
+  if (first_path.empty()) first_path = path;
+  const bool remove = field<bool>(change, "edit", "remove", false, "true or false");
+  const bool create = field<bool>(change, "edit", "create", false, "true or false");
+  const Json::json_pointer ptr = pointer_of(path);
+  const bool exists = doc.contains(ptr);
+  if (remove) {
+    if (!exists)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: cannot remove \"" + internal::clip_utf8(path, 120) + "\": the recipe has no such entry");
+    Json& parent = doc.at(ptr.parent_pointer());
+    if (parent.is_array())
+      parent.erase(static_cast<std::size_t>(std::stoul(ptr.back())));
+    else
+      parent.erase(ptr.back());
+    return;
+  }
+  if (!change.contains("value"))
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: the change of \"" + internal::clip_utf8(path, 120) + "\" has no \"value\" (or \"remove\": true)");
+  if (!exists) {
+    if (!create)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: the recipe has no \"" + internal::clip_utf8(path, 120) + "\"; to add it, send \"create\": true");
+    // Created keys hang from an object: the nearest existing entry above must be one (the
+    // missing ones between, e.g. "strokes" of a recipe without strokes, are made objects).
+    Json::json_pointer above = ptr.parent_pointer();
+    while (!above.empty() && !doc.contains(above)) above = above.parent_pointer();
+    if (!doc.at(above).is_object())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: cannot create \"" + internal::clip_utf8(path, 120) + "\": \"" + above.to_string() +
+                      "\" is not an object; a list item is changed by its index");
+  }
+  doc[ptr] = change.at("value");
+}
+
+}  // namespace
+
+namespace {
+
+/// The "fit" op: the stroke {points, plane?, tolerance?, corner_angle?} fitted as a recipe stroke
+/// with "pieces" would be (fit_stroke, split where it turns by more than corner_angle), and how:
+/// the page asks before it writes the stroke, so a stroke with corners becomes one with "pieces".
+/// Read by the shared path-aware reader, with a recipe stroke's limits; every problem is named.
+Json fit_reply(const Json& command) {
+  const internal::Json& c = command;
+  internal::JsonReader r;
+  r.limit_note = "a recipe stroke's limit: draw it as several strokes";
+  sketch::Stroke stroke;
+  if (const auto* pts = r.member(c, "", "points", true, "the drawn points [[x, y, z], ...]"))
+    if (auto p = r.points(*pts, "points", 2, 10000)) stroke.points = std::move(*p);
+  if (const auto* pl = r.member(c, "", "plane", false, "");
+      pl && r.object(*pl, "plane", {"origin", "normal", "x_axis", "y_axis"},
+                     "a plane {origin, normal, x_axis?} or {origin, x_axis, y_axis}")) {
+    auto vec = [&](const char* key, bool required) -> std::optional<Eigen::Vector3d> {
+      const auto* v = r.member(*pl, "plane", key, required, "[x, y, z]");
+      return v ? r.vec3(*v, internal::key_path("plane", key)) : std::nullopt;
+    };
+    const auto origin = vec("origin", true);
+    if (pl->contains("normal")) {
+      const auto normal = vec("normal", true);
+      const auto x = pl->contains("x_axis") ? vec("x_axis", true) : std::nullopt;
+      if (origin && normal) stroke.plane = sketch::make_plane(*origin, *normal, x);
+    } else {
+      const auto x = vec("x_axis", true), y = vec("y_axis", true);
+      if (origin && x && y) stroke.plane = sketch::SketchPlane{*origin, *x, *y};
+    }
+  }
+  sketch::FitOptions options;
+  options.tolerance =
+      r.number_or(c, "", "tolerance", options.tolerance, internal::Range{0, 1e6, true});
+  options.corner_angle = r.number_or(c, "", "corner_angle", options.corner_angle,
+                                     internal::Range{0, 180, true, false});
+  if (!r.problems.empty()) {
+    std::string list;
+    for (const auto& p : r.problems) list += (list.empty() ? "" : "; ") + p.path + ": " + p.message;
+    throw Error(ErrorCategory::InvalidArgument, "studio: \"fit\": " + list);
+  }
+  sketch::validate(stroke, "the fit's stroke");
+  const sketch::StrokeFit fit = sketch::fit_stroke(stroke, options);
+  return {{"op", "fit"},
+          {"pieces", fit.curves.size()},
+          {"corners", fit.corners},
+          {"closed", fit.closed},
+          {"max_deviation_mm", fit.max_deviation_mm},
+          {"corner_angle", options.corner_angle},
+          {"converged", fit.summary.converged()}};
+}
+
+/// Raised inside a run whose command was cancelled (StudioSession::handle's `cancelled`).
+struct Cancelled {};
+
+}  // namespace
+
+struct StudioSession::Impl {
+  fs::path base_dir;
+  std::string name;
+  struct Entry {
+    std::string label;
+    std::string text;   // the recipe text
+    std::string group;  // the "group" of the edits it holds ("" none)
+  };
+  std::vector<Entry> history;
+  int position = 0;
+  std::size_t dropped = 0;  // oldest entries dropped to keep the history within history_limit
+  std::size_t history_limit = history_bytes;
+  /// Per model, the topology key of the mesh last sent (topology_key): while it holds, runs send
+  /// the model's nets only. "hello" and "run" (what a new page sends first) forget them.
+  mutable std::map<std::string, std::uint64_t> meshed;
+  fs::path autosave;  // empty: none
+  std::chrono::steady_clock::time_point autosaved{};
+  bool autosave_pending = false;
+  Json restored;  // what restore() read ({entries, file}), for "hello"
+
+  const std::string& text() const { return history[static_cast<std::size_t>(position)].text; }
+
+  /// A run of the recipe text, and the surfaces a picture of it shows (final_surfaces). A
+  /// cancelled command ends at the next step.
+  struct Run {
+    RunResult result;
+    std::vector<std::string> shown;
+  };
+  Run run(const std::string& recipe_text, const std::function<bool()>& cancelled) const {
+    const Recipe recipe = parse_recipe(recipe_text, base_dir, name);
+    RunOptions options;
+    if (cancelled)
+      options.progress = [&](const StepReport&) {
+        if (cancelled()) throw Cancelled{};
+      };
+    if (cancelled && cancelled()) throw Cancelled{};
+    return {run_recipe(recipe, options), final_surfaces(recipe)};
+  }
+
+  Json history_json() const {
+    Json h = Json::array();
+    for (const Entry& e : history) h.push_back(e.label);
+    return Json{{"entries", h}, {"position", position}, {"dropped", dropped}};
+  }
+
+  /// Appends an entry after the current one (dropping the redo tail), then drops the oldest
+  /// entries while the texts exceed history_limit (the current one and one before it stay).
+  void push(Entry entry) {
+    history.resize(static_cast<std::size_t>(position) + 1);
+    history.push_back(std::move(entry));
+    position = static_cast<int>(history.size()) - 1;
+    std::size_t bytes = 0;
+    for (const Entry& e : history) bytes += e.text.size() + e.label.size();
+    while (bytes > history_limit && position > 1) {
+      bytes -= history.front().text.size() + history.front().label.size();
+      history.erase(history.begin());
+      --position;
+      ++dropped;
+    }
+    save_soon();
+  }
+
+  /// The history changed: autosave it now, unless the last autosave is under a second old (a
+  /// drag's updates); then flush_autosave (the server calls it when idle) writes it.
+  void save_soon() {
+    if (autosave.empty()) return;
+    autosave_pending = true;
+    if (std::chrono::steady_clock::now() - autosaved > std::chrono::seconds(1)) flush_autosave();
+  }
+
+  /// Writes the autosave (atomically): the newest autosave_entries entries of the history and
+  /// the position in them.
+  void flush_autosave() {
+    if (autosave.empty() || !autosave_pending) return;
+    const std::size_t from =
+        history.size() > autosave_entries ? history.size() - autosave_entries : 0;
+    const std::size_t current = static_cast<std::size_t>(position);
+    const std::size_t first = std::min(from, current);
+    Json entries = Json::array();
+    for (std::size_t k = first; k < history.size(); ++k)
+      entries.push_back(
+          {{"label", history[k].label}, {"group", history[k].group}, {"text", history[k].text}});
+    const Json doc = {{"format", "clayform.studio-autosave"},
+                      {"version", 1},
+                      {"recipe", name},
+                      {"position", current - first},
+                      {"history", entries}};
+    internal::write_atomically(autosave, reply_text(doc), "studio's autosave");
+    autosaved = std::chrono::steady_clock::now();
+    autosave_pending = false;
+  }
+
+  /// The reply of a run: its report figures per step, the history and the recipe text; then a
+  /// net frame per final surface, a curve frame per named curve, and a net frame per deformed
+  /// final surface's parent before its first step. Without `nets` (a drag update the page draws
+  /// itself), no frames: the figures and the history only.
+  Reply ran(const std::string& op, const Run& run, bool nets = true) const {
+    const RunResult& result = run.result;
+    Reply reply;
+    Json steps = Json::array();
+    for (const auto& s : result.steps) {
+      Json figures = Json::object();
+      for (const auto& [k, v] : s.figures)
+        std::visit([&, key = k](const auto& x) { figures[key] = x; }, v);
+      steps.push_back({{"path", s.path},
+                       {"kind", s.kind},
+                       {"seconds", s.seconds},
+                       {"warning", s.warning},
+                       {"message", s.message},
+                       {"figures", figures}});
+    }
+    auto push_net = [&](const std::string& n, const surface::BSplineSurface& s, bool before) {
+      Json header = {{"kind", "net"},
+                     {"name", n},
+                     {"degrees", {s.u.degree, s.v.degree}},
+                     {"counts", {s.u.count(), s.v.count()}},
+                     {"knots_u", s.u.knots},
+                     {"knots_v", s.v.knots},
+                     {"rational", s.is_rational()}};
+      if (before) header["before"] = true;
+      std::vector<double> points(s.points.data(), s.points.data() + s.points.size());
+      std::vector<double> weights(s.weights.data(), s.weights.data() + s.weights.size());
+      reply.frames.push_back(net_frame(header.dump(), points, weights));
+    };
+    // A drag update the page draws itself ("nets": false) gets no frames: none are made.
+    const std::vector<std::string> none;
+    const std::vector<std::string>& shown = nets ? run.shown : none;
+    Json surfaces = Json::array();
+    for (const std::string& n : shown) {
+      push_net(n, result.surface(n), false);
+      surfaces.push_back(n);
+    }
+    // Every named curve too (fitted strokes, sketch entities, bounds and targets): the page
+    // draws them from their nets and picks them by name.
+    Json curves = Json::array();
+    for (const auto& [n, c] : result.curves) {
+      if (!nets) break;
+      const Json header = {{"kind", "curve"},
+                           {"name", n},
+                           {"degree", c.basis.degree},
+                           {"knots", c.basis.knots},
+                           {"rational", c.is_rational()}};
+      std::vector<double> points(c.points.data(), c.points.data() + c.points.size());
+      std::vector<double> weights(c.weights.data(), c.weights.data() + c.weights.size());
+      reply.frames.push_back(net_frame(header.dump(), points, weights));
+      curves.push_back(n);
+    }
+    // A deformed surface's parent before its first step (the page's before/after view, and
+    // what a lattice drag is checked against).
+    Json befores = Json::array();
+    for (const std::string& n : shown) {
+      const auto stage = std::find_if(result.stages.begin(), result.stages.end(),
+                                      [&](const Stage& st) { return st.surface == n; });
+      if (stage == result.stages.end()) continue;
+      push_net(n, stage->before, true);
+      befores.push_back(n);
+    }
+    // The deviation map of each shown surface whose last step deforms space point by point (a
+    // lattice, taper, twist or bend; a style step moves control points and has none).
+    Json deviations = Json::array();
+    for (const std::string& n : shown) {
+      const auto stage = std::find_if(result.stages.rbegin(), result.stages.rend(),
+                                      [&](const Stage& st) { return st.surface == n; });
+      if (stage == result.stages.rend() || !stage->map) continue;
+      reply.frames.push_back(deviation_frame(n, result.surface(n), *stage, 41, 41));
+      deviations.push_back(n);
+    }
+    // Whole models (a recipe's "models", a STEP file opened in the studio): their trimmed faces
+    // as a triangle mesh when the page has none of this topology yet, else only the faces' nets
+    // (a lattice moved: the mesh's nodes keep their (u, v), the page evaluates them there).
+    Json models = Json::array();
+    if (nets)
+      for (const ModelRunResult& m : result.models) {
+        const std::uint64_t key = topology_key(m.model);
+        if (const auto it = meshed.find(m.name); it != meshed.end() && it->second == key) {
+          reply.frames.push_back(model_nets_frame(m.name, m.model));
+        } else {
+          const brep::ModelMesh mesh = brep::tessellate(m.model);
+          const Json header = {{"kind", "mesh"},
+                               {"name", m.name},
+                               {"vertices", mesh.positions.size()},
+                               {"triangles", mesh.triangles.size()},
+                               {"faces", m.model.faces.size()}};
+          reply.frames.push_back(mesh_frame(header.dump(), mesh));
+          meshed[m.name] = key;
+        }
+        models.push_back(m.name);
+      }
+    Json out = {{"op", op},       {"recipe", result.recipe},   {"seconds", result.seconds},
+                {"steps", steps}, {"history", history_json()}, {"text", text()}};
+    if (nets) {
+      out["surfaces"] = surfaces;
+      out["curves"] = curves;
+      out["befores"] = befores;
+      out["models"] = models;
+      out["deviations"] = deviations;
+    } else {
+      out["nets"] = false;
+    }
+    reply.json = reply_text(out);
+    return reply;
+  }
+
+  Reply hello() {
+    meshed.clear();  // a new page holds no mesh yet
+    const Recipe r = parse_recipe(text(), base_dir, name);
+    Json out = {{"op", "hello"},
+                {"recipe", r.name()},
+                {"surfaces", final_surfaces(r)},
+                {"deformations", r.deformation_names()},
+                {"history", history_json()}};
+    if (!restored.is_null()) out["restored"] = restored;
+    return {reply_text(out), {}};
+  }
+
+  Reply undo_redo(const std::string& op, const std::function<bool()>& cancelled) {
+    const int to = position + (op == "undo" ? -1 : 1);
+    if (to < 0 || to >= static_cast<int>(history.size()))
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: nothing to " + op + " (history position " + std::to_string(position) +
+                      " of " + std::to_string(history.size()) + ")");
+    const Run result = run(history[static_cast<std::size_t>(to)].text, cancelled);
+    position = to;
+    save_soon();
+    return ran(op, result);
+  }
+
+  /// "edit": one change ({path, value, create?} or {path, remove: true}) or several ("changes":
+  /// an array of them), applied in order as one entry of the history. Every field is read
+  /// before the history changes (a wrong-typed "nets" was answered with an error but applied).
+  Reply edit(const Json& c, const std::function<bool()>& cancelled) {
+    const std::string group = field<std::string>(c, "edit", "group", "", "a string");
+    const bool nets = field<bool>(c, "edit", "nets", true, "true or false");
+    const std::optional<std::string> label =
+        c.contains("label") ? std::optional(field<std::string>(c, "edit", "label", "", "a string"))
+                            : std::nullopt;
+    Json changes = Json::array();
+    if (c.contains("changes")) {
+      if (!c.at("changes").is_array() || c.at("changes").empty())
+        throw Error(ErrorCategory::InvalidArgument,
+                    "studio: \"changes\" must be a non-empty array of {path, value} or "
+                    "{path, remove: true}");
+      changes = c.at("changes");
+    } else {
+      changes.push_back(c);
+    }
+    Json doc = Json::parse(text());
+    std::string first_path;
+    for (const Json& change : changes) apply_change(doc, change, first_path);
+    std::string next = doc.dump(1, ' ', false, Json::error_handler_t::replace);
+    const Run result = run(next, cancelled);  // a recipe the edit breaks throws: nothing changes
+    // The updates of one drag share a "group": the latest replaces the entry an earlier one
+    // made, so the drag is one step of the history.
+    const auto at = static_cast<std::size_t>(position);
+    if (!group.empty() && at + 1 == history.size() && history[at].group == group) {
+      history[at].text = std::move(next);
+      save_soon();
+    } else {
+      push({label.value_or("edit " + first_path), std::move(next), group});
+    }
+    return ran("edit", result, nets);
+  }
+
+  /// "export" {folder, name?}: the final surfaces as STEP, IGES and glTF (write_outputs: read
+  /// back and checked), with the run's report and the models' files, into a folder inside the
+  /// recipe's.
+  Reply export_files(const Json& c, const std::function<bool()>& cancelled) {
+    if (!c.contains("folder") || !c.at("folder").is_string())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: \"export\" needs \"folder\" (a folder inside the recipe's, e.g. "
+                  "\"out\")");
+    const fs::path folder =
+        internal::path_under(base_dir, c.at("folder").get_ref<const std::string&>(),
+                             "studio: the export's folder");
+    const std::string export_name = field<std::string>(c, "export", "name", "", "a string");
+    if (c.contains("name")) internal::check_file_name(export_name, "studio: the export's name");
+    Run run = this->run(text(), cancelled);
+    if (run.shown.empty() && run.result.models.empty())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: the recipe has no surface or model to export yet; build one first");
+    run.result.exports.clear();
+    if (!run.shown.empty()) {
+      ExportResult e;
+      e.name = export_name.empty() ? run.result.recipe : export_name;
+      e.formats = {"step", "iges", "glb"};
+      for (const std::string& n : run.shown) {
+        e.surface_names.push_back(n);
+        e.surfaces.push_back(run.result.surface(n));
+      }
+      run.result.exports.push_back(std::move(e));
+    }
+    write_outputs(run.result, folder);  // checks every file name it writes
+    Json files = Json::array();
+    bool valid = true, identical = true;
+    for (const ExportResult& x : run.result.exports) {
+      for (const std::string& f : x.files) files.push_back(f);
+      valid = valid && x.valid;
+      identical = identical && x.read_back_identical;
+    }
+    for (const ModelRunResult& m : run.result.models) {
+      for (const std::string& f : m.files) files.push_back(f);
+      valid = valid && m.valid;
+    }
+    return {reply_text(Json{{"op", "exported"},
+                            {"folder", folder.string()},
+                            {"files", files},
+                            {"valid", valid},
+                            {"read_back_identical", identical}}),
+            {}};
+  }
+
+  /// "save" {file}: the current recipe text, written atomically as a plain file name in the
+  /// recipe's folder.
+  Reply save(const Json& c) {
+    if (!c.contains("file") || !c.at("file").is_string())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: \"save\" needs \"file\" (a file name in the recipe's folder)");
+    const std::string& file_name = c.at("file").get_ref<const std::string&>();
+    internal::check_file_name(file_name, "studio: the file to save");
+    const fs::path file = base_dir / file_name;
+    internal::write_atomically(file, text(), "recipe");
+    return {reply_text(Json{{"op", "saved"}, {"file", file.string()}}), {}};
+  }
+
+  Reply handle(const std::string& command, const std::function<bool()>& cancelled) {
+    // Read whole and bounded before parsing: nlohmann's parser recursed a command nested
+    // 1,000,000 levels deep until the stack overflowed.
+    if (command.size() > command_bytes)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: a command of " + std::to_string(command.size()) +
+                      " bytes is over the limit of " + std::to_string(command_bytes) +
+                      "; send smaller edits");
+    if (const auto deep = internal::nesting_too_deep(command, command_depth))
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: the command nests arrays and objects deeper than " +
+                      std::to_string(command_depth) + " levels (at byte " +
+                      std::to_string(deep->at) + "); a recipe needs at most 8");
+    const Json c = Json::parse(command);
+    if (!c.is_object() || !c.contains("op") || !c.at("op").is_string())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: a command is a JSON object with \"op\" (hello, recipe, edit, undo, "
+                  "redo, run, save, export, fit)");
+    const std::string op = c.at("op");
+    if (op == "hello") return hello();
+    if (op == "recipe") return {reply_text(Json{{"op", "recipe"}, {"text", text()}}), {}};
+    if (op == "fit") return {reply_text(fit_reply(c)), {}};
+    if (op == "run") {
+      meshed.clear();  // "run" sends everything: the page may hold nothing (a new page)
+      return ran("run", run(text(), cancelled));
+    }
+    if (op == "undo" || op == "redo") return undo_redo(op, cancelled);
+    if (op == "edit") return edit(c, cancelled);
+    if (op == "export") return export_files(c, cancelled);
+    if (op == "save") return save(c);
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: unknown op \"" + internal::clip_utf8(op, 40) +
+                    "\"; the ops: hello, recipe, edit, undo, redo, run, save, export, fit");
+  }
+};
+
+namespace {
+
+StudioSession::Reply error_reply(const std::string& category, const std::string& message) {
+  return {reply_text(Json{{"op", "error"}, {"category", category}, {"message", message}}), {}};
+}
+
+}  // namespace
+
+StudioSession::StudioSession(std::string text, fs::path base_dir, std::string name)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->base_dir = std::move(base_dir);
+  impl_->name = std::move(name);
+  parse_recipe(text, impl_->base_dir, impl_->name);  // throws Recipe listing the problems
+  impl_->history.push_back({"open", std::move(text), ""});
+}
+
+StudioSession::~StudioSession() = default;
+StudioSession::StudioSession(StudioSession&&) noexcept = default;
+StudioSession& StudioSession::operator=(StudioSession&&) noexcept = default;
+
+StudioSession StudioSession::load(const fs::path& file) {
+  return StudioSession(internal::read_text(file, "recipe"), file.parent_path(),
+                       file.stem().string());
+}
+
+StudioSession StudioSession::open(const fs::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  if (extension != ".step" && extension != ".stp" && extension != ".igs" && extension != ".iges")
+    return load(file);
+  if (!fs::exists(file))
+    throw Error(ErrorCategory::Io,
+                "studio: cannot read \"" + file.string() + "\": no such file; check the path");
+  // A model: a recipe beside it importing it whole, named after it (saved as STEM_studio.json).
+  std::string name;
+  for (char ch : file.stem().string())
+    name += std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' ? ch : '_';
+  name = name.substr(0, 50);
+  const Json recipe = {
+      {"format", "clayform.recipe"},
+      {"version", 1},
+      {"name", name + "_studio"},
+      {"description", "Opened in Clayform Studio from " + file.filename().string()},
+      {"models", {{name, {{"import", file.filename().string()}}}}}};
+  return StudioSession(recipe.dump(1, ' ', false, Json::error_handler_t::replace),
+                       file.parent_path(), name + "_studio");
+}
+
+const std::string& StudioSession::text() const { return impl_->text(); }
+
+const std::string& StudioSession::name() const { return impl_->name; }
+
+std::vector<std::string> StudioSession::history() const {
+  std::vector<std::string> out;
+  for (const auto& e : impl_->history) out.push_back(e.label);
+  return out;
+}
+
+int StudioSession::position() const { return impl_->position; }
+
+std::size_t StudioSession::history_dropped() const { return impl_->dropped; }
+
+void StudioSession::limit_history(std::size_t bytes) { impl_->history_limit = bytes; }
+
+fs::path StudioSession::autosave_file(const fs::path& recipe_folder, const std::string& name) {
+  return recipe_folder / (name + ".studio-autosave.json");
+}
+
+void StudioSession::autosave_to(const fs::path& file) {
+  impl_->autosave = file;
+  impl_->autosave_pending = true;
+  impl_->flush_autosave();
+}
+
+void StudioSession::flush_autosave() { impl_->flush_autosave(); }
+
+std::size_t StudioSession::restore(const fs::path& file) {
+  const std::string text = internal::read_text(file, "studio's autosave");
+  auto bad = [&](const std::string& why) {
+    return Error(ErrorCategory::Recipe, "the studio's autosave \"" + file.string() + "\" " + why +
+                                            "; start without it (--fresh) or remove it");
+  };
+  if (internal::nesting_too_deep(text, 64)) throw bad("nests too deep");
+  const Json doc = Json::parse(text, nullptr, false);
+  if (!doc.is_object() || doc.value("format", Json()) != "clayform.studio-autosave" ||
+      !doc.contains("history") || !doc.at("history").is_array() || doc.at("history").empty() ||
+      !doc.contains("position") || !doc.at("position").is_number_unsigned() ||
+      doc.at("position").get<std::size_t>() >= doc.at("history").size())
+    throw bad("is not a studio autosave (format, history, position)");
+  std::vector<Impl::Entry> entries;
+  for (const Json& e : doc.at("history")) {
+    if (!e.is_object() || !e.contains("label") || !e.at("label").is_string() ||
+        !e.contains("text") || !e.at("text").is_string() ||
+        (e.contains("group") && !e.at("group").is_string()))
+      throw bad("has an entry without a label and a text");
+    entries.push_back({e.at("label"), e.at("text"), e.value("group", "")});
+  }
+  const std::size_t position = doc.at("position");
+  parse_recipe(entries[position].text, impl_->base_dir, impl_->name);  // its problems, named
+  impl_->history = std::move(entries);
+  impl_->position = static_cast<int>(position);
+  impl_->restored = {{"entries", impl_->history.size()}, {"file", file.filename().string()}};
+  return impl_->history.size();
+}
+
+StudioSession::Reply StudioSession::handle(const std::string& command,
+                                           const std::function<bool()>& cancelled) {
+  // Nothing escapes: a command that throws anything is answered with an error and changes
+  // nothing (an exception escaping a connection's handler ended the server, issue #36).
+  try {
+    return impl_->handle(command, cancelled);
+  } catch (const Cancelled&) {
+    return error_reply("cancelled",
+                       "studio: the command was cancelled (a newer page took the session over, "
+                       "or the server is stopping); nothing changed");
+  } catch (const Error& e) {
+    return error_reply(std::string(to_string(e.category())), recipe_wording(e.message()));
+  } catch (const Json::parse_error& e) {
+    return error_reply("invalid argument",
+                       std::string("studio: the command is not valid JSON: ") + e.what());
+  } catch (const Json::exception& e) {  // a path's list index too large, and the like
+    return error_reply("invalid argument",
+                       std::string("studio: the command was refused: ") + e.what());
+  } catch (const std::bad_alloc&) {
+    return error_reply("internal error", "studio: out of memory while handling the command; "
+                                         "nothing changed");
+  } catch (const std::exception& e) {
+    return error_reply("invalid argument", std::string("studio: the command was refused: ") +
+                                               internal::clip_utf8(e.what(), 200));
+  }
+}
+
+}  // namespace clay::recipe

@@ -1,0 +1,509 @@
+// Clayform Studio as a security boundary (issue #36): a real server on 127.0.0.1 spoken to in
+// raw HTTP and WebSocket (with and without Origin and token), hostile messages, idle connections;
+// and the session's files: save and export only inside the recipe's folder, nothing half-written,
+// every field read before anything changes, the history bounded, autosave and restore.
+#include <catch2/catch.hpp>
+
+#include <clay/recipe/recipe.hpp>
+#include <clay/studio.hpp>
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/websocket.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+using namespace clay::recipe;
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+using Catch::Matchers::Contains;
+
+namespace {
+
+const fs::path examples = fs::path(CLAY_EXAMPLES_DIR) / "recipes";
+const std::string billow = "deformations.shape[1].moves[0].by[1]";
+
+std::string read(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void write(const fs::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+}
+
+/// A fresh folder under the test output folder.
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio_security" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+/// The names in a folder (not recursive).
+std::set<std::string> names_in(const fs::path& dir) {
+  std::set<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) out.insert(e.path().filename().string());
+  return out;
+}
+
+/// A TCP connection to 127.0.0.1:port (a plain socket: the test speaks raw bytes).
+int connect_to(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  REQUIRE(fd >= 0);
+  sockaddr_in at{};
+  at.sin_family = AF_INET;
+  at.sin_port = htons(static_cast<std::uint16_t>(port));
+  at.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  REQUIRE(::connect(fd, reinterpret_cast<sockaddr*>(&at), sizeof at) == 0);
+  return fd;
+}
+
+/// Sends `request` as it is and reads the answer until the server closes, or its head when it
+/// is a 101 (an upgrade stays open), within `seconds` (then whatever came).
+std::string raw_http(int port, const std::string& request, int seconds = 15) {
+  const int fd = connect_to(port);
+  timeval tv{seconds, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+  std::string answer;
+  char buffer[65536];
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+  while (std::chrono::steady_clock::now() < deadline && answer.size() < (4u << 20)) {
+    const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
+    if (n <= 0) break;
+    answer.append(buffer, static_cast<std::size_t>(n));
+    if (answer.rfind("HTTP/1.1 101", 0) == 0 && answer.find("\r\n\r\n") != std::string::npos)
+      break;
+  }
+  ::close(fd);
+  return answer;
+}
+
+/// The status code of an HTTP answer (0 when there is none: the server closed without one).
+int status_of(const std::string& answer) {
+  if (answer.rfind("HTTP/1.", 0) != 0 || answer.size() < 12) return 0;
+  return std::stoi(answer.substr(9, 3));
+}
+
+std::string get(int port, const std::string& target, const std::string& headers) {
+  return raw_http(port, "GET " + target + " HTTP/1.1\r\n" + headers + "\r\n");
+}
+
+std::string upgrade_request(int port, const std::string& target, const std::string& extra) {
+  return "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+         "\r\nConnection: Upgrade\r\nUpgrade: websocket\r\nSec-WebSocket-Version: 13\r\n"
+         "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n" +
+         extra + "\r\n";
+}
+
+namespace asio = boost::asio;
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+using tcp = asio::ip::tcp;
+
+/// The studio's page, as a WebSocket client with the session's token and Origin.
+struct Page {
+  asio::io_context io;
+  websocket::stream<tcp::socket> ws{io};
+  explicit Page(const StudioServer& server) {
+    const std::string port = std::to_string(server.port());
+    tcp::resolver resolver(io);
+    asio::connect(ws.next_layer(), resolver.resolve("127.0.0.1", port));
+    ws.set_option(websocket::stream_base::decorator([port](websocket::request_type& req) {
+      req.set(beast::http::field::origin, "http://127.0.0.1:" + port);
+    }));
+    ws.read_message_max(256u << 20);
+    ws.handshake("127.0.0.1:" + port, "/ws?token=" + server.token());
+  }
+  void send(const std::string& bytes, bool text = true) {
+    ws.text(text);
+    ws.write(asio::buffer(bytes));
+  }
+  /// The next JSON reply (binary frames skipped).
+  Json reply() {
+    while (true) {
+      beast::flat_buffer buffer;
+      ws.read(buffer);
+      if (ws.got_text()) return Json::parse(beast::buffers_to_string(buffer.data()));
+    }
+  }
+};
+
+/// A copy of an example recipe in a folder of its own; returns its path.
+fs::path example_copy(const std::string& name, const std::string& dir_name) {
+  const fs::path dir = fresh_dir(dir_name);
+  fs::copy_file(examples / (name + ".json"), dir / (name + ".json"));
+  return dir / (name + ".json");
+}
+
+}  // namespace
+
+TEST_CASE("studio server: only regular files under the page folder, with the token and its Host",
+          "[studio][security]") {
+  const fs::path dir = fresh_dir("files");
+  const fs::path front = dir / "front";
+  fs::create_directories(front / "assets");
+  write(front / "studio.html", "<title>the studio page</title>");
+  write(front / "assets" / "app-1a_B.js", "export const app = 1;");
+  write(dir / "secret.txt", "SECRET-OUTSIDE");
+  fs::create_directory_symlink(dir, front / "escape");
+  fs::create_symlink(dir / "secret.txt", front / "secret_link.txt");
+  REQUIRE(::mkfifo((front / "pipe.js").c_str(), 0644) == 0);
+
+  StudioOptions options;
+  options.port = 0;
+  options.front_end = front;
+  options.request_seconds = 2;
+  StudioServer server(StudioSession::load(examples / "sail.json"), options);
+  server.start();
+  const int port = server.port();
+  const std::string host = "Host: 127.0.0.1:" + std::to_string(port) + "\r\n";
+  const std::string& token = server.token();
+  CHECK(token.size() == 32);
+  CHECK(server.url() == "http://127.0.0.1:" + std::to_string(port) + "/?token=" + token);
+
+  // The page opened with its token: served, and the token kept as a cookie for the rest.
+  const std::string page = get(port, "/?token=" + token, host);
+  CHECK(status_of(page) == 200);
+  CHECK_THAT(page, Contains("the studio page"));
+  const std::string cookie = "clayform_studio_" + std::to_string(port) + "=" + token;
+  CHECK_THAT(page, Contains("Set-Cookie: " + cookie + "; Path=/; HttpOnly; SameSite=Strict"));
+  const std::string asset = get(port, "/assets/app-1a_B.js", host + "Cookie: " + cookie + "\r\n");
+  CHECK(status_of(asset) == 200);
+  CHECK_THAT(asset, Contains("export const app"));
+
+  // Without the token, with another one, from another name (DNS rebinding) or no Host: 403,
+  // before anything is read.
+  CHECK(status_of(get(port, "/assets/app-1a_B.js", host)) == 403);
+  CHECK(status_of(get(port, "/", host)) == 403);
+  CHECK(status_of(get(port, "/?token=0123456789abcdef0123456789abcdef", host)) == 403);
+  CHECK(status_of(get(port, "/?token=" + token,
+                      "Host: evil.example:" + std::to_string(port) + "\r\n")) == 403);
+  CHECK(status_of(get(port, "/?token=" + token, "")) == 403);
+  CHECK(status_of(get(port, "/?token=" + token, host + "Origin: http://evil.example\r\n")) == 403);
+
+  // With the token: nothing outside the page folder, no device, FIFO or link out of it.
+  for (const std::string target :
+       {"//etc/passwd", "x/etc/passwd", "/../secret.txt", "/assets/../../secret.txt",
+        "/%2e%2e/secret.txt", "/escape/secret.txt", "/secret_link.txt", "//dev/zero",
+        "/dev/zero", "//proc/self/environ", "/pipe.js", "/.", "/assets/"}) {
+    INFO("GET " << target);
+    const auto start = std::chrono::steady_clock::now();
+    const std::string answer = get(port, target, host + "Cookie: " + cookie + "\r\n");
+    CHECK(status_of(answer) != 200);
+    CHECK(answer.find("SECRET-OUTSIDE") == std::string::npos);
+    CHECK(answer.find("root:") == std::string::npos);
+    CHECK(answer.size() < 4096);
+    CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(5));
+  }
+  // Still serving.
+  CHECK(status_of(get(port, "/?token=" + token, host)) == 200);
+  server.stop();
+}
+
+TEST_CASE("studio server: the socket needs the token and its own page's Origin",
+          "[studio][security]") {
+  StudioOptions options;
+  options.port = 0;
+  StudioServer server(StudioSession::load(examples / "sail.json"), options);
+  server.start();
+  const int port = server.port();
+  const std::string origin = "Origin: http://127.0.0.1:" + std::to_string(port) + "\r\n";
+  const std::string& token = server.token();
+  // No token, a wrong one, no Origin (any local process), another Origin: 403.
+  CHECK(status_of(raw_http(port, upgrade_request(port, "/ws", origin))) == 403);
+  CHECK(status_of(raw_http(port, upgrade_request(port, "/ws?token=" + token.substr(1) + "0",
+                                                 origin))) == 403);
+  CHECK(status_of(raw_http(port, upgrade_request(port, "/ws?token=" + token, ""))) == 403);
+  CHECK(status_of(raw_http(port, upgrade_request(port, "/ws?token=" + token,
+                                                 "Origin: http://evil.example\r\n"))) == 403);
+  CHECK(status_of(raw_http(port, upgrade_request(port, "/ws?token=" + token, origin))) == 101);
+  // The page itself, with both.
+  Page p(server);
+  p.send(R"({"op": "hello"})");
+  CHECK(p.reply().at("recipe") == "sail");
+  server.stop();
+}
+
+TEST_CASE("studio server: hostile messages are answered, the server stays up, the recipe intact",
+          "[studio][security]") {
+  const fs::path recipe = example_copy("sail", "hostile");
+  StudioOptions options;
+  options.port = 0;
+  StudioServer server(StudioSession::load(recipe), options);
+  server.start();
+  const std::string before = server.recipe_text();
+  {
+    Page p(server);
+    std::vector<std::pair<std::string, bool>> messages = {
+        {R"({"op": 5})", true},
+        {"null", true},
+        {"[]", true},
+        {"5", true},
+        {R"({"op": "edit", "path": 5, "value": 1})", true},
+        // a non-ASCII string where a number belongs: the checker quotes it cut
+        {Json{{"op", "edit"},
+              {"path", "deformations.shape[0].curve_tolerance"},
+              {"value", std::string(40, 'x') + "\xc3\xa9\xc3\xa9\xc3\xa9"}}
+             .dump(),
+         true},
+        {Json{{"op", "edit"},
+              {"path", "deformations.shape[0].curve_tolerance"},
+              {"value", "\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9"
+                        "\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9"
+                        "\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9"}}
+             .dump(),
+         true},
+        // a binary frame with bytes that are not UTF-8
+        {"{\"op\": \"\xff\xfe\x80\"}", false},
+        {std::string("{\"op\": \"edit\", \"path\": \"a\xff\"}"), false},
+        // nesting: 100,000 deep fit points, 1,000,000 deep changes, a 10,000 deep value
+        {R"({"op": "fit", "points": )" + std::string(100000, '[') + std::string(100000, ']') +
+             "}",
+         true},
+        {R"({"op": "edit", "label": "x", "changes": )" + std::string(1000000, '[') +
+             std::string(1000000, ']') + "}",
+         true},
+        {R"({"op": "edit", "path": "description", "create": true, "value": )" +
+             std::string(10000, '[') + std::string(10000, ']') + "}",
+         true},
+        // indexes and fields of the wrong kind
+        {R"({"op": "edit", "path": "deformations.shape[99999999999999999999999]", "remove": true})",
+         true},
+        {R"({"op": "edit", "path": "deformations.shape[0]", "remove": "yes"})", true},
+        {Json{{"op", "edit"}, {"path", billow}, {"value", 410}, {"nets", "no"}}.dump(), true},
+        {Json{{"op", "edit"}, {"path", billow}, {"value", 420}, {"label", 5}}.dump(), true},
+        {Json{{"op", "edit"}, {"path", billow}, {"value", 430}, {"group", false}}.dump(), true},
+        {R"({"op": "save", "file": "../x.json"})", true},
+        {R"({"op": "export", "folder": "/tmp"})", true},
+    };
+    for (const auto& [message, text] : messages) {
+      INFO("message " << message.substr(0, 120));
+      p.send(message, text);
+      const Json r = p.reply();  // valid UTF-8 JSON, or this throws
+      CHECK(r.at("op") == "error");
+      CHECK(r.at("message").get<std::string>().size() < 4000);
+    }
+    p.send(R"({"op": "hello"})");
+    const Json hello = p.reply();
+    CHECK(hello.at("op") == "hello");
+    CHECK(hello.at("history").at("entries").size() == 1);
+    // A text frame that is not UTF-8: the WebSocket closes (RFC 6455), the server stays.
+    p.send("{\"op\": \"\xff\"}", true);
+    CHECK_THROWS(p.reply());
+  }
+  Page again(server);
+  again.send(R"({"op": "recipe"})");
+  CHECK(again.reply().at("text") == before);
+  CHECK(server.recipe_text() == before);
+  CHECK(names_in(recipe.parent_path()) == std::set<std::string>{"sail.json"});
+  server.stop();
+}
+
+TEST_CASE("studio server: 2,000 idle connections are dropped and a new page still connects",
+          "[studio][security]") {
+  // The test holds the idle clients' descriptors: raise its own limit (the server, in the same
+  // process, keeps at most max_connections of them).
+  rlimit limit{};
+  REQUIRE(::getrlimit(RLIMIT_NOFILE, &limit) == 0);
+  limit.rlim_cur = std::min<rlim_t>(limit.rlim_max, 8192);
+  ::setrlimit(RLIMIT_NOFILE, &limit);
+  REQUIRE(::getrlimit(RLIMIT_NOFILE, &limit) == 0);
+  const int idle = static_cast<int>(std::min<rlim_t>(2000, limit.rlim_cur - 200));
+  INFO(idle << " idle connections (descriptor limit " << limit.rlim_cur << ")");
+  REQUIRE(idle >= 900);  // past the 1,024-descriptor limit the old server died at, with its own
+
+  StudioOptions options;
+  options.port = 0;
+  StudioServer server(StudioSession::load(examples / "sail.json"), options);
+  server.start();
+  std::vector<int> clients;
+  for (int k = 0; k < idle; ++k) clients.push_back(connect_to(server.port()));
+  // A new page connects and is answered while they sit there.
+  {
+    Page p(server);
+    p.send(R"({"op": "hello"})");
+    CHECK(p.reply().at("recipe") == "sail");
+  }
+  // All but the newest few were closed by the server (end of stream, not a hang).
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  int closed = 0;
+  for (int fd : clients) {
+    char c;
+    if (::recv(fd, &c, 1, MSG_DONTWAIT) == 0) ++closed;
+    ::close(fd);
+  }
+  CHECK(closed >= idle - options.max_connections);
+  server.stop();
+}
+
+TEST_CASE("studio session: save and export write only inside the recipe's folder",
+          "[studio][security]") {
+  const fs::path outside = fresh_dir("files_out"), work = outside / "work";
+  fs::create_directories(work);
+  fs::copy_file(examples / "sail.json", work / "sail.json");
+  const fs::path recipe = work / "sail.json";
+  write(outside / "keep.txt", "KEEP");
+  StudioSession session = StudioSession::load(recipe);
+  auto refused = [&](const Json& command) {
+    INFO(command.dump());
+    const Json r = Json::parse(session.handle(command.dump()).json);
+    CHECK(r.at("op") == "error");
+    return r.at("message").get<std::string>();
+  };
+  for (const std::string& name :
+       {std::string("../x.json"), std::string("/tmp/clayform-studio-x.json"),
+        std::string("a\0b.json", 8), std::string(""), std::string("."), std::string(".."),
+        std::string("sub/x.json"), std::string("x\n.json"), std::string("/dev/null")})
+    CHECK_THAT(refused({{"op", "save"}, {"file", name}}), Contains("not a plain file name"));
+  CHECK_FALSE(fs::exists("/tmp/clayform-studio-x.json"));
+  for (const std::string folder : {"../out", "/tmp/clayform-studio-out", "a/../../b", "", "."})
+    refused({{"op", "export"}, {"folder", folder}});
+  refused({{"op", "export"}, {"folder", "out"}, {"name", "../x"}});
+  // The recipe's own name is a file stem: "../../x" is refused by the recipe check.
+  CHECK_THAT(refused({{"op", "edit"}, {"path", "name"}, {"value", "../../x"}}),
+             Contains("not a plain file name"));
+  CHECK(names_in(work) == std::set<std::string>{"sail.json"});
+  CHECK(names_in(outside) == std::set<std::string>{"keep.txt", "work"});
+
+  // A symbolic link planted at the target is replaced, not followed; a FIFO is refused.
+  fs::create_symlink(outside / "keep.txt", work / "planted.json");
+  CHECK(Json::parse(session.handle(R"({"op": "save", "file": "planted.json"})").json).at("op") ==
+        "saved");
+  CHECK(read(outside / "keep.txt") == "KEEP");
+  CHECK(fs::is_regular_file(fs::symlink_status(work / "planted.json")));
+  CHECK(read(work / "planted.json") == session.text());
+  REQUIRE(::mkfifo((work / "pipe.json").c_str(), 0644) == 0);
+  CHECK_THAT(refused({{"op", "save"}, {"file", "pipe.json"}}), Contains("not a regular file"));
+  // A folder reached through a symbolic link that leads out is refused too.
+  fs::create_directory_symlink(outside, work / "up");
+  CHECK_THAT(refused({{"op", "export"}, {"folder", "up/out"}}), Contains("leads out"));
+  CHECK(names_in(work) == std::set<std::string>{"sail.json", "planted.json", "pipe.json", "up"});
+  CHECK(names_in(outside) == std::set<std::string>{"keep.txt", "work"});
+
+  // Inside: exported, no temporary left.
+  const Json exported = Json::parse(
+      session.handle(R"({"op": "export", "folder": "out/v1", "name": "sail_v1"})").json);
+  REQUIRE(exported.at("op") == "exported");
+  CHECK(names_in(work / "out") == std::set<std::string>{"v1"});
+  CHECK(names_in(work / "out" / "v1").count("sail_v1.step") == 1);
+}
+
+TEST_CASE("studio session: every field is read before anything changes", "[studio][security]") {
+  StudioSession session = StudioSession::load(examples / "sail.json");
+  session.handle(Json{{"op", "edit"}, {"path", billow}, {"value", 500}, {"label", "a"}}.dump());
+  session.handle(R"({"op": "undo"})");
+  const std::string before = session.text();
+  for (const Json& bad :
+       {Json{{"op", "edit"}, {"path", billow}, {"value", 410}, {"nets", "no"}},
+        Json{{"op", "edit"}, {"path", billow}, {"value", 420}, {"label", 5}},
+        Json{{"op", "edit"}, {"path", billow}, {"value", 430}, {"group", 1}},
+        Json{{"op", "edit"}, {"path", billow}, {"value", 440}, {"create", "yes"}},
+        Json{{"op", "export"}, {"folder", "out"}, {"name", 7}}}) {
+    INFO(bad.dump());
+    const Json r = Json::parse(session.handle(bad.dump()).json);
+    CHECK(r.at("op") == "error");
+    CHECK_THAT(r.at("message").get<std::string>(), Contains("must be"));
+    CHECK(session.text() == before);
+    CHECK(session.history() == std::vector<std::string>{"open", "a"});
+    CHECK(session.position() == 0);
+  }
+  // The redo tail survived them all.
+  CHECK(Json::parse(session.handle(R"({"op": "redo"})").json).at("op") == "redo");
+  CHECK(Json::parse(session.text())["deformations"]["shape"][1]["moves"][0]["by"][1] == 500);
+}
+
+TEST_CASE("studio session: a cancelled command changes nothing", "[studio][security]") {
+  StudioSession session = StudioSession::load(examples / "sail.json");
+  const std::string before = session.text();
+  int asked = 0;
+  const auto r = Json::parse(
+      session
+          .handle(Json{{"op", "edit"}, {"path", billow}, {"value", 500}}.dump(),
+                  [&] { return ++asked > 0; })
+          .json);
+  CHECK(r.at("op") == "error");
+  CHECK(r.at("category") == "cancelled");
+  CHECK(asked >= 1);
+  CHECK(session.text() == before);
+  CHECK(session.history().size() == 1);
+}
+
+TEST_CASE("studio session: the history keeps within its byte limit", "[studio][security]") {
+  StudioSession session = StudioSession::load(examples / "sail.json");
+  const std::size_t one = session.text().size();
+  session.limit_history(4 * one);
+  for (int k = 1; k <= 12; ++k)
+    session.handle(
+        Json{{"op", "edit"}, {"path", billow}, {"value", 100 + k}, {"label", std::to_string(k)}}
+            .dump());
+  const auto entries = session.history();
+  INFO(entries.size() << " entries kept, " << session.history_dropped() << " dropped");
+  CHECK(entries.size() + session.history_dropped() == 13);
+  CHECK(entries.size() <= 4);
+  CHECK(entries.size() >= 2);
+  CHECK(entries.back() == "12");
+  // Undo walks back through what is kept, in order, then says there is nothing more.
+  for (std::size_t k = 1; k < entries.size(); ++k) {
+    CHECK(Json::parse(session.handle(R"({"op": "undo"})").json).at("op") == "undo");
+    CHECK(Json::parse(session.text())["deformations"]["shape"][1]["moves"][0]["by"][1] ==
+          100 + 12 - static_cast<int>(k));
+  }
+  CHECK_THAT(Json::parse(session.handle(R"({"op": "undo"})").json).at("message").get<std::string>(),
+             Contains("nothing to undo"));
+}
+
+TEST_CASE("studio session: the history is autosaved and restored", "[studio][security]") {
+  const fs::path recipe = example_copy("sail", "autosave");
+  const fs::path file = StudioSession::autosave_file(recipe.parent_path(), "sail");
+  CHECK(file.filename() == "sail.studio-autosave.json");
+  std::vector<std::string> labels;
+  std::string text;
+  {
+    StudioSession session = StudioSession::load(recipe);
+    session.autosave_to(file);
+    REQUIRE(fs::exists(file));
+    for (int v : {200, 300, 400})
+      session.handle(Json{{"op", "edit"}, {"path", billow}, {"value", v}, {"label", "billow " +
+                                                                                     std::to_string(v)}}
+                         .dump());
+    session.handle(R"({"op": "undo"})");
+    session.flush_autosave();
+    labels = session.history();
+    text = session.text();
+  }  // as if the studio had been stopped (Ctrl-C) here
+  StudioSession again = StudioSession::load(recipe);
+  CHECK(again.restore(file) == labels.size());
+  CHECK(again.history() == labels);
+  CHECK(again.text() == text);
+  CHECK(again.position() == 2);
+  const Json hello = Json::parse(again.handle(R"({"op": "hello"})").json);
+  CHECK(hello.at("restored").at("entries") == labels.size());
+  CHECK(Json::parse(again.handle(R"({"op": "redo"})").json).at("op") == "redo");
+  CHECK(Json::parse(again.text())["deformations"]["shape"][1]["moves"][0]["by"][1] == 400);
+  // Not an autosave, or one whose recipe is broken: refused, naming the file.
+  write(file, R"({"format": "clayform.recipe"})");
+  CHECK_THROWS_WITH(StudioSession::load(recipe).restore(file), Contains("not a studio autosave"));
+  CHECK(names_in(recipe.parent_path()) ==
+        std::set<std::string>{"sail.json", "sail.studio-autosave.json"});
+}
