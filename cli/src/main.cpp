@@ -383,10 +383,10 @@ int render_recipe(const fs::path& file, const fs::path& png, clay::render::Rende
 int studio(const std::string& recipe, int port, bool fresh) {
   namespace rc = clay::recipe;
   rc::StudioSession session =
-      recipe.empty() ? rc::StudioSession(
-                           R"({"format": "clayform.recipe", "version": 1, "name": "untitled"})",
-                           ".", "untitled")
-                     : rc::StudioSession::open(recipe);
+      recipe.empty()
+          ? rc::StudioSession(R"({"format": "clayform.recipe", "version": 1, "name": "untitled"})",
+                              ".", "untitled")
+          : rc::StudioSession::open(recipe);
   // Beside the recipe (or the model), named after the session's recipe.
   const fs::path autosave = rc::StudioSession::autosave_file(
       recipe.empty() ? fs::path(".") : fs::path(recipe).parent_path(), session.name());
@@ -395,15 +395,16 @@ int studio(const std::string& recipe, int port, bool fresh) {
     if (fresh) {
       fs::rename(autosave, autosave.string() + ".old", ec);
       if (ec)
-        throw clay::Error(clay::ErrorCategory::Io, "cannot set the autosave \"" +
-                                                       autosave.string() +
-                                                       "\" aside: " + ec.message());
+        throw clay::Error(
+            clay::ErrorCategory::Io,
+            "cannot set the autosave \"" + autosave.string() + "\" aside: " + ec.message());
       std::printf("Set the autosave aside as %s.old\n", autosave.string().c_str());
     } else {
       const std::size_t entries = session.restore(autosave);
-      std::printf("Continuing the autosave %s (%zu history entries; --fresh starts from the "
-                  "recipe file instead)\n",
-                  autosave.string().c_str(), entries);
+      std::printf(
+          "Continuing the autosave %s (%zu history entries; --fresh starts from the "
+          "recipe file instead)\n",
+          autosave.string().c_str(), entries);
     }
   }
   session.autosave_to(autosave);
@@ -418,9 +419,10 @@ int studio(const std::string& recipe, int port, bool fresh) {
   o.port = port;
   o.front_end = rc::viewer_dir();
   rc::StudioServer server(std::move(session), o);
-  std::printf("Clayform Studio at %s (open this address: it holds the session's token; "
-              "autosave %s; Ctrl-C to stop)\n",
-              server.url().c_str(), autosave.string().c_str());
+  std::printf(
+      "Clayform Studio at %s (open this address: it holds the session's token; "
+      "autosave %s; Ctrl-C to stop)\n",
+      server.url().c_str(), autosave.string().c_str());
   std::fflush(stdout);
   server.start();
   int signal_number = 0;

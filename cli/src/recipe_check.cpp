@@ -34,8 +34,9 @@ void RecipeChecker::run(const Json& root) {
     // The name is the stem of files written for the recipe (the studio's export and autosave):
     // a name such as "../../x" wrote outside the output folder (issue #36).
     if (const auto problem = internal::file_name_problem(data.name); problem && j->is_string())
-      c_.add("name", "the name \"" + internal::clip_utf8(data.name, 60) + "\" is not a plain file name (" +
-                         *problem + "); give a name such as \"hood_v2\"");
+      c_.add("name", "the name \"" + internal::clip_utf8(data.name, 60) +
+                         "\" is not a plain file name (" + *problem +
+                         "); give a name such as \"hood_v2\"");
   }
   if (const Json* j = c_.member(root, "", "description", false, ""))
     data.description = c_.string(*j, "description").value_or("");

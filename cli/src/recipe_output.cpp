@@ -198,8 +198,10 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
   std::vector<std::string> names;
   try {
     // Every file stem a plain name: nothing is written outside the output folder.
-    for (const auto& e : result.exports) internal::check_file_name(e.name, "write_outputs: the export");
-    for (const auto& m : result.models) internal::check_file_name(m.name, "write_outputs: the model");
+    for (const auto& e : result.exports)
+      internal::check_file_name(e.name, "write_outputs: the export");
+    for (const auto& m : result.models)
+      internal::check_file_name(m.name, "write_outputs: the model");
     for (auto& e : result.exports) {
       e.files.clear();
       for (const auto& format : e.formats) {

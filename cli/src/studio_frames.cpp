@@ -47,8 +47,6 @@ std::vector<std::uint8_t> net_frame(const std::string& header_json,
   return out;
 }
 
-
-
 /// A model's frame: the length and JSON header as in net_frame ({"kind": "mesh", "name",
 /// "vertices": n, "triangles": m, "faces"}), then n * 3 float64 positions, n * 3 float64 unit
 /// normals, n * 2 float64 (u, v) on each node's face, m * 3 uint32 node indices and n uint32
@@ -173,6 +171,5 @@ std::uint64_t topology_key(const brep::Model& model) {
   }
   return h;
 }
-
 
 }  // namespace clay::recipe

@@ -58,8 +58,9 @@ std::string random_token() {
     const ssize_t n = ::getrandom(bytes + got, sizeof bytes - got, 0);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0)
-      throw Error(ErrorCategory::Io, "studio: no random bytes for the session's token (getrandom "
-                                     "failed); give one with --token");
+      throw Error(ErrorCategory::Io,
+                  "studio: no random bytes for the session's token (getrandom "
+                  "failed); give one with --token");
     got += static_cast<std::size_t>(n);
   }
   static const char* hex = "0123456789abcdef";
@@ -162,10 +163,14 @@ std::pair<http::status, std::string> read_static_file(const fs::path& root, std:
 
 std::string content_type(const std::string& path) {
   static const std::map<std::string, std::string> types = {
-      {".html", "text/html; charset=utf-8"}, {".js", "text/javascript; charset=utf-8"},
-      {".mjs", "text/javascript; charset=utf-8"}, {".css", "text/css; charset=utf-8"},
-      {".json", "application/json"},         {".png", "image/png"},
-      {".svg", "image/svg+xml"},             {".wasm", "application/wasm"}};
+      {".html", "text/html; charset=utf-8"},
+      {".js", "text/javascript; charset=utf-8"},
+      {".mjs", "text/javascript; charset=utf-8"},
+      {".css", "text/css; charset=utf-8"},
+      {".json", "application/json"},
+      {".png", "image/png"},
+      {".svg", "image/svg+xml"},
+      {".wasm", "application/wasm"}};
   const auto t = types.find(fs::path(path).extension().string());
   return t == types.end() ? "application/octet-stream" : t->second;
 }
@@ -276,10 +281,9 @@ struct StudioServer::Impl::Http : std::enable_shared_from_this<Http> {
     parser->header_limit(16 * 1024);
     parser->body_limit(64 * 1024);  // a GET has none; the upgrade none
     stream.expires_after(std::chrono::seconds(s.options.request_seconds));
-    http::async_read(stream, buffer, *parser,
-                     [self = shared_from_this()](beast::error_code ec, std::size_t) {
-                       self->on_read(ec);
-                     });
+    http::async_read(
+        stream, buffer, *parser,
+        [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
   }
 
   /// Closes the connection (and leaves the list of open requests).
@@ -296,10 +300,9 @@ struct StudioServer::Impl::Http : std::enable_shared_from_this<Http> {
   void reply(Response&& response) {
     auto res = std::make_shared<std::decay_t<Response>>(std::forward<Response>(response));
     stream.expires_after(std::chrono::seconds(s.options.request_seconds));
-    http::async_write(stream, *res,
-                      [self = shared_from_this(), res](beast::error_code, std::size_t) {
-                        self->close();
-                      });
+    http::async_write(
+        stream, *res,
+        [self = shared_from_this(), res](beast::error_code, std::size_t) { self->close(); });
   }
 
   void on_read(beast::error_code ec) {
@@ -316,7 +319,8 @@ struct StudioServer::Impl::Http : std::enable_shared_from_this<Http> {
     if (!s.host_ok(view(req[http::field::host]))) {
       reply(plain(req, http::status::forbidden,
                   "refused: the studio answers requests to its own address only (Host must be "
-                  "127.0.0.1:" + std::to_string(s.port) + ")\n"));
+                  "127.0.0.1:" +
+                      std::to_string(s.port) + ")\n"));
       return;
     }
     const auto given = query_value(query, "token");
@@ -478,9 +482,8 @@ void StudioServer::Impl::Http::upgrade(http::request<http::string_body> req) {
 }
 
 void StudioServer::Impl::accept_next() {
-  acceptor.async_accept(io, [this](beast::error_code ec, tcp::socket socket) {
-    on_accept(ec, std::move(socket));
-  });
+  acceptor.async_accept(
+      io, [this](beast::error_code ec, tcp::socket socket) { on_accept(ec, std::move(socket)); });
 }
 
 void StudioServer::Impl::on_accept(beast::error_code ec, tcp::socket socket) {
@@ -527,9 +530,9 @@ void StudioServer::Impl::take_over(const std::shared_ptr<Page>& newer) {
   page = newer;
   holder = newer->id;
   std::lock_guard<std::mutex> lock(jobs_mutex);
-  jobs.erase(std::remove_if(jobs.begin(), jobs.end(),
-                            [&](const Job& j) { return j.page != newer->id; }),
-             jobs.end());
+  jobs.erase(
+      std::remove_if(jobs.begin(), jobs.end(), [&](const Job& j) { return j.page != newer->id; }),
+      jobs.end());
 }
 
 void StudioServer::Impl::submit(std::string command, std::uint64_t from) {

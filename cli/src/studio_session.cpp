@@ -52,7 +52,6 @@ T field(const Json& command, const char* op, const char* key, T fallback, const 
   return it->get<T>();
 }
 
-
 /// "a.b[2].c" -> JSON pointer "/a/b/2/c"; clay::Error(InvalidArgument) for a malformed path.
 Json::json_pointer pointer_of(const std::string& path) {
   std::string out;
@@ -64,7 +63,8 @@ Json::json_pointer pointer_of(const std::string& path) {
       const std::string index = close == std::string::npos ? "" : path.substr(i + 1, close - i - 1);
       if (index.empty() || !std::all_of(index.begin(), index.end(), ::isdigit))
         throw Error(ErrorCategory::InvalidArgument,
-                    "studio: path \"" + internal::clip_utf8(path, 120) + "\" has a malformed list index; write items as [i]");
+                    "studio: path \"" + internal::clip_utf8(path, 120) +
+                        "\" has a malformed list index; write items as [i]");
       out += "/" + index;
       i = close + 1;
       expect_key = false;
@@ -86,8 +86,8 @@ Json::json_pointer pointer_of(const std::string& path) {
     }
   }
   if (out.empty() || expect_key)
-    throw Error(ErrorCategory::InvalidArgument,
-                "studio: path \"" + internal::clip_utf8(path, 120) + "\" is empty or ends with \".\"");
+    throw Error(ErrorCategory::InvalidArgument, "studio: path \"" + internal::clip_utf8(path, 120) +
+                                                    "\" is empty or ends with \".\"");
   return Json::json_pointer(out);
 }
 
@@ -107,8 +107,9 @@ void apply_change(Json& doc, const Json& change, std::string& first_path) {
   const bool exists = doc.contains(ptr);
   if (remove) {
     if (!exists)
-      throw Error(ErrorCategory::InvalidArgument,
-                  "studio: cannot remove \"" + internal::clip_utf8(path, 120) + "\": the recipe has no such entry");
+      throw Error(ErrorCategory::InvalidArgument, "studio: cannot remove \"" +
+                                                      internal::clip_utf8(path, 120) +
+                                                      "\": the recipe has no such entry");
     Json& parent = doc.at(ptr.parent_pointer());
     if (parent.is_array())
       parent.erase(static_cast<std::size_t>(std::stoul(ptr.back())));
@@ -117,19 +118,22 @@ void apply_change(Json& doc, const Json& change, std::string& first_path) {
     return;
   }
   if (!change.contains("value"))
-    throw Error(ErrorCategory::InvalidArgument,
-                "studio: the change of \"" + internal::clip_utf8(path, 120) + "\" has no \"value\" (or \"remove\": true)");
+    throw Error(ErrorCategory::InvalidArgument, "studio: the change of \"" +
+                                                    internal::clip_utf8(path, 120) +
+                                                    "\" has no \"value\" (or \"remove\": true)");
   if (!exists) {
     if (!create)
-      throw Error(ErrorCategory::InvalidArgument,
-                  "studio: the recipe has no \"" + internal::clip_utf8(path, 120) + "\"; to add it, send \"create\": true");
+      throw Error(ErrorCategory::InvalidArgument, "studio: the recipe has no \"" +
+                                                      internal::clip_utf8(path, 120) +
+                                                      "\"; to add it, send \"create\": true");
     // Created keys hang from an object: the nearest existing entry above must be one (the
     // missing ones between, e.g. "strokes" of a recipe without strokes, are made objects).
     Json::json_pointer above = ptr.parent_pointer();
     while (!above.empty() && !doc.contains(above)) above = above.parent_pointer();
     if (!doc.at(above).is_object())
       throw Error(ErrorCategory::InvalidArgument,
-                  "studio: cannot create \"" + internal::clip_utf8(path, 120) + "\": \"" + above.to_string() +
+                  "studio: cannot create \"" + internal::clip_utf8(path, 120) + "\": \"" +
+                      above.to_string() +
                       "\" is not an object; a list item is changed by its index");
   }
   doc[ptr] = change.at("value");
@@ -464,9 +468,8 @@ struct StudioSession::Impl {
       throw Error(ErrorCategory::InvalidArgument,
                   "studio: \"export\" needs \"folder\" (a folder inside the recipe's, e.g. "
                   "\"out\")");
-    const fs::path folder =
-        internal::path_under(base_dir, c.at("folder").get_ref<const std::string&>(),
-                             "studio: the export's folder");
+    const fs::path folder = internal::path_under(
+        base_dir, c.at("folder").get_ref<const std::string&>(), "studio: the export's folder");
     const std::string export_name = field<std::string>(c, "export", "name", "", "a string");
     if (c.contains("name")) internal::check_file_name(export_name, "studio: the export's name");
     Run run = this->run(text(), cancelled);
@@ -678,8 +681,9 @@ StudioSession::Reply StudioSession::handle(const std::string& command,
     return error_reply("invalid argument",
                        std::string("studio: the command was refused: ") + e.what());
   } catch (const std::bad_alloc&) {
-    return error_reply("internal error", "studio: out of memory while handling the command; "
-                                         "nothing changed");
+    return error_reply("internal error",
+                       "studio: out of memory while handling the command; "
+                       "nothing changed");
   } catch (const std::exception& e) {
     return error_reply("invalid argument", std::string("studio: the command was refused: ") +
                                                internal::clip_utf8(e.what(), 200));

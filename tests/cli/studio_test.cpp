@@ -644,8 +644,7 @@ TEST_CASE("studio server: a burst of edits of one path is answered for the newes
   options.port = 0;
   StudioServer server(StudioSession::load(sail_file), options);
   server.start();
-  Client client(server.port(), "http://127.0.0.1:" + std::to_string(server.port()),
-                server.token());
+  Client client(server.port(), "http://127.0.0.1:" + std::to_string(server.port()), server.token());
   const int burst = 12;
   for (int k = 1; k <= burst; ++k)
     client.send(

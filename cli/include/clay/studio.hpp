@@ -123,9 +123,9 @@ struct StudioOptions {
   /// The session's secret (letters and digits, at least 16): every request must carry it, as
   /// ?token= or the cookie the first such request sets. Empty: 32 random hex digits.
   std::string token;
-  int max_connections = 64;      ///< open connections; beyond, the oldest not yet upgraded closes
-  int request_seconds = 10;      ///< a request's head and body must arrive within this
-  std::size_t max_file_bytes = 64u << 20;  ///< largest static file served
+  int max_connections = 64;  ///< open connections; beyond, the oldest not yet upgraded closes
+  int request_seconds = 10;  ///< a request's head and body must arrive within this
+  std::size_t max_file_bytes = 64u << 20;     ///< largest static file served
   std::size_t max_queued_bytes = 512u << 20;  ///< replies a page has not read; beyond, it closes
 };
 

@@ -43,8 +43,8 @@ inline std::optional<std::string> file_name_problem(std::string_view name) {
   for (char c : name) {
     if (c == '/' || c == '\\') return "it has a '" + std::string(1, c) + "' (a folder in it)";
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
-      return "it has a control character (byte " +
-             std::to_string(static_cast<unsigned char>(c)) + ")";
+      return "it has a control character (byte " + std::to_string(static_cast<unsigned char>(c)) +
+             ")";
   }
   return std::nullopt;
 }
@@ -103,8 +103,9 @@ inline void write_atomically(const std::filesystem::path& file, std::string_view
   namespace fs = std::filesystem;
   struct stat st {};
   if (::lstat(file.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode))
-    throw Error(ErrorCategory::Io, "cannot write the " + what + " \"" + file.string() +
-                                       "\": it exists and is not a regular file; give another name");
+    throw Error(ErrorCategory::Io,
+                "cannot write the " + what + " \"" + file.string() +
+                    "\": it exists and is not a regular file; give another name");
   std::string pattern = (file.parent_path().empty() ? fs::path(".") : file.parent_path()) /
                         ("." + file.filename().string() + ".XXXXXX");
   const int fd = ::mkstemp(pattern.data());

@@ -65,8 +65,7 @@ inline std::optional<TooDeep> nesting_too_deep(std::string_view text, int limit)
         ++i;  // the escaped character cannot end the string
       } else if (c == '"') {
         in_string = false;
-        if (depth == 1)
-          key = clip_utf8(text.substr(string_start, i - string_start), 64);
+        if (depth == 1) key = clip_utf8(text.substr(string_start, i - string_start), 64);
       }
       continue;
     }
