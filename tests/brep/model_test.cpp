@@ -7,6 +7,7 @@
 #include <clay/surface/bspline_surface.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <map>
 #include <string>
 #include <tuple>
@@ -441,6 +442,45 @@ TEST_CASE("volume_mm3 of a cube, a translated cube and a cube with a face turned
   turned.faces[1].reversed = true;  // inside out: refused, like volume_mm3
   CHECK(clay::test::error_of([&] { (void)clay::brep::body_volumes_mm3(turned); }).first ==
         clay::ErrorCategory::InvalidGeometry);
+}
+
+TEST_CASE("volume_mm3 ends on a face with an extreme weight, exact or refused, never hung",
+          "[brep]") {
+  // Issue #36: one rational weight of 1e6 in a 7 KB IGES file made the adaptive quadrature run
+  // for ever (its halved tolerance fell below rounding, so every branch went 2^40 deep). A
+  // bilinear sheet keeps its plane square whatever its corner weights are (only the
+  // parametrization crowds towards the heavy corner), so its flux of (0, 0, z) is still z × area.
+  for (double w : {1e3, 1e6, 1e9}) {
+    INFO("corner weight " << w);
+    Builder b;
+    const int f = b.quad({0, 0, 4}, {10, 0, 0}, {0, 10, 0}, "plate");
+    Body sheet;
+    sheet.kind = BodyKind::Sheet;
+    sheet.shells.push_back({{f}});
+    b.m.bodies.push_back(sheet);
+    // Untrimmed: the whole domain (its edges would follow the old parametrization).
+    b.m.faces[static_cast<std::size_t>(f)].loops.clear();
+    b.m.edges.clear();
+    b.m.vertices.clear();
+    clay::surface::BSplineSurface& s = b.m.faces[static_cast<std::size_t>(f)].surface;
+    s.weights = Eigen::VectorXd::Ones(s.points.rows());
+    s.weights(0) = w;
+    const Model& m = b.m;
+    INFO(all(clay::brep::problems(m)));
+    REQUIRE(clay::brep::problems(m).empty());
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      const double flux = clay::brep::volume_mm3(m, 0);
+      CHECK(flux == Approx(4 * 100).epsilon(1e-12));
+      CHECK(w < 1e6);  // 1e3 converges to the exact flux (a fixed 16-point rule gave 280)
+    } catch (const clay::Error& e) {  // did not converge: said so, with the estimate
+      CHECK(e.category() == clay::ErrorCategory::ToleranceNotMet);
+      CHECK_THAT(e.message(),
+                 Contains("the volume did not converge on 1 face(s) (0) within its budget"));
+      CHECK(w >= 1e6);
+    }
+    CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(30));
+  }
 }
 
 TEST_CASE("flattened places every instance of an assembly as a body of its own", "[brep]") {
