@@ -124,6 +124,23 @@ int info(const fs::path& file) {
   const bool broken = !read.report.problems.empty();
   clay::brep::ModelCheck check;
   if (!broken) check = clay::brep::check_model(m);
+  // An edge gap beyond 1 % of the model's size is no rounding, whatever tolerance the file gave
+  // its edges: never "valid" over it (a file with a duplicated entity read as valid with a 25 mm
+  // gap on a 2 mm part, issue #36).
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(1e300), high = -low;
+  for (const auto& f : m.faces) {
+    const auto [a, b] = control_box(f.surface);
+    low = low.cwiseMin(a);
+    high = high.cwiseMax(b);
+  }
+  const double size = m.faces.empty() ? 0.0 : (high - low).norm();
+  if (check.valid && read.report.max_edge_gap_mm > 0.01 * size) {
+    check.valid = false;
+    check.problems.insert(check.problems.begin(),
+                          "an edge gap of " + std::to_string(read.report.max_edge_gap_mm) +
+                              " mm is more than 1 % of the model's size (" + std::to_string(size) +
+                              " mm): its edges do not meet its faces");
+  }
   std::printf("%s: %zu face%s, max degree %d, %ld control points, %s\n", file.string().c_str(),
               m.faces.size(), m.faces.size() == 1 ? "" : "s", max_degree, control_points,
               broken ? "NOT valid (broken invariants)" : check.brief().c_str());

@@ -12,7 +12,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <string>
-#include <unordered_set>
+#include <unordered_map>
 #include <vector>
 
 namespace clay::surface::detail {
@@ -165,7 +165,10 @@ void precheck_step(const fs::path& file, std::string_view caller, int max_degree
     throw Error(ErrorCategory::Io,
                 std::string(caller) + ": '" + file.string() + "' cannot be opened");
   StepTokens tokens(in);
-  std::unordered_set<std::string> defined;
+  std::unordered_map<std::string, int> defined;  // entity number -> the line defining it
+  // Entries of each open list (one counter per open parenthesis): OpenCASCADE took past the
+  // reader's 120 s limit on a list of 10^5 references (issue #36).
+  std::vector<std::size_t> entries;
   struct Use {
     std::string id, entity;
     int line;
@@ -192,7 +195,13 @@ void precheck_step(const fs::path& file, std::string_view caller, int max_degree
         fail(caller, file, t.line, where(), "'#" + t.text + "' is not an entity number");
       if (depth == 0 && after.kind == Token::Symbol && after.text == "=") {
         entity = "#" + t.text;
-        defined.insert(t.text);
+        // ISO 10303-21 defines each entity number once; OpenCASCADE silently took one of two
+        // definitions, and the model read back with a negative volume and a 25 mm edge gap.
+        if (const auto [at, added] = defined.emplace(t.text, t.line); !added)
+          fail(caller, file, t.line, where(),
+               "#" + t.text + " is defined twice, on line " + std::to_string(at->second) +
+                   " and here (ISO 10303-21 allows one definition per entity number); keep one "
+                   "and renumber the other");
       } else {
         uses.push_back({t.text, entity, t.line});
       }
@@ -211,8 +220,19 @@ void precheck_step(const fs::path& file, std::string_view caller, int max_degree
       if (const std::string why = bad_number(t.text); !why.empty())
         fail(caller, file, t.line, where(), why);
     } else if (t.kind == Token::Symbol) {
-      if (t.text == "(") ++depth;
-      if (t.text == ")" && --depth < 0) fail(caller, file, t.line, where(), "a ')' closes no '('");
+      if (t.text == "(") {
+        ++depth;
+        entries.push_back(1);
+      }
+      if (t.text == "," && !entries.empty() && ++entries.back() > max_list_entries)
+        fail(caller, file, t.line, where(),
+             "a list has more than " + std::to_string(max_list_entries) +
+                 " entries (a limit of this reader: OpenCASCADE takes minutes on such lists); "
+                 "split the entity (a shell of fewer faces, a loop of fewer edges)");
+      if (t.text == ")") {
+        if (--depth < 0) fail(caller, file, t.line, where(), "a ')' closes no '('");
+        entries.pop_back();
+      }
       if (t.text == ";" && depth == 0) entity.clear();
     }
     // The degrees: the first integers of the B-spline's own parameter list (after its name).

@@ -5,6 +5,7 @@
 // StepToGeom::MakeCartesianPoint; NaN, infinite or denormal coordinates and degree 99 hung it);
 // these scans refuse the known triggers with the entity and line. They are a first line only:
 // the isolated read (a child process) catches what they miss.
+#include <cstddef>
 #include <filesystem>
 #include <string_view>
 
@@ -13,8 +14,13 @@ namespace clay::surface::detail {
 /// Largest magnitude a number in an exchange file may have; beyond it no geometry is meant.
 inline constexpr double max_file_number = 1e100;
 
+/// Most entries a list of a STEP entity may have (a shell of 50,000 faces; a B-spline's rows are
+/// far shorter): OpenCASCADE took past the reader's time limit on a list of 10^5 references.
+inline constexpr std::size_t max_list_entries = 50000;
+
 /// Checks a STEP (ISO 10303-21) file in one pass over its text: every `#n` reference in the DATA
-/// section names an entity the file defines; every number is finite, not denormal and at most
+/// section names an entity the file defines, and no entity number is defined twice; no list has
+/// more than max_list_entries entries; every number is finite, not denormal and at most
 /// max_file_number in magnitude; bare words are only entity names (so `NaN` and `INF` are
 /// refused); B-spline curve and surface degrees are integers in [1, max_degree]; parentheses
 /// balance and strings end. Throws clay::Error(Exchange) "CALLER: 'FILE' line L, entity #N: ..."

@@ -536,6 +536,8 @@ std::vector<std::pair<std::string, std::string>> write_mutated_files(const fs::p
       {"iges-nan-coordinate.igs", "'NaN' is not a number"},
       {"iges-infinite-coordinate.igs", "'1.0D999' is beyond the range of a double"},
       {"iges-denormal-coordinate.igs", "'4.9D-324' is denormal"},
+      {"step-duplicate-id.step", "is defined twice, on line "},
+      {"step-huge-list.step", "a list has more than 50000 entries"},
   };
   auto write = [&](const std::string& name, const std::string& text) {
     std::ofstream(folder / name, std::ios::binary) << text;
@@ -563,6 +565,13 @@ std::vector<std::pair<std::string, std::string>> write_mutated_files(const fs::p
   write(files[10].first, iges_edited(iges, record, 13, value, "NaN"));
   write(files[11].first, iges_edited(iges, record, 13, value, "1.0D999"));
   write(files[12].first, iges_edited(iges, record, 13, value, "4.9D-324"));
+  // The first control point defined a second time, elsewhere (issue #36: OpenCASCADE took one of
+  // the two silently), and a list of 50,001 coordinates.
+  const std::string moved = replaced(point, "'',(" + x, "'',(" + x + "1");
+  write(files[13].first, replaced(step, point + ";", point + ";\n" + moved + ";"));
+  std::string many;
+  for (int k = 0; k < 50000; ++k) many += "0.,";
+  write(files[14].first, coordinate(many + x));
   return files;
 }
 

@@ -594,8 +594,8 @@ std::string occt::read_in_child(const fs::path& file, const ReadOptions& options
     std::snprintf(limit, sizeof limit, "%g", options.time_limit_seconds);
     throw Error(ErrorCategory::Exchange,
                 std::string(caller) + ": reading " + quoted(file) + " took longer than " + limit +
-                    " s, the time limit, so it was stopped; the file is "
-                    "probably malformed (OpenCASCADE hangs on NaN coordinates and absurd degrees)");
+                    " s, the time limit, so it was stopped; the file is malformed in a way the "
+                    "pre-check does not catch, or too large to read within the limit");
   }
   const std::string memory = std::to_string(options.memory_limit_mb) + " MB";
   if (WIFSIGNALED(status))
