@@ -269,7 +269,8 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
 /// `clayform deform FILE --recipe R --out DIR`: the whole model of a STEP or IGES file (trimmed
 /// faces, solids, assembly) through the recipe's deformation stack, written as a valid model.
 int deform_model_file(const fs::path& file, const fs::path& recipe_file,
-                      const std::string& deformation, const fs::path& out, bool show) {
+                      const std::string& deformation, const fs::path& out, bool show,
+                      bool allow_fold) {
   const auto recipe = clay::recipe::load_recipe(recipe_file);
   const auto start = std::chrono::steady_clock::now();
   const clay::brep::ImportedModel read = read_model_file(file, "deform");
@@ -281,7 +282,7 @@ int deform_model_file(const fs::path& file, const fs::path& recipe_file,
     for (const auto& p : read.report.problems) m += "\n  " + p;
     throw clay::Error(clay::ErrorCategory::InvalidGeometry, m);
   }
-  const auto result = clay::recipe::deform_model(recipe, read.model, deformation);
+  const auto result = clay::recipe::deform_model(recipe, read.model, deformation, allow_fold);
   if (show)
     std::printf("deformed by %s: %s\n", result.deformation.c_str(), result.report.brief().c_str());
   const auto files = clay::recipe::write_model_outputs(result, out, file.stem().string());
@@ -289,7 +290,9 @@ int deform_model_file(const fs::path& file, const fs::path& recipe_file,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("%s: %s in %.2f s\n", file.string().c_str(), result.report.brief().c_str(), seconds);
   if (!result.fold_free)
-    std::printf("  WARNING: a lattice may fold (a Jacobian bound <= 0): check the result\n");
+    std::printf(
+        "  WARNING: a lattice may fold (a Jacobian bound <= 0, allowed by --allow-fold): "
+        "the solid may intersect itself\n");
   std::printf("outputs in %s (read back valid, BRepCheck):\n", out.string().c_str());
   for (const auto& f : files) std::printf("  %s\n", f.string().c_str());
   return 0;
@@ -526,6 +529,10 @@ int main(int argc, char** argv) {
   deform_cmd->add_option("--out", out_dir, "output folder (created when missing)")->required();
   deform_cmd->add_option("--deformation", deformation,
                          "which stack (needed when the recipe has several)");
+  bool allow_fold = false;
+  deform_cmd->add_flag("--allow-fold", allow_fold,
+                       "deform by a lattice not proven fold-free (the solid may intersect "
+                       "itself); refused otherwise");
   deform_cmd->add_flag("--quiet", quiet, "no progress lines");
   deform_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
   // clayform render
@@ -676,7 +683,8 @@ int main(int argc, char** argv) {
       auto result = clay::recipe::run_recipe(recipe, run_options(show));
       return finish(result, out_dir);
     }
-    if (*deform_cmd) return deform_model_file(file, recipe_file, deformation, out_dir, show);
+    if (*deform_cmd)
+      return deform_model_file(file, recipe_file, deformation, out_dir, show, allow_fold);
   } catch (const clay::Error& e) {
     std::fprintf(stderr, "clayform: %s\n", e.what());
     return exit_code(e.category());

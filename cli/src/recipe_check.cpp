@@ -286,8 +286,10 @@ std::optional<fs::path> RecipeChecker::exchange_file(const Json& f, const std::s
 }
 
 void RecipeChecker::modelling(const std::string& name, const Json& j, const std::string& path) {
-  if (!c_.object(j, path, {"import", "sew", "deformation", "bodies", "faces", "formats", "schema"},
-                 "a model {import, deformation, bodies, faces, formats, schema, sew}"))
+  if (!c_.object(
+          j, path,
+          {"import", "sew", "deformation", "bodies", "faces", "formats", "schema", "allow_fold"},
+          "a model {import, deformation, bodies, faces, formats, schema, sew}"))
     return;
   const std::size_t before = c_.problems.size();
   ModelDef def;
@@ -301,6 +303,7 @@ void RecipeChecker::modelling(const std::string& name, const Json& j, const std:
           c_.member(j, path, "import", true, "the path of a .step/.stp/.igs/.iges file"))
     if (const auto file = exchange_file(*f, key_path(path, "import"))) def.file = *file;
   def.sew = c_.boolean_or(j, path, "sew", def.sew);
+  def.allow_fold = c_.boolean_or(j, path, "allow_fold", def.allow_fold);
   if (const Json* d = c_.member(j, path, "deformation", false, "")) {
     const std::string dp = key_path(path, "deformation");
     if (const auto n = c_.string(*d, dp)) {

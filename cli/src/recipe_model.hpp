@@ -199,6 +199,7 @@ struct ModelDef {
   std::string name, path;
   std::filesystem::path file;
   bool sew = false;                        ///< sew loose faces into shells and solids
+  bool allow_fold = false;  ///< deform by a lattice not proven fold-free (the solid may fold)
   std::string deformation;                 ///< "" when the model is written as read
   std::vector<std::string> bodies, faces;  ///< names chosen to deform; both empty: every face
   std::vector<std::string> formats{"step", "iges", "glb"};

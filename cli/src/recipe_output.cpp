@@ -165,18 +165,22 @@ std::vector<fs::path> move_in(const Staging& s, const std::vector<std::string>& 
 }
 
 /// Moves the view folder from the temporary folder into the target as a whole: a previous run's
-/// meshes go, this run's come in one rename. Returns its path.
+/// meshes go, this run's come in one rename. The previous one is first renamed into this run's
+/// staging folder (removed with it), so runs into one folder at once never see a half-removed
+/// view, and one that lands between the two renames is moved aside again. Returns its path.
 fs::path move_view_in(const Staging& s) {
+  const fs::path view = s.target / "view";
   std::error_code ec;
-  fs::remove_all(s.target / "view", ec);
-  if (ec)
-    throw Error(ErrorCategory::Io,
-                "cannot replace \"" + (s.target / "view").string() + "\": " + ec.message());
-  fs::rename(s.tmp / "view", s.target / "view", ec);
-  if (ec)
-    throw Error(ErrorCategory::Io,
-                "cannot move \"view\" into \"" + s.target.string() + "\": " + ec.message());
-  return s.target / "view";
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    fs::rename(view, s.tmp / ("old-view-" + std::to_string(attempt)), ec);
+    if (ec && ec != std::errc::no_such_file_or_directory)
+      throw Error(ErrorCategory::Io, "cannot replace \"" + view.string() + "\": " + ec.message());
+    fs::rename(s.tmp / "view", view, ec);
+    if (!ec) return view;
+    if (ec != std::errc::directory_not_empty && ec != std::errc::file_exists) break;
+  }
+  throw Error(ErrorCategory::Io,
+              "cannot move \"view\" into \"" + s.target.string() + "\": " + ec.message());
 }
 
 void write_text(const fs::path& file, const std::string& text) {

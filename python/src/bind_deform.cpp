@@ -38,6 +38,7 @@ py::tuple frame_out(const Frame& f) {
 py::object deform_array(const FrozenLattice& lattice, const py::handle& points,
                         const py::object& out, int threads) {
   const auto in = points_in(points, "points");
+  require_finite(in, "points");
   deform::DeformOptions o;
   o.threads = threads;
   const std::span<const double> from(in.data(), static_cast<std::size_t>(in.size()));
@@ -55,6 +56,13 @@ py::object deform_array(const FrozenLattice& lattice, const py::handle& points,
   if (to.rows() != in.rows())
     throw py::value_error("out: expected " + std::to_string(in.rows()) + " rows, got " +
                           std::to_string(to.rows()));
+  // In place is fine (each row is read before it is written); a partial overlap would read rows
+  // already written over (issue #36: silently wrong).
+  const double *a = in.data(), *b = to.data();
+  if (a != b && b < a + in.size() && a < b + to.size())
+    throw py::value_error(
+        "out: it overlaps points without being points itself, so rows would be read after they "
+        "were written; give points itself (in place) or an array of its own");
   {
     py::gil_scoped_release free;
     deform::deform_points(lattice, from,
@@ -123,8 +131,21 @@ void lattice_common(py::class_<Lattice>& c) {
           "frame", [](const Lattice& l) { return frame_out(l.frame); },
           "(origin, s, t, u) of the parallelepiped, mm.")
       .def_property_readonly("counts", [](const Lattice& l) { return tuple_of(l.counts()); })
-      .def("index", &Lattice::index, py::arg("i"), py::arg("j"), py::arg("k"),
-           "The row of P_ijk in points.")
+      .def(
+          "index",
+          [](const Lattice& l, int i, int j, int k) {
+            // The kernel's index() is unchecked (inner loops); here a wrong index moved another
+            // point (issue #36).
+            const auto n = l.counts();
+            if (i < 0 || j < 0 || k < 0 || i >= n[0] || j >= n[1] || k >= n[2])
+              throw py::index_error("index (" + std::to_string(i) + ", " + std::to_string(j) +
+                                    ", " + std::to_string(k) + ") is outside the lattice's " +
+                                    std::to_string(n[0]) + " x " + std::to_string(n[1]) + " x " +
+                                    std::to_string(n[2]) + " points (0-based)");
+            return l.index(i, j, k);
+          },
+          py::arg("i"), py::arg("j"), py::arg("k"),
+          "The row of P_ijk in points; IndexError outside the lattice.")
       .def(
           "deform_points",
           [](const Lattice& l, const py::handle& points, const py::object& out, int threads) {

@@ -53,11 +53,11 @@ brep::Face& face_at(brep::Model& m, int k) {
 
 /// The recipe's deformation of a whole model (bind_recipe.cpp calls it on its Recipe class).
 py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
-                       const std::string& deformation) {
+                       const std::string& deformation, bool allow_fold) {
   recipe::ModelRunResult result;
   {
     py::gil_scoped_release free;
-    result = recipe::deform_model(r, model, deformation);
+    result = recipe::deform_model(r, model, deformation, allow_fold);
   }
   const auto& x = result.report;
   py::dict d;

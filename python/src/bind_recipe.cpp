@@ -14,7 +14,7 @@
 namespace clay::python {
 
 py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
-                       const std::string& deformation);  // bind_model.cpp
+                       const std::string& deformation, bool allow_fold);  // bind_model.cpp
 
 namespace {
 
@@ -161,12 +161,13 @@ void bind_recipe(py::module_& m) {
           "report.json and the view folder there as `clayform run --out` does.")
       .def(
           "deform_model",
-          [](const PyRecipe& r, const brep::Model& model, const std::string& deformation) {
-            return deform_model(r.recipe, model, deformation);
-          },
-          py::arg("model"), py::arg("deformation") = "",
+          [](const PyRecipe& r, const brep::Model& model, const std::string& deformation,
+             bool allow_fold) { return deform_model(r.recipe, model, deformation, allow_fold); },
+          py::arg("model"), py::arg("deformation") = "", py::kw_only(),
+          py::arg("allow_fold") = false,
           "The model deformed by the recipe's stack (the one named, or its only one), as "
-          "`clayform deform` does: (Model, report).")
+          "`clayform deform` does: (Model, report). A lattice not proven fold-free raises "
+          "InvalidGeometryError (a folded solid intersects itself) unless allow_fold=True.")
       .def("__repr__",
            [](const PyRecipe& r) { return "<clayform.Recipe '" + r.recipe.name() + "'>"; })
       .def(py::pickle(

@@ -7,6 +7,8 @@
 #include <clay/sketch/fit.hpp>
 #include <clay/sketch/plane.hpp>
 
+#include <array>
+
 namespace clay::python {
 
 namespace {
@@ -247,11 +249,26 @@ void bind_sketch(py::module_& m) {
           [](PySketch& s, double tolerance) {
             constraints::SolveOptions o;
             o.tolerance = tolerance;
+            // The solve runs without the GIL on a copy: another thread adding points meanwhile
+            // reallocated the vectors it read and crashed the interpreter (issue #36). Adding
+            // only grows the sketch, so its sizes tell whether it changed.
+            const sketch::Sketch copy = s.sketch;
+            const std::vector<constraints::Constraint> constraints = s.constraints;
+            const auto sizes = [&] {
+              return std::array<std::size_t, 4>{s.sketch.points.size(), s.sketch.entities.size(),
+                                                s.sketch.planes.size(), s.constraints.size()};
+            };
+            const auto before = sizes();
             constraints::SolveResult r;
             {
               py::gil_scoped_release free;
-              r = constraints::solve(s.sketch, s.constraints, o);
+              r = constraints::solve(copy, constraints, o);
             }
+            if (sizes() != before)
+              throw Error(ErrorCategory::InvalidArgument,
+                          "sketch: points, curves or constraints were added while solve() ran "
+                          "in another thread, so its result was not applied; solve again (or "
+                          "lock the sketch while one thread builds it)");
             s.sketch = std::move(r.sketch);
             return solve_report(r.report);
           },

@@ -69,6 +69,7 @@ void bind_stack(py::module_& m) {
           [](const deform::DeformationStack& s, const py::handle& points, int threads) {
             // The stack's bulk function works on its own matrix: one copy in, none out.
             Points3 p = points_in(points, "points");
+            require_finite(p, "points");
             deform::DeformOptions o;
             o.threads = threads;
             deform::StackReport report;

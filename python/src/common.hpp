@@ -14,6 +14,7 @@
 #include <pybind11/stl.h>
 
 #include <array>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -104,10 +105,34 @@ inline py::array_t<double> frozen_copy(const std::vector<double>& v) {
 
 /// An (n, 3) array or a 3-sequence as a point.
 inline Eigen::Vector3d vec3(const py::handle& obj, const std::string& what) {
-  const auto seq = py::cast<std::vector<double>>(obj);
-  if (seq.size() != 3)
-    throw py::value_error(what + ": expected 3 coordinates, got " + std::to_string(seq.size()));
-  return {seq[0], seq[1], seq[2]};
+  // A string is a sequence too (of characters), and a failed cast was a bare RuntimeError: both
+  // are named as the wrong type (issue #36).
+  std::optional<std::vector<double>> seq;
+  if (!py::isinstance<py::str>(obj) && !py::isinstance<py::bytes>(obj)) try {
+      seq = py::cast<std::vector<double>>(obj);
+    } catch (const py::cast_error&) {
+    }
+  if (!seq)
+    throw py::type_error(what + ": expected 3 numbers (x, y, z), got " +
+                         std::string(py::str(py::type::of(obj).attr("__name__"))) + " " +
+                         std::string(py::repr(obj)).substr(0, 60));
+  if (seq->size() != 3)
+    throw py::value_error(what + ": expected 3 coordinates, got " + std::to_string(seq->size()));
+  const Eigen::Vector3d x((*seq)[0], (*seq)[1], (*seq)[2]);
+  if (!x.allFinite())
+    throw py::value_error(what + ": the coordinates must be finite, got " +
+                          std::string(py::str(py::make_tuple(x[0], x[1], x[2]))));
+  return x;
+}
+
+/// Every value finite: NaN or infinite points passed through deformations unchanged and
+/// unreported (issue #36). ValueError naming the first row that is not.
+inline void require_finite(const Eigen::Ref<const Points3>& p, const std::string& what) {
+  for (Eigen::Index r = 0; r < p.rows(); ++r)
+    if (!p.row(r).allFinite())
+      throw py::value_error(what + ": row " + std::to_string(r) + " is not finite (" +
+                            std::string(py::str(py::make_tuple(p(r, 0), p(r, 1), p(r, 2)))) +
+                            "); remove or repair it");
 }
 
 /// A fixed-size array as a Python tuple (std::array alone becomes a list).

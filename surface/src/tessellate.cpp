@@ -17,11 +17,13 @@ namespace clay::surface {
 std::vector<double> tessellation_parameters(const BSplineBasis& basis, int per_span,
                                             int max_samples) {
   constexpr int min_samples = 17;
-  if (per_span < 1 || max_samples < min_samples)
+  // The upper bounds keep a grid within 4097 x 4097 points (16.8 M, 400 MB of positions and
+  // normals): a billion per span was asked of the allocator as it was (issue #36).
+  if (per_span < 1 || per_span > 4096 || max_samples < min_samples || max_samples > 4097)
     throw Error(ErrorCategory::InvalidArgument,
                 "tessellation_parameters: per_span = " + std::to_string(per_span) +
                     " and max_samples = " + std::to_string(max_samples) +
-                    " must be >= 1 and >= 17");
+                    " must be in [1, 4096] and [17, 4097]");
   const auto breaks = breakpoints(basis);
   const int spans = static_cast<int>(breaks.size()) - 1;
   const auto [t0, t1] = basis.domain();

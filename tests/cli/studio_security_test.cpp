@@ -605,3 +605,38 @@ TEST_CASE(
     "[studio][examples]") {
   edit_and_save_example("superellipsoid_taper_twist", true);
 }
+
+TEST_CASE("studio server: a new page takes a busy session over at once", "[studio][security]") {
+  // The first page asks for a run that takes a while (every step of the handset); a second page
+  // (a reload, another tab) connects meanwhile: it gets the socket at once, not a 409, the first
+  // is closed with the reason, and its run is cancelled at its next step.
+  const fs::path recipe = example_copy("handset", "takeover");
+  StudioOptions options;
+  options.port = 0;
+  StudioServer server(StudioSession::load(recipe), options);
+  server.start();
+  Page first(server);
+  first.send(R"({"op": "run"})");
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const auto start = std::chrono::steady_clock::now();
+  Page second(server);
+  second.send(R"({"op": "hello"})");
+  const Json hello = second.reply();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  CHECK(hello.at("op") == "hello");
+  INFO("the second page was answered after " << seconds << " s");
+  CHECK(seconds < 30);
+  // The first page's socket was closed with the reason its page shows.
+  try {
+    (void)first.reply();
+    FAIL("the first page still received a reply");
+  } catch (const beast::system_error& e) {
+    CHECK(e.code() == websocket::error::closed);
+    CHECK_THAT(std::string(first.ws.reason().reason.c_str()),
+               Contains("another page took the studio session over"));
+  }
+  second.send(R"({"op": "recipe"})");
+  CHECK(second.reply().at("text") == read(recipe));
+  server.stop();
+}

@@ -177,9 +177,13 @@ CLAY_RECIPE_API RunResult deform_surfaces(const Recipe& recipe,
 /// has exactly one) with the recipe's composition mode (deform::deform_model). Lattices, regular
 /// deformations and direct manipulation with moves given in space apply; a style step, or a move
 /// from a surface point, is refused (InvalidArgument naming the step): they shape one surface.
-/// Throws the deformation's clay::Error in the recipe's words, naming the stack.
+/// A lattice whose Jacobian bounds do not prove it fold-free (Sederberg–Parry §4) is refused
+/// (InvalidGeometry naming the step and its smallest coefficient: a folded solid intersects
+/// itself) unless `allow_fold`. Throws the deformation's clay::Error in the recipe's words,
+/// naming the stack.
 CLAY_RECIPE_API ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
-                                            std::string_view deformation = {});
+                                            std::string_view deformation = {},
+                                            bool allow_fold = false);
 
 /// Writes STEM.step, STEM.igs and STEM.glb (result.formats; the .glb a preview of the trimmed
 /// faces, brep::write_model), report.json and the view folder (the model's trimmed mesh, for

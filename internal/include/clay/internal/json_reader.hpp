@@ -177,6 +177,12 @@ class JsonReader {
                     (std::abs(x) > magnitude ? " (" + magnitude_note + ")" : ""));
       return std::nullopt;
     }
+    // A denormal number is no measure of anything, and exchange readers refuse it: a recipe that
+    // passed with one wrote a STEP file its own run then refused (issue #36).
+    if (x != 0 && std::abs(x) < std::numeric_limits<double>::min()) {
+      add(path, shortest(x) + " is denormal (nonzero, below 2.2e-308 in magnitude); write 0");
+      return std::nullopt;
+    }
     return x;
   }
 

@@ -25,7 +25,8 @@ struct GridMesh {
 
 /// The grid parameters of one direction: `per_span` samples per knot span following the knots
 /// (8 by default), at least 17 and at most `max_samples` in all (161 by default), ends included.
-/// Throws clay::Error(InvalidArgument) for per_span < 1 or max_samples < 17.
+/// Throws clay::Error(InvalidArgument) for per_span outside [1, 4096] or max_samples outside
+/// [17, 4097].
 CLAY_SURFACE_API std::vector<double> tessellation_parameters(const BSplineBasis& basis,
                                                              int per_span = 8,
                                                              int max_samples = 161);
