@@ -51,9 +51,28 @@ void write(const fs::path& file, const std::string& text) {
   out << text;
 }
 
-/// A fresh folder under the test output folder.
+/// A folder of this process's in the system's temporary folder, removed at exit: the tests plant
+/// symbolic links that point up the tree, which a glob of the source tree (the house format
+/// check) would follow round in circles if they were left in the build folder.
+const fs::path& scratch_root() {
+  static const struct Root {
+    fs::path path;
+    Root() {
+      std::string pattern = (fs::temp_directory_path() / "clayform-studio-security-XXXXXX");
+      REQUIRE(::mkdtemp(pattern.data()) != nullptr);
+      path = pattern;
+    }
+    ~Root() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  } root;
+  return root.path;
+}
+
+/// A fresh folder of this process's.
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio_security" / name;
+  const fs::path dir = scratch_root() / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;
