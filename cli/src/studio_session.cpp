@@ -215,7 +215,8 @@ struct StudioSession::Impl {
   fs::path autosave;  // empty: none
   std::chrono::steady_clock::time_point autosaved{};
   bool autosave_pending = false;
-  Json restored;  // what restore() read ({entries, file}), for "hello"
+  Json restored;                 // what restore() read ({entries, file}), for "hello"
+  std::string autosave_problem;  // why the last autosave failed ("" when it did not)
 
   const std::string& text() const { return history[static_cast<std::size_t>(position)].text; }
 
@@ -239,7 +240,9 @@ struct StudioSession::Impl {
   Json history_json() const {
     Json h = Json::array();
     for (const Entry& e : history) h.push_back(e.label);
-    return Json{{"entries", h}, {"position", position}, {"dropped", dropped}};
+    Json out{{"entries", h}, {"position", position}, {"dropped", dropped}};
+    if (!autosave_problem.empty()) out["autosave_problem"] = autosave_problem;
+    return out;
   }
 
   /// Appends an entry after the current one (dropping the redo tail), then drops the oldest
@@ -264,7 +267,15 @@ struct StudioSession::Impl {
   void save_soon() {
     if (autosave.empty()) return;
     autosave_pending = true;
-    if (std::chrono::steady_clock::now() - autosaved > std::chrono::seconds(1)) flush_autosave();
+    if (std::chrono::steady_clock::now() - autosaved <= std::chrono::seconds(1)) return;
+    // The edit is done whatever the disk says: a failed autosave is reported with the history
+    // (and tried again at the next change), not turned into the edit's error.
+    try {
+      flush_autosave();
+      autosave_problem.clear();
+    } catch (const Error& e) {
+      autosave_problem = e.message();
+    }
   }
 
   /// Writes the autosave (atomically): the newest autosave_entries entries of the history and

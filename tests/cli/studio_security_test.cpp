@@ -523,6 +523,22 @@ TEST_CASE("studio session: the history is autosaved and restored", "[studio][sec
   CHECK_THROWS_WITH(StudioSession::load(recipe).restore(file), Contains("not a studio autosave"));
   CHECK(names_in(recipe.parent_path()) ==
         std::set<std::string>{"sail.json", "sail.studio-autosave.json"});
+
+  // An autosave that cannot be written (its folder gone, a file in its place) does not fail the
+  // edit: the edit is applied and the history says why the autosave failed.
+  StudioSession third = StudioSession::load(recipe);
+  fs::create_directories(recipe.parent_path() / "gone");
+  third.autosave_to(recipe.parent_path() / "gone" / "sail.studio-autosave.json");
+  fs::remove_all(recipe.parent_path() / "gone");
+  write(recipe.parent_path() / "gone", "a file where the folder was");
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));  // past the once-a-second rule
+  const Json edited = Json::parse(
+      third.handle(Json{{"op", "edit"}, {"path", billow}, {"value", 111}, {"label", "x"}}.dump())
+          .json);
+  CHECK(edited.at("op") == "edit");
+  CHECK_THAT(edited.at("history").at("autosave_problem").get<std::string>(),
+             Contains("cannot write the studio's autosave"));
+  CHECK(third.history().size() == 2);
 }
 
 namespace {

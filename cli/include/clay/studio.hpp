@@ -78,7 +78,8 @@ class StudioSession {
                                              const std::string& name);
   /// Autosaves the history into `file` from now on (atomically, written now, then after each
   /// change at most once a second; flush_autosave writes what is pending). clay::Error(Io) when
-  /// it cannot be written.
+  /// it cannot be written now; a later failure does not fail the edit that caused it: the
+  /// history in each reply says why ("autosave_problem"), and the next change tries again.
   void autosave_to(const std::filesystem::path& file);
   /// Writes a pending autosave now (the server calls it when a drag's updates stop).
   void flush_autosave();
