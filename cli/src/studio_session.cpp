@@ -215,7 +215,7 @@ struct StudioSession::Impl {
   fs::path autosave;  // empty: none
   std::chrono::steady_clock::time_point autosaved{};
   bool autosave_pending = false;
-  Json restored;                 // what restore() read ({entries, file}), for "hello"
+  Json restored;                 // what restore() read ({entries, file}), in the history
   std::string autosave_problem;  // why the last autosave failed ("" when it did not)
 
   const std::string& text() const { return history[static_cast<std::size_t>(position)].text; }
@@ -242,6 +242,7 @@ struct StudioSession::Impl {
     for (const Entry& e : history) h.push_back(e.label);
     Json out{{"entries", h}, {"position", position}, {"dropped", dropped}};
     if (!autosave_problem.empty()) out["autosave_problem"] = autosave_problem;
+    if (!restored.is_null()) out["restored"] = restored;
     return out;
   }
 
@@ -419,7 +420,6 @@ struct StudioSession::Impl {
                 {"surfaces", final_surfaces(r)},
                 {"deformations", r.deformation_names()},
                 {"history", history_json()}};
-    if (!restored.is_null()) out["restored"] = restored;
     return {reply_text(out), {}};
   }
 

@@ -515,7 +515,7 @@ TEST_CASE("studio session: the history is autosaved and restored", "[studio][sec
   CHECK(again.text() == text);
   CHECK(again.position() == 2);
   const Json hello = Json::parse(again.handle(R"({"op": "hello"})").json);
-  CHECK(hello.at("restored").at("entries") == labels.size());
+  CHECK(hello.at("history").at("restored").at("entries") == labels.size());
   CHECK(Json::parse(again.handle(R"({"op": "redo"})").json).at("op") == "redo");
   CHECK(Json::parse(again.text())["deformations"]["shape"][1]["moves"][0]["by"][1] == 400);
   // Not an autosave, or one whose recipe is broken: refused, naming the file.

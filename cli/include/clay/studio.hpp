@@ -36,8 +36,9 @@ class StudioSession {
 
   /// The command's reply (JSON text) and the geometry frames that follow it (binary, see
   /// geometry_frames). Commands, as JSON objects with "op":
-  /// - "hello": the recipe's name, its surfaces and curves, the history (and "restored" when the
-  ///   session continues an autosave);
+  /// - "hello": the recipe's name, its surfaces and curves, the history (every reply's history
+  ///   has "restored" when the session continues an autosave, "autosave_problem" when the last
+  ///   autosave failed);
   /// - "recipe": the current recipe text;
   /// - "edit" {path, value, label?, create?, group?, nets?} or {path, remove: true} or
   ///   {changes: [...], label?}: set or remove values, check and run the new recipe, one history

@@ -339,6 +339,13 @@ function onReply(reply, frames, meta) {
   doc.reply = reply;
   doc.steps = reply.steps;
   doc.history = reply.history;
+  // Said once: the session continues an autosave (the studio restarted after a crash or
+  // Ctrl-C), or the last autosave failed (the edit itself was applied).
+  if (reply.history.restored && !doc.restoredShown) {
+    doc.restoredShown = true;
+    showMessage(`continued the autosave ${reply.history.restored.file}: ${reply.history.restored.entries} history entries (start clayform studio with --fresh to begin from the recipe file)`);
+  }
+  if (reply.history.autosave_problem) showMessage(`autosave failed: ${reply.history.autosave_problem}`, true);
   if (typeof reply.text === 'string') doc.recipe = JSON.parse(reply.text);
   if (reply.nets === false) {
     // a drag update the page draws itself: the kernel's figures and history only
