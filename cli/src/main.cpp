@@ -455,7 +455,8 @@ int studio(const std::string& recipe, int port, bool fresh) {
 }  // namespace
 
 /// clayform sweep: replaces this process with `python3 -m clayform.sweeps SPEC --out OUT ...`
-/// (its exit code is the command's: 0 all variants done, 1 some failed, 2 a bad description).
+/// (its exit code is the command's: 0 all variants done, 1 some failed, 2 a bad description, a
+/// storage error or a folder another sweep holds, 128 + N stopped by signal N; docs/sweeps.md).
 int run_sweep(const std::string& spec, const std::string& out, const std::string& executor,
               int workers, const std::string& scheduler) {
 #ifdef CLAYFORM_PYTHON_EXE

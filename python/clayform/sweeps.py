@@ -9,13 +9,16 @@ A sweep description (JSON, or the same dict in Python; docs/sweeps.md):
     # or "list": [{"deformations.styling[0].lambda": 0.5}, ...]
 
 Each parameter is a JSON path into the recipe (keys joined by ".", list items as "[i]") and its
-values; "grid" runs every combination, "list" the given ones. Every variant runs in its own
-process (OpenCASCADE's STEP writer is not thread-safe, and a variant that crashes loses only
-itself) and writes its STEP, IGES, glTF, report.json, thumbnail.png and variant.json into
-OUT/<id>, where id is a hash of its parameters. Folders appear whole (written beside, then
-renamed), so a re-run skips the variants already done and a killed sweep resumes. The sweep
-writes OUT/index.csv and OUT/index.jsonl (each variant's figures: deviation, volume ratios,
-fold-free, time, status) and OUT/contact_sheet.png.
+values; "grid" runs every combination, "list" the given ones. The description is checked whole
+before anything runs or is written (shape, paths, at most MAX_VARIANTS variants counted without
+building them): SpecError, one line naming its file and the fix. Every variant runs in its own
+process (OpenCASCADE's STEP writer is not thread-safe; a crash loses only that variant), which
+dies with the sweep (even a SIGKILLed one) and writes into OUT/.staging-<id>-<random>; the sweep
+adds variant.json and renames the folder into OUT/<id> (id: a hash of the parameters), so a re-run
+skips finished variants. OUT/index.csv and OUT/index.jsonl are rewritten (temporary, then rename)
+as variants finish; OUT/contact_sheet.png once all have run. A storage error stops the sweep at
+once (StorageError, naming the path), SIGINT/SIGTERM/SIGHUP cleanly (Interrupted): the index
+lists what finished and no staging folder stays.
 
 Executors: "local" (processes on this machine, the default) and "dask" (a
 distributed.LocalCluster, or an existing cluster at `scheduler`, e.g. "tcp://host:8786").
@@ -24,10 +27,15 @@ from __future__ import annotations
 
 import base64
 import concurrent.futures
+import contextlib
 import csv
+import errno
+import fcntl
 import hashlib
+import io
 import itertools
 import json
+import math
 import os
 import re
 import shutil
@@ -35,47 +43,115 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
+import warnings
 from pathlib import Path
-from typing import Any, Callable, Dict, Iterable, List, Optional, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Set, Tuple, Union
+
+if sys.argv[:1] == ["-m"]:
+    # `python3 -m clayform.sweeps` (what `clayform sweep` runs): the package imports this module
+    # before runpy runs it as __main__, and runpy warns about that on stderr, which should carry
+    # only the sweep's own lines. Both copies are this file; nothing is shared between them.
+    warnings.filterwarnings("ignore", message=r"'clayform\.sweeps' found in sys\.modules", category=RuntimeWarning)
 
 Params = Dict[str, Any]
 Spec = Dict[str, Any]
 
+#: The most variants one description may give (grid: the product of its lists' lengths, counted
+#: before any is built). Larger sweeps are refused: split them into several descriptions, or pass
+#: run(..., max_variants=N) from Python.
+MAX_VARIANTS = 10_000
 #: Written into each finished variant's folder, last: its presence marks the variant done.
 VARIANT_FILE = "variant.json"
-INDEX_FIELDS = [
-    "id",
-    "status",
-    "seconds",
-    "deviation_mm",
-    "volume_mm3",
-    "volume_ratio_min",
-    "volume_ratio_max",
-    "fold_free",
-    "control_points",
-    "error",
-    "parameters",
-]
+#: Variants per contact sheet page (contact_sheet.png, contact_sheet_2.png, ...).
+SHEET_TILES = 100
+#: The errno values of a storage error: the disk is full, the folder is read-only or not
+#: writable, the quota is used up, or a file is larger than allowed. Any variant would meet it.
+STORAGE_ERRNOS = frozenset({errno.ENOSPC, errno.EROFS, errno.EACCES, errno.EDQUOT, errno.EFBIG})
+INDEX_FIELDS = ["id", "status", "seconds", "deviation_mm", "volume_mm3", "volume_ratio_min", "volume_ratio_max",
+                "fold_free", "control_points", "error", "parameters"]
 _TOKEN = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
+_STAGING = ".staging-"
+_LOCK = ".sweep.lock"
+#: Every rename into OUT goes through here (a seam for the tests' storage faults).
+_rename = os.replace
+#: A variant's process: `python3 -m clayform.sweeps --run-variant`, started through this line so
+#: that it is tied to the sweep's life (PR_SET_PDEATHSIG) before it spends time importing.
+_BOOT = ("import os, sys\n"
+         "if sys.platform.startswith('linux'):\n"
+         "    try:\n        import ctypes; ctypes.CDLL(None).prctl(1, 9, 0, 0, 0)\n"
+         "    except Exception:\n        pass\n"
+         "if str(os.getppid()) != os.environ.get('CLAYFORM_SWEEP_PARENT'):\n    os._exit(3)\n"
+         "from clayform.sweeps import main\nsys.exit(main(['--run-variant']))\n")
+
+
+class SpecError(ValueError):
+    """A sweep description that cannot run, found before anything runs or is written. The
+    message is one line: "sweep: SPEC: what is wrong and the fix" (SPEC the description's file;
+    no SPEC for a description given as a dict)."""
+
+    def __init__(self, detail: str, spec: Optional[str] = None) -> None:
+        self.detail = " ".join(detail.split())
+        self.spec = spec
+        super().__init__(f"sweep: {spec}: {self.detail}" if spec else f"sweep: {self.detail}")
+
+
+class StorageError(OSError):
+    """Writing into the output folder failed (errno, strerror and filename as OSError has them).
+    The sweep stopped at once: no other variant was started, the staging folders are gone and the
+    index lists the variants that finished (unless writing it failed too; the message says)."""
+
+    def __init__(self, cause: OSError, path: str, finished: int, total: int, index: str) -> None:
+        super().__init__(cause.errno, cause.strerror or str(cause), path)
+        self.finished = finished
+        self.total = total
+        fix = {
+            errno.ENOSPC: "free some space",
+            errno.EDQUOT: "free some space or raise the quota",
+            errno.EFBIG: "raise the file size limit (ulimit -f) or use a file system that takes larger files",
+        }.get(cause.errno or 0, "make the folder writable or choose another output folder")
+        self.message = (
+            f"sweep: {path}: {self.strerror}; the sweep stopped: {finished} of {total} variants "
+            f"finished, {index}; {fix}, then run it again (finished variants are skipped)"
+        )
+
+    def __str__(self) -> str:
+        return self.message
+
+
+class Interrupted(KeyboardInterrupt):
+    """The sweep was stopped by a signal (SIGINT, SIGTERM, SIGHUP) after killing its running
+    variants, removing their staging folders and writing the index of what finished."""
+
+    def __init__(self, signum: int, message: str) -> None:
+        super().__init__(message)
+        self.signum = signum
+        self.message = message
+
+
+class FolderInUse(RuntimeError):
+    """Another sweep is writing into the same output folder."""
 
 
 def parse_path(path: str) -> List[Union[str, int]]:
     """'deformations.billow[0].moves[1].by[2]' -> ['deformations', 'billow', 0, 'moves', 1, 'by', 2]."""
     parts: List[Union[str, int]] = []
     pos = 0
+    if not isinstance(path, str):
+        raise SpecError(f"parameter path {path!r} is not a string of keys joined by '.' with list items as [i]")
     for m in _TOKEN.finditer(path):
         if m.start() != pos and path[pos:m.start()] != ".":
             break
         parts.append(m.group(1) if m.group(1) is not None else int(m.group(2)))
         pos = m.end()
     if not parts or pos != len(path):
-        raise ValueError(f"sweep: parameter path {path!r} is not keys joined by '.' with list items as [i]")
+        raise SpecError(f"parameter path {path!r} is not keys joined by '.' with list items as [i]")
     return parts
 
 
-def set_path(document: Any, path: str, value: Any) -> None:
-    """Sets the value at a JSON path of the recipe; the path must exist (no silent additions)."""
+def _walk(document: Any, path: str) -> Tuple[Any, Union[str, int]]:
+    """The container and key of a JSON path of the recipe; every part must exist."""
     parts = parse_path(path)
     node = document
     for depth, key in enumerate(parts):
@@ -84,29 +160,62 @@ def set_path(document: Any, path: str, value: Any) -> None:
         )
         if isinstance(key, int):
             if not isinstance(node, list) or key >= len(node):
-                raise ValueError(f"sweep: {where}: the recipe has no list item there")
+                raise SpecError(f"{where}: the recipe has no list item there")
         elif not isinstance(node, dict) or key not in node:
-            raise ValueError(f"sweep: {where}: the recipe has no key {key!r} there")
+            raise SpecError(f"{where}: the recipe has no key {key!r} there")
         if depth == len(parts) - 1:
-            node[key] = value
-        else:
-            node = node[key]
+            return node, key
+        node = node[key]
+    raise AssertionError("unreachable")
 
 
-def variants(spec: Spec) -> List[Params]:
-    """The parameter sets of a description: every combination of "grid", or the "list"."""
+def set_path(document: Any, path: str, value: Any) -> None:
+    """Sets the value at a JSON path of the recipe; the path must exist (no silent additions)."""
+    node, key = _walk(document, path)
+    node[key] = value
+
+
+def count_variants(spec: Spec, limit: Optional[int] = None) -> int:
+    """How many variants a description gives, without building them (the product of the grid's
+    list lengths, or the list's length), after checking the shape of "grid" or "list"; more than
+    `limit` are refused."""
     if ("grid" in spec) == ("list" in spec):
-        raise ValueError('sweep: give either "grid" (values per path) or "list" (parameter sets)')
+        raise SpecError('give either "grid" (values per path) or "list" (parameter sets), not both')
+    if "grid" in spec:
+        grid = spec["grid"]
+        if not isinstance(grid, dict) or not grid:
+            raise SpecError('"grid" maps each path to a non-empty list of values, e.g. {"a.b[0]": [1, 2]}')
+        for path, values in grid.items():
+            parse_path(path)
+            if not isinstance(values, list) or not values:
+                raise SpecError(f'"grid": {path}: give a non-empty list of values, e.g. [1, 2]')
+        count, what = math.prod(len(v) for v in grid.values()), " × ".join(str(len(v)) for v in grid.values()) + " values"
+    else:
+        items = spec["list"]
+        if not isinstance(items, list) or not items:
+            raise SpecError('"list" is a non-empty list of {path: value} objects')
+        for k, p in enumerate(items):
+            if not isinstance(p, dict):
+                raise SpecError(f'"list"[{k}]: expected a {{path: value}} object')
+            for path in p:
+                parse_path(path)
+        count, what = len(items), "list items"
+    if limit is not None and count > limit:
+        raise SpecError(f"{count:,} variants ({what}), more than the limit of "
+                        f"{limit:,} (clayform.sweeps.MAX_VARIANTS); give fewer values, or split the sweep into "
+                        "several descriptions")
+    return count
+
+
+def variants(spec: Spec, limit: int = MAX_VARIANTS) -> List[Params]:
+    """The parameter sets of a description: every combination of "grid", or the "list". Refuses
+    more than `limit` variants before building any."""
+    count_variants(spec, limit)
     if "grid" in spec:
         grid: Dict[str, List[Any]] = spec["grid"]
-        if not grid or any(not isinstance(v, list) or not v for v in grid.values()):
-            raise ValueError('sweep: "grid" maps each path to a non-empty list of values')
         keys = list(grid)
         return [dict(zip(keys, combo)) for combo in itertools.product(*(grid[k] for k in keys))]
-    items: List[Params] = spec["list"]
-    if not items or any(not isinstance(p, dict) for p in items):
-        raise ValueError('sweep: "list" is a non-empty list of {path: value} objects')
-    return [dict(p) for p in items]
+    return [dict(p) for p in spec["list"]]
 
 
 def variant_id(params: Params) -> str:
@@ -115,26 +224,64 @@ def variant_id(params: Params) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def load_spec(spec: Union[str, "os.PathLike[str]", Spec]) -> Tuple[Spec, str, Path]:
-    """The description, the base recipe's text and the folder its imports are resolved in."""
+def _read_json(path: Path, what: Optional[str]) -> Any:
+    """A JSON file: the description (what None: its path starts the message) or one it names."""
+    name = f"{what}: {path}" if what else "the description"
+    try:
+        return json.loads(path.read_bytes().decode("utf-8"))
+    except OSError as e:
+        raise SpecError(f"{what}: cannot read {path} ({e.strerror or e})" if what else
+                        f"cannot read it ({e.strerror or e})") from None
+    except UnicodeDecodeError:
+        raise SpecError(f"{name} is not UTF-8 text") from None
+    except json.JSONDecodeError as e:
+        raise SpecError(f"{name} is not JSON ({e.msg} at line {e.lineno}, column {e.colno})") from None
+
+
+def load_spec(spec: Union[str, "os.PathLike[str]", Spec], limit: int = MAX_VARIANTS) -> Tuple[Spec, str, Path]:
+    """The checked description, the base recipe's text and the folder its imports are resolved in.
+    Raises SpecError (one line naming the description's file) for anything that cannot run."""
+    try:
+        return _load(spec, limit)
+    except SpecError as e:
+        if not isinstance(spec, (str, os.PathLike)) or e.spec is not None:
+            raise
+        raise SpecError(e.detail, os.fspath(spec)) from None
+
+
+def _load(spec: Union[str, "os.PathLike[str]", Spec], limit: int) -> Tuple[Spec, str, Path]:
     if isinstance(spec, (str, os.PathLike)):
         path = Path(spec)
-        document = json.loads(path.read_text())
+        document = _read_json(path, None)
         base = path.parent
+    elif isinstance(spec, dict):
+        document, base = dict(spec), Path.cwd()
     else:
-        document = dict(spec)
-        base = Path.cwd()
-    if document.get("format", "clayform.sweep") != "clayform.sweep" or document.get("version", 1) != 1:
-        raise ValueError('sweep: expected "format": "clayform.sweep", "version": 1')
-    unknown = sorted(set(document) - {"format", "version", "description", "recipe", "grid", "list", "out"})
+        raise SpecError(f"give the description as a JSON file's path or a dict, not {type(spec).__name__}")
+    if not isinstance(document, dict):
+        raise SpecError('expected a JSON object {"format": "clayform.sweep", "version": 1, "recipe": ..., "grid": ...}')
+    version = document.get("version", 1)
+    if document.get("format", "clayform.sweep") != "clayform.sweep" or type(version) is not int or version != 1:
+        raise SpecError('expected "format": "clayform.sweep", "version": 1')
+    unknown = sorted(set(document) - {"format", "version", "description", "recipe", "grid", "list", "out"}, key=str)
     if unknown:
-        raise ValueError(f"sweep: unknown key(s) {', '.join(unknown)}; the description takes format, version, "
-                         "description, recipe, grid or list, out")
+        raise SpecError(f"unknown key(s) {', '.join(map(str, unknown))}; the description takes format, version, "
+                        "description, recipe, grid or list, out")
+    for key in ("description", "out"):
+        if key in document and not isinstance(document[key], str):
+            raise SpecError(f'"{key}" is a string')
+    count_variants(document, limit)  # before anything is built
     recipe = document.get("recipe")
-    if recipe is None:
-        raise ValueError('sweep: "recipe" names the base recipe file')
+    if not isinstance(recipe, str) or not recipe:
+        raise SpecError('"recipe" names the base recipe file (relative to the description)')
     recipe_path = Path(recipe) if Path(recipe).is_absolute() else base / recipe
-    return document, recipe_path.read_text(), recipe_path.parent
+    base_recipe = _read_json(recipe_path, '"recipe"')
+    if not isinstance(base_recipe, dict):
+        raise SpecError(f'"recipe": {recipe_path} is not a recipe (a JSON object)')
+    swept = document["grid"] if "grid" in document else {p: None for item in document["list"] for p in item}
+    for key in swept:
+        _walk(base_recipe, key)  # a path the recipe lacks is refused now, not in every variant
+    return document, recipe_path.read_text(encoding="utf-8"), recipe_path.parent
 
 
 def recipe_text(base_text: str, params: Params) -> str:
@@ -175,55 +322,208 @@ def _figures(report: Dict[str, Any]) -> Dict[str, Any]:
     }
 
 
+def _palette(k: int) -> Tuple[float, float, float]:
+    """The renderer's base colour of object k (golden-angle hue steps from blue; render.cpp)."""
+    h = math.fmod(0.58 + 0.381966 * k, 1.0) * 6.0
+    s, v = 0.45, 0.92
+    f = h - math.floor(h)
+    p, q, t = v * (1 - s), v * (1 - s * f), v * (1 - s * (1 - f))
+    return [(v, t, p), (q, v, p), (p, v, t), (p, q, v), (t, p, v), (v, p, q)][int(h) % 6]
+
+
+def mesh_png(meshes: List[Tuple[Any, Any]], width: int = 320, height: int = 240) -> bytes:
+    """A shaded picture (PNG bytes) of triangle meshes [(points (n, 3), triangles (m, 3))] side by
+    side, seen as render_png sees surfaces (orthographic, from -x, -y, +z; two-sided Lambert),
+    painted far to near. Draws models (their trimmed meshes), which render_png does not take."""
+    import numpy as np
+    from PIL import Image, ImageDraw  # python3-pil
+
+    eye = np.array([-1.0, -1.2, 0.9]) / np.linalg.norm([-1.0, -1.2, 0.9])
+    right = np.cross([0.0, 0.0, 1.0], eye)
+    right /= np.linalg.norm(right)
+    up = np.cross(eye, right)
+    light = eye + 0.5 * up - 0.5 * right
+    light /= np.linalg.norm(light)
+    xs, ys, depths, fills, shift = [], [], [], [], 0.0
+    for k, (points, triangles) in enumerate(meshes):
+        corners = np.asarray(points, dtype=float)[np.asarray(triangles, dtype=np.int64)]  # (m, 3, 3)
+        normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        normals /= np.maximum(np.linalg.norm(normals, axis=1), 1e-300)[:, None]
+        normals *= np.where(normals @ eye < 0, -1.0, 1.0)[:, None]
+        shade = np.clip(0.15 + 0.6 * np.maximum(normals @ light, 0.0) + 0.25 * (normals @ eye), 0.0, 1.0)
+        x = corners @ right
+        xs.append(x - x.min() + shift)  # each model to the right of the one before
+        shift += (x.max() - x.min()) * 1.1
+        ys.append(corners @ up)
+        depths.append((corners @ eye).mean(axis=1))
+        fills.append(np.rint(255 * np.outer(shade, _palette(k))).astype(int))
+    x, y, depth, fill = (np.concatenate(a) for a in (xs, ys, depths, fills))
+    w, h = 2 * width, 2 * height  # drawn at twice the size, then reduced: smooth edges
+    span = max((x.max() - x.min()) / (0.9 * w), (y.max() - y.min()) / (0.9 * h), 1e-300)
+    px = (x - (x.max() + x.min()) / 2) / span + w / 2
+    py = h / 2 - (y - (y.max() + y.min()) / 2) / span
+    picture = Image.new("RGB", (w, h), "white")
+    draw = ImageDraw.Draw(picture)
+    for k in np.argsort(depth):  # far first
+        draw.polygon([(px[k, c], py[k, c]) for c in range(3)], fill=(int(fill[k, 0]), int(fill[k, 1]), int(fill[k, 2])))
+    buffer = io.BytesIO()
+    picture.resize((width, height), Image.LANCZOS).save(buffer, format="PNG")
+    return buffer.getvalue()
+
+
+def _thumbnail(recipe: Any, result: Any, out_dir: str) -> Optional[bytes]:
+    """The variant's picture: its final surfaces (render_png), or, for a recipe with models and
+    no surfaces, its deformed models read back from the files it wrote; None when it has neither."""
+    from . import read_model, render_png
+
+    finals = [result.surfaces[name] for name in recipe.final_surfaces]
+    if finals:
+        return bytes(render_png(finals, width=320, height=240))
+    meshes = []
+    for model in result.report.get("models", []):
+        files = [f for f in model.get("files", []) if f.lower().endswith((".step", ".stp", ".igs", ".iges"))]
+        if files:
+            points, triangles, _ = read_model(str(Path(out_dir, files[0])))[0].tessellate()
+            if len(triangles):
+                meshes.append((points, triangles))
+    return mesh_png(meshes) if meshes else None
+
+
+def _storage_cause(error: BaseException, folder: str) -> Optional[OSError]:
+    """The storage error behind a failed write, if storage is the cause. The kernel's writers
+    report errors as text: a test write (1 MiB, synced) into the folder tells."""
+    if isinstance(error, OSError) and error.errno in STORAGE_ERRNOS:
+        return error
+    place = Path(folder)
+    while not place.is_dir() and place != place.parent:
+        place = place.parent
+    fd, name = -1, ""
+    try:
+        fd, name = tempfile.mkstemp(prefix=".probe-", dir=place)
+        for _ in range(16):
+            os.write(fd, bytes(1 << 16))
+        os.fsync(fd)
+    except OSError as e:
+        return e if e.errno in STORAGE_ERRNOS else None
+    finally:
+        if fd >= 0:
+            os.close(fd)
+            os.unlink(name)
+    return None
+
+
 def run_variant_here(text: str, base_dir: str, out_dir: str) -> Dict[str, Any]:
-    """Runs one variant in this process, writing its outputs and a thumbnail into out_dir."""
-    from . import Recipe, render_png  # the extension, imported where the variant runs
+    """Runs one variant in this process, writing its outputs and a thumbnail into out_dir. A
+    storage error while writing is status "storage" (errno, path); other errors raise."""
+    from . import Recipe  # the extension, imported where the variant runs
 
     start = time.perf_counter()
     recipe = Recipe.parse(text, base_dir)
-    result = recipe.run(out_dir)
-    finals = [result.surfaces[name] for name in recipe.final_surfaces]
-    Path(out_dir, "thumbnail.png").write_bytes(render_png(finals, width=320, height=240))
+    result = recipe.run()
+    try:
+        result.write(out_dir)
+        picture = _thumbnail(recipe, result, out_dir)
+        if picture is not None:
+            Path(out_dir, "thumbnail.png").write_bytes(picture)
+    except Exception as e:  # noqa: BLE001 - a storage error stops the sweep, anything else fails the variant
+        cause = _storage_cause(e, out_dir)
+        if cause is None:
+            raise
+        return {"status": "storage", "errno": cause.errno, "path": cause.filename or out_dir,
+                "error": cause.strerror or str(cause)}
     return {"status": "ok", "seconds": time.perf_counter() - start, **_figures(result.report)}
 
 
-def run_variant_isolated(job: Dict[str, Any]) -> Dict[str, Any]:
-    """Runs one variant in a child process and returns its figures and files (as base64), so
-    that it works the same on this machine and on a Dask worker elsewhere. A variant that raises
-    is "failed" with its message; one that kills its process is "crashed" with the signal."""
+class _Children:
+    """The variant processes of a sweep and their staging folders: processes start only until
+    stop(), which kills the running ones (from a signal handler too: the lock is reentrant)."""
+
+    def __init__(self) -> None:
+        self.lock = threading.RLock()
+        self.running: Set["subprocess.Popen[str]"] = set()
+        self.stagings: Set[Path] = set()
+        self.stopped = False
+        self.signum: Optional[int] = None
+
+    def start(self, argv: List[str], env: Dict[str, str]) -> Optional["subprocess.Popen[str]"]:
+        with self.lock:
+            if self.stopped:
+                return None
+            child = subprocess.Popen(argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True, env=env)
+            self.running.add(child)
+            return child
+
+    def stop(self, signum: Optional[int] = None) -> None:
+        with self.lock:
+            self.stopped, self.signum = True, self.signum or signum
+            for child in self.running:
+                with contextlib.suppress(OSError):
+                    child.kill()
+
+
+def run_variant_isolated(job: Dict[str, Any], children: Optional[_Children] = None) -> Dict[str, Any]:
+    """Runs one variant in a child process and returns its figures. With job["stage"] (a folder
+    path on a disk this machine shares with the sweep) the child writes its files there; without,
+    into a temporary folder whose files come back as base64, so that it works the same on a Dask
+    worker elsewhere. A variant that raises is "failed" with its message; one that kills its
+    process is "crashed" with the signal; one that meets a storage error is "storage"."""
     start = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="clayform-variant-") as tmp:
+    tmp = None if job.get("stage") else tempfile.mkdtemp(prefix="clayform-variant-")
+    out = job["stage"] if tmp is None else os.path.join(tmp, "variant")
+    try:
         env = dict(os.environ)
+        env["CLAYFORM_SWEEP_PARENT"] = str(os.getpid())
         if job.get("abort"):
             env["CLAYFORM_SWEEP_ABORT"] = "1"
-        child = subprocess.run(
-            [sys.executable, "-m", "clayform.sweeps", "--run-variant"],
-            input=json.dumps({"text": job["text"], "base_dir": job["base_dir"], "out": tmp}),
-            capture_output=True,
-            text=True,
-            env=env,
-        )
+        children = children or _Children()
+        child = children.start([sys.executable, "-c", _BOOT], env)
+        if child is None:
+            return {"status": "stopped", "seconds": None, "error": "the sweep stopped before it ran"}
+        try:
+            stdout, stderr = child.communicate(json.dumps({"text": job["text"], "base_dir": job["base_dir"], "out": out}))
+        finally:
+            with children.lock:
+                children.running.discard(child)
         seconds = time.perf_counter() - start
         if child.returncode < 0:
             name = signal.Signals(-child.returncode).name
             return {"status": "crashed", "seconds": seconds, "error": f"the variant's process died ({name})"}
         try:
-            answer: Dict[str, Any] = dict(json.loads(child.stdout.strip().splitlines()[-1]))
+            answer: Dict[str, Any] = dict(json.loads(stdout.strip().splitlines()[-1]))
         except (IndexError, json.JSONDecodeError):
-            tail = child.stderr.strip().splitlines()[-1:] or [f"exit code {child.returncode}"]
+            tail = stderr.strip().splitlines()[-1:] or [f"exit code {child.returncode}"]
             return {"status": "crashed", "seconds": seconds, "error": tail[0]}
-        if answer["status"] == "ok":
+        if answer["status"] == "ok" and tmp is not None:
             files: Dict[str, str] = {}
-            for path in Path(tmp).rglob("*"):
+            for path in Path(out).rglob("*"):
                 if path.is_file():
-                    files[str(path.relative_to(tmp))] = base64.b64encode(path.read_bytes()).decode()
+                    files[str(path.relative_to(out))] = base64.b64encode(path.read_bytes()).decode()
             answer["files"] = files
         answer["seconds"] = seconds
         return answer
+    finally:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _watch_parent() -> None:
+    """A variant's process ends when the sweep that started it does, SIGKILL included: _BOOT
+    arms PR_SET_PDEATHSIG on Linux; this watch on the parent's id covers the other systems."""
+    expected = os.environ.get("CLAYFORM_SWEEP_PARENT")
+
+    def watch() -> None:
+        while str(os.getppid()) == expected:
+            time.sleep(0.5)
+        os._exit(3)
+
+    if expected:
+        threading.Thread(target=watch, daemon=True).start()
 
 
 def _child_main() -> int:
     """`python -m clayform.sweeps --run-variant`: one variant, its job on stdin, one JSON line out."""
+    _watch_parent()
     job = json.loads(sys.stdin.read())
     if os.environ.get("CLAYFORM_SWEEP_ABORT") == "1":
         os.abort()  # fault injection for the tests: a variant that kills its process
@@ -235,50 +535,93 @@ def _child_main() -> int:
     return 0
 
 
-def _store(out: Path, vid: str, params: Params, answer: Dict[str, Any]) -> Dict[str, Any]:
-    """Writes a finished variant's folder atomically and returns its index row."""
-    row: Dict[str, Any] = {field: answer.get(field) for field in INDEX_FIELDS}
-    row.update(id=vid, parameters=params)
+def _store(out: Path, vid: str, params: Params, answer: Dict[str, Any], staging: Optional[Path] = None) -> Dict[str, Any]:
+    """Moves a finished variant's folder into place whole and returns its index row: the files
+    are in staging/<vid> (or, from a remote worker, in answer["files"], written into a new
+    staging folder first); variant.json is added last, then the folder is renamed into out/<vid>."""
+    row: Dict[str, Any] = {**{field: answer.get(field) for field in INDEX_FIELDS}, "id": vid, "parameters": params}
     if answer["status"] != "ok":
         return row
-    staging = Path(tempfile.mkdtemp(prefix=f".{vid}-", dir=out))
-    for name, data in answer["files"].items():
-        target = staging / name
-        target.parent.mkdir(parents=True, exist_ok=True)
-        target.write_bytes(base64.b64decode(data))
-    (staging / VARIANT_FILE).write_text(json.dumps(row, indent=1))
-    final = out / vid
-    if final.exists():
-        shutil.rmtree(final)
-    os.rename(staging, final)
+    if staging is None:
+        staging = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{vid}-", dir=out))
+    try:
+        folder = staging / vid
+        for name, data in answer.get("files", {}).items():
+            target = folder / name
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(base64.b64decode(data))
+        (folder / VARIANT_FILE).write_text(json.dumps(row, indent=1))
+        final = out / vid
+        if final.exists():
+            shutil.rmtree(final)  # a folder without variant.json: not a finished variant
+        _rename(folder, final)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
     return row
 
 
 def _done(out: Path, vid: str) -> Optional[Dict[str, Any]]:
     path = out / vid / VARIANT_FILE
-    if not path.exists():
-        return None
-    row: Dict[str, Any] = dict(json.loads(path.read_text()))
+    try:
+        row: Dict[str, Any] = dict(json.loads(path.read_text()))
+    except (OSError, ValueError, TypeError):
+        return None  # not finished (or not readable): it runs again
     row["status"] = "done"  # finished by an earlier run: skipped
     return row
 
 
-def _write_index(out: Path, rows: List[Dict[str, Any]]) -> None:
-    with open(out / ".index.jsonl", "w") as f:
-        for row in rows:
-            f.write(json.dumps(row) + "\n")
-    os.replace(out / ".index.jsonl", out / "index.jsonl")
-    with open(out / ".index.csv", "w", newline="") as f:
-        writer = csv.DictWriter(f, fieldnames=INDEX_FIELDS)
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({**row, "parameters": json.dumps(row["parameters"], sort_keys=True)})
-    os.replace(out / ".index.csv", out / "index.csv")
+def _umask() -> int:
+    status = re.search(r"^Umask:\s*([0-7]+)", Path("/proc/self/status").read_text(), re.M)  # Linux >= 4.7
+    return int(status.group(1), 8) if status else 0o022
+
+
+def _write_atomic(path: Path, data: Union[str, bytes]) -> None:
+    """Writes a file of OUT beside itself (with the mode open() would give), then renames it
+    into place."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            os.fchmod(f.fileno(), 0o666 & ~_umask())
+            f.write(data.encode() if isinstance(data, str) else data)
+        _rename(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+class _Index:
+    """OUT/index.jsonl and OUT/index.csv: the finished variants in the description's order,
+    rewritten as they finish (each row serialized once; rewrites are throttled to a twentieth
+    of the time, so a sweep of thousands does not spend it rewriting)."""
+
+    def __init__(self, folder: Path, ids: List[str]) -> None:
+        self.folder, self.ids = folder, ids
+        self.lines: Dict[str, Tuple[str, str]] = {}
+        self.next_write = 0.0
+
+    def add(self, row: Dict[str, Any]) -> None:
+        buffer = io.StringIO()
+        csv.DictWriter(buffer, fieldnames=INDEX_FIELDS, extrasaction="ignore").writerow(
+            {**row, "parameters": json.dumps(row["parameters"], sort_keys=True)})
+        self.lines[row["id"]] = (json.dumps(row) + "\n", buffer.getvalue())
+
+    def write(self, soon: bool = False) -> None:
+        if soon and time.perf_counter() < self.next_write:
+            return
+        start = time.perf_counter()
+        rows = [self.lines[vid] for vid in self.ids if vid in self.lines]
+        _write_atomic(self.folder / "index.jsonl", "".join(r[0] for r in rows))
+        header = io.StringIO()
+        csv.DictWriter(header, fieldnames=INDEX_FIELDS).writeheader()
+        _write_atomic(self.folder / "index.csv", header.getvalue() + "".join(r[1] for r in rows))
+        self.next_write = time.perf_counter() + 20 * (time.perf_counter() - start)
 
 
 def contact_sheet(out: Union[str, "os.PathLike[str]"], rows: List[Dict[str, Any]], columns: int = 4) -> Path:
     """OUT/contact_sheet.png: each variant's thumbnail in a grid, labelled by its parameters
-    (failed variants as a grey tile with their status)."""
+    (failed variants as a grey tile with their status), SHEET_TILES a page: more variants go on
+    contact_sheet_2.png, contact_sheet_3.png, ... Returns the first page's path."""
     from PIL import Image, ImageDraw  # python3-pil
 
     folder = Path(out)
@@ -293,28 +636,84 @@ def contact_sheet(out: Union[str, "os.PathLike[str]"], rows: List[Dict[str, Any]
                 return tail
         return path
 
-    tile_w, tile_h, label_h = 320, 240, 16 * 3
-    count = max(len(rows), 1)
-    cols = min(columns, count)
-    sheet = Image.new("RGB", (cols * tile_w, -(-count // cols) * (tile_h + label_h)), "white")
-    draw = ImageDraw.Draw(sheet)
-    for k, row in enumerate(rows):
-        x, y = (k % cols) * tile_w, (k // cols) * (tile_h + label_h)
-        thumb = folder / row["id"] / "thumbnail.png"
-        if thumb.exists():
-            sheet.paste(Image.open(thumb).convert("RGB").resize((tile_w, tile_h)), (x, y))
-        else:
-            draw.rectangle((x, y, x + tile_w - 1, y + tile_h - 1), fill=(200, 200, 200))
-            draw.text((x + 8, y + tile_h // 2), str(row["status"]), fill="black")
-        lines = [f"{label(p)} = {v}" for p, v in row["parameters"].items()][:2]
-        lines.append(f"{row['id'][:8]}  {row['status']}")
-        for i, line in enumerate(lines):
-            draw.text((x + 6, y + tile_h + 2 + 15 * i), line[:48], fill="black")
-    path = folder / "contact_sheet.png"
-    staging = folder / ".contact_sheet.png"
-    sheet.save(staging, format="PNG")
-    os.replace(staging, path)
-    return path
+    def page(rows: List[Dict[str, Any]], path: Path) -> None:
+        tile_w, tile_h, label_h = 320, 240, 16 * 3
+        count = max(len(rows), 1)
+        cols = min(columns, count)
+        sheet = Image.new("RGB", (cols * tile_w, -(-count // cols) * (tile_h + label_h)), "white")
+        draw = ImageDraw.Draw(sheet)
+        for k, row in enumerate(rows):
+            x, y = (k % cols) * tile_w, (k // cols) * (tile_h + label_h)
+            thumb = folder / row["id"] / "thumbnail.png"
+            if thumb.exists():
+                with Image.open(thumb) as picture:
+                    sheet.paste(picture.convert("RGB").resize((tile_w, tile_h)), (x, y))
+            else:
+                draw.rectangle((x, y, x + tile_w - 1, y + tile_h - 1), fill=(200, 200, 200))
+                missing = "no picture" if row["status"] in ("ok", "done") else str(row["status"])
+                draw.text((x + 8, y + tile_h // 2), missing, fill="black")
+            lines = [f"{label(p)} = {v}" for p, v in row["parameters"].items()][:2]
+            lines.append(f"{row['id'][:8]}  {row['status']}")
+            for i, line in enumerate(lines):
+                draw.text((x + 6, y + tile_h + 2 + 15 * i), line[:48], fill="black")
+        buffer = io.BytesIO()
+        sheet.save(buffer, format="PNG")
+        _write_atomic(path, buffer.getvalue())
+
+    pages = [rows[k:k + SHEET_TILES] for k in range(0, max(len(rows), 1), SHEET_TILES)]
+    names = ["contact_sheet.png"] + [f"contact_sheet_{n}.png" for n in range(2, len(pages) + 1)]
+    for chunk, name in zip(pages, names):
+        page(chunk, folder / name)
+    for old in folder.glob("contact_sheet_*.png"):  # pages of an earlier, longer sweep
+        if old.name not in names:
+            with contextlib.suppress(OSError):
+                old.unlink()
+    return folder / names[0]
+
+
+@contextlib.contextmanager
+def _lock(folder: Path, total: int) -> Iterator[None]:
+    """Creates OUT; one sweep at a time in it (flock on OUT/.sweep.lock, released by the kernel
+    even when the sweep is killed). Under it, what a killed sweep left (staging folders,
+    temporaries) is removed."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        handle = open(folder / _LOCK, "a+")
+    except OSError as e:
+        raise StorageError(e, str(e.filename or folder), 0, total, "nothing was written") from None
+    try:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise FolderInUse(f"sweep: {folder}: another sweep is writing into this folder; wait for it "
+                              "to end or choose another output folder") from None
+        for leftover in folder.iterdir():
+            name = leftover.name
+            if name.startswith(_STAGING) or re.fullmatch(r"\.[0-9a-f]{16}-.*", name):
+                shutil.rmtree(leftover, ignore_errors=True)
+            elif re.fullmatch(r"\.(index\.(csv|jsonl)|contact_sheet(_\d+)?\.png)\..*\.tmp", name):
+                with contextlib.suppress(OSError):
+                    leftover.unlink()
+        yield
+    finally:
+        handle.close()
+
+
+@contextlib.contextmanager
+def _stop_on_signals(children: _Children) -> Iterator[None]:
+    """SIGINT, SIGTERM and SIGHUP stop the sweep cleanly (children killed, index written)
+    instead of ending Python wherever it is. Only in the main thread, restored afterwards."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous: Dict[int, Any] = {}
+    try:
+        for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+            previous[s] = signal.signal(s, lambda signum, frame: children.stop(signum))
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler if handler is not None else signal.SIG_DFL)
 
 
 def run(
@@ -325,99 +724,227 @@ def run(
     scheduler: Optional[str] = None,
     progress: Optional[Callable[[int, int, Dict[str, Any]], None]] = None,
     abort: Iterable[str] = (),
+    max_variants: int = MAX_VARIANTS,
 ) -> List[Dict[str, Any]]:
     """Runs every variant of the description into OUT (see the module's doc); returns the index
     rows in the description's order. Without `out`, the description's "out" (relative to its
     folder) is used. `executor` is "local" or "dask" (`scheduler` an address of
     an existing cluster, else a LocalCluster of `workers` processes). `progress(done, total, row)`
     is called as variants finish (default: a line on stderr). `abort` lists variant ids whose
-    process is made to abort (fault injection for tests)."""
-    document, base_text, base_dir = load_spec(spec)
+    process is made to abort (fault injection for tests). Raises SpecError (nothing run or
+    written), StorageError, FolderInUse or Interrupted (see the module's doc)."""
+    if executor not in ("local", "dask"):
+        raise ValueError(f'sweep: executor {executor!r} is not "local" or "dask"')
+    where = os.fspath(spec) if isinstance(spec, (str, os.PathLike)) else None
+    document, base_text, base_dir = load_spec(spec, max_variants)
     if out is None:
         if "out" not in document:
-            raise ValueError('sweep: give the output folder (out=..., --out) or "out" in the description')
+            raise SpecError('give the output folder (out=..., --out) or "out" in the description', where)
         spec_dir = Path(spec).parent if isinstance(spec, (str, os.PathLike)) else Path.cwd()
         out = spec_dir / document["out"]
-    folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
-    sets = variants(document)
-    ids = [variant_id(p) for p in sets]
-    if len(set(ids)) != len(ids):
-        raise ValueError("sweep: two variants have the same parameters")
-    rows: Dict[str, Dict[str, Any]] = {}
-    jobs: Dict[str, Dict[str, Any]] = {}
-    for vid, params in zip(ids, sets):
-        done = _done(folder, vid)
-        if done is not None:
-            rows[vid] = done
-            continue
-        jobs[vid] = {
-            "text": recipe_text(base_text, params),
-            "base_dir": str(base_dir),
-            "abort": vid in set(abort),
-        }
-    report = progress or _print_progress
-    finished = len(rows)
-    for vid in ids:
-        if vid in rows:
-            report(finished, len(ids), rows[vid])
-
-    def accept(vid: str, answer: Dict[str, Any]) -> None:
-        nonlocal finished
-        rows[vid] = _store(folder, vid, sets[ids.index(vid)], answer)
-        finished += 1
-        report(finished, len(ids), rows[vid])
-
-    if jobs and executor == "local":
-        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-            futures = {pool.submit(run_variant_isolated, job): vid for vid, job in jobs.items()}
-            for future in concurrent.futures.as_completed(futures):
-                accept(futures[future], future.result())
-    elif jobs and executor == "dask":
-        _run_dask(jobs, accept, workers, scheduler)
-    elif executor not in ("local", "dask"):
-        raise ValueError(f'sweep: executor {executor!r} is not "local" or "dask"')
-    ordered = [rows[vid] for vid in ids]
-    _write_index(folder, ordered)
-    contact_sheet(folder, ordered)
-    return ordered
-
-
-def _run_dask(
-    jobs: Dict[str, Dict[str, Any]],
-    accept: Callable[[str, Dict[str, Any]], None],
-    workers: int,
-    scheduler: Optional[str],
-) -> None:
-    import importlib
-
-    # python3-distributed has no type information: used through Any.
-    dask: Any = importlib.import_module("distributed")
-    Client, LocalCluster, as_completed = dask.Client, dask.LocalCluster, dask.as_completed
-    cluster = None
-    if scheduler is None:
-        # One thread per worker process: each runs one variant at a time (in its own child).
-        cluster = LocalCluster(n_workers=max(1, workers), threads_per_worker=1, processes=True,
-                               dashboard_address=None)
-        client = Client(cluster)
-    else:
-        client = Client(scheduler)
+    sets = variants(document, max_variants)
     try:
-        futures = {
-            client.submit(run_variant_isolated, job, key=f"clayform-variant-{vid}", pure=False): vid
-            for vid, job in jobs.items()
-        }
-        for future in as_completed(futures):
-            vid = futures[future]
+        ids = [variant_id(p) for p in sets]
+    except (TypeError, ValueError) as e:
+        raise SpecError(f"a value is not JSON ({e})", where) from None
+    first: Dict[str, int] = {}
+    for k, vid in enumerate(ids):
+        if vid in first:
+            raise SpecError(f"variants {first[vid] + 1} and {k + 1} have the same parameters "
+                            f"({json.dumps(sets[k], sort_keys=True)[:200]}); give each value once", where)
+        first[vid] = k
+    folder = Path(out)
+    children = _Children()
+    with _lock(folder, len(ids)), _stop_on_signals(children):
+        sweep = _Sweep(folder, ids, sets, base_text, base_dir, set(abort), children,
+                       progress or _print_progress, progress is None)
+        rows = sweep.run(executor, workers, scheduler)
+    if children.signum is not None:  # checked once the handlers are back: no signal goes unseen
+        name = signal.Signals(children.signum).name
+        raise Interrupted(children.signum, f"sweep: stopped by {name}: {len(rows)} of {len(ids)} variants "
+                                           f"finished, {sweep.index_note}; run it again to resume")
+    return rows
+
+
+class _Sweep:
+    """One run of a checked description into a locked output folder."""
+
+    def __init__(self, folder: Path, ids: List[str], sets: List[Params], base_text: str, base_dir: Path,
+                 abort: Set[str], children: _Children, report: Callable[[int, int, Dict[str, Any]], None],
+                 chatty: bool) -> None:
+        self.folder, self.ids, self.sets = folder, ids, dict(zip(ids, sets))
+        self.base_text, self.base_dir, self.abort = base_text, str(base_dir), abort
+        self.children, self.report, self.chatty = children, report, chatty
+        self.rows: Dict[str, Dict[str, Any]] = {}
+        self.index = _Index(folder, ids)
+        self.failure: Optional[Tuple[OSError, str]] = None
+        self.index_note = ""
+
+    def job(self, vid: str, stage: Optional[Path]) -> Dict[str, Any]:
+        return {"text": recipe_text(self.base_text, self.sets[vid]), "base_dir": self.base_dir,
+                "abort": vid in self.abort, "stage": str(stage / vid) if stage else None}
+
+    def staging(self, vid: str) -> Optional[Path]:
+        """A new staging folder in OUT for a variant about to start; None once the sweep stopped."""
+        with self.children.lock:
+            if self.children.stopped:
+                return None
+            path = Path(tempfile.mkdtemp(prefix=f"{_STAGING}{vid}-", dir=self.folder))
+            self.children.stagings.add(path)
+            return path
+
+    def drop(self, staging: Optional[Path]) -> None:
+        if staging is not None:
+            shutil.rmtree(staging, ignore_errors=True)
+            with self.children.lock:
+                self.children.stagings.discard(staging)
+
+    def fail(self, error: OSError, path: str) -> None:
+        """A storage error: stop everything now."""
+        if self.failure is None:
+            self.failure = (error, path)
+        self.children.stop()
+
+    def accept(self, vid: str, answer: Dict[str, Any], staging: Optional[Path]) -> None:
+        status = answer.get("status")
+        try:
+            if self.failure is not None or (self.children.stopped and status in ("crashed", "stopped")):
+                return  # killed, or never run, because the sweep stopped: not a result
+            if status == "storage":  # met by the variant's process: OUT is named
+                code = answer.get("errno") or errno.EIO
+                self.fail(OSError(code, answer.get("error") or os.strerror(code)), str(self.folder))
+                return
+            row = self.rows[vid] = _store(self.folder, vid, self.sets[vid], answer, staging)
+            self.index.add(row)
+            self.index.write(soon=True)
+        except OSError as e:
+            self.fail(e, str(e.filename or self.folder))
+            return
+        finally:
+            self.drop(staging)
+        self.report(len(self.rows), len(self.ids), row)
+
+    def run(self, executor: str, workers: int, scheduler: Optional[str]) -> List[Dict[str, Any]]:
+        todo: List[str] = []
+        for vid in self.ids:
+            done = _done(self.folder, vid)
+            if done is None:
+                todo.append(vid)
+            else:
+                self.rows[vid] = done
+                self.index.add(done)
+        if self.chatty:
+            print(f"sweep: {_count(len(self.ids), 'variant')}, {len(self.ids) - len(todo)} finished earlier, "
+                  f"{len(todo)} to run ({executor}, {_count(max(1, workers), 'worker')}) into {self.folder}",
+                  file=sys.stderr, flush=True)
+        for k, vid in enumerate(vid for vid in self.ids if vid in self.rows):
+            self.report(k + 1, len(self.ids), self.rows[vid])
+        try:
+            if todo and executor == "local":
+                self.run_local(todo, workers)
+            elif todo:
+                self.run_dask(todo, workers, scheduler)
+        finally:
+            self.children.stop()
+            for staging in list(self.children.stagings):
+                self.drop(staging)
+            self.index_note = self.finish_index()
+        ordered = [self.rows[vid] for vid in self.ids if vid in self.rows]
+        if self.failure is None and self.children.signum is None:
             try:
-                answer = future.result()
-            except Exception as e:  # noqa: BLE001 - a lost worker loses only this variant
-                answer = {"status": "crashed", "seconds": None, "error": f"{type(e).__name__}: {e}"}
-            accept(vid, answer)
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+                contact_sheet(self.folder, ordered)
+            except OSError as e:
+                self.failure = (e, str(e.filename or self.folder))
+        if self.failure is not None:
+            raise StorageError(*self.failure, len(self.rows), len(self.ids), self.index_note)
+        return ordered
+
+    def finish_index(self) -> str:
+        try:
+            self.index.write()
+            return f"indexed in {self.folder / 'index.csv'}"
+        except OSError as e:
+            if self.failure is None:
+                self.failure = (e, str(e.filename or self.folder))
+            return f"and the index could not be written ({e.strerror or e}): their folders hold variant.json"
+
+    def run_local(self, todo: List[str], workers: int) -> None:
+        def one(vid: str) -> Tuple[Dict[str, Any], Optional[Path]]:
+            staging = self.staging(vid)  # OSError: a storage error
+            if staging is None:
+                return {"status": "stopped", "seconds": None}, None
+            try:
+                job = self.job(vid, staging)
+            except Exception as e:  # noqa: BLE001 - the paths were checked: not expected, but only this variant's
+                return {"status": "failed", "seconds": None, "error": f"{type(e).__name__}: {e}"}, staging
+            return run_variant_isolated(job, self.children), staging
+
+        pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, workers))
+        try:
+            futures = {pool.submit(one, vid): vid for vid in todo}
+            for future in concurrent.futures.as_completed(futures):
+                try:
+                    answer, staging = future.result()
+                except OSError as e:  # the staging folder could not be made
+                    self.fail(e, str(e.filename or self.folder))
+                    break
+                self.accept(futures[future], answer, staging)
+                if self.failure is not None:
+                    break
+        finally:
+            self.children.stop()  # nothing runs any more after a break; none start
+            pool.shutdown(wait=True, cancel_futures=True)
+
+    def run_dask(self, todo: List[str], workers: int, scheduler: Optional[str]) -> None:
+        import importlib
+
+        # python3-distributed has no type information: used through Any.
+        dask: Any = importlib.import_module("distributed")
+        cluster = None
+        if scheduler is None:
+            # One thread per worker process: each runs one variant at a time (in its own child).
+            cluster = dask.LocalCluster(n_workers=max(1, workers), threads_per_worker=1, processes=True,
+                                        dashboard_address=None)
+            client = dask.Client(cluster)
+        else:
+            client = dask.Client(scheduler)
+        try:
+            # A LocalCluster's workers share this disk and write into OUT's staging folders; remote
+            # ones send their files back. A window of jobs at a time: their texts are built late.
+            local, queue = scheduler is None, iter(todo)
+            futures: Dict[Any, Tuple[str, Optional[Path]]] = {}
+            pending = dask.as_completed()
+
+            def submit_next() -> None:
+                vid = next(queue, None)
+                staging = self.staging(vid) if vid is not None and local else None
+                if vid is not None and (staging is not None or not local):
+                    future = client.submit(run_variant_isolated, self.job(vid, staging),
+                                           key=f"clayform-variant-{vid}-{os.urandom(4).hex()}", pure=False)
+                    futures[future] = (vid, staging)
+                    pending.add(future)
+
+            for _ in range(max(4, 2 * sum(client.nthreads().values()))):
+                submit_next()
+            for future in pending:
+                vid, staging = futures.pop(future)
+                try:
+                    answer = future.result()
+                except Exception as e:  # noqa: BLE001 - a lost worker loses only this variant
+                    answer = {"status": "crashed", "seconds": None, "error": f"{type(e).__name__}: {e}"}
+                self.accept(vid, answer, staging)
+                if self.failure is not None or self.children.stopped:
+                    client.cancel(list(futures))
+                    break
+                submit_next()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+def _count(n: int, what: str) -> str:
+    return f"{n:,} {what}" + ("" if n == 1 else "s")
 
 
 def _print_progress(done: int, total: int, row: Dict[str, Any]) -> None:
@@ -429,7 +956,9 @@ def _print_progress(done: int, total: int, row: Dict[str, Any]) -> None:
 
 def main(argv: Optional[List[str]] = None) -> int:
     """`python -m clayform.sweeps SPEC --out DIR [--executor local|dask] [--workers N]
-    [--scheduler tcp://HOST:8786]` (what `clayform sweep` runs)."""
+    [--scheduler tcp://HOST:8786]` (what `clayform sweep` runs). Exit 0: every variant done;
+    1: some failed; 2: nothing ran or the sweep stopped (a bad description, a storage error,
+    another sweep in the folder), with one line on stderr; 128 + N: stopped by signal N."""
     import argparse
 
     args = list(sys.argv[1:] if argv is None else argv)
@@ -444,8 +973,17 @@ def main(argv: Optional[List[str]] = None) -> int:
     a = parser.parse_args(args)
     try:
         rows = run(a.spec, a.out, "dask" if a.scheduler else a.executor, a.workers, a.scheduler)
-    except (ValueError, OSError) as e:
-        print(f"clayform sweep: {e}", file=sys.stderr)
+    except Interrupted as e:
+        print(e.message, file=sys.stderr)
+        return 128 + e.signum
+    except KeyboardInterrupt:  # before the sweep started: nothing written
+        print(f"sweep: {a.spec}: interrupted before any variant ran", file=sys.stderr)
+        return 128 + signal.SIGINT
+    except (SpecError, StorageError, FolderInUse) as e:
+        print(" ".join(str(e).split()), file=sys.stderr)
+        return 2
+    except OSError as e:
+        print(f"sweep: {e.filename or a.out}: {e.strerror or e}", file=sys.stderr)
         return 2
     bad = [r for r in rows if r["status"] not in ("ok", "done")]
     print(f"{len(rows)} variants: {len(rows) - len(bad)} done, {len(bad)} failed; index {Path(a.out) / 'index.csv'}")

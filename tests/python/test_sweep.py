@@ -1,10 +1,20 @@
 """Sweeps: paths into the recipe, variants by hash, atomic folders, resume, failures that lose
-only themselves, the index and the contact sheet, on local processes and a Dask LocalCluster."""
+only themselves, the index and the contact sheet, on local processes and a Dask LocalCluster;
+descriptions refused up front, killed sweeps and storage errors (issue #36, items 15-18)."""
 from __future__ import annotations
 
 import csv
+import errno
+import itertools
 import json
+import os
+import resource
+import signal
+import subprocess
+import time
+import uuid
 from pathlib import Path
+from typing import Callable, List
 
 import numpy as np
 import pytest
@@ -118,3 +128,228 @@ def test_the_command_runs_a_sweep_and_resumes(examples: Path, exe: str, tmp_path
     bad.write_text(json.dumps({"recipe": str(examples / "recipes" / "sail.json"), "grid": {"nope.x": [1]}}))
     failed = subprocess.run([exe, "sweep", str(bad), "--out", str(tmp_path / "bad")], capture_output=True, text=True)
     assert failed.returncode == 2 and "no key 'nope'" in failed.stderr  # a bad description
+
+
+def index_ids(out: Path) -> List[str]:
+    """The ids index.jsonl lists, checked against index.csv (same ids, same order)."""
+    ids = [json.loads(line)["id"] for line in (out / "index.jsonl").read_text().splitlines()]
+    with open(out / "index.csv", newline="") as f:
+        assert [row["id"] for row in csv.DictReader(f)] == ids
+    return ids
+
+
+def test_a_huge_grid_is_refused_before_anything_is_built(examples: Path, exe: str, tmp_path: Path,
+                                                          monkeypatch: pytest.MonkeyPatch) -> None:
+    # 12 paths x 10 values: 10^12 variants in a description of under a kilobyte.
+    paths = [f"deformations.shape[1].moves[{i % 4}].by[{i // 4}]" for i in range(12)]
+    huge = {"format": "clayform.sweep", "version": 1, "recipe": str(examples / "recipes" / "sail.json"),
+            "grid": {p: list(range(10)) for p in paths}}
+    assert sweeps.count_variants(huge) == 10**12
+
+    def no_product(*args: object) -> None:
+        raise AssertionError("the variants were built")
+
+    with monkeypatch.context() as m:  # counted, never built
+        m.setattr(itertools, "product", no_product)
+        with pytest.raises(sweeps.SpecError, match=r"1,000,000,000,000 variants \(10 × 10 × .*\), more than the "
+                                                   r"limit of 10,000"):
+            cf.sweep(huge, tmp_path / "out", progress=lambda *a: None)
+    assert not (tmp_path / "out").exists()
+    # The limit is a documented constant: 10,000 variants pass, 10,001 do not (a list as well).
+    assert sweeps.MAX_VARIANTS == 10_000
+    limit = {**huge, "grid": {p: list(range(10)) for p in paths[:4]}}
+    assert sweeps.count_variants(limit) == 10_000 and sweeps.load_spec(limit)[0] == limit
+    listed = {"recipe": huge["recipe"], "list": [{BILLOW: k} for k in range(10_001)]}
+    with pytest.raises(sweeps.SpecError, match=r"10,001 variants \(list items\), more than the limit of 10,000"):
+        sweeps.load_spec(listed)
+    # From the command: exit 2, one line naming the description, the count and the limit. (The
+    # address space is capped so that a sweep that did build them fails fast instead of the OOM killer.)
+    description = tmp_path / "huge.json"
+    description.write_text(json.dumps(huge))
+    capped = subprocess.run([exe, "sweep", str(description), "--out", str(tmp_path / "out")], capture_output=True,
+                            text=True, preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30)))
+    assert capped.returncode == 2, capped.stderr
+    assert capped.stderr.splitlines() == [f"sweep: {description}: 1,000,000,000,000 variants (10 × 10 × 10 × 10 × "
+                                          "10 × 10 × 10 × 10 × 10 × 10 × 10 × 10 values), more than the limit of "
+                                          "10,000 (clayform.sweeps.MAX_VARIANTS); give fewer values, or split the "
+                                          "sweep into several descriptions"]
+    assert not (tmp_path / "out").exists()
+
+
+BAD_DESCRIPTIONS = {  # test id: (the description, with SAIL and BILLOW filled in; the message's words)
+    "not-json": ("{not json", "the description is not JSON (Expecting property name enclosed in double quotes "
+                              "at line 1, column 2)"),
+    "not-an-object": ("[1, 2]", 'expected a JSON object {"format": "clayform.sweep"'),
+    "grid-not-a-map": ('{"recipe": SAIL, "grid": [1, 2]}', '"grid" maps each path to a non-empty list of values'),
+    "grid-value-not-a-list": ('{"recipe": SAIL, "grid": {"BILLOW": 5}}', '"grid": BILLOW: give a non-empty list'),
+    "grid-and-list": ('{"recipe": SAIL, "grid": {"BILLOW": [1]}, "list": []}', 'give either "grid"'),
+    "list-item-not-a-map": ('{"recipe": SAIL, "list": [1]}', '"list"[0]: expected a {path: value} object'),
+    "recipe-not-a-string": ('{"recipe": 5, "grid": {"BILLOW": [1]}}', '"recipe" names the base recipe file'),
+    "recipe-missing": ('{"recipe": "missing.json", "grid": {"BILLOW": [1]}}', '"recipe": cannot read'),
+    "version-2": ('{"recipe": SAIL, "grid": {"BILLOW": [1]}, "version": 2}', 'expected "format": "clayform.sweep"'),
+    "out-not-a-string": ('{"recipe": SAIL, "grid": {"BILLOW": [1]}, "out": 5}', '"out" is a string'),
+    "path-not-in-recipe": ('{"recipe": SAIL, "grid": {"BILLOW.x": [1]}}', "BILLOW.x: the recipe has no key 'x' there"),
+    "path-malformed": ('{"recipe": SAIL, "grid": {"a..b": [1]}}', "parameter path 'a..b' is not keys joined by '.'"),
+    "same-variant-twice": ('{"recipe": SAIL, "grid": {"BILLOW": [1, 1]}}', "variants 1 and 2 have the same parameters"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_DESCRIPTIONS))
+def test_a_bad_description_exits_2_with_one_line(examples: Path, exe: str, tmp_path: Path, case: str) -> None:
+    text, message = BAD_DESCRIPTIONS[case]
+    description = tmp_path / "bad.json"
+    sail = json.dumps(str(examples / "recipes" / "sail.json"))
+    description.write_text(text.replace("SAIL", sail).replace("BILLOW", BILLOW))
+    failed = subprocess.run([exe, "sweep", str(description), "--out", str(tmp_path / "out")], capture_output=True,
+                            text=True)
+    assert failed.returncode == 2  # not 1, "some variants failed": nothing ran
+    lines = failed.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"sweep: {description}: "), failed.stderr  # no traceback
+    assert message.replace("BILLOW", BILLOW) in lines[0]
+    assert not (tmp_path / "out").exists()  # refused before anything is written
+
+
+def test_a_recipe_of_models_only_sweeps_with_pictures(examples: Path, tmp_path: Path) -> None:
+    # block_model.json has models and no surfaces: every variant ran and then failed "render: no
+    # surfaces" at the thumbnail. Its models are drawn instead, and their volumes indexed.
+    lift = "deformations.lift[0].moves[0].to[2]"
+    description = {"format": "clayform.sweep", "version": 1,
+                   "recipe": str(examples / "recipes" / "block_model.json"), "grid": {lift: [31, 40]}}
+    rows = cf.sweep(description, tmp_path, workers=2, progress=lambda *a: None)
+    assert [r["status"] for r in rows] == ["ok", "ok"], rows
+    # Lifting the top further adds volume (both models are summed; only the lifted one changes).
+    assert rows[1]["volume_mm3"] > rows[0]["volume_mm3"] > 0
+    from PIL import Image
+
+    for row in rows:
+        assert (tmp_path / row["id"] / "block_lifted.step").is_file()
+        with Image.open(tmp_path / row["id"] / "thumbnail.png") as picture:
+            assert picture.size == (320, 240)
+            pixels = np.asarray(picture.convert("RGB"), dtype=int)
+        drawn = (pixels.sum(axis=2) < 3 * 250).mean()  # not background
+        assert 0.1 < drawn < 0.9
+    assert (tmp_path / "contact_sheet.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def variant_processes(mark: str) -> List[int]:
+    """Live variant processes started under the environment mark (zombies have no environment)."""
+    found = []
+    for proc in Path("/proc").iterdir():
+        if proc.name.isdigit():
+            try:
+                environ = (proc / "environ").read_bytes().split(b"\0")
+                if f"CLAYFORM_TEST_MARK={mark}".encode() in environ and b"--run-variant" in (proc / "cmdline").read_bytes():
+                    found.append(int(proc.name))
+            except OSError:
+                pass
+    return found
+
+
+def wait_for(condition: Callable[[], bool], seconds: float) -> bool:
+    deadline = time.monotonic() + seconds
+    while not condition():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.01)
+    return True
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
+def test_a_killed_sweep_leaves_no_process_no_temporary_and_an_index(examples: Path, exe: str, tmp_path: Path,
+                                                                   sig: int) -> None:
+    description = tmp_path / "sweep.json"
+    description.write_text(json.dumps(spec(examples, [0, 100, 200, 300])))
+    out, tmp, mark = tmp_path / "out", tmp_path / "tmp", uuid.uuid4().hex
+    tmp.mkdir()  # the sweep's TMPDIR: whatever it would leave in /tmp lands here
+    env = {**os.environ, "TMPDIR": str(tmp), "CLAYFORM_TEST_MARK": mark}
+    sweep = subprocess.Popen([exe, "sweep", str(description), "--out", str(out), "--workers", "1"], env=env,
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        # Kill it after the first variant finished, while the second runs.
+        assert wait_for(lambda: any(out.glob("*/variant.json")) and bool(variant_processes(mark)), 60)
+        running = variant_processes(mark)
+        sweep.send_signal(sig)
+        _, stderr = sweep.communicate(timeout=30)
+    finally:
+        if sweep.poll() is None:
+            sweep.kill()
+    assert len(running) == 1
+    # No variant process outlives the sweep (a SIGKILLed one included: they die with it).
+    assert wait_for(lambda: not variant_processes(mark), 0.5), variant_processes(mark)
+    assert list(tmp.iterdir()) == []  # no clayform-variant-* folder (nor anything else) in TMPDIR
+    finished = sorted(p.parent.name for p in out.glob("*/variant.json"))
+    assert len(finished) >= 1 and sorted(index_ids(out)) == finished  # the index lists what finished
+    staging = [p.name for p in out.iterdir() if p.name.startswith(".staging-")]
+    if sig == signal.SIGTERM:
+        assert sweep.returncode == 128 + signal.SIGTERM
+        assert stderr.splitlines()[-1] == (f"sweep: stopped by SIGTERM: {len(finished)} of 4 variants finished, "
+                                           f"indexed in {out / 'index.csv'}; run it again to resume")
+        assert staging == [] and not (out / "contact_sheet.png").exists()
+    else:
+        assert sweep.returncode == -signal.SIGKILL
+        assert len(staging) <= 1  # the killed variant's, in OUT, not /tmp; the next run removes it
+    again = subprocess.run([exe, "sweep", str(description), "--out", str(out)], capture_output=True, text=True,
+                           env=env)
+    assert again.returncode == 0, again.stderr
+    assert again.stderr.count(" done") == len(finished) and again.stderr.count(" ok ") == 4 - len(finished)
+    assert not [p for p in out.iterdir() if p.name.startswith(".staging-")] and len(index_ids(out)) == 4
+    assert list(tmp.iterdir()) == []
+
+
+def test_a_storage_error_stops_the_sweep_at_once(examples: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # As root, a read-only folder still takes writes: the full disk is simulated at the rename
+    # that moves the second finished variant into place.
+    description = spec(examples, [0, 100, 200, 300])
+    ids = [sweeps.variant_id(p) for p in sweeps.variants(description)]
+    started: list = []
+    moved: list = []
+    refused: list = []
+    real_run, real_rename = sweeps.run_variant_isolated, sweeps._rename
+
+    def counting(job: dict, children: object = None) -> dict:
+        started.append(job)
+        return real_run(job, children)  # type: ignore[arg-type]
+
+    def full_disk(src: str, dst: str) -> None:
+        if Path(dst).name in ids:
+            if moved:
+                refused.append(str(dst))
+                raise OSError(errno.ENOSPC, "No space left on device", str(dst))
+            moved.append(Path(dst).name)
+        real_rename(src, dst)
+
+    monkeypatch.setattr(sweeps, "run_variant_isolated", counting)
+    monkeypatch.setattr(sweeps, "_rename", full_disk)
+    with pytest.raises(sweeps.StorageError) as caught:
+        cf.sweep(description, tmp_path, workers=1, progress=lambda *a: None)
+    error = caught.value
+    assert isinstance(error, OSError) and error.errno == errno.ENOSPC and error.filename == refused[0]
+    assert str(error).startswith(f"sweep: {refused[0]}: No space left on device; the sweep stopped: 1 of 4 "
+                                 f"variants finished, indexed in {tmp_path / 'index.csv'}; free some space")
+    # The pending variants did not run: the first, the refused one and at most the one the
+    # worker had started meanwhile (killed); never the fourth.
+    assert len(refused) == 1 and 2 <= len(started) <= 3
+    # Nothing half-written stays: no staging folder, no temporary, no contact sheet.
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([".sweep.lock", moved[0], "index.csv", "index.jsonl"])
+    assert index_ids(tmp_path) == moved
+    monkeypatch.undo()
+    again = cf.sweep(description, tmp_path, workers=2, progress=lambda *a: None)
+    assert sorted(r["status"] for r in again) == ["done", "ok", "ok", "ok"]
+
+
+def test_the_command_stops_on_a_storage_error_naming_the_folder(examples: Path, exe: str, tmp_path: Path) -> None:
+    # A real storage error, as root too: files may not grow past 200 kB (EFBIG), which the sail's
+    # IGES file and view meshes do. Every variant would meet it: the first stops the sweep.
+    description = tmp_path / "sweep.json"
+    description.write_text(json.dumps(spec(examples, [0, 100, 200, 300])))
+    out = tmp_path / "out"
+    limited = subprocess.run([exe, "sweep", str(description), "--out", str(out), "--workers", "1"],
+                             capture_output=True, text=True,
+                             preexec_fn=lambda: resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000)))
+    assert limited.returncode == 2, limited.stderr
+    lines = limited.stderr.splitlines()
+    assert lines[-1].startswith(f"sweep: {out}: File too large; the sweep stopped: 0 of 4 variants finished, "
+                                f"indexed in {out / 'index.csv'}; raise the file size limit (ulimit -f)")
+    assert "Traceback" not in limited.stderr and not [x for x in lines if x.startswith("[")]  # none reported
+    assert sorted(p.name for p in out.iterdir()) == [".sweep.lock", "index.csv", "index.jsonl"]
+    assert index_ids(out) == []
