@@ -477,8 +477,8 @@ struct StudioServer::Impl::Page : std::enable_shared_from_this<Page> {
 void StudioServer::Impl::Http::upgrade(http::request<http::string_body> req) {
   done = true;  // the page's connection now
   s.open_requests.erase(slot);
-  auto page = std::make_shared<Page>(s, std::move(stream));
-  page->accept(std::move(req));
+  auto holder_page = std::make_shared<Page>(s, std::move(stream));
+  holder_page->accept(std::move(req));
 }
 
 void StudioServer::Impl::accept_next() {
