@@ -7,8 +7,8 @@
 #include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 
-#include <boost/asio/connect.hpp>
-#include <boost/asio/ip/tcp.hpp>
+#include "studio_client.hpp"
+
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
 #include <nlohmann/json.hpp>
@@ -134,37 +134,14 @@ std::string upgrade_request(int port, const std::string& target, const std::stri
          extra + "\r\n";
 }
 
-namespace asio = boost::asio;
 namespace beast = boost::beast;
 namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
 
-/// The studio's page, as a WebSocket client with the session's token and Origin.
-struct Page {
-  asio::io_context io;
-  websocket::stream<tcp::socket> ws{io};
-  explicit Page(const StudioServer& server) {
-    const std::string port = std::to_string(server.port());
-    tcp::resolver resolver(io);
-    asio::connect(ws.next_layer(), resolver.resolve("127.0.0.1", port));
-    ws.set_option(websocket::stream_base::decorator([port](websocket::request_type& req) {
-      req.set(beast::http::field::origin, "http://127.0.0.1:" + port);
-    }));
-    ws.read_message_max(256u << 20);
-    ws.handshake("127.0.0.1:" + port, "/ws?token=" + server.token());
-  }
-  void send(const std::string& bytes, bool text = true) {
-    ws.text(text);
-    ws.write(asio::buffer(bytes));
-  }
-  /// The next JSON reply (binary frames skipped).
-  Json reply() {
-    while (true) {
-      beast::flat_buffer buffer;
-      ws.read(buffer);
-      if (ws.got_text()) return Json::parse(beast::buffers_to_string(buffer.data()));
-    }
-  }
+/// The studio's page: a WebSocket client with the session's token and its own Origin.
+struct Page : clay::test::StudioClient {
+  explicit Page(const StudioServer& server)
+      : StudioClient(server.port(), "http://127.0.0.1:" + std::to_string(server.port()),
+                     server.token()) {}
 };
 
 /// A copy of an example recipe in a folder of its own; returns its path.

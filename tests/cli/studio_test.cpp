@@ -9,8 +9,8 @@
 #include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/evaluate.hpp>
 
-#include <boost/asio/connect.hpp>
-#include <boost/asio/ip/tcp.hpp>
+#include "studio_client.hpp"
+
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
 #include <nlohmann/json.hpp>
@@ -566,34 +566,10 @@ TEST_CASE("studio session: a STEP model opened whole, meshed, deformed by a latt
 
 namespace {
 
-namespace asio = boost::asio;
 namespace beast = boost::beast;
 namespace websocket = beast::websocket;
-using tcp = asio::ip::tcp;
 
-/// A WebSocket client of the studio at `port`, sending `origin` (and Host 127.0.0.1:port) and
-/// the session's token.
-struct Client {
-  asio::io_context io;
-  websocket::stream<tcp::socket> ws{io};
-  Client(int port, const std::string& origin, const std::string& token) {
-    tcp::resolver resolver(io);
-    asio::connect(ws.next_layer(), resolver.resolve("127.0.0.1", std::to_string(port)));
-    ws.set_option(websocket::stream_base::decorator(
-        [origin](websocket::request_type& req) { req.set(beast::http::field::origin, origin); }));
-    ws.handshake("127.0.0.1:" + std::to_string(port), "/ws?token=" + token);
-  }
-  void send(const std::string& text) {
-    ws.text(true);
-    ws.write(asio::buffer(text));
-  }
-  /// The next message: (is text, bytes).
-  std::pair<bool, std::string> receive() {
-    beast::flat_buffer buffer;
-    ws.read(buffer);
-    return {ws.got_text(), beast::buffers_to_string(buffer.data())};
-  }
-};
+using Client = clay::test::StudioClient;
 
 }  // namespace
 
