@@ -119,6 +119,7 @@ class Checker : public internal::JsonReader {
  public:
   Checker() {
     magnitude = limit::magnitude;
+    refuse_denormal = true;
     magnitude_note = "recipe numbers are limited to ±" + shortest(limit::magnitude) +
                      ": mm, degrees, knots and weights";
     limit_note = "recipe limit";

@@ -198,9 +198,9 @@ struct ExportDef {
 struct ModelDef {
   std::string name, path;
   std::filesystem::path file;
-  bool sew = false;                        ///< sew loose faces into shells and solids
+  bool sew = false;         ///< sew loose faces into shells and solids
   bool allow_fold = false;  ///< deform by a lattice not proven fold-free (the solid may fold)
-  std::string deformation;                 ///< "" when the model is written as read
+  std::string deformation;  ///< "" when the model is written as read
   std::vector<std::string> bodies, faces;  ///< names chosen to deform; both empty: every face
   std::vector<std::string> formats{"step", "iges", "glb"};
   std::string schema = "AP214";
