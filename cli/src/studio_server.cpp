@@ -6,6 +6,7 @@
 // anything is read or served; static files resolve under the front end's folder only; no message,
 // connection count or exception ends it.
 #include <clay/error.hpp>
+#include <clay/internal/fenv.hpp>
 #include <clay/internal/files.hpp>
 #include <clay/internal/json_reader.hpp>
 #include <clay/studio.hpp>
@@ -181,7 +182,10 @@ std::optional<std::string> edit_key(const std::string& text) {
   if (text.size() > StudioSession::command_bytes ||
       internal::nesting_too_deep(text, StudioSession::command_depth))
     return std::nullopt;
-  const Json c = Json::parse(text, nullptr, false);
+  const Json c = [&] {
+    const internal::FpTrapsHeld traps_held;  // strtod's overflow on 1E99999 (StudioSession)
+    return Json::parse(text, nullptr, false);
+  }();
   if (!c.is_object()) return std::nullopt;
   const auto op = c.find("op");
   if (op == c.end() || !op->is_string() || *op != "edit") return std::nullopt;

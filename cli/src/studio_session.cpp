@@ -5,6 +5,7 @@
 
 #include <clay/brep/exchange.hpp>
 #include <clay/error.hpp>
+#include <clay/internal/fenv.hpp>
 #include <clay/internal/files.hpp>
 #include <clay/internal/json_reader.hpp>
 #include <clay/recipe/recipe.hpp>
@@ -544,7 +545,12 @@ struct StudioSession::Impl {
                   "studio: the command nests arrays and objects deeper than " +
                       std::to_string(command_depth) + " levels (at byte " +
                       std::to_string(deep->at) + "); a recipe needs at most 8");
-    const Json c = Json::parse(command);
+    // strtod raises overflow on a literal such as 1E99999 (as C requires): a host that traps
+    // it (the Debug tests, the fuzzer) died of the number the checks exist to refuse.
+    const Json c = [&] {
+      const internal::FpTrapsHeld traps_held;
+      return Json::parse(command);
+    }();
     if (!c.is_object() || !c.contains("op") || !c.at("op").is_string())
       throw Error(ErrorCategory::InvalidArgument,
                   "studio: a command is a JSON object with \"op\" (hello, recipe, edit, undo, "
@@ -651,7 +657,10 @@ std::size_t StudioSession::restore(const fs::path& file) {
                                             "; start without it (--fresh) or remove it");
   };
   if (internal::nesting_too_deep(text, 64)) throw bad("nests too deep");
-  const Json doc = Json::parse(text, nullptr, false);
+  const Json doc = [&] {
+    const internal::FpTrapsHeld traps_held;  // strtod's overflow, as in handle()
+    return Json::parse(text, nullptr, false);
+  }();
   if (!doc.is_object() || doc.value("format", Json()) != "clayform.studio-autosave" ||
       !doc.contains("history") || !doc.at("history").is_array() || doc.at("history").empty() ||
       !doc.contains("position") || !doc.at("position").is_number_unsigned() ||
