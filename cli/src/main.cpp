@@ -420,11 +420,16 @@ int studio(const std::string& recipe, int port, bool fresh) {
             "cannot set the autosave \"" + autosave.string() + "\" aside: " + ec.message());
       std::printf("Set the autosave aside as %s.old\n", autosave.string().c_str());
     } else {
+      const std::string opened = session.text();
       const std::size_t entries = session.restore(autosave);
-      std::printf(
-          "Continuing the autosave %s (%zu history entries; --fresh starts from the "
-          "recipe file instead)\n",
-          autosave.string().c_str(), entries);
+      if (entries == 1 && session.text() == opened)  // nothing was done since: start afresh
+        session = recipe.empty() ? rc::StudioSession(opened, ".", "untitled")
+                                 : rc::StudioSession::open(recipe);
+      else
+        std::printf(
+            "Continuing the autosave %s (%zu history entries; --fresh starts from the "
+            "recipe file instead)\n",
+            autosave.string().c_str(), entries);
     }
   }
   session.autosave_to(autosave);
