@@ -8,7 +8,7 @@
 #include <cmath>
 #include <random>
 
-#include "occt/reference.hpp"
+#include "occt_reference.hpp"
 
 using namespace clay::surface;
 

@@ -4,16 +4,16 @@
 // BRepCheck; target: under 1 s on 2 cores). The reference, in the
 // same run: OpenCASCADE's own affine map of the same solid, BRepBuilderAPI_GTransform (with
 // geometry copies), against deform_model with an affine lattice.
-#include <clay/brep/exchange.hpp>
 #include <clay/brep/volume.hpp>
 #include <clay/deform/model_deformation.hpp>
+#include <clay/occt/model_exchange.hpp>
 
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
 #include <string>
 
-#include "occt/test_models.hpp"
+#include "occt_test_models.hpp"
 
 namespace fs = std::filesystem;
 using namespace clay;

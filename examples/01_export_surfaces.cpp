@@ -6,6 +6,7 @@
 // The surfaces: a bicubic "hood" (8 x 6 control points, polynomial) and an exact rational torus
 // patch (biquadratic, a quarter of the tube swept a quarter turn). Exits non-zero if a read-back
 // differs by a single bit or a face fails OpenCASCADE's BRepCheck.
+#include <clay/occt.hpp>
 #include <clay/surface.hpp>
 
 #include <nlohmann/json.hpp>

@@ -9,9 +9,9 @@
 // the tangent plane at the bound by more than 0.5 degrees, moves a vertex outside the bound, or if
 // the STEP round trip changes the surface.
 #include <clay/deform.hpp>
+#include <clay/occt/surface_exchange.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
-#include <clay/surface/exchange.hpp>
 
 #include <cmath>
 #include <cstdio>

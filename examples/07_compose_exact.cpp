@@ -10,9 +10,9 @@
 // Exits non-zero if the composed surface differs from the pointwise deformation by more than
 // 1e-12 of the lattice size, or if a read-back surface is not bit-identical.
 #include <clay/deform.hpp>
+#include <clay/occt/surface_exchange.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/exchange.hpp>
 
 #include <algorithm>
 #include <cstdio>

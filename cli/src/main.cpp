@@ -1,7 +1,7 @@
 // clayform — the command-line shell over the kernel: parse, call one library function, print the
 // outcome, map error categories to exit codes (STYLE.md rule 18).
-#include <clay/brep/exchange.hpp>
 #include <clay/deform.hpp>
+#include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/render/render.hpp>
 #include <clay/serve.hpp>

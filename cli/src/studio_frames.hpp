@@ -2,8 +2,8 @@
 // The studio's binary geometry frames (clay/studio.hpp, docs/studio.md "Frames"): a model's mesh,
 // its faces' nets, a surface's deviation map, and what a mesh depends on. Internal to the
 // command's studio.
-#include <clay/brep/exchange.hpp>
 #include <clay/brep/model.hpp>
+#include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 
 #include <cstdint>

@@ -3,11 +3,11 @@
 // UTF-8 JSON whatever the command held; files are written only inside the recipe's folder.
 #include "studio_frames.hpp"
 
-#include <clay/brep/exchange.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/fenv.hpp>
 #include <clay/internal/files.hpp>
 #include <clay/internal/json_reader.hpp>
+#include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/sketch/fit.hpp>
 #include <clay/studio.hpp>

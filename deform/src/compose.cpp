@@ -6,7 +6,6 @@
 #include <clay/internal/checks.hpp>
 #include <clay/internal/math.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/exchange.hpp>
 #include <clay/surface/knots.hpp>
 
 #include <algorithm>
@@ -437,13 +436,13 @@ double largest_homogeneous_point(const BSplineSurface& s) {
 
 // ---- the pipeline shared by the entry points ------------------------------------------------
 
-[[noreturn]] void throw_degree(int du, int dv, const std::string& what,
+[[noreturn]] void throw_degree(int du, int dv, int max_degree, const std::string& what,
                                const std::string& ways_out) {
-  throw Error(ErrorCategory::DegreeLimit,
-              "compose_exact: the exact composition " + what + " has degree (" +
-                  std::to_string(du) + ", " + std::to_string(dv) + "), above the exchange limit " +
-                  std::to_string(surface::max_exchange_degree) +
-                  " (surface::max_exchange_degree, OpenCASCADE and most CAD systems); " + ways_out);
+  throw Error(
+      ErrorCategory::DegreeLimit,
+      "compose_exact: the exact composition " + what + " has degree (" + std::to_string(du) + ", " +
+          std::to_string(dv) + "), above the limit " + std::to_string(max_degree) +
+          " (ComposeOptions::max_degree; 25 is OpenCASCADE's and most CAD systems'); " + ways_out);
 }
 
 /// Joins composed patches, removes knots, measures the deviation against `pointwise`.
@@ -685,6 +684,12 @@ std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface,
 
 // ---- public ---------------------------------------------------------------------------------
 
+namespace {
+// The largest ComposeOptions::max_degree: the Bernstein products' binomials C(n, k) stay integers
+// exactly representable in a double (below 2^53) up to n = 56; 50 leaves room for the products.
+constexpr int kMaxComposeDegree = 50;
+}  // namespace
+
 std::vector<std::string> ComposeOptions::problems() const {
   std::vector<std::string> out;
   if (!(knot_tolerance >= 0 && knot_tolerance <= 1e-6))
@@ -695,6 +700,10 @@ std::vector<std::string> ComposeOptions::problems() const {
   if (check_samples < 0 || check_samples > 64)
     out.push_back("ComposeOptions: check_samples = " + std::to_string(check_samples) +
                   " breaks the rule 0 <= check_samples <= 64; give e.g. 4, or 0 to skip the check");
+  if (max_degree < 1 || max_degree > kMaxComposeDegree)
+    out.push_back("ComposeOptions: max_degree = " + std::to_string(max_degree) +
+                  " breaks the rule 1 <= max_degree <= " + std::to_string(kMaxComposeDegree) +
+                  "; give the receiver's limit, e.g. 25 (OpenCASCADE) or 15 (CATIA's order 16)");
   return out;
 }
 
@@ -732,9 +741,9 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
       auto& f = factors[static_cast<size_t>(a * bp.count_v() + b)];
       f = cell_factors(pc, {0, 0, 0}, {1, 1, 1});
       const auto [du, dv] = composition_degrees(f, lattice, monomials);
-      if (std::max(du, dv) > surface::max_exchange_degree)
+      if (std::max(du, dv) > options.max_degree)
         throw_degree(
-            du, dv,
+            du, dv, options.max_degree,
             "of surface " + patch_name(bp, a, b) + " (degree " + std::to_string(surface.u.degree) +
                 " x " + std::to_string(surface.v.degree) + ") with a Bézier lattice of degrees (" +
                 std::to_string(lattice.degrees[0]) + ", " + std::to_string(lattice.degrees[1]) +
@@ -834,9 +843,9 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
         known = monomials_of.emplace(cell_of[k], detail::lattice_monomials(*cell_of[k])).first;
       factors[k] = cell_factors(pc, lo, width);
       const auto [du, dv] = composition_degrees(factors[k], *cell_of[k], known->second);
-      if (std::max(du, dv) > surface::max_exchange_degree)
+      if (std::max(du, dv) > options.max_degree)
         throw_degree(
-            du, dv,
+            du, dv, options.max_degree,
             "of surface " + patch_name(bp, a, b) + " with a B-spline lattice of degrees (" +
                 std::to_string(lattice.bases[0].degree) + ", " +
                 std::to_string(lattice.bases[1].degree) + ", " +
@@ -925,9 +934,9 @@ ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface,
         WD = std::move(wp.back());
       }
       const int du = R.du + eu, dv = R.dv + ev;
-      if (std::max(du, dv) > surface::max_exchange_degree)
+      if (std::max(du, dv) > options.max_degree)
         throw_degree(
-            du, dv,
+            du, dv, options.max_degree,
             "of surface " + patch_name(bp, a, b) + " with a taper profile of degree " +
                 std::to_string(D),
             "use a taper profile of lower degree, or approximate the deformed surface with a "

@@ -2,14 +2,14 @@
 // "clayform.deformation-stack" version 1 (docs/deform.md). nlohmann-json stays in this file.
 //
 // Adding a deformation kind: one overload in each set below marked "per kind" (write_fields,
-// apply_in_place) and in clay/internal/deformation_json.hpp (kind_of, read_fields, the reader the
+// apply_in_place) and in clay/deform/detail/stack_json.hpp (kind_of, read_fields, the reader the
 // recipe shares); the variant drives the rest.
 #include <clay/deform/stack.hpp>
 
+#include <clay/deform/detail/stack_json.hpp>
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/checks.hpp>
-#include <clay/internal/deformation_json.hpp>
 #include <clay/internal/fenv.hpp>
 
 #include <nlohmann/json.hpp>

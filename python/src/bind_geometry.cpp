@@ -2,10 +2,10 @@
 // builders (fill, loft, revolve), exchange (STEP, IGES, glTF) and pictures.
 #include "common.hpp"
 
+#include <clay/occt/fill.hpp>
+#include <clay/occt/surface_exchange.hpp>
 #include <clay/render/render.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/exchange.hpp>
-#include <clay/surface/fill.hpp>
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/skin.hpp>
 #include <clay/surface/tessellate.hpp>

@@ -2,9 +2,9 @@
 // deform by a recipe's stack, write. A Model is a value: copies are independent.
 #include "common.hpp"
 
-#include <clay/brep/exchange.hpp>
 #include <clay/brep/model.hpp>
 #include <clay/brep/volume.hpp>
+#include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 
 #include <pybind11/stl/filesystem.h>

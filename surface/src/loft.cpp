@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "builder_tools.hpp"
+#include <clay/surface/detail/builder_tools.hpp>
 #include "section_interpolation.hpp"
 
 namespace clay::surface {

@@ -13,7 +13,7 @@
 #include <sstream>
 #include <string>
 
-#include "builder_tools.hpp"
+#include <clay/surface/detail/builder_tools.hpp>
 
 namespace clay::surface {
 namespace {

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "builder_tools.hpp"
+#include <clay/surface/detail/builder_tools.hpp>
 
 namespace clay::surface::detail {
 

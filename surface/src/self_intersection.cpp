@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "builder_tools.hpp"
+#include <clay/surface/detail/builder_tools.hpp>
 #include "homogeneous.hpp"
 namespace clay::surface {
 namespace {

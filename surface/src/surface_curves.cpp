@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "builder_tools.hpp"
+#include <clay/surface/detail/builder_tools.hpp>
 #include "curve_fit.hpp"
 #include "homogeneous.hpp"
 

@@ -5,9 +5,9 @@
 // local lattice leaves alone are kept bit for bit.
 #include <catch2/catch.hpp>
 
-#include <clay/brep/exchange.hpp>
 #include <clay/brep/volume.hpp>
 #include <clay/deform/model_deformation.hpp>
+#include <clay/occt/model_exchange.hpp>
 #include <clay/surface/evaluate.hpp>
 
 #include <filesystem>
@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "error_of.hpp"
-#include "occt/test_models.hpp"
-#include "test_files.hpp"
+#include "occt/test_files.hpp"
+#include "occt_test_models.hpp"
 
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;

@@ -7,11 +7,11 @@
 // within 1 % of the solids' volume by Green's theorem on the trimmed NURBS faces
 // (brep::volume_mm3), and every triangle corner within 1 % of the size of the model's box.
 // Prints the figures; exit 0 when they hold, 1 otherwise, 2 on a read error.
-#include <clay/brep/exchange.hpp>
 #include <clay/brep/volume.hpp>
 #include <clay/error.hpp>
+#include <clay/occt/model_exchange.hpp>
+#include <clay/occt/surface_exchange.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/exchange.hpp>
 #include <clay/surface/tessellate.hpp>
 
 #include <cstdio>

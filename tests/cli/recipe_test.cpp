@@ -4,15 +4,15 @@
 // lattice built here from the same numbers), closed forms, the exchange read-back.
 #include <catch2/catch.hpp>
 
-#include <clay/brep/exchange.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/regular.hpp>
+#include <clay/occt/model_exchange.hpp>
+#include <clay/occt/surface_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/exchange.hpp>
 
 #include <cfenv>
 #include <chrono>

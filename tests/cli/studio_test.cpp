@@ -3,7 +3,7 @@
 // origin checks and coalescing, through a Boost.Beast client.
 #include <catch2/catch.hpp>
 
-#include <clay/brep/exchange.hpp>
+#include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 #include <clay/surface/bspline_surface.hpp>

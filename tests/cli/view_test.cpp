@@ -4,8 +4,8 @@
 // `clayform view` exercised with cpp-httplib's client.
 #include <catch2/catch.hpp>
 
-#include <clay/brep/exchange.hpp>
 #include <clay/deform/regular.hpp>
+#include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/recipe/view.hpp>
 #include <clay/serve.hpp>

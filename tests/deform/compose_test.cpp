@@ -5,8 +5,8 @@
 #include <catch2/catch.hpp>
 
 #include <clay/deform.hpp>
+#include <clay/occt/surface_exchange.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/exchange.hpp>
 #include <clay/surface/revolve.hpp>
 
 #include <algorithm>
@@ -452,6 +452,32 @@ TEST_CASE("compose_exact errors name the problem and the fix") {
     const auto [category, what] = error_of([&] { compose_exact(taper, inside); });
     CHECK(category == ErrorCategory::DegreeLimit);
     CHECK_THAT(what, Contains("degree (27, 27)") && Contains("profile"));
+  }
+  SECTION("degree above the receiver's limit (ComposeOptions::max_degree)") {
+    // A trilinear displaced lattice on a bicubic: exact degree (3 + 3 + 3) = 9 at most; with a
+    // receiver capped at degree 8 it must fail before composing, naming the option.
+    const BezierLattice low = clay::test::displaced(make_bezier_lattice(frame, {1, 1, 1}), rng);
+    ComposeOptions options;
+    const ComposeResult ok = compose_exact(low, inside, options);
+    const int degree = std::max(ok.report.degree_u, ok.report.degree_v);
+    REQUIRE(degree > 3);
+    options.max_degree = degree - 1;
+    const auto [category, what] = error_of([&] { compose_exact(low, inside, options); });
+    CHECK(category == ErrorCategory::DegreeLimit);
+    CHECK_THAT(what, Contains("ComposeOptions::max_degree") &&
+                         Contains("above the limit " + std::to_string(degree - 1)));
+    options.max_degree = degree;
+    CHECK(compose_exact(low, inside, options).report.degree_u == ok.report.degree_u);
+  }
+  SECTION("max_degree outside [1, 50]") {
+    for (int bad : {0, -3, 51}) {
+      ComposeOptions options;
+      options.max_degree = bad;
+      const auto [category, what] = error_of([&] { compose_exact(lattice, inside, options); });
+      CHECK(category == ErrorCategory::InvalidArgument);
+      CHECK_THAT(what, Contains("max_degree = " + std::to_string(bad)) &&
+                           Contains("1 <= max_degree <= 50"));
+    }
   }
   SECTION("surface leaving the lattice") {
     const BSplineSurface out = surface_in(frame, 2, 2, 3, 3, false, rng, [&](int i, int j) {

@@ -10,16 +10,23 @@ function(run)
 endfunction()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${WORK_DIR}/prefix)
 foreach(f include/clay/surface/bspline_surface.hpp include/clay/deform.hpp include/clay/version.hpp
-          include/clay/surface/export.hpp include/clay/surface/exchange_export.hpp
+          include/clay/surface/export.hpp include/clay/occt/export.hpp
           include/clay/sketch/export.hpp include/clay/constraints/export.hpp
-          include/clay/deform/export.hpp include/clay/recipe/export.hpp
+          include/clay/deform/export.hpp include/clay/recipe/export.hpp include/clay/render/export.hpp
+          include/clay/occt.hpp include/clay/occt/surface_exchange.hpp include/clay/brep/mesh.hpp
+          include/clay/clayform.hpp
           lib/cmake/Clayform/ClayformConfig.cmake lib/cmake/Clayform/ClayformConfigVersion.cmake
           bin/clayform)
   if(NOT EXISTS ${WORK_DIR}/prefix/${f})
     message(FATAL_ERROR "install is missing ${f}")
   endif()
 endforeach()
-file(GLOB_RECURSE leaked ${WORK_DIR}/prefix/include/*occt* ${WORK_DIR}/prefix/include/*reference*)
+# Never installed: the OCCT library's sources' headers (convert, session, the OCCT reference),
+# the modules' detail headers, the shared internal helpers, the command's servers, templates.
+file(GLOB_RECURSE leaked ${WORK_DIR}/prefix/include/*reference* ${WORK_DIR}/prefix/include/*convert*
+     ${WORK_DIR}/prefix/include/*session* ${WORK_DIR}/prefix/include/*/detail/*
+     ${WORK_DIR}/prefix/include/clay/internal/* ${WORK_DIR}/prefix/include/clay/serve.hpp
+     ${WORK_DIR}/prefix/include/clay/studio.hpp ${WORK_DIR}/prefix/include/*.in)
 if(leaked)
   message(FATAL_ERROR "internal headers were installed: ${leaked}")
 endif()

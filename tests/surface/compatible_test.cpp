@@ -3,8 +3,8 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/occt/fill.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/fill.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/surface/projection.hpp>
 #include <clay/surface/skin.hpp>

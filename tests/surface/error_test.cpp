@@ -1,8 +1,8 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/occt/fill.hpp>
 #include <clay/summary.hpp>
-#include <clay/surface/fill.hpp>
 #include <clay/surface/projection.hpp>
 #include <clay/surface/skin.hpp>
 

@@ -1,9 +1,9 @@
 #include <catch2/catch.hpp>
 
 #include <clay/error.hpp>
+#include <clay/occt/surface_exchange.hpp>
 #include <clay/surface/arc.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/exchange.hpp>
 #include <clay/surface/revolve.hpp>
 
 #include <Eigen/Geometry>

@@ -1,7 +1,8 @@
 #pragma once
 /// Umbrella header of the surface module: NURBS value types, evaluation, knot operations, degree
-/// elevation, projection, self-intersection of curves, parent-surface builders (fill, loft, sweep,
-/// revolve, primitives) and STEP/IGES/glTF exchange.
+/// elevation, projection, self-intersection of curves, the parent-surface builders that need no
+/// OpenCASCADE (loft, sweep, revolve, primitives). Exchange and the fills are the OCCT library's
+/// (clay/occt.hpp).
 #include <clay/error.hpp>
 #include <clay/summary.hpp>
 #include <clay/surface/arc.hpp>
@@ -11,8 +12,6 @@
 #include <clay/surface/build_report.hpp>
 #include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/exchange.hpp>
-#include <clay/surface/fill.hpp>
 #include <clay/surface/knots.hpp>
 #include <clay/surface/primitives.hpp>
 #include <clay/surface/projection.hpp>

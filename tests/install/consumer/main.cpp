@@ -4,6 +4,7 @@
 // deformation stack through JSON (clay_deform, which links nlohmann-json privately).
 #include <clay/constraints.hpp>
 #include <clay/deform.hpp>
+#include <clay/occt.hpp>
 #include <clay/version.hpp>
 
 #include <cmath>

@@ -49,6 +49,11 @@ struct CLAY_DEFORM_API ComposeOptions {
   /// deformation of the original for ComposeReport::max_relative_deviation (>= 0; 0 skips the
   /// check).
   int check_samples = 4;
+  /// The highest degree the exact composition may have, in [1, 50]: above it compose_exact
+  /// throws DegreeLimit naming the degree and the ways out. 25 is what OpenCASCADE, and so our
+  /// STEP/IGES export, accepts (surface::max_exchange_degree in clay/occt/surface_exchange.hpp);
+  /// give the receiver's own limit (CATIA's order 16 is degree 15) to fail early.
+  int max_degree = 25;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -89,7 +94,7 @@ struct ComposeResult {
 /// surface patch by patch (see above). Throws clay::Error: InvalidGeometry for an invalid lattice
 /// or surface, InvalidArgument for bad options, OutOfDomain when part of the surface lies outside
 /// the lattice (naming the patch, the local coordinate and a parameter where it is outside),
-/// DegreeLimit when the exact degree exceeds surface::max_exchange_degree (naming the degree and
+/// DegreeLimit when the exact degree exceeds ComposeOptions::max_degree (naming the degree and
 /// the ways out: a lattice of lower degree in the thickness direction, or a refit tolerance).
 CLAY_DEFORM_API ComposeResult compose_exact(const BezierLattice& lattice,
                                             const surface::BSplineSurface& surface,
@@ -110,7 +115,7 @@ CLAY_DEFORM_API ComposeResult compose_exact(const BSplineLattice& lattice,
 /// d(z) is the degree of Barr's axial coordinate on the patch (0 when constant) and e that of the
 /// patch, weights W^(D+1). The taper deforms all of space, so no containment is required.
 /// Throws clay::Error: InvalidGeometry for an invalid taper or surface, InvalidArgument for bad
-/// options, DegreeLimit above surface::max_exchange_degree (naming the degree; ways out: a
+/// options, DegreeLimit above ComposeOptions::max_degree (naming the degree; ways out: a
 /// profile of lower degree, or a refit tolerance).
 CLAY_DEFORM_API ComposeResult compose_exact(const Taper& taper,
                                             const surface::BSplineSurface& surface,

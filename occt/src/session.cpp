@@ -1,0 +1,176 @@
+// The shared exchange helpers of session.hpp.
+#include "session.hpp"
+
+#include <clay/error.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <chrono>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <BRepCheck.hxx>
+#include <BRepCheck_ListOfStatus.hxx>
+#include <BRepCheck_Result.hxx>
+#include <Interface_Static.hxx>
+#include <TopExp_Explorer.hxx>
+
+namespace clay::surface::occt {
+
+namespace fs = std::filesystem;
+
+std::mutex& exchange_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+bool extension_is(const fs::path& file, std::initializer_list<const char*> list) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  for (const char* e : list)
+    if (ext == e) return true;
+  return false;
+}
+
+namespace {
+
+std::string random_suffix() {
+  static std::atomic<unsigned long> counter{0};
+  std::random_device device;
+  std::mt19937_64 rng(
+      (static_cast<unsigned long long>(device()) << 32) ^
+      static_cast<unsigned long long>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
+      counter.fetch_add(1));
+  std::ostringstream out;
+  out << std::hex << rng();
+  return out.str();
+}
+
+}  // namespace
+
+/// Checks that the folder of `file` exists and `file` names a file in it.
+void check_target(const fs::path& file, std::string_view caller) {
+  if (file.empty() || !file.has_filename())
+    throw Error(ErrorCategory::Io, std::string(caller) + ": " + quoted(file) +
+                                       " does not name a file; give a file path");
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec))
+    throw Error(ErrorCategory::Io, std::string(caller) + ": the output folder " + quoted(folder) +
+                                       " of " + quoted(file) +
+                                       " does not exist; create it before writing");
+}
+
+/// Writes through `write(temp_path)` into a temporary file next to `file` (".NAME.tmp-<random>")
+/// and renames it onto `file`. On any failure the temporary file is removed and the error
+/// rethrown, so nothing is left behind.
+void write_atomically(const fs::path& file, std::string_view caller,
+                      const std::function<void(const fs::path&)>& write) {
+  check_target(file, caller);
+  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
+  const fs::path temp = folder / ("." + file.filename().string() + ".tmp-" + random_suffix());
+  try {
+    write(temp);
+    std::error_code ec;
+    fs::rename(temp, file, ec);
+    if (ec)
+      throw Error(ErrorCategory::Io, std::string(caller) + ": could not rename " + quoted(temp) +
+                                         " to " + quoted(file) + ": " + ec.message());
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(temp, ignored);
+    throw;
+  }
+}
+
+/// Opens `temp` for writing, lets `print` fill it and checks the stream.
+void write_stream(const fs::path& temp, std::string_view caller,
+                  const std::function<bool(std::ostream&)>& print) {
+  std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+  if (!out)
+    throw Error(ErrorCategory::Io, std::string(caller) + ": could not create " + quoted(temp) +
+                                       "; check that the folder is writable");
+  const bool printed = print(out);
+  out.flush();
+  if (!printed)
+    throw Error(ErrorCategory::Exchange,
+                std::string(caller) + ": OpenCASCADE could not serialize the model");
+  out.close();
+  if (!out)
+    throw Error(ErrorCategory::Io, std::string(caller) + ": writing " + quoted(temp) +
+                                       " failed (disk full or folder not writable?)");
+}
+
+void check_readable(const fs::path& file, std::string_view caller) {
+  std::error_code ec;
+  if (!fs::exists(file, ec))
+    throw Error(ErrorCategory::Io,
+                std::string(caller) + ": " + quoted(file) + " does not exist; check the path");
+  if (!fs::is_regular_file(file, ec))
+    throw Error(ErrorCategory::Io,
+                std::string(caller) + ": " + quoted(file) + " is not a regular file");
+  std::ifstream probe(file, std::ios::binary);
+  if (!probe)
+    throw Error(ErrorCategory::Io, std::string(caller) + ": " + quoted(file) +
+                                       " cannot be opened; check its permissions");
+}
+
+void set_static(const char* name, const char* value) {
+  if (!Interface_Static::SetCVal(name, value))
+    throw Error(ErrorCategory::Internal,
+                std::string("OpenCASCADE setting '") + name + "' does not accept '" + value + "'");
+}
+
+void set_static(const char* name, int value) {
+  if (!Interface_Static::SetIVal(name, value))
+    throw Error(ErrorCategory::Internal, std::string("OpenCASCADE setting '") + name +
+                                             "' does not accept " + std::to_string(value));
+}
+
+std::vector<std::string> check_statuses(const TopoDS_Face& face,
+                                        const BRepCheck_Analyzer& analyzer) {
+  std::vector<std::string> found;
+  auto add = [&](const char* kind, int index, BRepCheck_Status status) {
+    if (status == BRepCheck_NoError) return;
+    std::ostringstream text;
+    BRepCheck::Print(status, text);
+    std::string line =
+        std::string(kind) + (index >= 0 ? " " + std::to_string(index) : "") + ": " + text.str();
+    while (!line.empty() && (line.back() == '\n' || line.back() == ' ')) line.pop_back();
+    for (const auto& f : found)
+      if (f == line) return;
+    found.push_back(line);
+  };
+  auto scan = [&](const TopoDS_Shape& shape, const char* kind, int index) {
+    // Result() throws Standard_NoSuchObject for a shape the analyzer did not reach (an edge of a
+    // face it stopped at); such a shape has no status to report.
+    Handle(BRepCheck_Result) result;
+    try {
+      result = analyzer.Result(shape);
+    } catch (const Standard_NoSuchObject&) {
+      return;
+    }
+    if (result.IsNull()) return;
+    for (BRepCheck_ListIteratorOfListOfStatus it(result->Status()); it.More(); it.Next())
+      add(kind, index, it.Value());
+    for (result->InitContextIterator(); result->MoreShapeInContext(); result->NextShapeInContext())
+      for (BRepCheck_ListIteratorOfListOfStatus it(result->StatusOnShape()); it.More(); it.Next())
+        add(kind, index, it.Value());
+  };
+  scan(face, "face", -1);
+  int index = 0;
+  for (TopExp_Explorer e(face, TopAbs_WIRE); e.More(); e.Next()) scan(e.Current(), "wire", index++);
+  index = 0;
+  for (TopExp_Explorer e(face, TopAbs_EDGE); e.More(); e.Next()) scan(e.Current(), "edge", index++);
+  index = 0;
+  for (TopExp_Explorer e(face, TopAbs_VERTEX); e.More(); e.Next())
+    scan(e.Current(), "vertex", index++);
+  return found;
+}
+
+}  // namespace clay::surface::occt

@@ -1,0 +1,1116 @@
+// Running a checked recipe in memory: every step in order, each timed and reported with the
+// quality figures of DESIGN.md; a failing step is rethrown with its path first.
+#include "recipe_model.hpp"
+
+#include <clay/brep/volume.hpp>
+#include <clay/constraints/solve.hpp>
+#include <clay/deform/jacobian.hpp>
+#include <clay/deform/model_deformation.hpp>
+#include <clay/deform/surface_deformation.hpp>
+#include <clay/error.hpp>
+#include <clay/occt/model_exchange.hpp>
+#include <clay/occt/surface_exchange.hpp>
+#include <clay/sketch/entities.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <set>
+
+namespace clay::recipe {
+
+namespace {
+
+namespace fs = std::filesystem;
+using surface::BSplineCurve;
+using surface::BSplineSurface;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+std::string format(const char* fmt, double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, x);
+  return buf;
+}
+
+/// Runs a library builder, rewording its error in the recipe's keys: the command and recipes name
+/// recipe keys, never the C++ option that holds them (`words` maps one to the other).
+using Words = std::vector<std::pair<std::string_view, std::string_view>>;
+
+template <class F>
+auto in_recipe_words(const Words& words, F&& build) {
+  try {
+    return build();
+  } catch (const Error& e) {
+    std::string m = e.message();
+    for (const auto& [cpp, key] : words)
+      for (auto at = m.find(cpp); at != std::string::npos; at = m.find(cpp, at + key.size()))
+        m.replace(at, cpp.size(), key);
+    throw Error(e.category(), m);
+  }
+}
+
+/// The run's state: named results so far, and the reports.
+/// One of the recipe's models: imported, flattened, and deformed when it names a stack
+/// (defined after the Runner).
+ModelRunResult run_model(const RecipeData& d, const ModelDef& def);
+
+class Runner {
+ public:
+  Runner(const RecipeData& d, const RunOptions& o, RunResult& r)
+      : data_(d), options_(o), result_(r) {}
+
+  /// Strokes, curves and sketches: every named curve, each after what it needs (a curve taken
+  /// from a surface after that surface and the curves it is built from).
+  void curves() {
+    for (const auto& s : data_.strokes) need_curve(s.pieces == 0 ? s.name : piece_name(s.name, 1));
+    for (const auto& c : data_.curves) need_curve(c.name);
+    for (std::size_t k = 0; k < data_.sketches.size(); ++k) need_sketch(k);
+  }
+  /// Every named surface, in document order unless one needs another first.
+  void surfaces() {
+    for (const auto& s : data_.surfaces) need_surface(s.name);
+  }
+
+  /// Above these an exported surface gets a warning: few surfacing tools edit more.
+  static constexpr int editable_degree = 9;
+  static constexpr long editable_control_points = 10000;
+
+  void exports() {
+    for (const auto& e : data_.exports)
+      timed(e.path, "export", [&](StepReport& rep) {
+        ExportResult x;
+        x.name = e.name;
+        x.surface_names = e.surfaces;
+        x.formats = e.formats;
+        x.schema = e.schema;
+        long points = 0;
+        int degree = 0;
+        for (const auto& n : e.surfaces) {
+          x.surfaces.push_back(surface_of(n));
+          points += x.surfaces.back().points.rows();
+          degree = std::max({degree, x.surfaces.back().u.degree, x.surfaces.back().v.degree});
+        }
+        if (degree > surface::max_exchange_degree &&
+            std::any_of(e.formats.begin(), e.formats.end(),
+                        [](const auto& f) { return f != "glb"; }))
+          throw Error(
+              ErrorCategory::DegreeLimit,
+              "degree " + std::to_string(degree) + " is above the exchange limit " +
+                  std::to_string(surface::max_exchange_degree) +
+                  " of STEP/IGES; lower the lattice degrees or compose with \"mode\": \"refit\"");
+        rep.figures = {{"patches", static_cast<long long>(x.surfaces.size())},
+                       {"control_points", static_cast<long long>(points)},
+                       {"degree", static_cast<long long>(degree)}};
+        rep.message = std::to_string(x.surfaces.size()) + " surface(s) for " + e.name;
+        // Exact results can be far beyond what surfacing tools edit: say so, per surface.
+        for (std::size_t k = 0; k < x.surfaces.size(); ++k) {
+          const BSplineSurface& f = x.surfaces[k];
+          if (std::max(f.u.degree, f.v.degree) <= editable_degree &&
+              f.points.rows() <= editable_control_points)
+            continue;
+          rep.warning = true;
+          rep.message +=
+              "; surface '" + e.surfaces[k] + "' has degree " + std::to_string(f.u.degree) + " x " +
+              std::to_string(f.v.degree) + " and " + std::to_string(f.points.rows()) +
+              " control points, more than most surfacing tools edit (degree " +
+              std::to_string(editable_degree) + ", " + std::to_string(editable_control_points) +
+              " control points): " +
+              (made_editable_.count(e.surfaces[k])
+                   ? std::string("this is its editable copy; loosen the composition's "
+                                 "\"tolerance\" for a lighter one")
+                   : std::string("ask for \"composition\": {\"editable\": {}} to export a "
+                                 "certified bicubic copy"));
+        }
+        result_.exports.push_back(std::move(x));
+      });
+  }
+
+  /// Every imported model, deformed when it names a stack.
+  void models() {
+    for (const auto& m : data_.models)
+      timed(m.path, "model", [&](StepReport& rep) {
+        result_.models.push_back(run_model(data_, m));
+        const ModelRunResult& r = result_.models.back();
+        const deform::ModelDeformationReport& x = r.report;
+        rep.figures = {{"faces", static_cast<long long>(x.counts.faces)},
+                       {"faces_exact", static_cast<long long>(x.faces_exact)},
+                       {"faces_refit", static_cast<long long>(x.faces_refit)},
+                       {"faces_untouched", static_cast<long long>(x.faces_untouched)},
+                       {"max_certified_bound_mm", x.max_certified_bound_mm},
+                       {"max_edge_gap_mm", x.max_edge_gap_mm},
+                       {"volume_before_mm3", x.volume_before_mm3},
+                       {"volume_after_mm3", x.volume_after_mm3},
+                       {"fold_free", r.fold_free}};
+        rep.message =
+            (r.deformation.empty() ? "read as it is: " : "deformed by " + r.deformation + ": ") +
+            x.brief();
+      });
+  }
+
+  /// One named surface deformed by a stack (the deform command and `deform` surfaces).
+  /// `final_surface` false: another definition builds on the result, which then stays exact
+  /// (an editable copy is made only of what leaves the recipe, so tolerances do not stack).
+  BSplineSurface deform(const BSplineSurface& parent, const StackDef& stack, const Composition& c,
+                        const std::string& path, const std::string& name,
+                        bool final_surface = true) {
+    BSplineSurface s = parent;
+    for (std::size_t i = 0; i < stack.steps.size(); ++i) {
+      const StepDef& step = stack.steps[i];
+      const std::string p = path + ".steps[" + std::to_string(i) + "]";
+      timed(p, step.kind, [&](StepReport& rep) {
+        rep.message = step.path + (step.name.empty() ? "" : " '" + step.name + "'");
+        if (!step.enabled) {
+          rep.message += ": disabled, skipped";
+          return;
+        }
+        Stage stage{name, p, step.kind, s, {}, {}, {}};
+        if (const auto* style = std::get_if<StyleDef>(&step.step)) {
+          if (!style->bound.empty()) stage.curves.push_back(style->bound);
+          stage.curves.push_back(style->target);
+        }
+        s = std::visit([&](const auto& d) { return apply(d, s, c, rep, stage); }, step.step);
+        stage.after = s;
+        result_.stages.push_back(std::move(stage));
+      });
+    }
+    if (c.editable && final_surface &&
+        (std::max(s.u.degree, s.v.degree) > c.editable->max_degree ||
+         s.points.rows() > c.editable->max_control_points))
+      timed(path + ".composition.editable", "editable", [&](StepReport& rep) {
+        s = editable(s, c, name, rep);
+        made_editable_.insert(name);
+      });
+    return s;
+  }
+
+  /// The exchange-friendly copy of a deformed surface above the "editable" limits: refitted at
+  /// the composition's degree, certified within its tolerance, starting from the surface's rough
+  /// breakpoints only (deform::refit_surface), into at most max_control_points.
+  static BSplineSurface editable(const BSplineSurface& s, const Composition& c,
+                                 const std::string& name, StepReport& rep) {
+    deform::RefitOptions o;
+    o.degree = c.degree;
+    o.tolerance = c.tolerance;
+    o.relative = c.relative;
+    o.max_control_points = c.editable->max_control_points;
+    o.keep_breakpoints = false;
+    const deform::RefitResult r = deform::refit_surface(s, o);
+    const auto& f = r.report;
+    rep.figures = {{"exact_degree_u", static_cast<long long>(s.u.degree)},
+                   {"exact_degree_v", static_cast<long long>(s.v.degree)},
+                   {"exact_control_points", static_cast<long long>(s.points.rows())},
+                   {"degree_u", static_cast<long long>(r.surface.u.degree)},
+                   {"degree_v", static_cast<long long>(r.surface.v.degree)},
+                   {"control_points", static_cast<long long>(r.surface.points.rows())},
+                   {"certified", f.certified},
+                   {"max_deviation_mm", f.certified ? f.certified_bound : f.sampled_max},
+                   {"sampled_max_mm", f.sampled_max},
+                   {"tolerance_mm", f.tolerance},
+                   {"size", f.size}};
+    rep.message = "surface '" + name + "' made editable: degree " + std::to_string(s.u.degree) +
+                  " x " + std::to_string(s.v.degree) + ", " + std::to_string(s.points.rows()) +
+                  " control points -> degree " + std::to_string(r.surface.u.degree) + " x " +
+                  std::to_string(r.surface.v.degree) + ", " +
+                  std::to_string(r.surface.points.rows()) + " control points, " + f.brief();
+    // An editable copy that misses its tolerance is a failure, unless the composition accepts
+    // refits out of tolerance: then it carries a warning, as a refitted step does.
+    if (!f.summary.converged()) {
+      if (!c.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    "the editable copy of surface '" + name +
+                        "' misses its tolerance: " + f.summary.message +
+                        "; raise \"editable\": {\"max_control_points\"} or the composition's "
+                        "\"tolerance\", or raise \"max_degree\" to keep the exact surface");
+      rep.warning = true;
+      rep.message += "; accepted out of tolerance (\"accept_out_of_tolerance\": true)";
+    }
+    return r.surface;
+  }
+
+  const BSplineSurface& surface_of(const std::string& name) const {
+    for (const auto& [n, s] : result_.surfaces)
+      if (n == name) return s;
+    throw Error(ErrorCategory::Internal,
+                "recipe run: surface '" + name + "' missing after checking");
+  }
+  const BSplineCurve& curve_of(const std::string& name) const {
+    const auto it = curve_index_.find(name);
+    if (it == curve_index_.end())
+      throw Error(ErrorCategory::Internal,
+                  "recipe run: curve '" + name + "' missing after checking");
+    return result_.curves[it->second].second;
+  }
+
+ private:
+  const RecipeData& data_;
+  const RunOptions& options_;
+  RunResult& result_;
+  std::map<std::string, std::size_t> curve_index_;
+  std::set<std::size_t> sketches_built_;  // indices into data_.sketches
+  std::set<std::string> building_;        // "curve NAME" / "surface NAME" being built
+  std::set<std::string> made_editable_;   // surfaces exported as their editable copy
+
+  template <class F>
+  void timed(const std::string& path, const std::string& kind, F&& f) {
+    StepReport rep;
+    rep.path = path;
+    rep.kind = kind;
+    const auto t0 = Clock::now();
+    try {
+      f(rep);
+    } catch (const Error& e) {
+      throw Error(e.category(), path + " (" + kind + "): " + recipe_wording(e.message()));
+    }
+    rep.seconds = seconds_since(t0);
+    if (options_.progress) options_.progress(rep);
+    result_.steps.push_back(std::move(rep));
+  }
+
+  /// Builds the curve `name` unless built: first what it needs, then its stroke, curve or sketch.
+  void need_curve(const std::string& name) {
+    if (curve_index_.count(name)) return;
+    guard("curve " + name, [&] {
+      const Needs needs = curve_needs(data_, name);
+      for (const auto& c : needs.curves) need_curve(c);
+      for (const auto& s : needs.surfaces) need_surface(s);
+      for (const auto& s : data_.strokes)
+        if (defines(s, name))
+          return timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); });
+      for (const auto& c : data_.curves)
+        if (c.name == name) return timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); });
+      for (std::size_t k = 0; k < data_.sketches.size(); ++k)
+        for (const auto& [entity, id] : data_.sketches[k].entities)
+          if (entity == name) return need_sketch(k);
+    });
+  }
+  void need_sketch(std::size_t k) {
+    if (sketches_built_.count(k)) return;
+    sketches_built_.insert(k);
+    const SketchDef& s = data_.sketches[k];
+    for (const auto& c : s.uses) need_curve(c);
+    timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); });
+  }
+  void need_surface(const std::string& name) {
+    if (std::any_of(result_.surfaces.begin(), result_.surfaces.end(),
+                    [&](const auto& s) { return s.first == name; }))
+      return;
+    guard("surface " + name, [&] {
+      for (const SurfaceDef& def : data_.surfaces)
+        if (def.name == name) {
+          const Needs needs = surface_needs(data_, def);
+          for (const auto& c : needs.curves) need_curve(c);
+          for (const auto& s : needs.surfaces) need_surface(s);
+          return build_surface(def);
+        }
+    });
+  }
+  /// Runs f for `node` once at a time: the checker reports cycles, so meeting one here is a bug.
+  template <class F>
+  void guard(const std::string& node, F&& f) {
+    if (!building_.insert(node).second)
+      throw Error(ErrorCategory::Internal,
+                  "recipe run: " + node + " needs itself (please report this recipe)");
+    f();
+    building_.erase(node);
+  }
+
+  void add_curve(const std::string& name, BSplineCurve c) {
+    curve_index_[name] = result_.curves.size();
+    result_.curves.emplace_back(name, std::move(c));
+  }
+
+  /// Whether the stroke's fit gives the curve `name`: its own name, or one of its pieces.
+  static bool defines(const StrokeDef& s, const std::string& name) {
+    if (s.pieces == 0) return s.name == name;
+    for (int k = 1; k <= s.pieces; ++k)
+      if (piece_name(s.name, k) == name) return true;
+    return false;
+  }
+
+  void stroke(const StrokeDef& s, StepReport& rep) {
+    const sketch::StrokeFit fit = sketch::fit_stroke(s.stroke, s.fit);
+    const std::size_t wanted = s.pieces == 0 ? 1 : static_cast<std::size_t>(s.pieces);
+    if (fit.curves.size() != wanted) {
+      const std::string found = std::to_string(fit.curves.size());
+      throw Error(ErrorCategory::InvalidGeometry,
+                  s.pieces == 0
+                      ? "the stroke was fitted with " + found +
+                            " curves; a recipe stroke without \"pieces\" gives one curve: draw "
+                            "it as separate strokes"
+                      : "the stroke turns by more than " + format("%g", s.fit.corner_angle) +
+                            " degrees at " + std::to_string(fit.corners.size()) +
+                            " corners, so it gives " + found + " curves, not " +
+                            std::to_string(s.pieces) + ": set \"pieces\": " + found + " (curves " +
+                            piece_name(s.name, 1) + " .. " +
+                            piece_name(s.name, static_cast<int>(fit.curves.size())) +
+                            "), change \"corner_angle\", or draw it again");
+    }
+    long long control_points = 0;
+    double rms = 0;
+    for (const auto& c : fit.curves) {
+      control_points += c.control_points;
+      rms = std::max(rms, c.rms_deviation_mm);
+    }
+    rep.figures = {{"control_points", control_points},
+                   {"max_deviation_mm", fit.max_deviation_mm},
+                   {"rms_deviation_mm", rms},
+                   {"closed", fit.closed}};
+    if (s.pieces > 0) {
+      rep.figures.emplace_back("pieces", static_cast<long long>(fit.curves.size()));
+      rep.figures.emplace_back("corners", static_cast<long long>(fit.corners.size()));
+    }
+    rep.message = fit.summary.brief();
+    if (!fit.summary.converged()) {  // a fit that misses its tolerance is a failure unless accepted
+      if (!s.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    "the fit misses its tolerance (" + fit.summary.brief() +
+                        "): raise the stroke's \"tolerance\" or its \"degree\", or draw it again; "
+                        "to keep the fit "
+                        "anyway, set \"accept_out_of_tolerance\": true on the stroke");
+      rep.warning = true;
+    }
+    if (s.pieces == 0) return add_curve(s.name, fit.curves.front().curve);
+    for (std::size_t k = 0; k < fit.curves.size(); ++k)
+      add_curve(piece_name(s.name, static_cast<int>(k + 1)), fit.curves[k].curve);
+  }
+
+  void curve(const CurveDef& c, StepReport& rep) {
+    std::optional<surface::FittedCurve> fitted;
+    BSplineCurve out;
+    if (c.curve) {
+      out = *c.curve;
+    } else if (!c.mirror_of.empty()) {
+      out = surface::mirrored(curve_of(c.mirror_of), c.plane.origin, c.plane.normal);
+    } else if (!c.reversed_of.empty()) {
+      out = surface::reversed(curve_of(c.reversed_of));
+    } else if (c.kind == "iso" || c.kind == "boundary") {
+      const BSplineSurface& s = surface_of(c.surface);
+      const auto [a, b] = c.fixed_u ? s.u.domain() : s.v.domain();
+      const double t = c.at == 1.0 ? b : a + c.at * (b - a);
+      out = c.fixed_u ? surface::iso_curve_u(s, t) : surface::iso_curve_v(s, t);
+    } else {
+      const BSplineSurface& s = surface_of(c.surface);
+      fitted = in_recipe_words({{"CurveFitOptions::tolerance_mm", "\"tolerance\""},
+                                {"max_control_points", "its limit of control points"},
+                                {"raise the tolerance", "raise \"tolerance\""}},
+                               [&] {
+                                 return c.kind == "project"
+                                            ? surface::project_curve(curve_of(c.source), s, c.fit)
+                                            : surface::offset_along_normal(curve_of(c.source), s,
+                                                                           c.distance, c.fit);
+                               });
+      out = fitted->curve;
+    }
+    rep.figures = {{"degree", static_cast<long long>(out.basis.degree)},
+                   {"control_points", static_cast<long long>(out.points.rows())},
+                   {"rational", out.is_rational()}};
+    if (fitted) {
+      rep.figures.emplace_back("max_deviation_mm", fitted->max_deviation_mm);
+      rep.figures.emplace_back("tolerance_mm", c.fit.tolerance_mm);
+      rep.message = c.kind + " of '" + c.source + "' on '" + c.surface + "' within " +
+                    format("%.3g", fitted->max_deviation_mm) + " mm (" +
+                    std::to_string(fitted->samples) + " samples)";
+    }
+    add_curve(c.name, std::move(out));
+  }
+
+  void sketch(const SketchDef& checked, StepReport& rep) {
+    // A sketch using a stroke's fit or a reversed curve is built now, with the real curves.
+    const SketchDef s =
+        checked.deferred_json.empty()
+            ? checked
+            : rebuild_sketch(checked, [&](const std::string& n) -> const BSplineCurve* {
+                const auto it = curve_index_.find(n);
+                return it == curve_index_.end() ? nullptr : &result_.curves[it->second].second;
+              });
+    const auto solved = constraints::solve(s.sketch, s.constraints, s.solve);
+    const auto& r = solved.report;
+    if (!r.conflicting.empty())  // the summary lists every conflicting set, once
+      throw Error(ErrorCategory::InvalidGeometry,
+                  "the sketch does not solve: " + r.summary.message +
+                      "; remove or change a conflicting constraint");
+    if (!r.summary.converged())  // nothing conflicts: the solver stopped short
+      throw Error(
+          ErrorCategory::InvalidGeometry,
+          "the solver stopped before the constraints hold (" + r.summary.brief() +
+              "); nothing conflicts: move the drawn geometry closer to what the constraints ask");
+    rep.figures = {{"max_residual", r.max_residual},
+                   {"degrees_of_freedom", static_cast<long long>(r.degrees_of_freedom)},
+                   {"redundant_sets", static_cast<long long>(r.redundant.size())},
+                   {"constraints", static_cast<long long>(s.constraints.size())}};
+    for (std::size_t k = 0; k < r.redundant.size(); ++k)  // every set, not only the first
+      rep.figures.emplace_back("redundant[" + std::to_string(k) + "]", r.redundant[k].message);
+    rep.message = r.summary.brief();
+    for (const auto& [name, id] : s.entities) add_curve(name, sketch::curve_of(solved.sketch, id));
+  }
+
+  /// Runs a builder that takes a list of curves, its errors naming them as the recipe does:
+  /// "curve #1" (the builder's index) becomes "curve \"leech\"".
+  template <class F>
+  static auto by_names(const std::vector<std::string>& names, const std::string& word, F build) {
+    try {
+      auto built = build();
+      built.report.method = named(built.report.method, names, word);
+      return built;
+    } catch (const Error& e) {
+      throw Error(e.category(), named(e.message(), names, word));
+    }
+  }
+  /// `m` with every "WORD #k" replaced by WORD "names[k]".
+  static std::string named(std::string m, const std::vector<std::string>& names,
+                           const std::string& word) {
+    const std::string tag = word + " #";
+    for (std::size_t at = m.find(tag); at != std::string::npos; at = m.find(tag, at + 1)) {
+      std::size_t end = at + tag.size();
+      while (end < m.size() && std::isdigit(static_cast<unsigned char>(m[end]))) ++end;
+      if (end == at + tag.size()) continue;
+      const std::size_t k = std::stoul(m.substr(at + tag.size(), end - at - tag.size()));
+      if (k < names.size()) m.replace(at, end - at, word + " \"" + names[k] + "\"");
+    }
+    return m;
+  }
+
+  std::vector<BSplineCurve> curves_named(const std::vector<std::string>& names) const {
+    std::vector<BSplineCurve> out;
+    for (const auto& n : names) out.push_back(curve_of(n));
+    return out;
+  }
+
+  static void build_figures(const surface::BuildReport& b, StepReport& rep) {
+    rep.figures = {{"degree_u", static_cast<long long>(b.degree_u)},
+                   {"degree_v", static_cast<long long>(b.degree_v)},
+                   {"control_points", static_cast<long long>(b.count_u) * b.count_v},
+                   {"rational", b.rational},
+                   {"exact", b.exact},
+                   {"max_deviation_mm", b.max_deviation_mm}};
+    rep.message = b.brief();
+  }
+
+  void build_surface(const SurfaceDef& def) {
+    static const Words superquadric_words{{"SuperquadricOptions::tolerance", "\"tolerance\""},
+                                          {", raise max_spans", ""}};
+    if (const auto* d = std::get_if<DeformDef>(&def.build)) {
+      const StackDef& stack =
+          *std::find_if(data_.stacks.begin(), data_.stacks.end(),
+                        [&](const StackDef& s) { return s.name == d->deformation; });
+      BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name,
+                                !built_on(data_, def.name));
+      result_.surfaces.emplace_back(def.name, std::move(s));
+      return;
+    }
+    timed(def.path, def.kind, [&](StepReport& rep) {
+      BSplineSurface s = std::visit(
+          [&](const auto& b) -> BSplineSurface {
+            using T = std::decay_t<decltype(b)>;
+            if constexpr (std::is_same_v<T, BSplineSurface>) {
+              build_figures(surface::describe(b, "inline B-spline surface"), rep);
+              return b;
+            } else if constexpr (std::is_same_v<T, FillDef>) {
+              const std::vector<BSplineCurve> boundary = curves_named(b.curves);
+              auto built =
+                  by_names(b.curves, "curve", [&] { return surface::fill(boundary, b.options); });
+              build_figures(built.report, rep);
+              if (b.snap) {
+                // How far the ends moved: each curve end to the nearest end of another curve,
+                // halved (the fill joins each corner at the midpoint of its two ends).
+                double snapped = 0;
+                for (std::size_t k = 0; k < boundary.size(); ++k)
+                  for (const double tk :
+                       {boundary[k].basis.domain().first, boundary[k].basis.domain().second}) {
+                    double nearest = std::numeric_limits<double>::infinity();
+                    for (std::size_t m = 0; m < boundary.size(); ++m)
+                      if (m != k)
+                        for (const double tm :
+                             {boundary[m].basis.domain().first, boundary[m].basis.domain().second})
+                          nearest = std::min(nearest, (surface::evaluate(boundary[k], tk) -
+                                                       surface::evaluate(boundary[m], tm))
+                                                          .norm());
+                    if (std::isfinite(nearest)) snapped = std::max(snapped, nearest / 2);
+                  }
+                rep.figures.emplace_back("snapped_mm", snapped);
+              }
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, SkinDef>) {
+              auto built = by_names(b.sections, "section", [&] {
+                return surface::loft(curves_named(b.sections), b.options);
+              });
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, SweepDef>) {
+              auto built = in_recipe_words(
+                  {{"SweepOptions::max_sections = ", "a sweep's limit of "},
+                   {"SweepOptions::tolerance", "\"tolerance\""},
+                   {"SweepOptions::twist_degrees", "\"twist_degrees\""}},
+                  [&] { return surface::sweep(curve_of(b.profile), curve_of(b.path), b.options); });
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, RevolveDef>) {
+              auto built = surface::revolve(curve_of(b.profile), b.axis, b.angle);
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, SuperellipsoidDef>) {
+              auto built = in_recipe_words(
+                  superquadric_words, [&] { return surface::superellipsoid(b.shape, b.options); });
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, SupertoroidDef>) {
+              auto built = in_recipe_words(
+                  superquadric_words, [&] { return surface::supertoroid(b.shape, b.options); });
+              build_figures(built.report, rep);
+              return std::move(built.surface);
+            } else if constexpr (std::is_same_v<T, ImportDef>) {
+              std::string ext = b.file.extension().string();
+              for (char& ch : ext)
+                ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+              // A file from elsewhere: read in a child process, so a file that crashes or hangs
+              // OpenCASCADE fails this step instead of the run (surface::ReadOptions).
+              surface::ReadOptions guard;
+              guard.isolate = true;
+              auto all = (ext == ".igs" || ext == ".iges") ? surface::read_iges(b.file, guard)
+                                                           : surface::read_step(b.file, guard);
+              if (b.index >= static_cast<int>(all.size()))
+                throw Error(ErrorCategory::InvalidArgument,
+                            "index " + std::to_string(b.index) + " but \"" + b.file.string() +
+                                "\" holds " + std::to_string(all.size()) +
+                                " surface(s); give an index below " + std::to_string(all.size()));
+              build_figures(surface::describe(all[static_cast<std::size_t>(b.index)], "import"),
+                            rep);
+              return std::move(all[static_cast<std::size_t>(b.index)]);
+            } else if constexpr (std::is_same_v<T, RebuildDef>) {
+              deform::RefitOptions o;
+              o.degree = b.degree;
+              o.count_u = b.count_u;
+              o.count_v = b.count_v;
+              o.tolerance = b.tolerance;
+              // Without counts the net grows only where the tolerance needs it, from the
+              // original's rough breakpoints alone, as the editable output does.
+              const bool fixed = b.count_u > 0;
+              o.keep_breakpoints = fixed;
+              const auto fit = deform::refit_surface(surface_of(b.surface), o);
+              const auto& r = fit.report;
+              surface::BuildReport built = surface::describe(
+                  fit.surface, "rebuild of '" + b.surface + "' " +
+                                   (fixed ? "on " + std::to_string(b.count_u) + " x " +
+                                                std::to_string(b.count_v) + " control points"
+                                          : "to its tolerance"));
+              built.max_deviation_mm = r.certified ? r.certified_bound : r.sampled_max;
+              built.samples = static_cast<int>(std::min<long>(r.samples, 1L << 30));
+              build_figures(built, rep);
+              rep.figures.emplace_back("certified_bound_mm", r.certified_bound);
+              rep.figures.emplace_back("sampled_max_mm", r.sampled_max);
+              rep.figures.emplace_back("tolerance_mm", r.tolerance);
+              rep.message = r.brief();
+              if (!r.summary.converged())
+                throw Error(ErrorCategory::ToleranceNotMet,
+                            "the rebuilt net misses its tolerance (" + r.summary.message +
+                                (fixed ? "): raise \"count_u\" and \"count_v\", \"tolerance\" or "
+                                         "\"degree\""
+                                       : "): raise \"tolerance\" or \"degree\""));
+              return fit.surface;
+            } else if constexpr (std::is_same_v<T, MirrorDef>) {
+              BSplineSurface m =
+                  surface::mirrored(surface_of(b.surface), b.plane.origin, b.plane.normal);
+              build_figures(surface::describe(m,
+                                              "mirror of "
+                                              " + b.surface + "
+                                              ""),
+                            rep);
+              return m;
+            } else {
+              throw Error(ErrorCategory::Internal, "recipe run: deform handled above");
+            }
+          },
+          def.build);
+      result_.surfaces.emplace_back(def.name, std::move(s));
+    });
+  }
+
+  // ---- deformation steps --------------------------------------------------------------------
+
+ public:
+  /// The composition's settings as deform_surface's (deform_model uses them too).
+  static deform::SurfaceDeformationOptions deformation_options(const Composition& c) {
+    deform::SurfaceDeformationOptions o;
+    o.compose.check_samples = c.check_samples;
+    if (c.refit) {
+      deform::RefitOptions r;
+      r.degree = c.degree;
+      r.tolerance = c.tolerance;
+      r.relative = c.relative;
+      r.max_control_points = c.max_control_points;
+      o.refit = r;
+    }
+    o.accept_out_of_tolerance = c.accept_out_of_tolerance;
+    return o;
+  }
+
+ private:
+  static void lattice_figures(const deform::Deformation& d, StepReport& rep) {
+    std::optional<deform::JacobianBounds> j;
+    if (const auto* b = std::get_if<deform::BezierLattice>(&d)) j = deform::jacobian_bounds(*b);
+    if (const auto* b = std::get_if<deform::BSplineLattice>(&d)) j = deform::jacobian_bounds(*b);
+    if (!j) return;
+    rep.figures.emplace_back("fold_free", j->fold_free);
+    rep.figures.emplace_back("volume_ratio_min", j->min);
+    rep.figures.emplace_back("volume_ratio_max", j->max);
+    if (!j->fold_free) {
+      rep.warning = true;
+      rep.message +=
+          "; the lattice may fold (Jacobian coefficient " + format("%.3g", j->min) + " <= 0)";
+    }
+  }
+
+  static BSplineSurface compose(const deform::Deformation& d, const BSplineSurface& s,
+                                const Composition& c, StepReport& rep) {
+    const auto r = deform::deform_surface(d, s, deformation_options(c));
+    const auto& o = r.report.steps.front();
+    auto sizes = [&] {
+      rep.figures.emplace_back("degree_u", static_cast<long long>(r.surface.u.degree));
+      rep.figures.emplace_back("degree_v", static_cast<long long>(r.surface.v.degree));
+      rep.figures.emplace_back("control_points", static_cast<long long>(r.surface.points.rows()));
+    };
+    if (o.method == deform::StepOutcome::Method::Exact) {
+      rep.figures.emplace_back("composition", std::string("exact"));
+      rep.figures.emplace_back("max_relative_deviation",
+                               o.compose.max_relative_deviation);  // of size
+      rep.figures.emplace_back("max_deviation_mm",
+                               o.compose.max_relative_deviation * o.compose.size);
+      sizes();
+      rep.figures.emplace_back("exact", true);
+      rep.figures.emplace_back("patches", static_cast<long long>(o.compose.patches));
+      rep.figures.emplace_back("size", o.compose.size);
+      rep.message += ": exact, " + o.compose.brief();
+    } else {
+      const auto& f = o.refit;
+      const double bound = f.certified ? f.certified_bound : f.sampled_max;
+      rep.figures.emplace_back("composition", std::string("refit"));
+      rep.figures.emplace_back("max_relative_deviation", bound / f.size);
+      rep.figures.emplace_back("max_deviation_mm", bound);
+      sizes();
+      rep.figures.emplace_back("exact", false);
+      rep.figures.emplace_back("certified", f.certified);
+      rep.figures.emplace_back("tolerance_mm", f.tolerance);
+      rep.figures.emplace_back("sampled_max_mm", f.sampled_max);
+      rep.figures.emplace_back("size", f.size);
+      rep.message += ": refit (" + o.reason + "), " + f.brief();
+      // A refit that misses its tolerance is a failure (deform_surface throws ToleranceNotMet),
+      // unless the composition accepts it: then the step carries a warning.
+      if (!f.summary.converged()) {
+        rep.warning = true;
+        rep.message += "; accepted out of tolerance (\"accept_out_of_tolerance\": true)";
+      }
+    }
+    return r.surface;
+  }
+
+  BSplineSurface apply(const deform::Deformation& d, const BSplineSurface& s, const Composition& c,
+                       StepReport& rep, Stage& stage) {
+    stage.map = [d](const Eigen::Vector3d& x) {
+      return std::visit(
+          [&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, d);
+    };
+    BSplineSurface out = compose(d, s, c, rep);
+    lattice_figures(d, rep);
+    return out;
+  }
+
+  BSplineSurface apply(const StyleDef& d, const BSplineSurface& s, const Composition&,
+                       StepReport& rep, Stage&) {
+    const auto r = d.bound.empty()
+                       ? deform::style_deform(s, curve_of(d.target), d.options)
+                       : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
+    const auto& x = r.report;
+    rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::Exact ? "exact" : "paper")},
+                   {"constraint_class", std::string(deform::to_string(x.constraint_class))},
+                   {"key_points", static_cast<long long>(x.m)},
+                   {"influenced_vertices", static_cast<long long>(x.influenced_vertices)},
+                   {"moved_vertices", static_cast<long long>(x.moved_vertices)},
+                   {"max_displacement", x.max_displacement},
+                   {"target_deviation", x.target_deviation},
+                   {"target_curve_deviation", x.target_curve_deviation},
+                   {"target_curve_distance", x.target_curve_distance},
+                   {"mean_curvature_min", x.mean_curvature_min},
+                   {"mean_curvature_max", x.mean_curvature_max},
+                   {"locality", x.locality},
+                   {"boundary_position_jump", x.boundary_position_jump},
+                   {"boundary_tangent_angle", x.boundary_tangent_angle},
+                   {"knots_inserted", static_cast<long long>(x.knots_inserted)},
+                   {"added_key_points", static_cast<long long>(x.added_key_points)},
+                   {"net_change", x.net_change},
+                   {"fairness_energy", x.fairness_energy},
+                   {"degree_u", static_cast<long long>(r.surface.u.degree)},
+                   {"degree_v", static_cast<long long>(r.surface.v.degree)},
+                   {"control_points", static_cast<long long>(r.surface.points.rows())}};
+    rep.message += ": " + x.message;
+    rep.figures.emplace_back("outcome", std::string(x.summary.converged() ? "met" : "missed"));
+    if (!x.summary.converged()) {
+      if (!d.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    x.summary.message +
+                        ". Nothing was written; to keep such a result anyway, set "
+                        "\"accept_out_of_tolerance\": true on this step");
+      rep.warning = true;
+      rep.message += "; accepted out of tolerance: " + x.summary.message;
+    }
+    return r.surface;
+  }
+
+  BSplineSurface apply(const DirectDef& d, const BSplineSurface& s, const Composition& c,
+                       StepReport& rep, Stage& stage) {
+    std::vector<deform::PointMove> moves;
+    for (const auto& m : d.moves) {
+      Eigen::Vector3d x = m.point;
+      if (m.on_surface) {
+        const auto [u0, u1] = s.u.domain();
+        const auto [v0, v1] = s.v.domain();
+        if (m.point.x() < u0 || m.point.x() > u1 || m.point.y() < v0 || m.point.y() > v1)
+          throw Error(ErrorCategory::OutOfDomain,
+                      "surface_point (" + format("%.17g", m.point.x()) + ", " +
+                          format("%.17g", m.point.y()) + ") is outside the surface's domain [" +
+                          format("%g", u0) + ", " + format("%g", u1) + "] x [" + format("%g", v0) +
+                          ", " + format("%g", v1) + "]; give parameters inside it");
+        x = surface::evaluate(s, m.point.x(), m.point.y());
+      }
+      moves.push_back({x, m.to});
+    }
+    deform::Deformation lattice;
+    deform::DirectManipulationReport r;
+    std::visit(
+        [&](const auto& lat) {
+          auto solved = deform::manipulate(lat, moves, d.options);
+          r = solved.report;
+          lattice = std::move(solved.lattice);
+        },
+        d.lattice);
+    rep.figures = {{"requested", static_cast<long long>(r.requested)},
+                   {"rank", static_cast<long long>(r.rank)},
+                   {"feasible", r.feasible},
+                   {"residual", r.residual},
+                   {"achieved_max_error", r.achieved_max_error},
+                   {"displacement_norm", r.displacement_norm}};
+    rep.message += ": " + r.summary.message;
+    if (!r.feasible) {  // moves the lattice cannot meet: a failure unless accepted
+      if (!d.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    "the lattice cannot meet every move (" + r.summary.message +
+                        "): free more control points (fewer \"locked\"), use a finer lattice, or "
+                        "ask for fewer "
+                        "moves; to keep the least-squares answer anyway, set "
+                        "\"accept_out_of_tolerance\": true on "
+                        "this step");
+      rep.warning = true;
+    }
+    stage.map = [lattice](const Eigen::Vector3d& x) {
+      return std::visit(
+          [&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, lattice);
+    };
+    BSplineSurface out = compose(lattice, s, c, rep);
+    lattice_figures(lattice, rep);
+    return out;
+  }
+};
+
+}  // namespace
+
+namespace {
+
+/// The value named `name` in a run's (name, value) list, or InvalidArgument naming the defined
+/// ones.
+template <class T>
+const T& named(const std::vector<std::pair<std::string, T>>& list, std::string_view name,
+               const char* what) {
+  std::string known;
+  for (const auto& [n, value] : list) {
+    if (n == name) return value;
+    known += (known.empty() ? "" : ", ") + n;
+  }
+  throw Error(ErrorCategory::InvalidArgument, "no " + std::string(what) + " named '" +
+                                                  std::string(name) + "' in the run; its " + what +
+                                                  "s: " + known);
+}
+
+}  // namespace
+
+const BSplineSurface& RunResult::surface(std::string_view name) const {
+  return named(surfaces, name, "surface");
+}
+
+const BSplineCurve& RunResult::curve(std::string_view name) const {
+  return named(curves, name, "curve");
+}
+
+RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "run_recipe: empty recipe; load or parse one first");
+  const auto t0 = Clock::now();
+  RunResult result;
+  result.recipe = recipe.data->name;
+  Runner runner(*recipe.data, options, result);
+  runner.curves();
+  runner.surfaces();
+  runner.exports();
+  runner.models();
+  result.seconds = seconds_since(t0);
+  return result;
+}
+
+std::vector<std::string> final_surfaces(const Recipe& recipe) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "final_surfaces: empty recipe; load or parse one first");
+  std::set<std::string> parents;
+  for (const SurfaceDef& s : recipe.data->surfaces)
+    if (const auto* d = std::get_if<DeformDef>(&s.build))
+      parents.insert(d->surface);
+    else if (const auto* r = std::get_if<RebuildDef>(&s.build))
+      parents.insert(r->surface);
+  std::vector<std::string> out;
+  for (const SurfaceDef& s : recipe.data->surfaces)
+    if (!parents.count(s.name)) out.push_back(s.name);
+  return out;
+}
+
+namespace {
+
+/// The recipe's deformation stack named `deformation`, or its only one when the name is empty.
+const StackDef& pick_stack(const RecipeData& d, std::string_view deformation) {
+  std::string names;
+  for (const auto& s : d.stacks) names += (names.empty() ? "" : ", ") + s.name;
+  if (deformation.empty()) {
+    if (d.stacks.size() != 1)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "the recipe has " + std::to_string(d.stacks.size()) + " deformation stacks (" +
+                      names + "); name one with --deformation");
+    return d.stacks.front();
+  }
+  for (const auto& s : d.stacks)
+    if (s.name == deformation) return s;
+  throw Error(ErrorCategory::InvalidArgument, "the recipe has no deformation stack '" +
+                                                  std::string(deformation) +
+                                                  "'; its stacks: " + names);
+}
+
+/// A stack for a whole model: lattices and regular deformations as they are, direct
+/// manipulation solved from moves in space; a style step or a move from a surface point is
+/// refused, naming the step. `fold_free` is cleared when a lattice's Jacobian bounds are not
+/// positive; then, unless `allow_fold`, the step is refused: a folded lattice wrote a
+/// self-intersecting solid reported valid, 155 mm^3 for a 15,708 mm^3 rod (issue #36).
+deform::DeformationStack model_stack(const StackDef& def, bool& fold_free, bool allow_fold) {
+  deform::DeformationStack stack;
+  for (std::size_t i = 0; i < def.steps.size(); ++i) {
+    const StepDef& step = def.steps[i];
+    const std::string where = def.path + ".steps[" + std::to_string(i) + "] (" + step.kind + ")";
+    deform::Deformation lattice = std::visit(
+        [&](const auto& k) -> deform::Deformation {
+          using T = std::decay_t<decltype(k)>;
+          if constexpr (std::is_same_v<T, deform::Deformation>) {
+            return k;
+          } else if constexpr (std::is_same_v<T, DirectDef>) {
+            std::vector<deform::PointMove> moves;
+            for (const auto& m : k.moves) {
+              if (m.on_surface)
+                throw Error(ErrorCategory::InvalidArgument,
+                            where +
+                                ": a move from a \"surface_point\" needs one surface; to "
+                                "deform a model, give the move's \"point\" in space");
+              moves.push_back({m.point, m.to});
+            }
+            deform::Deformation solved;
+            bool feasible = true;
+            std::string message;
+            std::visit(
+                [&](const auto& lat) {
+                  auto r = deform::manipulate(lat, moves, k.options);
+                  feasible = r.report.feasible;
+                  message = r.report.summary.message;
+                  solved = std::move(r.lattice);
+                },
+                k.lattice);
+            if (!feasible && !k.accept_out_of_tolerance)
+              throw Error(ErrorCategory::ToleranceNotMet,
+                          where + ": the lattice cannot meet every move (" + message +
+                              "); free more control points, use a finer lattice or ask for "
+                              "fewer moves");
+            return solved;
+          } else {
+            throw Error(ErrorCategory::InvalidArgument,
+                        where +
+                            ": a style step shapes one surface by its control points; a "
+                            "model deforms through lattices, direct manipulation and "
+                            "regular deformations (taper, twist, bend)");
+          }
+        },
+        step.step);
+    std::optional<deform::JacobianBounds> bounds;
+    if (const auto* b = std::get_if<deform::BezierLattice>(&lattice))
+      bounds = deform::jacobian_bounds(*b);
+    if (const auto* b = std::get_if<deform::BSplineLattice>(&lattice))
+      bounds = deform::jacobian_bounds(*b);
+    if (bounds && step.enabled && !bounds->fold_free) {
+      fold_free = false;
+      if (!allow_fold)
+        throw Error(ErrorCategory::InvalidGeometry,
+                    where +
+                        ": the lattice may fold space (the smallest Bernstein coefficient of "
+                        "its Jacobian is " +
+                        format("%.3g", bounds->min) +
+                        " <= 0, Sederberg-Parry section 4), so the deformed solid may intersect "
+                        "itself; move its points less or use a finer lattice, or allow it with "
+                        "\"allow_fold\": true on the model (clayform deform --allow-fold)");
+    }
+    stack.steps.push_back({std::move(lattice), step.name, step.enabled});
+  }
+  return stack;
+}
+
+/// The faces of `flat` the model's "bodies" and "faces" name (every face when both are empty);
+/// a name that matches nothing is refused, listing the names the model has.
+std::vector<int> chosen_faces(const brep::Model& flat, const ModelDef& def) {
+  std::vector<int> out;
+  if (def.bodies.empty() && def.faces.empty()) return out;
+  std::vector<bool> chosen(flat.faces.size(), false);
+  auto known = [](const auto& items) {
+    std::vector<std::string> names;
+    for (const auto& x : items)
+      if (!x.name.empty() && std::find(names.begin(), names.end(), x.name) == names.end())
+        names.push_back(x.name);
+    std::string text;
+    for (const auto& n : names) text += (text.empty() ? "\"" : ", \"") + n + "\"";
+    return text.empty() ? std::string("none is named") : text;
+  };
+  for (std::size_t i = 0; i < def.bodies.size(); ++i) {
+    bool found = false;
+    for (const brep::Body& body : flat.bodies)
+      if (body.name == def.bodies[i]) {
+        found = true;
+        for (const brep::Shell& shell : body.shells)
+          for (int f : shell.faces) chosen[static_cast<std::size_t>(f)] = true;
+      }
+    if (!found)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "bodies[" + std::to_string(i) + "]: the model has no body named \"" +
+                      def.bodies[i] + "\"; its bodies: " + known(flat.bodies));
+  }
+  for (std::size_t i = 0; i < def.faces.size(); ++i) {
+    bool found = false;
+    for (std::size_t f = 0; f < flat.faces.size(); ++f)
+      if (flat.faces[f].name == def.faces[i]) found = chosen[f] = true;
+    if (!found)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "faces[" + std::to_string(i) + "]: the model has no face named \"" +
+                      def.faces[i] + "\"; its named faces: " + known(flat.faces));
+  }
+  for (std::size_t f = 0; f < chosen.size(); ++f)
+    if (chosen[f]) out.push_back(static_cast<int>(f));
+  return out;
+}
+
+ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
+  const auto t0 = Clock::now();
+  ModelRunResult out;
+  out.recipe = d.name;
+  out.name = def.name;
+  out.source = def.file.string();
+  out.deformation = def.deformation;
+  out.bodies = def.bodies;
+  out.faces = def.faces;
+  out.formats = def.formats;
+  out.schema = def.schema;
+  brep::ModelReadOptions read_options;
+  read_options.sew = def.sew;
+  read_options.read.isolate = true;  // a file that crashes OpenCASCADE fails the run, not clayform
+  const brep::Model flat = brep::flattened(brep::read_model(def.file, read_options).model);
+  if (def.deformation.empty()) {
+    out.model = flat;
+    out.report.counts = brep::counts(flat);
+    out.report.faces_untouched = out.report.counts.faces;
+    out.report.edges_untouched = out.report.counts.edges;
+    for (const brep::EdgeGap& g : brep::edge_gaps(flat))
+      out.report.max_edge_gap_mm = std::max(out.report.max_edge_gap_mm, g.gap_mm);
+    out.report.volume_before_mm3 = out.report.volume_after_mm3 = brep::volume_mm3(flat);
+  } else {
+    const StackDef& stack_def = pick_stack(d, def.deformation);
+    const deform::DeformationStack stack = model_stack(stack_def, out.fold_free, def.allow_fold);
+    deform::ModelDeformationOptions options;
+    options.surface = Runner::deformation_options(d.composition);
+    options.faces = chosen_faces(flat, def);
+    auto r = deform::deform_model(stack, flat, options);
+    out.model = std::move(r.model);
+    out.report = std::move(r.report);
+  }
+  out.seconds = seconds_since(t0);
+  return out;
+}
+
+}  // namespace
+
+RunResult deform_surfaces(const Recipe& recipe, const std::vector<BSplineSurface>& surfaces,
+                          std::string_view stem, std::string_view deformation,
+                          const RunOptions& options) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "deform_surfaces: empty recipe; load or parse one first");
+  const RecipeData& d = *recipe.data;
+  const StackDef* stack = &pick_stack(d, deformation);
+  if (surfaces.empty())
+    throw Error(ErrorCategory::InvalidArgument, "deform_surfaces: no surfaces given");
+  const auto t0 = Clock::now();
+  RunResult result;
+  result.recipe = d.name;
+  Runner runner(d, options, result);
+  runner.curves();  // the curves its style steps use
+  ExportResult x;
+  x.name = std::string(stem);
+  x.formats = d.exports.empty() ? std::vector<std::string>{"step", "iges", "glb"}
+                                : d.exports.front().formats;
+  x.schema = d.exports.empty() ? "AP214" : d.exports.front().schema;
+  for (std::size_t k = 0; k < surfaces.size(); ++k) {
+    const std::string name = std::string(stem) + "-" + std::to_string(k);
+    BSplineSurface s =
+        runner.deform(surfaces[k], *stack, d.composition, "input[" + std::to_string(k) + "]", name);
+    result.surfaces.emplace_back(name, s);
+    x.surface_names.push_back(name);
+    x.surfaces.push_back(std::move(s));
+  }
+  result.exports.push_back(std::move(x));
+  result.seconds = seconds_since(t0);
+  return result;
+}
+
+ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
+                            std::string_view deformation, bool allow_fold) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "deform_model: empty recipe; load or parse one first");
+  const RecipeData& d = *recipe.data;
+  const StackDef& def = pick_stack(d, deformation);
+  const auto t0 = Clock::now();
+  ModelRunResult result;
+  result.recipe = d.name;
+  result.deformation = def.name;
+  const deform::DeformationStack stack = model_stack(def, result.fold_free, allow_fold);
+  deform::ModelDeformationOptions options;
+  options.surface = Runner::deformation_options(d.composition);
+  try {
+    auto r = deform::deform_model(stack, model, options);
+    result.model = std::move(r.model);
+    result.report = std::move(r.report);
+  } catch (const Error& e) {
+    throw Error(e.category(), def.path + ": " + recipe_wording(e.message()));
+  }
+  result.formats = d.exports.empty() ? std::vector<std::string>{"step", "iges", "glb"}
+                                     : d.exports.front().formats;
+  result.schema = d.exports.empty() ? "AP214" : d.exports.front().schema;
+  result.seconds = seconds_since(t0);
+  return result;
+}
+
+}  // namespace clay::recipe

@@ -1,0 +1,193 @@
+// Reading files written by other CAD systems (tests/data/cad, sources in its README): Autodesk
+// Inventor and its translation framework, CATIA V4 and V5, I-DEAS, Pro/ENGINEER, Rhino,
+// SolidWorks and Unigraphics; STEP AP203/AP214 and IGES 144/186. Each is read whole and checked
+// against independent figures: OpenCASCADE's own reading of the same file (counts, BRepCheck,
+// BRepGProp volume), closed forms where the part is one (the cube, the cone, the spheres) and
+// the volume the sending system wrote into the file (CATIA's validation property). Then each
+// goes through the rest of the pipeline: written as STEP and read back with the same geometry,
+// and deformed exactly by a lattice around it into a model that is still valid.
+#include <catch2/catch.hpp>
+
+#include <clay/brep/volume.hpp>
+#include <clay/deform/model_deformation.hpp>
+#include <clay/occt/model_exchange.hpp>
+#include <clay/surface/bspline_surface.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <optional>
+#include <string>
+
+#include "error_of.hpp"
+#include "occt_test_models.hpp"
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+using Catch::Matchers::Contains;
+using clay::brep::Model;
+
+namespace {
+
+fs::path cad_file(const std::string& name) { return fs::path(CLAY_TEST_CAD_DIR) / name; }
+
+/// One real file and what is known of it independently of our reader.
+struct RealFile {
+  std::string name;
+  int bodies, faces;
+  std::optional<double> volume_mm3;  ///< a closed form or the sending system's own figure
+  double volume_relative = 1e-9;     ///< how closely that figure is expected
+  std::string healing;               ///< a healing the report must name ("" for none)
+};
+
+RealFile real(std::string name, int bodies, int faces, std::optional<double> volume = {},
+              double relative = 1e-9, std::string healing = {}) {
+  return {std::move(name), bodies, faces, volume, relative, std::move(healing)};
+}
+
+/// A trilinear lattice around every control point of the model's placed instances, 5 % larger
+/// each way, one corner raised by a tenth of the box.
+clay::deform::DeformationStack corner_raised_around(const Model& model) {
+  const Model m = clay::brep::flattened(model);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const auto& f : m.faces)
+    for (Eigen::Index i = 0; i < f.surface.points.rows(); ++i) {
+      lo = lo.cwiseMin(f.surface.points.row(i).transpose());
+      hi = hi.cwiseMax(f.surface.points.row(i).transpose());
+    }
+  const Eigen::Vector3d pad = 0.05 * (hi - lo) + Eigen::Vector3d::Constant(1.0);
+  return clay::test::trilinear(lo - pad, hi + pad, 0.1 * (hi - lo + 2 * pad));
+}
+
+}  // namespace
+
+TEST_CASE("real files from other CAD systems read whole, valid, with their volumes") {
+  const double cone = std::numbers::pi * 35 * 35 * 100 / 3;  // I-DEAS: r 35, height 100
+  const double spheres = 2 * 4 * std::numbers::pi / 3;       // SolidWorks: 2 instances of r 1
+  const RealFile file = GENERATE_COPY(
+      real("inventor2019_cube10_ap214.stp", 1, 6, 1000.0),
+      real("inventor2019_cube10_msbo.igs", 1, 6, 1000.0),
+      real("autodesk_atf_conical_surface_ap214.step", 1, 5),
+      real("unigraphics16_io1_ap214.stp", 1, 17),
+      // CATIA's own validation property; the file's B-spline edges are within 5e-5 mm.
+      real("catia_v5r13_xr2_bolt_ap214.stp", 1, 7, 3200.49751584, 1e-6),
+      real("catia_v4_pr1_box_sphere_torus_cone_cc2.stp", 4, 15),
+      real("catia_v5r19_as1_assembly_ap203.stp", 3, 39),
+      real("catia_v5r14_cone_trimmed144.igs", 3, 3),
+      real("ideas11_cone_msbo186.igs", 1, 2, cone, 1e-9, "re-derived 1 pcurve from its edge"),
+      real("proe1999_t4m_surfaces_ap203.stp", 3, 11),
+      real("solidworks2013_spheres_asm_ap214.STEP", 1, 1, spheres),
+      real("rhino7_bspline_surface.igs", 1, 1),
+      real("solidworks2013_featuretype_holes_fillets_ap214.STEP", 1, 96),
+      real("solidworks2018_base_interface_plate_holes_ap214.STEP", 1, 30),
+      // A degree 12 x 12 Bézier torus patch trimmed across its seam.
+      real("harmonyware_torus_bspline_trimmed144.igs", 1, 1));
+  INFO(file.name);
+  const fs::path path = cad_file(file.name);
+  const auto imported = clay::brep::read_model(path);
+  const Model& m = imported.model;
+  INFO(imported.report.brief());
+  CHECK(m.bodies.size() == static_cast<std::size_t>(file.bodies));
+  CHECK(m.faces.size() == static_cast<std::size_t>(file.faces));
+  CHECK(clay::brep::problems(m).empty());
+  const double size = imported.report.size_mm;
+  CHECK(imported.report.max_rederivation_error_mm <= 1e-9 * size);
+  if (!file.healing.empty()) {
+    bool named = false;
+    for (const auto& h : imported.report.healing) named = named || h.find(file.healing) == 0;
+    CHECK(named);
+  }
+
+  // OpenCASCADE's own reading of the same file: the same counts (instances placed), and the
+  // same volume within its integration's accuracy.
+  const auto facts = clay::surface::occt_reference::facts_of_file(path);
+  const auto placed = clay::brep::counts(clay::brep::flattened(m));
+  CHECK(placed.faces == facts.faces);
+  CHECK(placed.edges == facts.edges);
+  const auto check = clay::brep::check_model(m);
+  INFO(check.brief());
+  CHECK(check.valid);
+  if (facts.solids > 0) {
+    CHECK(std::abs(check.volume_mm3 - facts.volume) <= 1e-6 * std::abs(facts.volume));
+  }
+  if (file.volume_mm3) {
+    CHECK(std::abs(check.volume_mm3 - *file.volume_mm3) <= file.volume_relative * *file.volume_mm3);
+  }
+
+  // Written as STEP and read back: the same counts, every surface bit-identical.
+  const fs::path out =
+      clay::test::test_output("real", fs::path(file.name).stem().string() + ".step");
+  clay::brep::write_model(m, out);
+  const Model again = clay::brep::read_model(out).model;
+  CHECK(clay::brep::counts(again) == clay::brep::counts(m));
+  int identical = 0;
+  for (std::size_t f = 0; f < m.faces.size() && f < again.faces.size(); ++f)
+    identical += clay::surface::identical(m.faces[f].surface, again.faces[f].surface);
+  CHECK(identical == static_cast<int>(m.faces.size()));
+
+  // Deformed by a trilinear lattice with a raised corner: still valid. Every face is exact but
+  // where the composition's degree would pass 25 (a face of degree above 8: the torus patch of
+  // degree 12), which is refitted, certified.
+  const Model placed_model = clay::brep::flattened(m);
+  int too_high = 0;
+  for (const auto& f : placed_model.faces)
+    too_high += std::max(f.surface.u.degree, f.surface.v.degree) > 8;
+  clay::deform::ModelDeformationOptions options;
+  options.surface.refit = clay::deform::RefitOptions{};
+  const auto deformed = clay::deform::deform_model(corner_raised_around(m), m, options);
+  INFO(deformed.report.brief());
+  CHECK(deformed.report.faces_refit == too_high);
+  CHECK(deformed.report.faces_exact == static_cast<int>(placed_model.faces.size()) - too_high);
+  CHECK(clay::brep::problems(deformed.model).empty());
+  const auto deformed_check = clay::brep::check_model(deformed.model);
+  INFO(deformed_check.brief());
+  CHECK(deformed_check.valid);
+}
+
+TEST_CASE("a real file with no face (Rhino wireframe) is refused, naming the file") {
+  const fs::path path = cad_file("rhino_stdev14_wireframe_line_ap214.stp");
+  const auto [category, message] = clay::test::error_of([&] { clay::brep::read_model(path); });
+  CHECK(category == clay::ErrorCategory::Exchange);
+  CHECK_THAT(message,
+             Contains("rhino_stdev14_wireframe_line_ap214.stp") && Contains("holds no face"));
+}
+
+TEST_CASE("a file OpenCASCADE's XCAF reader crashes on is read by its plain reader, and says so") {
+  // C3D Converter's IGES: solids placed by subfigures nested in subfigures. XCAF (IGESCAFControl)
+  // dies of SIGSEGV on it in OpenCASCADE 7.6; the isolated read survives, reads it again
+  // without XCAF and reports what that loses.
+  const fs::path path = cad_file("c3d_converter_plates_msbo186_subfigures.igs");
+  clay::brep::ModelReadOptions options;
+  options.read.isolate = true;
+  const auto imported = clay::brep::read_model(path, options);
+  INFO(imported.report.brief());
+  bool said = false;
+  for (const auto& h : imported.report.healing)
+    said = said || h.find("XCAF reader crashed") != std::string::npos;
+  CHECK(said);
+  CHECK(clay::brep::problems(imported.model).empty());
+  const auto facts = clay::surface::occt_reference::facts_of_file(path);
+  const auto placed = clay::brep::counts(clay::brep::flattened(imported.model));
+  CHECK(placed.faces == facts.faces);
+  CHECK(placed.edges == facts.edges);
+  CHECK(clay::brep::check_model(imported.model).valid);
+}
+
+TEST_CASE("a face that encloses no area is kept, and a file's open loops are listed, not hidden") {
+  // PCB Libraries' FPX Expert pin: directions written with 4 digits, a sliver face whose loop
+  // runs along one line, and loops whose ends do not share vertices.
+  const fs::path path = cad_file("pcblibraries_fpx2013_header_pin_lowprec_ap214.stp");
+  const auto imported = clay::brep::read_model(path);
+  INFO(imported.report.brief());
+  bool kept = false;
+  for (const auto& h : imported.report.healing)
+    kept = kept || h.find("kept 1 face that encloses no area") == 0;
+  CHECK(kept);
+  CHECK(imported.model.faces.size() == 16);
+  // The file's own defects are in the report, each naming its face and loop.
+  CHECK(!imported.report.problems.empty());
+  CHECK(imported.report.problems == clay::brep::problems(imported.model));
+  // Deforming it is refused, naming a problem, rather than writing a torn model.
+  CHECK_THROWS_AS(clay::deform::deform_model(corner_raised_around(imported.model), imported.model),
+                  clay::Error);
+}
