@@ -53,8 +53,16 @@ T field(const Json& command, const char* op, const char* key, T fallback, const 
   return it->get<T>();
 }
 
+/// A recipe path as a JSON pointer, and which of its tokens were list indices ([i]) rather than
+/// keys: a key may be all digits ("a.2"), and only the path tells the two apart.
+struct RecipePath {
+  Json::json_pointer pointer;
+  std::vector<bool> is_index;  ///< per token, from the first
+};
+
 /// "a.b[2].c" -> JSON pointer "/a/b/2/c"; clay::Error(InvalidArgument) for a malformed path.
-Json::json_pointer pointer_of(const std::string& path) {
+RecipePath pointer_of(const std::string& path) {
+  std::vector<bool> is_index;
   std::string out;
   std::size_t i = 0;
   bool expect_key = true;
@@ -67,6 +75,7 @@ Json::json_pointer pointer_of(const std::string& path) {
                     "studio: path \"" + internal::clip_utf8(path, 120) +
                         "\" has a malformed list index; write items as [i]");
       out += "/" + index;
+      is_index.push_back(true);
       i = close + 1;
       expect_key = false;
     } else if (path[i] == '.') {
@@ -82,6 +91,7 @@ Json::json_pointer pointer_of(const std::string& path) {
       std::string escaped;
       for (char c : key) escaped += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
       out += "/" + escaped;
+      is_index.push_back(false);
       i = end == std::string::npos ? path.size() : end;
       expect_key = false;
     }
@@ -89,7 +99,14 @@ Json::json_pointer pointer_of(const std::string& path) {
   if (out.empty() || expect_key)
     throw Error(ErrorCategory::InvalidArgument, "studio: path \"" + internal::clip_utf8(path, 120) +
                                                     "\" is empty or ends with \".\"");
-  return Json::json_pointer(out);
+  return {Json::json_pointer(out), std::move(is_index)};
+}
+
+/// The number of tokens of a JSON pointer.
+std::size_t depth_of(Json::json_pointer p) {
+  std::size_t n = 0;
+  for (; !p.empty(); p.pop_back()) ++n;
+  return n;
 }
 
 /// Applies one change of an "edit" to the recipe document: {path, value, create?} sets a value
@@ -104,7 +121,8 @@ void apply_change(Json& doc, const Json& change, std::string& first_path) {
   if (first_path.empty()) first_path = path;
   const bool remove = field<bool>(change, "edit", "remove", false, "true or false");
   const bool create = field<bool>(change, "edit", "create", false, "true or false");
-  const Json::json_pointer ptr = pointer_of(path);
+  const RecipePath parsed = pointer_of(path);
+  const Json::json_pointer& ptr = parsed.pointer;
   const bool exists = doc.contains(ptr);
   if (remove) {
     if (!exists)
@@ -122,22 +140,38 @@ void apply_change(Json& doc, const Json& change, std::string& first_path) {
     throw Error(ErrorCategory::InvalidArgument, "studio: the change of \"" +
                                                     internal::clip_utf8(path, 120) +
                                                     "\" has no \"value\" (or \"remove\": true)");
-  if (!exists) {
-    if (!create)
-      throw Error(ErrorCategory::InvalidArgument, "studio: the recipe has no \"" +
-                                                      internal::clip_utf8(path, 120) +
-                                                      "\"; to add it, send \"create\": true");
-    // Created keys hang from an object: the nearest existing entry above must be one (the
-    // missing ones between, e.g. "strokes" of a recipe without strokes, are made objects).
-    Json::json_pointer above = ptr.parent_pointer();
-    while (!above.empty() && !doc.contains(above)) above = above.parent_pointer();
-    if (!doc.at(above).is_object())
-      throw Error(ErrorCategory::InvalidArgument,
-                  "studio: cannot create \"" + internal::clip_utf8(path, 120) + "\": \"" +
-                      above.to_string() +
-                      "\" is not an object; a list item is changed by its index");
+  if (exists) {
+    doc.at(ptr) = change.at("value");
+    return;
   }
-  doc[ptr] = change.at("value");
+  if (!create)
+    throw Error(ErrorCategory::InvalidArgument, "studio: the recipe has no \"" +
+                                                    internal::clip_utf8(path, 120) +
+                                                    "\"; to add it, send \"create\": true");
+  // Created keys hang from an object: the nearest existing entry above must be one, and the
+  // missing ones between (e.g. "strokes" of a recipe without strokes) are made objects. They are
+  // walked here as object keys: JSON pointer's own creation would read a digit key ("a.123456789")
+  // as a list index and grow a list to that length (a fuzzed edit asked for 8.9e9 entries).
+  Json::json_pointer above = ptr.parent_pointer();
+  while (!above.empty() && !doc.contains(above)) above = above.parent_pointer();
+  if (!doc.at(above).is_object())
+    throw Error(ErrorCategory::InvalidArgument,
+                "studio: cannot create \"" + internal::clip_utf8(path, 120) + "\": \"" +
+                    internal::clip_utf8(above.to_string(), 120) +
+                    "\" is not an object; a list item is changed by its index");
+  std::vector<std::string> missing;
+  for (Json::json_pointer p = ptr; p != above; p.pop_back()) missing.push_back(p.back());
+  const std::size_t first_missing = depth_of(above);
+  for (std::size_t k = first_missing; k < parsed.is_index.size(); ++k)
+    if (parsed.is_index[k])
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: cannot create \"" + internal::clip_utf8(path, 120) +
+                      "\": it has no list at [" +
+                      internal::clip_utf8(missing[missing.size() - 1 - (k - first_missing)], 24) +
+                      "]; send the whole list as the value of its key");
+  Json* node = &doc.at(above);
+  for (auto key = missing.rbegin(); key != missing.rend(); ++key) node = &(*node)[*key];
+  *node = change.at("value");
 }
 
 }  // namespace

@@ -220,6 +220,14 @@ TEST_CASE("studio session: bad commands are refused and change nothing", "[studi
       error(R"({"op": "edit", "path": "deformations.shape[0].curve_tolerance", "value": -1})"),
       Contains("curve_tolerance"));
   CHECK_THAT(error(R"({"op": "undo"})"), Contains("nothing to undo"));
+  // Created levels are object keys, even all-digit ones: JSON pointer would read "8888888889" as
+  // a list index and grow a list of 8.9e9 entries (a fuzz finding). The recipe then refuses the
+  // unknown key, and nothing changes.
+  CHECK_THAT(error(R"({"op": "edit", "path": "extra.8888888889.x", "value": 1, "create": true})"),
+             Contains("extra"));
+  // A list index cannot be created: the list is sent whole.
+  CHECK_THAT(error(R"({"op": "edit", "path": "extra[4000000000]", "value": 1, "create": true})"),
+             Contains("no list at [4000000000]") && Contains("whole list"));
   CHECK(session.text() == before);
   CHECK(session.history().size() == 1);
   // create: a new key under an existing object.
