@@ -39,7 +39,9 @@ def main():
     ap.add_argument("--bench", action="append", help="bench_<name> to run (repeatable); default: all four")
     ap.add_argument("--filter", action="append", help="--benchmark_filter per --bench, in order")
     ap.add_argument("--rounds", type=int, default=5)
-    ap.add_argument("--out", default="bench-compare")
+    # The raw JSON goes to the build tree by default: results worth keeping are moved under
+    # bench/results/ with the perf diary (docs/perf/) that reads them.
+    ap.add_argument("--out", default=os.path.join("build", "bench", "compare"))
     a = ap.parse_args()
     benches = a.bench or ["evaluate", "deform", "compose", "style"]
     filters = (a.filter or []) + [""] * len(benches)
