@@ -7,6 +7,9 @@
 #   scripts/viewer.sh test [--run D]  build if stale, then the end-to-end test in headless Chromium
 #                                     (installs Debian's chromium when /usr/bin/chromium is missing);
 #                                     --run D tests against a run folder (clayform run ... --out D)
+#   scripts/viewer.sh lint [--fixture FILE]
+#                                     ESLint on the page and its tests (viewer/eslint.config.js); with
+#                                     --fixture, on FILE as if it were a page source instead
 #   scripts/viewer.sh studio-test --clayform PATH [--report FILE] [--shots DIR]
 #                                     build if stale, then Clayform Studio's end-to-end test against
 #                                     that clayform (e2e/studio.test.mjs)
@@ -42,6 +45,17 @@ if ((stale)); then
   npm run build
 else
   echo "==> viewer: dist is up to date"
+fi
+
+if [[ "${1:-}" == "lint" ]]; then
+  if [[ "${2:-}" == "--fixture" ]]; then
+    fixture=${3:?--fixture needs a file}
+    [[ $fixture == /* ]] || fixture=$OLDPWD/$fixture  # relative to where the script was called
+    echo "==> viewer: ESLint on $fixture as a page source"
+    exec npx --no-install eslint --stdin --stdin-filename src/lint-fixture.js <"$fixture"
+  fi
+  echo "==> viewer: ESLint"
+  exec npx --no-install eslint .
 fi
 
 if [[ "${1:-}" == "test" || "${1:-}" == "studio-test" ]]; then
