@@ -1,0 +1,249 @@
+// Running a recipe's models (imported, flattened, deformed by a stack; deform_model): see
+// recipe_run.hpp.
+#include "recipe_run.hpp"
+
+#include "recipe_model.hpp"
+
+#include <clay/brep/volume.hpp>
+#include <clay/constraints/solve.hpp>
+#include <clay/deform/jacobian.hpp>
+#include <clay/deform/model_deformation.hpp>
+#include <clay/deform/surface_deformation.hpp>
+#include <clay/error.hpp>
+#include <clay/occt/model_exchange.hpp>
+#include <clay/occt/surface_exchange.hpp>
+#include <clay/sketch/entities.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <set>
+
+namespace clay::recipe {
+namespace detail {
+
+deform::SurfaceDeformationOptions deformation_options(const Composition& c) {
+  deform::SurfaceDeformationOptions o;
+  o.compose.check_samples = c.check_samples;
+  if (c.refit) {
+    deform::RefitOptions r;
+    r.degree = c.degree;
+    r.tolerance = c.tolerance;
+    r.relative = c.relative;
+    r.max_control_points = c.max_control_points;
+    o.refit = r;
+  }
+  o.accept_out_of_tolerance = c.accept_out_of_tolerance;
+  return o;
+}
+
+namespace {
+using surface::BSplineSurface;
+}  // namespace
+
+/// The recipe's deformation stack named `deformation`, or its only one when the name is empty.
+const StackDef& pick_stack(const RecipeData& d, std::string_view deformation) {
+  std::string names;
+  for (const auto& s : d.stacks) names += (names.empty() ? "" : ", ") + s.name;
+  if (deformation.empty()) {
+    if (d.stacks.size() != 1)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "the recipe has " + std::to_string(d.stacks.size()) + " deformation stacks (" +
+                      names + "); name one with --deformation");
+    return d.stacks.front();
+  }
+  for (const auto& s : d.stacks)
+    if (s.name == deformation) return s;
+  throw Error(ErrorCategory::InvalidArgument, "the recipe has no deformation stack '" +
+                                                  std::string(deformation) +
+                                                  "'; its stacks: " + names);
+}
+
+/// A stack for a whole model: lattices and regular deformations as they are, direct
+/// manipulation solved from moves in space; a style step or a move from a surface point is
+/// refused, naming the step. `fold_free` is cleared when a lattice's Jacobian bounds are not
+/// positive; then, unless `allow_fold`, the step is refused: a folded lattice wrote a
+/// self-intersecting solid reported valid, 155 mm^3 for a 15,708 mm^3 rod (issue #36).
+deform::DeformationStack model_stack(const StackDef& def, bool& fold_free, bool allow_fold) {
+  deform::DeformationStack stack;
+  for (std::size_t i = 0; i < def.steps.size(); ++i) {
+    const StepDef& step = def.steps[i];
+    const std::string where = def.path + ".steps[" + std::to_string(i) + "] (" + step.kind + ")";
+    deform::Deformation lattice = std::visit(
+        [&](const auto& k) -> deform::Deformation {
+          using T = std::decay_t<decltype(k)>;
+          if constexpr (std::is_same_v<T, deform::Deformation>) {
+            return k;
+          } else if constexpr (std::is_same_v<T, DirectDef>) {
+            std::vector<deform::PointMove> moves;
+            for (const auto& m : k.moves) {
+              if (m.on_surface)
+                throw Error(ErrorCategory::InvalidArgument,
+                            where +
+                                ": a move from a \"surface_point\" needs one surface; to "
+                                "deform a model, give the move's \"point\" in space");
+              moves.push_back({m.point, m.to});
+            }
+            deform::Deformation solved;
+            bool feasible = true;
+            std::string message;
+            std::visit(
+                [&](const auto& lat) {
+                  auto r = deform::manipulate(lat, moves, k.options);
+                  feasible = r.report.feasible;
+                  message = r.report.summary.message;
+                  solved = std::move(r.lattice);
+                },
+                k.lattice);
+            if (!feasible && !k.accept_out_of_tolerance)
+              throw Error(ErrorCategory::ToleranceNotMet,
+                          where + ": the lattice cannot meet every move (" + message +
+                              "); free more control points, use a finer lattice or ask for "
+                              "fewer moves");
+            return solved;
+          } else {
+            throw Error(ErrorCategory::InvalidArgument,
+                        where +
+                            ": a style step shapes one surface by its control points; a "
+                            "model deforms through lattices, direct manipulation and "
+                            "regular deformations (taper, twist, bend)");
+          }
+        },
+        step.step);
+    std::optional<deform::JacobianBounds> bounds;
+    if (const auto* b = std::get_if<deform::BezierLattice>(&lattice))
+      bounds = deform::jacobian_bounds(*b);
+    if (const auto* b = std::get_if<deform::BSplineLattice>(&lattice))
+      bounds = deform::jacobian_bounds(*b);
+    if (bounds && step.enabled && !bounds->fold_free) {
+      fold_free = false;
+      if (!allow_fold)
+        throw Error(ErrorCategory::InvalidGeometry,
+                    where +
+                        ": the lattice may fold space (the smallest Bernstein coefficient of "
+                        "its Jacobian is " +
+                        format("%.3g", bounds->min) +
+                        " <= 0, Sederberg-Parry section 4), so the deformed solid may intersect "
+                        "itself; move its points less or use a finer lattice, or allow it with "
+                        "\"allow_fold\": true on the model (clayform deform --allow-fold)");
+    }
+    stack.steps.push_back({std::move(lattice), step.name, step.enabled});
+  }
+  return stack;
+}
+
+/// The faces of `flat` the model's "bodies" and "faces" name (every face when both are empty);
+/// a name that matches nothing is refused, listing the names the model has.
+std::vector<int> chosen_faces(const brep::Model& flat, const ModelDef& def) {
+  std::vector<int> out;
+  if (def.bodies.empty() && def.faces.empty()) return out;
+  std::vector<bool> chosen(flat.faces.size(), false);
+  auto known = [](const auto& items) {
+    std::vector<std::string> names;
+    for (const auto& x : items)
+      if (!x.name.empty() && std::find(names.begin(), names.end(), x.name) == names.end())
+        names.push_back(x.name);
+    std::string text;
+    for (const auto& n : names) text += (text.empty() ? "\"" : ", \"") + n + "\"";
+    return text.empty() ? std::string("none is named") : text;
+  };
+  for (std::size_t i = 0; i < def.bodies.size(); ++i) {
+    bool found = false;
+    for (const brep::Body& body : flat.bodies)
+      if (body.name == def.bodies[i]) {
+        found = true;
+        for (const brep::Shell& shell : body.shells)
+          for (int f : shell.faces) chosen[static_cast<std::size_t>(f)] = true;
+      }
+    if (!found)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "bodies[" + std::to_string(i) + "]: the model has no body named \"" +
+                      def.bodies[i] + "\"; its bodies: " + known(flat.bodies));
+  }
+  for (std::size_t i = 0; i < def.faces.size(); ++i) {
+    bool found = false;
+    for (std::size_t f = 0; f < flat.faces.size(); ++f)
+      if (flat.faces[f].name == def.faces[i]) found = chosen[f] = true;
+    if (!found)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "faces[" + std::to_string(i) + "]: the model has no face named \"" +
+                      def.faces[i] + "\"; its named faces: " + known(flat.faces));
+  }
+  for (std::size_t f = 0; f < chosen.size(); ++f)
+    if (chosen[f]) out.push_back(static_cast<int>(f));
+  return out;
+}
+
+ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
+  const auto t0 = Clock::now();
+  ModelRunResult out;
+  out.recipe = d.name;
+  out.name = def.name;
+  out.source = def.file.string();
+  out.deformation = def.deformation;
+  out.bodies = def.bodies;
+  out.faces = def.faces;
+  out.formats = def.formats;
+  out.schema = def.schema;
+  brep::ModelReadOptions read_options;
+  read_options.sew = def.sew;
+  read_options.read.isolate = true;  // a file that crashes OpenCASCADE fails the run, not clayform
+  const brep::Model flat = brep::flattened(brep::read_model(def.file, read_options).model);
+  if (def.deformation.empty()) {
+    out.model = flat;
+    out.report.counts = brep::counts(flat);
+    out.report.faces_untouched = out.report.counts.faces;
+    out.report.edges_untouched = out.report.counts.edges;
+    for (const brep::EdgeGap& g : brep::edge_gaps(flat))
+      out.report.max_edge_gap_mm = std::max(out.report.max_edge_gap_mm, g.gap_mm);
+    out.report.volume_before_mm3 = out.report.volume_after_mm3 = brep::volume_mm3(flat);
+  } else {
+    const StackDef& stack_def = pick_stack(d, def.deformation);
+    const deform::DeformationStack stack = model_stack(stack_def, out.fold_free, def.allow_fold);
+    deform::ModelDeformationOptions options;
+    options.surface = deformation_options(d.composition);
+    options.faces = chosen_faces(flat, def);
+    auto r = deform::deform_model(stack, flat, options);
+    out.model = std::move(r.model);
+    out.report = std::move(r.report);
+  }
+  out.seconds = seconds_since(t0);
+  return out;
+}
+
+}  // namespace detail
+
+using namespace detail;
+
+ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
+                            std::string_view deformation, bool allow_fold) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "deform_model: empty recipe; load or parse one first");
+  const RecipeData& d = *recipe.data;
+  const StackDef& def = pick_stack(d, deformation);
+  const auto t0 = Clock::now();
+  ModelRunResult result;
+  result.recipe = d.name;
+  result.deformation = def.name;
+  const deform::DeformationStack stack = model_stack(def, result.fold_free, allow_fold);
+  deform::ModelDeformationOptions options;
+  options.surface = deformation_options(d.composition);
+  try {
+    auto r = deform::deform_model(stack, model, options);
+    result.model = std::move(r.model);
+    result.report = std::move(r.report);
+  } catch (const Error& e) {
+    throw Error(e.category(), def.path + ": " + recipe_wording(e.message()));
+  }
+  result.formats = d.exports.empty() ? std::vector<std::string>{"step", "iges", "glb"}
+                                     : d.exports.front().formats;
+  result.schema = d.exports.empty() ? "AP214" : d.exports.front().schema;
+  result.seconds = seconds_since(t0);
+  return result;
+}
+
+}  // namespace clay::recipe
