@@ -280,7 +280,6 @@ bool begin_report(const KeyPoints& keys, const StyleOptions& options, StyleMode 
   report.mode = mode;
   report.constraint_class = keys.constraint_class;
   report.direction = keys.direction;
-  report.m = static_cast<int>(keys.points.size());
   report.key_points = keys.points;
   if (keys.constraint_class == ConstraintClass::OverConstrained) {
     report.message =
@@ -858,8 +857,8 @@ StyleResult style_paper(const surface::SurfaceProjector& projector, const Influe
 
   detail::measure(parent, out.surface, region.factors, region, target, trace, options, report);
   std::ostringstream msg;
-  msg << to_string(report.constraint_class) << ", m = " << report.m << " key points along "
-      << (along_u ? "u" : "v") << ", " << report.moved_vertices << " of "
+  msg << to_string(report.constraint_class) << ", m = " << report.key_points.size()
+      << " key points along " << (along_u ? "u" : "v") << ", " << report.moved_vertices << " of "
       << report.influenced_vertices << " influenced vertices moved";
   report.message = msg.str();
   return out;

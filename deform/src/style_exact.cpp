@@ -787,7 +787,6 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       }
     }
 
-    report.m = static_cast<int>(points.size());
     // E_k(d) from the net's own matrix (fixed vertices have d = 0), without the ridge.
     report.fairness_energy =
         nf > 0
@@ -806,8 +805,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     if (options.report_curves && region.polygon.empty())
       measure_boundary(parent, region.factors, region, s, out.surface, report);
     std::ostringstream msg;
-    msg << to_string(report.constraint_class) << ", m = " << report.m << " key points (" << nk
-        << " influenced";
+    msg << to_string(report.constraint_class) << ", m = " << report.key_points.size()
+        << " key points (" << nk << " influenced";
     if (report.added_key_points > 0)
       msg << ", " << report.added_key_points << " added where the target was missed";
     msg << "), " << nf << " free vertices, rank " << rank << ", " << report.degrees_of_freedom

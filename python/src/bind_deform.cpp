@@ -90,7 +90,7 @@ py::dict style_report(const deform::StyleReport& r) {
   py::dict d;
   d["mode"] = r.mode == deform::StyleMode::Exact ? "exact" : "paper";
   d["constraint_class"] = std::string(deform::to_string(r.constraint_class));
-  d["key_points"] = r.m;
+  d["key_points"] = r.key_points.size();
   d["influenced_vertices"] = r.influenced_vertices;
   d["moved_vertices"] = r.moved_vertices;
   d["max_displacement"] = r.max_displacement;

@@ -700,7 +700,7 @@ class Runner {
     const auto& x = r.report;
     rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::Exact ? "exact" : "paper")},
                    {"constraint_class", std::string(deform::to_string(x.constraint_class))},
-                   {"key_points", static_cast<long long>(x.m)},
+                   {"key_points", static_cast<long long>(x.key_points.size())},
                    {"influenced_vertices", static_cast<long long>(x.influenced_vertices)},
                    {"moved_vertices", static_cast<long long>(x.moved_vertices)},
                    {"max_displacement", x.max_displacement},

@@ -456,4 +456,17 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
   return out;
 }
 
+std::string StrokeFit::brief() const {
+  int points = 0;
+  for (const FittedCurve& c : curves) points += c.control_points;
+  std::ostringstream m;
+  m.precision(3);
+  m << curves.size() << (curves.size() == 1 ? " curve" : " curves")
+    << (closed ? " (closed)" : " (open)") << ", " << corners.size()
+    << (corners.size() == 1 ? " corner" : " corners") << ", " << points
+    << " control points, max deviation " << max_deviation_mm << " mm, plane offset " << plane_offset
+    << " mm; " << (summary.converged() ? "converged" : "not converged: " + summary.message);
+  return m.str();
+}
+
 }  // namespace clay::sketch

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 #include "curve_tools.hpp"
@@ -280,6 +281,23 @@ OversketchResult oversketch(const BSplineCurve& curve, const Stroke& stroke,
         << (*j)->tangent_angle << " rad, curvature difference " << (*j)->curvature_difference;
   out.summary.message = m.str();
   return out;
+}
+
+std::string OversketchResult::brief() const {
+  std::ostringstream m;
+  m.precision(3);
+  auto joint = [&](const std::optional<Joint>& j, const char* where) {
+    if (!j) return;
+    m << "; gap " << j->gap << " mm, angle " << j->tangent_angle * 180 / std::numbers::pi
+      << " deg at " << where;
+  };
+  m << "replaced [" << cut_start << ", " << cut_end << "] with " << control_points
+    << " control points, max deviation " << max_deviation_mm << " mm (rms " << rms_deviation_mm
+    << ")";
+  joint(start_joint, "start");
+  joint(end_joint, "end");
+  m << "; " << (summary.converged() ? "converged" : "not converged: " + summary.message);
+  return m.str();
 }
 
 }  // namespace clay::sketch

@@ -199,7 +199,7 @@ TEST_CASE(
   const StepReport& style_step = step(r, "surfaces.sail.steps[0]");
   CHECK(figure<std::string>(style_step, "mode") == "exact");
   CHECK(figure<double>(style_step, "locality") == 0.0);
-  CHECK(figure<long long>(style_step, "key_points") == styled.report.m);
+  CHECK(figure<long long>(style_step, "key_points") == std::ssize(styled.report.key_points));
   for (const auto& k : styled.report.key_points)
     if (k.influenced)
       CHECK(surface::closest_point(styled.surface, k.point).distance <= 1e-9 * size);

@@ -227,7 +227,7 @@ TEST_CASE("paper mode: forces along the normal, peak and symmetric fall-off (eqs
   const InfluenceRegion region = influence_factors(s, bound);
   CHECK(r.report.constraint_class == ConstraintClass::WellConstrained);
   CHECK(r.report.direction == KeyDirection::U);
-  REQUIRE(r.report.m > 3);
+  REQUIRE(std::ssize(r.report.key_points) > 3);
   for (Eigen::Index row = 0; row < s.points.rows(); ++row) {
     const Eigen::RowVector3d d = r.surface.points.row(row) - s.points.row(row);
     CHECK(d.head<2>().norm() == 0.0);  // moved along the normal (0, 0, 1) only
@@ -256,8 +256,8 @@ TEST_CASE("paper mode: forces along the normal, peak and symmetric fall-off (eqs
   options.smoothing = false;
   options.relaxation = false;
   const StyleResult plain = style_deform(s, bound, line, options);
-  CHECK(plain.report.moved_vertices >= plain.report.m);
-  CHECK(plain.report.moved_vertices <= 2 * plain.report.m);
+  CHECK(plain.report.moved_vertices >= std::ssize(plain.report.key_points));
+  CHECK(plain.report.moved_vertices <= 2 * std::ssize(plain.report.key_points));
   for (const KeyPoint& k : plain.report.key_points) {  // the area weights sum to 1 (eq. 4)
     double sum = 0;
     for (int j = 0; j < 15; ++j) sum += plain.surface.points(k.row * 15 + j, 2);
@@ -360,7 +360,7 @@ TEST_CASE("exact mode: the hood passes through every key point and joins the par
   options.mode = StyleMode::Exact;
   const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
   INFO(r.report.message);
-  REQUIRE(r.report.m >= 4);
+  REQUIRE(std::ssize(r.report.key_points) >= 4);
   for (const KeyPoint& k : r.report.key_points) {
     REQUIRE(k.influenced);
     const auto p = clay::surface::closest_point(r.surface, k.point);  // independent of the report
@@ -372,7 +372,7 @@ TEST_CASE("exact mode: the hood passes through every key point and joins the par
   // The target curve between key points: followed within curve_tolerance, or the message says not.
   const bool followed = r.report.target_curve_deviation <= options.curve_tolerance * size;
   CHECK(followed == (r.report.message.find("still missed") == std::string::npos));
-  CHECK(r.report.rank == r.report.m);
+  CHECK(r.report.rank == std::ssize(r.report.key_points));
   CHECK(normal_jump_along(s, r.surface, hood_bound()) <= 0.5);
   CHECK(r.report.boundary_tangent_angle <= 0.5);
   CHECK(r.report.locality == 0.0);
@@ -496,7 +496,7 @@ TEST_CASE("exact mode on a sail with uneven knots, with and without a bound curv
     const StyleResult r =
         with_bound ? style_deform(s, bound, target, options) : style_deform(s, target, options);
     INFO((with_bound ? "with bound: " : "without: ") << r.report.message);
-    REQUIRE(r.report.m >= 2);
+    REQUIRE(std::ssize(r.report.key_points) >= 2);
     CHECK(r.report.constraint_class != ConstraintClass::OverConstrained);
     for (const KeyPoint& k : r.report.key_points)
       if (k.influenced) {
@@ -535,7 +535,7 @@ TEST_CASE("exact mode refines a coarse net by knot insertion and reports conflic
   options.max_refinements = 0;
   const StyleResult coarse = style_deform(s, hood_bound(), hood_target(), options);
   CHECK(coarse.report.knots_inserted == 0);
-  CHECK(coarse.report.rank < coarse.report.m);
+  CHECK(coarse.report.rank < std::ssize(coarse.report.key_points));
   CHECK_FALSE(coarse.report.conflicting_key_points.empty());
   CHECK(coarse.report.message.find("cannot be met") != std::string::npos);
 }
@@ -604,7 +604,7 @@ TEST_CASE("StyleEditor: drags give the one-off results and reuse the exact facto
       // follow the target within curve_tolerance.
       const double agree = mode == StyleMode::Paper ? 1e-9 : options.curve_tolerance;
       CHECK((dragged.surface.points - once.surface.points).cwiseAbs().maxCoeff() <= agree * size);
-      CHECK(dragged.report.m == once.report.m);
+      CHECK(std::ssize(dragged.report.key_points) == std::ssize(once.report.key_points));
       CHECK(dragged.report.knots_inserted == once.report.knots_inserted);
       if (mode == StyleMode::Exact) CHECK(dragged.report.target_deviation <= 1e-6 * size);
     }

@@ -171,6 +171,12 @@ TEST_CASE("strokes with a corner are split there: two curves sharing the corner"
       CHECK(c->summary.converged());
       CHECK(c->control_points <= 8);
     }
+    // brief() tells the same counts, with the control points counted on the curves themselves.
+    const auto total = a.points.rows() + b.points.rows();
+    CHECK_THAT(fit.brief(),
+               Catch::Matchers::StartsWith("2 curves (open), 1 corner, " + std::to_string(total) +
+                                           " control points") &&
+                   Catch::Matchers::EndsWith("; converged"));
   }
 }
 

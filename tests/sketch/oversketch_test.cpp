@@ -127,6 +127,12 @@ TEST_CASE("oversketch G1: joints exact, kept parts unchanged, new part follows t
   // The new part follows the stroke within the tolerance.
   CHECK(r.max_deviation_mm <= o.fit.tolerance);
   CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance + 1e-4);
+  // brief(): the cut, both joints (gap 0, so "gap 0 mm"), the verdict.
+  CHECK_THAT(r.brief(), Catch::Matchers::StartsWith("replaced [0.3") &&
+                            Catch::Matchers::Contains("gap 0 mm, angle") &&
+                            Catch::Matchers::Contains("at start") &&
+                            Catch::Matchers::Contains("at end") &&
+                            Catch::Matchers::EndsWith("; converged"));
 }
 
 TEST_CASE("oversketch G2: curvature vectors agree across both joints", "[oversketch]") {

@@ -182,7 +182,6 @@ struct CLAY_DEFORM_API StyleReport {
   StyleMode mode = StyleMode::Paper;
   ConstraintClass constraint_class = ConstraintClass::OverConstrained;
   KeyDirection direction = KeyDirection::U;
-  int m = 0;                         ///< number of key points (eq. 8)
   std::vector<KeyPoint> key_points;  ///< on the parent surface
   int influenced_vertices = 0;       ///< vertices with E = 1
   int moved_vertices = 0;            ///< vertices actually displaced

@@ -57,7 +57,7 @@ struct Joint {
 };
 
 /// The redrawn curve and how it was made.
-struct OversketchResult {
+struct CLAY_SKETCH_API OversketchResult {
   surface::BSplineCurve curve;  ///< same domain and degree as the input curve
   double cut_start = 0;         ///< parameter where the replaced part begins (old and new curve)
   double cut_end = 0;           ///< parameter where it ends (a domain end for a new head/tail)
@@ -68,6 +68,11 @@ struct OversketchResult {
   int control_points = 0;            ///< control points of the new part
   int iterations = 0;                ///< refinement iterations of the new part's fit
   Summary summary;                   ///< the new part's fit; converged when within tolerance
+
+  /// One line: "replaced [0.25, 0.62] with 9 control points, max deviation 0.011 mm (rms 0.004),
+  /// joints: gap 3e-16 mm, angle 0.0021 deg at start; gap 0 mm, angle 0.0008 deg at end;
+  /// converged".
+  std::string brief() const;
 };
 
 /// Replaces the part of `curve` that `stroke` redraws (see above). The stroke may be drawn in
