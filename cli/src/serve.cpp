@@ -4,6 +4,7 @@
 #include <clay/serve.hpp>
 
 #include <httplib.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <array>
@@ -201,26 +202,24 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
   if (options.stage != "after" && options.stage != "before")
     throw Error(ErrorCategory::InvalidArgument,
                 "snapshot: unknown stage '" + options.stage + "'; give after or before");
-  // The surfaces to hide must be the run's: the manifest (written by write_outputs, compact, in
-  // insertion order) opens each surface with {"name":"NAME","export":" (a curve's name is
-  // followed by its points instead). Recipe names are identifiers, safe in a URL.
+  // The surfaces to hide must be the run's: the names of the manifest's "surfaces" (written by
+  // write_outputs). Recipe names are identifiers, safe in a URL.
   std::string query = "?mode=" + options.mode + (options.bare ? "&ui=0" : "");
   if (!options.hide.empty()) {
     std::ifstream in(run_dir / "view" / "manifest.json", std::ios::binary);
-    const std::string manifest((std::istreambuf_iterator<char>(in)), {});
-    const std::string open = "{\"name\":\"", close = "\",\"export\":\"";
+    const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
+    std::vector<std::string> surfaces;
+    if (manifest.is_object() && manifest.contains("surfaces") && manifest["surfaces"].is_array())
+      for (const nlohmann::json& surface : manifest["surfaces"])
+        if (surface.is_object() && surface.contains("name") && surface["name"].is_string())
+          surfaces.push_back(surface["name"].get<std::string>());
     std::string names, unknown;
-    for (std::size_t at = manifest.find(open); at != std::string::npos;
-         at = manifest.find(open, at + 1)) {
-      const std::size_t from = at + open.size(), to = manifest.find('"', from);
-      if (manifest.compare(to, close.size(), close) == 0)
-        names += (names.empty() ? "" : ", ") + manifest.substr(from, to - from);
-    }
+    for (const std::string& name : surfaces) names += (names.empty() ? "" : ", ") + name;
     for (const std::string& h : options.hide) {
       const bool plain = !h.empty() && std::all_of(h.begin(), h.end(), [](char c) {
         return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.';
       });
-      if (!plain || manifest.find(open + h + close) == std::string::npos)
+      if (!plain || std::find(surfaces.begin(), surfaces.end(), h) == surfaces.end())
         unknown += (unknown.empty() ? "" : ", ") + ("'" + h + "'");
     }
     if (in && !unknown.empty())  // (no manifest: the view server below says what is missing)

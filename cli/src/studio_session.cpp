@@ -8,6 +8,7 @@
 #include <clay/internal/files.hpp>
 #include <clay/internal/json_reader.hpp>
 #include <clay/occt/model_exchange.hpp>
+#include <clay/recipe/path.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/sketch/fit.hpp>
 #include <clay/studio.hpp>
@@ -60,46 +61,30 @@ struct RecipePath {
   std::vector<bool> is_index;  ///< per token, from the first
 };
 
-/// "a.b[2].c" -> JSON pointer "/a/b/2/c"; clay::Error(InvalidArgument) for a malformed path.
+/// "a.b[2].c" -> JSON pointer "/a/b/2/c" (the grammar is recipe::parse_path's, shared with the
+/// sweeps); clay::Error(InvalidArgument) for a malformed path.
 RecipePath pointer_of(const std::string& path) {
-  std::vector<bool> is_index;
-  std::string out;
-  std::size_t i = 0;
-  bool expect_key = true;
-  while (i < path.size()) {
-    if (path[i] == '[') {
-      const std::size_t close = path.find(']', i);
-      const std::string index = close == std::string::npos ? "" : path.substr(i + 1, close - i - 1);
-      if (index.empty() || !std::all_of(index.begin(), index.end(), ::isdigit))
-        throw Error(ErrorCategory::InvalidArgument,
-                    "studio: path \"" + internal::clip_utf8(path, 120) +
-                        "\" has a malformed list index; write items as [i]");
-      out += "/" + index;
-      is_index.push_back(true);
-      i = close + 1;
-      expect_key = false;
-    } else if (path[i] == '.') {
-      if (expect_key)
-        throw Error(ErrorCategory::InvalidArgument,
-                    "studio: path \"" + internal::clip_utf8(path, 120) + "\" has an empty key");
-      ++i;
-      expect_key = true;
-    } else {
-      const std::size_t end = path.find_first_of(".[", i);
-      std::string key = path.substr(i, end == std::string::npos ? std::string::npos : end - i);
+  std::vector<PathStep> steps;
+  try {
+    steps = parse_path(path);
+  } catch (const Error& e) {
+    throw Error(e.category(), "studio: " + e.message());
+  }
+  RecipePath out;
+  std::string pointer;
+  for (const PathStep& step : steps) {
+    if (const auto* key = std::get_if<std::string>(&step)) {
       // JSON pointer escapes: ~ as ~0, / as ~1.
-      std::string escaped;
-      for (char c : key) escaped += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
-      out += "/" + escaped;
-      is_index.push_back(false);
-      i = end == std::string::npos ? path.size() : end;
-      expect_key = false;
+      pointer += "/";
+      for (char c : *key) pointer += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+      out.is_index.push_back(false);
+    } else {
+      pointer += "/" + std::to_string(std::get<std::size_t>(step));
+      out.is_index.push_back(true);
     }
   }
-  if (out.empty() || expect_key)
-    throw Error(ErrorCategory::InvalidArgument, "studio: path \"" + internal::clip_utf8(path, 120) +
-                                                    "\" is empty or ends with \".\"");
-  return {Json::json_pointer(out), std::move(is_index)};
+  out.pointer = Json::json_pointer(pointer);
+  return out;
 }
 
 /// The number of tokens of a JSON pointer.

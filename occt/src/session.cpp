@@ -2,13 +2,11 @@
 #include "session.hpp"
 
 #include <clay/error.hpp>
+#include <clay/internal/files.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <cctype>
-#include <chrono>
 #include <fstream>
-#include <random>
 #include <sstream>
 
 #include <BRepCheck.hxx>
@@ -37,22 +35,6 @@ bool extension_is(const fs::path& file, std::initializer_list<const char*> list)
   return false;
 }
 
-namespace {
-
-std::string random_suffix() {
-  static std::atomic<unsigned long> counter{0};
-  std::random_device device;
-  std::mt19937_64 rng(
-      (static_cast<unsigned long long>(device()) << 32) ^
-      static_cast<unsigned long long>(std::chrono::steady_clock::now().time_since_epoch().count()) ^
-      counter.fetch_add(1));
-  std::ostringstream out;
-  out << std::hex << rng();
-  return out.str();
-}
-
-}  // namespace
-
 /// Checks that the folder of `file` exists and `file` names a file in it.
 void check_target(const fs::path& file, std::string_view caller) {
   if (file.empty() || !file.has_filename())
@@ -66,25 +48,18 @@ void check_target(const fs::path& file, std::string_view caller) {
                                        " does not exist; create it before writing");
 }
 
-/// Writes through `write(temp_path)` into a temporary file next to `file` (".NAME.tmp-<random>")
-/// and renames it onto `file`. On any failure the temporary file is removed and the error
-/// rethrown, so nothing is left behind.
+/// Writes through `write(temp_path)` with internal::write_atomically_via (a temporary made by
+/// mkstemp beside `file`, flushed, renamed over it; removed on any failure), after check_target.
+/// The helper's own errors are prefixed with `caller`, as the writers' are.
 void write_atomically(const fs::path& file, std::string_view caller,
                       const std::function<void(const fs::path&)>& write) {
   check_target(file, caller);
-  const fs::path folder = file.has_parent_path() ? file.parent_path() : fs::path(".");
-  const fs::path temp = folder / ("." + file.filename().string() + ".tmp-" + random_suffix());
+  const std::string prefix = std::string(caller) + ": ";
   try {
-    write(temp);
-    std::error_code ec;
-    fs::rename(temp, file, ec);
-    if (ec)
-      throw Error(ErrorCategory::Io, std::string(caller) + ": could not rename " + quoted(temp) +
-                                         " to " + quoted(file) + ": " + ec.message());
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    throw;
+    internal::write_atomically_via(file, "file", write);
+  } catch (const Error& e) {
+    if (e.message().rfind(prefix, 0) == 0) throw;
+    throw Error(e.category(), prefix + e.message());
   }
 }
 

@@ -49,6 +49,9 @@ import warnings
 from pathlib import Path
 from typing import Any, Callable, Dict, Iterable, Iterator, List, Optional, Set, Tuple, Union
 
+from ._clayform import recipe_path
+from .errors import InvalidArgumentError
+
 if sys.argv[:1] == ["-m"]:
     # `python3 -m clayform.sweeps` (what `clayform sweep` runs): the package imports this module
     # before runpy runs it as __main__, and runpy warns about that on stderr, which should carry
@@ -71,7 +74,6 @@ SHEET_TILES = 100
 STORAGE_ERRNOS = frozenset({errno.ENOSPC, errno.EROFS, errno.EACCES, errno.EDQUOT, errno.EFBIG})
 INDEX_FIELDS = ["id", "status", "seconds", "deviation_mm", "volume_mm3", "volume_ratio_min", "volume_ratio_max",
                 "fold_free", "control_points", "error", "parameters"]
-_TOKEN = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
 _STAGING = ".staging-"
 _LOCK = ".sweep.lock"
 #: Every rename into OUT goes through here (a seam for the tests' storage faults).
@@ -135,19 +137,14 @@ class FolderInUse(RuntimeError):
 
 
 def parse_path(path: str) -> List[Union[str, int]]:
-    """'deformations.billow[0].moves[1].by[2]' -> ['deformations', 'billow', 0, 'moves', 1, 'by', 2]."""
-    parts: List[Union[str, int]] = []
-    pos = 0
+    """'deformations.billow[0].moves[1].by[2]' -> ['deformations', 'billow', 0, 'moves', 1, 'by', 2]:
+    the kernel's grammar (clayform.recipe_path), the one the studio's edits use."""
     if not isinstance(path, str):
         raise SpecError(f"parameter path {path!r} is not a string of keys joined by '.' with list items as [i]")
-    for m in _TOKEN.finditer(path):
-        if m.start() != pos and path[pos:m.start()] != ".":
-            break
-        parts.append(m.group(1) if m.group(1) is not None else int(m.group(2)))
-        pos = m.end()
-    if not parts or pos != len(path):
-        raise SpecError(f"parameter path {path!r} is not keys joined by '.' with list items as [i]")
-    return parts
+    try:
+        return recipe_path(path)
+    except InvalidArgumentError as e:
+        raise SpecError(f"parameter {e}") from None
 
 
 def _walk(document: Any, path: str) -> Tuple[Any, Union[str, int]]:

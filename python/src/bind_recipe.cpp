@@ -3,6 +3,7 @@
 #include "common.hpp"
 
 #include <clay/internal/files.hpp>
+#include <clay/recipe/path.hpp>
 #include <clay/recipe/recipe.hpp>
 
 #include <pybind11/stl/filesystem.h>
@@ -46,6 +47,22 @@ py::object report_dict(const recipe::RunResult& r) {
 }  // namespace
 
 void bind_recipe(py::module_& m) {
+  m.def(
+      "recipe_path",
+      [](const std::string& path) {
+        py::list out;
+        for (const recipe::PathStep& step : recipe::parse_path(path)) {
+          if (const auto* key = std::get_if<std::string>(&step))
+            out.append(py::str(*key));
+          else
+            out.append(py::int_(std::get<std::size_t>(step)));
+        }
+        return out;
+      },
+      py::arg("path"),
+      "The steps of a recipe path ('a.b[2].c' -> ['a', 'b', 2, 'c']): the kernel's one grammar, "
+      "shared by the studio's edits and the sweeps' parameters. InvalidArgumentError names the "
+      "rule a malformed path breaks.");
   py::class_<recipe::RunResult>(m, "RunResult",
                                 "What a recipe run computed, in memory: surfaces, curves, steps "
                                 "and the report; write(out) writes the exports.")

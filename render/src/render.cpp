@@ -2,6 +2,7 @@
 #include <clay/brep/mesh.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/checks.hpp>
+#include <clay/internal/files.hpp>
 #include <clay/render/render.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
@@ -477,24 +478,15 @@ void write_png(const Image& image, const fs::path& file) {
   if (!file.has_filename())
     throw Error(ErrorCategory::InvalidArgument,
                 "write_png: \"" + file.string() + "\" names no file; give e.g. picture.png");
-  const fs::path tmp = (file.has_parent_path() ? file.parent_path() : fs::path(".")) /
-                       ("." + file.filename().string() + ".clayform-" + std::to_string(::getpid()));
-  png_image png = png_header(image);
-  std::error_code ec;
-  if (!png_image_write_to_file(&png, tmp.c_str(), 0, image.rgb.data(), 0, nullptr)) {
-    const std::string why = png.message;
-    png_image_free(&png);
-    fs::remove(tmp, ec);
-    throw Error(ErrorCategory::Io, "write_png: cannot write \"" + file.string() +
-                                       "\" (temporary \"" + tmp.string() + "\"): " + why +
-                                       "; check that the folder exists and is writable");
-  }
-  fs::rename(tmp, file, ec);
-  if (ec) {
-    const std::string why = ec.message();
-    fs::remove(tmp, ec);
-    throw Error(ErrorCategory::Io,
-                "write_png: cannot move the picture to \"" + file.string() + "\": " + why);
+  // Encoded in memory, then written as every library writes a file (internal::write_atomically):
+  // a temporary made by mkstemp beside it, flushed, renamed over it.
+  const std::vector<unsigned char> bytes = encode_png(image);
+  try {
+    internal::write_atomically(
+        file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+        "picture");
+  } catch (const Error& e) {
+    throw Error(e.category(), "write_png: " + e.message());
   }
 }
 

@@ -7,6 +7,7 @@ import csv
 import errno
 import itertools
 import json
+import re
 import os
 import resource
 import signal
@@ -35,6 +36,14 @@ def test_paths_and_variants(examples: Path) -> None:
     assert sweeps.parse_path("a.b[2].c[0]") == ["a", "b", 2, "c", 0]
     with pytest.raises(ValueError):
         sweeps.parse_path("a..b")
+    # The kernel's grammar, the studio's: each malformed path names its rule.
+    for bad, rule in [("", "is empty"), ("a.", 'ends with "."'), (".a", "empty key"),
+                      ("a[x]", "malformed list index"), ("a[1", "[ without ]"), ("a]", "] without ["),
+                      ("a[0]b", "right after a list index"), ("[0]", "starts with a list index"),
+                      ("a[99999999999999999999999]", "too large")]:
+        with pytest.raises(sweeps.SpecError, match=re.escape(rule)):
+            sweeps.parse_path(bad)
+    assert cf.recipe_path("x[0][1].y") == ["x", 0, 1, "y"]
     doc = {"a": {"b": [1, {"c": [5, 6]}]}}
     sweeps.set_path(doc, "a.b[1].c[0]", 9)
     assert doc["a"]["b"][1]["c"][0] == 9
@@ -189,7 +198,7 @@ BAD_DESCRIPTIONS = {  # test id: (the description, with SAIL and BILLOW filled i
     "version-2": ('{"recipe": SAIL, "grid": {"BILLOW": [1]}, "version": 2}', 'expected "format": "clayform.sweep"'),
     "out-not-a-string": ('{"recipe": SAIL, "grid": {"BILLOW": [1]}, "out": 5}', '"out" is a string'),
     "path-not-in-recipe": ('{"recipe": SAIL, "grid": {"BILLOW.x": [1]}}', "BILLOW.x: the recipe has no key 'x' there"),
-    "path-malformed": ('{"recipe": SAIL, "grid": {"a..b": [1]}}', "parameter path 'a..b' is not keys joined by '.'"),
+    "path-malformed": ('{"recipe": SAIL, "grid": {"a..b": [1]}}', "parameter path \"a..b\" has an empty key"),
     "same-variant-twice": ('{"recipe": SAIL, "grid": {"BILLOW": [1, 1]}}', "variants 1 and 2 have the same parameters"),
 }
 

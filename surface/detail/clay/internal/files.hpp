@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -93,29 +94,60 @@ inline std::filesystem::path path_under(const std::filesystem::path& folder,
   return out;
 }
 
-/// Writes `bytes` to `file` atomically: into a temporary made beside it by mkstemp (O_CREAT |
-/// O_EXCL: a planted file or symbolic link is never followed, and concurrent writers never share
-/// it), flushed to disk, then renamed over `file`. The temporary is removed on every failure.
-/// Refuses to replace anything but a regular file (a device, a FIFO, a folder). Throws
-/// clay::Error(Io) naming `what` and the file.
-inline void write_atomically(const std::filesystem::path& file, std::string_view bytes,
-                             const std::string& what) {
-  namespace fs = std::filesystem;
+namespace files_detail {
+
+/// Refuses to replace anything but a regular file or a symbolic link (which rename replaces, never
+/// follows): a device, a FIFO, a folder.
+inline void refuse_special(const std::filesystem::path& file, const std::string& what) {
   struct stat st {};
   if (::lstat(file.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISLNK(st.st_mode))
     throw Error(ErrorCategory::Io,
                 "cannot write the " + what + " \"" + file.string() +
                     "\": it exists and is not a regular file; give another name");
+}
+
+/// A new, empty temporary beside `file`, made by mkstemp (O_CREAT | O_EXCL: a planted file or
+/// link is never followed, concurrent writers never share one); its descriptor in `fd`.
+inline std::string temporary_beside(const std::filesystem::path& file, const std::string& what,
+                                    int& fd) {
+  namespace fs = std::filesystem;
   std::string pattern = (file.parent_path().empty() ? fs::path(".") : file.parent_path()) /
                         ("." + file.filename().string() + ".XXXXXX");
-  const int fd = ::mkstemp(pattern.data());
+  fd = ::mkstemp(pattern.data());
   if (fd < 0)
     throw Error(ErrorCategory::Io, "cannot write the " + what + " \"" + file.string() +
                                        "\": " + std::strerror(errno) + "; check the folder");
+  return pattern;
+}
+
+/// Renames the finished temporary over `file`; removes it and throws on failure.
+inline void rename_over(const std::string& temporary, const std::filesystem::path& file,
+                        const std::string& what) {
+  if (::rename(temporary.c_str(), file.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(temporary.c_str());
+    throw Error(ErrorCategory::Io, "cannot write the " + what + " \"" + file.string() +
+                                       "\": " + std::strerror(err) + "; check the folder");
+  }
+}
+
+}  // namespace files_detail
+
+/// Writes `bytes` to `file` atomically: into a temporary made beside it by mkstemp (O_CREAT |
+/// O_EXCL: a planted file or symbolic link is never followed, and concurrent writers never share
+/// it), flushed to disk, then renamed over `file`. The temporary is removed on every failure.
+/// Refuses to replace anything but a regular file (a device, a FIFO, a folder). Throws
+/// clay::Error(Io) naming `what` and the file. The one way the libraries write a file (issue #37:
+/// it was written three times); write_atomically_via is the same for writers that need a path.
+inline void write_atomically(const std::filesystem::path& file, std::string_view bytes,
+                             const std::string& what) {
+  files_detail::refuse_special(file, what);
+  int fd = -1;
+  const std::string temporary = files_detail::temporary_beside(file, what, fd);
   auto fail = [&](const std::string& doing) {
     const int err = errno;
     ::close(fd);
-    ::unlink(pattern.c_str());
+    ::unlink(temporary.c_str());
     throw Error(ErrorCategory::Io, "cannot write the " + what + " \"" + file.string() + "\" (" +
                                        doing + "): " + std::strerror(err) +
                                        "; check the folder and the free space");
@@ -129,16 +161,39 @@ inline void write_atomically(const std::filesystem::path& file, std::string_view
   if (::fchmod(fd, 0644) != 0 || ::fsync(fd) != 0) fail("flushing");
   if (::close(fd) != 0) {
     const int err = errno;
-    ::unlink(pattern.c_str());
+    ::unlink(temporary.c_str());
     throw Error(ErrorCategory::Io, "cannot write the " + what + " \"" + file.string() +
                                        "\": " + std::strerror(err) + "; check the free space");
   }
-  if (::rename(pattern.c_str(), file.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(pattern.c_str());
-    throw Error(ErrorCategory::Io, "cannot write the " + what + " \"" + file.string() +
-                                       "\": " + std::strerror(err) + "; check the folder");
+  files_detail::rename_over(temporary, file, what);
+}
+
+/// write_atomically for writers that take a path (OpenCASCADE's STEP, IGES and glTF writers):
+/// `write(temporary)` fills a temporary that mkstemp made beside `file` (it exists, is empty and
+/// is ours), which is then flushed and renamed over `file`. On any failure the temporary is
+/// removed and the writer's exception rethrown.
+inline void write_atomically_via(const std::filesystem::path& file, const std::string& what,
+                                 const std::function<void(const std::filesystem::path&)>& write) {
+  files_detail::refuse_special(file, what);
+  int fd = -1;
+  const std::string temporary = files_detail::temporary_beside(file, what, fd);
+  ::close(fd);
+  try {
+    write(temporary);
+    const int flush = ::open(temporary.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+    if (flush < 0 || ::fchmod(flush, 0644) != 0 || ::fsync(flush) != 0) {
+      const int err = errno;
+      if (flush >= 0) ::close(flush);
+      throw Error(ErrorCategory::Io, "cannot write the " + what + " \"" + file.string() +
+                                         "\" (flushing): " + std::strerror(err) +
+                                         "; check the folder and the free space");
+    }
+    ::close(flush);
+  } catch (...) {
+    ::unlink(temporary.c_str());
+    throw;
   }
+  files_detail::rename_over(temporary, file, what);
 }
 
 }  // namespace clay::internal
