@@ -1,4 +1,9 @@
 // The recipe checker: deformation stacks, lattices, style and direct steps (recipe_checker.hpp).
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
 #include "recipe_checker.hpp"
 
 namespace clay::recipe::check_detail {
@@ -431,6 +436,36 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
   }
   const std::size_t before = c_.problems.size();
   if (!c_.at_most(j, path, limit::steps, "steps")) return;
+  // One reader per step kind, by its name in the schema (docs/recipe.md § deformations); each
+  // sets the step and says whether it was valid.
+  auto set = [](StepDef& step, auto read) {
+    if (!read) return false;
+    step.step = std::move(*read);
+    return true;
+  };
+  auto schema = [&](const Json& s, const std::string& p, StepDef& step) {
+    auto d = schema_step(s, p);
+    return d && within_limits(*d, p) && set(step, std::move(d));
+  };
+  using Reader = std::function<bool(const Json&, const std::string&, StepDef&)>;
+  const std::vector<std::pair<std::string, Reader>> readers = {
+      {"bezier_lattice", [&](const Json& s, const std::string& p,
+                             StepDef& st) { return set(st, lattice(s, p, false, {})); }},
+      {"bspline_lattice", [&](const Json& s, const std::string& p,
+                              StepDef& st) { return set(st, lattice(s, p, true, {})); }},
+      {"extended_lattice",  // from a generator (a primitive's lattice), or given point by point
+       [&](const Json& s, const std::string& p, StepDef& st) {
+         return s.contains("generator") ? set(st, extended_from_generator(s, p)) : schema(s, p, st);
+       }},
+      {"taper", schema},
+      {"twist", schema},
+      {"bend", schema},
+      {"style",
+       [&](const Json& s, const std::string& p, StepDef& st) { return set(st, style(s, p)); }},
+      {"direct_manipulation",
+       [&](const Json& s, const std::string& p, StepDef& st) { return set(st, direct(s, p)); }}};
+  std::vector<std::string> kinds;
+  for (const auto& reader : readers) kinds.push_back(reader.first);
   for (std::size_t i = 0; i < j.size(); ++i) {
     const std::string p = index_path(path, i);
     const Json& s = j[i];
@@ -441,27 +476,13 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
     StepDef step{p, "", "", true, deform::Deformation{}};
     const Json* k = c_.member(s, p, "kind", true, "the step's kind, e.g. \"bezier_lattice\"");
     if (!k) continue;
-    const auto kind = c_.choice(*k, key_path(p, "kind"),
-                                {"bezier_lattice", "bspline_lattice", "extended_lattice", "taper",
-                                 "twist", "bend", "style", "direct_manipulation"});
+    const auto kind = c_.choice(*k, key_path(p, "kind"), kinds);
     if (!kind) continue;
     step.kind = k->get<std::string>();
     if (const Json* n = c_.member(s, p, "name", false, ""))
       step.name = c_.string(*n, key_path(p, "name")).value_or("");
     step.enabled = c_.boolean_or(s, p, "enabled", true);
-    bool ok = false;
-    if (*kind <= 1) {
-      if (auto d = lattice(s, p, *kind == 1, {})) step.step = std::move(*d), ok = true;
-    } else if (*kind == 2 && s.contains("generator")) {
-      if (auto d = extended_from_generator(s, p)) step.step = std::move(*d), ok = true;
-    } else if (*kind <= 5) {
-      if (auto d = schema_step(s, p); d && within_limits(*d, p))
-        step.step = std::move(*d), ok = true;
-    } else if (*kind == 6) {
-      if (auto d = style(s, p)) step.step = std::move(*d), ok = true;
-    } else {
-      if (auto d = direct(s, p)) step.step = std::move(*d), ok = true;
-    }
+    const bool ok = readers[static_cast<std::size_t>(*kind)].second(s, p, step);
     if (ok) def.steps.push_back(std::move(step));
   }
   if (c_.problems.size() == before) data.stacks.push_back(std::move(def));
@@ -548,7 +569,7 @@ std::optional<DirectDef> RecipeChecker::direct(const Json& j, const std::string&
     const auto kind = k ? c_.choice(*k, key_path(lp, "kind"), {"bezier_lattice", "bspline_lattice"})
                         : std::nullopt;
     if (kind) {
-      if (auto lat = lattice(*lj, lp, *kind == 1, {})) {
+      if (auto lat = lattice(*lj, lp, k->get<std::string>() == "bspline_lattice", {})) {
         if (auto* b = std::get_if<deform::BezierLattice>(&*lat)) {
           counts = b->counts();
           d.lattice = *b;
