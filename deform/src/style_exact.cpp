@@ -478,6 +478,207 @@ FreeArea make_free_area(const BSplineSurface& parent, const InfluenceRegion& reg
   return area;
 }
 
+/// The key-point rows on net `s` (Han–De Amicis–Conti eq. 9): Σ_free R_ij(u_k, v_k) d_ij =
+/// λ (K_k − P_k), one per influenced key point.
+struct KeyPointSystem {
+  std::vector<int> active;  // indices of the influenced key points
+  Eigen::MatrixXd B;        // nk x nf: the free vertices' basis functions at the key points
+  Eigen::MatrixXd rhs;      // nk x 3: λ (K_k − P_k)
+};
+
+KeyPointSystem key_point_system(const BSplineSurface& s, const std::vector<KeyPoint>& points,
+                                const std::vector<Eigen::Index>& free_index, Eigen::Index nf,
+                                double lambda) {
+  KeyPointSystem out;
+  for (size_t k = 0; k < points.size(); ++k)
+    if (points[k].influenced) out.active.push_back(static_cast<int>(k));
+  const Eigen::Index nk = static_cast<Eigen::Index>(out.active.size());
+  out.B = Eigen::MatrixXd::Zero(nk, nf);
+  out.rhs.resize(nk, 3);
+  for (Eigen::Index k = 0; k < nk; ++k) {
+    const KeyPoint& kp = points[static_cast<size_t>(out.active[static_cast<size_t>(k)])];
+    for (const auto& [r, value] : basis_at(s, kp.u, kp.v))
+      if (free_index[static_cast<size_t>(r)] >= 0)
+        out.B(k, free_index[static_cast<size_t>(r)]) = value;
+    out.rhs.row(k) = lambda * (kp.point - kp.foot).transpose();
+  }
+  return out;
+}
+
+/// The free vertices' displacements d (nf x 3) of least fairness energy that meet the key-point
+/// rows B d = rhs (Han–De Amicis–Conti §4, the energy of eq. 10 under the constraints of eq. 9),
+/// or, when the rows are dependent (rank < nk), the least-squares compromise of least energy.
+/// `qr` is the rank-revealing QR of B^T that gave `rank`; `tol` the tolerance in mm.
+Eigen::MatrixXd constrained_minimum(const NetCache& net, const Eigen::MatrixXd& B,
+                                    const Eigen::MatrixXd& rhs, int rank,
+                                    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd>& qr,
+                                    double tol) {
+  // The energy minimum subject to the key points, when they are independent: d = H^-1 B^T μ with
+  // (B H^-1 B^T) μ = r, else the KKT system (kkt_solve). Dependent key points:
+  // d = d0 + Z y with d0 the minimal-norm least-squares solution of B d = r, Z a basis of null(B)
+  // and y minimising the energy — the least-squares compromise of least energy.
+  const Eigen::Index nk = B.rows(), nf = B.cols();
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(nf, 3);
+  if (nk > 0 && nf > 0) {
+    if (rank == nk) {
+      // Range space first: Y = H^-1 B^T from the net's factorization, S = B Y (nk x nk, SPD),
+      // S μ = r, d = Y μ, one step of refinement on the key-point residual. It is accepted
+      // when it meets the key points to far below the tolerance; otherwise (S squares the
+      // conditioning of nearly dependent rows) the KKT system decides.
+      bool solved = false;
+      if (net.factorized) {
+        Eigen::MatrixXd Y;
+        if (net.inverse.size() > 0) {
+          Y = Eigen::MatrixXd::Zero(nf, nk);
+          for (Eigen::Index k = 0; k < nk; ++k)
+            for (Eigen::Index c = 0; c < nf; ++c)
+              if (B(k, c) != 0) Y.col(k) += B(k, c) * net.inverse.col(c);
+        } else {
+          Y = net.energy.solve(Eigen::MatrixXd(B.transpose()));
+        }
+        const Eigen::MatrixXd S = B * Y;
+        const Eigen::LDLT<Eigen::MatrixXd> schur(S);
+        if (schur.info() == Eigen::Success && schur.isPositive()) {
+          Eigen::MatrixXd mu = schur.solve(rhs);
+          mu += schur.solve(rhs - B * (Y * mu));
+          d = Y * mu;
+          // Both KKT conditions: the key points (B d = r) and stationarity (H d = B^T μ). The
+          // first alone cannot see an inaccurate Y, since S was made from the same Y; the
+          // second can (a nearly singular H, held definite only by its ridge where the free
+          // vertices reach the net's border, or μ large along S's weak directions).
+          const Eigen::MatrixXd force = B.transpose() * mu;
+          const double stationarity = (net.H * d - force).cwiseAbs().maxCoeff();
+          solved = internal::all_finite(d) &&
+                   (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
+                   stationarity <= range_space_stationarity * force.cwiseAbs().maxCoeff();
+        }
+      }
+      if (!solved) d = kkt_solve(net.H, B, rhs);
+    } else if (nf > dependent_dense_limit && net.factorized) {
+      // Too many free vertices for the dense null space below (Q is nf x nf): the same
+      // compromise as the limit of the penalty min d^T H d + |B d - r|^2 / ε, by the range
+      // space with a ridge on the Schur complement, d = Y (B Y + ε I)^-1 r, Y = H^-1 B^T.
+      const Eigen::MatrixXd Y = net.energy.solve(Eigen::MatrixXd(B.transpose()));
+      Eigen::MatrixXd S = B * Y;
+      const double ridge = 1e-10 * std::max(S.trace() / static_cast<double>(nk), 1e-300);
+      S.diagonal().array() += ridge;
+      d = Y * S.ldlt().solve(rhs);
+    } else {
+      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(B);
+      cod.setThreshold(1e-10);
+      d = cod.solve(rhs);
+      if (rank < nf) {
+        const Eigen::MatrixXd Q = qr.householderQ();
+        const Eigen::MatrixXd Z = Q.rightCols(nf - rank);
+        const Eigen::MatrixXd HZ = net.H * Z;
+        const Eigen::MatrixXd reduced = Z.transpose() * HZ;
+        d -= Z * reduced.ldlt().solve(HZ.transpose() * d);
+      }
+    }
+  }
+  return d;
+}
+
+/// Adds key points where `result_surface` still misses the target by more than curve_tolerance:
+/// at the local maxima of the miss along `fine` (the target's samples, 4 times as dense as the
+/// trace), away from key points already there. Returns how many were added.
+template <class InRegion>
+size_t add_key_points_at_misses(const BSplineSurface& s, const BSplineSurface& result_surface,
+                                const InfluenceRegion& reg, const std::vector<TraceSample>& fine,
+                                KeyDirection direction, const FreeArea& area, InRegion&& in_region,
+                                const StyleOptions& options, double size,
+                                std::vector<KeyPoint>& points) {
+  const double limit = options.curve_tolerance * size;
+  std::vector<double> miss(fine.size(), 0.0);
+  const surface::SurfaceProjector result(result_surface, options.projection);  // validated once
+  for (size_t k = 0; k < fine.size(); ++k) {
+    if (!in_region(fine[k]) || !area.holds(fine[k].u, fine[k].v)) continue;
+    // The distance from the wanted point (λ scales the move as for key points) to the result;
+    // the miss at the sample's own parameters bounds it from above and spares most
+    // projections.
+    const Eigen::Vector3d foot = surface::evaluate(s, fine[k].u, fine[k].v);
+    const Eigen::Vector3d wanted = foot + options.lambda * (fine[k].point - foot);
+    miss[k] = (surface::evaluate(result_surface, fine[k].u, fine[k].v) - wanted).norm();
+    if (miss[k] > limit) miss[k] = project_from(result, wanted, fine[k].u, fine[k].v).distance;
+  }
+  size_t added = 0;
+  for (size_t k = 0; k < fine.size(); ++k) {
+    // Local maxima, with a relative slack so that a plateau of two equal misses (a symmetric
+    // target) adds both samples, not whichever rounding favours.
+    const double floor = miss[k] * (1 - 1e-6);
+    const bool peak = miss[k] > limit && (k == 0 || floor >= miss[k - 1]) &&
+                      (k + 1 == fine.size() || floor >= miss[k + 1]);
+    if (!peak) continue;
+    // Not next to a key point already there (nearly equal rows would make the system
+    // ill-conditioned): at least half a sample step away along the curve.
+    const double gap =
+        0.5 * (fine.back().t - fine.front().t) / static_cast<double>(fine.size() - 1);
+    bool crowded = false;
+    for (const KeyPoint& p : points)
+      crowded = crowded || std::abs(p.curve_parameter - fine[k].t) < gap;
+    if (crowded) continue;
+    points.push_back(
+        make_key_point(s, reg, fine[k].point, fine[k].t, fine[k].u, fine[k].v, direction));
+    ++added;
+  }
+  return added;
+}
+
+/// The report of the solve that is kept: the energy, the rank and degrees of freedom, the key
+/// points that cannot be met, the measured figures, and the message saying what limited it.
+template <class Net>
+void finish_report(const BSplineSurface& parent, const InfluenceRegion& region,
+                   const BSplineSurface& s, const InfluenceRegion& reg,
+                   const BSplineSurface& result_surface, const Net& net, const Eigen::MatrixXd& d,
+                   const KeyPointSystem& system, int rank, double amplification, double min_share,
+                   const BSplineCurve& target, const std::vector<TraceSample>& trace,
+                   const StyleOptions& options, double size, const std::vector<KeyPoint>& points,
+                   StyleReport& report) {
+  const Eigen::Index nk = system.B.rows(), nf = system.B.cols();
+  const std::vector<int>& active = system.active;
+  const Eigen::MatrixXd achieved = system.B * d - system.rhs;
+  const double tol = options.tolerance * size;
+  report.key_points = points;
+  // E_k(d) from the net's own matrix (fixed vertices have d = 0), without the ridge.
+  report.fairness_energy =
+      nf > 0 ? net.scale * ((d.transpose() * (net.H * d)).trace() - energy_ridge * d.squaredNorm())
+             : 0.0;
+  report.rank = rank;
+  report.degrees_of_freedom = 3 * (static_cast<int>(nf) - rank);
+  for (Eigen::Index k = 0; k < nk; ++k)
+    if (achieved.row(k).norm() > tol)
+      report.conflicting_key_points.push_back(active[static_cast<size_t>(k)]);
+  measure(s, result_surface, reg.factors, reg, target, trace, options, report);
+  // The edge of a region without a bound is that of the parent's influenced vertices (the
+  // free area is made from them), not of those of the refined net, a band narrower by the
+  // refinement.
+  if (options.report_curves && region.polygon.empty())
+    measure_boundary(parent, region.factors, region, s, result_surface, report);
+  std::ostringstream msg;
+  msg << to_string(report.constraint_class) << ", m = " << report.key_points.size()
+      << " key points (" << nk << " influenced";
+  if (report.added_key_points > 0)
+    msg << ", " << report.added_key_points << " added where the target was missed";
+  msg << "), " << nf << " free vertices, rank " << rank << ", " << report.degrees_of_freedom
+      << " degrees of freedom left";
+  if (report.knots_inserted > 0) msg << ", " << report.knots_inserted << " knots inserted";
+  if (!report.conflicting_key_points.empty())
+    msg << "; " << report.conflicting_key_points.size()
+        << " key points cannot be met (the net is too coarse there: allow more max_refinements)";
+  if (amplification > max_amplification)
+    msg << "; the free vertices move up to " << amplification
+        << " times the farthest key point's distance (allow more max_refinements)";
+  if (min_share < min_free_share)
+    msg << "; a key point is held mostly by fixed vertices (free share " << min_share
+        << "): the free vertices move up to " << 1.0 / std::max(min_share, 1e-300)
+        << " times its distance (allow more max_refinements, or a bound further from the target)";
+  if (options.curve_tolerance > 0 && report.target_curve_deviation > options.curve_tolerance * size)
+    msg << "; the target curve is still missed by " << report.target_curve_deviation
+        << " mm, more than "
+        << "curve_tolerance x size = " << options.curve_tolerance * size
+        << " mm (allow more max_key_point_rounds or max_refinements)";
+  report.message = msg.str();
+}
 }  // namespace
 
 StyleResult style_exact(const surface::SurfaceProjector& projector, const InfluenceRegion& region,
@@ -563,20 +764,10 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     const auto& free_rows = net->free_rows;
     const Eigen::Index nf = static_cast<Eigen::Index>(free_rows.size());
 
-    std::vector<int> active;  // indices of the influenced key points
-    for (size_t k = 0; k < points.size(); ++k)
-      if (points[k].influenced) active.push_back(static_cast<int>(k));
-    const Eigen::Index nk = static_cast<Eigen::Index>(active.size());
-    // Key-point rows: sum_free R_ij(u_k, v_k) d_ij = λ (K_k - P_k).
-    Eigen::MatrixXd B = Eigen::MatrixXd::Zero(nk, nf);
-    Eigen::MatrixXd rhs(nk, 3);
-    for (Eigen::Index k = 0; k < nk; ++k) {
-      const KeyPoint& kp = points[static_cast<size_t>(active[static_cast<size_t>(k)])];
-      for (const auto& [r, value] : basis_at(s, kp.u, kp.v))
-        if (free_index[static_cast<size_t>(r)] >= 0)
-          B(k, free_index[static_cast<size_t>(r)]) = value;
-      rhs.row(k) = options.lambda * (kp.point - kp.foot).transpose();
-    }
+    const KeyPointSystem system = key_point_system(s, points, free_index, nf, options.lambda);
+    const Eigen::MatrixXd& B = system.B;
+    const Eigen::MatrixXd& rhs = system.rhs;
+    const Eigen::Index nk = B.rows();
     // Rank of the key-point system from a rank-revealing QR of B^T = Q R P^T: the last nf - rank
     // columns of Q span the null space of B, the displacements that leave every key point alone.
     int rank = 0;
@@ -618,68 +809,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       continue;
     }
 
-    // The energy minimum subject to the key points, when they are independent: d = H^-1 B^T μ with
-    // (B H^-1 B^T) μ = r, else the KKT system (kkt_solve). Dependent key points:
-    // d = d0 + Z y with d0 the minimal-norm least-squares solution of B d = r, Z a basis of null(B)
-    // and y minimising the energy — the least-squares compromise of least energy.
-    Eigen::MatrixXd d = Eigen::MatrixXd::Zero(nf, 3);
-    if (nk > 0 && nf > 0) {
-      if (rank == nk) {
-        // Range space first: Y = H^-1 B^T from the net's factorization, S = B Y (nk x nk, SPD),
-        // S μ = r, d = Y μ, one step of refinement on the key-point residual. It is accepted
-        // when it meets the key points to far below the tolerance; otherwise (S squares the
-        // conditioning of nearly dependent rows) the KKT system decides.
-        bool solved = false;
-        if (net->factorized) {
-          Eigen::MatrixXd Y;
-          if (net->inverse.size() > 0) {
-            Y = Eigen::MatrixXd::Zero(nf, nk);
-            for (Eigen::Index k = 0; k < nk; ++k)
-              for (Eigen::Index c = 0; c < nf; ++c)
-                if (B(k, c) != 0) Y.col(k) += B(k, c) * net->inverse.col(c);
-          } else {
-            Y = net->energy.solve(Eigen::MatrixXd(B.transpose()));
-          }
-          const Eigen::MatrixXd S = B * Y;
-          const Eigen::LDLT<Eigen::MatrixXd> schur(S);
-          if (schur.info() == Eigen::Success && schur.isPositive()) {
-            Eigen::MatrixXd mu = schur.solve(rhs);
-            mu += schur.solve(rhs - B * (Y * mu));
-            d = Y * mu;
-            // Both KKT conditions: the key points (B d = r) and stationarity (H d = B^T μ). The
-            // first alone cannot see an inaccurate Y, since S was made from the same Y; the
-            // second can (a nearly singular H, held definite only by its ridge where the free
-            // vertices reach the net's border, or μ large along S's weak directions).
-            const Eigen::MatrixXd force = B.transpose() * mu;
-            const double stationarity = (net->H * d - force).cwiseAbs().maxCoeff();
-            solved = internal::all_finite(d) &&
-                     (B * d - rhs).cwiseAbs().maxCoeff() <= range_space_accuracy * tol &&
-                     stationarity <= range_space_stationarity * force.cwiseAbs().maxCoeff();
-          }
-        }
-        if (!solved) d = kkt_solve(net->H, B, rhs);
-      } else if (nf > dependent_dense_limit && net->factorized) {
-        // Too many free vertices for the dense null space below (Q is nf x nf): the same
-        // compromise as the limit of the penalty min d^T H d + |B d - r|^2 / ε, by the range
-        // space with a ridge on the Schur complement, d = Y (B Y + ε I)^-1 r, Y = H^-1 B^T.
-        const Eigen::MatrixXd Y = net->energy.solve(Eigen::MatrixXd(B.transpose()));
-        Eigen::MatrixXd S = B * Y;
-        const double ridge = 1e-10 * std::max(S.trace() / static_cast<double>(nk), 1e-300);
-        S.diagonal().array() += ridge;
-        d = Y * S.ldlt().solve(rhs);
-      } else {
-        Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(B);
-        cod.setThreshold(1e-10);
-        d = cod.solve(rhs);
-        if (rank < nf) {
-          const Eigen::MatrixXd Q = qr.householderQ();
-          const Eigen::MatrixXd Z = Q.rightCols(nf - rank);
-          const Eigen::MatrixXd HZ = net->H * Z;
-          const Eigen::MatrixXd reduced = Z.transpose() * HZ;
-          d -= Z * reduced.ldlt().solve(HZ.transpose() * d);
-        }
-      }
-    }
+    const Eigen::MatrixXd d = constrained_minimum(*net, B, rhs, rank, qr, tol);
     // Key points independent but so nearly dependent that the solve misses them, or met only by
     // a wound-up net: a finer net. When the net may not be refined further and the last key points
     // added are what winds it up, they are taken back (the miss of the target curve is reported).
@@ -708,40 +838,9 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
     // the local maxima of the miss along the target's samples (4 times as dense as the trace: the
     // dense measure of the report found misses between the trace's samples) and solve again.
     if (!missed && options.curve_tolerance > 0 && additions < options.max_key_point_rounds) {
-      const double limit = options.curve_tolerance * size;
       if (fine.empty()) fine = densify(projector, target, trace);
-      std::vector<double> miss(fine.size(), 0.0);
-      const surface::SurfaceProjector result(out.surface, options.projection);  // validated once
-      for (size_t k = 0; k < fine.size(); ++k) {
-        if (!in_region(fine[k]) || !area->holds(fine[k].u, fine[k].v)) continue;
-        // The distance from the wanted point (λ scales the move as for key points) to the result;
-        // the miss at the sample's own parameters bounds it from above and spares most
-        // projections.
-        const Eigen::Vector3d foot = surface::evaluate(s, fine[k].u, fine[k].v);
-        const Eigen::Vector3d wanted = foot + options.lambda * (fine[k].point - foot);
-        miss[k] = (surface::evaluate(out.surface, fine[k].u, fine[k].v) - wanted).norm();
-        if (miss[k] > limit) miss[k] = project_from(result, wanted, fine[k].u, fine[k].v).distance;
-      }
-      size_t added = 0;
-      for (size_t k = 0; k < fine.size(); ++k) {
-        // Local maxima, with a relative slack so that a plateau of two equal misses (a symmetric
-        // target) adds both samples, not whichever rounding favours.
-        const double floor = miss[k] * (1 - 1e-6);
-        const bool peak = miss[k] > limit && (k == 0 || floor >= miss[k - 1]) &&
-                          (k + 1 == fine.size() || floor >= miss[k + 1]);
-        if (!peak) continue;
-        // Not next to a key point already there (nearly equal rows would make the system
-        // ill-conditioned): at least half a sample step away along the curve.
-        const double gap =
-            0.5 * (fine.back().t - fine.front().t) / static_cast<double>(fine.size() - 1);
-        bool crowded = false;
-        for (const KeyPoint& p : points)
-          crowded = crowded || std::abs(p.curve_parameter - fine[k].t) < gap;
-        if (crowded) continue;
-        points.push_back(
-            make_key_point(s, reg, fine[k].point, fine[k].t, fine[k].u, fine[k].v, keys.direction));
-        ++added;
-      }
+      const size_t added = add_key_points_at_misses(s, out.surface, reg, fine, keys.direction,
+                                                    *area, in_region, options, size, points);
       if (added > 0) {
         accepted_points = points.size() - added;
         ++additions;
@@ -787,48 +886,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       }
     }
 
-    // E_k(d) from the net's own matrix (fixed vertices have d = 0), without the ridge.
-    report.fairness_energy =
-        nf > 0
-            ? net->scale * ((d.transpose() * (net->H * d)).trace() - energy_ridge * d.squaredNorm())
-            : 0.0;
-    report.key_points = points;
-    report.rank = rank;
-    report.degrees_of_freedom = 3 * (static_cast<int>(nf) - rank);
-    for (Eigen::Index k = 0; k < nk; ++k)
-      if (achieved.row(k).norm() > tol)
-        report.conflicting_key_points.push_back(active[static_cast<size_t>(k)]);
-    measure(s, out.surface, reg.factors, reg, target, trace, options, report);
-    // The edge of a region without a bound is that of the parent's influenced vertices (the
-    // free area is made from them), not of those of the refined net, a band narrower by the
-    // refinement.
-    if (options.report_curves && region.polygon.empty())
-      measure_boundary(parent, region.factors, region, s, out.surface, report);
-    std::ostringstream msg;
-    msg << to_string(report.constraint_class) << ", m = " << report.key_points.size()
-        << " key points (" << nk << " influenced";
-    if (report.added_key_points > 0)
-      msg << ", " << report.added_key_points << " added where the target was missed";
-    msg << "), " << nf << " free vertices, rank " << rank << ", " << report.degrees_of_freedom
-        << " degrees of freedom left";
-    if (report.knots_inserted > 0) msg << ", " << report.knots_inserted << " knots inserted";
-    if (!report.conflicting_key_points.empty())
-      msg << "; " << report.conflicting_key_points.size()
-          << " key points cannot be met (the net is too coarse there: allow more max_refinements)";
-    if (amplification > max_amplification)
-      msg << "; the free vertices move up to " << amplification
-          << " times the farthest key point's distance (allow more max_refinements)";
-    if (min_share < min_free_share)
-      msg << "; a key point is held mostly by fixed vertices (free share " << min_share
-          << "): the free vertices move up to " << 1.0 / std::max(min_share, 1e-300)
-          << " times its distance (allow more max_refinements, or a bound further from the target)";
-    if (options.curve_tolerance > 0 &&
-        report.target_curve_deviation > options.curve_tolerance * size)
-      msg << "; the target curve is still missed by " << report.target_curve_deviation
-          << " mm, more than "
-          << "curve_tolerance x size = " << options.curve_tolerance * size
-          << " mm (allow more max_key_point_rounds or max_refinements)";
-    report.message = msg.str();
+    finish_report(parent, region, s, reg, out.surface, *net, d, system, rank, amplification,
+                  min_share, target, trace, options, size, points, report);
     return out;
   }
 }
