@@ -143,13 +143,13 @@ Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
     } catch (const Error& e) {
       throw Error(e.category(), name + ": " + e.message());
     }
-    if (!fit.report.certified || !(fit.report.certified_bound <= fit.report.tolerance))
+    if (!fit.report.certified || !(fit.report.certified_bound_mm <= fit.report.tolerance))
       throw Error(ErrorCategory::ToleranceNotMet,
                   name + ": the refit below max_degree " + std::to_string(options.max_degree) +
                       " missed its tolerance: " + fit.report.brief());
     s = std::move(fit.surface);
     out.way = Outcome::Way::Refit;
-    out.bound = fit.report.certified_bound;
+    out.bound = fit.report.certified_bound_mm;
     return out;
   }
   s = std::move(r.surface);
@@ -159,7 +159,7 @@ Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
       out.deviation =
           std::max(out.deviation, step.compose.max_relative_deviation * step.compose.size);
     if (step.method == StepOutcome::Method::Refit)
-      out.bound += step.refit.certified ? step.refit.certified_bound
+      out.bound += step.refit.certified ? step.refit.certified_bound_mm
                                         : std::numeric_limits<double>::infinity();
   }
   return out;

@@ -422,7 +422,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     report.summary.iterations = iteration;
     report.certified = cert.certified;
     report.sampled_max = cert.sampled;
-    report.certified_bound = cert.certified ? cert.bound : infinity;
+    report.certified_bound_mm = cert.certified ? cert.bound : infinity;
     report.samples = cert.samples;
     report.knots_added_u = static_cast<int>(bu.knots.size() - initial_u);
     report.knots_added_v = static_cast<int>(bv.knots.size() - initial_v);
@@ -480,7 +480,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
 
   std::string message;
   if (report.summary.termination == Termination::Converged) {
-    message = report.certified ? "certified bound " + short_format(report.certified_bound) +
+    message = report.certified ? "certified bound " + short_format(report.certified_bound_mm) +
                                      " mm within the tolerance " + short_format(tolerance) + " mm"
                                : "sampled maximum " + short_format(report.sampled_max) +
                                      " mm within the tolerance " + short_format(tolerance) +
@@ -488,7 +488,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
   } else {
     report.summary.termination = Termination::NotConverged;
     message = limit + ": " +
-              (report.certified ? "certified bound " + short_format(report.certified_bound)
+              (report.certified ? "certified bound " + short_format(report.certified_bound_mm)
                                 : "sampled maximum " + short_format(report.sampled_max)) +
               " mm above the tolerance " + short_format(tolerance) +
               (fixed ? " mm; give more control points (count_u, count_v), a larger tolerance or a "
@@ -548,7 +548,7 @@ std::string RefitReport::brief() const {
   char buffer[256];
   if (certified) {
     std::snprintf(buffer, sizeof buffer, "certified %.3g mm %s %.3g mm (sampled %.3g mm)",
-                  certified_bound, certified_bound <= tolerance ? "<=" : ">", tolerance,
+                  certified_bound_mm, certified_bound_mm <= tolerance ? "<=" : ">", tolerance,
                   sampled_max);
   } else {
     std::snprintf(buffer, sizeof buffer, "not certified, sampled %.3g mm %s %.3g mm", sampled_max,

@@ -16,8 +16,8 @@ py::dict refit_report(const deform::RefitReport& r) {
   py::dict d;
   d["converged"] = r.summary.converged();
   d["certified"] = r.certified;
-  d["certified_bound_mm"] = std::isfinite(r.certified_bound)
-                                ? py::object(py::float_(r.certified_bound))
+  d["certified_bound_mm"] = std::isfinite(r.certified_bound_mm)
+                                ? py::object(py::float_(r.certified_bound_mm))
                                 : py::object(py::none());
   d["sampled_max_mm"] = r.sampled_max;
   d["tolerance_mm"] = r.tolerance;

@@ -197,7 +197,7 @@ class Runner {
                    {"degree_v", static_cast<long long>(r.surface.v.degree)},
                    {"control_points", static_cast<long long>(r.surface.points.rows())},
                    {"certified", f.certified},
-                   {"max_deviation_mm", f.certified ? f.certified_bound : f.sampled_max},
+                   {"max_deviation_mm", f.certified ? f.certified_bound_mm : f.sampled_max},
                    {"sampled_max_mm", f.sampled_max},
                    {"tolerance_mm", f.tolerance},
                    {"size", f.size}};
@@ -587,10 +587,10 @@ class Runner {
                                    (fixed ? "on " + std::to_string(b.count_u) + " x " +
                                                 std::to_string(b.count_v) + " control points"
                                           : "to its tolerance"));
-              built.max_deviation_mm = r.certified ? r.certified_bound : r.sampled_max;
+              built.max_deviation_mm = r.certified ? r.certified_bound_mm : r.sampled_max;
               built.samples = static_cast<int>(std::min<long>(r.samples, 1L << 30));
               build_figures(built, rep);
-              rep.figures.emplace_back("certified_bound_mm", r.certified_bound);
+              rep.figures.emplace_back("certified_bound_mm", r.certified_bound_mm);
               rep.figures.emplace_back("sampled_max_mm", r.sampled_max);
               rep.figures.emplace_back("tolerance_mm", r.tolerance);
               rep.message = r.brief();
@@ -660,7 +660,7 @@ class Runner {
       rep.message += ": exact, " + o.compose.brief();
     } else {
       const auto& f = o.refit;
-      const double bound = f.certified ? f.certified_bound : f.sampled_max;
+      const double bound = f.certified ? f.certified_bound_mm : f.sampled_max;
       rep.figures.emplace_back("composition", std::string("refit"));
       rep.figures.emplace_back("max_relative_deviation", bound / f.size);
       rep.figures.emplace_back("max_deviation_mm", bound);

@@ -95,8 +95,8 @@ TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independentl
   CHECK(rep.degree_u == 3);
   CHECK(rep.degree_v == 3);
   CHECK(r.surface.u.degree == 3);
-  CHECK(rep.sampled_max <= rep.certified_bound);
-  CHECK(rep.certified_bound <= rep.tolerance);
+  CHECK(rep.sampled_max <= rep.certified_bound_mm);
+  CHECK(rep.certified_bound_mm <= rep.tolerance);
   CHECK(rep.crossings.empty());
 
   // the twist computed here: a rotation by 0.01 z about the z axis
@@ -112,11 +112,11 @@ TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independentl
   CHECK_THAT(rep.tolerance, WithinRel(1e-4 * size, 0.02));
 
   const double check = random_deviation(loft, r.surface, rotate, 4000, 11);
-  INFO("independent check " << check << " mm, bound " << rep.certified_bound << " mm");
-  CHECK(check <= rep.certified_bound);
+  INFO("independent check " << check << " mm, bound " << rep.certified_bound_mm << " mm");
+  CHECK(check <= rep.certified_bound_mm);
   CHECK(check <= 1e-4 * size);
-  CHECK(rep.certified_bound <= 10 * check);  // the bound is not wildly pessimistic
-  CHECK(check <= rep.sampled_max * 1.5);     // the sampled figure is representative
+  CHECK(rep.certified_bound_mm <= 10 * check);  // the bound is not wildly pessimistic
+  CHECK(check <= rep.sampled_max * 1.5);        // the sampled figure is representative
 }
 
 TEST_CASE("refit_surface makes a small certified bicubic copy of a dense high-degree surface",
@@ -148,12 +148,12 @@ TEST_CASE("refit_surface makes a small certified bicubic copy of a dense high-de
   REQUIRE(editable.report.certified);
   CHECK(editable.surface.u.degree == 3);
   CHECK(editable.surface.v.degree == 3);
-  CHECK(editable.report.certified_bound <= editable.report.tolerance);
+  CHECK(editable.report.certified_bound_mm <= editable.report.tolerance);
   // The bound holds against the exact surface at parameters the refit never sampled.
   const double check = random_deviation(
       exact, editable.surface, [](const Eigen::Vector3d& x) { return x; }, 4000, 5);
   INFO("independent check " << check << " mm");
-  CHECK(check <= editable.report.certified_bound);
+  CHECK(check <= editable.report.certified_bound_mm);
   // A small net: far fewer control points than the exact result, and than a refit that keeps
   // every breakpoint.
   options.keep_breakpoints = true;
@@ -190,9 +190,9 @@ TEST_CASE("refit_surface with a fixed net rebuilds on uniform knots, certified",
   const double check = random_deviation(
       parent, rebuilt.surface, [](const Eigen::Vector3d& x) { return x; }, 4000, 6);
   INFO("independent check " << check << " mm");
-  CHECK(check <= rebuilt.report.certified_bound);
+  CHECK(check <= rebuilt.report.certified_bound_mm);
   CHECK(rebuilt.report.summary.converged() ==
-        (rebuilt.report.certified_bound <= rebuilt.report.tolerance));
+        (rebuilt.report.certified_bound_mm <= rebuilt.report.tolerance));
   // Too few control points for a tight tolerance: not converged, and the message says what to
   // raise; no knot is added to a fixed net.
   options.count_u = options.count_v = 4;
@@ -225,9 +225,9 @@ TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor",
       sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, 4000,
       3);
   INFO("independent check " << check);
-  CHECK(check <= r.report.certified_bound);
-  CHECK(r.report.certified_bound <= 10 * check);
-  CHECK(r.report.certified_bound <= r.report.tolerance);
+  CHECK(check <= r.report.certified_bound_mm);
+  CHECK(r.report.certified_bound_mm <= 10 * check);
+  CHECK(r.report.certified_bound_mm <= r.report.tolerance);
 }
 
 TEST_CASE("B-spline lattice knot planes crossed by the surface are detected and reported",
@@ -277,7 +277,7 @@ TEST_CASE("B-spline lattice knot planes crossed by the surface are detected and 
       sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); }, 3000,
       4);
   INFO("independent check " << check);
-  CHECK(check <= r.report.certified_bound);
+  CHECK(check <= r.report.certified_bound_mm);
 }
 
 TEST_CASE("Refit keeps the original's C0 seams and breakpoints", "[refit]") {
@@ -304,8 +304,8 @@ TEST_CASE("Refit keeps the original's C0 seams and breakpoints", "[refit]") {
         return Eigen::Vector3d(k * x.x(), k * x.y(), x.z());
       },
       2000, 9);
-  CHECK(check <= r.report.certified_bound);
-  CHECK(r.report.certified_bound <= r.report.tolerance);
+  CHECK(check <= r.report.certified_bound_mm);
+  CHECK(r.report.certified_bound_mm <= r.report.tolerance);
 }
 
 TEST_CASE("Refit of a rational surface under a stack is certified", "[refit]") {
@@ -339,8 +339,8 @@ TEST_CASE("Refit of a rational surface under a stack is certified", "[refit]") {
   CHECK_THAT(r.report.tolerance, WithinRel(1e-3, 1e-15));
   const double check = random_deviation(
       s, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(stack, x); }, 3000, 2);
-  CHECK(check <= r.report.certified_bound);
-  CHECK(r.report.certified_bound <= 1e-3);
+  CHECK(check <= r.report.certified_bound_mm);
+  CHECK(r.report.certified_bound_mm <= 1e-3);
 }
 
 TEST_CASE("A bend region end crossing the surface gets a first-derivative bound", "[refit]") {
@@ -365,8 +365,8 @@ TEST_CASE("A bend region end crossing the surface gets a first-derivative bound"
   CHECK_THAT(r.report.summary.message, Contains("only C0"));
   const double check = random_deviation(
       sheet, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(bend, x); }, 3000, 6);
-  CHECK(check <= r.report.certified_bound);
-  CHECK(r.report.sampled_max <= r.report.certified_bound);
+  CHECK(check <= r.report.certified_bound_mm);
+  CHECK(r.report.sampled_max <= r.report.certified_bound_mm);
 }
 
 TEST_CASE("Point maps and extended lattices are fitted but not certified", "[refit]") {
@@ -376,7 +376,7 @@ TEST_CASE("Point maps and extended lattices are fitted but not certified", "[ref
   };
   const RefitResult r = refit_deformed(wave, loft);
   CHECK_FALSE(r.report.certified);
-  CHECK(std::isinf(r.report.certified_bound));
+  CHECK(std::isinf(r.report.certified_bound_mm));
   CHECK(r.report.summary.converged());
   CHECK(r.report.sampled_max <= r.report.tolerance);
   CHECK_THAT(r.report.summary.message, Contains("not certified"));
@@ -413,7 +413,7 @@ TEST_CASE("Refit limits end in a not-converged report", "[refit]") {
   CHECK(r.report.summary.termination == Termination::NotConverged);
   CHECK(r.report.summary.iterations == 1);
   CHECK_THAT(r.report.summary.message, Contains("iteration limit 1"));
-  CHECK(r.report.certified_bound > r.report.tolerance);
+  CHECK(r.report.certified_bound_mm > r.report.tolerance);
 
   options.max_iterations = 10;
   options.max_control_points = 100;
@@ -521,5 +521,5 @@ TEST_CASE("Refit keeps a closed side closed and a pole a point, bit for bit", "[
     CHECK(s.points.row(s.index(i, mv - 1)) == north);
   }
   CHECK(fit.report.certified);
-  CHECK(fit.report.certified_bound <= fit.report.tolerance);
+  CHECK(fit.report.certified_bound_mm <= fit.report.tolerance);
 }

@@ -124,9 +124,9 @@ TEST_CASE("deform_surface: a twist is refitted with a certified bound that holds
   CHECK_THAT(r.report.steps[1].reason, Contains("not polynomial"));
   const RefitReport& fit = r.report.steps[1].refit;
   REQUIRE(fit.certified);
-  CHECK(fit.certified_bound <= fit.tolerance);
+  CHECK(fit.certified_bound_mm <= fit.tolerance);
   // The exact first step contributes rounding only: the bound of the refit holds for the stack.
-  CHECK(worst_against_pointwise(stack, s, r.surface, 2000) <= fit.certified_bound + 1e-9);
+  CHECK(worst_against_pointwise(stack, s, r.surface, 2000) <= fit.certified_bound_mm + 1e-9);
   // Without a refit the twist is refused, naming the step and the way out.
   auto [category, message] = error_of([&] { deform_surface(stack, s); });
   CHECK(category == ErrorCategory::InvalidArgument);
@@ -163,7 +163,7 @@ TEST_CASE(
   DeformationStack one;
   one.steps.push_back({heavy, {}, true});
   CHECK(worst_against_pointwise(one, s, r.surface, 1000) <=
-        r.report.steps[0].refit.certified_bound + 1e-9);
+        r.report.steps[0].refit.certified_bound_mm + 1e-9);
 }
 
 TEST_CASE("deform_surface: bad input", "[surface_deformation][errors]") {
@@ -249,7 +249,7 @@ TEST_CASE("deform_surface: a refit that cannot meet a too tight tolerance within
   const SurfaceDeformationResult r = deform_surface(stack, s, options);
   const RefitReport& fit = r.report.steps[0].refit;
   CHECK_FALSE(fit.summary.converged());
-  CHECK(fit.certified_bound > fit.tolerance);
+  CHECK(fit.certified_bound_mm > fit.tolerance);
   // The bound is honest: the pointwise deformation is within it.
-  CHECK(worst_against_pointwise(stack, s, r.surface, 1000) <= fit.certified_bound);
+  CHECK(worst_against_pointwise(stack, s, r.surface, 1000) <= fit.certified_bound_mm);
 }

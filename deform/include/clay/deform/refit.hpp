@@ -93,11 +93,12 @@ struct CLAY_DEFORM_API RefitReport {
   /// Converged: the certified bound (or, when not certified, the sampled maximum) is within the
   /// tolerance; NotConverged: iteration or control point limit reached first.
   Summary summary;
-  bool certified = false;  ///< certified_bound is a true upper bound of |fit − D∘S|
+  bool certified = false;  ///< certified_bound_mm is a true upper bound of |fit − D∘S|
   double tolerance = 0;    ///< the tolerance applied (mm)
   double size = 0;         ///< diagonal of the deformed sample's bounding box (mm)
   double sampled_max = 0;  ///< largest deviation at the certificate's samples (mm)
-  double certified_bound = std::numeric_limits<double>::infinity();  ///< mm; inf if not certified
+  double certified_bound_mm =
+      std::numeric_limits<double>::infinity();  ///< mm; inf if not certified
   long samples = 0;         ///< number of points sampled by the last certificate
   int degree_u = 0;         ///< degree of the fit in u
   int degree_v = 0;         ///< degree of the fit in v
