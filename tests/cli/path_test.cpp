@@ -66,7 +66,9 @@ TEST_CASE("recipe paths: a malformed path names the rule it breaks", "[path]") {
       {"[0]", "starts with a list index"},
       {"a.[0]", "empty key before ["},
       {"a[18446744073709551616]", "too large"}};
-  for (const auto& [path, rule] : cases) {
+  for (const auto& c : cases) {
+    const std::string& path = c.first;  // (clang 14 cannot capture a structured binding)
+    const std::string& rule = c.second;
     INFO(path);
     const auto [category, what] = clay::test::error_of([&] { parse_path(path); });
     CHECK(category == ErrorCategory::InvalidArgument);
