@@ -71,9 +71,9 @@ bool extension_is(const std::filesystem::path& file, std::initializer_list<const
 /// Checks that the folder of `file` exists and `file` names a file in it (clay::Error(Io)).
 void check_target(const std::filesystem::path& file, std::string_view caller);
 
-/// Writes through `write(temp_path)` into a temporary file next to `file` (".NAME.tmp-<random>")
-/// and renames it onto `file`. On any failure the temporary file is removed and the error
-/// rethrown, so nothing is left behind.
+/// Writes through `write(temp_path)` with internal::write_atomically_via (a temporary made by
+/// mkstemp next to `file`, flushed, renamed onto it) after check_target. On any failure the
+/// temporary file is removed and the error rethrown, so nothing is left behind.
 void write_atomically(const std::filesystem::path& file, std::string_view caller,
                       const std::function<void(const std::filesystem::path&)>& write);
 
