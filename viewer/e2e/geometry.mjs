@@ -1,6 +1,11 @@
 // Geometry for Clayform Studio's end-to-end test and walkthrough, computed here and not by the
 // page: de Boor's algorithm for the nets the kernel sent, Sederberg–Parry's FFD, point in polygon,
-// the back-projection of a screen point through the page's camera matrices.
+// the back-projection of a screen point through the page's camera matrices. A lattice step's knots
+// and control points come from the page's lattice_math.js (one module, checked against the
+// kernel's values by tests/python/test_page_math.py); the sums over them are written here.
+import { latticeKnots, latticePoints, bsplineLatticePoints } from '../src/studio/lattice_math.js';
+
+export { latticePoints, bsplineLatticePoints };
 // Evaluated here with de Boor's algorithm (The NURBS Book A3.1 / A4.1 style, written apart from the
 // page's basis-function code), so the page's own evaluation is not what checks it.
 export function deBoor(knots, degree, ctrl, t) {
@@ -100,17 +105,6 @@ export function ffd(step, points, x) {
       }
   return out;
 }
-export function latticePoints(step) {
-  const [l, m, n] = step.degrees;
-  const { origin, s, t, u } = step.frame;
-  const out = [];
-  for (let i = 0; i <= l; i++) for (let j = 0; j <= m; j++) for (let k = 0; k <= n; k++) out.push([0, 1, 2].map((e) => origin[e] + (i / l) * s[e] + (j / m) * t[e] + (k / n) * u[e]));
-  for (const mv of step.moves || []) {
-    const at = (mv.index[0] * (m + 1) + mv.index[1]) * (n + 1) + mv.index[2];
-    out[at] = mv.to ? mv.to.slice() : out[at].map((c, e) => c + mv.by[e]);
-  }
-  return out;
-}
 export function insidePolygon(poly, x, y) {
   let inside = false;
   for (let i = 0, j = poly.length - 1; i < poly.length; j = i++) {
@@ -143,45 +137,15 @@ export function backProject(cam, clientX, clientY, z0) {
 }
 
 
-/** A lattice direction's knots for `cells` cells of degree p, "clamped" or "uniform" (docs/recipe.md). */
-function latticeKnots(cells, p, kind) {
-  const k = [];
-  if (kind === 'uniform') for (let i = 0; i <= cells + 2 * p; i++) k.push((i - p) / cells);
-  else {
-    for (let i = 0; i <= p; i++) k.push(0);
-    for (let i = 1; i < cells; i++) k.push(i / cells);
-    for (let i = 0; i <= p; i++) k.push(1);
-  }
-  return k;
-}
-
-/** A B-spline lattice step's points: undisplaced at the Greville abscissae (the identity), then its moves. */
-export function bsplineLatticePoints(step) {
-  const [xs, ys, zs] = [0, 1, 2].map((e) => {
-    const p = step.degrees[e];
-    const kn = latticeKnots(step.cells[e], p, step.knots || 'clamped');
-    return Array.from({ length: step.cells[e] + p }, (_, i) => kn.slice(i + 1, i + p + 1).reduce((a, b) => a + b, 0) / p);
-  });
-  const { origin, s, t, u } = step.frame;
-  const out = [];
-  for (const a of xs) for (const b of ys) for (const c of zs) out.push([0, 1, 2].map((e) => origin[e] + a * s[e] + b * t[e] + c * u[e]));
-  for (const mv of step.moves || []) {
-    const at = (mv.index[0] * ys.length + mv.index[1]) * zs.length + mv.index[2];
-    out[at] = mv.to ? mv.to.slice() : out[at].map((x, e) => x + mv.by[e]);
-  }
-  return out;
-}
-
 /** Hsu–Hughes–Kaufman eq. (1): the trivariate B-spline sum of a lattice step (cells, degrees, knots) at x. */
 export function bsplineFfd(step, points, x) {
-  const knotsOf = latticeKnots;
   const { origin, s: S, t: T, u: U } = step.frame;
   const d = [0, 1, 2].map((e) => x[e] - origin[e]);
   const det3 = (a, b, c) => a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
   const D = det3(S, T, U);
   const local = [det3(d, T, U) / D, det3(S, d, U) / D, det3(S, T, d) / D];
   const counts = [0, 1, 2].map((e) => step.cells[e] + step.degrees[e]);
-  const knots = [0, 1, 2].map((e) => knotsOf(step.cells[e], step.degrees[e], step.knots || 'clamped'));
+  const knots = [0, 1, 2].map((e) => latticeKnots(step.cells[e], step.degrees[e], step.knots || 'clamped'));
   const [nl, nm, nn] = counts;
   const rows = [];
   for (let i = 0; i < nl; i++) {

@@ -6,7 +6,7 @@
 // its tolerance); the normals come from the tangents carried by the map's Jacobian,
 // n = (J S_u) x (J S_v). The kernel's net replaces the picture when it arrives.
 import { basisDerivatives, findSpan } from './nurbs.js';
-import { latticeKnots } from './recipe_edits.js';
+import { latticeCounts, latticeKnots } from './lattice_math.js';
 
 /** Bernstein polynomials of degree n at x and their derivatives: [values, derivatives]. */
 function bernstein(n, x) {
@@ -55,7 +55,7 @@ function inverse3(m) {
  */
 export function prepareFfd(grid, step) {
   const bspline = step.kind === 'bspline_lattice';
-  const counts = bspline ? [0, 1, 2].map((e) => step.cells[e] + step.degrees[e]) : step.degrees.map((d) => d + 1);
+  const counts = latticeCounts(step);
   const knots = bspline ? [0, 1, 2].map((e) => latticeKnots(step.cells[e], step.degrees[e], step.knots || 'clamped')) : null;
   const basisOf = (e, x) => (bspline ? bsplineBasis(knots[e], step.degrees[e], counts[e], x) : [...bernstein(step.degrees[e], x), 0]);
   const { origin, s: S, t: T, u: U } = step.frame;

@@ -11,6 +11,7 @@ import { Link } from './link.js';
 import { curvePolyline, surfaceGrid, domain, sampleParameters, meshOnNets } from './nurbs.js';
 import * as names from './recipe_edits.js';
 import { prepareFfd, applyFfd } from './ffd_preview.js';
+import { latticeCounts, stepLatticePoints } from './lattice_math.js';
 
 const body = document.body;
 const $ = (id) => document.getElementById(id);
@@ -878,8 +879,8 @@ function rebuildHandles() {
     }
   }
   for (const lattice of latticesShown()) {
-    const pts = lattice.step.kind === 'bspline_lattice' ? names.bsplineLatticePoints(lattice.step) : names.latticePoints(lattice.step);
-    const [l, m, n] = names.latticeCounts(lattice.step).map((c) => c - 1);
+    const pts = stepLatticePoints(lattice.step);
+    const [l, m, n] = latticeCounts(lattice.step).map((c) => c - 1);
     const seg = [];
     const at = (i, j, k) => pts[(i * (m + 1) + j) * (n + 1) + k];
     for (let i = 0; i <= l; i++)
@@ -1042,7 +1043,7 @@ function showPreview(h, to, inputAt) {
     const moved = { ...preview.step, moves: names.withMove(preview.step.moves || [], h.index, to) };
     const position = preview.geometry.getAttribute('position');
     const normal = preview.geometry.getAttribute('normal');
-    const points = moved.kind === 'bspline_lattice' ? names.bsplineLatticePoints(moved) : names.latticePoints(moved);
+    const points = stepLatticePoints(moved);
     const ratio = applyFfd(preview.prepared, points, position.array, normal.array);
     preview.points = points;
     live = [Math.min(live[0], ratio[0]), Math.max(live[1], ratio[1])];

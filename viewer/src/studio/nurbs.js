@@ -139,17 +139,19 @@ export function sampleParameters(knots, degree, n) {
  * point (i, j) at i * nv + j) sampled on a rows x cols grid: positions, unit normals (S_u x S_v),
  * Gaussian and mean curvature (first and second fundamental forms), as Float32Arrays with vertex
  * (r, c) at r * cols + c, and the tangents S_u, S_v (Float64Arrays). Rows follow u, columns v.
+ * `Float` is the array type of the positions, normals and curvatures (Float64Array: the full
+ * doubles, as tests/python/test_page_math.py compares them with the kernel's).
  */
-export function surfaceGrid(net, rows, cols) {
+export function surfaceGrid(net, rows, cols, Float = Float32Array) {
   const [p, q] = net.degrees;
   const [nu, nv] = net.counts;
   const U = directionTable(net.knots_u, p, nu, Array.from(sampleParameters(net.knots_u, p, rows)));
   const V = directionTable(net.knots_v, q, nv, Array.from(sampleParameters(net.knots_v, q, cols)));
   const n = rows * cols;
-  const position = new Float32Array(3 * n);
-  const normal = new Float32Array(3 * n);
-  const gaussian = new Float32Array(n);
-  const mean = new Float32Array(n);
+  const position = new Float(3 * n);
+  const normal = new Float(3 * n);
+  const gaussian = new Float(n);
+  const mean = new Float(n);
   const su = new Float64Array(3 * n);
   const sv = new Float64Array(3 * n);
   // Homogeneous control points (w x, w y, w z, w).

@@ -1,6 +1,7 @@
 // The recipe edits the studio's actions make (docs/recipe.md): new names, a lattice around a
 // surface, a lattice control point moved, a curve's control point moved, the global taper,
-// twist and bend. Pure functions of the recipe (as JSON) and the nets the kernel sent.
+// twist and bend. Pure functions of the recipe (as JSON) and the nets the kernel sent. (A lattice's
+// knots and control points: lattice_math.js.)
 
 const SECTIONS = ['strokes', 'curves', 'sketches', 'surfaces', 'deformations', 'exports', 'models'];
 
@@ -42,78 +43,6 @@ export function boxFrame(points) {
   return { origin, s: [size[0], 0, 0], t: [0, size[1], 0], u: [0, 0, size[2]] };
 }
 const round = (x) => Number(x.toPrecision(6));
-
-/**
- * A Bézier lattice step's control points, s-major ((i (m+1) + j)(n+1) + k): the undisplaced
- * lattice P_ijk = X0 + i/l S + j/m T + k/n U (Sederberg–Parry §2), or its `points`, with its
- * `moves` applied ("to" a position or "by" an offset).
- */
-export function latticePoints(step) {
-  const [l, m, n] = step.degrees;
-  const { origin, s, t, u } = step.frame;
-  const out = [];
-  if (Array.isArray(step.points)) out.push(...step.points.map((p) => p.slice()));
-  else
-    for (let i = 0; i <= l; i++)
-      for (let j = 0; j <= m; j++)
-        for (let k = 0; k <= n; k++) out.push([0, 1, 2].map((e) => origin[e] + (i / l) * s[e] + (j / m) * t[e] + (k / n) * u[e]));
-  for (const move of step.moves || []) {
-    const [i, j, k] = move.index;
-    const at = (i * (m + 1) + j) * (n + 1) + k;
-    out[at] = move.to ? move.to.slice() : out[at].map((c, e) => c + move.by[e]);
-  }
-  return out;
-}
-
-/**
- * A B-spline lattice step's control points (docs/recipe.md: `cells`, `degrees`, `knots` "clamped"
- * or "uniform"), s-major like latticePoints: the undisplaced lattice at the Greville abscissae of
- * each direction's knots (Hsu–Hughes–Kaufman: the identity), with `moves` applied.
- */
-export function bsplineLatticePoints(step) {
-  const abscissae = (cells, p, kind) => {
-    const n = cells + p;
-    const knots = latticeKnots(cells, p, kind);
-    return Array.from({ length: n }, (_, i) => {
-      let sum = 0;
-      for (let k = 1; k <= p; k++) sum += knots[i + k];
-      return sum / p;
-    });
-  };
-  const [xs, ys, zs] = [0, 1, 2].map((e) => abscissae(step.cells[e], step.degrees[e], step.knots || 'clamped'));
-  const { origin, s, t, u } = step.frame;
-  const out = [];
-  for (const a of xs) for (const b of ys) for (const c of zs) out.push([0, 1, 2].map((e) => origin[e] + a * s[e] + b * t[e] + c * u[e]));
-  const [, m, n] = [xs.length, ys.length, zs.length];
-  for (const move of step.moves || []) {
-    const [i, j, k] = move.index;
-    const at = (i * m + j) * n + k;
-    out[at] = move.to ? move.to.slice() : out[at].map((x, e) => x + move.by[e]);
-  }
-  return out;
-}
-
-/** A lattice step's control point counts per direction. */
-/**
- * The knot vector of one direction of a B-spline lattice (docs/recipe.md, bspline_lattice) on its
- * local coordinate [0, 1]: `cells` spans of degree `p`, "clamped" (end knots p + 1 times) or
- * "uniform" (knots (i - p) / cells).
- */
-export function latticeKnots(cells, p, kind = 'clamped') {
-  const n = cells + p;
-  const knots = [];
-  if (kind === 'uniform') for (let i = 0; i <= n + p; i++) knots.push((i - p) / cells);
-  else {
-    for (let i = 0; i <= p; i++) knots.push(0);
-    for (let i = 1; i < cells; i++) knots.push(i / cells);
-    for (let i = 0; i <= p; i++) knots.push(1);
-  }
-  return knots;
-}
-
-export function latticeCounts(step) {
-  return step.kind === 'bspline_lattice' ? [0, 1, 2].map((e) => step.cells[e] + step.degrees[e]) : step.degrees.map((d) => d + 1);
-}
 
 /** A lattice's moves with the point at `index` moved to `to` (replacing an earlier move of it). */
 export function withMove(moves, index, to) {
