@@ -1,0 +1,82 @@
+// Style (docs/studio.md, step 5): the selected surface deformed by a bound and a target curve; the
+// Style panel's λ, key points per row, relaxation, smoothing and mode re-run the step live (a
+// slider's moves until it is let go are one history entry); and "restyle while drawing", where the
+// stroke being drawn is the style's target.
+import * as names from './recipe_edits.js';
+import { $, showMessage, setSlider, sliderGroup } from './ui.js';
+import { doc, selected, edit, dragEdit } from './store.js';
+import { select, targetSurface } from './select.js';
+
+/** The style step's deformation of the selected surface, or null. */
+export function activeStyle() {
+  for (const s of selected('surface')) {
+    const def = (doc.recipe.surfaces || {})[s];
+    const stack = def && def.deform && (doc.recipe.deformations || {})[def.deform.deformation];
+    if (stack && stack[0] && stack[0].kind === 'style') return def.deform.deformation;
+  }
+  return null;
+}
+
+/** The Style panel, for the selection. */
+export function showStylePanel() {
+  const style = activeStyle();
+  $('style-panel').hidden = !style;
+  if (style) {
+    const step = doc.recipe.deformations[style][0];
+    $('style-name').textContent = style;
+    $('style-mode').value = step.mode || 'paper';
+    setSlider('style-lambda', step.lambda ?? 1);
+    setSlider('style-kpr', step.key_points_per_row ?? 1);
+    $('style-relaxation').checked = step.relaxation ?? true;
+    $('style-smoothing').checked = step.smoothing ?? true;
+  }
+}
+
+/** The changes that make `stroke` the style's target under the live stroke's name (one history entry). */
+export function liveTarget(live, stroke) {
+  live.updates++;
+  return {
+    changes: [
+      { path: `strokes.${live.name}`, value: stroke, create: true },
+      { path: `deformations.${live.style}[0].target`, value: live.name },
+    ],
+    label: `restyle ${live.style}: target ${live.name} drawn`,
+  };
+}
+
+function buildStyle() {
+  const curves = selected('curve');
+  if (curves.length !== 2) return showMessage('select the bound (a closed curve) and then the target curve, then Style', true);
+  const surface = targetSurface();
+  if (!surface) return;
+  const deformation = names.free(doc.recipe, 'style');
+  const result = names.free(doc.recipe, `${surface}_styled`);
+  edit(
+    [
+      { path: `deformations.${deformation}`, value: [{ kind: 'style', name: deformation, bound: curves[0], target: curves[1], mode: 'exact' }], create: true },
+      { path: `surfaces.${result}`, value: { deform: { surface, deformation } }, create: true },
+    ],
+    `style ${surface}`,
+  ).then(({ reply }) => reply.op !== 'error' && select({ kind: 'surface', name: result }));
+}
+
+function styleField(id, field, read) {
+  $(id).addEventListener('input', (event) => {
+    const style = activeStyle();
+    if (!style) return;
+    const value = read($(id));
+    if ($(id).parentElement.querySelector('output')) $(id).parentElement.querySelector('output').textContent = String(value);
+    const group = sliderGroup(id);
+    dragEdit(() => ({ changes: { path: `deformations.${style}[0].${field}`, value, create: true }, label: `${style} ${field}`, group }), event.timeStamp);
+  });
+}
+
+/** Style, and the Style panel's fields. */
+export function wireStyle() {
+  $('build-style').addEventListener('click', buildStyle);
+  styleField('style-lambda', 'lambda', (e) => Number(e.value));
+  styleField('style-kpr', 'key_points_per_row', (e) => Number(e.value));
+  styleField('style-relaxation', 'relaxation', (e) => e.checked);
+  styleField('style-smoothing', 'smoothing', (e) => e.checked);
+  styleField('style-mode', 'mode', (e) => e.value);
+}
