@@ -10,9 +10,10 @@
 #   scripts/viewer.sh lint [--fixture FILE]
 #                                     ESLint on the page and its tests (viewer/eslint.config.js); with
 #                                     --fixture, on FILE as if it were a page source instead
-#   scripts/viewer.sh studio-test --clayform PATH [--report FILE] [--shots DIR]
+#   scripts/viewer.sh studio-test --clayform PATH [--part NAME] [--report FILE] [--shots DIR]
 #                                     build if stale, then Clayform Studio's end-to-end test against
-#                                     that clayform (e2e/studio.test.mjs)
+#                                     that clayform (e2e/studio.test.mjs: every part, or one of
+#                                     drawing, model, regular, corners, constraints: e2e/studio_NAME.mjs)
 set -euo pipefail
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 VIEWER=$ROOT/viewer

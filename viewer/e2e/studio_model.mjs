@@ -1,0 +1,66 @@
+// Clayform Studio's end-to-end test, part "model" (docs/studio.md § Opening a STEP model): a STEP
+// model opened whole, a lattice placed around it and dragged (the nodes moved onto the faces' new
+// nets, checked against Sederberg–Parry's FFD here), saved and replayed by `clayform run`.
+import { spawnSync } from 'node:child_process';
+import { copyFileSync, mkdirSync, readdirSync } from 'node:fs';
+import { join } from 'node:path';
+import { ffd, latticePoints } from './geometry.mjs';
+import { assert, here } from './studio_harness.mjs';
+
+export default async function model({ clayform, work, check, withStudio }) {
+  await check('a STEP model opened whole, a lattice placed around it and dragged, saved and replayed', async () => {
+    const modelDir = join(work, 'model');
+    mkdirSync(modelDir);
+    copyFileSync(join(here, '..', '..', 'examples', 'models', 'block.step'), join(modelDir, 'block.step'));
+    return withStudio(join(modelDir, 'block.step'), 'model', async (modelPage, m) => {
+      const models = await m.call(() => window.clayStudio.models());
+      assert(models.block && models.block.triangles > 0, `no mesh of the model: ${Object.keys(models)}`);
+      const topBefore = Math.max(...models.block.positions.filter((_, k) => k % 3 === 2));
+      // click the model where its mesh is, then Lattice
+      const centre = [0, 1, 2].map((e) => {
+        const c = models.block.positions.filter((_, k) => k % 3 === e);
+        return (Math.min(...c) + Math.max(...c)) / 2;
+      });
+      await m.clickAt([centre[0], centre[1], topBefore], false);
+      const selected = await modelPage.locator('#selection').textContent();
+      assert(selected.includes('model block'), `selection: ${selected}`);
+      await modelPage.click('#build-lattice');
+      await m.idle();
+      assert(!(await m.lastError()), await m.lastError());
+      const handle = (await m.call(() => window.clayStudio.handles())).find((h) => h.kind === 'lattice' && h.index.join() === '1,1,1');
+      assert(handle, 'no lattice handle [1, 1, 1]');
+      await modelPage.selectOption('#lattice-lock', 'z');
+      await modelPage.mouse.move(...handle.screen);
+      await modelPage.mouse.down();
+      for (let k = 1; k <= 10; k++) await modelPage.mouse.move(handle.screen[0], handle.screen[1] - 3 * k);
+      await modelPage.mouse.up();
+      await m.idle();
+      assert(!(await m.lastError()), await m.lastError());
+      const after = await m.call(() => window.clayStudio.models());
+      const topAfter = Math.max(...after.block.positions.filter((_, k) => k % 3 === 2));
+      assert(topAfter > topBefore + 1e-6, `the model's top did not rise: ${topBefore} -> ${topAfter}`);
+      // Only positions changed, so the kernel sent the faces' nets, not a mesh, and the page moved
+      // the nodes of the mesh it held onto them: each node is where Sederberg–Parry's FFD of the
+      // lattice in the recipe takes the node's first position.
+      assert(after.block.from === 'model_nets', `the model came as a ${after.block.from} frame after the drag`);
+      assert(after.block.triangles === models.block.triangles, 'the mesh changed its triangles');
+      const recipe = await m.call(() => window.clayStudio.recipe());
+      const step = recipe.deformations[recipe.models.block.deformation][0];
+      const lattice = latticePoints(step);
+      let worstNode = 0;
+      for (let k = 0; k < models.block.positions.length; k += 3) {
+        const want = ffd(step, lattice, models.block.positions.slice(k, k + 3));
+        worstNode = Math.max(worstNode, Math.hypot(...[0, 1, 2].map((e) => after.block.positions[k + e] - want[e])));
+      }
+      assert(worstNode < 1e-9, `a node of the model is ${worstNode} mm from the pointwise FFD`);
+      await modelPage.fill('#save-name', 'block_studio.json');
+      await modelPage.click('#save');
+      await m.idle();
+      const run = spawnSync(clayform, ['run', join(modelDir, 'block_studio.json'), '--out', join(modelDir, 'replay'), '--quiet'], { encoding: 'utf8' });
+      assert(run.status === 0, `clayform run: ${run.status} ${run.stderr}`);
+      const files = readdirSync(join(modelDir, 'replay'));
+      assert(files.includes('block.step'), `replay wrote ${files}`);
+      return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; after the drag the faces' nets only, the nodes ${worstNode.toExponential(1)} mm from the pointwise FFD; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}`;
+    });
+  });
+}
