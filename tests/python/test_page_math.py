@@ -203,8 +203,7 @@ def test_surface_points_normals_and_curvature_are_the_kernels(tmp_path):
         keep = np.ones((rows, cols), dtype=bool)
         if net is sphere:
             keep[-1, :] = False  # the pole: S_u x S_v vanishes there (no normal, no curvature)
-        kernel_normal = surface.normal(uu, vv)
-        worst["normals"] = max(worst["normals"], relative(normal[keep], kernel_normal[keep], 1.0))
+        worst["normals"] = max(worst["normals"], relative(normal[keep], surface.normal(uu[keep], vv[keep]), 1.0))
         if net is graph:
             x, y = position[..., 0], position[..., 1]
             fx, fy = 2 * a * x + c * y, 2 * b * y + c * x
