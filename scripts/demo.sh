@@ -17,7 +17,7 @@ echo
 echo "==> a picture through the browser viewer (clayform snapshot, headless Chromium):"
 "$CLAY_ROOT/scripts/viewer.sh"
 "$CLAY_BUILD/cli/clayform" snapshot "$out" --png "$out/sail.png" --width 1280 --height 800
-echo "Look at it interactively: $CLAY_BUILD/cli/clayform view $out  (then open http://127.0.0.1:8765/)"
+echo "Look at it interactively: $CLAY_BUILD/cli/clayform view $out  (then open the address it prints, with its ?token=)"
 echo
 echo "Outputs in $out:"
 ls -1 "$out" | sed "s|^|  $out/|"

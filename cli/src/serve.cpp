@@ -1,9 +1,10 @@
 // `clayform view` and `clayform snapshot`: the run folder and the built front end over HTTP
-// (cpp-httplib), and headless chromium for pictures.
+// (the command's one HTTP stack, http/web_server.hpp), and headless chromium for pictures.
+#include "http/web_server.hpp"
+
 #include <clay/error.hpp>
 #include <clay/serve.hpp>
 
-#include <httplib.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -45,9 +47,7 @@ fs::path viewer_dir() {
 }
 
 struct ViewServer::Impl {
-  httplib::Server server;
-  std::string host;
-  int port = 0;
+  std::optional<web::WebServer> server;
   std::thread thread;
 };
 
@@ -66,74 +66,38 @@ ViewServer::ViewServer(const fs::path& run_dir, const ServeOptions& options)
                     "\" (index.html is missing); build it "
                     "with scripts/viewer.sh (or `npm ci && npm run build` in viewer/), or set "
                     "CLAYFORM_VIEWER_DIR to a built viewer's folder");
-  auto& s = impl_->server;
-  for (const auto& [ext, type] : std::initializer_list<std::pair<const char*, const char*>>{
-           {"html", "text/html; charset=utf-8"},
-           {"js", "text/javascript; charset=utf-8"},
-           {"mjs", "text/javascript; charset=utf-8"},
-           {"css", "text/css; charset=utf-8"},
-           {"json", "application/json"},
-           {"bin", "application/octet-stream"},
-           {"png", "image/png"},
-           {"svg", "image/svg+xml"},
-           {"glb", "model/gltf-binary"},
-           {"step", "application/octet-stream"},
-           {"igs", "application/octet-stream"},
-           {"wasm", "application/wasm"},
-           {"txt", "text/plain; charset=utf-8"}})
-    s.set_file_extension_and_mimetype_mapping(ext, type);
-  s.set_pre_routing_handler([](const httplib::Request& req, httplib::Response& res) {
-    if (req.path.find("..") == std::string::npos)
-      return httplib::Server::HandlerResponse::Unhandled;
-    res.status = 400;
-    res.set_content("refused: a path with \"..\"\n", "text/plain");
-    return httplib::Server::HandlerResponse::Handled;
-  });
-  // A run folder is rewritten by the next run: never cached.
-  s.set_post_routing_handler([](const httplib::Request&, httplib::Response& res) {
-    res.set_header("Cache-Control", "no-store");
-  });
-  const fs::path run = fs::absolute(run_dir).lexically_normal();
-  if (!s.set_mount_point("/run/", run.string()) ||
-      !s.set_mount_point("/", fs::absolute(viewer).lexically_normal().string()))
-    throw Error(ErrorCategory::Io,
-                "cannot serve \"" + run.string() + "\" and \"" + viewer.string() + "\"");
-  impl_->host = options.host;
-  if (options.port < 0 || options.port > 65535)
-    throw Error(ErrorCategory::InvalidArgument,
-                "port " + std::to_string(options.port) +
-                    " is out of range; give 0..65535 (0: any free port)");
-  if (options.port == 0) {
-    impl_->port = s.bind_to_any_port(options.host);
-    if (impl_->port <= 0)
-      throw Error(ErrorCategory::Io,
-                  "cannot listen on " + options.host + "; check the host address");
-  } else {
-    if (!s.bind_to_port(options.host, options.port))
-      throw Error(ErrorCategory::Io, "cannot listen on " + options.host + ":" +
-                                         std::to_string(options.port) +
-                                         " (in use?); give another --port, or 0 for any free one");
-    impl_->port = options.port;
-  }
+  // The studio's server, without a socket: the same token, Host and Origin checks, and files
+  // only under the two folders.
+  web::WebOptions w;
+  w.name = "the viewer";
+  w.command = "clayform view";
+  w.cookie = "clayform_view";
+  w.host = options.host;
+  w.port = options.port;
+  w.token = options.token;
+  w.max_file_bytes = options.max_file_bytes;
+  w.mounts = {{"/run/", fs::absolute(run_dir).lexically_normal(), "", ""},
+              {"/", fs::absolute(viewer).lexically_normal(), "index.html", ""}};
+  impl_->server.emplace(std::move(w));
 }
 
 ViewServer::~ViewServer() { stop(); }
 
-int ViewServer::port() const noexcept { return impl_->port; }
+int ViewServer::port() const noexcept { return impl_->server->port(); }
 
-std::string ViewServer::url() const {
-  return "http://" + impl_->host + ":" + std::to_string(impl_->port) + "/";
-}
+const std::string& ViewServer::token() const { return impl_->server->token(); }
 
-void ViewServer::run() { impl_->server.listen_after_bind(); }
+std::string ViewServer::url() const { return impl_->server->url(); }
+
+void ViewServer::run() { impl_->server->run(); }
 
 void ViewServer::start() {
   if (impl_->thread.joinable()) return;
-  impl_->thread = std::thread([this] { impl_->server.listen_after_bind(); });
+  impl_->thread = std::thread([this] { impl_->server->run(); });
 }
 
 void ViewServer::stop() {
-  impl_->server.stop();
+  impl_->server->stop();
   if (impl_->thread.joinable()) impl_->thread.join();
 }
 
@@ -267,7 +231,7 @@ void snapshot(const fs::path& run_dir, const fs::path& png, const SnapshotOption
       "--window-size=" + std::to_string(options.width) + "," + std::to_string(options.height),
       "--virtual-time-budget=10000",
       "--screenshot=" + out.string(),
-      server.url() + query};
+      server.url() + "&" + query.substr(1)};  // url() ends with ?token=
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

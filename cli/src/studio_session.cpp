@@ -1,7 +1,7 @@
 // Clayform Studio's session (clay/studio.hpp): a recipe under edits with a named history, one
 // handler per op. Every command is read whole before anything changes; every reply is valid
 // UTF-8 JSON whatever the command held; files are written only inside the recipe's folder.
-#include "studio_frames.hpp"
+#include "frames/frames.hpp"
 
 #include <clay/error.hpp>
 #include <clay/internal/fenv.hpp>
@@ -22,6 +22,7 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <string_view>
 
 namespace clay::recipe {
 
@@ -432,7 +433,10 @@ struct StudioSession::Impl {
     return reply;
   }
 
-  Reply hello() {
+  // The ops, one handler each, all of one signature (the table kOps below names them).
+  using Cancel = std::function<bool()>;
+
+  Reply hello(const Json&, const Cancel&) {
     meshed.clear();  // a new page holds no mesh yet
     const Recipe r = parse_recipe(text(), base_dir, name);
     Json out = {{"op", "hello"},
@@ -443,7 +447,21 @@ struct StudioSession::Impl {
     return {reply_text(out), {}};
   }
 
-  Reply undo_redo(const std::string& op, const std::function<bool()>& cancelled) {
+  Reply recipe_text(const Json&, const Cancel&) {
+    return {reply_text(Json{{"op", "recipe"}, {"text", text()}}), {}};
+  }
+
+  Reply fit(const Json& c, const Cancel&) { return {reply_text(fit_reply(c)), {}}; }
+
+  Reply run_all(const Json&, const Cancel& cancelled) {
+    meshed.clear();  // "run" sends everything: the page may hold nothing (a new page)
+    return ran("run", run(text(), cancelled));
+  }
+
+  Reply undo(const Json&, const Cancel& cancelled) { return undo_redo("undo", cancelled); }
+  Reply redo(const Json&, const Cancel& cancelled) { return undo_redo("redo", cancelled); }
+
+  Reply undo_redo(const std::string& op, const Cancel& cancelled) {
     const int to = position + (op == "undo" ? -1 : 1);
     if (to < 0 || to >= static_cast<int>(history.size()))
       throw Error(ErrorCategory::InvalidArgument,
@@ -458,7 +476,7 @@ struct StudioSession::Impl {
   /// "edit": one change ({path, value, create?} or {path, remove: true}) or several ("changes":
   /// an array of them), applied in order as one entry of the history. Every field is read
   /// before the history changes (a wrong-typed "nets" was answered with an error but applied).
-  Reply edit(const Json& c, const std::function<bool()>& cancelled) {
+  Reply edit(const Json& c, const Cancel& cancelled) {
     const std::string group = field<std::string>(c, "edit", "group", "", "a string");
     const bool nets = field<bool>(c, "edit", "nets", true, "true or false");
     const std::optional<std::string> label =
@@ -494,7 +512,7 @@ struct StudioSession::Impl {
   /// "export" {folder, name?}: the final surfaces as STEP, IGES and glTF (write_outputs: read
   /// back and checked), with the run's report and the models' files, into a folder inside the
   /// recipe's.
-  Reply export_files(const Json& c, const std::function<bool()>& cancelled) {
+  Reply export_files(const Json& c, const Cancel& cancelled) {
     if (!c.contains("folder") || !c.at("folder").is_string())
       throw Error(ErrorCategory::InvalidArgument,
                   "studio: \"export\" needs \"folder\" (a folder inside the recipe's, e.g. "
@@ -540,7 +558,7 @@ struct StudioSession::Impl {
 
   /// "save" {file}: the current recipe text, written atomically as a plain file name in the
   /// recipe's folder.
-  Reply save(const Json& c) {
+  Reply save(const Json& c, const Cancel&) {
     if (!c.contains("file") || !c.at("file").is_string())
       throw Error(ErrorCategory::InvalidArgument,
                   "studio: \"save\" needs \"file\" (a file name in the recipe's folder)");
@@ -551,7 +569,23 @@ struct StudioSession::Impl {
     return {reply_text(Json{{"op", "saved"}, {"file", file.string()}}), {}};
   }
 
-  Reply handle(const std::string& command, const std::function<bool()>& cancelled) {
+  struct Op {
+    std::string_view name;
+    Reply (Impl::*reply)(const Json&, const Cancel&);
+  };
+  static constexpr Op kOps[] = {
+      {"hello", &Impl::hello}, {"recipe", &Impl::recipe_text},  {"edit", &Impl::edit},
+      {"undo", &Impl::undo},   {"redo", &Impl::redo},           {"run", &Impl::run_all},
+      {"save", &Impl::save},   {"export", &Impl::export_files}, {"fit", &Impl::fit},
+  };
+  /// "hello, recipe, edit, ...": the ops, for the messages that list them.
+  static std::string op_names() {
+    std::string names;
+    for (const Op& op : kOps) names += (names.empty() ? "" : ", ") + std::string(op.name);
+    return names;
+  }
+
+  Reply handle(const std::string& command, const Cancel& cancelled) {
     // Read whole and bounded before parsing: nlohmann's parser recursed a command nested
     // 1,000,000 levels deep until the stack overflowed.
     if (command.size() > command_bytes)
@@ -572,23 +606,15 @@ struct StudioSession::Impl {
     }();
     if (!c.is_object() || !c.contains("op") || !c.at("op").is_string())
       throw Error(ErrorCategory::InvalidArgument,
-                  "studio: a command is a JSON object with \"op\" (hello, recipe, edit, undo, "
-                  "redo, run, save, export, fit)");
+                  "studio: a command is a JSON object with \"op\" (" + op_names() + ")");
     const std::string op = c.at("op");
-    if (op == "hello") return hello();
-    if (op == "recipe") return {reply_text(Json{{"op", "recipe"}, {"text", text()}}), {}};
-    if (op == "fit") return {reply_text(fit_reply(c)), {}};
-    if (op == "run") {
-      meshed.clear();  // "run" sends everything: the page may hold nothing (a new page)
-      return ran("run", run(text(), cancelled));
-    }
-    if (op == "undo" || op == "redo") return undo_redo(op, cancelled);
-    if (op == "edit") return edit(c, cancelled);
-    if (op == "export") return export_files(c, cancelled);
-    if (op == "save") return save(c);
-    throw Error(ErrorCategory::InvalidArgument,
-                "studio: unknown op \"" + internal::clip_utf8(op, 40) +
-                    "\"; the ops: hello, recipe, edit, undo, redo, run, save, export, fit");
+    const auto handler = std::find_if(std::begin(kOps), std::end(kOps),
+                                      [&](const Op& known) { return known.name == op; });
+    if (handler == std::end(kOps))
+      throw Error(
+          ErrorCategory::InvalidArgument,
+          "studio: unknown op \"" + internal::clip_utf8(op, 40) + "\"; the ops: " + op_names());
+    return (this->*handler->reply)(c, cancelled);
   }
 };
 

@@ -7,6 +7,7 @@
 #include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 
+#include "raw_http.hpp"
 #include "studio_client.hpp"
 
 #include <boost/beast/core.hpp>
@@ -33,6 +34,10 @@ using namespace clay::recipe;
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 using Catch::Matchers::Contains;
+using clay::test::connect_to;
+using clay::test::get;
+using clay::test::raw_http;
+using clay::test::status_of;
 
 namespace {
 
@@ -83,48 +88,6 @@ std::set<std::string> names_in(const fs::path& dir) {
   std::set<std::string> out;
   for (const auto& e : fs::directory_iterator(dir)) out.insert(e.path().filename().string());
   return out;
-}
-
-/// A TCP connection to 127.0.0.1:port (a plain socket: the test speaks raw bytes).
-int connect_to(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  REQUIRE(fd >= 0);
-  sockaddr_in at{};
-  at.sin_family = AF_INET;
-  at.sin_port = htons(static_cast<std::uint16_t>(port));
-  at.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  REQUIRE(::connect(fd, reinterpret_cast<sockaddr*>(&at), sizeof at) == 0);
-  return fd;
-}
-
-/// Sends `request` as it is and reads the answer until the server closes, or its head when it
-/// is a 101 (an upgrade stays open), within `seconds` (then whatever came).
-std::string raw_http(int port, const std::string& request, int seconds = 15) {
-  const int fd = connect_to(port);
-  timeval tv{seconds, 0};
-  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-  ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
-  std::string answer;
-  char buffer[65536];
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
-  while (std::chrono::steady_clock::now() < deadline && answer.size() < (4u << 20)) {
-    const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
-    if (n <= 0) break;
-    answer.append(buffer, static_cast<std::size_t>(n));
-    if (answer.rfind("HTTP/1.1 101", 0) == 0 && answer.find("\r\n\r\n") != std::string::npos) break;
-  }
-  ::close(fd);
-  return answer;
-}
-
-/// The status code of an HTTP answer (0 when there is none: the server closed without one).
-int status_of(const std::string& answer) {
-  if (answer.rfind("HTTP/1.", 0) != 0 || answer.size() < 12) return 0;
-  return std::stoi(answer.substr(9, 3));
-}
-
-std::string get(int port, const std::string& target, const std::string& headers) {
-  return raw_http(port, "GET " + target + " HTTP/1.1\r\n" + headers + "\r\n");
 }
 
 std::string upgrade_request(int port, const std::string& target, const std::string& extra) {

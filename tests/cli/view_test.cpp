@@ -1,7 +1,7 @@
 // The view data of a run (issue #9): curvatures against closed forms (sphere, cylinder, plane),
 // the .bin files read back and compared with the surfaces evaluated here, the manifest's fields,
 // the refit deviation against the deformation applied pointwise; and the HTTP server of
-// `clayform view` exercised with cpp-httplib's client.
+// `clayform view` exercised in raw HTTP (tests/cli/raw_http.hpp).
 #include <catch2/catch.hpp>
 
 #include <clay/deform/regular.hpp>
@@ -15,7 +15,6 @@
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/tessellate.hpp>
 
-#include <httplib.h>
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
@@ -28,6 +27,7 @@
 #include <sstream>
 
 #include "error_of.hpp"
+#include "raw_http.hpp"
 
 using namespace clay::recipe;
 using Catch::Matchers::Contains;
@@ -115,7 +115,7 @@ std::string stages_recipe() {
       "dome": )" +
          dome_json() + R"(,
       "bulged": {"deform": {"surface": "dome", "deformation": "shape"}},
-      "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 0.01, "relative": false}}},
+      "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance_mm": 0.01}}},
       "styled": {"deform": {"surface": "dome", "deformation": "crease"}}},
     "deformations": {
       "shape": [{"kind": "bezier_lattice", "name": "bulge",
@@ -491,23 +491,30 @@ struct ServedFolders {
 
 TEST_CASE("the view server serves the front end at the root and the run folder under run",
           "[view]") {
+  using clay::test::body_of;
+  using clay::test::header_of;
+  using clay::test::status_of;
   const ServedFolders f;
   ServeOptions o;
   o.port = 0;
   o.viewer = f.dist;
   ViewServer server(f.run, o);
   REQUIRE(server.port() > 0);
-  CHECK(server.url() == "http://127.0.0.1:" + std::to_string(server.port()) + "/");
+  CHECK(server.url() ==
+        "http://127.0.0.1:" + std::to_string(server.port()) + "/?token=" + server.token());
+  CHECK(server.token().size() == 32);
   server.start();
-  httplib::Client client("127.0.0.1", server.port());
+  const std::string host = "Host: 127.0.0.1:" + std::to_string(server.port()) + "\r\n";
+  const std::string cookie =
+      "Cookie: clayform_view_" + std::to_string(server.port()) + "=" + server.token() + "\r\n";
   const auto get = [&](const std::string& path, int status, const std::string& type,
                        const std::string& body) {
     INFO(path);
-    auto res = client.Get(path.c_str());
-    REQUIRE(res);
-    CHECK(res->status == status);
-    if (!type.empty()) CHECK(res->get_header_value("Content-Type") == type);
-    if (!body.empty()) CHECK(res->body == body);
+    const std::string answer = clay::test::get(server.port(), path, host + cookie);
+    CHECK(status_of(answer) == status);
+    if (!type.empty()) CHECK(header_of(answer, "Content-Type") == type);
+    if (!body.empty()) CHECK(body_of(answer) == body);
+    CHECK(header_of(answer, "Cache-Control") == "no-store");  // a run folder is rewritten
   };
   get("/run/view/manifest.json", 200, "application/json",
       read_text(f.run / "view" / "manifest.json"));
@@ -518,11 +525,33 @@ TEST_CASE("the view server serves the front end at the root and the run folder u
   get("/assets/app.js", 200, "text/javascript; charset=utf-8", "console.log(1);\n");
   get("/assets/app.css", 200, "text/css; charset=utf-8", "body{}\n");
   get("/run/view/nothing.bin", 404, "", "");
-  get("/run/../secret.txt", 400, "", "");
-  get("/run/%2e%2e/secret.txt", 400, "", "");
-  get("/run/view/..%2f..%2fsecret.txt", 400, "", "");
+  // Nothing outside the two folders, however the path is spelled.
+  get("/run/../secret.txt", 404, "", "");
+  get("/run/%2e%2e/secret.txt", 404, "", "");
+  get("/run/view/..%2f..%2fsecret.txt", 404, "", "");
+  get("/../secret.txt", 404, "", "");
+  // The studio's boundary (issue #37 put the viewer on its HTTP stack): the token, opened once
+  // with ?token= (which sets the cookie) and then carried by the cookie; the server's own Host;
+  // the page's own Origin.
+  const std::string no_token = clay::test::get(server.port(), "/run/view/manifest.json", host);
+  CHECK(status_of(no_token) == 403);
+  CHECK_THAT(body_of(no_token), Contains("clayform view") && Contains("?token="));
+  CHECK(status_of(clay::test::get(server.port(), "/?token=" + std::string(32, '0'), host)) == 403);
+  const std::string opened = clay::test::get(server.port(), "/?token=" + server.token(), host);
+  CHECK(status_of(opened) == 200);
+  CHECK(header_of(opened, "Set-Cookie") == "clayform_view_" + std::to_string(server.port()) + "=" +
+                                               server.token() +
+                                               "; Path=/; HttpOnly; SameSite=Strict");
+  CHECK(status_of(clay::test::get(
+            server.port(), "/",
+            "Host: evil.example:" + std::to_string(server.port()) + "\r\n" + cookie)) == 403);
+  CHECK(status_of(clay::test::get(server.port(), "/run/view/manifest.json",
+                                  host + cookie + "Origin: http://evil.example\r\n")) == 403);
+  CHECK(status_of(clay::test::raw_http(server.port(), "POST /run/view/manifest.json HTTP/1.1\r\n" +
+                                                          host + cookie +
+                                                          "Content-Length: 0\r\n\r\n")) == 405);
   server.stop();
-  CHECK(!client.Get("/"));  // stopped: nobody answers
+  CHECK(!clay::test::can_connect(server.port()));  // stopped: nobody listens
 }
 
 TEST_CASE("the view server and snapshot name the fix for what is missing", "[view]") {

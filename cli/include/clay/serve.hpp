@@ -3,6 +3,7 @@
 /// `clayform snapshot` (docs/recipe.md "Viewing a run"). The built front end (viewer/dist) is
 /// served at `/`, the run folder (with its view/manifest.json, clay/recipe/view.hpp) under `/run/`.
 
+#include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -19,11 +20,18 @@ struct ServeOptions {
   std::string host = "127.0.0.1";
   int port = 8765;               ///< 0: any free port (see ViewServer::port)
   std::filesystem::path viewer;  ///< the built front end; empty: viewer_dir()
+  /// Every request must carry it (?token=, or the cookie the first such answer sets): letters
+  /// and digits, at least 16. Empty: 32 random hex digits.
+  std::string token;
+  std::size_t max_file_bytes = 1u << 30;  ///< largest file served (a dense run's mesh is large)
 };
 
-/// An HTTP server (cpp-httplib) of one run folder: `/` and static files from the front end,
-/// `/run/...` from the run folder; content types by extension (.bin application/octet-stream,
-/// .glb model/gltf-binary); paths containing ".." are refused (400). Binds in the constructor.
+/// An HTTP server of one run folder, on the studio's HTTP stack (Boost.Beast, one I/O thread):
+/// `/` and static files from the front end, `/run/...` from the run folder; content types by
+/// extension (.bin application/octet-stream, .glb model/gltf-binary). A security boundary as the
+/// studio is (docs/studio.md "Security"): the token, the server's own Host and, when a request
+/// has one, its own Origin, else 403; files only under the two folders, by plain names (".."
+/// and links leading out: 404). Binds in the constructor.
 class ViewServer {
  public:
   /// Checks `run_dir`/view/manifest.json and the front end's index.html (clay::Error(Io) naming
@@ -33,11 +41,12 @@ class ViewServer {
   ViewServer(const ViewServer&) = delete;
   ViewServer& operator=(const ViewServer&) = delete;
 
-  int port() const noexcept;  ///< the bound port
-  std::string url() const;    ///< "http://HOST:PORT/"
-  void run();                 ///< serves in this thread until stop() (from another thread)
-  void start();               ///< serves in a thread of its own
-  void stop();                ///< stops serving (and joins the thread of start)
+  int port() const noexcept;         ///< the bound port
+  const std::string& token() const;  ///< the token every request must carry
+  std::string url() const;           ///< "http://HOST:PORT/?token=TOKEN"
+  void run();                        ///< serves in this thread until stop() (from another thread)
+  void start();                      ///< serves in a thread of its own
+  void stop();                       ///< stops serving (and joins the thread of start)
 
  private:
   struct Impl;
