@@ -51,7 +51,7 @@ int main() {
   try {
     const Stroke stroke = drawn_stroke();
     FitOptions options;
-    options.tolerance = 0.3;  // mm: three times the noise
+    options.tolerance_mm = 0.3;  // three times the noise
 
     const auto t0 = std::chrono::steady_clock::now();
     const StrokeFit fit = fit_stroke(stroke, options);

@@ -48,7 +48,7 @@ int exit_code(clay::ErrorCategory c) {
       return 5;
     case clay::ErrorCategory::Exchange:
       return 6;
-    case clay::ErrorCategory::Recipe:
+    case clay::ErrorCategory::Document:
       return 7;
     case clay::ErrorCategory::ToleranceNotMet:
       return 8;
@@ -315,7 +315,7 @@ int validate(const fs::path& file) {
   std::printf("%s: %zu problem%s\n", file.string().c_str(), problems.size(),
               problems.size() == 1 ? "" : "s");
   for (const auto& p : problems) std::printf("  %s\n", clay::recipe::to_string(p).c_str());
-  return exit_code(clay::ErrorCategory::Recipe);
+  return exit_code(clay::ErrorCategory::Document);
 }
 
 // ---- clayform render (clay/render/render.hpp) ----
@@ -644,7 +644,8 @@ int main(int argc, char** argv) {
                         "an existing Dask scheduler, e.g. tcp://HOST:8786 (implies dask)");
   app.footer(
       "Exit codes: 0 success, 1 usage, 2 invalid argument, 3 invalid geometry or out of domain, "
-      "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 recipe problems, 8 tolerance not met, "
+      "4 degree limit, 5 file I/O, 6 exchange (STEP/IGES), 7 document problems (a recipe, stack or "
+      "autosave), 8 tolerance not met, "
       "70 internal error.");
   try {
     app.parse(argc, argv);

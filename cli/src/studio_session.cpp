@@ -172,6 +172,9 @@ Json fit_reply(const Json& command) {
   const internal::Json& c = command;
   internal::JsonReader r;
   r.limit_note = "a recipe stroke's limit: draw it as several strokes";
+  r.object(c, "", {"op", "points", "plane", "tolerance_mm", "corner_angle"},
+           "a fit {points, plane?, tolerance_mm?, corner_angle?}",
+           {{"tolerance", "tolerance_mm", "in millimetres"}});
   sketch::Stroke stroke;
   if (const auto* pts = r.member(c, "", "points", true, "the drawn points [[x, y, z], ...]"))
     if (auto p = r.points(*pts, "points", 2, 10000)) stroke.points = std::move(*p);
@@ -193,8 +196,8 @@ Json fit_reply(const Json& command) {
     }
   }
   sketch::FitOptions options;
-  options.tolerance =
-      r.number_or(c, "", "tolerance", options.tolerance, internal::Range{0, 1e6, true});
+  options.tolerance_mm =
+      r.number_or(c, "", "tolerance_mm", options.tolerance_mm, internal::Range{0, 1e6, true});
   options.corner_angle = r.number_or(c, "", "corner_angle", options.corner_angle,
                                      internal::Range{0, 180, true, false});
   if (!r.problems.empty()) {
@@ -329,18 +332,7 @@ struct StudioSession::Impl {
   Reply ran(const std::string& op, const Run& run, bool nets = true) const {
     const RunResult& result = run.result;
     Reply reply;
-    Json steps = Json::array();
-    for (const auto& s : result.steps) {
-      Json figures = Json::object();
-      for (const auto& [k, v] : s.figures)
-        std::visit([&, key = k](const auto& x) { figures[key] = x; }, v);
-      steps.push_back({{"path", s.path},
-                       {"kind", s.kind},
-                       {"seconds", s.seconds},
-                       {"warning", s.warning},
-                       {"message", s.message},
-                       {"figures", figures}});
-    }
+    const Json steps = Json::parse(step_reports_json(result.steps));  // as report.json has them
     auto push_net = [&](const std::string& n, const surface::BSplineSurface& s, bool before) {
       Json header = {{"kind", "net"},
                      {"name", n},
@@ -698,8 +690,8 @@ void StudioSession::flush_autosave() { impl_->flush_autosave(); }
 std::size_t StudioSession::restore(const fs::path& file) {
   const std::string text = internal::read_text(file, "studio's autosave");
   auto bad = [&](const std::string& why) {
-    return Error(ErrorCategory::Recipe, "the studio's autosave \"" + file.string() + "\" " + why +
-                                            "; start without it (--fresh) or remove it");
+    return Error(ErrorCategory::Document, "the studio's autosave \"" + file.string() + "\" " + why +
+                                              "; start without it (--fresh) or remove it");
   };
   if (internal::nesting_too_deep(text, 64)) throw bad("nests too deep");
   const Json doc = [&] {

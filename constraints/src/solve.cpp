@@ -29,7 +29,8 @@ std::vector<std::string> SolveOptions::problems() const {
     std::snprintf(buffer, sizeof buffer, "%g", value);
     out.push_back("SolveOptions::" + field + " = " + buffer + " breaks the rule " + rule);
   };
-  if (!(tolerance > 0 && tolerance <= 1e-3)) bad("tolerance", tolerance, "0 < tolerance <= 1e-3");
+  if (!(residual_tolerance > 0 && residual_tolerance <= 1e-3))
+    bad("residual_tolerance", residual_tolerance, "0 < residual_tolerance <= 1e-3");
   if (max_iterations < 1) bad("max_iterations", max_iterations, ">= 1");
   if (!(rank_tolerance > 0 && rank_tolerance <= 1e-2))
     bad("rank_tolerance", rank_tolerance, "0 < rank_tolerance <= 1e-2");
@@ -312,7 +313,7 @@ void run_ceres(CeresSystem& sys, const Model& m, const SolveOptions& options, bo
   o.jacobi_scaling = false;
   o.min_lm_diagonal = 1.0;
   o.max_lm_diagonal = 1.0;
-  StopWhenSolved stop(0.5 * std::pow(1e-3 * options.tolerance, 2));
+  StopWhenSolved stop(0.5 * std::pow(1e-3 * options.residual_tolerance, 2));
   if (stop_early) o.callbacks.push_back(&stop);
   (void)m;
   ceres::Solver::Summary summary;
@@ -616,7 +617,8 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
         Dependency dep;
         dep.constraints = list;
         for (int c : list)
-          dep.conflicting = dep.conflicting || worst_of[static_cast<size_t>(c)] > options.tolerance;
+          dep.conflicting =
+              dep.conflicting || worst_of[static_cast<size_t>(c)] > options.residual_tolerance;
         dep.message = std::string(dep.conflicting ? "conflicting: " : "redundant: ") +
                       constraint_list(list, constraints, sketch) +
                       (implicit ? " (with the equal radii of an arc)" : "");
@@ -645,7 +647,7 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
     s.message = std::to_string(report.conflicting.size()) + " conflicting set(s): ";
     for (size_t k = 0; k < report.conflicting.size(); ++k)
       s.message += (k ? "; " : "") + report.conflicting[k].message;
-  } else if (report.max_residual <= options.tolerance) {
+  } else if (report.max_residual <= options.residual_tolerance) {
     s.termination = Termination::Converged;
     s.message = "all " + std::to_string(constraints.size()) + " constraints hold" + dof;
     if (!report.redundant.empty())

@@ -132,9 +132,9 @@ std::vector<std::string> DirectManipulationOptions::problems() const {
     out.push_back("DirectManipulationOptions::rank_tolerance = " + format(rank_tolerance) +
                   " breaks the rule 0 < rank_tolerance < 1; give a small relative threshold "
                   "such as 1e-10");
-  if (!(std::isfinite(tolerance) && tolerance > 0))
-    out.push_back("DirectManipulationOptions::tolerance = " + format(tolerance) +
-                  " breaks the rule tolerance > 0 (finite, relative to the lattice size); "
+  if (!(std::isfinite(relative_tolerance) && relative_tolerance > 0))
+    out.push_back("DirectManipulationOptions::relative_tolerance = " + format(relative_tolerance) +
+                  " breaks the rule relative_tolerance > 0 (finite, relative to the lattice size); "
                   "give e.g. 1e-7");
   std::set<Eigen::Index> seen;
   for (size_t g = 0; g < tied.size(); ++g) {
@@ -324,7 +324,7 @@ DirectManipulationResult<Lattice> DirectManipulator<Lattice>::move(const Points3
         std::max(rep.achieved_max_error, (reached - targets.row(i).transpose()).norm());
   }
   rep.displacement_norm = (out.lattice.points - s.lattice.points).norm();
-  const double tolerance = s.options.tolerance * s.size;
+  const double tolerance = s.options.relative_tolerance * s.size;
   rep.feasible = rep.achieved_max_error <= tolerance;
 
   const std::string counts = "rank " + std::to_string(rep.rank) + " for " + std::to_string(n) +

@@ -143,7 +143,7 @@ Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
     } catch (const Error& e) {
       throw Error(e.category(), name + ": " + e.message());
     }
-    if (!fit.report.certified || !(fit.report.certified_bound_mm <= fit.report.tolerance))
+    if (!fit.report.certified || !(fit.report.certified_bound_mm <= fit.report.tolerance_mm))
       throw Error(ErrorCategory::ToleranceNotMet,
                   name + ": the refit below max_degree " + std::to_string(options.max_degree) +
                       " missed its tolerance: " + fit.report.brief());

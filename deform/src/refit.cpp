@@ -383,18 +383,19 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     sample.row(r) = deformed(d, sample.row(r).transpose()).transpose();
   const double size = (sample.colwise().maxCoeff() - sample.colwise().minCoeff()).norm();
   const double magnitude = sample.cwiseAbs().maxCoeff();
-  if (options.relative && !(size > 0))
+  const bool relative = options.relative_tolerance > 0;
+  if (relative && !(size > 0))
     throw Error(ErrorCategory::InvalidGeometry,
                 "refit_deformed: the deformed surface has zero size (" + format(size) +
-                    " mm), so a relative tolerance is zero; give an absolute tolerance "
-                    "(RefitOptions::relative = false)");
-  const double tolerance = options.relative ? options.tolerance * size : options.tolerance;
+                    " mm), so a relative tolerance is zero; give the tolerance in mm "
+                    "(RefitOptions::tolerance_mm, relative_tolerance = 0)");
+  const double tolerance = relative ? options.relative_tolerance * size : options.tolerance_mm;
   const double rounding = 1e-12 * (size + magnitude);
   const double budget = options.certificate_share * tolerance;
 
   RefitResult result;
   RefitReport& report = result.report;
-  report.tolerance = tolerance;
+  report.tolerance_mm = tolerance;
   report.size = size;
   report.degree_u = report.degree_v = p;
   const bool fixed = options.count_u > 0;
@@ -517,8 +518,16 @@ std::vector<std::string> RefitOptions::problems() const {
   if (degree < 1 || degree > 25)
     fail("degree = " + std::to_string(degree) +
          ": must be in [1, 25] (the exchange degree limit); 3 is usual");
-  if (!(std::isfinite(tolerance) && tolerance > 0))
-    fail("tolerance = " + format(tolerance) + ": must be finite and > 0 (e.g. 1e-4 relative)");
+  // Exactly one of the two: a tolerance whose unit the caller did not choose is refused.
+  for (const auto& [name, value] :
+       {std::pair{"relative_tolerance", relative_tolerance}, {"tolerance_mm", tolerance_mm}})
+    if (!(std::isfinite(value) && value >= 0))
+      fail(std::string(name) + " = " + internal::shortest(value) + ": must be finite and >= 0");
+  if ((relative_tolerance > 0) == (tolerance_mm > 0))
+    fail("relative_tolerance = " + internal::shortest(relative_tolerance) +
+         " and tolerance_mm = " + internal::shortest(tolerance_mm) +
+         ": exactly one must be > 0 (e.g. relative_tolerance = 1e-4, a fraction of the size, or "
+         "tolerance_mm = 0.01 with relative_tolerance = 0)");
   if (max_iterations < 1)
     fail("max_iterations = " + std::to_string(max_iterations) + ": must be >= 1");
   if (max_control_points < (degree + 1) * (degree + 1))
@@ -548,11 +557,11 @@ std::string RefitReport::brief() const {
   char buffer[256];
   if (certified) {
     std::snprintf(buffer, sizeof buffer, "certified %.3g mm %s %.3g mm (sampled %.3g mm)",
-                  certified_bound_mm, certified_bound_mm <= tolerance ? "<=" : ">", tolerance,
+                  certified_bound_mm, certified_bound_mm <= tolerance_mm ? "<=" : ">", tolerance_mm,
                   sampled_max);
   } else {
     std::snprintf(buffer, sizeof buffer, "not certified, sampled %.3g mm %s %.3g mm", sampled_max,
-                  sampled_max <= tolerance ? "<=" : ">", tolerance);
+                  sampled_max <= tolerance_mm ? "<=" : ">", tolerance_mm);
   }
   std::string line = buffer;
   std::snprintf(buffer, sizeof buffer,
@@ -586,49 +595,22 @@ RefitResult refit_surface(const BSplineSurface& surface, const RefitOptions& opt
   return refit(surface, identity, options);
 }
 
-RefitResult refit_deformed(const Taper& taper, const BSplineSurface& surface,
+RefitResult refit_deformed(const SpaceMap& map, const BSplineSurface& surface,
                            const RefitOptions& options) {
-  return refit_validated(surface, taper, options);
-}
-
-RefitResult refit_deformed(const Twist& twist, const BSplineSurface& surface,
-                           const RefitOptions& options) {
-  return refit_validated(surface, twist, options);
-}
-
-RefitResult refit_deformed(const Bend& bend, const BSplineSurface& surface,
-                           const RefitOptions& options) {
-  return refit_validated(surface, bend, options);
-}
-
-RefitResult refit_deformed(const BezierLattice& lattice, const BSplineSurface& surface,
-                           const RefitOptions& options) {
-  return refit_validated(surface, lattice, options);
-}
-
-RefitResult refit_deformed(const BSplineLattice& lattice, const BSplineSurface& surface,
-                           const RefitOptions& options) {
-  return refit_validated(surface, lattice, options);
-}
-
-RefitResult refit_deformed(const ExtendedLattice& lattice, const BSplineSurface& surface,
-                           const RefitOptions& options) {
-  return refit_validated(surface, lattice, options);
-}
-
-RefitResult refit_deformed(const DeformationStack& stack, const BSplineSurface& surface,
-                           const RefitOptions& options) {
-  return refit_validated(surface, stack, options);
-}
-
-RefitResult refit_deformed(const PointMap& map, const BSplineSurface& surface,
-                           const RefitOptions& options) {
-  if (!map)
-    throw Error(ErrorCategory::InvalidArgument,
-                "refit_deformed: the point map is empty; pass a callable Eigen::Vector3d -> "
-                "Eigen::Vector3d");
-  return refit(surface, {"point map", map, {}, "nothing is known of a point map's derivatives"},
-               options);
+  if (const auto* point_map = std::get_if<PointMap>(&map)) {
+    if (!*point_map)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "refit_deformed: the point map is empty; pass a callable Eigen::Vector3d -> "
+                  "Eigen::Vector3d");
+    return refit(surface,
+                 {"point map", *point_map, {}, "nothing is known of a point map's derivatives"},
+                 options);
+  }
+  if (const auto* stack = std::get_if<DeformationStack>(&map))
+    return refit_validated(surface, *stack, options);
+  return std::visit(
+      [&](const auto& deformation) { return refit_validated(surface, deformation, options); },
+      std::get<Deformation>(map));
 }
 
 }  // namespace clay::deform

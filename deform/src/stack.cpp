@@ -253,13 +253,13 @@ DeformationStack stack_from_json(std::string_view json) {
     const internal::FpTrapsHeld traps_held;  // the JSON parser's strtod
     root = Json::parse(json.begin(), json.end());
   } catch (const Json::parse_error& e) {
-    throw Error(ErrorCategory::Recipe,
+    throw Error(ErrorCategory::Document,
                 "deformation stack JSON is not valid JSON (byte " + std::to_string(e.byte) +
                     "): " + e.what() + "; fix the syntax (NaN and Infinity are not JSON numbers)");
   } catch (const Json::exception& e) {  // e.g. a number beyond the range of a double
-    throw Error(ErrorCategory::Recipe, std::string("deformation stack JSON could not be read: ") +
-                                           e.what() +
-                                           "; give finite numbers within the range of a double");
+    throw Error(ErrorCategory::Document, std::string("deformation stack JSON could not be read: ") +
+                                             e.what() +
+                                             "; give finite numbers within the range of a double");
   }
   // Every problem with its path (the shared reader), then the values of the steps read.
   internal::JsonReader r;
@@ -297,7 +297,8 @@ DeformationStack stack_from_json(std::string_view json) {
   if (!r.problems.empty()) {
     std::vector<std::string> list;
     for (const auto& p : r.problems) list.push_back(p.path + ": " + p.message);
-    throw Error(ErrorCategory::Recipe, "deformation stack JSON: " + internal::join_problems(list));
+    throw Error(ErrorCategory::Document,
+                "deformation stack JSON: " + internal::join_problems(list));
   }
   return stack;
 }

@@ -51,8 +51,8 @@ std::vector<std::string> StyleOptions::problems() const {
     fail("key_points_per_row = " + std::to_string(key_points_per_row) + " must be >= 1");
   if (boundary_rows < 0 || boundary_rows > 4)
     fail("boundary_rows = " + std::to_string(boundary_rows) + " must lie in [0, 4]");
-  if (!(tolerance > 0 && tolerance <= 1e-3))
-    fail("tolerance = " + std::to_string(tolerance) +
+  if (!(relative_tolerance > 0 && relative_tolerance <= 1e-3))
+    fail("relative_tolerance = " + std::to_string(relative_tolerance) +
          " must lie in (0, 1e-3] (relative to the model size)");
   if (max_refinements < 0 || max_refinements > 10)
     fail("max_refinements = " + std::to_string(max_refinements) +
@@ -712,12 +712,12 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
       s.termination = Termination::NotConverged;
       m << report.conflicting_key_points.size() << " key points cannot be met (missed by up to "
         << report.target_deviation
-        << " mm, more than tolerance x size = " << options.tolerance * size
+        << " mm, more than relative_tolerance x size = " << options.relative_tolerance * size
         << " mm): the control net is too coarse there; allow more max_refinements";
-    } else if (report.target_deviation > options.tolerance * size) {
+    } else if (report.target_deviation > options.relative_tolerance * size) {
       s.termination = Termination::NotConverged;
       m << "a key point is missed by " << report.target_deviation
-        << " mm, more than tolerance x size = " << options.tolerance * size
+        << " mm, more than relative_tolerance x size = " << options.relative_tolerance * size
         << " mm; allow more max_refinements";
     } else if (const double miss = std::max(
                    std::isfinite(report.target_curve_deviation) ? report.target_curve_deviation

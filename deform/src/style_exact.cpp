@@ -637,7 +637,7 @@ void finish_report(const BSplineSurface& parent, const InfluenceRegion& region,
   const Eigen::Index nk = system.B.rows(), nf = system.B.cols();
   const std::vector<int>& active = system.active;
   const Eigen::MatrixXd achieved = system.B * d - system.rhs;
-  const double tol = options.tolerance * size;
+  const double tol = options.relative_tolerance * size;
   report.key_points = points;
   // E_k(d) from the net's own matrix (fixed vertices have d = 0), without the ridge.
   report.fairness_energy =
@@ -686,7 +686,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
                         const StyleOptions& options, std::shared_ptr<const ExactCache>& cache) {
   const BSplineSurface& parent = projector.surface();
   const double size = model_size(parent);
-  const double tol = options.tolerance * size;
+  const double tol = options.relative_tolerance * size;
   const int order = options.continuity == BoundContinuity::G2 ? 3 : 2;
   const int fixed_rows = options.boundary_rows + (order - 2);
   if (parent.u.degree < order || parent.v.degree < order)

@@ -188,8 +188,9 @@ void refuse_torn(const Deformation& d, const surface::BSplineSurface& s, const R
   if (const auto* l = std::get_if<BezierLattice>(&d)) jump = face_jump(*l, s);
   if (const auto* l = std::get_if<BSplineLattice>(&d)) jump = face_jump(*l, s);
   if (!jump || jump->mm == 0) return;
-  double tolerance = o.tolerance;
-  if (o.relative) {  // as refit_deformed: of the deformed surface's size, sampled 8 x 8 per span
+  double tolerance = o.tolerance_mm;
+  if (o.relative_tolerance >
+      0) {  // as refit_deformed: of the deformed surface's size, sampled 8 x 8 per span
     const std::vector<double> su = surface::span_samples(s.u, 8),
                               sv = surface::span_samples(s.v, 8);
     Points3 sample = surface::evaluate_grid(s, su, sv);
@@ -200,7 +201,8 @@ void refuse_torn(const Deformation& d, const surface::BSplineSurface& s, const R
                           },
                           d)
                           .transpose();
-    tolerance *= (sample.colwise().maxCoeff() - sample.colwise().minCoeff()).norm();
+    tolerance =
+        o.relative_tolerance * (sample.colwise().maxCoeff() - sample.colwise().minCoeff()).norm();
   }
   if (jump->mm / 2 <= tolerance) return;
   constexpr const char* axis_name[3] = {"s", "t", "u"};
@@ -221,7 +223,7 @@ void refuse_torn(const Deformation& d, const surface::BSplineSurface& s, const R
 
 RefitResult refit_step(const Deformation& d, const surface::BSplineSurface& s,
                        const RefitOptions& o) {
-  return std::visit([&](const auto& deformation) { return refit_deformed(deformation, s, o); }, d);
+  return refit_deformed(d, s, o);
 }
 
 }  // namespace

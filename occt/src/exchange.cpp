@@ -215,7 +215,7 @@ BuiltFaces build_faces(const std::vector<BSplineSurface>& input, std::string_vie
   BRep_Builder builder;
   builder.MakeCompound(built.compound);
   ExchangeReport& report = built.report;
-  report.tolerance = face_tolerance;
+  report.tolerance_mm = face_tolerance;
   report.valid = true;
   for (size_t k = 0; k < input.size(); ++k) {
     const std::string name = surface_name(k);
@@ -661,7 +661,7 @@ std::string ExchangeReport::brief() const {
   std::snprintf(head, sizeof head,
                 "%d face%s, max degree %d, %ld control points, %s (BRepCheck at %.0e mm)", faces,
                 faces == 1 ? "" : "s", max_degree, control_points, valid ? "valid" : "NOT valid",
-                tolerance);
+                tolerance_mm);
   std::string line = head;
   if (!problems.empty())
     line += ": " + std::to_string(problems.size()) +

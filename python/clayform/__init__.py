@@ -43,6 +43,7 @@ from .errors import (
     InvalidGeometryError,
     IoError,
     OutOfDomainError,
+    DocumentError,
     RecipeError,
     ToleranceNotMetError,
 )
@@ -64,6 +65,7 @@ __all__ = [
     "Model",
     "OutOfDomainError",
     "Recipe",
+    "DocumentError",
     "RecipeError",
     "RunResult",
     "Sketch",

@@ -50,10 +50,16 @@ class ExchangeError(ClayError):
     category = "exchange"
 
 
-class RecipeError(ClayError, ValueError):
-    """A malformed recipe or a reference to a missing object; the message lists every problem."""
+class DocumentError(ClayError, ValueError):
+    """A malformed JSON document (a recipe, a deformation stack, a studio autosave) or a reference
+    in it to a missing object; the message lists every problem."""
 
-    category = "recipe"
+    category = "document"
+
+
+#: DocumentError's name until issue #37 (the kernel's category is not the recipe
+#: library's); kept so that `except RecipeError` goes on catching the same errors.
+RecipeError = DocumentError
 
 
 class ToleranceNotMetError(ClayError):
@@ -78,7 +84,7 @@ BY_CATEGORY = {
         DegreeLimitError,
         IoError,
         ExchangeError,
-        RecipeError,
+        DocumentError,
         ToleranceNotMetError,
         InternalError,
     )

@@ -51,7 +51,7 @@ py::dict exchange_report(const surface::ExchangeReport& r) {
   d["max_degree"] = r.max_degree;
   d["control_points"] = r.control_points;
   d["valid"] = r.valid;
-  d["tolerance_mm"] = r.tolerance;
+  d["tolerance_mm"] = r.tolerance_mm;
   d["message"] = r.brief();
   return d;
 }

@@ -132,7 +132,7 @@ void bind_recipe(py::module_& m) {
             return parse(internal::read_text(file, "recipe"), file.parent_path().string(),
                          file.stem().string());
           },
-          py::arg("path"), "Reads and checks a recipe file (RecipeError lists every problem).")
+          py::arg("path"), "Reads and checks a recipe file (DocumentError lists every problem).")
       .def_static("parse", &parse, py::arg("text"), py::arg("base_dir") = "", py::arg("name") = "",
                   "Checks recipe text; imports are resolved in base_dir; name is used when the "
                   "text has none.")

@@ -91,12 +91,12 @@ py::dict solve_report(const constraints::SolveReport& r) {
 void bind_sketch(py::module_& m) {
   m.def(
       "fit_stroke",
-      [](const py::handle& points, double tolerance, int degree, double corner_angle,
+      [](const py::handle& points, double tolerance_mm, int degree, double corner_angle,
          double closing_ratio) {
         sketch::Stroke stroke;
         stroke.points = points_in(points, "points");
         sketch::FitOptions o;
-        o.tolerance = tolerance;
+        o.tolerance_mm = tolerance_mm;
         o.degree = degree;
         o.corner_angle = corner_angle;
         o.closing_ratio = closing_ratio;
@@ -109,9 +109,9 @@ void bind_sketch(py::module_& m) {
         for (auto& c : fit.curves) curves.push_back(std::move(c.curve));
         return py::make_tuple(curves, fit_report(fit));
       },
-      py::arg("points"), py::arg("tolerance") = 0.1, py::arg("degree") = 3,
+      py::arg("points"), py::arg("tolerance_mm") = 0.1, py::arg("degree") = 3,
       py::arg("corner_angle") = 50.0, py::arg("closing_ratio") = 0.03,
-      "A drawn polyline (n, 3) fitted with B-spline curves within the tolerance (mm), split at "
+      "A drawn polyline (n, 3) fitted with B-spline curves within tolerance_mm, split at "
       "corners, closed when its ends meet: (curves, report).");
 
   py::class_<PySketch>(m, "Sketch",
@@ -246,9 +246,9 @@ void bind_sketch(py::module_& m) {
           py::arg("entity"), py::arg("end"), py::arg("direction"))
       .def(
           "solve",
-          [](PySketch& s, double tolerance) {
+          [](PySketch& s, double residual_tolerance) {
             constraints::SolveOptions o;
-            o.tolerance = tolerance;
+            o.residual_tolerance = residual_tolerance;
             // The solve runs without the GIL on a copy: another thread adding points meanwhile
             // reallocated the vectors it read and crashed the interpreter (issue #36). Adding
             // only grows the sketch, so its sizes tell whether it changed.
@@ -272,7 +272,7 @@ void bind_sketch(py::module_& m) {
             s.sketch = std::move(r.sketch);
             return solve_report(r.report);
           },
-          py::arg("tolerance") = 1e-10,
+          py::arg("residual_tolerance") = 1e-10,
           "Solves the constraints in place: the report (converged, max_residual, "
           "degrees_of_freedom, redundant and conflicting sets).");
 }

@@ -20,18 +20,19 @@ py::dict refit_report(const deform::RefitReport& r) {
                                 ? py::object(py::float_(r.certified_bound_mm))
                                 : py::object(py::none());
   d["sampled_max_mm"] = r.sampled_max;
-  d["tolerance_mm"] = r.tolerance;
+  d["tolerance_mm"] = r.tolerance_mm;
   d["degree_u"] = r.degree_u;
   d["degree_v"] = r.degree_v;
   d["message"] = r.brief();
   return d;
 }
 
-deform::RefitOptions refit_options(double tolerance, bool relative, int degree,
+deform::RefitOptions refit_options(double relative_tolerance, double tolerance_mm, int degree,
                                    int max_control_points) {
   deform::RefitOptions o;
-  o.tolerance = tolerance;
-  o.relative = relative;
+  // A tolerance in mm replaces the default relative one (as a recipe's composition reads them).
+  o.relative_tolerance = tolerance_mm > 0 ? 0.0 : relative_tolerance;
+  o.tolerance_mm = tolerance_mm;
   o.degree = degree;
   o.max_control_points = max_control_points;
   return o;
@@ -55,7 +56,7 @@ void bind_stack(py::module_& m) {
       "twist, bend), from their JSON form (docs/deform.md); pickles as that JSON, bit for bit.")
       .def_static(
           "from_json", [](const std::string& text) { return deform::stack_from_json(text); },
-          py::arg("text"), "Parses a stack (RecipeError names the JSON path and the fix).")
+          py::arg("text"), "Parses a stack (DocumentError names the JSON path and the fix).")
       .def("to_json", [](const deform::DeformationStack& s) { return deform::to_json(s); })
       .def_property_readonly("kinds",
                              [](const deform::DeformationStack& s) {
@@ -95,16 +96,17 @@ void bind_stack(py::module_& m) {
       .def(
           "refit",
           [](const deform::DeformationStack& s, const surface::BSplineSurface& surface,
-             double tolerance, bool relative, int degree, int max_control_points) {
+             double relative_tolerance, double tolerance_mm, int degree, int max_control_points) {
             deform::RefitResult r;
             {
               py::gil_scoped_release free;
               r = deform::refit_deformed(
-                  s, surface, refit_options(tolerance, relative, degree, max_control_points));
+                  s, surface,
+                  refit_options(relative_tolerance, tolerance_mm, degree, max_control_points));
             }
             return refit_result(std::move(r));
           },
-          py::arg("surface"), py::arg("tolerance") = 1e-4, py::arg("relative") = true,
+          py::arg("surface"), py::arg("relative_tolerance") = 1e-4, py::arg("tolerance_mm") = 0.0,
           py::arg("degree") = 3, py::arg("max_control_points") = 40000,
           "The deformed surface refitted on its own (u, v), with a certified bound: (surface, "
           "report). ToleranceNotMetError when the bound misses the tolerance.")
@@ -116,18 +118,19 @@ void bind_stack(py::module_& m) {
 
   m.def(
       "refit_surface",
-      [](const surface::BSplineSurface& surface, double tolerance, bool relative, int degree,
-         int max_control_points) {
+      [](const surface::BSplineSurface& surface, double relative_tolerance, double tolerance_mm,
+         int degree, int max_control_points) {
         deform::RefitResult r;
         {
           py::gil_scoped_release free;
-          deform::RefitOptions o = refit_options(tolerance, relative, degree, max_control_points);
+          deform::RefitOptions o =
+              refit_options(relative_tolerance, tolerance_mm, degree, max_control_points);
           o.keep_breakpoints = false;  // an editable copy: knots only where the tolerance needs
           r = deform::refit_surface(surface, o);
         }
         return refit_result(std::move(r));
       },
-      py::arg("surface"), py::arg("tolerance") = 1e-4, py::arg("relative") = true,
+      py::arg("surface"), py::arg("relative_tolerance") = 1e-4, py::arg("tolerance_mm") = 0.0,
       py::arg("degree") = 3, py::arg("max_control_points") = 40000,
       "A light, certified copy of a surface (the recipes' rebuild without counts): (surface, "
       "report).");

@@ -21,8 +21,8 @@ const char* error_class(ErrorCategory c) {
       return "IoError";
     case ErrorCategory::Exchange:
       return "ExchangeError";
-    case ErrorCategory::Recipe:
-      return "RecipeError";
+    case ErrorCategory::Document:
+      return "DocumentError";
     case ErrorCategory::ToleranceNotMet:
       return "ToleranceNotMetError";
     case ErrorCategory::Internal:
@@ -71,7 +71,7 @@ void register_errors(py::module_& m) {
             {"degree_limit", ErrorCategory::DegreeLimit},
             {"io", ErrorCategory::Io},
             {"exchange", ErrorCategory::Exchange},
-            {"recipe", ErrorCategory::Recipe},
+            {"document", ErrorCategory::Document},
             {"tolerance_not_met", ErrorCategory::ToleranceNotMet},
             {"internal", ErrorCategory::Internal}};
         for (const auto& [name, c] : names)

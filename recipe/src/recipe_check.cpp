@@ -171,15 +171,32 @@ std::vector<std::string> RecipeChecker::curve_refs(const Json& obj, const std::s
 }
 
 Composition RecipeChecker::composition(const Json& j, const std::string& path, Composition c) {
+  // An old composition's "tolerance" was in mm where its "relative" was false.
+  const bool old_mm = j.is_object() && j.contains("relative") && j.at("relative") == false;
+  const Renamed renamed_tolerance =
+      old_mm
+          ? Renamed{"tolerance", "tolerance_mm", "in millimetres, as \"relative\": false made it"}
+          : Renamed{"tolerance", "relative_tolerance", "a fraction of the size"};
   if (!c_.object(j, path,
-                 {"mode", "tolerance", "relative", "degree", "check_samples", "max_control_points",
-                  "accept_out_of_tolerance", "editable"},
-                 "a composition {\"mode\": \"exact\"|\"refit\", ...}"))
+                 {"mode", "relative_tolerance", "tolerance_mm", "degree", "check_samples",
+                  "max_control_points", "accept_out_of_tolerance", "editable"},
+                 "a composition {\"mode\": \"exact\"|\"refit\", ...}",
+                 {renamed_tolerance, dropped_relative}))
     return c;
   if (const Json* m = c_.member(j, path, "mode", false, ""))
     if (const auto k = c_.choice(*m, key_path(path, "mode"), {"exact", "refit"})) c.refit = *k == 1;
-  c.tolerance = c_.number_or(j, path, "tolerance", c.tolerance, tolerance_range);
-  c.relative = c_.boolean_or(j, path, "relative", c.relative);
+  // One tolerance, its unit in its key: a fraction of the size (the default) or millimetres.
+  if (j.contains("tolerance_mm")) {
+    c.tolerance_mm = c_.number_or(j, path, "tolerance_mm", 0.0, tolerance_range);
+    c.relative_tolerance = 0;
+    if (j.contains("relative_tolerance"))
+      c_.add(key_path(path, "relative_tolerance"),
+             "give one tolerance: \"relative_tolerance\" (a fraction of the size) or "
+             "\"tolerance_mm\", not both");
+  } else {
+    c.relative_tolerance =
+        c_.number_or(j, path, "relative_tolerance", c.relative_tolerance, tolerance_range);
+  }
   c.degree = c_.integer_or(j, path, "degree", c.degree, 1, 25);
   c.check_samples = c_.integer_or(j, path, "check_samples", c.check_samples, 2, 64);
   c.accept_out_of_tolerance =
@@ -620,16 +637,18 @@ std::string recipe_wording(std::string m) {
       {"Allow a certified refit (SurfaceDeformationOptions::refit) to approximate this step within "
        "a tolerance",
        "Allow a certified refit to approximate this step within a tolerance: give the deformation "
-       "\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4} (relative to the size)"},
+       "\"composition\": {\"mode\": \"refit\", \"relative_tolerance\": 1e-4} (a fraction of the "
+       "size)"},
       {"set SurfaceDeformationOptions::accept_out_of_tolerance",
        "set \"accept_out_of_tolerance\": true in the \"composition\""},
-      {"(RefitOptions::relative = false)", "(\"relative\": false in the \"composition\")"},
+      {"(RefitOptions::tolerance_mm, relative_tolerance = 0)",
+       "(\"tolerance_mm\" in the \"composition\")"},
       {"remove the repeated point or set FitOptions::drop_duplicates", "remove the repeated point"},
       {" (or build the plane with make_plane)", ""},
       {"; build the plane with make_plane(origin, normal, x direction)",
        "; give a \"y_axis\" perpendicular to the \"x_axis\""},
       {"reverse it or set LoftOptions::auto_orient", "reverse it (a curve {\"reversed\": NAME})"},
-      {"loosen SuperquadricOptions::tolerance, raise max_spans, ", "loosen \"tolerance\" "},
+      {"loosen SuperquadricOptions::tolerance_mm, raise max_spans, ", "loosen \"tolerance_mm\" "},
       {"not reached at max_sections", "not reached with the most sections allowed"},
       {"raise gap_tolerance", "raise \"gap_tolerance\""},
   };
@@ -639,12 +658,13 @@ std::string recipe_wording(std::string m) {
       at != std::string::npos) {
     const long reached = number_between(m, "control point limit ", " reached");
     const bool raisable = reached >= 0 && reached < limit::refit_control_points;
-    m.replace(
-        at, std::string_view("; raise the limits, the tolerance or the degree").size(),
-        raisable
-            ? "; raise the composition's \"max_control_points\" (at most 40,000), loosen its "
-              "\"tolerance\" or raise its \"degree\""
-            : "; loosen the composition's \"tolerance\" or raise its \"degree\", or deform less");
+    m.replace(at, std::string_view("; raise the limits, the tolerance or the degree").size(),
+              raisable
+                  ? "; raise the composition's \"max_control_points\" (at most 40,000), loosen its "
+                    "tolerance (\"relative_tolerance\" or \"tolerance_mm\") or raise its \"degree\""
+                  : "; loosen the composition's tolerance (\"relative_tolerance\" or "
+                    "\"tolerance_mm\") or "
+                    "raise its \"degree\", or deform less");
   }
   for (const auto& [from, to] : phrases)
     for (std::size_t at = m.find(from); at != std::string::npos; at = m.find(from, at + to.size()))
@@ -677,7 +697,7 @@ Recipe parse_recipe(std::string_view text, const fs::path& base_dir,
     std::string m = "the recipe has " + std::to_string(out.problems.size()) + " problem" +
                     (out.problems.size() == 1 ? "" : "s") + ":";
     for (const auto& p : out.problems) m += "\n  " + to_string(p);
-    throw Error(ErrorCategory::Recipe, m);
+    throw Error(ErrorCategory::Document, m);
   }
   if (out.data.name.empty()) out.data.name = std::string(default_name);
   return Recipe{std::make_shared<const RecipeData>(std::move(out.data))};
@@ -689,7 +709,7 @@ Recipe load_recipe(const fs::path& file) {
     std::string m = file.string() + ": the recipe has " + std::to_string(out.problems.size()) +
                     " problem" + (out.problems.size() == 1 ? "" : "s") + ":";
     for (const auto& p : out.problems) m += "\n  " + to_string(p);
-    throw Error(ErrorCategory::Recipe, m);
+    throw Error(ErrorCategory::Document, m);
   }
   if (out.data.name.empty()) out.data.name = file.stem().string();
   return Recipe{std::make_shared<const RecipeData>(std::move(out.data))};

@@ -41,10 +41,11 @@ void RecipeChecker::stroke(const std::string& name, const Json& j, const std::st
   if (declared == 0) names_.curves.push_back(name);
   for (int k = 1; k <= declared; ++k) names_.curves.push_back(piece_name(name, k));
   if (!c_.object(j, path,
-                 {"points", "plane", "tolerance", "degree", "fairness", "closing_ratio", "pieces",
-                  "corner_angle", "accept_out_of_tolerance"},
-                 "a stroke {points, plane, tolerance, degree, fairness, closing_ratio, pieces, "
-                 "corner_angle}"))
+                 {"points", "plane", "tolerance_mm", "degree", "fairness", "closing_ratio",
+                  "pieces", "corner_angle", "accept_out_of_tolerance"},
+                 "a stroke {points, plane, tolerance_mm, degree, fairness, closing_ratio, pieces, "
+                 "corner_angle}",
+                 {renamed_mm}))
     return;
   StrokeDef s{name, path, {}, {}};
   const Json* pts = c_.member(j, path, "points", true, "the drawn points [[x, y, z], ...]");
@@ -52,7 +53,7 @@ void RecipeChecker::stroke(const std::string& name, const Json& j, const std::st
       pts ? c_.points(*pts, key_path(path, "points"), 2, limit::stroke_points) : std::nullopt;
   if (const Json* pl = c_.member(j, path, "plane", false, ""))
     s.stroke.plane = plane(*pl, key_path(path, "plane"));
-  s.fit.tolerance = c_.number_or(j, path, "tolerance", s.fit.tolerance, tolerance_range);
+  s.fit.tolerance_mm = c_.number_or(j, path, "tolerance_mm", s.fit.tolerance_mm, tolerance_range);
   s.fit.degree = c_.integer_or(j, path, "degree", s.fit.degree, 2, 9);
   s.fit.fairness = c_.number_or(j, path, "fairness", s.fit.fairness, non_negative);
   s.fit.closing_ratio = c_.number_or(j, path, "closing_ratio", s.fit.closing_ratio, Range{0, 0.5});
@@ -181,10 +182,11 @@ void RecipeChecker::from_surface(const Json& v, const std::string& p, CurveDef& 
   const bool ok =
       def.kind == "iso" ? c_.object(v, p, {"surface", "u", "v"}, "an iso-curve {surface, u or v}")
       : def.kind == "boundary" ? c_.object(v, p, {"surface", "edge"}, "a boundary {surface, edge}")
-      : def.kind == "project"  ? c_.object(v, p, {"curve", "surface", "tolerance"},
-                                           "a projection {curve, surface, tolerance}")
-                               : c_.object(v, p, {"curve", "surface", "distance", "tolerance"},
-                                           "an offset {curve, surface, distance, tolerance}");
+      : def.kind == "project"
+          ? c_.object(v, p, {"curve", "surface", "tolerance_mm"},
+                      "a projection {curve, surface, tolerance_mm}", {renamed_mm})
+          : c_.object(v, p, {"curve", "surface", "distance", "tolerance_mm"},
+                      "an offset {curve, surface, distance, tolerance_mm}", {renamed_mm});
   if (!ok) return;
   std::optional<std::string> surface;
   // The surface may come later in the document: the run builds it first (the checker reports
@@ -204,7 +206,7 @@ void RecipeChecker::from_surface(const Json& v, const std::string& p, CurveDef& 
   if (def.kind == "project" || def.kind == "offset") {
     if (const Json* m = c_.member(v, p, "curve", true, "the name of a curve"))
       source = curve_ref(*m, key_path(p, "curve"));
-    def.fit.tolerance_mm = c_.number_or(v, p, "tolerance", 1e-3, tolerance_range);
+    def.fit.tolerance_mm = c_.number_or(v, p, "tolerance_mm", 1e-3, tolerance_range);
     if (!source) return;
     def.source = *source;
   }
@@ -412,8 +414,9 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
         names_.curves.push_back(name + "." + entity);
       }
   };
-  if (!c_.object(j, path, {"plane", "points", "entities", "constraints", "tolerance"},
-                 "a sketch {plane, points, entities, constraints, tolerance}")) {
+  if (!c_.object(j, path, {"plane", "points", "entities", "constraints", "residual_tolerance"},
+                 "a sketch {plane, points, entities, constraints, residual_tolerance}",
+                 {renamed_residual})) {
     return;
   }
   const std::size_t before = c_.problems.size();
@@ -641,8 +644,8 @@ void RecipeChecker::sketch(const std::string& name, const Json& j, const std::st
         }
     }
   }
-  def.solve.tolerance =
-      c_.number_or(j, path, "tolerance", def.solve.tolerance, Range{0, 1e-3, true, false});
+  def.solve.residual_tolerance = c_.number_or(
+      j, path, "residual_tolerance", def.solve.residual_tolerance, Range{0, 1e-3, true, false});
   register_entities();
   if (c_.problems.size() != before) return;
   for (const auto& [ename, id] : entities) def.entities.emplace_back(name + "." + ename, id);

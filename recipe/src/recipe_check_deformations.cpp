@@ -491,10 +491,10 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
 std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p) {
   if (!c_.object(j, p,
                  {"kind", "name", "enabled", "target", "bound", "mode", "lambda", "relaxation",
-                  "smoothing", "key_points_per_row", "boundary_rows", "tolerance",
+                  "smoothing", "key_points_per_row", "boundary_rows", "relative_tolerance",
                   "curve_tolerance", "max_refinements", "max_key_point_rounds", "continuity",
                   "net_convergence", "accept_out_of_tolerance"},
-                 "a style step"))
+                 "a style step", {renamed_relative}))
     return std::nullopt;
   StyleDef d;
   const std::size_t before = c_.problems.size();
@@ -532,7 +532,7 @@ std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p
   o.smoothing = c_.boolean_or(j, p, "smoothing", o.smoothing);
   o.key_points_per_row = c_.integer_or(j, p, "key_points_per_row", o.key_points_per_row, 1, 64);
   o.boundary_rows = c_.integer_or(j, p, "boundary_rows", o.boundary_rows, 0, 4);
-  o.tolerance = c_.number_or(j, p, "tolerance", o.tolerance, positive);
+  o.relative_tolerance = c_.number_or(j, p, "relative_tolerance", o.relative_tolerance, positive);
   o.curve_tolerance = c_.number_or(j, p, "curve_tolerance", o.curve_tolerance, positive);
   o.max_refinements = c_.integer_or(j, p, "max_refinements", o.max_refinements, 0, 10);
   if (const Json* m = c_.member(j, p, "continuity", false, ""))
@@ -550,9 +550,9 @@ std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p
 
 std::optional<DirectDef> RecipeChecker::direct(const Json& j, const std::string& p) {
   if (!c_.object(j, p,
-                 {"kind", "name", "enabled", "lattice", "moves", "locked", "tied", "tolerance",
-                  "accept_out_of_tolerance"},
-                 "a direct_manipulation step"))
+                 {"kind", "name", "enabled", "lattice", "moves", "locked", "tied",
+                  "relative_tolerance", "accept_out_of_tolerance"},
+                 "a direct_manipulation step", {renamed_relative}))
     return std::nullopt;
   const std::size_t before = c_.problems.size();
   DirectDef d{deform::BezierLattice{}, {}, {}, false};
@@ -655,7 +655,8 @@ std::optional<DirectDef> RecipeChecker::direct(const Json& j, const std::string&
       }
     }
   }
-  d.options.tolerance = c_.number_or(j, p, "tolerance", d.options.tolerance, positive);
+  d.options.relative_tolerance =
+      c_.number_or(j, p, "relative_tolerance", d.options.relative_tolerance, positive);
   c_.attempt(p, [&] { d.options.validate(); });
   if (c_.problems.size() != before) return std::nullopt;
   return d;

@@ -64,8 +64,9 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
       def.build = std::move(s);
     } else if (def.kind == "sweep") {
       SweepDef s;
-      if (c_.object(v, p, {"profile", "path", "twist_degrees", "tolerance"},
-                    "a sweep {profile, path, twist_degrees, tolerance}")) {
+      if (c_.object(v, p, {"profile", "path", "twist_degrees", "relative_tolerance"},
+                    "a sweep {profile, path, twist_degrees, relative_tolerance}",
+                    {renamed_relative})) {
         if (const Json* m = c_.member(v, p, "profile", true, "a curve name"))
           s.profile = curve_ref(*m, key_path(p, "profile")).value_or("");
         if (const Json* m = c_.member(v, p, "path", true, "a curve name"))
@@ -73,7 +74,8 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
         s.options.twist_degrees =
             c_.number_or(v, p, "twist_degrees", s.options.twist_degrees,
                          Range{-limit::sweep_twist_degrees, limit::sweep_twist_degrees});
-        s.options.tolerance = c_.number_or(v, p, "tolerance", s.options.tolerance, tolerance_range);
+        s.options.relative_tolerance =
+            c_.number_or(v, p, "relative_tolerance", s.options.relative_tolerance, tolerance_range);
         c_.attempt(p, [&] { s.options.validate(); });
       }
       def.build = std::move(s);
@@ -100,11 +102,11 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
       def.build = std::move(r);
     } else if (def.kind == "superellipsoid" || def.kind == "supertoroid") {
       const bool toroid = def.kind == "supertoroid";
-      std::initializer_list<std::string_view> keys_e{"radii", "e1", "e2", "tolerance", "degree"};
-      std::initializer_list<std::string_view> keys_t{"radii",     "e1",     "e2",
-                                                     "tolerance", "degree", "hole"};
-      if (c_.object(v, p, toroid ? keys_t : keys_e,
-                    toroid ? "a supertoroid" : "a superellipsoid")) {
+      std::initializer_list<std::string_view> keys_e{"radii", "e1", "e2", "tolerance_mm", "degree"};
+      std::initializer_list<std::string_view> keys_t{"radii",        "e1",     "e2",
+                                                     "tolerance_mm", "degree", "hole"};
+      if (c_.object(v, p, toroid ? keys_t : keys_e, toroid ? "a supertoroid" : "a superellipsoid",
+                    {renamed_mm})) {
         surface::SuperquadricOptions o;
         Eigen::Vector3d radii = Eigen::Vector3d::Ones();
         if (const Json* m = c_.member(v, p, "radii", false, "")) {
@@ -114,7 +116,7 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
         }
         const double e1 = c_.number_or(v, p, "e1", 1.0, Range{0, 10, true, false});
         const double e2 = c_.number_or(v, p, "e2", 1.0, Range{0, 10, true, false});
-        o.tolerance = c_.number_or(v, p, "tolerance", o.tolerance, tolerance_range);
+        o.tolerance_mm = c_.number_or(v, p, "tolerance_mm", o.tolerance_mm, tolerance_range);
         o.degree = c_.integer_or(v, p, "degree", o.degree, 2, 7);
         if (toroid) {
           SupertoroidDef d{{radii, 2.0, e1, e2}, o};
@@ -143,8 +145,9 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
       def.build = d;
     } else if (def.kind == "rebuild") {
       RebuildDef d;
-      if (c_.object(v, p, {"surface", "count_u", "count_v", "degree", "tolerance"},
-                    "a rebuild {surface, count_u, count_v, degree, tolerance}")) {
+      if (c_.object(v, p, {"surface", "count_u", "count_v", "degree", "relative_tolerance"},
+                    "a rebuild {surface, count_u, count_v, degree, relative_tolerance}",
+                    {renamed_relative})) {
         if (const Json* m = c_.member(v, p, "surface", true, "the name of an earlier surface"))
           d.surface = surface_ref(*m, key_path(p, "surface")).value_or("");
         d.degree = c_.integer_or(v, p, "degree", 3, 1, surface::max_exchange_degree);
@@ -158,7 +161,8 @@ void RecipeChecker::surface(const std::string& name, const Json& j, const std::s
           c_.add(key_path(p, v.contains("count_u") ? "count_v" : "count_u"),
                  "give both \"count_u\" and \"count_v\" for a fixed net, or neither for a net "
                  "that grows to the tolerance");
-        d.tolerance = c_.number_or(v, p, "tolerance", d.tolerance, Range{1e-9, 1e-1});
+        d.relative_tolerance =
+            c_.number_or(v, p, "relative_tolerance", d.relative_tolerance, Range{1e-9, 1e-1});
       }
       def.build = d;
     } else {  // deform
@@ -199,7 +203,7 @@ void RecipeChecker::exact_composable(const std::string& stack_name, const std::s
             path,
             step.path + " is a " + step.kind + ", which cannot be composed exactly (only " +
                 "Bézier and B-spline lattices and tapers can); give this surface or the recipe " +
-                "\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4}");
+                "\"composition\": {\"mode\": \"refit\", \"relative_tolerance\": 1e-4}");
     }
   }
 }

@@ -95,6 +95,18 @@ constexpr Range any{-limit::magnitude, limit::magnitude, false, false};
 constexpr Range positive{0, limit::magnitude, true, false};
 constexpr Range non_negative{0, limit::magnitude, false, false};
 constexpr Range tolerance_range{limit::min_tolerance, limit::magnitude};
+
+// Keys issue #37 renamed so that a tolerance's name says its unit; validate names the new key.
+using Renamed = internal::JsonReader::Renamed;
+constexpr Renamed renamed_mm{"tolerance", "tolerance_mm", "in millimetres"};
+constexpr Renamed renamed_relative{"tolerance", "relative_tolerance",
+                                   "a fraction of the model's size"};
+constexpr Renamed renamed_residual{"tolerance", "residual_tolerance",
+                                   "mm for distances, radians for angles"};
+constexpr Renamed dropped_relative{
+    "relative", "",
+    "the tolerance's key says its unit: \"relative_tolerance\" (a fraction of the size, what "
+    "\"relative\": true meant) or \"tolerance_mm\" (what \"relative\": false meant)"};
 // Weights beyond it overflow the homogeneous products (a bottle's neck with weights 1e300 read
 // back invalid); within it a weight ratio of 1e12 is still allowed.
 constexpr Range weight_range{limit::weight_min, limit::weight_max};

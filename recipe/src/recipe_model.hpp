@@ -33,9 +33,9 @@ struct Editable {
 };
 
 struct Composition {
-  bool refit = false;  ///< "refit": steps that cannot be exact are refitted
-  double tolerance = 1e-4;
-  bool relative = true;
+  bool refit = false;                ///< "refit": steps that cannot be exact are refitted
+  double relative_tolerance = 1e-4;  ///< "relative_tolerance": a fraction of the size, or
+  double tolerance_mm = 0;           ///< "tolerance_mm": exactly one of the two > 0
   int degree = 3;
   int check_samples = 4;
   bool accept_out_of_tolerance = false;  ///< "accept_out_of_tolerance": keep a refit that misses
@@ -147,7 +147,7 @@ struct MirrorDef {
 struct RebuildDef {
   std::string surface;
   int count_u = 0, count_v = 0, degree = 3;
-  double tolerance = 1e-3;  ///< relative to the surface's size
+  double relative_tolerance = 1e-3;  ///< relative to the surface's size
 };
 
 struct SurfaceDef {

@@ -1,5 +1,7 @@
 // The outputs of a run: STEP, IGES and glTF per export, read back and checked, and report.json —
 // written into a temporary folder and moved into place only when everything succeeded.
+#include "report_json.hpp"
+
 #include <clay/error.hpp>
 #include <clay/internal/files.hpp>
 #include <clay/occt/model_exchange.hpp>
@@ -23,9 +25,7 @@ namespace {
 using Json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
 
-Json figure_json(const Figure& f) {
-  return std::visit([](const auto& x) { return Json(x); }, f);
-}
+using detail::figure_json;
 
 Json model_figures(const ModelRunResult& r);
 
@@ -48,17 +48,8 @@ std::string report_json(const RunResult& result) {
   bool warnings = false;
   Json steps = Json::array();
   for (const auto& s : result.steps) {
-    Json x = Json::object();
-    x["path"] = s.path;
-    x["kind"] = s.kind;
-    x["seconds"] = s.seconds;
-    x["warning"] = s.warning;
-    x["message"] = s.message;
-    Json figures = Json::object();
-    for (const auto& [name, value] : s.figures) figures[name] = figure_json(value);
-    x["figures"] = std::move(figures);
     warnings = warnings || s.warning;
-    steps.push_back(std::move(x));
+    steps.push_back(detail::step_json(s));
   }
   j["ok"] = true;  // a run that throws writes no report
   j["warnings"] = warnings;

@@ -111,7 +111,8 @@ class Runner {
               " control points): " +
               (made_editable_.count(e.surfaces[k])
                    ? std::string("this is its editable copy; loosen the composition's "
-                                 "\"tolerance\" for a lighter one")
+                                 "tolerance (\"relative_tolerance\" or \"tolerance_mm\") for a "
+                                 "lighter one")
                    : std::string("ask for \"composition\": {\"editable\": {}} to export a "
                                  "certified bicubic copy"));
         }
@@ -184,8 +185,8 @@ class Runner {
                                  const std::string& name, StepReport& rep) {
     deform::RefitOptions o;
     o.degree = c.degree;
-    o.tolerance = c.tolerance;
-    o.relative = c.relative;
+    o.relative_tolerance = c.relative_tolerance;
+    o.tolerance_mm = c.tolerance_mm;
     o.max_control_points = c.editable->max_control_points;
     o.keep_breakpoints = false;
     const deform::RefitResult r = deform::refit_surface(s, o);
@@ -199,7 +200,7 @@ class Runner {
                    {"certified", f.certified},
                    {"max_deviation_mm", f.certified ? f.certified_bound_mm : f.sampled_max},
                    {"sampled_max_mm", f.sampled_max},
-                   {"tolerance_mm", f.tolerance},
+                   {"tolerance_mm", f.tolerance_mm},
                    {"size", f.size}};
     rep.message = "surface '" + name + "' made editable: degree " + std::to_string(s.u.degree) +
                   " x " + std::to_string(s.v.degree) + ", " + std::to_string(s.points.rows()) +
@@ -214,7 +215,8 @@ class Runner {
                     "the editable copy of surface '" + name +
                         "' misses its tolerance: " + f.summary.message +
                         "; raise \"editable\": {\"max_control_points\"} or the composition's "
-                        "\"tolerance\", or raise \"max_degree\" to keep the exact surface");
+                        "tolerance (\"relative_tolerance\" or \"tolerance_mm\"), or raise "
+                        "\"max_degree\" to keep the exact surface");
       rep.warning = true;
       rep.message += "; accepted out of tolerance (\"accept_out_of_tolerance\": true)";
     }
@@ -356,11 +358,12 @@ class Runner {
     rep.message = fit.summary.brief();
     if (!fit.summary.converged()) {  // a fit that misses its tolerance is a failure unless accepted
       if (!s.accept_out_of_tolerance)
-        throw Error(ErrorCategory::ToleranceNotMet,
-                    "the fit misses its tolerance (" + fit.summary.brief() +
-                        "): raise the stroke's \"tolerance\" or its \"degree\", or draw it again; "
-                        "to keep the fit "
-                        "anyway, set \"accept_out_of_tolerance\": true on the stroke");
+        throw Error(
+            ErrorCategory::ToleranceNotMet,
+            "the fit misses its tolerance (" + fit.summary.brief() +
+                "): raise the stroke's \"tolerance_mm\" or its \"degree\", or draw it again; "
+                "to keep the fit "
+                "anyway, set \"accept_out_of_tolerance\": true on the stroke");
       rep.warning = true;
     }
     if (s.pieces == 0) return add_curve(s.name, fit.curves.front().curve);
@@ -384,9 +387,9 @@ class Runner {
       out = c.fixed_u ? surface::iso_curve_u(s, t) : surface::iso_curve_v(s, t);
     } else {
       const BSplineSurface& s = surface_of(c.surface);
-      fitted = in_recipe_words({{"CurveFitOptions::tolerance_mm", "\"tolerance\""},
+      fitted = in_recipe_words({{"CurveFitOptions::tolerance_mm", "\"tolerance_mm\""},
                                 {"max_control_points", "its limit of control points"},
-                                {"raise the tolerance", "raise \"tolerance\""}},
+                                {"raise the tolerance", "raise \"tolerance_mm\""}},
                                [&] {
                                  return c.kind == "project"
                                             ? surface::project_curve(curve_of(c.source), s, c.fit)
@@ -481,7 +484,7 @@ class Runner {
   }
 
   void build_surface(const SurfaceDef& def) {
-    static const Words superquadric_words{{"SuperquadricOptions::tolerance", "\"tolerance\""},
+    static const Words superquadric_words{{"SuperquadricOptions::tolerance_mm", "\"tolerance_mm\""},
                                           {", raise max_spans", ""}};
     if (const auto* d = std::get_if<DeformDef>(&def.build)) {
       const StackDef& stack =
@@ -533,7 +536,7 @@ class Runner {
             } else if constexpr (std::is_same_v<T, SweepDef>) {
               auto built = in_recipe_words(
                   {{"SweepOptions::max_sections = ", "a sweep's limit of "},
-                   {"SweepOptions::tolerance", "\"tolerance\""},
+                   {"SweepOptions::relative_tolerance", "\"relative_tolerance\""},
                    {"SweepOptions::twist_degrees", "\"twist_degrees\""}},
                   [&] { return surface::sweep(curve_of(b.profile), curve_of(b.path), b.options); });
               build_figures(built.report, rep);
@@ -575,7 +578,7 @@ class Runner {
               o.degree = b.degree;
               o.count_u = b.count_u;
               o.count_v = b.count_v;
-              o.tolerance = b.tolerance;
+              o.relative_tolerance = b.relative_tolerance;
               // Without counts the net grows only where the tolerance needs it, from the
               // original's rough breakpoints alone, as the editable output does.
               const bool fixed = b.count_u > 0;
@@ -592,14 +595,14 @@ class Runner {
               build_figures(built, rep);
               rep.figures.emplace_back("certified_bound_mm", r.certified_bound_mm);
               rep.figures.emplace_back("sampled_max_mm", r.sampled_max);
-              rep.figures.emplace_back("tolerance_mm", r.tolerance);
+              rep.figures.emplace_back("tolerance_mm", r.tolerance_mm);
               rep.message = r.brief();
               if (!r.summary.converged())
                 throw Error(ErrorCategory::ToleranceNotMet,
                             "the rebuilt net misses its tolerance (" + r.summary.message +
-                                (fixed ? "): raise \"count_u\" and \"count_v\", \"tolerance\" or "
-                                         "\"degree\""
-                                       : "): raise \"tolerance\" or \"degree\""));
+                                (fixed ? "): raise \"count_u\" and \"count_v\", "
+                                         "\"relative_tolerance\" or \"degree\""
+                                       : "): raise \"relative_tolerance\" or \"degree\""));
               return fit.surface;
             } else if constexpr (std::is_same_v<T, MirrorDef>) {
               BSplineSurface m =
@@ -667,7 +670,7 @@ class Runner {
       sizes();
       rep.figures.emplace_back("exact", false);
       rep.figures.emplace_back("certified", f.certified);
-      rep.figures.emplace_back("tolerance_mm", f.tolerance);
+      rep.figures.emplace_back("tolerance_mm", f.tolerance_mm);
       rep.figures.emplace_back("sampled_max_mm", f.sampled_max);
       rep.figures.emplace_back("size", f.size);
       rep.message += ": refit (" + o.reason + "), " + f.brief();

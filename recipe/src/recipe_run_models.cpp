@@ -31,8 +31,8 @@ deform::SurfaceDeformationOptions deformation_options(const Composition& c) {
   if (c.refit) {
     deform::RefitOptions r;
     r.degree = c.degree;
-    r.tolerance = c.tolerance;
-    r.relative = c.relative;
+    r.relative_tolerance = c.relative_tolerance;
+    r.tolerance_mm = c.tolerance_mm;
     r.max_control_points = c.max_control_points;
     o.refit = r;
   }

@@ -1,5 +1,7 @@
 // The view data of a run: grid meshes with exact normals and curvatures, the refit deviation, and
 // the manifest the browser viewer reads (docs/recipe.md "Viewing a run").
+#include "report_json.hpp"
+
 #include <clay/error.hpp>
 #include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/view.hpp>
@@ -32,16 +34,8 @@ using Eigen::Vector3d;
 
 constexpr int curve_samples = 200;
 
-Json figure_json(const Figure& f) {
-  return std::visit([](const auto& x) { return Json(x); }, f);
-}
-
-Json figures_json(const StepReport* step) {
-  Json j = Json::object();
-  if (step)
-    for (const auto& [name, value] : step->figures) j[name] = figure_json(value);
-  return j;
-}
+using detail::figure_json;
+using detail::figures_json;
 
 Json point_json(const Vector3d& p) { return Json::array({p.x(), p.y(), p.z()}); }
 

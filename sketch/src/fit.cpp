@@ -24,8 +24,8 @@ std::vector<std::string> FitOptions::problems() const {
     s << "FitOptions::" << field << " = " << value << " " << rule;
     out.push_back(s.str());
   };
-  if (!(std::isfinite(tolerance) && tolerance > 0.0))
-    bad("tolerance", tolerance, "must be a positive distance in mm");
+  if (!(std::isfinite(tolerance_mm) && tolerance_mm > 0.0))
+    bad("tolerance_mm", tolerance_mm, "must be a positive distance in mm");
   if (degree < 2 || degree > 9) bad("degree", degree, "must be in [2, 9]");
   if (!(std::isfinite(fairness) && fairness >= 0.0))
     bad("fairness", fairness, "must be finite and >= 0");
@@ -293,7 +293,7 @@ std::vector<double> anchored_parameters(const Eigen::Vector3d& a, const Points3&
 PieceProblem piece_problem(const FitOptions& o) {
   PieceProblem pr;
   pr.degree = o.degree;
-  pr.tolerance = o.tolerance;
+  pr.tolerance_mm = o.tolerance_mm;
   pr.fairness = o.fairness;
   pr.fairness_reductions = o.fairness_reductions;
   pr.max_control_points = o.max_control_points;
@@ -357,7 +357,7 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
                      spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2),
                      spacing.end());
     const double median = spacing.empty() ? 0.0 : spacing[spacing.size() / 2];
-    window = std::max(10.0 * options.tolerance, 3.0 * median);
+    window = std::max(10.0 * options.tolerance_mm, 3.0 * median);
   }
   std::vector<Corner> corners = detail::find_corners(pts, closed, options.corner_angle, window);
   const bool plane = stroke.plane.has_value();
@@ -412,7 +412,7 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
     out.closed = true;
   } else {
     // The ends move at most three noise deviations (and the tolerance) from the drawn points.
-    const double limit = std::min(options.tolerance, 3.0 * detail::noise_level(pts, false));
+    const double limit = std::min(options.tolerance_mm, 3.0 * detail::noise_level(pts, false));
     // Each end is estimated from its own curve's points only (never across a corner).
     const Eigen::Index head = corners.empty() ? n : corners.front().split + 1;
     const Eigen::Index tail = corners.empty() ? n : n - corners.back().split - 1;
@@ -450,7 +450,7 @@ StrokeFit fit_stroke(const Stroke& stroke, const FitOptions& options) {
   m << out.curves.size() << (out.curves.size() == 1 ? " curve" : " curves") << ", "
     << corners.size() << (corners.size() == 1 ? " corner" : " corners") << ", "
     << (out.closed ? "closed" : "open") << "; max deviation " << out.max_deviation_mm
-    << " mm for tolerance " << options.tolerance << " mm";
+    << " mm for tolerance " << options.tolerance_mm << " mm";
   if (s.termination != Termination::Converged) m << " (see the curves' summaries)";
   s.message = m.str();
   return out;

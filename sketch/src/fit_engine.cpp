@@ -380,9 +380,9 @@ PieceResult fit_piece(const PieceProblem& pr) {
   // averages out, a misfit does not. Averaged pure noise stays below about 1.5 sigma for a few
   // hundred points (3.4 sigma / 3 in the plane normal to the curve).
   out.noise = noise_level(pr.data, periodic);
-  const bool noisy = out.noise > pr.tolerance / 8.0;
+  const bool noisy = out.noise > pr.tolerance_mm / 8.0;
   const int window = noisy ? 4 : 0;
-  const double limit = noisy ? std::max(0.5 * pr.tolerance, 1.5 * out.noise) : pr.tolerance;
+  const double limit = noisy ? std::max(0.5 * pr.tolerance_mm, 1.5 * out.noise) : pr.tolerance_mm;
 
   BSplineCurve curve;
   Eigen::VectorXd dist = Eigen::VectorXd::Zero(count);
@@ -438,7 +438,7 @@ PieceResult fit_piece(const PieceProblem& pr) {
       }
     const double worst = dist.maxCoeff();
     if (it == 0) out.summary.initial_residual = worst;
-    if (worst <= pr.tolerance) {
+    if (worst <= pr.tolerance_mm) {
       converged = true;
       why = "tolerance met";
       ++it;
@@ -447,7 +447,7 @@ PieceResult fit_piece(const PieceProblem& pr) {
     if (noisy && score.maxCoeff() <= limit) {
       // The curve follows the stroke; what is left is noise, which a fair curve does not chase.
       converged = true;
-      const auto beyond = (dist.array() > pr.tolerance).count();
+      const auto beyond = (dist.array() > pr.tolerance_mm).count();
       std::ostringstream m;
       m.precision(3);
       m << "tolerance met by the deviation averaged over " << 2 * window + 1
@@ -512,7 +512,7 @@ PieceResult fit_piece(const PieceProblem& pr) {
   std::ostringstream msg;
   msg.precision(3);
   msg << why << " (" << curve.points.rows() << " control points, max deviation "
-      << out.max_deviation << " mm for tolerance " << pr.tolerance << " mm, fairness " << alpha
+      << out.max_deviation << " mm for tolerance " << pr.tolerance_mm << " mm, fairness " << alpha
       << ")";
   out.summary.message = msg.str();
   out.summary.iterations = it;

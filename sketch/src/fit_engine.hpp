@@ -33,7 +33,7 @@ struct PieceProblem {
   bool periodic = false;       ///< closed piece: unclamped periodic knots, C^(p-1) everywhere
   int degree = 3;
   EndCondition start, end;      ///< ignored when periodic
-  double tolerance = 0.1;       ///< mm, max point-to-curve distance sought
+  double tolerance_mm = 0.1;    ///< max point-to-curve distance sought
   double fairness = 1e-8;       ///< alpha: lambda = alpha * points on the unit domain
   int fairness_reductions = 6;  ///< times alpha may be divided by 10
   int max_control_points = 100;

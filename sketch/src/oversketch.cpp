@@ -232,7 +232,8 @@ OversketchResult oversketch(const BSplineCurve& curve, const Stroke& stroke,
     e.curvature = detail::curvature_vector(d.d1, d.d2);
     return e;
   };
-  const double end_limit = std::min(options.fit.tolerance, 3.0 * detail::noise_level(pts, false));
+  const double end_limit =
+      std::min(options.fit.tolerance_mm, 3.0 * detail::noise_level(pts, false));
   if (left) {
     pr.start = joint_condition(*left, true);
   } else {

@@ -16,8 +16,8 @@ std::string_view to_string(ErrorCategory category) noexcept {
       return "i/o";
     case ErrorCategory::Exchange:
       return "exchange";
-    case ErrorCategory::Recipe:
-      return "recipe";
+    case ErrorCategory::Document:
+      return "document";
     case ErrorCategory::ToleranceNotMet:
       return "tolerance not met";
     case ErrorCategory::Internal:

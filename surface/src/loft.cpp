@@ -96,7 +96,7 @@ PreparedLoft prepare_loft(const std::vector<BSplineCurve>& sections, const LoftO
     all.push_back(&sections[k]);
   }
   const double size = model_size(all);
-  const double tol = options.tolerance * size;
+  const double tol = options.relative_tolerance * size;
   for (size_t k = 0; k < sections.size(); ++k) {
     const double length = polygon_length(sections[k]);
     if (!(length > tol))
@@ -170,8 +170,9 @@ std::vector<std::string> LoftOptions::problems() const {
   if (degree < 1 || degree > max_kernel_degree)
     out.push_back("LoftOptions::degree is " + std::to_string(degree) + "; it must be in [1, " +
                   std::to_string(max_kernel_degree) + "]");
-  if (!(tolerance > 0.0 && tolerance <= 1e-2))
-    out.push_back("LoftOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-2]");
+  if (!(relative_tolerance > 0.0 && relative_tolerance <= 1e-2))
+    out.push_back("LoftOptions::relative_tolerance is " + num(relative_tolerance) +
+                  "; it must be in (0, 1e-2]");
   detail::merge_option_problems("LoftOptions", min_span_ratio, merge_tolerance, out);
   return out;
 }

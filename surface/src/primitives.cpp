@@ -25,8 +25,8 @@ std::vector<std::string> SuperquadricOptions::problems() const {
     m << "SuperquadricOptions::" << field << " = " << value << " " << rule;
     out.push_back(m.str());
   };
-  if (!(std::isfinite(tolerance) && tolerance > 0.0))
-    bad("tolerance", tolerance, "must be a positive length in mm");
+  if (!(std::isfinite(tolerance_mm) && tolerance_mm > 0.0))
+    bad("tolerance_mm", tolerance_mm, "must be a positive length in mm");
   if (degree < 2 || degree > 7) bad("degree", degree, "must be in [2, 7]");
   if (max_spans < 8) bad("max_spans", max_spans, "must be >= 8");
   return out;
@@ -208,7 +208,7 @@ Profile interpolate(const Planar& f_of_angle, const std::vector<double>& angle_b
       std::ostringstream m;
       m << what << ": could not reach " << tol << " (relative to the radii) with " << o.max_spans
         << " spans (error " << worst
-        << "); loosen SuperquadricOptions::tolerance, raise max_spans, "
+        << "); loosen SuperquadricOptions::tolerance_mm, raise max_spans, "
         << "or use exponents further from 0";
       throw Error(ErrorCategory::InvalidArgument, m.str());
     }
@@ -272,7 +272,7 @@ BuiltSurface assemble(const std::function<Profile(double)>& make_m,
                       const std::function<Profile(double)>& make_h, const Eigen::Vector3d& radii,
                       const SuperquadricOptions& o, const std::string& method) {
   // Per-profile tolerance (relative to unit radii) from |S - x| <= a (|dm||H| + |m||dh|).
-  double share = o.tolerance / (4.0 * radii.maxCoeff());
+  double share = o.tolerance_mm / (4.0 * radii.maxCoeff());
   Profile m, h;
   for (int attempt = 0;; ++attempt) {
     m = make_m(share);
@@ -280,7 +280,7 @@ BuiltSurface assemble(const std::function<Profile(double)>& make_m,
     const double hx = h.magnitude.maxCoeff() + h.error, mx = m.magnitude.x() + m.error;
     const Eigen::Vector3d bound(radii.x() * (m.error * hx + mx * h.error),
                                 radii.y() * (m.error * hx + mx * h.error), radii.z() * m.error);
-    if (bound.norm() <= o.tolerance || attempt == 6) break;
+    if (bound.norm() <= o.tolerance_mm || attempt == 6) break;
     share *= 0.25;
   }
   BSplineSurface s = spherical_product(m.curve, h.curve);

@@ -398,8 +398,9 @@ std::vector<std::string> SweepOptions::problems() const {
   if (sections != 0 && sections < 2)
     out.push_back("SweepOptions::sections is " + std::to_string(sections) +
                   "; it must be 0 (adaptive) or >= 2");
-  if (!(tolerance > 0.0 && tolerance <= 1e-1))
-    out.push_back("SweepOptions::tolerance is " + num(tolerance) + "; it must be in (0, 1e-1]");
+  if (!(relative_tolerance > 0.0 && relative_tolerance <= 1e-1))
+    out.push_back("SweepOptions::relative_tolerance is " + num(relative_tolerance) +
+                  "; it must be in (0, 1e-1]");
   if (max_sections < 2)
     out.push_back("SweepOptions::max_sections is " + std::to_string(max_sections) +
                   "; it must be >= 2");
@@ -434,7 +435,7 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
                                    "there, or split it and sweep each part");
   const BSplineCurve shape = clamp(profile);
   const BSplineCurve track = clamp(path);
-  check_corners(track, options.tolerance);
+  check_corners(track, options.relative_tolerance);
   const PathTable table(track, size);
   if (!(table.length() > exact_tol))
     throw Error(
@@ -520,7 +521,7 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
   for (int m : intervals) initial += m;
   if (initial + 1 > options.max_sections)
     distribute_intervals(options.max_sections - 1, piece_sigma, intervals);
-  const double target = options.tolerance * size;
+  const double target = options.relative_tolerance * size;
   double worst = 0;
   int samples = 0;
   int count = 0;
@@ -571,13 +572,14 @@ BuiltSurface sweep(const BSplineCurve& profile, const BSplineCurve& path,
   // A sweep that misses its tolerance is a failure, not a result (DESIGN.md): a twist of 1e300
   // degrees used to come back as a wild surface whose export then ran for minutes (issue #18).
   if (options.sections == 0 && worst > target)
-    throw Error(ErrorCategory::InvalidArgument,
-                "sweep: the deviation " + num(worst) + " mm is still above the tolerance " +
-                    num(target) + " mm with " + std::to_string(count) +
-                    " sections, the most SweepOptions::max_sections = " +
-                    std::to_string(options.max_sections) +
-                    " allows; loosen SweepOptions::tolerance, reduce SweepOptions::twist_degrees "
-                    "or smooth the path");
+    throw Error(
+        ErrorCategory::InvalidArgument,
+        "sweep: the deviation " + num(worst) + " mm is still above the tolerance " + num(target) +
+            " mm with " + std::to_string(count) +
+            " sections, the most SweepOptions::max_sections = " +
+            std::to_string(options.max_sections) +
+            " allows; loosen SweepOptions::relative_tolerance, reduce SweepOptions::twist_degrees "
+            "or smooth the path");
   const std::string method =
       "sweep with rotation-minimizing frames, " + std::to_string(count) + " sections";
   built.report = describe(built.surface, method);

@@ -294,8 +294,8 @@ TEST_CASE("deform_model: a bend refits every face and edge, certified, and stays
   stack.steps.push_back({bend, "arch", true});
   clay::deform::ModelDeformationOptions options;
   clay::deform::RefitOptions refit;
-  refit.tolerance = 1e-3;
-  refit.relative = false;  // 1 micrometre
+  refit.relative_tolerance = 0;
+  refit.tolerance_mm = 1e-3;  // 1 micrometre
   options.surface.refit = refit;
   const auto result = clay::deform::deform_model(stack, block, options);
   const auto& r = result.report;
@@ -342,8 +342,8 @@ TEST_CASE("deform_model: max_degree refits exact results above it, certified") {
   CHECK(category == clay::ErrorCategory::DegreeLimit);
   CHECK_THAT(text, Contains("above max_degree 2"));
   clay::deform::RefitOptions refit;
-  refit.tolerance = 1e-3;
-  refit.relative = false;
+  refit.relative_tolerance = 0;
+  refit.tolerance_mm = 1e-3;
   options.surface.refit = refit;
   const auto result = clay::deform::deform_model(stack, block, options);
   INFO(result.report.brief());

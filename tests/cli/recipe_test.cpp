@@ -14,6 +14,8 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include <cfenv>
 #include <chrono>
 #include <cmath>
@@ -189,7 +191,7 @@ TEST_CASE("a twist needs the refit mode, and the refit is within its tolerance",
   CHECK(mentions(check_recipe(exact), "surfaces.spun.deform.deformation", "\"mode\": \"refit\""));
 
   const std::string refit = recipe_with(
-      R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 0.01, "relative": false}}})",
+      R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance_mm": 0.01}}})",
       R"("deformations": {"spin": [)" + twist + "]}");
   const auto result = run_recipe(parse_recipe(refit));
   deform::Twist t;
@@ -243,7 +245,7 @@ TEST_CASE("a stroke with \"pieces\" is split at its corners into curves NAME.1 .
     points.row(static_cast<Eigen::Index>(k)) = drawn[k];
   auto recipe = [&](const std::string& extra, const std::string& surfaces) {
     return R"({"format": "clayform.recipe", "version": 1, "strokes": {"r": {"points": )" +
-           points_json(points) + R"(, "tolerance": 0.1)" + extra + "}}" + surfaces + "}";
+           points_json(points) + R"(, "tolerance_mm": 0.1)" + extra + "}}" + surfaces + "}";
   };
   const auto result = run_recipe(parse_recipe(
       recipe(R"(, "pieces": 4)",
@@ -305,7 +307,7 @@ TEST_CASE("a stroke is fitted within its tolerance", "[recipe]") {
   pts += "]";
   const std::string text = R"({"format": "clayform.recipe", "version": 1,
     "strokes": {"s": {"points": )" +
-                           pts + R"(, "tolerance": 0.05}}})";
+                           pts + R"(, "tolerance_mm": 0.05}}})";
   const auto result = run_recipe(parse_recipe(text));
   const auto& c = result.curve("s");
   // every stroke point is within the tolerance of the curve (dense sampling of the curve)
@@ -556,7 +558,7 @@ TEST_CASE("check_recipe reports every problem at once, each with its path", "[re
   CHECK(mentions(problems, "exports.e.formats[0]", "step, iges, glb"));
   CHECK(problems.size() >= 17);
   const auto [category, message] = error_of([&] { parse_recipe(text); });
-  CHECK(category == ErrorCategory::Recipe);
+  CHECK(category == ErrorCategory::Document);
   CHECK_THAT(message, Contains("problems:"));
 }
 
@@ -638,7 +640,7 @@ TEST_CASE("a taper composes exactly and a cylindrical extended lattice is refitt
                 "moves": [{"index": [1, 2, 2], "by": [0, 0, 12]}]}]})";
   const std::string text = recipe_with(
       R"(, "flared": {"deform": {"surface": "dome", "deformation": "flare"}},
-         "dented": {"deform": {"surface": "dome", "deformation": "dent", "composition": {"mode": "refit", "tolerance": 0.2, "relative": false}}})",
+         "dented": {"deform": {"surface": "dome", "deformation": "dent", "composition": {"mode": "refit", "tolerance_mm": 0.2}}})",
       steps);
   const auto result = run_recipe(parse_recipe(text));
   const auto parent = dome();
@@ -688,10 +690,11 @@ TEST_CASE("a step failing at run time is named by its path, with its category", 
   CHECK(category == ErrorCategory::OutOfDomain);
   CHECK_THAT(message, Contains("surfaces.cut.steps[0] (bezier_lattice): "));
   // the way out in the recipe's words (issue #18), not the C++ option's
-  CHECK_THAT(message, Contains("\"composition\": {\"mode\": \"refit\", \"tolerance\": 1e-4}"));
+  CHECK_THAT(message,
+             Contains("\"composition\": {\"mode\": \"refit\", \"relative_tolerance\": 1e-4}"));
   CHECK_THAT(message, !Contains("Options::"));
-  CHECK(recipe_wording("RefitOptions::relative = false and SweepOptions::twist_degrees is 1e300") ==
-        "relative = false and twist_degrees is 1e300");
+  CHECK(recipe_wording("RefitOptions::degree = 0 and SweepOptions::twist_degrees is 1e300") ==
+        "degree = 0 and twist_degrees is 1e300");
 }
 
 TEST_CASE("recipe_wording rewords long messages without recursing per character", "[recipe]") {
@@ -729,7 +732,7 @@ TEST_CASE("a prismatic lattice's control points can be moved by index", "[recipe
       "sheet": {"bspline": {"degrees": [1, 1], "knots_u": [0, 0, 1, 1], "knots_v": [0, 0, 1, 1],
                 "points": [[2, 2, 15], [2, 28, 15], [28, 2, 15], [28, 28, 15]]}},
       "pressed": {"deform": {"surface": "sheet", "deformation": "press",
-                  "composition": {"mode": "refit", "tolerance": 0.5, "relative": false}}}},
+                  "composition": {"mode": "refit", "tolerance_mm": 0.5}}}},
     "deformations": {"press": [{"kind": "extended_lattice", "generator": {"prism": {
         "sections": [[[0, 0], [10, 0], [20, 0], [30, 0]], [[0, 30], [10, 30], [20, 30], [30, 30]]],
         "extrusion": [0, 0, 30]}},
@@ -861,7 +864,7 @@ TEST_CASE("a fitted stroke joins a sketch, built when the recipe runs", "[recipe
   const std::string plane = R"({"origin": [0, 0, 0], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0]})";
   const std::string text = R"({"format": "clayform.recipe", "version": 1,
     "strokes": {"swoosh": {"points": )" +
-                           pts + R"(, "plane": )" + plane + R"(, "tolerance": 0.05}},
+                           pts + R"(, "plane": )" + plane + R"(, "tolerance_mm": 0.05}},
     "sketches": {"s": {"plane": )" +
                            plane + R"(,
       "points": {"q": [100, 20]},
@@ -958,6 +961,64 @@ TEST_CASE("every redundant set of a recipe sketch is in its report", "[recipe]")
   CHECK_THAT(report, Contains("redundant[1]"));
 }
 
+TEST_CASE("validate names the tolerance keys issue #37 renamed, with the line to write",
+          "[recipe]") {
+  // A composition's unit came from "relative" (true by default): its new key follows it.
+  const auto relative =
+      check_recipe(recipe_with("", R"("composition": {"mode": "refit", "tolerance": 0.001})"));
+  CHECK(mentions(relative, "composition.tolerance",
+                 "\"tolerance\" was renamed \"relative_tolerance\" (a fraction of the size); "
+                 "write \"relative_tolerance\": 0.001 instead"));
+  const auto in_mm = check_recipe(
+      recipe_with("", R"("composition": {"mode": "refit", "tolerance": 0.2, "relative": false})"));
+  CHECK(mentions(in_mm, "composition.tolerance", "write \"tolerance_mm\": 0.2 instead"));
+  CHECK(mentions(in_mm, "composition.relative", "\"relative\" is no longer a key"));
+  // Both tolerances at once: one is refused, naming the two.
+  const auto both = check_recipe(recipe_with(
+      "", R"("composition": {"mode": "refit", "relative_tolerance": 1e-3, "tolerance_mm": 0.2})"));
+  CHECK(mentions(both, "composition.relative_tolerance", "give one tolerance"));
+  // The new key alone is valid (a run with it: the extended lattice refit to 0.2 mm above).
+  CHECK(check_recipe(recipe_with("", R"("composition": {"mode": "refit", "tolerance_mm": 0.2})"))
+            .empty());
+  // A key that was never a recipe's is still just unknown.
+  CHECK(mentions(check_recipe(recipe_with("", R"("composition": {"tolerence": 0.2})")),
+                 "composition.tolerence", "unknown key"));
+}
+
+TEST_CASE("step_reports_json: each step as report.json has it, figures in order and typed",
+          "[recipe]") {
+  // A surface and a lattice step: figures of several kinds (counts, measures, flags, words).
+  const auto result = run_recipe(parse_recipe(
+      recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                  std::string(R"("deformations": {"shape": [)") + lattice_step + "]}")));
+  REQUIRE(result.steps.size() >= 2);
+  const auto steps = nlohmann::ordered_json::parse(step_reports_json(result.steps));
+  const auto report = nlohmann::ordered_json::parse(report_json(result));
+  CHECK(steps == report.at("steps"));  // one serialiser: the studio's replies and report.json
+  REQUIRE(steps.size() == result.steps.size());
+  for (std::size_t k = 0; k < result.steps.size(); ++k) {
+    const StepReport& want = result.steps[k];
+    const auto& got = steps[k];
+    CHECK(got.at("path") == want.path);
+    CHECK(got.at("kind") == want.kind);
+    CHECK(got.at("seconds").get<double>() == want.seconds);
+    CHECK(got.at("warning").get<bool>() == want.warning);
+    CHECK(got.at("message") == want.message);
+    REQUIRE(got.at("figures").size() == want.figures.size());
+    std::size_t i = 0;
+    for (const auto& [name, value] : got.at("figures").items()) {
+      const auto& [want_name, want_value] = want.figures[i++];
+      CHECK(name == want_name);
+      std::visit(
+          [&, figure = &value](const auto& x) {
+            using T = std::decay_t<decltype(x)>;
+            CHECK(figure->template get<T>() == x);
+          },
+          want_value);
+    }
+  }
+}
+
 TEST_CASE("a refit of a torn lattice fails the run before refitting, naming the cause",
           "[recipe]") {
   // The outside check's case: the surface lies partly outside a lattice whose every control point
@@ -968,7 +1029,7 @@ TEST_CASE("a refit of a torn lattice fails the run before refitting, naming the 
        {"index": [0, 1, 0], "by": [0, 0, 5]}, {"index": [1, 1, 0], "by": [0, 0, 5]}, {"index": [0, 0, 1], "by": [0, 0, 5]},
        {"index": [1, 0, 1], "by": [0, 0, 5]}, {"index": [0, 1, 1], "by": [0, 0, 5]}, {"index": [1, 1, 1], "by": [0, 0, 5]}]})";
   const std::string text = recipe_with(
-      R"(, "cut": {"deform": {"surface": "dome", "deformation": "torn", "composition": {"mode": "refit", "tolerance": 1e-4}}})",
+      R"(, "cut": {"deform": {"surface": "dome", "deformation": "torn", "composition": {"mode": "refit", "relative_tolerance": 1e-4}}})",
       R"("deformations": {"torn": [)" + torn + "]}, " +
           R"("exports": {"cut": {"surfaces": ["cut"]}})");
   REQUIRE(check_recipe(text).empty());
@@ -982,7 +1043,7 @@ TEST_CASE("a refit of a torn lattice fails the run before refitting, naming the 
   // A tolerance just above half the jump (2.5 mm) is not refused up front; a net of at most 400
   // control points cannot follow the jump that closely, so the refit misses and is kept.
   const std::string accepted = recipe_with(
-      R"(, "cut": {"deform": {"surface": "dome", "deformation": "torn", "composition": {"mode": "refit", "tolerance": 2.51, "relative": false, "max_control_points": 400, "accept_out_of_tolerance": true}}})",
+      R"(, "cut": {"deform": {"surface": "dome", "deformation": "torn", "composition": {"mode": "refit", "tolerance_mm": 2.51, "max_control_points": 400, "accept_out_of_tolerance": true}}})",
       R"("deformations": {"torn": [)" + torn + "]}");
   REQUIRE(check_recipe(accepted).empty());
   const auto kept = run_recipe(parse_recipe(accepted));
@@ -1298,9 +1359,9 @@ TEST_CASE("every count and magnitude of a recipe has a limit that validate names
           R"("deformations": {"c": [{"kind": "extended_lattice", "generator": {"cylinder": {
       "sectors": 256, "rings": 64, "layers": 64}}}]}})",
       "deformations.c[0].generator.cylinder", {"1048576 chunks", "at most 4096"});
-  refused_quickly(
-      std::string(recipe_head) + R"("composition": {"mode": "refit", "tolerance": 1e-12}})",
-      "composition.tolerance", {"[1e-09, 1e+06]"});
+  refused_quickly(std::string(recipe_head) +
+                      R"("composition": {"mode": "refit", "relative_tolerance": 1e-12}})",
+                  "composition.relative_tolerance", {"[1e-09, 1e+06]"});
   refused_quickly(std::string(recipe_head) +
                       R"("composition": {"mode": "refit", "max_control_points": 100000}})",
                   "composition.max_control_points", {"[16, 40000]"});
@@ -1318,7 +1379,7 @@ TEST_CASE("a refit that misses its tolerance at the refit's caps fails the run, 
   const std::string twist =
       R"({"kind": "twist", "frame": {"origin": [50, 50, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "angle": [0, 0.05]})";
   const std::string text = recipe_with(
-      R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "tolerance": 1e-9, "max_control_points": 400}}})",
+      R"(, "spun": {"deform": {"surface": "dome", "deformation": "spin", "composition": {"mode": "refit", "relative_tolerance": 1e-9, "max_control_points": 400}}})",
       R"("deformations": {"spin": [)" + twist + "]}");
   const auto [category, message] = error_of([&] { run_recipe(parse_recipe(text)); });
   CHECK(category == ErrorCategory::ToleranceNotMet);
@@ -1443,8 +1504,8 @@ TEST_CASE("an editable composition refits a high-degree exact result, certified;
 
   // Too few control points for the tolerance: the run fails, naming the surface and the fix.
   const auto [category, message] = error_of([&] {
-    run_recipe(parse_recipe(
-        recipe(R"(, "composition": {"tolerance": 1e-9, "editable": {"max_control_points": 16}})")));
+    run_recipe(parse_recipe(recipe(
+        R"(, "composition": {"relative_tolerance": 1e-9, "editable": {"max_control_points": 16}})")));
   });
   CHECK(category == ErrorCategory::ToleranceNotMet);
   CHECK_THAT(message, Contains("surfaces.bulged.composition.editable") &&
@@ -1530,7 +1591,7 @@ TEST_CASE("a plane may be given by origin and normal", "[recipe]") {
   pts += "]";
   auto recipe = [&](const std::string& plane) {
     return R"({"format": "clayform.recipe", "version": 1, "strokes": {"s": {"points": )" + pts +
-           R"(, "tolerance": 0.05, "plane": )" + plane + "}}}";
+           R"(, "tolerance_mm": 0.05, "plane": )" + plane + "}}}";
   };
   const auto result =
       run_recipe(parse_recipe(recipe(R"({"origin": [0, 0, 5], "normal": [0, 3, 3]})")));
@@ -1559,9 +1620,9 @@ TEST_CASE("curves taken from a surface: boundary, iso, projection and normal off
         "e3": {"boundary": {"surface": "dome", "edge": "u0"}},
         "mid": {"iso": {"surface": "dome", "u": 0.25}},
         "drop": {"line": {"from": [20, 30, 60], "to": [80, 65, 60]}},
-        "shadow": {"project": {"curve": "drop", "surface": "dome", "tolerance": 0.001}},
+        "shadow": {"project": {"curve": "drop", "surface": "dome", "tolerance_mm": 0.001}},
         "lifted": {"offset": {"curve": "mid", "surface": "dome", "distance": 5,
-                              "tolerance": 0.001}}})");
+                              "tolerance_mm": 0.001}}})");
   INFO(dump(check_recipe(text)));
   const auto result = run_recipe(parse_recipe(text));
   const auto parent = dome();
@@ -1626,7 +1687,7 @@ TEST_CASE("curves taken from a surface: boundary, iso, projection and normal off
 
 TEST_CASE("rebuild refits a surface on a fixed uniform net, certified", "[recipe]") {
   const std::string text = recipe_with(
-      R"(, "even": {"rebuild": {"surface": "dome", "count_u": 9, "count_v": 7, "tolerance": 1e-3}})",
+      R"(, "even": {"rebuild": {"surface": "dome", "count_u": 9, "count_v": 7, "relative_tolerance": 1e-3}})",
       "");
   INFO(dump(check_recipe(text)));
   const auto result = run_recipe(parse_recipe(text));
@@ -1650,7 +1711,7 @@ TEST_CASE("rebuild refits a surface on a fixed uniform net, certified", "[recipe
   CHECK(final_surfaces(parse_recipe(text)) == std::vector<std::string>{"even"});
   // Too coarse for the tolerance: the step fails and names what to raise.
   const std::string coarse = recipe_with(
-      R"(, "even": {"rebuild": {"surface": "dome", "count_u": 4, "count_v": 4, "tolerance": 1e-8}})",
+      R"(, "even": {"rebuild": {"surface": "dome", "count_u": 4, "count_v": 4, "relative_tolerance": 1e-8}})",
       "");
   CHECK_THAT(error_of([&] { run_recipe(parse_recipe(coarse)); }).second,
              Contains("surfaces.even") && Contains("count_u"));
@@ -1663,7 +1724,7 @@ TEST_CASE("rebuild refits a surface on a fixed uniform net, certified", "[recipe
 
 TEST_CASE("rebuild without counts grows its net to the tolerance, certified", "[recipe]") {
   const std::string text =
-      recipe_with(R"(, "light": {"rebuild": {"surface": "dome", "tolerance": 1e-5}})", "");
+      recipe_with(R"(, "light": {"rebuild": {"surface": "dome", "relative_tolerance": 1e-5}})", "");
   INFO(dump(check_recipe(text)));
   const auto result = run_recipe(parse_recipe(text));
   const auto& light = result.surface("light");
@@ -1685,7 +1746,8 @@ TEST_CASE("rebuild without counts grows its net to the tolerance, certified", "[
   CHECK(light.v.degree == 3);
   // Missing the tolerance within the net limit: the step fails, naming what to loosen.
   const std::string tight = recipe_with(
-      R"(, "light": {"rebuild": {"surface": "dome", "tolerance": 1e-9, "degree": 1}})", "");
+      R"(, "light": {"rebuild": {"surface": "dome", "relative_tolerance": 1e-9, "degree": 1}})",
+      "");
   CHECK_THAT(error_of([&] { run_recipe(parse_recipe(tight)); }).second,
-             Contains("surfaces.light") && Contains("\"tolerance\""));
+             Contains("surfaces.light") && Contains("\"relative_tolerance\""));
 }

@@ -400,10 +400,10 @@ TEST_CASE("bad constraints raise clay::Error naming the constraint", "[constrain
   category_and({tangent(end_of(circle), start_of(l))}, "has no ends");
   category_and({end_tangent(end_of(l), Eigen::Vector3d::Zero())}, "zero vector");
   SolveOptions bad;
-  bad.tolerance = 0;
+  bad.residual_tolerance = 0;
   const auto [category, message] = error_of([&] { (void)solve(s, {}, bad); });
   CHECK(category == ErrorCategory::InvalidArgument);
-  CHECK_THAT(message, Contains("SolveOptions::tolerance"));
+  CHECK_THAT(message, Contains("SolveOptions::residual_tolerance"));
 }
 
 TEST_CASE("points on curves and arcs, equal radii, and joints across planes and 3D",
@@ -617,7 +617,7 @@ TEST_CASE(
 
 TEST_CASE("SolveOptions lists every bad field", "[solve]") {
   clay::constraints::SolveOptions o;
-  o.tolerance = 0;
+  o.residual_tolerance = 0;
   o.max_iterations = 0;
   o.rank_tolerance = 1;
   CHECK(o.problems().size() == 3);

@@ -388,7 +388,7 @@ TEST_CASE("direct manipulation rejects bad requests naming the culprit", "[defor
     CHECK(category == ErrorCategory::InvalidArgument);
     CHECK_THAT(what, Contains("rank_tolerance = 0") && Contains("0 < rank_tolerance < 1"));
     o = {};
-    o.tolerance = -1;
+    o.relative_tolerance = -1;
     CHECK_THAT(error_of([&] { o.validate(); }).second, Contains("tolerance = -1"));
     o = {};
     o.locked.assign(5, false);

@@ -97,7 +97,8 @@ TEST_CASE("a B-spline basis whose domain is not the unit interval is rejected", 
 TEST_CASE("Options structs list every bad field, not only the first", "[deform][errors]") {
   RefitOptions refit;
   refit.degree = 0;
-  refit.tolerance = -1;
+  refit.relative_tolerance = -1;
+  refit.tolerance_mm = 0.01;  // one tolerance > 0: the negative one is the only tolerance problem
   refit.certificate_share = 2;
   const auto list = refit.problems();
   REQUIRE(list.size() == 3);
@@ -124,7 +125,7 @@ TEST_CASE("Options structs list every bad field, not only the first", "[deform][
   CHECK(style.problems().size() == 3);
 
   DirectManipulationOptions direct;
-  direct.tolerance = 0;
+  direct.relative_tolerance = 0;
   direct.tied = {{1}, {-2, 3}};
   CHECK(direct.problems().size() == 3);
 

@@ -96,7 +96,7 @@ TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independentl
   CHECK(rep.degree_v == 3);
   CHECK(r.surface.u.degree == 3);
   CHECK(rep.sampled_max <= rep.certified_bound_mm);
-  CHECK(rep.certified_bound_mm <= rep.tolerance);
+  CHECK(rep.certified_bound_mm <= rep.tolerance_mm);
   CHECK(rep.crossings.empty());
 
   // the twist computed here: a rotation by 0.01 z about the z axis
@@ -109,7 +109,7 @@ TEST_CASE("Refit of a twisted loft meets 1e-4 of its size, verified independentl
   for (Eigen::Index k = 0; k < grid.rows(); ++k)
     grid.row(k) = rotate(grid.row(k).transpose()).transpose();
   const double size = (grid.colwise().maxCoeff() - grid.colwise().minCoeff()).norm();
-  CHECK_THAT(rep.tolerance, WithinRel(1e-4 * size, 0.02));
+  CHECK_THAT(rep.tolerance_mm, WithinRel(1e-4 * size, 0.02));
 
   const double check = random_deviation(loft, r.surface, rotate, 4000, 11);
   INFO("independent check " << check << " mm, bound " << rep.certified_bound_mm << " mm");
@@ -148,7 +148,7 @@ TEST_CASE("refit_surface makes a small certified bicubic copy of a dense high-de
   REQUIRE(editable.report.certified);
   CHECK(editable.surface.u.degree == 3);
   CHECK(editable.surface.v.degree == 3);
-  CHECK(editable.report.certified_bound_mm <= editable.report.tolerance);
+  CHECK(editable.report.certified_bound_mm <= editable.report.tolerance_mm);
   // The bound holds against the exact surface at parameters the refit never sampled.
   const double check = random_deviation(
       exact, editable.surface, [](const Eigen::Vector3d& x) { return x; }, 4000, 5);
@@ -178,7 +178,7 @@ TEST_CASE("refit_surface with a fixed net rebuilds on uniform knots, certified",
   RefitOptions options;
   options.count_u = 14;
   options.count_v = 11;
-  options.tolerance = 1e-3;
+  options.relative_tolerance = 1e-3;
   const RefitResult rebuilt = refit_surface(parent, options);
   INFO(rebuilt.report.brief());
   CHECK(rebuilt.surface.u.count() == 14);
@@ -192,11 +192,11 @@ TEST_CASE("refit_surface with a fixed net rebuilds on uniform knots, certified",
   INFO("independent check " << check << " mm");
   CHECK(check <= rebuilt.report.certified_bound_mm);
   CHECK(rebuilt.report.summary.converged() ==
-        (rebuilt.report.certified_bound_mm <= rebuilt.report.tolerance));
+        (rebuilt.report.certified_bound_mm <= rebuilt.report.tolerance_mm));
   // Too few control points for a tight tolerance: not converged, and the message says what to
   // raise; no knot is added to a fixed net.
   options.count_u = options.count_v = 4;
-  options.tolerance = 1e-7;
+  options.relative_tolerance = 1e-7;
   const RefitResult coarse = refit_surface(parent, options);
   CHECK(!coarse.report.summary.converged());
   CHECK(coarse.surface.points.rows() == 16);
@@ -215,7 +215,7 @@ TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor",
   const BezierLattice lattice = clay::test::displaced(make_bezier_lattice(f, {2, 2, 2}), rng, 0.12);
   const surface::BSplineSurface sheet = sheet_in(f, 0.1, 0.9, 0.2);
   RefitOptions options;
-  options.tolerance = 1e-5;
+  options.relative_tolerance = 1e-5;
   const RefitResult r = refit_deformed(lattice, sheet, options);
   INFO(r.report.brief());
   REQUIRE(r.report.summary.converged());
@@ -227,7 +227,7 @@ TEST_CASE("Bezier lattice refit bound is a true bound within a sensible factor",
   INFO("independent check " << check);
   CHECK(check <= r.report.certified_bound_mm);
   CHECK(r.report.certified_bound_mm <= 10 * check);
-  CHECK(r.report.certified_bound_mm <= r.report.tolerance);
+  CHECK(r.report.certified_bound_mm <= r.report.tolerance_mm);
 }
 
 TEST_CASE("B-spline lattice knot planes crossed by the surface are detected and reported",
@@ -238,7 +238,7 @@ TEST_CASE("B-spline lattice knot planes crossed by the surface are detected and 
       clay::test::displaced(make_bspline_lattice(f, {2, 2, 2}, {3, 3, 3}), rng, 0.05);
   const surface::BSplineSurface sheet = sheet_in(f, 0.05, 0.95, 0.25);
   RefitOptions options;
-  options.tolerance = 1e-4;
+  options.relative_tolerance = 1e-4;
   const RefitResult r = refit_deformed(lattice, sheet, options);
   INFO(r.report.brief() << " / " << r.report.summary.message);
   REQUIRE(r.report.certified);
@@ -252,7 +252,7 @@ TEST_CASE("B-spline lattice knot planes crossed by the surface are detected and 
   for (const KnotPlaneCrossing& c : r.report.crossings) {
     reported.insert({c.axis, c.plane});
     CHECK(c.sampled_max <= c.bound);
-    CHECK(c.bound <= r.report.tolerance);
+    CHECK(c.bound <= r.report.tolerance_mm);
     CHECK(c.step == 0);
   }
   const auto us = surface::linspace(0, 1, 80);
@@ -305,7 +305,7 @@ TEST_CASE("Refit keeps the original's C0 seams and breakpoints", "[refit]") {
       },
       2000, 9);
   CHECK(check <= r.report.certified_bound_mm);
-  CHECK(r.report.certified_bound_mm <= r.report.tolerance);
+  CHECK(r.report.certified_bound_mm <= r.report.tolerance_mm);
 }
 
 TEST_CASE("Refit of a rational surface under a stack is certified", "[refit]") {
@@ -330,13 +330,13 @@ TEST_CASE("Refit of a rational surface under a stack is certified", "[refit]") {
   twist.angle = {0.0, 0.02};
   stack.steps = {{taper, "taper", true}, {twist, "twist", true}};
   RefitOptions options;
-  options.tolerance = 1e-3;
-  options.relative = false;  // mm
+  options.relative_tolerance = 0;
+  options.tolerance_mm = 1e-3;
   const RefitResult r = refit_deformed(stack, s, options);
   INFO(r.report.brief());
   REQUIRE(r.report.certified);
   REQUIRE(r.report.summary.converged());
-  CHECK_THAT(r.report.tolerance, WithinRel(1e-3, 1e-15));
+  CHECK_THAT(r.report.tolerance_mm, WithinRel(1e-3, 1e-15));
   const double check = random_deviation(
       s, r.surface, [&](const Eigen::Vector3d& x) { return deform_point(stack, x); }, 3000, 2);
   CHECK(check <= r.report.certified_bound_mm);
@@ -356,7 +356,7 @@ TEST_CASE("A bend region end crossing the surface gets a first-derivative bound"
   bend.y_max = 5;
   bend.rate = 0.05;
   RefitOptions options;
-  options.tolerance = 1e-3;
+  options.relative_tolerance = 1e-3;
   options.max_iterations = 3;
   const RefitResult r = refit_deformed(bend, sheet, options);
   INFO(r.report.brief() << " / " << r.report.summary.message);
@@ -378,12 +378,12 @@ TEST_CASE("Point maps and extended lattices are fitted but not certified", "[ref
   CHECK_FALSE(r.report.certified);
   CHECK(std::isinf(r.report.certified_bound_mm));
   CHECK(r.report.summary.converged());
-  CHECK(r.report.sampled_max <= r.report.tolerance);
+  CHECK(r.report.sampled_max <= r.report.tolerance_mm);
   CHECK_THAT(r.report.summary.message, Contains("not certified"));
   CHECK_THAT(r.report.summary.message, Contains("point map"));
   CHECK_THAT(r.report.brief(), Contains("not certified"));
   // a sanity check, not a certificate: the 4x-denser sample is representative here
-  CHECK(random_deviation(loft, r.surface, wave, 2000, 5) <= 2 * r.report.tolerance);
+  CHECK(random_deviation(loft, r.surface, wave, 2000, 5) <= 2 * r.report.tolerance_mm);
 
   std::mt19937 rng(3);
   const Frame f = clay::test::random_frame(rng);
@@ -395,7 +395,7 @@ TEST_CASE("Point maps and extended lattices are fitted but not certified", "[ref
   for (int k = 0; k < chunk_control_points; ++k) chunk[static_cast<std::size_t>(k)] = k;
   e.chunks = {chunk};
   RefitOptions options;
-  options.tolerance = 1e-4;
+  options.relative_tolerance = 1e-4;
   options.max_iterations = 2;
   const RefitResult x = refit_deformed(e, sheet_in(f, 0.2, 0.8, 0.1), options);
   CHECK_FALSE(x.report.certified);
@@ -407,13 +407,13 @@ TEST_CASE("Refit limits end in a not-converged report", "[refit]") {
   Twist twist;
   twist.angle = {0.0, 0.02};
   RefitOptions options;
-  options.tolerance = 1e-7;
+  options.relative_tolerance = 1e-7;
   options.max_iterations = 1;
   const RefitResult r = refit_deformed(twist, loft, options);
   CHECK(r.report.summary.termination == Termination::NotConverged);
   CHECK(r.report.summary.iterations == 1);
   CHECK_THAT(r.report.summary.message, Contains("iteration limit 1"));
-  CHECK(r.report.certified_bound_mm > r.report.tolerance);
+  CHECK(r.report.certified_bound_mm > r.report.tolerance_mm);
 
   options.max_iterations = 10;
   options.max_control_points = 100;
@@ -448,11 +448,22 @@ TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]
   o.degree = 26;
   options_error(o, "degree = 26");
   o = {};
-  o.tolerance = 0;
-  options_error(o, "tolerance = 0");
+  // One tolerance, its unit chosen: neither, both, a negative or a NaN one is refused.
+  o.relative_tolerance = 0;
+  options_error(o, "relative_tolerance = 0 and tolerance_mm = 0: exactly one must be > 0");
   o = {};
-  o.tolerance = std::numeric_limits<double>::quiet_NaN();
-  options_error(o, "tolerance = nan");
+  o.tolerance_mm = 0.01;
+  options_error(o, "relative_tolerance = 1e-04 and tolerance_mm = 0.01: exactly one");
+  o = {};
+  o.relative_tolerance = -1e-4;
+  options_error(o, "relative_tolerance = -1e-04: must be finite and >= 0");
+  o = {};
+  o.relative_tolerance = std::numeric_limits<double>::quiet_NaN();
+  options_error(o, "relative_tolerance = nan");
+  o = {};
+  o.relative_tolerance = 0;
+  o.tolerance_mm = 0.01;
+  CHECK(o.problems().empty());
   o = {};
   o.max_iterations = 0;
   options_error(o, "max_iterations = 0");
@@ -491,7 +502,8 @@ TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]
   const PointMap collapse = [](const Eigen::Vector3d&) { return Eigen::Vector3d(1, 2, 3); };
   auto [c5, w5] = error_of([&] { refit_deformed(collapse, loft); });
   CHECK(c5 == ErrorCategory::InvalidGeometry);
-  CHECK_THAT(w5, Contains("absolute tolerance"));
+  CHECK_THAT(w5, Contains("zero size") &&
+                     Contains("give the tolerance in mm (RefitOptions::tolerance_mm"));
 }
 
 TEST_CASE("Refit keeps a closed side closed and a pole a point, bit for bit", "[refit]") {
@@ -508,7 +520,7 @@ TEST_CASE("Refit keeps a closed side closed and a pole a point, bit for bit", "[
   twist.frame.axis = {0.1, 0.2, 1};
   twist.angle = {0.1, 0.02};
   RefitOptions options;
-  options.tolerance = 1e-3;
+  options.relative_tolerance = 1e-3;
   const auto fit = refit_deformed(twist, sphere, options);
   const auto& s = fit.surface;
   const int mu = s.count_u(), mv = s.count_v();
@@ -521,5 +533,5 @@ TEST_CASE("Refit keeps a closed side closed and a pole a point, bit for bit", "[
     CHECK(s.points.row(s.index(i, mv - 1)) == north);
   }
   CHECK(fit.report.certified);
-  CHECK(fit.report.certified_bound_mm <= fit.report.tolerance);
+  CHECK(fit.report.certified_bound_mm <= fit.report.tolerance_mm);
 }

@@ -237,7 +237,7 @@ TEST_CASE("malformed stack JSON is rejected naming the path and the fix", "[defo
   };
   auto recipe_error = [](const std::string& text) {
     const auto [category, what] = error_of([&] { stack_from_json(text); });
-    CHECK(category == ErrorCategory::Recipe);
+    CHECK(category == ErrorCategory::Document);
     return what;
   };
   CHECK_THAT(recipe_error("{\"format\": "),
@@ -354,7 +354,7 @@ TEST_CASE("every malformed step field is named with its path", "[deform][stack]"
     const std::string text =
         head + step + "]}";  // the lambda captures this, not the binding (Clang 14)
     const auto [category, what] = error_of([&] { stack_from_json(text); });
-    CHECK(category == ErrorCategory::Recipe);
+    CHECK(category == ErrorCategory::Document);
     CHECK_THAT(what, Contains(expected));
   }
   CHECK_THAT(error_of([&] { stack_from_json(head + "], \"extra\": 1}"); }).second,
@@ -588,7 +588,7 @@ TEST_CASE("malformed extended lattice JSON is rejected naming the path", "[defor
   const std::string range = "(0.." + std::to_string(rows - 1) + ")";
   auto recipe_error = [](const std::string& text) {
     const auto [category, what] = error_of([&] { stack_from_json(text); });
-    CHECK(category == ErrorCategory::Recipe);
+    CHECK(category == ErrorCategory::Document);
     return what;
   };
   CHECK_THAT(recipe_error(with_chunk_entry(good, 3, 17, "5000")),
@@ -660,7 +660,7 @@ TEST_CASE("a number beyond a double leaves the caller's floating-point environme
         R"({"format": "clayform.deformation-stack", "version": 1, "steps": [{"kind": "taper",
         "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]}, "profile": [1, 1e999]}]})");
   });
-  CHECK(category == ErrorCategory::Recipe);
+  CHECK(category == ErrorCategory::Document);
   CHECK_THAT(what, Contains("number overflow parsing '1e999'") && Contains("give finite numbers"));
   CHECK(std::fetestexcept(FE_OVERFLOW | FE_INVALID | FE_DIVBYZERO) == 0);
 #if defined(__GLIBC__)
@@ -675,7 +675,7 @@ TEST_CASE("the stack reader reports every problem at once, each with its path", 
     {"kind": "bend", "frame": {"origin": [0, 0, 0], "axis": [0, 0, 1], "reference": [1, 0, 0]},
      "y_min": 0, "y_max": 1, "center": 0, "rate": null}], "colour": "red"})";
   const auto [category, what] = error_of([&] { stack_from_json(text); });
-  CHECK(category == ErrorCategory::Recipe);
+  CHECK(category == ErrorCategory::Document);
   CHECK_THAT(what, Contains("steps[0].frame.origin[2]: expected a number (any finite number), "
                             "found the string \"x\""));
   CHECK_THAT(what, Contains("steps[1].rate: expected a number (any finite number), found null"));

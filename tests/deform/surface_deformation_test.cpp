@@ -115,7 +115,7 @@ TEST_CASE("deform_surface: a twist is refitted with a certified bound that holds
   stack.steps.push_back({spin(), "spin", true});
   SurfaceDeformationOptions options;
   options.refit = RefitOptions{};
-  options.refit->tolerance = 1e-4;
+  options.refit->relative_tolerance = 1e-4;
   const SurfaceDeformationResult r = deform_surface(stack, s, options);
   INFO(r.report.brief());
   CHECK_FALSE(r.report.exact);
@@ -124,7 +124,7 @@ TEST_CASE("deform_surface: a twist is refitted with a certified bound that holds
   CHECK_THAT(r.report.steps[1].reason, Contains("not polynomial"));
   const RefitReport& fit = r.report.steps[1].refit;
   REQUIRE(fit.certified);
-  CHECK(fit.certified_bound_mm <= fit.tolerance);
+  CHECK(fit.certified_bound_mm <= fit.tolerance_mm);
   // The exact first step contributes rounding only: the bound of the refit holds for the stack.
   CHECK(worst_against_pointwise(stack, s, r.surface, 2000) <= fit.certified_bound_mm + 1e-9);
   // Without a refit the twist is refused, naming the step and the way out.
@@ -209,7 +209,7 @@ TEST_CASE(
   REQUIRE(jump > 5);
   SurfaceDeformationOptions options;
   options.refit = RefitOptions{};
-  options.refit->tolerance = 1e-4;
+  options.refit->relative_tolerance = 1e-4;
   const auto [category, message] = error_of([&] { deform_surface(d, s, options); });
   CHECK(category == ErrorCategory::ToleranceNotMet);
   CHECK_THAT(message, Contains("steps[0]") && Contains("discontinuous") &&
@@ -223,8 +223,8 @@ TEST_CASE(
   CHECK(said <= 8 * (1 + 1e-3));  // printed to 4 digits
   CHECK(said >= jump * (1 - 1e-3));
   // A tolerance above half the jump is not refused up front (the refit's own bound decides).
-  options.refit->tolerance = 10;
-  options.refit->relative = false;
+  options.refit->relative_tolerance = 0;
+  options.refit->tolerance_mm = 10;
   options.refit->max_iterations = 2;
   options.accept_out_of_tolerance = true;
   CHECK_NOTHROW(deform_surface(d, s, options));
@@ -237,7 +237,8 @@ TEST_CASE("deform_surface: a refit that cannot meet a too tight tolerance within
   stack.steps.push_back({spin(), "spin", true});
   SurfaceDeformationOptions options;
   options.refit = RefitOptions{};
-  options.refit->tolerance = 1e-11;  // relative: 1.4e-9 mm, far below what 2 rounds can reach
+  options.refit->relative_tolerance =
+      1e-11;  // relative: 1.4e-9 mm, far below what 2 rounds can reach
   options.refit->max_iterations = 2;
   const auto [category, message] = error_of([&] { deform_surface(stack, s, options); });
   CHECK(category == ErrorCategory::ToleranceNotMet);
@@ -249,7 +250,7 @@ TEST_CASE("deform_surface: a refit that cannot meet a too tight tolerance within
   const SurfaceDeformationResult r = deform_surface(stack, s, options);
   const RefitReport& fit = r.report.steps[0].refit;
   CHECK_FALSE(fit.summary.converged());
-  CHECK(fit.certified_bound_mm > fit.tolerance);
+  CHECK(fit.certified_bound_mm > fit.tolerance_mm);
   // The bound is honest: the pointwise deformation is within it.
   CHECK(worst_against_pointwise(stack, s, r.surface, 1000) <= fit.certified_bound_mm);
 }

@@ -91,7 +91,7 @@ void require_report(const ExchangeReport& report, const std::vector<BSplineSurfa
   REQUIRE(report.faces == static_cast<int>(surfaces.size()));
   REQUIRE(report.control_points == points);
   REQUIRE(report.max_degree == degree);
-  REQUIRE(report.tolerance == 1e-7);
+  REQUIRE(report.tolerance_mm == 1e-7);
   REQUIRE(report.valid);
   REQUIRE(report.problems.empty());
   REQUIRE(report.evaluation_error == 0.0);

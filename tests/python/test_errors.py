@@ -23,6 +23,14 @@ def test_builtin_bases() -> None:
     assert issubclass(cf.InternalError, RuntimeError)
 
 
+def test_recipe_error_is_the_old_name_of_document_error() -> None:
+    # The kernel's category was renamed Document (issue #37): code written against the old name
+    # catches the same errors.
+    assert cf.RecipeError is cf.DocumentError and issubclass(cf.DocumentError, ValueError)
+    with pytest.raises(cf.RecipeError, match="format"):
+        cf.Recipe.parse('{"format": "nope"}')
+
+
 def test_invalid_geometry_names_the_problem() -> None:
     with pytest.raises(cf.InvalidGeometryError, match="knot"):
         cf.Curve(3, [0, 0, 1, 0.5, 1, 1, 1, 1], np.zeros((4, 3)))
@@ -56,7 +64,7 @@ def test_malformed_step_is_refused_before_opencascade(tmp_path) -> None:  # type
 
 
 def test_recipe_problems_are_listed() -> None:
-    with pytest.raises(cf.RecipeError, match="format"):
+    with pytest.raises(cf.DocumentError, match="format"):
         cf.Recipe.parse('{"format": "nope"}')
     problems = cf.Recipe.check('{"format": "clayform.recipe", "version": 1, "surfaces": 3}')
     assert problems and all({"path", "message", "line", "column"} <= set(p) for p in problems)

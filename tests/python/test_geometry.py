@@ -95,7 +95,7 @@ def test_fill_of_four_lines_is_bilinear() -> None:
 def test_fit_stroke_follows_the_drawn_points() -> None:
     t = np.linspace(0, 1, 200)
     pts = np.stack([100 * t, 20 * np.sin(3 * t), np.zeros_like(t)], axis=1)
-    curves, report = cf.fit_stroke(pts, tolerance=0.05)
+    curves, report = cf.fit_stroke(pts, tolerance_mm=0.05)
     assert report["converged"] and len(curves) == 1 and report["max_deviation_mm"] <= 0.05
     dense = curves[0].evaluate(np.linspace(0, 1, 4001))
     gaps = np.min(np.linalg.norm(pts[:, None, :] - dense[None, :, :], axis=2), axis=1)
@@ -126,9 +126,9 @@ def test_style_deform_exact_meets_the_target_line() -> None:
     plate = cf.Surface((3, 3), knots, knots, pts)
     theta = np.linspace(0, 2 * np.pi, 40)[:-1]
     ring = np.stack([50 + 35 * np.cos(theta), 50 + 35 * np.sin(theta), np.zeros_like(theta)], axis=1)
-    bound = cf.fit_stroke(np.vstack([ring, ring[:1]]), tolerance=0.05)[0][0]
+    bound = cf.fit_stroke(np.vstack([ring, ring[:1]]), tolerance_mm=0.05)[0][0]
     x = np.linspace(35, 65, 13)
-    target = cf.fit_stroke(np.stack([x, np.full_like(x, 50), 8 * np.sin(np.pi * (x - 35) / 30)], axis=1), tolerance=0.01)[0][0]
+    target = cf.fit_stroke(np.stack([x, np.full_like(x, 50), 8 * np.sin(np.pi * (x - 35) / 30)], axis=1), tolerance_mm=0.01)[0][0]
     styled, report = cf.style_deform(plate, bound, target, mode="exact", curve_tolerance=1e-4)
     assert report["locality"] == 0.0
     samples = target.evaluate(np.linspace(0, 1, 201))

@@ -170,7 +170,7 @@ def test_a_denormal_coordinate_is_refused_by_the_check(examples: Path, tmp_path:
     doc["curves"]["luff"]["line"]["from"][0] = 5e-324
     path = tmp_path / "denormal.json"
     path.write_text(json.dumps(doc))
-    with pytest.raises(cf.RecipeError, match=r"curves\.luff\.line\.from\[0\].*denormal"):
+    with pytest.raises(cf.DocumentError, match=r"curves\.luff\.line\.from\[0\].*denormal"):
         cf.Recipe.load(path)
 
 

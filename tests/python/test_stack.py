@@ -38,7 +38,7 @@ def test_stack_pickles_bit_for_bit_and_refits_certified(bezier_patch: cf.Surface
     stack = taper_twist()
     back = pickle.loads(pickle.dumps(stack))
     assert back.to_json() == stack.to_json()
-    refit, report = stack.refit(bezier_patch, tolerance=1e-3, relative=False)
+    refit, report = stack.refit(bezier_patch, tolerance_mm=1e-3)
     assert report["certified"] and report["certified_bound_mm"] <= 1e-3
     u, v = np.meshgrid(np.linspace(0, 1, 31), np.linspace(0, 1, 29))
     pointwise = stack.deform_points(np.ascontiguousarray(bezier_patch.evaluate(u, v).reshape(-1, 3)))
@@ -46,11 +46,11 @@ def test_stack_pickles_bit_for_bit_and_refits_certified(bezier_patch: cf.Surface
 
 
 def test_refit_surface_and_errors(bezier_patch: cf.Surface) -> None:
-    light, report = cf.refit_surface(bezier_patch, tolerance=1e-6)
+    light, report = cf.refit_surface(bezier_patch, relative_tolerance=1e-6)
     assert report["certified"] and light.degrees == (3, 3)
     u, v = np.meshgrid(np.linspace(0, 1, 23), np.linspace(0, 1, 23))
     assert np.max(np.linalg.norm(light.evaluate(u, v) - bezier_patch.evaluate(u, v), axis=2)) <= report["certified_bound_mm"]
     with pytest.raises(cf.ToleranceNotMetError):
-        cf.refit_surface(bezier_patch, tolerance=1e-12, degree=1, max_control_points=16)
-    with pytest.raises(cf.RecipeError, match="format"):
+        cf.refit_surface(bezier_patch, relative_tolerance=1e-12, degree=1, max_control_points=16)
+    with pytest.raises(cf.DocumentError, match="format"):
         cf.DeformationStack.from_json('{"format": "nope"}')

@@ -72,7 +72,7 @@ def test_local_sweep_with_a_failure_and_a_crash_then_resume(examples: Path, tmp_
                     progress=lambda done, total, row: seen.append((done, total, row["status"])))
     status = {r["id"]: r["status"] for r in rows}
     assert status[crash] == "crashed" and "SIGABRT" in rows[1]["error"]
-    assert rows[-1]["status"] == "failed" and "RecipeError" in rows[-1]["error"]
+    assert rows[-1]["status"] == "failed" and "DocumentError" in rows[-1]["error"]
     assert [r["status"] for r in rows].count("ok") == 3 and len(seen) == 5 and seen[-1][0] == 5
     for row in rows:
         folder = tmp_path / row["id"]
@@ -109,7 +109,7 @@ def test_dask_local_cluster_sweep(examples: Path, tmp_path: Path) -> None:
     rows = cf.sweep(description, tmp_path, executor="dask", workers=2, abort=[crash],
                     progress=lambda *a: None)
     assert [r["status"] for r in rows] == ["ok", "ok", "crashed", "failed"]
-    assert "RecipeError" in rows[3]["error"] and "SIGABRT" in rows[2]["error"]
+    assert "DocumentError" in rows[3]["error"] and "SIGABRT" in rows[2]["error"]
     first = cf.read_step(tmp_path / rows[0]["id"] / "sail.step")[0]
     second = cf.read_step(tmp_path / rows[1]["id"] / "sail.step")[0]
     assert not first.identical(second)

@@ -59,7 +59,7 @@ NoisyCase noisy_case(unsigned seed) {
   NoisyCase out;
   out.stroke.points = clay::test::noisy_samples(exact, 300, noise_sigma, g);
   FitOptions o;
-  o.tolerance = 3 * noise_sigma;
+  o.tolerance_mm = 3 * noise_sigma;
   out.fit = fit_stroke(out.stroke, o);
   REQUIRE(out.fit.curves.size() == 1);
   const auto fitted = clay::test::analytic(out.fit.curves[0].curve);
@@ -121,17 +121,18 @@ TEST_CASE("a clean stroke is fitted within a tight tolerance, ends interpolated"
     s.points.row(i) << 40 * std::cos(a), 40 * std::sin(a), 8 * a;
   }
   FitOptions o;
-  o.tolerance = 1e-3;
+  o.tolerance_mm = 1e-3;
   const StrokeFit fit = fit_stroke(s, o);
   REQUIRE(fit.curves.size() == 1);
   const FittedCurve& c = fit.curves[0];
   INFO(c.summary.brief());
   CHECK(c.summary.converged());
-  CHECK(c.max_deviation_mm <= o.tolerance);
-  CHECK(stroke_deviation(s.points, c.curve) <= o.tolerance + 1e-5);
+  CHECK(c.max_deviation_mm <= o.tolerance_mm);
+  CHECK(stroke_deviation(s.points, c.curve) <= o.tolerance_mm + 1e-5);
   // Clean: the end estimate stays at the drawn point (within the tolerance it may move).
-  CHECK((c.curve.points.row(0) - s.points.row(0)).norm() <= o.tolerance);
-  CHECK((c.curve.points.row(c.curve.points.rows() - 1) - s.points.row(59)).norm() <= o.tolerance);
+  CHECK((c.curve.points.row(0) - s.points.row(0)).norm() <= o.tolerance_mm);
+  CHECK((c.curve.points.row(c.curve.points.rows() - 1) - s.points.row(59)).norm() <=
+        o.tolerance_mm);
 }
 
 TEST_CASE("strokes with a corner are split there: two curves sharing the corner", "[fit]") {
@@ -153,7 +154,7 @@ TEST_CASE("strokes with a corner are split there: two curves sharing the corner"
       s.points.row(i) = p.transpose() + g.vector(sigma);
     }
     FitOptions o;
-    o.tolerance = 3 * sigma;
+    o.tolerance_mm = 3 * sigma;
     const StrokeFit fit = fit_stroke(s, o);
     INFO(fit.summary.brief());
     REQUIRE(fit.curves.size() == 2);
@@ -165,7 +166,7 @@ TEST_CASE("strokes with a corner are split there: two curves sharing the corner"
     CHECK(a.points.row(a.points.rows() - 1) == b.points.row(0));
     CHECK(fit.curves[0].last_point + 1 == fit.curves[1].first_point);
     // The joint is at the drawn corner, within the tolerance.
-    CHECK((b.points.row(0).transpose() - corner).norm() <= o.tolerance);
+    CHECK((b.points.row(0).transpose() - corner).norm() <= o.tolerance_mm);
     // Each leg is straight to within the noise: its curve stays near the true segment.
     for (const auto* c : {&fit.curves[0], &fit.curves[1]}) {
       CHECK(c->summary.converged());
@@ -195,7 +196,7 @@ TEST_CASE("a closed noisy stroke gives one closed curve, G1 (indeed C2) at the s
                       g.vector(sigma);
   }
   FitOptions o;
-  o.tolerance = 3 * sigma;
+  o.tolerance_mm = 3 * sigma;
   const StrokeFit fit = fit_stroke(s, o);
   INFO(fit.summary.brief());
   REQUIRE(fit.curves.size() == 1);
@@ -256,7 +257,7 @@ TEST_CASE("strokes on a sketch plane give curves lying in the plane", "[fit]") {
                            30 * std::sin(2 * std::numbers::pi * f));
   };
   FitOptions o;
-  o.tolerance = 0.15;
+  o.tolerance_mm = 0.15;
   int closed = 0, split = 0;
   for (const Stroke& s : {drawn(wave, 200), drawn(ell, 200), drawn(circle, 200)}) {
     const StrokeFit fit = fit_stroke(s, o);
@@ -293,7 +294,7 @@ TEST_CASE("a closed stroke with corners gives a closed chain of curves", "[fit]"
       s.points.row(k * per_side + i) = ((1 - u) * v[a] + u * v[b]).transpose() + g.vector(0.08);
     }
   FitOptions o;
-  o.tolerance = 0.25;
+  o.tolerance_mm = 0.25;
   const StrokeFit fit = fit_stroke(s, o);
   INFO(fit.summary.brief());
   CHECK(fit.closed);
@@ -308,7 +309,7 @@ TEST_CASE("a closed stroke with corners gives a closed chain of curves", "[fit]"
     double nearest = 1e9;
     for (const auto& vertex : v)
       nearest = std::min(nearest, (b.points.row(0).transpose() - vertex).norm());
-    CHECK(nearest <= o.tolerance);
+    CHECK(nearest <= o.tolerance_mm);
   }
 }
 
@@ -328,7 +329,7 @@ TEST_CASE("a sparse stroke (points farther apart than 10 x tolerance) keeps its 
   s.points.resize(static_cast<Eigen::Index>(pts.size()), 3);
   for (size_t k = 0; k < pts.size(); ++k) s.points.row(static_cast<Eigen::Index>(k)) = pts[k];
   FitOptions o;
-  o.tolerance = 0.5;
+  o.tolerance_mm = 0.5;
   const StrokeFit fit = fit_stroke(s, o);
   INFO(fit.summary.brief());
   REQUIRE(fit.curves.size() == 4);
@@ -343,7 +344,7 @@ TEST_CASE("a sparse stroke (points farther apart than 10 x tolerance) keeps its 
 
 TEST_CASE("FitOptions and OversketchOptions list every bad field", "[fit]") {
   FitOptions f;
-  f.tolerance = 0;
+  f.tolerance_mm = 0;
   f.degree = 1;
   f.closing_ratio = 0.9;
   CHECK(f.problems().size() == 3);

@@ -101,7 +101,7 @@ TEST_CASE("oversketch G1: joints exact, kept parts unchanged, new part follows t
   const BSplineCurve old = old_curve();
   const Stroke stroke{bumped(old, 0.3, 0.7, 6.0, 160, 0.01, 3), std::nullopt};
   OversketchOptions o;
-  o.fit.tolerance = 0.05;
+  o.fit.tolerance_mm = 0.05;
   const OversketchResult r = oversketch(old, stroke, o);
   INFO(r.summary.brief());
   CHECK(r.summary.converged());
@@ -125,8 +125,8 @@ TEST_CASE("oversketch G1: joints exact, kept parts unchanged, new part follows t
   CHECK(unchanged(old, r.curve, 0.0, r.cut_start) <= 1e-12 * 170);
   CHECK(unchanged(old, r.curve, r.cut_end, 1.0) <= 1e-12 * 170);
   // The new part follows the stroke within the tolerance.
-  CHECK(r.max_deviation_mm <= o.fit.tolerance);
-  CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance + 1e-4);
+  CHECK(r.max_deviation_mm <= o.fit.tolerance_mm);
+  CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance_mm + 1e-4);
   // brief(): the cut, both joints (gap 0, so "gap 0 mm"), the verdict.
   CHECK_THAT(r.brief(), Catch::Matchers::StartsWith("replaced [0.3") &&
                             Catch::Matchers::Contains("gap 0 mm, angle") &&
@@ -140,7 +140,7 @@ TEST_CASE("oversketch G2: curvature vectors agree across both joints", "[overske
   const Stroke stroke{bumped(old, 0.25, 0.6, -5.0, 150, 0.01, 4), std::nullopt};
   OversketchOptions o;
   o.continuity = Continuity::G2;
-  o.fit.tolerance = 0.05;
+  o.fit.tolerance_mm = 0.05;
   const OversketchResult r = oversketch(old, stroke, o);
   INFO(r.summary.brief());
   CHECK(r.summary.converged());
@@ -159,14 +159,14 @@ TEST_CASE("oversketch G2: curvature vectors agree across both joints", "[overske
   }
   CHECK(unchanged(old, r.curve, 0.0, r.cut_start) <= 1e-12 * 170);
   CHECK(unchanged(old, r.curve, r.cut_end, 1.0) <= 1e-12 * 170);
-  CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance + 1e-4);
+  CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance_mm + 1e-4);
 }
 
 TEST_CASE("oversketch: a stroke drawn backwards replaces the same part", "[oversketch]") {
   const BSplineCurve old = old_curve();
   Stroke stroke{bumped(old, 0.3, 0.7, 6.0, 160, 0.01, 3), std::nullopt};
   OversketchOptions o;
-  o.fit.tolerance = 0.05;
+  o.fit.tolerance_mm = 0.05;
   const OversketchResult forward = oversketch(old, stroke, o);
   stroke.points = stroke.points.colwise().reverse().eval();
   const OversketchResult backward = oversketch(old, stroke, o);
@@ -175,7 +175,7 @@ TEST_CASE("oversketch: a stroke drawn backwards replaces the same part", "[overs
   REQUIRE(backward.start_joint);
   CHECK(backward.start_joint->tangent_angle <= 1e-9);
   CHECK(backward.end_joint->tangent_angle <= 1e-9);
-  CHECK(stroke_to_curve(stroke.points, backward.curve) <= o.fit.tolerance + 1e-4);
+  CHECK(stroke_to_curve(stroke.points, backward.curve) <= o.fit.tolerance_mm + 1e-4);
 }
 
 TEST_CASE("oversketch over the curve's end replaces its tail", "[oversketch]") {
@@ -196,7 +196,7 @@ TEST_CASE("oversketch over the curve's end replaces its tail", "[oversketch]") {
   for (int i = 0; i < past; ++i)
     stroke.points.row(along + i) = (end + 4.0 * up + 25.0 * (i + 1.0) / past * tangent).transpose();
   OversketchOptions o;
-  o.fit.tolerance = 0.05;
+  o.fit.tolerance_mm = 0.05;
   const OversketchResult r = oversketch(old, stroke, o);
   INFO(r.summary.brief());
   CHECK(r.summary.converged());
@@ -209,8 +209,8 @@ TEST_CASE("oversketch over the curve's end replaces its tail", "[oversketch]") {
   CHECK(unchanged(old, r.curve, 0.0, r.cut_start) <= 1e-12 * 170);
   // The new tail ends at the stroke's end.
   CHECK((clay::surface::evaluate(r.curve, 1.0) - stroke.points.row(along + past - 1).transpose())
-            .norm() <= o.fit.tolerance);
-  CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance + 1e-4);
+            .norm() <= o.fit.tolerance_mm);
+  CHECK(stroke_to_curve(stroke.points, r.curve) <= o.fit.tolerance_mm + 1e-4);
 }
 
 TEST_CASE("oversketch keeps a rational curve's kept parts exact", "[oversketch]") {
@@ -227,7 +227,7 @@ TEST_CASE("oversketch keeps a rational curve's kept parts exact", "[oversketch]"
     stroke.points.row(i) << r * std::cos(a), r * std::sin(a), 0;
   }
   OversketchOptions o;
-  o.fit.tolerance = 0.05;
+  o.fit.tolerance_mm = 0.05;
   const OversketchResult r = oversketch(old, stroke, o);
   INFO(r.summary.brief());
   CHECK(r.summary.converged());
@@ -318,7 +318,7 @@ TEST_CASE("bad oversketch options are refused, naming the field", "[oversketch]"
   CHECK_THAT(clay::test::error_of([&] { oversketch(old, stroke, o); }).second,
              Contains("OversketchOptions::continuity = 7"));
   o = {};
-  o.fit.tolerance = -1;
+  o.fit.tolerance_mm = -1;
   CHECK_THAT(clay::test::error_of([&] { oversketch(old, stroke, o); }).second,
-             Contains("FitOptions::tolerance = -1"));
+             Contains("FitOptions::tolerance_mm = -1"));
 }

@@ -117,9 +117,9 @@ TEST_CASE("a stroke with an invalid plane is refused, naming the plane", "[strok
 
 TEST_CASE("bad fit options are refused, naming the field, its value and the rule", "[stroke]") {
   const std::vector<std::pair<std::string, std::function<void(FitOptions&)>>> cases = {
-      {"FitOptions::tolerance = 0 must be a positive distance",
-       [](FitOptions& o) { o.tolerance = 0; }},
-      {"FitOptions::tolerance = nan", [](FitOptions& o) { o.tolerance = std::nan(""); }},
+      {"FitOptions::tolerance_mm = 0 must be a positive distance",
+       [](FitOptions& o) { o.tolerance_mm = 0; }},
+      {"FitOptions::tolerance_mm = nan", [](FitOptions& o) { o.tolerance_mm = std::nan(""); }},
       {"FitOptions::degree = 1 must be in [2, 9]", [](FitOptions& o) { o.degree = 1; }},
       {"FitOptions::degree = 10", [](FitOptions& o) { o.degree = 10; }},
       {"FitOptions::fairness = -1 must be finite and >= 0", [](FitOptions& o) { o.fairness = -1; }},

@@ -56,7 +56,7 @@ TEST_CASE("BuildReport describes a surface in one line", "[error]") {
 TEST_CASE("surface Options structs list every bad field, not only the first") {
   clay::surface::LoftOptions loft;
   loft.degree = 0;
-  loft.tolerance = 1;
+  loft.relative_tolerance = 1;
   CHECK(loft.problems().size() == 2);
   clay::surface::SweepOptions sweep;
   sweep.sections = 1;

@@ -107,7 +107,7 @@ TEST_CASE("ellipsoid, torus and hyperboloids are exact quadrics for exponents (1
 TEST_CASE("approximated superquadrics meet the tolerance against the analytic form",
           "[primitives]") {
   SuperquadricOptions options;
-  options.tolerance = 1e-3;
+  options.tolerance_mm = 1e-3;
   struct Case {
     double e1, e2;
   };
@@ -119,7 +119,7 @@ TEST_CASE("approximated superquadrics meet the tolerance against the analytic fo
     shape.e2 = c.e2;
     const BuiltSurface built = superellipsoid(shape, options);
     CHECK_FALSE(built.report.exact);
-    CHECK(built.report.max_deviation_mm <= options.tolerance);
+    CHECK(built.report.max_deviation_mm <= options.tolerance_mm);
     // Independent: Barr's formula at the same (eta, omega), on a grid other than the builder's.
     REQUIRE(built.surface.u.domain().second == 2.0);  // two north-south segments
     REQUIRE(built.surface.v.domain().second == 4.0);  // four quarter turns
@@ -133,7 +133,7 @@ TEST_CASE("approximated superquadrics meet the tolerance against the analytic fo
                                 30 * spow(eta[1], c.e1));
         worst = std::max(worst, (evaluate(built.surface, su, sv) - x).norm());
       }
-    CHECK(worst <= options.tolerance);
+    CHECK(worst <= options.tolerance_mm);
 
     Supertoroid tor;
     tor.radii = {10, 10, 10};
@@ -141,7 +141,7 @@ TEST_CASE("approximated superquadrics meet the tolerance against the analytic fo
     tor.e1 = c.e1;
     tor.e2 = c.e2;
     const BuiltSurface t = supertoroid(tor, options);
-    CHECK(t.report.max_deviation_mm <= options.tolerance);
+    CHECK(t.report.max_deviation_mm <= options.tolerance_mm);
     worst = 0;
     for (double su : linspace(0, 4, 97))
       for (double sv : linspace(0, 4, 97)) {
@@ -151,7 +151,7 @@ TEST_CASE("approximated superquadrics meet the tolerance against the analytic fo
                                 10 * spow(eta[1], c.e1));
         worst = std::max(worst, (evaluate(t.surface, su, sv) - x).norm());
       }
-    CHECK(worst <= options.tolerance);
+    CHECK(worst <= options.tolerance_mm);
   }
   // Hyperboloid of one sheet, approximated in both directions.
   Superhyperboloid hyp;
@@ -168,8 +168,8 @@ TEST_CASE("approximated superquadrics meet the tolerance against the analytic fo
                               5 * spow(sec, 0.7) * spow(omega[1], 1.8), 5 * spow(tan, 0.7));
       worst = std::max(worst, (evaluate(h.surface, su, sv) - x).norm());
     }
-  CHECK(worst <= options.tolerance);
-  CHECK(h.report.max_deviation_mm <= options.tolerance);
+  CHECK(worst <= options.tolerance_mm);
+  CHECK(h.report.max_deviation_mm <= options.tolerance_mm);
 }
 
 TEST_CASE("spherical product of two curves is their exact product", "[primitives]") {
@@ -207,7 +207,7 @@ TEST_CASE("superquadric builders refuse bad shapes and options", "[primitives][e
   o.degree = 9;
   CHECK_THROWS_WITH(superellipsoid(Superellipsoid{}, o), Catch::Contains("degree"));
   o = SuperquadricOptions{};
-  o.tolerance = 1e-14;
+  o.tolerance_mm = 1e-14;
   o.max_spans = 16;
   Superellipsoid hard;
   hard.e1 = 0.3;

@@ -277,8 +277,9 @@ TEST_CASE("loft options are validated", "[skin][loft][errors]") {
   o.degree = 0;
   CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("LoftOptions::degree is 0"));
   o = {};
-  o.tolerance = 0;
-  CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("LoftOptions::tolerance"));
+  o.relative_tolerance = 0;
+  CHECK_THAT(error_of([&] { o.validate(); }).second,
+             Catch::Contains("LoftOptions::relative_tolerance"));
 }
 
 // ---- sweep ----
@@ -700,8 +701,9 @@ TEST_CASE("sweep options are validated", "[skin][sweep][errors]") {
   CHECK_THAT(error_of([&] { o.validate(); }).second,
              Catch::Contains("SweepOptions::sections is 1"));
   o = {};
-  o.tolerance = 0;
-  CHECK_THAT(error_of([&] { o.validate(); }).second, Catch::Contains("SweepOptions::tolerance"));
+  o.relative_tolerance = 0;
+  CHECK_THAT(error_of([&] { o.validate(); }).second,
+             Catch::Contains("SweepOptions::relative_tolerance"));
   o = {};
   o.twist_degrees = std::nan("");
   CHECK_THAT(error_of([&] { o.validate(); }).second,
@@ -728,5 +730,5 @@ TEST_CASE("An adaptive sweep that misses its tolerance at max_sections is an err
   o.twist_degrees = 90;  // within reach: a result
   o.max_sections = 1025;
   CHECK(sweep(upright_profile(), quarter_circle(100, 0), o).report.max_deviation_mm <=
-        o.tolerance * 200);
+        o.relative_tolerance * 200);
 }

@@ -96,8 +96,8 @@ export default async function constraints({ check, withEmptyRecipe }) {
         shadow = Math.max(shadow, distanceToCurve({ ...flat, points: flat.points.map((c, e) => (e % 3 === 2 ? p[2] : c)) }, p));
         heights = Math.max(heights, Math.abs(p[2] - height(p[0])));
       }
-      assert(shadow <= 2 * stroke.tolerance + 1, `the 3D curve's shadow is ${shadow} mm off the first curve`);
-      assert(heights <= 2 * stroke.tolerance + 2, `the 3D curve's heights are ${heights} mm off the drawn ones`);
+      assert(shadow <= 2 * stroke.tolerance_mm + 1, `the 3D curve's shadow is ${shadow} mm off the first curve`);
+      assert(heights <= 2 * stroke.tolerance_mm + 2, `the 3D curve's heights are ${heights} mm off the drawn ones`);
       const threeDNote = `3D between two views: shadow within ${shadow.toFixed(2)} mm, heights within ${heights.toFixed(2)} mm`;
       // Revolve about a picked line: a profile and an axis drawn on XZ (front view), both picked.
       await sketchPage.selectOption('#sketch-on', 'xz');

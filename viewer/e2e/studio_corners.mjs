@@ -28,10 +28,10 @@ export default async function corners({ check, withEmptyRecipe, figures }) {
         const drawnCorner = corner.map((q) => drawn.reduce((best, d) => (dist(d, q) < dist(best, q) ? d : best)));
         joint = Math.max(joint, Math.min(...drawnCorner.map((q) => dist(q, end(c, true)))));
       });
-      assert(joint <= stroke.tolerance, `a joint is ${joint} mm from the drawn corner`);
+      assert(joint <= stroke.tolerance_mm, `a joint is ${joint} mm from the drawn corner`);
       let off = 0;
       for (const d of drawn) off = Math.max(off, Math.min(...pieces.map((c) => distanceToCurve(c, d))));
-      assert(off <= stroke.tolerance, `a drawn point is ${off} mm from the pieces (tolerance ${stroke.tolerance})`);
+      assert(off <= stroke.tolerance_mm, `a drawn point is ${off} mm from the pieces (tolerance ${stroke.tolerance_mm})`);
       // the four pieces filled: the patch's corners are the joints
       await cp.click('#tool-orbit');
       for (let i = 1; i <= 4; i++) await k.clickCurve(`s1.${i}`, i > 1);

@@ -91,7 +91,7 @@ export async function checkStroke(driver, name, drawn) {
     const d = distanceToCurve(curves[name], x);
     worst = Math.max(worst, d - allowance);
   });
-  assert(worst <= stroke.tolerance * (1 + 1e-9), `curve ${name}: a drawn point is ${worst} mm from the fitted curve, tolerance ${stroke.tolerance}`);
+  assert(worst <= stroke.tolerance_mm * (1 + 1e-9), `curve ${name}: a drawn point is ${worst} mm from the fitted curve, tolerance ${stroke.tolerance_mm}`);
   return { worst, snapStart, snapEnd, control_points: curves[name].weights.length };
 }
 

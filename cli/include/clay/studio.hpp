@@ -21,7 +21,7 @@ namespace clay::recipe {
 /// `create`, its parent must), so "Save recipe" writes what `clayform run` replays.
 class StudioSession {
  public:
-  /// A session on the recipe text (checked: clay::Error(Recipe) listing its problems).
+  /// A session on the recipe text (checked: clay::Error(Document) listing its problems).
   StudioSession(std::string text, std::filesystem::path base_dir, std::string name = "studio");
   ~StudioSession();
   StudioSession(StudioSession&&) noexcept;
@@ -85,7 +85,7 @@ class StudioSession {
   /// Writes a pending autosave now (the server calls it when a drag's updates stop).
   void flush_autosave();
   /// Continues the autosave `file` (written by autosave_to): its history and position replace
-  /// this session's. Returns the number of entries. clay::Error(Recipe) naming the file when it
+  /// this session's. Returns the number of entries. clay::Error(Document) naming the file when it
   /// is not an autosave or its current recipe has problems; Io when it cannot be read.
   std::size_t restore(const std::filesystem::path& file);
   /// Entries dropped from the start of the history to keep it within its limit.

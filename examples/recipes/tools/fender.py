@@ -121,15 +121,15 @@ recipe = {
     "units": "mm",
     "composition": {"mode": "exact", "editable": {}},
     "strokes": {
-        "rocker": {"points": rocker, "tolerance": 1.0},
-        "shoulder": {"points": shoulder, "tolerance": 1.0},
-        "front": {"points": front, "tolerance": 1.0},
-        "flare_line": {"points": flare, "tolerance": 1.0},
-        "bound_drawn": {"points": bound, "tolerance": 1.0},
+        "rocker": {"points": rocker, "tolerance_mm": 1.0},
+        "shoulder": {"points": shoulder, "tolerance_mm": 1.0},
+        "front": {"points": front, "tolerance_mm": 1.0},
+        "flare_line": {"points": flare, "tolerance_mm": 1.0},
+        "bound_drawn": {"points": bound, "tolerance_mm": 1.0},
     },
     "sketches": {"rear": rear},
     "curves": {
-        "bound": {"project": {"curve": "bound_drawn", "surface": "panel", "tolerance": 0.01}},
+        "bound": {"project": {"curve": "bound_drawn", "surface": "panel", "tolerance_mm": 0.01}},
     },
     "surfaces": {
         "panel": {"fill": {"curves": ["rocker", "rear.cut", "shoulder", "front"], "style": "coons",
@@ -138,7 +138,7 @@ recipe = {
         # The converged style result is a dense exact bicubic (about 178,000 control points); a
         # lattice composed with it exactly would be far denser still, so it is rebuilt to a
         # tenth of a millimetre first, as a stylist rebuilds before the next operation.
-        "styled_net": {"rebuild": {"surface": "styled", "tolerance": 1e-4}},
+        "styled_net": {"rebuild": {"surface": "styled", "relative_tolerance": 1e-4}},
         "fender": {"deform": {"surface": "styled_net", "deformation": "nose"}},
     },
     "deformations": {

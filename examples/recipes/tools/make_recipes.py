@@ -112,8 +112,8 @@ def handset():
         "lattice's C1 face as only continuous (first-order remainder) and halves them: the sampled "
         "deviation is 15 to 20 times below the certified bound. The steps come in the paper's order "
         "(local lattices on the straight bar, the global one last).",
-        {"mode": "refit", "tolerance": 2e-3, "degree": 3},
-        {"bar": {"superellipsoid": {"radii": [100, 24, 15], "e1": 0.4, "e2": 0.4, "tolerance": 0.1}},
+        {"mode": "refit", "relative_tolerance": 2e-3, "degree": 3},
+        {"bar": {"superellipsoid": {"radii": [100, 24, 15], "e1": 0.4, "e2": 0.4, "tolerance_mm": 0.1}},
          "handset": {"deform": {"surface": "bar", "deformation": "handset"}}},
         {"handset": [end_lattice(+1, 30, 0.2, "mouthpiece"), end_lattice(-1, 26, 0.3, "earpiece"), arch]},
         {"handset": {"surfaces": ["handset"]}})
@@ -147,7 +147,7 @@ def sandpie():
         "second sector boundary of the last moved cylinder is pulled 5 mm towards the axis, fluting "
         "the rim like a sand mould. Extended lattices are not polynomial maps: composition refit, "
         "bicubic, 1e-3 of the size, sampled (certified = false for an extended lattice).",
-        {"mode": "refit", "tolerance": 1e-3, "degree": 3},
+        {"mode": "refit", "relative_tolerance": 1e-3, "degree": 3},
         {"sheet": sheet(60), "sandpie": {"deform": {"surface": "sheet", "deformation": "sandpie"}}},
         {"sandpie": [{"kind": "extended_lattice", "name": "sandpie",
                       "generator": {"cylinder": {"origin": [0, 0, -5], "axis": [0, 0, 1], "reference": [1, 0, 0],
@@ -173,7 +173,7 @@ def cushion():
         "cylinder (radial 3) at every second sector boundary is pinched 7 mm on both faces. "
         "Composition refit, bicubic, 2e-3 of the size (0.33 mm; 1e-3 takes three times as long), "
         "sampled (certified = false for an extended lattice).",
-        {"mode": "refit", "tolerance": 2e-3, "degree": 3},
+        {"mode": "refit", "relative_tolerance": 2e-3, "degree": 3},
         {"profile": None,  # placeholder, replaced below
          "cushion_parent": {"revolve": {"profile": "profile", "axis": {"point": [0, 0, 0], "direction": [0, 0, 1]},
                                         "angle": 360}},
@@ -231,7 +231,7 @@ def s_letter():
         "ends. Moves by row: row = (i * 25 + j) * 4 + k (no points are welded for an open S). "
         "Composition refit, bicubic, 1e-3 of the size, sampled (certified = false for an extended "
         "lattice).",
-        {"mode": "refit", "tolerance": 1e-3, "degree": 3},
+        {"mode": "refit", "relative_tolerance": 1e-3, "degree": 3},
         {"sheet": sheet(45), "engraved": {"deform": {"surface": "sheet", "deformation": "s_press"}}},
         {"s_press": [{"kind": "extended_lattice", "name": "S",
                       "generator": {"prism": {"origin": [0, 0, -6], "x_axis": [1, 0, 0], "y_axis": [0, 1, 0],
@@ -252,8 +252,8 @@ def taper_twist():
         "degrees from bottom to top). The taper has a polynomial profile and composes exactly "
         "(degree 6); the twist is not polynomial: composition refit, bicubic, 1e-3 of the size, "
         "certified.",
-        {"mode": "refit", "tolerance": 1e-3, "degree": 3},
-        {"post": {"superellipsoid": {"radii": [25, 25, 60], "e1": 0.5, "e2": 0.5, "tolerance": 0.01}},
+        {"mode": "refit", "relative_tolerance": 1e-3, "degree": 3},
+        {"post": {"superellipsoid": {"radii": [25, 25, 60], "e1": 0.5, "e2": 0.5, "tolerance_mm": 0.01}},
          "twisted": {"deform": {"surface": "post", "deformation": "taper_twist"}}},
         {"taper_twist": [
             {"kind": "taper", "name": "taper",
@@ -277,8 +277,8 @@ def bend():
         "ends beyond the region move rigidly. The taper composes exactly; the bend is not "
         "polynomial and only C0 across y_min / y_max off the neutral plane: composition refit, "
         "bicubic, 1e-3 of the size, certified.",
-        {"mode": "refit", "tolerance": 1e-3, "degree": 3},
-        {"beam": {"superellipsoid": {"radii": [16, 60, 16], "e1": 0.5, "e2": 0.5, "tolerance": 0.01}},
+        {"mode": "refit", "relative_tolerance": 1e-3, "degree": 3},
+        {"beam": {"superellipsoid": {"radii": [16, 60, 16], "e1": 0.5, "e2": 0.5, "tolerance_mm": 0.01}},
          "bent": {"deform": {"surface": "beam", "deformation": "taper_bend"}}},
         {"taper_bend": [
             {"kind": "taper", "name": "taper",

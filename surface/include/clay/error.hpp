@@ -19,7 +19,8 @@ enum class ErrorCategory {
   DegreeLimit,      ///< a degree above what an exchange format or algorithm supports
   Io,               ///< a file could not be read, written or renamed
   Exchange,         ///< a STEP/IGES/glTF translation failed or produced invalid geometry
-  Recipe,           ///< a malformed recipe (JSON) or a reference to a missing object
+  Document,         ///< a malformed JSON document (a recipe, a deformation stack, a studio
+                    ///< autosave) or a reference in it to a missing object
   ToleranceNotMet,  ///< a result misses its tolerance (a refit's certified bound, a style target):
                     ///< a failure, not a warning; the message names the figure and the way out
   Internal,         ///< a kernel bug: please report it

@@ -90,7 +90,7 @@ export function startDirectManipulation(event) {
   const group = newGroup();
   const changes = [
     { path: `deformations.${deformation}`, value: [{ kind: 'direct_manipulation', name: deformation, lattice, moves: [{ surface_point: uv, to: start }] }], create: true },
-    { path: `surfaces.${result}`, value: { deform: { surface, deformation, composition: { mode: 'refit', tolerance: 1e-4 } } }, create: true },
+    { path: `surfaces.${result}`, value: { deform: { surface, deformation, composition: { mode: 'refit', relative_tolerance: 1e-4 } } }, create: true },
   ];
   send(commandOf(changes, `drag ${surface} at (${uv.map((x) => x.toPrecision(4))})`, 'edit', group)).then(({ reply }) => {
     if (reply.op !== 'error') select({ kind: 'surface', name: result }, false);
@@ -145,7 +145,7 @@ function buildLattice() {
   // iso-lines, so its result is a certified refit
   const bspline = $('lattice-kind').value === 'bspline';
   const step = bspline ? { kind: 'bspline_lattice', name: deformation, frame, cells: [4, 4, 1], degrees: [3, 3, 1], knots: 'clamped', moves: [] } : { kind: 'bezier_lattice', name: deformation, frame, degrees: [3, 3, 1], moves: [] };
-  const deform = bspline ? { surface, deformation, composition: { mode: 'refit', tolerance: 1e-4 } } : { surface, deformation };
+  const deform = bspline ? { surface, deformation, composition: { mode: 'refit', relative_tolerance: 1e-4 } } : { surface, deformation };
   edit(
     [
       { path: `deformations.${deformation}`, value: [step], create: true },
@@ -166,7 +166,7 @@ function buildGlobal() {
   edit(
     [
       { path: `deformations.${deformation}`, value: names.globalSteps(doc.surfaces.get(surface).points, 0, 0, 0), create: true },
-      { path: `surfaces.${result}`, value: { deform: { surface, deformation, composition: { mode: 'refit', tolerance: 1e-4 } } }, create: true },
+      { path: `surfaces.${result}`, value: { deform: { surface, deformation, composition: { mode: 'refit', relative_tolerance: 1e-4 } } }, create: true },
     ],
     `taper/twist/bend on ${surface}`,
   ).then(({ reply }) => reply.op !== 'error' && select({ kind: 'surface', name: result }));

@@ -78,7 +78,7 @@ function finishStroke(event) {
     dirty();
     return;
   }
-  const tolerance = Number($('stroke-tolerance').value) || 0.5;
+  const tolerance = Number($('stroke-tolerance').value) || 0.5; // mm: a stroke's tolerance_mm
   const dropInk = () => {
     inkGroup.remove(line);
     const i = pendingInk.findIndex((p) => p.line === line);
@@ -89,7 +89,7 @@ function finishStroke(event) {
     // the live target's last update: the whole stroke, in the drawing's history entry
     cancelDrag();
     sketch.lastLive = live;
-    const stroke = { points, tolerance };
+    const stroke = { points, tolerance_mm: tolerance };
     if (plane) stroke.plane = plane;
     const { changes, label } = liveTarget(live, stroke);
     pendingInk.push({ label, line });
@@ -107,7 +107,7 @@ function finishStroke(event) {
     const label = `stroke ${redrawn.name} (oversketch)`;
     pendingInk.push({ label, line });
     // a redrawn stroke may gain or lose corners: the kernel's fit says into how many pieces it splits
-    piecesOf(next, def.plane, def.tolerance || tolerance).then((pieces) => {
+    piecesOf(next, def.plane, def.tolerance_mm || tolerance).then((pieces) => {
       const changes = [{ path: `strokes.${redrawn.name}.points`, value: next }];
       if (pieces && (def.pieces || pieces > 1)) changes.push({ path: `strokes.${redrawn.name}.pieces`, value: pieces, create: true });
       return edit(changes, label, 'stroke', event.timeStamp);
@@ -124,11 +124,11 @@ function finishStroke(event) {
     // the 3D stroke takes the planar one's place (its name, so what was built from it follows)
     const label = `stroke ${over.name} (3D)`;
     pendingInk.push({ label, line });
-    edit({ path: `strokes.${over.name}`, value: { points, tolerance } }, label, 'stroke', event.timeStamp);
+    edit({ path: `strokes.${over.name}`, value: { points, tolerance_mm: tolerance } }, label, 'stroke', event.timeStamp);
     return;
   }
   const name = names.free(doc.recipe, 's');
-  const stroke = { points, tolerance };
+  const stroke = { points, tolerance_mm: tolerance };
   if (plane) stroke.plane = plane;
   const label = `stroke ${name}`;
   pendingInk.push({ label, line });
@@ -151,7 +151,7 @@ function finishStroke(event) {
 
 /** How many curves the kernel fits to the stroke (split at its corners), or null when it cannot. */
 function piecesOf(points, plane, tolerance) {
-  const command = { op: 'fit', points, tolerance };
+  const command = { op: 'fit', points, tolerance_mm: tolerance };
   if (plane) command.plane = plane;
   return send(command).then(({ reply }) => (reply.op === 'fit' ? reply.pieces : null));
 }
@@ -198,7 +198,7 @@ export function sketchMove(event) {
   }
   if (ink.live && ink.points.length >= 4) {
     const live = ink.live;
-    const stroke = { points: ink.points.slice(), tolerance: Number($('stroke-tolerance').value) || 0.5 };
+    const stroke = { points: ink.points.slice(), tolerance_mm: Number($('stroke-tolerance').value) || 0.5 };
     if (ink.plane) stroke.plane = ink.plane;
     dragEdit(() => ({ ...liveTarget(live, stroke), group: live.group }), event.timeStamp);
   }

@@ -28,9 +28,9 @@ struct Drag {
 
 /// Settings of solve().
 struct CLAY_CONSTRAINTS_API SolveOptions {
-  double tolerance = 1e-10;      ///< largest residual (mm, or radians for angles) of a solved
-                                 ///< constraint; in (0, 1e-3]
-  int max_iterations = 100;      ///< Levenberg–Marquardt iterations, >= 1
+  double residual_tolerance = 1e-10;  ///< largest residual (mm, or radians for angles) of a solved
+                                      ///< constraint; in (0, 1e-3]
+  int max_iterations = 100;           ///< Levenberg–Marquardt iterations, >= 1
   double rank_tolerance = 1e-9;  ///< pivot threshold of the rank-revealing QR on the normalised
                                  ///< Jacobian, in (0, 1e-2]
   bool diagnose = true;          ///< compute degrees of freedom and dependencies after the solve
@@ -80,13 +80,13 @@ struct SolveResult {
   SolveReport report;
 };
 
-/// Solves the constraints on the sketch. The result's sketch satisfies them to options.tolerance
-/// when report.summary.converged(); otherwise it is the least-squares compromise and the report
-/// names the conflicting sets. Throws clay::Error: InvalidArgument for a constraint that refers
-/// to a missing point/entity or to an entity of the wrong kind (naming "constraint #k" and the
-/// reference), for a planar constraint on entities not in one plane, for a non-positive
-/// distance/radius or a non-finite value, and for bad options; InvalidGeometry for an invalid
-/// sketch (sketch::validate).
+/// Solves the constraints on the sketch. The result's sketch satisfies them to
+/// options.residual_tolerance when report.summary.converged(); otherwise it is the least-squares
+/// compromise and the report names the conflicting sets. Throws clay::Error: InvalidArgument for a
+/// constraint that refers to a missing point/entity or to an entity of the wrong kind (naming
+/// "constraint #k" and the reference), for a planar constraint on entities not in one plane, for a
+/// non-positive distance/radius or a non-finite value, and for bad options; InvalidGeometry for an
+/// invalid sketch (sketch::validate).
 CLAY_CONSTRAINTS_API SolveResult solve(const sketch::Sketch& sketch,
                                        const std::vector<Constraint>& constraints,
                                        const SolveOptions& options = {});

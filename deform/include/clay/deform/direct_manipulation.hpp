@@ -59,8 +59,8 @@ struct CLAY_DEFORM_API DirectManipulationOptions {
   /// those get the least-squares compromise instead of a huge move.
   double rank_tolerance = 1e-10;
   /// Relative to the lattice size (|S|² + |T|² + |U|²)^(1/2), > 0: the request is feasible when
-  /// every selected point's new image is within tolerance × size of its target.
-  double tolerance = 1e-7;
+  /// every selected point's new image is within relative_tolerance × size of its target.
+  double relative_tolerance = 1e-7;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;

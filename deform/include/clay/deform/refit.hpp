@@ -36,17 +36,20 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace clay::deform {
 
 /// Settings of refit_deformed().
 struct CLAY_DEFORM_API RefitOptions {
-  int degree = 3;           ///< degree of the fit in u and v, 1..25 (the exchange limit)
-  double tolerance = 1e-4;  ///< > 0: allowed deviation, relative to the size when `relative`
-  bool relative = true;     ///< true: tolerance x diagonal of the deformed surface's bounding
-                            ///< box (of a sample); false: tolerance in mm
-  int max_iterations = 12;  ///< >= 1: fit / certify / refine rounds
+  int degree = 3;  ///< degree of the fit in u and v, 1..25 (the exchange limit)
+  /// Allowed deviation, exactly one of the two > 0 (the other 0): relative_tolerance is a
+  /// fraction of the deformed surface's size (the diagonal of a sample's bounding box),
+  /// tolerance_mm is in millimetres.
+  double relative_tolerance = 1e-4;
+  double tolerance_mm = 0;             ///< see relative_tolerance
+  int max_iterations = 12;             ///< >= 1: fit / certify / refine rounds
   int max_control_points = 40000;      ///< >= (degree + 1)^2: no refinement beyond this net size
   int max_count_per_direction = 1000;  ///< >= degree + 1: no refinement beyond this many control
                                        ///< points in u or in v (the dense least squares per
@@ -93,10 +96,10 @@ struct CLAY_DEFORM_API RefitReport {
   /// Converged: the certified bound (or, when not certified, the sampled maximum) is within the
   /// tolerance; NotConverged: iteration or control point limit reached first.
   Summary summary;
-  bool certified = false;  ///< certified_bound_mm is a true upper bound of |fit − D∘S|
-  double tolerance = 0;    ///< the tolerance applied (mm)
-  double size = 0;         ///< diagonal of the deformed sample's bounding box (mm)
-  double sampled_max = 0;  ///< largest deviation at the certificate's samples (mm)
+  bool certified = false;   ///< certified_bound_mm is a true upper bound of |fit − D∘S|
+  double tolerance_mm = 0;  ///< the tolerance applied
+  double size = 0;          ///< diagonal of the deformed sample's bounding box (mm)
+  double sampled_max = 0;   ///< largest deviation at the certificate's samples (mm)
   double certified_bound_mm =
       std::numeric_limits<double>::infinity();  ///< mm; inf if not certified
   long samples = 0;         ///< number of points sampled by the last certificate
@@ -123,50 +126,33 @@ struct RefitResult {
 using PointMap = std::function<Eigen::Vector3d(const Eigen::Vector3d&)>;
 
 /// Certified refit of the surface itself (the identity map): an exchange-friendly, lower-degree
-/// copy of an exact result, within options.tolerance everywhere on its domain. Throws as the
-/// taper overload.
+/// copy of an exact result, within the tolerance everywhere on its domain. Throws as
+/// refit_deformed().
 CLAY_DEFORM_API RefitResult refit_surface(const surface::BSplineSurface& surface,
                                           const RefitOptions& options = {});
 
-/// Refit of taper(S): certified. Throws clay::Error: InvalidArgument for bad options,
-/// InvalidGeometry for an invalid surface or taper, or a deformed surface of zero size with a
-/// relative tolerance.
-CLAY_DEFORM_API RefitResult refit_deformed(const Taper& taper,
-                                           const surface::BSplineSurface& surface,
-                                           const RefitOptions& options = {});
-/// Refit of twist(S): certified. Throws as the taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const Twist& twist,
-                                           const surface::BSplineSurface& surface,
-                                           const RefitOptions& options = {});
-/// Refit of bend(S): certified (first-derivative remainder in cells crossing y_min or y_max,
-/// where the bend is only C0 off its neutral plane). Throws as the taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const Bend& bend, const surface::BSplineSurface& surface,
-                                           const RefitOptions& options = {});
-/// Refit of lattice(S), Sederberg–Parry eq. (2): certified; cells crossing the lattice's faces
-/// are reported in crossings. Throws as the taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const BezierLattice& lattice,
-                                           const surface::BSplineSurface& surface,
-                                           const RefitOptions& options = {});
-/// Refit of lattice(S), Hsu–Hughes–Kaufman eq. (1): certified; every cell whose hull crosses a
-/// knot plane or face is reported in crossings with its sampled maximum and bound. Throws as the
-/// taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const BSplineLattice& lattice,
-                                           const surface::BSplineSurface& surface,
-                                           const RefitOptions& options = {});
-/// Refit of lattice(S) (pointwise, each point frozen alone): not certified (no derivative bounds
-/// for a Newton-frozen map); the report has the sampled maximum. Throws as the taper overload.
-CLAY_DEFORM_API RefitResult refit_deformed(const ExtendedLattice& lattice,
-                                           const surface::BSplineSurface& surface,
-                                           const RefitOptions& options = {});
-/// Refit of stack(S): certified when every enabled step is (derivative bounds chained through the
-/// steps), otherwise sampled only. Throws as the taper overload (invalid stack: InvalidGeometry).
-CLAY_DEFORM_API RefitResult refit_deformed(const DeformationStack& stack,
-                                           const surface::BSplineSurface& surface,
-                                           const RefitOptions& options = {});
-/// Refit of map(S) for any point map: not certified (nothing is known of its derivatives).
-/// Throws as the taper overload, and InvalidArgument for an empty map or one returning a
-/// non-finite point (naming the point).
-CLAY_DEFORM_API RefitResult refit_deformed(const PointMap& map,
+/// What refit_deformed() maps the surface by: one deformation (Deformation: a Bézier, B-spline or
+/// extended lattice, a taper, twist or bend), a stack of them, or any point map. Each converts
+/// implicitly, so refit_deformed(taper, surface) reads as before.
+using SpaceMap = std::variant<Deformation, DeformationStack, PointMap>;
+
+/// Certified refit of map(S), the one entry for every kind of map. Certified for:
+/// - taper and twist (analytic derivative bounds);
+/// - bend (first-derivative remainder in cells crossing y_min or y_max, where the bend is only C0
+///   off its neutral plane);
+/// - Bézier lattices (Sederberg–Parry eq. (2)): cells crossing the lattice's faces are reported in
+///   crossings;
+/// - B-spline lattices (Hsu–Hughes–Kaufman eq. (1)): every cell whose hull crosses a knot plane or
+///   face is reported in crossings with its sampled maximum and bound;
+/// - stacks whose every enabled step is (derivative bounds chained through the steps).
+/// Not certified, the report having only the sampled maximum and saying why: extended lattices
+/// (pointwise, each point frozen alone: no derivative bounds for a Newton-frozen map), stacks with
+/// such a step, and point maps (nothing is known of their derivatives).
+/// Throws clay::Error: InvalidArgument for bad options, for an empty point map or one returning a
+/// non-finite point (naming the point); InvalidGeometry for an invalid surface or deformation
+/// (for a stack, every step's problems), or a deformed surface of zero size with a relative
+/// tolerance.
+CLAY_DEFORM_API RefitResult refit_deformed(const SpaceMap& map,
                                            const surface::BSplineSurface& surface,
                                            const RefitOptions& options = {});
 

@@ -108,7 +108,7 @@ CLAY_DEFORM_API void deform_points(const DeformationStack& stack, const Points3&
 /// NaN), InvalidArgument for a step name that is not valid UTF-8.
 CLAY_DEFORM_API std::string to_json(const DeformationStack& stack);
 
-/// Parses a stack written by to_json (or by hand). Throws clay::Error(Recipe) for malformed
+/// Parses a stack written by to_json (or by hand). Throws clay::Error(Document) for malformed
 /// input, naming the JSON path and the fix ("steps[2].points[5]: expected 3 numbers, found 2;
 /// ..."): not JSON, a wrong format or version, unknown kinds or keys, missing or mistyped fields,
 /// wrong counts, non-finite numbers, and every problems() of the resulting stack.

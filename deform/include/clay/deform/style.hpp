@@ -81,8 +81,9 @@ struct CLAY_DEFORM_API StyleOptions {
   int key_points_per_row = 1;  ///< exact: key points per control-net row crossed, >= 1
   int boundary_rows = 2;       ///< exact: layers of region-net vertices inside the bound edge kept
                                ///< fixed, 0..4 (G2: one more)
-  double tolerance = 1e-9;     ///< exact: key-point deviation accepted, relative to the model size
-  int max_refinements = 6;     ///< exact: rounds of knot insertion allowed, 0..10
+  double relative_tolerance = 1e-9;  ///< exact: key-point deviation accepted, relative to the
+                                     ///< model size
+  int max_refinements = 6;           ///< exact: rounds of knot insertion allowed, 0..10
   BoundContinuity continuity = BoundContinuity::G1;  ///< exact: the energy, and the join at the
                                                      ///< bound in the limit of a fine net
   double net_convergence = 0;  ///< exact: the net is halved over the region until one more

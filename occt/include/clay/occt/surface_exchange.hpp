@@ -45,11 +45,11 @@ struct GltfWriteOptions {
 
 /// What was written (or checked): size figures and OpenCASCADE's BRepCheck verdict.
 struct ExchangeReport {
-  int faces = 0;            ///< faces written
-  int max_degree = 0;       ///< largest degree over both directions of every surface
-  long control_points = 0;  ///< control points over all surfaces
-  bool valid = false;       ///< every face passes BRepCheck_Analyzer at `tolerance`
-  double tolerance = 1e-7;  ///< tolerance of the faces' edges and vertices (mm), never raised
+  int faces = 0;               ///< faces written
+  int max_degree = 0;          ///< largest degree over both directions of every surface
+  long control_points = 0;     ///< control points over all surfaces
+  bool valid = false;          ///< every face passes BRepCheck_Analyzer at `tolerance_mm`
+  double tolerance_mm = 1e-7;  ///< tolerance of the faces' edges and vertices, never raised
   /// Largest gap (mm) between OpenCASCADE's cached evaluation (power basis per knot span, what
   /// BRepCheck and the mesher use) and exact de Boor evaluation, measured on the faces that fail
   /// BRepCheck; 0 when every face passes. For degree 20-25 surfaces with long (Bezier-like) spans

@@ -56,7 +56,7 @@ struct CLAY_RECIPE_API Recipe {
 CLAY_RECIPE_API std::vector<Problem> check_recipe(std::string_view text,
                                                   const std::filesystem::path& base_dir = {});
 
-/// The checked recipe. Throws clay::Error(Recipe) listing every problem of check_recipe, one per
+/// The checked recipe. Throws clay::Error(Document) listing every problem of check_recipe, one per
 /// line. `default_name` names a recipe whose text has no "name" (load_recipe gives the file
 /// stem).
 CLAY_RECIPE_API Recipe parse_recipe(std::string_view text,
@@ -198,6 +198,10 @@ CLAY_RECIPE_API std::vector<std::filesystem::path> write_model_outputs(
 /// per step its path, kind, seconds, warning, message and figures; per export its files and
 /// exchange figures (valid is filled in by write_outputs; report_json alone leaves it out).
 CLAY_RECIPE_API std::string report_json(const RunResult& result);
+
+/// The steps of a run as a JSON array, each step exactly as in report_json's "steps":
+/// {path, kind, seconds, warning, message, figures} (the studio's replies carry this).
+CLAY_RECIPE_API std::string step_reports_json(const std::vector<StepReport>& steps);
 
 /// Writes every export (NAME.step, NAME.igs, NAME.glb per its formats), report.json and the view
 /// folder (view/manifest.json and view/NNN.bin, clay/recipe/view.hpp) into `out_dir` (created when

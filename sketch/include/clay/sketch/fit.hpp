@@ -47,7 +47,7 @@ namespace clay::sketch {
 
 /// Settings of fit_stroke (and of the new piece in oversketch).
 struct CLAY_SKETCH_API FitOptions {
-  double tolerance = 0.1;        ///< mm, largest distance from a stroke point to its curve
+  double tolerance_mm = 0.1;     ///< largest distance from a stroke point to its curve
                                  ///< (averaged over 9 neighbours for a noisy stroke); > 0
   int degree = 3;                ///< degree of the curves, in [2, 9]
   double fairness = 1e-8;        ///< weight of the bending energy (see above), >= 0; its fourth
@@ -103,9 +103,9 @@ struct CLAY_SKETCH_API StrokeFit {
   std::string brief() const;
 };
 
-/// Fits `stroke` with clamped B-spline curves of options.degree within options.tolerance (see the
-/// method above). With a plane, the stroke is projected onto it first and every curve lies in it
-/// (its control points are computed in plane coordinates and mapped with to_world). Not meeting
+/// Fits `stroke` with clamped B-spline curves of options.degree within options.tolerance_mm (see
+/// the method above). With a plane, the stroke is projected onto it first and every curve lies in
+/// it (its control points are computed in plane coordinates and mapped with to_world). Not meeting
 /// the tolerance within the limits is reported in the summaries, not thrown.
 /// Throws clay::Error: InvalidArgument for bad options, InvalidGeometry for a stroke that
 /// problems(stroke) rejects (fewer than 2 points, NaN or infinite coordinate, repeated consecutive

@@ -137,15 +137,36 @@ class JsonReader {
         {path.empty() ? "(top level)" : std::move(path), wording(std::move(message))});
   }
 
-  /// True when j is an object; reports every key outside `allowed`.
+  /// A key the format renamed (or dropped): said as such instead of "unknown key", with the fix.
+  struct Renamed {
+    std::string_view old_key;
+    std::string_view new_key;  ///< empty: dropped
+    std::string_view note;     ///< what the new key means, or what replaces a dropped one
+  };
+
+  /// True when j is an object; reports every key outside `allowed`, a renamed one by its new name.
   bool object(const Json& j, const std::string& path,
-              std::initializer_list<std::string_view> allowed, std::string_view what) {
+              std::initializer_list<std::string_view> allowed, std::string_view what,
+              std::initializer_list<Renamed> renamed = {}) {
     if (!j.is_object()) {
       add(path, "expected " + std::string(what) + " (a JSON object), found " + found(j));
       return false;
     }
     for (const auto& [key, value] : j.items()) {
       if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+      const auto r = std::find_if(renamed.begin(), renamed.end(),
+                                  [&, k = &key](const Renamed& x) { return x.old_key == *k; });
+      if (r != renamed.end()) {
+        add(key_path(path, key),
+            r->new_key.empty()
+                ? "\"" + key + "\" is no longer a key of " + std::string(what) + ": " +
+                      std::string(r->note)
+                : "\"" + key + "\" was renamed \"" + std::string(r->new_key) + "\" (" +
+                      std::string(r->note) + "); write \"" + std::string(r->new_key) + "\": " +
+                      clip_utf8(value.dump(-1, ' ', false, Json::error_handler_t::replace), 40) +
+                      " instead");
+        continue;
+      }
       std::vector<std::string> names(allowed.begin(), allowed.end());
       add(key_path(path, key),
           "unknown key \"" + key + "\" in " + std::string(what) + "; the keys are: " + join(names));

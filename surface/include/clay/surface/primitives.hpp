@@ -29,9 +29,9 @@ namespace clay::surface {
 
 /// Settings of the superquadric builders.
 struct CLAY_SURFACE_API SuperquadricOptions {
-  double tolerance = 1e-3;  ///< mm: largest allowed distance from the analytic surface, > 0
-  int degree = 3;           ///< degree of approximated directions, in [2, 7]
-  int max_spans = 4096;     ///< knot spans per approximated direction before giving up, >= 8
+  double tolerance_mm = 1e-3;  ///< largest allowed distance from the analytic surface, > 0
+  int degree = 3;              ///< degree of approximated directions, in [2, 7]
+  int max_spans = 4096;        ///< knot spans per approximated direction before giving up, >= 8
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
   /// Throws clay::Error(InvalidArgument) listing problems(), if any.

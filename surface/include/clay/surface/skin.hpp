@@ -24,9 +24,10 @@ struct CLAY_SURFACE_API LoftOptions {
                    ///< min(degree, sections - 1), so the surface is C^(degree-1) across sections
   LoftParametrization parametrization = LoftParametrization::ChordLength;  ///< v spacing
   bool auto_orient = true;  ///< reverse a section that runs against its predecessor (else reject)
-  double tolerance = 1e-7;  ///< relative to the model size (diagonal of the sections' control
-                            ///< points): consecutive sections closer than this coincide, a section
-                            ///< whose control polygon is shorter is degenerate; in (0, 1e-2]
+  double relative_tolerance =
+      1e-7;  ///< relative to the model size (diagonal of the sections' control
+             ///< points): consecutive sections closer than this coincide, a section
+             ///< whose control polygon is shorter is degenerate; in (0, 1e-2]
   double min_span_ratio = 0.05;   ///< in [0, 0.5): slivers of the sections' knot union (spans
                                   ///< shorter than this times their longer neighbour) are merged
                                   ///< (make_compatible with KnotMergeOptions); 0 keeps every span
@@ -132,9 +133,9 @@ CLAY_SURFACE_API std::vector<double> loft_parameters(const std::vector<BSplineCu
 /// report's method says which). Throws clay::Error: InvalidArgument for fewer than 2 sections or
 /// bad options; InvalidGeometry naming the section index (0-based) for an invalid or degenerate
 /// section (control polygon ~0 long, e.g. a point), a section that crosses, touches or doubles
-/// back onto itself within options.tolerance × size (find_self_intersection; the message gives
-/// both parameters and the point), two consecutive coincident sections, a reversed section when
-/// auto_orient is false, or rational sections whose interpolated weights are not positive.
+/// back onto itself within options.relative_tolerance × size (find_self_intersection; the message
+/// gives both parameters and the point), two consecutive coincident sections, a reversed section
+/// when auto_orient is false, or rational sections whose interpolated weights are not positive.
 CLAY_SURFACE_API BuiltSurface loft(const std::vector<BSplineCurve>& sections,
                                    const LoftOptions& options = {});
 
@@ -144,10 +145,11 @@ struct CLAY_SURFACE_API SweepOptions {
                              ///< end, spread in proportion to arc length; finite
   int sections = 0;          ///< profile copies placed along the path: 0 = adaptive (refined until
                              ///< the deviation is within tolerance), else a fixed count >= 2
-  double tolerance = 1e-6;   ///< relative to the model size (diagonal of the profile's and path's
-                             ///< control points): the deviation the adaptive sweep must reach, and
-                             ///< the largest tangent turn (radians) at a path knot; in (0, 1e-1]
-  int max_sections = 1025;   ///< adaptive refinement stops here, >= 2
+  double relative_tolerance =
+      1e-6;                 ///< relative to the model size (diagonal of the profile's and path's
+                            ///< control points): the deviation the adaptive sweep must reach, and
+                            ///< the largest tangent turn (radians) at a path knot; in (0, 1e-1]
+  int max_sections = 1025;  ///< adaptive refinement stops here, >= 2
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
