@@ -15,29 +15,37 @@
 
 namespace clay::test {
 
-/// A TCP connection to 127.0.0.1:port (a plain socket: the test speaks raw bytes).
-inline int connect_to(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  REQUIRE(fd >= 0);
+/// 127.0.0.1:port as a socket address.
+inline sockaddr_in loopback(int port) {
   sockaddr_in at{};
   at.sin_family = AF_INET;
   at.sin_port = htons(static_cast<std::uint16_t>(port));
   at.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  REQUIRE(::connect(fd, reinterpret_cast<sockaddr*>(&at), sizeof at) == 0);
+  return at;
+}
+
+/// A socket connected to 127.0.0.1:port, or -1 when nothing listens there.
+inline int try_connect(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  REQUIRE(fd >= 0);
+  const sockaddr_in at = loopback(port);
+  if (::connect(fd, reinterpret_cast<const sockaddr*>(&at), sizeof at) == 0) return fd;
+  ::close(fd);
+  return -1;
+}
+
+/// A TCP connection to 127.0.0.1:port (a plain socket: the test speaks raw bytes).
+inline int connect_to(int port) {
+  const int fd = try_connect(port);
+  REQUIRE(fd >= 0);
   return fd;
 }
 
 /// Whether anything listens on 127.0.0.1:port.
 inline bool can_connect(int port) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  REQUIRE(fd >= 0);
-  sockaddr_in at{};
-  at.sin_family = AF_INET;
-  at.sin_port = htons(static_cast<std::uint16_t>(port));
-  at.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  const bool connected = ::connect(fd, reinterpret_cast<sockaddr*>(&at), sizeof at) == 0;
-  ::close(fd);
-  return connected;
+  const int fd = try_connect(port);
+  if (fd >= 0) ::close(fd);
+  return fd >= 0;
 }
 
 /// Sends `request` as it is and reads the answer until the server closes, or its head when it
