@@ -472,8 +472,10 @@ namespace {
 /// A run folder with view data and a fake front end, for the server.
 struct ServedFolders {
   fs::path run, dist;
-  ServedFolders() {
-    const fs::path base = output_dir("serve");
+  /// In a folder of the test's own (`name`): ctest runs the test cases in parallel, and two that
+  /// shared one removed each other's files.
+  explicit ServedFolders(const std::string& name) {
+    const fs::path base = output_dir(name);
     run = base / "run";
     dist = base / "dist";
     write_text(run / "view" / "manifest.json", R"({"format": "clayform.view", "version": 1})"
@@ -494,7 +496,7 @@ TEST_CASE("the view server serves the front end at the root and the run folder u
   using clay::test::body_of;
   using clay::test::header_of;
   using clay::test::status_of;
-  const ServedFolders f;
+  const ServedFolders f("serve");
   ServeOptions o;
   o.port = 0;
   o.viewer = f.dist;
@@ -555,7 +557,7 @@ TEST_CASE("the view server serves the front end at the root and the run folder u
 }
 
 TEST_CASE("the view server and snapshot name the fix for what is missing", "[view]") {
-  const ServedFolders f;
+  const ServedFolders f("serve_missing");
   ServeOptions o;
   o.port = 0;
   o.viewer = f.dist;
