@@ -12,7 +12,9 @@
 #include <string>
 #include <tuple>
 #include <utility>
+
 #include <vector>
+#include "sampling.hpp"
 
 namespace clay::brep {
 
@@ -36,44 +38,9 @@ double parameter_slack(double a, double b) {
   return 1e-12 * std::max({1.0, std::abs(a), std::abs(b)});
 }
 
-/// The parameters at which a coedge is sampled: both ends, the breakpoints of the pcurve and of
-/// the edge curve inside (t0, t1), and `per_span` points inside every piece between them.
-std::vector<double> coedge_samples(const Edge& e, const Coedge& c, int per_span) {
-  std::vector<double> breaks{e.t0, e.t1};
-  auto add_breaks = [&](const surface::BSplineBasis& basis) {
-    for (double k : surface::breakpoints(basis))
-      if (k > e.t0 && k < e.t1) breaks.push_back(k);
-  };
-  add_breaks(c.pcurve.basis);
-  if (!e.degenerate) add_breaks(e.curve.basis);
-  std::sort(breaks.begin(), breaks.end());
-  breaks.erase(std::unique(breaks.begin(), breaks.end()), breaks.end());
-  std::vector<double> ts;
-  for (size_t k = 0; k + 1 < breaks.size(); ++k) {
-    ts.push_back(breaks[k]);
-    for (int s = 1; s < per_span; ++s)
-      ts.push_back(breaks[k] + (breaks[k + 1] - breaks[k]) * s / per_span);
-  }
-  ts.push_back(breaks.back());
-  return ts;
-}
-
-/// t clamped to a curve's domain: problems() lets an edge range end within a rounding slack past
-/// it (a range read from a file), and evaluation refuses parameters outside.
-double within(const surface::BSplineCurve& c, double t) {
-  const auto [a, b] = c.basis.domain();
-  return std::clamp(t, a, b);
-}
-
-/// (u, v) of a pcurve at t, clamped to the surface's domain (a pcurve leaving the domain is a
-/// problem of its own; the gap is measured at the nearest point of the domain).
-Eigen::Vector2d uv_at(const surface::BSplineSurface& s, const surface::BSplineCurve& pcurve,
-                      double t) {
-  const Eigen::Vector3d p = surface::evaluate(pcurve, within(pcurve, t));
-  const auto [u0, u1] = s.u.domain();
-  const auto [v0, v1] = s.v.domain();
-  return {std::clamp(p.x(), u0, u1), std::clamp(p.y(), v0, v1)};
-}
+using detail::coedge_samples;
+using detail::uv_at;
+using detail::within;
 
 /// Largest |surface(pcurve(t)) - edge(t)| over the samples. Preconditions: indices and curves
 /// valid, the edge range inside both curves' domains.

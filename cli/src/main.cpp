@@ -1,5 +1,6 @@
 // clayform — the command-line shell over the kernel: parse, call one library function, print the
 // outcome, map error categories to exit codes (STYLE.md rule 18).
+#include <clay/brep/continuity.hpp>
 #include <clay/deform.hpp>
 #include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
@@ -110,8 +111,32 @@ void print_tree(const clay::brep::Model& m, const clay::brep::Instance& in, int 
   for (const auto& c : part.components) print_tree(m, c, depth + 1);
 }
 
+/// How the faces meet along their edges (brep::edge_continuity): the summary, then the smooth
+/// joins (tangent planes within 10 degrees: fillets, blends, seams), worst angle first, at most 20:
+/// where a class-A check looks. Sharp edges are in the summary only.
+void print_continuity(const clay::brep::Model& m) {
+  const clay::brep::ContinuityReport r = clay::brep::edge_continuity(m);
+  std::printf("  continuity: %s\n", r.brief().c_str());
+  std::vector<clay::brep::EdgeContinuity> smooth;
+  for (const auto& e : r.edges)
+    if (e.angle_deg < 10) smooth.push_back(e);
+  std::sort(smooth.begin(), smooth.end(),
+            [](const auto& a, const auto& b) { return a.angle_deg > b.angle_deg; });
+  if (!smooth.empty()) std::printf("  smooth joins (angle < 10 deg), worst first:\n");
+  for (std::size_t k = 0; k < smooth.size() && k < 20; ++k) {
+    const auto& e = smooth[k];
+    std::printf(
+        "    edge %d (faces %d, %d): gap %.2g mm, angle %.2g deg, curvature jump %.3g /mm "
+        "(relative %.3g)\n",
+        e.edge, e.face_a, e.face_b, e.gap_mm, e.angle_deg, e.curvature_jump,
+        e.relative_curvature_jump);
+  }
+  if (smooth.size() > 20) std::printf("    ... and %zu more\n", smooth.size() - 20);
+}
+
 /// `clayform info FILE`: the topology of a STEP or IGES file (bodies, shells, trimmed faces and
-/// holes, the assembly tree with names), OpenCASCADE's verdict, and each face's surface.
+/// holes, the assembly tree with names), OpenCASCADE's verdict, each face's surface, and how the
+/// faces meet along their edges.
 int info(const fs::path& file) {
   const clay::brep::ImportedModel read = read_model_file(file, "info");
   const clay::brep::Model& m = read.model;
@@ -185,6 +210,7 @@ int info(const fs::path& file) {
     std::printf("     control box [%.6g, %.6g, %.6g] .. [%.6g, %.6g, %.6g] mm\n", lo.x(), lo.y(),
                 lo.z(), hi.x(), hi.y(), hi.z());
   }
+  if (!broken) print_continuity(m);
   for (const auto& p : read.report.problems) std::printf("  problem: %s\n", p.c_str());
   for (const auto& p : check.problems) std::printf("  problem: %s\n", p.c_str());
   if (broken) return exit_code(clay::ErrorCategory::InvalidGeometry);

@@ -1,6 +1,7 @@
 # Runs `clayform info` on the STEP and IGES files of example 01 and checks what it prints against
 # the surfaces the example built (a bicubic 8 x 6 hood and an exact rational torus patch), plus
-# --version and the exit code for a file of the wrong kind.
+# --version, the exit code for a file of the wrong kind, and how the filleted block's faces meet
+# (examples/models/block.step, -DMODELS).
 foreach(file sample.step sample.igs)
   execute_process(COMMAND ${CLAYFORM} info ${DIR}/${file}
     OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
@@ -16,6 +17,17 @@ foreach(file sample.step sample.igs)
       message(FATAL_ERROR "clayform info ${file}: expected '${expect}' in:\n${out}")
     endif()
   endforeach()
+endforeach()
+# How the faces meet: the filleted block's 42 shared edges, its fillets tangent to their sides
+# (the angle below 1e-9 degrees) with the curvature jumping from 1/5 to 0 (closed forms).
+execute_process(COMMAND ${CLAYFORM} info ${MODELS}/block.step
+  OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+foreach(expect "continuity: 42 shared edges: gap <= [0-9.e-]+ mm, angle <= 90 deg"
+               "smooth joins \\(angle < 10 deg\\), worst first:"
+               "angle [0-9.]+e-1[0-9] deg, curvature jump 0.2 /mm \\(relative 1\\)")
+  if(NOT rc EQUAL 0 OR NOT out MATCHES "${expect}")
+    message(FATAL_ERROR "clayform info block.step (exit ${rc}): expected '${expect}' in:\n${out}${err}")
+  endif()
 endforeach()
 execute_process(COMMAND ${CLAYFORM} --version OUTPUT_VARIABLE out RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0 OR NOT out MATCHES "^clayform [0-9]+\\.[0-9]+\\.[0-9]+")
