@@ -136,7 +136,9 @@ std::string ContinuityReport::brief() const {
                 edges.size(), edges.size() == 1 ? "" : "s", max_gap_mm, max_angle_deg,
                 max_relative_curvature_jump, boundary_edges, degenerate_edges,
                 degenerate_edges == 1 ? "" : "s");
-  return line;
+  return non_manifold_edges == 0
+             ? std::string(line)
+             : line + ("; " + std::to_string(non_manifold_edges) + " non-manifold, not measured");
 }
 
 ContinuityReport edge_continuity(const Model& model, const ContinuityOptions& options) {
@@ -156,12 +158,10 @@ ContinuityReport edge_continuity(const Model& model, const ContinuityOptions& op
       report.degenerate_edges += !uses[e].empty();
       continue;
     }
-    if (uses[e].size() > 2)
-      throw Error(ErrorCategory::InvalidGeometry,
-                  "edge_continuity: edge " + std::to_string(e) + " is used by " +
-                      std::to_string(uses[e].size()) +
-                      " coedges (a non-manifold edge): which two faces meet there is not "
-                      "defined; measure the bodies apart");
+    if (uses[e].size() > 2) {  // which two faces meet there is not defined
+      ++report.non_manifold_edges;
+      continue;
+    }
     if (uses[e].size() < 2) {
       report.boundary_edges += uses[e].size() == 1;
       continue;

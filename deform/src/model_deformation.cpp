@@ -226,6 +226,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   brep::Model& m = result.model;
   m = brep::flattened(input);
   ModelDeformationReport& report = result.report;
+  report.continuity_before = brep::edge_continuity(m);
   const std::vector<double> before = brep::body_volumes_mm3(m);
   for (std::size_t b = 0; b < m.bodies.size(); ++b)
     if (m.bodies[b].kind == brep::BodyKind::Solid) report.volume_before_mm3 += before[b];
@@ -409,6 +410,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       },
       [&] { report.volume_ratio_bounded = false; });
   if (!report.volume_ratio_bounded) report.volume_ratio_min = report.volume_ratio_max = 1;
+  report.continuity_after = brep::edge_continuity(m);
   report.summary.termination = Termination::Converged;
   report.summary.final_residual = report.max_edge_gap_mm;
   report.summary.message = report.brief();

@@ -70,6 +70,23 @@ py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
   d["volume_before_mm3"] = x.volume_before_mm3;
   d["volume_after_mm3"] = x.volume_after_mm3;
   d["fold_free"] = result.fold_free;
+  // How the faces meet along each shared edge, after and before (brep::edge_continuity).
+  py::list edges;
+  for (std::size_t k = 0; k < x.continuity_after.edges.size(); ++k) {
+    const auto& e = x.continuity_after.edges[k];
+    py::dict one;
+    one["edge"] = e.edge;
+    one["faces"] = py::make_tuple(e.face_a, e.face_b);
+    one["gap_mm"] = e.gap_mm;
+    one["angle_deg"] = e.angle_deg;
+    one["relative_curvature_jump"] = e.relative_curvature_jump;
+    if (k < x.continuity_before.edges.size()) {
+      one["angle_deg_before"] = x.continuity_before.edges[k].angle_deg;
+      one["relative_curvature_jump_before"] = x.continuity_before.edges[k].relative_curvature_jump;
+    }
+    edges.append(one);
+  }
+  d["continuity"] = edges;
   d["message"] = x.brief();
   return py::make_tuple(std::move(result.model), d);
 }

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import json
 import subprocess
 from pathlib import Path
 
@@ -45,11 +46,26 @@ def test_deform_model_as_the_command_does(examples: Path, exe: str, tmp_path: Pa
     model, _ = cf.read_model(examples / "models" / "block.step")
     lifted, report = recipe.deform_model(model, "lift")
     assert report["faces_exact"] > 0 and report["fold_free"] and report["max_edge_gap_mm"] < 1e-6
+    # A smooth map composed exactly keeps every tangent edge tangent (the fillets), and every
+    # sharp one sharp.
+    assert len(report["continuity"]) == 42
+    for edge in report["continuity"]:
+        if edge["angle_deg_before"] < 1e-6:
+            assert edge["angle_deg"] < 1e-6
+        else:
+            assert edge["angle_deg"] > 1
     assert lifted.volume_mm3() > model.volume_mm3()  # the lattice raises the top
     lifted.write(tmp_path / "py.step")
     subprocess.run([exe, "deform", str(examples / "models" / "block.step"), "--recipe",
                     str(examples / "recipes" / "block_model.json"), "--deformation", "lift",
                     "--out", str(tmp_path / "cli"), "--quiet"], check=True)
+    # The command's report.json carries the same continuity, per edge with the source's figures.
+    written = json.loads((tmp_path / "cli" / "report.json").read_text())["model"]["continuity"]
+    assert written["shared_edges"] == 42 and len(written["edges"]) == 42
+    for edge, ours_edge in zip(written["edges"], report["continuity"]):
+        assert edge["edge"] == ours_edge["edge"]
+        assert edge["angle_deg"] == pytest.approx(ours_edge["angle_deg"], abs=1e-9)
+        assert edge["before"]["angle_deg"] == pytest.approx(ours_edge["angle_deg_before"], abs=1e-9)
     ours, _ = cf.read_model(tmp_path / "py.step")
     theirs, _ = cf.read_model(tmp_path / "cli" / "block.step")
     assert ours.counts == theirs.counts

@@ -52,19 +52,20 @@ struct EdgeContinuity {
 /// The continuity of every edge two faces (or one face, twice: a seam) use, in edge order.
 struct CLAY_BREP_API ContinuityReport {
   std::vector<EdgeContinuity> edges;
-  int boundary_edges = 0;    ///< edges used once (a sheet's border): nothing to compare
-  int degenerate_edges = 0;  ///< poles: no direction across them
+  int boundary_edges = 0;      ///< edges used once (a sheet's border): nothing to compare
+  int degenerate_edges = 0;    ///< poles: no direction across them
+  int non_manifold_edges = 0;  ///< edges used three times or more: which two faces meet there is
+                               ///< not defined, so they are counted, not measured
   double max_gap_mm = 0, max_angle_deg = 0, max_relative_curvature_jump = 0;
 
   /// One line: "12 shared edges: gap <= 1.2e-07 mm, angle <= 90 deg, relative curvature jump
-  /// <= 1 (3 boundary, 2 degenerate edges)".
+  /// <= 1 (3 boundary, 2 degenerate edges)", and the non-manifold edges when there are any.
   std::string brief() const;
 };
 
 /// Measures how the faces meet along every edge used twice. Throws clay::Error: InvalidArgument
 /// for bad options; InvalidGeometry when a face's surface, an edge's curve or a pcurve is invalid
-/// or an index is out of range (problems(model) names them), or when an edge is used more than
-/// twice (a non-manifold edge: which two faces to compare is not defined).
+/// or an index is out of range (problems(model) names them).
 CLAY_BREP_API ContinuityReport edge_continuity(const Model& model,
                                                const ContinuityOptions& options = {});
 

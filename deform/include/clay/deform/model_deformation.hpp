@@ -18,6 +18,7 @@
 /// - A mirroring stack (det DF < 0) turns solids inside out: detected by the sign of each solid's
 ///   volume, whose faces are then reversed.
 /// - An assembly is flattened first (brep::flattened): each placed instance deforms on its own.
+#include <clay/brep/continuity.hpp>
 #include <clay/brep/model.hpp>
 #include <clay/deform/export.hpp>
 #include <clay/deform/stack.hpp>
@@ -72,6 +73,11 @@ struct CLAY_DEFORM_API ModelDeformationReport {
   /// (exactly for exact results; within the refits' bounds otherwise).
   bool volume_ratio_bounded = false;
   double volume_ratio_min = 1, volume_ratio_max = 1;
+  /// How the faces meet along their shared edges (brep::edge_continuity), of the flattened model
+  /// before and of the result, the same edges in the same order: an exact composition keeps each
+  /// edge's continuity (a smooth map keeps tangency), a face-by-face refit can open a tangent
+  /// edge, and this says where and by how much (issue #38).
+  brep::ContinuityReport continuity_before, continuity_after;
   /// Converged, or Failed with the problems of the result; message = brief().
   Summary summary;
   /// One line: "42 faces: 30 exact, 0 refit, 12 untouched; 104 edges ...; edge gap 2e-12 mm;
