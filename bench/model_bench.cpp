@@ -4,6 +4,7 @@
 // BRepCheck; target: under 1 s on 2 cores). The reference, in the
 // same run: OpenCASCADE's own affine map of the same solid, BRepBuilderAPI_GTransform (with
 // geometry copies), against deform_model with an affine lattice.
+#include <clay/brep/continuity.hpp>
 #include <clay/brep/volume.hpp>
 #include <clay/deform/model_deformation.hpp>
 #include <clay/occt/model_exchange.hpp>
@@ -115,6 +116,15 @@ void BM_ValidateInvariants(benchmark::State& state) {
   faces_counter(state);
 }
 
+/// How the faces meet along every shared edge (brep::edge_continuity, issue #38): deform_model
+/// measures it twice, before and after, so this is its share of BM_DeformExact.
+void BM_EdgeContinuity(benchmark::State& state) {
+  plate();  // read once, outside the timing
+  for (auto _ : state) benchmark::DoNotOptimize(brep::edge_continuity(plate()));
+  faces_counter(state);
+  state.counters["shared_edges"] = static_cast<double>(brep::edge_continuity(plate()).edges.size());
+}
+
 void BM_ValidateBRepCheck(benchmark::State& state) {
   plate();  // read once, outside the timing
   const auto deformed = deform::deform_model(bent_stack(), plate()).model;
@@ -157,6 +167,7 @@ BENCHMARK(BM_DeformAffine)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_OcctGTransformAffine)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ValidateInvariants)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ValidateBRepCheck)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_EdgeContinuity)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Write)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Pipeline)->Unit(benchmark::kMillisecond);
 BENCHMARK_MAIN();
