@@ -10,6 +10,7 @@ import { tmpdir, cpus } from 'node:os';
 import { dirname, join, resolve } from 'node:path';
 import { backProject, dist, distanceToCurve, surfaceAt, surfaceDomain } from './geometry.mjs';
 import { launchBrowser, startStudio, studioPage } from './studio_driver.mjs';
+import { checker } from './checks.mjs';
 
 export const here = dirname(fileURLToPath(import.meta.url));
 
@@ -127,17 +128,7 @@ export async function openHarness(parts) {
 
   const results = [];
   const figures = {};
-  async function check(name, fn) {
-    const t0 = Date.now();
-    try {
-      const note = await fn();
-      results.push(true);
-      console.log(`ok - ${name}${note ? ` (${note})` : ''} [${Date.now() - t0} ms]`);
-    } catch (e) {
-      results.push(false);
-      console.log(`not ok - ${name}\n    ${String(e && e.stack ? e.stack : e).split('\n').slice(0, 5).join('\n    ')}`);
-    }
-  }
+  const check = checker(results, 5);
 
   const browser = await launchBrowser(executablePath);
   const page = await browser.newPage({ viewport: { width: 1280, height: 800 } });

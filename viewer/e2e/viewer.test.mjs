@@ -17,6 +17,7 @@ import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 import { makeFixture, makePlate, DOME, DEVIATION_MAX } from './make_fixture.mjs';
 import { decodePng, differingPixels } from './png.mjs';
+import { checker } from './checks.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const args = process.argv.slice(2);
@@ -131,17 +132,7 @@ const base = `http://127.0.0.1:${server.address().port}/`;
 
 // ------------------------------------------------------------------ the tests
 const results = [];
-async function check(name, fn) {
-  const t0 = Date.now();
-  try {
-    const note = await fn();
-    results.push(true);
-    console.log(`ok - ${name}${note ? ` (${note})` : ''} [${Date.now() - t0} ms]`);
-  } catch (e) {
-    results.push(false);
-    console.log(`not ok - ${name}\n    ${String(e && e.stack ? e.stack : e).split('\n').slice(0, 4).join('\n    ')}`);
-  }
-}
+const check = checker(results, 4);
 function assert(cond, message) {
   if (!cond) throw new Error(message);
 }

@@ -447,8 +447,6 @@ std::string WebServer::url() const {
 
 asio::io_context& WebServer::io() noexcept { return impl_->io; }
 
-bool WebServer::stopping() const noexcept { return impl_->stopping; }
-
 void WebServer::run() {
   impl_->accept_next();
   // A handler that throws (it should not: each answers its own errors) ends that handler, not

@@ -93,7 +93,6 @@ class WebServer {
   const std::string& token() const;        ///< the token every request must carry
   std::string url() const;                 ///< "http://HOST:PORT/?token=TOKEN"
   boost::asio::io_context& io() noexcept;  ///< the I/O thread's context (post to it)
-  bool stopping() const noexcept;          ///< stop() was called
   void run();   ///< accepts and serves in this thread until stop(); handlers that throw are logged
   void stop();  ///< from any thread: closes the acceptor and every connection not upgraded
 
