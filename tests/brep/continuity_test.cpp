@@ -96,7 +96,7 @@ TEST_CASE("continuity: the filleted block's fillets are tangent (G1, not G2), it
   CHECK(r.boundary_edges == 0);  // a closed solid
 }
 
-TEST_CASE("continuity: a sphere's seam is smooth; its poles have no direction across",
+TEST_CASE("continuity: a sphere's seam is smooth, its poles have no direction across",
           "[brep][continuity]") {
   const Model sphere = clay::test::read_test_model(
       TestModel::Sphere, clay::test::test_output("brep-continuity", "sphere.step"));
@@ -110,7 +110,7 @@ TEST_CASE("continuity: a sphere's seam is smooth; its poles have no direction ac
 }
 
 TEST_CASE(
-    "continuity: bad options and broken models are refused, named; non-manifold edges "
+    "continuity: bad options and broken models are refused, named, non-manifold edges "
     "counted",
     "[brep][continuity]") {
   ContinuityOptions o;

@@ -358,7 +358,7 @@ TEST_CASE("deform_model: max_degree refits exact results above it, certified") {
   CHECK(clay::brep::check_model(result.model).valid);
 }
 
-TEST_CASE("deform_model: only the chosen faces deform; a shared edge that would tear is refused") {
+TEST_CASE("deform_model: only the chosen faces deform, a shared edge that would tear is refused") {
   // The pair: a box [0, 20]^3 (faces 0-5) and a sphere at (50, 10, 10). A lattice over both,
   // with only the sphere chosen: the box stays bit for bit.
   const Model pair = read(TestModel::Separated, "pair-chosen.step");

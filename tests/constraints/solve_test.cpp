@@ -624,7 +624,7 @@ TEST_CASE("SolveOptions lists every bad field", "[solve]") {
   CHECK_THROWS_AS(o.validate(), clay::Error);
 }
 
-TEST_CASE("a constraint is a typed requirement; the factories and the structs build the same",
+TEST_CASE("a constraint is a typed requirement, the factories and the structs build the same",
           "[constraints]") {
   const PointId a{0}, b{1};
   const Constraint made = distance(a, b, 12.5);

@@ -39,7 +39,7 @@ TEST_CASE("binomial: Pascal's rows against the product formula and the row sums 
 }
 
 TEST_CASE(
-    "gauss_legendre: n points integrate x^k exactly for k <= 2n - 1; the 8-point constants agree") {
+    "gauss_legendre: n points integrate x^k exactly for k <= 2n - 1, the 8-point constants agree") {
   for (int n = 1; n <= 20; ++n) {
     const internal::GaussRule rule = internal::gauss_legendre(n);
     for (int k = 0; k <= 2 * n - 1; ++k) {
