@@ -264,19 +264,28 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
   // How each deformed surface was computed: exact composition or certified refit, and how close.
   for (const auto& step : result.steps) {
     const clay::recipe::Figure* mode = nullptr;
-    double relative = -1, mm = -1;
+    double relative = -1, mm = -1, accumulated = -1;
+    long long exact_points = 0;
     for (const auto& [name, value] : step.figures) {
       if (name == "composition") mode = &value;
       if (name == "max_relative_deviation" && std::holds_alternative<double>(value))
         relative = std::get<double>(value);
       if (name == "max_deviation_mm" && std::holds_alternative<double>(value))
         mm = std::get<double>(value);
+      if (name == "accumulated_bound_mm" && std::holds_alternative<double>(value))
+        accumulated = std::get<double>(value);
+      if (name == "exact_control_points" && std::holds_alternative<long long>(value))
+        exact_points = std::get<long long>(value);
     }
-    if (mode && relative >= 0)
-      std::printf("  %s (%s): %s composition, max deviation %.2g of the size (%.2g mm)\n",
+    if (mode && relative >= 0) {
+      std::printf("  %s (%s): %s composition, max deviation %.2g of the size (%.2g mm)",
                   step.path.c_str(), step.kind.c_str(), std::get<std::string>(*mode).c_str(),
                   relative, mm);
-    if (step.kind == "editable") std::printf("  %s: %s\n", step.path.c_str(), step.message.c_str());
+      if (exact_points > 0) std::printf(" instead of %lld exact control points", exact_points);
+      if (accumulated >= 0) std::printf(", within %.2g mm of the exact result", accumulated);
+      std::printf("\n");
+    }
+    if (step.kind == "light") std::printf("  %s: %s\n", step.path.c_str(), step.message.c_str());
   }
   // Warnings reach the user whether or not progress is shown (a script's run has no terminal).
   for (const auto& step : result.steps)

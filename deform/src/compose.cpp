@@ -18,10 +18,12 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
 #include "bernstein_poly.hpp"
+#include "compose_size.hpp"
 #include "lattice_monomials.hpp"
 #include "messages.hpp"
 #include "patch_containment.hpp"
@@ -436,13 +438,12 @@ double largest_homogeneous_point(const BSplineSurface& s) {
 
 // ---- the pipeline shared by the entry points ------------------------------------------------
 
-[[noreturn]] void throw_degree(int du, int dv, int max_degree, const std::string& what,
-                               const std::string& ways_out) {
-  throw Error(
-      ErrorCategory::DegreeLimit,
-      "compose_exact: the exact composition " + what + " has degree (" + std::to_string(du) + ", " +
-          std::to_string(dv) + "), above the limit " + std::to_string(max_degree) +
-          " (ComposeOptions::max_degree; 25 is OpenCASCADE's and most CAD systems'); " + ways_out);
+/// Why an exact composition is refused for its degree: the patch, its degree and the ways out.
+std::string degree_message(int du, int dv, int max_degree, const std::string& what,
+                           const std::string& ways_out) {
+  return "compose_exact: the exact composition " + what + " has degree (" + std::to_string(du) +
+         ", " + std::to_string(dv) + "), above the limit " + std::to_string(max_degree) +
+         " (ComposeOptions::max_degree; 25 is OpenCASCADE's and most CAD systems'); " + ways_out;
 }
 
 /// Joins composed patches, removes knots, measures the deviation against `pointwise`.
@@ -598,13 +599,14 @@ std::vector<double> roots(const std::vector<double>& b) {
 
 /// Splits `surface` where a local coordinate that depends on one surface parameter only crosses
 /// an interior knot plane of the lattice (HHK lattices meet the surface along iso-lines there):
-/// knots inserted to full multiplicity. Returns the split surface and the number of knots added.
-std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface,
-                                               const BSplineLattice& lattice,
-                                               const std::array<std::vector<double>, 3>& breaks) {
+/// knots inserted to full multiplicity. Returns the split surface, the number of knots added and
+/// every crossing (also those at existing breaks, where nothing is inserted).
+std::tuple<BSplineSurface, int, detail::PlaneCrossings> split_at_planes(
+    const BSplineSurface& surface, const BSplineLattice& lattice,
+    const std::array<std::vector<double>, 3>& breaks) {
   const auto dual = dual_vectors(lattice.frame);
   const auto bp = surface::extract_bezier(surface);
-  std::array<std::vector<double>, 2> cuts;
+  std::array<std::vector<double>, 2> cuts, at_breaks;
   for (int a = 0; a < bp.count_u(); ++a)
     for (int b = 0; b < bp.count_v(); ++b) {
       const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
@@ -649,6 +651,11 @@ std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface,
               if (t - x0 > 1e-13 * (x1 - x0) && x1 - t > 1e-13 * (x1 - x0))
                 cuts[static_cast<size_t>(dir)].push_back(t);
             }
+            // A crossing at the patch's own ends (an existing break) splits nothing, but the
+            // composition is only as smooth as the lattice there (compose_size.hpp).
+            for (const auto& [end, t] : {std::pair{h.front(), x0}, std::pair{h.back(), x1}})
+              if (std::abs(end) <= 1e-10 * pc.c_scale * pc.w_scale)
+                at_breaks[static_cast<size_t>(dir)].push_back(t);
           }
         }
       }
@@ -677,7 +684,11 @@ std::pair<BSplineSurface, int> split_at_planes(const BSplineSurface& surface,
       added += p - have;
     }
   }
-  return {out, added};
+  for (int dir = 0; dir < 2; ++dir)
+    cuts[static_cast<size_t>(dir)].insert(cuts[static_cast<size_t>(dir)].end(),
+                                          at_breaks[static_cast<size_t>(dir)].begin(),
+                                          at_breaks[static_cast<size_t>(dir)].end());
+  return {out, added, cuts};
 }
 
 }  // namespace
@@ -704,6 +715,9 @@ std::vector<std::string> ComposeOptions::problems() const {
     out.push_back("ComposeOptions: max_degree = " + std::to_string(max_degree) +
                   " breaks the rule 1 <= max_degree <= " + std::to_string(kMaxComposeDegree) +
                   "; give the receiver's limit, e.g. 25 (OpenCASCADE) or 15 (CATIA's order 16)");
+  if (max_control_points < 0)
+    out.push_back("ComposeOptions: max_control_points = " + std::to_string(max_control_points) +
+                  " breaks the rule max_control_points >= 0; give e.g. 10000, or 0 for no limit");
   return out;
 }
 
@@ -732,6 +746,8 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
   const LatticeMonomials monomials = detail::lattice_monomials(lattice);
   const int np = static_cast<int>(bp.patches.size());
   std::vector<std::array<Factor, 3>> factors(static_cast<size_t>(np));
+  std::vector<std::pair<int, int>> degrees(factors.size());
+  std::string too_high;  // the first patch above max_degree
   for (int a = 0; a < bp.count_u(); ++a)
     for (int b = 0; b < bp.count_v(); ++b) {
       const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
@@ -741,8 +757,9 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
       auto& f = factors[static_cast<size_t>(a * bp.count_v() + b)];
       f = cell_factors(pc, {0, 0, 0}, {1, 1, 1});
       const auto [du, dv] = composition_degrees(f, lattice, monomials);
-      if (std::max(du, dv) > options.max_degree)
-        throw_degree(
+      degrees[static_cast<size_t>(a * bp.count_v() + b)] = {du, dv};
+      if (std::max(du, dv) > options.max_degree && too_high.empty())
+        too_high = degree_message(
             du, dv, options.max_degree,
             "of surface " + patch_name(bp, a, b) + " (degree " + std::to_string(surface.u.degree) +
                 " x " + std::to_string(surface.v.degree) + ") with a Bézier lattice of degrees (" +
@@ -751,6 +768,7 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
             "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
             "the deformed surface with a refit tolerance (certified refit)");
     }
+  detail::check_size(detail::predicted_size(surface, bp, degrees), options, too_high);
   std::vector<ComposedPatch> patches(static_cast<size_t>(np));
   for (size_t k = 0; k < patches.size(); ++k)
     patches[k] = compose_cell(lattice, monomials, factors[k], rational);
@@ -766,13 +784,15 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
   validate(lattice, "compose_exact: B-spline lattice");
   surface::validate(surface, "compose_exact: surface");
   const BezierCells cells = bezier_cells(lattice);
-  const auto [split, splits] = split_at_planes(surface, lattice, cells.breaks);
+  const auto [split, splits, planes] = split_at_planes(surface, lattice, cells.breaks);
   const bool rational = split.is_rational();
   const auto bp = surface::extract_bezier(split);
   const auto dual = dual_vectors(lattice.frame);
   const auto counts = cells.counts();
   std::vector<std::array<Factor, 3>> factors(static_cast<size_t>(bp.patches.size()));
   std::vector<const BezierLattice*> cell_of(bp.patches.size());
+  std::vector<std::pair<int, int>> degrees(bp.patches.size());
+  std::string too_high;  // the first patch above max_degree
   // Each cell's monomials, found once for all the patches in it.
   std::map<const BezierLattice*, LatticeMonomials> monomials_of;
   for (int a = 0; a < bp.count_u(); ++a)
@@ -843,8 +863,9 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
         known = monomials_of.emplace(cell_of[k], detail::lattice_monomials(*cell_of[k])).first;
       factors[k] = cell_factors(pc, lo, width);
       const auto [du, dv] = composition_degrees(factors[k], *cell_of[k], known->second);
-      if (std::max(du, dv) > options.max_degree)
-        throw_degree(
+      degrees[k] = {du, dv};
+      if (std::max(du, dv) > options.max_degree && too_high.empty())
+        too_high = degree_message(
             du, dv, options.max_degree,
             "of surface " + patch_name(bp, a, b) + " with a B-spline lattice of degrees (" +
                 std::to_string(lattice.bases[0].degree) + ", " +
@@ -853,6 +874,9 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
             "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
             "the deformed surface with a refit tolerance (certified refit)");
     }
+  detail::check_size(
+      detail::predicted_size(surface, bp, degrees, planes, detail::lattice_continuity(lattice)),
+      options, too_high);
   std::vector<ComposedPatch> patches(bp.patches.size());
   for (size_t k = 0; k < patches.size(); ++k)
     patches[k] = compose_cell(*cell_of[k], monomials_of.at(cell_of[k]), factors[k], rational);
@@ -882,6 +906,7 @@ ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface,
   };
   const auto bp = surface::extract_bezier(surface);
   std::vector<ComposedPatch> patches(bp.patches.size());
+  std::vector<std::pair<int, int>> degrees(bp.patches.size());
   for (int a = 0; a < bp.count_u(); ++a)
     for (int b = 0; b < bp.count_v(); ++b) {
       const PatchCoordinates pc =
@@ -934,13 +959,16 @@ ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface,
         WD = std::move(wp.back());
       }
       const int du = R.du + eu, dv = R.dv + ev;
+      degrees[static_cast<size_t>(a * bp.count_v() + b)] = {du, dv};
       if (std::max(du, dv) > options.max_degree)
-        throw_degree(
-            du, dv, options.max_degree,
-            "of surface " + patch_name(bp, a, b) + " with a taper profile of degree " +
-                std::to_string(D),
-            "use a taper profile of lower degree, or approximate the deformed surface with a "
-            "refit tolerance (certified refit)");
+        detail::check_size(
+            {du, dv, 0}, options,
+            degree_message(
+                du, dv, options.max_degree,
+                "of surface " + patch_name(bp, a, b) + " with a taper profile of degree " +
+                    std::to_string(D),
+                "use a taper profile of lower degree, or approximate the deformed surface with a "
+                "refit tolerance (certified refit)"));
       Poly rxy = multiply(xy, R), wzw = multiply(zw, WD);
       scale(rxy, true);
       scale(wzw, true);
@@ -957,6 +985,8 @@ ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface,
         }
       patches[static_cast<size_t>(a * bp.count_v() + b)] = std::move(out);
     }
+  // A taper's patches are cheap to compose; the joined net is checked before it is built.
+  detail::check_size(detail::predicted_size(surface, bp, degrees), options, "");
   const auto box = surface::control_box(surface);
   return finish(
       bp, patches, rational, surface,

@@ -8,17 +8,43 @@
 #include <clay/surface/evaluate.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <sstream>
 #include <variant>
 
+#include "certifier.hpp"
+#include "compose_size.hpp"
 #include "messages.hpp"
 
 namespace clay::deform {
+
+RefitOptions Budget::light_fit() {
+  RefitOptions o;
+  o.keep_breakpoints = false;
+  return o;
+}
+
+std::vector<std::string> Budget::problems() const {
+  std::vector<std::string> out;
+  if (max_degree < 1 || max_degree > 25)
+    out.push_back("Budget: max_degree = " + std::to_string(max_degree) +
+                  " breaks the rule 1 <= max_degree <= 25; give e.g. 15 (CATIA's order 16)");
+  if (max_control_points < 1)
+    out.push_back("Budget: max_control_points = " + std::to_string(max_control_points) +
+                  " breaks the rule max_control_points >= 1; give e.g. 10000");
+  for (const std::string& p : light.problems()) out.push_back("Budget::light: " + p);
+  return out;
+}
 
 std::vector<std::string> SurfaceDeformationOptions::problems() const {
   std::vector<std::string> out;
   internal::append(out, compose.problems());
   if (refit) internal::append(out, refit->problems());
+  if (budget) internal::append(out, budget->problems());
+  if (!(input_bound_mm >= 0))
+    out.push_back("SurfaceDeformationOptions: input_bound_mm = " + detail::format(input_bound_mm) +
+                  " breaks the rule input_bound_mm >= 0 (inf when unknown)");
   return out;
 }
 
@@ -41,6 +67,13 @@ std::string SurfaceDeformationReport::brief() const {
       case StepOutcome::Method::Refit:
         out << ": refit, " << s.refit.brief();
         break;
+      case StepOutcome::Method::Light:
+        out << ": light form of the exact degree " << s.exact_size.degree_u << " x "
+            << s.exact_size.degree_v;
+        if (s.exact_size.control_points > 0)
+          out << ", " << s.exact_size.control_points << " control points";
+        out << ", " << s.refit.brief();
+        break;
     }
     out << "\n";
   }
@@ -49,6 +82,7 @@ std::string SurfaceDeformationReport::brief() const {
       << (exact       ? "exact"
           : certified ? "certified refit"
                       : "refit (not certified)");
+  if (!exact) out << ", within " << detail::format(accumulated_bound_mm, 3) << " mm of the exact";
   return out.str();
 }
 
@@ -70,17 +104,20 @@ struct Attempt {
   std::optional<ComposeResult> result;
   std::string reason;
   ErrorCategory category = ErrorCategory::InvalidArgument;
+  std::optional<ExactSize> size;  ///< refused for its size: what it would have been
 };
 
 template <class F>
 Attempt attempt(F compose) {
   try {
-    return {compose(), {}, {}};
+    return {compose(), {}, {}, {}};
+  } catch (const detail::ExactSizeError& e) {
+    return {std::nullopt, e.what(), e.category(), e.size()};
   } catch (const Error& e) {
     const ErrorCategory c = e.category();
     if (c == ErrorCategory::DegreeLimit || c == ErrorCategory::OutOfDomain ||
         c == ErrorCategory::InvalidArgument)
-      return {std::nullopt, e.what(), c};
+      return {std::nullopt, e.what(), c, {}};
     throw;
   }
 }
@@ -95,7 +132,8 @@ Attempt try_exact(const Deformation& d, const surface::BSplineSurface& s, const 
             return Attempt{std::nullopt,
                            "a " + std::string(kind_name(d)) +
                                " is not polynomial, so no NURBS equals the deformed surface",
-                           ErrorCategory::InvalidArgument};
+                           ErrorCategory::InvalidArgument,
+                           {}};
           }},
       d);
 }
@@ -221,9 +259,25 @@ void refuse_torn(const Deformation& d, const surface::BSplineSurface& s, const R
           "points at rest");
 }
 
-RefitResult refit_step(const Deformation& d, const surface::BSplineSurface& s,
-                       const RefitOptions& o) {
-  return refit_deformed(d, s, o);
+/// sup |D'| over the control box of `s` grown by `margin` (mm) on every side: a box that holds
+/// every point within `margin` of the surface, and the segments to them (certifier.hpp); inf
+/// when the kind has no derivative bounds.
+double lipschitz(const Deformation& d, const surface::BSplineSurface& s, double margin) {
+  const detail::Certifier c = std::visit([](const auto& k) { return detail::certifier(k); }, d);
+  if (!c.info) return std::numeric_limits<double>::infinity();
+  const auto [lo, hi] = surface::control_box(s);
+  Points3 corners(8, 3);
+  for (int k = 0; k < 8; ++k)
+    for (int a = 0; a < 3; ++a) corners(k, a) = (k >> a & 1) ? hi[a] + margin : lo[a] - margin;
+  return c.info(corners).bounds.first;
+}
+
+/// The bound ledger (StepOutcome::accumulated_bound_mm): E = e + L·E_in.
+double accumulated(const Deformation& d, const surface::BSplineSurface& input, double e,
+                   double in) {
+  if (in == 0) return e;
+  if (!std::isfinite(in) || !std::isfinite(e)) return std::numeric_limits<double>::infinity();
+  return e + lipschitz(d, input, in) * in;
 }
 
 }  // namespace
@@ -236,6 +290,7 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
   validate(stack);
   SurfaceDeformationResult out{surface, {}};
   SurfaceDeformationReport& report = out.report;
+  double bound = options.input_bound_mm;  // the ledger: how far from the exact reference
   for (size_t i = 0; i < stack.steps.size(); ++i) {
     const DeformationStep& step = stack.steps[i];
     StepOutcome o;
@@ -243,14 +298,49 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
     o.kind = std::string(kind_name(step.deformation));
     o.name = step.name;
     if (!step.enabled) {
+      o.accumulated_bound_mm = bound;
       report.steps.push_back(std::move(o));
       continue;
     }
-    Attempt a = try_exact(step.deformation, out.surface, options.compose);
+    ComposeOptions within = options.compose;
+    if (options.budget) {
+      within.max_degree = std::min(within.max_degree, options.budget->max_degree);
+      within.max_control_points = options.budget->max_control_points;
+    }
+    Attempt a = try_exact(step.deformation, out.surface, within);
+    const surface::BSplineSurface& input = out.surface;
     if (a.result) {
       o.method = StepOutcome::Method::Exact;
       o.compose = a.result->report;
+      o.accumulated_bound_mm = accumulated(step.deformation, input, 0, bound);
       out.surface = std::move(a.result->surface);
+    } else if (a.size && options.budget) {
+      const std::string where = "deform_surface: steps[" + std::to_string(i) + "] (" + o.kind +
+                                (o.name.empty() ? "" : " '" + o.name + "'") + ")";
+      refuse_torn(step.deformation, input, options.budget->light, where);
+      RefitResult r = refit_deformed(step.deformation, input, options.budget->light);
+      if (!r.report.summary.converged() && !options.accept_out_of_tolerance)
+        throw Error(ErrorCategory::ToleranceNotMet,
+                    where + ": its exact form (degree " + std::to_string(a.size->degree_u) + " x " +
+                        std::to_string(a.size->degree_v) +
+                        (a.size->control_points > 0
+                             ? ", " + std::to_string(a.size->control_points) + " control points"
+                             : std::string()) +
+                        ") is above the budget, and its light form misses its tolerance: " +
+                        r.report.summary.message +
+                        ". Loosen the light form's tolerance, allow it more control points, or "
+                        "raise the budget to keep the exact form");
+      o.method = StepOutcome::Method::Light;
+      o.reason = std::move(a.reason);
+      o.exact_size = *a.size;
+      o.refit = r.report;
+      o.bound_mm = r.report.certified ? r.report.certified_bound_mm
+                                      : std::numeric_limits<double>::infinity();
+      o.accumulated_bound_mm = accumulated(step.deformation, input, o.bound_mm, bound);
+      report.exact = false;
+      report.certified = report.certified && r.report.certified;
+      ++report.light_steps;
+      out.surface = std::move(r.surface);
     } else {
       const std::string where = "deform_surface: steps[" + std::to_string(i) + "] (" + o.kind +
                                 (o.name.empty() ? "" : " '" + o.name + "'") + ")";
@@ -260,7 +350,7 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
                         ". Allow a certified refit (SurfaceDeformationOptions::refit) to "
                         "approximate this step within a tolerance");
       refuse_torn(step.deformation, out.surface, *options.refit, where);
-      RefitResult r = refit_step(step.deformation, out.surface, *options.refit);
+      RefitResult r = refit_deformed(step.deformation, out.surface, *options.refit);
       if (!r.report.summary.converged() && !options.accept_out_of_tolerance)
         throw Error(ErrorCategory::ToleranceNotMet,
                     where + " misses its tolerance: the refit's " + r.report.summary.message +
@@ -269,18 +359,25 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
       o.method = StepOutcome::Method::Refit;
       o.reason = std::move(a.reason);
       o.refit = r.report;
+      o.bound_mm = r.report.certified ? r.report.certified_bound_mm
+                                      : std::numeric_limits<double>::infinity();
+      o.accumulated_bound_mm = accumulated(step.deformation, input, o.bound_mm, bound);
       report.exact = false;
       report.certified = report.certified && r.report.certified;
       out.surface = std::move(r.surface);
     }
+    bound = o.accumulated_bound_mm;
     report.steps.push_back(std::move(o));
   }
+  report.accumulated_bound_mm = bound;
   report.degree_u = out.surface.u.degree;
   report.degree_v = out.surface.v.degree;
   report.control_points = static_cast<long>(out.surface.points.rows());
   bool within = true;  // every refit within its tolerance (else it was accepted out of tolerance)
   for (const StepOutcome& o : report.steps)
-    within = within && (o.method != StepOutcome::Method::Refit || o.refit.summary.converged());
+    within = within &&
+             ((o.method != StepOutcome::Method::Refit && o.method != StepOutcome::Method::Light) ||
+              o.refit.summary.converged());
   report.summary.termination = within ? Termination::Converged : Termination::NotConverged;
   report.summary.message = report.brief();
   return out;

@@ -179,9 +179,9 @@ Composition RecipeChecker::composition(const Json& j, const std::string& path, C
           : Renamed{"tolerance", "relative_tolerance", "a fraction of the size"};
   if (!c_.object(j, path,
                  {"mode", "relative_tolerance", "tolerance_mm", "degree", "check_samples",
-                  "max_control_points", "accept_out_of_tolerance", "editable"},
+                  "max_control_points", "accept_out_of_tolerance", "budget"},
                  "a composition {\"mode\": \"exact\"|\"refit\", ...}",
-                 {renamed_tolerance, dropped_relative}))
+                 {renamed_tolerance, dropped_relative, renamed_editable}))
     return c;
   if (const Json* m = c_.member(j, path, "mode", false, ""))
     if (const auto k = c_.choice(*m, key_path(path, "mode"), {"exact", "refit"})) c.refit = *k == 1;
@@ -206,23 +206,31 @@ Composition RecipeChecker::composition(const Json& j, const std::string& path, C
   c.max_control_points =
       c_.integer_or(j, path, "max_control_points", c.max_control_points,
                     (c.degree + 1) * (c.degree + 1), limit::refit_control_points);
-  // Exchange-friendly output: surfaces above these limits are refitted at `degree` (bicubic by
-  // default), certified within `tolerance`, into at most max_control_points.
-  if (const Json* e = c_.member(j, path, "editable", false, "")) {
-    const std::string ep = key_path(path, "editable");
-    if (c_.object(*e, ep, {"max_degree", "max_control_points"},
-                  "an editable output {\"max_degree\": 9, \"max_control_points\": 10000}")) {
-      Editable ed;
-      ed.max_degree = c_.integer_or(*e, ep, "max_degree", ed.max_degree, 1, 25);
-      ed.max_control_points =
-          c_.integer_or(*e, ep, "max_control_points", ed.max_control_points,
+  // The budget (deform::Budget): within it exact, above it each step's certified light form at
+  // `degree` and the tolerance, in at most max_control_points; "none": exact whatever the size.
+  if (const Json* b = c_.member(j, path, "budget", false, "")) {
+    const std::string bp = key_path(path, "budget");
+    if (b->is_string() && *b == "none") {
+      c.budget.reset();
+    } else if (b->is_string()) {
+      c_.add(bp,
+             "expected \"none\" or a budget {\"max_degree\": 15, \"max_control_points\": "
+             "10000}, found " +
+                 found(*b));
+    } else if (c_.object(*b, bp, {"max_degree", "max_control_points"},
+                         "a budget {\"max_degree\": 15, \"max_control_points\": 10000} or "
+                         "\"none\"")) {
+      Budget budget = c.budget.value_or(Budget{});
+      budget.max_degree = c_.integer_or(*b, bp, "max_degree", budget.max_degree, 1, 25);
+      budget.max_control_points =
+          c_.integer_or(*b, bp, "max_control_points", budget.max_control_points,
                         (c.degree + 1) * (c.degree + 1), limit::refit_control_points);
-      if (c.degree > ed.max_degree)
-        c_.add(key_path(ep, "max_degree"),
-               "is " + std::to_string(ed.max_degree) + ", below the composition's \"degree\" " +
+      if (c.degree > budget.max_degree)
+        c_.add(key_path(bp, "max_degree"),
+               "is " + std::to_string(budget.max_degree) + ", below the composition's \"degree\" " +
                    std::to_string(c.degree) +
-                   " that editable surfaces are refitted at; raise it or lower \"degree\"");
-      c.editable = ed;
+                   " that light forms are fitted at; raise it or lower \"degree\"");
+      c.budget = budget;
     }
   }
   return c;

@@ -107,6 +107,10 @@ constexpr Renamed dropped_relative{
     "relative", "",
     "the tolerance's key says its unit: \"relative_tolerance\" (a fraction of the size, what "
     "\"relative\": true meant) or \"tolerance_mm\" (what \"relative\": false meant)"};
+// Issue #38: every result has a budget; "editable" (a final copy above its limits) became it.
+constexpr Renamed renamed_editable{
+    "editable", "budget",
+    "the same limits, now on every step: above them a step yields its certified light form"};
 // Weights beyond it overflow the homogeneous products (a bottle's neck with weights 1e300 read
 // back invalid); within it a weight ratio of 1e12 is still allowed.
 constexpr Range weight_range{limit::weight_min, limit::weight_max};

@@ -24,14 +24,17 @@
 
 namespace clay::recipe {
 
-/// The composition mode of deform surfaces.
-/// "editable": a deformed surface above these limits is refitted (certified, at the
-/// composition's degree and tolerance) into a net a surfacing tool can edit.
-struct Editable {
-  int max_degree = 9;
+/// "budget": how large an exact result may be (deform::Budget). Within it a lattice or taper step
+/// is composed exactly; above it the step yields its light form, a certified fit at the
+/// composition's degree and tolerance, and the exact net is never built; a surface that leaves
+/// the recipe above it (a style result) leaves as such a light copy. "none": exact whatever the
+/// size (up to the exchange degree 25).
+struct Budget {
+  int max_degree = 15;
   int max_control_points = 10000;
 };
 
+/// The composition mode of deform surfaces.
 struct Composition {
   bool refit = false;                ///< "refit": steps that cannot be exact are refitted
   double relative_tolerance = 1e-4;  ///< "relative_tolerance": a fraction of the size, or
@@ -40,7 +43,7 @@ struct Composition {
   int check_samples = 4;
   bool accept_out_of_tolerance = false;  ///< "accept_out_of_tolerance": keep a refit that misses
   int max_control_points = 40000;        // refit: the net may not grow beyond this (RefitOptions)
-  std::optional<Editable> editable;      ///< "editable": exchange-friendly output on request
+  std::optional<Budget> budget = Budget{};  ///< "budget"; empty: "none"
 };
 
 struct StrokeDef {

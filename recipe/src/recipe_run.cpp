@@ -65,9 +65,8 @@ class Runner {
     for (const auto& s : data_.surfaces) need_surface(s.name);
   }
 
-  /// Above these an exported surface gets a warning: few surfacing tools edit more.
-  static constexpr int editable_degree = 9;
-  static constexpr long editable_control_points = 10000;
+  /// Above the default budget an exported surface gets a warning: few surfacing tools edit more.
+  static constexpr Budget default_budget{};
 
   void exports() {
     for (const auto& e : data_.exports)
@@ -99,22 +98,18 @@ class Runner {
         // Exact results can be far beyond what surfacing tools edit: say so, per surface.
         for (std::size_t k = 0; k < x.surfaces.size(); ++k) {
           const BSplineSurface& f = x.surfaces[k];
-          if (std::max(f.u.degree, f.v.degree) <= editable_degree &&
-              f.points.rows() <= editable_control_points)
+          if (std::max(f.u.degree, f.v.degree) <= default_budget.max_degree &&
+              f.points.rows() <= default_budget.max_control_points)
             continue;
           rep.warning = true;
           rep.message +=
               "; surface '" + e.surfaces[k] + "' has degree " + std::to_string(f.u.degree) + " x " +
               std::to_string(f.v.degree) + " and " + std::to_string(f.points.rows()) +
-              " control points, more than most surfacing tools edit (degree " +
-              std::to_string(editable_degree) + ", " + std::to_string(editable_control_points) +
-              " control points): " +
-              (made_editable_.count(e.surfaces[k])
-                   ? std::string("this is its editable copy; loosen the composition's "
-                                 "tolerance (\"relative_tolerance\" or \"tolerance_mm\") for a "
-                                 "lighter one")
-                   : std::string("ask for \"composition\": {\"editable\": {}} to export a "
-                                 "certified bicubic copy"));
+              " control points, more than most surfacing tools edit (the default budget: degree " +
+              std::to_string(default_budget.max_degree) + ", " +
+              std::to_string(default_budget.max_control_points) +
+              " control points): give its composition a \"budget\" (not \"none\") to export a "
+              "certified light form";
         }
         result_.exports.push_back(std::move(x));
       });
@@ -142,13 +137,15 @@ class Runner {
       });
   }
 
-  /// One named surface deformed by a stack (the deform command and `deform` surfaces).
-  /// `final_surface` false: another definition builds on the result, which then stays exact
-  /// (an editable copy is made only of what leaves the recipe, so tolerances do not stack).
+  /// One named surface deformed by a stack (the deform command and `deform` surfaces), starting
+  /// the bound ledger at `input_bound` (how far `parent` may be from its exact reference). Steps
+  /// above the composition's budget yield their light form; a final surface (nothing is built on
+  /// it) still above the budget (a style result) leaves as a certified light copy.
   BSplineSurface deform(const BSplineSurface& parent, const StackDef& stack, const Composition& c,
-                        const std::string& path, const std::string& name,
-                        bool final_surface = true) {
+                        const std::string& path, const std::string& name, bool final_surface = true,
+                        double input_bound = 0) {
     BSplineSurface s = parent;
+    ledger_ = input_bound;
     for (std::size_t i = 0; i < stack.steps.size(); ++i) {
       const StepDef& step = stack.steps[i];
       const std::string p = path + ".steps[" + std::to_string(i) + "]";
@@ -168,28 +165,21 @@ class Runner {
         result_.stages.push_back(std::move(stage));
       });
     }
-    if (c.editable && final_surface &&
-        (std::max(s.u.degree, s.v.degree) > c.editable->max_degree ||
-         s.points.rows() > c.editable->max_control_points))
-      timed(path + ".composition.editable", "editable", [&](StepReport& rep) {
-        s = editable(s, c, name, rep);
-        made_editable_.insert(name);
-      });
+    if (c.budget && final_surface &&
+        (std::max(s.u.degree, s.v.degree) > c.budget->max_degree ||
+         s.points.rows() > c.budget->max_control_points))
+      timed(path + ".composition.budget", "light",
+            [&](StepReport& rep) { s = light_copy(s, c, name, rep); });
+    bound_of_[name] = ledger_;
     return s;
   }
 
-  /// The exchange-friendly copy of a deformed surface above the "editable" limits: refitted at
-  /// the composition's degree, certified within its tolerance, starting from the surface's rough
-  /// breakpoints only (deform::refit_surface), into at most max_control_points.
-  static BSplineSurface editable(const BSplineSurface& s, const Composition& c,
-                                 const std::string& name, StepReport& rep) {
-    deform::RefitOptions o;
-    o.degree = c.degree;
-    o.relative_tolerance = c.relative_tolerance;
-    o.tolerance_mm = c.tolerance_mm;
-    o.max_control_points = c.editable->max_control_points;
-    o.keep_breakpoints = false;
-    const deform::RefitResult r = deform::refit_surface(s, o);
+  /// The certified light copy of a final surface above the budget: refitted at the composition's
+  /// degree within its tolerance, from the surface's rough breakpoints only
+  /// (deform::refit_surface), into at most the composition's max_control_points.
+  BSplineSurface light_copy(const BSplineSurface& s, const Composition& c, const std::string& name,
+                            StepReport& rep) {
+    const deform::RefitResult r = deform::refit_surface(s, light_fit(c));
     const auto& f = r.report;
     rep.figures = {{"exact_degree_u", static_cast<long long>(s.u.degree)},
                    {"exact_degree_v", static_cast<long long>(s.v.degree)},
@@ -202,25 +192,46 @@ class Runner {
                    {"sampled_max_mm", f.sampled_max},
                    {"tolerance_mm", f.tolerance_mm},
                    {"size", f.size}};
-    rep.message = "surface '" + name + "' made editable: degree " + std::to_string(s.u.degree) +
-                  " x " + std::to_string(s.v.degree) + ", " + std::to_string(s.points.rows()) +
-                  " control points -> degree " + std::to_string(r.surface.u.degree) + " x " +
-                  std::to_string(r.surface.v.degree) + ", " +
-                  std::to_string(r.surface.points.rows()) + " control points, " + f.brief();
-    // An editable copy that misses its tolerance is a failure, unless the composition accepts
+    rep.message = "surface '" + name + "' above the budget (degree " +
+                  std::to_string(c.budget->max_degree) + ", " +
+                  std::to_string(c.budget->max_control_points) +
+                  " control points) leaves as its light form: degree " +
+                  std::to_string(s.u.degree) + " x " + std::to_string(s.v.degree) + ", " +
+                  std::to_string(s.points.rows()) + " control points -> degree " +
+                  std::to_string(r.surface.u.degree) + " x " + std::to_string(r.surface.v.degree) +
+                  ", " + std::to_string(r.surface.points.rows()) + " control points, " + f.brief();
+    ledger(rep, f.certified ? f.certified_bound_mm : std::numeric_limits<double>::infinity());
+    // A light copy that misses its tolerance is a failure, unless the composition accepts
     // refits out of tolerance: then it carries a warning, as a refitted step does.
     if (!f.summary.converged()) {
       if (!c.accept_out_of_tolerance)
         throw Error(ErrorCategory::ToleranceNotMet,
-                    "the editable copy of surface '" + name +
+                    "the light form of surface '" + name +
                         "' misses its tolerance: " + f.summary.message +
-                        "; raise \"editable\": {\"max_control_points\"} or the composition's "
-                        "tolerance (\"relative_tolerance\" or \"tolerance_mm\"), or raise "
-                        "\"max_degree\" to keep the exact surface");
+                        "; raise the composition's \"max_control_points\" or its tolerance "
+                        "(\"relative_tolerance\" or \"tolerance_mm\"), or raise \"budget\" "
+                        "(or set it to \"none\") to keep the exact surface");
       rep.warning = true;
       rep.message += "; accepted out of tolerance (\"accept_out_of_tolerance\": true)";
     }
     return r.surface;
+  }
+
+  /// The ledger after a step: `bound` (mm) added to it, and its figure on the step.
+  void ledger(StepReport& rep, double bound) {
+    ledger_ = ledger_ + bound;
+    ledger_figure(rep);
+  }
+  void ledger_figure(StepReport& rep) const {
+    if (std::isfinite(ledger_))
+      rep.figures.emplace_back("accumulated_bound_mm", ledger_);
+    else
+      rep.figures.emplace_back("accumulated_bound", std::string("unbounded"));
+  }
+  /// How far the named surface may be from its exact reference (mm; 0 when exact).
+  double bound_of(const std::string& name) const {
+    const auto it = bound_of_.find(name);
+    return it == bound_of_.end() ? 0.0 : it->second;
   }
 
   const BSplineSurface& surface_of(const std::string& name) const {
@@ -244,7 +255,10 @@ class Runner {
   std::map<std::string, std::size_t> curve_index_;
   std::set<std::size_t> sketches_built_;  // indices into data_.sketches
   std::set<std::string> building_;        // "curve NAME" / "surface NAME" being built
-  std::set<std::string> made_editable_;   // surfaces exported as their editable copy
+  // The bound ledger (issue #38): how far each surface, and the one being deformed, may be from
+  // its exact reference, the recipe with every step exact (mm; inf: not bounded).
+  std::map<std::string, double> bound_of_;
+  double ledger_ = 0;
 
   template <class F>
   void timed(const std::string& path, const std::string& kind, F&& f) {
@@ -491,7 +505,7 @@ class Runner {
           *std::find_if(data_.stacks.begin(), data_.stacks.end(),
                         [&](const StackDef& s) { return s.name == d->deformation; });
       BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name,
-                                !built_on(data_, def.name));
+                                !built_on(data_, def.name), bound_of(d->surface));
       result_.surfaces.emplace_back(def.name, std::move(s));
       return;
     }
@@ -597,6 +611,11 @@ class Runner {
               rep.figures.emplace_back("sampled_max_mm", r.sampled_max);
               rep.figures.emplace_back("tolerance_mm", r.tolerance_mm);
               rep.message = r.brief();
+              // A rebuild is the identity map: its bound adds to its parent's.
+              ledger_ = bound_of(b.surface);
+              ledger(rep,
+                     r.certified ? r.certified_bound_mm : std::numeric_limits<double>::infinity());
+              bound_of_[def.name] = ledger_;
               if (!r.summary.converged())
                 throw Error(ErrorCategory::ToleranceNotMet,
                             "the rebuilt net misses its tolerance (" + r.summary.message +
@@ -607,6 +626,7 @@ class Runner {
             } else if constexpr (std::is_same_v<T, MirrorDef>) {
               BSplineSurface m =
                   surface::mirrored(surface_of(b.surface), b.plane.origin, b.plane.normal);
+              bound_of_[def.name] = bound_of(b.surface);  // an isometry keeps the bound
               build_figures(surface::describe(m,
                                               "mirror of "
                                               " + b.surface + "
@@ -641,10 +661,13 @@ class Runner {
     }
   }
 
-  static BSplineSurface compose(const deform::Deformation& d, const BSplineSurface& s,
-                                const Composition& c, StepReport& rep) {
-    const auto r = deform::deform_surface(d, s, deformation_options(c));
+  BSplineSurface compose(const deform::Deformation& d, const BSplineSurface& s,
+                         const Composition& c, StepReport& rep) {
+    deform::SurfaceDeformationOptions options = deformation_options(c);
+    options.input_bound_mm = ledger_;
+    const auto r = deform::deform_surface(d, s, options);
     const auto& o = r.report.steps.front();
+    ledger_ = r.report.accumulated_bound_mm;
     auto sizes = [&] {
       rep.figures.emplace_back("degree_u", static_cast<long long>(r.surface.u.degree));
       rep.figures.emplace_back("degree_v", static_cast<long long>(r.surface.v.degree));
@@ -661,10 +684,20 @@ class Runner {
       rep.figures.emplace_back("patches", static_cast<long long>(o.compose.patches));
       rep.figures.emplace_back("size", o.compose.size);
       rep.message += ": exact, " + o.compose.brief();
+      if (ledger_ > 0) ledger_figure(rep);
     } else {
       const auto& f = o.refit;
       const double bound = f.certified ? f.certified_bound_mm : f.sampled_max;
-      rep.figures.emplace_back("composition", std::string("refit"));
+      const bool light = o.method == deform::StepOutcome::Method::Light;
+      rep.figures.emplace_back("composition", std::string(light ? "light" : "refit"));
+      if (light) {
+        rep.figures.emplace_back("exact_degree_u", static_cast<long long>(o.exact_size.degree_u));
+        rep.figures.emplace_back("exact_degree_v", static_cast<long long>(o.exact_size.degree_v));
+        if (o.exact_size.control_points > 0)
+          rep.figures.emplace_back("exact_control_points",
+                                   static_cast<long long>(o.exact_size.control_points));
+      }
+      ledger_figure(rep);
       rep.figures.emplace_back("max_relative_deviation", bound / f.size);
       rep.figures.emplace_back("max_deviation_mm", bound);
       sizes();
@@ -673,7 +706,8 @@ class Runner {
       rep.figures.emplace_back("tolerance_mm", f.tolerance_mm);
       rep.figures.emplace_back("sampled_max_mm", f.sampled_max);
       rep.figures.emplace_back("size", f.size);
-      rep.message += ": refit (" + o.reason + "), " + f.brief();
+      rep.message += light ? ": light form (" + light_reason(o, c) + "), " + f.brief()
+                           : ": refit (" + o.reason + "), " + f.brief();
       // A refit that misses its tolerance is a failure (deform_surface throws ToleranceNotMet),
       // unless the composition accepts it: then the step carries a warning.
       if (!f.summary.converged()) {
@@ -682,6 +716,18 @@ class Runner {
       }
     }
     return r.surface;
+  }
+
+  /// Why a step is light, in the recipe's words: the exact size against the budget.
+  static std::string light_reason(const deform::StepOutcome& o, const Composition& c) {
+    const deform::ExactSize& x = o.exact_size;
+    return "the exact form would have degree " + std::to_string(x.degree_u) + " x " +
+           std::to_string(x.degree_v) +
+           (x.control_points > 0
+                ? " and up to " + std::to_string(x.control_points) + " control points"
+                : std::string()) +
+           ", above the budget (degree " + std::to_string(c.budget->max_degree) + ", " +
+           std::to_string(c.budget->max_control_points) + " control points)";
   }
 
   BSplineSurface apply(const deform::Deformation& d, const BSplineSurface& s, const Composition& c,
@@ -724,6 +770,13 @@ class Runner {
                    {"control_points", static_cast<long long>(r.surface.points.rows())}};
     rep.message += ": " + x.message;
     rep.figures.emplace_back("outcome", std::string(x.summary.converged() ? "met" : "missed"));
+    if (ledger_ > 0) {  // the style of a light input is not the style of its exact reference
+      ledger_ = std::numeric_limits<double>::infinity();
+      ledger_figure(rep);
+      rep.message +=
+          "; its input is a light form, so its distance from the exact reference is "
+          "not bounded";
+    }
     if (!x.summary.converged()) {
       if (!d.accept_out_of_tolerance)
         throw Error(ErrorCategory::ToleranceNotMet,

@@ -26,6 +26,12 @@ inline std::string format(const char* fmt, double x) {
 
 /// The composition's settings as deform_surface's (the Runner and deform_model use them).
 deform::SurfaceDeformationOptions deformation_options(const Composition& c);
+/// A refit of a composition without a budget: its degree, tolerance and max_control_points,
+/// keeping the input's breakpoints.
+deform::RefitOptions fit_keeping_breakpoints(const Composition& c);
+/// The light form's fit of a composition: its degree and tolerance, from the input's rough
+/// breakpoints (deform::Budget::light_fit), within the budget's and max_control_points' nets.
+deform::RefitOptions light_fit(const Composition& c);
 
 /// The recipe's deformation stack named `deformation`, or its only one when the name is empty.
 const StackDef& pick_stack(const RecipeData& d, std::string_view deformation);

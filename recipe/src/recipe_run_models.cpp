@@ -28,16 +28,34 @@ namespace detail {
 deform::SurfaceDeformationOptions deformation_options(const Composition& c) {
   deform::SurfaceDeformationOptions o;
   o.compose.check_samples = c.check_samples;
-  if (c.refit) {
-    deform::RefitOptions r;
-    r.degree = c.degree;
-    r.relative_tolerance = c.relative_tolerance;
-    r.tolerance_mm = c.tolerance_mm;
-    r.max_control_points = c.max_control_points;
-    o.refit = r;
-  }
+  // Under a budget every fit is a light form: within the budget, knots where the error needs
+  // them; without one, a refit keeps the input's breakpoints, up to max_control_points.
+  if (c.refit) o.refit = c.budget ? light_fit(c) : fit_keeping_breakpoints(c);
   o.accept_out_of_tolerance = c.accept_out_of_tolerance;
+  if (c.budget) {
+    deform::Budget b;
+    b.max_degree = c.budget->max_degree;
+    b.max_control_points = c.budget->max_control_points;
+    b.light = light_fit(c);
+    o.budget = b;
+  }
   return o;
+}
+
+deform::RefitOptions fit_keeping_breakpoints(const Composition& c) {
+  deform::RefitOptions r;
+  r.degree = c.degree;
+  r.relative_tolerance = c.relative_tolerance;
+  r.tolerance_mm = c.tolerance_mm;
+  r.max_control_points = c.max_control_points;
+  return r;
+}
+
+deform::RefitOptions light_fit(const Composition& c) {
+  deform::RefitOptions r = fit_keeping_breakpoints(c);
+  r.keep_breakpoints = deform::Budget::light_fit().keep_breakpoints;
+  if (c.budget) r.max_control_points = std::min(c.max_control_points, c.budget->max_control_points);
+  return r;
 }
 
 namespace {
@@ -205,6 +223,9 @@ ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
     const deform::DeformationStack stack = model_stack(stack_def, out.fold_free, def.allow_fold);
     deform::ModelDeformationOptions options;
     options.surface = deformation_options(d.composition);
+    // A model's faces keep their exact forms: light faces fitted one by one would open their
+    // shared edges (fitting them with their edges is issue #38's step 7).
+    options.surface.budget.reset();
     options.faces = chosen_faces(flat, def);
     auto r = deform::deform_model(stack, flat, options);
     out.model = std::move(r.model);
@@ -232,6 +253,7 @@ ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
   const deform::DeformationStack stack = model_stack(def, result.fold_free, allow_fold);
   deform::ModelDeformationOptions options;
   options.surface = deformation_options(d.composition);
+  options.surface.budget.reset();  // faces stay exact, as in run_model above
   try {
     auto r = deform::deform_model(stack, model, options);
     result.model = std::move(r.model);

@@ -150,11 +150,11 @@ void check_exact_composition(const StepReport& s) {
 }  // namespace
 
 TEST_CASE(
-    "example sail: fill of three curves, exact style step, Bezier billow composed exactly, "
-    "editable output",
+    "example sail: fill of three curves, exact style step, Bezier billow as its certified light "
+    "form, the exact composition on request",
     "[examples]") {
   const RunResult r = run_example("sail");
-  const Json j = recipe_json("sail");
+  Json j = recipe_json("sail");
   const auto& flat = r.surface("flat_sail");
   const auto& sail = r.surface("sail");
   const double size = diagonal(sail);
@@ -172,30 +172,55 @@ TEST_CASE(
   const double gap = max_pointwise_gap(styled.surface, sail, [&](const Eigen::Vector3d& x) {
     return deform::deform_point(billow, x);
   });
-  // The recipe asks for editable output: the exact degree-9 composition is refitted into a
-  // certified bicubic, so the sail is within the certified bound of billow(styled(u, v)).
-  const StepReport& editable = step(r, "surfaces.sail.composition.editable");
-  CHECK(figure<bool>(editable, "certified"));
-  CHECK(figure<long long>(editable, "degree_u") == 3);
-  CHECK(figure<long long>(editable, "control_points") < 10000);
-  CHECK(figure<long long>(editable, "exact_control_points") > 10000);
-  const double certified = figure<double>(editable, "max_deviation_mm");
-  INFO("pointwise gap " << gap << " mm on a " << size << " mm sail, certified " << certified);
-  CHECK(gap <= certified + 1e-12 * size);
-  CHECK(certified <= figure<double>(editable, "tolerance_mm"));
-
-  // The report: exact composition, deviation at rounding level; the style step meets its key
-  // points.
+  // Its exact composition is above the default budget (degree 15, 10,000 control points): the
+  // step yields a certified bicubic of the same map, and the exact net is never built.
   const StepReport& lattice_step = step(r, "surfaces.sail.steps[1]");
-  check_exact_composition(lattice_step);
+  INFO(lattice_step.message);
+  CHECK(figure<std::string>(lattice_step, "composition") == "light");
+  CHECK(figure<bool>(lattice_step, "certified"));
+  CHECK(figure<long long>(lattice_step, "degree_u") == 3);
+  CHECK(figure<long long>(lattice_step, "control_points") < 10000);
   // The billow moves P_i0k and P_i1k alike, along y only: y = 1000 t + D(s, u) with D of degree
   // (2, 1), x and z linear. The lattice's highest monomial is s^2 u, total degree 3 (the
   // tensor-product rule's 2 + 1 + 1 = 4 counts an s^2 t u that is not there), so the cubic sail
   // composes to 3 x 3 = 9, not 12.
-  CHECK(figure<long long>(lattice_step, "degree_u") == 9);
-  CHECK(figure<long long>(lattice_step, "degree_v") == 9);
+  CHECK(figure<long long>(lattice_step, "exact_degree_u") == 9);
+  CHECK(figure<long long>(lattice_step, "exact_degree_v") == 9);
+  CHECK(figure<long long>(lattice_step, "exact_control_points") > 10000);
+  const double certified = figure<double>(lattice_step, "max_deviation_mm");
+  INFO("pointwise gap " << gap << " mm on a " << size << " mm sail, certified " << certified);
+  CHECK(gap <= certified + 1e-12 * size);
+  CHECK(certified <= figure<double>(lattice_step, "tolerance_mm"));
+  // The input was exact, so the ledger holds this step's bound alone.
+  CHECK(figure<double>(lattice_step, "accumulated_bound_mm") == certified);
+  CHECK(!has_step(r, "surfaces.sail.composition.budget"));  // already light
   CHECK_THAT(figure<double>(lattice_step, "volume_ratio_min"),
              WithinAbs(1.0, 1e-12));  // a pure shear
+
+  // The exact composition on request ("budget": "none"): exact to rounding, its size the one
+  // the light step predicted, and the light form within its certified bound of it.
+  j["composition"]["budget"] = "none";
+  const RunResult exact = run_recipe(parse_recipe(j.dump()));
+  const StepReport& exact_step = step(exact, "surfaces.sail.steps[1]");
+  check_exact_composition(exact_step);
+  CHECK(figure<long long>(exact_step, "degree_u") == 9);
+  // The prediction counts the knots the styled net's multiplicities say; knot removal also takes
+  // out those where the net is smoother than that (where the style step refined but moved
+  // nothing), so it is an upper bound.
+  CHECK(figure<long long>(exact_step, "control_points") <=
+        figure<long long>(lattice_step, "exact_control_points"));
+  CHECK(figure<long long>(exact_step, "control_points") > 10000);
+  const auto& reference = exact.surface("sail");
+  double light_gap = 0;
+  for (double u : surface::linspace(0, 1, 61))
+    for (double v : surface::linspace(0, 1, 61))
+      light_gap = std::max(
+          light_gap, (surface::evaluate(sail, u, v) - surface::evaluate(reference, u, v)).norm());
+  INFO("light form against the exact composition: " << light_gap << " mm");
+  CHECK(light_gap <= certified + 1e-9 * size);
+  CHECK(light_gap > 0);
+
+  // The report: the style step meets its key points.
   const StepReport& style_step = step(r, "surfaces.sail.steps[0]");
   CHECK(figure<std::string>(style_step, "mode") == "exact");
   CHECK(figure<double>(style_step, "locality") == 0.0);
@@ -215,7 +240,7 @@ TEST_CASE(
   CHECK(away > 50);
 
   // The luff lies on the lattice face s = 0 whose control points stay: it stays on the mast (x = y
-  // = 0), within the editable copy's certified bound.
+  // = 0), within the light form's certified bound.
   for (double u : surface::linspace(0, 1, 21)) {
     const Eigen::Vector3d p = surface::evaluate(sail, u, 0.0);
     CHECK_THAT(p.x(), WithinAbs(0.0, certified + 1e-9 * size));
@@ -533,8 +558,8 @@ TEST_CASE("example sail: key points added along the target do not wind the net u
 }
 
 TEST_CASE(
-    "example fender: strokes, a constrained door cut, a snapped fill, exact flare, lattice, "
-    "editable output",
+    "example fender: strokes, a constrained door cut, a snapped fill, exact flare, lattice as a "
+    "certified light form",
     "[examples]") {
   const RunResult r = run_example("fender");
   const Json j = recipe_json("fender");
@@ -612,27 +637,74 @@ TEST_CASE(
       max_pointwise_gap(styled, styled_net, [](const Eigen::Vector3d& x) { return x; });
   INFO("rebuild: pointwise gap " << rebuild_gap << " mm, certified " << rebuilt << " mm");
   CHECK(rebuild_gap <= rebuilt + 1e-12 * size);
-  // The styled net was not made editable on its own: only what leaves the recipe is.
-  CHECK_FALSE(has_step(r, "surfaces.styled.composition.editable"));
+  // The styled net (177,996 control points) is not a final surface: no light copy of it.
+  CHECK_FALSE(has_step(r, "surfaces.styled.composition.budget"));
 
-  // The nose lattice rebuilt from the recipe: fender(u, v) = nose(styled_net(u, v)) within the
-  // editable copy's certified bound.
+  // The nose lattice rebuilt from the recipe: its exact composition is above the default budget,
+  // so the step is its light form, fender(u, v) = nose(styled_net(u, v)) within its certified
+  // bound.
   const deform::BezierLattice nose = bezier_lattice_of(j.at("deformations").at("nose").at(0));
-  const double gap = max_pointwise_gap(
-      styled_net, fender, [&](const Eigen::Vector3d& x) { return deform::deform_point(nose, x); });
-  const StepReport& editable = step(r, "surfaces.fender.composition.editable");
-  const double certified = figure<double>(editable, "max_deviation_mm");
+  const auto nosed = [&](const Eigen::Vector3d& x) { return deform::deform_point(nose, x); };
+  const double gap = max_pointwise_gap(styled_net, fender, nosed);
+  const StepReport& light = step(r, "surfaces.fender.steps[0]");
+  const double certified = figure<double>(light, "max_deviation_mm");
   INFO("pointwise gap " << gap << " mm, certified " << certified << " mm");
-  CHECK(figure<bool>(editable, "certified"));
-  CHECK(figure<long long>(editable, "degree_u") == 3);
-  CHECK(figure<long long>(editable, "control_points") < 10000);
-  CHECK(figure<long long>(editable, "exact_control_points") > 10000);
+  CHECK(figure<std::string>(light, "composition") == "light");
+  CHECK(figure<bool>(light, "certified"));
+  CHECK(figure<long long>(light, "degree_u") == 3);
+  CHECK(figure<long long>(light, "control_points") < 10000);
+  CHECK(figure<long long>(light, "exact_control_points") > 10000);
   CHECK(gap <= certified + 1e-12 * size);
-  CHECK(certified <= figure<double>(editable, "tolerance_mm"));
-  check_exact_composition(step(r, "surfaces.fender.steps[0]"));
+  CHECK(certified <= figure<double>(light, "tolerance_mm"));
+  CHECK_FALSE(has_step(r, "surfaces.fender.composition.budget"));
+  // The ledger: the rebuild's bound carried through the lattice (times its Lipschitz bound) plus
+  // the light form's own; the fender is within it of the all-exact reference nose(styled(u, v)).
+  const double accumulated = figure<double>(light, "accumulated_bound_mm");
+  CHECK(figure<double>(rebuild, "accumulated_bound_mm") == rebuilt);
+  CHECK(accumulated >= certified + rebuilt);  // this lattice stretches: sup |D'| >= 1
+  const double reference_gap = max_pointwise_gap(styled, fender, nosed);
+  INFO("fender against nose(styled): " << reference_gap << " mm, ledger " << accumulated);
+  CHECK(reference_gap <= accumulated + 1e-12 * size);
   // The nose is wrapped inward: the front edge moved about 25 mm to -y, the rear edge not at all.
   CHECK((surface::evaluate(fender, 0, 0.5) - surface::evaluate(panel, 0, 0.5)).y() < -20);
   CHECK(std::abs((surface::evaluate(fender, 1, 0.5) - surface::evaluate(panel, 1, 0.5)).y()) <
         certified + rebuilt + 1.0);
   // (Replay determinism is checked on the lighter examples: this run takes half a minute.)
+}
+
+TEST_CASE(
+    "example tank: a studio session's fill, exact style and (3, 3, 1) lattice under the default "
+    "budget: a certified light form instead of an exact net of hundreds of thousands of points",
+    "[examples]") {
+  const RunResult r = run_example("tank");
+  const Json j = recipe_json("tank");
+  CHECK_FALSE(j.contains("composition"));  // every composition setting at its default
+  const auto& styled = r.surface("styled");
+  const auto& tank = r.surface("tank");
+  const double size = diagonal(tank);
+  const StepReport& lattice_step = step(r, "surfaces.tank.steps[0]");
+  INFO(lattice_step.message);
+  CHECK(figure<std::string>(lattice_step, "composition") == "light");
+  // The lattice's exact composition: every local coordinate of the fill is bicubic, so
+  // 3 x 3 + 3 x 3 + 1 x 3 = 21 at most; above the budget's degree 15 and far above its net.
+  CHECK(figure<long long>(lattice_step, "exact_degree_u") > 15);
+  CHECK(figure<long long>(lattice_step, "exact_degree_u") <= 21);
+  CHECK(figure<long long>(lattice_step, "exact_control_points") > 100000);
+  CHECK(figure<long long>(lattice_step, "degree_u") == 3);
+  CHECK(figure<long long>(lattice_step, "degree_v") == 3);
+  CHECK(figure<long long>(lattice_step, "control_points") <= 10000);
+  CHECK(tank.points.rows() == figure<long long>(lattice_step, "control_points"));
+  CHECK(figure<bool>(lattice_step, "certified"));
+  const double bound = figure<double>(lattice_step, "max_deviation_mm");
+  CHECK(bound <= figure<double>(lattice_step, "tolerance_mm"));
+  // The style result is exact, so the ledger is the light form's own bound.
+  CHECK(figure<double>(lattice_step, "accumulated_bound_mm") == bound);
+  // Independently: tank(u, v) against the lattice applied to styled(u, v), at random parameters.
+  const deform::BezierLattice knees = bezier_lattice_of(j.at("deformations").at("knees").at(0));
+  const double gap = max_pointwise_gap(
+      styled, tank, [&](const Eigen::Vector3d& x) { return deform::deform_point(knees, x); }, 3000);
+  INFO("pointwise gap " << gap << " mm, certified " << bound << " mm on a " << size << " mm tank");
+  CHECK(gap <= bound + 1e-12 * size);
+  CHECK(gap > bound / 20);  // the bound is not loose by orders of magnitude
+  CHECK(!has_step(r, "surfaces.tank.composition.budget"));
 }

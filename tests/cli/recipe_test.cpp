@@ -893,7 +893,7 @@ TEST_CASE("a fitted stroke joins a sketch, built when the recipe runs", "[recipe
 
 // ---- issue #18: outside-check defects --------------------------------------------------------
 
-TEST_CASE("an under-constrained recipe sketch converges; messages use the recipe's names",
+TEST_CASE("an under-constrained recipe sketch converges, messages use the recipe's names",
           "[recipe]") {
   // The smallest case of the outside check: a fixed start, a length of 10, the end drawn at
   // (0.02, 10.5): 1 DOF, nothing conflicts. It stopped after 101 iterations at residual 0.508.
@@ -1394,7 +1394,7 @@ TEST_CASE("a refit that misses its tolerance at the refit's caps fails the run, 
 }
 
 TEST_CASE(
-    "recipe models: the assembly's pins lean by name, exactly; the plate stays; a bend refits",
+    "recipe models: the assembly's pins lean by name, exactly, the plate stays, a bend refits",
     "[recipe]") {
   const fs::path file = fs::path(CLAY_EXAMPLES_DIR) / "recipes" / "assembly_model.json";
   const Recipe recipe = load_recipe(file);
@@ -1451,10 +1451,10 @@ TEST_CASE(
                          Contains("\"bodies\": [\n"));
 }
 
-TEST_CASE("an editable composition refits a high-degree exact result, certified; the export warns",
+TEST_CASE("a composition above the budget is its certified light form, the exact one on request",
           "[recipe]") {
   // The dome through a lattice of degrees (3, 3, 3) with inner points moved: an exact result of
-  // degree above 9, beyond what surfacing tools edit.
+  // degree 12, above a budget of degree 9.
   const std::string lattice = R"({"kind": "bezier_lattice", "name": "swell",
      "frame": {"origin": [-10, -10, -20], "s": [120, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
      "degrees": [3, 3, 3],
@@ -1466,60 +1466,78 @@ TEST_CASE("an editable composition refits a high-degree exact result, certified;
         R"("deformations": {"shape": [)" + lattice +
             R"(]}, "exports": {"part": {"surfaces": ["bulged"], "formats": ["step"]}})");
   };
-  const auto exact = run_recipe(parse_recipe(recipe("")));
+  // Without a budget: exact.
+  const auto exact = run_recipe(parse_recipe(recipe(R"(, "composition": {"budget": "none"})")));
   const surface::BSplineSurface& high = exact.surface("bulged");
   REQUIRE(std::max(high.u.degree, high.v.degree) > 9);
-  const StepReport& exported = exact.steps.back();
+  // An exported surface above the default budget (degree 15, 10,000 control points) that no
+  // budget applies to, a rebuild on 101 x 101 control points, carries a warning that says so.
+  const auto dense = run_recipe(parse_recipe(
+      recipe_with(R"(, "dense": {"rebuild": {"surface": "dome", "count_u": 101, "count_v": 101}})",
+                  R"("exports": {"part": {"surfaces": ["dense"], "formats": ["step"]}})")));
+  const StepReport& exported = dense.steps.back();
   REQUIRE(exported.kind == "export");
   CHECK(exported.warning);
-  CHECK_THAT(exported.message, Contains("surface 'bulged' has degree") &&
-                                   Contains("\"composition\": {\"editable\": {}}"));
+  CHECK_THAT(exported.message, Contains("surface 'dense' has degree 3 x 3 and 10201") &&
+                                   Contains("give its composition a \"budget\""));
 
-  const auto editable = run_recipe(parse_recipe(recipe(R"(, "composition": {"editable": {}})")));
-  const surface::BSplineSurface& low = editable.surface("bulged");
+  // Under a budget of degree 9 the step is its light form, and the exact net is never built.
+  const auto light =
+      run_recipe(parse_recipe(recipe(R"(, "composition": {"budget": {"max_degree": 9}})")));
+  const surface::BSplineSurface& low = light.surface("bulged");
   CHECK(low.u.degree == 3);
   CHECK(low.v.degree == 3);
   CHECK(low.points.rows() <= 10000);
   const StepReport* step = nullptr;
-  for (const auto& s : editable.steps)
-    if (s.kind == "editable") step = &s;
+  for (const auto& s : light.steps)
+    if (s.path == "surfaces.bulged.steps[0]") step = &s;
   REQUIRE(step != nullptr);
-  CHECK(step->path == "surfaces.bulged.composition.editable");
+  INFO(step->message);
   auto figure = [&](const std::string& name) {
     for (const auto& [n, v] : step->figures)
       if (n == name) return v;
     FAIL("no figure " << name);
     return Figure{};
   };
+  CHECK(std::get<std::string>(figure("composition")) == "light");
   CHECK(std::get<long long>(figure("exact_degree_u")) == high.u.degree);
-  CHECK(std::get<long long>(figure("exact_control_points")) == high.points.rows());
+  CHECK(std::get<long long>(figure("exact_degree_v")) == high.v.degree);
+  CHECK(std::get<long long>(figure("exact_control_points")) >= high.points.rows());
   CHECK(std::get<long long>(figure("control_points")) == low.points.rows());
   CHECK(std::get<bool>(figure("certified")));
+  CHECK_THAT(step->message, Contains("light form (the exact form would have degree"));
   const double bound = std::get<double>(figure("max_deviation_mm"));
   CHECK(bound <= std::get<double>(figure("tolerance_mm")));
+  CHECK(std::get<double>(figure("accumulated_bound_mm")) == bound);  // its input was exact
   // The bound holds against the exact result, independently sampled.
   const double gap = max_gap(
       low, [&](double u, double v) { return surface::evaluate(high, u, v); }, 2000);
   INFO("independent check " << gap << " mm, certified " << bound << " mm");
   CHECK(gap <= bound);
-  CHECK(!editable.steps.back().warning);  // the export of the editable copy does not warn
+  CHECK(!light.steps.back().warning);  // the export of the light form does not warn
 
-  // Too few control points for the tolerance: the run fails, naming the surface and the fix.
+  // Too few control points for the tolerance: the run fails, naming the step and the fix.
   const auto [category, message] = error_of([&] {
     run_recipe(parse_recipe(recipe(
-        R"(, "composition": {"relative_tolerance": 1e-9, "editable": {"max_control_points": 16}})")));
+        R"(, "composition": {"relative_tolerance": 1e-9, "budget": {"max_control_points": 16}})")));
   });
   CHECK(category == ErrorCategory::ToleranceNotMet);
-  CHECK_THAT(message, Contains("surfaces.bulged.composition.editable") &&
-                          Contains("the editable copy of surface 'bulged' misses its tolerance"));
-  // validate names a max_degree below the degree the copy would have.
-  const auto problems = check_recipe(recipe(R"(, "composition": {"editable": {"max_degree": 2}})"));
+  CHECK_THAT(message, Contains("surfaces.bulged.steps[0]") &&
+                          Contains("is above the budget, and its light form misses its tolerance"));
+  // validate names a max_degree below the degree light forms are fitted at, a budget that is
+  // neither "none" nor an object, and the old "editable" by its new name.
+  const auto problems = check_recipe(recipe(R"(, "composition": {"budget": {"max_degree": 2}})"));
   INFO(dump(problems));
-  CHECK(mentions(problems, "surfaces.bulged.deform.composition.editable.max_degree",
+  CHECK(mentions(problems, "surfaces.bulged.deform.composition.budget.max_degree",
                  "below the composition's \"degree\" 3"));
+  CHECK(mentions(check_recipe(recipe(R"(, "composition": {"budget": "all"})")),
+                 "surfaces.bulged.deform.composition.budget", "expected \"none\" or a budget"));
+  CHECK(mentions(check_recipe(recipe(R"(, "composition": {"editable": {}})")),
+                 "surfaces.bulged.deform.composition.editable",
+                 "\"editable\" was renamed \"budget\""));
 }
 
-TEST_CASE("arcs by three points and by radius and side; mirrored curves and surfaces", "[recipe]") {
+TEST_CASE("arcs by three points and by radius and side, mirrored curves and surfaces", "[recipe]") {
   const std::string text = recipe_with(
       R"(, "other_half": {"mirror": {"surface": "dome", "plane": {"origin": [0, 0, 0], "normal": [3, 0, 0]}}})",
       R"("curves": {

@@ -13,8 +13,8 @@ A car's front-fender side panel, about 1 m long and 420 mm high, built the way a
   the shape changes by less than 0.5 % when it is halved once more);
 - the styled surface rebuilt to a tenth of a millimetre (a dense exact net, made light before the
   next operation);
-- a Bezier lattice that wraps the nose inward;
-- exact composition, exported as its editable bicubic copy.
+- a Bezier lattice that wraps the nose inward, its exact composition above the default budget, so
+  the step yields its certified bicubic light form.
 
 Python 3 standard library only; the recipe file, not this script, is the reference.
 """
@@ -117,9 +117,10 @@ recipe = {
         "drawn beside the panel and projected onto it and a flare line rising 25 mm outboard as "
         "target, exact mode on a net refined until the shape converges, the result rebuilt to a "
         "tenth of a millimetre, a Bezier lattice (Sederberg & Parry 1986) that wraps the nose, "
-        "exact composition exported as a certified editable bicubic."),
+        "its exact composition above the default budget, so the step is its certified bicubic "
+        "light form."),
     "units": "mm",
-    "composition": {"mode": "exact", "editable": {}},
+    "composition": {"mode": "exact"},
     "strokes": {
         "rocker": {"points": rocker, "tolerance_mm": 1.0},
         "shoulder": {"points": shoulder, "tolerance_mm": 1.0},

@@ -54,11 +54,25 @@ struct CLAY_DEFORM_API ComposeOptions {
   /// STEP/IGES export, accepts (surface::max_exchange_degree in clay/occt/surface_exchange.hpp);
   /// give the receiver's own limit (CATIA's order 16 is degree 15) to fail early.
   int max_degree = 25;
+  /// > 0: the most control points the exact composition may have, predicted from every patch's
+  /// exact degrees and the continuity the surface's knot multiplicities give, before any patch is
+  /// composed (so a net of millions is never built; an upper bound, as knot removal may find the
+  /// surface smoother than its multiplicities say): above it compose_exact throws DegreeLimit
+  /// naming the size. 0 (the default): no limit. deform_surface's budget
+  /// (SurfaceDeformationOptions::budget) sets it.
+  long max_control_points = 0;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
   /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
+};
+
+/// The size of an exact composition: its degrees and control points.
+struct ExactSize {
+  int degree_u = 0;
+  int degree_v = 0;
+  long control_points = 0;
 };
 
 /// What compose_exact built, and how closely it matches the pointwise deformation.
