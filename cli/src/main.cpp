@@ -553,6 +553,10 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--out", out_dir, "output folder (created when missing)")->required();
   run_cmd->add_flag("--quiet", quiet, "no progress lines");
   run_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
+  std::string profile;
+  run_cmd->add_option("--profile", profile,
+                      "write every export for this receiver: exact, opencascade, catia, class_a "
+                      "or bicubic (default: each export's own \"profile\")");
   auto* validate_cmd = app.add_subcommand(
       "validate",
       "Check a recipe without running it: every problem at once, with its JSON path (and "
@@ -722,7 +726,10 @@ int main(int argc, char** argv) {
     if (*validate_cmd) return validate(recipe_file);
     if (*run_cmd) {
       const auto recipe = clay::recipe::load_recipe(recipe_file);
-      auto result = clay::recipe::run_recipe(recipe, run_options(show));
+      if (!profile.empty()) clay::deform::receiver_profile(profile);  // a typo fails at once
+      auto options = run_options(show);
+      options.profile = profile;
+      auto result = clay::recipe::run_recipe(recipe, options);
       return finish(result, out_dir);
     }
     if (*deform_cmd)

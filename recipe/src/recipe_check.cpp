@@ -237,11 +237,11 @@ Composition RecipeChecker::composition(const Json& j, const std::string& path, C
 }
 
 void RecipeChecker::exporting(const std::string& name, const Json& j, const std::string& path) {
-  if (!c_.object(j, path, {"surfaces", "formats", "schema"},
-                 "an export {surfaces, formats, schema}"))
+  if (!c_.object(j, path, {"surfaces", "formats", "schema", "profile"},
+                 "an export {surfaces, formats, schema, profile}"))
     return;
   const std::size_t before = c_.problems.size();
-  ExportDef def{name, path, {}, {"step", "iges", "glb"}, "AP214"};
+  ExportDef def{name, path, {}, {"step", "iges", "glb"}, "AP214", "opencascade"};
   if (const Json* s = c_.member(j, path, "surfaces", true, "an array of surface names")) {
     const std::string sp = key_path(path, "surfaces");
     if (!s->is_array() || s->empty()) {
@@ -266,6 +266,12 @@ void RecipeChecker::exporting(const std::string& name, const Json& j, const std:
   if (const Json* s = c_.member(j, path, "schema", false, ""))
     if (const auto k = c_.choice(*s, key_path(path, "schema"), {"AP214", "AP242"}))
       def.schema = *k == 0 ? "AP214" : "AP242";
+  // The receiver profile (deform/receiver.hpp): what the receiving system takes.
+  if (const Json* p = c_.member(j, path, "profile", false, "")) {
+    std::vector<std::string> names;
+    for (const auto& r : deform::receiver_profiles()) names.emplace_back(r.name);
+    if (const auto k = c_.choice(*p, key_path(path, "profile"), names)) def.profile = names[*k];
+  }
   if (c_.problems.size() == before) data.exports.push_back(std::move(def));
 }
 

@@ -10,6 +10,7 @@
 #include <clay/constraints/constraint.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
+#include <clay/deform/receiver.hpp>
 #include <clay/error.hpp>
 #include <clay/occt/surface_exchange.hpp>
 #include <clay/sketch/entities.hpp>

@@ -195,6 +195,7 @@ struct ExportDef {
   std::vector<std::string> surfaces;
   std::vector<std::string> formats;
   std::string schema = "AP214";
+  std::string profile = "opencascade";  ///< "profile": the receiver (deform/receiver.hpp)
 };
 
 /// A whole model imported from a STEP or IGES file and, optionally, deformed by a stack.

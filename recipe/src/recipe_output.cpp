@@ -77,6 +77,11 @@ std::string report_json(const RunResult& result) {
     x["control_points"] = points;
     x["degree"] = degree;
     x["sizes"] = std::move(sizes);
+    x["profile"] = e.profile;
+    // Per surface, how far it may be from the all-exact recipe (mm; null: not bounded).
+    Json bounds = Json::array();
+    for (double b : e.bounds_mm) bounds.push_back(std::isfinite(b) ? Json(b) : Json(nullptr));
+    x["bounds_mm"] = std::move(bounds);
     if (e.checked) {
       x["valid"] = e.valid;
       x["read_back_identical"] = e.read_back_identical;

@@ -6,6 +6,7 @@
 #include <clay/constraints/solve.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/model_deformation.hpp>
+#include <clay/deform/receiver.hpp>
 #include <clay/deform/surface_deformation.hpp>
 #include <clay/error.hpp>
 #include <clay/occt/model_exchange.hpp>
@@ -16,6 +17,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -68,6 +70,9 @@ class Runner {
   /// Above the default budget an exported surface gets a warning: few surfacing tools edit more.
   static constexpr Budget default_budget{};
 
+  /// Every export, its surfaces made to conform to its receiver profile (deform/receiver.hpp):
+  /// as they are when they conform, else refitted (certified) at the profile's degree within the
+  /// recipe composition's tolerance; the exact profile writes each surface's exact reference.
   void exports() {
     for (const auto& e : data_.exports)
       timed(e.path, "export", [&](StepReport& rep) {
@@ -76,25 +81,44 @@ class Runner {
         x.surface_names = e.surfaces;
         x.formats = e.formats;
         x.schema = e.schema;
+        x.profile = options_.profile.empty() ? e.profile : options_.profile;
+        const deform::ReceiverProfile& profile = deform::receiver_profile(x.profile);
+        // A preview alone (glb) takes any degree: written as it is.
+        const bool preview_only = std::all_of(e.formats.begin(), e.formats.end(),
+                                              [](const auto& f) { return f == "glb"; });
         long points = 0;
-        int degree = 0;
+        int degree = 0, refitted = 0;
+        double worst = 0;
         for (const auto& n : e.surfaces) {
-          x.surfaces.push_back(surface_of(n));
+          double bound = bound_of(n);
+          BSplineSurface s =
+              profile.fit_degree == 0 && bound > 0 ? exact_reference(n, bound) : surface_of(n);
+          if (!preview_only) {
+            const deform::ProfileFit f = deform::fit_to_profile(
+                s, profile, light_fit(data_.composition), "surface '" + n + "'");
+            bound += f.bound_mm;
+            refitted += f.refitted ? 1 : 0;
+            s = f.surface;
+          }
+          x.surfaces.push_back(std::move(s));
+          x.bounds_mm.push_back(bound);
+          worst = std::max(worst, bound);
           points += x.surfaces.back().points.rows();
           degree = std::max({degree, x.surfaces.back().u.degree, x.surfaces.back().v.degree});
         }
-        if (degree > surface::max_exchange_degree &&
-            std::any_of(e.formats.begin(), e.formats.end(),
-                        [](const auto& f) { return f != "glb"; }))
-          throw Error(
-              ErrorCategory::DegreeLimit,
-              "degree " + std::to_string(degree) + " is above the exchange limit " +
-                  std::to_string(surface::max_exchange_degree) +
-                  " of STEP/IGES; lower the lattice degrees or compose with \"mode\": \"refit\"");
         rep.figures = {{"patches", static_cast<long long>(x.surfaces.size())},
                        {"control_points", static_cast<long long>(points)},
-                       {"degree", static_cast<long long>(degree)}};
-        rep.message = std::to_string(x.surfaces.size()) + " surface(s) for " + e.name;
+                       {"degree", static_cast<long long>(degree)},
+                       {"profile", x.profile},
+                       {"surfaces_refitted", static_cast<long long>(refitted)}};
+        if (std::isfinite(worst))
+          rep.figures.emplace_back("max_deviation_mm", worst);
+        else
+          rep.figures.emplace_back("deviation", std::string("unbounded"));
+        rep.message =
+            std::to_string(x.surfaces.size()) + " surface(s) for " + e.name + " (profile " +
+            x.profile + (refitted > 0 ? ", " + std::to_string(refitted) + " refitted" : "") +
+            (worst > 0 ? ", within " + format("%.3g", worst) + " mm of the exact" : "") + ")";
         // Exact results can be far beyond what surfacing tools edit: say so, per surface.
         for (std::size_t k = 0; k < x.surfaces.size(); ++k) {
           const BSplineSurface& f = x.surfaces[k];
@@ -228,6 +252,22 @@ class Runner {
     else
       rep.figures.emplace_back("accumulated_bound", std::string("unbounded"));
   }
+  /// The named surface recomputed with every composition exact (no budget): the exact profile's
+  /// reference, computed only when asked for. `bound` becomes its own ledger (what rebuilds in
+  /// its chain still carry).
+  BSplineSurface exact_reference(const std::string& name, double& bound) const {
+    RecipeData exact = data_;
+    exact.composition.budget.reset();
+    for (SurfaceDef& def : exact.surfaces)
+      if (auto* d = std::get_if<DeformDef>(&def.build)) d->composition.budget.reset();
+    RunResult scratch;
+    const RunOptions quiet;
+    Runner runner(exact, quiet, scratch);
+    runner.need_surface(name);
+    bound = runner.bound_of(name);
+    return scratch.surface(name);
+  }
+
   /// How far the named surface may be from its exact reference (mm; 0 when exact).
   double bound_of(const std::string& name) const {
     const auto it = bound_of_.find(name);

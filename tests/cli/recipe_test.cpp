@@ -1537,6 +1537,67 @@ TEST_CASE("a composition above the budget is its certified light form, the exact
                  "\"editable\" was renamed \"budget\""));
 }
 
+TEST_CASE("exports in receiver profiles: exact on request, refitted where a receiver needs it",
+          "[recipe]") {
+  // The dome through the (3, 3, 3) lattice: exact at degree 12 (within the default budget).
+  const std::string lattice = R"({"kind": "bezier_lattice", "name": "swell",
+     "frame": {"origin": [-10, -10, -20], "s": [120, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
+     "degrees": [3, 3, 3],
+     "moves": [{"index": [1, 1, 1], "by": [3, -2, 15]}, {"index": [2, 2, 1], "by": [-4, 3, 9]},
+               {"index": [1, 2, 2], "by": [2, 2, -6]}]})";
+  auto recipe = [&](const std::string& composition, const std::string& profile) {
+    return recipe_with(
+        R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape")" + composition + "}}",
+        R"("deformations": {"shape": [)" + lattice +
+            R"(]}, "exports": {"part": {"surfaces": ["bulged"], "formats": ["step"], "profile": ")" +
+            profile + R"("}})");
+  };
+  auto export_step = [](const RunResult& r) -> const StepReport& {
+    const auto it = std::find_if(r.steps.begin(), r.steps.end(),
+                                 [](const StepReport& s) { return s.kind == "export"; });
+    REQUIRE(it != r.steps.end());
+    return *it;
+  };
+  const auto exact = run_recipe(parse_recipe(recipe("", "catia")));
+  const surface::BSplineSurface& reference = exact.surface("bulged");
+  REQUIRE(reference.u.degree == 12);
+  // CATIA takes degree 12: written as it is, exact.
+  REQUIRE(exact.exports.size() == 1);
+  CHECK(exact.exports[0].profile == "catia");
+  CHECK(surface::identical(exact.exports[0].surfaces[0], reference));
+  CHECK(exact.exports[0].bounds_mm == std::vector<double>{0.0});
+
+  // Bicubic: refitted, certified, within its bound of the exact surface.
+  const auto bicubic = run_recipe(parse_recipe(recipe("", "bicubic")));
+  const surface::BSplineSurface& written = bicubic.exports[0].surfaces[0];
+  CHECK(written.u.degree == 3);
+  CHECK(written.v.degree == 3);
+  const double bound = bicubic.exports[0].bounds_mm[0];
+  CHECK(bound > 0);
+  const double gap = max_gap(
+      written, [&](double u, double v) { return surface::evaluate(reference, u, v); }, 2000);
+  INFO("bicubic export: sampled " << gap << " mm, certified " << bound << " mm");
+  CHECK(gap <= bound);
+  CHECK_THAT(export_step(bicubic).message, Contains("profile bicubic, 1 refitted"));
+  CHECK(surface::identical(bicubic.surface("bulged"), reference));  // the design stays exact
+
+  // Exact on request: a light step (budget of degree 9) is recomputed without the budget for the
+  // export, only then, and written bit for bit as the exact composition.
+  const auto light = run_recipe(
+      parse_recipe(recipe(R"(, "composition": {"budget": {"max_degree": 9}})", "exact")));
+  CHECK(light.surface("bulged").u.degree == 3);
+  CHECK(surface::identical(light.exports[0].surfaces[0], reference));
+  CHECK(light.exports[0].bounds_mm == std::vector<double>{0.0});
+  // A run's profile (clayform run --profile) overrides every export's own.
+  RunOptions as_bicubic;
+  as_bicubic.profile = "bicubic";
+  const auto overridden = run_recipe(parse_recipe(recipe("", "catia")), as_bicubic);
+  CHECK(overridden.exports[0].profile == "bicubic");
+  CHECK(surface::identical(overridden.exports[0].surfaces[0], written));
+  // validate names an unknown profile and lists the profiles.
+  CHECK(mentions(check_recipe(recipe("", "alias")), "exports.part.profile", "opencascade"));
+}
+
 TEST_CASE("arcs by three points and by radius and side, mirrored curves and surfaces", "[recipe]") {
   const std::string text = recipe_with(
       R"(, "other_half": {"mirror": {"surface": "dome", "plane": {"origin": [0, 0, 0], "normal": [3, 0, 0]}}})",

@@ -16,6 +16,7 @@
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/model_deformation.hpp>
+#include <clay/deform/receiver.hpp>
 #include <clay/deform/refit.hpp>
 #include <clay/deform/regular.hpp>
 #include <clay/deform/stack.hpp>

@@ -84,6 +84,9 @@ struct StepReport {
 struct RunOptions {
   /// Called after each step (progress lines); may be empty.
   std::function<void(const StepReport&)> progress;
+  /// Non-empty: every export is written for this receiver profile (deform::receiver_profile:
+  /// "exact", "opencascade", "catia", "class_a", "bicubic") instead of its own.
+  std::string profile;
 };
 
 /// One export: the surfaces written together and what the exchange layer reported.
@@ -93,6 +96,11 @@ struct ExportResult {
   std::vector<surface::BSplineSurface> surfaces;  ///< what is written
   std::vector<std::string> formats;               ///< "step", "iges", "glb"
   std::string schema = "AP214";                   ///< STEP schema
+  /// The receiver profile the surfaces were made to conform to (deform::receiver_profile).
+  std::string profile = "opencascade";
+  /// Per surface: how far what is written may be from the all-exact recipe (mm): the surface's
+  /// bound ledger plus the profile's certified refit; inf when not bounded.
+  std::vector<double> bounds_mm;
   // Filled in by write_outputs:
   std::vector<std::string> files;     ///< file names written (in out_dir)
   bool checked = false;               ///< the STEP (or IGES) file was read back and checked
