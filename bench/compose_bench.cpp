@@ -4,6 +4,7 @@
 // Target: under 20 ms each. "checked" includes the default deviation check (4 x 4 pointwise
 // samples per patch, ComposeOptions::check_samples = 4); "unchecked" sets it to 0. One thread.
 #include <clay/deform/compose.hpp>
+#include <clay/deform/surface_deformation.hpp>
 #include <clay/surface/basis.hpp>
 
 #include <benchmark/benchmark.h>
@@ -18,19 +19,22 @@ namespace {
 
 using clay::bench::skewed_frame;
 
-clay::surface::BSplineSurface bicubic_sheet(const Frame& f) {
+clay::surface::BSplineSurface bicubic_sheet(const Frame& f, int n = 13) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> bump(0.3, 0.7), wiggle(-0.02, 0.02);
   clay::surface::BSplineSurface s;
-  s.u = clay::surface::clamped_uniform_basis(3, 13);
-  s.v = clay::surface::clamped_uniform_basis(3, 13);
-  s.points.resize(13 * 13, 3);
-  s.weights = Eigen::VectorXd::Ones(13 * 13);
-  for (int i = 0; i < 13; ++i)
-    for (int j = 0; j < 13; ++j)
-      s.points.row(s.index(i, j)) = f.point(0.05 + 0.9 * i / 12.0 + wiggle(rng),
-                                            0.05 + 0.9 * j / 12.0 + wiggle(rng), bump(rng))
-                                        .transpose();
+  s.u = clay::surface::clamped_uniform_basis(3, n);
+  s.v = clay::surface::clamped_uniform_basis(3, n);
+  s.points.resize(n * n, 3);
+  s.weights = Eigen::VectorXd::Ones(n * n);
+  const double step = 0.9 / (n - 1), shake = 0.26 / (n - 1);  // the 13 x 13 sheet's 0.02
+  std::uniform_real_distribution<double> jiggle(-shake, shake);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      s.points.row(s.index(i, j)) =
+          f.point(0.05 + step * i + (n == 13 ? wiggle(rng) : jiggle(rng)),
+                  0.05 + step * j + (n == 13 ? wiggle(rng) : jiggle(rng)), bump(rng))
+              .transpose();
   return s;
 }
 
@@ -66,6 +70,37 @@ BENCHMARK(BM_ComposeExact)
     ->ArgsProduct({{0, 1}, {4, 0}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// Issue #38: the exact composition against the light form of the same (3, 3, 1) lattice step
+// (deform_surface with the default Budget: certified bicubic within 1e-4 of the size), in one
+// run. Arguments: control points per direction of the sheet (13: 10 x 10 patches; 33: 30 x 30),
+// 0 = exact, 1 = light. Counters: the result's net, the exact net (composed, or predicted for the
+// light form) and the light form's certified bound.
+void BM_ExactOrLight(benchmark::State& state) {
+  const BezierLattice l = lattice({3, 3, 1});
+  const auto s = bicubic_sheet(l.frame, static_cast<int>(state.range(0)));
+  const bool light = state.range(1) == 1;
+  SurfaceDeformationOptions options;
+  if (light) options.budget = Budget{};
+  SurfaceDeformationResult r;
+  for (auto _ : state) {
+    r = deform_surface(Deformation(l), s, options);
+    benchmark::DoNotOptimize(r.surface.points.data());
+  }
+  const StepOutcome& o = r.report.steps.front();
+  const double exact_points =
+      light ? static_cast<double>(o.exact_size.control_points) : double(o.compose.control_points);
+  state.counters["control_points"] = static_cast<double>(r.surface.points.rows());
+  state.counters["exact_control_points"] = exact_points;
+  state.counters["bound_mm"] = light ? o.bound_mm : 0.0;
+  state.SetLabel(std::string(light ? "light form" : "exact") + ", sheet " +
+                 std::to_string(state.range(0)) + " x " + std::to_string(state.range(0)));
+}
+BENCHMARK(BM_ExactOrLight)
+    ->ArgsProduct({{13, 33}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 
 }  // namespace
 
