@@ -3,6 +3,7 @@
 // UTF-8 JSON whatever the command held; files are written only inside the recipe's folder.
 #include "frames/frames.hpp"
 
+#include <clay/deform/receiver.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/fenv.hpp>
 #include <clay/internal/files.hpp>
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <functional>
 #include <map>
@@ -501,9 +503,10 @@ struct StudioSession::Impl {
     return ran("edit", result, nets);
   }
 
-  /// "export" {folder, name?}: the final surfaces as STEP, IGES and glTF (write_outputs: read
-  /// back and checked), with the run's report and the models' files, into a folder inside the
-  /// recipe's.
+  /// "export" {folder, name?, profile?}: the final surfaces as STEP, IGES and glTF
+  /// (write_outputs: read back and checked), made to conform to the receiver profile (default
+  /// "opencascade"; recipe::conform_export), with the run's report and the models' files, into a
+  /// folder inside the recipe's.
   Reply export_files(const Json& c, const Cancel& cancelled) {
     if (!c.contains("folder") || !c.at("folder").is_string())
       throw Error(ErrorCategory::InvalidArgument,
@@ -513,6 +516,9 @@ struct StudioSession::Impl {
         base_dir, c.at("folder").get_ref<const std::string&>(), "studio: the export's folder");
     const std::string export_name = field<std::string>(c, "export", "name", "", "a string");
     if (c.contains("name")) internal::check_file_name(export_name, "studio: the export's name");
+    const std::string profile =
+        field<std::string>(c, "export", "profile", "opencascade", "a receiver profile name");
+    deform::receiver_profile(profile);  // an unknown name fails before the run
     Run run = this->run(text(), cancelled);
     if (run.shown.empty() && run.result.models.empty())
       throw Error(ErrorCategory::InvalidArgument,
@@ -522,10 +528,9 @@ struct StudioSession::Impl {
       ExportResult e;
       e.name = export_name.empty() ? run.result.recipe : export_name;
       e.formats = {"step", "iges", "glb"};
-      for (const std::string& n : run.shown) {
-        e.surface_names.push_back(n);
-        e.surfaces.push_back(run.result.surface(n));
-      }
+      e.surface_names = run.shown;
+      e.profile = profile;
+      conform_export(e, parse_recipe(text(), base_dir, name), run.result);
       run.result.exports.push_back(std::move(e));
     }
     write_outputs(run.result, folder);  // checks every file name it writes
@@ -540,8 +545,13 @@ struct StudioSession::Impl {
       for (const std::string& f : m.files) files.push_back(f);
       valid = valid && m.valid;
     }
+    Json bounds = Json::array();  // per surface, mm from the all-exact recipe (null: unbounded)
+    for (const ExportResult& x : run.result.exports)
+      for (double b : x.bounds_mm) bounds.push_back(std::isfinite(b) ? Json(b) : Json(nullptr));
     return {reply_text(Json{{"op", "exported"},
                             {"folder", folder.string()},
+                            {"profile", profile},
+                            {"bounds_mm", bounds},
                             {"files", files},
                             {"valid", valid},
                             {"read_back_identical", identical}}),

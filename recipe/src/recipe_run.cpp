@@ -82,61 +82,75 @@ class Runner {
         x.formats = e.formats;
         x.schema = e.schema;
         x.profile = options_.profile.empty() ? e.profile : options_.profile;
-        const deform::ReceiverProfile& profile = deform::receiver_profile(x.profile);
-        // A preview alone (glb) takes any degree: written as it is.
-        const bool preview_only = std::all_of(e.formats.begin(), e.formats.end(),
-                                              [](const auto& f) { return f == "glb"; });
-        long points = 0;
-        int degree = 0, refitted = 0;
-        double worst = 0;
-        for (const auto& n : e.surfaces) {
-          double bound = bound_of(n);
-          BSplineSurface s =
-              profile.fit_degree == 0 && bound > 0 ? exact_reference(n, bound) : surface_of(n);
-          if (!preview_only) {
-            const deform::ProfileFit f = deform::fit_to_profile(
-                s, profile, light_fit(data_.composition), "surface '" + n + "'");
-            bound += f.bound_mm;
-            refitted += f.refitted ? 1 : 0;
-            s = f.surface;
-          }
-          x.surfaces.push_back(std::move(s));
-          x.bounds_mm.push_back(bound);
-          worst = std::max(worst, bound);
-          points += x.surfaces.back().points.rows();
-          degree = std::max({degree, x.surfaces.back().u.degree, x.surfaces.back().v.degree});
-        }
-        rep.figures = {{"patches", static_cast<long long>(x.surfaces.size())},
-                       {"control_points", static_cast<long long>(points)},
-                       {"degree", static_cast<long long>(degree)},
-                       {"profile", x.profile},
-                       {"surfaces_refitted", static_cast<long long>(refitted)}};
-        if (std::isfinite(worst))
-          rep.figures.emplace_back("max_deviation_mm", worst);
-        else
-          rep.figures.emplace_back("deviation", std::string("unbounded"));
-        rep.message =
-            std::to_string(x.surfaces.size()) + " surface(s) for " + e.name + " (profile " +
-            x.profile + (refitted > 0 ? ", " + std::to_string(refitted) + " refitted" : "") +
-            (worst > 0 ? ", within " + format("%.3g", worst) + " mm of the exact" : "") + ")";
-        // Exact results can be far beyond what surfacing tools edit: say so, per surface.
-        for (std::size_t k = 0; k < x.surfaces.size(); ++k) {
-          const BSplineSurface& f = x.surfaces[k];
-          if (std::max(f.u.degree, f.v.degree) <= default_budget.max_degree &&
-              f.points.rows() <= default_budget.max_control_points)
-            continue;
-          rep.warning = true;
-          rep.message +=
-              "; surface '" + e.surfaces[k] + "' has degree " + std::to_string(f.u.degree) + " x " +
-              std::to_string(f.v.degree) + " and " + std::to_string(f.points.rows()) +
-              " control points, more than most surfacing tools edit (the default budget: degree " +
-              std::to_string(default_budget.max_degree) + ", " +
-              std::to_string(default_budget.max_control_points) +
-              " control points): give its composition a \"budget\" (not \"none\") to export a "
-              "certified light form";
-        }
+        conform(x, rep);
         result_.exports.push_back(std::move(x));
       });
+    result_.bounds.assign(bound_of_.begin(), bound_of_.end());
+  }
+
+  /// Seeds the ledger from an earlier run's (conform_export).
+  void seed_bounds(const std::vector<std::pair<std::string, double>>& bounds) {
+    bound_of_.insert(bounds.begin(), bounds.end());
+  }
+
+  /// Fills x.surfaces from x.surface_names made to conform to x.profile, x.bounds_mm with their
+  /// bounds, and the export step's figures and message.
+  void conform(ExportResult& x, StepReport& rep) const {
+    const deform::ReceiverProfile& profile = deform::receiver_profile(x.profile);
+    // A preview alone (glb) takes any degree: written as it is.
+    const bool preview_only =
+        !x.formats.empty() &&
+        std::all_of(x.formats.begin(), x.formats.end(), [](const auto& f) { return f == "glb"; });
+    x.surfaces.clear();
+    x.bounds_mm.clear();
+    long points = 0;
+    int degree = 0, refitted = 0;
+    double worst = 0;
+    for (const auto& n : x.surface_names) {
+      double bound = bound_of(n);
+      BSplineSurface s =
+          profile.fit_degree == 0 && bound > 0 ? exact_reference(n, bound) : surface_of(n);
+      if (!preview_only) {
+        const deform::ProfileFit f =
+            deform::fit_to_profile(s, profile, light_fit(data_.composition), "surface '" + n + "'");
+        bound += f.bound_mm;
+        refitted += f.refitted ? 1 : 0;
+        s = f.surface;
+      }
+      x.surfaces.push_back(std::move(s));
+      x.bounds_mm.push_back(bound);
+      worst = std::max(worst, bound);
+      points += x.surfaces.back().points.rows();
+      degree = std::max({degree, x.surfaces.back().u.degree, x.surfaces.back().v.degree});
+    }
+    rep.figures = {{"patches", static_cast<long long>(x.surfaces.size())},
+                   {"control_points", static_cast<long long>(points)},
+                   {"degree", static_cast<long long>(degree)},
+                   {"profile", x.profile},
+                   {"surfaces_refitted", static_cast<long long>(refitted)}};
+    if (std::isfinite(worst))
+      rep.figures.emplace_back("max_deviation_mm", worst);
+    else
+      rep.figures.emplace_back("deviation", std::string("unbounded"));
+    rep.message = std::to_string(x.surfaces.size()) + " surface(s) for " + x.name + " (profile " +
+                  x.profile + (refitted > 0 ? ", " + std::to_string(refitted) + " refitted" : "") +
+                  (worst > 0 ? ", within " + format("%.3g", worst) + " mm of the exact" : "") + ")";
+    // Exact results can be far beyond what surfacing tools edit: say so, per surface.
+    for (std::size_t k = 0; k < x.surfaces.size(); ++k) {
+      const BSplineSurface& f = x.surfaces[k];
+      if (std::max(f.u.degree, f.v.degree) <= default_budget.max_degree &&
+          f.points.rows() <= default_budget.max_control_points)
+        continue;
+      rep.warning = true;
+      rep.message +=
+          "; surface '" + x.surface_names[k] + "' has degree " + std::to_string(f.u.degree) +
+          " x " + std::to_string(f.v.degree) + " and " + std::to_string(f.points.rows()) +
+          " control points, more than most surfacing tools edit (the default budget: degree " +
+          std::to_string(default_budget.max_degree) + ", " +
+          std::to_string(default_budget.max_control_points) +
+          " control points): give its composition a \"budget\" (not \"none\") to export a "
+          "certified light form";
+    }
   }
 
   /// Every imported model, deformed when it names a stack.
@@ -927,6 +941,19 @@ RunResult run_recipe(const Recipe& recipe, const RunOptions& options) {
   runner.models();
   result.seconds = seconds_since(t0);
   return result;
+}
+
+void conform_export(ExportResult& e, const Recipe& recipe, const RunResult& run) {
+  if (!recipe.data)
+    throw Error(ErrorCategory::InvalidArgument,
+                "conform_export: empty recipe; load or parse one first");
+  RunResult scratch;  // the runner reads the run's surfaces from it
+  scratch.surfaces = run.surfaces;
+  const RunOptions quiet;
+  Runner runner(*recipe.data, quiet, scratch);
+  runner.seed_bounds(run.bounds);
+  StepReport report;
+  runner.conform(e, report);
 }
 
 std::vector<std::string> final_surfaces(const Recipe& recipe) {

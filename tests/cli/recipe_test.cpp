@@ -1588,6 +1588,13 @@ TEST_CASE("exports in receiver profiles: exact on request, refitted where a rece
   CHECK(light.surface("bulged").u.degree == 3);
   CHECK(surface::identical(light.exports[0].surfaces[0], reference));
   CHECK(light.exports[0].bounds_mm == std::vector<double>{0.0});
+  // conform_export does the same for an export made by hand (the studio's Export).
+  ExportResult by_hand;
+  by_hand.surface_names = {"bulged"};
+  by_hand.profile = "bicubic";
+  conform_export(by_hand, parse_recipe(recipe("", "catia")), exact);
+  CHECK(surface::identical(by_hand.surfaces.at(0), written));
+  CHECK(by_hand.bounds_mm.at(0) == bound);
   // A run's profile (clayform run --profile) overrides every export's own.
   RunOptions as_bicubic;
   as_bicubic.profile = "bicubic";

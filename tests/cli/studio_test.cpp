@@ -462,6 +462,21 @@ TEST_CASE(
   CHECK(exported.at("read_back_identical") == true);
   for (const char* f : {"patch.step", "patch.igs", "patch.glb", "report.json"})
     CHECK(fs::exists(dir / "out" / f));
+  CHECK(exported.at("profile") == "opencascade");
+  CHECK(exported.at("bounds_mm") == Json::array({0.0}));  // the fill is exact, and conforms
+  // Export for a receiver: class A takes the bicubic patch as it is; an unknown profile is
+  // refused before anything runs, naming the profiles.
+  const Json class_a = Json::parse(
+      session
+          .handle(R"({"op": "export", "folder": "out_a", "name": "patch", "profile": "class_a"})")
+          .json);
+  CHECK(class_a.at("profile") == "class_a");
+  CHECK(class_a.at("valid") == true);
+  const Json unknown = Json::parse(
+      session.handle(R"({"op": "export", "folder": "out_b", "profile": "alias"})").json);
+  CHECK(unknown.at("op") == "error");
+  CHECK_THAT(unknown.at("message").get<std::string>(), Contains("class_a, bicubic"));
+  CHECK_FALSE(fs::exists(dir / "out_b"));
 }
 
 TEST_CASE("studio session: a STEP model opened whole, meshed, deformed by a lattice, exported",

@@ -224,7 +224,7 @@ export default async function drawing({ clayform, work, browser, page, driver, c
 
     let beforeDrag = null;
     let afterDrag = null;
-    await check('a lattice on the styled surface, a point dragged for 5 s: the surface is the pointwise FFD', async () => {
+    await check('a lattice on the styled surface, a point dragged for 5 s: the surface is the pointwise FFD within its certified bound', async () => {
       await clickAt([260, 170, 0], false);
       const selected = await page.locator('#selection').textContent();
       assert(selected.includes('surface fill1_styled1'), `selection: ${selected}`);
@@ -258,12 +258,20 @@ export default async function drawing({ clayform, work, browser, page, driver, c
       afterDrag = surfaces.fill1_styled1_ffd1;
       const parent = befores.fill1_styled1_ffd1;
       const points = latticePoints(step);
+      // Exact, or (above the composition's budget) a certified light form: the step's report says
+      // which and its bound, and the page says so too.
+      const report = (await studioCall(() => window.clayStudio.steps())).find((s) => s.path === 'surfaces.fill1_styled1_ffd1.steps[0]');
+      assert(report, 'no report of the lattice step');
+      const light = report.figures.composition === 'light';
+      const bound = light ? report.figures.max_deviation_mm : 0;
       const worst = offPointwise(afterDrag, parent, (x) => ffd(step, points, x), 24);
-      assert(worst <= 1e-9 * 1000, `the dragged surface is ${worst} mm off the pointwise FFD`);
+      assert(worst <= bound + 1e-9 * 1000, `the dragged surface is ${worst} mm off the pointwise FFD (${report.figures.composition}, bound ${bound} mm)`);
+      const form = await page.textContent('#form');
+      assert(form.includes(`fill1_styled1_ffd1: ${light ? 'light form' : 'exact'}`), `the page says: ${form}`);
       // The Deviation mode's map, the kernel's: at its grid, the distance computed here from the
       // surface to the pointwise FFD of its parent.
       const deviation = await deviationAgainst(studioCall, 'fill1_styled1_ffd1', afterDrag, parent, (x) => ffd(step, points, x));
-      assert(deviation.max <= 1e-9 * 1000, `the deviation map's largest value is ${deviation.max} mm (exact composition)`);
+      assert(deviation.max <= bound + 1e-9 * 1000, `the deviation map's largest value is ${deviation.max} mm (bound ${bound} mm)`);
       await page.click('button[data-mode="deviation"]');
       await idle();
       const legend = await page.locator('#legend').textContent();
@@ -344,12 +352,17 @@ export default async function drawing({ clayform, work, browser, page, driver, c
       return `${compared} control points identical`;
     });
 
-    await check('export writes STEP, IGES and glTF, read back and checked', async () => {
+    await check('export for the chosen receiver (bicubic) writes STEP, IGES and glTF, read back and checked', async () => {
+      await page.selectOption('#export-profile', 'bicubic');
       await page.click('#export');
       await page.waitForFunction(() => document.getElementById('message').textContent.startsWith('exported') || document.body.dataset.error, null, { timeout: 60000 });
       assert(!(await lastError()), await lastError());
+      const message = await page.textContent('#message');
+      assert(message.includes('for bicubic, within'), `the message does not name the profile and bound: ${message}`);
       const files = readdirSync(join(work, 'drawn-export'));
       for (const ext of ['.step', '.igs', '.glb']) assert(files.some((f) => f.endsWith(ext)), `no ${ext} in ${files}`);
+      const report = JSON.parse(readFileSync(join(work, 'drawn-export', 'report.json'), 'utf8'));
+      assert(report.exports[0].profile === 'bicubic', `report.json says ${report.exports[0].profile}`);
       return files.join(', ');
     });
 

@@ -68,5 +68,7 @@ export function wireCommands() {
   $('undo').addEventListener('click', () => simple('undo'));
   $('redo').addEventListener('click', () => simple('redo'));
   $('save').addEventListener('click', save);
-  $('export').addEventListener('click', () => send({ op: 'export', folder: `${doc.recipe.name || 'studio'}-export` }));
+  $('export').addEventListener('click', () =>
+    send({ op: 'export', folder: `${doc.recipe.name || 'studio'}-export`, profile: $('export-profile').value }),
+  );
 }

@@ -6,6 +6,7 @@ import { doc, metrics } from './store.js';
 import { showSketchFigures } from './constraints.js';
 import { showStylePanel } from './style.js';
 import { showLatticePanels } from './lattice.js';
+import { formShown } from './forms.js';
 
 export function showPanels() {
   showSketchFigures();
@@ -48,7 +49,9 @@ export function showReport() {
       return d;
     }),
   );
+  $('form').textContent = formShown(doc.steps);
   const redraw = metrics.preview[metrics.preview.length - 1];
   const kernel = metrics.drag[metrics.drag.length - 1];
   $('status').textContent = `kernel ${doc.reply ? (1000 * doc.reply.seconds).toFixed(0) : '-'} ms${redraw ? `, drag to redraw ${redraw.ms.toFixed(0)} ms` : ''}${kernel ? `, drag to kernel answer ${kernel.ms.toFixed(0)} ms` : ''}`;
 }
+

@@ -25,7 +25,9 @@ function onReply(reply, frames, meta) {
     return;
   }
   if (reply.op === 'exported') {
-    showMessage(`exported ${reply.files.join(', ')} into ${reply.folder}${reply.valid ? ' (read back and checked)' : ''}`);
+    const worst = Math.max(0, ...reply.bounds_mm.map((b) => (b === null ? Infinity : b)));
+    const within = worst > 0 ? `, within ${Number.isFinite(worst) ? `${worst.toPrecision(3)} mm` : 'an unbounded distance'} of the exact` : ', exact';
+    showMessage(`exported ${reply.files.join(', ')} into ${reply.folder} for ${reply.profile}${within}${reply.valid ? ' (read back and checked)' : ''}`);
     return;
   }
   if (!('steps' in reply)) return;

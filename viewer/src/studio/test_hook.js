@@ -17,6 +17,8 @@ export function installTestHook() {
     recipe: () => doc.recipe,
     history: () => doc.history,
     reply: () => doc.reply,
+    /** The last run's step reports (as report.json has them). */
+    steps: () => doc.steps,
     surfaces: () => Object.fromEntries([...doc.surfaces].map(([n, s]) => [n, plainNet(s)])),
     befores: () => Object.fromEntries([...doc.befores].map(([n, s]) => [n, plainNet(s)])),
     lastLive: () => lastLive() && { ...lastLive() },

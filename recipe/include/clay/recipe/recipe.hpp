@@ -153,7 +153,10 @@ struct CLAY_RECIPE_API RunResult {
   std::vector<ModelRunResult> models;  ///< the recipe's imported models, in document order
   std::vector<StepReport> steps;       ///< every step in order of execution
   std::vector<Stage> stages;           ///< every enabled deformation step, in order of execution
-  double seconds = 0;                  ///< wall time of the whole run
+  /// The bound ledger: per surface that is not exact, how far it may be from the all-exact
+  /// recipe (mm; inf when not bounded); a surface not listed is exact.
+  std::vector<std::pair<std::string, double>> bounds;
+  double seconds = 0;  ///< wall time of the whole run
   /// The named surface. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
   const surface::BSplineSurface& surface(std::string_view name) const;
   /// The named curve. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
@@ -166,6 +169,14 @@ struct CLAY_RECIPE_API RunResult {
 /// split between threads). Throws clay::Error with the
 /// failing step's path first ("surfaces.sail.steps[2] (twist): ...") and that step's category.
 CLAY_RECIPE_API RunResult run_recipe(const Recipe& recipe, const RunOptions& options = {});
+
+/// Fills e.surfaces from e.surface_names (surfaces of `run`, a run of `recipe`) made to
+/// conform to the receiver profile e.profile, as a recipe export does: as they are when they
+/// conform, else refitted (certified, within the recipe composition's tolerance); the exact
+/// profile recomputes a light surface's exact reference. e.bounds_mm gets each surface's bound
+/// from the all-exact recipe. Throws clay::Error: InvalidArgument for an unknown profile or
+/// surface, ToleranceNotMet or DegreeLimit naming the surface that cannot conform.
+CLAY_RECIPE_API void conform_export(ExportResult& e, const Recipe& recipe, const RunResult& run);
 
 /// The recipe's surfaces that no "deform" surface takes as its parent, in document order: what
 /// a picture of the design shows (a styled hood, not also the hood before styling). Throws

@@ -1,0 +1,52 @@
+"""The studio page says which form it shows (issue #38): the page's reading of a run's step
+reports (viewer/src/studio/forms.js, run by Node) against the same figures read here from the
+report.json of `clayform run` on the tank example, whose lattice step is a certified light form.
+Skipped when `node` is missing."""
+import json
+import os
+import pathlib
+import shutil
+import subprocess
+
+import pytest
+
+NODE = shutil.which("node")
+pytestmark = pytest.mark.skipif(NODE is None, reason="node is not installed (apt-get install nodejs)")
+
+SOURCE = pathlib.Path(os.environ.get("CLAYFORM_SOURCE_DIR", pathlib.Path(__file__).resolve().parents[2]))
+FORMS = SOURCE / "viewer" / "src" / "studio" / "forms.js"
+EXAMPLES = pathlib.Path(os.environ.get("CLAYFORM_EXAMPLES", SOURCE / "examples"))
+
+
+def form_shown(steps, tmp_path):
+    script = tmp_path / "form.mjs"
+    script.write_text(
+        "import { formShown } from '%s';\n"
+        "let text = '';\nfor await (const chunk of process.stdin) text += chunk;\n"
+        "process.stdout.write(JSON.stringify(formShown(JSON.parse(text))));\n" % FORMS.as_posix())
+    done = subprocess.run([NODE, str(script)], input=json.dumps(steps), capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout)
+
+
+def test_the_page_says_the_tank_is_a_light_form_within_its_bound(tmp_path):
+    exe = os.environ["CLAYFORM_EXE"]
+    out = tmp_path / "tank"
+    subprocess.run([exe, "run", str(EXAMPLES / "recipes" / "tank.json"), "--out", str(out), "--quiet"],
+                   check=True, timeout=300)
+    steps = json.loads((out / "report.json").read_text())["steps"]
+    lattice = next(s for s in steps if s["path"] == "surfaces.tank.steps[0]")
+    f = lattice["figures"]
+    assert f["composition"] == "light"
+    expected = ("tank: light form, within %s mm of the exact (exact: degree %d, %d control points)"
+                % (format(f["accumulated_bound_mm"], ".2g"), f["exact_degree_u"], f["exact_control_points"]))
+    assert form_shown(steps, tmp_path) == expected
+    # An exact step, and one after a light one (carrying the bound), read as such.
+    exact = {"path": "surfaces.a.steps[0]", "kind": "bezier_lattice", "figures": {"composition": "exact"}}
+    carried = {"path": "surfaces.b.steps[1]", "kind": "taper",
+               "figures": {"composition": "exact", "accumulated_bound_mm": 0.25}}
+    unbounded = {"path": "surfaces.c.steps[0]", "kind": "twist",
+                 "figures": {"composition": "refit", "accumulated_bound": "unbounded"}}
+    assert form_shown([exact, carried, unbounded], tmp_path) == (
+        "a: exact; b: light form, within 0.25 mm of the exact; "
+        "c: refit, distance from the exact unbounded")
