@@ -174,9 +174,12 @@ void lattice_common(py::class_<Lattice>& c) {
           "The lattice prepared for fast evaluation (power-basis cells).")
       .def(
           "compose",
-          [](const Lattice& l, const BSplineSurface& s, int check_samples) {
+          [](const Lattice& l, const BSplineSurface& s, int check_samples, int max_degree,
+             long max_control_points) {
             deform::ComposeOptions o;
             o.check_samples = check_samples;
+            o.max_degree = max_degree;
+            o.max_control_points = max_control_points;
             deform::ComposeResult r;
             {
               py::gil_scoped_release free;
@@ -184,8 +187,11 @@ void lattice_common(py::class_<Lattice>& c) {
             }
             return py::make_tuple(std::move(r.surface), compose_report(r.report));
           },
-          py::arg("surface"), py::arg("check_samples") = 4,
-          "The surface deformed by the lattice exactly (compose_exact): (surface, report).")
+          py::arg("surface"), py::arg("check_samples") = 4, py::arg("max_degree") = 25,
+          py::arg("max_control_points") = 0,
+          "The surface deformed by the lattice exactly (compose_exact): (surface, report). "
+          "DegreeLimitError, before anything is composed, when the result would be above "
+          "max_degree or max_control_points (> 0; the net predicted from the degrees).")
       .def("validate", [](const Lattice& l) { deform::validate(l); })
       .def("__copy__", [](const Lattice& l) { return l; })
       .def("__deepcopy__", [](const Lattice& l, py::dict) { return l; });

@@ -2,6 +2,7 @@
 // docs/deform.md) and the certified refit of surfaces.
 #include "common.hpp"
 
+#include <clay/deform/receiver.hpp>
 #include <clay/deform/refit.hpp>
 #include <clay/deform/stack.hpp>
 
@@ -134,6 +135,32 @@ void bind_stack(py::module_& m) {
       py::arg("degree") = 3, py::arg("max_control_points") = 40000,
       "A light, certified copy of a surface (the recipes' rebuild without counts): (surface, "
       "report).");
+
+  m.def(
+      "fit_to_profile",
+      [](const surface::BSplineSurface& surface, const std::string& profile,
+         double relative_tolerance, double tolerance_mm, const std::string& name) {
+        const deform::ReceiverProfile& p = deform::receiver_profile(profile);
+        deform::ProfileFit f;
+        {
+          py::gil_scoped_release free;
+          f = deform::fit_to_profile(
+              surface, p, refit_options(relative_tolerance, tolerance_mm, 3, 40000), name);
+        }
+        py::dict d = f.refitted ? refit_report(f.report) : py::dict();
+        d["profile"] = profile;
+        d["refitted"] = f.refitted;
+        d["elevated"] = f.elevated;
+        d["bound_mm"] = f.bound_mm;
+        return py::make_tuple(std::move(f.surface), d);
+      },
+      py::arg("surface"), py::arg("profile"), py::arg("relative_tolerance") = 1e-4,
+      py::arg("tolerance_mm") = 0.0, py::arg("name") = "surface",
+      "The surface as a receiver takes it (docs/deform.md, Receiver profiles): profile 'exact', "
+      "'opencascade', 'catia', 'class_a' or 'bicubic'; unchanged when it conforms, raised "
+      "exactly, or refitted within the tolerance with a certified bound: (surface, report with "
+      "refitted, elevated, bound_mm). ToleranceNotMetError or DegreeLimitError when it cannot "
+      "conform.");
 }
 
 }  // namespace clay::python
