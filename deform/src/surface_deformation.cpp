@@ -309,6 +309,18 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
     }
     Attempt a = try_exact(step.deformation, out.surface, within);
     const surface::BSplineSurface& input = out.surface;
+    // A light or refitted step: its certified bound, the ledger, the result.
+    auto fitted = [&](StepOutcome::Method method, RefitResult r) {
+      o.method = method;
+      o.reason = std::move(a.reason);
+      o.refit = r.report;
+      o.bound_mm = r.report.certified ? r.report.certified_bound_mm
+                                      : std::numeric_limits<double>::infinity();
+      o.accumulated_bound_mm = accumulated(step.deformation, input, o.bound_mm, bound);
+      report.exact = false;
+      report.certified = report.certified && r.report.certified;
+      out.surface = std::move(r.surface);
+    };
     if (a.result) {
       o.method = StepOutcome::Method::Exact;
       o.compose = a.result->report;
@@ -330,17 +342,9 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
                         r.report.summary.message +
                         ". Loosen the light form's tolerance, allow it more control points, or "
                         "raise the budget to keep the exact form");
-      o.method = StepOutcome::Method::Light;
-      o.reason = std::move(a.reason);
       o.exact_size = *a.size;
-      o.refit = r.report;
-      o.bound_mm = r.report.certified ? r.report.certified_bound_mm
-                                      : std::numeric_limits<double>::infinity();
-      o.accumulated_bound_mm = accumulated(step.deformation, input, o.bound_mm, bound);
-      report.exact = false;
-      report.certified = report.certified && r.report.certified;
       ++report.light_steps;
-      out.surface = std::move(r.surface);
+      fitted(StepOutcome::Method::Light, std::move(r));
     } else {
       const std::string where = "deform_surface: steps[" + std::to_string(i) + "] (" + o.kind +
                                 (o.name.empty() ? "" : " '" + o.name + "'") + ")";
@@ -356,15 +360,7 @@ SurfaceDeformationResult deform_surface(const DeformationStack& stack,
                     where + " misses its tolerance: the refit's " + r.report.summary.message +
                         ". Nothing is returned; to accept the result anyway set "
                         "SurfaceDeformationOptions::accept_out_of_tolerance");
-      o.method = StepOutcome::Method::Refit;
-      o.reason = std::move(a.reason);
-      o.refit = r.report;
-      o.bound_mm = r.report.certified ? r.report.certified_bound_mm
-                                      : std::numeric_limits<double>::infinity();
-      o.accumulated_bound_mm = accumulated(step.deformation, input, o.bound_mm, bound);
-      report.exact = false;
-      report.certified = report.certified && r.report.certified;
-      out.surface = std::move(r.surface);
+      fitted(StepOutcome::Method::Refit, std::move(r));
     }
     bound = o.accumulated_bound_mm;
     report.steps.push_back(std::move(o));

@@ -1451,15 +1451,18 @@ TEST_CASE(
                          Contains("\"bodies\": [\n"));
 }
 
+/// The dome through this lattice of degrees (3, 3, 3), inner points moved, is exact at degree 12.
+const char* swell_lattice = R"({"kind": "bezier_lattice", "name": "swell",
+   "frame": {"origin": [-10, -10, -20], "s": [120, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
+   "degrees": [3, 3, 3],
+   "moves": [{"index": [1, 1, 1], "by": [3, -2, 15]}, {"index": [2, 2, 1], "by": [-4, 3, 9]},
+             {"index": [1, 2, 2], "by": [2, 2, -6]}]})";
+
 TEST_CASE("a composition above the budget is its certified light form, the exact one on request",
           "[recipe]") {
   // The dome through a lattice of degrees (3, 3, 3) with inner points moved: an exact result of
   // degree 12, above a budget of degree 9.
-  const std::string lattice = R"({"kind": "bezier_lattice", "name": "swell",
-     "frame": {"origin": [-10, -10, -20], "s": [120, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
-     "degrees": [3, 3, 3],
-     "moves": [{"index": [1, 1, 1], "by": [3, -2, 15]}, {"index": [2, 2, 1], "by": [-4, 3, 9]},
-               {"index": [1, 2, 2], "by": [2, 2, -6]}]})";
+  const std::string lattice = swell_lattice;
   auto recipe = [&](const std::string& composition) {
     return recipe_with(
         R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape")" + composition + "}}",
@@ -1540,11 +1543,7 @@ TEST_CASE("a composition above the budget is its certified light form, the exact
 TEST_CASE("exports in receiver profiles: exact on request, refitted where a receiver needs it",
           "[recipe]") {
   // The dome through the (3, 3, 3) lattice: exact at degree 12 (within the default budget).
-  const std::string lattice = R"({"kind": "bezier_lattice", "name": "swell",
-     "frame": {"origin": [-10, -10, -20], "s": [120, 0, 0], "t": [0, 120, 0], "u": [0, 0, 60]},
-     "degrees": [3, 3, 3],
-     "moves": [{"index": [1, 1, 1], "by": [3, -2, 15]}, {"index": [2, 2, 1], "by": [-4, 3, 9]},
-               {"index": [1, 2, 2], "by": [2, 2, -6]}]})";
+  const std::string lattice = swell_lattice;
   auto recipe = [&](const std::string& composition, const std::string& profile) {
     return recipe_with(
         R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape")" + composition + "}}",

@@ -15,23 +15,16 @@
 #include <string>
 
 #include "error_of.hpp"
+#include "shapes.hpp"
 
 using namespace clay::deform;
 using Catch::Matchers::Contains;
 using clay::ErrorCategory;
 using clay::test::error_of;
+using namespace clay::test;
 namespace surface = clay::surface;
 
 namespace {
-
-Frame box_frame() {
-  Frame f;
-  f.origin = {-10, -10, -20};
-  f.s = {120, 0, 0};
-  f.t = {0, 120, 0};
-  f.u = {0, 0, 60};
-  return f;
-}
 
 /// A bicubic dome, 100 x 100 mm, inside box_frame(): on uniform knots, or (rough) with a
 /// double knot at 0.5 and a triple one at 0.75 in u, a double one at 0.4 in v, and control points
@@ -57,19 +50,6 @@ surface::BSplineSurface dome(bool rough = false) {
   return surface::make_surface(bu, bv, p);
 }
 
-BezierLattice bulge() {
-  BezierLattice l = make_bezier_lattice(box_frame(), {2, 2, 1});
-  l.points.row(l.index(1, 1, 1)) += Eigen::RowVector3d(3, -2, 15);
-  return l;
-}
-
-Taper flare() {
-  Taper t;
-  t.frame.origin = {50, 50, 0};
-  t.profile = {1.0, 0.004};  // r(z) = 1 + 0.004 z
-  return t;
-}
-
 /// The control points compose_exact refuses with: "up to N control points" in its message.
 long refused_at(const Deformation& d, const surface::BSplineSurface& s, long limit) {
   ComposeOptions o;
@@ -89,17 +69,6 @@ long refused_at(const Deformation& d, const surface::BSplineSurface& s, long lim
   std::smatch m;
   REQUIRE(std::regex_search(message, m, std::regex("up to ([0-9]+) control points")));
   return std::stol(m[1]);
-}
-
-/// Largest |a(u, v) - b(u, v)| on a 61 x 61 grid of the unit square.
-double grid_gap(const surface::BSplineSurface& a, const surface::BSplineSurface& b) {
-  double worst = 0;
-  for (int i = 0; i <= 60; ++i)
-    for (int j = 0; j <= 60; ++j)
-      worst = std::max(worst, (surface::evaluate(a, i / 60.0, j / 60.0) -
-                               surface::evaluate(b, i / 60.0, j / 60.0))
-                                  .norm());
-  return worst;
 }
 
 }  // namespace

@@ -11,11 +11,13 @@
 #include <string>
 
 #include "error_of.hpp"
+#include "shapes.hpp"
 
 using namespace clay::deform;
 using Catch::Matchers::Contains;
 using clay::ErrorCategory;
 using clay::test::error_of;
+using namespace clay::test;
 namespace surface = clay::surface;
 
 namespace {
@@ -31,17 +33,6 @@ surface::BSplineSurface dome(int degree, int count) {
       p.row(i * count + j) << x, y, 20 * std::sin(0.03 * x) * std::sin(0.03 * y);
     }
   return surface::make_surface(b, b, p);
-}
-
-/// Largest |a - b| on a 51 x 51 grid of the unit square.
-double grid_gap(const surface::BSplineSurface& a, const surface::BSplineSurface& b) {
-  double worst = 0;
-  for (int i = 0; i <= 50; ++i)
-    for (int j = 0; j <= 50; ++j)
-      worst = std::max(worst, (surface::evaluate(a, i / 50.0, j / 50.0) -
-                               surface::evaluate(b, i / 50.0, j / 50.0))
-                                  .norm());
-  return worst;
 }
 
 }  // namespace

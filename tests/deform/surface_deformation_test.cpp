@@ -14,23 +14,16 @@
 #include <random>
 
 #include "error_of.hpp"
+#include "shapes.hpp"
 
 using namespace clay::deform;
 using Catch::Matchers::Contains;
 using clay::ErrorCategory;
 using clay::test::error_of;
+using namespace clay::test;
 namespace surface = clay::surface;
 
 namespace {
-
-Frame box_frame() {
-  Frame f;
-  f.origin = {-10, -10, -20};
-  f.s = {120, 0, 0};
-  f.t = {0, 120, 0};
-  f.u = {0, 0, 60};
-  return f;
-}
 
 /// A bicubic dome, 100 x 100 mm, inside box_frame().
 surface::BSplineSurface dome() {
@@ -43,19 +36,6 @@ surface::BSplineSurface dome() {
       p.row(i * 6 + j) << x, y, 20 * std::sin(0.03 * x) * std::sin(0.03 * y);
     }
   return surface::make_surface(b, b, p);
-}
-
-BezierLattice bulge() {
-  BezierLattice l = make_bezier_lattice(box_frame(), {2, 2, 1});
-  l.points.row(l.index(1, 1, 1)) += Eigen::RowVector3d(3, -2, 15);
-  return l;
-}
-
-Taper flare() {
-  Taper t;
-  t.frame.origin = {50, 50, 0};
-  t.profile = {1.0, 0.004};  // r(z) = 1 + 0.004 z
-  return t;
 }
 
 Twist spin() {
