@@ -138,18 +138,24 @@ class Runner {
     // Exact results can be far beyond what surfacing tools edit: say so, per surface.
     for (std::size_t k = 0; k < x.surfaces.size(); ++k) {
       const BSplineSurface& f = x.surfaces[k];
-      if (std::max(f.u.degree, f.v.degree) <= default_budget.max_degree &&
-          f.points.rows() <= default_budget.max_control_points)
-        continue;
+      const std::optional<Budget> own = budget_of(x.surface_names[k]);
+      auto within = [&](const Budget& b) {
+        return std::max(f.u.degree, f.v.degree) <= b.max_degree &&
+               f.points.rows() <= b.max_control_points;
+      };
+      // Within the default budget, or within a budget its recipe chose: no warning.
+      if (within(default_budget) || (own && within(*own))) continue;
       rep.warning = true;
       rep.message +=
           "; surface '" + x.surface_names[k] + "' has degree " + std::to_string(f.u.degree) +
           " x " + std::to_string(f.v.degree) + " and " + std::to_string(f.points.rows()) +
           " control points, more than most surfacing tools edit (the default budget: degree " +
           std::to_string(default_budget.max_degree) + ", " +
-          std::to_string(default_budget.max_control_points) +
-          " control points): give its composition a \"budget\" (not \"none\") to export a "
-          "certified light form";
+          std::to_string(default_budget.max_control_points) + " control points): " +
+          (own ? std::string("export it for a lighter receiver (\"profile\": \"bicubic\" or "
+                             "\"class_a\") or rebuild it lighter")
+               : std::string("give its composition a \"budget\" (not \"none\") to export a "
+                             "certified light form"));
     }
   }
 
@@ -280,6 +286,15 @@ class Runner {
     runner.need_surface(name);
     bound = runner.bound_of(name);
     return scratch.surface(name);
+  }
+
+  /// The budget that applied to the named surface: its deform's composition's, else the
+  /// recipe's (empty: "none").
+  std::optional<Budget> budget_of(const std::string& name) const {
+    for (const SurfaceDef& def : data_.surfaces)
+      if (const auto* d = std::get_if<DeformDef>(&def.build); d && def.name == name)
+        return d->composition.budget;
+    return data_.composition.budget;
   }
 
   /// How far the named surface may be from its exact reference (mm; 0 when exact).

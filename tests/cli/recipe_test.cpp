@@ -1482,7 +1482,18 @@ TEST_CASE("a composition above the budget is its certified light form, the exact
   REQUIRE(exported.kind == "export");
   CHECK(exported.warning);
   CHECK_THAT(exported.message, Contains("surface 'dense' has degree 3 x 3 and 10201") &&
-                                   Contains("give its composition a \"budget\""));
+                                   Contains("export it for a lighter receiver"));
+  // Without a budget the warning says to give one; within a budget the recipe chose, none.
+  const auto none = run_recipe(parse_recipe(
+      recipe_with(R"(, "dense": {"rebuild": {"surface": "dome", "count_u": 101, "count_v": 101}})",
+                  R"("composition": {"budget": "none"},
+         "exports": {"part": {"surfaces": ["dense"], "formats": ["step"]}})")));
+  CHECK_THAT(none.steps.back().message, Contains("give its composition a \"budget\""));
+  const auto chosen = run_recipe(parse_recipe(
+      recipe_with(R"(, "dense": {"rebuild": {"surface": "dome", "count_u": 101, "count_v": 101}})",
+                  R"("composition": {"budget": {"max_control_points": 20000}},
+         "exports": {"part": {"surfaces": ["dense"], "formats": ["step"]}})")));
+  CHECK_FALSE(chosen.steps.back().warning);
 
   // Under a budget of degree 9 the step is its light form, and the exact net is never built.
   const auto light =
