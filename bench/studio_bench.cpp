@@ -8,6 +8,7 @@
 //   (style, exact and paper) and for a lattice composed exactly with the hood.
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/lattice.hpp>
+#include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/bspline_surface.hpp>
@@ -124,8 +125,61 @@ void session_drag_step(benchmark::State& state) {
   state.SetLabel(labels[state.range(0)]);
 }
 
+// Issue #38 step 4: a drag of the tank's (3, 3, 1) lattice (examples/recipes/tank.json: fill,
+// exact style, lattice whose exact form would have 727,065 control points, so its light form is
+// used). Point [1, 1, 1] of "knees" moved each iteration. Arguments:
+// 0 = before: what a drag update cost until then, the edited recipe run whole (run_recipe: the
+//     fill, the style and the certified light fit);
+// 1 = after: StudioSession::handle of the drag update ("nets": false): the fill and the style
+//     taken from the last run, the light form one product of the lattice's points;
+// 2 = the release ("nets": true): the style taken from the last run, the light form fitted and
+//     certified.
+void tank_drag_step(benchmark::State& state) {
+  const std::filesystem::path file =
+      std::filesystem::path(CLAY_EXAMPLES_DIR) / "recipes" / "tank.json";
+  const std::string text = read(file);
+  Json doc = Json::parse(text);
+  Json& moves = doc["deformations"]["knees"][0]["moves"];
+  std::size_t moved = 0;
+  while (moves[moved]["index"] != Json::array({1, 1, 1})) ++moved;
+  recipe::StudioSession session(text, file.parent_path(), "tank");
+  session.handle(Json{{"op", "run"}}.dump());
+  const std::string path = "deformations.knees[0].moves[" + std::to_string(moved) + "].by[2]";
+  int step = 0;
+  clay::bench::StepTimes times;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double value = 8 + 6 * std::sin(0.1 * ++step);
+    if (state.range(0) == 0) {
+      moves[moved]["by"][2] = value;
+      const auto r = recipe::run_recipe(recipe::parse_recipe(doc.dump(), file.parent_path()));
+      benchmark::DoNotOptimize(r.surfaces.data());
+    } else {
+      const auto reply = session.handle(Json{
+          {"op", "edit"},
+          {"path", path},
+          {"value", value},
+          {"label", "drag"},
+          {"group", "drag"},
+          {"nets", state.range(0) == 2}}.dump());
+      if (reply.json.find("\"op\":\"error\"") != std::string::npos) {
+        state.SkipWithError(reply.json.c_str());
+        break;
+      }
+      benchmark::DoNotOptimize(reply.json.data());
+    }
+    times.record(t0);
+  }
+  times.report(state);
+  const char* labels[] = {"tank lattice drag, before: the recipe run whole",
+                          "tank lattice drag update: style reused, light form one product",
+                          "tank lattice release: style reused, light form fitted and certified"};
+  state.SetLabel(labels[state.range(0)]);
+}
+
 }  // namespace
 
+BENCHMARK(tank_drag_step)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(lattice_drag_step)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(session_drag_step)
     ->Arg(0)

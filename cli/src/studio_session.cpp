@@ -23,6 +23,7 @@
 #include <cstring>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string_view>
 
@@ -238,6 +239,9 @@ struct StudioSession::Impl {
   /// Per model, the topology key of the mesh last sent (topology_key): while it holds, runs send
   /// the model's nets only. "hello" and "run" (what a new page sends first) forget them.
   mutable std::map<std::string, std::uint64_t> meshed;
+  // The last run and the recipe text it ran: what the next edit of deformations alone reuses.
+  mutable std::shared_ptr<const RunResult> last_run;
+  mutable std::string last_text;
   fs::path autosave;  // empty: none
   std::chrono::steady_clock::time_point autosaved{};
   bool autosave_pending = false;
@@ -249,18 +253,51 @@ struct StudioSession::Impl {
   /// A run of the recipe text, and the surfaces a picture of it shows (final_surfaces). A
   /// cancelled command ends at the next step.
   struct Run {
-    RunResult result;
+    std::shared_ptr<RunResult> result;
     std::vector<std::string> shown;
   };
-  Run run(const std::string& recipe_text, const std::function<bool()>& cancelled) const {
+  /// Runs the recipe text; `changed` (the deformations an edit changed, and nothing else) lets
+  /// the run take every other surface from the last run, and `preview` (a drag update) lets a
+  /// lattice's light form be the one product of its linear map (RunOptions).
+  Run run(const std::string& recipe_text, const std::function<bool()>& cancelled,
+          const std::optional<std::vector<std::string>>& changed = std::nullopt,
+          bool preview = false) const {
     const Recipe recipe = parse_recipe(recipe_text, base_dir, name);
     RunOptions options;
     if (cancelled)
       options.progress = [&](const StepReport&) {
         if (cancelled()) throw Cancelled{};
       };
+    if (changed && last_run) {
+      options.previous = last_run;
+      options.changed_deformations = *changed;
+      options.preview = preview;
+    }
     if (cancelled && cancelled()) throw Cancelled{};
-    return {run_recipe(recipe, options), final_surfaces(recipe)};
+    Run out{std::make_shared<RunResult>(run_recipe(recipe, options)), final_surfaces(recipe)};
+    last_run = out.result;
+    last_text = recipe_text;
+    return out;
+  }
+
+  /// The deformations whose definitions differ between the last run's recipe and `next`, when
+  /// nothing else differs (then the run may take every other surface from the last run).
+  std::optional<std::vector<std::string>> changed_deformations(const Json& next) const {
+    if (!last_run) return std::nullopt;
+    Json before = Json::parse(last_text);
+    Json after = next;
+    const Json none = Json::object();
+    const Json a = before.contains("deformations") ? before["deformations"] : none;
+    const Json b = after.contains("deformations") ? after["deformations"] : none;
+    before.erase("deformations");
+    after.erase("deformations");
+    if (before != after || !a.is_object() || !b.is_object()) return std::nullopt;
+    std::vector<std::string> changed;
+    for (const auto& [key, value] : a.items())
+      if (!b.contains(key) || b.at(key) != value) changed.push_back(key);
+    for (const auto& [key, value] : b.items())
+      if (!a.contains(key)) changed.push_back(key);
+    return changed;
   }
 
   Json history_json() const {
@@ -332,7 +369,7 @@ struct StudioSession::Impl {
   /// final surface's parent before its first step. Without `nets` (a drag update the page draws
   /// itself), no frames: the figures and the history only.
   Reply ran(const std::string& op, const Run& run, bool nets = true) const {
-    const RunResult& result = run.result;
+    const RunResult& result = *run.result;
     Reply reply;
     const Json steps = Json::parse(step_reports_json(result.steps));  // as report.json has them
     auto push_net = [&](const std::string& n, const surface::BSplineSurface& s, bool before) {
@@ -490,7 +527,9 @@ struct StudioSession::Impl {
     std::string first_path;
     for (const Json& change : changes) apply_change(doc, change, first_path);
     std::string next = doc.dump(1, ' ', false, Json::error_handler_t::replace);
-    const Run result = run(next, cancelled);  // a recipe the edit breaks throws: nothing changes
+    // A recipe the edit breaks throws: nothing changes. An edit of deformations alone reruns
+    // only what they touch; a drag update (no nets) previews a lattice's light form.
+    const Run result = run(next, cancelled, changed_deformations(doc), !nets);
     // The updates of one drag share a "group": the latest replaces the entry an earlier one
     // made, so the drag is one step of the history.
     const auto at = static_cast<std::size_t>(position);
@@ -520,33 +559,33 @@ struct StudioSession::Impl {
         field<std::string>(c, "export", "profile", "opencascade", "a receiver profile name");
     deform::receiver_profile(profile);  // an unknown name fails before the run
     Run run = this->run(text(), cancelled);
-    if (run.shown.empty() && run.result.models.empty())
+    if (run.shown.empty() && run.result->models.empty())
       throw Error(ErrorCategory::InvalidArgument,
                   "studio: the recipe has no surface or model to export yet; build one first");
-    run.result.exports.clear();
+    run.result->exports.clear();
     if (!run.shown.empty()) {
       ExportResult e;
-      e.name = export_name.empty() ? run.result.recipe : export_name;
+      e.name = export_name.empty() ? run.result->recipe : export_name;
       e.formats = {"step", "iges", "glb"};
       e.surface_names = run.shown;
       e.profile = profile;
-      conform_export(e, parse_recipe(text(), base_dir, name), run.result);
-      run.result.exports.push_back(std::move(e));
+      conform_export(e, parse_recipe(text(), base_dir, name), *run.result);
+      run.result->exports.push_back(std::move(e));
     }
-    write_outputs(run.result, folder);  // checks every file name it writes
+    write_outputs(*run.result, folder);  // checks every file name it writes
     Json files = Json::array();
     bool valid = true, identical = true;
-    for (const ExportResult& x : run.result.exports) {
+    for (const ExportResult& x : run.result->exports) {
       for (const std::string& f : x.files) files.push_back(f);
       valid = valid && x.valid;
       identical = identical && x.read_back_identical;
     }
-    for (const ModelRunResult& m : run.result.models) {
+    for (const ModelRunResult& m : run.result->models) {
       for (const std::string& f : m.files) files.push_back(f);
       valid = valid && m.valid;
     }
     Json bounds = Json::array();  // per surface, mm from the all-exact recipe (null: unbounded)
-    for (const ExportResult& x : run.result.exports)
+    for (const ExportResult& x : run.result->exports)
       for (double b : x.bounds_mm) bounds.push_back(std::isfinite(b) ? Json(b) : Json(nullptr));
     return {reply_text(Json{{"op", "exported"},
                             {"folder", folder.string()},

@@ -34,10 +34,41 @@
 
 #include "certifier.hpp"
 #include "extended_internal.hpp"
+#include "fit_samples.hpp"
 #include "messages.hpp"
 #include "seal.hpp"
 
 namespace clay::deform {
+
+// The light form's samples and collocation (fit_samples.hpp), shared with light_map.cpp.
+namespace detail {
+
+std::vector<double> fit_parameters(const surface::BSplineBasis& basis, int intervals) {
+  const std::vector<double> breaks = surface::breakpoints(basis);
+  std::vector<double> t;
+  for (std::size_t s = 0; s + 1 < breaks.size(); ++s) {
+    const double a = breaks[s], b = breaks[s + 1];
+    for (int k = 0; k < intervals; ++k)
+      t.push_back(a + (b - a) * 0.5 * (1 - std::cos(std::numbers::pi * k / intervals)));
+  }
+  t.push_back(breaks.back());
+  return t;
+}
+
+Eigen::MatrixXd collocation(const surface::BSplineBasis& basis, const std::vector<double>& t) {
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(t.size()), basis.count());
+  std::vector<double> values(static_cast<std::size_t>(basis.degree + 1));
+  for (std::size_t r = 0; r < t.size(); ++r) {
+    const int span = surface::find_span(basis, t[r]);
+    surface::basis_functions(basis, span, t[r], values);
+    for (int k = 0; k <= basis.degree; ++k)
+      a(static_cast<Eigen::Index>(r), span - basis.degree + k) =
+          values[static_cast<std::size_t>(k)];
+  }
+  return a;
+}
+
+}  // namespace detail
 
 namespace {
 
@@ -53,6 +84,8 @@ std::string short_format(double v) { return internal::with_digits(v, 3); }
 using detail::Bounds;
 using detail::Certifier;
 using detail::certifier;
+using detail::collocation;
+using detail::fit_parameters;
 using detail::HullInfo;
 using detail::Plane;
 
@@ -107,33 +140,6 @@ BSplineBasis initial_basis(const BSplineSurface& surface, bool along_u, int degr
   }
   b.knots.insert(b.knots.end(), static_cast<std::size_t>(degree + 1), breaks.back());
   return b;
-}
-
-/// Chebyshev–Lobatto parameters, `intervals` per non-empty span, ends shared.
-std::vector<double> fit_parameters(const BSplineBasis& basis, int intervals) {
-  const std::vector<double> breaks = surface::breakpoints(basis);
-  std::vector<double> t;
-  for (std::size_t s = 0; s + 1 < breaks.size(); ++s) {
-    const double a = breaks[s], b = breaks[s + 1];
-    for (int k = 0; k < intervals; ++k)
-      t.push_back(a + (b - a) * 0.5 * (1 - std::cos(std::numbers::pi * k / intervals)));
-  }
-  t.push_back(breaks.back());
-  return t;
-}
-
-/// Collocation matrix: row r holds N_j(t_r).
-Eigen::MatrixXd collocation(const BSplineBasis& basis, const std::vector<double>& t) {
-  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(t.size()), basis.count());
-  std::vector<double> values(static_cast<std::size_t>(basis.degree + 1));
-  for (std::size_t r = 0; r < t.size(); ++r) {
-    const int span = surface::find_span(basis, t[r]);
-    surface::basis_functions(basis, span, t[r], values);
-    for (int k = 0; k <= basis.degree; ++k)
-      a(static_cast<Eigen::Index>(r), span - basis.degree + k) =
-          values[static_cast<std::size_t>(k)];
-  }
-  return a;
 }
 
 /// Tensor-product least squares: the net C minimising Σ |Σ N_i(u_r) N_j(v_s) C_ij − F_rs|^2 is

@@ -199,7 +199,7 @@ class Runner {
           rep.message += ": disabled, skipped";
           return;
         }
-        Stage stage{name, p, step.kind, s, {}, {}, {}};
+        Stage stage{name, p, step.kind, s, {}, {}, {}, {}};
         if (const auto* style = std::get_if<StyleDef>(&step.step)) {
           if (!style->bound.empty()) stage.curves.push_back(style->bound);
           stage.curves.push_back(style->target);
@@ -215,6 +215,8 @@ class Runner {
       timed(path + ".composition.budget", "light",
             [&](StepReport& rep) { s = light_copy(s, c, name, rep); });
     bound_of_[name] = ledger_;
+    if (previewing_) result_.previewed.push_back(name);
+    previewing_ = false;
     return s;
   }
 
@@ -328,6 +330,8 @@ class Runner {
   // its exact reference, the recipe with every step exact (mm; inf: not bounded).
   std::map<std::string, double> bound_of_;
   double ledger_ = 0;
+  std::map<std::string, bool> affected_;  // by surface name: needs what changed
+  bool previewing_ = false;               // the surface being deformed has a previewed step
 
   template <class F>
   void timed(const std::string& path, const std::string& kind, F&& f) {
@@ -379,10 +383,18 @@ class Runner {
           const Needs needs = surface_needs(data_, def);
           for (const auto& c : needs.curves) need_curve(c);
           for (const auto& s : needs.surfaces) need_surface(s);
+          // Taken from the previous run when nothing it needs changed (run_reuse.cpp).
+          if (options_.previous &&
+              !needs_changed(data_, *options_.previous, options_.changed_deformations, name,
+                             affected_) &&
+              take_surface(*options_.previous, def, result_, bound_of_, options_.progress))
+            return;
           return build_surface(def);
         }
     });
   }
+  // ---- what an earlier run gives (RunOptions::previous) ---------------------------------------
+
   /// Runs f for `node` once at a time: the checker reports cycles, so meeting one here is a bug.
   template <class F>
   void guard(const std::string& node, F&& f) {
@@ -712,9 +724,6 @@ class Runner {
   }
 
   // ---- deformation steps --------------------------------------------------------------------
-
- public:
- private:
   static void lattice_figures(const deform::Deformation& d, StepReport& rep) {
     std::optional<deform::JacobianBounds> j;
     if (const auto* b = std::get_if<deform::BezierLattice>(&d)) j = deform::jacobian_bounds(*b);
@@ -805,6 +814,16 @@ class Runner {
       return std::visit(
           [&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, d);
     };
+    if (options_.preview && options_.previous)
+      if (auto map = preview_map(*options_.previous, d, s, stage.step)) {
+        BSplineSurface out = deform::light_net(*map, d);
+        ledger_ = std::numeric_limits<double>::infinity();  // no certificate until let go
+        preview_figures(out, rep);
+        stage.light_map = std::move(map);
+        previewing_ = true;
+        lattice_figures(d, rep);
+        return out;
+      }
     BSplineSurface out = compose(d, s, c, rep);
     lattice_figures(d, rep);
     return out;

@@ -1,12 +1,18 @@
 #pragma once
 // What the recipe runner's two files share (recipe_run.cpp: the Runner, curves, surfaces and
 // exports; recipe_run_models.cpp: whole models and deform_model). Internal to the recipe library.
+#include <clay/deform/light_map.hpp>
 #include <clay/deform/surface_deformation.hpp>
+#include <clay/recipe/recipe.hpp>
 
 #include <chrono>
 #include <cstdio>
+#include <functional>
+#include <map>
+#include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "recipe_model.hpp"
 
@@ -38,5 +44,34 @@ const StackDef& pick_stack(const RecipeData& d, std::string_view deformation);
 
 /// One of the recipe's models: imported, flattened, and deformed when it names a stack.
 ModelRunResult run_model(const RecipeData& d, const ModelDef& def);
+
+// ---- what an earlier run gives (RunOptions::previous; run_reuse.cpp) -------------------------
+
+/// True when the surface needs one of the `changed` deformations, or a surface `previous` only
+/// previewed, through its deform, the surfaces and the curves it is built from. `memo` keeps the
+/// answers by surface name for one run.
+bool needs_changed(const RecipeData& d, const RunResult& previous,
+                   const std::vector<std::string>& changed, const std::string& surface,
+                   std::map<std::string, bool>& memo);
+
+/// Appends the surface `previous` made for `def` to `into`, with its step reports (each passed
+/// to `progress` when set), its stages and its bound (into `bounds`); false when `previous` has
+/// no such surface.
+bool take_surface(const RunResult& previous, const SurfaceDef& def, RunResult& into,
+                  std::map<std::string, double>& bounds,
+                  const std::function<void(const StepReport&)>& progress);
+
+/// The linear map of a lattice step's light form for a drag preview: `previous`'s for that step
+/// when it applies (deform::applies_to), else one made on the knots of the light form `previous`
+/// gave the step; empty when the deformation is not a Bézier or B-spline lattice or the step was
+/// not a light form.
+std::shared_ptr<const deform::LatticeLightMap> preview_map(const RunResult& previous,
+                                                           const deform::Deformation& d,
+                                                           const surface::BSplineSurface& s,
+                                                           const std::string& step);
+
+/// The figures and message of a step previewed by its light map: light, preview, not
+/// certified, the bound ledger unbounded until the release.
+void preview_figures(const surface::BSplineSurface& net, StepReport& rep);
 
 }  // namespace clay::recipe::detail

@@ -47,6 +47,10 @@ def test_the_page_says_the_tank_is_a_light_form_within_its_bound(tmp_path):
                "figures": {"composition": "exact", "accumulated_bound_mm": 0.25}}
     unbounded = {"path": "surfaces.c.steps[0]", "kind": "twist",
                  "figures": {"composition": "refit", "accumulated_bound": "unbounded"}}
-    assert form_shown([exact, carried, unbounded], tmp_path) == (
+    # A drag update's preview (figures as tests/cli/reuse_test.cpp checks the session sends them).
+    preview = {"path": "surfaces.d.steps[0]", "kind": "bezier_lattice",
+               "figures": {"composition": "light", "preview": True, "accumulated_bound": "unbounded",
+                           "certified": False}}
+    assert form_shown([exact, carried, unbounded, preview], tmp_path) == (
         "a: exact; b: light form, within 0.25 mm of the exact; "
-        "c: refit, distance from the exact unbounded")
+        "c: refit, distance from the exact unbounded; d: light form (drag preview, certified when let go)")

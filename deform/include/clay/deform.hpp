@@ -6,7 +6,8 @@
 /// deformations (taper, twist, bend), deformation stacks with their JSON form, the style
 /// deformation by bound and target curves (Han–De Amicis–Conti 2007), the exact composition of
 /// lattices and polynomial tapers with NURBS surfaces (Sederberg–Parry §2.1) and the certified
-/// refit of deformed surfaces that are not polynomial.
+/// refit of deformed surfaces that are not polynomial, with budgets, light forms (and their linear
+/// map in a lattice's points, for drags) and receiver profiles.
 #include <clay/deform/compose.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
@@ -15,6 +16,7 @@
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/lattice.hpp>
+#include <clay/deform/light_map.hpp>
 #include <clay/deform/model_deformation.hpp>
 #include <clay/deform/receiver.hpp>
 #include <clay/deform/refit.hpp>

@@ -2,7 +2,8 @@
 // tests it against the kernel's report (tests/python/test_page_form.py).
 /**
  * Which form each deformed surface has, from the last run's steps: "exact", or "light" with how
- * far it may be from the exact (its bound ledger) and the exact form's size it stands for.
+ * far it may be from the exact (its bound ledger) and the exact form's size it stands for, or a
+ * drag's uncertified preview.
  */
 export function formShown(steps) {
   const last = new Map();
@@ -13,6 +14,8 @@ export function formShown(steps) {
   return [...last.entries()]
     .map(([name, s]) => {
       const f = s.figures;
+      // a drag update: the light form on its last knots, one product of the lattice's points
+      if (f.preview) return `${name}: light form (drag preview, certified when let go)`;
       if (f.composition === 'exact' && f.accumulated_bound_mm === undefined) return `${name}: exact`;
       const bound = f.accumulated_bound_mm !== undefined ? `within ${f.accumulated_bound_mm.toPrecision(2)} mm of the exact` : 'distance from the exact unbounded';
       const size = f.exact_control_points !== undefined ? ` (exact: degree ${f.exact_degree_u}, ${f.exact_control_points} control points)` : '';

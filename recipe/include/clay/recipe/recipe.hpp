@@ -5,6 +5,7 @@
 /// and applied to other surfaces (Coquillart's recording operator). The `clayform` command is a
 /// shell over these functions.
 #include <clay/brep/model.hpp>
+#include <clay/deform/light_map.hpp>
 #include <clay/deform/model_deformation.hpp>
 #include <clay/recipe/export.hpp>
 #include <clay/surface/bspline_curve.hpp>
@@ -81,12 +82,25 @@ struct StepReport {
 };
 
 /// Settings of run_recipe / deform_surfaces.
+struct RunResult;
 struct RunOptions {
   /// Called after each step (progress lines); may be empty.
   std::function<void(const StepReport&)> progress;
   /// Non-empty: every export is written for this receiver profile (deform::receiver_profile:
   /// "exact", "opencascade", "catia", "class_a", "bicubic") instead of its own.
   std::string profile;
+  /// An earlier run of this recipe whose definitions differed only in the deformations named in
+  /// `changed_deformations` (the studio's lattice edits; the caller compares the texts). Every
+  /// surface that needs none of them (through its deform, the surfaces and the curves it is built
+  /// from) is taken from it with its step reports, stages and bound instead of being built
+  /// again; a surface RunResult::previewed lists is always built again.
+  std::shared_ptr<const RunResult> previous;
+  std::vector<std::string> changed_deformations;
+  /// With `previous`: a Bézier or B-spline lattice step whose light form the previous run made
+  /// gives the light net on that form's knots (deform::light_net, one product per update) without
+  /// a certificate: a drag preview, listed in RunResult::previewed. Run again without it to fit
+  /// and certify.
+  bool preview = false;
 };
 
 /// One export: the surfaces written together and what the exchange layer reported.
@@ -120,7 +134,11 @@ struct Stage {
   std::vector<std::string> curves;  ///< names of the curves the step used, in RunResult::curves
   /// The step's deformation of space, point by point (`after` equals it applied to `before`,
   /// exactly or within the refit's bound); empty for a style step, which moves control points.
-  std::function<Eigen::Vector3d(const Eigen::Vector3d&)> map;
+  std::function<Eigen::Vector3d(const Eigen::Vector3d&)>
+      map;  /// A lattice step's light form as a linear map of its points (RunOptions::preview),
+            /// kept for
+  /// the next update of the same drag; empty otherwise.
+  std::shared_ptr<const deform::LatticeLightMap> light_map;
 };
 
 /// A whole model deformed by a recipe's deformation stack (the "clayform deform" use, and each
@@ -156,6 +174,8 @@ struct CLAY_RECIPE_API RunResult {
   /// The bound ledger: per surface that is not exact, how far it may be from the all-exact
   /// recipe (mm; inf when not bounded); a surface not listed is exact.
   std::vector<std::pair<std::string, double>> bounds;
+  /// Surfaces built in a preview run (RunOptions::preview): uncertified, never reused.
+  std::vector<std::string> previewed;
   double seconds = 0;  ///< wall time of the whole run
   /// The named surface. Throws clay::Error(InvalidArgument) naming the defined ones when absent.
   const surface::BSplineSurface& surface(std::string_view name) const;
