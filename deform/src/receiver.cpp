@@ -74,18 +74,13 @@ ProfileFit fit_to_profile(const surface::BSplineSurface& s, const ReceiverProfil
   fit.keep_breakpoints = false;
   RefitResult r;
   if (p.max_count_per_direction > 0) {
-    // A capped net (class A): uniform nets of growing size up to the cap, each fitted once and
-    // certified, the first within the tolerance kept. (An adaptive fit at degree 5 would start
-    // from every C2 join of a bicubic, rougher than its own C4 joins.)
-    for (int n = p.fit_degree + 3;; n = std::min(p.max_count_per_direction, n * 3 / 2)) {
-      fit.count_u = fit.count_v = n;
-      r = refit_surface(s, fit);
-      if ((r.report.summary.converged() && r.report.certified) || n == p.max_count_per_direction)
-        break;
-    }
-  } else {
-    r = refit_surface(s, fit);
+    // A capped net (class A): adaptive from a uniform 8 x 8 start (from the original's breaks a
+    // degree 5 fit would keep every C2 join of a bicubic, rougher than its own C4 joins), the
+    // spans with the worst cells split first up to the cap.
+    fit.initial_count = std::min(p.fit_degree + 3, p.max_count_per_direction);
+    fit.max_count_per_direction = p.max_count_per_direction;
   }
+  r = refit_surface(s, fit);
   std::vector<std::string> still = conformance_problems(r.surface, p);
   if (!r.report.summary.converged() || !r.report.certified || !still.empty())
     throw Error(ErrorCategory::ToleranceNotMet,

@@ -365,6 +365,21 @@ Certificate certify(const BSplineSurface& original, const BSplineSurface& fit, c
 }
 
 /// The basis with a knot added at the middle of every marked non-empty span.
+/// Keeps the marks of at most `room` spans, those with the worst cells; true when any mark is
+/// left.
+bool keep_worst(std::vector<char>& marked, const std::vector<double>& worst, int room) {
+  std::vector<std::size_t> spans;
+  for (std::size_t s = 0; s < marked.size(); ++s)
+    if (marked[s]) spans.push_back(s);
+  const std::size_t keep = static_cast<std::size_t>(std::max(room, 0));
+  if (spans.size() > keep) {
+    std::stable_sort(spans.begin(), spans.end(),
+                     [&](std::size_t a, std::size_t b) { return worst[a] > worst[b]; });
+    for (std::size_t k = keep; k < spans.size(); ++k) marked[spans[k]] = 0;
+  }
+  return std::min(spans.size(), keep) > 0;
+}
+
 BSplineBasis split_spans(const BSplineBasis& basis, const std::vector<char>& marked) {
   const std::vector<double> breaks = surface::breakpoints(basis);
   BSplineBasis out = basis;
@@ -405,14 +420,18 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
   report.size = size;
   report.degree_u = report.degree_v = p;
   const bool fixed = options.count_u > 0;
-  BSplineBasis bu = fixed ? surface::clamped_uniform_basis(p, options.count_u,
-                                                           surface.u.domain().first,
-                                                           surface.u.domain().second)
-                          : initial_basis(surface, true, p, options.keep_breakpoints, tolerance),
-               bv = fixed ? surface::clamped_uniform_basis(p, options.count_v,
-                                                           surface.v.domain().first,
-                                                           surface.v.domain().second)
-                          : initial_basis(surface, false, p, options.keep_breakpoints, tolerance);
+  // A fixed net, or an adaptive one from a uniform start (initial_count) or from the original's
+  // breakpoints.
+  const int uniform_u = fixed ? options.count_u : options.initial_count;
+  const int uniform_v = fixed ? options.count_v : options.initial_count;
+  BSplineBasis bu = uniform_u > 0
+                        ? surface::clamped_uniform_basis(p, uniform_u, surface.u.domain().first,
+                                                         surface.u.domain().second)
+                        : initial_basis(surface, true, p, options.keep_breakpoints, tolerance),
+               bv = uniform_v > 0
+                        ? surface::clamped_uniform_basis(p, uniform_v, surface.v.domain().first,
+                                                         surface.v.domain().second)
+                        : initial_basis(surface, false, p, options.keep_breakpoints, tolerance);
   const std::size_t initial_u = bu.knots.size(), initial_v = bv.knots.size();
   std::string limit;
   for (int iteration = 1;; ++iteration) {
@@ -437,6 +456,8 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     report.crossings.clear();
     std::vector<char> mark_u(static_cast<std::size_t>(cert.spans_u), 0);
     std::vector<char> mark_v(static_cast<std::size_t>(cert.spans_v), 0);
+    // the worst cell of each span row and column (which to split first under a cap)
+    std::vector<double> worst_u(mark_u.size(), 0.0), worst_v(mark_v.size(), 0.0);
     for (int iu = 0; iu < cert.cells_u; ++iu)
       for (int iv = 0; iv < cert.cells_v; ++iv) {
         const CellResult& c = cert.cells[static_cast<std::size_t>(iu * cert.cells_v + iv)];
@@ -447,8 +468,12 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
           report.crossings.push_back(
               {span_u, span_v, pl.step, pl.axis, pl.value, c.sampled, c.bound});
         const double measure = cert.certified ? c.bound : c.sampled;
-        if (measure > tolerance)
+        if (measure > tolerance) {
           mark_u[static_cast<std::size_t>(span_u)] = mark_v[static_cast<std::size_t>(span_v)] = 1;
+          double& wu = worst_u[static_cast<std::size_t>(span_u)];
+          double& wv = worst_v[static_cast<std::size_t>(span_v)];
+          wu = std::max(wu, measure), wv = std::max(wv, measure);
+        }
       }
     const double measure = cert.certified ? cert.bound : cert.sampled;
     if (iteration == 1) report.summary.initial_residual = measure;
@@ -466,14 +491,19 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
       limit = "iteration limit " + std::to_string(options.max_iterations) + " reached";
       break;
     }
-    BSplineBasis nu = split_spans(bu, mark_u), nv = split_spans(bv, mark_v);
     // The least squares are dense per direction ((degree + 1) rows per span x count columns), so
     // one long direction costs count^2 memory even within max_control_points: a twist of 1e6
-    // degrees grew one direction to 10,000 and took 4.4 GB (issue #18).
-    if (std::max(nu.count(), nv.count()) > options.max_count_per_direction) {
+    // degrees grew one direction to 10,000 and took 4.4 GB (issue #18). Near the cap, the spans
+    // with the worst cells are split first, as many as it leaves room for (a class-A net of at
+    // most 32 control points per direction puts its knots where the error is).
+    const bool room = keep_worst(mark_u, worst_u, options.max_count_per_direction - bu.count()) |
+                      keep_worst(mark_v, worst_v, options.max_count_per_direction - bv.count());
+    BSplineBasis nu = split_spans(bu, mark_u), nv = split_spans(bv, mark_v);
+    if (!room || std::max(nu.count(), nv.count()) > options.max_count_per_direction) {
       limit = "control point limit per direction " +
-              std::to_string(options.max_count_per_direction) + " reached (next net " +
-              std::to_string(nu.count()) + " x " + std::to_string(nv.count()) + ")";
+              std::to_string(options.max_count_per_direction) + " reached (" +
+              (room ? "next net " : "net ") + std::to_string(nu.count()) + " x " +
+              std::to_string(nv.count()) + ")";
       break;
     }
     if (static_cast<long>(nu.count()) * nv.count() > options.max_control_points) {
@@ -542,6 +572,11 @@ std::vector<std::string> RefitOptions::problems() const {
   if (max_count_per_direction < degree + 1)
     fail("max_count_per_direction = " + std::to_string(max_count_per_direction) +
          ": must be >= degree + 1 = " + std::to_string(degree + 1));
+  if (initial_count != 0 && (initial_count < degree + 1 || initial_count > max_count_per_direction))
+    fail("initial_count = " + std::to_string(initial_count) +
+         " breaks the rule 0, or degree + 1 (" + std::to_string(degree + 1) +
+         ") <= initial_count <= max_count_per_direction (" +
+         std::to_string(max_count_per_direction) + ")");
   if ((count_u > 0) != (count_v > 0) || count_u < 0 || count_v < 0)
     fail("count_u = " + std::to_string(count_u) + ", count_v = " + std::to_string(count_v) +
          ": give both (a fixed net) or neither (0, adaptive)");

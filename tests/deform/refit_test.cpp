@@ -13,6 +13,7 @@
 #include <clay/surface/revolve.hpp>
 #include <clay/surface/skin.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -433,6 +434,62 @@ TEST_CASE("Refit limits end in a not-converged report", "[refit]") {
   CHECK(d.surface.count_v() <= 12);
 }
 
+TEST_CASE("Refit from a uniform start under a cap puts its knots where the error is", "[refit]") {
+  // A 100 x 100 mm bicubic sheet with a narrow bump near (20, 20): the error of a quintic fit
+  // lives there.
+  const auto b = surface::clamped_uniform_basis(3, 40);
+  const auto x = surface::greville_abscissae(b);
+  surface::Points3 p(1600, 3);
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const double u = 100 * x[static_cast<size_t>(i)], v = 100 * x[static_cast<size_t>(j)];
+      p.row(i * 40 + j) << u, v,
+          6 * std::exp(-((u - 20) * (u - 20) + (v - 20) * (v - 20)) / 40) + 0.05 * u;
+    }
+  const surface::BSplineSurface sheet = surface::make_surface(b, b, p);
+  RefitOptions o;
+  o.degree = 5;
+  o.relative_tolerance = 0;
+  o.tolerance_mm = 0.035;
+  o.keep_breakpoints = false;
+  o.initial_count = 8;
+  o.max_count_per_direction = 20;
+  const RefitResult adaptive = refit_surface(sheet, o);
+  INFO(adaptive.report.summary.message);
+  REQUIRE(adaptive.report.summary.converged());
+  REQUIRE(adaptive.report.certified);
+  CHECK(adaptive.surface.u.degree == 5);
+  CHECK(adaptive.surface.count_u() <= 20);
+  CHECK(adaptive.surface.count_v() <= 20);
+  // The knots crowd round the bump: more interior knots below 0.4 than above 0.6.
+  auto knots_in = [](const std::vector<double>& k, double a, double c) {
+    return std::count_if(k.begin(), k.end(), [&](double t) { return t > a && t < c; });
+  };
+  CHECK(knots_in(adaptive.surface.u.knots, 0, 0.4) > knots_in(adaptive.surface.u.knots, 0.6, 1));
+  // The certified bound holds at 201 x 201 points of the sheet.
+  double worst = 0;
+  for (int i = 0; i <= 200; ++i)
+    for (int j = 0; j <= 200; ++j)
+      worst = std::max(worst, (surface::evaluate(adaptive.surface, i / 200.0, j / 200.0) -
+                               surface::evaluate(sheet, i / 200.0, j / 200.0))
+                                  .norm());
+  CHECK(worst <= adaptive.report.certified_bound_mm);
+  // The uniform net of the cap's size misses where the adaptive one meets.
+  RefitOptions uniform = o;
+  uniform.initial_count = 0;
+  uniform.count_u = uniform.count_v = 20;
+  const RefitResult fixed = refit_surface(sheet, uniform);
+  INFO(fixed.report.summary.message);
+  CHECK_FALSE(fixed.report.summary.converged());
+  CHECK(fixed.report.certified_bound_mm > o.tolerance_mm);  // 0.047 mm against 0.029 mm
+  // Under a cap too small for the tolerance: the message names the cap and the net it reached.
+  o.max_count_per_direction = 10;
+  const RefitResult capped = refit_surface(sheet, o);
+  CHECK_FALSE(capped.report.summary.converged());
+  CHECK_THAT(capped.report.summary.message,
+             Contains("control point limit per direction 10 reached (net 10 x 10)"));
+}
+
 TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]") {
   const surface::BSplineSurface loft = loft_surface();
   Twist twist;
@@ -476,6 +533,9 @@ TEST_CASE("Refit errors name the field, the value and the fix", "[refit][errors]
   o = {};
   o.certificate_share = 1;
   options_error(o, "certificate_share = 1");
+  o = {};
+  o.initial_count = 3;  // below degree + 1
+  options_error(o, "initial_count = 3");
 
   surface::BSplineSurface bad = loft;
   bad.points(0, 0) = std::numeric_limits<double>::quiet_NaN();

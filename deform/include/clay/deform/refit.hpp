@@ -71,6 +71,12 @@ struct CLAY_DEFORM_API RefitOptions {
   /// neither, each in [degree + 1, max_count_per_direction].
   int count_u = 0;
   int count_v = 0;  ///< see count_u
+  /// > 0 (adaptive fits only): start from a uniform net of initial_count x initial_count control
+  /// points instead of the original's breakpoints, then add knots where cells miss. Near
+  /// max_count_per_direction the spans with the worst cells are split first, so a capped net
+  /// (class A: degree 5, at most 32 per direction) has its knots where the error is. 0, or in
+  /// [degree + 1, max_count_per_direction].
+  int initial_count = 0;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
