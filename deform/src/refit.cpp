@@ -380,6 +380,37 @@ bool keep_worst(std::vector<char>& marked, const std::vector<double>& worst, int
   return std::min(spans.size(), keep) > 0;
 }
 
+/// The basis with the same number of simple interior knots moved so that each span carries an
+/// equal share of the error (de Boor's equidistribution, "A Practical Guide to Splines" ch. XII):
+/// a degree-p fit's error on a span of length h is about (h rho)^(p + 1), so span s of the old
+/// basis, with error e_s, holds mass e_s^(1 / (p + 1)) spread evenly over it; the new breaks cut
+/// the running mass into equal parts. A floor of a tenth of the mean mass keeps every region some
+/// knots. `error` has one entry per non-empty span.
+BSplineBasis equidistributed(const BSplineBasis& basis, const std::vector<double>& error) {
+  const std::vector<double> breaks = surface::breakpoints(basis);
+  const std::size_t spans = breaks.size() - 1;
+  std::vector<double> mass(spans);
+  double mean = 0;
+  for (std::size_t s = 0; s < spans; ++s)
+    mean += mass[s] = std::pow(std::max(error[s], 0.0), 1.0 / (basis.degree + 1));
+  mean /= static_cast<double>(spans);
+  double total = 0;
+  for (double& m : mass) total += m = std::max(m, 0.1 * mean);
+  BSplineBasis out;
+  out.degree = basis.degree;
+  out.knots.assign(static_cast<std::size_t>(basis.degree + 1), breaks.front());
+  double below = 0;  // mass of the spans before s
+  std::size_t s = 0;
+  for (std::size_t k = 1; k < spans; ++k) {
+    const double at = total * static_cast<double>(k) / static_cast<double>(spans);
+    while (s + 1 < spans && below + mass[s] < at) below += mass[s++];
+    const double f = mass[s] > 0 ? std::clamp((at - below) / mass[s], 0.0, 1.0) : 0.5;
+    out.knots.push_back(breaks[s] + f * (breaks[s + 1] - breaks[s]));
+  }
+  out.knots.insert(out.knots.end(), static_cast<std::size_t>(basis.degree + 1), breaks.back());
+  return out;
+}
+
 BSplineBasis split_spans(const BSplineBasis& basis, const std::vector<char>& marked) {
   const std::vector<double> breaks = surface::breakpoints(basis);
   BSplineBasis out = basis;
@@ -434,6 +465,9 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
                         : initial_basis(surface, false, p, options.keep_breakpoints, tolerance);
   const std::size_t initial_u = bu.knots.size(), initial_v = bv.knots.size();
   std::string limit;
+  RefitResult best;  // the best fit that missed, kept when moving knots did worse
+  double best_measure = infinity;
+  int relocations = 0;
   for (int iteration = 1;; ++iteration) {
     const std::vector<double> us = fit_parameters(bu, intervals),
                               vs = fit_parameters(bv, intervals);
@@ -456,8 +490,10 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     report.crossings.clear();
     std::vector<char> mark_u(static_cast<std::size_t>(cert.spans_u), 0);
     std::vector<char> mark_v(static_cast<std::size_t>(cert.spans_v), 0);
-    // the worst cell of each span row and column (which to split first under a cap)
+    // the worst cell of each span row and column that misses (which to split first under a
+    // cap), and of every one (where to move knots once the cap is reached)
     std::vector<double> worst_u(mark_u.size(), 0.0), worst_v(mark_v.size(), 0.0);
+    std::vector<double> error_u(mark_u.size(), 0.0), error_v(mark_v.size(), 0.0);
     for (int iu = 0; iu < cert.cells_u; ++iu)
       for (int iv = 0; iv < cert.cells_v; ++iv) {
         const CellResult& c = cert.cells[static_cast<std::size_t>(iu * cert.cells_v + iv)];
@@ -468,6 +504,10 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
           report.crossings.push_back(
               {span_u, span_v, pl.step, pl.axis, pl.value, c.sampled, c.bound});
         const double measure = cert.certified ? c.bound : c.sampled;
+        error_u[static_cast<std::size_t>(span_u)] =
+            std::max(error_u[static_cast<std::size_t>(span_u)], measure);
+        error_v[static_cast<std::size_t>(span_v)] =
+            std::max(error_v[static_cast<std::size_t>(span_v)], measure);
         if (measure > tolerance) {
           mark_u[static_cast<std::size_t>(span_u)] = mark_v[static_cast<std::size_t>(span_v)] = 1;
           double& wu = worst_u[static_cast<std::size_t>(span_u)];
@@ -482,6 +522,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
       report.summary.termination = Termination::Converged;
       break;
     }
+    if (measure < best_measure) best_measure = measure, best = result;
     if (fixed) {
       limit = "the fixed net of " + std::to_string(options.count_u) + " x " +
               std::to_string(options.count_v) + " control points (count_u, count_v)";
@@ -496,9 +537,18 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     // degrees grew one direction to 10,000 and took 4.4 GB (issue #18). Near the cap, the spans
     // with the worst cells are split first, as many as it leaves room for (a class-A net of at
     // most 32 control points per direction puts its knots where the error is).
-    const bool room = keep_worst(mark_u, worst_u, options.max_count_per_direction - bu.count()) |
-                      keep_worst(mark_v, worst_v, options.max_count_per_direction - bv.count());
+    // Both directions are trimmed, so neither call may be short-circuited away.
+    const bool room_u = keep_worst(mark_u, worst_u, options.max_count_per_direction - bu.count());
+    const bool room_v = keep_worst(mark_v, worst_v, options.max_count_per_direction - bv.count());
+    const bool room = room_u || room_v;
     BSplineBasis nu = split_spans(bu, mark_u), nv = split_spans(bv, mark_v);
+    if (!room && options.initial_count > 0 && relocations < 4) {
+      // Every span that misses is in a direction at its cap: move the knots instead, so that
+      // each span carries an equal share of the error (kept only when it does better).
+      ++relocations;
+      bu = equidistributed(bu, error_u), bv = equidistributed(bv, error_v);
+      continue;
+    }
     if (!room || std::max(nu.count(), nv.count()) > options.max_count_per_direction) {
       limit = "control point limit per direction " +
               std::to_string(options.max_count_per_direction) + " reached (" +
@@ -513,6 +563,13 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
       break;
     }
     bu = std::move(nu), bv = std::move(nv);
+  }
+  if (report.summary.termination != Termination::Converged &&
+      report.summary.final_residual > best_measure) {
+    const Summary summary = report.summary;
+    result = std::move(best);
+    report.summary = summary;
+    report.summary.final_residual = best_measure;
   }
 
   std::string message;

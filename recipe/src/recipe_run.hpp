@@ -64,7 +64,7 @@ bool take_surface(const RunResult& previous, const SurfaceDef& def, RunResult& i
 /// The linear map of a lattice step's light form for a drag preview: `previous`'s for that step
 /// when it applies (deform::applies_to), else one made on the knots of the light form `previous`
 /// gave the step; empty when the deformation is not a Bézier or B-spline lattice or the step was
-/// not a light form.
+/// neither a light form nor a refit.
 std::shared_ptr<const deform::LatticeLightMap> preview_map(const RunResult& previous,
                                                            const deform::Deformation& d,
                                                            const surface::BSplineSurface& s,

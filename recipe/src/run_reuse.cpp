@@ -73,9 +73,13 @@ std::shared_ptr<const deform::LatticeLightMap> preview_map(const RunResult& prev
   if (stage->light_map && deform::applies_to(*stage->light_map, d, s)) return stage->light_map;
   const auto rep = std::find_if(previous.steps.begin(), previous.steps.end(),
                                 [&](const StepReport& r) { return r.path == step; });
-  const std::pair<std::string, Figure> light{"composition", std::string("light")};
+  // A light form, or a refit (composition "refit", or a B-spline lattice's knot planes): both are
+  // refit's least squares on their final knots, so both are linear in the lattice's points.
+  const std::pair<std::string, Figure> light{"composition", std::string("light")},
+      refit{"composition", std::string("refit")};
   if (rep == previous.steps.end() ||
-      std::find(rep->figures.begin(), rep->figures.end(), light) == rep->figures.end())
+      (std::find(rep->figures.begin(), rep->figures.end(), light) == rep->figures.end() &&
+       std::find(rep->figures.begin(), rep->figures.end(), refit) == rep->figures.end()))
     return {};
   // The knots of the last light form serve any input: the map fits the moved lattice's image of
   // this step's input on them (when the input changed too, it is made again at the next update).
@@ -84,7 +88,7 @@ std::shared_ptr<const deform::LatticeLightMap> preview_map(const RunResult& prev
 }
 
 void preview_figures(const surface::BSplineSurface& net, StepReport& rep) {
-  rep.figures.emplace_back("composition", std::string("light"));
+  rep.figures.emplace_back("composition", std::string("light"));  // a refit's preview too
   rep.figures.emplace_back("preview", true);
   rep.figures.emplace_back("accumulated_bound", std::string("unbounded"));
   rep.figures.emplace_back("degree_u", static_cast<long long>(net.u.degree));

@@ -559,7 +559,7 @@ TEST_CASE("example sail: key points added along the target do not wind the net u
 
 TEST_CASE(
     "example fender: strokes, a constrained door cut, a snapped fill, exact flare, lattice as a "
-    "certified light form",
+    "certified light form, exported for a class-A receiver",
     "[examples]") {
   const RunResult r = run_example("fender");
   const Json j = recipe_json("fender");
@@ -669,6 +669,28 @@ TEST_CASE(
   CHECK((surface::evaluate(fender, 0, 0.5) - surface::evaluate(panel, 0, 0.5)).y() < -20);
   CHECK(std::abs((surface::evaluate(fender, 1, 0.5) - surface::evaluate(panel, 1, 0.5)).y()) <
         certified + rebuilt + 1.0);
+
+  // The export, for a class-A receiver: a quintic of at most 32 x 32 control points (a net a
+  // stylist edits), certified within its bound of the fender, and within the export's bound (the
+  // ledger plus that fit) of the all-exact reference nose(styled(u, v)).
+  REQUIRE(r.exports.size() == 1);
+  const ExportResult& out = r.exports.front();
+  CHECK(out.profile == "class_a");
+  REQUIRE(out.surfaces.size() == 1);
+  const surface::BSplineSurface& written = out.surfaces.front();
+  CHECK(written.u.degree == 5);
+  CHECK(written.v.degree == 5);
+  CHECK(written.count_u() <= 32);
+  CHECK(written.count_v() <= 32);
+  const double fitted = out.bounds_mm.front() - accumulated;
+  CHECK(fitted > 0);
+  CHECK(fitted <= figure<double>(light, "tolerance_mm") * 1.01);  // the recipe's tolerance
+  const double class_a_gap =
+      max_pointwise_gap(fender, written, [](const Eigen::Vector3d& x) { return x; });
+  INFO("class A: " << written.count_u() << " x " << written.count_v() << ", gap " << class_a_gap
+                   << " mm, certified " << fitted << " mm");
+  CHECK(class_a_gap <= fitted + 1e-12 * size);
+  CHECK(max_pointwise_gap(styled, written, nosed) <= out.bounds_mm.front() + 1e-12 * size);
   // (Replay determinism is checked on the lighter examples: this run takes half a minute.)
 }
 

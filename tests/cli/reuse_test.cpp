@@ -157,6 +157,43 @@ TEST_CASE("run_recipe: a drag preview is the light form on its last knots, certi
   CHECK(let_go.previewed.empty());
 }
 
+TEST_CASE("run_recipe: a refitted lattice step is previewed on its knots too", "[recipe][reuse]") {
+  // The tank under a B-spline lattice (Hsu-Hughes-Kaufman) whose knot planes cross the panel off
+  // its iso-lines, refitted (composition "refit"): also refit's least squares on its final knots,
+  // so also one product of the lattice's points.
+  auto refitted = [](double z) {
+    Json doc = tank();
+    Json& knees = doc["deformations"]["knees"][0];
+    knees = {{"kind", "bspline_lattice"},
+             {"frame", knees["frame"]},
+             {"degrees", {3, 3, 1}},
+             {"cells", {2, 2, 1}},
+             {"moves", {{{"index", {2, 2, 1}}, {"by", {0, 0, 10 + z}}}}}};
+    doc["surfaces"]["tank"]["deform"]["composition"] = {{"mode", "refit"}};
+    return doc;
+  };
+  const auto first = std::make_shared<const RunResult>(run(refitted(0)));
+  REQUIRE(std::get<std::string>(*figure(step(*first, lattice_step), "composition")) == "refit");
+  RunOptions o;
+  o.previous = first;
+  o.changed_deformations = {"knees"};
+  o.preview = true;
+  const RunResult preview = run(refitted(4), o);
+  CHECK(std::get<bool>(*figure(step(preview, lattice_step), "preview")));
+  const surface::BSplineSurface& net = preview.surface("tank");
+  CHECK(net.u.knots == first->surface("tank").u.knots);
+  const Stage& st = stage(preview, lattice_step);
+  double worst = 0;
+  for (double u : surface::linspace(0, 1, 31))
+    for (double v : surface::linspace(0, 1, 31))
+      worst = std::max(
+          worst,
+          (surface::evaluate(net, u, v) - st.map(surface::evaluate(st.before, u, v))).norm());
+  const double tolerance = std::get<double>(*figure(step(*first, lattice_step), "tolerance_mm"));
+  INFO("refit preview off the moved map by " << worst << " mm, tolerance " << tolerance);
+  CHECK(worst < tolerance);
+}
+
 TEST_CASE("studio session: a lattice drag previews in one product, the release certifies",
           "[studio][reuse]") {
   std::ifstream in(tank_file, std::ios::binary);

@@ -482,6 +482,27 @@ TEST_CASE("Refit from a uniform start under a cap puts its knots where the error
   INFO(fixed.report.summary.message);
   CHECK_FALSE(fixed.report.summary.converged());
   CHECK(fixed.report.certified_bound_mm > o.tolerance_mm);  // 0.047 mm against 0.029 mm
+  // At a cap of 16 the splits alone reach 16 x 16 and miss; the knots are then moved until each
+  // span carries an equal share of the error (de Boor's equidistribution): 0.020 mm, where the
+  // uniform 16 x 16 net is 0.398 mm off.
+  RefitOptions tight = o;
+  tight.max_count_per_direction = 16;
+  const RefitResult moved = refit_surface(sheet, tight);
+  INFO(moved.report.summary.message);
+  REQUIRE(moved.report.summary.converged());
+  CHECK(moved.surface.count_u() == 16);
+  CHECK(moved.surface.count_v() == 16);
+  double moved_worst = 0;
+  for (int i = 0; i <= 200; ++i)
+    for (int j = 0; j <= 200; ++j)
+      moved_worst = std::max(moved_worst, (surface::evaluate(moved.surface, i / 200.0, j / 200.0) -
+                                           surface::evaluate(sheet, i / 200.0, j / 200.0))
+                                              .norm());
+  CHECK(moved_worst <= moved.report.certified_bound_mm);
+  CHECK(moved.report.certified_bound_mm <= o.tolerance_mm);
+  RefitOptions uniform16 = uniform;
+  uniform16.count_u = uniform16.count_v = 16;
+  CHECK(refit_surface(sheet, uniform16).report.certified_bound_mm > 10 * o.tolerance_mm);
   // Under a cap too small for the tolerance: the message names the cap and the net it reached.
   o.max_count_per_direction = 10;
   const RefitResult capped = refit_surface(sheet, o);

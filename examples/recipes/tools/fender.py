@@ -118,7 +118,8 @@ recipe = {
         "target, exact mode on a net refined until the shape converges, the result rebuilt to a "
         "tenth of a millimetre, a Bezier lattice (Sederberg & Parry 1986) that wraps the nose, "
         "its exact composition above the default budget, so the step is its certified bicubic "
-        "light form."),
+        "light form, exported for a class-A receiver (degree 5, 32 x 32 control points, knots "
+        "where the error is)."),
     "units": "mm",
     "composition": {"mode": "exact"},
     "strokes": {
@@ -159,7 +160,7 @@ recipe = {
                        {"index": [1, 0, 1], "by": [0, -8, 0]}, {"index": [1, 1, 1], "by": [0, -8, 0]}]},
         ]
     },
-    "exports": {"fender": {"surfaces": ["fender"]}},
+    "exports": {"fender": {"surfaces": ["fender"], "profile": "class_a"}},
 }
 
 path = os.path.join(OUT, "fender.json")
