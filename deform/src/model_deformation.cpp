@@ -117,9 +117,11 @@ struct Outcome {
   double deviation = 0;  // largest deviation of an exact result from the pointwise map (mm)
 };
 
-/// One surface through the stack, with the degree cap: its result and what happened.
+/// One surface through the stack, with the degree cap: its result and what happened. A face
+/// that is not exact is refitted whole from `s` with its edges matched (`edges`, when given).
 Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
-                   const ModelDeformationOptions& options, const std::string& name) {
+                   const ModelDeformationOptions& options, const std::string& name,
+                   const std::vector<MatchedCurve>& edges = {}) {
   Outcome out;
   SurfaceDeformationResult r;
   try {
@@ -128,7 +130,8 @@ Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
     throw Error(e.category(), name + ": " + e.message());
   }
   const bool too_high = std::max(r.report.degree_u, r.report.degree_v) > options.max_degree;
-  if (too_high) {
+  // (An uncertified refit, an extended lattice's, is kept as deform_surface made it.)
+  if (too_high || (!r.report.exact && r.report.certified && !edges.empty())) {
     if (!options.surface.refit)
       throw Error(ErrorCategory::DegreeLimit,
                   name + ": the exact result has degree " +
@@ -137,16 +140,24 @@ Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
                       "; allow a refit (a refit tolerance) or raise max_degree");
     RefitOptions refit = *options.surface.refit;
     refit.degree = std::min(refit.degree, options.max_degree);
+    // One fit of the whole stack from the original, following the exact result along the
+    // face's edges (step by step, each step's fit would wander from them).
+    refit.matched_curves = edges;
+    refit.matched_gap_mm = options.edge_gap_mm;
+    refit.matched_angle_deg = options.edge_angle_deg;
     RefitResult fit;
     try {
       fit = refit_deformed(stack, s, refit);
     } catch (const Error& e) {
       throw Error(e.category(), name + ": " + e.message());
     }
-    if (!fit.report.certified || !(fit.report.certified_bound_mm <= fit.report.tolerance_mm))
+    if (!fit.report.certified || !(fit.report.certified_bound_mm <= fit.report.tolerance_mm) ||
+        !fit.report.summary.converged())
       throw Error(ErrorCategory::ToleranceNotMet,
-                  name + ": the refit below max_degree " + std::to_string(options.max_degree) +
-                      " missed its tolerance: " + fit.report.brief());
+                  name + ": the refit" +
+                      (too_high ? " below max_degree " + std::to_string(options.max_degree) : "") +
+                      " missed its tolerance: " + fit.report.summary.message +
+                      (edges.empty() ? "" : "; or relax edge_gap_mm and edge_angle_deg"));
     s = std::move(fit.surface);
     out.way = Outcome::Way::Refit;
     out.bound = fit.report.certified_bound_mm;
@@ -175,6 +186,24 @@ double size_of(const brep::Model& m) {
   return m.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
 }
 
+/// The face's edges as curves on its surface, for a refit that follows them (none when
+/// ModelDeformationOptions turns that off). Each pcurve's part on its edge, [t0, t1] clamped to
+/// the pcurve's own domain; poles are left out.
+std::vector<MatchedCurve> matched_edges(const brep::Model& m, const brep::Face& face,
+                                        const ModelDeformationOptions& options) {
+  std::vector<MatchedCurve> out;
+  if (options.edge_gap_mm == 0) return out;
+  for (const brep::Loop& loop : face.loops)
+    for (const brep::Coedge& co : loop.coedges) {
+      const brep::Edge& edge = m.edges[static_cast<std::size_t>(co.edge)];
+      if (edge.degenerate) continue;
+      const auto [a, b] = co.pcurve.basis.domain();
+      const double t0 = std::max(edge.t0, a), t1 = std::min(edge.t1, b);
+      if (t0 < t1) out.push_back({co.pcurve, t0, t1});
+    }
+  return out;
+}
+
 std::string face_name(const brep::Model& m, std::size_t f) {
   const std::string& name = m.faces[f].name;
   return "face " + std::to_string(f) + (name.empty() ? "" : " (\"" + name + "\")");
@@ -186,6 +215,13 @@ std::vector<std::string> ModelDeformationOptions::problems() const {
   std::vector<std::string> out = surface.problems();
   if (max_degree < 1 || max_degree > 25)
     out.push_back("max_degree is " + std::to_string(max_degree) + "; it must be in [1, 25]");
+  if (!((edge_gap_mm > 0 && std::isfinite(edge_gap_mm) && edge_angle_deg > 0 &&
+         edge_angle_deg < 90) ||
+        (edge_gap_mm == 0 && edge_angle_deg == 0)))
+    out.push_back("edge_gap_mm is " + internal::shortest(edge_gap_mm) + " and edge_angle_deg " +
+                  internal::shortest(edge_angle_deg) +
+                  "; give both (a gap > 0 mm, an angle in (0, 90) deg; class A: 0.0005 and 0.008 "
+                  "per face) or both 0 (faces fitted alone)");
   return out;
 }
 
@@ -253,7 +289,8 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       ++report.faces_untouched;
       continue;
     }
-    faces[f] = deform_one(stack, face.surface, options, face_name(m, f));
+    faces[f] =
+        deform_one(stack, face.surface, options, face_name(m, f), matched_edges(m, face, options));
     face.elementary.reset();  // no longer a plane, cylinder, ...: only untouched faces keep it
     (faces[f].way == Outcome::Way::Exact ? report.faces_exact : report.faces_refit) += 1;
     report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, faces[f].bound);
@@ -292,7 +329,15 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
                         " mm: choose both faces, or keep the deformation off that edge");
     }
   }
-  // Edges: F∘C on the same t, when a deformed face uses them.
+  // Edges: F∘C on the same t, when a deformed face uses them; refitted within edge_gap_mm when
+  // the faces follow their edges that closely.
+  ModelDeformationOptions edge_options = options;
+  if (options.edge_gap_mm > 0 && edge_options.surface.refit) {
+    RefitOptions& refit = *edge_options.surface.refit;
+    refit.tolerance_mm = refit.tolerance_mm > 0 ? std::min(refit.tolerance_mm, options.edge_gap_mm)
+                                                : options.edge_gap_mm;
+    refit.relative_tolerance = 0;
+  }
   std::vector<double> edge_bound(m.edges.size(), 0.0);
   for (std::size_t e = 0; e < m.edges.size(); ++e) {
     brep::Edge& edge = m.edges[e];
@@ -304,7 +349,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       continue;
     }
     surface::BSplineSurface strip = ruled(edge.curve);
-    const Outcome o = deform_one(stack, strip, options, "edge " + std::to_string(e));
+    const Outcome o = deform_one(stack, strip, edge_options, "edge " + std::to_string(e));
     edge.curve = row_zero(strip);
     (o.way == Outcome::Way::Exact ? report.edges_exact : report.edges_refit) += 1;
     report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, o.bound);

@@ -36,6 +36,7 @@
 #include "extended_internal.hpp"
 #include "fit_samples.hpp"
 #include "messages.hpp"
+#include "refit_edges.hpp"
 #include "seal.hpp"
 
 namespace clay::deform {
@@ -451,6 +452,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
   report.size = size;
   report.degree_u = report.degree_v = p;
   const bool fixed = options.count_u > 0;
+  const bool matching = !options.matched_curves.empty();
   // A fixed net, or an adaptive one from a uniform start (initial_count) or from the original's
   // breakpoints.
   const int uniform_u = fixed ? options.count_u : options.initial_count;
@@ -474,7 +476,22 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     Points3 values = surface::evaluate_grid(surface, us, vs);
     for (Eigen::Index r = 0; r < values.rows(); ++r)
       values.row(r) = deformed(d, values.row(r).transpose()).transpose();
-    result.surface = least_squares(bu, bv, us, vs, values);
+    // Along matched curves (a model face's edges) D∘S's position and derivatives are weighted
+    // rows too: 1e4 times a grid sample's weight, so the fit follows them as closely as its
+    // knots allow; the spans are then split until they are within their figures.
+    std::vector<detail::EdgeSample> edge;
+    if (matching) {
+      const auto spans = [](const BSplineBasis& b) {
+        return static_cast<int>(surface::breakpoints(b).size()) - 1;
+      };
+      const int per_curve = std::min(4000, 4 * intervals * (spans(bu) + spans(bv)) + 32);
+      edge = detail::edge_samples(
+          surface, options.matched_curves, [&](const Eigen::Vector3d& x) { return deformed(d, x); },
+          size, per_curve);
+      result.surface = detail::least_squares_matching(bu, bv, us, vs, values, edge, 100.0);
+    } else {
+      result.surface = least_squares(bu, bv, us, vs, values);
+    }
     detail::keep_closed_and_collapsed(surface, result.surface,
                                       [&](const Eigen::Vector3d& x) { return deformed(d, x); });
     const Certificate cert = certify(surface, result.surface, d, base, budget, rounding);
@@ -515,14 +532,45 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
           wu = std::max(wu, measure), wv = std::max(wv, measure);
         }
       }
+    // The matched curves' figures, as a share of their allowance: spans holding a sample that
+    // misses are split (their worst counted as that share of the tolerance).
+    double edge_share = 0;
+    if (matching) {
+      const std::vector<detail::EdgeMiss> misses = detail::edge_misses(result.surface, edge);
+      const std::vector<double> breaks_u = surface::breakpoints(bu),
+                                breaks_v = surface::breakpoints(bv);
+      auto span_of = [](const std::vector<double>& breaks, double t) {
+        const auto k = std::upper_bound(breaks.begin(), breaks.end(), t) - breaks.begin() - 1;
+        return static_cast<std::size_t>(
+            std::clamp<std::ptrdiff_t>(k, 0, static_cast<std::ptrdiff_t>(breaks.size()) - 2));
+      };
+      report.matched_gap_mm = report.matched_angle_deg = 0;
+      report.matched_samples = static_cast<long>(edge.size());
+      for (std::size_t k = 0; k < edge.size(); ++k) {
+        report.matched_gap_mm = std::max(report.matched_gap_mm, misses[k].gap_mm);
+        report.matched_angle_deg = std::max(report.matched_angle_deg, misses[k].angle_deg);
+        const double share = std::max(misses[k].gap_mm / options.matched_gap_mm,
+                                      misses[k].angle_deg / options.matched_angle_deg);
+        edge_share = std::max(edge_share, share);
+        if (share <= 1) continue;
+        const std::size_t iu = span_of(breaks_u, edge[k].u), iv = span_of(breaks_v, edge[k].v);
+        mark_u[iu] = mark_v[iv] = 1;
+        worst_u[iu] = std::max(worst_u[iu], share * tolerance);
+        worst_v[iv] = std::max(worst_v[iv], share * tolerance);
+        error_u[iu] = std::max(error_u[iu], share * tolerance);
+        error_v[iv] = std::max(error_v[iv], share * tolerance);
+      }
+    }
     const double measure = cert.certified ? cert.bound : cert.sampled;
     if (iteration == 1) report.summary.initial_residual = measure;
     report.summary.final_residual = measure;
-    if (measure <= tolerance) {
+    if (measure <= tolerance && edge_share <= 1) {
       report.summary.termination = Termination::Converged;
       break;
     }
-    if (measure < best_measure) best_measure = measure, best = result;
+    // the fit kept when the limits are reached: the least miss of the tolerance and the figures
+    const double miss = std::max(measure, edge_share * tolerance);
+    if (miss < best_measure) best_measure = miss, best = result;
     if (fixed) {
       limit = "the fixed net of " + std::to_string(options.count_u) + " x " +
               std::to_string(options.count_v) + " control points (count_u, count_v)";
@@ -565,11 +613,15 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
     bu = std::move(nu), bv = std::move(nv);
   }
   if (report.summary.termination != Termination::Converged &&
-      report.summary.final_residual > best_measure) {
+      std::max(report.summary.final_residual,
+               matching ? tolerance * std::max(report.matched_gap_mm / options.matched_gap_mm,
+                                               report.matched_angle_deg / options.matched_angle_deg)
+                        : 0.0) > best_measure) {
     const Summary summary = report.summary;
     result = std::move(best);
     report.summary = summary;
-    report.summary.final_residual = best_measure;
+    report.summary.final_residual =
+        result.report.certified ? result.report.certified_bound_mm : result.report.sampled_max;
   }
 
   std::string message;
@@ -588,6 +640,13 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
               (fixed ? " mm; give more control points (count_u, count_v), a larger tolerance or a "
                        "higher degree"
                      : " mm; raise the limits, the tolerance or the degree");
+  }
+  if (matching) {
+    message += "; matched curves: gap " + short_format(report.matched_gap_mm) + " mm (" +
+               short_format(options.matched_gap_mm) + " allowed), normal angle " +
+               short_format(report.matched_angle_deg) + " deg (" +
+               short_format(options.matched_angle_deg) + " allowed) at " +
+               std::to_string(report.matched_samples) + " samples";
   }
   if (!report.certified) {
     message += "; not certified: ";
@@ -644,6 +703,25 @@ std::vector<std::string> RefitOptions::problems() const {
          std::to_string(degree + 1) + ", " + std::to_string(max_count_per_direction) + "]");
   if (!(certificate_share > 0 && certificate_share < 1))
     fail("certificate_share = " + format(certificate_share) + ": must be in (0, 1), e.g. 0.1");
+  if (!matched_curves.empty()) {
+    if (!(matched_gap_mm > 0 && std::isfinite(matched_gap_mm)) ||
+        !(matched_angle_deg > 0 && matched_angle_deg < 90))
+      fail("matched_gap_mm = " + format(matched_gap_mm) +
+           ", matched_angle_deg = " + format(matched_angle_deg) +
+           ": with matched_curves both must be given, a gap > 0 mm and an angle in (0, 90) deg "
+           "(class A: 0.0005 mm and 0.008 deg per face)");
+    for (std::size_t k = 0; k < matched_curves.size(); ++k) {
+      const MatchedCurve& c = matched_curves[k];
+      const std::string name = "matched_curves[" + std::to_string(k) + "]";
+      for (const std::string& problem : surface::problems(c.pcurve, name + ".pcurve"))
+        fail(problem);
+      const auto [a, b] = c.pcurve.basis.domain();
+      if (!(std::isfinite(c.t0) && std::isfinite(c.t1) && c.t0 < c.t1 && c.t0 >= a && c.t1 <= b))
+        fail(name + ": t0 = " + format(c.t0) + ", t1 = " + format(c.t1) +
+             ": must be finite, t0 < t1, within the pcurve's domain [" + format(a) + ", " +
+             format(b) + "]");
+    }
+  }
   return out;
 }
 

@@ -179,7 +179,7 @@ Composition RecipeChecker::composition(const Json& j, const std::string& path, C
           : Renamed{"tolerance", "relative_tolerance", "a fraction of the size"};
   if (!c_.object(j, path,
                  {"mode", "relative_tolerance", "tolerance_mm", "degree", "check_samples",
-                  "max_control_points", "accept_out_of_tolerance", "budget"},
+                  "max_control_points", "accept_out_of_tolerance", "budget", "edges"},
                  "a composition {\"mode\": \"exact\"|\"refit\", ...}",
                  {renamed_tolerance, dropped_relative, renamed_editable}))
     return c;
@@ -231,6 +231,22 @@ Composition RecipeChecker::composition(const Json& j, const std::string& path, C
                    std::to_string(c.degree) +
                    " that light forms are fitted at; raise it or lower \"degree\"");
       c.budget = budget;
+    }
+  }
+  // How closely a model's refitted faces follow their edges (deform::ModelDeformationOptions):
+  // {"gap_mm", "angle_deg"} per face, or "alone" (each face fitted to its tolerance only).
+  if (const Json* e = c_.member(j, path, "edges", false, "")) {
+    const std::string ep = key_path(path, "edges");
+    constexpr const char* shape =
+        "{\"gap_mm\": 0.0005, \"angle_deg\": 0.008} (per face; two faces meet within twice "
+        "these) or \"alone\"";
+    if (e->is_string() && *e == "alone") {
+      c.edge_gap_mm = c.edge_angle_deg = 0;
+    } else if (e->is_string()) {
+      c_.add(ep, std::string("expected ") + shape + ", found " + found(*e));
+    } else if (c_.object(*e, ep, {"gap_mm", "angle_deg"}, shape)) {
+      c.edge_gap_mm = c_.number_or(*e, ep, "gap_mm", 0.0005, {1e-9, 1e3});
+      c.edge_angle_deg = c_.number_or(*e, ep, "angle_deg", 0.008, {1e-6, 10});
     }
   }
   return c;

@@ -44,6 +44,9 @@ struct Composition {
   bool accept_out_of_tolerance = false;  ///< "accept_out_of_tolerance": keep a refit that misses
   int max_control_points = 40000;        // refit: the net may not grow beyond this (RefitOptions)
   std::optional<Budget> budget = Budget{};  ///< "budget"; empty: "none"
+  /// "edges" (models): a refitted face follows its edges within these (ModelDeformationOptions);
+  /// "alone": both 0.
+  double edge_gap_mm = 0.0005, edge_angle_deg = 0.008;
 };
 
 struct StrokeDef {

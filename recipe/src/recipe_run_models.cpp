@@ -223,9 +223,11 @@ ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
     const deform::DeformationStack stack = model_stack(stack_def, out.fold_free, def.allow_fold);
     deform::ModelDeformationOptions options;
     options.surface = deformation_options(d.composition);
-    // A model's faces keep their exact forms: light faces fitted one by one would open their
-    // shared edges (fitting them with their edges is issue #38's step 7).
+    // A model's faces keep their exact forms (light faces above a budget are not fitted with
+    // their edges yet); refitted faces follow their edges (composition "edges").
     options.surface.budget.reset();
+    options.edge_gap_mm = d.composition.edge_gap_mm;
+    options.edge_angle_deg = d.composition.edge_angle_deg;
     options.faces = chosen_faces(flat, def);
     auto r = deform::deform_model(stack, flat, options);
     out.model = std::move(r.model);
@@ -254,6 +256,8 @@ ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
   deform::ModelDeformationOptions options;
   options.surface = deformation_options(d.composition);
   options.surface.budget.reset();  // faces stay exact, as in run_model above
+  options.edge_gap_mm = d.composition.edge_gap_mm;
+  options.edge_angle_deg = d.composition.edge_angle_deg;
   try {
     auto r = deform::deform_model(stack, model, options);
     result.model = std::move(r.model);

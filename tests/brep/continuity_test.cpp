@@ -184,6 +184,7 @@ TEST_CASE("continuity: a twist refitted face by face breaks the block's fillets,
   clay::deform::RefitOptions refit;
   refit.relative_tolerance = 0.01;
   options.surface.refit = refit;
+  options.edge_gap_mm = options.edge_angle_deg = 0;  // each face fitted alone, as before #38
   const auto result = clay::deform::deform_model(stack, block, options);
   const Model& twisted = result.model;
   // deform_model's report measures both, the same edges in the same order.
@@ -217,4 +218,64 @@ TEST_CASE("continuity: a twist refitted face by face breaks the block's fillets,
   }
   CHECK(opened == 8);  // every fillet edge: the faces were fitted one by one
   CHECK(after.max_gap_mm > 0.01);
+}
+
+TEST_CASE("continuity: faces refitted with their edges keep the twisted block's fillets tangent",
+          "[brep][continuity]") {
+  // The same twist and tolerance with deform_model's defaults: each refitted face follows the
+  // twist along its edges within 0.0005 mm and 0.008 deg, so the fillets' tangent edges stay
+  // within the class-A fillet figures (0.001 mm, 0.016 deg), measured here from points alone.
+  const Model block = clay::test::read_test_model(
+      TestModel::FilletedBlock, clay::test::test_output("brep-continuity", "block-matched.step"));
+  clay::deform::Twist twist;
+  twist.frame.origin = {0, 0, 0};
+  twist.frame.axis = {0, 0, 1};
+  twist.frame.reference = {1, 0, 0};
+  twist.angle = {0, 0.005};
+  clay::deform::DeformationStack stack;
+  stack.steps.push_back({twist, "twist", true});
+  clay::deform::ModelDeformationOptions options;
+  clay::deform::RefitOptions refit;
+  refit.relative_tolerance = 0.01;
+  options.surface.refit = refit;
+  const auto result = clay::deform::deform_model(stack, block, options);
+  const Model& twisted = result.model;
+  const auto& before = result.report.continuity_before;
+  const auto& after = result.report.continuity_after;
+  INFO(result.report.brief() << "\n" << before.brief() << "\n" << after.brief());
+  CHECK(result.report.faces_refit > 0);
+  REQUIRE(after.edges.size() == before.edges.size());
+  int fillet_edges = 0;
+  for (size_t k = 0; k < after.edges.size(); ++k) {
+    const auto& was = before.edges[k];
+    const auto& now = after.edges[k];
+    INFO("edge " << now.edge << ": gap " << now.gap_mm << " mm, " << now.angle_deg << " deg");
+    CHECK(now.gap_mm <= 0.001);
+    if (was.face_a == was.face_b || was.angle_deg > 1e-6) continue;
+    ++fillet_edges;
+    CHECK(now.angle_deg <= 0.016);
+    const auto& edge_uses = [&](int face) -> const clay::brep::Coedge& {
+      for (const auto& loop : twisted.faces[static_cast<size_t>(face)].loops)
+        for (const auto& co : loop.coedges)
+          if (co.edge == now.edge) return co;
+      FAIL("no coedge of edge " << now.edge << " on face " << face);
+      throw;
+    };
+    // along the whole edge, at points of its own, the normals from differences of points
+    const auto& ca = edge_uses(now.face_a);
+    const auto& cb = edge_uses(now.face_b);
+    const auto& edge = twisted.edges[static_cast<size_t>(now.edge)];
+    double worst = 0;
+    for (int j = 0; j <= 50; ++j) {
+      const double t = edge.t0 + (edge.t1 - edge.t0) * (j + 0.37) / 51.0;
+      const Vector3d na =
+          normal_by_differences(twisted.faces[static_cast<size_t>(now.face_a)], ca, t);
+      const Vector3d nb =
+          normal_by_differences(twisted.faces[static_cast<size_t>(now.face_b)], cb, t);
+      worst = std::max(worst, std::atan2(na.cross(nb).norm(), na.dot(nb)) * 180 / std::numbers::pi);
+    }
+    CHECK(worst <= 0.016);
+  }
+  CHECK(fillet_edges == 8);
+  CHECK(after.max_gap_mm <= 0.001);
 }

@@ -14,7 +14,9 @@
 /// - Where exact composition is impossible (a face crossing a lattice's boundary or a knot plane
 ///   off its iso-lines, twist, bend, extended lattices, a degree above max_degree), the face and
 ///   its edges are refitted on the same (u, v) and t with a certified bound when
-///   options.surface.refit allows it; edge and vertex tolerances then grow by the bounds.
+///   options.surface.refit allows it; edge and vertex tolerances then grow by the bounds. A
+///   refitted face follows the exact result along its edges within edge_gap_mm and
+///   edge_angle_deg, so its neighbours keep the continuity the exact result has there.
 /// - A mirroring stack (det DF < 0) turns solids inside out: detected by the sign of each solid's
 ///   volume, whose faces are then reversed.
 /// - An assembly is flattened first (brep::flattened): each placed instance deforms on its own.
@@ -43,6 +45,15 @@ struct CLAY_DEFORM_API ModelDeformationOptions {
   /// face shares with a kept one must stay where it is: a stack that moves it by more than its
   /// tolerance is refused (InvalidArgument naming both faces and the edge).
   std::vector<int> faces;
+  /// A refitted face is fitted with its edges (issue #38 step 7; RefitOptions::matched_curves):
+  /// along every edge it follows the exact result within edge_gap_mm and its normal within
+  /// edge_angle_deg, so two faces refitted alone meet within twice these wherever the exact
+  /// result's faces meet: a fillet's tangent edge stays tangent. The defaults are half the
+  /// class-A fillet figures (0.001 mm, 0.016 deg). Both 0: faces fitted to their tolerance
+  /// alone (each edge opens by however much its faces' fits wander). Sampled along the edges,
+  /// not certified; the edges' curves are refitted within edge_gap_mm too.
+  double edge_gap_mm = 0.0005;
+  double edge_angle_deg = 0.008;  ///< see edge_gap_mm
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;

@@ -41,6 +41,13 @@
 
 namespace clay::deform {
 
+/// A curve on a surface, as a pcurve: (u, v, 0) = pcurve(t) for t in [t0, t1] (brep::Coedge's
+/// form). RefitOptions::matched_curves.
+struct MatchedCurve {
+  surface::BSplineCurve pcurve;
+  double t0 = 0, t1 = 0;  ///< the part of the pcurve on the surface's edge, t0 < t1
+};
+
 /// Settings of refit_deformed().
 struct CLAY_DEFORM_API RefitOptions {
   int degree = 3;  ///< degree of the fit in u and v, 1..25 (the exchange limit)
@@ -77,6 +84,17 @@ struct CLAY_DEFORM_API RefitOptions {
   /// (class A: degree 5, at most 32 per direction) has its knots where the error is. 0, or in
   /// [degree + 1, max_count_per_direction].
   int initial_count = 0;
+
+  /// Curves on the surface along which the fit follows the map more closely than the tolerance
+  /// asks (a model face's edges, issue #38 step 7): their samples are weighted rows of the least
+  /// squares for the position and both first derivatives of D∘S, and spans are split until, at
+  /// every sample, the fit is within matched_gap_mm of D∘S and its normal within
+  /// matched_angle_deg of D∘S's. Two faces fitted so along their shared edge then meet within
+  /// twice these figures, wherever the exact result's faces meet (a tangent edge stays tangent).
+  /// Sampled, not certified (the certificate still bounds the whole surface by the tolerance).
+  std::vector<MatchedCurve> matched_curves;
+  double matched_gap_mm = 0;     ///< > 0 with matched_curves: largest distance along them (mm)
+  double matched_angle_deg = 0;  ///< > 0 with matched_curves: largest normal angle along them
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -115,6 +133,10 @@ struct CLAY_DEFORM_API RefitReport {
   int knots_added_v = 0;    ///< same in v
   int lipschitz_cells = 0;  ///< cells bounded by first derivatives only (D not C1 there)
   std::vector<KnotPlaneCrossing> crossings;  ///< every lattice plane crossing of the final fit
+  /// With RefitOptions::matched_curves: the largest distance from D∘S (mm) and the largest angle
+  /// between the normals (deg) at their samples; 0 without.
+  double matched_gap_mm = 0, matched_angle_deg = 0;
+  long matched_samples = 0;  ///< samples along the matched curves
 
   /// One line: "certified 3.1e-03 mm <= 1.0e-02 mm (sampled 2.2e-03 mm), 12 x 9 control points,
   /// 3 iterations, 0 knot-plane crossings".

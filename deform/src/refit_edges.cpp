@@ -1,0 +1,154 @@
+// The refit's matched curves (refit_edges.hpp): a model face fitted with its edges, so that two
+// faces fitted alone still meet where the exact result's faces meet (issue #38 step 7).
+#include "refit_edges.hpp"
+
+#include "fit_samples.hpp"
+
+#include <clay/error.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace clay::deform::detail {
+
+std::vector<EdgeSample> edge_samples(
+    const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve) {
+  const auto [u0, u1] = surface.u.domain();
+  const auto [v0, v1] = surface.v.domain();
+  const double step = 1e-5 * size;
+  // D'(x) w by central differences along w's direction, scaled back by |w|.
+  auto directional = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& w) -> Eigen::Vector3d {
+    const double length = w.norm();
+    if (!(length > 0)) return Eigen::Vector3d::Zero();
+    const Eigen::Vector3d e = (step / length) * w;
+    return (map(x + e) - map(x - e)) * (length / (2 * step));
+  };
+  std::vector<EdgeSample> out;
+  out.reserve(curves.size() * static_cast<std::size_t>(per_curve));
+  for (const MatchedCurve& c : curves)
+    for (int k = 0; k < per_curve; ++k) {
+      const double t = c.t0 + (c.t1 - c.t0) * k / (per_curve - 1);
+      const Eigen::Vector3d uv = surface::evaluate(c.pcurve, t);
+      EdgeSample s;
+      s.u = std::clamp(uv.x(), u0, u1);
+      s.v = std::clamp(uv.y(), v0, v1);
+      const surface::SurfaceDerivatives d = surface::derivatives(surface, s.u, s.v, 1);
+      s.point = map(d.point);
+      s.du = directional(d.point, d.du);
+      s.dv = directional(d.point, d.dv);
+      out.push_back(s);
+    }
+  return out;
+}
+
+surface::BSplineSurface least_squares_matching(
+    const surface::BSplineBasis& bu, const surface::BSplineBasis& bv, const std::vector<double>& us,
+    const std::vector<double>& vs, const surface::Points3& values,
+    const std::vector<EdgeSample>& samples, double weight) {
+  const int nu = bu.count(), nv = bv.count();
+  const Eigen::Index n = static_cast<Eigen::Index>(nu) * nv;
+  const Eigen::MatrixXd au = collocation(bu, us), av = collocation(bv, vs);
+  const Eigen::MatrixXd gu = au.transpose() * au, gv = av.transpose() * av;
+  auto index = [nv](Eigen::Index i, Eigen::Index j) { return i * nv + j; };
+
+  // The grid: (A_u^T A_u) ⊗ (A_v^T A_v), both banded.
+  std::vector<Eigen::Triplet<double>> entries;
+  std::vector<std::pair<Eigen::Index, Eigen::Index>> nz_u, nz_v;
+  for (Eigen::Index i = 0; i < nu; ++i)
+    for (Eigen::Index k = 0; k < nu; ++k)
+      if (gu(i, k) != 0) nz_u.emplace_back(i, k);
+  for (Eigen::Index j = 0; j < nv; ++j)
+    for (Eigen::Index l = 0; l < nv; ++l)
+      if (gv(j, l) != 0) nz_v.emplace_back(j, l);
+  entries.reserve(nz_u.size() * nz_v.size() +
+                  samples.size() * static_cast<std::size_t>((bu.degree + 1) * (bv.degree + 1)) *
+                      static_cast<std::size_t>((bu.degree + 1) * (bv.degree + 1)));
+  for (const auto& [i, k] : nz_u)
+    for (const auto& [j, l] : nz_v)
+      entries.emplace_back(index(i, j), index(k, l), gu(i, k) * gv(j, l));
+  Eigen::MatrixXd rhs(n, 3);
+  const auto mu = static_cast<Eigen::Index>(us.size()), mv = static_cast<Eigen::Index>(vs.size());
+  for (int c = 0; c < 3; ++c) {
+    Eigen::MatrixXd f(mu, mv);
+    for (Eigen::Index i = 0; i < mu; ++i)
+      for (Eigen::Index j = 0; j < mv; ++j) f(i, j) = values(i * mv + j, c);
+    const Eigen::MatrixXd r = au.transpose() * f * av;
+    for (Eigen::Index i = 0; i < nu; ++i)
+      for (Eigen::Index j = 0; j < nv; ++j) rhs(index(i, j), c) = r(i, j);
+  }
+
+  // The samples: three weighted rows each (position, h_u d/du, h_v d/dv) on (p+1)(q+1) points.
+  const int pu = bu.degree, pv = bv.degree;
+  const int local = (pu + 1) * (pv + 1);
+  std::vector<double> du(static_cast<std::size_t>(2 * (pu + 1))),
+      dv(static_cast<std::size_t>(2 * (pv + 1)));
+  Eigen::MatrixXd rows(3, local);
+  Eigen::MatrixXd targets(3, 3);
+  const double w2 = weight * weight;
+  for (const EdgeSample& s : samples) {
+    const int su = surface::find_span(bu, s.u), sv = surface::find_span(bv, s.v);
+    surface::basis_derivatives(bu, su, s.u, 1, du);
+    surface::basis_derivatives(bv, sv, s.v, 1, dv);
+    const double hu =
+        bu.knots[static_cast<std::size_t>(su) + 1] - bu.knots[static_cast<std::size_t>(su)];
+    const double hv =
+        bv.knots[static_cast<std::size_t>(sv) + 1] - bv.knots[static_cast<std::size_t>(sv)];
+    for (int a = 0; a <= pu; ++a)
+      for (int b = 0; b <= pv; ++b) {
+        const auto ua = static_cast<std::size_t>(a), vb = static_cast<std::size_t>(b);
+        const auto up = static_cast<std::size_t>(pu + 1 + a),
+                   vp = static_cast<std::size_t>(pv + 1 + b);
+        const Eigen::Index col = a * (pv + 1) + b;
+        rows(0, col) = du[ua] * dv[vb];
+        rows(1, col) = hu * du[up] * dv[vb];
+        rows(2, col) = hv * du[ua] * dv[vp];
+      }
+    targets.row(0) = s.point.transpose();
+    targets.row(1) = hu * s.du.transpose();
+    targets.row(2) = hv * s.dv.transpose();
+    const Eigen::MatrixXd block = w2 * rows.transpose() * rows;
+    const Eigen::MatrixXd pulled = w2 * rows.transpose() * targets;
+    for (int a = 0; a < local; ++a) {
+      const Eigen::Index ga = index(su - pu + a / (pv + 1), sv - pv + a % (pv + 1));
+      rhs.row(ga) += pulled.row(a);
+      for (int b = 0; b < local; ++b)
+        entries.emplace_back(ga, index(su - pu + b / (pv + 1), sv - pv + b % (pv + 1)),
+                             block(a, b));
+    }
+  }
+  Eigen::SparseMatrix<double> normal(n, n);
+  normal.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
+  if (solver.info() != Eigen::Success)
+    throw Error(ErrorCategory::Internal,
+                "refit_deformed: the least squares with matched curves is singular (" +
+                    std::to_string(nu) + " x " + std::to_string(nv) + " control points)");
+  const Eigen::MatrixXd net = solver.solve(rhs);
+  return surface::make_surface(bu, bv, surface::Points3(net));
+}
+
+std::vector<EdgeMiss> edge_misses(const surface::BSplineSurface& fit,
+                                  const std::vector<EdgeSample>& samples) {
+  std::vector<EdgeMiss> out;
+  out.reserve(samples.size());
+  for (const EdgeSample& s : samples) {
+    const surface::SurfaceDerivatives d = surface::derivatives(fit, s.u, s.v, 1);
+    EdgeMiss m;
+    m.gap_mm = (d.point - s.point).norm();
+    const Eigen::Vector3d n_map = s.du.cross(s.dv), n_fit = d.du.cross(d.dv);
+    if (n_map.norm() > 1e-12 * s.du.norm() * s.dv.norm() && n_fit.norm() > 0)
+      m.angle_deg =
+          std::atan2(n_fit.cross(n_map).norm(), n_fit.dot(n_map)) * 180 / std::numbers::pi;
+    out.push_back(m);
+  }
+  return out;
+}
+
+}  // namespace clay::deform::detail

@@ -1,0 +1,48 @@
+#pragma once
+// Internal to clay_deform: the refit's matched curves (RefitOptions::matched_curves, issue #38
+// step 7). Samples of D∘S along curves on the surface, a least squares that weights them, and
+// the fit's figures at them.
+#include <clay/deform/refit.hpp>
+#include <clay/surface/bspline_surface.hpp>
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <vector>
+
+namespace clay::deform::detail {
+
+/// D∘S at one point of a matched curve: where (u, v), and the map's position and first partial
+/// derivatives there (mm, mm per unit of parameter).
+struct EdgeSample {
+  double u = 0, v = 0;
+  Eigen::Vector3d point, du, dv;
+};
+
+/// `per_curve` samples of each curve (t uniform in [t0, t1], ends included), (u, v) clamped to
+/// the surface's domain. The derivatives are D'(S) S_u and D'(S) S_v, D' by central differences
+/// of `map` in space over 1e-5 of `size` (an O(1e-10) relative error for a smooth map).
+std::vector<EdgeSample> edge_samples(
+    const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve);
+
+/// The net on bu x bv minimising Σ_grid |fit − values|² + w² Σ_samples (|fit − D∘S|² +
+/// h_u² |fit_u − (D∘S)_u|² + h_v² |fit_v − (D∘S)_v|²), h the width of the fit's span holding
+/// the sample: the grid's normal equations are (A_u^T A_u) ⊗ (A_v^T A_v), banded, and the
+/// samples add small blocks, so the system is sparse (Cholesky, LDL^T).
+surface::BSplineSurface least_squares_matching(
+    const surface::BSplineBasis& bu, const surface::BSplineBasis& bv, const std::vector<double>& us,
+    const std::vector<double>& vs, const surface::Points3& values,
+    const std::vector<EdgeSample>& samples, double weight);
+
+/// The fit's distance from D∘S and angle between the normals at one sample.
+struct EdgeMiss {
+  double gap_mm = 0;
+  double angle_deg = 0;
+};
+
+/// The fit's figures at every sample (angle 0 where D∘S's normal vanishes: a pole).
+std::vector<EdgeMiss> edge_misses(const surface::BSplineSurface& fit,
+                                  const std::vector<EdgeSample>& samples);
+
+}  // namespace clay::deform::detail
