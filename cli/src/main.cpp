@@ -305,8 +305,9 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
 /// faces, solids, assembly) through the recipe's deformation stack, written as a valid model.
 int deform_model_file(const fs::path& file, const fs::path& recipe_file,
                       const std::string& deformation, const fs::path& out, bool show,
-                      bool allow_fold) {
+                      bool allow_fold, const std::string& profile) {
   const auto recipe = clay::recipe::load_recipe(recipe_file);
+  if (!profile.empty()) clay::deform::receiver_profile(profile);  // a typo fails at once
   const auto start = std::chrono::steady_clock::now();
   const clay::brep::ImportedModel read = read_model_file(file, "deform");
   if (show) std::printf("read %s: %s\n", file.string().c_str(), read.report.brief().c_str());
@@ -317,7 +318,8 @@ int deform_model_file(const fs::path& file, const fs::path& recipe_file,
     for (const auto& p : read.report.problems) m += "\n  " + p;
     throw clay::Error(clay::ErrorCategory::InvalidGeometry, m);
   }
-  const auto result = clay::recipe::deform_model(recipe, read.model, deformation, allow_fold);
+  const auto result =
+      clay::recipe::deform_model(recipe, read.model, deformation, allow_fold, profile);
   if (show)
     std::printf("deformed by %s: %s\n", result.deformation.c_str(), result.report.brief().c_str());
   const auto files = clay::recipe::write_model_outputs(result, out, file.stem().string());
@@ -578,6 +580,10 @@ int main(int argc, char** argv) {
   deform_cmd->add_flag("--allow-fold", allow_fold,
                        "deform by a lattice not proven fold-free (the solid may intersect "
                        "itself); refused otherwise");
+  deform_cmd->add_option("--profile", profile,
+                         "write the model for this receiver: exact, opencascade, catia, class_a "
+                         "or bicubic; the faces it would not take are refitted to it with their "
+                         "edges (default: none, faces above degree 25 refitted)");
   deform_cmd->add_flag("--quiet", quiet, "no progress lines");
   deform_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
   // clayform render
@@ -733,7 +739,7 @@ int main(int argc, char** argv) {
       return finish(result, out_dir);
     }
     if (*deform_cmd)
-      return deform_model_file(file, recipe_file, deformation, out_dir, show, allow_fold);
+      return deform_model_file(file, recipe_file, deformation, out_dir, show, allow_fold, profile);
   } catch (const clay::Error& e) {
     std::fprintf(stderr, "clayform: %s\n", e.what());
     return exit_code(e.category());

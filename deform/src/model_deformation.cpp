@@ -8,6 +8,7 @@
 #include <clay/internal/checks.hpp>
 #include <clay/internal/format.hpp>
 #include <clay/surface/bspline_curve.hpp>
+#include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 
 #include <algorithm>
@@ -117,29 +118,75 @@ struct Outcome {
   double deviation = 0;  // largest deviation of an exact result from the pointwise map (mm)
 };
 
-/// One surface through the stack, with the degree cap: its result and what happened. A face
-/// that is not exact is refitted whole from `s` with its edges matched (`edges`, when given).
-Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
+/// True when `s` breaks only the profile's minimum degree (raised exactly, nothing refitted).
+bool only_low(const surface::BSplineSurface& s, const ReceiverProfile& profile) {
+  return std::max(s.u.degree, s.v.degree) <= profile.max_degree &&
+         (profile.max_count_per_direction == 0 ||
+          std::max(s.u.count(), s.v.count()) <= profile.max_count_per_direction);
+}
+
+/// `s` raised exactly to the profile's minimum degree (when it has one above s's).
+void elevate_to(surface::BSplineSurface& s, const ReceiverProfile& profile) {
+  if (s.u.degree < profile.min_degree)
+    s = surface::elevate_degree_u(s, profile.min_degree - s.u.degree);
+  if (s.v.degree < profile.min_degree)
+    s = surface::elevate_degree_v(s, profile.min_degree - s.v.degree);
+}
+
+/// One surface through the stack, with the degree cap and the receiver profile: its result and
+/// what happened. A face that is not exact, or that the profile would not take, is refitted
+/// whole from `s` with its edges matched (`edges`, when given). No stack: `s` kept (a face the
+/// stack leaves alone), refitted only when the profile would not take it.
+Outcome deform_one(const DeformationStack* stack, surface::BSplineSurface& s,
                    const ModelDeformationOptions& options, const std::string& name,
                    const std::vector<MatchedCurve>& edges = {}) {
   Outcome out;
   SurfaceDeformationResult r;
-  try {
-    r = deform_surface(stack, s, options.surface);
-  } catch (const Error& e) {
-    throw Error(e.category(), name + ": " + e.message());
+  if (stack == nullptr) {
+    r.surface = s;
+    r.report.exact = r.report.certified = true;
+    r.report.degree_u = s.u.degree, r.report.degree_v = s.v.degree;
+  } else {
+    try {
+      r = deform_surface(*stack, s, options.surface);
+    } catch (const Error& e) {
+      throw Error(e.category(), name + ": " + e.message());
+    }
   }
-  const bool too_high = std::max(r.report.degree_u, r.report.degree_v) > options.max_degree;
+  const ReceiverProfile* profile = options.profile ? &*options.profile : nullptr;
+  const int cap = profile ? std::min(options.max_degree, profile->max_degree) : options.max_degree;
+  const bool too_high = std::max(r.report.degree_u, r.report.degree_v) > cap;
+  const bool off_profile = profile && !only_low(r.surface, *profile);
+  if ((too_high || off_profile) && profile && profile->fit_degree == 0)
+    throw Error(
+        ErrorCategory::DegreeLimit,
+        name + " cannot be written exactly: " + conformance_problems(r.surface, *profile).front() +
+            " (the STEP/IGES writers' limit); choose a profile that refits it (e.g. "
+            "\"opencascade\") or lower the degree of the steps that deform it");
   // (An uncertified refit, an extended lattice's, is kept as deform_surface made it.)
-  if (too_high || (!r.report.exact && r.report.certified && !edges.empty())) {
+  if (too_high || off_profile || (!r.report.exact && r.report.certified && !edges.empty())) {
     if (!options.surface.refit)
       throw Error(ErrorCategory::DegreeLimit,
                   name + ": the exact result has degree " +
                       std::to_string(std::max(r.report.degree_u, r.report.degree_v)) +
-                      ", above max_degree " + std::to_string(options.max_degree) +
+                      (profile ? " (" + std::to_string(r.surface.u.count()) + " x " +
+                                     std::to_string(r.surface.v.count()) +
+                                     " control points), not what the " +
+                                     std::string(profile->name) + " profile takes"
+                               : ", above max_degree " + std::to_string(options.max_degree)) +
                       "; allow a refit (a refit tolerance) or raise max_degree");
     RefitOptions refit = *options.surface.refit;
-    refit.degree = std::min(refit.degree, options.max_degree);
+    refit.degree = std::min(refit.degree, cap);
+    if (profile) {
+      // As fit_to_profile: the profile's degree, from the rough breakpoints only; a capped net
+      // (class A) adaptive from a uniform start, the worst spans split first up to the cap.
+      refit.degree = profile->fit_degree;
+      refit.keep_breakpoints = false;
+      if (profile->max_count_per_direction > 0) {
+        refit.initial_count = std::min(profile->fit_degree + 3, profile->max_count_per_direction);
+        refit.max_count_per_direction = profile->max_count_per_direction;
+      }
+    }
     // One fit of the whole stack from the original, following the exact result along the
     // face's edges (step by step, each step's fit would wander from them).
     refit.matched_curves = edges;
@@ -147,23 +194,30 @@ Outcome deform_one(const DeformationStack& stack, surface::BSplineSurface& s,
     refit.matched_angle_deg = options.edge_angle_deg;
     RefitResult fit;
     try {
-      fit = refit_deformed(stack, s, refit);
+      fit = stack ? refit_deformed(*stack, s, refit) : refit_surface(s, refit);
     } catch (const Error& e) {
       throw Error(e.category(), name + ": " + e.message());
     }
     if (!fit.report.certified || !(fit.report.certified_bound_mm <= fit.report.tolerance_mm) ||
-        !fit.report.summary.converged())
+        !fit.report.summary.converged() || (profile && !only_low(fit.surface, *profile)))
       throw Error(ErrorCategory::ToleranceNotMet,
                   name + ": the refit" +
-                      (too_high ? " below max_degree " + std::to_string(options.max_degree) : "") +
-                      " missed its tolerance: " + fit.report.summary.message +
-                      (edges.empty() ? "" : "; or relax edge_gap_mm and edge_angle_deg"));
+                      (profile    ? " for the " + std::string(profile->name) + " profile"
+                       : too_high ? " below max_degree " + std::to_string(options.max_degree)
+                                  : "") +
+                      " failed: " + fit.report.summary.message +
+                      (edges.empty() ? ""
+                                     : "; or relax edge_gap_mm and edge_angle_deg (a recipe's "
+                                       "composition \"edges\")") +
+                      (profile ? ", or choose a profile with a larger net" : ""));
     s = std::move(fit.surface);
+    if (profile) elevate_to(s, *profile);
     out.way = Outcome::Way::Refit;
     out.bound = fit.report.certified_bound_mm;
     return out;
   }
   s = std::move(r.surface);
+  if (profile) elevate_to(s, *profile);
   out.way = r.report.exact ? Outcome::Way::Exact : Outcome::Way::Refit;
   for (const StepOutcome& step : r.report.steps) {
     if (step.method == StepOutcome::Method::Exact)
@@ -263,6 +317,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   m = brep::flattened(input);
   ModelDeformationReport& report = result.report;
   report.continuity_before = brep::edge_continuity(m);
+  if (options.profile) report.profile = std::string(options.profile->name);
   const std::vector<double> before = brep::body_volumes_mm3(m);
   for (std::size_t b = 0; b < m.bodies.size(); ++b)
     if (m.bodies[b].kind == brep::BodyKind::Solid) report.volume_before_mm3 += before[b];
@@ -286,11 +341,34 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     brep::Face& face = m.faces[f];
     if (!chosen[f] || leaves.alone(face.surface.points)) {
-      ++report.faces_untouched;
+      // Kept, unless a profile would not take it: an analytic face is written as such; a NURBS
+      // one below the profile's degree is raised exactly; one beyond it is refitted below.
+      const ReceiverProfile* profile = options.profile ? &*options.profile : nullptr;
+      const bool conforms =
+          !profile || face.elementary || conformance_problems(face.surface, *profile).empty();
+      if (conforms || only_low(face.surface, *profile)) {
+        if (!conforms) {
+          elevate_to(face.surface, *profile);
+          ++report.faces_elevated;
+        }
+        ++report.faces_untouched;
+      } else {
+        // Refitted in place, following its edges, which stay where they are.
+        faces[f] = deform_one(nullptr, face.surface, options, face_name(m, f),
+                              matched_edges(m, face, options));
+        face.elementary.reset();
+        ++report.faces_refit;
+        report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, faces[f].bound);
+        for (const brep::Loop& loop : face.loops)
+          for (const brep::Coedge& co : loop.coedges) {
+            const auto e = static_cast<std::size_t>(co.edge);
+            edge_face_bound[e] = std::max(edge_face_bound[e], faces[f].bound);
+          }
+      }
       continue;
     }
     faces[f] =
-        deform_one(stack, face.surface, options, face_name(m, f), matched_edges(m, face, options));
+        deform_one(&stack, face.surface, options, face_name(m, f), matched_edges(m, face, options));
     face.elementary.reset();  // no longer a plane, cylinder, ...: only untouched faces keep it
     (faces[f].way == Outcome::Way::Exact ? report.faces_exact : report.faces_refit) += 1;
     report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, faces[f].bound);
@@ -332,6 +410,11 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   // Edges: F∘C on the same t, when a deformed face uses them; refitted within edge_gap_mm when
   // the faces follow their edges that closely.
   ModelDeformationOptions edge_options = options;
+  // An edge's curve is no net a receiver edits: only the profile's degree cap applies to it.
+  if (options.profile) {
+    edge_options.max_degree = std::min(options.max_degree, options.profile->max_degree);
+    edge_options.profile.reset();
+  }
   if (options.edge_gap_mm > 0 && edge_options.surface.refit) {
     RefitOptions& refit = *edge_options.surface.refit;
     refit.tolerance_mm = refit.tolerance_mm > 0 ? std::min(refit.tolerance_mm, options.edge_gap_mm)
@@ -342,14 +425,20 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   for (std::size_t e = 0; e < m.edges.size(); ++e) {
     brep::Edge& edge = m.edges[e];
     if (!edge_touched[e] || edge.degenerate) {
-      if (edge_touched[e])
+      if (edge_touched[e]) {
         ++report.edges_exact;  // a pole: nothing to map but its vertex
-      else
+      } else {
         ++report.edges_untouched;
+        // a kept edge of a face refitted for the profile: that face's bound widens it
+        edge.tolerance_mm += edge_face_bound[e];
+        for (int v : {edge.start, edge.end})
+          m.vertices[static_cast<std::size_t>(v)].tolerance_mm =
+              std::max(m.vertices[static_cast<std::size_t>(v)].tolerance_mm, edge.tolerance_mm);
+      }
       continue;
     }
     surface::BSplineSurface strip = ruled(edge.curve);
-    const Outcome o = deform_one(stack, strip, edge_options, "edge " + std::to_string(e));
+    const Outcome o = deform_one(&stack, strip, edge_options, "edge " + std::to_string(e));
     edge.curve = row_zero(strip);
     (o.way == Outcome::Way::Exact ? report.edges_exact : report.edges_refit) += 1;
     report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, o.bound);

@@ -143,6 +143,27 @@ BSplineBasis initial_basis(const BSplineSurface& surface, bool along_u, int degr
   return b;
 }
 
+/// A uniform start (RefitOptions::initial_count) with the original's creases and C1 joins added,
+/// at the multiplicity that keeps them: a rational conic's joins (a cylinder's quarters) are only
+/// C1 in its parameter, and a quintic without knots there would need dense knots around them to
+/// follow the first derivatives a matched curve asks for.
+BSplineBasis with_rough_breaks(BSplineBasis uniform, const BSplineBasis& original) {
+  const std::vector<double> breaks = surface::breakpoints(original);
+  const double width = original.domain().second - original.domain().first;
+  for (std::size_t k = 1; k + 1 < breaks.size(); ++k) {
+    const int continuity = original.degree - surface::multiplicity(original, breaks[k]);
+    if (continuity > 1) continue;
+    const int want = std::clamp(uniform.degree - continuity, 1, uniform.degree);
+    // a uniform knot within 1e-12 of the domain counts as the same knot
+    const auto near = [&](double t) { return std::abs(t - breaks[k]) <= 1e-12 * width; };
+    const int have =
+        static_cast<int>(std::count_if(uniform.knots.begin(), uniform.knots.end(), near));
+    for (int m = have; m < want; ++m) uniform.knots.push_back(breaks[k]);
+    std::sort(uniform.knots.begin(), uniform.knots.end());
+  }
+  return uniform;
+}
+
 /// Tensor-product least squares: the net C minimising Σ |Σ N_i(u_r) N_j(v_s) C_ij − F_rs|^2 is
 /// C = A_u^+ F A_v^+T per coordinate (the problem separates).
 BSplineSurface least_squares(const BSplineBasis& bu, const BSplineBasis& bv,
@@ -381,13 +402,14 @@ bool keep_worst(std::vector<char>& marked, const std::vector<double>& worst, int
   return std::min(spans.size(), keep) > 0;
 }
 
-/// The basis with the same number of simple interior knots moved so that each span carries an
+/// The basis with `interior` simple interior knots placed so that each span carries an
 /// equal share of the error (de Boor's equidistribution, "A Practical Guide to Splines" ch. XII):
 /// a degree-p fit's error on a span of length h is about (h rho)^(p + 1), so span s of the old
 /// basis, with error e_s, holds mass e_s^(1 / (p + 1)) spread evenly over it; the new breaks cut
 /// the running mass into equal parts. A floor of a tenth of the mean mass keeps every region some
 /// knots. `error` has one entry per non-empty span.
-BSplineBasis equidistributed(const BSplineBasis& basis, const std::vector<double>& error) {
+BSplineBasis equidistributed(const BSplineBasis& basis, const std::vector<double>& error,
+                             std::size_t interior) {
   const std::vector<double> breaks = surface::breakpoints(basis);
   const std::size_t spans = breaks.size() - 1;
   std::vector<double> mass(spans);
@@ -402,8 +424,8 @@ BSplineBasis equidistributed(const BSplineBasis& basis, const std::vector<double
   out.knots.assign(static_cast<std::size_t>(basis.degree + 1), breaks.front());
   double below = 0;  // mass of the spans before s
   std::size_t s = 0;
-  for (std::size_t k = 1; k < spans; ++k) {
-    const double at = total * static_cast<double>(k) / static_cast<double>(spans);
+  for (std::size_t k = 1; k <= interior; ++k) {
+    const double at = total * static_cast<double>(k) / static_cast<double>(interior + 1);
     while (s + 1 < spans && below + mass[s] < at) below += mass[s++];
     const double f = mass[s] > 0 ? std::clamp((at - below) / mass[s], 0.0, 1.0) : 0.5;
     out.knots.push_back(breaks[s] + f * (breaks[s + 1] - breaks[s]));
@@ -465,6 +487,8 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
                         ? surface::clamped_uniform_basis(p, uniform_v, surface.v.domain().first,
                                                          surface.v.domain().second)
                         : initial_basis(surface, false, p, options.keep_breakpoints, tolerance);
+  if (!fixed && uniform_u > 0) bu = with_rough_breaks(std::move(bu), surface.u);
+  if (!fixed && uniform_v > 0) bv = with_rough_breaks(std::move(bv), surface.v);
   const std::size_t initial_u = bu.knots.size(), initial_v = bv.knots.size();
   std::string limit;
   RefitResult best;  // the best fit that missed, kept when moving knots did worse
@@ -488,7 +512,9 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
       edge = detail::edge_samples(
           surface, options.matched_curves, [&](const Eigen::Vector3d& x) { return deformed(d, x); },
           size, per_curve);
-      result.surface = detail::least_squares_matching(bu, bv, us, vs, values, edge, 100.0);
+      result.surface = detail::least_squares_matching(
+          bu, bv, us, vs, values, edge, 100.0, options.matched_gap_mm, options.matched_angle_deg,
+          detail::closed_sides(surface));
     } else {
       result.surface = least_squares(bu, bv, us, vs, values);
     }
@@ -594,7 +620,20 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
       // Every span that misses is in a direction at its cap: move the knots instead, so that
       // each span carries an equal share of the error (kept only when it does better).
       ++relocations;
-      bu = equidistributed(bu, error_u), bv = equidistributed(bv, error_v);
+      // as many control points as before: the simple knots moved, the rough breaks' kept
+      auto moved = [&](const BSplineBasis& b, const std::vector<double>& error,
+                       const BSplineBasis& original) {
+        BSplineBasis bare;
+        bare.degree = b.degree;
+        bare.knots.assign(static_cast<std::size_t>(2 * (b.degree + 1)), original.domain().first);
+        std::fill(bare.knots.begin() + b.degree + 1, bare.knots.end(), original.domain().second);
+        const std::size_t rough =
+            with_rough_breaks(bare, original).knots.size() - bare.knots.size();
+        const std::size_t interior = b.knots.size() - bare.knots.size();
+        return with_rough_breaks(equidistributed(b, error, interior > rough ? interior - rough : 0),
+                                 original);
+      };
+      bu = moved(bu, error_u, surface.u), bv = moved(bv, error_v, surface.v);
       continue;
     }
     if (!room || std::max(nu.count(), nv.count()) > options.max_count_per_direction) {
@@ -633,13 +672,18 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
                                      " mm, not certified";
   } else {
     report.summary.termination = Termination::NotConverged;
-    message = limit + ": " +
-              (report.certified ? "certified bound " + short_format(report.certified_bound_mm)
-                                : "sampled maximum " + short_format(report.sampled_max)) +
-              " mm above the tolerance " + short_format(tolerance) +
-              (fixed ? " mm; give more control points (count_u, count_v), a larger tolerance or a "
-                       "higher degree"
-                     : " mm; raise the limits, the tolerance or the degree");
+    const double reached = report.certified ? report.certified_bound_mm : report.sampled_max;
+    const std::string what =
+        (report.certified ? "certified bound " : "sampled maximum ") + short_format(reached);
+    if (reached <= tolerance)  // only the matched curves miss
+      message = limit + ": " + what + " mm within the tolerance " + short_format(tolerance) +
+                " mm, but the matched curves miss their figures; give more control points or "
+                "relax the figures";
+    else
+      message = limit + ": " + what + " mm above the tolerance " + short_format(tolerance) +
+                (fixed ? " mm; give more control points (count_u, count_v), a larger tolerance "
+                         "or a higher degree"
+                       : " mm; raise the limits, the tolerance or the degree");
   }
   if (matching) {
     message += "; matched curves: gap " + short_format(report.matched_gap_mm) + " mm (" +

@@ -48,15 +48,39 @@ std::vector<EdgeSample> edge_samples(
   return out;
 }
 
+ClosedSides closed_sides(const surface::BSplineSurface& original) {
+  const int nu = original.count_u(), nv = original.count_v();
+  auto same = [&](int i0, int j0, int i1, int j1) {
+    const Eigen::Index a = original.index(i0, j0), b = original.index(i1, j1);
+    return original.points.row(a) == original.points.row(b) &&
+           original.weights[a] == original.weights[b];
+  };
+  ClosedSides out{true, true};
+  for (int j = 0; j < nv && out.u; ++j) out.u = same(0, j, nu - 1, j);
+  for (int i = 0; i < nu && out.v; ++i) out.v = same(i, 0, i, nv - 1);
+  return out;
+}
+
 surface::BSplineSurface least_squares_matching(
     const surface::BSplineBasis& bu, const surface::BSplineBasis& bv, const std::vector<double>& us,
     const std::vector<double>& vs, const surface::Points3& values,
-    const std::vector<EdgeSample>& samples, double weight) {
+    const std::vector<EdgeSample>& samples, double weight, double gap_mm, double angle_deg,
+    ClosedSides closed) {
   const int nu = bu.count(), nv = bv.count();
-  const Eigen::Index n = static_cast<Eigen::Index>(nu) * nv;
   const Eigen::MatrixXd au = collocation(bu, us), av = collocation(bv, vs);
   const Eigen::MatrixXd gu = au.transpose() * au, gv = av.transpose() * av;
-  auto index = [nv](Eigen::Index i, Eigen::Index j) { return i * nv + j; };
+  // The unknowns: one per control point, a closed side's last row folded onto its first.
+  std::vector<Eigen::Index> unknown(static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv));
+  Eigen::Index n = 0;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const int fi = closed.u && i == nu - 1 ? 0 : i, fj = closed.v && j == nv - 1 ? 0 : j;
+      unknown[static_cast<std::size_t>(i * nv + j)] =
+          fi == i && fj == j ? n++ : unknown[static_cast<std::size_t>(fi * nv + fj)];
+    }
+  auto index = [&](Eigen::Index i, Eigen::Index j) {
+    return unknown[static_cast<std::size_t>(i * nv + j)];
+  };
 
   // The grid: (A_u^T A_u) ⊗ (A_v^T A_v), both banded.
   std::vector<Eigen::Triplet<double>> entries;
@@ -73,7 +97,7 @@ surface::BSplineSurface least_squares_matching(
   for (const auto& [i, k] : nz_u)
     for (const auto& [j, l] : nz_v)
       entries.emplace_back(index(i, j), index(k, l), gu(i, k) * gv(j, l));
-  Eigen::MatrixXd rhs(n, 3);
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, 3);
   const auto mu = static_cast<Eigen::Index>(us.size()), mv = static_cast<Eigen::Index>(vs.size());
   for (int c = 0; c < 3; ++c) {
     Eigen::MatrixXd f(mu, mv);
@@ -81,10 +105,15 @@ surface::BSplineSurface least_squares_matching(
       for (Eigen::Index j = 0; j < mv; ++j) f(i, j) = values(i * mv + j, c);
     const Eigen::MatrixXd r = au.transpose() * f * av;
     for (Eigen::Index i = 0; i < nu; ++i)
-      for (Eigen::Index j = 0; j < nv; ++j) rhs(index(i, j), c) = r(i, j);
+      for (Eigen::Index j = 0; j < nv; ++j) rhs(index(i, j), c) += r(i, j);
   }
 
-  // The samples: three weighted rows each (position, h_u d/du, h_v d/dv) on (p+1)(q+1) points.
+  // The samples: three weighted rows each (position, h_u d/du, h_v d/dv) on (p+1)(q+1) points,
+  // each row in units of its allowance: a derivative error of angle |(D∘S)_u| tilts the normal
+  // by about the angle, so h_u = gap / (angle |(D∘S)_u|) makes both rows count as much at their
+  // limits. (The span's width instead would weaken the derivative rows just where refinement
+  // made spans short: a cylinder's joins kept missing the angle at 32 spans.)
+  const double angle = angle_deg * std::numbers::pi / 180;
   const int pu = bu.degree, pv = bv.degree;
   const int local = (pu + 1) * (pv + 1);
   std::vector<double> du(static_cast<std::size_t>(2 * (pu + 1))),
@@ -96,10 +125,9 @@ surface::BSplineSurface least_squares_matching(
     const int su = surface::find_span(bu, s.u), sv = surface::find_span(bv, s.v);
     surface::basis_derivatives(bu, su, s.u, 1, du);
     surface::basis_derivatives(bv, sv, s.v, 1, dv);
-    const double hu =
-        bu.knots[static_cast<std::size_t>(su) + 1] - bu.knots[static_cast<std::size_t>(su)];
-    const double hv =
-        bv.knots[static_cast<std::size_t>(sv) + 1] - bv.knots[static_cast<std::size_t>(sv)];
+    const double speed_u = s.du.norm(), speed_v = s.dv.norm();
+    const double hu = speed_u > 0 ? gap_mm / (angle * speed_u) : 0;
+    const double hv = speed_v > 0 ? gap_mm / (angle * speed_v) : 0;
     for (int a = 0; a <= pu; ++a)
       for (int b = 0; b <= pv; ++b) {
         const auto ua = static_cast<std::size_t>(a), vb = static_cast<std::size_t>(b);
@@ -130,8 +158,11 @@ surface::BSplineSurface least_squares_matching(
     throw Error(ErrorCategory::Internal,
                 "refit_deformed: the least squares with matched curves is singular (" +
                     std::to_string(nu) + " x " + std::to_string(nv) + " control points)");
-  const Eigen::MatrixXd net = solver.solve(rhs);
-  return surface::make_surface(bu, bv, surface::Points3(net));
+  const Eigen::MatrixXd solved = solver.solve(rhs);
+  surface::Points3 net(static_cast<Eigen::Index>(nu) * nv, 3);
+  for (Eigen::Index i = 0; i < nu; ++i)
+    for (Eigen::Index j = 0; j < nv; ++j) net.row(i * nv + j) = solved.row(index(i, j));
+  return surface::make_surface(bu, bv, std::move(net));
 }
 
 std::vector<EdgeMiss> edge_misses(const surface::BSplineSurface& fit,

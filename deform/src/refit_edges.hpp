@@ -26,14 +26,25 @@ std::vector<EdgeSample> edge_samples(
     const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve);
 
+/// Whether `original`'s first and last columns (closed_u: i = 0 and i = last) or rows (closed_v)
+/// of control points and weights are equal bit for bit: a closed side (seal.hpp).
+struct ClosedSides {
+  bool u = false, v = false;
+};
+ClosedSides closed_sides(const surface::BSplineSurface& original);
+
 /// The net on bu x bv minimising Σ_grid |fit − values|² + w² Σ_samples (|fit − D∘S|² +
-/// h_u² |fit_u − (D∘S)_u|² + h_v² |fit_v − (D∘S)_v|²), h the width of the fit's span holding
-/// the sample: the grid's normal equations are (A_u^T A_u) ⊗ (A_v^T A_v), banded, and the
-/// samples add small blocks, so the system is sparse (Cholesky, LDL^T).
+/// h_u² |fit_u − (D∘S)_u|² + h_v² |fit_v − (D∘S)_v|²), h_u = gap_mm / (angle |(D∘S)_u|) (each
+/// row in units of its allowance, the angle in radians; 0 where D∘S's derivative vanishes): the
+/// grid's normal equations are (A_u^T A_u) ⊗ (A_v^T A_v), banded, and the
+/// samples add small blocks, so the system is sparse (Cholesky, LDL^T). A closed side's first
+/// and last rows are one unknown (copying one onto the other after the fit would move the last
+/// row by the two fits' difference, which a short end span turns into a normal angle).
 surface::BSplineSurface least_squares_matching(
     const surface::BSplineBasis& bu, const surface::BSplineBasis& bv, const std::vector<double>& us,
     const std::vector<double>& vs, const surface::Points3& values,
-    const std::vector<EdgeSample>& samples, double weight);
+    const std::vector<EdgeSample>& samples, double weight, double gap_mm, double angle_deg,
+    ClosedSides closed = {});
 
 /// The fit's distance from D∘S and angle between the normals at one sample.
 struct EdgeMiss {

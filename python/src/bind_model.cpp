@@ -53,11 +53,12 @@ brep::Face& face_at(brep::Model& m, int k) {
 
 /// The recipe's deformation of a whole model (bind_recipe.cpp calls it on its Recipe class).
 py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
-                       const std::string& deformation, bool allow_fold) {
+                       const std::string& deformation, bool allow_fold,
+                       const std::string& profile) {
   recipe::ModelRunResult result;
   {
     py::gil_scoped_release free;
-    result = recipe::deform_model(r, model, deformation, allow_fold);
+    result = recipe::deform_model(r, model, deformation, allow_fold, profile);
   }
   const auto& x = result.report;
   py::dict d;
@@ -65,6 +66,8 @@ py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
   d["faces_exact"] = x.faces_exact;
   d["faces_refit"] = x.faces_refit;
   d["faces_untouched"] = x.faces_untouched;
+  d["profile"] = x.profile;
+  d["faces_elevated"] = x.faces_elevated;
   d["max_certified_bound_mm"] = x.max_certified_bound_mm;
   d["max_edge_gap_mm"] = x.max_edge_gap_mm;
   d["volume_before_mm3"] = x.volume_before_mm3;

@@ -15,7 +15,8 @@
 namespace clay::python {
 
 py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
-                       const std::string& deformation, bool allow_fold);  // bind_model.cpp
+                       const std::string& deformation, bool allow_fold,
+                       const std::string& profile);  // bind_model.cpp
 
 namespace {
 
@@ -179,12 +180,16 @@ void bind_recipe(py::module_& m) {
       .def(
           "deform_model",
           [](const PyRecipe& r, const brep::Model& model, const std::string& deformation,
-             bool allow_fold) { return deform_model(r.recipe, model, deformation, allow_fold); },
+             bool allow_fold, const std::string& profile) {
+            return deform_model(r.recipe, model, deformation, allow_fold, profile);
+          },
           py::arg("model"), py::arg("deformation") = "", py::kw_only(),
-          py::arg("allow_fold") = false,
+          py::arg("allow_fold") = false, py::arg("profile") = "",
           "The model deformed by the recipe's stack (the one named, or its only one), as "
           "`clayform deform` does: (Model, report). A lattice not proven fold-free raises "
-          "InvalidGeometryError (a folded solid intersects itself) unless allow_fold=True.")
+          "InvalidGeometryError (a folded solid intersects itself) unless allow_fold=True. "
+          "profile: the receiver the model is written for (exact, opencascade, catia, class_a, "
+          "bicubic; '' none): faces it would not take are refitted to it with their edges.")
       .def("__repr__",
            [](const PyRecipe& r) { return "<clayform.Recipe '" + r.recipe.name() + "'>"; })
       .def(py::pickle(

@@ -318,6 +318,10 @@ Json model_figures(const ModelRunResult& r) {
   model["faces_exact"] = m.faces_exact;
   model["faces_refit"] = m.faces_refit;
   model["faces_untouched"] = m.faces_untouched;
+  if (!m.profile.empty()) {
+    model["profile"] = m.profile;
+    model["faces_elevated"] = m.faces_elevated;
+  }
   model["edges_exact"] = m.edges_exact;
   model["edges_refit"] = m.edges_refit;
   model["edges_untouched"] = m.edges_untouched;

@@ -242,7 +242,8 @@ ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
 using namespace detail;
 
 ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
-                            std::string_view deformation, bool allow_fold) {
+                            std::string_view deformation, bool allow_fold,
+                            std::string_view profile) {
   if (!recipe.data)
     throw Error(ErrorCategory::InvalidArgument,
                 "deform_model: empty recipe; load or parse one first");
@@ -258,6 +259,7 @@ ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
   options.surface.budget.reset();  // faces stay exact, as in run_model above
   options.edge_gap_mm = d.composition.edge_gap_mm;
   options.edge_angle_deg = d.composition.edge_angle_deg;
+  if (!profile.empty()) options.profile = deform::receiver_profile(profile);
   try {
     auto r = deform::deform_model(stack, model, options);
     result.model = std::move(r.model);

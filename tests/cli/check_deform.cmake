@@ -31,6 +31,21 @@ execute_process(COMMAND ${CLAYFORM} info ${WORK}/out/sample.step OUTPUT_VARIABLE
 if(NOT rc EQUAL 0 OR NOT out MATCHES "2 faces, max degree [0-9]+, [0-9]+ control points, valid \\(BRepCheck\\)" OR NOT out MATCHES "#1 degree \\([0-9]+, [0-9]+\\), [0-9]+ x [0-9]+ control points, rational")
   message(FATAL_ERROR "clayform info on the deformed file (exit ${rc}):\n${out}")
 endif()
+# --profile: an unknown receiver fails at once, naming the profiles; "exact" keeps the faces
+# exact and says so in report.json.
+execute_process(COMMAND ${CLAYFORM} deform ${DIR}/sample.step --recipe ${RECIPE} --deformation flare
+                        --out ${WORK}/nope --profile alias
+  OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "no receiver profile \"alias\"; the profiles: exact, opencascade, catia, class_a, bicubic")
+  message(FATAL_ERROR "deform --profile alias: exit ${rc}, stderr '${err}'")
+endif()
+execute_process(COMMAND ${CLAYFORM} deform ${DIR}/sample.step --recipe ${RECIPE} --deformation flare
+                        --out ${WORK}/exact --profile exact --quiet
+  OUTPUT_VARIABLE out ERROR_VARIABLE err RESULT_VARIABLE rc)
+file(READ ${WORK}/exact/report.json report)
+if(NOT rc EQUAL 0 OR NOT report MATCHES "\"profile\": *\"exact\"" OR NOT report MATCHES "\"faces_exact\": *2")
+  message(FATAL_ERROR "deform --profile exact: exit ${rc}:\n${out}${err}")
+endif()
 foreach(cmd run validate deform info)
   execute_process(COMMAND ${CLAYFORM} ${cmd} --help OUTPUT_VARIABLE out RESULT_VARIABLE rc)
   if(NOT rc EQUAL 0 OR NOT out MATCHES "Usage:")

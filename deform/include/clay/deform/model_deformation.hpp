@@ -23,10 +23,12 @@
 #include <clay/brep/continuity.hpp>
 #include <clay/brep/model.hpp>
 #include <clay/deform/export.hpp>
+#include <clay/deform/receiver.hpp>
 #include <clay/deform/stack.hpp>
 #include <clay/deform/surface_deformation.hpp>
 #include <clay/summary.hpp>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +56,13 @@ struct CLAY_DEFORM_API ModelDeformationOptions {
   /// not certified; the edges' curves are refitted within edge_gap_mm too.
   double edge_gap_mm = 0.0005;
   double edge_angle_deg = 0.008;  ///< see edge_gap_mm
+  /// The receiver the model is written for (receiver.hpp; empty: none, max_degree alone). A face
+  /// it would not take is refitted from the original through the stack at the profile's fit
+  /// degree and net cap (class A: degree 5, at most 32 per direction), with its edges matched
+  /// as above and certified against the exact result; one only below its minimum degree
+  /// (bicubic) is raised exactly. Faces written as planes, cylinders, ... (Face::elementary)
+  /// conform as they are. The exact profile refits nothing: a face above degree 25 is refused.
+  std::optional<ReceiverProfile> profile;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -65,6 +74,9 @@ struct CLAY_DEFORM_API ModelDeformationOptions {
 struct CLAY_DEFORM_API ModelDeformationReport {
   brep::Counts counts;  ///< of the deformed model (the same as before, flattened)
   int faces_exact = 0, faces_refit = 0, faces_untouched = 0;
+  /// With a receiver profile: its name, and the faces raised exactly to its minimum degree.
+  std::string profile;
+  int faces_elevated = 0;
   int edges_exact = 0, edges_refit = 0, edges_untouched = 0;
   /// Largest certified bound of a refitted face or edge (mm); 0 when everything was exact.
   double max_certified_bound_mm = 0;

@@ -218,11 +218,14 @@ CLAY_RECIPE_API RunResult deform_surfaces(const Recipe& recipe,
 /// from a surface point, is refused (InvalidArgument naming the step): they shape one surface.
 /// A lattice whose Jacobian bounds do not prove it fold-free (Sederberg–Parry §4) is refused
 /// (InvalidGeometry naming the step and its smallest coefficient: a folded solid intersects
-/// itself) unless `allow_fold`. Throws the deformation's clay::Error in the recipe's words,
-/// naming the stack.
+/// itself) unless `allow_fold`. `profile` (deform::receiver_profile's names; empty: none, faces
+/// above degree 25 refitted) is the receiver the model is written for: the faces it would not
+/// take are refitted to it with their edges (deform::ModelDeformationOptions::profile). Throws
+/// the deformation's clay::Error in the recipe's words, naming the stack; InvalidArgument for
+/// an unknown profile.
 CLAY_RECIPE_API ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
                                             std::string_view deformation = {},
-                                            bool allow_fold = false);
+                                            bool allow_fold = false, std::string_view profile = {});
 
 /// Writes STEM.step, STEM.igs and STEM.glb (result.formats; the .glb a preview of the trimmed
 /// faces, brep::write_model), report.json and the view folder (the model's trimmed mesh, for
