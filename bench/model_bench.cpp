@@ -7,10 +7,12 @@
 #include <clay/brep/continuity.hpp>
 #include <clay/brep/volume.hpp>
 #include <clay/deform/model_deformation.hpp>
+#include <clay/deform/regular.hpp>
 #include <clay/occt/model_exchange.hpp>
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 
@@ -159,8 +161,49 @@ void BM_Pipeline(benchmark::State& state) {
   faces_counter(state);
 }
 
+const brep::Model& filleted_block() {
+  static const brep::Model m = [] {
+    const fs::path f = fs::temp_directory_path() / "clayform-bench-block.step";
+    surface::occt_reference::write_test_model(surface::occt_reference::TestModel::FilletedBlock, f);
+    return brep::read_model(f).model;
+  }();
+  return m;
+}
+
+/// Issue #38 step 7, before and after in one run: the filleted block twisted about z at
+/// 0.005 rad/mm, each face refitted within 1 % of its size, alone (arg 0: edge_gap_mm =
+/// edge_angle_deg = 0, as before) or following its edges (arg 1: the defaults, 0.0005 mm and
+/// 0.008 deg). Counters: the fillets' largest tangent-plane angle and the largest gap after,
+/// and the time per refitted face.
+void BM_TwistBlockEdges(benchmark::State& state) {
+  const brep::Model& block = filleted_block();
+  deform::Twist twist;
+  twist.angle = {0, 0.005};
+  deform::DeformationStack stack;
+  stack.steps.push_back({twist, "twist", true});
+  deform::ModelDeformationOptions options;
+  deform::RefitOptions refit;
+  refit.relative_tolerance = 0.01;
+  options.surface.refit = refit;
+  if (state.range(0) == 0) options.edge_gap_mm = options.edge_angle_deg = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(deform::deform_model(stack, block, options));
+  const auto r = deform::deform_model(stack, block, options).report;
+  double fillet = 0;
+  for (std::size_t k = 0; k < r.continuity_after.edges.size(); ++k) {
+    const auto& was = r.continuity_before.edges[k];
+    if (was.face_a != was.face_b && was.angle_deg < 1e-6)
+      fillet = std::max(fillet, r.continuity_after.edges[k].angle_deg);
+  }
+  state.counters["fillet_angle_deg"] = fillet;
+  state.counters["max_gap_mm"] = r.continuity_after.max_gap_mm;
+  state.counters["faces_refit"] = r.faces_refit;
+  state.counters["per_face"] = benchmark::Counter(
+      r.faces_refit, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
 }  // namespace
 
+BENCHMARK(BM_TwistBlockEdges)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Read)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DeformExact)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DeformAffine)->Unit(benchmark::kMillisecond);
