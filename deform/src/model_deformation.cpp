@@ -8,7 +8,6 @@
 #include <clay/internal/checks.hpp>
 #include <clay/internal/format.hpp>
 #include <clay/surface/bspline_curve.hpp>
-#include <clay/surface/degree_elevation.hpp>
 #include <clay/surface/evaluate.hpp>
 
 #include <algorithm>
@@ -125,12 +124,11 @@ bool only_low(const surface::BSplineSurface& s, const ReceiverProfile& profile) 
           std::max(s.u.count(), s.v.count()) <= profile.max_count_per_direction);
 }
 
-/// `s` raised exactly to the profile's minimum degree (when it has one above s's).
+/// `s` raised exactly to the profile's minimum degree, when only that is what it breaks
+/// (fit_to_profile's exact branch; nothing is refitted here).
 void elevate_to(surface::BSplineSurface& s, const ReceiverProfile& profile) {
-  if (s.u.degree < profile.min_degree)
-    s = surface::elevate_degree_u(s, profile.min_degree - s.u.degree);
-  if (s.v.degree < profile.min_degree)
-    s = surface::elevate_degree_v(s, profile.min_degree - s.v.degree);
+  if (std::min(s.u.degree, s.v.degree) < profile.min_degree)
+    s = fit_to_profile(s, profile, RefitOptions{}).surface;
 }
 
 /// One surface through the stack, with the degree cap and the receiver profile: its result and

@@ -48,19 +48,6 @@ std::vector<EdgeSample> edge_samples(
   return out;
 }
 
-ClosedSides closed_sides(const surface::BSplineSurface& original) {
-  const int nu = original.count_u(), nv = original.count_v();
-  auto same = [&](int i0, int j0, int i1, int j1) {
-    const Eigen::Index a = original.index(i0, j0), b = original.index(i1, j1);
-    return original.points.row(a) == original.points.row(b) &&
-           original.weights[a] == original.weights[b];
-  };
-  ClosedSides out{true, true};
-  for (int j = 0; j < nv && out.u; ++j) out.u = same(0, j, nu - 1, j);
-  for (int i = 0; i < nu && out.v; ++i) out.v = same(i, 0, i, nv - 1);
-  return out;
-}
-
 surface::BSplineSurface least_squares_matching(
     const surface::BSplineBasis& bu, const surface::BSplineBasis& bv, const std::vector<double>& us,
     const std::vector<double>& vs, const surface::Points3& values,

@@ -10,6 +10,8 @@
 #include <functional>
 #include <vector>
 
+#include "seal.hpp"
+
 namespace clay::deform::detail {
 
 /// D∘S at one point of a matched curve: where (u, v), and the map's position and first partial
@@ -25,13 +27,6 @@ struct EdgeSample {
 std::vector<EdgeSample> edge_samples(
     const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve);
-
-/// Whether `original`'s first and last columns (closed_u: i = 0 and i = last) or rows (closed_v)
-/// of control points and weights are equal bit for bit: a closed side (seal.hpp).
-struct ClosedSides {
-  bool u = false, v = false;
-};
-ClosedSides closed_sides(const surface::BSplineSurface& original);
 
 /// The net on bu x bv minimising Σ_grid |fit − values|² + w² Σ_samples (|fit − D∘S|² +
 /// h_u² |fit_u − (D∘S)_u|² + h_v² |fit_v − (D∘S)_v|²), h_u = gap_mm / (angle |(D∘S)_u|) (each

@@ -17,26 +17,37 @@ namespace clay::deform::detail {
 /// ~1e-3 mm open, which shades as a dark spot); a closed side that is open by rounding is also
 /// "closed" by a STEP reader, so the file would not read back as written. The changes are within
 /// that rounding or approximation; callers measure or certify the result after this.
-template <class Map>
-void keep_closed_and_collapsed(const surface::BSplineSurface& original,
-                               surface::BSplineSurface& image, Map&& map) {
-  const int nu = original.count_u(), nv = original.count_v(), mu = image.count_u(),
-            mv = image.count_v();
+/// Which sides of `original` are closed: its first and last columns (u: i = 0 and i = last) or
+/// rows (v) of control points and weights equal bit for bit.
+struct ClosedSides {
+  bool u = false, v = false;
+};
+inline ClosedSides closed_sides(const surface::BSplineSurface& original) {
+  const int nu = original.count_u(), nv = original.count_v();
   auto same = [&](int i0, int j0, int i1, int j1) {
     const Eigen::Index a = original.index(i0, j0), b = original.index(i1, j1);
     return original.points.row(a) == original.points.row(b) &&
            original.weights[a] == original.weights[b];
   };
+  ClosedSides out{true, true};
+  for (int j = 0; j < nv && out.u; ++j) out.u = same(0, j, nu - 1, j);
+  for (int i = 0; i < nu && out.v; ++i) out.v = same(i, 0, i, nv - 1);
+  return out;
+}
+
+template <class Map>
+void keep_closed_and_collapsed(const surface::BSplineSurface& original,
+                               surface::BSplineSurface& image, Map&& map) {
+  const int nu = original.count_u(), nv = original.count_v(), mu = image.count_u(),
+            mv = image.count_v();
   auto copy = [&](Eigen::Index to, Eigen::Index from) {
     image.points.row(to) = image.points.row(from);
     image.weights[to] = image.weights[from];
   };
-  bool closed_v = true, closed_u = true;
-  for (int i = 0; i < nu && closed_v; ++i) closed_v = same(i, 0, i, nv - 1);
-  for (int j = 0; j < nv && closed_u; ++j) closed_u = same(0, j, nu - 1, j);
-  if (closed_v)
+  const ClosedSides closed = closed_sides(original);
+  if (closed.v)
     for (int i = 0; i < mu; ++i) copy(image.index(i, mv - 1), image.index(i, 0));
-  if (closed_u)
+  if (closed.u)
     for (int j = 0; j < mv; ++j) copy(image.index(mu - 1, j), image.index(0, j));
   auto point = [&](int i, int j) { return original.points.row(original.index(i, j)); };
   for (const auto& [side, image_side] : {std::pair{0, 0}, std::pair{nu - 1, mu - 1}}) {
