@@ -163,7 +163,12 @@ Outcome deform_one(const DeformationStack* stack, surface::BSplineSurface& s,
             "\"opencascade\") or lower the degree of the steps that deform it");
   // (An uncertified refit, an extended lattice's, is kept as deform_surface made it.)
   if (too_high || off_profile || (!r.report.exact && r.report.certified && !edges.empty())) {
-    if (!options.surface.refit)
+    // the composition's refit settings, else (an exact composition above its budget) the
+    // budget's light fit
+    const RefitOptions* base = options.surface.refit    ? &*options.surface.refit
+                               : options.surface.budget ? &options.surface.budget->light
+                                                        : nullptr;
+    if (base == nullptr)
       throw Error(ErrorCategory::DegreeLimit,
                   name + ": the exact result has degree " +
                       std::to_string(std::max(r.report.degree_u, r.report.degree_v)) +
@@ -173,7 +178,7 @@ Outcome deform_one(const DeformationStack* stack, surface::BSplineSurface& s,
                                      std::string(profile->name) + " profile takes"
                                : ", above max_degree " + std::to_string(options.max_degree)) +
                       "; allow a refit (a refit tolerance) or raise max_degree");
-    RefitOptions refit = *options.surface.refit;
+    RefitOptions refit = *base;
     refit.degree = std::min(refit.degree, cap);
     if (profile) {
       // As fit_to_profile: the profile's degree, from the rough breakpoints only; a capped net

@@ -223,9 +223,8 @@ ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
     const deform::DeformationStack stack = model_stack(stack_def, out.fold_free, def.allow_fold);
     deform::ModelDeformationOptions options;
     options.surface = deformation_options(d.composition);
-    // A model's faces keep their exact forms (light faces above a budget are not fitted with
-    // their edges yet); refitted faces follow their edges (composition "edges").
-    options.surface.budget.reset();
+    // Faces above the composition's budget are light, and every refitted or light face
+    // follows its edges (composition "edges"), so its neighbours keep their continuity.
     options.edge_gap_mm = d.composition.edge_gap_mm;
     options.edge_angle_deg = d.composition.edge_angle_deg;
     options.faces = chosen_faces(flat, def);
@@ -256,7 +255,6 @@ ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
   const deform::DeformationStack stack = model_stack(def, result.fold_free, allow_fold);
   deform::ModelDeformationOptions options;
   options.surface = deformation_options(d.composition);
-  options.surface.budget.reset();  // faces stay exact, as in run_model above
   options.edge_gap_mm = d.composition.edge_gap_mm;
   options.edge_angle_deg = d.composition.edge_angle_deg;
   if (!profile.empty()) options.profile = deform::receiver_profile(profile);

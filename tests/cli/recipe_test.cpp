@@ -250,6 +250,63 @@ TEST_CASE("a model's refitted faces follow their edges as the composition's \"ed
                  "composition.edges.gap", "unknown key"));
 }
 
+TEST_CASE("a model's faces above the composition's budget are light and keep their edges",
+          "[recipe]") {
+  // A (3, 3, 3) Bézier lattice on the filleted block: its cylinders (fillets, holes) compose to
+  // degree 18, above the default budget's 15, so they are light (bicubic, certified) and follow
+  // their edges; the planes stay exact. "budget": "none" keeps all 17 faces exact.
+  const std::string lattice =
+      R"({"kind": "bezier_lattice", "frame": {"origin": [-5, -5, -5], "s": [70, 0, 0], "t": [0, 50, 0], "u": [0, 0, 30]},
+          "degrees": [3, 3, 3], "moves": [{"index": [1, 1, 3], "by": [0, 0, 4]}, {"index": [3, 1, 1], "by": [3, 0, 0]}]})";
+  auto with = [&](const std::string& composition) {
+    return parse_recipe(
+        recipe_with("", R"("deformations": {"bulge": [)" + lattice + "]}" + composition));
+  };
+  const clay::brep::Model block = clay::brep::flattened(
+      clay::brep::read_model(fs::path(CLAY_EXAMPLES_DIR) / "models" / "block.step").model);
+  const auto light = clay::recipe::deform_model(with(""), block, "bulge");
+  const auto exact =
+      clay::recipe::deform_model(with(R"(, "composition": {"budget": "none"})"), block, "bulge");
+  INFO(light.report.brief() << "\n" << exact.report.brief());
+  CHECK(exact.report.faces_exact == 17);
+  CHECK(light.report.faces_exact == 11);
+  CHECK(light.report.faces_refit == 6);
+  int highest_exact = 0, highest_light = 0;
+  for (const auto& f : exact.model.faces)
+    highest_exact = std::max({highest_exact, f.surface.u.degree, f.surface.v.degree});
+  for (const auto& f : light.model.faces)
+    highest_light = std::max({highest_light, f.surface.u.degree, f.surface.v.degree});
+  CHECK(highest_exact == 18);
+  CHECK(highest_light <= 15);
+  // each light face within its certified bound of the exact face, at parameters of its own
+  // (both on the original's (u, v))
+  CHECK(light.report.max_certified_bound_mm <= 1e-4 * 75);
+  std::mt19937 rng(3);
+  double worst = 0;
+  for (std::size_t f = 0; f < light.model.faces.size(); ++f) {
+    const auto& a = light.model.faces[f].surface;
+    const auto& b = exact.model.faces[f].surface;
+    const auto [u0, u1] = b.u.domain();
+    const auto [v0, v1] = b.v.domain();
+    std::uniform_real_distribution<double> du(u0, u1), dv(v0, v1);
+    for (int k = 0; k < 400; ++k) {
+      const double u = du(rng), v = dv(rng);
+      worst = std::max(worst, (surface::evaluate(a, u, v) - surface::evaluate(b, u, v)).norm());
+    }
+  }
+  CHECK(worst <= light.report.max_certified_bound_mm);
+  CHECK(worst > 0);
+  const auto& before = light.report.continuity_before;
+  const auto& after = light.report.continuity_after;
+  REQUIRE(after.edges.size() == before.edges.size());
+  for (std::size_t k = 0; k < after.edges.size(); ++k) {
+    CHECK(after.edges[k].gap_mm <= 0.001);
+    if (before.edges[k].angle_deg < 1e-6) CHECK(after.edges[k].angle_deg <= 0.016);
+  }
+  CHECK(std::abs(light.report.volume_after_mm3 - exact.report.volume_after_mm3) <
+        1e-5 * exact.report.volume_after_mm3);
+}
+
 TEST_CASE("curves: line, polyline, arc and reversed match their closed forms", "[recipe]") {
   const std::string text = R"({"format": "clayform.recipe", "version": 1,
     "curves": {
