@@ -117,8 +117,9 @@ struct Outcome {
   double deviation = 0;  // largest deviation of an exact result from the pointwise map (mm)
 };
 
-/// True when `s` breaks only the profile's minimum degree (raised exactly, nothing refitted).
-bool only_low(const surface::BSplineSurface& s, const ReceiverProfile& profile) {
+/// True when `s` is within the profile's degree and net caps: it conforms, or breaks only the
+/// minimum degree (raised exactly, nothing refitted).
+bool within_caps(const surface::BSplineSurface& s, const ReceiverProfile& profile) {
   return std::max(s.u.degree, s.v.degree) <= profile.max_degree &&
          (profile.max_count_per_direction == 0 ||
           std::max(s.u.count(), s.v.count()) <= profile.max_count_per_direction);
@@ -154,7 +155,7 @@ Outcome deform_one(const DeformationStack* stack, surface::BSplineSurface& s,
   const ReceiverProfile* profile = options.profile ? &*options.profile : nullptr;
   const int cap = profile ? std::min(options.max_degree, profile->max_degree) : options.max_degree;
   const bool too_high = std::max(r.report.degree_u, r.report.degree_v) > cap;
-  const bool off_profile = profile && !only_low(r.surface, *profile);
+  const bool off_profile = profile && !within_caps(r.surface, *profile);
   if ((too_high || off_profile) && profile && profile->fit_degree == 0)
     throw Error(
         ErrorCategory::DegreeLimit,
@@ -202,7 +203,7 @@ Outcome deform_one(const DeformationStack* stack, surface::BSplineSurface& s,
       throw Error(e.category(), name + ": " + e.message());
     }
     if (!fit.report.certified || !(fit.report.certified_bound_mm <= fit.report.tolerance_mm) ||
-        !fit.report.summary.converged() || (profile && !only_low(fit.surface, *profile)))
+        !fit.report.summary.converged() || (profile && !within_caps(fit.surface, *profile)))
       throw Error(ErrorCategory::ToleranceNotMet,
                   name + ": the refit" +
                       (profile    ? " for the " + std::string(profile->name) + " profile"
@@ -349,7 +350,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       const ReceiverProfile* profile = options.profile ? &*options.profile : nullptr;
       const bool conforms =
           !profile || face.elementary || conformance_problems(face.surface, *profile).empty();
-      if (conforms || only_low(face.surface, *profile)) {
+      if (conforms || within_caps(face.surface, *profile)) {
         if (!conforms) {
           elevate_to(face.surface, *profile);
           ++report.faces_elevated;
@@ -418,11 +419,15 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
     edge_options.max_degree = std::min(options.max_degree, options.profile->max_degree);
     edge_options.profile.reset();
   }
-  if (options.edge_gap_mm > 0 && edge_options.surface.refit) {
-    RefitOptions& refit = *edge_options.surface.refit;
+  // (The budget's light fit too: an exact composition's edge above the budget is light.)
+  auto within_edge_gap = [&](RefitOptions& refit) {
     refit.tolerance_mm = refit.tolerance_mm > 0 ? std::min(refit.tolerance_mm, options.edge_gap_mm)
                                                 : options.edge_gap_mm;
     refit.relative_tolerance = 0;
+  };
+  if (options.edge_gap_mm > 0) {
+    if (edge_options.surface.refit) within_edge_gap(*edge_options.surface.refit);
+    if (edge_options.surface.budget) within_edge_gap(edge_options.surface.budget->light);
   }
   std::vector<double> edge_bound(m.edges.size(), 0.0);
   for (std::size_t e = 0; e < m.edges.size(); ++e) {

@@ -167,6 +167,15 @@ Vector3d normal_by_differences(const clay::brep::Face& face, const clay::brep::C
   return (face.reversed ? -1.0 : 1.0) * su.cross(sv).normalized();
 }
 
+/// The coedge of `edge` on `face` (the test fails when the face does not use it).
+const clay::brep::Coedge& coedge_of(const Model& m, int face, int edge) {
+  for (const auto& loop : m.faces[static_cast<size_t>(face)].loops)
+    for (const auto& co : loop.coedges)
+      if (co.edge == edge) return co;
+  FAIL("no coedge of edge " << edge << " on face " << face);
+  throw;
+}
+
 /// Issue #38's twist of the block: about z at 0.005 rad/mm.
 clay::deform::DeformationStack block_twist() {
   clay::deform::Twist twist;
@@ -216,11 +225,7 @@ TEST_CASE("continuity: a twist refitted face by face breaks the block's fillets,
     INFO("edge " << now.edge << ": " << now.angle_deg << " deg at t = " << now.t_angle);
     // The angle reported, against normals the test computes from points alone at that t.
     const auto& edge_uses = [&](int face) -> const clay::brep::Coedge& {
-      for (const auto& loop : twisted.faces[static_cast<size_t>(face)].loops)
-        for (const auto& co : loop.coedges)
-          if (co.edge == now.edge) return co;
-      FAIL("no coedge of edge " << now.edge << " on face " << face);
-      throw;
+      return coedge_of(twisted, face, now.edge);
     };
     const Vector3d na = normal_by_differences(twisted.faces[static_cast<size_t>(now.face_a)],
                                               edge_uses(now.face_a), now.t_angle);
@@ -260,11 +265,7 @@ TEST_CASE("continuity: faces refitted with their edges keep the twisted block's 
     ++fillet_edges;
     CHECK(now.angle_deg <= 0.016);
     const auto& edge_uses = [&](int face) -> const clay::brep::Coedge& {
-      for (const auto& loop : twisted.faces[static_cast<size_t>(face)].loops)
-        for (const auto& co : loop.coedges)
-          if (co.edge == now.edge) return co;
-      FAIL("no coedge of edge " << now.edge << " on face " << face);
-      throw;
+      return coedge_of(twisted, face, now.edge);
     };
     // along the whole edge, at points of its own, the normals from differences of points
     const auto& ca = edge_uses(now.face_a);
