@@ -557,10 +557,13 @@ TEST_CASE("example sail: key points added along the target do not wind the net u
   CHECK(miss <= 1e-3 * size);
 }
 
+// Release only ([release-only]): sanitized, the example takes 8 minutes, more than a test may; each
+// of its steps runs sanitized in its own tests (the exact style to a converged net, the rebuild,
+// the lattice's light form, the class-A export).
 TEST_CASE(
     "example fender: strokes, a constrained door cut, a snapped fill, exact flare, lattice as a "
     "certified light form, exported for a class-A receiver",
-    "[examples]") {
+    "[examples][release-only]") {
   const RunResult r = run_example("fender");
   const Json j = recipe_json("fender");
   const auto& panel = r.surface("panel");

@@ -535,7 +535,7 @@ void edit_and_save_example(const std::string& name, bool replay) {
 
 // One test per example, so a slow one shows by name. The slowest (fender, 30 s a run) is checked
 // key for key without a second run, in release builds only ([release-only]: sanitized it takes
-// 7 minutes, which the sanitized suite's own run of the example spends already).
+// 7 minutes; its steps run sanitized in their own tests).
 TEST_CASE("studio session: example bump opens, edits, saves in order and replays",
           "[studio][examples]") {
   edit_and_save_example("bump", true);
