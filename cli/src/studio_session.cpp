@@ -261,9 +261,10 @@ struct StudioSession::Impl {
   /// lattice's light form be the one product of its linear map (RunOptions).
   Run run(const std::string& recipe_text, const std::function<bool()>& cancelled,
           const std::optional<std::vector<std::string>>& changed = std::nullopt,
-          bool preview = false) const {
+          bool preview = false, const std::string& profile = "") const {
     const Recipe recipe = parse_recipe(recipe_text, base_dir, name);
     RunOptions options;
+    options.profile = profile;  // the export's receiver, for the deformed models
     if (cancelled)
       options.progress = [&](const StepReport&) {
         if (cancelled()) throw Cancelled{};
@@ -544,8 +545,8 @@ struct StudioSession::Impl {
 
   /// "export" {folder, name?, profile?}: the final surfaces as STEP, IGES and glTF
   /// (write_outputs: read back and checked), made to conform to the receiver profile (default
-  /// "opencascade"; recipe::conform_export), with the run's report and the models' files, into a
-  /// folder inside the recipe's.
+  /// "opencascade"; recipe::conform_export), with the run's report and the models' files (their
+  /// deformed faces written for the same profile), into a folder inside the recipe's.
   Reply export_files(const Json& c, const Cancel& cancelled) {
     if (!c.contains("folder") || !c.at("folder").is_string())
       throw Error(ErrorCategory::InvalidArgument,
@@ -558,7 +559,8 @@ struct StudioSession::Impl {
     const std::string profile =
         field<std::string>(c, "export", "profile", "opencascade", "a receiver profile name");
     deform::receiver_profile(profile);  // an unknown name fails before the run
-    Run run = this->run(text(), cancelled);
+    // The deformed models are written for the profile too (their faces fitted with their edges).
+    Run run = this->run(text(), cancelled, std::nullopt, false, profile);
     if (run.shown.empty() && run.result->models.empty())
       throw Error(ErrorCategory::InvalidArgument,
                   "studio: the recipe has no surface or model to export yet; build one first");

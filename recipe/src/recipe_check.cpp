@@ -333,10 +333,10 @@ std::optional<fs::path> RecipeChecker::exchange_file(const Json& f, const std::s
 }
 
 void RecipeChecker::modelling(const std::string& name, const Json& j, const std::string& path) {
-  if (!c_.object(
-          j, path,
-          {"import", "sew", "deformation", "bodies", "faces", "formats", "schema", "allow_fold"},
-          "a model {import, deformation, bodies, faces, formats, schema, sew}"))
+  if (!c_.object(j, path,
+                 {"import", "sew", "deformation", "bodies", "faces", "formats", "schema",
+                  "allow_fold", "profile"},
+                 "a model {import, deformation, bodies, faces, profile, formats, schema, sew}"))
     return;
   const std::size_t before = c_.problems.size();
   ModelDef def;
@@ -396,6 +396,16 @@ void RecipeChecker::modelling(const std::string& name, const Json& j, const std:
     c_.add(path,
            "\"bodies\" and \"faces\" choose what a deformation deforms; name one with "
            "\"deformation\"");
+  // The receiver its deformed faces are written for (deform::ModelDeformationOptions::profile).
+  if (const Json* p = c_.member(j, path, "profile", false, "")) {
+    std::vector<std::string> names;
+    for (const auto& r : deform::receiver_profiles()) names.emplace_back(r.name);
+    if (const auto k = c_.choice(*p, key_path(path, "profile"), names)) def.profile = names[*k];
+    if (def.deformation.empty())
+      c_.add(key_path(path, "profile"),
+             "a profile says how a deformed model's faces are written; a model without "
+             "\"deformation\" is written as read: name a deformation or remove \"profile\"");
+  }
   if (const Json* f = c_.member(j, path, "formats", false, ""))
     def.formats = formats(*f, key_path(path, "formats"));
   if (const Json* s = c_.member(j, path, "schema", false, ""))

@@ -209,6 +209,9 @@ struct ModelDef {
   bool allow_fold = false;  ///< deform by a lattice not proven fold-free (the solid may fold)
   std::string deformation;  ///< "" when the model is written as read
   std::vector<std::string> bodies, faces;  ///< names chosen to deform; both empty: every face
+  /// "profile": the receiver its deformed faces are written for (deform::receiver_profile's
+  /// names); "" = none (faces exact where they can be, light above the composition's budget)
+  std::string profile;
   std::vector<std::string> formats{"step", "iges", "glb"};
   std::string schema = "AP214";
 };

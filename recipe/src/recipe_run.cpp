@@ -163,7 +163,7 @@ class Runner {
   void models() {
     for (const auto& m : data_.models)
       timed(m.path, "model", [&](StepReport& rep) {
-        result_.models.push_back(run_model(data_, m));
+        result_.models.push_back(run_model(data_, m, options_.profile));
         const ModelRunResult& r = result_.models.back();
         const deform::ModelDeformationReport& x = r.report;
         rep.figures = {{"faces", static_cast<long long>(x.counts.faces)},

@@ -42,8 +42,9 @@ deform::RefitOptions light_fit(const Composition& c);
 /// The recipe's deformation stack named `deformation`, or its only one when the name is empty.
 const StackDef& pick_stack(const RecipeData& d, std::string_view deformation);
 
-/// One of the recipe's models: imported, flattened, and deformed when it names a stack.
-ModelRunResult run_model(const RecipeData& d, const ModelDef& def);
+/// One of the recipe's models: imported, flattened, and deformed when it names a stack, for
+/// `profile` (RunOptions::profile) when given, else for its own "profile", if any.
+ModelRunResult run_model(const RecipeData& d, const ModelDef& def, const std::string& profile);
 
 // ---- what an earlier run gives (RunOptions::previous; run_reuse.cpp) -------------------------
 

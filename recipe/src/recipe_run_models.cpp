@@ -195,7 +195,7 @@ std::vector<int> chosen_faces(const brep::Model& flat, const ModelDef& def) {
   return out;
 }
 
-ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
+ModelRunResult run_model(const RecipeData& d, const ModelDef& def, const std::string& profile) {
   const auto t0 = Clock::now();
   ModelRunResult out;
   out.recipe = d.name;
@@ -228,6 +228,8 @@ ModelRunResult run_model(const RecipeData& d, const ModelDef& def) {
     options.edge_gap_mm = d.composition.edge_gap_mm;
     options.edge_angle_deg = d.composition.edge_angle_deg;
     options.faces = chosen_faces(flat, def);
+    const std::string& receiver = profile.empty() ? def.profile : profile;
+    if (!receiver.empty()) options.profile = deform::receiver_profile(receiver);
     auto r = deform::deform_model(stack, flat, options);
     out.model = std::move(r.model);
     out.report = std::move(r.report);

@@ -307,6 +307,78 @@ TEST_CASE("a model's faces above the composition's budget are light and keep the
         1e-5 * exact.report.volume_after_mm3);
 }
 
+TEST_CASE("a model's \"profile\" writes its deformed faces for that receiver", "[recipe]") {
+  // block_model's "lift" (a (2, 1, 1) Bézier lattice raising the top's middle 6 mm): exact, its
+  // planes stay planes of degree 1 or 2. For a bicubic receiver every face is degree 3 x 3, and
+  // within the report's certified bound of the lattice's closed form at the original's (u, v).
+  const fs::path models = fs::path(CLAY_EXAMPLES_DIR) / "models";
+  auto text = [](const std::string& model_extra) {
+    return std::string(R"({"format": "clayform.recipe", "version": 1, "name": "profiled",
+      "deformations": {"lift": [{"kind": "bezier_lattice",
+        "frame": {"origin": [-5, -5, -5], "s": [70, 0, 0], "t": [0, 50, 0], "u": [0, 0, 30]},
+        "degrees": [2, 1, 1],
+        "moves": [{"index": [1, 0, 1], "to": [30, -5, 31]}, {"index": [1, 1, 1], "to": [30, 45, 31]}]}]},
+      "models": {"block": {"import": "block.step")") +
+           model_extra + "}}}";
+  };
+  deform::Frame f;
+  f.origin = {-5, -5, -5};
+  f.s = {70, 0, 0};
+  f.t = {0, 50, 0};
+  f.u = {0, 0, 30};
+  auto lattice = deform::make_bezier_lattice(f, {2, 1, 1});
+  lattice.points.row(lattice.index(1, 0, 1)) = Eigen::RowVector3d(30, -5, 31);
+  lattice.points.row(lattice.index(1, 1, 1)) = Eigen::RowVector3d(30, 45, 31);
+  const clay::brep::Model block =
+      clay::brep::flattened(clay::brep::read_model(models / "block.step").model);
+
+  const auto bicubic =
+      run_recipe(parse_recipe(text(R"(, "deformation": "lift", "profile": "bicubic")"), models));
+  REQUIRE(bicubic.models.size() == 1);
+  const auto& m = bicubic.models[0];
+  INFO(m.report.brief());
+  CHECK(m.report.profile == "bicubic");
+  REQUIRE(m.model.faces.size() == block.faces.size());
+  std::mt19937 rng(11);
+  double worst = 0;
+  for (std::size_t k = 0; k < m.model.faces.size(); ++k) {
+    const auto& face = m.model.faces[k].surface;
+    CHECK(face.u.degree == 3);
+    CHECK(face.v.degree == 3);
+    const auto& original = block.faces[k].surface;
+    const auto [u0, u1] = original.u.domain();
+    const auto [v0, v1] = original.v.domain();
+    std::uniform_real_distribution<double> du(u0, u1), dv(v0, v1);
+    for (int n = 0; n < 200; ++n) {
+      const double u = du(rng), v = dv(rng);
+      worst = std::max(worst, (surface::evaluate(face, u, v) -
+                               deform::deform_point(lattice, surface::evaluate(original, u, v)))
+                                  .norm());
+    }
+  }
+  CHECK(worst <= m.report.max_certified_bound_mm + 1e-9);
+
+  // RunOptions::profile (clayform run --profile) overrides the model's own: CATIA takes the exact
+  // faces as they are, so the planes keep their low degree.
+  RunOptions catia;
+  catia.profile = "catia";
+  const auto as_catia = run_recipe(
+      parse_recipe(text(R"(, "deformation": "lift", "profile": "bicubic")"), models), catia);
+  REQUIRE(as_catia.models.size() == 1);
+  CHECK(as_catia.models[0].report.profile == "catia");
+  CHECK(as_catia.models[0].report.faces_exact == 17);
+  int lowest = 25;
+  for (const auto& face : as_catia.models[0].model.faces)
+    lowest = std::min({lowest, face.surface.u.degree, face.surface.v.degree});
+  CHECK(lowest < 3);
+
+  // validate names the key and the way out
+  CHECK(mentions(check_recipe(text(R"(, "deformation": "lift", "profile": "alias")"), models),
+                 "models.block.profile", "one of exact, opencascade, catia, class_a, bicubic"));
+  CHECK(mentions(check_recipe(text(R"(, "profile": "bicubic")"), models), "models.block.profile",
+                 "name a deformation"));
+}
+
 TEST_CASE("curves: line, polyline, arc and reversed match their closed forms", "[recipe]") {
   const std::string text = R"({"format": "clayform.recipe", "version": 1,
     "curves": {

@@ -592,6 +592,27 @@ TEST_CASE("studio session: a STEP model opened whole, meshed, deformed by a latt
   REQUIRE(exported.at("op") == "exported");
   CHECK(exported.at("valid") == true);
   for (const char* f : {"block.step", "block.igs", "block.glb"}) CHECK(fs::exists(dir / "out" / f));
+  // Export for a bicubic receiver: the model's faces too (the planes were degree 1), read back
+  // from the written STEP.
+  const Json bicubic = Json::parse(
+      session.handle(R"({"op": "export", "folder": "out_bicubic", "profile": "bicubic"})").json);
+  INFO(bicubic.dump());
+  REQUIRE(bicubic.at("op") == "exported");
+  CHECK(bicubic.at("valid") == true);
+  CHECK(bicubic.at("profile") == "bicubic");
+  const auto written = clay::brep::read_model(dir / "out_bicubic" / "block.step").model;
+  int bicubic_faces = 0;
+  for (const auto& face : clay::brep::flattened(written).faces) {
+    CHECK(face.surface.u.degree == 3);
+    CHECK(face.surface.v.degree == 3);
+    ++bicubic_faces;
+  }
+  CHECK(bicubic_faces == 17);
+  int lowest = 25;
+  for (const auto& face :
+       clay::brep::flattened(clay::brep::read_model(dir / "out" / "block.step").model).faces)
+    lowest = std::min({lowest, face.surface.u.degree, face.surface.v.degree});
+  CHECK(lowest == 1);
 }
 
 namespace {

@@ -86,8 +86,9 @@ struct RunResult;
 struct RunOptions {
   /// Called after each step (progress lines); may be empty.
   std::function<void(const StepReport&)> progress;
-  /// Non-empty: every export is written for this receiver profile (deform::receiver_profile:
-  /// "exact", "opencascade", "catia", "class_a", "bicubic") instead of its own.
+  /// Non-empty: every export and every deformed model is written for this receiver profile
+  /// (deform::receiver_profile: "exact", "opencascade", "catia", "class_a", "bicubic") instead
+  /// of its own.
   std::string profile;
   /// An earlier run of this recipe whose definitions differed only in the deformations named in
   /// `changed_deformations` (the studio's lattice edits; the caller compares the texts). Every
