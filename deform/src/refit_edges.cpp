@@ -34,7 +34,9 @@ std::vector<EdgeSample> edge_samples(
   out.reserve(curves.size() * static_cast<std::size_t>(per_curve));
   for (const MatchedCurve& c : curves)
     for (int k = 0; k < per_curve; ++k) {
-      const double t = c.t0 + (c.t1 - c.t0) * k / (per_curve - 1);
+      // The last sample at t1 itself: t0 + (t1 - t0) rounds past t1 (by one step of 3.14 on a
+      // cylinder's pcurve, outside its domain), so it is the end, not the sum.
+      const double t = k == per_curve - 1 ? c.t1 : c.t0 + (c.t1 - c.t0) * k / (per_curve - 1);
       const Eigen::Vector3d uv = surface::evaluate(c.pcurve, t);
       EdgeSample s;
       s.u = std::clamp(uv.x(), u0, u1);

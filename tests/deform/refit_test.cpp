@@ -678,6 +678,41 @@ TEST_CASE("Refit's matched curves need their figures and a valid range", "[refit
                         Contains("within the pcurve's domain [0, 1]"));
 }
 
+TEST_CASE("Refit's matched curves are sampled to their ends, never past them", "[refit]") {
+  // t0 + (t1 - t0) k / (n - 1) rounds past t1 at k = n - 1 for some (t0, t1, n): a cylinder
+  // face's [pi/2, pi] with 12 samples gave pi + 4.4e-16, outside the pcurve's domain (class A,
+  // g2_block.step). Domains of 40 random ends, each face twisted and fitted with its 4 sides:
+  // every fit samples its sides and ends within the figures.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> start(-4, 4), width(0.1, 7);
+  for (int n = 0; n < 40; ++n) {
+    const double a = start(rng), b = a + width(rng);
+    surface::Points3 corners(4, 3);
+    corners << 0, 0, 0, 0, 30, 0, 40, 0, 2, 40, 30, 0;
+    const auto face = surface::make_surface({1, {a, a, b, b}}, {1, {0, 0, 1, 1}}, corners);
+    RefitOptions o;
+    o.relative_tolerance = 0;
+    o.tolerance_mm = 0.01;
+    o.matched_gap_mm = 0.001;
+    o.matched_angle_deg = 0.01;
+    auto side = [&](double u0, double v0, double u1, double v1, double t0, double t1) {
+      surface::Points3 ends(2, 3);
+      ends << u0, v0, 0, u1, v1, 0;
+      return MatchedCurve{surface::make_curve(1, {t0, t0, t1, t1}, ends), t0, t1};
+    };
+    o.matched_curves = {side(a, 0, b, 0, a, b), side(a, 1, b, 1, a, b), side(a, 0, a, 1, 0, 1),
+                        side(b, 0, b, 1, 0, 1)};
+    Twist twist;
+    twist.frame.origin = {20, 15, 0};
+    twist.angle = {0, 0.01};
+    const RefitResult r = refit_deformed(twist, face, o);
+    INFO("domain [" << a << ", " << b << "]: " << r.report.brief());
+    CHECK(r.report.summary.converged());
+    CHECK(r.report.matched_samples > 0);
+    CHECK(r.report.matched_gap_mm <= o.matched_gap_mm);
+  }
+}
+
 TEST_CASE("Refit keeps a closed side closed and a pole a point, bit for bit", "[refit]") {
   // A full revolution of a half circle: closed in u (first row == last row), both ends of the
   // profile on the axis (the columns j = 0 and j = last collapse to the poles).
