@@ -514,7 +514,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
           size, per_curve);
       result.surface = detail::least_squares_matching(
           bu, bv, us, vs, values, edge, 100.0, options.matched_gap_mm, options.matched_angle_deg,
-          detail::closed_sides(surface));
+          options.matched_curvature, size, detail::closed_sides(surface));
     } else {
       result.surface = least_squares(bu, bv, us, vs, values);
     }
@@ -747,6 +747,9 @@ std::vector<std::string> RefitOptions::problems() const {
          std::to_string(degree + 1) + ", " + std::to_string(max_count_per_direction) + "]");
   if (!(certificate_share > 0 && certificate_share < 1))
     fail("certificate_share = " + format(certificate_share) + ": must be in (0, 1), e.g. 0.1");
+  if (!(matched_curvature >= 0 && matched_curvature < 1))
+    fail("matched_curvature = " + format(matched_curvature) +
+         ": must be in [0, 1), a fraction of the normal curvature (0.002; 0: no curvature rows)");
   if (!matched_curves.empty()) {
     if (!(matched_gap_mm > 0 && std::isfinite(matched_gap_mm)) ||
         !(matched_angle_deg > 0 && matched_angle_deg < 90))

@@ -30,6 +30,15 @@ std::vector<EdgeSample> edge_samples(
     const Eigen::Vector3d e = (step / length) * w;
     return (map(x + e) - map(x - e)) * (length / (2 * step));
   };
+  // D''(x)[w, w] by a second difference along w, scaled back by |w|^2; D''[a, b] by
+  // polarization, (D''[a + b, a + b] - D''[a - b, a - b]) / 4.
+  const double step2 = 1e-3 * size;
+  auto second = [&](const Eigen::Vector3d& x, const Eigen::Vector3d& w) -> Eigen::Vector3d {
+    const double length = w.norm();
+    if (!(length > 0)) return Eigen::Vector3d::Zero();
+    const Eigen::Vector3d e = (step2 / length) * w;
+    return (map(x + e) - 2 * map(x) + map(x - e)) * (length * length / (step2 * step2));
+  };
   std::vector<EdgeSample> out;
   out.reserve(curves.size() * static_cast<std::size_t>(per_curve));
   for (const MatchedCurve& c : curves)
@@ -41,10 +50,14 @@ std::vector<EdgeSample> edge_samples(
       EdgeSample s;
       s.u = std::clamp(uv.x(), u0, u1);
       s.v = std::clamp(uv.y(), v0, v1);
-      const surface::SurfaceDerivatives d = surface::derivatives(surface, s.u, s.v, 1);
+      const surface::SurfaceDerivatives d = surface::derivatives(surface, s.u, s.v, 2);
       s.point = map(d.point);
       s.du = directional(d.point, d.du);
       s.dv = directional(d.point, d.dv);
+      s.duu = second(d.point, d.du) + directional(d.point, d.duu);
+      s.dvv = second(d.point, d.dv) + directional(d.point, d.dvv);
+      s.duv = 0.25 * (second(d.point, d.du + d.dv) - second(d.point, d.du - d.dv)) +
+              directional(d.point, d.duv);
       out.push_back(s);
     }
   return out;
@@ -54,7 +67,7 @@ surface::BSplineSurface least_squares_matching(
     const surface::BSplineBasis& bu, const surface::BSplineBasis& bv, const std::vector<double>& us,
     const std::vector<double>& vs, const surface::Points3& values,
     const std::vector<EdgeSample>& samples, double weight, double gap_mm, double angle_deg,
-    ClosedSides closed) {
+    double curvature, double size, ClosedSides closed) {
   const int nu = bu.count(), nv = bv.count();
   const Eigen::MatrixXd au = collocation(bu, us), av = collocation(bv, vs);
   const Eigen::MatrixXd gu = au.transpose() * au, gv = av.transpose() * av;
@@ -102,21 +115,39 @@ surface::BSplineSurface least_squares_matching(
   // by about the angle, so h_u = gap / (angle |(D∘S)_u|) makes both rows count as much at their
   // limits. (The span's width instead would weaken the derivative rows just where refinement
   // made spans short: a cylinder's joins kept missing the angle at 32 spans.)
+  // With `curvature`: three more rows, the second derivatives, each in units of its allowance
+  // curvature x k x |(D∘S)_a| |(D∘S)_b|, k the larger normal curvature of D∘S along u and v
+  // (at least 1 / size): an error e in (D∘S)_uu changes the normal curvature along u by at most
+  // e / |(D∘S)_u|^2, so at its allowance by that fraction of k. Two faces fitted so meet with
+  // their curvatures within twice the fraction where the exact result is G2.
   const double angle = angle_deg * std::numbers::pi / 180;
   const int pu = bu.degree, pv = bv.degree;
   const int local = (pu + 1) * (pv + 1);
-  std::vector<double> du(static_cast<std::size_t>(2 * (pu + 1))),
-      dv(static_cast<std::size_t>(2 * (pv + 1)));
-  Eigen::MatrixXd rows(3, local);
-  Eigen::MatrixXd targets(3, 3);
+  const int order = curvature > 0 ? 2 : 1, count = curvature > 0 ? 6 : 3;
+  std::vector<double> du(static_cast<std::size_t>((order + 1) * (pu + 1))),
+      dv(static_cast<std::size_t>((order + 1) * (pv + 1)));
+  Eigen::MatrixXd rows(count, local);
+  Eigen::MatrixXd targets(count, 3);
   const double w2 = weight * weight;
   for (const EdgeSample& s : samples) {
     const int su = surface::find_span(bu, s.u), sv = surface::find_span(bv, s.v);
-    surface::basis_derivatives(bu, su, s.u, 1, du);
-    surface::basis_derivatives(bv, sv, s.v, 1, dv);
+    surface::basis_derivatives(bu, su, s.u, order, du);
+    surface::basis_derivatives(bv, sv, s.v, order, dv);
     const double speed_u = s.du.norm(), speed_v = s.dv.norm();
     const double hu = speed_u > 0 ? gap_mm / (angle * speed_u) : 0;
     const double hv = speed_v > 0 ? gap_mm / (angle * speed_v) : 0;
+    double huu = 0, huv = 0, hvv = 0;
+    if (curvature > 0 && speed_u > 0 && speed_v > 0) {
+      const Eigen::Vector3d normal = s.du.cross(s.dv);
+      if (normal.norm() > 1e-12 * speed_u * speed_v) {
+        const Eigen::Vector3d unit = normal.normalized();
+        const double k = std::max({std::abs(s.duu.dot(unit)) / (speed_u * speed_u),
+                                   std::abs(s.dvv.dot(unit)) / (speed_v * speed_v), 1 / size});
+        huu = gap_mm / (curvature * k * speed_u * speed_u);
+        huv = gap_mm / (curvature * k * speed_u * speed_v);
+        hvv = gap_mm / (curvature * k * speed_v * speed_v);
+      }
+    }
     for (int a = 0; a <= pu; ++a)
       for (int b = 0; b <= pv; ++b) {
         const auto ua = static_cast<std::size_t>(a), vb = static_cast<std::size_t>(b);
@@ -126,10 +157,22 @@ surface::BSplineSurface least_squares_matching(
         rows(0, col) = du[ua] * dv[vb];
         rows(1, col) = hu * du[up] * dv[vb];
         rows(2, col) = hv * du[ua] * dv[vp];
+        if (count == 6) {
+          const auto upp = static_cast<std::size_t>(2 * (pu + 1) + a),
+                     vpp = static_cast<std::size_t>(2 * (pv + 1) + b);
+          rows(3, col) = huu * du[upp] * dv[vb];
+          rows(4, col) = huv * du[up] * dv[vp];
+          rows(5, col) = hvv * du[ua] * dv[vpp];
+        }
       }
     targets.row(0) = s.point.transpose();
     targets.row(1) = hu * s.du.transpose();
     targets.row(2) = hv * s.dv.transpose();
+    if (count == 6) {
+      targets.row(3) = huu * s.duu.transpose();
+      targets.row(4) = huv * s.duv.transpose();
+      targets.row(5) = hvv * s.dvv.transpose();
+    }
     const Eigen::MatrixXd block = w2 * rows.transpose() * rows;
     const Eigen::MatrixXd pulled = w2 * rows.transpose() * targets;
     for (int a = 0; a < local; ++a) {

@@ -19,11 +19,15 @@ namespace clay::deform::detail {
 struct EdgeSample {
   double u = 0, v = 0;
   Eigen::Vector3d point, du, dv;
+  Eigen::Vector3d duu, duv, dvv;  ///< second partial derivatives (the curvature rows)
 };
 
 /// `per_curve` samples of each curve (t uniform in [t0, t1], ends included), (u, v) clamped to
 /// the surface's domain. The derivatives are D'(S) S_u and D'(S) S_v, D' by central differences
-/// of `map` in space over 1e-5 of `size` (an O(1e-10) relative error for a smooth map).
+/// of `map` in space over 1e-5 of `size` (an O(1e-10) relative error for a smooth map); the
+/// second ones D''(S)[S_a, S_b] + D'(S) S_ab, D'' by second differences over 1e-3 of `size`
+/// (D''[a, b] by polarization), all in space: an edge lies on the domain's border, where
+/// differences in (u, v) would leave it.
 std::vector<EdgeSample> edge_samples(
     const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve);
@@ -31,7 +35,9 @@ std::vector<EdgeSample> edge_samples(
 /// The net on bu x bv minimising Σ_grid |fit − values|² + w² Σ_samples (|fit − D∘S|² +
 /// h_u² |fit_u − (D∘S)_u|² + h_v² |fit_v − (D∘S)_v|²), h_u = gap_mm / (angle |(D∘S)_u|) (each
 /// row in units of its allowance, the angle in radians; 0 where D∘S's derivative vanishes): the
-/// grid's normal equations are (A_u^T A_u) ⊗ (A_v^T A_v), banded, and the
+/// grid's normal equations are (A_u^T A_u) ⊗ (A_v^T A_v), banded. With `curvature` > 0 the
+/// second derivatives are rows too, in units of an allowance of that fraction of the normal
+/// curvature (G2 edges keep their curvature; see the .cpp). The
 /// samples add small blocks, so the system is sparse (Cholesky, LDL^T). A closed side's first
 /// and last rows are one unknown (copying one onto the other after the fit would move the last
 /// row by the two fits' difference, which a short end span turns into a normal angle).
@@ -39,7 +45,7 @@ surface::BSplineSurface least_squares_matching(
     const surface::BSplineBasis& bu, const surface::BSplineBasis& bv, const std::vector<double>& us,
     const std::vector<double>& vs, const surface::Points3& values,
     const std::vector<EdgeSample>& samples, double weight, double gap_mm, double angle_deg,
-    ClosedSides closed = {});
+    double curvature, double size, ClosedSides closed = {});
 
 /// The fit's distance from D∘S and angle between the normals at one sample.
 struct EdgeMiss {

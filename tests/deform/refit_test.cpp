@@ -676,6 +676,11 @@ TEST_CASE("Refit's matched curves need their figures and a valid range", "[refit
   const auto range = error_of([&] { refit_deformed(Twist{}, s, o); }).second;
   CHECK_THAT(range, Contains("matched_curves[0]: t0 = 0, t1 = 2") &&
                         Contains("within the pcurve's domain [0, 1]"));
+  o.matched_curves[0].t1 = 1;
+  o.matched_curvature = -0.1;
+  const auto curvature = error_of([&] { refit_deformed(Twist{}, s, o); });
+  CHECK(curvature.first == ErrorCategory::InvalidArgument);
+  CHECK_THAT(curvature.second, Contains("matched_curvature = -0.1") && Contains("[0, 1)"));
 }
 
 TEST_CASE("Refit's matched curves are sampled to their ends, never past them", "[refit]") {

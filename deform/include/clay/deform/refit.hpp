@@ -95,6 +95,10 @@ struct CLAY_DEFORM_API RefitOptions {
   std::vector<MatchedCurve> matched_curves;
   double matched_gap_mm = 0;     ///< > 0 with matched_curves: largest distance along them (mm)
   double matched_angle_deg = 0;  ///< > 0 with matched_curves: largest normal angle along them
+  /// With matched_curves: D∘S's second derivatives along them are rows too, each allowed this
+  /// fraction of the larger normal curvature there (at least 1 / size), so that edges where the
+  /// exact result is G2 keep their curvature; 0: position and normals only.
+  double matched_curvature = 0.002;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
