@@ -244,10 +244,23 @@ double size_of(const brep::Model& m) {
   return m.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
 }
 
+/// What a refit keeps along each edge (MatchedCurve::order), from the source's own figures: the
+/// curvature where it is G2 (relative jump <= 5 %), the normal where it is tangent (<= 1 deg: an
+/// exporter's tangent edge is rarely tangent to 1e-3 deg), else the position (sharp, or used by
+/// one face only).
+std::vector<int> edge_orders(const brep::Model& m, const brep::ContinuityReport& before) {
+  std::vector<int> out(m.edges.size(), 0);
+  for (const brep::EdgeContinuity& e : before.edges)
+    out[static_cast<std::size_t>(e.edge)] =
+        e.angle_deg <= 1 ? (e.relative_curvature_jump <= 0.05 ? 2 : 1) : 0;
+  return out;
+}
+
 /// The face's edges as curves on its surface, for a refit that follows them (none when
-/// ModelDeformationOptions turns that off). Each pcurve's part on its edge, [t0, t1] clamped to
-/// the pcurve's own domain; poles are left out.
+/// ModelDeformationOptions turns that off), each with its edge's order (edge_orders). Each
+/// pcurve's part on its edge, [t0, t1] clamped to the pcurve's own domain; poles are left out.
 std::vector<MatchedCurve> matched_edges(const brep::Model& m, const brep::Face& face,
+                                        const std::vector<int>& orders,
                                         const ModelDeformationOptions& options) {
   std::vector<MatchedCurve> out;
   if (options.edge_gap_mm == 0) return out;
@@ -257,7 +270,7 @@ std::vector<MatchedCurve> matched_edges(const brep::Model& m, const brep::Face& 
       if (edge.degenerate) continue;
       const auto [a, b] = co.pcurve.basis.domain();
       const double t0 = std::max(edge.t0, a), t1 = std::min(edge.t1, b);
-      if (t0 < t1) out.push_back({co.pcurve, t0, t1});
+      if (t0 < t1) out.push_back({co.pcurve, t0, t1, orders[static_cast<std::size_t>(co.edge)]});
     }
   return out;
 }
@@ -321,6 +334,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   m = brep::flattened(input);
   ModelDeformationReport& report = result.report;
   report.continuity_before = brep::edge_continuity(m);
+  const std::vector<int> orders = edge_orders(m, report.continuity_before);
   if (options.profile) report.profile = std::string(options.profile->name);
   const std::vector<double> before = brep::body_volumes_mm3(m);
   for (std::size_t b = 0; b < m.bodies.size(); ++b)
@@ -359,7 +373,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       } else {
         // Refitted in place, following its edges, which stay where they are.
         faces[f] = deform_one(nullptr, face.surface, options, face_name(m, f),
-                              matched_edges(m, face, options));
+                              matched_edges(m, face, orders, options));
         face.elementary.reset();
         ++report.faces_refit;
         report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, faces[f].bound);
@@ -371,8 +385,8 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       }
       continue;
     }
-    faces[f] =
-        deform_one(&stack, face.surface, options, face_name(m, f), matched_edges(m, face, options));
+    faces[f] = deform_one(&stack, face.surface, options, face_name(m, f),
+                          matched_edges(m, face, orders, options));
     face.elementary.reset();  // no longer a plane, cylinder, ...: only untouched faces keep it
     (faces[f].way == Outcome::Way::Exact ? report.faces_exact : report.faces_refit) += 1;
     report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, faces[f].bound);

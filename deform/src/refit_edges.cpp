@@ -17,6 +17,129 @@
 
 namespace clay::deform::detail {
 
+namespace {
+
+// The tie of the sides a = a0 and a = a1 of `s` (a = u when `along_u`): see seam_ties.
+SeamTie side_tie(const surface::BSplineSurface& s, bool along_u) {
+  SeamTie tie;
+  tie.order = 0;
+  const auto [a0, a1] = along_u ? s.u.domain() : s.v.domain();
+  const std::vector<double> across = surface::span_samples(along_u ? s.v : s.u, 4);
+  struct End {
+    Eigen::Vector3d d1, d2;
+  };
+  std::vector<End> near, far;
+  for (const double t : across) {
+    const surface::SurfaceDerivatives n =
+        along_u ? surface::derivatives(s, a0, t, 2) : surface::derivatives(s, t, a0, 2);
+    const surface::SurfaceDerivatives f =
+        along_u ? surface::derivatives(s, a1, t, 2) : surface::derivatives(s, t, a1, 2);
+    near.push_back(along_u ? End{n.du, n.duu} : End{n.dv, n.dvv});
+    far.push_back(along_u ? End{f.du, f.duu} : End{f.dv, f.dvv});
+  }
+  // r from the fastest sample (a pole's samples have no speed), then every sample checked
+  std::size_t fastest = 0;
+  for (std::size_t k = 0; k < near.size(); ++k)
+    if (near[k].d1.norm() > near[fastest].d1.norm()) fastest = k;
+  const double speed = near[fastest].d1.norm();
+  if (!(speed > 0)) return tie;
+  const double r = far[fastest].d1.norm() / speed;
+  const double scale1 = std::max(speed * r, far[fastest].d1.norm());
+  for (std::size_t k = 0; k < near.size(); ++k)
+    if ((far[k].d1 - r * near[k].d1).norm() > 1e-9 * scale1) return tie;
+  tie.order = 1, tie.ratio = r;
+  // t by least squares over the samples, then every sample checked
+  double along = 0, squared = 0, scale2 = scale1 * scale1 / std::max(speed, 1e-300) * 1e-6;
+  for (std::size_t k = 0; k < near.size(); ++k) {
+    along += (far[k].d2 - r * r * near[k].d2).dot(near[k].d1);
+    squared += near[k].d1.squaredNorm();
+    scale2 = std::max({scale2, far[k].d2.norm(), r * r * near[k].d2.norm()});
+  }
+  const double t = along / squared;
+  for (std::size_t k = 0; k < near.size(); ++k)
+    if ((far[k].d2 - r * r * near[k].d2 - t * near[k].d1).norm() > 1e-9 * scale2) return tie;
+  tie.order = 2, tie.tangential = t;
+  return tie;
+}
+
+// A fit direction's control points as combinations of its unknowns: rows[i] lists (unknown,
+// coefficient); the last order + 1 rows of a tied side combine the first order + 1.
+struct DirectionTie {
+  int unknowns = 0;
+  std::vector<std::vector<std::pair<int, double>>> rows;
+};
+
+DirectionTie direction_tie(const surface::BSplineBasis& b, SeamTie tie) {
+  const int n = b.count(), p = b.degree;
+  // the tie this basis holds: derivatives up to p - 1 across, and the two ends' rows apart
+  int order = std::min(tie.order, p - 1);
+  while (order >= 0 && n <= 2 * order + 1) --order;
+  DirectionTie out;
+  out.unknowns = n - (order + 1);
+  out.rows.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < out.unknowns; ++i) out.rows[static_cast<std::size_t>(i)] = {{i, 1.0}};
+  if (order < 0) return out;
+  const auto [a0, a1] = b.domain();
+  const auto width = static_cast<std::size_t>(p + 1);
+  std::vector<double> first((order + 1) * width), last((order + 1) * width);
+  surface::basis_derivatives(b, surface::find_span(b, a0), a0, order, first);
+  surface::basis_derivatives(b, surface::find_span(b, a1), a1, order, last);
+  // the near end's m-th derivative on the first m + 1 points, the far end's on the last m + 1
+  // (clamped ends): far_m = r^m near_m (+ t near_1 for m = 2), solved for point n - 1 - m.
+  std::vector<std::vector<double>> combination;  // over unknowns 0..order
+  for (int m = 0; m <= order; ++m) {
+    std::vector<double> c(static_cast<std::size_t>(order + 1), 0.0);
+    const double rm = std::pow(tie.ratio, m);
+    for (int a = 0; a <= m; ++a) c[static_cast<std::size_t>(a)] += rm * first[m * width + a];
+    if (m == 2)
+      for (int a = 0; a <= 1; ++a)
+        c[static_cast<std::size_t>(a)] += tie.tangential * first[width + a];
+    for (int j = 0; j < m; ++j) {
+      const double beta = last[m * width + static_cast<std::size_t>(p - j)];
+      for (int a = 0; a <= order; ++a)
+        c[static_cast<std::size_t>(a)] -= beta * combination[static_cast<std::size_t>(j)][a];
+    }
+    const double pivot = last[m * width + static_cast<std::size_t>(p - m)];
+    for (double& x : c) x /= pivot;
+    combination.push_back(c);
+    auto& row = out.rows[static_cast<std::size_t>(n - 1 - m)];
+    for (int a = 0; a <= order; ++a)
+      if (c[static_cast<std::size_t>(a)] != 0) row.emplace_back(a, c[static_cast<std::size_t>(a)]);
+  }
+  return out;
+}
+
+}  // namespace
+
+SeamTies seam_ties(const surface::BSplineSurface& source, ClosedSides closed) {
+  SeamTies out;
+  if (closed.u) out.u = side_tie(source, true);
+  if (closed.v) out.v = side_tie(source, false);
+  return out;
+}
+
+void mark_seams(std::vector<EdgeSample>& samples, int per_curve,
+                const surface::BSplineSurface& surface, SeamTies ties) {
+  const auto [u0, u1] = surface.u.domain();
+  const auto [v0, v1] = surface.v.domain();
+  const double eu = 1e-9 * (u1 - u0), ev = 1e-9 * (v1 - v0);  // a pcurve's rounding
+  const auto per = static_cast<std::size_t>(per_curve);
+  for (std::size_t start = 0; start + per <= samples.size(); start += per) {
+    auto all = [&](auto on) {
+      for (std::size_t k = start; k < start + per; ++k)
+        if (!on(samples[k])) return false;
+      return true;
+    };
+    const bool seam =
+        (ties.u.order >= 1 &&
+         (all([&](const EdgeSample& s) { return std::abs(s.u - u0) <= eu; }) ||
+          all([&](const EdgeSample& s) { return std::abs(s.u - u1) <= eu; }))) ||
+        (ties.v.order >= 1 && (all([&](const EdgeSample& s) { return std::abs(s.v - v0) <= ev; }) ||
+                               all([&](const EdgeSample& s) { return std::abs(s.v - v1) <= ev; })));
+    for (std::size_t k = start; k < start + per; ++k) samples[k].seam = seam;
+  }
+}
+
 std::vector<EdgeSample> edge_samples(
     const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
     const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve) {
@@ -47,7 +170,11 @@ std::vector<EdgeSample> edge_samples(
       // cylinder's pcurve, outside its domain), so it is the end, not the sum.
       const double t = k == per_curve - 1 ? c.t1 : c.t0 + (c.t1 - c.t0) * k / (per_curve - 1);
       const Eigen::Vector3d uv = surface::evaluate(c.pcurve, t);
+      const Eigen::Vector3d tangent = surface::derivatives(c.pcurve, t, 1).d1;
       EdgeSample s;
+      s.order = c.order;
+      s.along_u = std::abs(tangent.x()) / (u1 - u0);
+      s.along_v = std::abs(tangent.y()) / (v1 - v0);
       s.u = std::clamp(uv.x(), u0, u1);
       s.v = std::clamp(uv.y(), v0, v1);
       const surface::SurfaceDerivatives d = surface::derivatives(surface, s.u, s.v, 2);
@@ -67,22 +194,17 @@ surface::BSplineSurface least_squares_matching(
     const surface::BSplineBasis& bu, const surface::BSplineBasis& bv, const std::vector<double>& us,
     const std::vector<double>& vs, const surface::Points3& values,
     const std::vector<EdgeSample>& samples, double weight, double gap_mm, double angle_deg,
-    double curvature, double size, ClosedSides closed) {
+    double curvature, double size, SeamTies ties) {
   const int nu = bu.count(), nv = bv.count();
   const Eigen::MatrixXd au = collocation(bu, us), av = collocation(bv, vs);
   const Eigen::MatrixXd gu = au.transpose() * au, gv = av.transpose() * av;
-  // The unknowns: one per control point, a closed side's last row folded onto its first.
-  std::vector<Eigen::Index> unknown(static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv));
-  Eigen::Index n = 0;
-  for (int i = 0; i < nu; ++i)
-    for (int j = 0; j < nv; ++j) {
-      const int fi = closed.u && i == nu - 1 ? 0 : i, fj = closed.v && j == nv - 1 ? 0 : j;
-      unknown[static_cast<std::size_t>(i * nv + j)] =
-          fi == i && fj == j ? n++ : unknown[static_cast<std::size_t>(fi * nv + fj)];
-    }
-  auto index = [&](Eigen::Index i, Eigen::Index j) {
-    return unknown[static_cast<std::size_t>(i * nv + j)];
-  };
+  // The system is assembled on every control point, index i nv + j, then reduced to the
+  // unknowns: control points = T x unknowns, T = T_u ⊗ T_v (identity but for a tied side's last
+  // rows), so the normal equations become T^T N T.
+  const DirectionTie tu = direction_tie(bu, ties.u), tv = direction_tie(bv, ties.v);
+  const bool tied = tu.unknowns < nu || tv.unknowns < nv;
+  const Eigen::Index n = static_cast<Eigen::Index>(nu) * nv;
+  auto index = [&](Eigen::Index i, Eigen::Index j) { return i * nv + j; };
 
   // The grid: (A_u^T A_u) ⊗ (A_v^T A_v), both banded.
   std::vector<Eigen::Triplet<double>> entries;
@@ -134,10 +256,11 @@ surface::BSplineSurface least_squares_matching(
     surface::basis_derivatives(bu, su, s.u, order, du);
     surface::basis_derivatives(bv, sv, s.v, order, dv);
     const double speed_u = s.du.norm(), speed_v = s.dv.norm();
-    const double hu = speed_u > 0 ? gap_mm / (angle * speed_u) : 0;
-    const double hv = speed_v > 0 ? gap_mm / (angle * speed_v) : 0;
+    // a sharp edge's sample: its position only; a tangent edge's: no curvature
+    const double hu = speed_u > 0 && s.order >= 1 ? gap_mm / (angle * speed_u) : 0;
+    const double hv = speed_v > 0 && s.order >= 1 ? gap_mm / (angle * speed_v) : 0;
     double huu = 0, huv = 0, hvv = 0;
-    if (curvature > 0 && speed_u > 0 && speed_v > 0) {
+    if (curvature > 0 && s.order >= 2 && speed_u > 0 && speed_v > 0) {
       const Eigen::Vector3d normal = s.du.cross(s.dv);
       if (normal.norm() > 1e-12 * speed_u * speed_v) {
         const Eigen::Vector3d unit = normal.normalized();
@@ -185,15 +308,27 @@ surface::BSplineSurface least_squares_matching(
   }
   Eigen::SparseMatrix<double> normal(n, n);
   normal.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseMatrix<double> t;
+  if (tied) {
+    std::vector<Eigen::Triplet<double>> kron;
+    for (int i = 0; i < nu; ++i)
+      for (int j = 0; j < nv; ++j)
+        for (const auto& [a, ca] : tu.rows[static_cast<std::size_t>(i)])
+          for (const auto& [b, cb] : tv.rows[static_cast<std::size_t>(j)])
+            kron.emplace_back(index(i, j), static_cast<Eigen::Index>(a) * tv.unknowns + b, ca * cb);
+    t.resize(n, static_cast<Eigen::Index>(tu.unknowns) * tv.unknowns);
+    t.setFromTriplets(kron.begin(), kron.end());
+    const Eigen::SparseMatrix<double> tt = t.transpose();
+    normal = tt * normal * t;
+    rhs = tt * rhs;
+  }
   const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
   if (solver.info() != Eigen::Success)
     throw Error(ErrorCategory::Internal,
                 "refit_deformed: the least squares with matched curves is singular (" +
                     std::to_string(nu) + " x " + std::to_string(nv) + " control points)");
   const Eigen::MatrixXd solved = solver.solve(rhs);
-  surface::Points3 net(static_cast<Eigen::Index>(nu) * nv, 3);
-  for (Eigen::Index i = 0; i < nu; ++i)
-    for (Eigen::Index j = 0; j < nv; ++j) net.row(i * nv + j) = solved.row(index(i, j));
+  surface::Points3 net = tied ? surface::Points3(t * solved) : surface::Points3(solved);
   return surface::make_surface(bu, bv, std::move(net));
 }
 

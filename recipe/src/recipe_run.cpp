@@ -225,7 +225,9 @@ class Runner {
   /// (deform::refit_surface), into at most the composition's max_control_points.
   BSplineSurface light_copy(const BSplineSurface& s, const Composition& c, const std::string& name,
                             StepReport& rep) {
-    const deform::RefitResult r = deform::refit_surface(s, light_fit(c));
+    deform::RefitOptions fit = light_fit(c);
+    follow_shared(fit, shared_, c);
+    const deform::RefitResult r = deform::refit_surface(s, fit);
     const auto& f = r.report;
     rep.figures = {{"exact_degree_u", static_cast<long long>(s.u.degree)},
                    {"exact_degree_v", static_cast<long long>(s.v.degree)},
@@ -332,6 +334,9 @@ class Runner {
   double ledger_ = 0;
   std::map<std::string, bool> affected_;  // by surface name: needs what changed
   bool previewing_ = false;               // the surface being deformed has a previewed step
+  // The sides the surface being deformed shares with the recipe's other surfaces: its light
+  // forms and refits follow them (issue #38 step 3, surfaces built to meet).
+  std::vector<deform::MatchedCurve> shared_;
 
   template <class F>
   void timed(const std::string& path, const std::string& kind, F&& f) {
@@ -585,8 +590,10 @@ class Runner {
       const StackDef& stack =
           *std::find_if(data_.stacks.begin(), data_.stacks.end(),
                         [&](const StackDef& s) { return s.name == d->deformation; });
+      shared_ = shared_sides(surface_of(d->surface), result_.surfaces, d->composition);
       BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name,
                                 !built_on(data_, def.name), bound_of(d->surface));
+      shared_.clear();
       result_.surfaces.emplace_back(def.name, std::move(s));
       return;
     }
@@ -708,11 +715,7 @@ class Runner {
               BSplineSurface m =
                   surface::mirrored(surface_of(b.surface), b.plane.origin, b.plane.normal);
               bound_of_[def.name] = bound_of(b.surface);  // an isometry keeps the bound
-              build_figures(surface::describe(m,
-                                              "mirror of "
-                                              " + b.surface + "
-                                              ""),
-                            rep);
+              build_figures(surface::describe(m, "mirror of '" + b.surface + "'"), rep);
               return m;
             } else {
               throw Error(ErrorCategory::Internal, "recipe run: deform handled above");
@@ -724,25 +727,12 @@ class Runner {
   }
 
   // ---- deformation steps --------------------------------------------------------------------
-  static void lattice_figures(const deform::Deformation& d, StepReport& rep) {
-    std::optional<deform::JacobianBounds> j;
-    if (const auto* b = std::get_if<deform::BezierLattice>(&d)) j = deform::jacobian_bounds(*b);
-    if (const auto* b = std::get_if<deform::BSplineLattice>(&d)) j = deform::jacobian_bounds(*b);
-    if (!j) return;
-    rep.figures.emplace_back("fold_free", j->fold_free);
-    rep.figures.emplace_back("volume_ratio_min", j->min);
-    rep.figures.emplace_back("volume_ratio_max", j->max);
-    if (!j->fold_free) {
-      rep.warning = true;
-      rep.message +=
-          "; the lattice may fold (Jacobian coefficient " + format("%.3g", j->min) + " <= 0)";
-    }
-  }
-
   BSplineSurface compose(const deform::Deformation& d, const BSplineSurface& s,
                          const Composition& c, StepReport& rep) {
     deform::SurfaceDeformationOptions options = deformation_options(c);
     options.input_bound_mm = ledger_;
+    if (options.refit) follow_shared(*options.refit, shared_, c);
+    if (options.budget) follow_shared(options.budget->light, shared_, c);
     const auto r = deform::deform_surface(d, s, options);
     const auto& o = r.report.steps.front();
     ledger_ = r.report.accumulated_bound_mm;

@@ -38,6 +38,20 @@ deform::RefitOptions fit_keeping_breakpoints(const Composition& c);
 /// The light form's fit of a composition: its degree and tolerance, from the input's rough
 /// breakpoints (deform::Budget::light_fit), within the budget's and max_control_points' nets.
 deform::RefitOptions light_fit(const Composition& c);
+/// The sides `parent` shares with `surfaces` (deform::shared_boundaries, within 1e-9 of its
+/// size), when a fit may be made of it (a refit or a budget) and the composition matches edges
+/// ("edges" not "none"): each surface is fitted alone, so two built to meet (fills on one
+/// boundary curve, mirrored halves) keep meeting only if both follow their shared sides.
+std::vector<deform::MatchedCurve> shared_sides(
+    const surface::BSplineSurface& parent,
+    const std::vector<std::pair<std::string, surface::BSplineSurface>>& surfaces,
+    const Composition& c);
+/// `o` following `shared` within the composition's edge figures (nothing when it is empty).
+void follow_shared(deform::RefitOptions& o, const std::vector<deform::MatchedCurve>& shared,
+                   const Composition& c);
+/// A lattice step's figures: fold_free and the Jacobian's volume ratio bounds, and a warning
+/// when it may fold.
+void lattice_figures(const deform::Deformation& d, StepReport& rep);
 
 /// The recipe's deformation stack named `deformation`, or its only one when the name is empty.
 const StackDef& pick_stack(const RecipeData& d, std::string_view deformation);

@@ -8,6 +8,7 @@
 #include <clay/constraints/solve.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/model_deformation.hpp>
+#include <clay/deform/refit.hpp>
 #include <clay/deform/surface_deformation.hpp>
 #include <clay/error.hpp>
 #include <clay/occt/model_exchange.hpp>
@@ -49,6 +50,42 @@ deform::RefitOptions fit_keeping_breakpoints(const Composition& c) {
   r.tolerance_mm = c.tolerance_mm;
   r.max_control_points = c.max_control_points;
   return r;
+}
+
+std::vector<deform::MatchedCurve> shared_sides(
+    const surface::BSplineSurface& parent,
+    const std::vector<std::pair<std::string, surface::BSplineSurface>>& surfaces,
+    const Composition& c) {
+  if (!(c.refit || c.budget) || !(c.edge_gap_mm > 0)) return {};
+  std::vector<const surface::BSplineSurface*> others;
+  for (const auto& [n, s] : surfaces) others.push_back(&s);
+  // built to meet: one boundary curve, or a mirror's rounding (1e-9 of the size)
+  const Eigen::Vector3d lo = parent.points.colwise().minCoeff().transpose();
+  const Eigen::Vector3d hi = parent.points.colwise().maxCoeff().transpose();
+  return deform::shared_boundaries(parent, others, std::max(1e-9 * (hi - lo).norm(), 1e-12));
+}
+
+void follow_shared(deform::RefitOptions& o, const std::vector<deform::MatchedCurve>& shared,
+                   const Composition& c) {
+  if (shared.empty()) return;
+  o.matched_curves = shared;
+  o.matched_gap_mm = c.edge_gap_mm;
+  o.matched_angle_deg = c.edge_angle_deg;
+}
+
+void lattice_figures(const deform::Deformation& d, StepReport& rep) {
+  std::optional<deform::JacobianBounds> j;
+  if (const auto* b = std::get_if<deform::BezierLattice>(&d)) j = deform::jacobian_bounds(*b);
+  if (const auto* b = std::get_if<deform::BSplineLattice>(&d)) j = deform::jacobian_bounds(*b);
+  if (!j) return;
+  rep.figures.emplace_back("fold_free", j->fold_free);
+  rep.figures.emplace_back("volume_ratio_min", j->min);
+  rep.figures.emplace_back("volume_ratio_max", j->max);
+  if (!j->fold_free) {
+    rep.warning = true;
+    rep.message +=
+        "; the lattice may fold (Jacobian coefficient " + format("%.3g", j->min) + " <= 0)";
+  }
 }
 
 deform::RefitOptions light_fit(const Composition& c) {

@@ -53,7 +53,10 @@ struct CLAY_DEFORM_API ModelDeformationOptions {
   /// result's faces meet: a fillet's tangent edge stays tangent. The defaults are half the
   /// class-A fillet figures (0.001 mm, 0.016 deg). Both 0: faces fitted to their tolerance
   /// alone (each edge opens by however much its faces' fits wander). Sampled along the edges,
-  /// not certified; the edges' curves are refitted within edge_gap_mm too.
+  /// not certified; the edges' curves are refitted within edge_gap_mm too. What an edge keeps
+  /// follows the source (MatchedCurve::order): the angle where it is tangent within 1 deg, the
+  /// curvature too where its relative curvature jump is <= 5 %, the position alone where it is
+  /// sharp; a seam is tied (continuous across as the source is).
   double edge_gap_mm = 0.0005;
   double edge_angle_deg = 0.008;  ///< see edge_gap_mm
   /// The receiver the model is written for (receiver.hpp; empty: none, max_degree alone). A face

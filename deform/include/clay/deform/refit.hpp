@@ -46,6 +46,9 @@ namespace clay::deform {
 struct MatchedCurve {
   surface::BSplineCurve pcurve;
   double t0 = 0, t1 = 0;  ///< the part of the pcurve on the surface's edge, t0 < t1
+  /// What the fit keeps along it: 0 the position (a sharp edge: its faces' angle there is not
+  /// continuity), 1 also the normal (a tangent edge), 2 also the curvature (a G2 edge).
+  int order = 2;
 };
 
 /// Settings of refit_deformed().
@@ -92,6 +95,8 @@ struct CLAY_DEFORM_API RefitOptions {
   /// matched_angle_deg of D∘S's. Two faces fitted so along their shared edge then meet within
   /// twice these figures, wherever the exact result's faces meet (a tangent edge stays tangent).
   /// Sampled, not certified (the certificate still bounds the whole surface by the tolerance).
+  /// A closed side's seam (the face meets itself) is tied instead: the fit keeps the source's
+  /// own continuity across it (up to G2) exactly, and its samples only weigh in the fit.
   std::vector<MatchedCurve> matched_curves;
   double matched_gap_mm = 0;     ///< > 0 with matched_curves: largest distance along them (mm)
   double matched_angle_deg = 0;  ///< > 0 with matched_curves: largest normal angle along them
@@ -138,7 +143,7 @@ struct CLAY_DEFORM_API RefitReport {
   int lipschitz_cells = 0;  ///< cells bounded by first derivatives only (D not C1 there)
   std::vector<KnotPlaneCrossing> crossings;  ///< every lattice plane crossing of the final fit
   /// With RefitOptions::matched_curves: the largest distance from D∘S (mm) and the largest angle
-  /// between the normals (deg) at their samples; 0 without.
+  /// between the normals (deg) at their samples (a tied seam's left out); 0 without.
   double matched_gap_mm = 0, matched_angle_deg = 0;
   long matched_samples = 0;  ///< samples along the matched curves
 
@@ -187,5 +192,17 @@ using SpaceMap = std::variant<Deformation, DeformationStack, PointMap>;
 CLAY_DEFORM_API RefitResult refit_deformed(const SpaceMap& map,
                                            const surface::BSplineSurface& surface,
                                            const RefitOptions& options = {});
+
+/// The sides of `surface` (its iso-curves u = u0, u = u1, v = v0, v = v1; poles left out) that
+/// lie on a side of one of `neighbours` (9 points each within `tolerance_mm` of it), as matched
+/// curves for a refit of `surface`: surfaces built to meet (fills sharing a boundary curve, a
+/// loft's neighbours, mirrored halves) then keep meeting when each is refitted alone (issue #38
+/// step 3). Order 0 (the position) where the two meet at more than 1 deg somewhere along the side
+/// (a crease), else 2 (normal and curvature: a tangent or G2 join stays so). Normals are compared
+/// up to orientation. Throws clay::Error(InvalidArgument) for a tolerance that is not > 0 and
+/// finite, InvalidGeometry for an invalid surface.
+CLAY_DEFORM_API std::vector<MatchedCurve> shared_boundaries(
+    const surface::BSplineSurface& surface,
+    const std::vector<const surface::BSplineSurface*>& neighbours, double tolerance_mm);
 
 }  // namespace clay::deform
