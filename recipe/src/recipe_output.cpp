@@ -272,37 +272,6 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
 namespace {
 
 /// A model run's figures: its topology and what the deformation did (report.json "model").
-/// How the faces meet, before and after, per shared edge (docs/recipe.md "Outputs").
-Json continuity_json(const brep::ContinuityReport& before, const brep::ContinuityReport& after) {
-  Json j = Json::object();
-  j["shared_edges"] = after.edges.size();
-  j["max_gap_mm"] = after.max_gap_mm;
-  j["max_angle_deg"] = after.max_angle_deg;
-  j["max_relative_curvature_jump"] = after.max_relative_curvature_jump;
-  j["message"] = after.brief();
-  j["before"] = before.brief();
-  Json edges = Json::array();
-  for (std::size_t k = 0; k < after.edges.size(); ++k) {
-    const brep::EdgeContinuity& e = after.edges[k];
-    Json x = Json::object();
-    x["edge"] = e.edge;
-    x["faces"] = Json::array({e.face_a, e.face_b});
-    x["gap_mm"] = e.gap_mm;
-    x["angle_deg"] = e.angle_deg;
-    x["curvature_jump"] = e.curvature_jump;
-    x["relative_curvature_jump"] = e.relative_curvature_jump;
-    if (k < before.edges.size() && before.edges[k].edge == e.edge) {
-      const brep::EdgeContinuity& b = before.edges[k];
-      x["before"] = Json{{"gap_mm", b.gap_mm},
-                         {"angle_deg", b.angle_deg},
-                         {"relative_curvature_jump", b.relative_curvature_jump}};
-    }
-    edges.push_back(std::move(x));
-  }
-  j["edges"] = std::move(edges);
-  return j;
-}
-
 Json model_figures(const ModelRunResult& r) {
   const auto& m = r.report;
   const brep::Counts& c = m.counts;
@@ -336,7 +305,7 @@ Json model_figures(const ModelRunResult& r) {
     model["volume_ratio_max"] = m.volume_ratio_max;
   }
   model["fold_free"] = r.fold_free;
-  model["continuity"] = continuity_json(m.continuity_before, m.continuity_after);
+  model["continuity"] = detail::continuity_json(m.continuity_before, m.continuity_after);
   model["message"] = m.brief();
   return model;
 }

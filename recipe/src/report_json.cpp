@@ -29,6 +29,39 @@ ReportJson step_json(const StepReport& step) {
   return x;
 }
 
+ReportJson continuity_json(const brep::ContinuityReport& before,
+                           const brep::ContinuityReport& after) {
+  using Json = ReportJson;
+  Json j = Json::object();
+  j["shared_edges"] = after.edges.size();
+  j["max_gap_mm"] = after.max_gap_mm;
+  j["max_angle_deg"] = after.max_angle_deg;
+  j["max_relative_curvature_jump"] = after.max_relative_curvature_jump;
+  j["message"] = after.brief();
+  j["before"] = before.brief();
+  Json edges = Json::array();
+  for (std::size_t k = 0; k < after.edges.size(); ++k) {
+    const brep::EdgeContinuity& e = after.edges[k];
+    Json x = Json::object();
+    x["edge"] = e.edge;
+    x["faces"] = Json::array({e.face_a, e.face_b});
+    x["gap_mm"] = e.gap_mm;
+    x["angle_deg"] = e.angle_deg;
+    x["curvature_jump"] = e.curvature_jump;
+    x["relative_curvature_jump"] = e.relative_curvature_jump;
+    if (k < before.edges.size() && before.edges[k].edge == e.edge) {
+      const brep::EdgeContinuity& b = before.edges[k];
+      x["class"] = b.angle_deg <= 1 ? (b.relative_curvature_jump <= 0.05 ? "G2" : "G1") : "G0";
+      x["before"] = Json{{"gap_mm", b.gap_mm},
+                         {"angle_deg", b.angle_deg},
+                         {"relative_curvature_jump", b.relative_curvature_jump}};
+    }
+    edges.push_back(std::move(x));
+  }
+  j["edges"] = std::move(edges);
+  return j;
+}
+
 }  // namespace detail
 
 std::string step_reports_json(const std::vector<StepReport>& steps) {

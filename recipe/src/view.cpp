@@ -422,6 +422,8 @@ void write_view_data(const RunResult& result, const fs::path& dir) {
         Json{{"file", name}, {"vertices", m.position.size()}, {"triangles", m.triangles.size()}};
     x["net"] = nullptr;
     x["stages"] = Json::array();
+    x["continuity"] =
+        detail::continuity_json(model.report.continuity_before, model.report.continuity_after);
     surfaces.push_back(std::move(x));
   }
 

@@ -215,6 +215,31 @@ await check('data-surfaces, the panels and the vertices match the manifest', asy
   return `${n} surfaces, ${stages} stages, ${vertices(finals)} vertices`;
 });
 
+await check("a model's panel lists its edges' continuity, worst first, against the class-A figures", async () => {
+  const models = manifest.surfaces.map((s, i) => [s, i]).filter(([s]) => s.continuity);
+  if (models.length === 0) return 'skipped: no model in this run';
+  const out = [];
+  for (const [s, i] of models) {
+    const edges = s.continuity.edges;
+    // the class-A figures per the source's class, computed here from the manifest's numbers
+    const misses = edges.filter((e) => e.gap_mm > 0.01 ||
+      ((e.class === 'G1' || e.class === 'G2') && e.angle_deg > 0.016) ||
+      (e.class === 'G2' && e.relative_curvature_jump > 0.01));
+    const panel = `.surface-panel[data-surface="${i}"] details.continuity`;
+    assert((await page.getAttribute(panel, 'data-misses')) === String(misses.length), `${s.name}: data-misses`);
+    const rows = await page.$$eval(`${panel} tr[data-edge]`, (r) => r.map((x) => Number(x.dataset.edge)));
+    assert(rows.length === Math.min(20, edges.length), `${s.name}: ${rows.length} edge rows of ${edges.length}`);
+    // every edge that misses comes before every edge that does not
+    const missed = new Set(misses.map((e) => e.edge));
+    const firstKept = rows.findIndex((e) => !missed.has(e));
+    assert(firstKept < 0 || rows.slice(firstKept).every((e) => !missed.has(e)), `${s.name}: misses not first`);
+    const warned = await page.$$eval(`${panel} td.warn`, (c) => c.length);
+    assert((misses.length === 0) === (warned === 0), `${s.name}: ${warned} cells marked for ${misses.length} misses`);
+    out.push(`${s.name}: ${edges.length} edges, ${misses.length} off class A`);
+  }
+  return out.join('; ');
+});
+
 let shaded;
 await check('zebra mode changes data-mode and the picture', async () => {
   if (empty) return 'skipped: this run has no surface';

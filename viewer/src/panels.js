@@ -44,6 +44,55 @@ export function figuresTable(figures) {
   return table;
 }
 
+// The class-A figures an edge is held to (issue #38): fillets' tangent angle, curvature matched
+// within 1 % where the source was G2, and the positional gap.
+const CLASS_A = { angle_deg: 0.016, relative_curvature_jump: 0.01, gap_mm: 0.01 };
+
+/** Whether a model's edge (manifest continuity entry) misses the class-A figures for its class. */
+export function edgeMisses(e) {
+  if (e.gap_mm > CLASS_A.gap_mm) return true;
+  if ((e.class === 'G1' || e.class === 'G2') && e.angle_deg > CLASS_A.angle_deg) return true;
+  return e.class === 'G2' && e.relative_curvature_jump > CLASS_A.relative_curvature_jump;
+}
+
+/**
+ * A model's continuity (manifest `continuity`): a summary line, then its shared edges, worst
+ * first (those missing the class-A figures for their class, then by angle), at most `limit`, each
+ * with the source's class and figures before. Cells missing a figure are marked `warn`.
+ */
+export function continuityTable(continuity, limit = 20) {
+  const edges = [...(continuity.edges || [])];
+  const severity = (e) => (edgeMisses(e) ? 1e9 : 0) + (e.class === 'G0' ? 0 : e.angle_deg);
+  edges.sort((a, b) => severity(b) - severity(a));
+  const misses = edges.filter(edgeMisses).length;
+  const root = el('details', { class: 'continuity', 'data-misses': String(misses) });
+  root.open = misses > 0;
+  root.append(el('summary', {
+    text: `edges: ${continuity.shared_edges} shared, ${misses} off the class-A figures · ` +
+      `gap ≤ ${formatNumber(continuity.max_gap_mm)} mm`,
+  }));
+  const table = el('table', { class: 'figures continuity-edges' });
+  table.append(el('tr', {}, ...['edge', 'class', 'gap mm', 'angle °', 'κ jump %', 'before °'].map(
+    (t) => el('th', { scope: 'col', text: t }))));
+  for (const e of edges.slice(0, limit)) {
+    const cell = (text, bad) => el('td', { class: bad ? 'warn' : '', text });
+    const tangent = e.class === 'G1' || e.class === 'G2';
+    table.append(el('tr', { 'data-edge': String(e.edge) },
+      el('th', { scope: 'row', text: `${e.edge} (${e.faces.join('–')})` }),
+      cell(e.class || '—', false),
+      cell(formatNumber(e.gap_mm), e.gap_mm > CLASS_A.gap_mm),
+      cell(formatNumber(e.angle_deg), tangent && e.angle_deg > CLASS_A.angle_deg),
+      cell(formatNumber(100 * e.relative_curvature_jump),
+        e.class === 'G2' && e.relative_curvature_jump > CLASS_A.relative_curvature_jump),
+      cell(e.before ? formatNumber(e.before.angle_deg) : '—', false)));
+  }
+  if (edges.length > limit) {
+    table.append(el('tr', {}, el('td', { class: 'none', text: `… ${edges.length - limit} more in report.json` })));
+  }
+  root.append(table);
+  return root;
+}
+
 /**
  * Builds the panel of `surface` (manifest entry) number `index`. `actions`:
  * onToggle(index, stage), onFocus(index), onVisible(index, shown). Returns {root, update(state, stats)}.
@@ -64,6 +113,7 @@ export function surfacePanel(surface, index, actions) {
     showing,
     stats,
     figuresTable(surface.figures),
+    surface.continuity ? continuityTable(surface.continuity) : null,
   );
   meta.textContent =
     surface.mesh.triangles !== undefined
