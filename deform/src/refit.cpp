@@ -515,7 +515,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
       const int per_curve = std::min(4000, 4 * intervals * (spans(bu) + spans(bv)) + 32);
       edge = detail::edge_samples(
           surface, options.matched_curves, [&](const Eigen::Vector3d& x) { return deformed(d, x); },
-          size, per_curve);
+          size, per_curve, options.matched_curvature > 0);
       detail::mark_seams(edge, per_curve, surface, ties);
       result.surface = detail::least_squares_matching(
           bu, bv, us, vs, values, edge, 100.0, options.matched_gap_mm, options.matched_angle_deg,

@@ -142,7 +142,8 @@ void mark_seams(std::vector<EdgeSample>& samples, int per_curve,
 
 std::vector<EdgeSample> edge_samples(
     const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
-    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve) {
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve,
+    bool second_derivatives) {
   const auto [u0, u1] = surface.u.domain();
   const auto [v0, v1] = surface.v.domain();
   const double step = 1e-5 * size;
@@ -181,10 +182,14 @@ std::vector<EdgeSample> edge_samples(
       s.point = map(d.point);
       s.du = directional(d.point, d.du);
       s.dv = directional(d.point, d.dv);
-      s.duu = second(d.point, d.du) + directional(d.point, d.duu);
-      s.dvv = second(d.point, d.dv) + directional(d.point, d.dvv);
-      s.duv = 0.25 * (second(d.point, d.du + d.dv) - second(d.point, d.du - d.dv)) +
-              directional(d.point, d.duv);
+      if (second_derivatives && c.order >= 2) {
+        s.duu = second(d.point, d.du) + directional(d.point, d.duu);
+        s.dvv = second(d.point, d.dv) + directional(d.point, d.dvv);
+        s.duv = 0.25 * (second(d.point, d.du + d.dv) - second(d.point, d.du - d.dv)) +
+                directional(d.point, d.duv);
+      } else {
+        s.duu = s.duv = s.dvv = Eigen::Vector3d::Zero();
+      }
       out.push_back(s);
     }
   return out;

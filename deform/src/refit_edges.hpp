@@ -58,10 +58,12 @@ void mark_seams(std::vector<EdgeSample>& samples, int per_curve,
 /// of `map` in space over 1e-5 of `size` (an O(1e-10) relative error for a smooth map); the
 /// second ones D''(S)[S_a, S_b] + D'(S) S_ab, D'' by second differences over 1e-3 of `size`
 /// (D''[a, b] by polarization), all in space: an edge lies on the domain's border, where
-/// differences in (u, v) would leave it.
+/// differences in (u, v) would leave it. Without `second` (no curvature rows), or on a curve
+/// of order < 2, the second derivatives are left zero: they cost 12 of the 17 map evaluations.
 std::vector<EdgeSample> edge_samples(
     const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
-    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve);
+    const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& map, double size, int per_curve,
+    bool second = true);
 
 /// The net on bu x bv minimising Σ_grid |fit − values|² + w² Σ_samples (|fit − D∘S|² +
 /// h_u² |fit_u − (D∘S)_u|² + h_v² |fit_v − (D∘S)_v|²), h_u = gap_mm / (angle |(D∘S)_u|) (each
