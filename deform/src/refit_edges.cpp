@@ -182,7 +182,10 @@ std::vector<EdgeSample> edge_samples(
       s.point = map(d.point);
       s.du = directional(d.point, d.du);
       s.dv = directional(d.point, d.dv);
-      if (second_derivatives && c.order >= 2) {
+      const double slow = std::min(s.du.norm(), s.dv.norm()),
+                   fast = std::max(s.du.norm(), s.dv.norm());
+      if (!(slow >= 0.01 * fast)) s.order = 0;  // near a pole: no normal to match
+      if (second_derivatives && s.order >= 2) {
         s.duu = second(d.point, d.du) + directional(d.point, d.duu);
         s.dvv = second(d.point, d.dv) + directional(d.point, d.dvv);
         s.duv = 0.25 * (second(d.point, d.du + d.dv) - second(d.point, d.du - d.dv)) +
@@ -260,7 +263,11 @@ surface::BSplineSurface least_squares_matching(
     const int su = surface::find_span(bu, s.u), sv = surface::find_span(bv, s.v);
     surface::basis_derivatives(bu, su, s.u, order, du);
     surface::basis_derivatives(bv, sv, s.v, order, dv);
-    const double speed_u = s.du.norm(), speed_v = s.dv.norm();
+    // Near a pole one speed vanishes, and the allowance of its derivative row with it would grow
+    // without bound (a sphere's seam reached rows 1e12 times a grid sample's, and the least
+    // squares came out singular): each speed counts as at least 1 % of the other.
+    const double speed_u = std::max(s.du.norm(), 0.01 * s.dv.norm());
+    const double speed_v = std::max(s.dv.norm(), 0.01 * s.du.norm());
     // a sharp edge's sample: its position only; a tangent edge's: no curvature
     const double hu = speed_u > 0 && s.order >= 1 ? gap_mm / (angle * speed_u) : 0;
     const double hv = speed_v > 0 && s.order >= 1 ? gap_mm / (angle * speed_v) : 0;

@@ -21,7 +21,7 @@ struct EdgeSample {
   Eigen::Vector3d point, du, dv;
   Eigen::Vector3d duu, duv, dvv;  ///< second partial derivatives (the curvature rows)
   bool seam = false;  ///< on a seam tied to order >= 1 (see SeamTie): its own side is the neighbour
-  int order = 2;      ///< its curve's MatchedCurve::order
+  int order = 2;      ///< its curve's MatchedCurve::order, 0 near a pole (see edge_samples)
   /// the curve's direction in (u, v), each component relative to its domain's width
   double along_u = 0, along_v = 0;
 };
@@ -58,7 +58,10 @@ void mark_seams(std::vector<EdgeSample>& samples, int per_curve,
 /// of `map` in space over 1e-5 of `size` (an O(1e-10) relative error for a smooth map); the
 /// second ones D''(S)[S_a, S_b] + D'(S) S_ab, D'' by second differences over 1e-3 of `size`
 /// (D''[a, b] by polarization), all in space: an edge lies on the domain's border, where
-/// differences in (u, v) would leave it. Without `second` (no curvature rows), or on a curve
+/// differences in (u, v) would leave it. Near a pole (one of D∘S's speeds below 1 % of the
+/// other) the normal is not defined well enough to match: the sample keeps its position only
+/// (order 0; a cone's edges to its apex split spans there until the least squares lost every
+/// digit). Without `second` (no curvature rows), or on a curve
 /// of order < 2, the second derivatives are left zero: they cost 12 of the 17 map evaluations.
 std::vector<EdgeSample> edge_samples(
     const surface::BSplineSurface& surface, const std::vector<MatchedCurve>& curves,
