@@ -120,8 +120,9 @@ SeamTies seam_ties(const surface::BSplineSurface& source, ClosedSides closed) {
 
 void mark_seams(std::vector<EdgeSample>& samples, int per_curve,
                 const surface::BSplineSurface& surface, SeamTies ties) {
-  const auto [u0, u1] = surface.u.domain();
-  const auto [v0, v1] = surface.v.domain();
+  // (plain copies: a lambda may not capture a structured binding before C++20 in clang 14)
+  const double u0 = surface.u.domain().first, u1 = surface.u.domain().second;
+  const double v0 = surface.v.domain().first, v1 = surface.v.domain().second;
   const double eu = 1e-9 * (u1 - u0), ev = 1e-9 * (v1 - v0);  // a pcurve's rounding
   const auto per = static_cast<std::size_t>(per_curve);
   for (std::size_t start = 0; start + per <= samples.size(); start += per) {

@@ -42,7 +42,8 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 TEST_CASE("shared_boundaries finds the sides two surfaces share and how they meet",
           "[refit][shared]") {
-  const auto [a, b] = halves();
+  const auto sides = halves();
+  const surface::BSplineSurface &a = sides.first, &b = sides.second;
   const auto curves = shared_boundaries(a, {&b}, 1e-6);
   // the two lines (the revolution's first and last profile: u = u0, u = u1), tangent: order 2
   REQUIRE(curves.size() == 2);
@@ -80,7 +81,8 @@ TEST_CASE("Mirrored halves refitted with their shared sides keep meeting tangent
   // Both halves twisted about a tilted, offset axis and each refitted alone within 0.05 mm: alone
   // their tangent joins open; following shared_boundaries' curves (0.0005 mm, 0.008 deg each)
   // they meet within twice that, measured between the two fits at 201 points per side.
-  const auto [a, b] = halves();
+  const auto sides = halves();  // (not bound: lambdas below use them, which clang 14 refuses)
+  const surface::BSplineSurface &a = sides.first, &b = sides.second;
   Twist twist;
   twist.frame.origin = {2, 1, 0};
   twist.frame.axis = {0.2, 0.1, 1};
@@ -103,8 +105,8 @@ TEST_CASE("Mirrored halves refitted with their shared sides keep meeting tangent
   };
   // The halves meet along a's sides u = u0 and u = u1, each on one of b's (the mirror may
   // reverse u to keep the normals outward: which one, from the source).
-  const auto [u0, u1] = a.u.domain();
-  const auto [v0, v1] = a.v.domain();
+  const double u0 = a.u.domain().first, u1 = a.u.domain().second;
+  const double v0 = a.v.domain().first, v1 = a.v.domain().second;
   auto partner = [&](double u) {
     const double mid = 0.5 * (v0 + v1);
     return (surface::evaluate(b, u, mid) - surface::evaluate(a, u, mid)).norm() < 1e-9
