@@ -274,8 +274,16 @@ def test_a_killed_sweep_leaves_no_process_no_temporary_and_an_index(examples: Pa
     sweep = subprocess.Popen([exe, "sweep", str(description), "--out", str(out), "--workers", "1"], env=env,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        # Kill it after the first variant finished, while the second runs.
-        assert wait_for(lambda: any(out.glob("*/variant.json")) and bool(variant_processes(mark)), 60)
+        # Kill it after the first variant finished (its folder in place and indexed: the sweep
+        # renames the folder, then writes the index, and a SIGKILL between the two, which a loaded
+        # machine widened, leaves the index to the next run), while the second runs.
+        def indexed() -> bool:
+            folders = {p.parent.name for p in out.glob("*/variant.json")}
+            index = out / "index.jsonl"  # (index.csv follows it: read with index_ids below)
+            return bool(folders) and index.exists() and folders <= {
+                json.loads(line)["id"] for line in index.read_text().splitlines()}
+
+        assert wait_for(lambda: indexed() and bool(variant_processes(mark)), 60)
         running = variant_processes(mark)
         sweep.send_signal(sig)
         _, stderr = sweep.communicate(timeout=30)
