@@ -72,48 +72,66 @@ std::vector<MatchedCurve> shared_boundaries(
                 "shared_boundaries: tolerance_mm is " + internal::shortest(tolerance_mm) +
                     "; give a distance > 0 mm (how far apart two sides may be and still be one)");
   surface::validate(s, "shared_boundaries surface");
-  std::vector<MatchedCurve> out;
   constexpr int samples = 9;
-  for (const Side& side : sides_of(s)) {
-    std::array<Eigen::Vector3d, samples> points;
-    std::array<Eigen::Vector3d, samples> normals;
+  struct Samples {
+    std::array<Eigen::Vector3d, samples> points, normals;
+    bool pole = false;
+  };
+  const std::array<Side, 4> sides = sides_of(s);
+  std::array<Samples, 4> at_side;
+  int live = 0;  // sides that are not poles
+  for (std::size_t q = 0; q < 4; ++q) {
+    const Side& side = sides[q];
     double length = 0;
-    for (int k = 0; k < samples; ++k) {
+    for (std::size_t k = 0; k < samples; ++k) {
       // ends excluded: a corner lies on two sides of every neighbour
-      const double t = side.t0 + (side.t1 - side.t0) * (k + 0.5) / samples;
+      const double t = side.t0 + (side.t1 - side.t0) * (static_cast<double>(k) + 0.5) / samples;
       const surface::SurfaceDerivatives d = at(s, side, t, 1);
-      points[static_cast<std::size_t>(k)] = d.point;
-      normals[static_cast<std::size_t>(k)] = unit_normal(d);
-      if (k > 0)
-        length +=
-            (points[static_cast<std::size_t>(k)] - points[static_cast<std::size_t>(k - 1)]).norm();
+      at_side[q].points[k] = d.point;
+      at_side[q].normals[k] = unit_normal(d);
+      if (k > 0) length += (at_side[q].points[k] - at_side[q].points[k - 1]).norm();
     }
-    if (length <= tolerance_mm) continue;  // a pole
-    bool shared = false;
-    double angle = 0;
-    for (const surface::BSplineSurface* o : neighbours) {
-      if (o == nullptr || o == &s) continue;
+    at_side[q].pole = length <= tolerance_mm;
+    live += !at_side[q].pole;
+  }
+  std::array<bool, 4> shared{};
+  std::array<double, 4> angle{};
+  for (const surface::BSplineSurface* o : neighbours) {
+    if (o == nullptr || o == &s) continue;
+    std::array<bool, 4> on{};
+    std::array<double, 4> worst{};
+    int count = 0;
+    for (std::size_t q = 0; q < 4; ++q) {
+      if (at_side[q].pole) continue;
       for (const Side& other : sides_of(*o)) {
-        bool on = true;
-        double worst = 0;
-        for (int k = 0; k < samples && on; ++k) {
-          const Eigen::Vector3d& p = points[static_cast<std::size_t>(k)];
+        bool all = true;
+        double w = 0;
+        for (std::size_t k = 0; k < samples && all; ++k) {
+          const Eigen::Vector3d& p = at_side[q].points[k];
           const surface::SurfaceDerivatives d = at(*o, other, nearest(*o, other, p), 1);
-          on = (d.point - p).norm() <= tolerance_mm;
-          const double c = std::abs(unit_normal(d).dot(normals[static_cast<std::size_t>(k)]));
-          worst = std::max(worst, std::acos(std::min(c, 1.0)) * 180 / std::numbers::pi);
+          all = (d.point - p).norm() <= tolerance_mm;
+          const double c = std::abs(unit_normal(d).dot(at_side[q].normals[k]));
+          w = std::max(w, std::acos(std::min(c, 1.0)) * 180 / std::numbers::pi);
         }
-        if (!on) continue;
-        shared = true;
-        angle = std::max(angle, worst);
+        if (all) on[q] = true, worst[q] = std::max(worst[q], w);
       }
+      count += on[q];
     }
-    if (!shared) continue;
+    // the same patch all round (a copy, the surface it was styled or rebuilt from, a variant of
+    // it): not a neighbour, nothing is built to meet it
+    if (count == live) continue;
+    for (std::size_t q = 0; q < 4; ++q)
+      if (on[q]) shared[q] = true, angle[q] = std::max(angle[q], worst[q]);
+  }
+  std::vector<MatchedCurve> out;
+  for (std::size_t q = 0; q < 4; ++q) {
+    if (!shared[q]) continue;
+    const Side& side = sides[q];
     surface::Points3 ends(2, 3);
     ends << (side.u_fixed ? side.fixed : side.t0), (side.u_fixed ? side.t0 : side.fixed), 0,
         (side.u_fixed ? side.fixed : side.t1), (side.u_fixed ? side.t1 : side.fixed), 0;
     out.push_back({surface::make_curve(1, {side.t0, side.t0, side.t1, side.t1}, ends), side.t0,
-                   side.t1, angle <= 1 ? 2 : 0});
+                   side.t1, angle[q] <= 1 ? 2 : 0});
   }
   return out;
 }

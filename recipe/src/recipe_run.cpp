@@ -226,7 +226,7 @@ class Runner {
   BSplineSurface light_copy(const BSplineSurface& s, const Composition& c, const std::string& name,
                             StepReport& rep) {
     deform::RefitOptions fit = light_fit(c);
-    follow_shared(fit, shared_, c);
+    follow_shared(fit, shared(), c);
     const deform::RefitResult r = deform::refit_surface(s, fit);
     const auto& f = r.report;
     rep.figures = {{"exact_degree_u", static_cast<long long>(s.u.degree)},
@@ -334,9 +334,18 @@ class Runner {
   double ledger_ = 0;
   std::map<std::string, bool> affected_;  // by surface name: needs what changed
   bool previewing_ = false;               // the surface being deformed has a previewed step
-  // The sides the surface being deformed shares with the recipe's other surfaces: its light
-  // forms and refits follow them (issue #38 step 3, surfaces built to meet).
-  std::vector<deform::MatchedCurve> shared_;
+  // The sides the surface being deformed shares with others, which its fits follow (issue #38
+  // step 3), found when a step first composes: a studio drag's preview never pays for them.
+  const BSplineSurface* shared_parent_ = nullptr;
+  const Composition* shared_composition_ = nullptr;
+  std::optional<std::vector<deform::MatchedCurve>> shared_;
+  const std::vector<deform::MatchedCurve>& shared() {
+    if (!shared_)
+      shared_ = shared_parent_
+                    ? shared_sides(*shared_parent_, result_.surfaces, *shared_composition_)
+                    : std::vector<deform::MatchedCurve>{};
+    return *shared_;
+  }
 
   template <class F>
   void timed(const std::string& path, const std::string& kind, F&& f) {
@@ -590,10 +599,12 @@ class Runner {
       const StackDef& stack =
           *std::find_if(data_.stacks.begin(), data_.stacks.end(),
                         [&](const StackDef& s) { return s.name == d->deformation; });
-      shared_ = shared_sides(surface_of(d->surface), result_.surfaces, d->composition);
+      shared_parent_ = &surface_of(d->surface), shared_composition_ = &d->composition;
+      shared_.reset();
       BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name,
                                 !built_on(data_, def.name), bound_of(d->surface));
-      shared_.clear();
+      shared_parent_ = nullptr, shared_composition_ = nullptr;
+      shared_.reset();
       result_.surfaces.emplace_back(def.name, std::move(s));
       return;
     }
@@ -731,8 +742,8 @@ class Runner {
                          const Composition& c, StepReport& rep) {
     deform::SurfaceDeformationOptions options = deformation_options(c);
     options.input_bound_mm = ledger_;
-    if (options.refit) follow_shared(*options.refit, shared_, c);
-    if (options.budget) follow_shared(options.budget->light, shared_, c);
+    if (options.refit) follow_shared(*options.refit, shared(), c);
+    if (options.budget) follow_shared(options.budget->light, shared(), c);
     const auto r = deform::deform_surface(d, s, options);
     const auto& o = r.report.steps.front();
     ledger_ = r.report.accumulated_bound_mm;

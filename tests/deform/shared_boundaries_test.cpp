@@ -68,6 +68,23 @@ TEST_CASE("shared_boundaries finds the sides two surfaces share and how they mee
   moved.points.col(1).array() += 0.01;
   CHECK(shared_boundaries(a, {&moved}, 1e-6).empty());
   CHECK(shared_boundaries(a, {&moved}, 0.1).size() == 1);
+  // A copy of a sheet, or a variant with its boundary all round (an inner point raised, as a
+  // style step leaves a surface): the same patch, not a neighbour; the sheet beside it still is.
+  auto grid = [](double x0) {
+    surface::Points3 p(16, 3);
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) p.row(i * 4 + j) << x0 + 10 * i, 20.0 * j / 3, 0;
+    return surface::make_surface(surface::clamped_uniform_basis(3, 4),
+                                 surface::clamped_uniform_basis(3, 4), p);
+  };
+  const auto left = grid(0), right = grid(30), copy = grid(0);
+  auto variant = left;
+  variant.points.row(variant.index(1, 2)) += Eigen::RowVector3d(0, 0, 3);
+  CHECK(shared_boundaries(left, {&copy}, 1e-6).empty());
+  CHECK(shared_boundaries(left, {&variant}, 1e-6).empty());
+  const auto beside = shared_boundaries(left, {&copy, &variant, &right}, 1e-6);
+  REQUIRE(beside.size() == 1);
+  CHECK(surface::evaluate(beside[0].pcurve, beside[0].t0).x() == 1.0);  // the side u = 1 (x = 30)
   // nothing to share with itself or with no neighbour
   CHECK(shared_boundaries(a, {&a}, 1e-6).empty());
   CHECK(shared_boundaries(a, {}, 1e-6).empty());

@@ -199,8 +199,10 @@ CLAY_DEFORM_API RefitResult refit_deformed(const SpaceMap& map,
 /// loft's neighbours, mirrored halves) then keep meeting when each is refitted alone (issue #38
 /// step 3). Order 0 (the position) where the two meet at more than 1 deg somewhere along the side
 /// (a crease), else 2 (normal and curvature: a tangent or G2 join stays so). Normals are compared
-/// up to orientation. Throws clay::Error(InvalidArgument) for a tolerance that is not > 0 and
-/// finite, InvalidGeometry for an invalid surface.
+/// up to orientation. A neighbour on every side of `surface` (a copy, the surface it was styled or
+/// rebuilt from, a variant of it) is the same patch, not a neighbour. Throws
+/// clay::Error(InvalidArgument) for a tolerance that is not > 0 and finite, InvalidGeometry for an
+/// invalid surface.
 CLAY_DEFORM_API std::vector<MatchedCurve> shared_boundaries(
     const surface::BSplineSurface& surface,
     const std::vector<const surface::BSplineSurface*>& neighbours, double tolerance_mm);
