@@ -479,8 +479,13 @@ double distance(const Elementary& e, const Eigen::Vector3d& p) {
     }
     case ElementaryKind::Sphere:
       return std::abs(d.norm() - e.radius);
-    case ElementaryKind::Torus:
-      return std::abs(std::hypot(radial - e.radius, axial) - e.minor_radius);
+    case ElementaryKind::Torus: {
+      // A spindle torus (minor radius above the major: EUCLID's screw threads) also holds the
+      // points whose tube circle is across the axis, R + r cos v < 0.
+      const double near = std::abs(std::hypot(radial - e.radius, axial) - e.minor_radius);
+      if (!(e.minor_radius > e.radius)) return near;
+      return std::min(near, std::abs(std::hypot(radial + e.radius, axial) - e.minor_radius));
+    }
   }
   return INFINITY;
 }

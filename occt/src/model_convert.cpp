@@ -64,6 +64,7 @@
 #include <TColgp_HArray1OfPnt2d.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
+#include <gp_Trsf.hxx>
 
 namespace clay::brep::detail {
 
@@ -192,6 +193,43 @@ void close_exactly(const Handle(Geom_BSplineCurve) & c, double size) {
     c->SetPole(n, c->Pole(1), c->Weight(1));
 }
 
+/// GeomConvert's B-spline of `s` on the box. OpenCASCADE 7.6 converts an elementary surface
+/// trimmed to a full turn in u that starts off a multiple of the period wrongly: a cylinder of
+/// radius 3.5 on [pi/2, 5 pi/2] comes back with the knots of [0, 2 pi] and 0.135 mm off at its
+/// knots (a cone 0.20 mm, a torus of tube 3 0.50 mm; MicroStation's and HiCAD's holes, issue #39).
+/// Such a surface is turned by the start about its axis, t(w) = s(w + u0), converted on
+/// [0, period], and its u knots moved by u0: the same B-spline on the face's own seam.
+Handle(Geom_BSplineSurface)
+    to_bspline(const Handle(Geom_Surface) & s, const std::array<double, 4>& box) {
+  const auto elementary = Handle(Geom_ElementarySurface)::DownCast(s);
+  const double period = s->IsUPeriodic() ? s->UPeriod() : 0.0;
+  const double u0 = box[0];
+  const bool full_turn = period > 0 && box[1] - box[0] >= period * (1 - 1e-12);
+  const bool off_period = std::abs(u0 - std::round(u0 / period) * period) > 1e-12 * period;
+  if (elementary.IsNull() || !full_turn || !off_period)
+    return GeomConvert::SurfaceToBSplineSurface(
+        new Geom_RectangularTrimmedSurface(s, box[0], box[1], box[2], box[3]));
+  const double v_mid = 0.5 * (box[2] + box[3]);
+  const gp_Pnt start = s->Value(u0, v_mid);
+  Handle(Geom_Surface) turned;
+  for (const double angle : {u0, -u0}) {  // +u0 about a direct frame's axis, -u0 an indirect one
+    gp_Trsf rotation;
+    rotation.SetRotation(elementary->Position().Axis(), angle);
+    turned = Handle(Geom_Surface)::DownCast(s->Transformed(rotation));
+    if (turned->Value(0.0, v_mid).Distance(start) <= 1e-12 * (1 + start.XYZ().Modulus())) break;
+    turned.Nullify();
+  }
+  if (turned.IsNull())  // not a surface of its axis: left to the checks of the conversion
+    return GeomConvert::SurfaceToBSplineSurface(
+        new Geom_RectangularTrimmedSurface(s, box[0], box[1], box[2], box[3]));
+  Handle(Geom_BSplineSurface) b = GeomConvert::SurfaceToBSplineSurface(
+      new Geom_RectangularTrimmedSurface(turned, 0.0, period, box[2], box[3]));
+  TColStd_Array1OfReal knots(1, b->NbUKnots());
+  for (int k = 1; k <= b->NbUKnots(); ++k) knots.SetValue(k, b->UKnot(k) + u0);
+  b->SetUKnots(knots);
+  return b;
+}
+
 FaceConversion convert_face(const TopoDS_Face& face, double size, const std::string& name) {
   FaceConversion c;
   c.size = size;
@@ -251,9 +289,7 @@ FaceConversion convert_face(const TopoDS_Face& face, double size, const std::str
   }
   if (c.nurbs.IsNull()) {
     try {
-      Handle(Geom_Surface) trimmed =
-          new Geom_RectangularTrimmedSurface(c.old_surface, box[0], box[1], box[2], box[3]);
-      c.nurbs = GeomConvert::SurfaceToBSplineSurface(trimmed);
+      c.nurbs = to_bspline(c.old_surface, box);
     } catch (const Standard_Failure& failure) {
       throw Error(
           ErrorCategory::Exchange,

@@ -29,7 +29,11 @@
 #include <GeomAPI_Interpolate.hxx>
 #include <GeomAPI_ProjectPointOnSurf.hxx>
 #include <Geom_BSplineSurface.hxx>
+#include <Geom_ConicalSurface.hxx>
+#include <Geom_CylindricalSurface.hxx>
 #include <Geom_OffsetSurface.hxx>
+#include <Geom_SphericalSurface.hxx>
+#include <Geom_ToroidalSurface.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <IGESCAFControl_Writer.hxx>
 #include <IGESControl_Controller.hxx>
@@ -59,6 +63,7 @@
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Ax2.hxx>
+#include <gp_Ax3.hxx>
 #include <gp_Circ.hxx>
 #include <gp_Elips.hxx>
 #include <gp_GTrsf.hxx>
@@ -284,6 +289,22 @@ void write_test_model(TestModel model, const fs::path& file) {
       Handle(Geom_OffsetSurface) offset = new Geom_OffsetSurface(bump, 2.0);
       add_part(shapes, colours, BRepBuilderAPI_MakeFace(offset, 0, 1, 0, 1, 1e-7).Face(),
                "offset sheet", srgb(0.6, 0.6, 0.8));
+      break;
+    }
+    case TestModel::TurnedSeams: {
+      constexpr double pi = 3.14159265358979323846;
+      auto frame = [](double x, double y) {
+        return gp_Ax3(gp_Pnt(x, y, 0), gp_Dir(0, 0, 1), gp_Dir(1, 0, 0));
+      };
+      auto face = [&](const Handle(Geom_Surface) & s, double u0, double v0, double v1,
+                      const char* name) {
+        add_part(shapes, colours, BRepBuilderAPI_MakeFace(s, u0, u0 + 2 * pi, v0, v1, 1e-7).Face(),
+                 name, srgb(0.7, 0.7, 0.7));
+      };
+      face(new Geom_CylindricalSurface(frame(0, 0), 3.5), pi / 2, 0, 6, "cylinder");
+      face(new Geom_ConicalSurface(frame(20, 0), 0.3, 4.0), 1.0, 0, 6, "cone");
+      face(new Geom_SphericalSurface(frame(0, 20), 5.0), -pi / 2, -1.2, 1.2, "sphere");
+      face(new Geom_ToroidalSurface(frame(20, 20), 10.0, 3.0), pi / 2, 0, 2 * pi, "torus");
       break;
     }
     case TestModel::Assembly: {

@@ -28,6 +28,9 @@ enum class TestModel {
   LoftWithHoles,  ///< a ruled loft through a circle r 20 (z 0), an ellipse 30 x 15 (z 30) and a
                   ///< circle r 12 (z 60), cut by two cylinders r 4 across it at 45 degrees (z 15
                   ///< and 45): B-spline side faces with four trimmed holes (Boolean rims)
+  TurnedSeams,    ///< four loose full-turn faces whose seams are off u = 0: a cylinder (r 3.5,
+                  ///< u from pi/2), a cone (u from 1), a sphere (r 5, u from -pi/2) and a torus
+                  ///< (R 10, r 3, u from pi/2), as MicroStation and HiCAD write holes
 };
 
 /// Builds `model` with OpenCASCADE and writes it through XCAF (names, colours, assembly) as

@@ -481,6 +481,35 @@ TEST_CASE("elementary surfaces: points in closed form and distances along the no
   }
 }
 
+TEST_CASE("elementary surfaces: a spindle torus holds its points across the axis", "[brep]") {
+  // EUCLID writes screw threads on tori whose tube (54.87) is wider than their ring (8.25): where
+  // R + r cos v < 0 the point is across the axis (issue #39: such faces were called 3.09 mm off).
+  using clay::brep::Elementary;
+  using clay::brep::ElementaryKind;
+  Elementary e;
+  e.kind = ElementaryKind::Torus;
+  e.radius = 8.25;
+  e.minor_radius = 54.873718663856;
+  for (double u : {0.0, 1.3, 4.0})
+    for (double v : {0.2, 2.0, 3.0, 3.1415, 4.1}) {
+      const double ring = 8.25 + 54.873718663856 * std::cos(v);
+      const Vector3d p(ring * std::cos(u), ring * std::sin(u), 54.873718663856 * std::sin(v));
+      CHECK((clay::brep::point(e, u, v) - p).norm() <= 1e-12);
+      CHECK(clay::brep::distance(e, p) <= 1e-12);
+      // Along the normal: the tube's centre for this v is on the ring at angle u.
+      const Vector3d centre(8.25 * std::cos(u), 8.25 * std::sin(u), 0);
+      const Vector3d out = (p - centre).normalized();
+      for (double d : {0.25, -0.5})
+        CHECK(clay::brep::distance(e, p + d * out) == Approx(std::abs(d)).margin(1e-12));
+    }
+  // On the axis, 0.1 above the apex where the spindle closes: every tube circle's centre is
+  // 8.25 off the axis, so the distance is hypot(8.25, z) - r (0.0989, not 0.1: the surface
+  // meets the axis at a slant).
+  const double apex = std::sqrt(54.873718663856 * 54.873718663856 - 8.25 * 8.25);
+  CHECK(clay::brep::distance(e, Vector3d(0, 0, apex + 0.1)) ==
+        Approx(std::hypot(8.25, apex + 0.1) - 54.873718663856).epsilon(1e-12));
+}
+
 TEST_CASE("problems checks a face's elementary surface against its NURBS", "[brep]") {
   using clay::brep::Elementary;
   using clay::brep::ElementaryKind;

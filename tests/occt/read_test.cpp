@@ -205,6 +205,36 @@ TEST_CASE("read_model: an offset face is approximated on its own (u, v), measure
   CHECK(check.valid);
 }
 
+TEST_CASE("read_model: full turns whose seam is off u = 0 convert onto their surfaces") {
+  // OpenCASCADE 7.6's GeomConvert put a cylinder on [pi/2, 5 pi/2] 0.135 mm off itself
+  // (MicroStation's and HiCAD's holes were refused, issue #39): each face must lie on its
+  // surface, independently projected by OpenCASCADE, with its seam where the file has it.
+  const fs::path file = written(TestModel::TurnedSeams, "turned-seams.step");
+  const auto read = read_model(file);
+  INFO(read.report.brief());
+  for (const auto& problem : read.report.problems) UNSCOPED_INFO(problem);
+  CHECK(read.report.problems.empty());
+  REQUIRE(read.model.faces.size() == 4);
+  const double size = read.report.size_mm;
+  const double distance = clay::surface::occt_reference::max_distance_to_surfaces(
+      file, surface_samples(read.model, 400));
+  CHECK(distance <= 1e-9 * size);
+  // The cylinder, in closed form: every point 3.5 from the z axis, and its seam (the start of
+  // its u domain) on the +y side, where the file's face starts.
+  const auto& cylinder = read.model.faces[0].surface;
+  const auto [u0, u1] = cylinder.u.domain();
+  const auto [v0, v1] = cylinder.v.domain();
+  for (int i = 0; i <= 24; ++i)
+    for (int j = 0; j <= 4; ++j) {
+      const Eigen::Vector3d p =
+          clay::surface::evaluate(cylinder, u0 + (u1 - u0) * i / 24, v0 + (v1 - v0) * j / 4);
+      CHECK(std::abs(p.head<2>().norm() - 3.5) <= 1e-12 * size);
+    }
+  const Eigen::Vector3d seam = clay::surface::evaluate(cylinder, u0, v0);
+  CHECK(seam.x() == Approx(0).margin(1e-12 * size));
+  CHECK(seam.y() == Approx(3.5).margin(1e-12 * size));
+}
+
 TEST_CASE("read_model: STEP and IGES of the same solid give the same topology") {
   const fs::path step = written(TestModel::FilletedBlock, "block-same.step");
   const fs::path iges = written(TestModel::FilletedBlock, "block-same.igs");
