@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
-#include <cfloat>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -35,7 +34,6 @@ std::string bad_number(std::string_view token) {
   if (std::isinf(x)) return shown + " is beyond the range of a double";
   if (std::abs(x) > max_file_number)
     return shown + " is larger in magnitude than 1e100, which no geometry needs";
-  if (x != 0 && std::abs(x) < DBL_MIN) return shown + " is denormal (below 2.2e-308 in magnitude)";
   return {};
 }
 
@@ -342,10 +340,12 @@ void check_bspline(const IgesRecord& r, int type, std::string_view caller, const
     return u;
   };
   long needed = 0;
-  if (type == 126) {  // K, M, PROP1-4, knots, weights, points, V0, V1, normal
+  if (type == 126) {  // K, M, PROP1-4, knots, weights, points, V0, V1[, normal]
     const long m = degree(2, "degree M");
     const long k = upper(1, m, "upper index K");
-    needed = 1 + 2 + 4 + (k + 1 + m + 1) + (k + 1) + 3 * (k + 1) + 2 + 3;
+    // The unit normal of a planar curve closes the record, and writers leave it out (Spatial's
+    // XPlus for Solid Edge writes 2D trim curves without it; OpenCASCADE reads them).
+    needed = 1 + 2 + 4 + (k + 1 + m + 1) + (k + 1) + 3 * (k + 1) + 2;
   } else {  // K1, K2, M1, M2, PROP1-5, knots S and T, weights, points, U0, U1, V0, V1
     const long m1 = degree(3, "degree M1"), m2 = degree(4, "degree M2");
     const long k1 = upper(1, m1, "upper index K1"), k2 = upper(2, m2, "upper index K2");

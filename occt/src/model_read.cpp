@@ -26,6 +26,7 @@
 #include "convert.hpp"
 #include "exchange_precheck.hpp"
 #include "model_convert.hpp"
+#include "model_heal.hpp"
 #include "model_wire.hpp"
 #include "session.hpp"
 
@@ -172,6 +173,8 @@ class ModelBuilder {
         model_.roots.push_back(root);
       }
     }
+    if (const auto pulled = pull_pcurves_into_domains(model_); pulled.count > 0)
+      report_.healing.push_back(describe(pulled));
     raise_tolerances_to_gaps();
     if (faces_enclosing_nothing_ > 0)
       report_.healing.push_back(
@@ -216,15 +219,20 @@ class ModelBuilder {
     // The largest gap per edge first, then one decision against the file's tolerance.
     std::map<int, double> widest;
     for (const EdgeGap& g : gaps) widest[g.edge] = std::max(widest[g.edge], g.gap_mm);
-    std::set<int> raised;
-    double largest = 0;
+    std::set<int> raised, widened;
+    double largest = 0, widest_gap = 0;
     for (const auto& [edge, gap] : widest) {
       Edge& e = model_.edges[static_cast<std::size_t>(edge)];
-      if (!(gap > e.tolerance_mm) ||
-          !(gap <= std::max(1.5 * e.tolerance_mm, tolerant_edge_relative * size_)))
+      if (!(gap > e.tolerance_mm)) continue;
+      if (gap <= std::max(1.5 * e.tolerance_mm, tolerant_edge_relative * size_)) {
+        raised.insert(edge);
+        largest = std::max(largest, gap - e.tolerance_mm);
+      } else if (gap <= healed_gap_relative * size_) {
+        widened.insert(edge);
+        widest_gap = std::max(widest_gap, gap);
+      } else {
         continue;
-      raised.insert(edge);
-      largest = std::max(largest, gap - e.tolerance_mm);
+      }
       // A margin of rounding at the model's size too: a placed instance, rotated when an
       // assembly is flattened, measures the same gap 3e-15 mm wider (CATIA's as1 assembly).
       e.tolerance_mm = gap * (1 + 1e-9) + 1e-12 * size_;
@@ -238,6 +246,12 @@ class ModelBuilder {
                                 " edge" + (raised.size() == 1 ? "" : "s") +
                                 " to the gaps measured densely (by at most " + shortest(largest) +
                                 " mm)");
+    if (!widened.empty())
+      report_.healing.push_back("set the tolerances of " + std::to_string(widened.size()) +
+                                " edge" + (widened.size() == 1 ? "" : "s") +
+                                " to the file's own gaps between faces and edges (up to " +
+                                shortest(widest_gap) + " mm, " + shortest(widest_gap / size_) +
+                                " of the model's size)");
   }
 
   /// A pcurve parametrized unlike its edge, though the edge lies on the face: an I-DEAS IGES

@@ -146,6 +146,12 @@ int find_span(const BSplineBasis& basis, double t) {
   const double a = k[static_cast<size_t>(p)];
   const double b = k[static_cast<size_t>(n)];
   // isfinite first: an ordered comparison with NaN would raise FE_INVALID where traps are on.
+  // A parameter past an end by rounding (1.9999999999999998 on [2, 10], -2.8284271247451125 on
+  // [-2.828427124744922, 0]: issue #39's refusals) is in the end span: its polynomial is
+  // evaluated 1e-12 of the domain's scale past the end, a difference far below any tolerance.
+  const double rounding = 1e-12 * std::max({b - a, std::abs(a), std::abs(b)});
+  if (std::isfinite(t) && t < a && t >= a - rounding) t = a;
+  if (std::isfinite(t) && t > b && t <= b + rounding) t = b;
   if (!std::isfinite(t) || t < a || t > b) {
     std::ostringstream m;
     m.precision(17);

@@ -527,7 +527,7 @@ std::vector<std::pair<std::string, std::string>> write_mutated_files(const fs::p
       {"step-dangling-direction.step", "which the file does not define (a dangling reference)"},
       {"step-nan-coordinate.step", "'NaN' is not a STEP value"},
       {"step-infinite-coordinate.step", "'1.0E999' is beyond the range of a double"},
-      {"step-denormal-coordinate.step", "'4.9E-324' is denormal"},
+      {"step-denormal-coordinate.step", ""},  // read: see below
       {"step-absurd-coordinate.step", "larger in magnitude than 1e100"},
       {"step-degree-99.step", "B_SPLINE_SURFACE_WITH_KNOTS has degree 99"},
       {"step-rational-degree-99.step", "B_SPLINE_SURFACE has degree 99"},
@@ -535,7 +535,7 @@ std::vector<std::pair<std::string, std::string>> write_mutated_files(const fs::p
       {"iges-counts-inconsistent.igs", "upper index K1 7000 is inconsistent"},
       {"iges-nan-coordinate.igs", "'NaN' is not a number"},
       {"iges-infinite-coordinate.igs", "'1.0D999' is beyond the range of a double"},
-      {"iges-denormal-coordinate.igs", "'4.9D-324' is denormal"},
+      {"iges-denormal-coordinate.igs", ""},
       {"step-duplicate-id.step", "is defined twice, on line "},
       {"step-huge-list.step", "a list has more than 50000 entries"},
   };
@@ -552,7 +552,7 @@ std::vector<std::pair<std::string, std::string>> write_mutated_files(const fs::p
   write(files[7].first, replaced(step, "B_SPLINE_SURFACE(2,2,(", "B_SPLINE_SURFACE(99,2,("));
   write(files[8].first, iges_edited(iges, record, 0, record, "128,7,5,99,3,"));
   write(files[9].first, iges_edited(iges, record, 0, record, "128,7000,5,3,3,"));
-  // the first control point's x: the 14th line of the record (after 10 + 8 + 6 ... parameters)
+  // the 14th line of the record (after 10 + 8 + 6 ... parameters): its first number, a weight
   const std::string line = [&] {
     std::istringstream in(iges);
     std::string l;
@@ -602,6 +602,29 @@ TEST_CASE("The pre-check refuses malformed STEP and IGES files, naming the entit
     INFO(name);
     const auto start = std::chrono::steady_clock::now();
     const fs::path file = folder / name;  // the lambda captures this, not the binding (Clang 14)
+    if (why.empty()) {
+      // A denormal number (Alibre writes one in a centroid) is read as it is, as OpenCASCADE and
+      // FreeCAD read it (issue #39: the pre-check refused such files). The changed control
+      // coordinate is the file's 4.9e-324, the rest of the net as in the original.
+      const auto read = read_any(file, {});
+      const auto valid =
+          read_any(folder / (name.rfind("step", 0) == 0 ? "valid.step" : "valid.igs"), {});
+      REQUIRE(read.size() == valid.size());
+      int changed = 0;
+      for (std::size_t k = 0; k < read.size(); ++k) {
+        REQUIRE(read[k].points.rows() == valid[k].points.rows());
+        for (Eigen::Index r = 0; r < read[k].points.rows(); ++r)
+          for (Eigen::Index c = 0; c < read[k].points.cols(); ++c)
+            if (read[k].points(r, c) != valid[k].points(r, c)) {
+              ++changed;
+              CHECK(std::abs(read[k].points(r, c)) <= 1e-300);
+            }
+      }
+      // STEP: the first control point's x. IGES: the 14th line of the record holds a weight of
+      // the polynomial bicubic (PROP3 = 1), which its reading does not use: nothing changes.
+      CHECK(changed == (name.rfind("step", 0) == 0 ? 1 : 0));
+      continue;
+    }
     const std::string m = message_of([&] { (void)read_any(file, {}); });
     CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 5.0);
     CHECK_THAT(m, Catch::Matchers::Contains(why));

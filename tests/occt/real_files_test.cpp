@@ -1,6 +1,8 @@
 // Reading files written by other CAD systems (tests/data/cad, sources in its README): Autodesk
 // Inventor and its translation framework, CATIA V4 and V5, I-DEAS, Pro/ENGINEER, Rhino,
-// SolidWorks and Unigraphics; STEP AP203/AP214 and IGES 144/186. Each is read whole and checked
+// SolidWorks and Unigraphics; since issue #39 also MicroStation, HiCAD, EUCLID, Solid Edge,
+// AutoCAD, CADDS 5, CoCreate, SYRKO, FreeCAD, ANSA, STRIM, Geomagic and 3DIPSOS; STEP AP203/AP214
+// and IGES 128/144/186, one test per group of senders. Each is read whole (isolated) and checked
 // against independent figures: OpenCASCADE's own reading of the same file (counts, BRepCheck,
 // BRepGProp volume), closed forms where the part is one (the cube, the cone, the spheres) and
 // the volume the sending system wrote into the file (CATIA's validation property). Then each
@@ -40,11 +42,15 @@ struct RealFile {
   std::optional<double> volume_mm3;  ///< a closed form or the sending system's own figure
   double volume_relative = 1e-9;     ///< how closely that figure is expected
   std::string healing;               ///< a healing the report must name ("" for none)
+  /// How closely OpenCASCADE's own volume of the file is expected: where the file's faces are
+  /// farther from their edges than rounding, the trims we derive from the edges and its pcurves
+  /// enclose slightly different volumes.
+  double occt_volume_relative = 1e-6;
 };
 
 RealFile real(std::string name, int bodies, int faces, std::optional<double> volume = {},
-              double relative = 1e-9, std::string healing = {}) {
-  return {std::move(name), bodies, faces, volume, relative, std::move(healing)};
+              double relative = 1e-9, std::string healing = {}, double occt_relative = 1e-6) {
+  return {std::move(name), bodies, faces, volume, relative, std::move(healing), occt_relative};
 }
 
 /// A trilinear lattice around every control point of the model's placed instances, 5 % larger
@@ -61,32 +67,16 @@ clay::deform::DeformationStack corner_raised_around(const Model& model) {
   return clay::test::trilinear(lo - pad, hi + pad, 0.1 * (hi - lo + 2 * pad));
 }
 
-}  // namespace
-
-TEST_CASE("real files from other CAD systems read whole, valid, with their volumes") {
-  const double cone = std::numbers::pi * 35 * 35 * 100 / 3;  // I-DEAS: r 35, height 100
-  const double spheres = 2 * 4 * std::numbers::pi / 3;       // SolidWorks: 2 instances of r 1
-  const RealFile file = GENERATE_COPY(
-      real("inventor2019_cube10_ap214.stp", 1, 6, 1000.0),
-      real("inventor2019_cube10_msbo.igs", 1, 6, 1000.0),
-      real("autodesk_atf_conical_surface_ap214.step", 1, 5),
-      real("unigraphics16_io1_ap214.stp", 1, 17),
-      // CATIA's own validation property; the file's B-spline edges are within 5e-5 mm.
-      real("catia_v5r13_xr2_bolt_ap214.stp", 1, 7, 3200.49751584, 1e-6),
-      real("catia_v4_pr1_box_sphere_torus_cone_cc2.stp", 4, 15),
-      real("catia_v5r19_as1_assembly_ap203.stp", 3, 39),
-      real("catia_v5r14_cone_trimmed144.igs", 3, 3),
-      real("ideas11_cone_msbo186.igs", 1, 2, cone, 1e-9, "re-derived 1 pcurve from its edge"),
-      real("proe1999_t4m_surfaces_ap203.stp", 3, 11),
-      real("solidworks2013_spheres_asm_ap214.STEP", 1, 1, spheres),
-      real("rhino7_bspline_surface.igs", 1, 1),
-      real("solidworks2013_featuretype_holes_fillets_ap214.STEP", 1, 96),
-      real("solidworks2018_base_interface_plate_holes_ap214.STEP", 1, 30),
-      // A degree 12 x 12 Bézier torus patch trimmed across its seam.
-      real("harmonyware_torus_bspline_trimmed144.igs", 1, 1));
+/// Reads `file` whole and checks it against OpenCASCADE's own reading and what is known of it,
+/// writes it back, and deforms it (see the file's comment).
+void check_real_file(const RealFile& file) {
   INFO(file.name);
   const fs::path path = cad_file(file.name);
-  const auto imported = clay::brep::read_model(path);
+  // Isolated, as the command reads: OpenCASCADE's XCAF reader crashes on CoCreate's file, and
+  // the plain reader then reads it in a second child.
+  clay::brep::ModelReadOptions read_options;
+  read_options.read.isolate = true;
+  const auto imported = clay::brep::read_model(path, read_options);
   const Model& m = imported.model;
   INFO(imported.report.brief());
   CHECK(m.bodies.size() == static_cast<std::size_t>(file.bodies));
@@ -110,7 +100,8 @@ TEST_CASE("real files from other CAD systems read whole, valid, with their volum
   INFO(check.brief());
   CHECK(check.valid);
   if (facts.solids > 0) {
-    CHECK(std::abs(check.volume_mm3 - facts.volume) <= 1e-6 * std::abs(facts.volume));
+    CHECK(std::abs(check.volume_mm3 - facts.volume) <=
+          file.occt_volume_relative * std::abs(facts.volume));
   }
   if (file.volume_mm3) {
     CHECK(std::abs(check.volume_mm3 - *file.volume_mm3) <= file.volume_relative * *file.volume_mm3);
@@ -144,6 +135,99 @@ TEST_CASE("real files from other CAD systems read whole, valid, with their volum
   const auto deformed_check = clay::brep::check_model(deformed.model);
   INFO(deformed_check.brief());
   CHECK(deformed_check.valid);
+}
+
+}  // namespace
+
+TEST_CASE("real files from Autodesk, Unigraphics, I-DEAS and Rhino read whole, valid, deformed") {
+  const double cone = std::numbers::pi * 35 * 35 * 100 / 3;  // I-DEAS: r 35, height 100
+  check_real_file(GENERATE_COPY(
+      real("inventor2019_cube10_ap214.stp", 1, 6, 1000.0),
+      real("inventor2019_cube10_msbo.igs", 1, 6, 1000.0),
+      real("autodesk_atf_conical_surface_ap214.step", 1, 5),
+      real("unigraphics16_io1_ap214.stp", 1, 17),
+      real("ideas11_cone_msbo186.igs", 1, 2, cone, 1e-9, "re-derived 1 pcurve from its edge"),
+      real("rhino7_bspline_surface.igs", 1, 1)));
+}
+
+TEST_CASE("real files from CATIA V4 and V5 read whole, valid, deformed") {
+  check_real_file(GENERATE(
+      // CATIA's own validation property; the file's B-spline edges are within 5e-5 mm.
+      real("catia_v5r13_xr2_bolt_ap214.stp", 1, 7, 3200.49751584, 1e-6),
+      real("catia_v4_pr1_box_sphere_torus_cone_cc2.stp", 4, 15),
+      real("catia_v5r19_as1_assembly_ap203.stp", 3, 39),
+      real("catia_v5r14_cone_trimmed144.igs", 3, 3)));
+}
+
+TEST_CASE("real files from SolidWorks, Pro/ENGINEER and HarmonyWare read whole, valid, deformed") {
+  const double spheres = 2 * 4 * std::numbers::pi / 3;  // SolidWorks: 2 instances of r 1
+  check_real_file(GENERATE_COPY(real("proe1999_t4m_surfaces_ap203.stp", 3, 11),
+                                real("solidworks2013_spheres_asm_ap214.STEP", 1, 1, spheres),
+                                real("solidworks2013_featuretype_holes_fillets_ap214.STEP", 1, 96),
+                                real("solidworks2018_base_interface_plate_holes_ap214.STEP", 1, 30),
+                                // A degree 12 x 12 Bézier torus patch trimmed across its seam.
+                                real("harmonyware_torus_bspline_trimmed144.igs", 1, 1)));
+}
+
+TEST_CASE(
+    "real files healed on reading (issue #39): MicroStation, HiCAD, EUCLID, NX, Onshape, Solid "
+    "Edge") {
+  // Refused before issue #39: full-turn holes whose seam is off u = 0 (MicroStation, HiCAD:
+  // OpenCASCADE's conversion was 0.13 mm off), spindle tori (EUCLID), pcurves just outside their
+  // surfaces' domains and IGES 126 records without their trailing normal (Solid Edge).
+  check_real_file(GENERATE(real("microstation_j_io1_ap214.stp", 1, 17),
+                           real("hicad2_v1009_as1_assembly_ap214.stp", 5, 39),
+                           real("euclid_ol20b_screw_cc1.step", 1, 10),
+                           real("solidedge_spatial_xplus3_deflettore_msbo186.igs", 1, 18, {}, 1e-9,
+                                "pulled 10 pcurves into")));
+}
+
+TEST_CASE(
+    "real files from AutoCAD, CADDS 5, CoCreate, Theorem, SYRKO, Pro/E 2014, FreeCAD read whole") {
+  check_real_file(GENERATE(
+      // Faces up to 0.01 mm from their edges: 2.1e-4 from OpenCASCADE's volume (its own 14612.2
+      // mm^3 against 14615.2), where the trims we derive from the edges and its pcurves differ.
+      real("autocad2000i_k1_brep_with_voids_ap203.stp", 2, 76, {}, 1e-9, "", 3e-4),
+      real("cadds5_cv_io1_ap214.stp", 1, 29), real("theorem_cadds5_io1_surfrev_ap214.stp", 1, 29),
+      real("cocreate_modeling16_io1_ap214.stp", 1, 29, {}, 1e-9,
+           "OpenCASCADE's XCAF reader crashed on this file"),
+      real("syrko_v11_bv1_brep_with_voids_cc1.stp", 1, 18),
+      real("proe2014_30338_two_part_asm_ap214.stp", 2, 11),
+      real("freecad_occt72_comb_ap214.step", 1, 11, 24000.0)));
+}
+
+TEST_CASE("real IGES surfaces from ANSA, STRIM, Geomagic and 3DIPSOS read whole, deformed") {
+  check_real_file(GENERATE(real("ansa9_faces1_trimmed144.igs", 3, 3),
+                           real("strim100_bspline128_surfaces.igs", 7, 7),
+                           real("geomagic_studio5_lens_bspline128_inch.igs", 9, 9),
+                           real("3dipsos32_bspline128.igs", 1, 4)));
+}
+
+TEST_CASE("NX 9's faces farther from their edges than its tolerances read valid, tolerances set") {
+  // The file gives 0.0157 mm where its B-spline faces are 0.026 mm from their edges (issue #39):
+  // the tolerances are set to the gaps measured, as OpenCASCADE's FixSameParameter sets them,
+  // and the report says so. (Deforming it is not yet valid: a face comes back unorientable.)
+  const fs::path path = cad_file("nx9_281390_bsplines_sphere_ap214.stp");
+  const auto imported = clay::brep::read_model(path);
+  INFO(imported.report.brief());
+  bool named = false;
+  for (const auto& h : imported.report.healing)
+    named = named || h.find("set the tolerances of 3 edges to the file's own gaps") == 0;
+  CHECK(named);
+  CHECK(clay::brep::problems(imported.model).empty());
+  CHECK(imported.report.max_edge_tolerance_mm >= 0.0256);
+  CHECK(imported.report.max_edge_tolerance_mm <= 1e-3 * imported.report.size_mm);
+  const auto facts = clay::surface::occt_reference::facts_of_file(path);
+  const auto placed = clay::brep::counts(clay::brep::flattened(imported.model));
+  CHECK(placed.faces == facts.faces);
+  CHECK(placed.edges == facts.edges);
+  const auto check = clay::brep::check_model(imported.model);
+  INFO(check.brief());
+  CHECK(check.valid);
+  // Its faces and edges disagree by 0.026 mm, so the trims we derive from the edges and the
+  // file's own pcurves, which OpenCASCADE integrates, enclose volumes 5.4e-4 apart (28664.8 mm^3
+  // against 28680.3).
+  CHECK(std::abs(check.volume_mm3 - facts.volume) <= 6e-4 * facts.volume);
 }
 
 TEST_CASE("a real file with no face (Rhino wireframe) is refused, naming the file") {
