@@ -33,8 +33,9 @@ std::vector<double> pcurve_samples(const Edge& e, const surface::BSplineCurve& p
 PulledPcurves pull_pcurves_into_domains(Model& model) {
   PulledPcurves out;
   for (Face& face : model.faces) {
-    const auto [u0, u1] = face.surface.u.domain();
-    const auto [v0, v1] = face.surface.v.domain();
+    // Plain copies: Clang 14 refuses structured bindings captured by lambdas.
+    const double u0 = face.surface.u.domain().first, u1 = face.surface.u.domain().second;
+    const double v0 = face.surface.v.domain().first, v1 = face.surface.v.domain().second;
     const double du = u1 - u0, dv = v1 - v0;
     const double slack = 1e-9 * std::max(du, dv);  // problems()'s rounding slack
     // How far outside the domain (u, v) is, as fractions of the widths (0 inside).

@@ -1,7 +1,7 @@
 // Reading files written by other CAD systems (tests/data/cad, sources in its README): Autodesk
 // Inventor and its translation framework, CATIA V4 and V5, I-DEAS, Pro/ENGINEER, Rhino,
 // SolidWorks and Unigraphics; since issue #39 also MicroStation, HiCAD, EUCLID, Solid Edge,
-// AutoCAD, CADDS 5, CoCreate, SYRKO, FreeCAD, ANSA, STRIM, Geomagic and 3DIPSOS; STEP AP203/AP214
+// AutoCAD, CADDS 5, CoCreate, SYRKO, FreeCAD, ANSA, STRIM and Geomagic; STEP AP203/AP214
 // and IGES 128/144/186, one test per group of senders. Each is read whole (isolated) and checked
 // against independent figures: OpenCASCADE's own reading of the same file (counts, BRepCheck,
 // BRepGProp volume), closed forms where the part is one (the cube, the cone, the spheres) and
@@ -169,9 +169,7 @@ TEST_CASE("real files from SolidWorks, Pro/ENGINEER and HarmonyWare read whole, 
                                 real("harmonyware_torus_bspline_trimmed144.igs", 1, 1)));
 }
 
-TEST_CASE(
-    "real files healed on reading (issue #39): MicroStation, HiCAD, EUCLID, NX, Onshape, Solid "
-    "Edge") {
+TEST_CASE("real files healed on reading (issue #39): MicroStation, HiCAD, EUCLID, Solid Edge") {
   // Refused before issue #39: full-turn holes whose seam is off u = 0 (MicroStation, HiCAD:
   // OpenCASCADE's conversion was 0.13 mm off), spindle tori (EUCLID), pcurves just outside their
   // surfaces' domains and IGES 126 records without their trailing normal (Solid Edge).
@@ -196,11 +194,10 @@ TEST_CASE(
       real("freecad_occt72_comb_ap214.step", 1, 11, 24000.0)));
 }
 
-TEST_CASE("real IGES surfaces from ANSA, STRIM, Geomagic and 3DIPSOS read whole, deformed") {
+TEST_CASE("real IGES surfaces from ANSA, STRIM and Geomagic read whole, deformed") {
   check_real_file(GENERATE(real("ansa9_faces1_trimmed144.igs", 3, 3),
                            real("strim100_bspline128_surfaces.igs", 7, 7),
-                           real("geomagic_studio5_lens_bspline128_inch.igs", 9, 9),
-                           real("3dipsos32_bspline128.igs", 1, 4)));
+                           real("geomagic_studio5_lens_bspline128_inch.igs", 9, 9)));
 }
 
 TEST_CASE("NX 9's faces farther from their edges than its tolerances read valid, tolerances set") {
