@@ -204,8 +204,10 @@ Handle(Geom_BSplineSurface)
   const auto elementary = Handle(Geom_ElementarySurface)::DownCast(s);
   const double period = s->IsUPeriodic() ? s->UPeriod() : 0.0;
   const double u0 = box[0];
+  // Only for a periodic u: u0 / 0 would raise the division-by-zero trap of the Debug tests.
   const bool full_turn = period > 0 && box[1] - box[0] >= period * (1 - 1e-12);
-  const bool off_period = std::abs(u0 - std::round(u0 / period) * period) > 1e-12 * period;
+  const bool off_period =
+      full_turn && std::abs(u0 - std::round(u0 / period) * period) > 1e-12 * period;
   if (elementary.IsNull() || !full_turn || !off_period)
     return GeomConvert::SurfaceToBSplineSurface(
         new Geom_RectangularTrimmedSurface(s, box[0], box[1], box[2], box[3]));
