@@ -49,15 +49,47 @@ EdgeGap gap_of(const Model& m, int f, int l, int c, int per_span) {
   const Coedge& co = face.loops[static_cast<size_t>(l)].coedges[static_cast<size_t>(c)];
   const Edge& e = m.edges[static_cast<size_t>(co.edge)];
   EdgeGap g{f, l, c, co.edge, e.t0, 0.0};
-  for (double t : coedge_samples(e, co, per_span)) {
+  auto distance = [&](double t) {
     const Eigen::Vector2d uv = uv_at(face.surface, co.pcurve, t);
     const Eigen::Vector3d on_face = surface::evaluate(face.surface, uv.x(), uv.y());
     const Eigen::Vector3d on_edge = e.degenerate ? m.vertices[static_cast<size_t>(e.start)].point
                                                  : surface::evaluate(e.curve, within(e.curve, t));
-    const double d = (on_face - on_edge).norm();
-    if (d > g.gap_mm || std::isnan(d)) {
-      g.gap_mm = d;
-      g.t = t;
+    return (on_face - on_edge).norm();
+  };
+  const std::vector<double> ts = coedge_samples(e, co, per_span);
+  std::vector<double> d(ts.size());
+  for (size_t k = 0; k < ts.size(); ++k) {
+    d[k] = distance(ts[k]);
+    if (d[k] > g.gap_mm || std::isnan(d[k])) {
+      g.gap_mm = d[k];
+      g.t = ts[k];
+    }
+  }
+  if (std::isnan(g.gap_mm)) return g;
+  // The samples miss the peak between them: OpenCASCADE's BRepCheck maximizes the distance and
+  // found NX 9's deformed edge 0.2 % farther than 16 samples per span said, past a tolerance set
+  // to the sampled gap. Each local maximum within half the largest is refined by golden section
+  // between its neighbours (a peak narrower than the spacing, far below the others, is not).
+  const double sampled = g.gap_mm;
+  for (size_t k = 1; k + 1 < ts.size(); ++k) {
+    if (!(d[k] >= d[k - 1] && d[k] >= d[k + 1] && d[k] >= 0.5 * sampled && d[k] > 0)) continue;
+    constexpr double ratio = 0.6180339887498949;
+    double a = ts[k - 1], b = ts[k + 1];
+    double x1 = b - ratio * (b - a), x2 = a + ratio * (b - a);
+    double f1 = distance(x1), f2 = distance(x2);
+    for (int it = 0; it < 60 && b - a > 1e-13 * std::max({1.0, std::abs(a), std::abs(b)}); ++it) {
+      if (f1 >= f2) {
+        b = x2, x2 = x1, f2 = f1;
+        x1 = b - ratio * (b - a), f1 = distance(x1);
+      } else {
+        a = x1, x1 = x2, f1 = f2;
+        x2 = a + ratio * (b - a), f2 = distance(x2);
+      }
+    }
+    const double best_t = f1 >= f2 ? x1 : x2, best = std::max(f1, f2);
+    if (best > g.gap_mm) {
+      g.gap_mm = best;
+      g.t = best_t;
     }
   }
   return g;
@@ -543,6 +575,22 @@ std::vector<EdgeGap> edge_gaps(const Model& model, int samples_per_span) {
       }
   }
   return out;
+}
+
+double loop_area(const Model& model, int face, int loop) {
+  if (face < 0 || static_cast<size_t>(face) >= model.faces.size())
+    throw Error(ErrorCategory::InvalidArgument, "loop_area: face " + std::to_string(face) +
+                                                    " does not exist; the model has " +
+                                                    std::to_string(model.faces.size()) + " faces");
+  const Face& f = model.faces[static_cast<size_t>(face)];
+  if (loop < 0 || static_cast<size_t>(loop) >= f.loops.size())
+    throw Error(ErrorCategory::InvalidArgument, "loop_area: " + face_name(model, face) +
+                                                    " has no loop " + std::to_string(loop) +
+                                                    "; it has " + std::to_string(f.loops.size()));
+  for (size_t c = 0; c < f.loops[static_cast<size_t>(loop)].coedges.size(); ++c)
+    if (auto bad = coedge_problems(model, face, loop, static_cast<int>(c)); !bad.empty())
+      internal::throw_problems(ErrorCategory::InvalidGeometry, bad);
+  return signed_area(model, f.loops[static_cast<size_t>(loop)]);
 }
 
 std::vector<std::string> problems(const Model& model) {

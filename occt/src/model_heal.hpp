@@ -4,7 +4,9 @@
 // library; each step returns what it did, for the read report.
 #include <clay/brep/model.hpp>
 
+#include <optional>
 #include <string>
+#include <utility>
 
 namespace clay::brep::detail {
 
@@ -37,5 +39,23 @@ PulledPcurves pull_pcurves_into_domains(Model& model);
 
 /// The report's words for `pulled` ("" when nothing was pulled).
 std::string describe(const PulledPcurves& pulled);
+
+/// Puts each face's outer loop first where the reader's order has a hole there: a face whose
+/// first loop runs clockwise in (u, v) while exactly one other loop runs counter-clockwise has
+/// that loop moved to the front (the others keep their order). OpenCASCADE's
+/// BRepTools::OuterWire picks the outer wire by its pcurves' boxes, and a pcurve 0.1 rad off near
+/// a sphere's pole (Alibre's s1) made it pick a hole. Faces whose loops cannot be measured are
+/// left for problems() to name. Returns how many faces were changed.
+int outer_loops_first(Model& model);
+
+/// The pcurve of `edge` on `surface` re-derived from the edge: its points projected onto the
+/// surface (Newton from `old` at the same parameter, else the closest point), interpolated by
+/// cubics piece by piece between the edge's knots and where the projection crosses the surface's
+/// knot lines, a piece halved until the face along it is within `fit_tol` of the projection.
+/// Returns the pcurve and the largest gap between the face along it and the edge; nullopt when
+/// the edge leaves the face by more than `accepted` or no fit is found.
+std::optional<std::pair<surface::BSplineCurve, double>> pcurve_from_edge(
+    const surface::BSplineSurface& surface, const Edge& edge, const surface::BSplineCurve& old,
+    double accepted, double fit_tol);
 
 }  // namespace clay::brep::detail

@@ -10,7 +10,6 @@
 #include <clay/internal/format.hpp>
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
-#include <clay/surface/projection.hpp>
 
 #include <algorithm>
 #include <array>
@@ -38,8 +37,7 @@
 #include <BRep_Builder.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
-#include <Geom2dAPI_Interpolate.hxx>
-#include <Geom2d_BSplineCurve.hxx>
+#include <Geom2d_Curve.hxx>
 #include <Geom_BSplineCurve.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESControl_Controller.hxx>
@@ -54,8 +52,6 @@
 #include <ShapeFix_Solid.hxx>
 #include <StepData_StepModel.hxx>
 #include <StepData_UndefinedEntity.hxx>
-#include <TColStd_HArray1OfReal.hxx>
-#include <TColgp_HArray1OfPnt2d.hxx>
 #include <TCollection_AsciiString.hxx>
 #include <TDF_Label.hxx>
 #include <TDF_LabelSequence.hxx>
@@ -176,6 +172,10 @@ class ModelBuilder {
     if (const auto pulled = pull_pcurves_into_domains(model_); pulled.count > 0)
       report_.healing.push_back(describe(pulled));
     raise_tolerances_to_gaps();
+    if (const int turned = outer_loops_first(model_); turned > 0)
+      report_.healing.push_back("took the counter-clockwise loop as the outer loop of " +
+                                std::to_string(turned) + (turned == 1 ? " face" : " faces") +
+                                " (OpenCASCADE's OuterWire had chosen a hole)");
     if (faces_enclosing_nothing_ > 0)
       report_.healing.push_back(
           "kept " + std::to_string(faces_enclosing_nothing_) +
@@ -274,7 +274,8 @@ class ModelBuilder {
       Face& face = model_.faces[static_cast<std::size_t>(g.face)];
       Coedge& coedge =
           face.loops[static_cast<std::size_t>(g.loop)].coedges[static_cast<std::size_t>(g.coedge)];
-      if (auto fitted = pcurve_from_edge(face.surface, edge, coedge.pcurve, accepted)) {
+      if (auto fitted =
+              pcurve_from_edge(face.surface, edge, coedge.pcurve, accepted, fit_relative * size_)) {
         coedge.pcurve = std::move(fitted->first);
         worst_fit = std::max(worst_fit, fitted->second);
         worst_before = std::max(worst_before, g.gap_mm);
@@ -288,91 +289,6 @@ class ModelBuilder {
           " (parametrized unlike their edges: gaps up to " + shortest(worst_before) +
           " mm at equal parameters, " + shortest(worst_fit) + " mm after)");
     return replaced > 0;
-  }
-
-  /// The pcurve of `edge` on `surface` by projection (see rederive_pcurves_from_edges), with its
-  /// largest measured gap; nullopt when the edge leaves the face by more than `accepted` or no
-  /// fit within fit_relative of the size is found.
-  std::optional<std::pair<surface::BSplineCurve, double>> pcurve_from_edge(
-      const surface::BSplineSurface& surface, const Edge& edge, const surface::BSplineCurve& old,
-      double accepted) const {
-    const double fit_tol = fit_relative * size_;
-    std::vector<double> breaks{edge.t0};
-    for (double k : edge.curve.basis.knots)
-      if (k - breaks.back() > 1e-9 * (edge.t1 - edge.t0) &&
-          edge.t1 - k > 1e-9 * (edge.t1 - edge.t0))
-        breaks.push_back(k);
-    breaks.push_back(edge.t1);
-    bool off_face = false;
-    // Plain copies: Clang 14 refuses structured bindings captured by lambdas.
-    const double u0 = surface.u.domain().first, u1 = surface.u.domain().second;
-    const double v0 = surface.v.domain().first, v1 = surface.v.domain().second;
-    const surface::SurfaceProjector projector(surface);  // validated once, not per point
-    auto foot = [&](double t) {
-      const Eigen::Vector3d point = surface::evaluate(edge.curve, t);
-      const Eigen::Vector3d start = surface::evaluate(old, t);
-      // Pcurves reach rounding outside the domain (v = -1e-20 on the I-DEAS cone).
-      const auto p = projector.project_normal(point, std::clamp(start.x(), u0, u1),
-                                              std::clamp(start.y(), v0, v1));
-      off_face = off_face || !(p.distance <= accepted);
-      return gp_Pnt2d(p.u, p.v);
-    };
-    std::vector<Handle(Geom2d_BSplineCurve)> pieces;
-    double worst = 0;
-    try {
-      // Breaks also where the foot crosses a knot line of the surface (span_changes).
-      const auto crossings = span_changes(
-          [&](double t) {
-            const gp_Pnt2d uv = foot(t);
-            const auto& ku = surface.u.knots;
-            const auto& kv = surface.v.knots;
-            return std::pair<long, long>(
-                std::upper_bound(ku.begin(), ku.end(), uv.X()) - ku.begin(),
-                std::upper_bound(kv.begin(), kv.end(), uv.Y()) - kv.begin());
-          },
-          edge.t0, edge.t1);
-      breaks.insert(breaks.end() - 1, crossings.begin(), crossings.end());
-      std::sort(breaks.begin(), breaks.end());
-      breaks.erase(
-          std::unique(breaks.begin(), breaks.end(),
-                      [&](double x, double y) { return y - x <= 1e-9 * (edge.t1 - edge.t0); }),
-          breaks.end());
-      breaks.back() = edge.t1;
-      for (std::size_t k = 0; k + 1 < breaks.size(); ++k) {
-        const double a = breaks[k], b = breaks[k + 1];
-        Handle(Geom2d_BSplineCurve) piece;
-        double error = 0;
-        for (int samples = 8;; samples *= 2) {
-          if (samples > 1024 || off_face) return std::nullopt;
-          Handle(TColgp_HArray1OfPnt2d) points = new TColgp_HArray1OfPnt2d(1, samples + 1);
-          Handle(TColStd_HArray1OfReal) parameters = new TColStd_HArray1OfReal(1, samples + 1);
-          for (int i = 0; i <= samples; ++i) {
-            const double t = i == samples ? b : a + (b - a) * i / samples;
-            points->SetValue(i + 1, foot(t));
-            parameters->SetValue(i + 1, t);
-          }
-          Geom2dAPI_Interpolate interpolate(points, parameters, false, 1e-15);
-          interpolate.Perform();
-          if (!interpolate.IsDone()) continue;
-          piece = interpolate.Curve();
-          error = 0;
-          for (int i = 0; i <= 4 * samples; ++i) {
-            const double t = a + (b - a) * i / (4 * samples);
-            const gp_Pnt2d uv = piece->Value(t);  // within rounding of the domain
-            error = std::max(error, (surface::evaluate(surface, std::clamp(uv.X(), u0, u1),
-                                                       std::clamp(uv.Y(), v0, v1)) -
-                                     surface::evaluate(edge.curve, t))
-                                        .norm());
-          }
-          if (error <= fit_tol) break;
-        }
-        worst = std::max(worst, error);
-        pieces.push_back(piece);
-      }
-    } catch (const Error&) {
-      return std::nullopt;  // a projection outside the domain: left for problems() to name
-    }
-    return std::pair{joined(pieces), worst};
   }
 
   /// The part of a label (a simple shape or an assembly), converted once.

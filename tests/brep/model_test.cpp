@@ -227,6 +227,32 @@ TEST_CASE("a face with a hole: the outer loop counter-clockwise, the hole clockw
                             "(signed area 0.25)"));
 }
 
+TEST_CASE("loop_area gives each loop's signed area in (u, v), named errors out of range",
+          "[brep]") {
+  Builder b;
+  plate_with_hole(b, 0);
+  // The unit square counter-clockwise, the hole [0.25, 0.75]^2 clockwise (closed forms).
+  CHECK(clay::brep::loop_area(b.m, 0, 0) == Approx(1).epsilon(1e-14));
+  CHECK(clay::brep::loop_area(b.m, 0, 1) == Approx(-0.25).epsilon(1e-14));
+  Model flipped = b.m;
+  Loop& hole = flipped.faces[0].loops[1];
+  std::reverse(hole.coedges.begin(), hole.coedges.end());
+  for (Coedge& co : hole.coedges) co.same_sense = !co.same_sense;
+  CHECK(clay::brep::loop_area(flipped, 0, 1) == Approx(0.25).epsilon(1e-14));
+  const auto [face_category, face_message] =
+      clay::test::error_of([&] { (void)clay::brep::loop_area(b.m, 3, 0); });
+  CHECK(face_category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(face_message, Contains("face 3 does not exist; the model has 1 faces"));
+  const auto [loop_category, loop_message] =
+      clay::test::error_of([&] { (void)clay::brep::loop_area(b.m, 0, 2); });
+  CHECK(loop_category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(loop_message, Contains("has no loop 2; it has 2"));
+  Model broken = b.m;
+  broken.faces[0].loops[1].coedges[0].edge = 99;
+  CHECK(clay::test::error_of([&] { (void)clay::brep::loop_area(broken, 0, 1); }).first ==
+        clay::ErrorCategory::InvalidGeometry);
+}
+
 TEST_CASE("a pole: a degenerate edge stands at its vertex", "[brep]") {
   // A triangle as a bilinear patch whose side v = 1 collapses to the apex.
   Model m;
@@ -344,11 +370,12 @@ TEST_CASE("volume_mm3 of a cube, a translated cube and a cube with a face turned
   CHECK(clay::brep::volume_mm3(b.m) == 0);  // no solid
   CHECK(clay::test::error_of([&] { (void)clay::brep::volume_mm3(b.m, 1); }).first ==
         clay::ErrorCategory::InvalidArgument);
-  // Every body at once: the cube's a^3, and the sheet's signed flux, as one at a time.
+  // Every body at once: the cube's a^3; a sheet's faces are not integrated (a surface model's
+  // large trimmed sheets may not converge, and their flux depends on the origin): 0.
   const std::vector<double> one = clay::brep::body_volumes_mm3(cube(10));
   REQUIRE(one.size() == 1);
   CHECK(one[0] == Approx(1000).epsilon(1e-14));
-  CHECK(clay::brep::body_volumes_mm3(b.m) == std::vector<double>{clay::brep::volume_mm3(b.m, 0)});
+  CHECK(clay::brep::body_volumes_mm3(b.m) == std::vector<double>{0.0});
   Model turned = cube(10);
   turned.faces[1].reversed = true;  // inside out: refused, like volume_mm3
   CHECK(clay::test::error_of([&] { (void)clay::brep::body_volumes_mm3(turned); }).first ==
@@ -390,8 +417,62 @@ TEST_CASE("volume_mm3 ends on a face with an extreme weight, exact or refused, n
                  Contains("the volume did not converge on 1 face(s) (0) within its budget"));
       CHECK(w >= 1e6);
     }
+    // A sheet has no volume: its faces are not integrated, so it is never refused (WiZ WORX's
+    // surface model was refused for a sheet face that did not converge).
+    CHECK(clay::brep::body_volumes_mm3(m) == std::vector<double>{0.0});
+    CHECK(clay::brep::volume_mm3(m) == 0);
     CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(30));
   }
+}
+
+TEST_CASE("volume_mm3 integrates across a C0 knot line that a loop crosses", "[brep]") {
+  // Issue #39 (Alias's k1 key): the loop integrand z (x_u y_v - x_v y_u) v'(t) jumps where a
+  // pcurve crosses a C0 knot line in v, and an adaptive rule halving its tolerance with the
+  // interval never met it there. The plane z = 4 over [0, 10]^2 with y(v) broken at v = 0.3
+  // (y = 2 there: the v speed jumps from 6.7 to 11.4; not at a bisection point of [0, 1]); its
+  // flux of (0, 0, z) is 4 x 100.
+  using clay::surface::make_curve;
+  Model m;
+  clay::surface::Points3 p(6, 3);  // (i, j) at row 3 i + j: x = 10 i, y in {0, 2, 10}
+  const double ys[3] = {0, 2, 10};
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 3; ++j) p.row(3 * i + j) = Vector3d(10.0 * i, ys[j], 4);
+  Face face;
+  face.surface = clay::surface::make_surface({1, {0, 0, 1, 1}}, {1, {0, 0, 0.3, 1, 1}}, p);
+  m.vertices = {{{0, 0, 4}, 1e-9}, {{10, 0, 4}, 1e-9}, {{10, 10, 4}, 1e-9}, {{0, 10, 4}, 1e-9}};
+  auto polyline = [](std::vector<double> knots, std::vector<Vector3d> points) {
+    clay::surface::Points3 q(static_cast<Eigen::Index>(points.size()), 3);
+    for (std::size_t k = 0; k < points.size(); ++k) q.row(static_cast<Eigen::Index>(k)) = points[k];
+    return make_curve(1, std::move(knots), q);
+  };
+  const std::vector<double> side_knots{0, 0, 0.3, 1, 1}, line_knots{0, 0, 1, 1};
+  auto edge = [&](int a, int b, clay::surface::BSplineCurve c) {
+    Edge e;
+    e.curve = std::move(c);
+    e.start = a;
+    e.end = b;
+    e.tolerance_mm = 1e-9;
+    m.edges.push_back(e);
+  };
+  // Edges in t = u along v = 0 and v = 1, t = v along u = 0 and u = 1 (y broken like the face).
+  edge(0, 1, polyline(line_knots, {{0, 0, 4}, {10, 0, 4}}));
+  edge(1, 2, polyline(side_knots, {{10, 0, 4}, {10, 2, 4}, {10, 10, 4}}));
+  edge(3, 2, polyline(line_knots, {{0, 10, 4}, {10, 10, 4}}));
+  edge(0, 3, polyline(side_knots, {{0, 0, 4}, {0, 2, 4}, {0, 10, 4}}));
+  Loop loop;
+  loop.coedges.push_back({0, true, polyline(line_knots, {{0, 0, 0}, {1, 0, 0}})});
+  loop.coedges.push_back({1, true, polyline(line_knots, {{1, 0, 0}, {1, 1, 0}})});
+  loop.coedges.push_back({2, false, polyline(line_knots, {{0, 1, 0}, {1, 1, 0}})});
+  loop.coedges.push_back({3, false, polyline(line_knots, {{0, 0, 0}, {0, 1, 0}})});
+  face.loops.push_back(loop);
+  m.faces.push_back(face);
+  Body sheet;
+  sheet.kind = BodyKind::Sheet;
+  sheet.shells.push_back({{0}});
+  m.bodies.push_back(sheet);
+  INFO(all(clay::brep::problems(m)));
+  REQUIRE(clay::brep::problems(m).empty());
+  CHECK(clay::brep::volume_mm3(m, 0) == Approx(400).epsilon(1e-13));
 }
 
 TEST_CASE("flattened places every instance of an assembly as a body of its own", "[brep]") {

@@ -188,6 +188,12 @@ struct EdgeGap {
 /// InvalidGeometry when a coedge's indices or curves are invalid (see problems()).
 CLAY_BREP_API std::vector<EdgeGap> edge_gaps(const Model& model, int samples_per_span = 16);
 
+/// The signed area in (u, v) of loop `loop` of face `face`: the polygon through 8 samples per
+/// knot span of each coedge's pcurve, in loop order; positive when it runs counter-clockwise
+/// (an outer loop), negative for a hole. Throws InvalidArgument for indices out of range,
+/// InvalidGeometry when a coedge's data is invalid (see problems()).
+CLAY_BREP_API double loop_area(const Model& model, int face, int loop);
+
 /// Every invariant the model breaks, in words, each naming the body, face, loop, coedge, edge or
 /// vertex. Empty when valid:
 /// - indices in range; surfaces, curves and pcurves valid; pcurves in the plane z = 0 and inside

@@ -24,8 +24,9 @@ namespace clay::brep {
 /// breaks an invariant (validate).
 CLAY_BREP_API double volume_mm3(const Model& model, int body);
 
-/// The signed volume of every body (indexed like model.bodies; meaningful for solids), the faces
-/// integrated on the hardware's threads (the result does not depend on them). Throws
+/// The signed volume of every solid (indexed like model.bodies; 0 for a sheet or wire body, whose
+/// faces are not integrated), the faces integrated on the hardware's threads (the result does not
+/// depend on them). Throws
 /// clay::Error(InvalidGeometry) when the model breaks an invariant (validate).
 CLAY_BREP_API std::vector<double> body_volumes_mm3(const Model& model);
 
