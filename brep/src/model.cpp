@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 #include <tuple>
@@ -600,6 +601,31 @@ std::vector<std::string> problems(const Model& model) {
   shell_problems(model, out);
   assembly_problems(model, out);
   return out;
+}
+
+Box control_box(const Model& model, const std::vector<int>& faces) {
+  const Model flat = flattened(model);
+  if (flat.faces.empty())
+    throw Error(ErrorCategory::InvalidArgument,
+                "control_box: the model has no face; read or build one with faces first");
+  std::vector<int> chosen = faces;
+  if (chosen.empty())
+    for (size_t f = 0; f < flat.faces.size(); ++f) chosen.push_back(static_cast<int>(f));
+  Box box{Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
+          Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity())};
+  for (int f : chosen) {
+    if (f < 0 || static_cast<size_t>(f) >= flat.faces.size())
+      throw Error(ErrorCategory::InvalidArgument,
+                  "control_box: face " + std::to_string(f) + " does not exist; the model has " +
+                      std::to_string(flat.faces.size()) +
+                      " faces (indices into the flattened model, from 0)");
+    const surface::Points3& p = flat.faces[static_cast<size_t>(f)].surface.points;
+    for (Eigen::Index r = 0; r < p.rows(); ++r) {
+      box.lo = box.lo.cwiseMin(p.row(r).transpose());
+      box.hi = box.hi.cwiseMax(p.row(r).transpose());
+    }
+  }
+  return box;
 }
 
 Model flattened(const Model& model) {

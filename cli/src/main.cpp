@@ -76,7 +76,8 @@ std::string knots_summary(const BSplineBasis& b) {
 /// The whole model of a STEP or IGES file (brep::read_model), read in a child process
 /// (ReadOptions::isolate): a file that crashes or hangs OpenCASCADE ends in exit code 6 and a
 /// message, never in a signal.
-clay::brep::ImportedModel read_model_file(const fs::path& file, const char* command) {
+clay::brep::ImportedModel read_model_file(const fs::path& file, const char* command,
+                                          bool strict = false) {
   std::string ext = file.extension().string();
   for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (ext != ".step" && ext != ".stp" && ext != ".igs" && ext != ".iges")
@@ -85,6 +86,7 @@ clay::brep::ImportedModel read_model_file(const fs::path& file, const char* comm
                           "'; give a .step/.stp or .igs/.iges file");
   clay::brep::ModelReadOptions options;
   options.read.isolate = true;
+  options.strict = strict;
   return clay::brep::read_model(file, options);
 }
 
@@ -137,8 +139,8 @@ void print_continuity(const clay::brep::Model& m) {
 /// `clayform info FILE`: the topology of a STEP or IGES file (bodies, shells, trimmed faces and
 /// holes, the assembly tree with names), OpenCASCADE's verdict, each face's surface, and how the
 /// faces meet along their edges.
-int info(const fs::path& file) {
-  const clay::brep::ImportedModel read = read_model_file(file, "info");
+int info(const fs::path& file, bool strict) {
+  const clay::brep::ImportedModel read = read_model_file(file, "info", strict);
   const clay::brep::Model& m = read.model;
   int max_degree = 0;
   long control_points = 0;
@@ -305,11 +307,11 @@ int finish(clay::recipe::RunResult& result, const fs::path& out) {
 /// faces, solids, assembly) through the recipe's deformation stack, written as a valid model.
 int deform_model_file(const fs::path& file, const fs::path& recipe_file,
                       const std::string& deformation, const fs::path& out, bool show,
-                      bool allow_fold, const std::string& profile) {
+                      bool allow_fold, const std::string& profile, bool strict) {
   const auto recipe = clay::recipe::load_recipe(recipe_file);
   if (!profile.empty()) clay::deform::receiver_profile(profile);  // a typo fails at once
   const auto start = std::chrono::steady_clock::now();
-  const clay::brep::ImportedModel read = read_model_file(file, "deform");
+  const clay::brep::ImportedModel read = read_model_file(file, "deform", strict);
   if (show) std::printf("read %s: %s\n", file.string().c_str(), read.report.brief().c_str());
   if (!read.report.problems.empty()) {
     std::string m = "deform: the model of '" + file.string() + "' breaks " +
@@ -545,6 +547,11 @@ int main(int argc, char** argv) {
                                       "List the surfaces of a STEP or IGES file: degrees, "
                                       "control points, knots, rational, box, validity");
   info_cmd->add_option("FILE", file, "a .step/.stp or .igs/.iges file")->required();
+  bool strict = false;
+  const char* strict_help =
+      "read as before issue #39's healing: pcurves outside their domains, gaps wider than the "
+      "file's tolerances and misordered loops are listed as problems, not healed";
+  info_cmd->add_flag("--strict", strict, strict_help);
   std::string recipe_file, out_dir, deformation;
   bool quiet = false, progress = false;
   auto* run_cmd = app.add_subcommand(
@@ -584,6 +591,7 @@ int main(int argc, char** argv) {
                          "write the model for this receiver: exact, opencascade, catia, class_a "
                          "or bicubic; the faces it would not take are refitted to it with their "
                          "edges (default: none, faces above degree 25 refitted)");
+  deform_cmd->add_flag("--strict", strict, strict_help);
   deform_cmd->add_flag("--quiet", quiet, "no progress lines");
   deform_cmd->add_flag("--progress", progress, "progress lines even when stdout is not a terminal");
   // clayform render
@@ -699,7 +707,7 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 1;
   }
   try {
-    if (*info_cmd) return info(file);
+    if (*info_cmd) return info(file, strict);
     if (*sweep_cmd) return run_sweep(sweep_spec, out_dir, executor, workers, scheduler);
     if (*studio_cmd) return studio(studio_recipe, studio_port, studio_fresh);
     if (*render_cmd) {
@@ -739,7 +747,8 @@ int main(int argc, char** argv) {
       return finish(result, out_dir);
     }
     if (*deform_cmd)
-      return deform_model_file(file, recipe_file, deformation, out_dir, show, allow_fold, profile);
+      return deform_model_file(file, recipe_file, deformation, out_dir, show, allow_fold, profile,
+                               strict);
   } catch (const clay::Error& e) {
     std::fprintf(stderr, "clayform: %s\n", e.what());
     return exit_code(e.category());

@@ -166,4 +166,86 @@ double max_abs_coefficient(const Poly& g) {
   return m;
 }
 
+namespace {
+
+/// Sign changes of a coefficient sequence, zeros skipped (Descartes' rule for the Bernstein form:
+/// the number of roots in the open interval is at most this, and of the same parity).
+int sign_changes(const std::vector<double>& b) {
+  int changes = 0;
+  double last = 0;
+  for (double x : b) {
+    if (x == 0) continue;
+    if (last != 0 && (x < 0) != (last < 0)) ++changes;
+    last = x;
+  }
+  return changes;
+}
+
+/// Value of a univariate Bernstein polynomial at x (de Casteljau).
+double bernstein_value(std::vector<double> w, double x) {
+  const size_t p = w.size() - 1;
+  for (size_t l = 1; l <= p; ++l)
+    for (size_t k = 0; k + l <= p; ++k) w[k] = (1 - x) * w[k] + x * w[k + 1];
+  return w[0];
+}
+
+/// Isolates the roots of `b` (Bernstein coefficients on [a, c]) by halving: no sign change, no
+/// root; one sign change between non-zero ends, exactly one root, refined by bisection to
+/// rounding; otherwise halve. An interval narrower than 1e-13 still showing several changes holds
+/// a cluster (a double root: the surface touches the plane along an iso-line): one root, its
+/// middle — a split there is harmless.
+void isolate(const std::vector<double>& b, double a, double c, std::vector<double>& out) {
+  const int changes = sign_changes(b);
+  if (changes == 0) return;
+  if (changes == 1 && b.front() != 0 && b.back() != 0) {
+    double lo = 0, hi = 1;
+    const bool rising = b.front() < 0;
+    for (int it = 0; it < 200; ++it) {
+      const double m = 0.5 * (lo + hi);
+      if (m <= lo || m >= hi) break;
+      const double f = bernstein_value(b, m);
+      if (f == 0) {
+        lo = hi = m;
+        break;
+      }
+      if ((f < 0) == rising)
+        lo = m;
+      else
+        hi = m;
+    }
+    out.push_back(a + 0.5 * (lo + hi) * (c - a));
+    return;
+  }
+  const double m = 0.5 * (a + c);
+  if (c - a <= 1e-13 || m <= a || m >= c) {
+    out.push_back(m);
+    return;
+  }
+  const size_t p = b.size() - 1;
+  std::vector<double> w = b, left(p + 1), right(p + 1);
+  left[0] = w[0];
+  right[p] = w[p];
+  for (size_t l = 1; l <= p; ++l) {
+    for (size_t k = 0; k + l <= p; ++k) w[k] = 0.5 * (w[k] + w[k + 1]);
+    left[l] = w[0];
+    right[p - l] = w[p - l];
+  }
+  isolate(left, a, m, out);
+  if (right[0] == 0) out.push_back(m);
+  isolate(right, m, c, out);
+}
+
+}  // namespace
+
+/// Roots in (0, 1) of the univariate Bernstein polynomial `b`, each isolated with certainty
+/// (isolate above): two crossings closer than any sampling step are both found.
+std::vector<double> bernstein_roots(const std::vector<double>& b) {
+  std::vector<double> out;
+  isolate(b, 0, 1, out);
+  std::sort(out.begin(), out.end());
+  out.erase(std::remove_if(out.begin(), out.end(), [](double x) { return !(x > 0 && x < 1); }),
+            out.end());
+  return out;
+}
+
 }  // namespace clay::deform::detail

@@ -90,4 +90,10 @@ Poly derivative(const Poly& g, int dir);
 double max_coefficient(const Poly& g);
 double max_abs_coefficient(const Poly& g);
 
+/// Roots in (0, 1) of the univariate Bernstein polynomial `b` (its coefficients on [0, 1]),
+/// increasing, each isolated with certainty by halving (Descartes' rule of signs) and refined by
+/// bisection to rounding: two crossings closer than any sampling step are both found. A cluster
+/// narrower than 1e-13 (a double root) counts once, at its middle.
+std::vector<double> bernstein_roots(const std::vector<double>& b);
+
 }  // namespace clay::deform::detail

@@ -519,84 +519,6 @@ double lattice_size(const Points3& points) {
   return (points.colwise().maxCoeff() - points.colwise().minCoeff()).norm();
 }
 
-/// Sign changes of a coefficient sequence, zeros skipped (Descartes' rule for the Bernstein form:
-/// the number of roots in the open interval is at most this, and of the same parity).
-int sign_changes(const std::vector<double>& b) {
-  int changes = 0;
-  double last = 0;
-  for (double x : b) {
-    if (x == 0) continue;
-    if (last != 0 && (x < 0) != (last < 0)) ++changes;
-    last = x;
-  }
-  return changes;
-}
-
-/// Value of a univariate Bernstein polynomial at x (de Casteljau).
-double bernstein_value(std::vector<double> w, double x) {
-  const size_t p = w.size() - 1;
-  for (size_t l = 1; l <= p; ++l)
-    for (size_t k = 0; k + l <= p; ++k) w[k] = (1 - x) * w[k] + x * w[k + 1];
-  return w[0];
-}
-
-/// Isolates the roots of `b` (Bernstein coefficients on [a, c]) by halving: no sign change, no
-/// root; one sign change between non-zero ends, exactly one root, refined by bisection to
-/// rounding; otherwise halve. An interval narrower than 1e-13 still showing several changes holds
-/// a cluster (a double root: the surface touches the plane along an iso-line): one root, its
-/// middle — a split there is harmless.
-void isolate(const std::vector<double>& b, double a, double c, std::vector<double>& out) {
-  const int changes = sign_changes(b);
-  if (changes == 0) return;
-  if (changes == 1 && b.front() != 0 && b.back() != 0) {
-    double lo = 0, hi = 1;
-    const bool rising = b.front() < 0;
-    for (int it = 0; it < 200; ++it) {
-      const double m = 0.5 * (lo + hi);
-      if (m <= lo || m >= hi) break;
-      const double f = bernstein_value(b, m);
-      if (f == 0) {
-        lo = hi = m;
-        break;
-      }
-      if ((f < 0) == rising)
-        lo = m;
-      else
-        hi = m;
-    }
-    out.push_back(a + 0.5 * (lo + hi) * (c - a));
-    return;
-  }
-  const double m = 0.5 * (a + c);
-  if (c - a <= 1e-13 || m <= a || m >= c) {
-    out.push_back(m);
-    return;
-  }
-  const size_t p = b.size() - 1;
-  std::vector<double> w = b, left(p + 1), right(p + 1);
-  left[0] = w[0];
-  right[p] = w[p];
-  for (size_t l = 1; l <= p; ++l) {
-    for (size_t k = 0; k + l <= p; ++k) w[k] = 0.5 * (w[k] + w[k + 1]);
-    left[l] = w[0];
-    right[p - l] = w[p - l];
-  }
-  isolate(left, a, m, out);
-  if (right[0] == 0) out.push_back(m);
-  isolate(right, m, c, out);
-}
-
-/// Roots in (0, 1) of the univariate Bernstein polynomial `b`, each isolated with certainty
-/// (isolate above): two crossings closer than any sampling step are both found.
-std::vector<double> roots(const std::vector<double>& b) {
-  std::vector<double> out;
-  isolate(b, 0, 1, out);
-  std::sort(out.begin(), out.end());
-  out.erase(std::remove_if(out.begin(), out.end(), [](double x) { return !(x > 0 && x < 1); }),
-            out.end());
-  return out;
-}
-
 /// Splits `surface` where a local coordinate that depends on one surface parameter only crosses
 /// an interior knot plane of the lattice (HHK lattices meet the surface along iso-lines there):
 /// knots inserted to full multiplicity. Returns the split surface, the number of knots added and
@@ -646,7 +568,7 @@ std::tuple<BSplineSurface, int, detail::PlaneCrossings> split_at_planes(
             std::vector<double> h(static_cast<size_t>(p + 1));
             for (int k = 0; k <= p; ++k)
               h[static_cast<size_t>(k)] = get(c, k, 0) - br[plane] * get(pc.w, k, 0);
-            for (double x : roots(h)) {
+            for (double x : detail::bernstein_roots(h)) {
               const double t = x0 + x * (x1 - x0);
               if (t - x0 > 1e-13 * (x1 - x0) && x1 - t > 1e-13 * (x1 - x0))
                 cuts[static_cast<size_t>(dir)].push_back(t);
@@ -874,12 +796,45 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
             "use a lattice of lower degree (e.g. in the thickness direction), or approximate "
             "the deformed surface with a refit tolerance (certified refit)");
     }
+  // A rational patch's homogeneous weight is W^t, t the degree its route composes with: the
+  // tensor product's, or a cell's true total degree by monomials (lower where the cell is
+  // undisplaced, affine). Neighbouring patches composed with different t are the same rational
+  // surface with different homogeneous points, and joining them fails (a rational fillet under
+  // a bulged B-spline lattice, issue #39). So when the patches' t differ, every patch takes the
+  // tensor route, whose t is the same in every cell.
+  bool tensor_only = false;
+  if (rational) {
+    auto power = [&](size_t k) {
+      const LatticeMonomials& lm = monomials_of.at(cell_of[k]);
+      return by_monomials(factors[k], *cell_of[k], lm) ? varying_degree(factors[k], lm) : -1;
+    };
+    for (size_t k = 1; k < bp.patches.size() && !tensor_only; ++k)
+      tensor_only = power(k) != power(0);
+  }
+  if (tensor_only) {
+    too_high.clear();
+    for (size_t k = 0; k < bp.patches.size(); ++k) {
+      degrees[k] = composed_degrees(factors[k], cell_of[k]->degrees);
+      const auto [du, dv] = degrees[k];
+      if (std::max(du, dv) > options.max_degree && too_high.empty()) {
+        const int a = static_cast<int>(k) / bp.count_v(), b = static_cast<int>(k) % bp.count_v();
+        too_high = degree_message(
+            du, dv, options.max_degree,
+            "of rational surface " + patch_name(bp, a, b) +
+                " with a B-spline lattice whose cells differ in degree",
+            "use a lattice of lower degree, or approximate the deformed surface with a refit "
+            "tolerance (certified refit)");
+      }
+    }
+  }
   detail::check_size(
       detail::predicted_size(surface, bp, degrees, planes, detail::lattice_continuity(lattice)),
       options, too_high);
   std::vector<ComposedPatch> patches(bp.patches.size());
   for (size_t k = 0; k < patches.size(); ++k)
-    patches[k] = compose_cell(*cell_of[k], monomials_of.at(cell_of[k]), factors[k], rational);
+    patches[k] = tensor_only
+                     ? compose_patch(*cell_of[k], factors[k], rational)
+                     : compose_cell(*cell_of[k], monomials_of.at(cell_of[k]), factors[k], rational);
   return finish(
       bp, patches, rational, split,
       [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); },

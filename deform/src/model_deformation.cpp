@@ -9,11 +9,14 @@
 #include <clay/internal/format.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/evaluate.hpp>
+#include <clay/surface/knots.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <variant>
@@ -109,6 +112,28 @@ surface::BSplineCurve row_zero(const surface::BSplineSurface& s) {
     weights[i] = s.weights[s.index(i, 0)];
   }
   return surface::make_curve(s.u.degree, s.u.knots, std::move(points), std::move(weights));
+}
+
+/// The box [u0, u1, v0, v1] of a trimmed face's pcurves' control points (which holds the
+/// pcurves: convex hull property) within its surface's domain, when it is smaller than the
+/// domain; nullopt for an untrimmed face or one whose trims span the whole domain.
+std::optional<std::array<double, 4>> trims_box(const brep::Face& face) {
+  if (face.loops.empty()) return std::nullopt;
+  const auto [a, b] = face.surface.u.domain();
+  const auto [c, d] = face.surface.v.domain();
+  std::array<double, 4> box{b, a, d, c};
+  for (const brep::Loop& loop : face.loops)
+    for (const brep::Coedge& co : loop.coedges)
+      for (Eigen::Index r = 0; r < co.pcurve.points.rows(); ++r) {
+        box[0] = std::min(box[0], co.pcurve.points(r, 0));
+        box[1] = std::max(box[1], co.pcurve.points(r, 0));
+        box[2] = std::min(box[2], co.pcurve.points(r, 1));
+        box[3] = std::max(box[3], co.pcurve.points(r, 1));
+      }
+  box = {std::max(box[0], a), std::min(box[1], b), std::max(box[2], c), std::min(box[3], d)};
+  if (!(box[0] < box[1] && box[2] < box[3])) return std::nullopt;
+  if (box[0] == a && box[1] == b && box[2] == c && box[3] == d) return std::nullopt;
+  return box;
 }
 
 struct Outcome {
@@ -321,6 +346,9 @@ std::string ModelDeformationReport::brief() const {
   }
   if (solids_reversed > 0)
     line += "; " + std::to_string(solids_reversed) + " solids reversed (mirroring stack)";
+  if (faces_restricted > 0)
+    line += "; " + std::to_string(faces_restricted) +
+            " faces composed on the part of their surface their trims use";
   return line;
 }
 
@@ -385,8 +413,19 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
       }
       continue;
     }
-    faces[f] = deform_one(&stack, face.surface, options, face_name(m, f),
-                          matched_edges(m, face, orders, options));
+    try {
+      faces[f] = deform_one(&stack, face.surface, options, face_name(m, f),
+                            matched_edges(m, face, orders, options));
+    } catch (const Error& e) {
+      // A trimmed face inside the lattice on a carrier that leaves it (a large plane or
+      // B-spline): composed on the part of the carrier its trims use (issue #39 item 7).
+      const auto box = e.category() == ErrorCategory::OutOfDomain ? trims_box(face) : std::nullopt;
+      if (!box) throw;
+      face.surface = surface::restricted(face.surface, (*box)[0], (*box)[1], (*box)[2], (*box)[3]);
+      faces[f] = deform_one(&stack, face.surface, options, face_name(m, f),
+                            matched_edges(m, face, orders, options));
+      ++report.faces_restricted;
+    }
     face.elementary.reset();  // no longer a plane, cylinder, ...: only untouched faces keep it
     (faces[f].way == Outcome::Way::Exact ? report.faces_exact : report.faces_refit) += 1;
     report.max_certified_bound_mm = std::max(report.max_certified_bound_mm, faces[f].bound);
@@ -571,6 +610,30 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   report.summary.final_residual = report.max_edge_gap_mm;
   report.summary.message = report.brief();
   return result;
+}
+
+Frame frame_around(const brep::Model& model, double margin, const std::vector<int>& faces) {
+  if (!(margin > 0 && margin <= 10))
+    throw Error(ErrorCategory::InvalidArgument,
+                "frame_around: margin " + shortest(margin) +
+                    " must lie in (0, 10] (a fraction of the box's extent on each side; 0.05 "
+                    "by default): the control points must lie strictly inside the lattice");
+  const brep::Box box = brep::control_box(model, faces);
+  const Eigen::Vector3d extent = box.hi - box.lo;
+  // An axis thinner than a tenth of the diagonal grows as if it were that thick: a flat panel
+  // still gets a lattice with volume to move its points in.
+  const double thinnest = 0.1 * extent.norm();
+  Eigen::Vector3d pad;
+  for (int k = 0; k < 3; ++k) pad[k] = margin * std::max(extent[k], thinnest);
+  if (!(pad.minCoeff() > 0))  // a single point: a 1 mm cube around it
+    pad = Eigen::Vector3d::Constant(0.5);
+  Frame frame;
+  frame.origin = box.lo - pad;
+  const Eigen::Vector3d size = extent + 2 * pad;
+  frame.s = Eigen::Vector3d(size.x(), 0, 0);
+  frame.t = Eigen::Vector3d(0, size.y(), 0);
+  frame.u = Eigen::Vector3d(0, 0, size.z());
+  return frame;
 }
 
 }  // namespace clay::deform

@@ -169,10 +169,11 @@ class ModelBuilder {
         model_.roots.push_back(root);
       }
     }
-    if (const auto pulled = pull_pcurves_into_domains(model_); pulled.count > 0)
-      report_.healing.push_back(describe(pulled));
+    if (!options_.strict)
+      if (const auto pulled = pull_pcurves_into_domains(model_); pulled.count > 0)
+        report_.healing.push_back(describe(pulled));
     raise_tolerances_to_gaps();
-    if (const int turned = outer_loops_first(model_); turned > 0)
+    if (const int turned = options_.strict ? 0 : outer_loops_first(model_); turned > 0)
       report_.healing.push_back("took the counter-clockwise loop as the outer loop of " +
                                 std::to_string(turned) + (turned == 1 ? " face" : " faces") +
                                 " (OpenCASCADE's OuterWire had chosen a hole)");
@@ -227,7 +228,7 @@ class ModelBuilder {
       if (gap <= std::max(1.5 * e.tolerance_mm, tolerant_edge_relative * size_)) {
         raised.insert(edge);
         largest = std::max(largest, gap - e.tolerance_mm);
-      } else if (gap <= healed_gap_relative * size_) {
+      } else if (!options_.strict && gap <= healed_gap_relative * size_) {
         widened.insert(edge);
         widest_gap = std::max(widest_gap, gap);
       } else {

@@ -4,6 +4,8 @@
 
 #include <clay/brep/model.hpp>
 #include <clay/brep/volume.hpp>
+#include <clay/deform/model_deformation.hpp>
+#include <clay/deform/stack.hpp>
 #include <clay/occt/model_exchange.hpp>
 #include <clay/recipe/recipe.hpp>
 
@@ -49,17 +51,8 @@ brep::Face& face_at(brep::Model& m, int k) {
   return m.faces[static_cast<std::size_t>(k)];
 }
 
-}  // namespace
-
-/// The recipe's deformation of a whole model (bind_recipe.cpp calls it on its Recipe class).
-py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
-                       const std::string& deformation, bool allow_fold,
-                       const std::string& profile) {
-  recipe::ModelRunResult result;
-  {
-    py::gil_scoped_release free;
-    result = recipe::deform_model(r, model, deformation, allow_fold, profile);
-  }
+/// A model deformation's (Model, report dict), as Recipe.deform_model and Model.deform give it.
+py::tuple model_result(recipe::ModelRunResult&& result) {
   const auto& x = result.report;
   py::dict d;
   d["counts"] = counts_dict(x.counts);
@@ -68,6 +61,7 @@ py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
   d["faces_untouched"] = x.faces_untouched;
   d["profile"] = x.profile;
   d["faces_elevated"] = x.faces_elevated;
+  d["faces_restricted"] = x.faces_restricted;
   d["max_certified_bound_mm"] = x.max_certified_bound_mm;
   d["max_edge_gap_mm"] = x.max_edge_gap_mm;
   d["volume_before_mm3"] = x.volume_before_mm3;
@@ -91,7 +85,44 @@ py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
   }
   d["continuity"] = edges;
   d["message"] = x.brief();
+  d["seconds"] = result.seconds;
   return py::make_tuple(std::move(result.model), d);
+}
+
+/// Every enabled step of a stack, or one lattice as a stack of one step.
+deform::DeformationStack stack_of(const py::handle& deformation) {
+  if (py::isinstance<deform::DeformationStack>(deformation))
+    return deformation.cast<deform::DeformationStack>();
+  deform::DeformationStack stack;
+  if (py::isinstance<deform::BezierLattice>(deformation))
+    stack.steps.push_back({deformation.cast<deform::BezierLattice>(), "lattice", true});
+  else if (py::isinstance<deform::BSplineLattice>(deformation))
+    stack.steps.push_back({deformation.cast<deform::BSplineLattice>(), "lattice", true});
+  else
+    throw Error(ErrorCategory::InvalidArgument,
+                "Model.deform: deformation is a " +
+                    std::string(py::str(deformation.get_type().attr("__name__"))) +
+                    "; give a BezierLattice, a BSplineLattice or a DeformationStack (taper, "
+                    "twist and bend: DeformationStack.from_json)");
+  return stack;
+}
+
+std::vector<int> face_list(const py::object& faces) {
+  return faces.is_none() ? std::vector<int>{} : faces.cast<std::vector<int>>();
+}
+
+}  // namespace
+
+/// The recipe's deformation of a whole model (bind_recipe.cpp calls it on its Recipe class).
+py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
+                       const std::string& deformation, bool allow_fold,
+                       const std::string& profile) {
+  recipe::ModelRunResult result;
+  {
+    py::gil_scoped_release free;
+    result = recipe::deform_model(r, model, deformation, allow_fold, profile);
+  }
+  return model_result(std::move(result));
 }
 
 void bind_model(py::module_& m) {
@@ -185,6 +216,38 @@ void bind_model(py::module_& m) {
           py::arg("path"),
           "Writes STEP (.step/.stp), IGES (.igs/.iges) or a glTF preview (.glb), atomically, read "
           "back and checked (BRepCheck): the check as a dict.")
+      .def(
+          "bounding_box",
+          [](const brep::Model& x, const py::object& faces) {
+            const brep::Box b = brep::control_box(x, face_list(faces));
+            return py::make_tuple(tuple_of(b.lo), tuple_of(b.hi));
+          },
+          py::arg("faces") = py::none(),
+          "((x, y, z) low, (x, y, z) high): the box of the faces' control points (of the "
+          "flattened model; faces: indices into flattened().faces, None: all), which contains "
+          "the faces and their untrimmed surfaces, as a lattice must to compose them exactly.")
+      .def(
+          "deform",
+          [](const brep::Model& x, const py::handle& deformation, const py::object& faces,
+             bool allow_fold, const std::string& profile) {
+            const deform::DeformationStack stack = stack_of(deformation);
+            const std::vector<int> chosen = face_list(faces);
+            recipe::ModelRunResult result;
+            {
+              py::gil_scoped_release free;
+              result = recipe::deform_model(stack, x, allow_fold, profile, chosen);
+            }
+            return model_result(std::move(result));
+          },
+          py::arg("deformation"), py::kw_only(), py::arg("faces") = py::none(),
+          py::arg("allow_fold") = false, py::arg("profile") = "",
+          "The model deformed by a lattice (BezierLattice, BSplineLattice) or a "
+          "DeformationStack, as `clayform deform` does with a recipe's default composition: "
+          "(Model, report). Faces compose exactly; above the budget, certified light forms. "
+          "faces: indices into flattened().faces to deform (None: all; an edge shared with a "
+          "kept face must not move). A lattice not proven fold-free raises "
+          "InvalidGeometryError unless allow_fold=True. profile: the receiver (exact, "
+          "opencascade, catia, class_a, bicubic; '' none).")
       .def("__copy__", [](const brep::Model& x) { return x; })
       .def("__deepcopy__", [](const brep::Model& x, py::dict) { return x; })
       .def("__repr__", [](const brep::Model& x) {
@@ -196,10 +259,11 @@ void bind_model(py::module_& m) {
 
   m.def(
       "read_model",
-      [](const std::filesystem::path& path, bool sew, bool isolate) {
+      [](const std::filesystem::path& path, bool sew, bool isolate, bool strict) {
         brep::ModelReadOptions o;
         o.sew = sew;
         o.read.isolate = isolate;
+        o.strict = strict;
         brep::ImportedModel imported;
         {
           py::gil_scoped_release free;
@@ -219,9 +283,29 @@ void bind_model(py::module_& m) {
         return py::make_tuple(std::move(imported.model), d);
       },
       py::arg("path"), py::arg("sew") = false, py::arg("isolate") = false,
+      py::arg("strict") = false,
       "Reads a whole STEP or IGES model (trimmed faces, solids, assembly): (Model, report). "
       "isolate=True reads in a child process, so a file that crashes OpenCASCADE raises "
-      "ExchangeError.");
+      "ExchangeError. report['healing'] lists what was healed; strict=True heals as before "
+      "issue #39 (pcurves outside their domains, gaps wider than the file's tolerances and "
+      "misordered loops are listed in report['problems'] instead).");
+
+  m.def(
+      "lattice_around",
+      [](const brep::Model& model, std::array<int, 3> degrees, const py::object& cells,
+         double margin, const py::object& faces) -> py::object {
+        const deform::Frame frame = deform::frame_around(model, margin, face_list(faces));
+        if (cells.is_none()) return py::cast(deform::make_bezier_lattice(frame, degrees));
+        return py::cast(
+            deform::make_bspline_lattice(frame, degrees, cells.cast<std::array<int, 3>>()));
+      },
+      py::arg("model"), py::arg("degrees") = std::array<int, 3>{3, 3, 3},
+      py::arg("cells") = py::none(), py::arg("margin") = 0.05, py::arg("faces") = py::none(),
+      "An undisplaced lattice around a model (or its faces: indices into flattened().faces), "
+      "axes along x, y, z: Model.bounding_box() grown by margin of its extent on each side (an "
+      "axis thinner than a tenth of the diagonal as if that thick). cells=None: a BezierLattice of "
+      "the degrees; else a "
+      "BSplineLattice with those cells. Move its points, then Model.deform(lattice).");
 }
 
 }  // namespace clay::python

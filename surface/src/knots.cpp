@@ -194,6 +194,68 @@ BSplineSurface insert_knot_v(const BSplineSurface& surface, double v, int times)
   return insert_in(surface, Direction::V, v, times, "insert_knot_v");
 }
 
+BSplineSurface restricted(const BSplineSurface& surface, double u0, double u1, double v0,
+                          double v1) {
+  validate(surface);
+  auto check = [](const BSplineBasis& b, double lo, double hi, const char* name) {
+    const auto [a, c] = b.domain();
+    if (!(lo >= a && hi <= c && lo < hi))
+      throw Error(ErrorCategory::InvalidArgument,
+                  std::string("restricted: the ") + name + " range [" + std::to_string(lo) + ", " +
+                      std::to_string(hi) + "] is not a non-empty part of the domain [" +
+                      std::to_string(a) + ", " + std::to_string(c) + "]");
+    if (!is_clamped(b))
+      throw Error(
+          ErrorCategory::InvalidArgument,
+          std::string("restricted: the ") + name +
+              " basis is not clamped; clamp it first (its ends of multiplicity degree + 1)");
+  };
+  check(surface.u, u0, u1, "u");
+  check(surface.v, v0, v1, "v");
+  BSplineSurface s = surface;
+  // Each cut to multiplicity degree (the ends are clamped already).
+  for (const double u : {u0, u1}) {
+    const int have = multiplicity(s.u, u);
+    if (have < s.u.degree) s = insert_knot_u(s, u, s.u.degree - have);
+  }
+  for (const double v : {v0, v1}) {
+    const int have = multiplicity(s.v, v);
+    if (have < s.v.degree) s = insert_knot_v(s, v, s.v.degree - have);
+  }
+  // The kept knots: lo once more, the last `degree` copies of lo .. the first `degree` of hi, hi
+  // once more; the control points from one before the first kept copy of lo.
+  struct Cut {
+    BSplineBasis basis;
+    int first = 0, count = 0;
+  };
+  auto cut = [](const BSplineBasis& b, double lo, double hi) {
+    const int p = b.degree;
+    const auto& k = b.knots;
+    const int last_lo = static_cast<int>(std::upper_bound(k.begin(), k.end(), lo) - k.begin()) - 1;
+    const int first_hi = static_cast<int>(std::lower_bound(k.begin(), k.end(), hi) - k.begin());
+    const int start = last_lo - p + 1;
+    Cut c;
+    c.basis.degree = p;
+    c.basis.knots.push_back(lo);
+    c.basis.knots.insert(c.basis.knots.end(), k.begin() + start, k.begin() + first_hi + p);
+    c.basis.knots.push_back(hi);
+    c.first = start - 1;
+    c.count = first_hi - start + 1;
+    return c;
+  };
+  const Cut cu = cut(s.u, u0, u1), cv = cut(s.v, v0, v1);
+  Points3 points(static_cast<Eigen::Index>(cu.count) * cv.count, 3);
+  Eigen::VectorXd weights(points.rows());
+  for (int i = 0; i < cu.count; ++i)
+    for (int j = 0; j < cv.count; ++j) {
+      const Eigen::Index to = static_cast<Eigen::Index>(i) * cv.count + j;
+      const Eigen::Index from = s.index(cu.first + i, cv.first + j);
+      points.row(to) = s.points.row(from);
+      weights(to) = s.weights(from);
+    }
+  return make_surface(cu.basis, cv.basis, std::move(points), std::move(weights));
+}
+
 BSplineCurve refine_knots(const BSplineCurve& curve, std::span<const double> knots) {
   validate(curve);
   auto sorted = checked_knots(curve.basis, knots, "refine_knots");

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "error_of.hpp"
+#include "hand_models.hpp"
 #include "occt/test_files.hpp"
 #include "occt_test_models.hpp"
 
@@ -218,6 +219,98 @@ TEST_CASE("deform_model: a uniform scale changes the volume by its determinant")
     CHECK(result.model.faces[f].surface.u.degree == sphere.faces[f].surface.u.degree);
     CHECK(result.model.faces[f].surface.v.degree == sphere.faces[f].surface.v.degree);
   }
+  CHECK(clay::brep::check_model(result.model).valid);
+}
+
+TEST_CASE("frame_around: a lattice around a model or its faces, grown by a margin") {
+  const Model sphere = read(TestModel::Sphere, "sphere.step");
+  const clay::brep::Box box = clay::brep::control_box(sphere);
+  // The control box holds every mesh-free sample of every face (convex hull property).
+  for (const auto& f : sphere.faces)
+    for (double u : {0.0, 0.37, 1.0})
+      for (double v : {0.0, 0.61, 1.0}) {
+        const auto [u0, u1] = f.surface.u.domain();
+        const auto [v0, v1] = f.surface.v.domain();
+        const Vector3d p =
+            clay::surface::evaluate(f.surface, u0 + u * (u1 - u0), v0 + v * (v1 - v0));
+        CHECK((p.array() >= box.lo.array() - 1e-12).all());
+        CHECK((p.array() <= box.hi.array() + 1e-12).all());
+      }
+  const clay::deform::Frame frame = clay::deform::frame_around(sphere, 0.1);
+  const Vector3d extent = box.hi - box.lo;
+  CHECK((frame.origin - (box.lo - 0.1 * extent)).norm() <= 1e-12 * extent.norm());
+  CHECK(std::abs(frame.s.x() - 1.2 * extent.x()) <= 1e-12 * extent.norm());
+  CHECK(frame.s.y() == 0);
+  CHECK(std::abs(frame.u.z() - 1.2 * extent.z()) <= 1e-12 * extent.norm());
+  // A lattice around it, moved affinely (a stretch by 1.2 along x): the volume by 1.2 exactly.
+  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  for (Eigen::Index r = 0; r < lattice.points.rows(); ++r)
+    lattice.points(r, 0) = frame.origin.x() + 1.2 * (lattice.points(r, 0) - frame.origin.x());
+  DeformationStack stack;
+  stack.steps.push_back({lattice, "stretch", true});
+  const auto stretched = clay::deform::deform_model(stack, sphere);
+  CHECK(std::abs(clay::brep::volume_mm3(stretched.model) / clay::brep::volume_mm3(sphere) - 1.2) <=
+        1e-9 * 1.2);
+  // A flat selection (one planar face of a block) still gets a lattice with volume.
+  const Model block = read(TestModel::FilletedBlock, "block-frame.step");
+  int planar = -1;
+  for (std::size_t f = 0; f < block.faces.size() && planar < 0; ++f) {
+    const clay::brep::Box b = clay::brep::control_box(block, {static_cast<int>(f)});
+    if ((b.hi - b.lo).minCoeff() == 0) planar = static_cast<int>(f);
+  }
+  REQUIRE(planar >= 0);
+  CHECK(std::abs(clay::deform::frame_around(block, 0.05, {planar}).volume()) > 0);
+  // Errors name the argument and the rule.
+  const auto [margin_category, margin_message] =
+      clay::test::error_of([&] { (void)clay::deform::frame_around(sphere, 0.0); });
+  CHECK(margin_category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(margin_message, Contains("margin 0 must lie in (0, 10]"));
+  const auto [face_category, face_message] =
+      clay::test::error_of([&] { (void)clay::brep::control_box(sphere, {99}); });
+  CHECK(face_category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(face_message, Contains("face 99 does not exist"));
+  CHECK(clay::test::error_of([&] { (void)clay::brep::control_box(Model{}); }).first ==
+        clay::ErrorCategory::InvalidArgument);
+}
+
+TEST_CASE("deform_model: trimmed faces on carriers larger than the lattice compose exactly") {
+  // Issue #39 item 7: "face 42: cannot be composed exactly: out of domain". The cube [0, 10]^3
+  // with each face's plane carried on three times its size (u, v in [-1, 2], the trims on
+  // [0, 1]^2): the lattice [-1, 11]^3 holds every trim, not the carriers. Each face is composed
+  // on the box of its pcurves (surface::restricted: the same (u, v)), exactly.
+  Model cube = clay::test::cube(10);
+  for (auto& face : cube.faces) {
+    const auto& p = face.surface.points;  // bilinear: rows (0,0), (0,1), (1,0), (1,1)
+    const Vector3d o = p.row(0).transpose();
+    const Vector3d e1 = p.row(2).transpose() - o, e2 = p.row(1).transpose() - o;
+    clay::surface::Points3 big(4, 3);
+    big.row(0) = (o - e1 - e2).transpose();
+    big.row(1) = (o - e1 + 2 * e2).transpose();
+    big.row(2) = (o + 2 * e1 - e2).transpose();
+    big.row(3) = (o + 2 * e1 + 2 * e2).transpose();
+    face.surface = clay::surface::make_surface({1, {-1, -1, 2, 2}}, {1, {-1, -1, 2, 2}}, big);
+  }
+  REQUIRE(clay::brep::problems(cube).empty());
+  const auto stack = trilinear({-1, -1, -1}, {11, 11, 11}, {1.5, -1, 2});
+  const auto result = clay::deform::deform_model(stack, cube);
+  INFO(result.report.brief());
+  CHECK(result.report.faces_restricted == 6);
+  CHECK(result.report.faces_exact == 6);
+  CHECK(clay::brep::problems(result.model).empty());
+  CHECK_THAT(result.report.brief(), Contains("6 faces composed on the part of their surface"));
+  // Each face at the same (u, v) inside its trims is the lattice's map of the original point.
+  const auto& lattice = std::get<clay::deform::BezierLattice>(stack.steps[0].deformation);
+  double worst = 0;
+  for (std::size_t f = 0; f < cube.faces.size(); ++f)
+    for (double u : {0.0, 0.3, 1.0})
+      for (double v : {0.0, 0.8, 1.0}) {
+        const Vector3d expected = clay::deform::deform_point(
+            lattice, clay::surface::evaluate(cube.faces[f].surface, u, v));
+        worst = std::max(
+            worst,
+            (clay::surface::evaluate(result.model.faces[f].surface, u, v) - expected).norm());
+      }
+  CHECK(worst <= 1e-12 * 10);
   CHECK(clay::brep::check_model(result.model).valid);
 }
 

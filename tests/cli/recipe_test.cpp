@@ -4,8 +4,10 @@
 // lattice built here from the same numbers), closed forms, the exchange read-back.
 #include <catch2/catch.hpp>
 
+#include <clay/brep/volume.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
+#include <clay/deform/model_deformation.hpp>
 #include <clay/deform/regular.hpp>
 #include <clay/occt/model_exchange.hpp>
 #include <clay/occt/surface_exchange.hpp>
@@ -2022,4 +2024,36 @@ TEST_CASE("rebuild without counts grows its net to the tolerance, certified", "[
       "");
   CHECK_THAT(error_of([&] { run_recipe(parse_recipe(tight)); }).second,
              Contains("surfaces.light") && Contains("\"relative_tolerance\""));
+}
+
+TEST_CASE("deform_model by a stack built in code, with the recipes' defaults", "[recipe]") {
+  // Python's Model.deform (issue #39 item 9): no recipe JSON. A lattice around the block
+  // (deform::frame_around) stretched by 1.25 along z: affine, every face exact at its own
+  // degrees, the volume 1.25 times the original; only chosen faces move when asked.
+  const clay::brep::Model block = clay::brep::flattened(
+      clay::brep::read_model(fs::path(CLAY_EXAMPLES_DIR) / "models" / "block.step").model);
+  const clay::deform::Frame frame = clay::deform::frame_around(block);
+  auto lattice = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  for (Eigen::Index r = 0; r < lattice.points.rows(); ++r)
+    lattice.points(r, 2) = frame.origin.z() + 1.25 * (lattice.points(r, 2) - frame.origin.z());
+  clay::deform::DeformationStack stack;
+  stack.steps.push_back({lattice, "stretch", true});
+  const auto stretched = clay::recipe::deform_model(stack, block);
+  INFO(stretched.report.brief());
+  CHECK(stretched.fold_free);
+  CHECK(stretched.report.faces_exact == static_cast<int>(block.faces.size()));
+  for (std::size_t f = 0; f < block.faces.size(); ++f)
+    CHECK(stretched.model.faces[f].surface.u.degree == block.faces[f].surface.u.degree);
+  CHECK(std::abs(clay::brep::volume_mm3(stretched.model) - 1.25 * clay::brep::volume_mm3(block)) <=
+        1e-9 * 1.25 * clay::brep::volume_mm3(block));
+  // A folded lattice is refused, naming the step, unless allowed.
+  auto folded = clay::deform::make_bezier_lattice(frame, {1, 1, 1});
+  folded.points.row(0) += 2.5 * frame.s.transpose();
+  clay::deform::DeformationStack fold;
+  fold.steps.push_back({folded, "fold", true});
+  const auto [category, message] =
+      clay::test::error_of([&] { (void)clay::recipe::deform_model(fold, block); });
+  CHECK(category == clay::ErrorCategory::InvalidGeometry);
+  CHECK_THAT(message, Contains("deform_model: step 0 (bezier_lattice)") &&
+                          Contains("may fold space") && Contains("allow_fold"));
 }

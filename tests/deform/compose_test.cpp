@@ -299,6 +299,26 @@ TEST_CASE("compose_exact with a B-spline lattice splits at knot planes met along
       if (!rational) require_round_trips(r.surface, fresh_folder("sheet"), "sheet");
     }
   }
+  SECTION("a rational sheet across the plane between a moved and an unmoved cell (issue #39)") {
+    // One point of the last cell in s moved: the first cell is affine (composed by its
+    // monomials, weight W^1), the last one is not (W^4). Neighbours must share homogeneous
+    // points to be joined; a rational fillet of a real part was refused ("neighbouring patches
+    // do not meet") until every patch took the tensor route there.
+    BSplineLattice bulged = make_bspline_lattice(frame, {2, 2, 2}, {2, 1, 1});
+    const auto n = bulged.counts();
+    bulged.points.row(bulged.index(n[0] - 1, 1, n[2] - 1)) += 0.2 * frame.u.transpose();
+    const auto bulged_map = [&](const Eigen::Vector3d& p) { return deform_point(bulged, p); };
+    std::vector<double> x{0.05, 0.3, 0.6, 0.7, 0.95}, y{0.1, 0.4, 0.6, 0.9};
+    BSplineSurface s = surface_in(frame, 3, 2, 5, 4, false, rng, [&](int i, int j) {
+      return Eigen::Vector3d(x[size_t(i)], y[size_t(j)], 0.5);
+    });
+    for (int i = 0; i < 5; ++i)
+      for (int j = 0; j < 4; ++j) s.weights(s.index(i, j)) = (1.0 + 0.3 * i) * (1.5 - 0.1 * j);
+    const ComposeResult r = compose_exact(bulged, s);
+    INFO(r.report.brief());
+    CHECK(r.report.splits > 0);
+    CHECK(deviation(s, r.surface, bulged_map, 1000, rng) <= 1e-12 * size);
+  }
   SECTION("a small patch inside one cell composes with that cell") {
     const BSplineSurface s = surface_in(frame, 2, 2, 3, 3, true, rng, [&](int i, int j) {
       return Eigen::Vector3d(0.4 + 0.05 * i, 0.1 + 0.1 * j, 0.3 + 0.1 * i * j);

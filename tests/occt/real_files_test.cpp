@@ -248,6 +248,25 @@ TEST_CASE("Alibre's pcurves 0.95 mm off beside a sphere's pole are re-derived, o
   CHECK(clay::brep::check_model(deformed.model).valid);
 }
 
+TEST_CASE("a strict read heals as before issue #39: the defects are listed, not healed") {
+  // Alias's pcurves leave their domains (pulled in when healing); Alibre's outer loops are holes
+  // (put first when healing). Strict, each is a problem that names the face, as before.
+  clay::brep::ModelReadOptions strict;
+  strict.strict = true;
+  const auto alias =
+      clay::brep::read_model(cad_file("alias_autostudio96_k1_bspline_solid_ap214.stp"), strict);
+  bool pulled = false;
+  for (const auto& h : alias.report.healing) pulled = pulled || h.find("pulled") == 0;
+  CHECK_FALSE(pulled);
+  REQUIRE_FALSE(alias.report.problems.empty());
+  CHECK_THAT(alias.report.problems.front(), Contains("the pcurve leaves the surface's domain"));
+  const auto alibre = clay::brep::read_model(cad_file("alibre_s1_assembly_ap214.stp"), strict);
+  bool outer = false;
+  for (const auto& p : alibre.report.problems)
+    outer = outer || p.find("(the outer loop) runs clockwise") != std::string::npos;
+  CHECK(outer);
+}
+
 TEST_CASE("NX 9's faces farther from their edges than its tolerances read valid and deform valid") {
   // The file gives 0.0157 mm where its B-spline faces are 0.026 mm from three of their edges at
   // equal parameters (issue #39). Those pcurves are re-derived from the edges (projected): the

@@ -79,3 +79,85 @@ def test_model_errors(tmp_path: Path) -> None:
     with pytest.raises(cf.InvalidArgumentError, match="no face 99"):
         model, _ = cf.read_model(Path(__file__).parents[2] / "examples" / "models" / "block.step")
         model.face_surface(99)
+
+
+def test_deform_a_model_by_a_lattice_around_it(examples: Path, tmp_path: Path) -> None:
+    """Issue #39 item 9: a lattice fitted around a model and Model.deform, no recipe JSON."""
+    model, _ = cf.read_model(examples / "models" / "block.step")
+    lo, hi = (np.array(c) for c in model.bounding_box())
+    # The box holds every face: each mesh node lies on a face, so inside it.
+    vertices, _, _ = model.tessellate()
+    assert (vertices >= lo - 1e-9).all() and (vertices <= hi + 1e-9).all()
+    # ... and it is the box of the control points (each face's, read independently).
+    nets = np.vstack([model.face_surface(k).points for k in range(model.face_count)])
+    assert np.array_equal(nets.min(axis=0), lo) and np.array_equal(nets.max(axis=0), hi)
+    lattice = cf.lattice_around(model, degrees=(1, 1, 1), margin=0.1)
+    origin, s, t, u = (np.array(v) for v in lattice.frame)
+    extent = hi - lo
+    assert origin == pytest.approx(lo - 0.1 * extent, abs=1e-12)
+    assert np.diag(np.array([s, t, u])) == pytest.approx(1.2 * extent, abs=1e-12)
+
+    # An affine stretch of the lattice's points maps space affinely: every face composes with
+    # its own degrees, and the volume is det(A) times the original (issue #39 item 8).
+    stretch = np.diag([1.2, 0.9, 1.1])
+    lattice.points = lattice.points @ stretch.T
+    stretched, report = model.deform(lattice)
+    assert report["faces_exact"] == model.face_count and report["fold_free"]
+    assert stretched.problems() == []
+    det = np.linalg.det(stretch)
+    assert stretched.volume_mm3() == pytest.approx(det * model.volume_mm3(), rel=1e-9)
+    for k in range(model.face_count):
+        a, b = model.face_surface(k), stretched.face_surface(k)
+        assert a.degrees == b.degrees
+        (u0, u1), (v0, v1) = a.domain
+        for x, y in ((u0, v0), (0.3 * u0 + 0.7 * u1, 0.6 * v0 + 0.4 * v1), (u1, v1)):
+            assert b.evaluate(x, y) == pytest.approx(stretch @ a.evaluate(x, y), abs=1e-9)
+    check = stretched.write(tmp_path / "stretched.step")
+    assert check["valid"], check["message"]
+
+    # A bulge by a B-spline lattice (the top's middle point raised 5 mm): every face, at the same
+    # (u, v), is the lattice's map of the original point. (The rational fillets cross the knot
+    # plane z = 10, where the raised cell meets an undisplaced one: refused before issue #39.)
+    bulge = cf.lattice_around(model, degrees=(2, 2, 2), cells=(2, 2, 2))
+    points = bulge.points
+    n = bulge.counts
+    top_middle = bulge.index(n[0] // 2, n[1] // 2, n[2] - 1)
+    points[top_middle, 2] += 5.0
+    bulge.points = points
+    bulged, report = model.deform(bulge)
+    assert bulged.problems() == [] and report["max_edge_gap_mm"] < 1e-6
+    assert bulged.volume_mm3() > model.volume_mm3()
+    for k in range(model.face_count):
+        a, b = model.face_surface(k), bulged.face_surface(k)
+        (u0, u1), (v0, v1) = a.domain
+        x, y = 0.5 * (u0 + u1), 0.5 * (v0 + v1)
+        assert b.evaluate(x, y) == pytest.approx(bulge.deform_point(a.evaluate(x, y)), abs=1e-9)
+
+
+def test_model_deform_errors(examples: Path) -> None:
+    model, _ = cf.read_model(examples / "models" / "block.step")
+    with pytest.raises(cf.InvalidArgumentError, match="margin 0 must lie in"):
+        cf.lattice_around(model, margin=0)
+    with pytest.raises(cf.InvalidArgumentError, match="face 999 does not exist"):
+        model.bounding_box(faces=[999])
+    with pytest.raises(cf.InvalidArgumentError, match="give a BezierLattice, a BSplineLattice"):
+        model.deform("lift")  # type: ignore[arg-type]
+    # A lattice folded on itself (one point pulled through the others) is refused unless allowed.
+    folded = cf.lattice_around(model, degrees=(1, 1, 1))
+    points = folded.points
+    origin, s, _, _ = (np.array(v) for v in folded.frame)
+    points[folded.index(0, 0, 0)] += 2.5 * s
+    folded.points = points
+    with pytest.raises(cf.InvalidGeometryError, match="step 0 .* may fold space"):
+        model.deform(folded)
+
+
+def test_strict_read_lists_what_healing_would_fix() -> None:
+    cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
+    path = cad / "alias_autostudio96_k1_bspline_solid_ap214.stp"
+    _, report = cf.read_model(path)
+    assert report["problems"] == [] and report["healing"][0].startswith("pulled 14 pcurves")
+    strict, report = cf.read_model(path, strict=True)
+    assert not any(h.startswith("pulled") for h in report["healing"])
+    assert "the pcurve leaves the surface's domain" in report["problems"][0]
+    assert strict.problems() == report["problems"]

@@ -56,6 +56,45 @@ TEST_CASE("knot insertion in u and v keeps surfaces unchanged", "[knots]") {
   }
 }
 
+TEST_CASE("restricted keeps the surface over a box of its domain, parameters unchanged",
+          "[knots]") {
+  std::mt19937 rng(71);
+  for (int p = 1; p <= 4; ++p)
+    for (bool rational : {false, true}) {
+      const BSplineSurface s =
+          clay::test::random_surface(rng, p, 5 - p, p + 4, 8 - p, rational, true, 2);
+      const auto [a, b] = s.u.domain();
+      const auto [c, d] = s.v.domain();
+      // Inside, at an existing knot (no insertion needed) and at the domain's own side.
+      const double u0 = a + 0.23 * (b - a),
+                   u1 = s.u.knots[s.u.knots.size() - 1 - static_cast<std::size_t>(p) - 1];
+      const double v0 = c, v1 = c + 0.71 * (d - c);
+      if (!(u1 > u0)) continue;
+      const BSplineSurface r = restricted(s, u0, u1, v0, v1);
+      INFO("degree " << p << (rational ? " rational" : ""));
+      CHECK(r.u.domain() == std::pair{u0, u1});
+      CHECK(r.v.domain() == std::pair{v0, v1});
+      CHECK(r.u.degree == s.u.degree);
+      double worst = 0;
+      std::uniform_real_distribution<double> x(0, 1);
+      for (int k = 0; k < 200; ++k) {
+        const double u = u0 + x(rng) * (u1 - u0), v = v0 + x(rng) * (v1 - v0);
+        worst = std::max(worst, (evaluate(r, u, v) - evaluate(s, u, v)).norm());
+      }
+      for (const double u : {u0, u1})
+        for (const double v : {v0, v1})
+          worst = std::max(worst, (evaluate(r, u, v) - evaluate(s, u, v)).norm());
+      CHECK(worst <= 1e-12 * 100);
+    }
+  const BSplineSurface s = clay::test::random_surface(rng, 3, 3, 6, 6, false);
+  const auto [a, b] = s.u.domain();
+  const auto [c, d] = s.v.domain();
+  CHECK(clay::test::error_of([&] { (void)restricted(s, a - 1, b, c, d); }).first ==
+        clay::ErrorCategory::InvalidArgument);
+  CHECK(clay::test::error_of([&] { (void)restricted(s, a, b, d, d); }).first ==
+        clay::ErrorCategory::InvalidArgument);
+}
+
 TEST_CASE("refinement equals repeated insertion and keeps the shape", "[knots]") {
   std::mt19937 rng(33);
   for (int p = 1; p <= 6; ++p) {

@@ -218,6 +218,18 @@ CLAY_BREP_API std::vector<std::string> problems(const Model& model);
 /// cycle.
 CLAY_BREP_API Model flattened(const Model& model);
 
+/// An axis-aligned box (mm): lo <= hi componentwise.
+struct Box {
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
+};
+
+/// The box of the control points of the faces of flattened(model) (of `faces` only, indices into
+/// flattened(model).faces, when given): it contains those faces and their whole untrimmed
+/// surfaces (convex hull property, weights positive), which is what a lattice must contain for
+/// an exact composition. Throws InvalidArgument for a model without faces or a face index out of
+/// range, InvalidGeometry as flattened.
+CLAY_BREP_API Box control_box(const Model& model, const std::vector<int>& faces = {});
+
 /// Throws clay::Error(InvalidGeometry) listing problems(model) when there are any.
 CLAY_BREP_API void validate(const Model& model);
 

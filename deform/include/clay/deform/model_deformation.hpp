@@ -92,6 +92,9 @@ struct CLAY_DEFORM_API ModelDeformationReport {
   double volume_before_mm3 = 0;  ///< brep::volume_mm3 of the solids
   double volume_after_mm3 = 0;
   int solids_reversed = 0;  ///< solids turned inside out by a mirroring stack, faces reversed
+  /// Trimmed faces whose surface leaves a lattice though their trims do not: each composed on the
+  /// box of its pcurves (surface::restricted, exact, the same (u, v); issue #39 item 7).
+  int faces_restricted = 0;
   /// When every enabled step is a fold-free Bézier or B-spline lattice and every face was free to
   /// deform: bounds on the volume ratio det DF from the lattices' Jacobian coefficients
   /// (Sederberg–Parry §4), multiplied over the steps and widened to 1 (the FFD is the identity
@@ -126,5 +129,15 @@ struct ModelDeformationResult {
 CLAY_DEFORM_API ModelDeformationResult deform_model(const DeformationStack& stack,
                                                     const brep::Model& model,
                                                     const ModelDeformationOptions& options = {});
+
+/// The frame of a lattice around `model` (around `faces` only, indices into
+/// flattened(model).faces, when given), its edges along x, y and z: brep::control_box grown on
+/// each side by `margin` times its extent along that axis, an axis thinner than a tenth of the
+/// box's diagonal as if it were that thick (a flat part still gets a lattice with volume). Every
+/// control point then lies
+/// strictly inside, so every face composes exactly. Throws InvalidArgument for a margin outside
+/// (0, 10] and as brep::control_box.
+CLAY_DEFORM_API Frame frame_around(const brep::Model& model, double margin = 0.05,
+                                   const std::vector<int>& faces = {});
 
 }  // namespace clay::deform

@@ -42,6 +42,11 @@ struct CLAY_OCCT_API ModelReadOptions {
   /// its plain reader in a second child (no names, colours or assembly tree; the report's
   /// healing says so). The `clayform` command reads every model isolated.
   surface::ReadOptions read;
+  /// The reader before issue #39's healing: pcurves that leave their surface's domain are not
+  /// pulled in, tolerances are not set to gaps wider than 1.5 times a file's own tolerance (or
+  /// 1e-4 of the model's size), and a hole taken for the outer loop stays first: problems()
+  /// names each, and the report lists them, as for a broken file.
+  bool strict = false;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;

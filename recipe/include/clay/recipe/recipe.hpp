@@ -228,6 +228,16 @@ CLAY_RECIPE_API ModelRunResult deform_model(const Recipe& recipe, const brep::Mo
                                             std::string_view deformation = {},
                                             bool allow_fold = false, std::string_view profile = {});
 
+/// Deforms `model` by `stack`, a stack built in code (Python's Model.deform), as the overload
+/// above deforms it by a recipe's, with a recipe's default composition mode (docs/recipe.md §
+/// composition): the same fold check (a lattice step not proven fold-free is refused, naming the
+/// step, unless `allow_fold`) and receiver `profile`. `faces` (indices into
+/// flattened(model).faces; empty: every face) are the faces deformed; the others are kept.
+CLAY_RECIPE_API ModelRunResult deform_model(const deform::DeformationStack& stack,
+                                            const brep::Model& model, bool allow_fold = false,
+                                            std::string_view profile = {},
+                                            const std::vector<int>& faces = {});
+
 /// Writes STEM.step, STEM.igs and STEM.glb (result.formats; the .glb a preview of the trimmed
 /// faces, brep::write_model), report.json and the view folder (the model's trimmed mesh, for
 /// `clayform view`) into `out_dir`, through a temporary folder as

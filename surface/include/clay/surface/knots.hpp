@@ -26,6 +26,14 @@ CLAY_SURFACE_API BSplineSurface insert_knot_u(const BSplineSurface& surface, dou
 CLAY_SURFACE_API BSplineSurface insert_knot_v(const BSplineSurface& surface, double v,
                                               int times = 1);
 
+/// The part of `surface` over [u0, u1] x [v0, v1], exactly: each cut inserted to full
+/// multiplicity (Boehm), the net between kept. The same parameters: the result evaluates like
+/// the surface at every (u, v) of the box, so a trimmed face's pcurves stay valid on it. A box
+/// side on the domain's side cuts nothing there. Throws InvalidArgument for a box not inside the
+/// domain or empty in a direction, or an unclamped basis.
+CLAY_SURFACE_API BSplineSurface restricted(const BSplineSurface& surface, double u0, double u1,
+                                           double v0, double v1);
+
 /// Inserts all of `knots` (sorted or not, repeats allowed) at once (The NURBS Book A5.4).
 CLAY_SURFACE_API BSplineCurve refine_knots(const BSplineCurve& curve,
                                            std::span<const double> knots);
