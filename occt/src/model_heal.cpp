@@ -192,6 +192,13 @@ std::optional<std::pair<surface::BSplineCurve, double>> pcurve_from_edge(
         interpolate.Perform();
         if (!interpolate.IsDone()) continue;
         piece = interpolate.Curve();
+        // The feet lie in the domain, but a cubic through them can overshoot it between them
+        // (Onshape's pcurve along v = 0 came out at v = -3.2e-9): its poles are clamped into
+        // the domain, so the curve is inside (convex hull), and the fit is measured after.
+        for (int i = 1; i <= piece->NbPoles(); ++i) {
+          const gp_Pnt2d pole = piece->Pole(i);
+          piece->SetPole(i, gp_Pnt2d(std::clamp(pole.X(), u0, u1), std::clamp(pole.Y(), v0, v1)));
+        }
         // The fit against the projection (an edge 1.6e-6 mm off its face, within its
         // tolerance, can never come within fit_tol of it), the gap against the edge.
         error = 0;

@@ -229,25 +229,27 @@ void bind_model(py::module_& m) {
       .def(
           "deform",
           [](const brep::Model& x, const py::handle& deformation, const py::object& faces,
-             bool allow_fold, const std::string& profile) {
+             bool allow_fold, const std::string& profile, double tolerance_mm) {
             const deform::DeformationStack stack = stack_of(deformation);
             const std::vector<int> chosen = face_list(faces);
             recipe::ModelRunResult result;
             {
               py::gil_scoped_release free;
-              result = recipe::deform_model(stack, x, allow_fold, profile, chosen);
+              result = recipe::deform_model(stack, x, allow_fold, profile, chosen, tolerance_mm);
             }
             return model_result(std::move(result));
           },
           py::arg("deformation"), py::kw_only(), py::arg("faces") = py::none(),
-          py::arg("allow_fold") = false, py::arg("profile") = "",
+          py::arg("allow_fold") = false, py::arg("profile") = "", py::arg("tolerance_mm") = 0.0,
           "The model deformed by a lattice (BezierLattice, BSplineLattice) or a "
           "DeformationStack, as `clayform deform` does with a recipe's default composition: "
           "(Model, report). Faces compose exactly; above the budget, certified light forms. "
           "faces: indices into flattened().faces to deform (None: all; an edge shared with a "
           "kept face must not move). A lattice not proven fold-free raises "
           "InvalidGeometryError unless allow_fold=True. profile: the receiver (exact, "
-          "opencascade, catia, class_a, bicubic; '' none).")
+          "opencascade, catia, class_a, bicubic; '' none). tolerance_mm > 0: a face that cannot be "
+          "exact (a B-spline lattice's knot plane across it, twist, bend) is refitted within it, "
+          "certified; 0: refused, naming the face.")
       .def("__copy__", [](const brep::Model& x) { return x; })
       .def("__deepcopy__", [](const brep::Model& x, py::dict) { return x; })
       .def("__repr__", [](const brep::Model& x) {

@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -320,7 +321,11 @@ ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
 
 ModelRunResult deform_model(const deform::DeformationStack& stack, const brep::Model& model,
                             bool allow_fold, std::string_view profile,
-                            const std::vector<int>& faces) {
+                            const std::vector<int>& faces, double refit_tolerance_mm) {
+  if (!(refit_tolerance_mm >= 0 && std::isfinite(refit_tolerance_mm)))
+    throw Error(ErrorCategory::InvalidArgument,
+                "deform_model: refit_tolerance_mm " + format("%g", refit_tolerance_mm) +
+                    " must be >= 0 and finite (0: faces that cannot be exact are refused)");
   const auto t0 = Clock::now();
   ModelRunResult result;
   for (std::size_t i = 0; i < stack.steps.size(); ++i)
@@ -329,7 +334,12 @@ ModelRunResult deform_model(const deform::DeformationStack& stack, const brep::M
                  "deform_model: step " + std::to_string(i) + " (" +
                      std::string(deform::kind_name(stack.steps[i].deformation)) + ")",
                  "allow_fold", result.fold_free, allow_fold);
-  const Composition defaults;  // a recipe's, where it says nothing
+  Composition defaults;  // a recipe's, where it says nothing
+  if (refit_tolerance_mm > 0) {
+    defaults.refit = true;
+    defaults.tolerance_mm = refit_tolerance_mm;
+    defaults.relative_tolerance = 0;
+  }
   deform::ModelDeformationOptions options;
   options.surface = deformation_options(defaults);
   options.edge_gap_mm = defaults.edge_gap_mm;

@@ -161,3 +161,23 @@ def test_strict_read_lists_what_healing_would_fix() -> None:
     assert not any(h.startswith("pulled") for h in report["healing"])
     assert "the pcurve leaves the surface's domain" in report["problems"][0]
     assert strict.problems() == report["problems"]
+
+
+def test_a_face_that_cannot_be_exact_is_refitted_within_tolerance_mm() -> None:
+    # Alias's key under a B-spline lattice: a knot plane crosses its faces off their iso-lines, so
+    # no single polynomial patch is exact there. Refused, naming the face, unless Model.deform is
+    # given a tolerance; then refitted within it, certified, and the model stays valid.
+    cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
+    model, _ = cf.read_model(cad / "alias_autostudio96_k1_bspline_solid_ap214.stp", isolate=True)
+    lattice = cf.lattice_around(model, degrees=(2, 2, 2), cells=(2, 2, 2))
+    points = lattice.points
+    n = lattice.counts
+    points[lattice.index(n[0] // 2, n[1] // 2, n[2] - 1), 2] += 2.0
+    lattice.points = points
+    with pytest.raises(cf.InvalidArgumentError, match=r"face \d+ .*crosses the lattice knot plane"):
+        model.deform(lattice)
+    bulged, report = model.deform(lattice, tolerance_mm=0.01)
+    assert report["faces_refit"] > 0 and 0 < report["max_certified_bound_mm"] <= 0.01
+    assert bulged.problems() == []
+    with pytest.raises(cf.InvalidArgumentError, match="refit_tolerance_mm -1 must be >= 0"):
+        model.deform(lattice, tolerance_mm=-1)

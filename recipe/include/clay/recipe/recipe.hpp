@@ -233,10 +233,15 @@ CLAY_RECIPE_API ModelRunResult deform_model(const Recipe& recipe, const brep::Mo
 /// composition): the same fold check (a lattice step not proven fold-free is refused, naming the
 /// step, unless `allow_fold`) and receiver `profile`. `faces` (indices into
 /// flattened(model).faces; empty: every face) are the faces deformed; the others are kept.
+/// `refit_tolerance_mm` > 0: a face that cannot be composed exactly (crossing a knot plane off
+/// its iso-lines; twist, bend, extended lattices) is refitted within it, certified, with its
+/// edges; 0: such a face is refused, naming it. Throws InvalidArgument for a negative or
+/// non-finite tolerance.
 CLAY_RECIPE_API ModelRunResult deform_model(const deform::DeformationStack& stack,
                                             const brep::Model& model, bool allow_fold = false,
                                             std::string_view profile = {},
-                                            const std::vector<int>& faces = {});
+                                            const std::vector<int>& faces = {},
+                                            double refit_tolerance_mm = 0);
 
 /// Writes STEM.step, STEM.igs and STEM.glb (result.formats; the .glb a preview of the trimmed
 /// faces, brep::write_model), report.json and the view folder (the model's trimmed mesh, for

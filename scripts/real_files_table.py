@@ -1,0 +1,96 @@
+#!/usr/bin/env python3
+"""The table of issue #39: every file of tests/data/cad read (isolated, as `clayform` reads),
+stretched by an affine lattice (volume against det(A) x the original) and bulged by a (1, 1, 2)
+Bézier lattice, each result checked (brep problems, written as STEP and checked by BRepCheck), with the
+times. Prints a Markdown table. Usage: PYTHONPATH=build/python scripts/real_files_table.py"""
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+import clayform as cf
+
+CAD = Path(__file__).resolve().parents[1] / "tests" / "data" / "cad"
+STRETCH = np.diag([1.2, 0.9, 1.1])
+
+
+def stretched(model: cf.Model) -> cf.BezierLattice:
+    lattice = cf.lattice_around(model, degrees=(1, 1, 1))
+    origin = np.array(lattice.frame[0])
+    lattice.points = (lattice.points - origin) @ STRETCH.T + origin
+    return lattice
+
+
+def bulged(model: cf.Model) -> cf.BezierLattice:
+    """The (1, 1, 2) bulge of issue #39: the middle layer pushed out along x by a tenth."""
+    lattice = cf.lattice_around(model, degrees=(1, 1, 2))
+    lo, hi = (np.array(c) for c in model.bounding_box())
+    points = lattice.points
+    for i in range(2):
+        for j in range(2):
+            points[lattice.index(i, j, 1), 0] += (0.1 if i else -0.1) * (hi - lo).max()
+    lattice.points = points
+    return lattice
+
+
+def outcome(model: cf.Model, lattice: object, folder: Path, name: str) -> tuple[str, float, object]:
+    start = time.perf_counter()
+    try:
+        result, report = model.deform(lattice, profile="opencascade")
+    except cf.ClayError as e:
+        return "refused: " + str(e).splitlines()[0][:90], time.perf_counter() - start, None
+    check = result.write(folder / f"{name}.step")
+    seconds = time.perf_counter() - start
+    verdict = "valid" if check["valid"] and not result.problems() else "NOT valid"
+    return verdict, seconds, (result, report)
+
+
+def main() -> int:
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        for path in sorted(CAD.iterdir()):
+            if path.suffix.lower() not in (".stp", ".step", ".igs", ".iges"):
+                continue
+            start = time.perf_counter()
+            try:
+                model, report = cf.read_model(path, isolate=True)
+            except cf.ClayError as e:
+                rows.append(f"| `{path.name}` | — | refused: {str(e).splitlines()[0][:80]} | | | | |")
+                continue
+            read_s = time.perf_counter() - start
+            healing = len(report["healing"])
+            problems = len(report["problems"])
+            read = "yes" if not problems else f"yes, {problems} problems"
+            if healing:
+                read += f" ({healing} healing step{'s' if healing > 1 else ''})"
+            counts = model.counts
+            if problems:
+                rows.append(f"| `{path.name}` | {counts['faces']} | {read} | — | — | — | {read_s:.1f} |")
+                continue
+            s_verdict, s_time, s_result = outcome(model, stretched(model), folder, "s")
+            b_verdict, b_time, _ = outcome(model, bulged(model), folder, "b")
+            error = "— (no solid)"
+            if counts["solids"] and s_result is not None:
+                before = model.volume_mm3()
+                after = s_result[0].volume_mm3()
+                det = float(np.linalg.det(STRETCH))
+                error = f"{abs(after - det * before) / (det * before):.1e}"
+            rows.append(
+                f"| `{path.name}` | {counts['faces']} | {read} | {s_verdict} | {b_verdict} | "
+                f"{error} | {read_s:.1f} + {s_time:.1f} + {b_time:.1f} |")
+            print(rows[-1], file=sys.stderr, flush=True)
+    print("| file | faces | read | stretched (affine) | bulged (B-spline) | "
+          "stretched volume against det × V | time read + stretch + bulge (s) |")
+    print("|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(r)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
