@@ -2,9 +2,13 @@
 """The table of issue #39: every file of tests/data/cad read (isolated, as `clayform` reads),
 stretched by an affine lattice (volume against det(A) x the original) and bulged by a (1, 1, 2)
 Bézier lattice, each result checked (brep problems, written as STEP and checked by BRepCheck), with the
-times. Prints a Markdown table. Usage: PYTHONPATH=build/python scripts/real_files_table.py"""
+times, beside FreeCAD's own reading (faces, solids, volume, validity) when its figures are given.
+Prints a Markdown table. Usage:
+    CLAY_FREECAD_OUT=freecad.json freecadcmd scripts/freecad_real_files.py
+    PYTHONPATH=build/python scripts/real_files_table.py [freecad.json]"""
 from __future__ import annotations
 
+import json
 import sys
 import tempfile
 import time
@@ -49,7 +53,22 @@ def outcome(model: cf.Model, lattice: object, folder: Path, name: str) -> tuple[
     return verdict, seconds, (result, report)
 
 
+def freecad_columns(freecad: dict, name: str, model: cf.Model | None) -> str:
+    """FreeCAD's faces / solids, validity, and our volume against FreeCAD's."""
+    if not freecad:
+        return ""
+    f = freecad.get(name)
+    if f is None or "error" in f:
+        return " | not read | "
+    seen = f"{f['faces']} / {f['solids']}, {'valid' if f['valid'] else 'NOT valid'}"
+    if model is None or not f["solids"]:
+        return f" | {seen} | "
+    ours = model.volume_mm3()
+    return f" | {seen} | {abs(ours - f['volume']) / f['volume']:.1e}"
+
+
 def main() -> int:
+    freecad = json.loads(Path(sys.argv[1]).read_text()) if len(sys.argv) > 1 else {}
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
@@ -60,7 +79,8 @@ def main() -> int:
             try:
                 model, report = cf.read_model(path, isolate=True)
             except cf.ClayError as e:
-                rows.append(f"| `{path.name}` | — | refused: {str(e).splitlines()[0][:80]} | | | | |")
+                rows.append(f"| `{path.name}` | — | refused: {str(e).splitlines()[0][:80]} | | | | "
+                            f"{freecad_columns(freecad, path.name, None)} |")
                 continue
             read_s = time.perf_counter() - start
             healing = len(report["healing"])
@@ -70,7 +90,8 @@ def main() -> int:
                 read += f" ({healing} healing step{'s' if healing > 1 else ''})"
             counts = model.counts
             if problems:
-                rows.append(f"| `{path.name}` | {counts['faces']} | {read} | — | — | — | {read_s:.1f} |")
+                rows.append(f"| `{path.name}` | {counts['faces']} / {counts['solids']} | {read} | — | — | — | "
+                            f"{read_s:.1f}{freecad_columns(freecad, path.name, None)} |")
                 continue
             s_verdict, s_time, s_result = outcome(model, stretched(model), folder, "s")
             b_verdict, b_time, _ = outcome(model, bulged(model), folder, "b")
@@ -81,12 +102,16 @@ def main() -> int:
                 det = float(np.linalg.det(STRETCH))
                 error = f"{abs(after - det * before) / (det * before):.1e}"
             rows.append(
-                f"| `{path.name}` | {counts['faces']} | {read} | {s_verdict} | {b_verdict} | "
-                f"{error} | {read_s:.1f} + {s_time:.1f} + {b_time:.1f} |")
+                f"| `{path.name}` | {counts['faces']} / {counts['solids']} | {read} | {s_verdict} | "
+                f"{b_verdict} | {error} | {read_s:.1f} + {s_time:.1f} + {b_time:.1f}"
+                f"{freecad_columns(freecad, path.name, model)} |")
             print(rows[-1], file=sys.stderr, flush=True)
-    print("| file | faces | read | stretched (affine) | bulged (B-spline) | "
-          "stretched volume against det × V | time read + stretch + bulge (s) |")
-    print("|---|---|---|---|---|---|---|")
+    head = ("| file | faces / solids | read | stretched (affine) | bulged (B-spline) | "
+            "stretched volume against det × V | time read + stretch + bulge (s) |")
+    if freecad:
+        head += " FreeCAD: faces / solids, validity | volume against FreeCAD's |"
+    print(head)
+    print("|---" * (head.count("|") - 1) + "|")
     for r in rows:
         print(r)
     return 0

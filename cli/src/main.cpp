@@ -172,6 +172,9 @@ int info(const fs::path& file, bool strict) {
               m.faces.size(), m.faces.size() == 1 ? "" : "s", max_degree, control_points,
               broken ? "NOT valid (broken invariants)" : check.brief().c_str());
   std::printf("  read: %s\n", read.report.brief().c_str());
+  for (const auto& h : read.report.healing) std::printf("  healed: %s\n", h.c_str());
+  for (const auto& h : read.report.ignored) std::printf("  ignored: %s\n", h.c_str());
+  for (const auto& h : read.report.skipped) std::printf("  skipped: %s\n", h.c_str());
   for (size_t b = 0; b < m.bodies.size(); ++b) {
     const auto& body = m.bodies[b];
     int faces = 0, trimmed = 0, holes = 0;

@@ -44,6 +44,9 @@
 #include <IGESControl_Reader.hxx>
 #include <IGESData_IGESModel.hxx>
 #include <IGESData_UndefinedEntity.hxx>
+#include <Interface_Check.hxx>
+#include <Interface_CheckIterator.hxx>
+#include <Interface_InterfaceModel.hxx>
 #include <Quantity_Color.hxx>
 #include <STEPCAFControl_Controller.hxx>
 #include <STEPCAFControl_Reader.hxx>
@@ -70,10 +73,13 @@
 #include <TopoDS_Solid.hxx>
 #include <TopoDS_Vertex.hxx>
 #include <TopoDS_Wire.hxx>
+#include <Transfer_TransientProcess.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
+#include <XSControl_TransferReader.hxx>
+#include <XSControl_WorkSession.hxx>
 #include <gp_Trsf.hxx>
 
 namespace clay::brep {
@@ -84,6 +90,19 @@ using namespace detail;
 using internal::shortest;
 using surface::occt::extension_is;
 using surface::occt::quoted;
+
+/// What read_model throws when the file gave no shape (`what`: "holds no face"): OpenCASCADE's
+/// failures on entities (failed_entities), when there are any, name what broke, and FreeCAD, on
+/// the same OpenCASCADE, reads nothing from such a file either.
+[[noreturn]] void nothing_read(const fs::path& file, std::string_view what,
+                               const std::vector<std::string>& failed) {
+  std::string m = "read_model: " + quoted(file) + " " + std::string(what);
+  if (!failed.empty())
+    m += ": OpenCASCADE failed to transfer " + std::to_string(failed.size()) + " entit" +
+         (failed.size() == 1 ? "y" : "ies") + ", the first " + failed.front() +
+         "; correct that entity in the sending system";
+  throw Error(ErrorCategory::Exchange, m);
+}
 
 /// Gaps up to this fraction of the model size raise an edge's tolerance on reading (see
 /// ModelBuilder::raise_tolerances_to_gaps).
@@ -132,20 +151,24 @@ Eigen::Isometry3d isometry_of(const TopLoc_Location& location, const std::string
 
 class ModelBuilder {
  public:
+  /// `failed`: the entities OpenCASCADE failed to transfer (failed_entities), for the messages.
   ModelBuilder(const fs::path& file, const ModelReadOptions& options,
-               Handle(XCAFDoc_ShapeTool) shapes, Handle(XCAFDoc_ColorTool) colours)
-      : file_(file), options_(options), shapes_(std::move(shapes)), colours_(std::move(colours)) {}
+               Handle(XCAFDoc_ShapeTool) shapes, Handle(XCAFDoc_ColorTool) colours,
+               std::vector<std::string> failed)
+      : file_(file),
+        options_(options),
+        shapes_(std::move(shapes)),
+        colours_(std::move(colours)),
+        failed_(std::move(failed)) {}
 
   ImportedModel build() {
     TDF_LabelSequence free;
     shapes_->GetFreeShapes(free);
-    if (free.IsEmpty())
-      throw Error(ErrorCategory::Exchange, "read_model: " + quoted(file_) + " holds no shape");
+    if (free.IsEmpty()) nothing_read(file_, "holds no shape", failed_);
     // The model's size (tolerances are relative to it): OpenCASCADE's box of every free shape.
     Bnd_Box box;
     for (int i = 1; i <= free.Length(); ++i) BRepBndLib::Add(shapes_->GetShape(free.Value(i)), box);
-    if (box.IsVoid())
-      throw Error(ErrorCategory::Exchange, "read_model: " + quoted(file_) + " holds no geometry");
+    if (box.IsVoid()) nothing_read(file_, "holds no geometry", failed_);
     size_ = std::sqrt(box.SquareExtent());
     if (!(size_ > 0) || !std::isfinite(size_)) size_ = 1;
 
@@ -701,6 +724,7 @@ class ModelBuilder {
   ModelReadOptions options_;
   Handle(XCAFDoc_ShapeTool) shapes_;
   Handle(XCAFDoc_ColorTool) colours_;
+  std::vector<std::string> failed_;
   Model model_;
   ModelReadReport report_;
   double size_ = 1;
@@ -750,6 +774,10 @@ std::string ModelReadReport::brief() const {
   if (!ignored.empty())
     line += "; ignored " + std::to_string(ignored.size()) + " unknown entity type" +
             (ignored.size() == 1 ? "" : "s") + ": " + ignored.front();
+  if (!skipped.empty())
+    line += "; skipped " + std::to_string(skipped.size()) + " entit" +
+            (skipped.size() == 1 ? "y" : "ies") +
+            " OpenCASCADE could not transfer: " + skipped.front();
   if (!problems.empty())
     line += "; " + std::to_string(problems.size()) + " problems, the first: " + problems.front();
   return line;
@@ -776,9 +804,38 @@ struct UnknownEntities {
   }
 };
 
+/// The entities whose transfer OpenCASCADE gave up on, one line each ("#73 CYLINDRICAL_SURFACE:
+/// <its failure>"). OpenCASCADE catches an exception per entity (a Standard_ConstructionError on
+/// a negative radius) and leaves the entity, and what is built on it, out of the shape: the rest
+/// is read, and these lines say what is missing.
+std::vector<std::string> failed_entities(const Handle(XSControl_WorkSession) & session) {
+  std::vector<std::string> out;
+  if (session.IsNull() || session->TransferReader().IsNull()) return out;
+  const Handle(Transfer_TransientProcess)& process = session->TransferReader()->TransientProcess();
+  if (process.IsNull()) return out;
+  const Handle(Interface_InterfaceModel) model = process->Model();
+  const Interface_CheckIterator checks = process->CheckList(true);
+  for (checks.Start(); checks.More(); checks.Next()) {
+    const Handle(Interface_Check)& check = checks.Value();
+    if (check.IsNull() || !check->HasFailed()) continue;
+    std::string line = "an entity";
+    if (check->HasEntity() && !model.IsNull() && model->Contains(check->Entity())) {
+      const Handle(TCollection_HAsciiString) label = model->StringLabel(check->Entity());
+      line = (label.IsNull() ? std::string("?") : std::string(label->ToCString())) + " " +
+             model->TypeName(check->Entity(), false);
+    }
+    line += ": " + std::string(check->CFail(1));
+    if (check->NbFails() > 1) line += " (and " + std::to_string(check->NbFails() - 1) + " more)";
+    out.push_back(line);
+  }
+  return out;
+}
+
 /// The shapes of `file` by OpenCASCADE's plain reader (no XCAF: no names, colours or assembly),
-/// as one free shape of `document`; whether the transfer gave a shape.
-bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) & document) {
+/// as one free shape of `document`; whether the transfer gave a shape. The entities it could not
+/// transfer go to `failed`.
+bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) & document,
+                std::vector<std::string>& failed) {
   TopoDS_Shape shape;
   if (step) {
     STEPControl_Controller::Init();
@@ -789,6 +846,7 @@ bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) 
                   "read_model: " + quoted(file) + " could not be parsed as a STEP file");
     reader.TransferRoots();
     shape = reader.OneShape();
+    failed = failed_entities(reader.WS());
   } else {
     IGESControl_Controller::Init();
     surface::occt::set_static("xstep.cascade.unit", "MM");
@@ -799,6 +857,7 @@ bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) 
                   "read_model: " + quoted(file) + " could not be parsed as an IGES file");
     reader.TransferRoots();
     shape = reader.OneShape();
+    failed = failed_entities(reader.WS());
   }
   if (shape.IsNull()) return false;
   XCAFDoc_DocumentTool::ShapeTool(document->Main())->AddShape(shape, false);
@@ -814,8 +873,9 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
     XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
     bool read = false;
     UnknownEntities unknown;
+    std::vector<std::string> failed;
     if (plain) {
-      read = read_plain(file, step, document);
+      read = read_plain(file, step, document, failed);
     } else if (step) {
       STEPCAFControl_Controller::Init();
       surface::occt::set_static("xstep.cascade.unit", "MM");
@@ -832,6 +892,7 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
         if (auto u = Handle(StepData_UndefinedEntity)::DownCast(model->Value(i)); !u.IsNull())
           unknown.add(u->StepType(), "#" + std::to_string(model->IdentLabel(u)));
       read = reader.Transfer(document);
+      failed = failed_entities(reader.Reader().WS());
     } else {
       IGESControl_Controller::Init();
       surface::occt::set_static("xstep.cascade.unit", "MM");
@@ -849,18 +910,16 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
           unknown.add("entity type " + std::to_string(u->TypeNumber()),
                       "D" + std::to_string(2 * i - 1));
       read = reader.Transfer(document);
+      failed = failed_entities(reader.WS());
     }
-    if (!read)
-      throw Error(ErrorCategory::Exchange,
-                  "read_model: OpenCASCADE could not transfer the shapes of " + quoted(file));
+    if (!read) nothing_read(file, "gave OpenCASCADE no shape to transfer", failed);
     ModelBuilder builder(file, options, XCAFDoc_DocumentTool::ShapeTool(document->Main()),
-                         XCAFDoc_DocumentTool::ColorTool(document->Main()));
+                         XCAFDoc_DocumentTool::ColorTool(document->Main()), failed);
     ImportedModel out = builder.build();
     out.report.ignored = unknown.lines();
+    out.report.skipped = failed;
     XCAFApp_Application::GetApplication()->Close(document);
-    if (out.model.faces.empty())
-      throw Error(ErrorCategory::Exchange,
-                  "read_model: " + quoted(file) + " holds no face that could be read");
+    if (out.model.faces.empty()) nothing_read(file, "holds no face that could be read", failed);
     return out;
   });
 }

@@ -196,6 +196,8 @@ std::string serialize(const ImportedModel& x) {
   for (const auto& h : r.healing) put_string(out, h);
   put(out, static_cast<std::uint64_t>(r.ignored.size()));
   for (const auto& h : r.ignored) put_string(out, h);
+  put(out, static_cast<std::uint64_t>(r.skipped.size()));
+  for (const auto& h : r.skipped) put_string(out, h);
   return out;
 }
 
@@ -287,6 +289,8 @@ ImportedModel deserialize(const std::string& bytes) {
   for (auto& h : r.healing) h = take_string(in);
   r.ignored.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
   for (auto& h : r.ignored) h = take_string(in);
+  r.skipped.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
+  for (auto& h : r.skipped) h = take_string(in);
   return x;
 }
 

@@ -280,6 +280,8 @@ void bind_model(py::module_& m) {
         d["faces_angular"] = r.faces_angular;
         d["max_edge_gap_mm"] = r.max_edge_gap_mm;
         d["healing"] = r.healing;
+        d["ignored"] = r.ignored;
+        d["skipped"] = r.skipped;
         d["problems"] = r.problems;
         d["message"] = r.brief();
         return py::make_tuple(std::move(imported.model), d);
@@ -288,7 +290,9 @@ void bind_model(py::module_& m) {
       py::arg("strict") = false,
       "Reads a whole STEP or IGES model (trimmed faces, solids, assembly): (Model, report). "
       "isolate=True reads in a child process, so a file that crashes OpenCASCADE raises "
-      "ExchangeError. report['healing'] lists what was healed; strict=True heals as before "
+      "ExchangeError. report['healing'] lists what was healed, report['ignored'] the entity types "
+      "OpenCASCADE does not know, report['skipped'] the entities it failed to transfer (the rest "
+      "is read); strict=True heals as before "
       "issue #39 (pcurves outside their domains, gaps wider than the file's tolerances and "
       "misordered loops are listed in report['problems'] instead).");
 

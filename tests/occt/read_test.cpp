@@ -612,3 +612,52 @@ TEST_CASE("read_model: entities OpenCASCADE does not know are named in the repor
   CHECK_THAT(read.report.ignored.front(), Contains("#99001"));
   CHECK_THAT(read.report.brief(), Contains("ignored 1 unknown entity type"));
 }
+
+namespace {
+
+/// The text of `file` with the radius of its first `entity` ("CONICAL_SURFACE") made negative: a
+/// Standard_ConstructionError in OpenCASCADE's transfer of that entity, as broken exporters cause.
+fs::path negative_radius(const fs::path& file, const std::string& entity, const std::string& name) {
+  std::string text;
+  {
+    std::ifstream in(file, std::ios::binary);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const std::size_t at = text.find(entity + "('',");
+  REQUIRE(at != std::string::npos);
+  const std::size_t radius = text.find(',', at + entity.size() + 4) + 1;  // after the placement
+  text.insert(radius, "-");
+  const fs::path broken = output(name);
+  std::ofstream(broken, std::ios::binary) << text;
+  return broken;
+}
+
+}  // namespace
+
+TEST_CASE("read_model: an entity OpenCASCADE fails on is skipped and named, the rest is read") {
+  const fs::path broken =
+      negative_radius(written(TestModel::Cone, "cone.step"), "CONICAL_SURFACE", "cone-broken.step");
+  const auto read = read_model(broken);
+  // OpenCASCADE's own reading of the same file: the cone's side is left out, its two planes read.
+  const auto occt = clay::surface::occt_reference::facts_of_file(broken);
+  CHECK(occt.faces == 2);
+  CHECK(static_cast<int>(read.model.faces.size()) == occt.faces);
+  REQUIRE(read.report.skipped.size() == 1);
+  CHECK_THAT(read.report.skipped.front(), Contains("CONICAL_SURFACE"));
+  CHECK_THAT(read.report.brief(), Contains("skipped 1 entity OpenCASCADE could not transfer"));
+  // Isolated, the lines come through the pipe.
+  clay::brep::ModelReadOptions isolated;
+  isolated.read.isolate = true;
+  CHECK(read_model(broken, isolated).report.skipped == read.report.skipped);
+  // A clean file skips nothing.
+  CHECK(read_model(written(TestModel::Cone, "cone-clean.step")).report.skipped.empty());
+}
+
+TEST_CASE("read_model: a file none of whose shapes transfer is refused, naming the entity") {
+  const fs::path broken = negative_radius(written(TestModel::Sphere, "sphere.step"),
+                                          "SPHERICAL_SURFACE", "sphere-broken.step");
+  const auto [category, message] = clay::test::error_of([&] { read_model(broken); });
+  CHECK(category == clay::ErrorCategory::Exchange);
+  CHECK_THAT(message, Contains("SPHERICAL_SURFACE"));
+  CHECK_THAT(message, Contains("correct that entity"));
+}

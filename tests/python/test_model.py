@@ -163,6 +163,19 @@ def test_strict_read_lists_what_healing_would_fix() -> None:
     assert strict.problems() == report["problems"]
 
 
+def test_an_entity_opencascade_fails_on_is_skipped_and_named(tmp_path: Path) -> None:
+    cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
+    text = (cad / "autodesk_atf_conical_surface_ap214.step").read_text()
+    line = "#73=CYLINDRICAL_SURFACE('',#100,0.216535433070866);"
+    assert line in text
+    broken = tmp_path / "negative_radius.step"  # a Standard_ConstructionError in OpenCASCADE
+    broken.write_text(text.replace(line, line.replace(",0.2", ",-0.2")))
+    model, report = cf.read_model(broken)
+    assert model.counts["faces"] == 4  # of 5: FreeCAD 0.20 reads the same 4 faces
+    assert len(report["skipped"]) == 1 and report["skipped"][0].startswith("#73 CYLINDRICAL_SURFACE")
+    assert report["ignored"] == []
+
+
 def test_a_face_that_cannot_be_exact_is_refitted_within_tolerance_mm() -> None:
     # Alias's key under a B-spline lattice: a knot plane crosses its faces off their iso-lines, so
     # no single polynomial patch is exact there. Refused, naming the face, unless Model.deform is

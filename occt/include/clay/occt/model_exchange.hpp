@@ -84,6 +84,10 @@ struct CLAY_OCCT_API ModelReadReport {
   /// Entities of the file OpenCASCADE does not know and ignored, one line per type:
   /// "FOO_BAR x 3 (the first #999)" (STEP) or "entity type 999 x 2 (the first D17)" (IGES).
   std::vector<std::string> ignored;
+  /// Entities OpenCASCADE failed to transfer and left out (with what it built on them), one line
+  /// each: "#73 CYLINDRICAL_SURFACE: <OpenCASCADE's failure>". The rest of the file is read; a
+  /// file none of whose shapes transfer is refused, naming the first.
+  std::vector<std::string> skipped;
   /// brep::problems(model): invariants the model breaks (empty for a clean file). The model is
   /// still returned, so that it can be inspected; deforming it refuses it.
   std::vector<std::string> problems;
