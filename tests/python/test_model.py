@@ -193,6 +193,25 @@ def test_an_edge_in_its_light_form_has_its_bound_in_its_tolerance(tmp_path: Path
     assert check["valid"], check["problems"]
 
 
+def test_a_bulged_assembly_is_valid_where_brepcheck_measures_the_gaps_itself(
+        tmp_path: Path) -> None:
+    # Alibre's s1 under a (1, 1, 2) bulge: an annulus whose circles lie a constant 5.5e-7 mm off
+    # its face. A tolerance of that gap x (1 + 1e-9) was below BRepCheck's own measure of it.
+    cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
+    model, _ = cf.read_model(cad / "alibre_s1_assembly_ap214.stp", isolate=True)
+    lattice = cf.lattice_around(model, degrees=(1, 1, 2))
+    lo, hi = (np.array(c) for c in model.bounding_box())
+    points = lattice.points
+    for i in range(2):
+        for j in range(2):
+            points[lattice.index(i, j, 1), 0] += (0.1 if i else -0.1) * (hi - lo).max()
+    lattice.points = points
+    result, _ = model.deform(lattice, profile="opencascade")
+    assert result.problems() == []
+    check = result.write(tmp_path / "alibre.step")
+    assert check["valid"], check["problems"]
+
+
 def test_a_face_that_cannot_be_exact_is_refitted_within_tolerance_mm() -> None:
     # Alias's key under a B-spline lattice: a knot plane crosses its faces off their iso-lines, so
     # no single polynomial patch is exact there. Refused, naming the face, unless Model.deform is
