@@ -150,13 +150,13 @@ long face_budget(const surface::BSplineSurface& s) {
   return 200000 + 1000 * std::min(spans, 1800L);
 }
 
-/// F(u, v) = ∫_a^u z (x_u y_v − x_v y_u) ds, per knot span of u. On a polynomial surface of
+/// F(u, v) = ∫_a^u (S − c)·(S_u × S_v) / 3 ds, per knot span of u. On a polynomial surface of
 /// degree p in u the integrand has degree 3p - 1 there, so ceil(3p / 2) points are exact. A
 /// rational one is integrated adaptively to `tol` (F's units: volume per unit of v) within the
 /// face's budget: a fixed 16-point rule was 30 % off where a weight of 1e3 crowds the
 /// parametrization (issue #36).
-double inner(const surface::BSplineSurface& s, double a, double u, double v, double tol,
-             Budget& budget) {
+double inner(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double a, double u,
+             double v, double tol, Budget& budget) {
   // A pcurve may stand a rounding error outside the surface's domain (problems() allows it):
   // evaluate on its boundary there.
   u = std::clamp(u, s.u.domain().first, s.u.domain().second);
@@ -166,7 +166,7 @@ double inner(const surface::BSplineSurface& s, double a, double u, double v, dou
   const auto spans = breaks(s.u, lo, hi);
   auto integrand = [&](double x) {
     const surface::SurfaceDerivatives d = surface::derivatives(s, x, v, 1);
-    return d.point.z() * (d.du.x() * d.dv.y() - d.dv.x() * d.du.y());
+    return (d.point - c).dot(d.du.cross(d.dv)) / 3.0;
   };
   double sum = 0;
   for (std::size_t k = 0; k + 1 < spans.size(); ++k)
@@ -182,7 +182,8 @@ struct FaceVolume {
   Budget budget;
 };
 
-FaceVolume face_volume(const Model& m, const Face& face, double tol) {
+FaceVolume face_volume(const Model& m, const Face& face, const Eigen::Vector3d& centre,
+                       double tol) {
   FaceVolume out;
   out.budget.intervals = face_budget(face.surface);
   const surface::BSplineSurface& s = face.surface;
@@ -198,7 +199,8 @@ FaceVolume face_volume(const Model& m, const Face& face, double tol) {
     for (std::size_t k = 0; k + 1 < spans.size(); ++k)
       sum += adaptive(
           spans[k], spans[k + 1],
-          [&](double v) { return inner(s, u0, u1, v, tol_inner, out.budget); }, tol, out.budget);
+          [&](double v) { return inner(s, centre, u0, u1, v, tol_inner, out.budget); }, tol,
+          out.budget);
   } else {
     const double a = u0;  // any reference works: ∂F/∂u is the integrand for every choice
     for (const Loop& loop : face.loops)
@@ -212,7 +214,8 @@ FaceVolume face_volume(const Model& m, const Face& face, double tol) {
               surface::derivatives(c.pcurve, std::clamp(t, d0, d1), 1);
           return q.d1.y() == 0.0
                      ? 0.0
-                     : inner(s, a, q.point.x(), q.point.y(), tol_inner, out.budget) * q.d1.y();
+                     : inner(s, centre, a, q.point.x(), q.point.y(), tol_inner, out.budget) *
+                           q.d1.y();
         };
         const auto pieces =
             with_knot_crossings(c.pcurve, breaks(c.pcurve.basis, e.t0, e.t1), s.v, d0, d1);
@@ -238,6 +241,42 @@ double size_cubed(const Model& m) {
   return d * d * d;
 }
 
+/// The centre of the field (x − c) / 3 for body `b`: the mean of the vertices its faces' edges
+/// end at (each once), else of its faces' control points (a body of untrimmed closed faces). Any
+/// c gives the same volume on a watertight shell; on a real file's shell with gaps (up to its
+/// edge tolerances) the figure is the flux through the faces only, and a c that moves with the
+/// model keeps it covariant: an affine map x -> A x + b maps the vertices' mean to A c + b, so it
+/// multiplies the figure by det A exactly. The field (0, 0, z) of the first version was not: NX
+/// 9's gappy bracket, stretched, was 6.5e-5 off det A x V (issue #39). Near the body, c also
+/// keeps the gaps' lever arm short.
+Eigen::Vector3d body_centre(const Model& m, const Body& body) {
+  std::vector<char> seen(m.vertices.size(), 0);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  long count = 0;
+  for (const Shell& shell : body.shells)
+    for (int f : shell.faces)
+      for (const Loop& loop : m.faces[static_cast<std::size_t>(f)].loops)
+        for (const Coedge& coedge : loop.coedges) {
+          const Edge& e = m.edges[static_cast<std::size_t>(coedge.edge)];
+          for (int v : {e.start, e.end})
+            if (!seen[static_cast<std::size_t>(v)]) {
+              seen[static_cast<std::size_t>(v)] = 1;
+              sum += m.vertices[static_cast<std::size_t>(v)].point;
+              ++count;
+            }
+        }
+  if (count > 0) return sum / static_cast<double>(count);
+  for (const Shell& shell : body.shells)
+    for (int f : shell.faces) {
+      const auto& points = m.faces[static_cast<std::size_t>(f)].surface.points;
+      for (Eigen::Index r = 0; r < points.rows(); ++r) {
+        sum += points.row(r).transpose();
+        ++count;
+      }
+    }
+  return count > 0 ? Eigen::Vector3d(sum / static_cast<double>(count)) : Eigen::Vector3d::Zero();
+}
+
 /// The signed volume of the bodies `wanted` says (0 for the others): the faces' contributions
 /// integrated on the hardware's threads (each face on its own), then summed per body in shell
 /// order, so the result does not depend on the threads. Only the wanted bodies' faces are
@@ -247,15 +286,21 @@ std::vector<double> body_volumes(const Model& m, const std::vector<bool>& wanted
   const double tol = 1e-14 * size_cubed(m);
   std::vector<FaceVolume> face(m.faces.size());
   std::vector<bool> integrate(m.faces.size(), false);
+  std::vector<Eigen::Vector3d> centre(m.faces.size(), Eigen::Vector3d::Zero());
   for (std::size_t b = 0; b < m.bodies.size(); ++b)
-    if (wanted[b])
+    if (wanted[b]) {
+      const Eigen::Vector3d c = body_centre(m, m.bodies[b]);
       for (const Shell& shell : m.bodies[b].shells)
-        for (int f : shell.faces) integrate[static_cast<std::size_t>(f)] = true;
+        for (int f : shell.faces) {
+          integrate[static_cast<std::size_t>(f)] = true;
+          centre[static_cast<std::size_t>(f)] = c;
+        }
+    }
   const std::size_t parts = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1,
                                                     std::max<std::size_t>(1, m.faces.size()));
   run_on_threads(parts, [&](std::size_t part) {
     for (std::size_t f = part; f < m.faces.size(); f += parts)
-      if (integrate[f]) face[f] = face_volume(m, m.faces[f], tol);
+      if (integrate[f]) face[f] = face_volume(m, m.faces[f], centre[f], tol);
   });
   std::vector<double> out(m.bodies.size(), 0.0);
   for (std::size_t b = 0; b < m.bodies.size(); ++b)

@@ -257,9 +257,11 @@ class ModelBuilder {
       } else {
         continue;
       }
-      // A margin of rounding at the model's size too: a placed instance, rotated when an
-      // assembly is flattened, measures the same gap 3e-15 mm wider (CATIA's as1 assembly).
-      e.tolerance_mm = gap * (1 + 1e-9) + 1e-12 * size_;
+      // 0.1 % to spare, as deform_model leaves: BRepCheck measures the gap by its own sampling
+      // and rounding (it found Alibre's bulged annulus above the gap x (1 + 1e-9)); and a margin
+      // of rounding at the model's size: a placed instance, rotated when an assembly is
+      // flattened, measures the same gap 3e-15 mm wider (CATIA's as1 assembly).
+      e.tolerance_mm = gap * (1 + 1e-3) + 1e-12 * size_;
       for (int v : {e.start, e.end})
         if (v >= 0 && static_cast<std::size_t>(v) < model_.vertices.size())
           model_.vertices[static_cast<std::size_t>(v)].tolerance_mm =

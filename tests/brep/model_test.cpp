@@ -48,6 +48,44 @@ void plate_with_hole(Builder& b, double z) {
   b.m.bodies.push_back(sheet);
 }
 
+/// Adds to body `body` of `m` (a sheet) the mirror image of its faces in the plane z = 0, turned
+/// to face the other way, as shells of their own. The pair is symmetric about z = 0, so the
+/// centre c of volume_mm3's field (x − c) / 3 (the mean of the body's vertices, or of its control
+/// points when it has none) lies in that plane: a plate at height h of area A, facing +z, and its
+/// mirror add (2/3) h A, a closed form to hold the quadrature to.
+void add_mirror_below(Model& m, int body) {
+  const auto vertex0 = static_cast<int>(m.vertices.size());
+  const auto edge0 = static_cast<int>(m.edges.size());
+  const std::size_t vertices = m.vertices.size(), edges = m.edges.size();
+  for (std::size_t v = 0; v < vertices; ++v) {
+    Vertex copy = m.vertices[v];
+    copy.point.z() = -copy.point.z();
+    m.vertices.push_back(copy);
+  }
+  for (std::size_t e = 0; e < edges; ++e) {
+    Edge copy = m.edges[e];
+    copy.curve.points.col(2) *= -1.0;
+    copy.start += vertex0;
+    copy.end += vertex0;
+    m.edges.push_back(copy);
+  }
+  Body& b = m.bodies[static_cast<std::size_t>(body)];
+  const std::vector<clay::brep::Shell> shells = b.shells;
+  for (const clay::brep::Shell& shell : shells) {
+    clay::brep::Shell mirrored;
+    for (int f : shell.faces) {
+      Face copy = m.faces[static_cast<std::size_t>(f)];
+      copy.surface.points.col(2) *= -1.0;
+      copy.reversed = !copy.reversed;  // a reflection turns S_u x S_v
+      for (Loop& loop : copy.loops)
+        for (Coedge& c : loop.coedges) c.edge += edge0;
+      mirrored.faces.push_back(static_cast<int>(m.faces.size()));
+      m.faces.push_back(copy);
+    }
+    b.shells.push_back(mirrored);
+  }
+}
+
 std::string all(const std::vector<std::string>& list) {
   std::string s;
   for (const auto& p : list) s += p + "\n";
@@ -354,8 +392,7 @@ TEST_CASE("the assembly tree: instances of a part, bad references and cycles", "
 
 TEST_CASE("volume_mm3 of a cube, a translated cube and a cube with a face turned inside out",
           "[brep]") {
-  // a^3 for the cube [0, a]^3 wherever it stands (the field (0, 0, z) depends on the origin
-  // face by face, not in total).
+  // a^3 for the cube [0, a]^3 wherever it stands.
   CHECK(clay::brep::volume_mm3(cube(10), 0) == Approx(1000).epsilon(1e-14));
   Model moved = cube(3);
   for (Face& f : moved.faces) f.surface.points.rowwise() += Eigen::RowVector3d(5, -7, 11);
@@ -363,10 +400,13 @@ TEST_CASE("volume_mm3 of a cube, a translated cube and a cube with a face turned
   for (Edge& e : moved.edges) e.curve.points.rowwise() += Eigen::RowVector3d(5, -7, 11);
   CHECK(clay::brep::volume_mm3(moved) == Approx(27).epsilon(1e-14));
   // A trimmed face: the plate with a hole, as an open sheet, integrates over the trimmed domain
-  // only. With the field (0, 0, z) and the plate at z = 4, its flux is 4 × (100 - 25).
+  // only. The plate at z = 4 and its mirror: (2/3) × 4 × (100 - 25).
   Builder b;
   plate_with_hole(b, 4);
-  CHECK(clay::brep::volume_mm3(b.m, 0) == Approx(4 * 75).epsilon(1e-14));
+  add_mirror_below(b.m, 0);
+  INFO(all(clay::brep::problems(b.m)));
+  REQUIRE(clay::brep::problems(b.m).empty());
+  CHECK(clay::brep::volume_mm3(b.m, 0) == Approx(2.0 / 3.0 * 4 * 75).epsilon(1e-14));
   CHECK(clay::brep::volume_mm3(b.m) == 0);  // no solid
   CHECK(clay::test::error_of([&] { (void)clay::brep::volume_mm3(b.m, 1); }).first ==
         clay::ErrorCategory::InvalidArgument);
@@ -382,12 +422,50 @@ TEST_CASE("volume_mm3 of a cube, a translated cube and a cube with a face turned
         clay::ErrorCategory::InvalidGeometry);
 }
 
+TEST_CASE("volume_mm3 of a shell with gaps is multiplied by det A under an affine map", "[brep]") {
+  // Issue #39: a real file's faces meet their edges only within the edge tolerances, so the
+  // faces' flux misses the gaps'. With the field (0, 0, z) that miss changed with the map (NX 9's
+  // stretched bracket was 6.5e-5 off det A x V); with (x - c) / 3, c the vertices' mean, it is
+  // covariant: the flux of the image is det A times the flux of the original, whatever the gaps.
+  Model m = cube(10);
+  for (Vertex& v : m.vertices) v.tolerance_mm = 2e-3;
+  for (Edge& e : m.edges) e.tolerance_mm = 2e-3;
+  // The top face lifted 1e-3 mm off its edges, the right one leaning out by up to 1.5e-3 mm.
+  for (Face& f : m.faces) {
+    auto& p = f.surface.points;
+    if ((p.col(2).array() == 10.0).all()) p.col(2).array() += 1e-3;
+    if ((p.col(0).array() == 10.0).all())
+      for (Eigen::Index r = 0; r < p.rows(); ++r) p(r, 0) += 1.5e-4 * p(r, 2);
+  }
+  INFO(all(clay::brep::problems(m)));
+  REQUIRE(clay::brep::problems(m).empty());
+  const double original = clay::brep::volume_mm3(m, 0);
+  CHECK(std::abs(original - 1000) > 1e-3);  // the gaps count: not the cube's 1000
+  Eigen::Matrix3d a;
+  a << 1.7, 0.3, -0.2, 0.1, 0.8, 0.5, -0.4, 0.2, 2.1;
+  const Vector3d shift(120, -35, 7);
+  auto map = [&](clay::surface::Points3& p) {
+    for (Eigen::Index r = 0; r < p.rows(); ++r)
+      p.row(r) = (a * Vector3d(p.row(r).transpose()) + shift).transpose();
+  };
+  Model image = m;
+  for (Vertex& v : image.vertices) v.point = a * v.point + shift;
+  for (Edge& e : image.edges) map(e.curve.points);
+  for (Face& f : image.faces) map(f.surface.points);
+  for (Vertex& v : image.vertices) v.tolerance_mm = 1e-2;  // the map stretches the gaps
+  for (Edge& e : image.edges) e.tolerance_mm = 1e-2;
+  INFO(all(clay::brep::problems(image)));
+  REQUIRE(clay::brep::problems(image).empty());
+  CHECK(clay::brep::volume_mm3(image, 0) == Approx(a.determinant() * original).epsilon(1e-13));
+}
+
 TEST_CASE("volume_mm3 ends on a face with an extreme weight, exact or refused, never hung",
           "[brep]") {
   // Issue #36: one rational weight of 1e6 in a 7 KB IGES file made the adaptive quadrature run
   // for ever (its halved tolerance fell below rounding, so every branch went 2^40 deep). A
   // bilinear sheet keeps its plane square whatever its corner weights are (only the
-  // parametrization crowds towards the heavy corner), so its flux of (0, 0, z) is still z × area.
+  // parametrization crowds towards the heavy corner), so with its mirror the flux is still
+  // (2/3) z × area (add_mirror_below).
   for (double w : {1e3, 1e6, 1e9}) {
     INFO("corner weight " << w);
     Builder b;
@@ -403,18 +481,22 @@ TEST_CASE("volume_mm3 ends on a face with an extreme weight, exact or refused, n
     clay::surface::BSplineSurface& s = b.m.faces[static_cast<std::size_t>(f)].surface;
     s.weights = Eigen::VectorXd::Ones(s.points.rows());
     s.weights(0) = w;
+    add_mirror_below(b.m, 0);
     const Model& m = b.m;
     INFO(all(clay::brep::problems(m)));
     REQUIRE(clay::brep::problems(m).empty());
     const auto start = std::chrono::steady_clock::now();
     try {
       const double flux = clay::brep::volume_mm3(m, 0);
-      CHECK(flux == Approx(4 * 100).epsilon(1e-12));
+      CHECK(flux == Approx(2.0 / 3.0 * 4 * 100).epsilon(1e-12));
       CHECK(w < 1e6);  // 1e3 converges to the exact flux (a fixed 16-point rule gave 280)
     } catch (const clay::Error& e) {  // did not converge: said so, with the estimate
       CHECK(e.category() == clay::ErrorCategory::ToleranceNotMet);
-      CHECK_THAT(e.message(),
-                 Contains("the volume did not converge on 1 face(s) (0) within its budget"));
+      CHECK_THAT(
+          e.message(),
+          Contains(
+              "the volume did not converge on 2 face(s) (0, 1) within its budget"));  // and its
+                                                                                      // mirror
       CHECK(w >= 1e6);
     }
     // A sheet has no volume: its faces are not integrated, so it is never refused (WiZ WORX's
@@ -429,8 +511,8 @@ TEST_CASE("volume_mm3 integrates across a C0 knot line that a loop crosses", "[b
   // Issue #39 (Alias's k1 key): the loop integrand z (x_u y_v - x_v y_u) v'(t) jumps where a
   // pcurve crosses a C0 knot line in v, and an adaptive rule halving its tolerance with the
   // interval never met it there. The plane z = 4 over [0, 10]^2 with y(v) broken at v = 0.3
-  // (y = 2 there: the v speed jumps from 6.7 to 11.4; not at a bisection point of [0, 1]); its
-  // flux of (0, 0, z) is 4 x 100.
+  // (y = 2 there: the v speed jumps from 6.7 to 11.4; not at a bisection point of [0, 1]); with
+  // its mirror (add_mirror_below) the flux is (2/3) x 4 x 100.
   using clay::surface::make_curve;
   Model m;
   clay::surface::Points3 p(6, 3);  // (i, j) at row 3 i + j: x = 10 i, y in {0, 2, 10}
@@ -471,8 +553,9 @@ TEST_CASE("volume_mm3 integrates across a C0 knot line that a loop crosses", "[b
   sheet.shells.push_back({{0}});
   m.bodies.push_back(sheet);
   INFO(all(clay::brep::problems(m)));
+  add_mirror_below(m, 0);
   REQUIRE(clay::brep::problems(m).empty());
-  CHECK(clay::brep::volume_mm3(m, 0) == Approx(400).epsilon(1e-13));
+  CHECK(clay::brep::volume_mm3(m, 0) == Approx(2.0 / 3.0 * 400).epsilon(1e-13));
 }
 
 TEST_CASE("flattened places every instance of an assembly as a body of its own", "[brep]") {
