@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """The table of issue #39: every file of tests/data/cad read (isolated, as `clayform` reads),
 stretched by an affine lattice (volume against det(A) x the original) and bulged by a (1, 1, 2)
-Bézier lattice, each result checked (brep problems, written as STEP and checked by BRepCheck), with the
+Bézier lattice, each result checked (brep problems, written as STEP and checked by BRepCheck;
+every face at (u, v) against the lattice's map of the original face at the same (u, v)), with the
 times, beside FreeCAD's own reading (faces, solids, volume, validity) when its figures are given.
 Prints a Markdown table. Usage:
     CLAY_FREECAD_OUT=freecad.json freecadcmd scripts/freecad_real_files.py
@@ -53,6 +54,35 @@ def outcome(model: cf.Model, lattice: object, folder: Path, name: str) -> tuple[
     return verdict, seconds, (result, report)
 
 
+def off_the_map(model: cf.Model, result: cf.Model, lattice: object) -> float:
+    """The largest distance, over a 5 x 5 grid of every face's domain (the deformed face's: a
+    restricted one is a part of the original's), between the deformed face at (u, v) and the
+    lattice's map of the original face at the same (u, v)."""
+    if model.is_assembly:  # the deformed model is the flattened one (each placed instance)
+        model = model.flattened()
+    worst = 0.0
+    for k in range(result.face_count):
+        before, after = model.face_surface(k), result.face_surface(k)
+        (u0, u1), (v0, v1) = after.domain
+        for a in np.linspace(0.0, 1.0, 5):
+            for b in np.linspace(0.0, 1.0, 5):
+                u, v = u0 + a * (u1 - u0), v0 + b * (v1 - v0)
+                mapped = lattice.deform_point(before.evaluate(u, v))
+                worst = max(worst, float(np.linalg.norm(after.evaluate(u, v) - mapped)))
+    return worst
+
+
+def pointwise(model: cf.Model, deformed: object, lattice: object) -> str:
+    """off_the_map, beside the certified bound of faces written in a light form."""
+    if deformed is None:
+        return "—"
+    result, report = deformed
+    text = f"{off_the_map(model, result, lattice):.1e}"
+    if report["max_certified_bound_mm"] > 0:
+        text += f" (bound {report['max_certified_bound_mm']:.1e})"
+    return text
+
+
 def freecad_columns(freecad: dict, name: str, model: cf.Model | None) -> str:
     """FreeCAD's faces / solids, validity, and our volume against FreeCAD's."""
     if not freecad:
@@ -79,7 +109,7 @@ def main() -> int:
             try:
                 model, report = cf.read_model(path, isolate=True)
             except cf.ClayError as e:
-                rows.append(f"| `{path.name}` | — | refused: {str(e).splitlines()[0][:80]} | | | | "
+                rows.append(f"| `{path.name}` | — | refused: {str(e).splitlines()[0][:80]} | | | | | "
                             f"{freecad_columns(freecad, path.name, None)} |")
                 continue
             read_s = time.perf_counter() - start
@@ -90,11 +120,14 @@ def main() -> int:
                 read += f" ({healing} healing step{'s' if healing > 1 else ''})"
             counts = model.counts
             if problems:
-                rows.append(f"| `{path.name}` | {counts['faces']} / {counts['solids']} | {read} | — | — | — | "
+                rows.append(f"| `{path.name}` | {counts['faces']} / {counts['solids']} | {read} | — | — | — | — | "
                             f"{read_s:.1f}{freecad_columns(freecad, path.name, None)} |")
                 continue
-            s_verdict, s_time, s_result = outcome(model, stretched(model), folder, "s")
-            b_verdict, b_time, _ = outcome(model, bulged(model), folder, "b")
+            s_lattice, b_lattice = stretched(model), bulged(model)
+            s_verdict, s_time, s_result = outcome(model, s_lattice, folder, "s")
+            b_verdict, b_time, b_result = outcome(model, b_lattice, folder, "b")
+            maps = (f"{pointwise(model, s_result, s_lattice)} / "
+                    f"{pointwise(model, b_result, b_lattice)}")
             error = "— (no solid)"
             if counts["solids"] and s_result is not None:
                 before = model.volume_mm3()
@@ -103,11 +136,12 @@ def main() -> int:
                 error = f"{abs(after - det * before) / (det * before):.1e}"
             rows.append(
                 f"| `{path.name}` | {counts['faces']} / {counts['solids']} | {read} | {s_verdict} | "
-                f"{b_verdict} | {error} | {read_s:.1f} + {s_time:.1f} + {b_time:.1f}"
+                f"{b_verdict} | {error} | {maps} | {read_s:.1f} + {s_time:.1f} + {b_time:.1f}"
                 f"{freecad_columns(freecad, path.name, model)} |")
             print(rows[-1], file=sys.stderr, flush=True)
     head = ("| file | faces / solids | read | stretched (affine) | bulged (B-spline) | "
-            "stretched volume against det × V | time read + stretch + bulge (s) |")
+            "stretched volume against det × V | faces against the map at the same (u, v), "
+            "stretched / bulged (mm) | time read + stretch + bulge (s) |")
     if freecad:
         head += " FreeCAD: faces / solids, validity | volume against FreeCAD's |"
     print(head)

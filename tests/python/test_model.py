@@ -230,6 +230,38 @@ def test_a_gappy_solid_under_an_affine_map_has_det_a_times_its_volume(name: str)
                                                    rel=1e-12)
 
 
+@pytest.mark.parametrize("name", ["alias_autostudio96_k1_bspline_solid_ap214.stp",
+                                  "euclid_ol20b_screw_cc1.step",
+                                  "solidworks2013_featuretype_holes_fillets_ap214.STEP"])
+def test_a_bulged_real_solid_is_the_lattice_map_of_the_original_at_the_same_uv(name: str) -> None:
+    # Issue #39: "B-spline faces equal to F at the same (u, v)". The (1, 1, 2) bulge of the table
+    # of real files (docs/perf/real-files.md): every face composed exactly, each point of it the
+    # lattice's map (evaluated by de Casteljau, independently of the composition) of the
+    # original face's point at the same (u, v).
+    cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
+    model, _ = cf.read_model(cad / name, isolate=True)
+    lattice = cf.lattice_around(model, degrees=(1, 1, 2))
+    lo, hi = (np.array(c) for c in model.bounding_box())
+    points = lattice.points
+    for i in range(2):
+        for j in range(2):
+            points[lattice.index(i, j, 1), 0] += (0.1 if i else -0.1) * (hi - lo).max()
+    lattice.points = points
+    result, report = model.deform(lattice)
+    assert report["faces_exact"] == model.face_count and result.face_count == model.face_count
+    assert result.problems() == []
+    worst = 0.0
+    for k in range(model.face_count):
+        before, after = model.face_surface(k), result.face_surface(k)
+        (u0, u1), (v0, v1) = after.domain
+        for a in np.linspace(0.0, 1.0, 4):
+            for b in np.linspace(0.0, 1.0, 4):
+                u, v = u0 + a * (u1 - u0), v0 + b * (v1 - v0)
+                mapped = lattice.deform_point(before.evaluate(u, v))
+                worst = max(worst, float(np.linalg.norm(after.evaluate(u, v) - mapped)))
+    assert worst <= 1e-11 * np.linalg.norm(hi - lo)
+
+
 def test_a_face_that_cannot_be_exact_is_refitted_within_tolerance_mm() -> None:
     # Alias's key under a B-spline lattice: a knot plane crosses its faces off their iso-lines, so
     # no single polynomial patch is exact there. Refused, naming the face, unless Model.deform is
