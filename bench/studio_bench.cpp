@@ -1,11 +1,14 @@
-// Clayform Studio's drag step (issue #23), kernel side, wall time (UseRealTime):
+// Clayform Studio's drag step (issue #23) and stroke step (issue #40), kernel side, wall time
+// (UseRealTime):
 // - lattice_drag_step: one control point of a (3, 3, 1) Bézier lattice moved, the lattice frozen
 //   again (FrozenLattice) and a 173 x 173 = 29,929-vertex tessellation of the parent deformed
 //   pointwise: what a drag costs when the deformed tessellation is computed from the parent's
 //   (the page does this itself in the studio; bench_style's drag is the style step's figure);
 // - session_drag_step: what `clayform studio` does today for one drag update: the recipe edited,
 //   checked and run whole (StudioSession::handle with "nets": false), for the car hood's crease
-//   (style, exact and paper) and for a lattice composed exactly with the hood.
+//   (style, exact and paper) and for a lattice composed exactly with the hood;
+// - stroke_step: pointer-up to fitted curve for a design of 1, 20 and 40 hand-drawn strokes,
+//   before and after the session kept its steps' results (recipe::RunCache).
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/recipe/recipe.hpp>
@@ -23,6 +26,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -177,10 +181,82 @@ void tank_drag_step(benchmark::State& state) {
   state.SetLabel(labels[state.range(0)]);
 }
 
+/// A stroke drawn as a hand draws (issue #40): a section across a 600 mm panel on the plane
+/// y = `y`, 120 points spaced unevenly (the pen slows at the ends), with correlated tremor (a
+/// first-order autoregressive jitter, 0.12 mm, correlation 0.9 from point to point) normal to
+/// the line. `seed` varies the tremor.
+Json hand_stroke(double y, unsigned seed) {
+  std::uint64_t state = 0x9e3779b97f4a7c15ull * (seed + 1);
+  auto uniform = [&] {  // splitmix64, in [-1, 1)
+    state += 0x9e3779b97f4a7c15ull;
+    std::uint64_t z = state;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return static_cast<double>((z ^ (z >> 31)) >> 11) / 4503599627370496.0 - 1.0;
+  };
+  Json points = Json::array();
+  double tremor = 0;
+  constexpr int n = 120;
+  for (int k = 0; k < n; ++k) {
+    const double s = 0.5 - 0.5 * std::cos(M_PI * k / (n - 1));  // slow at both ends
+    const double x = -300 + 600 * s;
+    tremor = 0.9 * tremor + 0.12 * std::sqrt(1 - 0.81) * 1.7 * uniform();
+    const double z = 60 * std::sin(M_PI * s) + 8 * std::sin(3 * M_PI * s + 0.01 * y) + tremor;
+    points.push_back({x, y, z});
+  }
+  return {{"points", points},
+          {"plane", {{"origin", {0, y, 0}}, {"normal", {0, 1, 0}}}},
+          {"tolerance_mm", 0.5}};
+}
+
+// Issue #40: pointer-up to fitted curve in the studio, a design of N hand-drawn strokes
+// (Arg 0: N = 1, 20 or 40), the last stroke drawn again each iteration (its tremor differs):
+// the page's "fit" (does the stroke split at corners?) then the "edit" that puts it in the
+// recipe, with its nets ("nets": true), as the page sends them. Arg 1: 0 = before, every step run
+// again (the session's RunCache cleared before each edit: what every edit cost until then);
+// 1 = after, the other strokes taken from the cache.
+void stroke_step(benchmark::State& state) {
+  const int strokes = static_cast<int>(state.range(0));
+  const bool cached = state.range(1) == 1;
+  Json doc = {{"format", "clayform.recipe"}, {"version", 1}, {"name", "strokes"}};
+  for (int k = 0; k < strokes; ++k)
+    doc["strokes"]["s" + std::to_string(k)] = hand_stroke(-400 + 20.0 * k, k);
+  recipe::StudioSession session(doc.dump(), std::filesystem::temp_directory_path(), "strokes");
+  session.handle(Json{{"op", "run"}}.dump());
+  const std::string last = "strokes.s" + std::to_string(strokes - 1);
+  unsigned seed = 1000;
+  clay::bench::StepTimes times;
+  for (auto _ : state) {
+    const Json stroke = hand_stroke(-400 + 20.0 * (strokes - 1), ++seed);
+    if (!cached) session.run_cache()->clear();
+    const auto t0 = std::chrono::steady_clock::now();
+    Json fit = {{"op", "fit"}};
+    fit.update(stroke);
+    const auto asked = session.handle(fit.dump());
+    const auto reply = session.handle(
+        Json{{"op", "edit"}, {"path", last}, {"value", stroke}, {"label", "stroke"}}.dump());
+    times.record(t0);
+    if (reply.json.find("\"op\":\"error\"") != std::string::npos ||
+        asked.json.find("\"op\":\"error\"") != std::string::npos) {
+      state.SkipWithError((asked.json + reply.json).c_str());
+      break;
+    }
+    benchmark::DoNotOptimize(reply.json.data());
+  }
+  times.report(state);
+  state.SetLabel(std::to_string(strokes) + " strokes, " +
+                 (cached ? "after: the other steps taken from the run cache"
+                         : "before: every step run again"));
+}
+
 }  // namespace
 
 BENCHMARK(tank_drag_step)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(lattice_drag_step)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(stroke_step)
+    ->ArgsProduct({{1, 20, 40}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(session_drag_step)
     ->Arg(0)
     ->Arg(3)

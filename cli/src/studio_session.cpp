@@ -242,6 +242,9 @@ struct StudioSession::Impl {
   // The last run and the recipe text it ran: what the next edit of deformations alone reuses.
   mutable std::shared_ptr<const RunResult> last_run;
   mutable std::string last_text;
+  // Every step's result kept between runs (issue #40): an edit re-runs only the steps
+  // downstream of what it changed; undo, redo and a restored autosave meet their steps again.
+  std::shared_ptr<RunCache> cache = std::make_shared<RunCache>();
   fs::path autosave;  // empty: none
   std::chrono::steady_clock::time_point autosaved{};
   bool autosave_pending = false;
@@ -265,6 +268,7 @@ struct StudioSession::Impl {
     const Recipe recipe = parse_recipe(recipe_text, base_dir, name);
     RunOptions options;
     options.profile = profile;  // the export's receiver, for the deformed models
+    options.cache = cache;
     if (cancelled)
       options.progress = [&](const StepReport&) {
         if (cancelled()) throw Cancelled{};
@@ -723,6 +727,8 @@ std::vector<std::string> StudioSession::history() const {
 int StudioSession::position() const { return impl_->position; }
 
 std::size_t StudioSession::history_dropped() const { return impl_->dropped; }
+
+std::shared_ptr<RunCache> StudioSession::run_cache() const { return impl_->cache; }
 
 void StudioSession::limit_history(std::size_t bytes) { impl_->history_limit = bytes; }
 

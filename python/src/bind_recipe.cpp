@@ -94,6 +94,7 @@ void bind_recipe(py::module_& m) {
               d["kind"] = s.kind;
               d["seconds"] = s.seconds;
               d["warning"] = s.warning;
+              d["reused"] = s.reused;
               d["message"] = s.message;
               for (const auto& [k, v] : s.figures) figures[py::str(k)] = figure(v);
               d["figures"] = figures;
@@ -101,7 +102,8 @@ void bind_recipe(py::module_& m) {
             }
             return out;
           },
-          "Every step's report: path, kind, seconds, warning, message, figures.")
+          "Every step's report: path, kind, seconds, warning, reused (taken from a RunCache), "
+          "message, figures.")
       .def_property_readonly("report", &report_dict, "The report as report.json holds it (a dict).")
       .def_property_readonly("seconds", [](const recipe::RunResult& r) { return r.seconds; })
       .def(
@@ -122,6 +124,33 @@ void bind_recipe(py::module_& m) {
       .def("__repr__", [](const recipe::RunResult& r) {
         return "<clayform.RunResult '" + r.recipe + "': " + std::to_string(r.surfaces.size()) +
                " surfaces, " + std::to_string(r.steps.size()) + " steps>";
+      });
+
+  py::class_<recipe::RunCache, std::shared_ptr<recipe::RunCache>>(
+      m, "RunCache",
+      "The results of recipe steps kept from one run for the next (docs/recipe.md, run cache): "
+      "pass the same cache to Recipe.run and a step whose definition and inputs did not change "
+      "is taken, bit for bit, instead of run again. Thread-safe; the least recently used "
+      "results go beyond capacity_bytes.")
+      .def(py::init<std::size_t>(), py::arg("capacity_bytes") = std::size_t{256} << 20)
+      .def_property_readonly(
+          "counts",
+          [](const recipe::RunCache& c) {
+            const auto n = c.counts();
+            py::dict d;
+            d["reused"] = n.reused;
+            d["kept"] = n.kept;
+            d["evicted"] = n.evicted;
+            d["entries"] = n.entries;
+            d["bytes"] = n.bytes;
+            return d;
+          },
+          "reused (steps taken), kept (results stored), evicted, entries and bytes held now.")
+      .def("clear", &recipe::RunCache::clear, "Drops every kept result and zeroes the counts.")
+      .def("__repr__", [](const recipe::RunCache& c) {
+        const auto n = c.counts();
+        return "<clayform.RunCache: " + std::to_string(n.entries) + " results, " +
+               std::to_string(n.bytes) + " bytes>";
       });
 
   py::class_<PyRecipe>(m, "Recipe",
@@ -162,11 +191,14 @@ void bind_recipe(py::module_& m) {
                              [](const PyRecipe& r) { return recipe::final_surfaces(r.recipe); })
       .def(
           "run",
-          [](const PyRecipe& r, const std::optional<fs::path>& out) {
+          [](const PyRecipe& r, const std::optional<fs::path>& out,
+             std::shared_ptr<recipe::RunCache> cache) {
             recipe::RunResult result;
             {
               py::gil_scoped_release free;
-              result = recipe::run_recipe(r.recipe);
+              recipe::RunOptions options;
+              options.cache = std::move(cache);
+              result = recipe::run_recipe(r.recipe, options);
             }
             if (out) {
               py::gil_scoped_release free;
@@ -174,9 +206,10 @@ void bind_recipe(py::module_& m) {
             }
             return result;
           },
-          py::arg("out") = py::none(),
+          py::arg("out") = py::none(), py::kw_only(), py::arg("cache") = nullptr,
           "Runs every step in memory (the GIL released); with out, writes the exports, "
-          "report.json and the view folder there as `clayform run --out` does.")
+          "report.json and the view folder there as `clayform run --out` does. With cache (a "
+          "RunCache), the steps it holds unchanged are taken from it and the others kept in it.")
       .def(
           "deform_model",
           [](const PyRecipe& r, const brep::Model& model, const std::string& deformation,

@@ -2,6 +2,7 @@
 // file holds the document's walk, composition and exports, the syntax checks and the public
 // entry points; the readers of the other sections are in recipe_check_*.cpp (recipe_checker.hpp).
 #include "recipe_checker.hpp"
+#include "run_cache.hpp"
 
 #include <clay/internal/files.hpp>
 
@@ -571,6 +572,9 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   rc.run(root);
   out.data = std::move(rc.data);
   out.problems = recipe_problems(c);
+  if (out.problems.empty())
+    out.data.document =
+        std::make_shared<const detail::DocumentJson>(detail::DocumentJson{std::move(root)});
   return out;
 }
 

@@ -17,6 +17,7 @@
 #include <clay/surface/surface_curves.hpp>
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <variant>
@@ -216,8 +217,15 @@ struct ModelDef {
   std::string schema = "AP214";
 };
 
+namespace detail {
+struct DocumentJson;  // run_cache.hpp
+}
+
 struct RecipeData {
   std::string name, description;
+  /// The JSON as checked: the run's cache keys (RunCache) start with each step's own text. Null
+  /// for a recipe made in code; then nothing is cached.
+  std::shared_ptr<const detail::DocumentJson> document;
   Composition composition;
   std::vector<StrokeDef> strokes;
   std::vector<CurveDef> curves;

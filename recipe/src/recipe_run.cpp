@@ -1,6 +1,7 @@
 // Running a checked recipe in memory: every step in order, each timed and reported with the
 // quality figures of DESIGN.md; a failing step is rethrown with its path first.
 #include "recipe_run.hpp"
+#include "run_cache.hpp"
 
 #include <clay/brep/volume.hpp>
 #include <clay/constraints/solve.hpp>
@@ -20,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <set>
 
 namespace clay::recipe {
@@ -327,7 +329,9 @@ class Runner {
   RunResult& result_;
   std::map<std::string, std::size_t> curve_index_;
   std::set<std::size_t> sketches_built_;  // indices into data_.sketches
-  std::set<std::string> building_;        // "curve NAME" / "surface NAME" being built
+  // The digests of the keys of the steps that gave each curve and surface (RunOptions::cache).
+  std::map<std::string, std::string> curve_digest_, surface_digest_;
+  std::set<std::string> building_;  // "curve NAME" / "surface NAME" being built
   // The bound ledger (issue #38): how far each surface, and the one being deformed, may be from
   // its exact reference, the recipe with every step exact (mm; inf: not bounded).
   std::map<std::string, double> bound_of_;
@@ -363,7 +367,8 @@ class Runner {
     result_.steps.push_back(std::move(rep));
   }
 
-  /// Builds the curve `name` unless built: first what it needs, then its stroke, curve or sketch.
+  /// Builds the curve `name` unless built: first what it needs, then its stroke, curve or sketch
+  /// (each taken from the run's cache when its key is there).
   void need_curve(const std::string& name) {
     if (curve_index_.count(name)) return;
     guard("curve " + name, [&] {
@@ -372,9 +377,12 @@ class Runner {
       for (const auto& s : needs.surfaces) need_surface(s);
       for (const auto& s : data_.strokes)
         if (defines(s, name))
-          return timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); });
+          return cached([&] { return own_key("strokes", s.name, needs); },
+                        [&] { timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); }); });
       for (const auto& c : data_.curves)
-        if (c.name == name) return timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); });
+        if (c.name == name)
+          return cached([&] { return own_key("curves", c.name, needs); },
+                        [&] { timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); }); });
       for (std::size_t k = 0; k < data_.sketches.size(); ++k)
         for (const auto& [entity, id] : data_.sketches[k].entities)
           if (entity == name) return need_sketch(k);
@@ -385,7 +393,11 @@ class Runner {
     sketches_built_.insert(k);
     const SketchDef& s = data_.sketches[k];
     for (const auto& c : s.uses) need_curve(c);
-    timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); });
+    cached(
+        [&] {
+          return own_key("sketches", s.name, Needs{s.uses, {}});
+        },
+        [&] { timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); }); });
   }
   void need_surface(const std::string& name) {
     if (std::any_of(result_.surfaces.begin(), result_.surfaces.end(),
@@ -397,16 +409,123 @@ class Runner {
           const Needs needs = surface_needs(data_, def);
           for (const auto& c : needs.curves) need_curve(c);
           for (const auto& s : needs.surfaces) need_surface(s);
-          // Taken from the previous run when nothing it needs changed (run_reuse.cpp).
-          if (options_.previous &&
-              !needs_changed(data_, *options_.previous, options_.changed_deformations, name,
-                             affected_) &&
-              take_surface(*options_.previous, def, result_, bound_of_, options_.progress))
-            return;
-          return build_surface(def);
+          return cached(
+              [&] { return surface_key(def, needs); },
+              [&] {
+                // Taken from the previous run when nothing it needs changed (run_reuse.cpp).
+                if (options_.previous &&
+                    !needs_changed(data_, *options_.previous, options_.changed_deformations, name,
+                                   affected_) &&
+                    take_surface(*options_.previous, def, result_, bound_of_, options_.progress))
+                  return;
+                build_surface(def);
+              });
         }
     });
   }
+
+  // ---- what earlier runs give (RunOptions::cache; run_cache.hpp) -----------------------------
+
+  /// Runs `build` (one step: a stroke, a curve, a sketch, or a surface with its stack), or takes
+  /// what it adds from the run's cache when its key is there; what it adds is kept under the
+  /// key. Every curve and surface it adds gets a digest of the key, which the keys of the steps
+  /// built on it contain. Without a cache (or a document to key on) it only builds.
+  template <class K, class B>
+  void cached(K&& key_of, B&& build) {
+    if (!options_.cache || !data_.document) return build();
+    const std::optional<std::string> key = key_of();
+    if (!key) return build();
+    const std::string d = digest(*key);
+    if (const auto hit = CacheAccess::find(*options_.cache, *key)) return take(*hit, d);
+    const std::size_t curves0 = result_.curves.size(), surfaces0 = result_.surfaces.size(),
+                      steps0 = result_.steps.size(), stages0 = result_.stages.size(),
+                      previewed0 = result_.previewed.size();
+    build();
+    CacheEntry e;
+    e.curves.assign(result_.curves.begin() + static_cast<std::ptrdiff_t>(curves0),
+                    result_.curves.end());
+    e.surfaces.assign(result_.surfaces.begin() + static_cast<std::ptrdiff_t>(surfaces0),
+                      result_.surfaces.end());
+    e.steps.assign(result_.steps.begin() + static_cast<std::ptrdiff_t>(steps0),
+                   result_.steps.end());
+    e.stages.assign(result_.stages.begin() + static_cast<std::ptrdiff_t>(stages0),
+                    result_.stages.end());
+    for (const auto& [n, s] : e.surfaces)
+      if (const auto b = bound_of_.find(n); b != bound_of_.end())
+        e.bounds.emplace_back(n, b->second);
+    note_digests(e, d);
+    // A drag's preview is uncertified: never kept.
+    if (result_.previewed.size() == previewed0)
+      CacheAccess::keep(*options_.cache, *key, std::move(e));
+  }
+
+  /// Adds a kept entry to the run as building it would have, its reports marked reused.
+  void take(const CacheEntry& e, const std::string& d) {
+    for (const auto& [n, c] : e.curves) add_curve(n, c);
+    for (const auto& s : e.surfaces) result_.surfaces.push_back(s);
+    for (StepReport rep : e.steps) {
+      rep.reused = true;
+      if (options_.progress) options_.progress(rep);
+      result_.steps.push_back(std::move(rep));
+    }
+    result_.stages.insert(result_.stages.end(), e.stages.begin(), e.stages.end());
+    for (const auto& [n, b] : e.bounds) bound_of_[n] = b;
+    note_digests(e, d);
+  }
+
+  void note_digests(const CacheEntry& e, const std::string& d) {
+    for (const auto& c : e.curves) curve_digest_[c.first] = d + "/" + c.first;
+    for (const auto& s : e.surfaces) surface_digest_[s.first] = d;
+  }
+
+  /// A step's key: its section and definition as written, then the digest of every curve and
+  /// surface it needs (empty when one has none: then it is built, not kept).
+  std::optional<std::string> own_key(const char* section, const std::string& name,
+                                     const Needs& needs) const {
+    std::string k = std::string(section) + "\n" + definition_text(*data_.document, section, name);
+    for (const auto& c : needs.curves) {
+      const auto it = curve_digest_.find(c);
+      if (it == curve_digest_.end()) return std::nullopt;
+      k += "\ncurve " + c + " " + it->second;
+    }
+    for (const auto& s : needs.surfaces) {
+      const auto it = surface_digest_.find(s);
+      if (it == surface_digest_.end()) return std::nullopt;
+      k += "\nsurface " + s + " " + it->second;
+    }
+    return k;
+  }
+
+  /// A surface's key: own_key with the recipe's composition; for a deformed surface its stack's
+  /// definition, whether it leaves the recipe (a light copy above the budget) and every surface
+  /// built before it (its fits follow the sides it shares with them); for an import, the file's
+  /// size and time of change.
+  std::optional<std::string> surface_key(const SurfaceDef& def, const Needs& needs) const {
+    std::optional<std::string> k = own_key("surfaces", def.name, needs);
+    if (!k) return k;
+    const auto comp = data_.document->root.find("composition");
+    *k += "\ncomposition " + (comp == data_.document->root.end() ? std::string() : comp->dump());
+    if (const auto* d = std::get_if<DeformDef>(&def.build)) {
+      *k += "\nstack " + definition_text(*data_.document, "deformations", d->deformation);
+      *k += built_on(data_, def.name) ? "\nbuilt on" : "\nfinal";
+      *k += "\nafter";
+      for (const auto& [n, s] : result_.surfaces) {
+        const auto it = surface_digest_.find(n);
+        if (it == surface_digest_.end()) return std::nullopt;
+        *k += " " + n + " " + it->second;
+      }
+    }
+    if (const auto* b = std::get_if<ImportDef>(&def.build)) {
+      std::error_code size_error, time_error;
+      const auto size = fs::file_size(b->file, size_error);
+      const auto time = fs::last_write_time(b->file, time_error);
+      if (size_error || time_error) return std::nullopt;
+      *k += "\nfile " + b->file.string() + " " + std::to_string(size) + " " +
+            std::to_string(time.time_since_epoch().count());
+    }
+    return k;
+  }
+
   // ---- what an earlier run gives (RunOptions::previous) ---------------------------------------
 
   /// Runs f for `node` once at a time: the checker reports cycles, so meeting one here is a bug.

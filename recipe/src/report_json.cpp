@@ -24,6 +24,7 @@ ReportJson step_json(const StepReport& step) {
   x["kind"] = step.kind;
   x["seconds"] = step.seconds;
   x["warning"] = step.warning;
+  if (step.reused) x["reused"] = true;  // taken from an earlier run (RunCache, previous)
   x["message"] = step.message;
   x["figures"] = figures_json(&step);
   return x;

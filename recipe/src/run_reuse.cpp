@@ -49,8 +49,10 @@ bool take_surface(const RunResult& previous, const SurfaceDef& def, RunResult& i
   // Its own steps: "surfaces.NAME", "surfaces.NAME.steps[k]", "surfaces.NAME.composition.budget".
   for (const StepReport& rep : previous.steps)
     if (rep.path == def.path || rep.path.rfind(def.path + ".", 0) == 0) {
-      if (progress) progress(rep);
-      into.steps.push_back(rep);
+      StepReport taken = rep;
+      taken.reused = true;
+      if (progress) progress(taken);
+      into.steps.push_back(std::move(taken));
     }
   for (const Stage& st : previous.stages)
     if (st.surface == def.name) into.stages.push_back(st);

@@ -1,6 +1,8 @@
-"""Pickling through a separate process, recipes in Python against the command, and the GIL."""
+"""Pickling through a separate process, recipes in Python against the command, the GIL, and the
+run cache."""
 from __future__ import annotations
 
+import json
 import pickle
 import subprocess
 import sys
@@ -73,3 +75,33 @@ def test_long_calls_release_the_gil() -> None:
     duration = call[1] - call[0]
     assert len(inside) > 10, f"the main thread ran {len(inside)} times during a {duration:.2f} s call"
     assert max(np.diff(inside)) < duration / 3
+
+
+def test_a_run_cache_takes_unchanged_steps_bit_for_bit(examples: Path) -> None:
+    # Issue #40: a second run with the same RunCache takes every step; an edit of the sail's
+    # deformation re-runs only the deformed surface, and every result equals a run without cache.
+    text = (examples / "recipes" / "sail.json").read_text()
+    base = str(examples / "recipes")
+    cache = cf.RunCache()
+    first = cf.Recipe.parse(text, base).run(cache=cache)
+    assert not any(s["reused"] for s in first.steps)
+    assert cache.counts["kept"] == 7  # five curves and two surfaces
+    again = cf.Recipe.parse(text, base).run(cache=cache)
+    assert all(s["reused"] for s in again.steps if not s["path"].startswith("exports."))
+    assert cache.counts["reused"] == 7
+    doc = json.loads(text)
+    doc["deformations"]["shape"][1]["moves"][0]["by"][1] = 350
+    edited = json.dumps(doc)
+    cached = cf.Recipe.parse(edited, base).run(cache=cache)
+    whole = cf.Recipe.parse(edited, base).run()
+    assert {s["path"] for s in cached.steps if not s["reused"] and not s["path"].startswith("exports.")} == {
+        "surfaces.sail.steps[0]", "surfaces.sail.steps[1]"}
+    for name, surface in whole.surfaces.items():
+        assert np.array_equal(cached.surfaces[name].points, surface.points)
+        assert np.array_equal(cached.surfaces[name].weights, surface.weights)
+    for name, curve in whole.curves.items():
+        assert np.array_equal(cached.curves[name].points, curve.points)
+    small = cf.RunCache(capacity_bytes=16)  # holds none of them: nothing kept, nothing wrong
+    assert np.array_equal(cf.Recipe.parse(text, base).run(cache=small).surfaces["sail"].points,
+                          first.surfaces["sail"].points)
+    assert small.counts["entries"] == 0

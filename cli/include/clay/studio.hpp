@@ -15,6 +15,8 @@
 
 namespace clay::recipe {
 
+class RunCache;  // clay/recipe/recipe.hpp
+
 /// One studio document: the recipe's JSON text, the folder its imports are resolved in, and the
 /// history of named edits (undo and redo move in it). Every edit replaces a value at a JSON path
 /// of the recipe (keys joined by ".", list items as "[i]"; the path must exist, or, with
@@ -101,6 +103,10 @@ class StudioSession {
   std::vector<std::string> history() const;
   /// Index of the current entry in history().
   int position() const;
+  /// The results kept between this session's runs (recipe::RunCache): an edit re-runs only the
+  /// steps downstream of what it changed; its counts say how many were taken. Clearing it makes
+  /// the next command run every step.
+  std::shared_ptr<RunCache> run_cache() const;
 
  private:
   struct Impl;

@@ -77,8 +77,50 @@ struct StepReport {
   std::string kind;  ///< "stroke", "bspline", "fill", "bezier_lattice", "style", "step", ...
   double seconds = 0;    ///< wall time of the step
   bool warning = false;  ///< produced its result but an outcome fell short (see message)
-  std::string message;   ///< what happened, in words
+  /// Taken with its result from an earlier run (RunOptions::cache or previous) instead of being
+  /// done again; `seconds` is then what it took when it was done.
+  bool reused = false;
+  std::string message;                                  ///< what happened, in words
   std::vector<std::pair<std::string, Figure>> figures;  ///< in a fixed order per kind
+};
+
+namespace detail {
+class CacheAccess;
+}
+
+/// The results of a recipe's steps kept from one run for the next (issue #40: an edit re-runs
+/// only the steps it reaches). Every stroke, curve, sketch and surface a run builds is kept
+/// under a key made of its own definition (its JSON as written), the recipe's composition and
+/// the keys of everything it is built from: for a deformed surface its stack's definition too
+/// and the surfaces built before it (whose shared sides its fits follow), for an import the
+/// file's size and time. A later run meeting the same key takes the kept result, bit for bit
+/// what building it gives, its step reports marked `reused`. One cache serves the runs of a
+/// studio session, of a Python program or of a sweep's variants in one process (variants that
+/// share a prefix compute it once); safe to share between threads. The least recently used
+/// results go first once the kept ones exceed `capacity_bytes` (estimated from their nets).
+class CLAY_RECIPE_API RunCache {
+ public:
+  explicit RunCache(std::size_t capacity_bytes = std::size_t{256} << 20);
+  ~RunCache();
+  RunCache(const RunCache&) = delete;
+  RunCache& operator=(const RunCache&) = delete;
+
+  /// What the cache did since it was made (or cleared) and holds now.
+  struct Counts {
+    long long reused = 0;   ///< steps taken from it (a surface with its stack counts once)
+    long long kept = 0;     ///< results built and stored
+    long long evicted = 0;  ///< results dropped for the capacity
+    long long entries = 0;  ///< results held now
+    std::size_t bytes = 0;  ///< their estimated size
+  };
+  Counts counts() const;
+  /// Drops every kept result and zeroes the counts.
+  void clear();
+
+ private:
+  friend class detail::CacheAccess;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 /// Settings of run_recipe / deform_surfaces.
@@ -102,6 +144,10 @@ struct RunOptions {
   /// a certificate: a drag preview, listed in RunResult::previewed. Run again without it to fit
   /// and certify.
   bool preview = false;
+  /// Results kept between runs (RunCache): each stroke, curve, sketch and surface whose
+  /// definition and inputs are unchanged is taken from it; what is built is kept in it. Empty:
+  /// everything is built. Previewed surfaces are never kept.
+  std::shared_ptr<RunCache> cache;
 };
 
 /// One export: the surfaces written together and what the exchange layer reported.

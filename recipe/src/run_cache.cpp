@@ -1,0 +1,124 @@
+// RunCache (issue #40): results kept between runs under keys of their definitions and inputs,
+// least recently used dropped first beyond the capacity.
+#include "run_cache.hpp"
+
+#include <cstdint>
+#include <cstdio>
+#include <list>
+#include <mutex>
+#include <unordered_map>
+
+namespace clay::recipe {
+
+struct RunCache::Impl {
+  explicit Impl(std::size_t capacity) : capacity_bytes(capacity) {}
+  struct Slot {
+    std::shared_ptr<const detail::CacheEntry> entry;
+    std::size_t bytes = 0;
+    std::list<std::string>::iterator recent;  // its place in `order`
+  };
+  std::size_t capacity_bytes;
+  mutable std::mutex mutex;
+  std::unordered_map<std::string, Slot> slots;
+  std::list<std::string> order;  // most recently used first
+  Counts counts;
+};
+
+RunCache::RunCache(std::size_t capacity_bytes) : impl_(std::make_unique<Impl>(capacity_bytes)) {}
+RunCache::~RunCache() = default;
+
+RunCache::Counts RunCache::counts() const {
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->counts;
+}
+
+void RunCache::clear() {
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->slots.clear();
+  impl_->order.clear();
+  impl_->counts = {};
+}
+
+namespace detail {
+
+std::string definition_text(const DocumentJson& doc, const char* section, const std::string& name) {
+  const auto s = doc.root.find(section);
+  if (s == doc.root.end() || !s->is_object()) return {};
+  const auto n = s->find(name);
+  return n == s->end() ? std::string() : n->dump();
+}
+
+std::string digest(const std::string& key) {
+  // Two independent 64-bit hashes: FNV-1a and a multiply-xorshift mix of 8-byte words. A digest
+  // stands for a step's whole key inside the keys built on it; the step itself is looked up by
+  // its full key, so a collision of digests alone cannot return a wrong entry for it.
+  std::uint64_t fnv = 14695981039346656037ull;
+  for (const unsigned char c : key) {
+    fnv ^= c;
+    fnv *= 1099511628211ull;
+  }
+  std::uint64_t mix = 0x9e3779b97f4a7c15ull ^ key.size();
+  for (std::size_t k = 0; k < key.size(); k += 8) {
+    std::uint64_t w = 0;
+    for (std::size_t j = 0; j < 8 && k + j < key.size(); ++j)
+      w |= static_cast<std::uint64_t>(static_cast<unsigned char>(key[k + j])) << (8 * j);
+    mix ^= w + 0x9e3779b97f4a7c15ull + (mix << 6) + (mix >> 2);
+    mix *= 0xff51afd7ed558ccdull;
+    mix ^= mix >> 33;
+  }
+  char out[33];
+  std::snprintf(out, sizeof out, "%016llx%016llx", static_cast<unsigned long long>(fnv),
+                static_cast<unsigned long long>(mix));
+  return out;
+}
+
+std::size_t entry_bytes(const CacheEntry& e) {
+  auto curve = [](const surface::BSplineCurve& c) {
+    return static_cast<std::size_t>(c.points.size() + c.weights.size()) * sizeof(double) +
+           c.basis.knots.size() * sizeof(double);
+  };
+  auto net = [](const surface::BSplineSurface& s) {
+    return static_cast<std::size_t>(s.points.size() + s.weights.size()) * sizeof(double) +
+           (s.u.knots.size() + s.v.knots.size()) * sizeof(double);
+  };
+  std::size_t bytes = sizeof(CacheEntry);
+  for (const auto& [name, c] : e.curves) bytes += name.size() + curve(c);
+  for (const auto& [name, s] : e.surfaces) bytes += name.size() + net(s);
+  for (const Stage& st : e.stages) bytes += net(st.before) + net(st.after) + 256;
+  for (const StepReport& r : e.steps) bytes += r.message.size() + 64 * (r.figures.size() + 2);
+  return bytes;
+}
+
+std::shared_ptr<const CacheEntry> CacheAccess::find(RunCache& cache, const std::string& key) {
+  RunCache::Impl& c = *cache.impl_;
+  const std::lock_guard<std::mutex> lock(c.mutex);
+  const auto it = c.slots.find(key);
+  if (it == c.slots.end()) return nullptr;
+  c.order.splice(c.order.begin(), c.order, it->second.recent);
+  ++c.counts.reused;
+  return it->second.entry;
+}
+
+void CacheAccess::keep(RunCache& cache, const std::string& key, CacheEntry entry) {
+  const std::size_t bytes = entry_bytes(entry) + key.size();
+  RunCache::Impl& c = *cache.impl_;
+  const std::lock_guard<std::mutex> lock(c.mutex);
+  if (bytes > c.capacity_bytes || c.slots.count(key)) return;
+  while (!c.order.empty() && c.counts.bytes + bytes > c.capacity_bytes) {
+    const auto last = c.slots.find(c.order.back());
+    c.counts.bytes -= last->second.bytes;
+    c.slots.erase(last);
+    c.order.pop_back();
+    ++c.counts.evicted;
+    --c.counts.entries;
+  }
+  c.order.push_front(key);
+  c.slots.emplace(key, RunCache::Impl::Slot{std::make_shared<const CacheEntry>(std::move(entry)),
+                                            bytes, c.order.begin()});
+  c.counts.bytes += bytes;
+  ++c.counts.kept;
+  ++c.counts.entries;
+}
+
+}  // namespace detail
+}  // namespace clay::recipe

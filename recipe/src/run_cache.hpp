@@ -1,0 +1,50 @@
+#pragma once
+// What run_recipe keeps between runs (RunCache, issue #40): the entries, their keys and the
+// recipe's document the keys are read from. Internal to the recipe library.
+#include <clay/recipe/recipe.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace clay::recipe::detail {
+
+/// The recipe's JSON as checked (RecipeData::document): each step's key starts with its own
+/// definition's text.
+struct DocumentJson {
+  nlohmann::ordered_json root;
+};
+
+/// The text of `root[section][name]` (its JSON, as written), or "" when absent.
+std::string definition_text(const DocumentJson& doc, const char* section, const std::string& name);
+
+/// A 128-bit digest of `key` in hex: how a step's key enters the keys of the steps built on it.
+std::string digest(const std::string& key);
+
+/// What one step (a stroke, curve, sketch or surface with its stack) added to a run.
+struct CacheEntry {
+  std::vector<std::pair<std::string, surface::BSplineCurve>> curves;
+  std::vector<std::pair<std::string, surface::BSplineSurface>> surfaces;
+  std::vector<StepReport> steps;
+  std::vector<Stage> stages;
+  std::vector<std::pair<std::string, double>> bounds;
+};
+
+/// The estimated bytes an entry holds (its nets, knots and reports).
+std::size_t entry_bytes(const CacheEntry& e);
+
+/// The runner's access to a RunCache.
+class CacheAccess {
+ public:
+  /// The entry kept under `key` (counted as reused and made the most recent), or null.
+  static std::shared_ptr<const CacheEntry> find(RunCache& cache, const std::string& key);
+  /// Keeps `entry` under `key`, dropping the least recently used entries beyond the capacity;
+  /// an entry larger than the whole capacity is not kept.
+  static void keep(RunCache& cache, const std::string& key, CacheEntry entry);
+};
+
+}  // namespace clay::recipe::detail
