@@ -60,7 +60,27 @@ export default async function model({ clayform, work, check, withStudio }) {
       assert(run.status === 0, `clayform run: ${run.status} ${run.stderr}`);
       const files = readdirSync(join(modelDir, 'replay'));
       assert(files.includes('block.step'), `replay wrote ${files}`);
-      return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; after the drag the faces' nets only, the nodes ${worstNode.toExponential(1)} mm from the pointwise FFD; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}`;
+      // Issue #40: a z-locked drag in the Top view, the axis along the line of sight, threw a
+      // lattice point to z = 857 mm. Now the pointer's height moves it a pixel's size per pixel,
+      // and x and y stay exactly what they were.
+      await modelPage.click('button[data-view="top"]');
+      await m.idle();
+      const top = (await m.call(() => window.clayStudio.handles())).find((h) => h.kind === 'lattice' && h.index.join() === '1,1,1');
+      await modelPage.mouse.move(...top.screen);
+      await modelPage.mouse.down();
+      for (let k = 1; k <= 10; k++) await modelPage.mouse.move(top.screen[0] + 2 * k, top.screen[1] - 3 * k);
+      await modelPage.mouse.up();
+      await m.idle();
+      assert(!(await m.lastError()), await m.lastError());
+      const locked = await m.call(() => window.clayStudio.recipe());
+      const lockedStep = locked.deformations[locked.models.block.deformation][0];
+      const move = lockedStep.moves.find((mv) => mv.index.join() === '1,1,1');
+      assert(move && move.to, `no move of [1, 1, 1]: ${JSON.stringify(lockedStep.moves)}`);
+      assert(move.to[0] === top.p[0] && move.to[1] === top.p[1], `x, y moved under a z lock: ${top.p} -> ${move.to}`);
+      const height = Math.hypot(...lockedStep.frame.u);
+      const rise = move.to[2] - top.p[2];
+      assert(rise > 0 && rise < 0.5 * height, `a 30-pixel z-locked drag in the Top view moved the point by ${rise} mm (lattice ${height} mm high)`);
+      return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; after the drag the faces' nets only, the nodes ${worstNode.toExponential(1)} mm from the pointwise FFD; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}; a z-locked drag in the Top view rose ${rise.toFixed(2)} mm, x and y kept exactly`;
     });
   });
 }

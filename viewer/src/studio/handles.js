@@ -8,7 +8,7 @@ import * as names from './recipe_edits.js';
 import { stepLatticePoints, latticeCounts } from './lattice_math.js';
 import { $, body, showMessage } from './ui.js';
 import { doc, state, commandOf, dragEdit, send, cancelDrag, newGroup } from './store.js';
-import { canvas, camera, controls, handleGroup, disposeGroup, dirty, pointerRay, toScreen } from './scene.js';
+import { canvas, camera, controls, handleGroup, disposeGroup, dirty, pointerRay, toScreen, millimetresPerPixel } from './scene.js';
 import { previews, startPreview, showPreview, endPreview } from './lattice_preview.js';
 import { latticesShown } from './lattice.js';
 
@@ -87,29 +87,54 @@ function pickHandle(clientX, clientY) {
   return best;
 }
 
-/** Where a dragged point goes for the pointer's ray: on its lock's axis or plane, else in the view plane. */
-function dragTarget(start, raycaster, lock) {
+/** Sine squared of 15 degrees: an axis closer than this to the line of sight is dragged by the pointer's height (dragTarget). */
+const SIGHT_SIN2 = Math.sin(THREE.MathUtils.degToRad(15)) ** 2;
+
+/**
+ * Where a dragged point goes for the pointer at (x, y): on its lock's axis or plane, else in the
+ * view plane. A locked axis or plane keeps the other coordinates exactly (they are copied, not
+ * recomputed).
+ */
+function dragTarget(start, x, y, lock) {
+  const raycaster = pointerRay(x, y);
   const s = new THREE.Vector3(...start);
-  const axis = { x: [1, 0, 0], y: [0, 1, 0], z: [0, 0, 1] };
-  if (axis[lock]) {
-    // the point of the axis line closest to the ray
-    const d = new THREE.Vector3(...axis[lock]);
+  const axisIndex = { x: 0, y: 1, z: 2 }[lock];
+  if (axisIndex !== undefined) {
+    const d = new THREE.Vector3(...[0, 1, 2].map((e) => (e === axisIndex ? 1 : 0)));
     const r = raycaster.ray;
     const w0 = s.clone().sub(r.origin);
     const b = d.dot(r.direction);
-    const denom = 1 - b * b;
-    if (denom < 1e-9) return null;
-    const t = (b * r.direction.dot(w0) - d.dot(w0)) / denom;
-    return s.addScaledVector(d, t).toArray();
+    const out = start.slice();
+    if (1 - b * b < SIGHT_SIN2) {
+      // An axis near the line of sight (z in the Top view): the axis point closest to the ray
+      // runs off to infinity as they turn parallel (a z-locked drag in the Top view threw a
+      // lattice point to z = 857 mm, issue #40). Here the pointer's height on the screen moves
+      // the point along the axis, a pixel's size at its depth per pixel, up towards the viewer.
+      const towards = Math.sign(d.dot(camera.position.clone().sub(s))) || 1;
+      out[axisIndex] = start[axisIndex] + towards * (toScreen(start)[1] - y) * millimetresPerPixel(start);
+      return out;
+    }
+    // the point of the axis line closest to the ray
+    out[axisIndex] = start[axisIndex] + (b * r.direction.dot(w0) - d.dot(w0)) / (1 - b * b);
+    return out;
   }
-  const planeNormal = { yz: [1, 0, 0], xz: [0, 1, 0], xy: [0, 0, 1] }[lock];
-  const normal = planeNormal ? new THREE.Vector3(...planeNormal) : camera.position.clone().sub(controls.target).normalize();
+  const kept = { yz: 0, xz: 1, xy: 2 }[lock];
+  const viewNormal = camera.position.clone().sub(controls.target).normalize();
+  let normal = viewNormal;
+  if (kept !== undefined) {
+    normal = new THREE.Vector3(...[0, 1, 2].map((e) => (e === kept ? 1 : 0)));
+    // a plane seen edge-on (xy in the Front view): the view plane's point, then onto the plane
+    if (Math.abs(normal.dot(raycaster.ray.direction)) < Math.sin(THREE.MathUtils.degToRad(5))) normal = viewNormal;
+  }
   const p = raycaster.ray.intersectPlane(new THREE.Plane().setFromNormalAndCoplanarPoint(normal, s), new THREE.Vector3());
-  return p ? p.toArray() : null;
+  if (!p) return null;
+  const out = p.toArray();
+  if (kept !== undefined) out[kept] = start[kept];
+  return out;
 }
 /** Where a point grabbed at `start` goes for this pointer event: the lock's target, scaled by the strength; null off the lock. */
 export function draggedTo(start, event) {
-  const target = dragTarget(start, pointerRay(event.clientX, event.clientY), $('lattice-lock').value);
+  const target = dragTarget(start, event.clientX, event.clientY, $('lattice-lock').value);
   if (!target) return null;
   const strength = Number($('lattice-strength').value) || 1;
   return start.map((c, i) => c + strength * (target[i] - c));
