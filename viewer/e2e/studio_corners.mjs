@@ -13,7 +13,8 @@ export default async function corners({ check, withEmptyRecipe, figures }) {
       const cam = await k.call(() => window.clayStudio.camera());
       const drawn = path.map(([x, y]) => backProject(cam, x, y, 0));
       const recipe = await k.call(() => window.clayStudio.recipe());
-      const stroke = recipe.strokes.s1;
+      const stroke = (recipe.strokes || {}).s1;
+      if (!stroke) throw new Error(`no stroke written: ${JSON.stringify(recipe).slice(0, 300)}; the page says "${await kp.textContent('#message')}"`);
       assert(stroke && stroke.pieces === 4, `the stroke was written with pieces ${stroke && stroke.pieces}`);
       const curves = await k.call(() => window.clayStudio.curves());
       const pieces = [1, 2, 3, 4].map((i) => curves[`s1.${i}`]);
@@ -58,6 +59,36 @@ export default async function corners({ check, withEmptyRecipe, figures }) {
       assert(reflection <= 1e-9, `the mirrored curve is ${reflection} mm from the reflection in x = 10`);
       figures.corners = { pieces: 4, joint_mm: joint, off_drawn_mm: off, fill_corner_gap_mm: gap, mirror_mm: reflection };
       return `4 pieces, joints ${joint.toExponential(1)} mm from the drawn corners, drawn points within ${off.toExponential(2)} mm; fill corners on the joints (${gap.toExponential(1)} mm); mirror in x = 10 within ${reflection.toExponential(1)} mm`;
+    });
+  });
+  await check('a stroke whose fit misses its tolerance is kept as its best curve, and the stylist is told how far', async () => {
+    // Issue #40: 8 of 30 hand strokes were refused and their ink vanished. A wave of 25
+    // periods, 24 pixels long and 1.5 high (turning too little for corners), at a tolerance of
+    // 0.01 mm: 100 control points cannot follow it.
+    return withEmptyRecipe('kept', async (kp, k) => {
+      await kp.fill('#stroke-tolerance', '0.01');
+      const [a, b] = await k.call(() => [window.clayStudio.toScreen([0, 0, 0]), window.clayStudio.toScreen([10, 0, 0])]);
+      const mmPerPixel = 10 / Math.hypot(b[0] - a[0], b[1] - a[1]);
+      const amplitude = 1.5 * mmPerPixel;
+      const period = 24 * mmPerPixel;
+      const world = [];
+      for (let i = 0; i <= 600; i++) {
+        const x = -12.5 * period + (25 * period * i) / 600;
+        world.push([x, amplitude * Math.sin((2 * Math.PI * x) / period), 0]);
+      }
+      await k.draw(world, { steps: 600 });
+      const recipe = await k.call(() => window.clayStudio.recipe());
+      const stroke = (recipe.strokes || {}).s1;
+      if (!stroke) throw new Error(`no stroke written: ${JSON.stringify(recipe).slice(0, 300)}; the page says "${await kp.textContent('#message')}"`);
+      assert(stroke && stroke.accept_out_of_tolerance === true, `the stroke was written as ${JSON.stringify(stroke && { ...stroke, points: stroke.points.length })}`);
+      const curves = await k.call(() => window.clayStudio.curves());
+      assert(curves.s1, `no curve s1: ${Object.keys(curves)}`);
+      const message = await kp.textContent('#message');
+      const warning = await kp.getAttribute('#message', 'class');
+      assert(message.startsWith('stroke s1 kept: its best fit is') && warning.includes('warning'), `the page says: "${message}" (${warning})`);
+      const step = (await k.call(() => window.clayStudio.steps())).find((st) => st.path === 'strokes.s1');
+      assert(step && step.warning, `the stroke's step: ${JSON.stringify(step)}`);
+      return `kept with its best fit ${step.figures.max_deviation_mm.toPrecision(3)} mm from the ink (tolerance 0.01 mm); the page says "${message.slice(0, 60)}..."`;
     });
   });
 }

@@ -2,7 +2,7 @@
 // and its frames made the document (nets, curves, models moved onto their faces' nets, deviation
 // maps), then every view redrawn; and the start: the socket opened and the recipe run.
 import { meshOnNets } from './nurbs.js';
-import { $, body, showMessage } from './ui.js';
+import { $, body, showMessage, clearError } from './ui.js';
 import { doc, state, metrics, connect, busy, send, simple } from './store.js';
 import { dirty, setView } from './scene.js';
 import { rebuildSurfaces, rebuildCurves } from './display.js';
@@ -20,6 +20,7 @@ function onReply(reply, frames, meta) {
     return;
   }
   body.dataset.error = '';
+  clearError();
   if (reply.op === 'saved') {
     showMessage(`saved ${reply.file}`);
     return;

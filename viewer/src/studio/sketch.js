@@ -102,15 +102,34 @@ function finishStroke(event) {
     const forward = redrawn.from < redrawn.to;
     const lo = Math.min(redrawn.from, redrawn.to);
     const hi = Math.max(redrawn.from, redrawn.to);
-    const drawn = forward ? points : [...points].reverse();
-    const next = [...q.slice(0, lo), ...drawn, ...q.slice(hi + 1)];
+    const drawn = (forward ? points : [...points].reverse()).map((p) => p.slice());
+    // The joins blended (issue #40): the new ink's ends moved onto the old stroke where it leaves
+    // and rejoins it, fading over a fifth of the new ink (names.moveEnd), so the points have no
+    // step there for the fit to chase; how far the ends moved is said.
+    const gaps = [];
+    if (lo > 0) {
+      gaps.push(Math.hypot(...drawn[0].map((c, e) => c - q[lo - 1][e])));
+      names.moveEnd(drawn, 0, q[lo - 1]);
+    }
+    if (hi + 1 < q.length) {
+      gaps.push(Math.hypot(...drawn[drawn.length - 1].map((c, e) => c - q[hi + 1][e])));
+      names.moveEnd(drawn, drawn.length - 1, q[hi + 1]);
+    }
+    const next = [...q.slice(0, Math.max(0, lo - 1)), ...drawn, ...q.slice(hi + 2)];
     const label = `stroke ${redrawn.name} (oversketch)`;
     pendingInk.push({ label, line });
     // a redrawn stroke may gain or lose corners: the kernel's fit says into how many pieces it splits
-    piecesOf(next, def.plane, def.tolerance_mm || tolerance).then((pieces) => {
+    fitOf(next, def.plane, def.tolerance_mm || tolerance).then((fit) => {
+      if (!fit) return dropInk();
       const changes = [{ path: `strokes.${redrawn.name}.points`, value: next }];
-      if (pieces && (def.pieces || pieces > 1)) changes.push({ path: `strokes.${redrawn.name}.pieces`, value: pieces, create: true });
-      return edit(changes, label, 'stroke', event.timeStamp);
+      if (def.pieces || fit.pieces > 1) changes.push({ path: `strokes.${redrawn.name}.pieces`, value: fit.pieces, create: true });
+      if (!fit.converged) changes.push({ path: `strokes.${redrawn.name}.accept_out_of_tolerance`, value: true, create: true });
+      return edit(changes, label, 'stroke', event.timeStamp).then(({ reply }) => {
+        if (reply.op === 'error') return dropInk();
+        const joins = gaps.length ? `; its joins blended (the ends moved ${gaps.map((g) => `${g.toPrecision(2)} mm`).join(' and ')})` : '';
+        if (!fit.converged) showMessage(kept(redrawn.name, fit, def.tolerance_mm || tolerance) + joins, 'warning');
+        else if (gaps.some((g) => g > (def.tolerance_mm || tolerance))) showMessage(`stroke ${redrawn.name} redrawn${joins}`);
+      });
     });
     return;
   }
@@ -134,9 +153,13 @@ function finishStroke(event) {
   pendingInk.push({ label, line });
   // The kernel's fit first: a stroke that turns sharply is split at its corners into pieces
   // NAME.1 .. NAME.N (the recipe's "pieces"), one curve each.
-  piecesOf(points, plane, tolerance).then((pieces) => {
-    if (!pieces) return dropInk();
+  fitOf(points, plane, tolerance).then((fit) => {
+    if (!fit) return dropInk();
+    const pieces = fit.pieces;
     if (pieces > 1) stroke.pieces = pieces;
+    // Never thrown away (issue #40): a fit that misses the tolerance is kept as the best curve
+    // the kernel found, marked accepted, and the stylist is told how far it is from the ink.
+    if (!fit.converged) stroke.accept_out_of_tolerance = true;
     const changes = [{ path: `strokes.${name}`, value: stroke, create: true }];
     const mirror = mirrorPlane();
     if (mirror) {
@@ -144,16 +167,22 @@ function finishStroke(event) {
       curves.forEach((curve, k) => changes.push({ path: `curves.${name}_mirror${pieces > 1 ? `_${k + 1}` : ''}`, value: { mirror: { curve, plane: mirror } }, create: true }));
     }
     return edit(changes, label, 'stroke', event.timeStamp).then(({ reply }) => {
-      if (reply.op === 'error') dropInk();
+      if (reply.op === 'error') return dropInk();
+      if (!fit.converged) showMessage(kept(name, fit, tolerance), 'warning');
     });
   });
 }
 
-/** How many curves the kernel fits to the stroke (split at its corners), or null when it cannot. */
-function piecesOf(points, plane, tolerance) {
+/** What the stylist is told of a stroke kept beyond its tolerance. */
+function kept(name, fit, tolerance) {
+  return `stroke ${name} kept: its best fit is ${fit.max_deviation_mm.toPrecision(3)} mm from the ink at most, beyond its tolerance of ${tolerance} mm. Keep it, or undo (Ctrl+Z) and draw it again (or raise tol)`;
+}
+
+/** The kernel's fit of the stroke: {pieces (split at its corners), converged, max_deviation_mm}, or null when it cannot. */
+function fitOf(points, plane, tolerance) {
   const command = { op: 'fit', points, tolerance_mm: tolerance };
   if (plane) command.plane = plane;
-  return send(command).then(({ reply }) => (reply.op === 'fit' ? reply.pieces : null));
+  return send(command).then(({ reply }) => (reply.op === 'fit' ? reply : null));
 }
 
 // ------------------------------------------------------------------------------ pointer input

@@ -6,15 +6,29 @@ import { newGroup } from './store.js';
 export const body = document.body;
 export const $ = (id) => document.getElementById(id);
 
-// The message line: an error stays, anything else goes after 4 s.
+// The message line (issue #40): a message stays until it is read (its × closes it) or a newer
+// one replaces it, so an export's result is there when the stylist comes back; an error also goes
+// when the next command succeeds (clearError). The line lets pointer events through to the view
+// below it, but for its ×.
 const messageBox = $('message');
-const message = { timer: null };
-export function showMessage(text, isError) {
+const messageText = document.createElement('span');
+const messageClose = document.createElement('button');
+messageClose.textContent = '×';
+messageClose.title = 'Close this message';
+messageClose.className = 'message-close';
+messageBox.append(messageText, messageClose);
+messageClose.addEventListener('click', () => showMessage(''));
+/** Shows `text` (empty: hides the line); kind true or 'error', 'warning', or nothing for news. */
+export function showMessage(text, kind) {
+  const level = kind === true ? 'error' : kind || '';
   messageBox.hidden = !text;
-  messageBox.textContent = text || '';
-  messageBox.classList.toggle('error', !!isError);
-  clearTimeout(message.timer);
-  if (text && !isError) message.timer = setTimeout(() => showMessage(''), 4000);
+  messageText.textContent = text || '';
+  messageBox.classList.toggle('error', level === 'error');
+  messageBox.classList.toggle('warning', level === 'warning');
+}
+/** Hides the line when it shows an error (a command has just succeeded). */
+export function clearError() {
+  if (messageBox.classList.contains('error')) showMessage('');
 }
 
 /** A slider set from the recipe (not while the user holds it), its output beside it. */
