@@ -402,6 +402,87 @@ std::string constraint_list(const std::vector<int>& ids, const std::vector<Const
 }  // namespace
 }  // namespace detail
 
+namespace detail {
+
+/// SolveOptions::spread_curve_changes: for each B-spline curve entity, the displacement of its
+/// control points from `start` whose second differences are least (plus 1e-8 of its own norm, so
+/// that one held point translates the curve) with the held ones as solved, written into the
+/// blocks of its free control points. A control point is held when a (non-substituted) equation
+/// uses one of its scalars, when it is fixed or shares its block with another scalar
+/// (substituted), so that no equation's residual changes. Returns whether anything moved.
+bool spread_curve_changes(const sketch::Sketch& sketch, const Model& m, const Reduction& red,
+                          const std::vector<double>& start, std::vector<double>& values) {
+  const std::size_t n = m.scalars.size();
+  std::vector<char> used(n, 0);
+  for (const Equation& eq : m.equations)
+    if (!eq.substitutable)
+      for (int s : eq.scalars)
+        if (s >= 0 && static_cast<std::size_t>(s) < n) used[static_cast<std::size_t>(s)] = 1;
+  std::vector<int> sharing(values.size(), 0);
+  for (std::size_t s = 0; s < n; ++s)
+    if (red.block[s] >= 0) ++sharing[static_cast<std::size_t>(red.block[s])];
+  auto value_of = [&](std::size_t s) {
+    return red.block[s] >= 0 ? values[static_cast<std::size_t>(red.block[s])] : red.fixed[s];
+  };
+  bool moved_any = false;
+  for (const sketch::Entity& entity : sketch.entities) {
+    const auto* curve = std::get_if<sketch::Curve>(&entity);
+    if (!curve || curve->control_points.size() < 3) continue;
+    const auto count = static_cast<Eigen::Index>(curve->control_points.size());
+    const PointRef& first = m.point_vars[static_cast<std::size_t>(curve->control_points[0].index)];
+    const int dim = first.dim;
+    std::vector<char> held(static_cast<std::size_t>(count), 0);
+    Eigen::MatrixXd delta = Eigen::MatrixXd::Zero(count, dim);
+    double largest = 0, size = 0;
+    for (Eigen::Index k = 0; k < count; ++k) {
+      const PointRef& v = m.point_vars[static_cast<std::size_t>(
+          curve->control_points[static_cast<std::size_t>(k)].index)];
+      if (v.dim != dim) return moved_any;  // mixed planar and free points: left as solved
+      for (int i = 0; i < dim; ++i) {
+        const auto s = static_cast<std::size_t>(v.offset + i);
+        const int b = red.block[s];
+        if (b < 0 || used[s] || sharing[static_cast<std::size_t>(b)] > 1)
+          held[static_cast<std::size_t>(k)] = 1;
+        delta(k, i) = value_of(s) - start[s];
+        size = std::max(size, std::abs(start[s]));
+      }
+      if (held[static_cast<std::size_t>(k)]) largest = std::max(largest, delta.row(k).norm());
+    }
+    const long free = std::count(held.begin(), held.end(), 0);
+    if (free == 0 || !(largest > 1e-12 * std::max(1.0, size))) continue;
+    // A = D2^T D2 + 1e-8 I over all control points; the free rows solved with the held ones known.
+    Eigen::MatrixXd a = 1e-8 * Eigen::MatrixXd::Identity(count, count);
+    for (Eigen::Index k = 1; k + 1 < count; ++k) {
+      const Eigen::Index idx[3] = {k - 1, k, k + 1};
+      const double c[3] = {1, -2, 1};
+      for (int r = 0; r < 3; ++r)
+        for (int q = 0; q < 3; ++q) a(idx[r], idx[q]) += c[r] * c[q];
+    }
+    std::vector<Eigen::Index> f, h;
+    for (Eigen::Index k = 0; k < count; ++k)
+      (held[static_cast<std::size_t>(k)] ? h : f).push_back(k);
+    Eigen::MatrixXd aff(f.size(), f.size()), afh(f.size(), h.size()), dh(h.size(), dim);
+    for (std::size_t r = 0; r < f.size(); ++r) {
+      for (std::size_t q = 0; q < f.size(); ++q) aff(r, q) = a(f[r], f[q]);
+      for (std::size_t q = 0; q < h.size(); ++q) afh(r, q) = a(f[r], h[q]);
+    }
+    for (std::size_t q = 0; q < h.size(); ++q) dh.row(q) = delta.row(h[q]);
+    const Eigen::MatrixXd df = aff.ldlt().solve(-afh * dh);
+    for (std::size_t r = 0; r < f.size(); ++r) {
+      const PointRef& v = m.point_vars[static_cast<std::size_t>(
+          curve->control_points[static_cast<std::size_t>(f[r])].index)];
+      for (int i = 0; i < dim; ++i) {
+        const auto s = static_cast<std::size_t>(v.offset + i);
+        values[static_cast<std::size_t>(red.block[s])] = start[s] + df(r, i);
+      }
+    }
+    moved_any = true;
+  }
+  return moved_any;
+}
+
+}  // namespace detail
+
 SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& constraints,
                   const SolveOptions& options) {
   using namespace detail;
@@ -500,6 +581,10 @@ SolveResult solve(const sketch::Sketch& sketch, const std::vector<Constraint>& c
       sys.add(m, m.equations[e], static_cast<int>(e), block_of, constant_of);
   report.equations = static_cast<int>(sys.equation_of_row.size());
   run_ceres(sys, m, options, true, &iterations);
+  // The free control points of curves take the least-bending share of their held ones' change;
+  // no equation uses them, so the solve from there only confirms (it stops at once).
+  if (options.spread_curve_changes && spread_curve_changes(sketch, m, red, start, values))
+    run_ceres(sys, m, options, true, &iterations);
   report.solve_seconds = seconds_since(t0);
 
   const std::vector<double> x = expand(values);

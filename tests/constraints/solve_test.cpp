@@ -643,3 +643,62 @@ TEST_CASE("a constraint is a typed requirement, the factories and the structs bu
         static_cast<int>(std::variant_size_v<Requirement>) - 1);
   CHECK(std::holds_alternative<Tangent>(tangent({}, {}).requirement));
 }
+
+TEST_CASE(
+    "a constraint on a freehand curve's ends is spread over the curve, not dumped at its ends",
+    "[constraints]") {
+  // Issue #40: a distance between a fitted stroke's ends moved only its last control point (the
+  // minimum-norm step), a hook of the whole change at the end. Ten control points of a wavy
+  // planar cubic from (0, 0) to about (95, 0), its start fixed and its ends pulled 110 mm apart.
+  Sketch s;
+  const PlaneId plane = s.add_plane(clay::sketch::make_plane({0, 0, 0}, {0, 0, 1}));
+  clay::surface::Points3 p(10, 3);
+  for (int k = 0; k < 10; ++k) p.row(k) << 10.5 * k, 6 * std::sin(0.7 * k), 0;
+  const std::vector<double> knots{0, 0, 0, 0, 1, 2, 3, 4, 5, 6, 7, 7, 7, 7};
+  const EntityId curve = s.add_curve(clay::surface::make_curve(3, knots, p), plane);
+  const auto cps = std::get<clay::sketch::Curve>(s.entities[0]).control_points;
+  const clay::surface::BSplineCurve before = clay::sketch::curve_of(s, curve);
+  const double drawn = (p.row(9) - p.row(0)).norm();
+  const std::vector<Constraint> cs{fixed(cps[0]), distance(cps[0], cps[9], 110.0)};
+  auto measure = [&](const SolveResult& r) {
+    REQUIRE(r.report.summary.converged());
+    const clay::surface::BSplineCurve after = clay::sketch::curve_of(r.sketch, curve);
+    CHECK_THAT((r.sketch.points[static_cast<std::size_t>(cps[9].index)].position -
+                r.sketch.points[static_cast<std::size_t>(cps[0].index)].position)
+                   .norm(),
+               WithinAbs(110, 1e-9));
+    double deviation = 0;
+    for (int k = 0; k <= 700; ++k) {
+      const double t = 7.0 * k / 700;
+      deviation =
+          std::max(deviation,
+                   (clay::surface::evaluate(after, t) - clay::surface::evaluate(before, t)).norm());
+    }
+    // The hook: how much the curve's second derivative changes, at its worst (its bending).
+    double bending = 0;
+    for (int k = 0; k <= 700; ++k) {
+      const double t = 7.0 * k / 700;
+      bending = std::max(bending, (clay::surface::derivatives(after, t, 2).d2 -
+                                   clay::surface::derivatives(before, t, 2).d2)
+                                      .norm());
+    }
+    return std::pair{deviation, bending};
+  };
+  SolveOptions ends_only;
+  ends_only.spread_curve_changes = false;
+  const auto [hook_deviation, hook_bending] = measure(solve(s, cs, ends_only));
+  const SolveResult spread = solve(s, cs);
+  const auto [deviation, bending] = measure(spread);
+  const double change = 110 - drawn;  // how far the constraint moves the end
+  // Neither leaves the end's own change (the convex hull property); spread, the second
+  // derivative changes a tenth as much (the change is shared by ten control points, in
+  // proportion, a stretch), and the middle control point moves by 5/9 of the end's change.
+  CHECK(hook_deviation <= change + 1e-9);
+  CHECK(deviation <= change + 1e-9);
+  INFO("largest change of C'': " << hook_bending << " with the end alone, " << bending
+                                 << " spread");
+  CHECK(bending < hook_bending / 5);
+  const Eigen::Vector3d middle =
+      spread.sketch.points[static_cast<std::size_t>(cps[5].index)].position;
+  CHECK_THAT((middle - Eigen::Vector3d(p.row(5))).norm(), WithinAbs(change * 5 / 9, 0.01 * change));
+}

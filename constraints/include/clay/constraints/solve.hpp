@@ -38,6 +38,13 @@ struct CLAY_CONSTRAINTS_API SolveOptions {
   /// first minimises |p − target|² + 1e-8 |x − start|² + 1e4 |constraint residuals|² (the
   /// constraints as heavy equations), then solves the constraints alone from there.
   std::vector<Drag> drag;
+  /// A B-spline curve entity whose constrained control points moved (a distance or a tangent at
+  /// its ends) has the change spread over its other control points, as the displacement of least
+  /// bending (minimum sum of squared second differences of the control points' displacements,
+  /// the moved ones held): the minimum-norm solve alone moves only what the constraints name,
+  /// leaving hooks of the whole change at a freehand curve's ends (issue #40). Control points
+  /// that any equation uses, or that share a point with another entity, keep the solver's value.
+  bool spread_curve_changes = true;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
