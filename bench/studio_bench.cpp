@@ -14,6 +14,7 @@
 #include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 #include <clay/surface/basis.hpp>
+#include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
 #include <clay/surface/evaluate.hpp>
 
@@ -129,6 +130,49 @@ void session_drag_step(benchmark::State& state) {
   state.SetLabel(labels[state.range(0)]);
 }
 
+// Issue #40: a style drag on the tank: the target "spine" made the B-spline it was fitted to (as
+// the studio does at a curve's first drag), its middle control point moved up and down, each
+// update an edit of that point ("nets": false): the style step and the lattice's light-form
+// preview after it re-run, the strokes, the bound and the fill taken from the session's cache.
+void tank_style_drag(benchmark::State& state, const std::filesystem::path& file, Json doc) {
+  const recipe::RunResult first =
+      recipe::run_recipe(recipe::parse_recipe(doc.dump(), file.parent_path()));
+  const surface::BSplineCurve& spine = first.curve("spine");
+  Json points = Json::array();
+  for (Eigen::Index k = 0; k < spine.points.rows(); ++k)
+    points.push_back({spine.points(k, 0), spine.points(k, 1), spine.points(k, 2)});
+  doc["strokes"].erase("spine");
+  doc["curves"]["spine"] = {
+      {"bspline",
+       {{"degree", spine.basis.degree}, {"knots", spine.basis.knots}, {"points", points}}}};
+  recipe::StudioSession session(doc.dump(), file.parent_path(), "tank");
+  session.handle(Json{{"op", "run"}}.dump());
+  const Eigen::Index middle = spine.points.rows() / 2;
+  const std::string path = "curves.spine.bspline.points[" + std::to_string(middle) + "][2]";
+  const double z0 = spine.points(middle, 2);
+  int step = 0;
+  clay::bench::StepTimes times;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double value = z0 + 6 * std::sin(0.1 * ++step);
+    const auto reply = session.handle(Json{
+        {"op", "edit"},
+        {"path", path},
+        {"value", value},
+        {"label", "drag"},
+        {"group", "drag"},
+        {"nets", false}}.dump());
+    if (reply.json.find("\"op\":\"error\"") != std::string::npos) {
+      state.SkipWithError(reply.json.c_str());
+      break;
+    }
+    benchmark::DoNotOptimize(reply.json.data());
+    times.record(t0);
+  }
+  times.report(state);
+  state.SetLabel("tank style drag update: the target's middle control point, exact style");
+}
+
 // Issue #38 step 4: a drag of the tank's (3, 3, 1) lattice (examples/recipes/tank.json: fill,
 // exact style, lattice whose exact form would have 727,065 control points, so its light form is
 // used). Point [1, 1, 1] of "knees" moved each iteration. Arguments:
@@ -143,6 +187,7 @@ void tank_drag_step(benchmark::State& state) {
       std::filesystem::path(CLAY_EXAMPLES_DIR) / "recipes" / "tank.json";
   const std::string text = read(file);
   Json doc = Json::parse(text);
+  if (state.range(0) == 3) return tank_style_drag(state, file, doc);
   Json& moves = doc["deformations"]["knees"][0]["moves"];
   std::size_t moved = 0;
   while (moves[moved]["index"] != Json::array({1, 1, 1})) ++moved;
@@ -251,7 +296,13 @@ void stroke_step(benchmark::State& state) {
 
 }  // namespace
 
-BENCHMARK(tank_drag_step)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(tank_drag_step)
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Arg(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(lattice_drag_step)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(stroke_step)
     ->ArgsProduct({{1, 20, 40}, {0, 1}})

@@ -277,6 +277,12 @@ struct StudioSession::Impl {
       options.previous = last_run;
       options.changed_deformations = *changed;
       options.preview = preview;
+    } else if (preview && last_run) {
+      // A drag of something else (a style's target curve): the lattice steps after it preview
+      // on their last light forms too; what is unchanged comes from the cache.
+      options.previous = last_run;
+      options.take_from_previous = false;
+      options.preview = true;
     }
     if (cancelled && cancelled()) throw Cancelled{};
     Run out{std::make_shared<RunResult>(run_recipe(recipe, options)), final_surfaces(recipe)};

@@ -413,7 +413,7 @@ class Runner {
               [&] { return surface_key(def, needs); },
               [&] {
                 // Taken from the previous run when nothing it needs changed (run_reuse.cpp).
-                if (options_.previous &&
+                if (options_.previous && options_.take_from_previous &&
                     !needs_changed(data_, *options_.previous, options_.changed_deformations, name,
                                    affected_) &&
                     take_surface(*options_.previous, def, result_, bound_of_, options_.progress))

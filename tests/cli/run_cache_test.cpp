@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -272,4 +273,58 @@ TEST_CASE("studio session: a new stroke is fitted alone, the rest taken from the
   for (const Json& step : undone.at("steps"))
     if (step.at("path").get<std::string>().rfind("exports.", 0) != 0)
       CHECK(step.value("reused", false));
+}
+
+TEST_CASE(
+    "studio session: dragging a style's target previews the lattice after it, the release "
+    "certifies",
+    "[recipe][cache][studio]") {
+  // Issue #40: a drag of the tank's target curve re-ran the lattice's certified light fit on
+  // every update (740 ms); now the update previews it on its last knots, as a lattice drag does,
+  // and the release fits and certifies it: what a whole run of the saved recipe gives.
+  Json doc = tank();
+  const RunResult first = run(doc);
+  const surface::BSplineCurve& spine = first.curve("spine");
+  Json points = Json::array();
+  for (Eigen::Index k = 0; k < spine.points.rows(); ++k)
+    points.push_back({spine.points(k, 0), spine.points(k, 1), spine.points(k, 2)});
+  doc["strokes"].erase("spine");
+  doc["curves"]["spine"] = {
+      {"bspline",
+       {{"degree", spine.basis.degree}, {"knots", spine.basis.knots}, {"points", points}}}};
+  StudioSession session(doc.dump(), tank_file.parent_path(), "tank");
+  REQUIRE(Json::parse(session.handle(R"({"op": "run"})").json).at("op") == "run");
+  const Eigen::Index middle = spine.points.rows() / 2;
+  const std::string path = "curves.spine.bspline.points[" + std::to_string(middle) + "][2]";
+  auto drag = [&](double z, bool nets) {
+    const Json r = Json::parse(
+        session
+            .handle(Json{
+                {"op", "edit"}, {"path", path}, {"value", z}, {"group", "drag"}, {"nets", nets}}
+                        .dump())
+            .json);
+    REQUIRE(r.at("op") == "edit");
+    std::map<std::string, Json> steps;
+    for (const Json& s : r.at("steps")) steps[s.at("path").get<std::string>()] = s;
+    return steps;
+  };
+  const double z0 = spine.points(middle, 2);
+  for (double dz : {2.0, 4.0}) {
+    auto steps = drag(z0 + dz, false);
+    CHECK(steps.at("strokes.left").value("reused", false));  // from the cache
+    CHECK(steps.at("surfaces.panel").value("reused", false));
+    CHECK_FALSE(steps.at("surfaces.styled.steps[0]").value("reused", false));
+    CHECK(steps.at("surfaces.tank.steps[0]").at("figures").at("preview") == true);
+    CHECK(steps.at("surfaces.tank.steps[0]").at("figures").at("certified") == false);
+  }
+  auto released = drag(z0 + 4.0, true);
+  const Json& figures = released.at("surfaces.tank.steps[0]").at("figures");
+  CHECK_FALSE(figures.contains("preview"));
+  CHECK(figures.at("certified") == true);
+  const RunResult whole = run_recipe(parse_recipe(session.text(), tank_file.parent_path(), "tank"));
+  for (const StepReport& s : whole.steps)
+    if (s.path == "surfaces.tank.steps[0]")
+      for (const auto& [key, value] : s.figures)
+        if (key == "max_deviation_mm")
+          CHECK(figures.at(key).get<double>() == std::get<double>(value));
 }

@@ -144,6 +144,10 @@ struct RunOptions {
   /// a certificate: a drag preview, listed in RunResult::previewed. Run again without it to fit
   /// and certify.
   bool preview = false;
+  /// With `previous`: false when the edit changed more than `changed_deformations` (a curve
+  /// dragged): `previous` then only gives a preview its lattice steps' light maps, and no surface
+  /// is taken from it (the cache takes what is unchanged).
+  bool take_from_previous = true;
   /// Results kept between runs (RunCache): each stroke, curve, sketch and surface whose
   /// definition and inputs are unchanged is taken from it; what is built is kept in it. Empty:
   /// everything is built. Previewed surfaces are never kept.
