@@ -33,23 +33,6 @@ using surface::BSplineCurve;
 using surface::BSplineSurface;
 using namespace detail;
 
-/// Runs a library builder, rewording its error in the recipe's keys: the command and recipes name
-/// recipe keys, never the C++ option that holds them (`words` maps one to the other).
-using Words = std::vector<std::pair<std::string_view, std::string_view>>;
-
-template <class F>
-auto in_recipe_words(const Words& words, F&& build) {
-  try {
-    return build();
-  } catch (const Error& e) {
-    std::string m = e.message();
-    for (const auto& [cpp, key] : words)
-      for (auto at = m.find(cpp); at != std::string::npos; at = m.find(cpp, at + key.size()))
-        m.replace(at, cpp.size(), key);
-    throw Error(e.category(), m);
-  }
-}
-
 /// The run's state: named results so far, and the reports.
 
 class Runner {
@@ -330,7 +313,7 @@ class Runner {
   std::map<std::string, std::size_t> curve_index_;
   std::set<std::size_t> sketches_built_;  // indices into data_.sketches
   // The digests of the keys of the steps that gave each curve and surface (RunOptions::cache).
-  std::map<std::string, std::string> curve_digest_, surface_digest_;
+  Digests digests_;
   std::set<std::string> building_;  // "curve NAME" / "surface NAME" being built
   // The bound ledger (issue #38): how far each surface, and the one being deformed, may be from
   // its exact reference, the recipe with every step exact (mm; inf: not bounded).
@@ -377,11 +360,11 @@ class Runner {
       for (const auto& s : needs.surfaces) need_surface(s);
       for (const auto& s : data_.strokes)
         if (defines(s, name))
-          return cached([&] { return own_key("strokes", s.name, needs); },
+          return cached([&] { return own_key(data_, digests_, "strokes", s.name, needs); },
                         [&] { timed(s.path, "stroke", [&](StepReport& rep) { stroke(s, rep); }); });
       for (const auto& c : data_.curves)
         if (c.name == name)
-          return cached([&] { return own_key("curves", c.name, needs); },
+          return cached([&] { return own_key(data_, digests_, "curves", c.name, needs); },
                         [&] { timed(c.path, c.kind, [&](StepReport& rep) { curve(c, rep); }); });
       for (std::size_t k = 0; k < data_.sketches.size(); ++k)
         for (const auto& [entity, id] : data_.sketches[k].entities)
@@ -395,7 +378,7 @@ class Runner {
     for (const auto& c : s.uses) need_curve(c);
     cached(
         [&] {
-          return own_key("sketches", s.name, Needs{s.uses, {}});
+          return own_key(data_, digests_, "sketches", s.name, Needs{s.uses, {}});
         },
         [&] { timed(s.path, "sketch", [&](StepReport& rep) { sketch(s, rep); }); });
   }
@@ -410,7 +393,7 @@ class Runner {
           for (const auto& c : needs.curves) need_curve(c);
           for (const auto& s : needs.surfaces) need_surface(s);
           return cached(
-              [&] { return surface_key(def, needs); },
+              [&] { return surface_key(data_, digests_, def, needs, result_.surfaces); },
               [&] {
                 // Taken from the previous run when nothing it needs changed (run_reuse.cpp).
                 if (options_.previous && options_.take_from_previous &&
@@ -453,7 +436,7 @@ class Runner {
     for (const auto& [n, s] : e.surfaces)
       if (const auto b = bound_of_.find(n); b != bound_of_.end())
         e.bounds.emplace_back(n, b->second);
-    note_digests(e, d);
+    note_digests(digests_, e, d);
     // A drag's preview is uncertified: never kept.
     if (result_.previewed.size() == previewed0)
       CacheAccess::keep(*options_.cache, *key, std::move(e));
@@ -470,60 +453,7 @@ class Runner {
     }
     result_.stages.insert(result_.stages.end(), e.stages.begin(), e.stages.end());
     for (const auto& [n, b] : e.bounds) bound_of_[n] = b;
-    note_digests(e, d);
-  }
-
-  void note_digests(const CacheEntry& e, const std::string& d) {
-    for (const auto& c : e.curves) curve_digest_[c.first] = d + "/" + c.first;
-    for (const auto& s : e.surfaces) surface_digest_[s.first] = d;
-  }
-
-  /// A step's key: its section and definition as written, then the digest of every curve and
-  /// surface it needs (empty when one has none: then it is built, not kept).
-  std::optional<std::string> own_key(const char* section, const std::string& name,
-                                     const Needs& needs) const {
-    std::string k = std::string(section) + "\n" + definition_text(*data_.document, section, name);
-    for (const auto& c : needs.curves) {
-      const auto it = curve_digest_.find(c);
-      if (it == curve_digest_.end()) return std::nullopt;
-      k += "\ncurve " + c + " " + it->second;
-    }
-    for (const auto& s : needs.surfaces) {
-      const auto it = surface_digest_.find(s);
-      if (it == surface_digest_.end()) return std::nullopt;
-      k += "\nsurface " + s + " " + it->second;
-    }
-    return k;
-  }
-
-  /// A surface's key: own_key with the recipe's composition; for a deformed surface its stack's
-  /// definition, whether it leaves the recipe (a light copy above the budget) and every surface
-  /// built before it (its fits follow the sides it shares with them); for an import, the file's
-  /// size and time of change.
-  std::optional<std::string> surface_key(const SurfaceDef& def, const Needs& needs) const {
-    std::optional<std::string> k = own_key("surfaces", def.name, needs);
-    if (!k) return k;
-    const auto comp = data_.document->root.find("composition");
-    *k += "\ncomposition " + (comp == data_.document->root.end() ? std::string() : comp->dump());
-    if (const auto* d = std::get_if<DeformDef>(&def.build)) {
-      *k += "\nstack " + definition_text(*data_.document, "deformations", d->deformation);
-      *k += built_on(data_, def.name) ? "\nbuilt on" : "\nfinal";
-      *k += "\nafter";
-      for (const auto& [n, s] : result_.surfaces) {
-        const auto it = surface_digest_.find(n);
-        if (it == surface_digest_.end()) return std::nullopt;
-        *k += " " + n + " " + it->second;
-      }
-    }
-    if (const auto* b = std::get_if<ImportDef>(&def.build)) {
-      std::error_code size_error, time_error;
-      const auto size = fs::file_size(b->file, size_error);
-      const auto time = fs::last_write_time(b->file, time_error);
-      if (size_error || time_error) return std::nullopt;
-      *k += "\nfile " + b->file.string() + " " + std::to_string(size) + " " +
-            std::to_string(time.time_since_epoch().count());
-    }
-    return k;
+    note_digests(digests_, e, d);
   }
 
   // ---- what an earlier run gives (RunOptions::previous) ---------------------------------------
@@ -681,34 +611,10 @@ class Runner {
       throw Error(e.category(), named(e.message(), names, word));
     }
   }
-  /// `m` with every "WORD #k" replaced by WORD "names[k]".
-  static std::string named(std::string m, const std::vector<std::string>& names,
-                           const std::string& word) {
-    const std::string tag = word + " #";
-    for (std::size_t at = m.find(tag); at != std::string::npos; at = m.find(tag, at + 1)) {
-      std::size_t end = at + tag.size();
-      while (end < m.size() && std::isdigit(static_cast<unsigned char>(m[end]))) ++end;
-      if (end == at + tag.size()) continue;
-      const std::size_t k = std::stoul(m.substr(at + tag.size(), end - at - tag.size()));
-      if (k < names.size()) m.replace(at, end - at, word + " \"" + names[k] + "\"");
-    }
-    return m;
-  }
-
   std::vector<BSplineCurve> curves_named(const std::vector<std::string>& names) const {
     std::vector<BSplineCurve> out;
     for (const auto& n : names) out.push_back(curve_of(n));
     return out;
-  }
-
-  static void build_figures(const surface::BuildReport& b, StepReport& rep) {
-    rep.figures = {{"degree_u", static_cast<long long>(b.degree_u)},
-                   {"degree_v", static_cast<long long>(b.degree_v)},
-                   {"control_points", static_cast<long long>(b.count_u) * b.count_v},
-                   {"rational", b.rational},
-                   {"exact", b.exact},
-                   {"max_deviation_mm", b.max_deviation_mm}};
-    rep.message = b.brief();
   }
 
   void build_surface(const SurfaceDef& def) {
@@ -916,18 +822,6 @@ class Runner {
     return r.surface;
   }
 
-  /// Why a step is light, in the recipe's words: the exact size against the budget.
-  static std::string light_reason(const deform::StepOutcome& o, const Composition& c) {
-    const deform::ExactSize& x = o.exact_size;
-    return "the exact form would have degree " + std::to_string(x.degree_u) + " x " +
-           std::to_string(x.degree_v) +
-           (x.control_points > 0
-                ? " and up to " + std::to_string(x.control_points) + " control points"
-                : std::string()) +
-           ", above the budget (degree " + std::to_string(c.budget->max_degree) + ", " +
-           std::to_string(c.budget->max_control_points) + " control points)";
-  }
-
   BSplineSurface apply(const deform::Deformation& d, const BSplineSurface& s, const Composition& c,
                        StepReport& rep, Stage& stage) {
     stage.map = [d](const Eigen::Vector3d& x) {
@@ -955,27 +849,7 @@ class Runner {
                        ? deform::style_deform(s, curve_of(d.target), d.options)
                        : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
     const auto& x = r.report;
-    rep.figures = {{"mode", std::string(x.mode == deform::StyleMode::Exact ? "exact" : "paper")},
-                   {"constraint_class", std::string(deform::to_string(x.constraint_class))},
-                   {"key_points", static_cast<long long>(x.key_points.size())},
-                   {"influenced_vertices", static_cast<long long>(x.influenced_vertices)},
-                   {"moved_vertices", static_cast<long long>(x.moved_vertices)},
-                   {"max_displacement", x.max_displacement},
-                   {"target_deviation", x.target_deviation},
-                   {"target_curve_deviation", x.target_curve_deviation},
-                   {"target_curve_distance", x.target_curve_distance},
-                   {"mean_curvature_min", x.mean_curvature_min},
-                   {"mean_curvature_max", x.mean_curvature_max},
-                   {"locality", x.locality},
-                   {"boundary_position_jump", x.boundary_position_jump},
-                   {"boundary_tangent_angle", x.boundary_tangent_angle},
-                   {"knots_inserted", static_cast<long long>(x.knots_inserted)},
-                   {"added_key_points", static_cast<long long>(x.added_key_points)},
-                   {"net_change", x.net_change},
-                   {"fairness_energy", x.fairness_energy},
-                   {"degree_u", static_cast<long long>(r.surface.u.degree)},
-                   {"degree_v", static_cast<long long>(r.surface.v.degree)},
-                   {"control_points", static_cast<long long>(r.surface.points.rows())}};
+    style_figures(r, rep);
     rep.message += ": " + x.message;
     rep.figures.emplace_back("outcome", std::string(x.summary.converged() ? "met" : "missed"));
     if (ledger_ > 0) {  // the style of a light input is not the style of its exact reference

@@ -2,8 +2,11 @@
 // What the recipe runner's two files share (recipe_run.cpp: the Runner, curves, surfaces and
 // exports; recipe_run_models.cpp: whole models and deform_model). Internal to the recipe library.
 #include <clay/deform/light_map.hpp>
+#include <clay/deform/style.hpp>
 #include <clay/deform/surface_deformation.hpp>
+#include <clay/error.hpp>
 #include <clay/recipe/recipe.hpp>
+#include <clay/surface/build_report.hpp>
 
 #include <chrono>
 #include <cstdio>
@@ -12,6 +15,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "recipe_model.hpp"
@@ -29,6 +33,37 @@ inline std::string format(const char* fmt, double x) {
   std::snprintf(buf, sizeof buf, fmt, x);
   return buf;
 }
+
+/// Runs a library builder, rewording its error in the recipe's keys: the command and recipes name
+/// recipe keys, never the C++ option that holds them (`words` maps one to the other).
+using Words = std::vector<std::pair<std::string_view, std::string_view>>;
+
+template <class F>
+auto in_recipe_words(const Words& words, F&& build) {
+  try {
+    return build();
+  } catch (const clay::Error& e) {
+    std::string m = e.message();
+    for (const auto& [cpp, key] : words)
+      for (auto at = m.find(cpp); at != std::string::npos; at = m.find(cpp, at + key.size()))
+        m.replace(at, cpp.size(), key);
+    throw clay::Error(e.category(), m);
+  }
+}
+
+/// `m` with every "WORD #k" replaced by WORD "names[k]" (a builder's "curve #1" in the recipe's
+/// names).
+std::string named(std::string m, const std::vector<std::string>& names, const std::string& word);
+
+/// A built surface's figures and message (degrees, control points, rational, exact, deviation).
+void build_figures(const surface::BuildReport& b, StepReport& rep);
+
+/// Why a step is light, in the recipe's words: the exact size against the budget.
+std::string light_reason(const deform::StepOutcome& o, const Composition& c);
+
+/// A style step's figures (docs/recipe.md, report): its mode, class, key points, deviations,
+/// curvature, boundary figures and sizes.
+void style_figures(const deform::StyleResult& r, StepReport& rep);
 
 /// The composition's settings as deform_surface's (the Runner and deform_model use them).
 deform::SurfaceDeformationOptions deformation_options(const Composition& c);

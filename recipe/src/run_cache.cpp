@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <list>
 #include <mutex>
 #include <unordered_map>
@@ -87,6 +88,55 @@ std::size_t entry_bytes(const CacheEntry& e) {
   for (const Stage& st : e.stages) bytes += net(st.before) + net(st.after) + 256;
   for (const StepReport& r : e.steps) bytes += r.message.size() + 64 * (r.figures.size() + 2);
   return bytes;
+}
+
+void note_digests(Digests& g, const CacheEntry& e, const std::string& d) {
+  for (const auto& c : e.curves) g.curve[c.first] = d + "/" + c.first;
+  for (const auto& s : e.surfaces) g.surface[s.first] = d;
+}
+
+std::optional<std::string> own_key(const RecipeData& data, const Digests& g, const char* section,
+                                   const std::string& name, const Needs& needs) {
+  std::string k = std::string(section) + "\n" + definition_text(*data.document, section, name);
+  for (const auto& c : needs.curves) {
+    const auto it = g.curve.find(c);
+    if (it == g.curve.end()) return std::nullopt;
+    k += "\ncurve " + c + " " + it->second;
+  }
+  for (const auto& s : needs.surfaces) {
+    const auto it = g.surface.find(s);
+    if (it == g.surface.end()) return std::nullopt;
+    k += "\nsurface " + s + " " + it->second;
+  }
+  return k;
+}
+
+std::optional<std::string> surface_key(
+    const RecipeData& data, const Digests& g, const SurfaceDef& def, const Needs& needs,
+    const std::vector<std::pair<std::string, surface::BSplineSurface>>& before) {
+  std::optional<std::string> k = own_key(data, g, "surfaces", def.name, needs);
+  if (!k) return k;
+  const auto comp = data.document->root.find("composition");
+  *k += "\ncomposition " + (comp == data.document->root.end() ? std::string() : comp->dump());
+  if (const auto* d = std::get_if<DeformDef>(&def.build)) {
+    *k += "\nstack " + definition_text(*data.document, "deformations", d->deformation);
+    *k += built_on(data, def.name) ? "\nbuilt on" : "\nfinal";
+    *k += "\nafter";
+    for (const auto& built : before) {
+      const auto it = g.surface.find(built.first);
+      if (it == g.surface.end()) return std::nullopt;
+      *k += " " + built.first + " " + it->second;
+    }
+  }
+  if (const auto* b = std::get_if<ImportDef>(&def.build)) {
+    std::error_code size_error, time_error;
+    const auto size = std::filesystem::file_size(b->file, size_error);
+    const auto time = std::filesystem::last_write_time(b->file, time_error);
+    if (size_error || time_error) return std::nullopt;
+    *k += "\nfile " + b->file.string() + " " + std::to_string(size) + " " +
+          std::to_string(time.time_since_epoch().count());
+  }
+  return k;
 }
 
 std::shared_ptr<const CacheEntry> CacheAccess::find(RunCache& cache, const std::string& key) {

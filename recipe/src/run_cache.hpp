@@ -3,10 +3,14 @@
 // recipe's document the keys are read from. Internal to the recipe library.
 #include <clay/recipe/recipe.hpp>
 
+#include "recipe_model.hpp"
+
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
+#include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -36,6 +40,27 @@ struct CacheEntry {
 
 /// The estimated bytes an entry holds (its nets, knots and reports).
 std::size_t entry_bytes(const CacheEntry& e);
+
+/// The digests of the keys of the steps that gave each curve and surface of a run.
+struct Digests {
+  std::map<std::string, std::string> curve, surface;
+};
+
+/// Records the digest `d` of the step that added `e`'s curves and surfaces.
+void note_digests(Digests& g, const CacheEntry& e, const std::string& d);
+
+/// A step's key: its section and definition as written, then the digest of every curve and
+/// surface it needs (empty when one has none: then it is built, not kept).
+std::optional<std::string> own_key(const RecipeData& data, const Digests& g, const char* section,
+                                   const std::string& name, const Needs& needs);
+
+/// A surface's key: own_key with the recipe's composition; for a deformed surface its stack's
+/// definition, whether it leaves the recipe (a light copy above the budget) and every surface
+/// built before it (`before`: its fits follow the sides it shares with them); for an import, the
+/// file's size and time of change.
+std::optional<std::string> surface_key(
+    const RecipeData& data, const Digests& g, const SurfaceDef& def, const Needs& needs,
+    const std::vector<std::pair<std::string, surface::BSplineSurface>>& before);
 
 /// The runner's access to a RunCache.
 class CacheAccess {
