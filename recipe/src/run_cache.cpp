@@ -51,8 +51,8 @@ std::string definition_text(const DocumentJson& doc, const char* section, const 
 
 std::string digest(const std::string& key) {
   // Two independent 64-bit hashes: FNV-1a and a multiply-xorshift mix of 8-byte words. A digest
-  // stands for a step's whole key inside the keys built on it; the step itself is looked up by
-  // its full key, so a collision of digests alone cannot return a wrong entry for it.
+  // stands for a step's whole key inside the keys built on it (a step itself is looked up by its
+  // full key): a wrong entry would need two different inputs with one 128-bit digest.
   std::uint64_t fnv = 14695981039346656037ull;
   for (const unsigned char c : key) {
     fnv ^= c;
