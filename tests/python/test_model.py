@@ -193,12 +193,9 @@ def test_an_edge_in_its_light_form_has_its_bound_in_its_tolerance(tmp_path: Path
     assert check["valid"], check["problems"]
 
 
-def test_a_bulged_assembly_is_valid_where_brepcheck_measures_the_gaps_itself(
-        tmp_path: Path) -> None:
-    # Alibre's s1 under a (1, 1, 2) bulge: an annulus whose circles lie a constant 5.5e-7 mm off
-    # its face. A tolerance of that gap x (1 + 1e-9) was below BRepCheck's own measure of it.
-    cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
-    model, _ = cf.read_model(cad / "alibre_s1_assembly_ap214.stp", isolate=True)
+def bulge_of(model: cf.Model) -> cf.BezierLattice:
+    """The (1, 1, 2) bulge of the table of real files (scripts/real_files_table.py): a lattice
+    around the model whose middle layer is pushed out along x by a tenth of its largest extent."""
     lattice = cf.lattice_around(model, degrees=(1, 1, 2))
     lo, hi = (np.array(c) for c in model.bounding_box())
     points = lattice.points
@@ -206,6 +203,16 @@ def test_a_bulged_assembly_is_valid_where_brepcheck_measures_the_gaps_itself(
         for j in range(2):
             points[lattice.index(i, j, 1), 0] += (0.1 if i else -0.1) * (hi - lo).max()
     lattice.points = points
+    return lattice
+
+
+def test_a_bulged_assembly_is_valid_where_brepcheck_measures_the_gaps_itself(
+        tmp_path: Path) -> None:
+    # Alibre's s1 under a (1, 1, 2) bulge: an annulus whose circles lie a constant 5.5e-7 mm off
+    # its face. A tolerance of that gap x (1 + 1e-9) was below BRepCheck's own measure of it.
+    cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
+    model, _ = cf.read_model(cad / "alibre_s1_assembly_ap214.stp", isolate=True)
+    lattice = bulge_of(model)
     result, _ = model.deform(lattice, profile="opencascade")
     assert result.problems() == []
     check = result.write(tmp_path / "alibre.step")
@@ -240,13 +247,8 @@ def test_a_bulged_real_solid_is_the_lattice_map_of_the_original_at_the_same_uv(n
     # original face's point at the same (u, v).
     cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
     model, _ = cf.read_model(cad / name, isolate=True)
-    lattice = cf.lattice_around(model, degrees=(1, 1, 2))
+    lattice = bulge_of(model)
     lo, hi = (np.array(c) for c in model.bounding_box())
-    points = lattice.points
-    for i in range(2):
-        for j in range(2):
-            points[lattice.index(i, j, 1), 0] += (0.1 if i else -0.1) * (hi - lo).max()
-    lattice.points = points
     result, report = model.deform(lattice)
     assert report["faces_exact"] == model.face_count and result.face_count == model.face_count
     assert result.problems() == []
