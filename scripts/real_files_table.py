@@ -119,8 +119,17 @@ def main() -> int:
             if healing:
                 read += f" ({healing} healing step{'s' if healing > 1 else ''})"
             counts = model.counts
+            shape = f"{counts['faces']} / {counts['solids']}"
+            if counts["wire_edges"]:
+                shape += f" + {counts['wire_edges']} free curve{'s' if counts['wire_edges'] > 1 else ''}"
+            if report["left_out"]:
+                read += f", left out: {report['left_out'][0][:70]}"
+            if counts["faces"] == 0 and counts["wire_edges"] == 0:
+                rows.append(f"| `{path.name}` | {shape} | {read} | — | — | — | — | "
+                            f"{read_s:.1f}{freecad_columns(freecad, path.name, None)} |")
+                continue
             if problems:
-                rows.append(f"| `{path.name}` | {counts['faces']} / {counts['solids']} | {read} | — | — | — | — | "
+                rows.append(f"| `{path.name}` | {shape} | {read} | — | — | — | — | "
                             f"{read_s:.1f}{freecad_columns(freecad, path.name, None)} |")
                 continue
             s_lattice, b_lattice = stretched(model), bulged(model)
@@ -135,7 +144,7 @@ def main() -> int:
                 det = float(np.linalg.det(STRETCH))
                 error = f"{abs(after - det * before) / (det * before):.1e}"
             rows.append(
-                f"| `{path.name}` | {counts['faces']} / {counts['solids']} | {read} | {s_verdict} | "
+                f"| `{path.name}` | {shape} | {read} | {s_verdict} | "
                 f"{b_verdict} | {error} | {maps} | {read_s:.1f} + {s_time:.1f} + {b_time:.1f}"
                 f"{freecad_columns(freecad, path.name, model)} |")
             print(rows[-1], file=sys.stderr, flush=True)

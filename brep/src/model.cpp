@@ -357,6 +357,7 @@ void face_problems(const Model& m, std::vector<std::string>& out) {
 void shell_problems(const Model& m, std::vector<std::string>& out) {
   std::vector<int> shell_of_face(m.faces.size(), -1);
   std::vector<int> uses(m.edges.size(), 0);
+  std::vector<int> wire_of_edge(m.edges.size(), -1);  // the wire body holding each edge
   int shell_index = 0;
   for (size_t bi = 0; bi < m.bodies.size(); ++bi) {
     const Body& body = m.bodies[bi];
@@ -365,6 +366,33 @@ void shell_problems(const Model& m, std::vector<std::string>& out) {
     if (!colour_ok(body.colour))
       out.push_back(body_name + ": colour " + colour_text(*body.colour) +
                     " has a component outside [0, 1]");
+    if (body.kind == BodyKind::Wire) {
+      if (!body.shells.empty())
+        out.push_back(body_name + ": a wire body holds edges, not shells (it has " +
+                      std::to_string(body.shells.size()) + "); make it a sheet or a shell");
+      if (body.edges.empty()) out.push_back(body_name + ": a wire body has no edges");
+      for (int e : body.edges) {
+        if (!in_range(e, m.edges.size())) {
+          out.push_back(body_name + ": edge index " + std::to_string(e) + " is not one of the " +
+                        std::to_string(m.edges.size()) + " edges");
+          continue;
+        }
+        if (m.edges[static_cast<size_t>(e)].degenerate)
+          out.push_back(body_name + ": edge " + std::to_string(e) +
+                        " is degenerate (a pole); a wire body's edges are curves");
+        if (wire_of_edge[static_cast<size_t>(e)] >= 0)
+          out.push_back(body_name + ": edge " + std::to_string(e) + " is already in body " +
+                        std::to_string(wire_of_edge[static_cast<size_t>(e)]) +
+                        "; an edge belongs to one wire body");
+        else
+          wire_of_edge[static_cast<size_t>(e)] = static_cast<int>(bi);
+      }
+      continue;
+    }
+    if (!body.edges.empty())
+      out.push_back(body_name + ": a " + std::string(to_string(body.kind)) + " lists " +
+                    std::to_string(body.edges.size()) +
+                    " free edges; only a wire body holds edges (its faces hold theirs)");
     if (body.shells.empty()) out.push_back(body_name + ": has no shells");
     for (size_t si = 0; si < body.shells.size(); ++si, ++shell_index) {
       const Shell& shell = body.shells[si];
@@ -419,8 +447,14 @@ void shell_problems(const Model& m, std::vector<std::string>& out) {
       for (const Coedge& co : loop.coedges)
         if (in_range(co.edge, m.edges.size())) ++uses[static_cast<size_t>(co.edge)];
   }
-  for (size_t e = 0; e < m.edges.size(); ++e)
-    if (uses[e] == 0) out.push_back("edge " + std::to_string(e) + " is dangling: no face uses it");
+  for (size_t e = 0; e < m.edges.size(); ++e) {
+    if (uses[e] > 0 && wire_of_edge[e] >= 0)
+      out.push_back("edge " + std::to_string(e) + " is in wire body " +
+                    std::to_string(wire_of_edge[e]) +
+                    " and used by a face; a wire body's edges are free (copy the edge)");
+    if (uses[e] == 0 && wire_of_edge[e] < 0)
+      out.push_back("edge " + std::to_string(e) + " is dangling: no face and no wire body uses it");
+  }
 }
 
 void assembly_problems(const Model& m, std::vector<std::string>& out) {
@@ -529,6 +563,8 @@ Counts counts(const Model& model) {
   for (const Body& b : model.bodies) {
     c.solids += b.kind == BodyKind::Solid;
     c.shells += static_cast<int>(b.shells.size());
+    c.wires += b.kind == BodyKind::Wire;
+    c.wire_edges += static_cast<int>(b.edges.size());
   }
   c.faces = static_cast<int>(model.faces.size());
   for (const Face& f : model.faces) {
@@ -605,25 +641,33 @@ std::vector<std::string> problems(const Model& model) {
 
 Box control_box(const Model& model, const std::vector<int>& faces) {
   const Model flat = flattened(model);
-  if (flat.faces.empty())
+  const int wire_edges = counts(flat).wire_edges;
+  if (flat.faces.empty() && wire_edges == 0)
     throw Error(ErrorCategory::InvalidArgument,
-                "control_box: the model has no face; read or build one with faces first");
-  std::vector<int> chosen = faces;
-  if (chosen.empty())
-    for (size_t f = 0; f < flat.faces.size(); ++f) chosen.push_back(static_cast<int>(f));
+                "control_box: the model has no face and no wire edge; read or build one with "
+                "faces or curves first");
   Box box{Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()),
           Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity())};
+  auto add = [&](const surface::Points3& p) {
+    for (Eigen::Index r = 0; r < p.rows(); ++r) {
+      box.lo = box.lo.cwiseMin(p.row(r).transpose());
+      box.hi = box.hi.cwiseMax(p.row(r).transpose());
+    }
+  };
+  std::vector<int> chosen = faces;
+  if (chosen.empty()) {
+    for (size_t f = 0; f < flat.faces.size(); ++f) chosen.push_back(static_cast<int>(f));
+    for (const Body& body : flat.bodies)
+      for (int e : body.edges)
+        if (in_range(e, flat.edges.size())) add(flat.edges[static_cast<size_t>(e)].curve.points);
+  }
   for (int f : chosen) {
     if (f < 0 || static_cast<size_t>(f) >= flat.faces.size())
       throw Error(ErrorCategory::InvalidArgument,
                   "control_box: face " + std::to_string(f) + " does not exist; the model has " +
                       std::to_string(flat.faces.size()) +
                       " faces (indices into the flattened model, from 0)");
-    const surface::Points3& p = flat.faces[static_cast<size_t>(f)].surface.points;
-    for (Eigen::Index r = 0; r < p.rows(); ++r) {
-      box.lo = box.lo.cwiseMin(p.row(r).transpose());
-      box.hi = box.hi.cwiseMax(p.row(r).transpose());
-    }
+    add(flat.faces[static_cast<size_t>(f)].surface.points);
   }
   return box;
 }
@@ -685,6 +729,7 @@ Model flattened(const Model& model) {
       }
       copy.shells.push_back(std::move(moved_shell));
     }
+    for (int e : body.edges) copy.edges.push_back(edge(e));
     out.bodies.push_back(std::move(copy));
   };
   auto walk = [&](auto& self, int p, const Eigen::Isometry3d& place,
@@ -727,6 +772,8 @@ std::string_view to_string(BodyKind kind) noexcept {
       return "shell";
     case BodyKind::Sheet:
       return "sheet";
+    case BodyKind::Wire:
+      return "wire";
   }
   return "unknown";
 }

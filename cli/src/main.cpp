@@ -175,8 +175,15 @@ int info(const fs::path& file, bool strict) {
   for (const auto& h : read.report.healing) std::printf("  healed: %s\n", h.c_str());
   for (const auto& h : read.report.ignored) std::printf("  ignored: %s\n", h.c_str());
   for (const auto& h : read.report.skipped) std::printf("  skipped: %s\n", h.c_str());
+  for (const auto& h : read.report.left_out) std::printf("  left out: %s\n", h.c_str());
   for (size_t b = 0; b < m.bodies.size(); ++b) {
     const auto& body = m.bodies[b];
+    if (body.kind == clay::brep::BodyKind::Wire) {
+      std::printf("  body %zu: wire%s%s, %zu free edge%s\n", b, quoted_name(body.name).c_str(),
+                  colour_text(body.colour).c_str(), body.edges.size(),
+                  body.edges.size() == 1 ? "" : "s");
+      continue;
+    }
     int faces = 0, trimmed = 0, holes = 0;
     for (const auto& shell : body.shells)
       for (int f : shell.faces) {

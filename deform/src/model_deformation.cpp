@@ -263,13 +263,8 @@ Outcome deform_one(const DeformationStack* stack, surface::BSplineSurface& s,
 }
 
 double size_of(const brep::Model& m) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  for (const brep::Face& f : m.faces)
-    for (Eigen::Index r = 0; r < f.surface.points.rows(); ++r) {
-      lo = lo.cwiseMin(f.surface.points.row(r).transpose());
-      hi = hi.cwiseMax(f.surface.points.row(r).transpose());
-    }
-  return m.faces.empty() ? 1.0 : std::max((hi - lo).norm(), 1e-300);
+  const brep::Box box = brep::control_box(m);  // faces and free edges
+  return std::max((box.hi - box.lo).norm(), 1e-300);
 }
 
 /// What a refit keeps along each edge (MatchedCurve::order), from the source's own figures: the
@@ -363,6 +358,10 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
   ModelDeformationResult result;
   brep::Model& m = result.model;
   m = brep::flattened(input);
+  if (m.faces.empty() && brep::counts(m).wire_edges == 0)
+    throw Error(ErrorCategory::InvalidArgument,
+                "deform_model: the model has no face and no wire edge; nothing to deform (read "
+                "a file with faces or curves)");
   ModelDeformationReport& report = result.report;
   report.continuity_before = brep::edge_continuity(m);
   const std::vector<int> orders = edge_orders(m, report.continuity_before);
@@ -440,6 +439,12 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
         edge_face_bound[e] = std::max(edge_face_bound[e], faces[f].bound);
       }
   }
+  // A wire body's free edges move with the whole model (a selection of faces keeps them).
+  if (options.faces.empty())
+    for (const brep::Body& body : m.bodies)
+      for (int e : body.edges)
+        if (!leaves.alone(m.edges[static_cast<std::size_t>(e)].curve.points))
+          edge_touched[static_cast<std::size_t>(e)] = true;
   // An edge a deformed face shares with a kept one must stay where it is (within its tolerance).
   if (!options.faces.empty()) {
     std::vector<int> kept_user(m.edges.size(), -1), deformed_user(m.edges.size(), -1);

@@ -47,6 +47,7 @@
 #include <Interface_Check.hxx>
 #include <Interface_CheckIterator.hxx>
 #include <Interface_InterfaceModel.hxx>
+#include <Precision.hxx>
 #include <Quantity_Color.hxx>
 #include <STEPCAFControl_Controller.hxx>
 #include <STEPCAFControl_Reader.hxx>
@@ -154,12 +155,13 @@ class ModelBuilder {
   /// `failed`: the entities OpenCASCADE failed to transfer (failed_entities), for the messages.
   ModelBuilder(const fs::path& file, const ModelReadOptions& options,
                Handle(XCAFDoc_ShapeTool) shapes, Handle(XCAFDoc_ColorTool) colours,
-               std::vector<std::string> failed)
+               std::vector<std::string> failed, Handle(XSControl_WorkSession) session)
       : file_(file),
         options_(options),
         shapes_(std::move(shapes)),
         colours_(std::move(colours)),
-        failed_(std::move(failed)) {}
+        failed_(std::move(failed)),
+        session_(std::move(session)) {}
 
   ImportedModel build() {
     TDF_LabelSequence free;
@@ -167,8 +169,9 @@ class ModelBuilder {
     if (free.IsEmpty()) nothing_read(file_, "holds no shape", failed_);
     // The model's size (tolerances are relative to it): OpenCASCADE's box of every free shape.
     Bnd_Box box;
-    for (int i = 1; i <= free.Length(); ++i) BRepBndLib::Add(shapes_->GetShape(free.Value(i)), box);
-    if (box.IsVoid()) nothing_read(file_, "holds no geometry", failed_);
+    for (int i = 1; i <= free.Length(); ++i) add_finite(shapes_->GetShape(free.Value(i)), box);
+    // A void box (only unbounded curves): read_locked refuses the file if nothing is held and
+    // nothing named as left out.
     size_ = std::sqrt(box.SquareExtent());
     if (!(size_ > 0) || !std::isfinite(size_)) size_ = 1;
 
@@ -200,6 +203,10 @@ class ModelBuilder {
       report_.healing.push_back("took the counter-clockwise loop as the outer loop of " +
                                 std::to_string(turned) + (turned == 1 ? " face" : " faces") +
                                 " (OpenCASCADE's OuterWire had chosen a hole)");
+    if (free_edges_given_vertices_ > 0)
+      report_.healing.push_back("gave " + std::to_string(free_edges_given_vertices_) +
+                                " free edge" + (free_edges_given_vertices_ == 1 ? "" : "s") +
+                                " without vertices vertices at their curves' ends");
     if (faces_enclosing_nothing_ > 0)
       report_.healing.push_back(
           "kept " + std::to_string(faces_enclosing_nothing_) +
@@ -217,6 +224,21 @@ class ModelBuilder {
   }
 
  private:
+  /// Adds `shape` to `box`, leaving out unbounded edges (OpenCASCADE's +-2e100 range of a line in
+  /// a curve set would make the model's size, and every tolerance relative to it, 4e100).
+  static void add_finite(const TopoDS_Shape& shape, Bnd_Box& box) {
+    for (TopExp_Explorer f(shape, TopAbs_FACE); f.More(); f.Next())
+      BRepBndLib::Add(f.Current(), box);
+    for (TopExp_Explorer e(shape, TopAbs_EDGE, TopAbs_FACE); e.More(); e.Next()) {
+      double first = 0, last = 0;
+      BRep_Tool::Range(TopoDS::Edge(e.Current()), first, last);
+      if (!Precision::IsInfinite(first) && !Precision::IsInfinite(last))
+        BRepBndLib::Add(e.Current(), box);
+    }
+    for (TopExp_Explorer v(shape, TopAbs_VERTEX, TopAbs_EDGE); v.More(); v.Next())
+      BRepBndLib::Add(v.Current(), box);
+  }
+
   /// A file's edge tolerance is what its writer (or OpenCASCADE's reader, for STEP, which stores
   /// none) measured by sampling a few points; edge_gaps samples every knot span densely and finds
   /// gaps up to twice as large (0.0012 mm where OpenCASCADE's STEP reader set 0.00075 mm on a
@@ -403,6 +425,19 @@ class ModelBuilder {
                                 " edges same-parameter (BRepLib::SameParameter)");
   }
 
+  /// The file's entity a shape was transferred from ("#15 LINE", "D23 entity type 126"), or
+  /// "entity unknown" when the transfer did not record it.
+  std::string entity_of(const TopoDS_Shape& shape) const {
+    if (session_.IsNull() || session_->TransferReader().IsNull()) return "entity unknown";
+    const Handle(Standard_Transient) entity =
+        session_->TransferReader()->EntityFromShapeResult(shape, 1);
+    const Handle(Interface_InterfaceModel) model = session_->Model();
+    if (entity.IsNull() || model.IsNull() || !model->Contains(entity)) return "entity unknown";
+    const Handle(TCollection_HAsciiString) label = model->StringLabel(entity);
+    return (label.IsNull() ? std::string("?") : std::string(label->ToCString())) + " " +
+           model->TypeName(entity, false);
+  }
+
   std::string edge_name(const TopoDS_Edge&) const {
     return "read_model: " + quoted(file_) + " edge #" + std::to_string(model_.edges.size());
   }
@@ -481,7 +516,85 @@ class ModelBuilder {
       for (const TopoDS_Face& f : loose) shell.faces.push_back(add_face(f, attributes));
       model_.bodies[static_cast<std::size_t>(b)].shells.push_back(std::move(shell));
     }
+    // Free curves (a wireframe, curves sent beside the surfaces): a wire body per free wire,
+    // and one for the loose edges. Edges inside faces are not visited (faces hold wires).
+    TopTools_IndexedMapOfShape visited;
+    auto wire_body = [&](const TopoDS_Shape& holder, const std::vector<TopoDS_Edge>& edges) {
+      std::vector<int> held;
+      for (const TopoDS_Edge& e : edges)
+        if (const auto index = free_edge_of(e)) held.push_back(*index);
+      if (held.empty()) return;
+      model_.bodies[static_cast<std::size_t>(add_body(BodyKind::Wire, holder))].edges =
+          std::move(held);
+    };
+    for (TopExp_Explorer w(shape, TopAbs_WIRE, TopAbs_FACE); w.More(); w.Next()) {
+      std::vector<TopoDS_Edge> edges;
+      for (TopExp_Explorer e(w.Current(), TopAbs_EDGE); e.More(); e.Next())
+        if (!visited.Contains(e.Current())) {
+          visited.Add(e.Current());
+          edges.push_back(TopoDS::Edge(e.Current()));
+        }
+      wire_body(w.Current(), edges);
+    }
+    std::vector<TopoDS_Edge> loose_edges;
+    for (TopExp_Explorer e(shape, TopAbs_EDGE, TopAbs_WIRE); e.More(); e.Next())
+      if (!visited.Contains(e.Current())) {
+        visited.Add(e.Current());
+        loose_edges.push_back(TopoDS::Edge(e.Current()));
+      }
+    wire_body(TopoDS_Shape(), loose_edges);
+    int points = 0;
+    for (TopExp_Explorer v(shape, TopAbs_VERTEX, TopAbs_EDGE); v.More(); v.Next()) ++points;
+    if (points > 0)
+      report_.left_out.push_back(std::to_string(points) + " free point" + (points == 1 ? "" : "s") +
+                                 " (vertices no edge uses): a model holds points only as the "
+                                 "ends of edges");
     return out;
+  }
+
+  /// The model edge of a free edge (one no face uses), converted once; nullopt when the model
+  /// cannot hold it (an unbounded line or curve: report_.left_out says so). An edge without
+  /// vertices gets vertices at its curve's ends, within its tolerance.
+  std::optional<int> free_edge_of(const TopoDS_Edge& edge) {
+    if (const int found = edges_.FindIndex(edge); found > 0) return found - 1;
+    const std::string name = "a free edge (" + entity_of(edge) + ")";
+    if (BRep_Tool::Degenerated(edge)) {
+      report_.left_out.push_back(name + ": a degenerate free edge (a point)");
+      return std::nullopt;
+    }
+    double f = 0, l = 0;
+    const Handle(Geom_Curve) curve = BRep_Tool::Curve(edge, f, l);
+    if (curve.IsNull()) {
+      report_.left_out.push_back(name + ": a free edge without a 3D curve");
+      return std::nullopt;
+    }
+    if (Precision::IsInfinite(f) || Precision::IsInfinite(l)) {
+      // OpenCASCADE gives an unbounded line (STEP's LINE in a curve set) the range +-2e100: it
+      // has no extent for a lattice to hold or a B-spline to write back.
+      report_.left_out.push_back(name + ": an unbounded " + curve->DynamicType()->Name() +
+                                 " (OpenCASCADE's range [" + shortest(f) + ", " + shortest(l) +
+                                 "]): it has no extent to deform or write back; give it end "
+                                 "points in the sending system");
+      return std::nullopt;
+    }
+    TopoDS_Vertex first, last;
+    TopExp::Vertices(TopoDS::Edge(edge.Oriented(TopAbs_FORWARD)), first, last);
+    if (first.IsNull() || last.IsNull()) {
+      // Vertices at the curve's ends, made on a copy: the shape stays as it was read.
+      TopoDS_Edge copy = TopoDS::Edge(edge.EmptyCopied().Oriented(TopAbs_FORWARD));
+      BRep_Builder builder;
+      const double tolerance = BRep_Tool::Tolerance(edge);
+      builder.MakeVertex(first, curve->Value(f), tolerance);
+      builder.MakeVertex(last, curve->Value(l), tolerance);
+      if (curve->Value(f).Distance(curve->Value(l)) <= tolerance) last = first;
+      builder.Add(copy, first.Oriented(TopAbs_FORWARD));
+      builder.Add(copy, last.Oriented(TopAbs_REVERSED));
+      ++free_edges_given_vertices_;
+      const int index = edge_of(copy);
+      edges_.Substitute(edges_.FindIndex(copy), edge);  // found again by the file's edge
+      return index;
+    }
+    return edge_of(edge);
   }
 
   void add_shell(int body, const TopoDS_Shape& shell_shape,
@@ -727,6 +840,7 @@ class ModelBuilder {
   Handle(XCAFDoc_ShapeTool) shapes_;
   Handle(XCAFDoc_ColorTool) colours_;
   std::vector<std::string> failed_;
+  Handle(XSControl_WorkSession) session_;  // may be null
   Model model_;
   ModelReadReport report_;
   double size_ = 1;
@@ -734,9 +848,10 @@ class ModelBuilder {
   std::vector<std::pair<TDF_Label, int>> parts_;  // few: a linear search
   TopTools_IndexedMapOfShape vertices_, edges_;
   std::vector<EdgeConversion> conversions_;
-  std::map<int, bool> seam_flipped_;  // seams made by seam_of: runs against the old edge
-  std::map<int, double> widened_;     // edges widened for approximated faces, by how much
-  int faces_enclosing_nothing_ = 0;   // kept on a widened box (face_box)
+  std::map<int, bool> seam_flipped_;   // seams made by seam_of: runs against the old edge
+  std::map<int, double> widened_;      // edges widened for approximated faces, by how much
+  int faces_enclosing_nothing_ = 0;    // kept on a widened box (face_box)
+  int free_edges_given_vertices_ = 0;  // free edges the file gave no vertices (free_edge_of)
 };
 
 }  // namespace
@@ -772,6 +887,12 @@ std::string ModelReadReport::brief() const {
                   max_approximation_error_mm);
     line += text;
   }
+  if (counts.wires > 0)
+    line += "; " + std::to_string(counts.wires) + " wire bod" + (counts.wires == 1 ? "y" : "ies") +
+            " (" + std::to_string(counts.wire_edges) + " free edge" +
+            (counts.wire_edges == 1 ? "" : "s") + ")";
+  if (!left_out.empty())
+    line += "; left out " + std::to_string(left_out.size()) + ": " + left_out.front();
   if (!healing.empty()) line += "; healed: " + healing.front();
   if (!ignored.empty())
     line += "; ignored " + std::to_string(ignored.size()) + " unknown entity type" +
@@ -837,7 +958,7 @@ std::vector<std::string> failed_entities(const Handle(XSControl_WorkSession) & s
 /// as one free shape of `document`; whether the transfer gave a shape. The entities it could not
 /// transfer go to `failed`.
 bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) & document,
-                std::vector<std::string>& failed) {
+                std::vector<std::string>& failed, Handle(XSControl_WorkSession) & session) {
   TopoDS_Shape shape;
   if (step) {
     STEPControl_Controller::Init();
@@ -849,6 +970,7 @@ bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) 
     reader.TransferRoots();
     shape = reader.OneShape();
     failed = failed_entities(reader.WS());
+    session = reader.WS();
   } else {
     IGESControl_Controller::Init();
     surface::occt::set_static("xstep.cascade.unit", "MM");
@@ -860,6 +982,7 @@ bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) 
     reader.TransferRoots();
     shape = reader.OneShape();
     failed = failed_entities(reader.WS());
+    session = reader.WS();
   }
   if (shape.IsNull()) return false;
   XCAFDoc_DocumentTool::ShapeTool(document->Main())->AddShape(shape, false);
@@ -876,8 +999,9 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
     bool read = false;
     UnknownEntities unknown;
     std::vector<std::string> failed;
+    Handle(XSControl_WorkSession) session;  // for naming the entities of shapes left out
     if (plain) {
-      read = read_plain(file, step, document, failed);
+      read = read_plain(file, step, document, failed, session);
     } else if (step) {
       STEPCAFControl_Controller::Init();
       surface::occt::set_static("xstep.cascade.unit", "MM");
@@ -895,6 +1019,7 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
           unknown.add(u->StepType(), "#" + std::to_string(model->IdentLabel(u)));
       read = reader.Transfer(document);
       failed = failed_entities(reader.Reader().WS());
+      session = reader.Reader().WS();
     } else {
       IGESControl_Controller::Init();
       surface::occt::set_static("xstep.cascade.unit", "MM");
@@ -913,15 +1038,17 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
                       "D" + std::to_string(2 * i - 1));
       read = reader.Transfer(document);
       failed = failed_entities(reader.WS());
+      session = reader.WS();
     }
     if (!read) nothing_read(file, "gave OpenCASCADE no shape to transfer", failed);
     ModelBuilder builder(file, options, XCAFDoc_DocumentTool::ShapeTool(document->Main()),
-                         XCAFDoc_DocumentTool::ColorTool(document->Main()), failed);
+                         XCAFDoc_DocumentTool::ColorTool(document->Main()), failed, session);
     ImportedModel out = builder.build();
     out.report.ignored = unknown.lines();
     out.report.skipped = failed;
     XCAFApp_Application::GetApplication()->Close(document);
-    if (out.model.faces.empty()) nothing_read(file, "holds no face that could be read", failed);
+    if (out.model.faces.empty() && counts(out.model).wire_edges == 0 && out.report.left_out.empty())
+      nothing_read(file, "holds no face or curve that could be read", failed);
     return out;
   });
 }

@@ -171,6 +171,7 @@ std::string serialize(const ImportedModel& x) {
     put(out, static_cast<std::int32_t>(b.kind));
     put(out, static_cast<std::uint64_t>(b.shells.size()));
     for (const Shell& s : b.shells) put_ints(out, s.faces);
+    put_ints(out, b.edges);
     put_string(out, b.name);
     put_colour(out, b.colour);
   }
@@ -198,6 +199,8 @@ std::string serialize(const ImportedModel& x) {
   for (const auto& h : r.ignored) put_string(out, h);
   put(out, static_cast<std::uint64_t>(r.skipped.size()));
   for (const auto& h : r.skipped) put_string(out, h);
+  put(out, static_cast<std::uint64_t>(r.left_out.size()));
+  for (const auto& h : r.left_out) put_string(out, h);
   return out;
 }
 
@@ -264,6 +267,7 @@ ImportedModel deserialize(const std::string& bytes) {
     b.kind = static_cast<BodyKind>(in.take<std::int32_t>());
     b.shells.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
     for (Shell& s : b.shells) s.faces = take_ints(in);
+    b.edges = take_ints(in);
     b.name = take_string(in);
     b.colour = take_colour(in);
   }
@@ -291,6 +295,8 @@ ImportedModel deserialize(const std::string& bytes) {
   for (auto& h : r.ignored) h = take_string(in);
   r.skipped.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
   for (auto& h : r.skipped) h = take_string(in);
+  r.left_out.resize(static_cast<std::size_t>(in.take<std::uint64_t>() & 0xffffffffu));
+  for (auto& h : r.left_out) h = take_string(in);
   return x;
 }
 

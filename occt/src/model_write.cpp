@@ -208,7 +208,14 @@ Shapes build_shapes(const Model& m) {
       out.Closed(BRep_Tool::IsClosed(out));
       shells.push_back(out);
     }
-    if (body.kind == BodyKind::Solid) {
+    if (body.kind == BodyKind::Wire) {
+      // Free edges as a compound of edges: STEP's translator writes it as a curve set
+      // (GEOMETRICALLY_BOUNDED_WIREFRAME), IGES's as curves.
+      TopoDS_Compound compound;
+      b.MakeCompound(compound);
+      for (int e : body.edges) b.Add(compound, s.edges[static_cast<std::size_t>(e)]);
+      s.bodies.push_back(compound);
+    } else if (body.kind == BodyKind::Solid) {
       TopoDS_Solid solid;
       b.MakeSolid(solid);
       for (const TopoDS_Shell& shell : shells) b.Add(solid, shell);

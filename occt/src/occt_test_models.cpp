@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include <BRepAdaptor_Curve.hxx>
 #include <BRepAdaptor_Surface.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_GTransform.hxx>
@@ -466,6 +467,24 @@ double max_distance_to_surfaces(const fs::path& file,
   }
   if (k != points.size()) return std::numeric_limits<double>::infinity();
   return worst;
+}
+
+std::vector<std::vector<Eigen::Vector3d>> edge_points(
+    const fs::path& file, const std::vector<std::vector<double>>& parameters) {
+  const TopoDS_Shape shape = read_shape(file);
+  TopTools_IndexedMapOfShape edges;
+  TopExp::MapShapes(shape, TopAbs_EDGE, edges);
+  std::vector<std::vector<Eigen::Vector3d>> out;
+  for (int i = 1; i <= edges.Extent() && out.size() < parameters.size(); ++i) {
+    const BRepAdaptor_Curve curve(TopoDS::Edge(edges(i)));
+    std::vector<Eigen::Vector3d> points;
+    for (double t : parameters[out.size()]) {
+      const gp_Pnt p = curve.Value(t);
+      points.emplace_back(p.X(), p.Y(), p.Z());
+    }
+    out.push_back(std::move(points));
+  }
+  return out;
 }
 
 struct GTransformReference::Impl {

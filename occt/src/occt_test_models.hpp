@@ -54,6 +54,12 @@ ShapeFacts facts_of_file(const std::filesystem::path& file);
 double max_distance_to_surfaces(const std::filesystem::path& file,
                                 const std::vector<std::vector<Eigen::Vector3d>>& points);
 
+/// For each edge of `file` (TopExp_Explorer order, distinct edges) and each parameter in
+/// `parameters[edge]`, the point OpenCASCADE evaluates on that edge's 3D curve
+/// (BRep_Adaptor_Curve, the edge's own parametrization and location).
+std::vector<std::vector<Eigen::Vector3d>> edge_points(
+    const std::filesystem::path& file, const std::vector<std::vector<double>>& parameters);
+
 /// OpenCASCADE's own affine map of a whole shape, the reference of bench/model_bench.cpp: the
 /// file's shape is read once (STEPControl_Reader); transform() runs BRepBuilderAPI_GTransform.
 class GTransformReference {

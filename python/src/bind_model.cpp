@@ -28,6 +28,8 @@ py::dict counts_dict(const brep::Counts& c) {
   d["vertices"] = c.vertices;
   d["parts"] = c.parts;
   d["instances"] = c.instances;
+  d["wires"] = c.wires;
+  d["wire_edges"] = c.wire_edges;
   return d;
 }
 
@@ -39,6 +41,8 @@ const char* kind_name(brep::BodyKind k) {
       return "shell";
     case brep::BodyKind::Sheet:
       return "sheet";
+    case brep::BodyKind::Wire:
+      return "wire";
   }
   return "sheet";
 }
@@ -126,9 +130,11 @@ py::tuple deform_model(const recipe::Recipe& r, const brep::Model& model,
 }
 
 void bind_model(py::module_& m) {
-  py::class_<brep::Model>(m, "Model",
-                          "A whole B-rep model: faces (NURBS surfaces with trimming loops), "
-                          "edges, vertices, bodies (solids, shells, sheets), an assembly tree.")
+  py::class_<brep::Model>(
+      m, "Model",
+      "A whole B-rep model: faces (NURBS surfaces with trimming loops), "
+      "edges, vertices, bodies (solids, shells, sheets, wires of free edges), an assembly "
+      "tree.")
       .def_property_readonly("counts",
                              [](const brep::Model& x) { return counts_dict(brep::counts(x)); })
       .def_property_readonly("is_assembly", &brep::Model::is_assembly)
@@ -144,11 +150,13 @@ void bind_model(py::module_& m) {
               for (const auto& s : b.shells)
                 faces.insert(faces.end(), s.faces.begin(), s.faces.end());
               d["faces"] = faces;
+              d["edges"] = b.edges;
               out.append(d);
             }
             return out;
           },
-          "Each body's name, kind (solid, shell, sheet) and face indices.")
+          "Each body's name, kind (solid, shell, sheet, wire), face indices and (a wire body's) "
+          "free edge indices.")
       .def_property_readonly("face_count", [](const brep::Model& x) { return x.faces.size(); })
       .def(
           "face_surface", [](brep::Model& x, int k) { return face_at(x, k).surface; },
@@ -223,9 +231,10 @@ void bind_model(py::module_& m) {
             return py::make_tuple(tuple_of(b.lo), tuple_of(b.hi));
           },
           py::arg("faces") = py::none(),
-          "((x, y, z) low, (x, y, z) high): the box of the faces' control points (of the "
-          "flattened model; faces: indices into flattened().faces, None: all), which contains "
-          "the faces and their untrimmed surfaces, as a lattice must to compose them exactly.")
+          "((x, y, z) low, (x, y, z) high): the box of the faces' control points and the wire "
+          "bodies' curves' (of the flattened model; faces: indices into flattened().faces, only "
+          "those faces; None: all), which contains the faces, their untrimmed surfaces and the "
+          "free curves, as a lattice must to compose them exactly.")
       .def(
           "deform",
           [](const brep::Model& x, const py::handle& deformation, const py::object& faces,
@@ -282,6 +291,7 @@ void bind_model(py::module_& m) {
         d["healing"] = r.healing;
         d["ignored"] = r.ignored;
         d["skipped"] = r.skipped;
+        d["left_out"] = r.left_out;
         d["problems"] = r.problems;
         d["message"] = r.brief();
         return py::make_tuple(std::move(imported.model), d);
@@ -292,7 +302,8 @@ void bind_model(py::module_& m) {
       "isolate=True reads in a child process, so a file that crashes OpenCASCADE raises "
       "ExchangeError. report['healing'] lists what was healed, report['ignored'] the entity types "
       "OpenCASCADE does not know, report['skipped'] the entities it failed to transfer (the rest "
-      "is read); strict=True heals as before "
+      "is read), report['left_out'] the shapes a model cannot hold (an unbounded line); free "
+      "curves become wire bodies; strict=True heals as before "
       "issue #39 (pcurves outside their domains, gaps wider than the file's tolerances and "
       "misordered loops are listed in report['problems'] instead).");
 

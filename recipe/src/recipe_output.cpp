@@ -284,6 +284,10 @@ Json model_figures(const ModelRunResult& r) {
   model["inner_loops"] = c.inner_loops;
   model["edges"] = c.edges;
   model["vertices"] = c.vertices;
+  if (c.wires > 0) {
+    model["wires"] = c.wires;
+    model["wire_edges"] = c.wire_edges;
+  }
   model["faces_exact"] = m.faces_exact;
   model["faces_refit"] = m.faces_refit;
   model["faces_untouched"] = m.faces_untouched;

@@ -218,6 +218,12 @@ std::vector<int> chosen_faces(const brep::Model& flat, const ModelDef& def) {
     for (const brep::Body& body : flat.bodies)
       if (body.name == def.bodies[i]) {
         found = true;
+        if (body.kind == brep::BodyKind::Wire)
+          throw Error(ErrorCategory::InvalidArgument,
+                      "bodies[" + std::to_string(i) + "]: \"" + def.bodies[i] +
+                          "\" is a wire body (free curves); a selection chooses faces, and free "
+                          "curves move only when the whole model is deformed: leave \"bodies\" "
+                          "and \"faces\" out");
         for (const brep::Shell& shell : body.shells)
           for (int f : shell.faces) chosen[static_cast<std::size_t>(f)] = true;
       }

@@ -176,7 +176,7 @@ TEST_CASE("problems finds a solid that does not close, a loose face and a dangli
   m.edges.push_back(m.edges[0]);  // a copy no face refers to
   const auto dangling = clay::brep::problems(m);
   REQUIRE(dangling.size() == 1);
-  CHECK(dangling[0] == "edge 12 is dangling: no face uses it");
+  CHECK(dangling[0] == "edge 12 is dangling: no face and no wire body uses it");
 }
 
 TEST_CASE("problems finds an open loop, an edge off its vertex and a pcurve off the plane",
@@ -594,6 +594,114 @@ TEST_CASE("flattened places every instance of an assembly as a body of its own",
   // Pcurves are untouched.
   CHECK(clay::surface::identical(flat.faces[7].loops[0].coedges[0].pcurve,
                                  m.faces[1].loops[0].coedges[0].pcurve));
+}
+
+/// `model` with a wire body of two chained line edges (a polyline (0,0,20) -> (30,0,20) ->
+/// (30,40,20)) beside its bodies: new vertices and edges, appended.
+Model with_polyline(Model model) {
+  const int v0 = static_cast<int>(model.vertices.size());
+  for (const Vector3d& p : {Vector3d(0, 0, 20), Vector3d(30, 0, 20), Vector3d(30, 40, 20)})
+    model.vertices.push_back({p, 1e-7});
+  Body wire;
+  wire.kind = BodyKind::Wire;
+  wire.name = "sketch";
+  for (int k = 0; k < 2; ++k) {
+    Edge e;
+    e.curve = line(model.vertices[static_cast<std::size_t>(v0 + k)].point,
+                   model.vertices[static_cast<std::size_t>(v0 + k + 1)].point);
+    e.start = v0 + k;
+    e.end = v0 + k + 1;
+    model.edges.push_back(e);
+    wire.edges.push_back(static_cast<int>(model.edges.size()) - 1);
+  }
+  model.bodies.push_back(wire);
+  return model;
+}
+
+TEST_CASE("a wire body holds free edges: counted, checked, flattened, boxed", "[brep]") {
+  const Model m = with_polyline(cube(10));
+  INFO(all(clay::brep::problems(m)));
+  CHECK(clay::brep::problems(m).empty());
+  const auto c = clay::brep::counts(m);
+  CHECK(c.bodies == 2);
+  CHECK(c.wires == 1);
+  CHECK(c.wire_edges == 2);
+  CHECK(c.edges == 14);
+  CHECK(c.vertices == 11);
+  CHECK(clay::brep::to_string(BodyKind::Wire) == "wire");
+  // The box holds the cube's faces and the polyline; faces chosen: the faces only.
+  const auto box = clay::brep::control_box(m);
+  CHECK(box.lo == Vector3d(0, 0, 0));
+  CHECK(box.hi == Vector3d(30, 40, 20));
+  CHECK(clay::brep::control_box(m, {0}).hi.maxCoeff() <= 10);
+  // Only the wire: still a box, and volume 0 from the cube's absence.
+  Model only = with_polyline(Model());
+  CHECK(clay::brep::problems(only).empty());
+  CHECK(clay::brep::control_box(only).hi == Vector3d(30, 40, 20));
+  CHECK(clay::brep::volume_mm3(only) == 0);
+  CHECK(clay::brep::volume_mm3(m) == Approx(1000).epsilon(1e-14));  // the cube's alone
+  // Placed twice in an assembly, each copy's polyline moves with its placement.
+  Model assembly = m;
+  assembly.parts.push_back({"kit", {0, 1}, {}, std::nullopt});
+  for (double x : {0.0, 100.0})
+    assembly.roots.push_back({0, Eigen::Isometry3d(Eigen::Translation3d(x, 0, 0)), ""});
+  REQUIRE(clay::brep::problems(assembly).empty());
+  const Model flat = clay::brep::flattened(assembly);
+  INFO(all(clay::brep::problems(flat)));
+  CHECK(clay::brep::problems(flat).empty());
+  CHECK(clay::brep::counts(flat).wires == 2);
+  CHECK(clay::brep::counts(flat).wire_edges == 4);
+  const Body& second = flat.bodies[3];
+  REQUIRE(second.kind == BodyKind::Wire);
+  const Edge& moved = flat.edges[static_cast<std::size_t>(second.edges[1])];
+  CHECK(flat.vertices[static_cast<std::size_t>(moved.end)].point == Vector3d(130, 40, 20));
+  CHECK(clay::brep::control_box(assembly).hi == Vector3d(130, 40, 20));
+}
+
+TEST_CASE("problems names a wire body's bad edges: shared with a face, twice held, a pole",
+          "[brep]") {
+  Model m = with_polyline(cube(10));
+  Body& wire = m.bodies[1];
+  {
+    Model bad = m;
+    bad.bodies[1].edges.push_back(0);  // a cube edge, used by two faces
+    CHECK_THAT(all(clay::brep::problems(bad)),
+               Contains("edge 0 is in wire body 1 and used by a face"));
+  }
+  {
+    Model bad = m;
+    bad.bodies.push_back(bad.bodies[1]);  // the same edges in a second wire body
+    CHECK_THAT(all(clay::brep::problems(bad)), Contains("is already in body 1"));
+  }
+  {
+    Model bad = m;
+    bad.bodies[1].edges.push_back(99);
+    CHECK_THAT(all(clay::brep::problems(bad)), Contains("edge index 99 is not one of the 14"));
+  }
+  {
+    Model bad = m;
+    bad.bodies[1].edges.clear();
+    const auto list = all(clay::brep::problems(bad));
+    CHECK_THAT(list, Contains("a wire body has no edges"));
+    CHECK_THAT(list, Contains("edge 12 is dangling: no face and no wire body uses it"));
+  }
+  {
+    Model bad = m;
+    bad.bodies[1].shells.push_back({{0}});
+    CHECK_THAT(all(clay::brep::problems(bad)), Contains("a wire body holds edges, not shells"));
+  }
+  {
+    Model bad = m;
+    bad.bodies[0].edges.push_back(12);
+    CHECK_THAT(all(clay::brep::problems(bad)), Contains("only a wire body holds edges"));
+  }
+  {
+    Model bad = m;
+    bad.edges[12].degenerate = true;
+    bad.edges[12].end = bad.edges[12].start;
+    CHECK_THAT(all(clay::brep::problems(bad)), Contains("is degenerate (a pole)"));
+  }
+  CHECK(wire.edges.size() == 2);
 }
 
 TEST_CASE("elementary surfaces: points in closed form and distances along the normal", "[brep]") {

@@ -1569,6 +1569,30 @@ TEST_CASE("a refit that misses its tolerance at the refit's caps fails the run, 
   CHECK_THAT(message, !Contains("Options"));
 }
 
+TEST_CASE("recipe models: a wire body chosen by name is refused, naming it and the fix",
+          "[recipe]") {
+  // A selection chooses faces; a wire body's free curves move only with the whole model. Read
+  // OpenCASCADE 6.6's IGES curve (one wire body, named "EDGE" by OpenCASCADE) and choose it.
+  std::ifstream in(fs::path(CLAY_EXAMPLES_DIR) / "recipes" / "assembly_model.json");
+  nlohmann::json recipe = nlohmann::json::parse(in);
+  const fs::path curve = fs::path(CLAY_EXAMPLES_DIR).parent_path() / "tests" / "data" / "cad" /
+                         "occt66_bspline_curve126_line.igs";
+  recipe["deformations"]["lean"][0]["frame"] = {
+      {"origin", {-5, -5, -5}}, {"s", {30, 0, 0}}, {"t", {0, 30, 0}}, {"u", {0, 0, 30}}};
+  recipe["deformations"]["lean"][0]["moves"] = {{{"index", {1, 1, 1}}, {"to", {27, 27, 27}}}};
+  recipe["models"] = {
+      {"picked", {{"import", curve.string()}, {"deformation", "lean"}, {"bodies", {"EDGE"}}}}};
+  const auto [category, message] = error_of([&] { run_recipe(parse_recipe(recipe.dump())); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("\"EDGE\" is a wire body") && Contains("leave \"bodies\""));
+  // The whole model: the curve moves with it.
+  recipe["models"]["picked"].erase("bodies");
+  const RunResult run = run_recipe(parse_recipe(recipe.dump()));
+  REQUIRE(run.models.size() == 1);
+  CHECK(clay::brep::counts(run.models[0].model).wire_edges == 1);
+  CHECK(run.models[0].report.edges_exact == 1);
+}
+
 TEST_CASE(
     "recipe models: the assembly's pins lean by name, exactly, the plate stays, a bend refits",
     "[recipe]") {

@@ -16,6 +16,7 @@
 #include <clay/deform/stack.hpp>
 #include <clay/occt/model_exchange.hpp>
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/evaluate.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -304,12 +305,90 @@ TEST_CASE("NX 9's faces farther from their edges than its tolerances read valid 
   CHECK(deformed_check.valid);
 }
 
-TEST_CASE("a real file with no face (Rhino wireframe) is refused, naming the file") {
-  const fs::path path = cad_file("rhino_stdev14_wireframe_line_ap214.stp");
-  const auto [category, message] = clay::test::error_of([&] { clay::brep::read_model(path); });
-  CHECK(category == clay::ErrorCategory::Exchange);
-  CHECK_THAT(message,
-             Contains("rhino_stdev14_wireframe_line_ap214.stp") && Contains("holds no face"));
+TEST_CASE("a real file whose one curve is unbounded (Rhino wireframe) reads empty, naming it") {
+  // One LINE in a GEOMETRIC_CURVE_SET: OpenCASCADE (and FreeCAD) read an edge over +-2e100. A
+  // model holds no unbounded curve: the read gives no body, and the report names the entity.
+  const auto imported = clay::brep::read_model(cad_file("rhino_stdev14_wireframe_line_ap214.stp"));
+  CHECK(imported.model.bodies.empty());
+  CHECK(imported.model.edges.empty());
+  REQUIRE(imported.report.left_out.size() == 1);
+  CHECK_THAT(imported.report.left_out.front(),
+             Contains("#15 LINE") && Contains("unbounded") && Contains("2e+100"));
+  CHECK(clay::brep::problems(imported.model).empty());
+  const auto facts = clay::surface::occt_reference::facts_of_file(
+      cad_file("rhino_stdev14_wireframe_line_ap214.stp"));
+  CHECK(facts.edges == 1);  // what was left out, OpenCASCADE's own reading holds
+  CHECK(facts.faces == 0);
+  // Nothing to deform: said, not a silent empty result.
+  const auto [category, message] = clay::test::error_of(
+      [&] { clay::deform::deform_model(clay::deform::DeformationStack{}, imported.model); });
+  CHECK(category == clay::ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Contains("no face and no wire edge"));
+}
+
+TEST_CASE(
+    "a real wireframe IGES (OpenCASCADE 6.6's 126 curve) reads as a wire body, deforms exactly") {
+  const fs::path path = cad_file("occt66_bspline_curve126_line.igs");
+  const auto imported = clay::brep::read_model(path);
+  INFO(imported.report.brief());
+  const Model& m = imported.model;
+  REQUIRE(m.bodies.size() == 1);
+  CHECK(m.bodies[0].kind == clay::brep::BodyKind::Wire);
+  REQUIRE(m.bodies[0].edges.size() == 1);
+  CHECK(clay::brep::problems(m).empty());
+  const auto c = clay::brep::counts(m);
+  CHECK(c.wires == 1);
+  CHECK(c.wire_edges == 1);
+  CHECK(c.faces == 0);
+  const auto facts = clay::surface::occt_reference::facts_of_file(path);
+  CHECK(facts.edges == c.edges);
+  CHECK(facts.vertices == c.vertices);
+  // The curve is the file's: OpenCASCADE's own edge at the same parameters.
+  const clay::brep::Edge& edge = m.edges[static_cast<std::size_t>(m.bodies[0].edges[0])];
+  std::vector<double> ts;
+  for (int k = 0; k <= 40; ++k) ts.push_back(edge.t0 + (edge.t1 - edge.t0) * k / 40);
+  const auto occt = clay::surface::occt_reference::edge_points(path, {ts});
+  REQUIRE(occt.size() == 1);
+  double off = 0;
+  for (std::size_t k = 0; k < ts.size(); ++k)
+    off = std::max(off, (clay::surface::evaluate(edge.curve, ts[k]) - occt[0][k]).norm());
+  CHECK(off <= 1e-12);
+  // Deformed: F(C(t)) at the same t, exactly (the pointwise map as the reference).
+  const clay::brep::Box box = clay::brep::control_box(m);
+  const Eigen::Vector3d pad = 0.05 * (box.hi - box.lo) + Eigen::Vector3d::Constant(1.0);
+  const auto stack =
+      clay::test::trilinear(box.lo - pad, box.hi + pad, 0.1 * (box.hi - box.lo + 2 * pad));
+  const auto deformed = clay::deform::deform_model(stack, m);
+  INFO(deformed.report.brief());
+  CHECK(deformed.report.edges_exact == 1);
+  const clay::brep::Edge& moved = deformed.model.edges[0];
+  double worst = 0;
+  for (double t : ts)
+    worst =
+        std::max(worst, (clay::surface::evaluate(moved.curve, t) -
+                         clay::deform::deform_point(stack, clay::surface::evaluate(edge.curve, t)))
+                            .norm());
+  CHECK(worst <= 1e-12 * (box.hi - box.lo).norm());
+  for (int v : {moved.start, moved.end}) {
+    const Eigen::Vector3d at =
+        clay::surface::evaluate(moved.curve, v == moved.start ? moved.t0 : moved.t1);
+    CHECK((deformed.model.vertices[static_cast<std::size_t>(v)].point - at).norm() <= 1e-12);
+  }
+  // Written back as STEP and IGES: OpenCASCADE reads the same curve at the same parameters.
+  for (const char* name : {"curve.stp", "curve.igs"}) {
+    const fs::path out = clay::test::test_output("wireframe_curve126", name);
+    const auto check = clay::brep::write_model(deformed.model, out);
+    CHECK(check.valid);
+    const auto back = clay::surface::occt_reference::edge_points(out, {ts});
+    REQUIRE(back.size() == 1);
+    double apart = 0;
+    for (std::size_t k = 0; k < ts.size(); ++k)
+      apart = std::max(apart, (back[0][k] - clay::surface::evaluate(moved.curve, ts[k])).norm());
+    INFO(name);
+    CHECK(apart <= 1e-9);
+    const auto reread = clay::brep::read_model(out);
+    CHECK(clay::brep::counts(reread.model).wire_edges == 1);
+  }
 }
 
 TEST_CASE("a file OpenCASCADE's XCAF reader crashes on is read by its plain reader, and says so") {

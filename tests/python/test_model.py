@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import copy
+import importlib
 import json
 import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -282,3 +284,83 @@ def test_a_face_that_cannot_be_exact_is_refitted_within_tolerance_mm() -> None:
     assert bulged.problems() == []
     with pytest.raises(cf.InvalidArgumentError, match="refit_tolerance_mm -1 must be >= 0"):
         model.deform(lattice, tolerance_mm=-1)
+
+
+def freecad_part():  # type: ignore[no-untyped-def]
+    """FreeCAD's Part module (Debian's freecad-python3, the same OpenCASCADE and Python as ours):
+    an exporter and a reader independent of Clayform."""
+    sys.path.append("/usr/lib/freecad/lib")
+    try:
+        importlib.import_module("FreeCAD")  # before Part, which it sets up
+        import Part
+    except ImportError:
+        pytest.skip("FreeCAD (freecad-python3) is not installed: scripts/test.sh installs it")
+    return Part
+
+
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
+def test_free_curves_written_by_freecad_read_as_wire_bodies_and_deform_exactly(
+        tmp_path: Path, suffix: str) -> None:
+    # A wireframe as a stylist sends it: a polyline (3 chained edges), a full circle (one closed
+    # edge) and a B-spline through 6 points, beside a plate. FreeCAD writes it; Clayform reads the
+    # free curves as wire bodies, bulges them exactly with the plate, writes them back, and
+    # FreeCAD reads each curve back at F(C(t)).
+    Part = freecad_part()
+    from FreeCAD import Vector
+    polyline = Part.makePolygon([Vector(0, 0, 0), Vector(30, 0, 0), Vector(30, 20, 5),
+                                 Vector(10, 25, 10)])
+    circle = Part.makeCircle(8, Vector(15, 10, 2))
+    spline = Part.BSplineCurve()
+    spline.interpolate([Vector(0, 30, 0), Vector(8, 34, 3), Vector(16, 31, 6), Vector(24, 36, 4),
+                        Vector(30, 33, 1), Vector(36, 38, 0)])
+    plate = Part.makePlane(40, 40, Vector(-2, -2, -1))
+    source = tmp_path / ("wires" + suffix)
+    compound = Part.makeCompound([plate, polyline, circle, spline.toShape()])
+    if suffix == ".step":
+        compound.exportStep(str(source))
+    else:
+        compound.exportIges(str(source))
+    model, report = cf.read_model(source)
+    assert report["problems"] == [] and report["left_out"] == []
+    counts = model.counts
+    assert (counts["faces"], counts["wire_edges"]) == (1, 5), (counts, report["message"])
+    # the plate: a shell from STEP, a sheet from IGES; the curves: a wire body per free wire
+    # (IGES keeps the polyline a wire) and one for the loose edges
+    kinds = [b["kind"] for b in model.bodies]
+    assert sorted(set(kinds) - {"wire"}) in (["shell"], ["sheet"]) and "wire" in kinds, kinds
+    assert sum(len(b["edges"]) for b in model.bodies) == 5
+    lo, hi = (np.array(c) for c in model.bounding_box())
+    assert hi[1] >= 38 and lo[2] <= -1  # the box holds the curves as well as the plate
+    lattice = bulge_of(model)
+    deformed, figures = model.deform(lattice)
+    assert deformed.problems() == []
+    assert figures["counts"]["wire_edges"] == 5
+    written = tmp_path / ("bulged" + suffix)
+    assert deformed.write(written)["valid"]
+    # FreeCAD's own reading of both files: each free edge of the original, mapped pointwise,
+    # lies on the written one at the same parameter.
+    before, after = Part.Shape(), Part.Shape()
+    before.read(str(source))
+    after.read(str(written))
+    free_before = [e for e in before.Edges if not any(e.isSame(x) for f in before.Faces
+                                                       for x in f.Edges)]
+    free_after = [e for e in after.Edges if not any(e.isSame(x) for f in after.Faces
+                                                     for x in f.Edges)]
+    assert len(free_before) == len(free_after) == 5
+    size = float(np.linalg.norm(hi - lo))
+    worst = 0.0
+    for a in free_before:
+        ts = np.linspace(a.FirstParameter, a.LastParameter, 17)
+        mapped = lattice.deform_points(np.array([tuple(a.valueAt(t)) for t in ts]))
+        # the written edge that starts where the mapped edge starts (edge order may differ)
+        b = min(free_after, key=lambda e: np.linalg.norm(np.array(tuple(e.valueAt(
+            e.FirstParameter))) - mapped[0]) + np.linalg.norm(np.array(tuple(e.valueAt(
+                e.LastParameter))) - mapped[-1]))
+        if isinstance(a.Curve, Part.Circle):
+            # read as a rational B-spline, whose parameter is not the angle: on the curve
+            off = max(b.distToShape(Part.Vertex(Vector(*m)))[0] for m in mapped)
+        else:  # lines and B-splines keep their parameter: at the same t
+            assert b.FirstParameter == pytest.approx(a.FirstParameter, abs=1e-12 * size)
+            off = float(np.abs(np.array([tuple(b.valueAt(t)) for t in ts]) - mapped).max())
+        worst = max(worst, off)
+    assert worst <= 1e-9 * size, worst

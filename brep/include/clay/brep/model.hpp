@@ -119,13 +119,17 @@ struct Shell {
 };
 
 /// What a body is: a solid (closed shells: the first the outside, the others voids), one or more
-/// connected shells of faces (open or closed), or loose faces.
-enum class BodyKind { Solid, Shell, Sheet };
+/// connected shells of faces (open or closed), loose faces, or a wire body: free edges (curves no
+/// face uses: a wireframe, a package drawing's lines, style curves sent beside their surfaces).
+enum class BodyKind { Solid, Shell, Sheet, Wire };
 
-/// A body: its shells, name and colour.
+/// A body: its shells (a wire body: its edges instead), name and colour.
 struct Body {
   BodyKind kind = BodyKind::Solid;
-  std::vector<Shell> shells;
+  std::vector<Shell> shells;  ///< empty for a wire body
+  /// A wire body's edges, indices into Model::edges, in the order they were read (chains share
+  /// vertices); no face uses them. Empty for the other kinds.
+  std::vector<int> edges;
   std::string name;
   std::optional<Colour> colour;
 };
@@ -166,6 +170,7 @@ struct CLAY_BREP_API Model {
 struct Counts {
   int bodies = 0, solids = 0, shells = 0, faces = 0, trimmed_faces = 0, loops = 0, inner_loops = 0,
       coedges = 0, edges = 0, degenerate_edges = 0, vertices = 0, parts = 0, instances = 0;
+  int wires = 0, wire_edges = 0;  ///< wire bodies, and the edges they hold (among `edges`)
   friend bool operator==(const Counts&, const Counts&) = default;
 };
 
@@ -205,7 +210,9 @@ CLAY_BREP_API double loop_area(const Model& model, int face, int loop);
 /// - the outer loop runs counter-clockwise in (u, v) and holes clockwise;
 /// - in a shell, an edge is used by at most two coedges, and two uses run in opposite directions
 ///   (a consistent orientation); every shell of a solid is closed, and no edge is left dangling
-///   (unused by any face);
+///   (unused by any face and by any wire body);
+/// - a wire body holds edges and no shells; its edges are not degenerate, and no face and no other
+///   wire body uses them;
 /// - the assembly tree refers to existing parts and bodies and has no cycle.
 CLAY_BREP_API std::vector<std::string> problems(const Model& model);
 
@@ -223,11 +230,11 @@ struct Box {
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
 };
 
-/// The box of the control points of the faces of flattened(model) (of `faces` only, indices into
-/// flattened(model).faces, when given): it contains those faces and their whole untrimmed
-/// surfaces (convex hull property, weights positive), which is what a lattice must contain for
-/// an exact composition. Throws InvalidArgument for a model without faces or a face index out of
-/// range, InvalidGeometry as flattened.
+/// The box of the control points of the faces and wire bodies' edges of flattened(model) (of
+/// `faces` only, indices into flattened(model).faces, when given): it contains those faces and
+/// their whole untrimmed surfaces, and the curves (convex hull property, weights positive), which
+/// is what a lattice must contain for an exact composition. Throws InvalidArgument for a model
+/// with neither faces nor wire edges or a face index out of range, InvalidGeometry as flattened.
 CLAY_BREP_API Box control_box(const Model& model, const std::vector<int>& faces = {});
 
 /// Throws clay::Error(InvalidGeometry) listing problems(model) when there are any.
@@ -236,7 +243,7 @@ CLAY_BREP_API void validate(const Model& model);
 /// The name of an elementary kind: "plane", "cylinder", "cone", "sphere", "torus".
 CLAY_BREP_API std::string_view to_string(ElementaryKind kind) noexcept;
 
-/// The name of a body kind: "solid", "shell", "sheet".
+/// The name of a body kind: "solid", "shell", "sheet", "wire".
 CLAY_BREP_API std::string_view to_string(BodyKind kind) noexcept;
 
 }  // namespace clay::brep

@@ -6,7 +6,8 @@
 /// Exact composition F∘S keeps a face's (u, v) parametrization, so its pcurves stay valid bit for
 /// bit; each edge's curve composes exactly as F∘C on the same parameter t (as the ruled surface
 /// C(t) × [0, 1], row 0 of the composed net), and F(S(pcurve(t))) = F(C(t)) wherever
-/// S(pcurve(t)) = C(t). Vertices are mapped by the stack's pointwise deformation.
+/// S(pcurve(t)) = C(t). Vertices are mapped by the stack's pointwise deformation. The free edges
+/// of wire bodies compose the same way, when the whole model is deformed (options.faces empty).
 /// - A face whose control points all lie on the outer side of one face of every enabled
 ///   lattice's box, or whose lattices are undisplaced, is untouched: kept bit for bit (the FFD
 ///   is the identity outside its lattice), and keeps its type (Face::elementary: a plane is still

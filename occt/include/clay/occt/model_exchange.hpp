@@ -88,6 +88,10 @@ struct CLAY_OCCT_API ModelReadReport {
   /// each: "#73 CYLINDRICAL_SURFACE: <OpenCASCADE's failure>". The rest of the file is read; a
   /// file none of whose shapes transfer is refused, naming the first.
   std::vector<std::string> skipped;
+  /// Shapes OpenCASCADE read that a model cannot hold, one line each, naming the shape and why:
+  /// an unbounded line (OpenCASCADE's range +-2e100: no extent to deform or write back), free
+  /// points. A file whose shapes are all left out is read as an empty model with these lines.
+  std::vector<std::string> left_out;
   /// brep::problems(model): invariants the model breaks (empty for a clean file). The model is
   /// still returned, so that it can be inspected; deforming it refuses it.
   std::vector<std::string> problems;
@@ -104,11 +108,12 @@ struct ImportedModel {
 };
 
 /// Reads a STEP (.step, .stp) or IGES (.iges, .igs) file, chosen by its extension, into a model:
-/// solids, shells and loose faces become bodies; an assembly becomes parts and instances with
-/// their placements; names and colours of parts, bodies and faces are kept. Throws
-/// clay::Error(Io) when the file is missing or cannot be opened, Exchange when it cannot be
-/// parsed, fails the pre-check, holds no face, or holds geometry that cannot be converted
-/// (naming the face or edge and what failed), InvalidGeometry for a surface or curve with
+/// solids, shells and loose faces become bodies, and free curves wire bodies (a body per free
+/// wire, one for the loose edges; unbounded curves are left out, named in the report); an assembly
+/// becomes parts and instances with their placements; names and colours of parts, bodies and faces
+/// are kept. Throws clay::Error(Io) when the file is missing or cannot be opened, Exchange when it
+/// cannot be parsed, fails the pre-check, holds no face or curve, or holds geometry that cannot be
+/// converted (naming the face or edge and what failed), InvalidGeometry for a surface or curve with
 /// non-finite coordinates or weights that no exact reparametrization makes positive (naming the
 /// face), InvalidArgument for bad options or an unknown extension.
 CLAY_OCCT_API ImportedModel read_model(const std::filesystem::path& file,
