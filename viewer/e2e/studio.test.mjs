@@ -7,6 +7,7 @@
 //   regular      taper, twist, direct manipulation, B-spline lattice (studio_regular.mjs)
 //   corners      strokes split at corners, mirror (studio_corners.mjs)
 //   constraints  constraints, 3D strokes, revolve, picked planes (studio_constraints.mjs)
+//   drafting     the grid snapped to, the pointer's coordinates, ortho and back views, an underlay (studio_drafting.mjs)
 // Geometry is checked here, not by the page (geometry.mjs). Latencies and frame times come from
 // the page's window.clayStudio hook and are reported (not asserted: they depend on the machine).
 //
@@ -17,8 +18,9 @@ import model from './studio_model.mjs';
 import regular from './studio_regular.mjs';
 import corners from './studio_corners.mjs';
 import constraints from './studio_constraints.mjs';
+import drafting from './studio_drafting.mjs';
 
-const parts = { drawing, model, regular, corners, constraints };
+const parts = { drawing, model, regular, corners, constraints, drafting };
 const h = await openHarness(Object.keys(parts));
 try {
   for (const [name, run] of Object.entries(parts)) if (h.wants(name)) await run(h);

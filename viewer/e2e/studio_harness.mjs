@@ -137,10 +137,11 @@ export async function openHarness(parts) {
   page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
   const driver = studioPage(page);
   let shotCount = 0;
-  async function shot(label) {
+  /** A screenshot into --shots (of the main page, or of `target`, a studio of withStudio's). */
+  async function shot(label, target = page) {
     if (!shots) return;
     mkdirSync(shots, { recursive: true });
-    await page.screenshot({ path: join(shots, `${String(++shotCount).padStart(2, '0')}-${label}.png`) });
+    await target.screenshot({ path: join(shots, `${String(++shotCount).padStart(2, '0')}-${label}.png`) });
   }
 
   /**

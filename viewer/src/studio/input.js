@@ -63,7 +63,8 @@ function onKey(e) {
   else if (e.key === 'e') setTool('edit');
   else if (e.key === 'b') toggleBefore();
   else if (e.key === 'f') setView('fit');
-  else if (['1', '2', '3', '4'].includes(e.key)) setView(['top', 'front', 'side', 'iso'][Number(e.key) - 1]);
+  else if (['1', '2', '3', '4', '5'].includes(e.key)) setView(['top', 'front', 'side', 'iso', 'back'][Number(e.key) - 1]);
+  else if (e.key === 'p') $('projection').click();
   else if (e.key === 'Delete' || e.key === 'Backspace') deleteSelected();
   else if (e.key === 'Escape') select(null);
   else if (['x', 'y', 'z', 'X', 'Y', 'Z'].includes(e.key)) {

@@ -11,6 +11,8 @@ import './studio.css';
 import { body } from './ui.js';
 import { busy } from './store.js';
 import { wireScene } from './scene.js';
+import { wireDrafting } from './drafting.js';
+import { sketchPlane, snapEnd } from './sketch_geometry.js';
 import { wireDisplay } from './display.js';
 import { wireHandles } from './handles.js';
 import { wireLattice } from './lattice.js';
@@ -22,6 +24,7 @@ import { installTestHook } from './test_hook.js';
 import { start } from './replies.js';
 
 wireScene();
+wireDrafting({ plane: sketchPlane, snap: snapEnd });
 wireConstraints();
 wireStyle();
 wireLattice();

@@ -8,6 +8,7 @@ import { $, showMessage } from './ui.js';
 import { doc } from './store.js';
 import { scene, camera, controls, curveGroup, dirty, sceneBox, toScreen, millimetresPerPixel } from './scene.js';
 import { PICK_PX } from './select.js';
+import { gridNode } from './drafting.js';
 
 const PLANE_NORMALS = { xy: [0, 0, 1], xz: [0, 1, 0], yz: [1, 0, 0] };
 const PLANE_X = { xy: [1, 0, 0], xz: [1, 0, 0], yz: [0, 1, 0] };
@@ -134,8 +135,7 @@ function curveEnds() {
   return out;
 }
 const SNAP_PX = 12;
-const GRID_MM = 10;
-/** The stroke's end point snapped: to a curve end, else a curve, else a grid node; or null. */
+/** The stroke's end point snapped: to a curve end, else a curve, else a node of the grid drawn; or null. */
 export function snapEnd(p) {
   const s = toScreen(p);
   let best = null;
@@ -155,7 +155,9 @@ export function snapEnd(p) {
     }
   }
   if (best) return best;
-  const g = p.map((c) => Math.round(c / GRID_MM) * GRID_MM);
+  // the grid drawn on the sketch plane, at the spacing shown (an invisible 10 mm grid moved a
+  // stroke end by 5 mm, issue #40); in the plane's own axes, the offset along its normal kept
+  const g = gridNode(p);
   const q = toScreen(g);
   if (Math.hypot(q[0] - s[0], q[1] - s[1]) < 6) return { p: g, to: 'grid' };
   return null;

@@ -2,7 +2,8 @@
 // them, the camera, the handles, the latencies and frame times recorded, and a promise for
 // "everything answered".
 import { doc, state, metrics, busy } from './store.js';
-import { canvas, camera, renderPending, setView, toScreen } from './scene.js';
+import { canvas, camera, renderPending, setView, toScreen, isOrthographic } from './scene.js';
+import { gridSpacing, gridNode, underlaySettings, spacingAt } from './drafting.js';
 import { previews } from './lattice_preview.js';
 import { lastLive } from './sketch.js';
 import { handleList } from './handles.js';
@@ -34,6 +35,18 @@ export function installTestHook() {
     },
     toScreen,
     setView,
+    /** The drafting aids' state: grid spacing and visibility, the status line's texts, the projection, the underlay. */
+    drafting: () => ({
+      spacing: gridSpacing(),
+      gridShown: document.getElementById('show-grid').checked,
+      cursor: document.getElementById('cursor').textContent,
+      gridText: document.getElementById('grid-spacing').textContent,
+      snap: document.getElementById('snap-target').textContent,
+      orthographic: isOrthographic(),
+      underlay: underlaySettings(),
+    }),
+    gridNode,
+    spacingAt,
     select: (items) => {
       state.selection = [];
       items.forEach((it) => select(it, true));
