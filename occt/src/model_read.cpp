@@ -2,7 +2,8 @@
 // readers, so that names, colours and the assembly tree come with the shapes.
 //
 // Converting faces, edges and pcurves: model_convert.hpp; the isolated read's answer:
-// model_wire.hpp.
+// model_wire.hpp; what OpenCASCADE's transfer left out or did not know, and its plain reader:
+// model_transfer.hpp; the options' checks and the report's line: model_read_report.cpp.
 #include <clay/occt/model_exchange.hpp>
 
 #include <clay/error.hpp>
@@ -26,6 +27,7 @@
 #include "exchange_precheck.hpp"
 #include "model_convert.hpp"
 #include "model_heal.hpp"
+#include "model_transfer.hpp"
 #include "model_wire.hpp"
 #include "session.hpp"
 
@@ -41,18 +43,13 @@
 #include <Geom_BSplineCurve.hxx>
 #include <IGESCAFControl_Reader.hxx>
 #include <IGESControl_Controller.hxx>
-#include <IGESControl_Reader.hxx>
 #include <IGESData_IGESModel.hxx>
 #include <IGESData_UndefinedEntity.hxx>
-#include <Interface_Check.hxx>
-#include <Interface_CheckIterator.hxx>
 #include <Interface_InterfaceModel.hxx>
 #include <Precision.hxx>
 #include <Quantity_Color.hxx>
 #include <STEPCAFControl_Controller.hxx>
 #include <STEPCAFControl_Reader.hxx>
-#include <STEPControl_Controller.hxx>
-#include <STEPControl_Reader.hxx>
 #include <ShapeFix_Solid.hxx>
 #include <StepData_StepModel.hxx>
 #include <StepData_UndefinedEntity.hxx>
@@ -74,7 +71,6 @@
 #include <TopoDS_Solid.hxx>
 #include <TopoDS_Vertex.hxx>
 #include <TopoDS_Wire.hxx>
-#include <Transfer_TransientProcess.hxx>
 #include <XCAFApp_Application.hxx>
 #include <XCAFDoc_ColorTool.hxx>
 #include <XCAFDoc_DocumentTool.hxx>
@@ -853,141 +849,6 @@ class ModelBuilder {
   int faces_enclosing_nothing_ = 0;    // kept on a widened box (face_box)
   int free_edges_given_vertices_ = 0;  // free edges the file gave no vertices (free_edge_of)
 };
-
-}  // namespace
-
-std::vector<std::string> ModelReadOptions::problems() const {
-  std::vector<std::string> out = read.problems();
-  if (!(sewing_tolerance_mm > 0 && sewing_tolerance_mm <= 1))
-    out.push_back("sewing_tolerance_mm is " + shortest(sewing_tolerance_mm) +
-                  "; it must be in (0, 1] mm");
-  return out;
-}
-
-void ModelReadOptions::validate() const {
-  internal::throw_if(ErrorCategory::InvalidArgument, problems());
-}
-
-std::string ModelReadReport::brief() const {
-  char text[512];
-  std::snprintf(text, sizeof text,
-                "%d bod%s (%d solid%s), %d shell%s, %d face%s (%d trimmed, %d holes), %d edges, "
-                "%d vertices; faces %d B-spline, %d affine, %d angular; pcurves %d kept, %d "
-                "exact, %d fitted (<= %.1e mm); edge gap %.1e mm",
-                counts.bodies, counts.bodies == 1 ? "y" : "ies", counts.solids,
-                counts.solids == 1 ? "" : "s", counts.shells, counts.shells == 1 ? "" : "s",
-                counts.faces, counts.faces == 1 ? "" : "s", counts.trimmed_faces,
-                counts.inner_loops, counts.edges, counts.vertices, faces_bspline, faces_affine,
-                faces_angular, pcurves_kept, pcurves_exact, pcurves_fitted,
-                max_rederivation_error_mm, max_edge_gap_mm);
-  std::string line = text;
-  if (faces_approximated > 0) {
-    std::snprintf(text, sizeof text, "; %d offset face%s approximated (<= %.1e mm)",
-                  faces_approximated, faces_approximated == 1 ? "" : "s",
-                  max_approximation_error_mm);
-    line += text;
-  }
-  if (counts.wires > 0)
-    line += "; " + std::to_string(counts.wires) + " wire bod" + (counts.wires == 1 ? "y" : "ies") +
-            " (" + std::to_string(counts.wire_edges) + " free edge" +
-            (counts.wire_edges == 1 ? "" : "s") + ")";
-  if (!left_out.empty())
-    line += "; left out " + std::to_string(left_out.size()) + ": " + left_out.front();
-  if (!healing.empty()) line += "; healed: " + healing.front();
-  if (!ignored.empty())
-    line += "; ignored " + std::to_string(ignored.size()) + " unknown entity type" +
-            (ignored.size() == 1 ? "" : "s") + ": " + ignored.front();
-  if (!skipped.empty())
-    line += "; skipped " + std::to_string(skipped.size()) + " entit" +
-            (skipped.size() == 1 ? "y" : "ies") +
-            " OpenCASCADE could not transfer: " + skipped.front();
-  if (!problems.empty())
-    line += "; " + std::to_string(problems.size()) + " problems, the first: " + problems.front();
-  return line;
-}
-
-namespace {
-
-/// The entities of a file OpenCASCADE does not know, per type, for the report.
-struct UnknownEntities {
-  std::vector<std::pair<std::string, std::pair<int, std::string>>> types;  // count, first
-  void add(const std::string& type, const std::string& where) {
-    for (auto& [t, seen] : types)
-      if (t == type) {
-        ++seen.first;
-        return;
-      }
-    types.push_back({type, {1, where}});
-  }
-  std::vector<std::string> lines() const {
-    std::vector<std::string> out;
-    for (const auto& [t, seen] : types)
-      out.push_back(t + " x " + std::to_string(seen.first) + " (the first " + seen.second + ")");
-    return out;
-  }
-};
-
-/// The entities whose transfer OpenCASCADE gave up on, one line each ("#73 CYLINDRICAL_SURFACE:
-/// <its failure>"). OpenCASCADE catches an exception per entity (a Standard_ConstructionError on
-/// a negative radius) and leaves the entity, and what is built on it, out of the shape: the rest
-/// is read, and these lines say what is missing.
-std::vector<std::string> failed_entities(const Handle(XSControl_WorkSession) & session) {
-  std::vector<std::string> out;
-  if (session.IsNull() || session->TransferReader().IsNull()) return out;
-  const Handle(Transfer_TransientProcess)& process = session->TransferReader()->TransientProcess();
-  if (process.IsNull()) return out;
-  const Handle(Interface_InterfaceModel) model = process->Model();
-  const Interface_CheckIterator checks = process->CheckList(true);
-  for (checks.Start(); checks.More(); checks.Next()) {
-    const Handle(Interface_Check)& check = checks.Value();
-    if (check.IsNull() || !check->HasFailed()) continue;
-    std::string line = "an entity";
-    if (check->HasEntity() && !model.IsNull() && model->Contains(check->Entity())) {
-      const Handle(TCollection_HAsciiString) label = model->StringLabel(check->Entity());
-      line = (label.IsNull() ? std::string("?") : std::string(label->ToCString())) + " " +
-             model->TypeName(check->Entity(), false);
-    }
-    line += ": " + std::string(check->CFail(1));
-    if (check->NbFails() > 1) line += " (and " + std::to_string(check->NbFails() - 1) + " more)";
-    out.push_back(line);
-  }
-  return out;
-}
-
-/// The shapes of `file` by OpenCASCADE's plain reader (no XCAF: no names, colours or assembly),
-/// as one free shape of `document`; whether the transfer gave a shape. The entities it could not
-/// transfer go to `failed`.
-bool read_plain(const fs::path& file, bool step, const Handle(TDocStd_Document) & document,
-                std::vector<std::string>& failed, Handle(XSControl_WorkSession) & session) {
-  TopoDS_Shape shape;
-  if (step) {
-    STEPControl_Controller::Init();
-    surface::occt::set_static("xstep.cascade.unit", "MM");  // after Init (OCCT-NOTES)
-    STEPControl_Reader reader;
-    if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
-      throw Error(ErrorCategory::Exchange,
-                  "read_model: " + quoted(file) + " could not be parsed as a STEP file");
-    reader.TransferRoots();
-    shape = reader.OneShape();
-    failed = failed_entities(reader.WS());
-    session = reader.WS();
-  } else {
-    IGESControl_Controller::Init();
-    surface::occt::set_static("xstep.cascade.unit", "MM");
-    surface::occt::set_static("read.iges.bspline.continuity", 0);
-    IGESControl_Reader reader;
-    if (reader.ReadFile(file.string().c_str()) != IFSelect_RetDone)
-      throw Error(ErrorCategory::Exchange,
-                  "read_model: " + quoted(file) + " could not be parsed as an IGES file");
-    reader.TransferRoots();
-    shape = reader.OneShape();
-    failed = failed_entities(reader.WS());
-    session = reader.WS();
-  }
-  if (shape.IsNull()) return false;
-  XCAFDoc_DocumentTool::ShapeTool(document->Main())->AddShape(shape, false);
-  return true;
-}
 
 /// read_model's work; the caller holds the exchange session. `plain`: read_plain instead of
 /// the XCAF readers.
