@@ -11,11 +11,13 @@
 #include <clay/studio.hpp>
 
 #include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/websocket.hpp>
 #include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
@@ -60,6 +62,21 @@ std::optional<std::string> edit_key(const std::string& text) {
   return key;
 }
 
+/// True for the page's {"op": "cancel"}: answered by no reply of its own; the command it cancels
+/// answers {"op": "error", "category": "cancelled"}.
+bool is_cancel(const std::string& text) {
+  if (text.size() > 256) return false;
+  const Json c = [&] {
+    const internal::FpTrapsHeld traps_held;
+    return Json::parse(text, nullptr, false);
+  }();
+  return c.is_object() && c.size() == 1 && c.contains("op") && c.at("op") == "cancel";
+}
+
+/// How long a command runs before its progress lines go to the page, and how often they do.
+constexpr auto progress_after = std::chrono::milliseconds(500);
+constexpr auto progress_every = std::chrono::milliseconds(250);
+
 }  // namespace
 
 struct StudioServer::Impl {
@@ -79,6 +96,7 @@ struct StudioServer::Impl {
     std::string command;
     std::uint64_t page = 0;  // the page that sent it (its reply goes there, if it still holds it)
     std::optional<std::string> key;
+    std::uint64_t seq = 0;  // in the order received
   };
   std::mutex jobs_mutex;
   std::condition_variable jobs_wake;
@@ -87,6 +105,23 @@ struct StudioServer::Impl {
   std::thread worker;
   std::atomic<std::uint64_t> holder{0};  // the page that holds the socket (0: none)
   mutable std::mutex session_mutex;      // one command at a time on the session
+  // The page's Cancel: every command received before it (seq <= cancel_through) stops at its
+  // next check (clay/cancel.hpp) or is answered "cancelled" before it starts.
+  std::uint64_t last_seq = 0;  // under jobs_mutex
+  std::atomic<std::uint64_t> cancel_through{0};
+
+  // The running command's latest progress line (StudioSession::Progress), sent to its page by
+  // the I/O thread's timer once the command has run progress_after, each time it changes.
+  struct Running {
+    std::uint64_t page = 0;  // 0: nothing runs
+    std::chrono::steady_clock::time_point since;
+    std::string progress;
+    bool sent = true;
+  };
+  std::mutex running_mutex;
+  Running running;
+  std::optional<asio::steady_timer> progress_timer;
+  void watch_progress();
 
   explicit Impl(StudioSession s) : session(std::move(s)) {}
 
@@ -207,10 +242,16 @@ void StudioServer::Impl::take_over(const std::shared_ptr<Page>& newer) {
 }
 
 void StudioServer::Impl::submit(std::string command, std::uint64_t from) {
+  if (is_cancel(command)) {
+    std::lock_guard<std::mutex> lock(jobs_mutex);
+    cancel_through = last_seq;
+    return;
+  }
   Job job{std::move(command), from, std::nullopt};
   job.key = edit_key(job.command);
   {
     std::lock_guard<std::mutex> lock(jobs_mutex);
+    job.seq = ++last_seq;
     // A newer edit of a path replaces a waiting one in its place (a drag sends many; the kernel
     // answers the newest).
     bool replaced = false;
@@ -240,20 +281,60 @@ void StudioServer::Impl::work() {
     }
     if (job.page != holder) continue;  // its page is gone
     auto reply = std::make_shared<StudioSession::Reply>();
+    {
+      std::lock_guard<std::mutex> lock(running_mutex);
+      running = {job.page, std::chrono::steady_clock::now(), "", true};
+    }
     try {
-      std::lock_guard<std::mutex> lock(session_mutex);
-      *reply = session.handle(job.command,
-                              [this, from = job.page] { return stopping || holder != from; });
+      std::lock_guard<std::mutex> session_lock(session_mutex);
+      *reply = session.handle(
+          job.command,
+          [this, from = job.page, seq = job.seq] {
+            return stopping || holder != from || seq <= cancel_through;
+          },
+          [this](const std::string& line) {
+            std::lock_guard<std::mutex> progress_lock(running_mutex);
+            running.progress = line;
+            running.sent = false;
+          });
       if (idle_after) session.flush_autosave();  // a drag's updates have stopped
     } catch (const std::exception& e) {  // (handle answers everything; an autosave may fail)
       *reply = {Json{{"op", "error"}, {"category", "i/o"}, {"message", e.what()}}.dump(
                     -1, ' ', false, Json::error_handler_t::replace),
                 {}};
     }
+    {
+      std::lock_guard<std::mutex> lock(running_mutex);
+      running = {};
+    }
     asio::post(web->io(), [this, reply, from = job.page] {
       if (auto p = page.lock(); p && p->id == from) p->send(std::move(*reply));
     });
   }
+}
+
+void StudioServer::Impl::watch_progress() {
+  // On the I/O thread: a command running longer than progress_after has its newest progress
+  // line sent (once per change), so a long export or a slow step shows what it is doing. A
+  // line posted here is sent before the reply, which the worker posts after it finishes.
+  progress_timer->expires_after(progress_every);
+  progress_timer->async_wait([this](beast::error_code ec) {
+    if (ec || stopping) return;  // (a timer left waiting would keep run() from returning)
+    std::string line;
+    std::uint64_t to = 0;
+    {
+      std::lock_guard<std::mutex> lock(running_mutex);
+      if (running.page != 0 && !running.sent &&
+          std::chrono::steady_clock::now() - running.since >= progress_after) {
+        line = running.progress;
+        to = running.page;
+        running.sent = true;
+      }
+    }
+    if (!line.empty())
+      if (auto p = page.lock(); p && p->id == to) p->send({std::move(line), {}});
+    watch_progress();
+  });
 }
 
 StudioServer::StudioServer(StudioSession session, const StudioOptions& options)
@@ -301,6 +382,8 @@ void StudioServer::run() {
     s.worker_stop = false;
   }
   s.worker = std::thread([&s] { s.work(); });
+  s.progress_timer.emplace(s.web->io());
+  s.watch_progress();
   s.web->run();
   {
     std::lock_guard<std::mutex> lock(s.jobs_mutex);
@@ -325,6 +408,7 @@ void StudioServer::stop() {
   impl_->stopping = true;
   asio::post(impl_->web->io(), [s = impl_.get()] {
     if (auto p = s->page.lock()) p->close();
+    if (s->progress_timer) s->progress_timer->cancel();
   });
   impl_->web->stop();
   if (impl_->thread.joinable()) impl_->thread.join();

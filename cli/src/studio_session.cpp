@@ -3,6 +3,7 @@
 // UTF-8 JSON whatever the command held; files are written only inside the recipe's folder.
 #include "frames/frames.hpp"
 
+#include <clay/cancel.hpp>
 #include <clay/deform/receiver.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/fenv.hpp>
@@ -219,9 +220,6 @@ Json fit_reply(const Json& command) {
           {"converged", fit.summary.converged()}};
 }
 
-/// Raised inside a run whose command was cancelled (StudioSession::handle's `cancelled`).
-struct Cancelled {};
-
 }  // namespace
 
 struct StudioSession::Impl {
@@ -253,6 +251,28 @@ struct StudioSession::Impl {
 
   const std::string& text() const { return history[static_cast<std::size_t>(position)].text; }
 
+  // The command being handled, for its progress lines (handle() sets them).
+  struct Doing {
+    std::string op;
+    StudioSession::Progress progress;
+    std::chrono::steady_clock::time_point since;
+    int steps_done = 0;
+  };
+  mutable Doing doing;
+
+  /// Tells the progress callback what the command does now: {"op": "progress", "command",
+  /// "doing" (a step's path and kind, or a phase of an export), "steps_done", "seconds"}.
+  void tell(const std::string& what) const {
+    if (!doing.progress) return;
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - doing.since).count();
+    doing.progress(reply_text(Json{{"op", "progress"},
+                                   {"command", doing.op},
+                                   {"doing", what},
+                                   {"steps_done", doing.steps_done},
+                                   {"seconds", seconds}}));
+  }
+
   /// A run of the recipe text, and the surfaces a picture of it shows (final_surfaces). A
   /// cancelled command ends at the next step.
   struct Run {
@@ -269,10 +289,11 @@ struct StudioSession::Impl {
     RunOptions options;
     options.profile = profile;  // the export's receiver, for the deformed models
     options.cache = cache;
-    if (cancelled)
-      options.progress = [&](const StepReport&) {
-        if (cancelled()) throw Cancelled{};
-      };
+    // (A cancel stops the run inside its long steps too: handle() opened a CancelScope.)
+    options.progress = [this](const StepReport&) { ++doing.steps_done; };
+    options.starting = [this](const std::string& path, const std::string& kind) {
+      tell(path + " (" + kind + ")");
+    };
     if (changed && last_run) {
       options.previous = last_run;
       options.changed_deformations = *changed;
@@ -284,7 +305,7 @@ struct StudioSession::Impl {
       options.take_from_previous = false;
       options.preview = true;
     }
-    if (cancelled && cancelled()) throw Cancelled{};
+    if (cancelled && cancelled()) throw Cancelled{"the studio's command"};
     Run out{std::make_shared<RunResult>(run_recipe(recipe, options)), final_surfaces(recipe)};
     last_run = out.result;
     last_text = recipe_text;
@@ -581,9 +602,11 @@ struct StudioSession::Impl {
       e.formats = {"step", "iges", "glb"};
       e.surface_names = run.shown;
       e.profile = profile;
+      tell("fitting the surfaces for the receiver (" + profile + ")");
       conform_export(e, parse_recipe(text(), base_dir, name), *run.result);
       run.result->exports.push_back(std::move(e));
     }
+    tell("writing the files and reading them back");
     write_outputs(*run.result, folder);  // checks every file name it writes
     Json files = Json::array();
     bool valid = true, identical = true;
@@ -638,7 +661,8 @@ struct StudioSession::Impl {
     return names;
   }
 
-  Reply handle(const std::string& command, const Cancel& cancelled) {
+  Reply handle(const std::string& command, const Cancel& cancelled,
+               const StudioSession::Progress& progress) {
     // Read whole and bounded before parsing: nlohmann's parser recursed a command nested
     // 1,000,000 levels deep until the stack overflowed.
     if (command.size() > command_bytes)
@@ -667,6 +691,13 @@ struct StudioSession::Impl {
       throw Error(
           ErrorCategory::InvalidArgument,
           "studio: unknown op \"" + internal::clip_utf8(op, 40) + "\"; the ops: " + op_names());
+    // The command's long loops ask `cancelled` too (clay/cancel.hpp), not only its steps.
+    const CancelScope scope(cancelled);
+    doing = {op, progress, std::chrono::steady_clock::now(), 0};
+    struct Done {
+      Doing& d;
+      ~Done() { d = {}; }
+    } done{doing};
     return (this->*handler->reply)(c, cancelled);
   }
 };
@@ -783,15 +814,16 @@ std::size_t StudioSession::restore(const fs::path& file) {
 }
 
 StudioSession::Reply StudioSession::handle(const std::string& command,
-                                           const std::function<bool()>& cancelled) {
+                                           const std::function<bool()>& cancelled,
+                                           const Progress& progress) {
   // Nothing escapes: a command that throws anything is answered with an error and changes
   // nothing (an exception escaping a connection's handler ended the server, issue #36).
   try {
-    return impl_->handle(command, cancelled);
-  } catch (const Cancelled&) {
-    return error_reply("cancelled",
-                       "studio: the command was cancelled (a newer page took the session over, "
-                       "or the server is stopping); nothing changed");
+    return impl_->handle(command, cancelled, progress);
+  } catch (const Cancelled& c) {
+    return error_reply("cancelled", "studio: the command was cancelled in " + c.where +
+                                        " (the page's Cancel, a newer page taking the session "
+                                        "over, or the server stopping); nothing changed");
   } catch (const Error& e) {
     return error_reply(std::string(to_string(e.category())), recipe_wording(e.message()));
   } catch (const Json::parse_error& e) {

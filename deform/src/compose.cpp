@@ -1,5 +1,6 @@
 // Exact FFD composition (Sederberg–Parry 1986 §2.1): Bernstein products per Bézier patch of the
 // surface, patches joined into one B-spline surface, exact knot removal (The NURBS Book A5.8).
+#include <clay/cancel.hpp>
 #include <clay/deform/compose.hpp>
 
 #include <clay/error.hpp>
@@ -692,8 +693,10 @@ ComposeResult compose_exact(const BezierLattice& lattice, const BSplineSurface& 
     }
   detail::check_size(detail::predicted_size(surface, bp, degrees), options, too_high);
   std::vector<ComposedPatch> patches(static_cast<size_t>(np));
-  for (size_t k = 0; k < patches.size(); ++k)
+  for (size_t k = 0; k < patches.size(); ++k) {
+    throw_if_cancelled("an exact composition");
     patches[k] = compose_cell(lattice, monomials, factors[k], rational);
+  }
   return finish(
       bp, patches, rational, surface,
       [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); },
@@ -831,10 +834,12 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
       detail::predicted_size(surface, bp, degrees, planes, detail::lattice_continuity(lattice)),
       options, too_high);
   std::vector<ComposedPatch> patches(bp.patches.size());
-  for (size_t k = 0; k < patches.size(); ++k)
+  for (size_t k = 0; k < patches.size(); ++k) {
+    throw_if_cancelled("an exact composition");
     patches[k] = tensor_only
                      ? compose_patch(*cell_of[k], factors[k], rational)
                      : compose_cell(*cell_of[k], monomials_of.at(cell_of[k]), factors[k], rational);
+  }
   return finish(
       bp, patches, rational, split,
       [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); },

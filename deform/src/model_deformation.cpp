@@ -1,4 +1,5 @@
 // Deformation of whole B-rep models (see clay/deform/model_deformation.hpp).
+#include <clay/cancel.hpp>
 #include <clay/deform/model_deformation.hpp>
 
 #include <clay/deform/jacobian.hpp>
@@ -387,6 +388,7 @@ ModelDeformationResult deform_model(const DeformationStack& stack, const brep::M
     chosen[static_cast<std::size_t>(f)] = true;
   }
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
+    throw_if_cancelled("a model's deformation");
     brep::Face& face = m.faces[f];
     if (!chosen[f] || leaves.alone(face.surface.points)) {
       // Kept, unless a profile would not take it: an analytic face is written as such; a NURBS

@@ -6,6 +6,7 @@
 // Note for the lead: the other certificate, comparing control nets after splitting and
 // degree elevation to a common basis, needs the exact Bézier composition (compose.hpp, written in
 // parallel); it is not used here. This file has no Bernstein-product routine of its own.
+#include <clay/cancel.hpp>
 #include <clay/deform/refit.hpp>
 
 #include <clay/error.hpp>
@@ -499,6 +500,7 @@ RefitResult refit(const BSplineSurface& surface, const Certifier& d, const Refit
   int relocations = 0, moves_u = 0, moves_v = 0;
   std::vector<double> best_error_u, best_error_v;  // the best fit's error per span
   for (int iteration = 1;; ++iteration) {
+    throw_if_cancelled("a certified refit");
     const std::vector<double> us = fit_parameters(bu, intervals),
                               vs = fit_parameters(bv, intervals);
     Points3 values = surface::evaluate_grid(surface, us, vs);

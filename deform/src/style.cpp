@@ -241,6 +241,45 @@ Eigen::Vector3d normal_or_zero(const BSplineSurface& s, double u, double v) {
   return n / len;
 }
 
+// Mean curvature H = (E N - 2 F M + G L) / (2 (E G - F^2)) (The NURBS Book's fundamental forms;
+// sign along S_u x S_v); NaN where the surface is degenerate.
+double mean_curvature(const BSplineSurface& s, double u, double v) {
+  const auto d = surface::derivatives(s, u, v, 2);
+  const Eigen::Vector3d cross = d.du.cross(d.dv);
+  const double E = d.du.dot(d.du), F = d.du.dot(d.dv), G = d.dv.dot(d.dv);
+  const double det = E * G - F * F;
+  if (!(cross.norm() > 1e-12 * std::sqrt(E * G)) || !(det > 0))
+    return std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector3d normal = cross.normalized();
+  const double L = d.duu.dot(normal), M = d.duv.dot(normal), N = d.dvv.dot(normal);
+  return (E * N - 2 * F * M + G * L) / (2 * det);
+}
+
+// Turning points of a sequence: local extrema between swings of at least `swing` each way (a
+// hysteresis, so that rounding does not count); its ends are not turns.
+int turns(const std::vector<double>& values, double swing) {
+  if (values.size() < 3) return 0;
+  int dir = 0, count = 0;
+  double lo = values.front(), hi = lo, extreme = lo;
+  for (const double x : values) {
+    if (dir == 0) {
+      lo = std::min(lo, x);
+      hi = std::max(hi, x);
+      if (x - lo >= swing)
+        dir = 1, extreme = x;
+      else if (hi - x >= swing)
+        dir = -1, extreme = x;
+    } else if (dir * (x - extreme) > 0) {
+      extreme = x;
+    } else if (dir * (extreme - x) >= swing) {
+      ++count;
+      dir = -dir;
+      extreme = x;
+    }
+  }
+  return count;
+}
+
 // Whether a sample lies in the region: inside the bound polygon, or anywhere when the region was
 // made from the target itself.
 class RegionTest {
@@ -450,6 +489,7 @@ void measure(const BSplineSurface& parent, const BSplineSurface& result,
   report.target_curve_distance = nan;
   report.mean_curvature_min = nan;
   report.mean_curvature_max = nan;
+  report.curvature_waves = -1;
   report.boundary_position_jump = nan;
   report.boundary_tangent_angle = nan;
   if (!options.report_curves) return;
@@ -474,31 +514,33 @@ void measure(const BSplineSurface& parent, const BSplineSurface& result,
   }
 
   // Mean curvature H = (E N - 2 F M + G L) / (2 (E G - F^2)) of the result on a 41 x 41 grid over
-  // the region's box, at the points inside the region.
+  // the region's box, at the points inside the region; and its change from the parent's, whose
+  // waves along the grid's lines are the rings Zebra shows (curvature_waves).
   {
     constexpr int n = 41;
     const Eigen::AlignedBox2d box = region_box(parent, region);
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    Eigen::MatrixXd change = Eigen::MatrixXd::Constant(n, n, nan);  // ΔH, NaN outside
+    double largest_change = 0;
     for (int a = 0; a < n; ++a)
       for (int b = 0; b < n; ++b) {
         const Eigen::Vector2d uv =
             box.min() + Eigen::Vector2d(a, b).cwiseProduct(box.sizes()) / (n - 1);
         if (!inside(uv.x(), uv.y())) continue;
-        const auto d = surface::derivatives(result, uv.x(), uv.y(), 2);
-        const Eigen::Vector3d cross = d.du.cross(d.dv);
-        const double E = d.du.dot(d.du), F = d.du.dot(d.dv), G = d.dv.dot(d.dv);
-        const double det = E * G - F * F;
-        if (!(cross.norm() > 1e-12 * std::sqrt(E * G)) || !(det > 0)) continue;  // degenerate
-        const Eigen::Vector3d normal = cross.normalized();
-        const double L = d.duu.dot(normal), M = d.duv.dot(normal), N = d.dvv.dot(normal);
-        const double h = (E * N - 2 * F * M + G * L) / (2 * det);
+        const double h = mean_curvature(result, uv.x(), uv.y());
+        if (std::isnan(h)) continue;  // degenerate
         lo = std::min(lo, h);
         hi = std::max(hi, h);
+        const double h0 = mean_curvature(parent, uv.x(), uv.y());
+        if (std::isnan(h0)) continue;
+        change(a, b) = h - h0;
+        largest_change = std::max(largest_change, std::abs(h - h0));
       }
     if (lo <= hi) {
       report.mean_curvature_min = lo;
       report.mean_curvature_max = hi;
     }
+    report.curvature_waves = deform::grid_waves(change, 0.1 * largest_change);
   }
   report.target_curve_deviation = samples.empty() ? nan : 0.0;
   for (const TraceSample& t : samples) {
@@ -889,6 +931,29 @@ std::string StyleReport::brief() const {
        << " key points, " << moved_vertices << " vertices moved (largest " << max_displacement
        << " mm), target deviation " << target_deviation << " mm";
   return text.str();
+}
+
+int grid_waves(const Eigen::MatrixXd& grid, double swing) {
+  if (!(swing > 0)) return 0;
+  int most = 0;
+  std::vector<double> run;
+  auto line = [&](auto at, Eigen::Index length) {
+    run.clear();
+    for (Eigen::Index k = 0; k <= length; ++k) {
+      const double x = k < length ? at(k) : std::numeric_limits<double>::quiet_NaN();
+      if (!std::isnan(x)) {
+        run.push_back(x);
+        continue;
+      }
+      most = std::max(most, detail::turns(run, swing));
+      run.clear();
+    }
+  };
+  for (Eigen::Index a = 0; a < grid.rows(); ++a)
+    line([&](Eigen::Index k) { return grid(a, k); }, grid.cols());
+  for (Eigen::Index b = 0; b < grid.cols(); ++b)
+    line([&](Eigen::Index k) { return grid(k, b); }, grid.rows());
+  return most;
 }
 
 }  // namespace clay::deform

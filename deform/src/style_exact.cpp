@@ -12,6 +12,7 @@
 #include "fairness.hpp"
 #include "style_internal.hpp"
 
+#include <clay/cancel.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/checks.hpp>
 #include <clay/surface/basis.hpp>
@@ -747,6 +748,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   double amplification = 0;
 
   for (;;) {
+    throw_if_cancelled("an exact style");
     std::shared_ptr<const NetCache> net;
     if (cache)
       for (const auto& n : cache->nets)
@@ -760,6 +762,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       grown->nets.push_back(net);
       cache = std::move(grown);
     }
+    throw_if_cancelled("an exact style");  // a new net's factorization takes seconds on a fine net
     const auto& free_index = net->free_index;
     const auto& free_rows = net->free_rows;
     const Eigen::Index nf = static_cast<Eigen::Index>(free_rows.size());

@@ -105,6 +105,7 @@ py::dict style_report(const deform::StyleReport& r) {
   d["net_change"] = std::isnan(r.net_change) ? py::object(py::none()) : py::float_(r.net_change);
   d["mean_curvature_min"] = r.mean_curvature_min;
   d["mean_curvature_max"] = r.mean_curvature_max;
+  d["curvature_waves"] = r.curvature_waves;
   d["fairness_energy"] = r.fairness_energy;
   d["converged"] = r.summary.converged();
   d["message"] = r.message;

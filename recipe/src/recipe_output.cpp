@@ -2,6 +2,7 @@
 // written into a temporary folder and moved into place only when everything succeeded.
 #include "report_json.hpp"
 
+#include <clay/cancel.hpp>
 #include <clay/error.hpp>
 #include <clay/internal/files.hpp>
 #include <clay/occt/model_exchange.hpp>
@@ -205,6 +206,7 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
     for (auto& e : result.exports) {
       e.files.clear();
       for (const auto& format : e.formats) {
+        throw_if_cancelled("writing a recipe's files");  // (the staging folder is removed)
         const std::string file = e.name + (format == "step"   ? ".step"
                                            : format == "iges" ? ".igs"
                                                               : ".glb");
@@ -250,6 +252,7 @@ std::vector<fs::path> write_outputs(RunResult& result, const fs::path& out_dir) 
       }
     }
     for (auto& m : result.models) {
+      throw_if_cancelled("writing a recipe's files");
       std::vector<std::string> files;
       write_model_files(m, staging, m.name, files);
       m.files = files;

@@ -4,6 +4,7 @@
 #include "run_cache.hpp"
 
 #include <clay/brep/volume.hpp>
+#include <clay/cancel.hpp>
 #include <clay/constraints/solve.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/model_deformation.hpp>
@@ -92,6 +93,7 @@ class Runner {
     int degree = 0, refitted = 0;
     double worst = 0;
     for (const auto& n : x.surface_names) {
+      throw_if_cancelled("an export's receiver fits");
       double bound = bound_of(n);
       BSplineSurface s =
           profile.fit_degree == 0 && bound > 0 ? exact_reference(n, bound) : surface_of(n);
@@ -340,6 +342,9 @@ class Runner {
     rep.path = path;
     rep.kind = kind;
     const auto t0 = Clock::now();
+    // A cancel (clay/cancel.hpp) stops a run between steps as well as inside the long ones.
+    throw_if_cancelled("a recipe's steps");
+    if (options_.starting) options_.starting(path, kind);
     try {
       f(rep);
     } catch (const Error& e) {
@@ -845,12 +850,22 @@ class Runner {
 
   BSplineSurface apply(const StyleDef& d, const BSplineSurface& s, const Composition&,
                        StepReport& rep, Stage&) {
+    deform::StyleOptions o = d.options;
+    const bool first_net_only = options_.preview && o.net_convergence > 0;
+    if (first_net_only) {
+      // A drag update previews the style on its first net (tenths of a second where the
+      // convergence rounds take seconds); the release builds it again with them, since a
+      // previewed surface is never kept.
+      o.net_convergence = 0;
+      previewing_ = true;
+    }
     const auto r = d.bound.empty()
-                       ? deform::style_deform(s, curve_of(d.target), d.options)
-                       : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), d.options);
+                       ? deform::style_deform(s, curve_of(d.target), o)
+                       : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), o);
     const auto& x = r.report;
     style_figures(r, rep);
     rep.message += ": " + x.message;
+    if (first_net_only) rep.message += "; a drag's preview on the first net (converged on release)";
     rep.figures.emplace_back("outcome", std::string(x.summary.converged() ? "met" : "missed"));
     if (ledger_ > 0) {  // the style of a light input is not the style of its exact reference
       ledger_ = std::numeric_limits<double>::infinity();
@@ -867,6 +882,16 @@ class Runner {
                         "\"accept_out_of_tolerance\": true on this step");
       rep.warning = true;
       rep.message += "; accepted out of tolerance: " + x.summary.message;
+    }
+    if (x.curvature_waves > deform::curvature_waves_calm && !first_net_only) {
+      // Rings: not a tolerance missed (the target is met), but a shape the stylist should see.
+      rep.warning = true;
+      rep.message += "; rings: the change of mean curvature turns " +
+                     std::to_string(x.curvature_waves) +
+                     " times along one section of the region (a calm push: up to " +
+                     std::to_string(deform::curvature_waves_calm) +
+                     "); for calmer reflections set \"net_convergence\" (0.05 calmed the "
+                     "examples' styles) or \"mode\": \"paper\"";
     }
     return r.surface;
   }

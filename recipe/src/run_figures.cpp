@@ -55,6 +55,7 @@ void style_figures(const deform::StyleResult& r, StepReport& rep) {
                  {"target_curve_distance", x.target_curve_distance},
                  {"mean_curvature_min", x.mean_curvature_min},
                  {"mean_curvature_max", x.mean_curvature_max},
+                 {"curvature_waves", static_cast<long long>(x.curvature_waves)},
                  {"locality", x.locality},
                  {"boundary_position_jump", x.boundary_position_jump},
                  {"boundary_tangent_angle", x.boundary_tangent_angle},

@@ -1,3 +1,4 @@
+#include <clay/cancel.hpp>
 #include <clay/parallel.hpp>
 
 #include <exception>
@@ -11,8 +12,11 @@ void run_on_threads(std::size_t parts, const std::function<void(std::size_t part
   std::exception_ptr first;
   std::mutex guard;
   // A task that throws on a worker would otherwise end the process (std::thread calls terminate).
+  // The caller's cancel check goes with the work (clay/cancel.hpp): a thread of ours has none.
+  const std::function<bool()> check = current_cancel_check();
   auto run = [&](std::size_t part) {
     try {
+      const CancelScope scope(check);
       task(part);
     } catch (...) {
       const std::lock_guard lock(guard);

@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -231,4 +233,37 @@ TEST_CASE("studio session: a lattice drag previews in one product, the release c
   const RunResult whole = run_recipe(parse_recipe(session.text(), tank_file.parent_path(), "tank"));
   const auto certified = std::get<double>(*figure(step(whole, lattice_step), "max_deviation_mm"));
   CHECK(figures.at("max_deviation_mm").get<double>() == certified);
+}
+
+TEST_CASE("run_recipe: a style with net convergence previews on its first net, converges after",
+          "[recipe][reuse]") {
+  // The tank's exact style refined until a halving changes it by under 5 % (what the studio
+  // gives a new style): a drag update styles on the first net alone, the release converges.
+  const std::string style_step = "surfaces.styled.steps[0]";
+  Json doc = tank();
+  doc["deformations"]["spine"][0]["net_convergence"] = 0.05;
+  const auto first = std::make_shared<const RunResult>(run(doc));
+  const double converged = std::get<double>(*figure(step(*first, style_step), "net_change"));
+  CHECK(converged <= 0.05);
+  RunOptions o;
+  o.previous = first;
+  o.changed_deformations = {"spine"};
+  o.preview = true;
+  const RunResult preview = run(doc, o);
+  const StepReport& previewed = step(preview, style_step);
+  INFO(previewed.message);
+  CHECK(std::isnan(std::get<double>(*figure(previewed, "net_change"))));
+  CHECK(previewed.message.find("a drag's preview on the first net") != std::string::npos);
+  CHECK(std::find(preview.previewed.begin(), preview.previewed.end(), "styled") !=
+        preview.previewed.end());
+  // The preview is the style without convergence rounds, bit for bit.
+  Json coarse = tank();
+  coarse["deformations"]["spine"][0]["net_convergence"] = 0;
+  const RunResult plain = run(coarse);
+  CHECK(preview.surface("styled").points == plain.surface("styled").points);
+  CHECK(preview.surface("styled").u.knots == plain.surface("styled").u.knots);
+  // The release (no preview) is the converged style again, not a kept preview.
+  o.preview = false;
+  const RunResult released = run(doc, o);
+  CHECK(released.surface("styled").points == first->surface("styled").points);
 }

@@ -39,11 +39,13 @@ struct StudioClient {
     ws.read(buffer);
     return {ws.got_text(), boost::beast::buffers_to_string(buffer.data())};
   }
-  /// The next JSON reply (binary frames skipped).
+  /// The next JSON reply (binary frames and progress lines skipped).
   nlohmann::ordered_json reply() {
     while (true) {
       auto [text, bytes] = receive();
-      if (text) return nlohmann::ordered_json::parse(bytes);
+      if (!text) continue;
+      auto r = nlohmann::ordered_json::parse(bytes);
+      if (r.value("op", "") != "progress") return r;
     }
   }
 };

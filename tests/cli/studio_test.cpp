@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
+#include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -624,6 +625,69 @@ using Client = clay::test::StudioClient;
 
 }  // namespace
 
+TEST_CASE(
+    "studio session: progress names each step built, and a cancel changes nothing and keeps its steps",
+    "[studio]") {
+  const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio_cancel";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  StudioSession session(read(sail_file), dir, "sail");
+  std::vector<Json> lines;
+  const auto progress = [&](const std::string& line) { lines.push_back(Json::parse(line)); };
+  // Cancelled once two steps have started: it stops before the third, and says so.
+  const std::string before = session.text();
+  const Json cancelled = Json::parse(
+      session.handle(R"({"op": "run"})", [&] { return lines.size() >= 2; }, progress).json);
+  INFO(cancelled.dump());
+  CHECK(cancelled.at("op") == "error");
+  CHECK(cancelled.at("category") == "cancelled");
+  CHECK_THAT(cancelled.at("message").get<std::string>(), Contains("cancelled in a recipe's steps"));
+  REQUIRE(lines.size() == 2);
+  for (std::size_t k = 0; k < lines.size(); ++k) {
+    CHECK(lines[k].at("op") == "progress");
+    CHECK(lines[k].at("command") == "run");
+    CHECK(lines[k].at("steps_done") == k);
+    CHECK(lines[k].at("seconds").get<double>() >= 0);
+  }
+  CHECK(lines[0].at("doing") == "curves.luff (line)");
+  CHECK(lines[1].at("doing") == "curves.foot (bspline)");
+  CHECK(session.text() == before);
+  CHECK(session.history().size() == 1);
+  // Run whole: a line per step built, none for the two the cancelled run finished (the cache).
+  lines.clear();
+  const Json whole = Json::parse(session.handle(R"({"op": "run"})", {}, progress).json);
+  REQUIRE(whole.at("op") == "run");
+  std::size_t reused = 0;
+  for (const Json& step : whole.at("steps")) reused += step.value("reused", false) ? 1 : 0;
+  CHECK(reused == 2);
+  CHECK(lines.size() == whole.at("steps").size() - reused);
+  CHECK(lines.back().at("steps_done") == whole.at("steps").size() - 1);
+
+  // An export cancelled while it writes leaves no file behind; the next one writes them all.
+  lines.clear();
+  const auto writing = [&] {
+    return !lines.empty() && lines.back().at("doing") == "writing the files and reading them back";
+  };
+  const Json stopped = Json::parse(
+      session.handle(R"({"op": "export", "folder": "out", "name": "sail"})", writing, progress)
+          .json);
+  INFO(stopped.dump());
+  CHECK(stopped.at("category") == "cancelled");
+  CHECK_THAT(stopped.at("message").get<std::string>(), Contains("writing a recipe's files"));
+  std::vector<std::string> left;
+  if (fs::exists(dir / "out"))
+    for (const auto& entry : fs::recursive_directory_iterator(dir / "out"))
+      left.push_back(entry.path().string());
+  CHECK(left.empty());
+  lines.clear();
+  const Json exported = Json::parse(
+      session.handle(R"({"op": "export", "folder": "out", "name": "sail"})", {}, progress).json);
+  REQUIRE(exported.at("op") == "exported");
+  CHECK(exported.at("valid") == true);
+  CHECK(fs::exists(dir / "out" / "sail.step"));
+  CHECK(lines.back().at("doing") == "writing the files and reading them back");
+}
+
 TEST_CASE("studio server: its own page's origin talks, any other is refused", "[studio]") {
   StudioOptions options;
   options.port = 0;
@@ -687,6 +751,7 @@ TEST_CASE("studio server: a burst of edits of one path is answered for the newes
       continue;
     }
     const Json r = Json::parse(body);
+    if (r.at("op") == "progress") continue;  // (a loaded machine's edit may run half a second)
     if (r.at("op") == "hello") {
       CHECK(r.at("history").at("entries").size() == static_cast<std::size_t>(edits + 1));
       break;
@@ -705,6 +770,54 @@ TEST_CASE("studio server: a burst of edits of one path is answered for the newes
   const auto replay = run_recipe(parse_recipe(doc.dump(), sail_file.parent_path(), "sail"));
   CHECK(same(decode(std::vector<std::uint8_t>(last_net.begin(), last_net.end())),
              replay.surface("sail")));
+  client.ws.close(websocket::close_code::normal);
+  server.stop();
+}
+
+TEST_CASE("studio server: a long run sends its progress and stops at the page's cancel",
+          "[studio]") {
+  // The fender (46 s in a Release build) is still running when its first progress line comes.
+  const fs::path fender = fs::path(CLAY_EXAMPLES_DIR) / "recipes" / "fender.json";
+  StudioOptions options;
+  options.port = 0;
+  StudioServer server(StudioSession::load(fender), options);
+  server.start();
+  Client client(server.port(), "http://127.0.0.1:" + std::to_string(server.port()), server.token());
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  const auto sent = Clock::now();
+  client.send(R"({"op": "run"})");
+  auto next_text = [&] {
+    while (true) {
+      const auto [text, body] = client.receive();
+      if (text) return Json::parse(body);
+    }
+  };
+  const Json line = next_text();
+  const double first_line = since(sent);
+  INFO(line.dump() << " after " << first_line << " s");
+  REQUIRE(line.at("op") == "progress");
+  CHECK(line.at("command") == "run");
+  CHECK(first_line >= 0.5);  // a command under half a second sends none
+  CHECK_THAT(line.at("doing").get<std::string>(), Contains(" ("));
+  const auto cancel = Clock::now();
+  client.send(R"({"op": "cancel"})");
+  Json reply = next_text();
+  int lines_after = 0;
+  for (; reply.at("op") == "progress"; reply = next_text()) ++lines_after;
+  const double stopped = since(cancel);
+  INFO(reply.dump() << "; " << lines_after << " progress lines after the cancel; stopped after "
+                    << stopped << " s");
+  CHECK(reply.at("op") == "error");
+  CHECK(reply.at("category") == "cancelled");
+  CHECK(stopped < 60);  // (a sanitized build on a loaded 2-core machine: a step's longest loop)
+  // Nothing changed, and the server answers the next command.
+  client.send(R"({"op": "hello"})");
+  const Json hello = client.reply();
+  CHECK(hello.at("op") == "hello");
+  CHECK(hello.at("history").at("entries").size() == 1);
   client.ws.close(websocket::close_code::normal);
   server.stop();
 }

@@ -4,6 +4,7 @@
 // round trips compared bit for bit.
 #include <catch2/catch.hpp>
 
+#include <clay/cancel.hpp>
 #include <clay/deform.hpp>
 #include <clay/occt/surface_exchange.hpp>
 #include <clay/surface/evaluate.hpp>
@@ -151,6 +152,28 @@ TEST_CASE("compose_exact matches the pointwise Bezier FFD on random surfaces and
     }
   }
   CHECK(params >= 10000);
+}
+
+TEST_CASE("compose_exact stops between patches when its caller cancels, and composes after") {
+  std::mt19937 rng(40);
+  const Frame frame = clay::test::random_frame(rng, false);
+  const BezierLattice lattice = clay::test::displaced(make_bezier_lattice(frame, {2, 2, 1}), rng);
+  const BSplineSurface s = random_surface_in(frame, 2, 2, 6, 6, false, rng);  // 4 x 4 patches
+  int asked = 0;
+  {
+    const clay::CancelScope scope([&] { return ++asked == 3; });
+    try {
+      (void)compose_exact(lattice, s);
+      FAIL("compose_exact ran to its end");
+    } catch (const clay::Cancelled& c) {
+      CHECK(c.where == "an exact composition");
+    }
+  }
+  CHECK(asked == 3);  // asked once per patch: it stopped at the third of 16
+  // Nothing is left behind: the same composition runs whole afterwards, exact.
+  const ComposeResult r = compose_exact(lattice, s);
+  const auto map = [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); };
+  CHECK(deviation(s, r.surface, map, 200, rng) <= 1e-12 * clay::test::size_of(lattice.points));
 }
 
 TEST_CASE("compose_exact degrees follow the per-direction rule") {

@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "error_of.hpp"
 
@@ -719,6 +720,64 @@ TEST_CASE("exact mode: net convergence refines until the shape settles, and says
   const StyleResult stuck = style_deform(s, hood_bound(), hood_target(), options);
   CHECK_FALSE(stuck.report.summary.converged());
   CHECK(stuck.report.summary.message.find("net_convergence") != std::string::npos);
+}
+
+TEST_CASE("grid_waves counts the turns along a grid's rows and columns: sin of k periods, 2k",
+          "[style]") {
+  // sin(2 pi k x) on [0, 1] has 2k interior extrema, each a full swing of 1 or 2 from the last.
+  for (int k = 1; k <= 5; ++k) {
+    const int n = 200 * k + 1;
+    Eigen::MatrixXd rows(3, n);
+    for (int j = 0; j < n; ++j) rows.col(j).setConstant(std::sin(2 * M_PI * k * j / (n - 1.0)));
+    CHECK(grid_waves(rows, 0.5) == 2 * k);
+    CHECK(grid_waves(Eigen::MatrixXd(rows.transpose()), 0.5) == 2 * k);  // columns too
+    // Ripples below the swing do not count: 0.01 * sin(60 pi x) on top changes nothing.
+    Eigen::MatrixXd rippled = rows;
+    for (int j = 0; j < n; ++j)
+      rippled.col(j).array() += 0.01 * std::sin(60 * M_PI * j / (n - 1.0));
+    CHECK(grid_waves(rippled, 0.5) == 2 * k);
+  }
+  // The ripples alone (10 periods: 20 turns) count when the swing asked is smaller than theirs.
+  Eigen::MatrixXd ripples(1, 2001);
+  for (int j = 0; j < 2001; ++j) ripples(0, j) = 0.01 * std::sin(20 * M_PI * j / 2000.0);
+  CHECK(grid_waves(ripples, 0.005) == 20);
+  CHECK(grid_waves(ripples, 0.5) == 0);
+  // NaN cells (outside a region) cut a line into runs counted apart: two halves of sin(4 pi x)
+  // cut at its middle zero, each with 2 turns.
+  Eigen::MatrixXd cut(1, 401);
+  for (int j = 0; j < 401; ++j) cut(0, j) = std::sin(4 * M_PI * j / 400.0);
+  CHECK(grid_waves(cut, 0.5) == 4);
+  cut(0, 200) = std::numeric_limits<double>::quiet_NaN();
+  CHECK(grid_waves(cut, 0.5) == 2);
+  CHECK(grid_waves(cut, 0) == 0);  // no swing: nothing counted
+  CHECK(grid_waves(Eigen::MatrixXd::Zero(4, 4), 0.1) == 0);
+}
+
+TEST_CASE(
+    "curvature_waves: a push rings on its first net, calm once converged, unmeasured without "
+    "curves",
+    "[style]") {
+  const BSplineSurface s = hood(16, 16);
+  StyleOptions options;
+  options.mode = StyleMode::Exact;
+  // On its first net the push rings (the change of mean curvature turns 7 times along a section;
+  // Zebra shows beads along the bound); refined until a halving changes it by under 2 %, calm.
+  const StyleResult first = style_deform(s, hood_bound(), hood_target(), options);
+  options.net_convergence = 0.02;
+  const StyleResult r = style_deform(s, hood_bound(), hood_target(), options);
+  INFO(r.report.message << "; waves " << r.report.curvature_waves << ", on the first net "
+                        << first.report.curvature_waves);
+  CHECK(first.report.curvature_waves > curvature_waves_calm);
+  // A push changes the curvature (a crest at least); calm, it turns no more than a crest and its
+  // shoulders do.
+  CHECK(r.report.curvature_waves >= 1);
+  CHECK(r.report.curvature_waves <= curvature_waves_calm);
+  options.report_curves = false;
+  CHECK(style_deform(s, hood_bound(), hood_target(), options).report.curvature_waves == -1);
+  // Paper mode measures it too.
+  options.report_curves = true;
+  options.mode = StyleMode::Paper;
+  CHECK(style_deform(s, hood_bound(), hood_target(), options).report.curvature_waves >= 0);
 }
 
 TEST_CASE("exact mode with G2 at the bound: third-derivative energy, one more fixed layer",

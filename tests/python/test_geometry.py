@@ -137,3 +137,5 @@ def test_style_deform_exact_meets_the_target_line() -> None:
     miss = max(np.min(np.linalg.norm(dense - p, axis=1)) for p in samples)
     assert miss < 0.2  # sampled closest points at a 0.25 mm grid: the line lies on the surface
     assert report["target_curve_distance"] <= 1e-4 * 150
+    # The rings figure (docs/deform.md § Rings): a push changes the curvature, so it turns at least once.
+    assert isinstance(report["curvature_waves"], int) and report["curvature_waves"] >= 1

@@ -2,6 +2,7 @@
 // against closed forms.
 #include <catch2/catch.hpp>
 
+#include <clay/cancel.hpp>
 #include <clay/internal/checks.hpp>
 #include <clay/internal/math.hpp>
 #include <clay/internal/parallel.hpp>
@@ -10,7 +11,9 @@
 #include <atomic>
 #include <cfenv>
 #include <cmath>
+#include <exception>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -107,6 +110,63 @@ TEST_CASE("run_on_threads runs every part once and rethrows a task's exception a
                   std::runtime_error);
   CHECK(finished.load() == 4);
   CHECK_NOTHROW(run_on_threads(0, [](std::size_t) { throw std::runtime_error("never called"); }));
+}
+
+TEST_CASE("a CancelScope stops the loops that ask, on the threads the work is split over") {
+  // No scope: nothing cancels.
+  CHECK_NOTHROW(throw_if_cancelled("a loop"));
+  CHECK(!current_cancel_check());
+  std::atomic<int> asked{0};
+  {
+    const CancelScope scope([&] { return ++asked > 2; });
+    CHECK_NOTHROW(throw_if_cancelled("a loop"));
+    CHECK_NOTHROW(throw_if_cancelled("a loop"));
+    try {
+      throw_if_cancelled("the third round");
+      FAIL("not cancelled");
+    } catch (const Cancelled& c) {
+      CHECK(c.where == "the third round");
+    }
+    {
+      // The innermost scope decides; closing it gives the outer one back.
+      const CancelScope inner([] { return false; });
+      CHECK_NOTHROW(throw_if_cancelled("inner"));
+    }
+    CHECK_THROWS_AS(throw_if_cancelled("outer again"), Cancelled);
+  }
+  CHECK_NOTHROW(throw_if_cancelled("closed"));
+
+  // The work run_on_threads and run_parts split over threads carries the caller's check: every
+  // part stops, and the caller gets Cancelled (not a clay::Error: no fallback takes it).
+  std::atomic<bool> stop{false};
+  const CancelScope scope([&] { return stop.load(); });
+  std::atomic<int> finished{0};
+  run_on_threads(4, [&](std::size_t) {
+    throw_if_cancelled("part");
+    ++finished;
+  });
+  CHECK(finished.load() == 4);
+  stop = true;
+  CHECK_THROWS_AS(run_on_threads(4, [&](std::size_t) { throw_if_cancelled("part"); }), Cancelled);
+  const Executor pool = [](std::size_t parts, const std::function<void(std::size_t)>& task) {
+    // an embedder's pool: the parts on threads of its own
+    std::vector<std::thread> threads;
+    std::exception_ptr first;
+    std::mutex m;
+    for (std::size_t p = 0; p < parts; ++p)
+      threads.emplace_back([&, p] {
+        try {
+          task(p);
+        } catch (...) {
+          const std::lock_guard lock(m);
+          first = std::current_exception();
+        }
+      });
+    for (auto& t : threads) t.join();
+    if (first) std::rethrow_exception(first);
+  };
+  CHECK_THROWS_AS(internal::run_parts(3, pool, [](std::size_t) { throw_if_cancelled("part"); }),
+                  Cancelled);
 }
 
 TEST_CASE("run_parts hands the parts to a supplied executor, and runs one part inline") {

@@ -146,15 +146,18 @@ export async function openHarness(parts) {
 
   /**
    * Runs `fn(page, driver)` on a studio of its own: `clayform studio FILE` and a page open on it
-   * (its page errors counted as the test's), closed and stopped afterwards.
+   * (its page errors counted as the test's), closed and stopped afterwards. With `wait` false,
+   * fn starts as soon as the page is loaded, before its first run has been answered.
    */
-  async function withStudio(file, label, fn) {
+  async function withStudio(file, label, fn, { wait = true } = {}) {
     const studio = await startStudio(clayform, file);
     const other = await browser.newPage({ viewport: { width: 1100, height: 700 } });
     other.on('pageerror', (e) => problems.push(`page error (${label}): ${e.message}`));
+    other.on('crash', () => problems.push(`the page crashed (${label})`));
     const driver = studioPage(other);
     try {
-      await driver.open(studio.url);
+      if (wait) await driver.open(studio.url);
+      else await other.goto(studio.url);
       return await fn(other, driver);
     } finally {
       await other.close();

@@ -56,13 +56,20 @@ class StudioSession {
   ///   plain file name.
   /// A bad command gets {"op": "error", "category", "message"}: every field is read before
   /// anything changes, so the session is unchanged; nothing a command holds makes this throw,
-  /// and every reply is valid UTF-8. `cancelled`, when given, is asked between the run's steps;
-  /// true ends the command with {"op": "error", "category": "cancelled"} and changes nothing.
+  /// and every reply is valid UTF-8. `cancelled`, when given, is asked between the run's steps
+  /// and inside its long loops (clay/cancel.hpp: an exact composition's patches, a refit's
+  /// rounds, a model's faces, the files written); true ends the command with {"op": "error",
+  /// "category": "cancelled"} and changes nothing (no history entry, no file). `progress`, when
+  /// given, is called on the same thread with a JSON text {"op": "progress", "command",
+  /// "doing" (the step being built, "PATH (KIND)", or an export's phase), "steps_done",
+  /// "seconds" (since the command started)} each time the command starts something new.
   struct Reply {
     std::string json;
     std::vector<std::vector<std::uint8_t>> frames;
   };
-  Reply handle(const std::string& command, const std::function<bool()>& cancelled = {});
+  using Progress = std::function<void(const std::string& json)>;
+  Reply handle(const std::string& command, const std::function<bool()>& cancelled = {},
+               const Progress& progress = {});
 
   /// The largest command (bytes) and its deepest nesting of arrays and objects; beyond either a
   /// command is refused before it is parsed.
@@ -152,7 +159,11 @@ struct StudioOptions {
 /// One page at a time holds the WebSocket: the newest (a reload, another tab) takes it over at
 /// once, the older one is closed and a command it was running is cancelled at its next step.
 /// Commands that arrive while one is being handled are coalesced: of several "edit" commands on
-/// the same path only the newest is handled.
+/// the same path only the newest is handled. {"op": "cancel"} (no reply of its own) cancels
+/// every command received before it: the running one stops at its next check and answers
+/// {"op": "error", "category": "cancelled"}. A command running over half a second sends its
+/// progress lines (StudioSession::handle), each new one at most every quarter second, before
+/// its reply.
 class StudioServer {
  public:
   /// Binds the port (clay::Error(Io) when it cannot; InvalidArgument for a bad host, token or

@@ -23,3 +23,27 @@ export function formShown(steps) {
     })
     .join('; ');
 }
+
+/** The most curvature waves a calm style shows (deform::curvature_waves_calm; docs/deform.md § Rings). */
+export const calmWaves = 4;
+
+/**
+ * The Style panel's figures from a style step's report figures: how near the target, the join at
+ * the bound, the mean curvature inside the region, the net's convergence; and a warning when the
+ * result shows rings (its change of mean curvature turns more often than a calm push's along a
+ * section of the region: `curvature_waves`).
+ */
+export function styleSummary(f) {
+  const finite = (x) => typeof x === 'number' && Number.isFinite(x);
+  const lines = [];
+  if (finite(f.target_curve_distance)) lines.push(`target curve within ${f.target_curve_distance.toPrecision(2)} mm`);
+  if (finite(f.boundary_tangent_angle)) lines.push(`at the bound: ${f.boundary_position_jump.toPrecision(2)} mm, ${f.boundary_tangent_angle.toPrecision(2)}°`);
+  if (finite(f.mean_curvature_min)) lines.push(`mean curvature ${f.mean_curvature_min.toPrecision(2)} … ${f.mean_curvature_max.toPrecision(2)} /mm`);
+  if (finite(f.net_change)) lines.push(`net converged: last halving ${(100 * f.net_change).toPrecision(2)} %`);
+  if (finite(f.curvature_waves) && f.curvature_waves >= 0) lines.push(`curvature waves ${f.curvature_waves} (calm: up to ${calmWaves})`);
+  const rings = finite(f.curvature_waves) && f.curvature_waves > calmWaves;
+  return {
+    text: lines.join('\n'),
+    warning: rings ? `rings: the curvature turns ${f.curvature_waves} times across the region; try net convergence or paper mode, or a target farther from the bound` : '',
+  };
+}

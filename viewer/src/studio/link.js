@@ -99,6 +99,23 @@ export class Link {
     });
   }
 
+  /**
+   * The command in flight, for the progress line: {op, sentAt, progress (the kernel's last
+   * progress line for it, or null)}; null when nothing waits for an answer.
+   */
+  get running() {
+    const f = this.inFlight;
+    return f && { op: f.command.op, kind: f.command.kind, nets: f.command.nets, sentAt: f.sentAt, progress: f.progress || null };
+  }
+
+  /**
+   * Cancels the command in flight (docs/studio.md § Long jobs): the kernel stops it at its next
+   * check and answers it with an error of category "cancelled"; the message itself gets no reply.
+   */
+  cancel() {
+    if (this.inFlight) this.socket.send(JSON.stringify({ op: 'cancel' }));
+  }
+
   /** Drops the waiting drag update, if any (resolved with null). */
   cancelDrag() {
     if (this.pendingDrag) this.pendingDrag.resolve(null);
@@ -128,7 +145,13 @@ export class Link {
     const f = this.inFlight;
     if (!f) return; // nothing asked: ignore
     if (typeof data === 'string') {
-      f.reply = JSON.parse(data);
+      const text = JSON.parse(data);
+      if (text.op === 'progress') {
+        // what a command running over half a second is doing: not its reply
+        f.progress = text;
+        return;
+      }
+      f.reply = text;
       f.waiting = ['surfaces', 'curves', 'befores', 'deviations', 'models'].reduce((n, k) => n + (f.reply[k] ? f.reply[k].length : 0), 0);
       if (f.reply.op === 'error') f.waiting = 0;
     } else {

@@ -14,6 +14,13 @@ import { showPanels, showReport, showHistory } from './panels.js';
 const session = { restoredShown: false }; // the autosave's continuation said once
 
 function onReply(reply, frames, meta) {
+  if (reply.op === 'error' && reply.category === 'cancelled') {
+    // the stylist's own Cancel (or a newer page): not an error, nothing changed
+    showMessage(`cancelled: ${meta.command.op} stopped, nothing changed`, 'warning');
+    body.dataset.error = '';
+    body.dataset.cancelled = String(Number(body.dataset.cancelled || 0) + 1);
+    return;
+  }
   if (reply.op === 'error') {
     showMessage(`${reply.category}: ${reply.message}`, true);
     body.dataset.error = reply.message;
@@ -107,7 +114,7 @@ export async function start() {
     return;
   }
   const { reply } = await simple('run');
-  if (reply.op === 'error') showMessage(reply.message, true);
+  if (reply.op === 'error' && reply.category !== 'cancelled') showMessage(reply.message, true);
   $('run-title').textContent = `Clayform Studio — ${doc.recipe.name || reply.recipe || 'untitled'}`;
   $('save-name').value = `${doc.recipe.name || 'studio'}.json`;
   // a recipe with geometry is seen from the side, an empty one from the top (to sketch on XY)

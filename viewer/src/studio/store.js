@@ -39,6 +39,10 @@ export function connect(onReply, onClose) {
 export const busy = () => !!(connection.link && connection.link.busy);
 /** Sends a command; resolves with {reply, frames}. */
 export const send = (command, inputAt) => connection.link.send(command, inputAt);
+/** The command waiting for its answer ({op, sentAt, progress}), or null (Link.running). */
+export const running = () => (connection.link ? connection.link.running : null);
+/** Cancels the command waiting for its answer: it is answered "cancelled", nothing changed. */
+export const cancelRunning = () => connection.link && connection.link.cancel();
 /** Drops a drag update that waits to be sent. */
 export const cancelDrag = () => connection.link.cancelDrag();
 

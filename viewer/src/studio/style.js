@@ -6,6 +6,7 @@ import * as names from './recipe_edits.js';
 import { $, showMessage, setSlider, sliderGroup } from './ui.js';
 import { doc, selected, edit, dragEdit } from './store.js';
 import { select, targetSurface } from './select.js';
+import { styleSummary } from './forms.js';
 
 /** The style step's deformation of the selected surface, or null. */
 export function activeStyle() {
@@ -17,19 +18,38 @@ export function activeStyle() {
   return null;
 }
 
-/** The Style panel, for the selection. */
+/** The selected styled surface's style step report (its figures), or null. */
+function styleStep() {
+  for (const s of selected('surface')) {
+    const step = doc.steps.find((st) => st.kind === 'style' && st.path.startsWith(`surfaces.${s}.`));
+    if (step) return step;
+  }
+  return null;
+}
+
+/** The Style panel, for the selection: the step's settings and the kernel's figures. */
 export function showStylePanel() {
   const style = activeStyle();
   $('style-panel').hidden = !style;
-  if (style) {
-    const step = doc.recipe.deformations[style][0];
-    $('style-name').textContent = style;
-    $('style-mode').value = step.mode || 'paper';
-    setSlider('style-lambda', step.lambda ?? 1);
-    setSlider('style-kpr', step.key_points_per_row ?? 1);
-    $('style-relaxation').checked = step.relaxation ?? true;
-    $('style-smoothing').checked = step.smoothing ?? true;
-  }
+  if (!style) return;
+  const step = doc.recipe.deformations[style][0];
+  const exact = step.mode === 'exact';
+  $('style-name').textContent = style;
+  $('style-mode').value = step.mode || 'paper';
+  setSlider('style-lambda', step.lambda ?? 1);
+  setSlider('style-kpr', step.key_points_per_row ?? 1);
+  $('style-relaxation').checked = step.relaxation ?? true;
+  $('style-smoothing').checked = step.smoothing ?? true;
+  $('style-continuity').value = step.continuity || 'G1';
+  $('style-convergence').value = String(step.net_convergence ?? 0);
+  // the exact mode's settings; the paper's relaxation and smoothing
+  $('style-continuity').disabled = $('style-convergence').disabled = !exact;
+  $('style-relaxation').disabled = $('style-smoothing').disabled = exact;
+  const report = styleStep();
+  const summary = report ? styleSummary(report.figures) : { text: '', warning: '' };
+  $('style-figures').textContent = summary.text;
+  $('style-warning').textContent = summary.warning;
+  $('style-warning').hidden = !summary.warning;
 }
 
 /** The changes that make `stroke` the style's target under the live stroke's name (one history entry). */
@@ -79,4 +99,6 @@ export function wireStyle() {
   styleField('style-relaxation', 'relaxation', (e) => e.checked);
   styleField('style-smoothing', 'smoothing', (e) => e.checked);
   styleField('style-mode', 'mode', (e) => e.value);
+  styleField('style-continuity', 'continuity', (e) => e.value);
+  styleField('style-convergence', 'net_convergence', (e) => Number(e.value));
 }

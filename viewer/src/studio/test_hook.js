@@ -1,7 +1,7 @@
 // The window hook, for the end-to-end test and for scripting the page: the nets as the kernel sent
 // them, the camera, the handles, the latencies and frame times recorded, and a promise for
 // "everything answered".
-import { doc, state, metrics, busy } from './store.js';
+import { doc, state, metrics, busy, send } from './store.js';
 import { canvas, camera, renderPending, setView, toScreen, isOrthographic } from './scene.js';
 import { gridSpacing, gridNode, underlaySettings, spacingAt } from './drafting.js';
 import { previews } from './lattice_preview.js';
@@ -47,12 +47,25 @@ export function installTestHook() {
     }),
     gridNode,
     spacingAt,
+    /** The progress line of a long command: shown, its text, whether its Cancel was pressed. */
+    progress: () => ({
+      shown: !document.getElementById('progress').hidden,
+      text: document.getElementById('progress-text').textContent,
+      cancelling: document.getElementById('progress-cancel').disabled,
+    }),
+    /** The message line: its text and level (error, warning or news). */
+    message: () => {
+      const m = document.getElementById('message');
+      return { shown: !m.hidden, text: m.textContent.replace(/×$/, ''), level: m.classList.contains('error') ? 'error' : m.classList.contains('warning') ? 'warning' : 'news' };
+    },
     select: (items) => {
       state.selection = [];
       items.forEach((it) => select(it, true));
     },
     handles: () => handleList().map((h) => ({ kind: h.kind, name: h.name, index: h.index, p: h.p, screen: toScreen(h.p) })),
     metrics,
+    /** Sends a command to the kernel as the page does; resolves with {reply} (frames left out). */
+    send: (command) => send(command).then(({ reply }) => ({ reply })),
     resetMetrics: () => Object.keys(metrics).forEach((k) => (metrics[k].length = 0)),
     idle: () =>
       new Promise((resolve) => {

@@ -178,6 +178,18 @@ CLAY_DEFORM_API KeyPoints key_points(const surface::BSplineSurface& parent,
                                      const surface::BSplineCurve& target,
                                      const StyleOptions& options = {});
 
+/// The most curvature_waves a calm style has. A push is a crest and its two shoulders (3 turns
+/// of the change of mean curvature across it); measured on the examples' exact styles, calm
+/// results (Zebra) show 3-4, rings 5-7 (docs/deform.md, "Rings").
+inline constexpr int curvature_waves_calm = 4;
+
+/// The most turning points along one row or one column of `grid`: local extrema between swings of
+/// at least `swing` each way (a hysteresis, so that noise below it does not count); the ends of a
+/// line are not turns, and NaN cells break a line into runs counted apart. 0 when `swing` is not
+/// positive. StyleReport::curvature_waves is this of the change of mean curvature sampled over the
+/// region, with swing a tenth of its largest magnitude.
+CLAY_DEFORM_API int grid_waves(const Eigen::MatrixXd& grid, double swing);
+
 /// What a style deformation did and how well (DESIGN.md quality figures). Lengths in mm.
 struct CLAY_DEFORM_API StyleReport {
   StyleMode mode = StyleMode::Paper;
@@ -213,8 +225,14 @@ struct CLAY_DEFORM_API StyleReport {
   double mean_curvature_min = 0;     ///< smallest mean curvature of the result inside the region
                                      ///< (1/mm, sign along the surface normal)
   double mean_curvature_max = 0;     ///< largest mean curvature of the result inside the region
-  double model_size = 0;             ///< diagonal of the parent's control box
-  std::string message;               ///< what happened, in words
+  /// Rings (issue #40 item 8): the most turns (local extrema, each swing at least a tenth of the
+  /// largest |ΔH|) of the change of mean curvature ΔH = H(result) − H(parent) along one line of
+  /// the 41 × 41 grid over the region, rows and columns. A calm push across a target has up to
+  /// 3 (the two shoulders and the crest); more are waves the target did not ask for, what Zebra
+  /// shows as rings (curvature_waves_calm). −1 when not measured (report_curves off).
+  int curvature_waves = -1;
+  double model_size = 0;  ///< diagonal of the parent's control box
+  std::string message;    ///< what happened, in words
   /// Whether the step did what it was asked (judge_style): Converged; NotConverged when the
   /// target is missed (exact mode: a key point beyond tolerance x size, the target curve beyond
   /// curve_tolerance x size, key points that cannot be met) or a control vertex moves more than

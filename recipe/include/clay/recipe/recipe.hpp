@@ -128,6 +128,9 @@ struct RunResult;
 struct RunOptions {
   /// Called after each step (progress lines); may be empty.
   std::function<void(const StepReport&)> progress;
+  /// Called before each step that is built (not one taken from `cache` or `previous`), with its
+  /// path and kind: what a long run is doing now (the studio's progress line); may be empty.
+  std::function<void(const std::string& path, const std::string& kind)> starting;
   /// Non-empty: every export and every deformed model is written for this receiver profile
   /// (deform::receiver_profile: "exact", "opencascade", "catia", "class_a", "bicubic") instead
   /// of its own.

@@ -1,6 +1,7 @@
 #pragma once
 // Splitting bulk work into parts and running them on an Executor (internal, not installed). The
 // one place where the kernel decides how many threads a call uses.
+#include <clay/cancel.hpp>
 #include <clay/parallel.hpp>
 
 #include <algorithm>
@@ -26,11 +27,15 @@ void run_parts(std::size_t parts, const Executor& executor, const Work& work) {
     if (parts == 1) work(std::size_t{0});
     return;
   }
-  const std::function<void(std::size_t)> task = [&work](std::size_t part) { work(part); };
-  if (executor)
-    executor(parts, task);
-  else
-    run_on_threads(parts, task);
+  if (executor) {
+    // An embedder's pool runs the parts on its threads: the caller's cancel check goes along.
+    executor(parts, [&work, check = current_cancel_check()](std::size_t part) {
+      const CancelScope scope(check);
+      work(part);
+    });
+    return;
+  }
+  run_on_threads(parts, [&work](std::size_t part) { work(part); });  // carries the check itself
 }
 
 }  // namespace clay::internal
