@@ -859,13 +859,21 @@ class Runner {
       o.net_convergence = 0;
       previewing_ = true;
     }
-    const auto r = d.bound.empty()
+    // A drag update of the target (a preview, with a cache to keep it in) goes to a kept
+    // StyleEditor: the region, the projector and the exact nets' factorizations are made once
+    // per drag, not per update. Previewed, so the release styles once more from scratch.
+    const bool from_editor = options_.preview && options_.cache && !d.bound.empty();
+    if (from_editor) previewing_ = true;
+    const auto r = from_editor ? CacheAccess::style_editor(*options_.cache, s, curve_of(d.bound), o)
+                                     ->update(curve_of(d.target))
+                   : d.bound.empty()
                        ? deform::style_deform(s, curve_of(d.target), o)
                        : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), o);
     const auto& x = r.report;
     style_figures(r, rep);
     rep.message += ": " + x.message;
     if (first_net_only) rep.message += "; a drag's preview on the first net (converged on release)";
+    if (from_editor) rep.message += "; a drag's preview from the kept style editor";
     rep.figures.emplace_back("outcome", std::string(x.summary.converged() ? "met" : "missed"));
     if (ledger_ > 0) {  // the style of a light input is not the style of its exact reference
       ledger_ = std::numeric_limits<double>::infinity();

@@ -23,6 +23,15 @@ struct RunCache::Impl {
   std::unordered_map<std::string, Slot> slots;
   std::list<std::string> order;  // most recently used first
   Counts counts;
+  // Style editors for drag previews, most recent first (CacheAccess::style_editor); a few
+  // only: each holds its exact nets' factorizations.
+  struct Editor {
+    surface::BSplineCurve bound;
+    deform::StyleOptions options;
+    std::shared_ptr<deform::StyleEditor> editor;
+  };
+  std::list<Editor> editors;
+  static constexpr std::size_t max_editors = 4;
 };
 
 RunCache::RunCache(std::size_t capacity_bytes) : impl_(std::make_unique<Impl>(capacity_bytes)) {}
@@ -37,6 +46,7 @@ void RunCache::clear() {
   const std::lock_guard<std::mutex> lock(impl_->mutex);
   impl_->slots.clear();
   impl_->order.clear();
+  impl_->editors.clear();
   impl_->counts = {};
 }
 
@@ -168,6 +178,24 @@ void CacheAccess::keep(RunCache& cache, const std::string& key, CacheEntry entry
   c.counts.bytes += bytes;
   ++c.counts.kept;
   ++c.counts.entries;
+}
+
+std::shared_ptr<deform::StyleEditor> CacheAccess::style_editor(
+    RunCache& cache, const surface::BSplineSurface& parent, const surface::BSplineCurve& bound,
+    const deform::StyleOptions& options) {
+  RunCache::Impl& c = *cache.impl_;
+  const std::lock_guard<std::mutex> lock(c.mutex);
+  for (auto it = c.editors.begin(); it != c.editors.end(); ++it)
+    if (it->options == options && surface::identical(it->bound, bound) &&
+        surface::identical(it->editor->parent(), parent)) {
+      c.editors.splice(c.editors.begin(), c.editors, it);  // the most recent
+      return c.editors.front().editor;
+    }
+  auto editor = std::make_shared<deform::StyleEditor>(
+      parent, deform::influence_factors(parent, bound, options), options);
+  c.editors.push_front({bound, options, editor});
+  if (c.editors.size() > RunCache::Impl::max_editors) c.editors.pop_back();
+  return editor;
 }
 
 }  // namespace detail

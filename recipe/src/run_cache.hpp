@@ -5,6 +5,8 @@
 
 #include "recipe_model.hpp"
 
+#include <clay/deform/style.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
@@ -70,6 +72,13 @@ class CacheAccess {
   /// Keeps `entry` under `key`, dropping the least recently used entries beyond the capacity;
   /// an entry larger than the whole capacity is not kept.
   static void keep(RunCache& cache, const std::string& key, CacheEntry entry);
+  /// A style editor of `parent` inside `bound` with `options` (deform::StyleEditor: its region,
+  /// projector and exact factorizations made once), kept for a style's drag previews; the most
+  /// recent few are kept, one per parent, bound and settings, each compared bit for bit.
+  static std::shared_ptr<deform::StyleEditor> style_editor(RunCache& cache,
+                                                           const surface::BSplineSurface& parent,
+                                                           const surface::BSplineCurve& bound,
+                                                           const deform::StyleOptions& options);
 };
 
 }  // namespace clay::recipe::detail

@@ -267,3 +267,55 @@ TEST_CASE("run_recipe: a style with net convergence previews on its first net, c
   const RunResult released = run(doc, o);
   CHECK(released.surface("styled").points == first->surface("styled").points);
 }
+
+TEST_CASE("run_recipe: a style target drag previews from a kept StyleEditor, the release restyles",
+          "[recipe][reuse]") {
+  // The tank with its target a B-spline curve whose middle control point is dragged, run as the
+  // studio session runs a drag update (a preview with the last run and the session's cache).
+  Json doc = tank();
+  const RunResult plain = run(doc);
+  const surface::BSplineCurve& spine = plain.curve("spine");
+  Json points = Json::array();
+  for (Eigen::Index k = 0; k < spine.points.rows(); ++k)
+    points.push_back({spine.points(k, 0), spine.points(k, 1), spine.points(k, 2)});
+  doc["strokes"].erase("spine");
+  doc["curves"]["spine"] = {
+      {"bspline",
+       {{"degree", spine.basis.degree}, {"knots", spine.basis.knots}, {"points", points}}}};
+  const auto middle = static_cast<std::size_t>(spine.points.rows() / 2);
+  auto moved = [&](double lift) {
+    Json d = doc;
+    d["curves"]["spine"]["bspline"]["points"][middle][2] =
+        spine.points(static_cast<Eigen::Index>(middle), 2) + lift;
+    return d;
+  };
+  const std::string style_step = "surfaces.styled.steps[0]";
+  const surface::BSplineSurface& panel = plain.surface("panel");
+  const double size =
+      (panel.points.colwise().maxCoeff() - panel.points.colwise().minCoeff()).norm();
+  RunOptions o;
+  o.cache = std::make_shared<RunCache>();
+  o.previous = std::make_shared<const RunResult>(run(doc, o));
+  o.take_from_previous = false;
+  o.preview = true;
+  for (double lift : {2.0, 4.0, 6.0}) {
+    const RunResult preview = run(moved(lift), o);
+    INFO(step(preview, style_step).message);
+    CHECK(step(preview, style_step).message.find("from the kept style editor") !=
+          std::string::npos);
+    CHECK(std::find(preview.previewed.begin(), preview.previewed.end(), "styled") !=
+          preview.previewed.end());
+    // Against the one-off style of the same target, run whole: within the style's curve
+    // tolerance (the editor's warm-started projections may place added key points otherwise).
+    const RunResult once = run(moved(lift));
+    REQUIRE(preview.surface("styled").points.rows() == once.surface("styled").points.rows());
+    CHECK(
+        (preview.surface("styled").points - once.surface("styled").points).cwiseAbs().maxCoeff() <=
+        1e-4 * size);
+  }
+  // The release styles from scratch: the whole run of the recipe it leaves, bit for bit.
+  o.preview = false;
+  const RunResult released = run(moved(6), o);
+  CHECK(step(released, style_step).message.find("kept style editor") == std::string::npos);
+  CHECK(released.surface("styled").points == run(moved(6)).surface("styled").points);
+}

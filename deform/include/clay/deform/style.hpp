@@ -104,6 +104,8 @@ struct CLAY_DEFORM_API StyleOptions {
   std::vector<std::string> problems() const;
   /// Throws clay::Error(InvalidArgument) listing problems(), if any.
   void validate() const;
+  /// Field by field (a kept StyleEditor serves only the settings it was made with).
+  bool operator==(const StyleOptions&) const = default;
 };
 
 /// Influence factors E(Q_ij) of every control vertex (Han et al. eq. 2) and where they came from.

@@ -27,6 +27,9 @@ struct CLAY_SURFACE_API ProjectionOptions {
   int samples_per_span = 4;         ///< closest_point: start grid density per knot span, >= 1
   int starts = 4;                   ///< closest_point: Newton runs from the best grid samples, >= 1
 
+  /// Field by field (the recipe's cache of style editors compares settings).
+  bool operator==(const ProjectionOptions&) const = default;
+
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
   /// Throws clay::Error(InvalidArgument) listing problems(), if any.
