@@ -863,7 +863,10 @@ class Runner {
     // StyleEditor: the region, the projector and the exact nets' factorizations are made once
     // per drag, not per update. Previewed, so the release styles once more from scratch.
     const bool from_editor = options_.preview && options_.cache && !d.bound.empty();
-    if (from_editor) previewing_ = true;
+    if (from_editor) {
+      previewing_ = true;
+      o.report_curves = false;  // the sampled figures (global closest points) wait for the release
+    }
     const auto r = from_editor ? CacheAccess::style_editor(*options_.cache, s, curve_of(d.bound), o)
                                      ->update(curve_of(d.target))
                    : d.bound.empty()
