@@ -9,6 +9,7 @@
 //   constraints  constraints, 3D strokes, revolve, picked planes (studio_constraints.mjs)
 //   drafting     the grid snapped to, the pointer's coordinates, ortho and back views, an underlay (studio_drafting.mjs)
 //   jobs         a long run's progress line and its Cancel (studio_jobs.mjs)
+//   design       40 strokes drawn as a hand draws, a fill, a constraint, a style, a lattice (studio_design.mjs)
 // Geometry is checked here, not by the page (geometry.mjs). Latencies and frame times come from
 // the page's window.clayStudio hook and are reported (not asserted: they depend on the machine).
 //
@@ -21,8 +22,9 @@ import corners from './studio_corners.mjs';
 import constraints from './studio_constraints.mjs';
 import drafting from './studio_drafting.mjs';
 import jobs from './studio_jobs.mjs';
+import design from './studio_design.mjs';
 
-const parts = { drawing, model, regular, corners, constraints, drafting, jobs };
+const parts = { drawing, model, regular, corners, constraints, drafting, jobs, design };
 const h = await openHarness(Object.keys(parts));
 try {
   for (const [name, run] of Object.entries(parts)) if (h.wants(name)) await run(h);
