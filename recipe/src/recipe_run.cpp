@@ -850,34 +850,9 @@ class Runner {
 
   BSplineSurface apply(const StyleDef& d, const BSplineSurface& s, const Composition&,
                        StepReport& rep, Stage&) {
-    deform::StyleOptions o = d.options;
-    const bool first_net_only = options_.preview && o.net_convergence > 0;
-    if (first_net_only) {
-      // A drag update previews the style on its first net (tenths of a second where the
-      // convergence rounds take seconds); the release builds it again with them, since a
-      // previewed surface is never kept.
-      o.net_convergence = 0;
-      previewing_ = true;
-    }
-    // A drag update of the target (a preview, with a cache to keep it in) goes to a kept
-    // StyleEditor: the region, the projector and the exact nets' factorizations are made once
-    // per drag, not per update. Previewed, so the release styles once more from scratch.
-    const bool from_editor = options_.preview && options_.cache && !d.bound.empty();
-    if (from_editor) {
-      previewing_ = true;
-      o.report_curves = false;  // the sampled figures (global closest points) wait for the release
-    }
-    const auto r = from_editor ? CacheAccess::style_editor(*options_.cache, s, curve_of(d.bound), o)
-                                     ->update(curve_of(d.target))
-                   : d.bound.empty()
-                       ? deform::style_deform(s, curve_of(d.target), o)
-                       : deform::style_deform(s, curve_of(d.bound), curve_of(d.target), o);
-    const auto& x = r.report;
-    style_figures(r, rep);
-    rep.message += ": " + x.message;
-    if (first_net_only) rep.message += "; a drag's preview on the first net (converged on release)";
-    if (from_editor) rep.message += "; a drag's preview from the kept style editor";
-    rep.figures.emplace_back("outcome", std::string(x.summary.converged() ? "met" : "missed"));
+    StyleStep out = style_step(d, s, d.bound.empty() ? nullptr : &curve_of(d.bound),
+                               curve_of(d.target), options_, rep);
+    if (out.previewed) previewing_ = true;
     if (ledger_ > 0) {  // the style of a light input is not the style of its exact reference
       ledger_ = std::numeric_limits<double>::infinity();
       ledger_figure(rep);
@@ -885,26 +860,7 @@ class Runner {
           "; its input is a light form, so its distance from the exact reference is "
           "not bounded";
     }
-    if (!x.summary.converged()) {
-      if (!d.accept_out_of_tolerance)
-        throw Error(ErrorCategory::ToleranceNotMet,
-                    x.summary.message +
-                        ". Nothing was written; to keep such a result anyway, set "
-                        "\"accept_out_of_tolerance\": true on this step");
-      rep.warning = true;
-      rep.message += "; accepted out of tolerance: " + x.summary.message;
-    }
-    if (x.curvature_waves > deform::curvature_waves_calm && !first_net_only) {
-      // Rings: not a tolerance missed (the target is met), but a shape the stylist should see.
-      rep.warning = true;
-      rep.message += "; rings: the change of mean curvature turns " +
-                     std::to_string(x.curvature_waves) +
-                     " times along one section of the region (a calm push: up to " +
-                     std::to_string(deform::curvature_waves_calm) +
-                     "); for calmer reflections set \"net_convergence\" (0.05 calmed the "
-                     "examples' styles) or \"mode\": \"paper\"";
-    }
-    return r.surface;
+    return std::move(out.surface);
   }
 
   BSplineSurface apply(const DirectDef& d, const BSplineSurface& s, const Composition& c,

@@ -65,6 +65,19 @@ std::string light_reason(const deform::StepOutcome& o, const Composition& c);
 /// curvature, boundary figures and sizes.
 void style_figures(const deform::StyleResult& r, StepReport& rep);
 
+/// A style step as a run makes it (run_style.cpp): the style of `parent` toward `target` inside
+/// `bound` (null: the target's support band), its figures, message and warnings in `rep`. A drag
+/// update (options.preview) styles on the first net, and with a bound and options.cache from a
+/// StyleEditor kept there without the sampled figures; `previewed` then says the release must
+/// style again. Throws ToleranceNotMet when the target is missed and the step does not accept it.
+struct StyleStep {
+  surface::BSplineSurface surface;
+  bool previewed = false;
+};
+StyleStep style_step(const StyleDef& d, const surface::BSplineSurface& parent,
+                     const surface::BSplineCurve* bound, const surface::BSplineCurve& target,
+                     const RunOptions& options, StepReport& rep);
+
 /// The composition's settings as deform_surface's (the Runner and deform_model use them).
 deform::SurfaceDeformationOptions deformation_options(const Composition& c);
 /// A refit of a composition without a budget: its degree, tolerance and max_control_points,
