@@ -626,7 +626,8 @@ using Client = clay::test::StudioClient;
 }  // namespace
 
 TEST_CASE(
-    "studio session: progress names each step built, and a cancel changes nothing and keeps its steps",
+    "studio session: progress names each step built, and a cancel changes nothing and keeps its "
+    "steps",
     "[studio]") {
   const fs::path dir = fs::path(CLAY_TEST_OUTPUT_DIR) / "studio_cancel";
   fs::remove_all(dir);
