@@ -18,6 +18,8 @@
 #include <memory>
 #include <sstream>
 
+#include "bspline_target.hpp"
+
 using namespace clay::recipe;
 namespace fs = std::filesystem;
 namespace surface = clay::surface;
@@ -275,13 +277,7 @@ TEST_CASE("run_recipe: a style target drag previews from a kept StyleEditor, the
   Json doc = tank();
   const RunResult plain = run(doc);
   const surface::BSplineCurve& spine = plain.curve("spine");
-  Json points = Json::array();
-  for (Eigen::Index k = 0; k < spine.points.rows(); ++k)
-    points.push_back({spine.points(k, 0), spine.points(k, 1), spine.points(k, 2)});
-  doc["strokes"].erase("spine");
-  doc["curves"]["spine"] = {
-      {"bspline",
-       {{"degree", spine.basis.degree}, {"knots", spine.basis.knots}, {"points", points}}}};
+  doc = with_bspline_curve(doc, "spine", spine);
   const auto middle = static_cast<std::size_t>(spine.points.rows() / 2);
   auto moved = [&](double lift) {
     Json d = doc;

@@ -20,6 +20,8 @@
 #include <sstream>
 #include <string>
 
+#include "bspline_target.hpp"
+
 using namespace clay::recipe;
 namespace fs = std::filesystem;
 namespace surface = clay::surface;
@@ -285,13 +287,7 @@ TEST_CASE(
   Json doc = tank();
   const RunResult first = run(doc);
   const surface::BSplineCurve& spine = first.curve("spine");
-  Json points = Json::array();
-  for (Eigen::Index k = 0; k < spine.points.rows(); ++k)
-    points.push_back({spine.points(k, 0), spine.points(k, 1), spine.points(k, 2)});
-  doc["strokes"].erase("spine");
-  doc["curves"]["spine"] = {
-      {"bspline",
-       {{"degree", spine.basis.degree}, {"knots", spine.basis.knots}, {"points", points}}}};
+  doc = with_bspline_curve(doc, "spine", spine);
   StudioSession session(doc.dump(), tank_file.parent_path(), "tank");
   REQUIRE(Json::parse(session.handle(R"({"op": "run"})").json).at("op") == "run");
   const Eigen::Index middle = spine.points.rows() / 2;
