@@ -8,6 +8,7 @@
 
 #include <vector>
 
+#include <STEPControl_Writer.hxx>
 #include <TDocStd_Document.hxx>
 #include <TopoDS_Edge.hxx>
 #include <TopoDS_Face.hxx>
@@ -31,6 +32,12 @@ Shapes build_shapes(const Model& m);
 
 /// Fills an XCAF document with the shapes, the names, colours and the assembly tree.
 void fill_document(const Model& m, const Shapes& s, const Handle(TDocStd_Document) & document);
+
+/// After `writer` has translated the shapes: a face's loop that is only its seam (and poles),
+/// beside other loops, is written as the seam's EDGE_LOOP instead of OpenCASCADE's VERTEX_LOOP,
+/// which its reader drops when the face has other bounds (model_write_seams.cpp). Throws
+/// clay::Error(Exchange) naming the face when it cannot.
+void write_seam_loops(const Model& m, const Shapes& s, STEPControl_Writer& writer);
 
 /// Meshes the shapes (tessellate()'s mesh) and writes the document as a binary glTF, atomically.
 void write_glb(const Model& m, const Shapes& shapes, const std::filesystem::path& file,

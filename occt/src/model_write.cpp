@@ -482,6 +482,7 @@ ModelCheck write_model(const Model& model, const fs::path& file, const ModelWrit
       if (!writer.Transfer(document, STEPControl_AsIs))
         throw Error(ErrorCategory::Exchange,
                     "write_model: OpenCASCADE's STEP translator refused the model");
+      write_seam_loops(m, shapes, writer.ChangeWriter());
       Handle(StepData_StepModel) step_model = writer.ChangeWriter().Model();
       // Closed flags off: OpenCASCADE's reader makes a surface or curve it is told is closed
       // periodic, merging its first and last rows of poles, which then differ from ours in
