@@ -229,7 +229,13 @@ struct StudioSession::Impl {
     std::string label;
     std::string text;   // the recipe text
     std::string group;  // the "group" of the edits it holds ("" none)
+    /// The edit's changes that make `text` from the entry before it (a group's, in order), or
+    /// null: the autosave writes these instead of the text, so its size follows the edits, not
+    /// the number of entries times the recipe (issue #40).
+    Json changes = nullptr;
   };
+  /// A group's changes past which its entry is autosaved as its text again.
+  static constexpr std::size_t group_changes_kept = 256;
   std::vector<Entry> history;
   int position = 0;
   std::size_t dropped = 0;  // oldest entries dropped to keep the history within history_limit
@@ -237,9 +243,15 @@ struct StudioSession::Impl {
   /// Per model, the topology key of the mesh last sent (topology_key): while it holds, runs send
   /// the model's nets only. "hello" and "run" (what a new page sends first) forget them.
   mutable std::map<std::string, std::uint64_t> meshed;
+  /// Per frame ("net NAME", "before NAME", "curve NAME"; "deviation NAME" keyed by the two nets
+  /// it is made from), the frame_key last sent: a run's reply sends only what changed and names
+  /// the rest under "kept", so a stroke's reply stays the size of the stroke however many
+  /// surfaces, styles and curves the page shows (issue #40). Forgotten with `meshed`.
+  mutable std::map<std::string, std::uint64_t> sent;
   // The last run and the recipe text it ran: what the next edit of deformations alone reuses.
   mutable std::shared_ptr<const RunResult> last_run;
   mutable std::string last_text;
+  mutable std::shared_ptr<const Json> last_doc;  // last_text parsed, when an edit had it so
   // Every step's result kept between runs (issue #40): an edit re-runs only the steps
   // downstream of what it changed; undo, redo and a restored autosave meet their steps again.
   std::shared_ptr<RunCache> cache = std::make_shared<RunCache>();
@@ -284,7 +296,8 @@ struct StudioSession::Impl {
   /// lattice's light form be the one product of its linear map (RunOptions).
   Run run(const std::string& recipe_text, const std::function<bool()>& cancelled,
           const std::optional<std::vector<std::string>>& changed = std::nullopt,
-          bool preview = false, const std::string& profile = "") const {
+          bool preview = false, const std::string& profile = "",
+          std::shared_ptr<const Json> parsed = nullptr) const {
     const Recipe recipe = parse_recipe(recipe_text, base_dir, name);
     RunOptions options;
     options.profile = profile;  // the export's receiver, for the deformed models
@@ -309,21 +322,27 @@ struct StudioSession::Impl {
     Run out{std::make_shared<RunResult>(run_recipe(recipe, options)), final_surfaces(recipe)};
     last_run = out.result;
     last_text = recipe_text;
+    last_doc = std::move(parsed);
     return out;
   }
 
   /// The deformations whose definitions differ between the last run's recipe and `next`, when
   /// nothing else differs (then the run may take every other surface from the last run).
-  std::optional<std::vector<std::string>> changed_deformations(const Json& next) const {
+  /// Compared section by section in place: a stroke's edit of a long recipe copies nothing.
+  std::optional<std::vector<std::string>> changed_deformations(const Json& after) const {
     if (!last_run) return std::nullopt;
-    Json before = Json::parse(last_text);
-    Json after = next;
+    if (!last_doc) last_doc = std::make_shared<const Json>(Json::parse(last_text));
+    const Json& before = *last_doc;
+    if (!before.is_object() || !after.is_object()) return std::nullopt;
+    for (const auto& [key, value] : before.items())
+      if (key != "deformations" && (!after.contains(key) || after.at(key) != value))
+        return std::nullopt;
+    for (const auto& [key, value] : after.items())
+      if (key != "deformations" && !before.contains(key)) return std::nullopt;
     const Json none = Json::object();
-    const Json a = before.contains("deformations") ? before["deformations"] : none;
-    const Json b = after.contains("deformations") ? after["deformations"] : none;
-    before.erase("deformations");
-    after.erase("deformations");
-    if (before != after || !a.is_object() || !b.is_object()) return std::nullopt;
+    const Json& a = before.contains("deformations") ? before.at("deformations") : none;
+    const Json& b = after.contains("deformations") ? after.at("deformations") : none;
+    if (!a.is_object() || !b.is_object()) return std::nullopt;
     std::vector<std::string> changed;
     for (const auto& [key, value] : a.items())
       if (!b.contains(key) || b.at(key) != value) changed.push_back(key);
@@ -383,11 +402,17 @@ struct StudioSession::Impl {
     const std::size_t current = static_cast<std::size_t>(position);
     const std::size_t first = std::min(from, current);
     Json entries = Json::array();
-    for (std::size_t k = first; k < history.size(); ++k)
-      entries.push_back(
-          {{"label", history[k].label}, {"group", history[k].group}, {"text", history[k].text}});
+    for (std::size_t k = first; k < history.size(); ++k) {
+      const Entry& e = history[k];
+      Json entry = {{"label", e.label}, {"group", e.group}};
+      if (k > first && e.changes.is_array())
+        entry["changes"] = e.changes;  // made from the entry before it on restoring
+      else
+        entry["text"] = e.text;
+      entries.push_back(std::move(entry));
+    }
     const Json doc = {{"format", "clayform.studio-autosave"},
-                      {"version", 1},
+                      {"version", 2},
                       {"recipe", name},
                       {"position", current - first},
                       {"history", entries}};
@@ -398,33 +423,59 @@ struct StudioSession::Impl {
 
   /// The reply of a run: its report figures per step, the history and the recipe text; then a
   /// net frame per final surface, a curve frame per named curve, and a net frame per deformed
-  /// final surface's parent before its first step. Without `nets` (a drag update the page draws
+  /// final surface's parent before its first step, each only when it differs from the one last
+  /// sent (the others named under "kept"). Without `nets` (a drag update the page draws
   /// itself), no frames: the figures and the history only.
   Reply ran(const std::string& op, const Run& run, bool nets = true) const {
     const RunResult& result = *run.result;
     Reply reply;
     const Json steps = Json::parse(step_reports_json(result.steps));  // as report.json has them
+    Json kept = {{"surfaces", Json::array()},
+                 {"curves", Json::array()},
+                 {"befores", Json::array()},
+                 {"deviations", Json::array()},
+                 {"models", Json::array()}};
+    // Sends `frame` unless the page holds it already; true when sent.
+    auto send = [&](const std::string& key, std::vector<std::uint8_t> frame) {
+      const std::uint64_t content = frame_key(frame);
+      if (const auto it = sent.find(key); it != sent.end() && it->second == content) return false;
+      sent[key] = content;
+      reply.frames.push_back(std::move(frame));
+      return true;
+    };
+    std::map<std::string, std::uint64_t> net_keys;  // "net NAME", "before NAME": for deviations
+    auto net_header = [](const std::string& n, const surface::BSplineSurface& s) {
+      return Json{{"kind", "net"},
+                  {"name", n},
+                  {"degrees", {s.u.degree, s.v.degree}},
+                  {"counts", {s.u.count(), s.v.count()}},
+                  {"knots_u", s.u.knots},
+                  {"knots_v", s.v.knots},
+                  {"rational", s.is_rational()}};
+    };
+    auto net_of = [](const surface::BSplineSurface& s) {
+      return std::pair{std::vector<double>(s.points.data(), s.points.data() + s.points.size()),
+                       std::vector<double>(s.weights.data(), s.weights.data() + s.weights.size())};
+    };
+    auto surface_key = [&](const surface::BSplineSurface& s) {
+      const auto [points, weights] = net_of(s);
+      return frame_key(net_frame(net_header("", s).dump(), points, weights));
+    };
     auto push_net = [&](const std::string& n, const surface::BSplineSurface& s, bool before) {
-      Json header = {{"kind", "net"},
-                     {"name", n},
-                     {"degrees", {s.u.degree, s.v.degree}},
-                     {"counts", {s.u.count(), s.v.count()}},
-                     {"knots_u", s.u.knots},
-                     {"knots_v", s.v.knots},
-                     {"rational", s.is_rational()}};
+      Json header = net_header(n, s);
       if (before) header["before"] = true;
-      std::vector<double> points(s.points.data(), s.points.data() + s.points.size());
-      std::vector<double> weights(s.weights.data(), s.weights.data() + s.weights.size());
-      reply.frames.push_back(net_frame(header.dump(), points, weights));
+      const auto [points, weights] = net_of(s);
+      const std::string key = (before ? "before " : "net ") + n;
+      std::vector<std::uint8_t> frame = net_frame(header.dump(), points, weights);
+      net_keys[key] = frame_key(frame);
+      return send(key, std::move(frame));
     };
     // A drag update the page draws itself ("nets": false) gets no frames: none are made.
     const std::vector<std::string> none;
     const std::vector<std::string>& shown = nets ? run.shown : none;
     Json surfaces = Json::array();
-    for (const std::string& n : shown) {
-      push_net(n, result.surface(n), false);
-      surfaces.push_back(n);
-    }
+    for (const std::string& n : shown)
+      (push_net(n, result.surface(n), false) ? surfaces : kept["surfaces"]).push_back(n);
     // Every named curve too (fitted strokes, sketch entities, bounds and targets): the page
     // draws them from their nets and picks them by name.
     Json curves = Json::array();
@@ -437,8 +488,8 @@ struct StudioSession::Impl {
                            {"rational", c.is_rational()}};
       std::vector<double> points(c.points.data(), c.points.data() + c.points.size());
       std::vector<double> weights(c.weights.data(), c.weights.data() + c.weights.size());
-      reply.frames.push_back(net_frame(header.dump(), points, weights));
-      curves.push_back(n);
+      const bool fresh = send("curve " + n, net_frame(header.dump(), points, weights));
+      (fresh ? curves : kept["curves"]).push_back(n);
     }
     // A deformed surface's parent before its first step (the page's before/after view, and
     // what a lattice drag is checked against).
@@ -447,8 +498,7 @@ struct StudioSession::Impl {
       const auto stage = std::find_if(result.stages.begin(), result.stages.end(),
                                       [&](const Stage& st) { return st.surface == n; });
       if (stage == result.stages.end()) continue;
-      push_net(n, stage->before, true);
-      befores.push_back(n);
+      (push_net(n, stage->before, true) ? befores : kept["befores"]).push_back(n);
     }
     // The deviation map of each shown surface whose last step deforms space point by point (a
     // lattice, taper, twist or bend; a style step moves control points and has none).
@@ -457,6 +507,16 @@ struct StudioSession::Impl {
       const auto stage = std::find_if(result.stages.rbegin(), result.stages.rend(),
                                       [&](const Stage& st) { return st.surface == n; });
       if (stage == result.stages.rend() || !stage->map) continue;
+      // Made from the surface and the one before its last step: the same two nets, the same
+      // map (41 x 41 evaluations spared).
+      const std::uint64_t made_from =
+          net_keys["net " + n] * 1099511628211ull ^ surface_key(stage->before);
+      const std::string key = "deviation " + n;
+      if (const auto it = sent.find(key); it != sent.end() && it->second == made_from) {
+        kept["deviations"].push_back(n);
+        continue;
+      }
+      sent[key] = made_from;
       reply.frames.push_back(deviation_frame(n, result.surface(n), *stage, 41, 41));
       deviations.push_back(n);
     }
@@ -468,7 +528,10 @@ struct StudioSession::Impl {
       for (const ModelRunResult& m : result.models) {
         const std::uint64_t key = topology_key(m.model);
         if (const auto it = meshed.find(m.name); it != meshed.end() && it->second == key) {
-          reply.frames.push_back(model_nets_frame(m.name, m.model));
+          if (!send("model " + m.name, model_nets_frame(m.name, m.model))) {
+            kept["models"].push_back(m.name);
+            continue;
+          }
         } else {
           const brep::ModelMesh mesh = brep::tessellate(m.model);
           const Json header = {{"kind", "mesh"},
@@ -478,6 +541,7 @@ struct StudioSession::Impl {
                                {"faces", m.model.faces.size()}};
           reply.frames.push_back(mesh_frame(header.dump(), mesh));
           meshed[m.name] = key;
+          sent.erase("model " + m.name);  // the mesh holds the nets it was made on
         }
         models.push_back(m.name);
       }
@@ -489,6 +553,7 @@ struct StudioSession::Impl {
       out["befores"] = befores;
       out["models"] = models;
       out["deviations"] = deviations;
+      out["kept"] = kept;
     } else {
       out["nets"] = false;
     }
@@ -501,6 +566,7 @@ struct StudioSession::Impl {
 
   Reply hello(const Json&, const Cancel&) {
     meshed.clear();  // a new page holds no mesh yet
+    sent.clear();
     const Recipe r = parse_recipe(text(), base_dir, name);
     Json out = {{"op", "hello"},
                 {"recipe", r.name()},
@@ -518,6 +584,7 @@ struct StudioSession::Impl {
 
   Reply run_all(const Json&, const Cancel& cancelled) {
     meshed.clear();  // "run" sends everything: the page may hold nothing (a new page)
+    sent.clear();
     return ran("run", run(text(), cancelled));
   }
 
@@ -555,21 +622,32 @@ struct StudioSession::Impl {
     } else {
       changes.push_back(c);
     }
-    Json doc = Json::parse(text());
+    // The text as the last run parsed it, when it is the current one (a copy costs less than a
+    // parse of a long recipe's text).
+    Json doc = last_doc && last_text == text() ? *last_doc : Json::parse(text());
     std::string first_path;
     for (const Json& change : changes) apply_change(doc, change, first_path);
     std::string next = doc.dump(1, ' ', false, Json::error_handler_t::replace);
     // A recipe the edit breaks throws: nothing changes. An edit of deformations alone reruns
     // only what they touch; a drag update (no nets) previews a lattice's light form.
-    const Run result = run(next, cancelled, changed_deformations(doc), !nets);
+    const auto changed = changed_deformations(doc);
+    const Run result =
+        run(next, cancelled, changed, !nets, "", std::make_shared<const Json>(std::move(doc)));
     // The updates of one drag share a "group": the latest replaces the entry an earlier one
     // made, so the drag is one step of the history.
     const auto at = static_cast<std::size_t>(position);
     if (!group.empty() && at + 1 == history.size() && history[at].group == group) {
       history[at].text = std::move(next);
+      Json& kept_changes = history[at].changes;
+      for (const Json& change : changes) {
+        if (!kept_changes.is_array()) break;
+        kept_changes.push_back(change);
+      }
+      if (kept_changes.is_array() && kept_changes.size() > group_changes_kept)
+        kept_changes = nullptr;
       save_soon();
     } else {
-      push({label.value_or("edit " + first_path), std::move(next), group});
+      push({label.value_or("edit " + first_path), std::move(next), group, std::move(changes)});
     }
     return ran("edit", result, nets);
   }
@@ -799,11 +877,27 @@ std::size_t StudioSession::restore(const fs::path& file) {
     throw bad("is not a studio autosave (format, history, position)");
   std::vector<Impl::Entry> entries;
   for (const Json& e : doc.at("history")) {
+    const bool whole = e.is_object() && e.contains("text") && e.at("text").is_string();
+    const bool changes =
+        e.is_object() && e.contains("changes") && e.at("changes").is_array() && !entries.empty();
     if (!e.is_object() || !e.contains("label") || !e.at("label").is_string() ||
-        !e.contains("text") || !e.at("text").is_string() ||
-        (e.contains("group") && !e.at("group").is_string()))
-      throw bad("has an entry without a label and a text");
-    entries.push_back({e.at("label"), e.at("text"), e.value("group", "")});
+        (!whole && !changes) || (e.contains("group") && !e.at("group").is_string()))
+      throw bad("has an entry without a label and a text (or the changes from the one before)");
+    if (whole) {
+      entries.push_back({e.at("label"), e.at("text"), e.value("group", "")});
+      continue;
+    }
+    // Version 2: the entry's edit replayed on the entry before it, as edit() made it.
+    Json recipe = Json::parse(entries.back().text, nullptr, false);
+    std::string first_path;
+    try {
+      if (recipe.is_discarded()) throw bad("has an entry whose text is not JSON");
+      for (const Json& change : e.at("changes")) apply_change(recipe, change, first_path);
+    } catch (const Error& error) {
+      throw bad("has an entry whose changes do not apply (" + error.message() + ")");
+    }
+    entries.push_back({e.at("label"), recipe.dump(1, ' ', false, Json::error_handler_t::replace),
+                       e.value("group", ""), e.at("changes")});
   }
   const std::size_t position = doc.at("position");
   parse_recipe(entries[position].text, impl_->base_dir, impl_->name);  // its problems, named

@@ -156,11 +156,23 @@ TEST_CASE("studio session: edits, undo, redo and save replay to identical contro
   CHECK(reply.at("curves").size() == replay.curves.size());
   CHECK(session.history() == std::vector<std::string>{"open", "billow 500"});
 
-  // Undo gives the original sail, redo the edited one again.
+  // Undo gives the original sail, redo the edited one again. Only what changed is sent again
+  // (the sail and its deviation map); the curves and the sail's parent, as the page holds them
+  // already, are named under "kept" (issue #40: a reply's size does not grow with the scene).
   const auto undone = session.handle(R"({"op": "undo"})");
-  REQUIRE(undone.frames.size() == 3 + replay.curves.size());
+  REQUIRE(undone.frames.size() == 2);
   const auto original = run_recipe(load_recipe(sail_file));
   CHECK(same(decode(undone.frames[0]), original.surface("sail")));
+  CHECK(decode(undone.frames[1]).header.at("kind") == "deviation");
+  const Json undone_reply = Json::parse(undone.json);
+  CHECK(undone_reply.at("surfaces") == Json::array({"sail"}));
+  CHECK(undone_reply.at("befores").empty());
+  CHECK(undone_reply.at("curves").empty());
+  CHECK(undone_reply.at("kept").at("befores") == Json::array({"sail"}));
+  CHECK(undone_reply.at("kept").at("curves").size() == replay.curves.size());
+  CHECK(undone_reply.at("kept").at("surfaces").empty());
+  // "run" (what a new page sends) sends everything again.
+  CHECK(session.handle(R"({"op": "run"})").frames.size() == 3 + replay.curves.size());
   CHECK(session.position() == 0);
   const auto redone = session.handle(R"({"op": "redo"})");
   CHECK(same(decode(redone.frames[0]), replay.surface("sail")));

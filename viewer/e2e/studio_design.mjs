@@ -125,7 +125,11 @@ export default async function design({ check, withEmptyRecipe, figures, shot }) 
       const window5 = (from) => ms.slice(from - 1, from + 4);
       const at = (from) => ({ p50: Math.round(quantile(window5(from), 0.5)), p95: Math.round(quantile(window5(from), 0.95)) });
       const latency = { strokes_1_5: at(1), strokes_18_22: at(18), strokes_36_40: at(36) };
-      figures.design = { strokes, kept_out_of_tolerance: warned.length, latency_ms: latency };
+      // the same windows' medians in parts: the kernel's run, the reply here, drawn
+      const parts = await k.call(() => window.clayStudio.metrics.stroke.map((m) => [m.kernel, m.received, m.ms]));
+      const median = (from, j) => Math.round(quantile(parts.slice(from - 1, from + 4).map((x) => x[j]), 0.5));
+      const breakdown = Object.fromEntries([1, 18, 36].map((from) => [`strokes_${from}_${from + 4}`, { kernel: median(from, 0), reply_here: median(from, 1), drawn: median(from, 2) }]));
+      figures.design = { strokes, kept_out_of_tolerance: warned.length, latency_ms: latency, parts_p50_ms: breakdown };
       return `40 strokes kept (${warned.length} as best fits, said so); pointer-up to curve drawn p50/p95: ${latency.strokes_1_5.p50}/${latency.strokes_1_5.p95} ms at 1-5, ${latency.strokes_18_22.p50}/${latency.strokes_18_22.p95} at 18-22, ${latency.strokes_36_40.p50}/${latency.strokes_36_40.p95} at 36-40`;
     }),
   );

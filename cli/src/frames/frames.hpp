@@ -27,6 +27,9 @@ std::vector<std::uint8_t> model_nets_frame(const std::string& name, const brep::
 std::vector<std::uint8_t> deviation_frame(const std::string& name, const surface::BSplineSurface& s,
                                           const Stage& stage, int rows, int cols);
 
+/// A frame's content (FNV-1a, 64 bits): a run's reply leaves out a frame the page already holds.
+std::uint64_t frame_key(const std::vector<std::uint8_t>& frame);
+
 /// What a model's mesh depends on besides its faces' control points (FNV-1a, 64 bits).
 std::uint64_t topology_key(const brep::Model& model);
 

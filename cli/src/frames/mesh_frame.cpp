@@ -42,6 +42,12 @@ std::vector<std::uint8_t> mesh_frame(const std::string& header_json, const brep:
 /// What a model's mesh depends on besides its faces' control points: the faces, their domains,
 /// sides and loops (edges used, senses, pcurves bit for bit). Exact composition keeps (u, v), so
 /// a deformed model keeps its key and its mesh's nodes stay at their (u, v) (FNV-1a, 64 bits).
+std::uint64_t frame_key(const std::vector<std::uint8_t>& frame) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (std::uint8_t b : frame) h = (h ^ b) * 1099511628211ull;
+  return h;
+}
+
 std::uint64_t topology_key(const brep::Model& model) {
   std::uint64_t h = 1469598103934665603ull;
   auto mix = [&](const void* data, std::size_t bytes) {

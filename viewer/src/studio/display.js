@@ -65,13 +65,31 @@ function showLegend(text) {
   $('legend').textContent = text;
 }
 
+// Each net's drawing, kept while the net is (a reply the kernel did not send again keeps its
+// objects): a stroke's reply re-evaluates nothing of the styled surfaces beside it.
+const drawn = new Map(); // name -> {net, deviation, geometry}
+function geometryOf(name, net, deviation) {
+  const known = drawn.get(name);
+  if (known && known.net === net && known.deviation === deviation) return known.geometry;
+  if (known) known.geometry.dispose();
+  const geometry = meshOf(net, deviation);
+  geometry.userData.kept = true; // disposed here, when its net goes, not by disposeGroup
+  drawn.set(name, { net, deviation, geometry });
+  return geometry;
+}
+
 export function rebuildSurfaces() {
   const { selection, showBefore } = state;
   disposeGroup(surfaceGroup);
   const nets = showBefore ? new Map([...doc.surfaces].map(([n, net]) => [n, doc.befores.get(n) || net])) : doc.surfaces;
+  for (const [name, known] of drawn)
+    if (nets.get(name) !== known.net) {
+      known.geometry.dispose();
+      drawn.delete(name);
+    }
   for (const [name, net] of nets) {
     const preview = previews.get(name);
-    const mesh = new THREE.Mesh(preview && !showBefore ? preview.geometry : meshOf(net, !showBefore && doc.deviations.get(name)), materials.shaded);
+    const mesh = new THREE.Mesh(preview && !showBefore ? preview.geometry : geometryOf(name, net, (!showBefore && doc.deviations.get(name)) || null), materials.shaded);
     mesh.name = name;
     mesh.userData = { kind: 'surface', name, selected: selection.some((s) => s.kind === 'surface' && s.name === name) };
     surfaceGroup.add(mesh);
@@ -99,6 +117,13 @@ function inSketches() {
     }
   return out;
 }
+// Each curve's polyline, kept while the curve object is (as the surfaces' drawings above).
+const polylines = new WeakMap();
+function polylineOf(curve, samples) {
+  if (!polylines.has(curve)) polylines.set(curve, curvePolyline(curve, samples));
+  return polylines.get(curve);
+}
+
 export function rebuildCurves() {
   disposeGroup(curveGroup);
   const hidden = inSketches();
@@ -106,7 +131,7 @@ export function rebuildCurves() {
     if (hidden.has(name)) continue;
     const samples = Math.min(400, 24 * (curve.knots.length - 2 * curve.degree) + 40);
     const line = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: state.selection.some((s) => s.kind === 'curve' && s.name === name) ? SELECTED_COLOUR : CURVE_COLOUR, depthTest: false }));
-    line.geometry.setAttribute('position', new THREE.BufferAttribute(curvePolyline(curve, samples), 3));
+    line.geometry.setAttribute('position', new THREE.BufferAttribute(polylineOf(curve, samples), 3));
     line.renderOrder = 2;
     line.name = name;
     line.userData = { kind: 'curve', name };

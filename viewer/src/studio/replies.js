@@ -14,6 +14,7 @@ import { showPanels, showReport, showHistory } from './panels.js';
 const session = { restoredShown: false }; // the autosave's continuation said once
 
 function onReply(reply, frames, meta) {
+  const receivedAt = performance.now();
   if (reply.op === 'error' && reply.category === 'cancelled') {
     // the stylist's own Cancel (or a newer page): not an error, nothing changed
     showMessage(`cancelled: ${meta.command.op} stopped, nothing changed`, 'warning');
@@ -59,11 +60,22 @@ function onReply(reply, frames, meta) {
     return;
   }
   const meshes = doc.models;
+  // What the kernel did not send again (reply.kept) is what the page holds already: the same
+  // objects, so their drawings are kept too (display.js); only what changed is new.
+  const held = { surfaces: doc.surfaces, befores: doc.befores, curves: doc.curves, models: doc.models, deviations: doc.deviations };
   doc.surfaces = new Map();
   doc.befores = new Map();
   doc.curves = new Map();
   doc.models = new Map();
   doc.deviations = new Map();
+  let lost = false;
+  for (const [kind, names] of Object.entries(reply.kept || {}))
+    for (const name of names) {
+      const value = held[kind] && held[kind].get(name);
+      if (value) doc[kind].set(name, value);
+      else lost = true;
+    }
+  if (lost) setTimeout(() => send({ op: 'run' })); // the page lost something: ask for everything
   for (const f of frames) {
     const h = f.header;
     if (h.kind === 'mesh') doc.models.set(h.name, f);
@@ -92,7 +104,9 @@ function onReply(reply, frames, meta) {
   dirty((drawnAt) => {
     if (kind === 'drag') metrics.drag.push({ at: drawnAt, ms: drawnAt - meta.inputAt });
     if (kind === 'drag-end') metrics.dragEnd.push({ at: drawnAt, ms: drawnAt - meta.inputAt });
-    if (kind === 'stroke') metrics.stroke.push({ at: drawnAt, ms: drawnAt - meta.inputAt });
+    // a stroke's latency in parts: the kernel's run, the rest until the reply was here (fit,
+    // socket, the server's reply), and the page's drawing after it
+    if (kind === 'stroke') metrics.stroke.push({ at: drawnAt, ms: drawnAt - meta.inputAt, kernel: 1000 * reply.seconds, received: receivedAt - meta.inputAt });
     body.dataset.rendered = String(Number(body.dataset.rendered || 0) + 1);
   });
 }

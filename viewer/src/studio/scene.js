@@ -124,7 +124,7 @@ export function wireScene() {
 /** Removes a group's children, disposing of their geometry (not a drag preview's: its owner does). */
 export function disposeGroup(group) {
   for (const child of [...group.children]) {
-    child.traverse((o) => o.geometry && !o.geometry.userData.preview && o.geometry.dispose());
+    child.traverse((o) => o.geometry && !o.geometry.userData.preview && !o.geometry.userData.kept && o.geometry.dispose());
     group.remove(child);
   }
 }
