@@ -8,8 +8,8 @@ import * as THREE from 'three';
 import * as names from './recipe_edits.js';
 import { $, showMessage } from './ui.js';
 import { doc, selected, edit, dragEdit, commandOf, send, cancelDrag, newGroup } from './store.js';
-import { canvas, controls, inkGroup, dirty, pointerRay, onPlane, onSurface } from './scene.js';
-import { pickedPlane, placePickedPlane, sketchPlane, mirrorPlane, extrusionOf, onExtrusion, snapEnd, oversketchTarget } from './sketch_geometry.js';
+import { canvas, controls, inkGroup, dirty, pointerRay, onPlane, onSurface, toScreen } from './scene.js';
+import { pickedPlane, placePickedPlane, sketchPlane, mirrorPlane, extrusionOf, onExtrusion, snapEnd, oversketchTarget, screenLength } from './sketch_geometry.js';
 import { activeStyle, liveTarget } from './style.js';
 
 // ink: the stroke being drawn {points: [[x,y,z]], plane, over, line, pointerId, live};
@@ -134,9 +134,14 @@ function finishStroke(event) {
     return;
   }
   if ($('snap').checked && !event.altKey && !over) {
+    // A snap is a small correction: an end moves by at most a quarter of the ink's length on
+    // the screen (zoomed out, a 13 px stroke had an end pulled 12 px onto its neighbour).
+    const reach = 0.25 * screenLength(points);
     for (const end of [0, points.length - 1]) {
       const s = snapEnd(points[end]);
-      if (s) names.moveEnd(points, end, s.p);
+      const from = toScreen(points[end]);
+      const to = s && toScreen(s.p);
+      if (s && Math.hypot(to[0] - from[0], to[1] - from[1]) <= reach) names.moveEnd(points, end, s.p);
     }
   }
   if (over) {

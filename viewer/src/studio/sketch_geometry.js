@@ -135,6 +135,16 @@ function curveEnds() {
   return out;
 }
 const SNAP_PX = 12;
+/** A polyline's length on the screen, in pixels. */
+export function screenLength(points) {
+  let length = 0;
+  for (let i = 1; i < points.length; i++) {
+    const a = toScreen(points[i - 1]);
+    const b = toScreen(points[i]);
+    length += Math.hypot(b[0] - a[0], b[1] - a[1]);
+  }
+  return length;
+}
 /** The stroke's end point snapped: to a curve end, else a curve, else a node of the grid drawn; or null. */
 export function snapEnd(p) {
   const s = toScreen(p);
@@ -173,6 +183,7 @@ export function oversketchTarget(points) {
   const strokes = doc.recipe.strokes || {};
   const a = points[0];
   const b = points[points.length - 1];
+  const ink = screenLength(points);
   for (const [name, stroke] of Object.entries(strokes)) {
     const q = stroke.points;
     if (!Array.isArray(q) || q.length < 4) continue;
@@ -190,7 +201,12 @@ export function oversketchTarget(points) {
     const ia = near(a);
     const ib = near(b);
     const endsFree = (i) => i > 1 && i < q.length - 2;
-    if (ia.d < SNAP_PX && ib.d < SNAP_PX && Math.abs(ia.i - ib.i) > 2 && endsFree(ia.i) && endsFree(ib.i)) return { name, from: ia.i, to: ib.i };
+    if (!(ia.d < SNAP_PX && ib.d < SNAP_PX && Math.abs(ia.i - ib.i) > 2 && endsFree(ia.i) && endsFree(ib.i))) continue;
+    // Both the ink and the part it redraws longer on the screen than twice the reach: else the
+    // ends' nearness says nothing (zoomed out, strokes 35 mm apart were 11 px apart and 13 px
+    // long, and each new one was taken for an oversketch of its neighbour, issue #40).
+    const part = q.slice(Math.min(ia.i, ib.i), Math.max(ia.i, ib.i) + 1);
+    if (ink >= 2 * SNAP_PX && screenLength(part) >= 2 * SNAP_PX) return { name, from: ia.i, to: ib.i };
   }
   return null;
 }
