@@ -134,7 +134,10 @@ void session_drag_step(benchmark::State& state) {
 // the studio does at a curve's first drag), its middle control point moved up and down, each
 // update an edit of that point ("nets": false): the style step and the lattice's light-form
 // preview after it re-run, the strokes, the bound and the fill taken from the session's cache.
-void tank_style_drag(benchmark::State& state, const std::filesystem::path& file, Json doc) {
+// `whole`: what such an update cost before issue #40, the edited recipe run whole (run_recipe:
+// the fill, the style and the lattice's certified light fit).
+void tank_style_drag(benchmark::State& state, const std::filesystem::path& file, Json doc,
+                     bool whole) {
   const recipe::RunResult first =
       recipe::run_recipe(recipe::parse_recipe(doc.dump(), file.parent_path()));
   const surface::BSplineCurve& spine = first.curve("spine");
@@ -155,6 +158,13 @@ void tank_style_drag(benchmark::State& state, const std::filesystem::path& file,
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     const double value = z0 + 6 * std::sin(0.1 * ++step);
+    if (whole) {
+      doc["curves"]["spine"]["bspline"]["points"][static_cast<std::size_t>(middle)][2] = value;
+      const auto r = recipe::run_recipe(recipe::parse_recipe(doc.dump(), file.parent_path()));
+      benchmark::DoNotOptimize(r.surfaces.data());
+      times.record(t0);
+      continue;
+    }
     const auto reply = session.handle(Json{
         {"op", "edit"},
         {"path", path},
@@ -170,7 +180,8 @@ void tank_style_drag(benchmark::State& state, const std::filesystem::path& file,
     times.record(t0);
   }
   times.report(state);
-  state.SetLabel("tank style drag update: the target's middle control point, exact style");
+  state.SetLabel(whole ? "tank style drag, before: the recipe run whole"
+                       : "tank style drag update: the target's middle control point, exact style");
 }
 
 // Issue #38 step 4: a drag of the tank's (3, 3, 1) lattice (examples/recipes/tank.json: fill,
@@ -181,13 +192,14 @@ void tank_style_drag(benchmark::State& state, const std::filesystem::path& file,
 // 1 = after: StudioSession::handle of the drag update ("nets": false): the fill and the style
 //     taken from the last run, the light form one product of the lattice's points;
 // 2 = the release ("nets": true): the style taken from the last run, the light form fitted and
-//     certified.
+//     certified;
+// 3 = a drag of the style's target instead (tank_style_drag), 4 = the same run whole (before).
 void tank_drag_step(benchmark::State& state) {
   const std::filesystem::path file =
       std::filesystem::path(CLAY_EXAMPLES_DIR) / "recipes" / "tank.json";
   const std::string text = read(file);
   Json doc = Json::parse(text);
-  if (state.range(0) == 3) return tank_style_drag(state, file, doc);
+  if (state.range(0) >= 3) return tank_style_drag(state, file, doc, state.range(0) == 4);
   Json& moves = doc["deformations"]["knees"][0]["moves"];
   std::size_t moved = 0;
   while (moves[moved]["index"] != Json::array({1, 1, 1})) ++moved;
@@ -300,6 +312,7 @@ BENCHMARK(tank_drag_step)
     ->Arg(0)
     ->Arg(1)
     ->Arg(2)
+    ->Arg(4)
     ->Arg(3)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -429,6 +429,10 @@ struct StudioSession::Impl {
   Reply ran(const std::string& op, const Run& run, bool nets = true) const {
     const RunResult& result = *run.result;
     Reply reply;
+    // What the page will hold once it has this reply, made aside and kept only when the whole
+    // reply is made: an exception part-way would otherwise mark frames sent that never left.
+    std::map<std::string, std::uint64_t> sending = sent;
+    std::map<std::string, std::uint64_t> meshing = meshed;
     const Json steps = Json::parse(step_reports_json(result.steps));  // as report.json has them
     Json kept = {{"surfaces", Json::array()},
                  {"curves", Json::array()},
@@ -438,8 +442,9 @@ struct StudioSession::Impl {
     // Sends `frame` unless the page holds it already; true when sent.
     auto send = [&](const std::string& key, std::vector<std::uint8_t> frame) {
       const std::uint64_t content = frame_key(frame);
-      if (const auto it = sent.find(key); it != sent.end() && it->second == content) return false;
-      sent[key] = content;
+      if (const auto it = sending.find(key); it != sending.end() && it->second == content)
+        return false;
+      sending[key] = content;
       reply.frames.push_back(std::move(frame));
       return true;
     };
@@ -512,11 +517,11 @@ struct StudioSession::Impl {
       const std::uint64_t made_from =
           net_keys["net " + n] * 1099511628211ull ^ surface_key(stage->before);
       const std::string key = "deviation " + n;
-      if (const auto it = sent.find(key); it != sent.end() && it->second == made_from) {
+      if (const auto it = sending.find(key); it != sending.end() && it->second == made_from) {
         kept["deviations"].push_back(n);
         continue;
       }
-      sent[key] = made_from;
+      sending[key] = made_from;
       reply.frames.push_back(deviation_frame(n, result.surface(n), *stage, 41, 41));
       deviations.push_back(n);
     }
@@ -527,7 +532,7 @@ struct StudioSession::Impl {
     if (nets)
       for (const ModelRunResult& m : result.models) {
         const std::uint64_t key = topology_key(m.model);
-        if (const auto it = meshed.find(m.name); it != meshed.end() && it->second == key) {
+        if (const auto it = meshing.find(m.name); it != meshing.end() && it->second == key) {
           if (!send("model " + m.name, model_nets_frame(m.name, m.model))) {
             kept["models"].push_back(m.name);
             continue;
@@ -540,8 +545,8 @@ struct StudioSession::Impl {
                                {"triangles", mesh.triangles.size()},
                                {"faces", m.model.faces.size()}};
           reply.frames.push_back(mesh_frame(header.dump(), mesh));
-          meshed[m.name] = key;
-          sent.erase("model " + m.name);  // the mesh holds the nets it was made on
+          meshing[m.name] = key;
+          sending.erase("model " + m.name);  // the mesh holds the nets it was made on
         }
         models.push_back(m.name);
       }
@@ -558,6 +563,8 @@ struct StudioSession::Impl {
       out["nets"] = false;
     }
     reply.json = reply_text(out);
+    sent = std::move(sending);
+    meshed = std::move(meshing);
     return reply;
   }
 

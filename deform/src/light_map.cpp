@@ -1,6 +1,7 @@
 // The light form of a lattice step as an affine map of the lattice's points (light_map.hpp).
 #include <clay/deform/light_map.hpp>
 
+#include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/error.hpp>
 #include <clay/surface/basis.hpp>
@@ -8,6 +9,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <array>
 #include <string>
 #include <type_traits>
@@ -98,29 +100,98 @@ const Points3* lattice_points(const Deformation& d) {
   return nullptr;
 }
 
+/// Refit's least-squares parameters on a light form's bases (degree + 1 Chebyshev–Lobatto
+/// intervals per span) and the pseudo-inverses A_u⁺, A_v⁺ of its collocations, by the same
+/// column-pivoting QR as refit's least squares.
+struct LightFit {
+  std::vector<double> us, vs;
+  Eigen::MatrixXd pu, pv;
+  explicit LightFit(const BSplineSurface& light)
+      : us(detail::fit_parameters(light.u, light.u.degree + 1)),
+        vs(detail::fit_parameters(light.v, light.v.degree + 1)) {
+    const auto mu = static_cast<Eigen::Index>(us.size()), mv = static_cast<Eigen::Index>(vs.size());
+    pu = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(detail::collocation(light.u, us))
+             .solve(Eigen::MatrixXd::Identity(mu, mu));
+    pv = Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(detail::collocation(light.v, vs))
+             .solve(Eigen::MatrixXd::Identity(mv, mv));
+  }
+  /// A_u⁺ F A_vᵀ⁺ with F(r, s) = f(r mv + s), written to column `c` of `out` (row i cv + j).
+  template <class Sample, class Out>
+  void fit(Sample&& f, Out& out, Eigen::Index c) const {
+    const auto mu = static_cast<Eigen::Index>(us.size()), mv = static_cast<Eigen::Index>(vs.size());
+    Eigen::MatrixXd grid(mu, mv);
+    for (Eigen::Index r = 0; r < mu; ++r)
+      for (Eigen::Index s = 0; s < mv; ++s) grid(r, s) = f(r * mv + s);
+    const Eigen::MatrixXd n = pu * grid * pv.transpose();
+    const Eigen::Index cv = pv.rows();
+    for (Eigen::Index i = 0; i < pu.rows(); ++i)
+      for (Eigen::Index j = 0; j < cv; ++j) out(i * cv + j, c) = n(i, j);
+  }
+};
+
+/// `what`'s arguments: a Bézier or B-spline lattice (the only deformations linear in their
+/// points), a polynomial light form, valid surfaces.
+void check_light(const Deformation& lattice, const BSplineSurface& input,
+                 const BSplineSurface& light, const std::string& what) {
+  if (!lattice_points(lattice))
+    throw Error(ErrorCategory::InvalidArgument,
+                what +
+                    ": the deformation is not a Bézier or B-spline lattice, so its light form is "
+                    "not linear in control points; refit it (refit_deformed) instead");
+  if (light.is_rational())
+    throw Error(ErrorCategory::InvalidArgument,
+                what +
+                    ": the light form is rational; give the polynomial net refit_deformed made "
+                    "for this step");
+  surface::validate(input, what + " input");
+  surface::validate(light, what + " light form");
+}
+
+/// Closed sides and poles as the light form's fit keeps them (seal.hpp).
+void seal(const BSplineSurface& input, BSplineSurface& out, const Deformation& d) {
+  detail::keep_closed_and_collapsed(input, out, [&](const Eigen::Vector3d& x) {
+    return std::visit([&](const auto& l) -> Eigen::Vector3d { return deform_point(l, x); }, d);
+  });
+}
+
 }  // namespace
+
+BSplineSurface light_fit(const Deformation& d, const BSplineSurface& input,
+                         const BSplineSurface& light) {
+  check_light(d, input, light, "light_fit");
+  const LightFit fit(light);
+  const Points3 samples = surface::evaluate_grid(input, fit.us, fit.vs);
+  // The lattice frozen once (its power form, Sederberg–Parry eq. (2) to ~1e-15 of its size), as
+  // a drag update deforms thousands of samples: de Casteljau per sample took most of the tank's
+  // style drag update after the style itself.
+  const Points3 moved = std::visit(
+      [&](const auto& l) -> Points3 {
+        using T = std::decay_t<decltype(l)>;
+        if constexpr (std::is_same_v<T, BezierLattice> || std::is_same_v<T, BSplineLattice>) {
+          validate(l, "light_fit lattice");
+          return deform_points(l, samples);
+        } else {
+          return {};
+        }
+      },
+      d);
+  Points3 net(fit.pu.rows() * fit.pv.rows(), 3);
+  for (Eigen::Index c = 0; c < 3; ++c) fit.fit([&](Eigen::Index k) { return moved(k, c); }, net, c);
+  BSplineSurface out = surface::make_surface(light.u, light.v, std::move(net));
+  seal(input, out, d);
+  return out;
+}
 
 LatticeLightMap lattice_light_map(const Deformation& lattice, const BSplineSurface& input,
                                   const BSplineSurface& light) {
-  if (!lattice_points(lattice))
-    throw Error(ErrorCategory::InvalidArgument,
-                "lattice_light_map: the deformation is not a Bézier or B-spline lattice, so its "
-                "light form is not linear in control points; refit it (refit_deformed) instead");
-  if (light.is_rational())
-    throw Error(ErrorCategory::InvalidArgument,
-                "lattice_light_map: the light form is rational; give the polynomial net "
-                "refit_deformed made for this step");
-  surface::validate(input, "lattice_light_map input");
-  surface::validate(light, "lattice_light_map light form");
+  check_light(lattice, input, light, "lattice_light_map");
   LatticeLightMap map;
   map.input = input;
   map.lattice = lattice;
   map.u = light.u;
   map.v = light.v;
-  // The samples of refit's least squares: degree + 1 Chebyshev–Lobatto intervals per span.
-  const std::vector<double> us = detail::fit_parameters(light.u, light.u.degree + 1);
-  const std::vector<double> vs = detail::fit_parameters(light.v, light.v.degree + 1);
-  const Points3 samples = surface::evaluate_grid(input, us, vs);
+  const LightFit fit(light);
+  const Points3 samples = surface::evaluate_grid(input, fit.us, fit.vs);
   std::vector<char> outside;
   const Eigen::MatrixXd w = std::visit(
       [&](const auto& l) -> Eigen::MatrixXd {
@@ -133,44 +204,23 @@ LatticeLightMap lattice_light_map(const Deformation& lattice, const BSplineSurfa
         }
       },
       lattice);
-  // The pseudo-inverses A_u⁺, A_v⁺ by the same column-pivoting QR as refit's least squares.
-  const auto mu = static_cast<Eigen::Index>(us.size()), mv = static_cast<Eigen::Index>(vs.size());
-  const Eigen::MatrixXd pu =
-      Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(detail::collocation(light.u, us))
-          .solve(Eigen::MatrixXd::Identity(mu, mu));
-  const Eigen::MatrixXd pv =
-      Eigen::ColPivHouseholderQR<Eigen::MatrixXd>(detail::collocation(light.v, vs))
-          .solve(Eigen::MatrixXd::Identity(mv, mv));
-  const Eigen::Index cu = pu.rows(), cv = pv.rows();
   // N_a = A_u⁺ F_a A_vᵀ⁺ with F_a(r, s) = w(r mv + s, a); row i cv + j of N is C_ij.
-  auto fit = [&](const Eigen::MatrixXd& f) -> Eigen::MatrixXd { return pu * f * pv.transpose(); };
+  const Eigen::Index cu = fit.pu.rows(), cv = fit.pv.rows();
   map.weights.resize(cu * cv, w.cols());
-  Eigen::MatrixXd f(mu, mv);
   for (Eigen::Index a = 0; a < w.cols(); ++a) {
-    if (w.col(a).isZero(0)) {
+    if (w.col(a).isZero(0))
       map.weights.col(a).setZero();
-      continue;
-    }
-    for (Eigen::Index r = 0; r < mu; ++r)
-      for (Eigen::Index s = 0; s < mv; ++s) f(r, s) = w(r * mv + s, a);
-    const Eigen::MatrixXd n = fit(f);
-    for (Eigen::Index i = 0; i < cu; ++i)
-      for (Eigen::Index j = 0; j < cv; ++j) map.weights(i * cv + j, a) = n(i, j);
+    else
+      fit.fit([&](Eigen::Index k) { return w(k, a); }, map.weights, a);
   }
   map.outside = Points3::Zero(cu * cv, 3);
-  for (int c = 0; c < 3; ++c) {
-    bool any = false;
-    for (Eigen::Index r = 0; r < mu; ++r)
-      for (Eigen::Index s = 0; s < mv; ++s) {
-        const bool out = outside[static_cast<std::size_t>(r * mv + s)] != 0;
-        f(r, s) = out ? samples(r * mv + s, c) : 0.0;
-        any = any || out;
-      }
-    if (!any) continue;
-    const Eigen::MatrixXd n = fit(f);
-    for (Eigen::Index i = 0; i < cu; ++i)
-      for (Eigen::Index j = 0; j < cv; ++j) map.outside(i * cv + j, c) = n(i, j);
-  }
+  if (std::find(outside.begin(), outside.end(), 1) != outside.end())
+    for (Eigen::Index c = 0; c < 3; ++c)
+      fit.fit(
+          [&](Eigen::Index k) {
+            return outside[static_cast<std::size_t>(k)] ? samples(k, c) : 0.0;
+          },
+          map.outside, c);
   return map;
 }
 
@@ -191,11 +241,7 @@ BSplineSurface light_net(const LatticeLightMap& map, const Deformation& lattice)
                 "map was made for; make a new map (lattice_light_map) for this lattice");
   Points3 net = map.weights * *lattice_points(lattice) + map.outside;
   BSplineSurface out = surface::make_surface(map.u, map.v, std::move(net));
-  // Closed sides and poles as the light form's fit keeps them (seal.hpp).
-  detail::keep_closed_and_collapsed(map.input, out, [&](const Eigen::Vector3d& x) {
-    return std::visit([&](const auto& l) -> Eigen::Vector3d { return deform_point(l, x); },
-                      lattice);
-  });
+  seal(map.input, out, lattice);
   return out;
 }
 

@@ -506,14 +506,84 @@ KeyPointSystem key_point_system(const BSplineSurface& s, const std::vector<KeyPo
   return out;
 }
 
+/// H^-1 X for the factorization H = P^T L D L^T P and X with few columns (the key-point rows'
+/// transposes, 30 to 60 on a styled panel): the right-hand sides are held row by row, so each
+/// entry of L is read once for all of them (Eigen's solve sweeps L once per column, and L of a
+/// refined net, 2 MB at 1631 free vertices, does not stay in cache between the sweeps), and the
+/// forward sweep skips the rows still zero (a key point's row reaches (p+1)(q+1) vertices).
+Eigen::MatrixXd solve_columns(const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>& f,
+                              const Eigen::MatrixXd& x) {
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::Index n = x.rows(), m = x.cols();
+  RowMajor z = f.permutationP() * x;
+  const Eigen::SparseMatrix<double>& L = f.matrixL().nestedExpression();  // strictly lower
+  double* const rows = z.data();
+  for (Eigen::Index j = 0; j < n; ++j) {  // L y = P x, column by column of L
+    const double* zj = rows + j * m;
+    bool zero = true;
+    for (Eigen::Index c = 0; c < m && zero; ++c) zero = zj[c] == 0;
+    if (zero) continue;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(L, j); it; ++it) {
+      double* zi = rows + it.index() * m;
+      const double l = it.value();
+      for (Eigen::Index c = 0; c < m; ++c) zi[c] -= l * zj[c];
+    }
+  }
+  const Eigen::VectorXd& d = f.vectorD();
+  for (Eigen::Index i = 0; i < n; ++i) z.row(i) /= d[i];
+  for (Eigen::Index j = n - 1; j >= 0; --j) {  // L^T w = D^-1 y: row j of L^T is column j of L
+    double* zj = rows + j * m;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(L, j); it; ++it) {
+      const double* zi = rows + it.index() * m;
+      const double l = it.value();
+      for (Eigen::Index c = 0; c < m; ++c) zj[c] -= l * zi[c];
+    }
+  }
+  return f.permutationPinv() * z;
+}
+
+/// Y = H^-1 B^T for the key-point rows B on `net`, its columns kept across the solves of one
+/// style on the same net: a round of added key points appends rows to B, and the columns of the
+/// rows already there are taken as they were. Emptied whenever the solve moves to another net.
+struct RangeColumns {
+  std::shared_ptr<const NetCache> net;  // the net B and Y are of
+  Eigen::MatrixXd B, Y;
+};
+
+const Eigen::MatrixXd& energy_inverse_times(const NetCache& net, const Eigen::MatrixXd& B,
+                                            RangeColumns& kept) {
+  const Eigen::Index nk = B.rows(), nf = B.cols();
+  Eigen::Index same = 0;  // leading rows of B equal to those of the last call on this net
+  if (kept.net.get() == &net && kept.B.cols() == nf)
+    while (same < std::min(nk, kept.B.rows()) && kept.B.row(same) == B.row(same)) ++same;
+  Eigen::MatrixXd Y(nf, nk);
+  Y.leftCols(same) = kept.Y.leftCols(same);
+  if (same < nk) {
+    const Eigen::MatrixXd fresh = B.bottomRows(nk - same).transpose();
+    if (net.inverse.size() > 0) {
+      // A key point's row has (p+1)(q+1) nonzeros: its column of Y is as many columns of H^-1.
+      Y.rightCols(nk - same).setZero();
+      for (Eigen::Index k = 0; k < nk - same; ++k)
+        for (Eigen::Index c = 0; c < nf; ++c)
+          if (fresh(c, k) != 0) Y.col(same + k) += fresh(c, k) * net.inverse.col(c);
+    } else {
+      Y.rightCols(nk - same) = solve_columns(net.energy, fresh);
+    }
+  }
+  kept.B = B;
+  kept.Y = std::move(Y);
+  return kept.Y;
+}
+
 /// The free vertices' displacements d (nf x 3) of least fairness energy that meet the key-point
 /// rows B d = rhs (Han–De Amicis–Conti §4, the energy of eq. 10 under the constraints of eq. 9),
 /// or, when the rows are dependent (rank < nk), the least-squares compromise of least energy.
 /// `qr` is the rank-revealing QR of B^T that gave `rank`; `tol` the tolerance in mm.
+/// `kept` holds H^-1 B^T's columns between the solves of one style (energy_inverse_times).
 Eigen::MatrixXd constrained_minimum(const NetCache& net, const Eigen::MatrixXd& B,
                                     const Eigen::MatrixXd& rhs, int rank,
                                     const Eigen::ColPivHouseholderQR<Eigen::MatrixXd>& qr,
-                                    double tol) {
+                                    double tol, RangeColumns& kept) {
   // The energy minimum subject to the key points, when they are independent: d = H^-1 B^T μ with
   // (B H^-1 B^T) μ = r, else the KKT system (kkt_solve). Dependent key points:
   // d = d0 + Z y with d0 the minimal-norm least-squares solution of B d = r, Z a basis of null(B)
@@ -528,15 +598,7 @@ Eigen::MatrixXd constrained_minimum(const NetCache& net, const Eigen::MatrixXd& 
       // conditioning of nearly dependent rows) the KKT system decides.
       bool solved = false;
       if (net.factorized) {
-        Eigen::MatrixXd Y;
-        if (net.inverse.size() > 0) {
-          Y = Eigen::MatrixXd::Zero(nf, nk);
-          for (Eigen::Index k = 0; k < nk; ++k)
-            for (Eigen::Index c = 0; c < nf; ++c)
-              if (B(k, c) != 0) Y.col(k) += B(k, c) * net.inverse.col(c);
-        } else {
-          Y = net.energy.solve(Eigen::MatrixXd(B.transpose()));
-        }
+        const Eigen::MatrixXd& Y = energy_inverse_times(net, B, kept);
         const Eigen::MatrixXd S = B * Y;
         const Eigen::LDLT<Eigen::MatrixXd> schur(S);
         if (schur.info() == Eigen::Success && schur.isPositive()) {
@@ -559,7 +621,7 @@ Eigen::MatrixXd constrained_minimum(const NetCache& net, const Eigen::MatrixXd& 
       // Too many free vertices for the dense null space below (Q is nf x nf): the same
       // compromise as the limit of the penalty min d^T H d + |B d - r|^2 / ε, by the range
       // space with a ridge on the Schur complement, d = Y (B Y + ε I)^-1 r, Y = H^-1 B^T.
-      const Eigen::MatrixXd Y = net.energy.solve(Eigen::MatrixXd(B.transpose()));
+      const Eigen::MatrixXd& Y = energy_inverse_times(net, B, kept);
       Eigen::MatrixXd S = B * Y;
       const double ridge = 1e-10 * std::max(S.trace() / static_cast<double>(nk), 1e-300);
       S.diagonal().array() += ridge;
@@ -746,6 +808,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       options.net_convergence > 0 ? shape_grid(parent, region, in_region) : ShapeGrid{};
   report.net_change = std::numeric_limits<double>::quiet_NaN();
   double amplification = 0;
+  RangeColumns range_columns;  // H^-1 B^T, kept between the solves on one net
 
   for (;;) {
     throw_if_cancelled("an exact style");
@@ -812,7 +875,8 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
       continue;
     }
 
-    const Eigen::MatrixXd d = constrained_minimum(*net, B, rhs, rank, qr, tol);
+    if (range_columns.net != net) range_columns = RangeColumns{net, {}, {}};
+    const Eigen::MatrixXd d = constrained_minimum(*net, B, rhs, rank, qr, tol, range_columns);
     // Key points independent but so nearly dependent that the solve misses them, or met only by
     // a wound-up net: a finer net. When the net may not be refined further and the last key points
     // added are what winds it up, they are taken back (the miss of the target curve is reported).

@@ -834,11 +834,11 @@ class Runner {
           [&](const auto& k) -> Eigen::Vector3d { return deform::deform_point(k, x); }, d);
     };
     if (options_.preview && options_.previous)
-      if (auto map = preview_map(*options_.previous, d, s, stage.step)) {
-        BSplineSurface out = deform::light_net(*map, d);
+      if (auto preview = preview_light(*options_.previous, d, s, stage.step)) {
+        BSplineSurface out = std::move(preview->net);
         ledger_ = std::numeric_limits<double>::infinity();  // no certificate until let go
         preview_figures(out, rep);
-        stage.light_map = std::move(map);
+        stage.light_map = std::move(preview->map);
         previewing_ = true;
         lattice_figures(d, rep);
         return out;

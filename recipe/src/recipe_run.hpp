@@ -13,6 +13,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -124,14 +125,21 @@ bool take_surface(const RunResult& previous, const SurfaceDef& def, RunResult& i
                   std::map<std::string, double>& bounds,
                   const std::function<void(const StepReport&)>& progress);
 
-/// The linear map of a lattice step's light form for a drag preview: `previous`'s for that step
-/// when it applies (deform::applies_to), else one made on the knots of the light form `previous`
-/// gave the step; empty when the deformation is not a Bézier or B-spline lattice or the step was
-/// neither a light form nor a refit.
-std::shared_ptr<const deform::LatticeLightMap> preview_map(const RunResult& previous,
-                                                           const deform::Deformation& d,
-                                                           const surface::BSplineSurface& s,
-                                                           const std::string& step);
+/// A lattice step's light net for a drag preview, and the map that gave it (null when fitted at
+/// once).
+struct PreviewLight {
+  surface::BSplineSurface net;
+  std::shared_ptr<const deform::LatticeLightMap> map;  ///< kept for the next update of the drag
+};
+
+/// The light net of a lattice step for a drag preview, on the knots of the light form `previous`
+/// gave the step: by `previous`'s map when it applies (deform::applies_to); by a new map when the
+/// step's input is the one `previous` deformed (the lattice is dragged); fitted at once otherwise
+/// (the input is dragged: deform::light_fit). Empty when the deformation is not a Bézier or
+/// B-spline lattice or the step was neither a light form nor a refit.
+std::optional<PreviewLight> preview_light(const RunResult& previous, const deform::Deformation& d,
+                                          const surface::BSplineSurface& s,
+                                          const std::string& step);
 
 /// The figures and message of a step previewed by its light map: light, preview, not
 /// certified, the bound ledger unbounded until the release.

@@ -62,17 +62,17 @@ bool take_surface(const RunResult& previous, const SurfaceDef& def, RunResult& i
   return true;
 }
 
-std::shared_ptr<const deform::LatticeLightMap> preview_map(const RunResult& previous,
-                                                           const deform::Deformation& d,
-                                                           const surface::BSplineSurface& s,
-                                                           const std::string& step) {
+std::optional<PreviewLight> preview_light(const RunResult& previous, const deform::Deformation& d,
+                                          const surface::BSplineSurface& s,
+                                          const std::string& step) {
   if (!std::holds_alternative<deform::BezierLattice>(d) &&
       !std::holds_alternative<deform::BSplineLattice>(d))
     return {};
   const auto stage = std::find_if(previous.stages.begin(), previous.stages.end(),
                                   [&](const Stage& st) { return st.step == step; });
   if (stage == previous.stages.end()) return {};
-  if (stage->light_map && deform::applies_to(*stage->light_map, d, s)) return stage->light_map;
+  if (stage->light_map && deform::applies_to(*stage->light_map, d, s))
+    return PreviewLight{deform::light_net(*stage->light_map, d), stage->light_map};
   const auto rep = std::find_if(previous.steps.begin(), previous.steps.end(),
                                 [&](const StepReport& r) { return r.path == step; });
   // A light form, or a refit (composition "refit", or a B-spline lattice's knot planes): both are
@@ -83,10 +83,18 @@ std::shared_ptr<const deform::LatticeLightMap> preview_map(const RunResult& prev
       (std::find(rep->figures.begin(), rep->figures.end(), light) == rep->figures.end() &&
        std::find(rep->figures.begin(), rep->figures.end(), refit) == rep->figures.end()))
     return {};
-  // The knots of the last light form serve any input: the map fits the moved lattice's image of
-  // this step's input on them (when the input changed too, it is made again at the next update).
-  return std::make_shared<const deform::LatticeLightMap>(
-      deform::lattice_light_map(d, s, stage->after));
+  // The knots of the last light form serve any input. The same input as the last run's: the
+  // lattice is what is dragged, so its map is made (kept for the next update). Another input: a
+  // drag upstream (a style's target), whose next update changes the input again, so the net is
+  // fitted at once, a third of a map's columns or fewer.
+  if (stage->before.points.rows() == s.points.rows() && stage->before.points == s.points &&
+      stage->before.u.knots == s.u.knots && stage->before.v.knots == s.v.knots &&
+      stage->before.weights == s.weights) {
+    auto map = std::make_shared<const deform::LatticeLightMap>(
+        deform::lattice_light_map(d, s, stage->after));
+    return PreviewLight{deform::light_net(*map, d), map};
+  }
+  return PreviewLight{deform::light_fit(d, s, stage->after), nullptr};
 }
 
 void preview_figures(const surface::BSplineSurface& net, StepReport& rep) {

@@ -289,6 +289,8 @@ TEST_CASE("run_recipe: a style target drag previews from a kept StyleEditor, the
   const surface::BSplineSurface& panel = plain.surface("panel");
   const double size =
       (panel.points.colwise().maxCoeff() - panel.points.colwise().minCoeff()).norm();
+  const double lattice_tolerance =
+      std::get<double>(*figure(step(plain, lattice_step), "tolerance_mm"));
   RunOptions o;
   o.cache = std::make_shared<RunCache>();
   o.previous = std::make_shared<const RunResult>(run(doc, o));
@@ -308,6 +310,27 @@ TEST_CASE("run_recipe: a style target drag previews from a kept StyleEditor, the
     CHECK(
         (preview.surface("styled").points - once.surface("styled").points).cwiseAbs().maxCoeff() <=
         1e-4 * size);
+    // The lattice after the style is previewed on its last knots, its moved input fitted at once
+    // (no map made for an input the next update changes): within its fit's tolerance of the
+    // lattice applied point by point to the previewed style.
+    const Stage& lattice = stage(preview, lattice_step);
+    CHECK_FALSE(lattice.light_map);
+    CHECK(lattice.before.points == preview.surface("styled").points);
+    const StepReport& lattice_rep = step(preview, lattice_step);
+    CHECK(std::get<bool>(*figure(lattice_rep, "preview")));
+    const surface::BSplineSurface& net = preview.surface("tank");
+    double worst = 0;
+    for (int i = 0; i <= 30; ++i)
+      for (int j = 0; j <= 30; ++j) {
+        const auto [a0, a1] = net.u.domain();
+        const auto [b0, b1] = net.v.domain();
+        const double u = a0 + (a1 - a0) * i / 30, v = b0 + (b1 - b0) * j / 30;
+        worst = std::max(worst, (surface::evaluate(net, u, v) -
+                                 lattice.map(surface::evaluate(lattice.before, u, v)))
+                                    .norm());
+      }
+    INFO("the lattice's preview off its map by " << worst << " mm");
+    CHECK(worst < lattice_tolerance);
   }
   // The release styles from scratch: the whole run of the recipe it leaves, bit for bit.
   o.preview = false;

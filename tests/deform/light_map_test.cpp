@@ -97,13 +97,45 @@ RefitOptions light_options() {
   return o;
 }
 
+/// A (3, 3, 1) Bézier lattice around the dome, one inner top point moved (4, -3, 18) mm.
+BezierLattice raised_lattice() {
+  BezierLattice lattice = make_bezier_lattice(box_frame(), {3, 3, 1});
+  lattice.points.row(lattice.index(1, 2, 1)) += Eigen::RowVector3d(4, -3, 18);
+  return lattice;
+}
+
+/// A frame over the dome's part at x > 30 mm (u > 0.3).
+Frame half_frame() {
+  Frame half;
+  half.origin = {30, -10, -20};
+  half.s = {90, 0, 0};
+  half.t = {0, 120, 0};
+  half.u = {0, 0, 60};
+  return half;
+}
+
+/// `light` made rational (one weight 2): not a net a light form has.
+surface::BSplineSurface rational_copy(const surface::BSplineSurface& light) {
+  surface::BSplineSurface rational = light;
+  rational.weights = Eigen::VectorXd::Constant(rational.points.rows(), 1.0);
+  rational.weights[3] = 2;
+  return rational;
+}
+
+/// `call` throws clay::Error(InvalidArgument) with a message that contains `says`.
+template <class Call>
+void check_refused(Call&& call, const std::string& says) {
+  const auto [category, message] = error_of(std::forward<Call>(call));
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Catch::Matchers::Contains(says));
+}
+
 }  // namespace
 
 TEST_CASE("lattice_light_map: the light form again at its own points, the moved one's fit after",
           "[light_map]") {
   const surface::BSplineSurface s = dome();
-  BezierLattice lattice = make_bezier_lattice(box_frame(), {3, 3, 1});
-  lattice.points.row(lattice.index(1, 2, 1)) += Eigen::RowVector3d(4, -3, 18);
+  const BezierLattice lattice = raised_lattice();
   const RefitResult light = refit_deformed(Deformation(lattice), s, light_options());
   REQUIRE(light.report.certified);
   INFO(light.surface.points.rows());
@@ -133,12 +165,7 @@ TEST_CASE("lattice_light_map: the light form again at its own points, the moved 
 TEST_CASE("lattice_light_map: a B-spline lattice over part of the surface (the rest stays)",
           "[light_map]") {
   const surface::BSplineSurface s = dome();
-  Frame half;
-  half.origin = {30, -10, -20};
-  half.s = {90, 0, 0};
-  half.t = {0, 120, 0};
-  half.u = {0, 0, 60};
-  BSplineLattice lattice = make_bspline_lattice(half, {2, 2, 1}, {3, 2, 1});
+  BSplineLattice lattice = make_bspline_lattice(half_frame(), {2, 2, 1}, {3, 2, 1});
   const RefitResult light = refit_deformed(Deformation(lattice), s, light_options());
   const LatticeLightMap map = lattice_light_map(lattice, s, light.surface);
   CHECK_FALSE(map.outside.isZero(0));  // the samples at u < 0.3 are left where they are
@@ -147,6 +174,36 @@ TEST_CASE("lattice_light_map: a B-spline lattice over part of the surface (the r
   CHECK(largest_difference(preview, least_squares_here(lattice, s, light.surface)) < 1e-9 * 100);
   // Far from the lattice the surface has not moved (the fit of the identity, to its tolerance).
   CHECK((surface::evaluate(preview, 0.02, 0.5) - surface::evaluate(s, 0.02, 0.5)).norm() < 0.05);
+}
+
+TEST_CASE("light_fit: the moved lattice's fit of another input at once, as the map would give",
+          "[light_map]") {
+  // A drag upstream of the lattice (a style's target) changes the lattice's input at every
+  // update: light_fit fits it on the last light form's knots without a map.
+  const surface::BSplineSurface s = dome();
+  const BezierLattice lattice = raised_lattice();
+  const RefitResult light = refit_deformed(Deformation(lattice), s, light_options());
+  surface::BSplineSurface input = s;  // the input pushed up in its middle, as a style does
+  for (Eigen::Index r = 0; r < input.points.rows(); ++r)
+    input.points(r, 2) +=
+        6 *
+        std::exp(-(input.points.row(r).head<2>() - Eigen::RowVector2d(50, 50)).squaredNorm() / 800);
+  const surface::BSplineSurface fitted = light_fit(lattice, input, light.surface);
+  CHECK(fitted.u.knots == light.surface.u.knots);
+  CHECK(fitted.v.knots == light.surface.v.knots);
+  CHECK(largest_difference(fitted, least_squares_here(lattice, input, light.surface)) < 1e-9 * 100);
+  CHECK(largest_difference(fitted, light_net(lattice_light_map(lattice, input, light.surface),
+                                             lattice)) < 1e-10 * 100);
+  CHECK(largest_difference(fitted, light.surface) > 1);  // it followed the input's push
+  // A B-spline lattice over part of the surface: the rest is fitted where it is.
+  BSplineLattice partial = make_bspline_lattice(half_frame(), {2, 2, 1}, {3, 2, 1});
+  partial.points.row(partial.index(2, 1, 1)) += Eigen::RowVector3d(2, 3, 12);
+  CHECK(largest_difference(light_fit(partial, input, light.surface),
+                           least_squares_here(partial, input, light.surface)) < 1e-9 * 100);
+
+  check_refused([&] { light_fit(flare(), input, light.surface); }, "light_fit: the deformation");
+  check_refused([&] { light_fit(lattice, input, rational_copy(light.surface)); },
+                "light_fit: the light form is rational");
 }
 
 TEST_CASE("lattice_light_map: other lattices, inputs and kinds are named", "[light_map][errors]") {
@@ -164,16 +221,7 @@ TEST_CASE("lattice_light_map: other lattices, inputs and kinds are named", "[lig
   CHECK_FALSE(applies_to(map, lattice, other));
   CHECK_FALSE(applies_to(map, flare(), s));
 
-  const auto [category, message] = error_of([&] { light_net(map, wider); });
-  CHECK(category == ErrorCategory::InvalidArgument);
-  CHECK_THAT(message, Catch::Matchers::Contains("make a new map"));
-  const auto [kind, why] = error_of([&] { lattice_light_map(flare(), s, light.surface); });
-  CHECK(kind == ErrorCategory::InvalidArgument);
-  CHECK_THAT(why, Catch::Matchers::Contains("refit it"));
-  surface::BSplineSurface rational = light.surface;
-  rational.weights = Eigen::VectorXd::Constant(rational.points.rows(), 1.0);
-  rational.weights[3] = 2;
-  const auto [r_kind, r_why] = error_of([&] { lattice_light_map(lattice, s, rational); });
-  CHECK(r_kind == ErrorCategory::InvalidArgument);
-  CHECK_THAT(r_why, Catch::Matchers::Contains("rational"));
+  check_refused([&] { light_net(map, wider); }, "make a new map");
+  check_refused([&] { lattice_light_map(flare(), s, light.surface); }, "refit it");
+  check_refused([&] { lattice_light_map(lattice, s, rational_copy(light.surface)); }, "rational");
 }

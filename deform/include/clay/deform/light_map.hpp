@@ -46,6 +46,15 @@ CLAY_DEFORM_API LatticeLightMap lattice_light_map(const Deformation& lattice,
 CLAY_DEFORM_API bool applies_to(const LatticeLightMap& map, const Deformation& lattice,
                                 const surface::BSplineSurface& input) noexcept;
 
+/// The light net of `input` deformed by `lattice` on the bases of `light`, fitted at once: what
+/// light_net(lattice_light_map(lattice, input, light), lattice) gives (to rounding), for three
+/// columns of samples instead of one per lattice point. For an input that changes at every call
+/// (a drag upstream of the lattice: the style's target), where a map would serve once. Throws
+/// clay::Error as lattice_light_map does.
+CLAY_DEFORM_API surface::BSplineSurface light_fit(const Deformation& lattice,
+                                                  const surface::BSplineSurface& input,
+                                                  const surface::BSplineSurface& light);
+
 /// The light net of map.input deformed by `lattice` (its points moved): Σ_a N_a P_a + C_out, then
 /// closed sides kept closed and poles kept one point, as the light form's fit does. Throws
 /// clay::Error(InvalidArgument) when the map does not apply to the lattice's structure (then make

@@ -188,9 +188,8 @@ struct Stage {
   std::vector<std::string> curves;  ///< names of the curves the step used, in RunResult::curves
   /// The step's deformation of space, point by point (`after` equals it applied to `before`,
   /// exactly or within the refit's bound); empty for a style step, which moves control points.
-  std::function<Eigen::Vector3d(const Eigen::Vector3d&)>
-      map;  /// A lattice step's light form as a linear map of its points (RunOptions::preview),
-            /// kept for
+  std::function<Eigen::Vector3d(const Eigen::Vector3d&)> map;
+  /// A lattice step's light form as a linear map of its points (RunOptions::preview), kept for
   /// the next update of the same drag; empty otherwise.
   std::shared_ptr<const deform::LatticeLightMap> light_map;
 };
