@@ -87,9 +87,7 @@ std::optional<PreviewLight> preview_light(const RunResult& previous, const defor
   // lattice is what is dragged, so its map is made (kept for the next update). Another input: a
   // drag upstream (a style's target), whose next update changes the input again, so the net is
   // fitted at once, a third of a map's columns or fewer.
-  if (stage->before.points.rows() == s.points.rows() && stage->before.points == s.points &&
-      stage->before.u.knots == s.u.knots && stage->before.v.knots == s.v.knots &&
-      stage->before.weights == s.weights) {
+  if (surface::identical(stage->before, s)) {
     auto map = std::make_shared<const deform::LatticeLightMap>(
         deform::lattice_light_map(d, s, stage->after));
     return PreviewLight{deform::light_net(*map, d), map};
