@@ -557,7 +557,7 @@ const Eigen::MatrixXd& energy_inverse_times(const NetCache& net, const Eigen::Ma
   if (kept.net.get() == &net && kept.B.cols() == nf)
     while (same < std::min(nk, kept.B.rows()) && kept.B.row(same) == B.row(same)) ++same;
   Eigen::MatrixXd Y(nf, nk);
-  Y.leftCols(same) = kept.Y.leftCols(same);
+  if (same > 0) Y.leftCols(same) = kept.Y.leftCols(same);  // (an empty kept.Y has no rows)
   if (same < nk) {
     const Eigen::MatrixXd fresh = B.bottomRows(nk - same).transpose();
     if (net.inverse.size() > 0) {
