@@ -10,6 +10,7 @@
 #include <clay/internal/files.hpp>
 #include <clay/internal/json_reader.hpp>
 #include <clay/occt/model_exchange.hpp>
+#include <clay/recipe/document.hpp>
 #include <clay/recipe/path.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/sketch/fit.hpp>
@@ -21,6 +22,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <functional>
 #include <map>
@@ -234,10 +236,16 @@ struct StudioSession::Impl {
     /// the number of entries times the recipe (issue #40).
     Json changes = nullptr;
   };
+  /// recipe::check's limit of a recipe's text, which an edit's document is checked without.
+  static constexpr std::size_t recipe_bytes = 64u << 20;
   /// A group's changes past which its entry is autosaved as its text again.
   static constexpr std::size_t group_changes_kept = 256;
   std::vector<Entry> history;
   int position = 0;
+  /// Counts the changes of the current text (an edit, an undo, a redo, a restore): an edit's
+  /// reply carries its changes from `revision - 1` instead of the whole text, and the page,
+  /// holding that revision, applies them (issue #40: the text grew every reply with the recipe).
+  std::uint64_t revision = 0;
   std::size_t dropped = 0;  // oldest entries dropped to keep the history within history_limit
   std::size_t history_limit = history_bytes;
   /// Per model, the topology key of the mesh last sent (topology_key): while it holds, runs send
@@ -298,7 +306,9 @@ struct StudioSession::Impl {
           const std::optional<std::vector<std::string>>& changed = std::nullopt,
           bool preview = false, const std::string& profile = "",
           std::shared_ptr<const Json> parsed = nullptr) const {
-    const Recipe recipe = parse_recipe(recipe_text, base_dir, name);
+    // An edit's document is checked as it is: its text, printed from it, need not be parsed.
+    const Recipe recipe = parsed ? parse_recipe_document(parsed, base_dir, name)
+                                 : parse_recipe(recipe_text, base_dir, name);
     RunOptions options;
     options.profile = profile;  // the export's receiver, for the deformed models
     options.cache = cache;
@@ -425,8 +435,10 @@ struct StudioSession::Impl {
   /// net frame per final surface, a curve frame per named curve, and a net frame per deformed
   /// final surface's parent before its first step, each only when it differs from the one last
   /// sent (the others named under "kept"). Without `nets` (a drag update the page draws
-  /// itself), no frames: the figures and the history only.
-  Reply ran(const std::string& op, const Run& run, bool nets = true) const {
+  /// itself), no frames: the figures and the history only. With `changes` (an edit's), the
+  /// reply carries them and the revision they apply to instead of the recipe's whole text.
+  Reply ran(const std::string& op, const Run& run, bool nets = true,
+            const Json* changes = nullptr) const {
     const RunResult& result = *run.result;
     Reply reply;
     // What the page will hold once it has this reply, made aside and kept only when the whole
@@ -551,7 +563,13 @@ struct StudioSession::Impl {
         models.push_back(m.name);
       }
     Json out = {{"op", op},       {"recipe", result.recipe},   {"seconds", result.seconds},
-                {"steps", steps}, {"history", history_json()}, {"text", text()}};
+                {"steps", steps}, {"history", history_json()}, {"revision", revision}};
+    if (changes) {
+      out["changes"] = *changes;
+      out["from_revision"] = revision - 1;
+    } else {
+      out["text"] = text();
+    }
     if (nets) {
       out["surfaces"] = surfaces;
       out["curves"] = curves;
@@ -584,7 +602,7 @@ struct StudioSession::Impl {
   }
 
   Reply recipe_text(const Json&, const Cancel&) {
-    return {reply_text(Json{{"op", "recipe"}, {"text", text()}}), {}};
+    return {reply_text(Json{{"op", "recipe"}, {"text", text()}, {"revision", revision}}), {}};
   }
 
   Reply fit(const Json& c, const Cancel&) { return {reply_text(fit_reply(c)), {}}; }
@@ -606,6 +624,7 @@ struct StudioSession::Impl {
                       " of " + std::to_string(history.size()) + ")");
     const Run result = run(history[static_cast<std::size_t>(to)].text, cancelled);
     position = to;
+    ++revision;
     save_soon();
     return ran(op, result);
   }
@@ -635,11 +654,18 @@ struct StudioSession::Impl {
     std::string first_path;
     for (const Json& change : changes) apply_change(doc, change, first_path);
     std::string next = doc.dump(1, ' ', false, Json::error_handler_t::replace);
+    if (next.size() > recipe_bytes)
+      throw Error(ErrorCategory::InvalidArgument,
+                  "studio: the edit makes the recipe " + std::to_string(next.size()) +
+                      " bytes, over the recipe limit of " + std::to_string(recipe_bytes) +
+                      " (64 MiB); nothing changed");
     // A recipe the edit breaks throws: nothing changes. An edit of deformations alone reruns
     // only what they touch; a drag update (no nets) previews a lattice's light form.
     const auto changed = changed_deformations(doc);
     const Run result =
         run(next, cancelled, changed, !nets, "", std::make_shared<const Json>(std::move(doc)));
+    ++revision;
+    const Json applied = changes;  // the reply's: the page applies them to the text it holds
     // The updates of one drag share a "group": the latest replaces the entry an earlier one
     // made, so the drag is one step of the history.
     const auto at = static_cast<std::size_t>(position);
@@ -656,7 +682,7 @@ struct StudioSession::Impl {
     } else {
       push({label.value_or("edit " + first_path), std::move(next), group, std::move(changes)});
     }
-    return ran("edit", result, nets);
+    return ran("edit", result, nets, &applied);
   }
 
   /// "export" {folder, name?, profile?}: the final surfaces as STEP, IGES and glTF
@@ -910,6 +936,7 @@ std::size_t StudioSession::restore(const fs::path& file) {
   parse_recipe(entries[position].text, impl_->base_dir, impl_->name);  // its problems, named
   impl_->history = std::move(entries);
   impl_->position = static_cast<int>(position);
+  ++impl_->revision;
   impl_->restored = {{"entries", impl_->history.size()}, {"file", file.filename().string()}};
   return impl_->history.size();
 }

@@ -4,6 +4,8 @@
 #include "recipe_checker.hpp"
 #include "run_cache.hpp"
 
+#include <clay/recipe/document.hpp>
+
 #include <clay/internal/files.hpp>
 
 namespace clay::recipe {
@@ -528,6 +530,64 @@ Json parse_reporting_duplicates(std::string_view text, Checker& c) {
 
 }  // namespace
 
+namespace {
+
+/// Where a parsed document's arrays and objects first nest deeper than limit::depth, named by
+/// the top-level key it is under (too_deep of the text, for a document held parsed).
+std::optional<Problem> too_deep(const Json& root) {
+  // Iterative: a document built in code may nest without bound.
+  std::vector<std::pair<const Json*, int>> open{{&root, 0}};
+  std::vector<std::string> top_keys{""};
+  while (!open.empty()) {
+    const auto [node, depth] = open.back();
+    const std::string top = top_keys.back();
+    open.pop_back();
+    top_keys.pop_back();
+    if (!node->is_structured()) continue;
+    if (depth + 1 > limit::depth)
+      return Problem{top.empty() ? "(top level)" : top,
+                     "arrays and objects nest deeper than " + std::to_string(limit::depth) +
+                         " levels here (recipe limit; a recipe needs at most 8): remove the "
+                         "extra brackets",
+                     0, 0};
+    if (node->is_object())
+      for (const auto& [key, value] : node->items()) {
+        open.emplace_back(&value, depth + 1);
+        top_keys.push_back(depth == 0 ? key : top);
+      }
+    else
+      for (const Json& value : *node) {
+        open.emplace_back(&value, depth + 1);
+        top_keys.push_back(top);
+      }
+  }
+  return std::nullopt;
+}
+
+/// The schema's checks of a parsed document (whose syntax, duplicate keys and depth are checked).
+CheckOutcome check_parsed(std::shared_ptr<const Json> root, const fs::path& base_dir, Checker& c) {
+  CheckOutcome out;
+  RecipeChecker rc(c, base_dir);
+  rc.run(*root);
+  out.data = std::move(rc.data);
+  out.problems = recipe_problems(c);
+  if (out.problems.empty())
+    out.data.document =
+        std::make_shared<const detail::DocumentJson>(detail::DocumentJson{std::move(root)});
+  return out;
+}
+
+/// The problems as clay::Error(Document), one per line after `what` ("the recipe has 2
+/// problems:").
+[[noreturn]] void throw_problems(const std::string& what, const std::vector<Problem>& problems) {
+  std::string m = what + "the recipe has " + std::to_string(problems.size()) + " problem" +
+                  (problems.size() == 1 ? "" : "s") + ":";
+  for (const auto& p : problems) m += "\n  " + to_string(p);
+  throw Error(ErrorCategory::Document, m);
+}
+
+}  // namespace
+
 CheckOutcome check(std::string_view text, const fs::path& base_dir) {
   Checker c;
   CheckOutcome out;
@@ -568,14 +628,7 @@ CheckOutcome check(std::string_view text, const fs::path& base_dir) {
           {"(syntax)", what + "; give finite numbers within the range of a double", 0, 0});
     return out;
   }
-  RecipeChecker rc(c, base_dir);
-  rc.run(root);
-  out.data = std::move(rc.data);
-  out.problems = recipe_problems(c);
-  if (out.problems.empty())
-    out.data.document =
-        std::make_shared<const detail::DocumentJson>(detail::DocumentJson{std::move(root)});
-  return out;
+  return check_parsed(std::make_shared<const Json>(std::move(root)), base_dir, c);
 }
 
 SketchDef rebuild_sketch(
@@ -737,24 +790,27 @@ std::vector<Problem> check_recipe(std::string_view text, const fs::path& base_di
 Recipe parse_recipe(std::string_view text, const fs::path& base_dir,
                     std::string_view default_name) {
   CheckOutcome out = check(text, base_dir);
-  if (!out.problems.empty()) {
-    std::string m = "the recipe has " + std::to_string(out.problems.size()) + " problem" +
-                    (out.problems.size() == 1 ? "" : "s") + ":";
-    for (const auto& p : out.problems) m += "\n  " + to_string(p);
-    throw Error(ErrorCategory::Document, m);
-  }
+  if (!out.problems.empty()) throw_problems("", out.problems);
+  if (out.data.name.empty()) out.data.name = std::string(default_name);
+  return Recipe{std::make_shared<const RecipeData>(std::move(out.data))};
+}
+
+Recipe parse_recipe_document(std::shared_ptr<const nlohmann::ordered_json> document,
+                             const fs::path& base_dir, std::string_view default_name) {
+  if (!document)
+    throw Error(ErrorCategory::InvalidArgument,
+                "parse_recipe_document: the document is null; pass a parsed recipe");
+  if (auto deep = too_deep(*document)) throw_problems("", {*deep});
+  Checker c;
+  CheckOutcome out = check_parsed(std::move(document), base_dir, c);
+  if (!out.problems.empty()) throw_problems("", out.problems);
   if (out.data.name.empty()) out.data.name = std::string(default_name);
   return Recipe{std::make_shared<const RecipeData>(std::move(out.data))};
 }
 
 Recipe load_recipe(const fs::path& file) {
   CheckOutcome out = check(internal::read_text(file, "recipe"), file.parent_path());
-  if (!out.problems.empty()) {
-    std::string m = file.string() + ": the recipe has " + std::to_string(out.problems.size()) +
-                    " problem" + (out.problems.size() == 1 ? "" : "s") + ":";
-    for (const auto& p : out.problems) m += "\n  " + to_string(p);
-    throw Error(ErrorCategory::Document, m);
-  }
+  if (!out.problems.empty()) throw_problems(file.string() + ": ", out.problems);
   if (out.data.name.empty()) out.data.name = file.stem().string();
   return Recipe{std::make_shared<const RecipeData>(std::move(out.data))};
 }

@@ -53,8 +53,8 @@ void RunCache::clear() {
 namespace detail {
 
 std::string definition_text(const DocumentJson& doc, const char* section, const std::string& name) {
-  const auto s = doc.root.find(section);
-  if (s == doc.root.end() || !s->is_object()) return {};
+  const auto s = doc.root->find(section);
+  if (s == doc.root->end() || !s->is_object()) return {};
   const auto n = s->find(name);
   return n == s->end() ? std::string() : n->dump();
 }
@@ -126,8 +126,8 @@ std::optional<std::string> surface_key(
     const std::vector<std::pair<std::string, surface::BSplineSurface>>& before) {
   std::optional<std::string> k = own_key(data, g, "surfaces", def.name, needs);
   if (!k) return k;
-  const auto comp = data.document->root.find("composition");
-  *k += "\ncomposition " + (comp == data.document->root.end() ? std::string() : comp->dump());
+  const auto comp = data.document->root->find("composition");
+  *k += "\ncomposition " + (comp == data.document->root->end() ? std::string() : comp->dump());
   if (const auto* d = std::get_if<DeformDef>(&def.build)) {
     *k += "\nstack " + definition_text(*data.document, "deformations", d->deformation);
     *k += built_on(data, def.name) ? "\nbuilt on" : "\nfinal";

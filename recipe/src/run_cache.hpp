@@ -20,9 +20,10 @@
 namespace clay::recipe::detail {
 
 /// The recipe's JSON as checked (RecipeData::document): each step's key starts with its own
-/// definition's text.
+/// definition's text. Shared with the caller that checked a document it holds
+/// (parse_recipe_document: the studio's edited recipe is neither copied nor parsed again).
 struct DocumentJson {
-  nlohmann::ordered_json root;
+  std::shared_ptr<const nlohmann::ordered_json> root;
 };
 
 /// The text of `root[section][name]` (its JSON, as written), or "" when absent.

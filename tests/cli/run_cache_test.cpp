@@ -4,6 +4,8 @@
 // bit for bit against a whole run of the same recipe without a cache.
 #include <catch2/catch.hpp>
 
+#include <clay/error.hpp>
+#include <clay/recipe/document.hpp>
 #include <clay/recipe/recipe.hpp>
 #include <clay/studio.hpp>
 #include <clay/surface/bspline_curve.hpp>
@@ -12,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -323,4 +326,103 @@ TEST_CASE(
       for (const auto& [key, value] : s.figures)
         if (key == "max_deviation_mm")
           CHECK(figures.at(key).get<double>() == std::get<double>(value));
+}
+
+TEST_CASE("parse_recipe_document: a document held parsed runs as its text does",
+          "[recipe][cache]") {
+  // The studio checks its edited document without printing and parsing it (issue #40): the
+  // same recipe, the same cache keys, bit for bit what the text gives.
+  const std::string text = tank().dump();
+  const auto document =
+      std::make_shared<const nlohmann::ordered_json>(nlohmann::ordered_json::parse(text));
+  const auto cache = std::make_shared<RunCache>();
+  RunOptions options;
+  options.cache = cache;
+  const RunResult held =
+      run_recipe(parse_recipe_document(document, tank_file.parent_path(), "tank"), options);
+  require_identical(held, run(tank()));
+  CHECK(built(held) == tank_steps);
+  // The text's run meets every step the document's run kept: the keys are the same.
+  CHECK(built(run(tank(), cache)).empty());
+  CHECK(cache->counts().reused == 10);
+
+  SECTION("its problems are the text's, in one error") {
+    nlohmann::ordered_json bad = *document;
+    bad["surfaces"]["panel"]["fill"]["curvs"] = 1;
+    bad["strokes"]["left"]["tolerance_mm"] = -1;
+    std::string from_text;
+    try {
+      (void)parse_recipe(bad.dump(), tank_file.parent_path());
+    } catch (const clay::Error& e) {
+      from_text = e.message();
+    }
+    REQUIRE(from_text.find("the recipe has 2 problems:") != std::string::npos);
+    try {
+      (void)parse_recipe_document(std::make_shared<const nlohmann::ordered_json>(bad),
+                                  tank_file.parent_path());
+      FAIL("a document with two problems was accepted");
+    } catch (const clay::Error& e) {
+      CHECK(e.category() == clay::ErrorCategory::Document);
+      CHECK(e.message() == from_text);
+    }
+  }
+  SECTION("a document nested deeper than a text may be is refused by its section") {
+    nlohmann::ordered_json deep = *document;
+    nlohmann::ordered_json* node = &deep["notes"];
+    for (int k = 0; k < 70; ++k) node = &(*node)["x"];
+    *node = 1;
+    try {
+      (void)parse_recipe_document(std::make_shared<const nlohmann::ordered_json>(deep));
+      FAIL("a document nested 70 deep was accepted");
+    } catch (const clay::Error& e) {
+      CHECK(e.category() == clay::ErrorCategory::Document);
+      CHECK_THAT(e.message(), Catch::Contains("notes: arrays and objects nest deeper than 64"));
+    }
+  }
+  SECTION("a null document is named") {
+    CHECK_THROWS_MATCHES(parse_recipe_document(nullptr), clay::Error,
+                         Catch::Matchers::Predicate<clay::Error>([](const clay::Error& e) {
+                           return e.category() == clay::ErrorCategory::InvalidArgument &&
+                                  e.message().find("the document is null") != std::string::npos;
+                         }));
+  }
+}
+
+TEST_CASE("studio session: an edit's reply carries its changes and revisions, not the text",
+          "[recipe][studio]") {
+  // Issue #40: the reply of every edit held the recipe's whole text, which grew with the design.
+  // Now it holds the edit's changes and the revision they apply to; the text held at that
+  // revision, changed by them (here by JSON pointers, independently of the session), is the
+  // session's new text. Runs, undos and redos still carry the text.
+  StudioSession session(tank().dump(), tank_file.parent_path(), "tank");
+  const Json ran = Json::parse(session.handle(R"({"op": "run"})").json);
+  REQUIRE(ran.at("op") == "run");
+  const auto revision = ran.at("revision").get<std::uint64_t>();
+  Json held = Json::parse(ran.at("text").get<std::string>());
+  const Json changes =
+      Json::array({{{"path", "strokes.extra"},
+                    {"value", {{"points", {{0, 300, 0}, {100, 302, 4}, {200, 301, 9}}}}},
+                    {"create", true}},
+                   {{"path", "strokes.left.tolerance_mm"}, {"value", 0.4}}});
+  const Json edited =
+      Json::parse(session.handle(Json{{"op", "edit"}, {"changes", changes}}.dump()).json);
+  REQUIRE(edited.at("op") == "edit");
+  CHECK_FALSE(edited.contains("text"));
+  CHECK(edited.at("from_revision") == revision);
+  CHECK(edited.at("revision") == revision + 1);
+  CHECK(edited.at("changes") == changes);
+  held["/strokes/extra"_json_pointer] = changes[0]["value"];
+  held["/strokes/left/tolerance_mm"_json_pointer] = 0.4;
+  CHECK(held == Json::parse(session.text()));
+  // A refused edit changes nothing: no revision is spent.
+  const Json refused = Json::parse(
+      session.handle(R"({"op": "edit", "path": "strokes.left.tolerance_mm", "value": -1})").json);
+  CHECK(refused.at("op") == "error");
+  const Json undone = Json::parse(session.handle(R"({"op": "undo"})").json);
+  CHECK(undone.at("revision") == revision + 2);
+  CHECK(Json::parse(undone.at("text").get<std::string>()) ==
+        Json::parse(ran.at("text").get<std::string>()));
+  const Json asked = Json::parse(session.handle(R"({"op": "recipe"})").json);
+  CHECK(asked.at("revision") == revision + 2);
+  CHECK(asked.at("text") == session.text());
 }

@@ -154,6 +154,13 @@ export default async function design({ check, withEmptyRecipe, figures, shot }) 
       const moved = (i, j) => Math.hypot(...[0, 1, 2].map((c) => redrawn[i][c] - before[j][c]));
       assert(moved(0, 0) === 0 && moved(redrawn.length - 1, before.length - 1) === 0, 's3 keeps its corner ends');
       assert(!(await k.lastError()), `after the oversketch: ${await k.lastError()}`);
+      // An edit's reply carries its changes, not the recipe's text: the page's recipe, made from
+      // 40-odd such replies, is the kernel's text, key for key and in its order.
+      const last = await k.call(() => window.clayStudio.reply());
+      assert(Array.isArray(last.changes) && !('text' in last), `the last edit's reply has ${Object.keys(last)}`);
+      const held = { recipe: await k.call(() => window.clayStudio.recipe()), revision: await k.call(() => window.clayStudio.revision()) };
+      const { reply: whole } = await k.call(() => window.clayStudio.send({ op: 'recipe' }));
+      assert(held.revision === whole.revision && JSON.stringify(JSON.parse(whole.text)) === JSON.stringify(held.recipe), `the page's recipe (revision ${held.revision}) is not the kernel's (revision ${whole.revision})`);
       figures.design = { strokes: drawn, kept_out_of_tolerance: warned.length, latency_ms: latency, parts_p50_ms: breakdown, oversketch: { points_before: before.length, points_after: redrawn.length } };
       return `40 strokes kept (${warned.length} as best fits, said so), none split or taken for an oversketch, s3 oversketched; pointer-up to curve drawn p50/p95: ${latency.strokes_1_5.p50}/${latency.strokes_1_5.p95} ms at 1-5, ${latency.strokes_18_22.p50}/${latency.strokes_18_22.p95} at 18-22, ${latency.strokes_36_40.p50}/${latency.strokes_36_40.p95} at 36-40`;
     }),

@@ -220,3 +220,70 @@ export function nearestEnds(a, b) {
     }
   return best;
 }
+
+/**
+ * The tokens of a recipe path ("deformations.lift[0].moves[1].by[2]": keys and list indices as
+ * numbers), in the kernel's grammar (recipe::parse_path); null for a path it refuses.
+ */
+export function pathTokens(path) {
+  const tokens = [];
+  let expectKey = true; // at the start or after '.': a key must come
+  for (let i = 0; i < path.length; ) {
+    const c = path[i];
+    if (c === '[') {
+      const close = path.indexOf(']', i);
+      const digits = close < 0 ? '' : path.slice(i + 1, close);
+      if (!tokens.length || expectKey || !/^[0-9]+$/.test(digits)) return null;
+      tokens.push(Number(digits));
+      i = close + 1;
+    } else if (c === '.') {
+      if (expectKey) return null;
+      expectKey = true;
+      i++;
+    } else {
+      if (c === ']' || !expectKey) return null;
+      let end = i;
+      while (end < path.length && !'.[]'.includes(path[end])) end++;
+      tokens.push(path.slice(i, end));
+      i = end;
+      expectKey = false;
+    }
+  }
+  return tokens.length && !expectKey ? tokens : null;
+}
+
+/**
+ * The recipe with an edit's changes applied as the kernel applied them (studio_session.cpp
+ * apply_change: {path, value, create?} sets, {path, remove: true} removes), or null when one
+ * does not apply (the page's copy is not the kernel's: ask for the text). The recipe is not
+ * changed: the objects along each path are copied, the rest shared, so what another part of the
+ * page holds of the old recipe stays as it was.
+ */
+export function applyChanges(recipe, changes) {
+  let root = recipe;
+  for (const change of changes) {
+    const tokens = pathTokens(String(change.path));
+    if (!tokens || tokens.includes('__proto__')) return null; // an assignment would not make that key
+    root = { ...root };
+    let node = root;
+    for (let k = 0; k < tokens.length - 1; k++) {
+      const t = tokens[k];
+      const child = node[t];
+      const has = Object.hasOwn(node, t) && child !== null && typeof child === 'object';
+      if (!has && (change.remove || !change.create || typeof t === 'number')) return null;
+      node[t] = has ? (Array.isArray(child) ? [...child] : { ...child }) : {};
+      node = node[t];
+    }
+    const last = tokens[tokens.length - 1];
+    const present = Array.isArray(node) ? typeof last === 'number' && last < node.length : Object.hasOwn(node, last);
+    if (change.remove) {
+      if (!present) return null;
+      if (Array.isArray(node)) node.splice(last, 1);
+      else delete node[last];
+    } else {
+      if (!present && (!change.create || Array.isArray(node))) return null;
+      node[last] = change.value;
+    }
+  }
+  return root;
+}

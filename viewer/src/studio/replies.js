@@ -2,6 +2,7 @@
 // and its frames made the document (nets, curves, models moved onto their faces' nets, deviation
 // maps), then every view redrawn; and the start: the socket opened and the recipe run.
 import { meshOnNets } from './nurbs.js';
+import { applyChanges } from './recipe_edits.js';
 import { $, body, showMessage, clearError } from './ui.js';
 import { doc, state, metrics, connect, busy, send, simple } from './store.js';
 import { dirty, setView } from './scene.js';
@@ -12,6 +13,12 @@ import { rebuildHandles } from './handles.js';
 import { showPanels, showReport, showHistory } from './panels.js';
 
 const session = { restoredShown: false }; // the autosave's continuation said once
+
+/** The recipe's whole text and its revision, from a run, an undo or redo, or the "recipe" op. */
+function holdText(reply) {
+  doc.recipe = JSON.parse(reply.text);
+  doc.revision = reply.revision;
+}
 
 function onReply(reply, frames, meta) {
   const receivedAt = performance.now();
@@ -39,6 +46,10 @@ function onReply(reply, frames, meta) {
     showMessage(`exported ${reply.files.join(', ')} into ${reply.folder} for ${reply.profile}${within}${reply.valid ? ' (read back and checked)' : ''}`);
     return;
   }
+  if (reply.op === 'recipe') {
+    holdText(reply);
+    return;
+  }
   if (!('steps' in reply)) return;
   metrics.kernel.push(reply.seconds * 1000);
   doc.reply = reply;
@@ -51,7 +62,19 @@ function onReply(reply, frames, meta) {
     showMessage(`continued the autosave ${reply.history.restored.file}: ${reply.history.restored.entries} history entries (start clayform studio with --fresh to begin from the recipe file)`);
   }
   if (reply.history.autosave_problem) showMessage(`autosave failed: ${reply.history.autosave_problem}`, true);
-  if (typeof reply.text === 'string') doc.recipe = JSON.parse(reply.text);
+  if (typeof reply.text === 'string') holdText(reply);
+  else if (Array.isArray(reply.changes)) {
+    // An edit's reply carries its changes, not the whole text (which grew every reply with the
+    // recipe): applied to the revision held, or the text asked for when the page holds another.
+    const next = reply.from_revision === doc.revision ? applyChanges(doc.recipe, reply.changes) : null;
+    if (next) {
+      doc.recipe = next;
+      doc.revision = reply.revision;
+    } else {
+      doc.revision = null;
+      setTimeout(() => send({ op: 'recipe' }));
+    }
+  }
   if (reply.nets === false) {
     // a drag update the page draws itself: the kernel's figures and history only
     metrics.drag.push({ at: performance.now(), ms: performance.now() - meta.inputAt });

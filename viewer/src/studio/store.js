@@ -6,7 +6,7 @@ import { Link } from './link.js';
 
 // What the last run gave: the recipe, its final surfaces' nets (and their parents before their
 // first step), every named curve's net, the history.
-export const doc = { recipe: {}, surfaces: new Map(), befores: new Map(), curves: new Map(), models: new Map(), deviations: new Map(), history: { entries: [], position: 0 }, steps: [], reply: null };
+export const doc = { recipe: {}, surfaces: new Map(), befores: new Map(), curves: new Map(), models: new Map(), deviations: new Map(), history: { entries: [], position: 0 }, steps: [], reply: null, revision: null };
 
 export const state = {
   selection: [], // [{kind: 'curve' | 'surface' | 'model', name}]

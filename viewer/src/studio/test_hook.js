@@ -16,6 +16,8 @@ function plainNet(s) {
 export function installTestHook() {
   window.clayStudio = {
     recipe: () => doc.recipe,
+    /** The revision of the recipe the page holds (null while it asks for the text). */
+    revision: () => doc.revision,
     history: () => doc.history,
     reply: () => doc.reply,
     /** The last run's step reports (as report.json has them). */
