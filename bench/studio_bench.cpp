@@ -30,6 +30,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 using namespace clay;
@@ -266,6 +267,34 @@ Json hand_stroke(double y, unsigned seed) {
           {"tolerance_mm", 0.5}};
 }
 
+// The iterations of a stroke benchmark: the stroke at `path` (the k-th hand stroke, at
+// y = -400 + 20 k) drawn again with a new tremor each time and timed as the page sends it, the
+// "fit" (does it split at corners?) then the "edit" that puts it in the recipe with its nets;
+// `untimed` runs before each.
+void draw_again(benchmark::State& state, recipe::StudioSession& session, const std::string& path,
+                int k, const std::function<void()>& untimed) {
+  unsigned seed = 1000;
+  clay::bench::StepTimes times;
+  for (auto _ : state) {
+    const Json stroke = hand_stroke(-400 + 20.0 * k, ++seed);
+    untimed();
+    const auto t0 = std::chrono::steady_clock::now();
+    Json fit = {{"op", "fit"}};
+    fit.update(stroke);
+    const auto asked = session.handle(fit.dump());
+    const auto reply = session.handle(
+        Json{{"op", "edit"}, {"path", path}, {"value", stroke}, {"label", "stroke"}}.dump());
+    times.record(t0);
+    if (reply.json.find("\"op\":\"error\"") != std::string::npos ||
+        asked.json.find("\"op\":\"error\"") != std::string::npos) {
+      state.SkipWithError((asked.json + reply.json).c_str());
+      break;
+    }
+    benchmark::DoNotOptimize(reply.json.data());
+  }
+  times.report(state);
+}
+
 // Issue #40: pointer-up to fitted curve in the studio, a design of N hand-drawn strokes
 // (Arg 0: N = 1, 20 or 40), the last stroke drawn again each iteration (its tremor differs):
 // the page's "fit" (does the stroke split at corners?) then the "edit" that puts it in the
@@ -281,26 +310,9 @@ void stroke_step(benchmark::State& state) {
   recipe::StudioSession session(doc.dump(), std::filesystem::temp_directory_path(), "strokes");
   session.handle(Json{{"op", "run"}}.dump());
   const std::string last = "strokes.s" + std::to_string(strokes - 1);
-  unsigned seed = 1000;
-  clay::bench::StepTimes times;
-  for (auto _ : state) {
-    const Json stroke = hand_stroke(-400 + 20.0 * (strokes - 1), ++seed);
+  draw_again(state, session, last, strokes - 1, [&] {
     if (!cached) session.run_cache()->clear();
-    const auto t0 = std::chrono::steady_clock::now();
-    Json fit = {{"op", "fit"}};
-    fit.update(stroke);
-    const auto asked = session.handle(fit.dump());
-    const auto reply = session.handle(
-        Json{{"op", "edit"}, {"path", last}, {"value", stroke}, {"label", "stroke"}}.dump());
-    times.record(t0);
-    if (reply.json.find("\"op\":\"error\"") != std::string::npos ||
-        asked.json.find("\"op\":\"error\"") != std::string::npos) {
-      state.SkipWithError((asked.json + reply.json).c_str());
-      break;
-    }
-    benchmark::DoNotOptimize(reply.json.data());
-  }
-  times.report(state);
+  });
   state.SetLabel(std::to_string(strokes) + " strokes, " +
                  (cached ? "after: the other steps taken from the run cache"
                          : "before: every step run again"));
@@ -320,25 +332,7 @@ void styled_stroke_step(benchmark::State& state) {
   recipe::StudioSession session(doc.dump(), file.parent_path(), "tank");
   session.handle(Json{{"op", "run"}}.dump());
   const std::string last = "strokes.h" + std::to_string(strokes - 1);
-  unsigned seed = 1000;
-  clay::bench::StepTimes times;
-  for (auto _ : state) {
-    const Json stroke = hand_stroke(-400 + 20.0 * (strokes - 1), ++seed);
-    const auto t0 = std::chrono::steady_clock::now();
-    Json fit = {{"op", "fit"}};
-    fit.update(stroke);
-    const auto asked = session.handle(fit.dump());
-    const auto reply = session.handle(
-        Json{{"op", "edit"}, {"path", last}, {"value", stroke}, {"label", "stroke"}}.dump());
-    times.record(t0);
-    if (reply.json.find("\"op\":\"error\"") != std::string::npos ||
-        asked.json.find("\"op\":\"error\"") != std::string::npos) {
-      state.SkipWithError((asked.json + reply.json).c_str());
-      break;
-    }
-    benchmark::DoNotOptimize(reply.json.data());
-  }
-  times.report(state);
+  draw_again(state, session, last, strokes - 1, [] {});
   state.SetLabel(std::to_string(strokes) + " strokes beside the tank's styled fill and lattice");
 }
 
