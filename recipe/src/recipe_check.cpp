@@ -535,31 +535,32 @@ namespace {
 /// Where a parsed document's arrays and objects first nest deeper than limit::depth, named by
 /// the top-level key it is under (too_deep of the text, for a document held parsed).
 std::optional<Problem> too_deep(const Json& root) {
-  // Iterative: a document built in code may nest without bound.
-  std::vector<std::pair<const Json*, int>> open{{&root, 0}};
-  std::vector<std::string> top_keys{""};
-  while (!open.empty()) {
-    const auto [node, depth] = open.back();
-    const std::string top = top_keys.back();
-    open.pop_back();
-    top_keys.pop_back();
-    if (!node->is_structured()) continue;
-    if (depth + 1 > limit::depth)
-      return Problem{top.empty() ? "(top level)" : top,
-                     "arrays and objects nest deeper than " + std::to_string(limit::depth) +
-                         " levels here (recipe limit; a recipe needs at most 8): remove the "
-                         "extra brackets",
-                     0, 0};
-    if (node->is_object())
-      for (const auto& [key, value] : node->items()) {
-        open.emplace_back(&value, depth + 1);
-        top_keys.push_back(depth == 0 ? key : top);
-      }
-    else
-      for (const Json& value : *node) {
-        open.emplace_back(&value, depth + 1);
-        top_keys.push_back(top);
-      }
+  // Iterative, level by level from 2 (the root's values): a document built in code may nest
+  // without bound.
+  auto deeper = [](const Json& value) {
+    std::vector<std::pair<const Json*, int>> open{{&value, 2}};
+    while (!open.empty()) {
+      const auto [node, level] = open.back();
+      open.pop_back();
+      if (!node->is_structured()) continue;
+      if (level > limit::depth) return true;
+      for (const Json& child : *node) open.emplace_back(&child, level + 1);
+    }
+    return false;
+  };
+  auto problem = [](const std::string& path) {
+    return Problem{path,
+                   "arrays and objects nest deeper than " + std::to_string(limit::depth) +
+                       " levels here (recipe limit; a recipe needs at most 8): remove the extra "
+                       "brackets",
+                   0, 0};
+  };
+  if (root.is_object()) {
+    for (const auto& [key, value] : root.items())
+      if (deeper(value)) return problem(key);
+  } else if (root.is_array()) {
+    for (const Json& value : root)
+      if (deeper(value)) return problem("(top level)");
   }
   return std::nullopt;
 }
