@@ -4,8 +4,9 @@
 // misses its tolerance is kept as the kernel's best curve, said as a warning), none split at a
 // corner it does not have or taken for an oversketch of a neighbour (no key held, as a hand
 // draws), and an edge's oversketch redraws it; the page's latency
-// from pointer-up to the curve drawn is reported at 1, 20 and 40 strokes (p50 and p95 of five
-// strokes each), not asserted: it depends on the machine (bench_studio measures the kernel).
+// from pointer-up to the curve drawn (its render issued) and on the screen (its frame committed)
+// is reported at 1, 20 and 40 strokes (p50 and p95 of five strokes each), not asserted: it
+// depends on the machine (bench_studio measures the kernel).
 import { quantile } from './geometry.mjs';
 import { assert } from './studio_harness.mjs';
 
@@ -47,7 +48,7 @@ export function hand(a, b, { bow = 0, tremor = 0.6, seed = 1, n = 48 } = {}) {
   });
 }
 
-export default async function design({ check, withEmptyRecipe, figures, shot }) {
+export default async function design({ check, withEmptyRecipe, figures, shot, browser }) {
   await check('a hand-drawn design of 40 strokes, a fill, a constraint, a style and a lattice: every stroke kept', async () =>
     withEmptyRecipe('design', async (p, k) => {
       await p.check('#snap'); // the corners snap to the grid, so the fill's edges meet
@@ -106,7 +107,11 @@ export default async function design({ check, withEmptyRecipe, figures, shot }) 
       await press('#build-style');
       // 37-40: more lines beside the bound, with the styled surface in the scene
       await p.click('#tool-sketch');
+      // CLAY_TRACE=FILE: a Chrome trace of these four strokes (chrome://tracing, Perfetto), as
+      // docs/studio.md § Measured read the page's side of a stroke beside a styled surface
+      if (process.env.CLAY_TRACE) await browser.startTracing(p, { path: process.env.CLAY_TRACE, categories: ['devtools.timeline', 'disabled-by-default-devtools.timeline', 'v8.execute', 'blink.user_timing', 'toplevel', 'gpu', 'cc', 'viz'] });
       for (const x of [-240, -200, 200, 240]) await stroke(hand([x, -110], [x + 5, 120], { bow: 6, seed: 200 + x }));
+      if (process.env.CLAY_TRACE) await browser.stopTracing();
       // a lattice on the styled surface
       await p.click('#tool-orbit');
       const surfaces = await k.call(() => Object.keys(window.clayStudio.surfaces()));
@@ -124,11 +129,13 @@ export default async function design({ check, withEmptyRecipe, figures, shot }) 
       const kinds = new Set(reply.steps.map((s) => s.kind));
       assert(['style'].every((kind) => kinds.has(kind)) && reply.steps.some((s) => /lattice/.test(s.kind)), `steps: ${[...kinds]}`);
       // The page's pointer-up to curve drawn, in windows of five strokes.
-      const ms = await k.call(() => window.clayStudio.metrics.stroke.map((m) => m.ms));
-      assert(ms.length === 40, `${ms.length} stroke latencies recorded`);
-      const window5 = (from) => ms.slice(from - 1, from + 4);
-      const at = (from) => ({ p50: Math.round(quantile(window5(from), 0.5)), p95: Math.round(quantile(window5(from), 0.95)) });
+      // Drawn: the render issued; on the screen: the frame committed (the next one begun).
+      const ms = await k.call(() => window.clayStudio.metrics.stroke.map((m) => [m.ms, m.shown]));
+      assert(ms.length === 40 && ms.every(([, shown]) => shown > 0), `${ms.length} stroke latencies recorded`);
+      const window5 = (from, j) => ms.slice(from - 1, from + 4).map((x) => x[j]);
+      const at = (from, j = 0) => ({ p50: Math.round(quantile(window5(from, j), 0.5)), p95: Math.round(quantile(window5(from, j), 0.95)) });
       const latency = { strokes_1_5: at(1), strokes_18_22: at(18), strokes_36_40: at(36) };
+      const onScreen = { strokes_1_5: at(1, 1), strokes_18_22: at(18, 1), strokes_36_40: at(36, 1) };
       // None taken for an oversketch, none split at a corner it does not have.
       const recipe = await k.call(() => window.clayStudio.recipe());
       const split = Object.entries(recipe.strokes || {}).filter(([, v]) => v.pieces > 1).map(([n, v]) => `${n}: ${v.pieces} pieces`);
@@ -161,8 +168,8 @@ export default async function design({ check, withEmptyRecipe, figures, shot }) 
       const held = { recipe: await k.call(() => window.clayStudio.recipe()), revision: await k.call(() => window.clayStudio.revision()) };
       const { reply: whole } = await k.call(() => window.clayStudio.send({ op: 'recipe' }));
       assert(held.revision === whole.revision && JSON.stringify(JSON.parse(whole.text)) === JSON.stringify(held.recipe), `the page's recipe (revision ${held.revision}) is not the kernel's (revision ${whole.revision})`);
-      figures.design = { strokes: drawn, kept_out_of_tolerance: warned.length, latency_ms: latency, parts_p50_ms: breakdown, oversketch: { points_before: before.length, points_after: redrawn.length } };
-      return `40 strokes kept (${warned.length} as best fits, said so), none split or taken for an oversketch, s3 oversketched; pointer-up to curve drawn p50/p95: ${latency.strokes_1_5.p50}/${latency.strokes_1_5.p95} ms at 1-5, ${latency.strokes_18_22.p50}/${latency.strokes_18_22.p95} at 18-22, ${latency.strokes_36_40.p50}/${latency.strokes_36_40.p95} at 36-40`;
+      figures.design = { strokes: drawn, kept_out_of_tolerance: warned.length, latency_ms: latency, on_screen_ms: onScreen, parts_p50_ms: breakdown, oversketch: { points_before: before.length, points_after: redrawn.length } };
+      return `40 strokes kept (${warned.length} as best fits, said so), none split or taken for an oversketch, s3 oversketched; pointer-up to curve drawn p50/p95: ${latency.strokes_1_5.p50}/${latency.strokes_1_5.p95} ms at 1-5, ${latency.strokes_18_22.p50}/${latency.strokes_18_22.p95} at 18-22, ${latency.strokes_36_40.p50}/${latency.strokes_36_40.p95} at 36-40; on the screen ${onScreen.strokes_1_5.p50}/${onScreen.strokes_1_5.p95}, ${onScreen.strokes_18_22.p50}/${onScreen.strokes_18_22.p95}, ${onScreen.strokes_36_40.p50}/${onScreen.strokes_36_40.p95}`;
     }),
   );
 }

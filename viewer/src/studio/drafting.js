@@ -5,7 +5,7 @@
 // placed on a plane. The underlay stays in this browser (localStorage), never sent to the kernel.
 import * as THREE from 'three';
 import { $, showMessage } from './ui.js';
-import { scene, canvas, camera, controls, dirty, pointerRay, onPlane, onSurface, millimetresPerPixel, isOrthographic, setOrthographic } from './scene.js';
+import { scene, canvas, controls, dirty, addOverlayPainter, overlayDirty, pointerRay, onPlane, onSurface, millimetresPerPixel, isOrthographic, setOrthographic } from './scene.js';
 
 // ------------------------------------------------------------------------------ the plane's frame
 /** Where the grid lies: set by wireDrafting (the sketch plane, which sketch_geometry.js owns). */
@@ -118,25 +118,29 @@ function formatMm(x) {
 }
 
 // ------------------------------------------------------------------------------ snap marker and cursor
-const marker = new THREE.Mesh(new THREE.RingGeometry(0.6, 1, 24), new THREE.MeshBasicMaterial({ color: 0xffd166, depthTest: false, side: THREE.DoubleSide }));
-marker.renderOrder = 5;
-marker.visible = false;
-scene.add(marker);
+// drawn on the view's overlay (scene.js): showing it as the pointer moves renders no scene
+const snapShown = { p: null };
+addOverlayPainter((ctx, at) => {
+  if (!snapShown.p) return;
+  const [x, y] = at(snapShown.p);
+  ctx.strokeStyle = '#ffd166';
+  ctx.lineWidth = 2;
+  ctx.beginPath();
+  ctx.arc(x, y, 4, 0, 2 * Math.PI);
+  ctx.stroke();
+});
 
-/** Shows (or hides, with null) where a stroke end would snap: a ring facing the viewer, 10 px wide. */
+/** Shows (or hides, with null) where a stroke end would snap: a ring 10 px wide. */
 export function showSnap(target) {
   if (!target) {
-    if (marker.visible) dirty();
-    marker.visible = false;
+    if (snapShown.p) overlayDirty();
+    snapShown.p = null;
     $('snap-target').textContent = '';
     return;
   }
-  marker.position.set(...target.p);
-  marker.quaternion.copy(camera.quaternion);
-  marker.scale.setScalar(5 * millimetresPerPixel(target.p));
-  marker.visible = true;
+  snapShown.p = target.p;
   $('snap-target').textContent = `snap: ${target.to === 'grid' ? 'grid node' : target.to}`;
-  dirty();
+  overlayDirty();
 }
 
 /** The point under the pointer: on the sketch plane when there is one, else on a surface, else on XY. */

@@ -128,8 +128,14 @@ function onReply(reply, frames, meta) {
     if (kind === 'drag') metrics.drag.push({ at: drawnAt, ms: drawnAt - meta.inputAt });
     if (kind === 'drag-end') metrics.dragEnd.push({ at: drawnAt, ms: drawnAt - meta.inputAt });
     // a stroke's latency in parts: the kernel's run, the rest until the reply was here (fit,
-    // socket, the server's reply), and the page's drawing after it
-    if (kind === 'stroke') metrics.stroke.push({ at: drawnAt, ms: drawnAt - meta.inputAt, kernel: 1000 * reply.seconds, received: receivedAt - meta.inputAt });
+    // socket, the server's reply), the page's drawing after it (`ms`, the render issued), and on
+    // the screen: the next frame starts once this one is committed (in software compositing,
+    // once its picture has been read back from the renderer: 55 ms with a styled surface in view)
+    if (kind === 'stroke') {
+      const m = { at: drawnAt, ms: drawnAt - meta.inputAt, kernel: 1000 * reply.seconds, received: receivedAt - meta.inputAt, shown: null };
+      metrics.stroke.push(m);
+      requestAnimationFrame(() => (m.shown = performance.now() - meta.inputAt));
+    }
     body.dataset.rendered = String(Number(body.dataset.rendered || 0) + 1);
   });
 }

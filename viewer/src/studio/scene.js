@@ -1,6 +1,6 @@
 // The scene the studio draws into: renderer, cameras (perspective or orthographic) and orbit
-// controls, lights, the groups each tool fills (surfaces, curves, handles, ink), the render loop,
-// the standard views, and the pointer's geometry (rays, screen points, a pixel's size in
+// controls, lights, the groups each tool fills (surfaces, curves, handles), the render loop and
+// the 2D overlay drawn over it (ink, the snap ring), the standard views, and the pointer's geometry (rays, screen points, a pixel's size in
 // millimetres). The grid and the other drafting aids are drafting.js's.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
@@ -30,26 +30,68 @@ controls.enableDamping = false;
 export const surfaceGroup = new THREE.Group();
 export const curveGroup = new THREE.Group();
 export const handleGroup = new THREE.Group();
-export const inkGroup = new THREE.Group();
-scene.add(surfaceGroup, curveGroup, handleGroup, inkGroup);
+scene.add(surfaceGroup, curveGroup, handleGroup);
 
 // A render is asked for with `dirty()` and done in the next animation frame: input handlers run
 // before it in the same frame, so ink drawn in a pointer event shows in that frame.
-const loop = { needsRender: false, lastFrameAt: null, afterRender: [] };
+const loop = { needsRender: false, needsOverlay: false, lastFrameAt: null, afterRender: [] };
 export function dirty(then) {
   if (then) loop.afterRender.push(then);
   loop.needsRender = true;
 }
-/** Whether a render was asked for and not yet done. */
-export const renderPending = () => loop.needsRender;
+/** Whether a render (of the scene or of the overlay) was asked for and not yet done. */
+export const renderPending = () => loop.needsRender || loop.needsOverlay;
+
+// The overlay: a 2D canvas over the view for what changes under the pointer (a stroke's ink, the
+// snap ring), drawn in 3D points projected with the camera of the frame, without rendering the
+// scene again. Each pointer move of a stroke was a render of the whole scene: with a styled
+// surface in view, 55 ms a frame in headless Chromium's software renderer, which the stroke's
+// release and its reply then waited behind (issue #40).
+const overlay = $('overlay');
+const painters = [];
+/** Adds `paint(ctx, at)` to the overlay's drawing: ctx a 2D context in CSS pixels, `at` a 3D point's [x, y] on it. */
+export function addOverlayPainter(paint) {
+  painters.push(paint);
+}
+/** Asks for the overlay alone to be drawn again in the next frame. */
+export function overlayDirty() {
+  loop.needsOverlay = true;
+}
+function drawOverlay() {
+  const box = canvas.getBoundingClientRect();
+  const scale = Math.min(window.devicePixelRatio || 1, 2);
+  const w = Math.max(1, Math.round(box.width * scale));
+  const h = Math.max(1, Math.round(box.height * scale));
+  if (overlay.width !== w || overlay.height !== h) {
+    overlay.width = w;
+    overlay.height = h;
+  }
+  const ctx = overlay.getContext('2d');
+  ctx.setTransform(scale, 0, 0, scale, 0, 0);
+  ctx.clearRect(0, 0, box.width, box.height);
+  const project = screenProjector();
+  const at = (p) => {
+    const [x, y] = project(p);
+    return [x - box.left, y - box.top];
+  };
+  for (const paint of painters) paint(ctx, at);
+}
+
 function frame(now) {
   if (state.dragging && loop.lastFrameAt !== null) metrics.frames.push(now - loop.lastFrameAt);
   loop.lastFrameAt = state.dragging ? now : null;
   if (loop.needsRender) {
     loop.needsRender = false;
+    loop.needsOverlay = true; // the camera may have moved: the overlay follows it
     key.position.copy(camera.position).add(new THREE.Vector3(300, 200, 800));
     key.target.position.copy(controls.target);
     renderer.render(scene, camera);
+  }
+  if (loop.needsOverlay) {
+    loop.needsOverlay = false;
+    drawOverlay();
+  }
+  if (loop.afterRender.length) {
     const done = performance.now();
     loop.afterRender.splice(0).forEach((f) => f(done));
   }
@@ -178,9 +220,23 @@ export function pointerRay(clientX, clientY) {
   return raycaster;
 }
 export function toScreen(p) {
+  return screenProjector()(p);
+}
+/**
+ * toScreen for many points under the camera as it is now: the canvas's box and the camera's
+ * matrices read once, no object made per point (snapping and oversketch tests project every
+ * point of every curve: with a Vector3 and a layout read per point, 12 ms at 40 strokes).
+ */
+export function screenProjector() {
   const rect = canvas.getBoundingClientRect();
-  const v = new THREE.Vector3(...p).project(camera);
-  return [rect.left + ((v.x + 1) / 2) * rect.width, rect.top + ((1 - v.y) / 2) * rect.height];
+  const m = new THREE.Matrix4().multiplyMatrices(camera.projectionMatrix, camera.matrixWorldInverse).elements;
+  return (p) => {
+    const [x, y, z] = p;
+    const w = m[3] * x + m[7] * y + m[11] * z + m[15];
+    const sx = (m[0] * x + m[4] * y + m[8] * z + m[12]) / w;
+    const sy = (m[1] * x + m[5] * y + m[9] * z + m[13]) / w;
+    return [rect.left + ((sx + 1) / 2) * rect.width, rect.top + ((1 - sy) / 2) * rect.height];
+  };
 }
 /** The size of a screen pixel, in mm, at the depth of point p. */
 export function millimetresPerPixel(p) {

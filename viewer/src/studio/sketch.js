@@ -4,43 +4,46 @@
 // its corners into pieces), ends snapped, mirrored when asked; an oversketch redraws part of a
 // stroke; with "restyle while drawing" the ink is the style's target as it is drawn. The ink stays
 // until the kernel's fitted curve replaces it.
-import * as THREE from 'three';
 import * as names from './recipe_edits.js';
 import { $, showMessage } from './ui.js';
 import { doc, selected, edit, dragEdit, commandOf, send, cancelDrag, newGroup } from './store.js';
-import { canvas, controls, inkGroup, dirty, pointerRay, onPlane, onSurface, toScreen } from './scene.js';
+import { canvas, controls, addOverlayPainter, overlayDirty, pointerRay, onPlane, onSurface, toScreen } from './scene.js';
 import { pickedPlane, placePickedPlane, sketchPlane, mirrorPlane, extrusionOf, onExtrusion, snapEnd, oversketchTarget, screenLength } from './sketch_geometry.js';
 import { activeStyle, liveTarget } from './style.js';
 
 // ink: the stroke being drawn {points: [[x,y,z]], plane, over, line, pointerId, live};
 // pending: ink shown until the kernel's fitted curve replaces it, {label, line};
-// lastLive: the last stroke drawn as a live style target {style, name, group, updates}
+// lastLive: the last stroke drawn as a live style target {style, name, group, updates}.
+// A line is the ink's points; every line is drawn on the view's overlay (scene.js), not in the
+// scene: a pointer move draws the overlay alone.
 const sketch = { ink: null, pending: [], lastLive: null };
+const INK_COLOUR = '#ffffff';
+addOverlayPainter((ctx, at) => {
+  const lines = sketch.pending.map((p) => p.line);
+  if (sketch.ink) lines.push(sketch.ink.line);
+  ctx.strokeStyle = INK_COLOUR;
+  ctx.lineWidth = 1.5;
+  ctx.lineJoin = 'round';
+  for (const line of lines) {
+    if (line.length < 2) continue;
+    ctx.beginPath();
+    line.forEach((p, k) => (k ? ctx.lineTo(...at(p)) : ctx.moveTo(...at(p))));
+    ctx.stroke();
+  }
+});
 
 /** Whether a stroke is being drawn. */
 export const inking = () => !!sketch.ink;
 /** The last stroke drawn as a live style target (for the test hook). */
 export const lastLive = () => sketch.lastLive;
 
-function inkLine() {
-  const line = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: 0xffffff, depthTest: false }));
-  line.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * 4096), 3));
-  line.geometry.setDrawRange(0, 0);
-  line.renderOrder = 3;
-  inkGroup.add(line);
-  return line;
-}
 function pushInk(p) {
   const ink = sketch.ink;
   const last = ink.points[ink.points.length - 1];
   if (last && Math.hypot(p[0] - last[0], p[1] - last[1], p[2] - last[2]) < 1e-6) return; // no repeated point
   if (ink.points.length >= 4096) return;
   ink.points.push(p);
-  const attr = ink.line.geometry.getAttribute('position');
-  attr.array.set(p, 3 * (ink.points.length - 1));
-  attr.needsUpdate = true;
-  ink.line.geometry.setDrawRange(0, ink.points.length);
-  dirty();
+  overlayDirty();
 }
 function inkPoint(event) {
   const ink = sketch.ink;
@@ -63,10 +66,8 @@ export function clearInk(command) {
   const pendingInk = sketch.pending;
   const i = pendingInk.findIndex((p) => p.label === command.label);
   if (i < 0) return;
-  inkGroup.remove(pendingInk[i].line);
-  pendingInk[i].line.geometry.dispose();
   pendingInk.splice(i, 1);
-  dirty();
+  overlayDirty();
 }
 
 function finishStroke(event) {
@@ -74,16 +75,14 @@ function finishStroke(event) {
   const pendingInk = sketch.pending;
   sketch.ink = null;
   if (points.length < 3) {
-    inkGroup.remove(line);
-    dirty();
+    overlayDirty();
     return;
   }
   const tolerance = Number($('stroke-tolerance').value) || 0.5; // mm: a stroke's tolerance_mm
   const dropInk = () => {
-    inkGroup.remove(line);
     const i = pendingInk.findIndex((p) => p.line === line);
     if (i >= 0) pendingInk.splice(i, 1);
-    dirty();
+    overlayDirty();
   };
   if (live) {
     // the live target's last update: the whole stroke, in the drawing's history entry
@@ -211,7 +210,8 @@ export function sketchDown(event) {
     return;
   }
   const plane = on === 'surface' || on === 'over' ? null : sketchPlane();
-  sketch.ink = { points: [], plane, over, line: inkLine(), pointerId: event.pointerId };
+  const points = [];
+  sketch.ink = { points, plane, over, line: points, pointerId: event.pointerId };
   // Restyle while drawing: the stroke is the selected style's new target from its first
   // points on, each pointer move one drag update (newest wins), the release the last.
   const style = !over && $('style-live').checked ? activeStyle() : null;

@@ -6,7 +6,7 @@ import * as THREE from 'three';
 import { curvePolyline } from './nurbs.js';
 import { $, showMessage } from './ui.js';
 import { doc } from './store.js';
-import { scene, camera, controls, curveGroup, dirty, sceneBox, toScreen, millimetresPerPixel } from './scene.js';
+import { scene, camera, controls, curveGroup, dirty, sceneBox, screenProjector, millimetresPerPixel } from './scene.js';
 import { PICK_PX } from './select.js';
 import { gridNode } from './drafting.js';
 
@@ -135,8 +135,8 @@ function curveEnds() {
   return out;
 }
 const SNAP_PX = 12;
-/** A polyline's length on the screen, in pixels. */
-export function screenLength(points) {
+/** A polyline's length on the screen, in pixels (`toScreen`: a projector already made, or one made here). */
+export function screenLength(points, toScreen = screenProjector()) {
   let length = 0;
   for (let i = 1; i < points.length; i++) {
     const a = toScreen(points[i - 1]);
@@ -147,6 +147,7 @@ export function screenLength(points) {
 }
 /** The stroke's end point snapped: to a curve end, else a curve, else a node of the grid drawn; or null. */
 export function snapEnd(p) {
+  const toScreen = screenProjector();
   const s = toScreen(p);
   let best = null;
   for (const e of curveEnds()) {
@@ -155,13 +156,17 @@ export function snapEnd(p) {
     if (d < SNAP_PX && (!best || d < best.d)) best = { d, p: e.p, to: `${e.name}.${e.at}` };
   }
   if (best) return best;
+  const x = [0, 0, 0];
   for (const [name] of doc.curves) {
     const pos = curveGroup.getObjectByName(name)?.geometry.getAttribute('position').array;
     if (!pos) continue;
     for (let k = 0; k < pos.length / 3; k++) {
-      const q = toScreen([pos[3 * k], pos[3 * k + 1], pos[3 * k + 2]]);
+      x[0] = pos[3 * k];
+      x[1] = pos[3 * k + 1];
+      x[2] = pos[3 * k + 2];
+      const q = toScreen(x);
       const d = Math.hypot(q[0] - s[0], q[1] - s[1]);
-      if (d < PICK_PX && (!best || d < best.d)) best = { d, p: [pos[3 * k], pos[3 * k + 1], pos[3 * k + 2]], to: name };
+      if (d < PICK_PX && (!best || d < best.d)) best = { d, p: x.slice(), to: name };
     }
   }
   if (best) return best;
@@ -181,32 +186,34 @@ export function snapEnd(p) {
  */
 export function oversketchTarget(points) {
   const strokes = doc.recipe.strokes || {};
+  const toScreen = screenProjector();
   const a = points[0];
   const b = points[points.length - 1];
-  const ink = screenLength(points);
+  const ink = screenLength(points, toScreen);
+  const ends = [a, b].map((x) => ({ x, s: toScreen(x), reach: SNAP_PX * millimetresPerPixel(x) }));
   for (const [name, stroke] of Object.entries(strokes)) {
     const q = stroke.points;
     if (!Array.isArray(q) || q.length < 4) continue;
-    const near = (x) => {
-      const s = toScreen(x);
-      const reach = SNAP_PX * millimetresPerPixel(x);
+    // the nearest point on the screen of those near in space (tested first: it needs no projection)
+    const near = ({ x, s, reach }) => {
       let best = { d: Infinity, i: -1 };
       q.forEach((p, i) => {
+        if (!(Math.hypot(p[0] - x[0], p[1] - x[1], p[2] - x[2]) < reach)) return;
         const t = toScreen(p);
         const d = Math.hypot(t[0] - s[0], t[1] - s[1]);
-        if (d < best.d && Math.hypot(p[0] - x[0], p[1] - x[1], p[2] - x[2]) < reach) best = { d, i };
+        if (d < best.d) best = { d, i };
       });
       return best;
     };
-    const ia = near(a);
-    const ib = near(b);
+    const ia = near(ends[0]);
+    const ib = near(ends[1]);
     const endsFree = (i) => i > 1 && i < q.length - 2;
     if (!(ia.d < SNAP_PX && ib.d < SNAP_PX && Math.abs(ia.i - ib.i) > 2 && endsFree(ia.i) && endsFree(ib.i))) continue;
     // Both the ink and the part it redraws longer on the screen than twice the reach: else the
     // ends' nearness says nothing (zoomed out, strokes 35 mm apart were 11 px apart and 13 px
     // long, and each new one was taken for an oversketch of its neighbour, issue #40).
     const part = q.slice(Math.min(ia.i, ib.i), Math.max(ia.i, ib.i) + 1);
-    if (ink >= 2 * SNAP_PX && screenLength(part) >= 2 * SNAP_PX) return { name, from: ia.i, to: ib.i };
+    if (ink >= 2 * SNAP_PX && screenLength(part, toScreen) >= 2 * SNAP_PX) return { name, from: ia.i, to: ib.i };
   }
   return null;
 }
