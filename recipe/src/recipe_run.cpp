@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -172,14 +173,38 @@ class Runner {
   /// the bound ledger at `input_bound` (how far `parent` may be from its exact reference). Steps
   /// above the composition's budget yield their light form; a final surface (nothing is built on
   /// it) still above the budget (a style result) leaves as a certified light copy.
-  BSplineSurface deform(const BSplineSurface& parent, const StackDef& stack, const Composition& c,
-                        const std::string& path, const std::string& name, bool final_surface = true,
-                        double input_bound = 0) {
+  ///
+  /// With `prefix_key` (k -> the key of the stack's first k steps on this surface, or none), the
+  /// steps before the last are kept in the run's cache one by one as they are made, and a run
+  /// takes from it the longest first steps it holds: a sweep or an edit of a later step (a
+  /// lattice after a style) does not style again. The last step is kept with the whole surface.
+  BSplineSurface deform(
+      const BSplineSurface& parent, const StackDef& stack, const Composition& c,
+      const std::string& path, const std::string& name, bool final_surface = true,
+      double input_bound = 0,
+      const std::function<std::optional<std::string>(std::size_t)>& prefix_key = {}) {
     BSplineSurface s = parent;
     ledger_ = input_bound;
-    for (std::size_t i = 0; i < stack.steps.size(); ++i) {
+    std::size_t first = 0;  // the first step to run: those before it are taken from the cache
+    const bool keeping = options_.cache && prefix_key && stack.steps.size() > 1;
+    if (keeping)
+      for (; first + 1 < stack.steps.size(); ++first) {
+        const std::optional<std::string> key = prefix_key(first + 1);
+        const auto hit = key ? CacheAccess::find(*options_.cache, "stage\n" + *key) : nullptr;
+        if (!hit) break;
+        s = hit->surfaces.front().second;
+        ledger_ = hit->bounds.front().second;
+        for (StepReport rep : hit->steps) {
+          rep.reused = true;
+          if (options_.progress) options_.progress(rep);
+          result_.steps.push_back(std::move(rep));
+        }
+        result_.stages.insert(result_.stages.end(), hit->stages.begin(), hit->stages.end());
+      }
+    for (std::size_t i = first; i < stack.steps.size(); ++i) {
       const StepDef& step = stack.steps[i];
       const std::string p = path + ".steps[" + std::to_string(i) + "]";
+      const std::size_t steps0 = result_.steps.size(), stages0 = result_.stages.size();
       timed(p, step.kind, [&](StepReport& rep) {
         rep.message = step.path + (step.name.empty() ? "" : " '" + step.name + "'");
         if (!step.enabled) {
@@ -195,6 +220,19 @@ class Runner {
         stage.after = s;
         result_.stages.push_back(std::move(stage));
       });
+      // Kept: this step's report, stage, surface and ledger after it, under its prefix's key
+      // (not the last step's: the whole surface's entry holds it; never a drag's preview).
+      if (keeping && i + 1 < stack.steps.size() && !previewing_)
+        if (const std::optional<std::string> key = prefix_key(i + 1)) {
+          CacheEntry e;
+          e.surfaces.emplace_back(name, s);
+          e.bounds.emplace_back(name, ledger_);
+          e.steps.assign(result_.steps.begin() + static_cast<std::ptrdiff_t>(steps0),
+                         result_.steps.end());
+          e.stages.assign(result_.stages.begin() + static_cast<std::ptrdiff_t>(stages0),
+                          result_.stages.end());
+          CacheAccess::keep(*options_.cache, "stage\n" + *key, std::move(e));
+        }
     }
     if (c.budget && final_surface &&
         (std::max(s.u.degree, s.v.degree) > c.budget->max_degree ||
@@ -631,8 +669,14 @@ class Runner {
                         [&](const StackDef& s) { return s.name == d->deformation; });
       shared_parent_ = &surface_of(d->surface), shared_composition_ = &d->composition;
       shared_.reset();
+      const Needs needs = surface_needs(data_, def);
+      // result_.surfaces holds the surfaces built before this one until it is added, as its key
+      const auto prefix_key = [&](std::size_t k) -> std::optional<std::string> {
+        if (!data_.document) return std::nullopt;
+        return surface_key(data_, digests_, def, needs, result_.surfaces, k);
+      };
       BSplineSurface s = deform(surface_of(d->surface), stack, d->composition, def.path, def.name,
-                                !built_on(data_, def.name), bound_of(d->surface));
+                                !built_on(data_, def.name), bound_of(d->surface), prefix_key);
       shared_parent_ = nullptr, shared_composition_ = nullptr;
       shared_.reset();
       result_.surfaces.emplace_back(def.name, std::move(s));

@@ -123,13 +123,25 @@ std::optional<std::string> own_key(const RecipeData& data, const Digests& g, con
 
 std::optional<std::string> surface_key(
     const RecipeData& data, const Digests& g, const SurfaceDef& def, const Needs& needs,
-    const std::vector<std::pair<std::string, surface::BSplineSurface>>& before) {
+    const std::vector<std::pair<std::string, surface::BSplineSurface>>& before,
+    std::optional<std::size_t> stack_prefix) {
   std::optional<std::string> k = own_key(data, g, "surfaces", def.name, needs);
   if (!k) return k;
   const auto comp = data.document->root->find("composition");
   *k += "\ncomposition " + (comp == data.document->root->end() ? std::string() : comp->dump());
   if (const auto* d = std::get_if<DeformDef>(&def.build)) {
-    *k += "\nstack " + definition_text(*data.document, "deformations", d->deformation);
+    if (!stack_prefix) {
+      *k += "\nstack " + definition_text(*data.document, "deformations", d->deformation);
+    } else {
+      // the first k steps as written (the checker took the stack for an array of steps)
+      const auto section = data.document->root->find("deformations");
+      if (section == data.document->root->end() || !section->is_object()) return std::nullopt;
+      const auto steps = section->find(d->deformation);
+      if (steps == section->end() || !steps->is_array() || *stack_prefix > steps->size())
+        return std::nullopt;
+      *k += "\nstack prefix " + std::to_string(*stack_prefix);
+      for (std::size_t i = 0; i < *stack_prefix; ++i) *k += "\n" + (*steps)[i].dump();
+    }
     *k += built_on(data, def.name) ? "\nbuilt on" : "\nfinal";
     *k += "\nafter";
     for (const auto& built : before) {

@@ -60,10 +60,13 @@ std::optional<std::string> own_key(const RecipeData& data, const Digests& g, con
 /// A surface's key: own_key with the recipe's composition; for a deformed surface its stack's
 /// definition, whether it leaves the recipe (a light copy above the budget) and every surface
 /// built before it (`before`: its fits follow the sides it shares with them); for an import, the
-/// file's size and time of change.
+/// file's size and time of change. With `stack_prefix` k, the key of the deformed surface's
+/// first k stack steps alone (the stack's later steps left out: a sweep of a lattice after a
+/// style takes the style from the variant before).
 std::optional<std::string> surface_key(
     const RecipeData& data, const Digests& g, const SurfaceDef& def, const Needs& needs,
-    const std::vector<std::pair<std::string, surface::BSplineSurface>>& before);
+    const std::vector<std::pair<std::string, surface::BSplineSurface>>& before,
+    std::optional<std::size_t> stack_prefix = std::nullopt);
 
 /// The runner's access to a RunCache.
 class CacheAccess {

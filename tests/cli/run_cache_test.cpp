@@ -176,6 +176,35 @@ TEST_CASE("run_recipe with a cache: an edit re-runs only the steps downstream of
   }
 }
 
+TEST_CASE("run_recipe with a cache: a stack's first steps are taken when a later one changed",
+          "[recipe][cache]") {
+  // The sail: a fill, then the stack "shape" of an exact style and a lattice. A sweep or an edit
+  // of the lattice's moves (issue #40: a sweep whose variants share a prefix computes it once)
+  // takes the style from the cache and runs the lattice alone; an edit of the style runs both.
+  std::ifstream in(tank_file.parent_path() / "sail.json", std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  const Json sail = Json::parse(text.str());
+  const auto cache = std::make_shared<RunCache>();
+  const RunResult first = run(sail, cache);
+  require_identical(first, run(sail));
+  CHECK(built(first).count("surfaces.sail.steps[0]") == 1);
+  CHECK(built(first).count("surfaces.sail.steps[1]") == 1);
+  for (const double lift : {150.0, 0.0, -80.0}) {
+    INFO("the billow's first move by " << lift << " mm");
+    Json edited = sail;
+    edited["deformations"]["shape"][1]["moves"][0]["by"][1] = lift;
+    const RunResult r = run(edited, cache);
+    require_identical(r, run(edited));
+    CHECK(built(r) == std::set<std::string>{"surfaces.sail.steps[1]"});
+  }
+  Json restyled = sail;
+  restyled["deformations"]["shape"][0]["curve_tolerance"] = 0.02;
+  const RunResult r = run(restyled, cache);
+  require_identical(r, run(restyled));
+  CHECK(built(r) == std::set<std::string>{"surfaces.sail.steps[0]", "surfaces.sail.steps[1]"});
+}
+
 TEST_CASE("run_recipe with a cache: a sketch and the curves built on it", "[recipe][cache]") {
   // A stroke on the plane z = 0 taken into a sketch whose start point is fixed, a line beside it
   // and a band skinned through both (a curve may not use a sketch's, defined after it): editing
