@@ -11,9 +11,12 @@ A sweep description (JSON, or the same dict in Python; docs/sweeps.md):
 Each parameter is a JSON path into the recipe (keys joined by ".", list items as "[i]") and its
 values; "grid" runs every combination, "list" the given ones. The description is checked whole
 before anything runs or is written (shape, paths, at most MAX_VARIANTS variants counted without
-building them): SpecError, one line naming its file and the fix. Every variant runs in its own
-process (OpenCASCADE's STEP writer is not thread-safe; a crash loses only that variant), which
-dies with the sweep (even a SIGKILLed one) and writes into OUT/.staging-<id>-<random>; the sweep
+building them): SpecError, one line naming its file and the fix. Variants run in variant
+processes, one variant at a time each (OpenCASCADE's STEP writer is not thread-safe; a crash
+loses only the variant it ran, and the next starts a new process); a process is kept for the
+worker's next variants with one RunCache, so the steps variants share (a surface built before the
+swept lattice) are computed once per process. It dies with the sweep (even a SIGKILLed one) and
+writes into OUT/.staging-<id>-<random>; the sweep
 adds variant.json and renames the folder into OUT/<id> (id: a hash of the parameters), so a re-run
 skips finished variants. OUT/index.csv and OUT/index.jsonl are rewritten (temporary, then rename)
 as variants finish; OUT/contact_sheet.png once all have run. A storage error stops the sweep at
@@ -73,7 +76,7 @@ SHEET_TILES = 100
 #: writable, the quota is used up, or a file is larger than allowed. Any variant would meet it.
 STORAGE_ERRNOS = frozenset({errno.ENOSPC, errno.EROFS, errno.EACCES, errno.EDQUOT, errno.EFBIG})
 INDEX_FIELDS = ["id", "status", "seconds", "deviation_mm", "volume_mm3", "volume_ratio_min", "volume_ratio_max",
-                "fold_free", "control_points", "error", "parameters"]
+                "fold_free", "control_points", "steps_reused", "error", "parameters"]
 _STAGING = ".staging-"
 _LOCK = ".sweep.lock"
 #: Every rename into OUT goes through here (a seam for the tests' storage faults).
@@ -409,14 +412,17 @@ def _storage_cause(error: BaseException, folder: str) -> Optional[OSError]:
     return None
 
 
-def run_variant_here(text: str, base_dir: str, out_dir: str) -> Dict[str, Any]:
-    """Runs one variant in this process, writing its outputs and a thumbnail into out_dir. A
-    storage error while writing is status "storage" (errno, path); other errors raise."""
+def run_variant_here(text: str, base_dir: str, out_dir: str, cache: Any = None) -> Dict[str, Any]:
+    """Runs one variant in this process, writing its outputs and a thumbnail into out_dir; with
+    cache (a clayform.RunCache), the steps it holds unchanged are taken from it ("steps_reused"
+    counts them). A storage error while writing is status "storage" (errno, path); other errors
+    raise."""
     from . import Recipe  # the extension, imported where the variant runs
 
     start = time.perf_counter()
     recipe = Recipe.parse(text, base_dir)
-    result = recipe.run()
+    result = recipe.run(cache=cache)
+    reused = sum(1 for step in result.steps if step["reused"])
     try:
         result.write(out_dir)
         picture = _thumbnail(recipe, result, out_dir)
@@ -428,7 +434,7 @@ def run_variant_here(text: str, base_dir: str, out_dir: str) -> Dict[str, Any]:
             raise
         return {"status": "storage", "errno": cause.errno, "path": cause.filename or out_dir,
                 "error": cause.strerror or str(cause)}
-    return {"status": "ok", "seconds": time.perf_counter() - start, **_figures(result.report)}
+    return {"status": "ok", "seconds": time.perf_counter() - start, "steps_reused": reused, **_figures(result.report)}
 
 
 class _Children:
@@ -442,11 +448,11 @@ class _Children:
         self.stopped = False
         self.signum: Optional[int] = None
 
-    def start(self, argv: List[str], env: Dict[str, str]) -> Optional["subprocess.Popen[str]"]:
+    def start(self, argv: List[str], env: Dict[str, str], stderr: Any) -> Optional["subprocess.Popen[str]"]:
         with self.lock:
             if self.stopped:
                 return None
-            child = subprocess.Popen(argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+            child = subprocess.Popen(argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=stderr,
                                      text=True, env=env)
             self.running.add(child)
             return child
@@ -459,49 +465,130 @@ class _Children:
                     child.kill()
 
 
-def run_variant_isolated(job: Dict[str, Any], children: Optional[_Children] = None) -> Dict[str, Any]:
-    """Runs one variant in a child process and returns its figures. With job["stage"] (a folder
-    path on a disk this machine shares with the sweep) the child writes its files there; without,
-    into a temporary folder whose files come back as base64, so that it works the same on a Dask
+class _VariantProcess:
+    """A variant process kept for many variants, one at a time: a job a line on its stdin, its
+    answer a line back. It holds one RunCache, so the steps the variants share are taken from the
+    variant before instead of computed again; it starts on the first job and again after a
+    variant killed it. Its stderr goes to a file (kept short: emptied at each job) whose last line
+    says why a process died."""
+
+    def __init__(self, children: _Children) -> None:
+        self.children = children
+        self.child: Optional["subprocess.Popen[str]"] = None
+        self.errors: Optional[io.BufferedRandom] = None
+
+    def _start(self) -> bool:
+        env = dict(os.environ)
+        env["CLAYFORM_SWEEP_PARENT"] = str(os.getpid())
+        # appended to (O_APPEND), so the process writes at its end after the file is emptied
+        fd, name = tempfile.mkstemp(prefix="clayform-variant-", suffix=".err")
+        os.close(fd)
+        try:
+            self.errors = open(os.open(name, os.O_RDWR | os.O_APPEND), "a+b")
+        finally:
+            os.unlink(name)
+        self.child = self.children.start([sys.executable, "-c", _BOOT], env, self.errors)
+        return self.child is not None
+
+    def _forget(self) -> None:
+        if self.child is not None:
+            with self.children.lock:
+                self.children.running.discard(self.child)
+        if self.errors is not None:
+            self.errors.close()
+        self.child, self.errors = None, None
+
+    def _last_error(self, fallback: str) -> str:
+        assert self.errors is not None
+        self.errors.seek(0)
+        tail = self.errors.read().decode(errors="replace").strip().splitlines()[-1:]
+        return tail[0] if tail else fallback
+
+    def run(self, job: Dict[str, Any]) -> Dict[str, Any]:
+        """The job's answer ({"status": ...}); "crashed" when the process died on it (the next job
+        starts a new one), "stopped" when the sweep stopped before it could start one."""
+        if self.child is None or self.child.poll() is not None:
+            self._forget()
+            if not self._start():
+                return {"status": "stopped", "seconds": None, "error": "the sweep stopped before it ran"}
+        assert self.child is not None and self.child.stdin is not None and self.child.stdout is not None
+        assert self.errors is not None
+        self.errors.truncate(0)
+        try:
+            self.child.stdin.write(json.dumps(job) + "\n")
+            self.child.stdin.flush()
+            line = self.child.stdout.readline()
+        except OSError:  # the process is gone (a broken pipe)
+            line = ""
+        if not line:
+            code = self.child.wait()
+            error = (f"the variant's process died ({signal.Signals(-code).name})" if code < 0
+                     else self._last_error(f"exit code {code}"))
+            self._forget()
+            return {"status": "crashed", "seconds": None, "error": error}
+        try:
+            return dict(json.loads(line))
+        except (json.JSONDecodeError, TypeError, ValueError):
+            self.close()
+            return {"status": "crashed", "seconds": None, "error": f"the variant's process answered {line[:80]!r}"}
+
+    def close(self) -> None:
+        """Ends the process (its stdin closed: it exits; killed if it does not within 10 s)."""
+        if self.child is not None:
+            with contextlib.suppress(OSError):
+                if self.child.stdin is not None:
+                    self.child.stdin.close()
+            try:
+                self.child.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                self.child.kill()
+                self.child.wait()
+        self._forget()
+
+
+def run_variant_isolated(job: Dict[str, Any], children: Optional[_Children] = None,
+                         process: Optional[_VariantProcess] = None) -> Dict[str, Any]:
+    """Runs one variant in a variant process (`process`, kept for the next ones; without it, one
+    started for this variant alone) and returns its figures. With job["stage"] (a folder path on
+    a disk this machine shares with the sweep) the process writes its files there; without, into
+    a temporary folder whose files come back as base64, so that it works the same on a Dask
     worker elsewhere. A variant that raises is "failed" with its message; one that kills its
     process is "crashed" with the signal; one that meets a storage error is "storage"."""
     start = time.perf_counter()
     tmp = None if job.get("stage") else tempfile.mkdtemp(prefix="clayform-variant-")
     out = job["stage"] if tmp is None else os.path.join(tmp, "variant")
+    own = process is None
+    runner = process or _VariantProcess(children or _Children())
     try:
-        env = dict(os.environ)
-        env["CLAYFORM_SWEEP_PARENT"] = str(os.getpid())
-        if job.get("abort"):
-            env["CLAYFORM_SWEEP_ABORT"] = "1"
-        children = children or _Children()
-        child = children.start([sys.executable, "-c", _BOOT], env)
-        if child is None:
-            return {"status": "stopped", "seconds": None, "error": "the sweep stopped before it ran"}
-        try:
-            stdout, stderr = child.communicate(json.dumps({"text": job["text"], "base_dir": job["base_dir"], "out": out}))
-        finally:
-            with children.lock:
-                children.running.discard(child)
-        seconds = time.perf_counter() - start
-        if child.returncode < 0:
-            name = signal.Signals(-child.returncode).name
-            return {"status": "crashed", "seconds": seconds, "error": f"the variant's process died ({name})"}
-        try:
-            answer: Dict[str, Any] = dict(json.loads(stdout.strip().splitlines()[-1]))
-        except (IndexError, json.JSONDecodeError):
-            tail = stderr.strip().splitlines()[-1:] or [f"exit code {child.returncode}"]
-            return {"status": "crashed", "seconds": seconds, "error": tail[0]}
+        answer = runner.run({"text": job["text"], "base_dir": job["base_dir"], "out": out,
+                             "abort": bool(job.get("abort"))})
+        answer["seconds"] = time.perf_counter() - start if answer["status"] != "stopped" else None
         if answer["status"] == "ok" and tmp is not None:
             files: Dict[str, str] = {}
             for path in Path(out).rglob("*"):
                 if path.is_file():
                     files[str(path.relative_to(out))] = base64.b64encode(path.read_bytes()).decode()
             answer["files"] = files
-        answer["seconds"] = seconds
         return answer
     finally:
+        if own:
+            runner.close()
         if tmp is not None:
             shutil.rmtree(tmp, ignore_errors=True)
+
+
+#: On a Dask worker: each of its threads' kept variant process (run_variant_on_worker).
+_worker = threading.local()
+_worker_children = _Children()
+
+
+def run_variant_on_worker(job: Dict[str, Any]) -> Dict[str, Any]:
+    """run_variant_isolated in the variant process this Dask worker thread keeps (started on its
+    first variant, tied to the worker's life), so the worker's variants share their steps."""
+    process = getattr(_worker, "process", None)
+    if process is None:
+        process = _worker.process = _VariantProcess(_worker_children)
+    return run_variant_isolated(job, process=process)
 
 
 def _watch_parent() -> None:
@@ -519,16 +606,25 @@ def _watch_parent() -> None:
 
 
 def _child_main() -> int:
-    """`python -m clayform.sweeps --run-variant`: one variant, its job on stdin, one JSON line out."""
+    """`python -m clayform.sweeps --run-variant`: variants, one job a line on stdin and one JSON
+    answer a line on stdout each, until stdin ends; one RunCache across them."""
     _watch_parent()
-    job = json.loads(sys.stdin.read())
-    if os.environ.get("CLAYFORM_SWEEP_ABORT") == "1":
-        os.abort()  # fault injection for the tests: a variant that kills its process
-    try:
-        answer = run_variant_here(job["text"], job["base_dir"], job["out"])
-    except Exception as e:  # noqa: BLE001 - every failure is the variant's result
-        answer = {"status": "failed", "error": f"{type(e).__name__}: {e}"}
-    print(json.dumps(answer))
+    # The answers get the process's stdout to themselves: anything a library prints goes to stderr.
+    answers = os.fdopen(os.dup(1), "w")
+    os.dup2(2, 1)
+    from . import RunCache
+
+    cache = RunCache()
+    for line in sys.stdin:
+        job = json.loads(line)
+        if job.get("abort"):
+            os.abort()  # fault injection for the tests: a variant that kills its process
+        try:
+            answer = run_variant_here(job["text"], job["base_dir"], job["out"], cache)
+        except Exception as e:  # noqa: BLE001 - every failure is the variant's result
+            answer = {"status": "failed", "error": f"{type(e).__name__}: {e}"}
+        answers.write(json.dumps(answer) + "\n")
+        answers.flush()
     return 0
 
 
@@ -866,6 +962,10 @@ class _Sweep:
             return f"and the index could not be written ({e.strerror or e}): their folders hold variant.json"
 
     def run_local(self, todo: List[str], workers: int) -> None:
+        # each worker thread's variant process, kept for its next variants
+        kept = threading.local()
+        processes: List[_VariantProcess] = []
+
         def one(vid: str) -> Tuple[Dict[str, Any], Optional[Path]]:
             staging = self.staging(vid)  # OSError: a storage error
             if staging is None:
@@ -874,7 +974,10 @@ class _Sweep:
                 job = self.job(vid, staging)
             except Exception as e:  # noqa: BLE001 - the paths were checked: not expected, but only this variant's
                 return {"status": "failed", "seconds": None, "error": f"{type(e).__name__}: {e}"}, staging
-            return run_variant_isolated(job, self.children), staging
+            if getattr(kept, "process", None) is None:
+                kept.process = _VariantProcess(self.children)
+                processes.append(kept.process)
+            return run_variant_isolated(job, self.children, kept.process), staging
 
         pool = concurrent.futures.ThreadPoolExecutor(max_workers=max(1, workers))
         try:
@@ -891,6 +994,8 @@ class _Sweep:
         finally:
             self.children.stop()  # nothing runs any more after a break; none start
             pool.shutdown(wait=True, cancel_futures=True)
+            for process in processes:
+                process.close()
 
     def run_dask(self, todo: List[str], workers: int, scheduler: Optional[str]) -> None:
         import importlib
@@ -916,7 +1021,7 @@ class _Sweep:
                 vid = next(queue, None)
                 staging = self.staging(vid) if vid is not None and local else None
                 if vid is not None and (staging is not None or not local):
-                    future = client.submit(run_variant_isolated, self.job(vid, staging),
+                    future = client.submit(run_variant_on_worker, self.job(vid, staging),
                                            key=f"clayform-variant-{vid}-{os.urandom(4).hex()}", pure=False)
                     futures[future] = (vid, staging)
                     pending.add(future)
@@ -959,7 +1064,7 @@ def main(argv: Optional[List[str]] = None) -> int:
     import argparse
 
     args = list(sys.argv[1:] if argv is None else argv)
-    if args == ["--run-variant"]:
+    if args == ["--run-variant"]:  # a variant process (_VariantProcess)
         return _child_main()
     parser = argparse.ArgumentParser(prog="clayform sweep", description="Run every variant of a sweep.")
     parser.add_argument("spec", help="the sweep description (JSON)")

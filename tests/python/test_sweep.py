@@ -99,6 +99,29 @@ def test_local_sweep_with_a_failure_and_a_crash_then_resume(examples: Path, tmp_
     assert again[-1]["status"] == "failed"
 
 
+def test_variants_on_one_process_share_the_steps_before_the_swept_one(examples: Path, tmp_path: Path) -> None:
+    # Issue #40: a sweep whose variants share a prefix computes it once (per variant process).
+    # The sail's curves, fill and exact style come before the swept lattice move: one worker
+    # runs the three variants in one process, the first computing every step, the next two
+    # taking those from its RunCache.
+    description = spec(examples, [0, 150, 300])
+    rows = cf.sweep(description, tmp_path, workers=1, progress=lambda *a: None)
+    assert [r["status"] for r in rows] == ["ok", "ok", "ok"]
+    steps = json.loads((tmp_path / rows[0]["id"] / "report.json").read_text())["steps"]
+    kinds = [s["kind"] for s in steps]
+    upstream = kinds.index("style") + 1  # every step up to the style, which the lattice deforms
+    assert rows[0]["steps_reused"] == 0
+    assert all(r["steps_reused"] >= upstream for r in rows[1:]), [r["steps_reused"] for r in rows]
+    # ... and what they give is what a fresh run gives, bit for bit.
+    for row in rows[1:]:
+        text = sweeps.recipe_text((examples / "recipes" / "sail.json").read_text(), row["parameters"])
+        direct = cf.Recipe.parse(text, str(examples / "recipes")).run().surfaces["sail"]
+        assert cf.read_step(str(tmp_path / row["id"] / "sail.step"))[0].identical(direct)
+    # The index carries the count.
+    with open(tmp_path / "index.csv", newline="") as f:
+        assert [t["steps_reused"] for t in csv.DictReader(f)] == [str(r["steps_reused"]) for r in rows]
+
+
 def test_dask_local_cluster_sweep(examples: Path, tmp_path: Path) -> None:
     pytest.importorskip("distributed")
     sets = [{BILLOW: 0, DRAFT: 0.01}, {BILLOW: 100, DRAFT: 0.01}, {BILLOW: 200, DRAFT: 0.01},
@@ -323,9 +346,9 @@ def test_a_storage_error_stops_the_sweep_at_once(examples: Path, tmp_path: Path,
     refused: list = []
     real_run, real_rename = sweeps.run_variant_isolated, sweeps._rename
 
-    def counting(job: dict, children: object = None) -> dict:
+    def counting(job: dict, children: object = None, process: object = None) -> dict:
         started.append(job)
-        return real_run(job, children)  # type: ignore[arg-type]
+        return real_run(job, children, process)  # type: ignore[arg-type]
 
     def full_disk(src: str, dst: str) -> None:
         if Path(dst).name in ids:
