@@ -79,13 +79,14 @@ def test_long_calls_release_the_gil() -> None:
 
 def test_a_run_cache_takes_unchanged_steps_bit_for_bit(examples: Path) -> None:
     # Issue #40: a second run with the same RunCache takes every step; an edit of the sail's
-    # deformation re-runs only the deformed surface, and every result equals a run without cache.
+    # lattice (its stack's second step) re-runs only the lattice, the style before it taken from
+    # the cache, and every result equals a run without cache.
     text = (examples / "recipes" / "sail.json").read_text()
     base = str(examples / "recipes")
     cache = cf.RunCache()
     first = cf.Recipe.parse(text, base).run(cache=cache)
     assert not any(s["reused"] for s in first.steps)
-    assert cache.counts["kept"] == 7  # five curves and two surfaces
+    assert cache.counts["kept"] == 8  # five curves, two surfaces and the sail's stack's first step
     again = cf.Recipe.parse(text, base).run(cache=cache)
     assert all(s["reused"] for s in again.steps if not s["path"].startswith("exports."))
     assert cache.counts["reused"] == 7
@@ -95,7 +96,7 @@ def test_a_run_cache_takes_unchanged_steps_bit_for_bit(examples: Path) -> None:
     cached = cf.Recipe.parse(edited, base).run(cache=cache)
     whole = cf.Recipe.parse(edited, base).run()
     assert {s["path"] for s in cached.steps if not s["reused"] and not s["path"].startswith("exports.")} == {
-        "surfaces.sail.steps[0]", "surfaces.sail.steps[1]"}
+        "surfaces.sail.steps[1]"}
     for name, surface in whole.surfaces.items():
         assert np.array_equal(cached.surfaces[name].points, surface.points)
         assert np.array_equal(cached.surfaces[name].weights, surface.weights)
