@@ -459,9 +459,13 @@ void bind_geometry(py::module_& m) {
           py::gil_scoped_release free;
           return step ? surface::read_step(path, o) : surface::read_iges(path, o);
         },
-        py::arg("path"), py::arg("precheck") = true, py::arg("isolate") = false,
-        step ? "The surface of every face of a STEP file, as Surfaces."
-             : "Every B-spline surface of an IGES file, as Surfaces.");
+        py::arg("path"), py::arg("precheck") = true, py::arg("isolate") = true,
+        step ? "The surface of every face of a STEP file, as Surfaces. Read in a child process "
+               "(isolate=True, the default: a file that crashes OpenCASCADE raises ExchangeError "
+               "instead of killing the interpreter); isolate=False reads in this process."
+             : "Every B-spline surface of an IGES file, as Surfaces. Read in a child process "
+               "(isolate=True, the default: a file that crashes OpenCASCADE raises ExchangeError "
+               "instead of killing the interpreter); isolate=False reads in this process.");
   }
 }
 

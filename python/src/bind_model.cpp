@@ -296,11 +296,13 @@ void bind_model(py::module_& m) {
         d["message"] = r.brief();
         return py::make_tuple(std::move(imported.model), d);
       },
-      py::arg("path"), py::arg("sew") = false, py::arg("isolate") = false,
+      py::arg("path"), py::arg("sew") = false, py::arg("isolate") = true,
       py::arg("strict") = false,
       "Reads a whole STEP or IGES model (trimmed faces, solids, assembly): (Model, report). "
-      "isolate=True reads in a child process, so a file that crashes OpenCASCADE raises "
-      "ExchangeError. report['healing'] lists what was healed, report['ignored'] the entity types "
+      "isolate=True (the default) reads in a child process, so a file that crashes OpenCASCADE "
+      "raises ExchangeError (or, when only its XCAF reader crashes, is read by its plain reader "
+      "and report['healing'] says so) instead of killing the interpreter; isolate=False reads in "
+      "this process. report['healing'] lists what was healed, report['ignored'] the entity types "
       "OpenCASCADE does not know, report['skipped'] the entities it failed to transfer (the rest "
       "is read), report['left_out'] the shapes a model cannot hold (an unbounded line); free "
       "curves become wire bodies; strict=True heals as before "

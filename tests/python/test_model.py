@@ -221,6 +221,20 @@ def test_a_bulged_assembly_is_valid_where_brepcheck_measures_the_gaps_itself(
     assert check["valid"], check["problems"]
 
 
+def test_a_file_that_crashes_opencascade_does_not_kill_the_interpreter() -> None:
+    # CoCreate's part (a public file FreeCAD reads) crashes OpenCASCADE 7.6's XCAF reader with
+    # SIGSEGV: read in this process it killed Python. Reading is isolated by default: the plain
+    # reader reads it in the child, and the report says what that loses. Its volume, 78,234 mm^3,
+    # is OpenCASCADE's own for the file (tests/occt/real_files_test.cpp compares the two).
+    cad = Path(__file__).parents[2] / "tests" / "data" / "cad"
+    model, report = cf.read_model(cad / "cocreate_modeling16_io1_ap214.stp")
+    assert any("XCAF reader crashed" in h for h in report["healing"]), report["healing"]
+    assert model.counts["faces"] == 29 and model.problems() == []
+    assert abs(model.volume_mm3() - 78234.4) < 1.0
+    surfaces = cf.read_step(cad / "cocreate_modeling16_io1_ap214.stp")  # isolated too: no crash
+    assert len(surfaces) == 29
+
+
 @pytest.mark.parametrize("name", ["euclid_ol20b_screw_cc1.step", "catia_v5r13_xr2_bolt_ap214.stp"])
 def test_a_gappy_solid_under_an_affine_map_has_det_a_times_its_volume(name: str) -> None:
     # Issue #39 item 8: these files' faces meet their edges within tolerances of 1e-5 to 1e-2 mm,
@@ -346,7 +360,12 @@ def test_free_curves_written_by_freecad_read_as_wire_bodies_and_deform_exactly(
                                                        for x in f.Edges)]
     free_after = [e for e in after.Edges if not any(e.isSame(x) for f in after.Faces
                                                      for x in f.Edges)]
-    assert len(free_before) == len(free_after) == 5
+    # FreeCAD's IGES reader (read.iges.bspline.continuity 1, its default) splits a curve at knots
+    # where it is only C0 in its parameter: the exactly deformed circle, a rational B-spline that
+    # is G1 there, comes back in pieces (3); every other curve comes back whole. (This passed with
+    # 5 only while Clayform read in FreeCAD's process: its reader's setting of 0 stayed set.)
+    assert len(free_before) == 5
+    assert len(free_after) == 5 if suffix == ".step" else len(free_after) >= 5
     size = float(np.linalg.norm(hi - lo))
     worst = 0.0
     for a in free_before:
@@ -357,8 +376,9 @@ def test_free_curves_written_by_freecad_read_as_wire_bodies_and_deform_exactly(
             e.FirstParameter))) - mapped[0]) + np.linalg.norm(np.array(tuple(e.valueAt(
                 e.LastParameter))) - mapped[-1]))
         if isinstance(a.Curve, Part.Circle):
-            # read as a rational B-spline, whose parameter is not the angle: on the curve
-            off = max(b.distToShape(Part.Vertex(Vector(*m)))[0] for m in mapped)
+            # read as a rational B-spline, whose parameter is not the angle (and from IGES in
+            # pieces): on the curves read
+            off = max(min(e.distToShape(Part.Vertex(Vector(*m)))[0] for e in free_after) for m in mapped)
         else:  # lines and B-splines keep their parameter: at the same t
             assert b.FirstParameter == pytest.approx(a.FirstParameter, abs=1e-12 * size)
             off = float(np.abs(np.array([tuple(b.valueAt(t)) for t in ts]) - mapped).max())
