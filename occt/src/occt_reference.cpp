@@ -3,6 +3,9 @@
 
 #include "convert.hpp"
 
+#include <IGESControl_Controller.hxx>
+#include <Interface_Static.hxx>
+#include <STEPControl_Controller.hxx>
 #include <gp_Pnt.hxx>
 #include <gp_Vec.hxx>
 
@@ -71,6 +74,34 @@ Eigen::Vector3d GridEvaluator::evaluate(double u, double v) const {
   gp_Pnt p;
   impl_->surface->D0(u, v, p);
   return {p.X(), p.Y(), p.Z()};
+}
+
+namespace {
+void init_controllers() {
+  STEPControl_Controller::Init();
+  IGESControl_Controller::Init();
+}
+}  // namespace
+
+int exchange_setting_int(const char* name) {
+  init_controllers();
+  return Interface_Static::IVal(name);
+}
+
+std::string exchange_setting_text(const char* name) {
+  init_controllers();
+  const char* text = Interface_Static::CVal(name);
+  return text ? text : "";
+}
+
+bool set_exchange_setting(const char* name, int value) {
+  init_controllers();
+  return Interface_Static::SetIVal(name, value);
+}
+
+bool set_exchange_setting(const char* name, const char* value) {
+  init_controllers();
+  return Interface_Static::SetCVal(name, value);
 }
 
 }  // namespace clay::surface::occt_reference

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <span>
+#include <string>
 
 namespace clay::surface::occt_reference {
 
@@ -19,6 +20,14 @@ CurveDerivatives curve_d2(const BSplineCurve& curve, double t);
 BSplineSurface round_trip(const BSplineSurface& surface);
 /// Ours -> Geom_BSplineCurve -> ours.
 BSplineCurve round_trip(const BSplineCurve& curve);
+
+/// OpenCASCADE's exchange settings (Interface_Static), as a host application in the same process
+/// sets and reads them, after the STEP and IGES controllers' Init: an integer or enumerated one
+/// by its number, a text one by its text. The setters return false when OpenCASCADE refuses.
+int exchange_setting_int(const char* name);
+std::string exchange_setting_text(const char* name);
+bool set_exchange_setting(const char* name, int value);
+bool set_exchange_setting(const char* name, const char* value);
 
 /// Holds one Geom_BSplineSurface and evaluates grids with its D0 (the benchmark's baseline).
 class GridEvaluator {

@@ -95,13 +95,46 @@ void check_readable(const fs::path& file, std::string_view caller) {
                                        " cannot be opened; check its permissions");
 }
 
+namespace {
+// The KeptSettings of the exchange call in progress (one at a time: the exchange lock).
+KeptSettings* kept_settings = nullptr;
+}  // namespace
+
+KeptSettings::KeptSettings() : outer_(kept_settings) { kept_settings = this; }
+
+KeptSettings::~KeptSettings() {
+  for (auto it = saved_.rbegin(); it != saved_.rend(); ++it) {
+    if (it->integer)
+      Interface_Static::SetIVal(it->name.c_str(), it->ival);
+    else
+      Interface_Static::SetCVal(it->name.c_str(), it->cval.c_str());
+  }
+  kept_settings = outer_;
+}
+
+void KeptSettings::remember(const char* name, bool integer) {
+  if (!Interface_Static::IsPresent(name)) return;  // set_static refuses it
+  for (const Saved& s : saved_)
+    if (s.name == name) return;
+  Saved s;
+  s.name = name;
+  s.integer = integer;
+  if (integer)
+    s.ival = Interface_Static::IVal(name);
+  else if (const char* text = Interface_Static::CVal(name))
+    s.cval = text;
+  saved_.push_back(std::move(s));
+}
+
 void set_static(const char* name, const char* value) {
+  if (kept_settings) kept_settings->remember(name, false);
   if (!Interface_Static::SetCVal(name, value))
     throw Error(ErrorCategory::Internal,
                 std::string("OpenCASCADE setting '") + name + "' does not accept '" + value + "'");
 }
 
 void set_static(const char* name, int value) {
+  if (kept_settings) kept_settings->remember(name, true);
   if (!Interface_Static::SetIVal(name, value))
     throw Error(ErrorCategory::Internal, std::string("OpenCASCADE setting '") + name +
                                              "' does not accept " + std::to_string(value));

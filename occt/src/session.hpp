@@ -55,11 +55,38 @@ class QuietMessages {
   std::vector<Message_Gravity> saved_;
 };
 
-/// The exchange lock, quiet messages and non-stop floating point, for one public call.
+/// While alive, every OpenCASCADE exchange setting (Interface_Static) changed through
+/// set_static is put back as it was when it ends. OpenCASCADE's settings are the process's: a
+/// host application in the same process (FreeCAD, a workbench) keeps its own. Our readers left
+/// read.iges.bspline.continuity at 0, and FreeCAD's own IGES reading then kept curves whole that
+/// it splits by default.
+class KeptSettings {
+ public:
+  KeptSettings();
+  ~KeptSettings();
+  KeptSettings(const KeptSettings&) = delete;
+  KeptSettings& operator=(const KeptSettings&) = delete;
+  /// Records `name`'s value (an integer or a text setting) before its first change here.
+  void remember(const char* name, bool integer);
+
+ private:
+  struct Saved {
+    std::string name;
+    bool integer = false;
+    int ival = 0;
+    std::string cval;
+  };
+  std::vector<Saved> saved_;
+  KeptSettings* outer_ = nullptr;
+};
+
+/// The exchange lock, quiet messages, non-stop floating point and the settings put back, for one
+/// public call.
 struct ExchangeSession {
   std::lock_guard<std::mutex> lock{exchange_mutex()};
   QuietMessages quiet;
   internal::FpTrapsHeld floating_point;
+  KeptSettings settings;
 };
 
 /// 'path', for messages.

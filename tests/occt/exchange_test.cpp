@@ -9,6 +9,7 @@
 #include <clay/surface/tessellate.hpp>
 
 #include <gltf_reader.hpp>
+#include <occt_reference.hpp>
 #include <random_geometry.hpp>
 
 #include <algorithm>
@@ -127,6 +128,39 @@ TEST_CASE("STEP AP214 round trip is bit-identical and faces are valid at 1e-7",
   REQUIRE_THAT(text, Catch::Matchers::Contains("PRODUCT('clayform','clayform'"));
   REQUIRE_THAT(text, Catch::Matchers::Contains("RATIONAL_B_SPLINE_SURFACE"));
   REQUIRE(names_in(file.parent_path()) == std::vector<std::string>{"surfaces.step"});
+}
+
+TEST_CASE("exchange calls leave OpenCASCADE's settings as they found them (a host's own)",
+          "[exchange]") {
+  // OpenCASCADE's Interface_Static settings are the process's: an application embedding us
+  // (FreeCAD) sets its own. Ours are set for each call and put back after it: our IGES reading
+  // left read.iges.bspline.continuity at 0, and FreeCAD's own reading then kept curves whole
+  // that it splits by default. The host's values here are unusual ones, read back after.
+  namespace ref = clay::surface::occt_reference;
+  REQUIRE(ref::set_exchange_setting("read.iges.bspline.continuity", 2));
+  REQUIRE(ref::set_exchange_setting("write.iges.brep.mode", 1));
+  REQUIRE(ref::set_exchange_setting("write.iges.unit", 1));  // inches
+  REQUIRE(ref::set_exchange_setting("write.step.unit", 1));  // inches
+  REQUIRE(ref::set_exchange_setting("write.step.product.name", "host part"));
+  std::mt19937 rng(7);
+  const auto surfaces = mixed_surfaces(rng);
+  const fs::path folder = fresh_folder("host_settings");
+  write_iges(surfaces, folder / "s.igs");
+  write_step(surfaces, folder / "s.step");
+  // ours were in force for the calls: millimetres, faces (144), the files read back
+  require_identical(read_iges(folder / "s.igs"), surfaces);
+  require_identical(read_step(folder / "s.step"), surfaces);
+  CHECK(ref::exchange_setting_int("read.iges.bspline.continuity") == 2);
+  CHECK(ref::exchange_setting_int("write.iges.brep.mode") == 1);
+  CHECK(ref::exchange_setting_int("write.iges.unit") == 1);
+  CHECK(ref::exchange_setting_int("write.step.unit") == 1);
+  CHECK(ref::exchange_setting_text("write.step.product.name") == "host part");
+  // OpenCASCADE's defaults again, for the tests after this one
+  ref::set_exchange_setting("read.iges.bspline.continuity", 1);
+  ref::set_exchange_setting("write.iges.brep.mode", 0);
+  ref::set_exchange_setting("write.iges.unit", "MM");
+  ref::set_exchange_setting("write.step.unit", "MM");
+  ref::set_exchange_setting("write.step.product.name", "");
 }
 
 TEST_CASE("STEP AP242 round trip is bit-identical", "[exchange][step]") {
