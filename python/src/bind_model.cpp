@@ -296,8 +296,7 @@ void bind_model(py::module_& m) {
         d["message"] = r.brief();
         return py::make_tuple(std::move(imported.model), d);
       },
-      py::arg("path"), py::arg("sew") = false, py::arg("isolate") = true,
-      py::arg("strict") = false,
+      py::arg("path"), py::arg("sew") = false, py::arg("isolate") = true, py::arg("strict") = false,
       "Reads a whole STEP or IGES model (trimmed faces, solids, assembly): (Model, report). "
       "isolate=True (the default) reads in a child process, so a file that crashes OpenCASCADE "
       "raises ExchangeError (or, when only its XCAF reader crashes, is read by its plain reader "
