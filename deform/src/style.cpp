@@ -771,7 +771,8 @@ Summary judge_style(const StyleReport& report, const StyleOptions& options) {
       m << "the target curve is missed by " << miss
         << " mm, more than curve_tolerance x size = " << options.curve_tolerance * size
         << " mm; allow more max_key_point_rounds or max_refinements, or a larger curve_tolerance";
-    } else if (options.net_convergence > 0 && !(report.net_change <= options.net_convergence)) {
+    } else if (options.net_convergence > 0 && !options.net_convergence_best_effort &&
+               !(report.net_change <= options.net_convergence)) {
       s.termination = Termination::NotConverged;
       if (std::isnan(report.net_change))
         m << "the net could not be halved to check that the shape has converged";

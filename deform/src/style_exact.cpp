@@ -807,6 +807,7 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
   const ShapeGrid grid =
       options.net_convergence > 0 ? shape_grid(parent, region, in_region) : ShapeGrid{};
   report.net_change = std::numeric_limits<double>::quiet_NaN();
+  double previous_change = 0;  // net_change of the halving before (best effort's stall test)
   double amplification = 0;
   RangeColumns range_columns;  // H^-1 B^T, kept between the solves on one net
 
@@ -927,7 +928,13 @@ StyleResult style_exact(const surface::SurfaceProjector& projector, const Influe
         report.net_change = change.relative;
       }
       const bool settled = previous && report.net_change <= options.net_convergence;
-      if (!settled && refinements < options.max_refinements) {
+      // Best effort stops where a halving no longer shrinks the change by a fifth: the shape
+      // does not converge (a target reaching the bound, which holds the net still there), and
+      // each further round costs about four times the last.
+      const bool stalled = options.net_convergence_best_effort && previous_change > 0 &&
+                           report.net_change > 0.8 * previous_change;
+      if (previous) previous_change = report.net_change;
+      if (!settled && !stalled && refinements < options.max_refinements) {
         previous = out.surface;
         if (change.at.empty()) {
           refine();  // the first comparison needs a halving everywhere

@@ -302,7 +302,7 @@ void bind_deform(py::module_& m) {
       "style_deform",
       [](const BSplineSurface& parent, const py::object& bound, const BSplineCurve& target,
          const std::string& mode, double lam, double curve_tolerance, double net_convergence,
-         const std::string& continuity) {
+         const std::string& continuity, bool net_convergence_best_effort) {
         deform::StyleOptions o;
         if (mode == "exact")
           o.mode = deform::StyleMode::Exact;
@@ -317,6 +317,7 @@ void bind_deform(py::module_& m) {
         o.lambda = lam;
         o.curve_tolerance = curve_tolerance;
         o.net_convergence = net_convergence;
+        o.net_convergence_best_effort = net_convergence_best_effort;
         const std::optional<BSplineCurve> b =
             bound.is_none() ? std::nullopt : std::optional(bound.cast<BSplineCurve>());
         deform::StyleResult r;
@@ -333,10 +334,11 @@ void bind_deform(py::module_& m) {
       },
       py::arg("parent"), py::arg("bound"), py::arg("target"), py::arg("mode") = "exact",
       py::arg("lam") = 1.0, py::arg("curve_tolerance") = 1e-4, py::arg("net_convergence") = 0.0,
-      py::arg("continuity") = "G1",
+      py::arg("continuity") = "G1", py::arg("net_convergence_best_effort") = false,
       "Han-De Amicis-Conti style deformation of parent by a closed bound curve (None: the "
       "target's support band) and a target curve: (surface, report). A result that misses its "
-      "tolerance raises ToleranceNotMetError.");
+      "tolerance raises ToleranceNotMetError; with net_convergence_best_effort, a net that "
+      "stops short of net_convergence keeps its finest result (report['net_change']).");
 }
 
 }  // namespace clay::python

@@ -493,7 +493,7 @@ std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p
                  {"kind", "name", "enabled", "target", "bound", "mode", "lambda", "relaxation",
                   "smoothing", "key_points_per_row", "boundary_rows", "relative_tolerance",
                   "curve_tolerance", "max_refinements", "max_key_point_rounds", "continuity",
-                  "net_convergence", "accept_out_of_tolerance"},
+                  "net_convergence", "net_convergence_best_effort", "accept_out_of_tolerance"},
                  "a style step", {renamed_relative}))
     return std::nullopt;
   StyleDef d;
@@ -539,6 +539,12 @@ std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p
     if (const auto k = c_.choice(*m, key_path(p, "continuity"), {"G1", "G2"}))
       o.continuity = *k == 0 ? deform::BoundContinuity::G1 : deform::BoundContinuity::G2;
   o.net_convergence = c_.number_or(j, p, "net_convergence", o.net_convergence, Range{0, 0.5});
+  o.net_convergence_best_effort =
+      c_.boolean_or(j, p, "net_convergence_best_effort", o.net_convergence_best_effort);
+  if (o.net_convergence_best_effort && !(o.net_convergence > 0))
+    c_.add(key_path(p, "net_convergence_best_effort"),
+           "best effort needs a \"net_convergence\" to work towards (e.g. 0.05): set it, or "
+           "drop \"net_convergence_best_effort\"");
   o.max_key_point_rounds =
       c_.integer_or(j, p, "max_key_point_rounds", o.max_key_point_rounds, 0, 16);
   d.accept_out_of_tolerance =

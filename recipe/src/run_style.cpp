@@ -1,5 +1,8 @@
 // A recipe's style step (Han, De Amicis & Conti; clay/deform/style.hpp) as a run makes it: the
 // settings a drag update uses, the style, its figures and what it warns of (recipe_run.hpp).
+#include <clay/internal/format.hpp>
+
+#include <cmath>
 #include <string>
 
 #include "recipe_run.hpp"
@@ -46,6 +49,17 @@ StyleStep style_step(const StyleDef& d, const surface::BSplineSurface& parent,
                       "\"accept_out_of_tolerance\": true on this step");
     rep.warning = true;
     rep.message += "; accepted out of tolerance: " + x.summary.message;
+  }
+  if (o.net_convergence_best_effort && !first_net_only && !(x.net_change <= o.net_convergence)) {
+    // Best effort (the studio's calm default): the finest net's result, said to be short.
+    rep.warning = true;
+    rep.message += std::isnan(x.net_change)
+                       ? std::string("; net convergence not checked: the net could not be halved")
+                       : "; net convergence stopped at " + format("%.3g", 100 * x.net_change) +
+                             " % (best effort for " + format("%g", 100 * o.net_convergence) +
+                             " %: one more halving no longer shrinks the change, or "
+                             "max_refinements was used; a target that runs into its bound "
+                             "does not converge)";
   }
   if (x.curvature_waves > deform::curvature_waves_calm && !first_net_only) {
     // Rings: not a tolerance missed (the target is met), but a shape the stylist should see.

@@ -1304,6 +1304,29 @@ TEST_CASE("a style step's continuity and net_convergence: read, and bad values n
   const double asked = net_change(R"(, "continuity": "G2", "net_convergence": 0.5)");
   CHECK(asked >= 0);
   CHECK(std::isfinite(asked));
+  // Best effort needs a convergence to work towards, and must be a boolean.
+  const auto alone = check_recipe(text(R"(, "net_convergence_best_effort": true)"));
+  INFO(dump(alone));
+  CHECK(mentions(alone, "deformations.crease[0].net_convergence_best_effort",
+                 "needs a \"net_convergence\""));
+  const auto not_bool =
+      check_recipe(text(R"(, "net_convergence": 0.05, "net_convergence_best_effort": 1)"));
+  CHECK(mentions(not_bool, "deformations.crease[0].net_convergence_best_effort", "true or false"));
+  // Short of its convergence (1e-4 within its 6 rounds), a best-effort step succeeds with a warning
+  // naming the figure it stopped at; the same step without best effort fails.
+  const std::string short_of =
+      R"(, "net_convergence": 0.0001, "net_convergence_best_effort": true)";
+  const auto run = run_recipe(parse_recipe(text(short_of)));
+  std::string message;
+  bool warned = false;
+  for (const auto& step : run.steps)
+    if (step.path == "surfaces.styled.steps[0]") {
+      message = step.message;
+      warned = step.warning && message.find("net convergence stopped at") != std::string::npos;
+    }
+  INFO(message);
+  CHECK(warned);
+  CHECK_THROWS_AS(run_recipe(parse_recipe(text(R"(, "net_convergence": 0.0001)"))), clay::Error);
 }
 
 TEST_CASE("a fill with \"join\": \"snap\" closes stated gaps between curve ends at their midpoints",

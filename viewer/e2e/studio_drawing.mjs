@@ -142,10 +142,31 @@ export default async function drawing({ clayform, work, browser, page, driver, c
       assert(moved <= 1e-9, `a point carried only by control points outside the bound moved ${moved} mm`);
       // the target met: the styled surface passes through the target curve (within the step's
       // curve tolerance, relative to the model's size, as reported)
-      figures.style = { key_points: f.key_points, target_deviation: f.target_deviation, target_curve_deviation: f.target_curve_deviation, locality: f.locality, moved_outside_mm: moved, samples_outside: checked, kernel_ms: 1000 * step.seconds };
-      return `${f.key_points} key points, target deviation ${f.target_deviation}, curve ${f.target_curve_deviation}; ${checked} samples outside the bound moved ${moved} mm`;
+      figures.style = { key_points: f.key_points, target_deviation: f.target_deviation, target_curve_deviation: f.target_curve_deviation, locality: f.locality, moved_outside_mm: moved, samples_outside: checked, kernel_ms: 1000 * step.seconds, curvature_waves: f.curvature_waves };
+      return `${f.key_points} key points, target deviation ${f.target_deviation}, curve ${f.target_curve_deviation}; ${checked} samples outside the bound moved ${moved} mm; curvature waves ${f.curvature_waves}`;
     });
     await shot('styled');
+
+    await check('the Style panel\'s net convergence: 5 % converges as far as it goes (best effort), off styles on the first net again', async () => {
+      const figuresAt = async (value) => {
+        await page.selectOption('#style-convergence', value);
+        await idle();
+        assert(!(await lastError()), await lastError());
+        const recipe = await studioCall(() => window.clayStudio.recipe());
+        const written = Object.values(recipe.deformations).find((st) => st[0].kind === 'style')[0];
+        assert(written.net_convergence === Number(value) && written.net_convergence_best_effort === Number(value) > 0, `convergence ${value} wrote ${JSON.stringify(written)}`);
+        const step = (await studioCall(() => window.clayStudio.reply())).steps.find((st) => st.kind === 'style');
+        return { waves: step.figures.curvature_waves, net_change: step.figures.net_change, knots: step.figures.knots_inserted, ms: 1000 * step.seconds };
+      };
+      const calm = await figuresAt('0.05');
+      const shown = await page.locator('#style-figures').textContent();
+      assert(shown.includes('net convergence: last halving'), `the Style panel shows: ${shown}`);
+      const off = await figuresAt('0');
+      assert(off.net_change === null, `convergence off measured a net change ${off.net_change}`);
+      assert(Number.isFinite(calm.net_change) && calm.knots > off.knots, `5 %: ${JSON.stringify(calm)}, off ${JSON.stringify(off)}`);
+      figures.style_convergence = { off, calm };
+      return `first net: ${off.waves} curvature waves, ${off.knots} knots inserted, ${off.ms.toFixed(0)} ms; 5 % best effort: ${calm.waves} waves, net change ${calm.net_change.toPrecision(2)}, ${calm.knots} knots, ${calm.ms.toFixed(0)} ms`;
+    });
 
     await check('the target curve dragged by a control point: the style follows, in one history entry', async () => {
       await clickCurve('s6', false);

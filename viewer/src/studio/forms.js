@@ -39,7 +39,7 @@ export function styleSummary(f) {
   if (finite(f.target_curve_distance)) lines.push(`target curve within ${f.target_curve_distance.toPrecision(2)} mm`);
   if (finite(f.boundary_tangent_angle)) lines.push(`at the bound: ${f.boundary_position_jump.toPrecision(2)} mm, ${f.boundary_tangent_angle.toPrecision(2)}°`);
   if (finite(f.mean_curvature_min)) lines.push(`mean curvature ${f.mean_curvature_min.toPrecision(2)} … ${f.mean_curvature_max.toPrecision(2)} /mm`);
-  if (finite(f.net_change)) lines.push(`net converged: last halving ${(100 * f.net_change).toPrecision(2)} %`);
+  if (finite(f.net_change)) lines.push(`net convergence: last halving ${(100 * f.net_change).toPrecision(2)} %`);
   if (finite(f.curvature_waves) && f.curvature_waves >= 0) lines.push(`curvature waves ${f.curvature_waves} (calm: up to ${calmWaves})`);
   const rings = finite(f.curvature_waves) && f.curvature_waves > calmWaves;
   return {

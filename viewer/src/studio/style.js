@@ -100,5 +100,17 @@ export function wireStyle() {
   styleField('style-smoothing', 'smoothing', (e) => e.checked);
   styleField('style-mode', 'mode', (e) => e.value);
   styleField('style-continuity', 'continuity', (e) => e.value);
-  styleField('style-convergence', 'net_convergence', (e) => Number(e.value));
+  // Net convergence, best effort when on: the panel's styles keep the finest net's result (with a
+  // warning) where the shape stops converging, instead of failing (off: no rounds at all).
+  $('style-convergence').addEventListener('input', (event) => {
+    const style = activeStyle();
+    if (!style) return;
+    const value = Number($('style-convergence').value);
+    const at = `deformations.${style}[0]`;
+    const changes = [
+      { path: `${at}.net_convergence`, value, create: true },
+      { path: `${at}.net_convergence_best_effort`, value: value > 0, create: true },
+    ];
+    dragEdit(() => ({ changes, label: `${style} net convergence`, group: sliderGroup('style-convergence') }), event.timeStamp);
+  });
 }

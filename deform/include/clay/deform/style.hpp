@@ -90,6 +90,12 @@ struct CLAY_DEFORM_API StyleOptions {
                                ///< halving changes the styled shape by less than this fraction
                                ///< of its largest displacement (0 = no such rounds; see
                                ///< docs/deform.md for what convergence costs)
+  bool net_convergence_best_effort = false;  ///< exact: a net that stops short of
+                                             ///< net_convergence (max_refinements used, or a
+                                             ///< halving that no longer shrinks the change: a
+                                             ///< target that runs into the bound) keeps its
+                                             ///< finest result and reports its net_change
+                                             ///< instead of failing (the studio's calm default)
   double curve_tolerance =
       1e-4;                      ///< exact: where the result misses the target curve (at its
                                  ///< samples) by more than this, relative to the model size,
