@@ -174,7 +174,8 @@ namespace {
 /// with "pieces" would be (fit_stroke, split where it turns by more than corner_angle), and how:
 /// the page asks before it writes the stroke, so a stroke with corners becomes one with "pieces".
 /// Read by the shared path-aware reader, with a recipe stroke's limits; every problem is named.
-Json fit_reply(const Json& command) {
+/// Fitted through the session's `cache`: the edit that writes the stroke takes this fit.
+Json fit_reply(const Json& command, recipe::RunCache& cache) {
   const internal::Json& c = command;
   internal::JsonReader r;
   r.limit_note = "a recipe stroke's limit: draw it as several strokes";
@@ -212,7 +213,7 @@ Json fit_reply(const Json& command) {
     throw Error(ErrorCategory::InvalidArgument, "studio: \"fit\": " + list);
   }
   sketch::validate(stroke, "the fit's stroke");
-  const sketch::StrokeFit fit = sketch::fit_stroke(stroke, options);
+  const sketch::StrokeFit fit = cache.fit_stroke(stroke, options);
   return {{"op", "fit"},
           {"pieces", fit.curves.size()},
           {"corners", fit.corners},
@@ -605,7 +606,7 @@ struct StudioSession::Impl {
     return {reply_text(Json{{"op", "recipe"}, {"text", text()}, {"revision", revision}}), {}};
   }
 
-  Reply fit(const Json& c, const Cancel&) { return {reply_text(fit_reply(c)), {}}; }
+  Reply fit(const Json& c, const Cancel&) { return {reply_text(fit_reply(c, *cache)), {}}; }
 
   Reply run_all(const Json&, const Cancel& cancelled) {
     meshed.clear();  // "run" sends everything: the page may hold nothing (a new page)

@@ -143,9 +143,11 @@ void bind_recipe(py::module_& m) {
             d["evicted"] = n.evicted;
             d["entries"] = n.entries;
             d["bytes"] = n.bytes;
+            d["fits_reused"] = n.fits_reused;
             return d;
           },
-          "reused (steps taken), kept (results stored), evicted, entries and bytes held now.")
+          "reused (steps taken), kept (results stored), evicted, entries and bytes held now, "
+          "fits_reused (stroke fits taken).")
       .def("clear", &recipe::RunCache::clear, "Drops every kept result and zeroes the counts.")
       .def("__repr__", [](const recipe::RunCache& c) {
         const auto n = c.counts();

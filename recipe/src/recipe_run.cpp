@@ -525,7 +525,8 @@ class Runner {
   }
 
   void stroke(const StrokeDef& s, StepReport& rep) {
-    for (auto& [name, c] : stroke_curves(s, rep)) add_curve(name, std::move(c));
+    for (auto& [name, c] : stroke_curves(s, rep, options_.cache.get()))
+      add_curve(name, std::move(c));
   }
 
   void curve(const CurveDef& c, StepReport& rep) {

@@ -105,9 +105,11 @@ void lattice_figures(const deform::Deformation& d, StepReport& rep);
 /// A recipe stroke fitted (sketch::fit_stroke, run_stroke.cpp): its curve, or its pieces NAME.1 ..
 /// NAME.N, with the step's figures and message in `rep`. clay::Error when the fit gives another
 /// number of curves than its "pieces" asks, or misses its tolerance without
-/// "accept_out_of_tolerance" (then kept, with a warning).
+/// "accept_out_of_tolerance" (then kept, with a warning). Fitted through `cache` when given
+/// (RunCache::fit_stroke: a stroke the studio asked about is not fitted again).
 std::vector<std::pair<std::string, surface::BSplineCurve>> stroke_curves(const StrokeDef& s,
-                                                                         StepReport& rep);
+                                                                         StepReport& rep,
+                                                                         RunCache* cache);
 
 /// The recipe's deformation stack named `deformation`, or its only one when the name is empty.
 const StackDef& pick_stack(const RecipeData& d, std::string_view deformation);

@@ -32,7 +32,45 @@ struct RunCache::Impl {
   };
   std::list<Editor> editors;
   static constexpr std::size_t max_editors = 4;
+  // Stroke fits, most recent first, each under its stroke's and settings' bytes (fit_key).
+  struct Fit {
+    std::string key;
+    double corner_angle, corner_window;
+    sketch::StrokeFit fit;
+  };
+  std::list<Fit> fits;
+  static constexpr std::size_t max_fits = 8;
 };
+
+namespace {
+
+template <class T>
+void append_bytes(std::string& key, const T& value) {
+  key.append(reinterpret_cast<const char*>(&value), sizeof value);
+}
+
+/// Every input of sketch::fit_stroke as bytes but the corner settings (RunCache::fit_stroke
+/// compares those itself).
+std::string fit_key(const sketch::Stroke& stroke, const sketch::FitOptions& o) {
+  std::string key;
+  key.reserve(static_cast<std::size_t>(stroke.points.size()) * sizeof(double) + 160);
+  append_bytes(key, stroke.points.rows());
+  key.append(reinterpret_cast<const char*>(stroke.points.data()),
+             static_cast<std::size_t>(stroke.points.size()) * sizeof(double));
+  append_bytes(key, stroke.plane.has_value());
+  if (stroke.plane)
+    for (const Eigen::Vector3d* v :
+         {&stroke.plane->origin, &stroke.plane->x_axis, &stroke.plane->y_axis})
+      for (int i = 0; i < 3; ++i) append_bytes(key, (*v)[i]);
+  for (const double d : {o.tolerance_mm, o.fairness, o.closing_ratio}) append_bytes(key, d);
+  for (const int i :
+       {o.degree, o.fairness_reductions, o.max_control_points, o.max_iterations, o.end_samples})
+    append_bytes(key, i);
+  append_bytes(key, o.drop_duplicates);
+  return key;
+}
+
+}  // namespace
 
 RunCache::RunCache(std::size_t capacity_bytes) : impl_(std::make_unique<Impl>(capacity_bytes)) {}
 RunCache::~RunCache() = default;
@@ -47,7 +85,40 @@ void RunCache::clear() {
   impl_->slots.clear();
   impl_->order.clear();
   impl_->editors.clear();
+  impl_->fits.clear();
   impl_->counts = {};
+}
+
+sketch::StrokeFit RunCache::fit_stroke(const sketch::Stroke& stroke,
+                                       const sketch::FitOptions& options) {
+  std::string key = fit_key(stroke, options);
+  // The corner settings only choose the corners (a turn by more than corner_angle, measured over
+  // corner_window): a fit that found none is the fit at any larger angle (the studio asks at
+  // 50 degrees, a recipe stroke without "pieces" is fitted at 180, never split).
+  auto same = [&](const Impl::Fit& f) {
+    if (f.key != key) return false;
+    if (f.corner_angle == options.corner_angle && f.corner_window == options.corner_window)
+      return true;
+    return f.fit.corners.empty() &&
+           (options.corner_angle >= 180.0 ||
+            (options.corner_angle >= f.corner_angle && options.corner_window == f.corner_window));
+  };
+  {
+    const std::lock_guard<std::mutex> lock(impl_->mutex);
+    auto& fits = impl_->fits;
+    for (auto it = fits.begin(); it != fits.end(); ++it)
+      if (same(*it)) {
+        fits.splice(fits.begin(), fits, it);  // the most recent
+        ++impl_->counts.fits_reused;
+        return fits.front().fit;
+      }
+  }
+  // Fitted outside the lock: other threads' runs go on meanwhile.
+  sketch::StrokeFit fit = sketch::fit_stroke(stroke, options);
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  impl_->fits.push_front({std::move(key), options.corner_angle, options.corner_window, fit});
+  if (impl_->fits.size() > Impl::max_fits) impl_->fits.pop_back();
+  return fit;
 }
 
 namespace detail {

@@ -13,8 +13,10 @@
 namespace clay::recipe::detail {
 
 std::vector<std::pair<std::string, surface::BSplineCurve>> stroke_curves(const StrokeDef& s,
-                                                                         StepReport& rep) {
-  const sketch::StrokeFit fit = sketch::fit_stroke(s.stroke, s.fit);
+                                                                         StepReport& rep,
+                                                                         RunCache* cache) {
+  const sketch::StrokeFit fit =
+      cache ? cache->fit_stroke(s.stroke, s.fit) : sketch::fit_stroke(s.stroke, s.fit);
   const std::size_t wanted = s.pieces == 0 ? 1 : static_cast<std::size_t>(s.pieces);
   if (fit.curves.size() != wanted) {
     const std::string found = std::to_string(fit.curves.size());

@@ -22,6 +22,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "bspline_target.hpp"
 
@@ -307,6 +308,66 @@ TEST_CASE("studio session: a new stroke is fitted alone, the rest taken from the
   for (const Json& step : undone.at("steps"))
     if (step.at("path").get<std::string>().rfind("exports.", 0) != 0)
       CHECK(step.value("reused", false));
+}
+
+TEST_CASE(
+    "studio session: a stroke the page asked about is fitted once, for the question and "
+    "the edit that writes it",
+    "[recipe][cache][studio]") {
+  // The page asks "fit" (at 50 degrees, to find corners) and then writes the stroke: the run
+  // takes the question's fit (RunCache::fit_stroke) when the stroke has no corners, whose fit at
+  // the recipe's 180 degrees is the same computation. Checked bit for bit against a run without
+  // a cache. A stroke with a corner written without "pieces" is fitted again, unsplit; written
+  // with them, its fit is the question's.
+  const std::string text = R"({"format": "clayform.recipe", "version": 1})";
+  const Json smooth = {
+      {"points",
+       {{0, 0, 0}, {40, 9, 1}, {80, 14, 3}, {120, 12, 4}, {160, 5, 4}, {200, -3, 5}, {240, -6, 7}}},
+      {"tolerance_mm", 0.5}};
+  const Json cornered = {{"points",
+                          {{0, 0, 0},
+                           {25, 1, 0},
+                           {50, 0, 0},
+                           {75, 1, 0},
+                           {100, 0, 0},
+                           {101, 25, 0},
+                           {100, 50, 0},
+                           {101, 75, 0},
+                           {100, 100, 0}}},
+                         {"tolerance_mm", 0.5}};
+  Json in_pieces = cornered;
+  in_pieces["pieces"] = 2;
+  for (const auto& [name, stroke, pieces, reused] :
+       {std::tuple{"smooth", smooth, 1, 1LL}, std::tuple{"cornered", cornered, 2, 0LL},
+        std::tuple{"cornered, written in pieces", in_pieces, 2, 1LL}}) {
+    INFO(name);
+    StudioSession session(text, fs::path(CLAY_TEST_OUTPUT_DIR), "fit_once");
+    Json ask = stroke;
+    ask.erase("pieces");
+    ask["op"] = "fit";
+    const Json fit = Json::parse(session.handle(ask.dump()).json);
+    REQUIRE(fit.at("op") == "fit");
+    CHECK(fit.at("pieces") == pieces);
+    const Json reply = Json::parse(
+        session
+            .handle(Json{{"op", "edit"}, {"path", "strokes.s"}, {"value", stroke}, {"create", true}}
+                        .dump())
+            .json);
+    REQUIRE(reply.at("op") == "edit");
+    CHECK(session.run_cache()->counts().fits_reused == reused);
+    Json doc = Json::parse(text);
+    doc["strokes"]["s"] = stroke;
+    const RunResult fresh = run_recipe(parse_recipe(doc.dump(), fs::path(CLAY_TEST_OUTPUT_DIR)));
+    const RunResult in_session =
+        run_recipe(parse_recipe(session.text(), fs::path(CLAY_TEST_OUTPUT_DIR)));
+    REQUIRE(fresh.curves.size() == static_cast<std::size_t>(stroke.value("pieces", 1)));
+    RunOptions cached;
+    cached.cache = session.run_cache();
+    const RunResult from_cache =
+        run_recipe(parse_recipe(session.text(), fs::path(CLAY_TEST_OUTPUT_DIR)), cached);
+    require_identical(from_cache, fresh);
+    require_identical(in_session, fresh);
+  }
 }
 
 TEST_CASE(

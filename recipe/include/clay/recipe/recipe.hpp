@@ -8,6 +8,7 @@
 #include <clay/deform/light_map.hpp>
 #include <clay/deform/model_deformation.hpp>
 #include <clay/recipe/export.hpp>
+#include <clay/sketch/fit.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
@@ -107,15 +108,22 @@ class CLAY_RECIPE_API RunCache {
 
   /// What the cache did since it was made (or cleared) and holds now.
   struct Counts {
-    long long reused = 0;   ///< steps taken from it (a surface with its stack counts once)
-    long long kept = 0;     ///< results built and stored
-    long long evicted = 0;  ///< results dropped for the capacity
-    long long entries = 0;  ///< results held now
-    std::size_t bytes = 0;  ///< their estimated size
+    long long reused = 0;       ///< steps taken from it (a surface with its stack counts once)
+    long long kept = 0;         ///< results built and stored
+    long long evicted = 0;      ///< results dropped for the capacity
+    long long entries = 0;      ///< results held now
+    std::size_t bytes = 0;      ///< their estimated size
+    long long fits_reused = 0;  ///< stroke fits taken from it (fit_stroke)
   };
   Counts counts() const;
   /// Drops every kept result and zeroes the counts.
   void clear();
+
+  /// sketch::fit_stroke, each stroke fitted once: a stroke whose points, plane and settings are
+  /// bit for bit those of one of the most recent fits gets that fit (the studio asks how a
+  /// stroke fits before it writes it, and the run of that edit fits it again). Throws as
+  /// sketch::fit_stroke does; nothing is kept for a stroke that throws.
+  sketch::StrokeFit fit_stroke(const sketch::Stroke& stroke, const sketch::FitOptions& options);
 
  private:
   friend class detail::CacheAccess;
