@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "bernstein_poly.hpp"
+#include "compose_factors.hpp"
 #include "compose_size.hpp"
 #include "lattice_monomials.hpp"
 #include "messages.hpp"
@@ -42,129 +43,28 @@ std::string fmt(double v) { return format(v, 6); }  // short figures for message
 
 constexpr const char* coordinate_name[3] = {"s", "t", "u"};
 
+using detail::casteljau;
+using detail::cell_factors;
 using detail::constant_poly;
+using detail::degree_tolerance;
+using detail::dual_vectors;
 using detail::exact_degree;
+using detail::Factor;
 using detail::halve;
 using detail::LatticeMonomials;
 using detail::leaves;
+using detail::make_factor;
 using detail::mul_add;
 using detail::multiply;
+using detail::patch_coordinates;
+using detail::PatchCoordinates;
 using detail::Poly;
+using detail::ratio_poly;
 using detail::scale;
 using detail::to_degree;
 using detail::value_at;
 using detail::Violation;
-
-// ---- one Bézier patch of the surface in lattice coordinates ---------------------------------
-
-/// Homogeneous coordinate polys of a patch: W and, per coordinate, its numerator C (c = C / W),
-/// with the rounding scale of each (for the exact degree tests).
-struct PatchCoordinates {
-  Poly w;
-  std::array<Poly, 3> c;
-  double w_scale = 1, c_scale = 1;
-};
-
-/// Coordinates c_d = dual_d · (X − origin) of a Bézier patch, homogeneous: C = w dual · (P − X0).
-PatchCoordinates patch_coordinates(const BSplineSurface& patch, const Eigen::Vector3d& origin,
-                                   const std::array<Eigen::Vector3d, 3>& dual) {
-  const int p = patch.u.degree, q = patch.v.degree;
-  PatchCoordinates pc;
-  pc.w = Poly(p, q, 1);
-  double wmax = 0, xmax = 0;
-  for (int d = 0; d < 3; ++d) pc.c[static_cast<size_t>(d)] = Poly(p, q, 1);
-  for (int i = 0; i <= p; ++i)
-    for (int j = 0; j <= q; ++j) {
-      const Eigen::Index r = patch.index(i, j);
-      const double w = patch.weights(r);
-      const Eigen::Vector3d x = patch.points.row(r).transpose() - origin;
-      pc.w.at(i, j) = w;
-      wmax = std::max(wmax, w);
-      xmax = std::max(xmax, x.norm());
-      for (int d = 0; d < 3; ++d)
-        pc.c[static_cast<size_t>(d)].at(i, j) = w * dual[static_cast<size_t>(d)].dot(x);
-    }
-  double dmax = 0;
-  for (const auto& v : dual) dmax = std::max(dmax, v.norm());
-  pc.w_scale = wmax;
-  pc.c_scale = wmax * xmax * dmax;
-  return pc;
-}
-
-/// Dual vectors of a frame: local coordinate d of X is dual[d] · (X − X0) (Sederberg–Parry eq.
-/// (1)).
-std::array<Eigen::Vector3d, 3> dual_vectors(const Frame& f) {
-  const Eigen::Vector3d tu = f.t.cross(f.u), su = f.s.cross(f.u), st = f.s.cross(f.t);
-  return {tu / tu.dot(f.s), su / su.dot(f.t), st / st.dot(f.u)};
-}
-
-/// Relative tolerance of the exact degree tests (docs: 1e-14 of the rounding scale).
-constexpr double degree_tolerance = 1e-14;
-
-/// A factor of eq. (2) on a patch: a constant coordinate (S = value, V = 1 − value, degree 0) or
-/// the homogeneous pair (S, V = W − S) at degrees (du, dv), scaled.
-struct Factor {
-  bool constant = false;
-  double value = 0;
-  int du = 0, dv = 0;
-  Poly s, v;  // scaled
-  Poly w;     // W, scaled, at its exact degrees: the powers W^k of compose_by_monomials
-};
-
-/// W's exact degrees (reduced coefficients kept positive).
-std::pair<int, int> weight_degrees(const PatchCoordinates& pc) {
-  const double tol = degree_tolerance * pc.w_scale;
-  return {exact_degree(pc.w, 0, tol, true), exact_degree(pc.w, 1, tol, true)};
-}
-
-/// True when c = C / W is constant on the patch (C = c0 W coefficient by coefficient); sets c0.
-bool constant_coordinate(const Poly& c, const Poly& w, double c_scale, double& c0) {
-  double sum = 0, wsum = 0;
-  for (size_t k = 0; k < c.c.size(); ++k) sum += c.c[k], wsum += w.c[k];
-  c0 = sum / wsum;
-  for (size_t k = 0; k < c.c.size(); ++k)
-    if (std::abs(c.c[k] - c0 * w.c[k]) > degree_tolerance * c_scale) return false;
-  return true;
-}
-
-/// The factor of coordinate numerator `c` with weight `w` (scale `c_scale`), W's exact degrees
-/// `wd`: constant, or the pair at the homogeneous degrees max(deg C, deg W) per direction.
-Factor make_factor(const Poly& c, const Poly& w, double c_scale, std::pair<int, int> wd) {
-  Factor f;
-  f.w = to_degree(to_degree(w, wd.first, 0), wd.second, 1);
-  scale(f.w, false);
-  double c0 = 0;
-  if (constant_coordinate(c, w, c_scale, c0)) {
-    f.constant = true;
-    f.value = c0;
-    f.s = constant_poly(c0);
-    f.v = constant_poly(1 - c0);
-    return f;
-  }
-  const double tol = degree_tolerance * c_scale;
-  f.du = std::max(exact_degree(c, 0, tol, false), wd.first);
-  f.dv = std::max(exact_degree(c, 1, tol, false), wd.second);
-  f.s = to_degree(to_degree(c, f.du, 0), f.dv, 1);
-  const Poly wr = to_degree(to_degree(w, f.du, 0), f.dv, 1);
-  f.v = wr;
-  for (size_t k = 0; k < f.v.c.size(); ++k) f.v.c[k] -= f.s.c[k];
-  scale(f.s, false);
-  scale(f.v, false);
-  return f;
-}
-
-/// Homogeneous de Casteljau with polynomial parameter: level r point i = V · P_i + S · P_{i+1}
-/// (Sederberg–Parry eq. (2) in one direction), points given scaled; returns the scaled result.
-Poly casteljau(std::vector<Poly> pts, const Factor& f) {
-  for (size_t level = 1; level < pts.size(); ++level)
-    for (size_t i = 0; i + level < pts.size(); ++i) {
-      Poly next(pts[i].du + f.s.du, pts[i].dv + f.s.dv, pts[i].dim);
-      mul_add(pts[i], f.v, next);
-      mul_add(pts[i + 1], f.s, next);
-      pts[i] = std::move(next);
-    }
-  return std::move(pts[0]);
-}
+using detail::weight_degrees;
 
 /// A composed patch: unscaled homogeneous coefficients (x w, y w, z w, w), dim 4.
 struct ComposedPatch {
@@ -349,17 +249,6 @@ ComposedPatch compose_cell(const BezierLattice& cell, const LatticeMonomials& lm
                                    : compose_patch(cell, f, rational);
 }
 
-/// C and W of coordinate d as one dim-2 poly.
-Poly ratio_poly(const PatchCoordinates& pc, int d) {
-  Poly cw(pc.w.du, pc.w.dv, 2);
-  for (int i = 0; i <= cw.du; ++i)
-    for (int j = 0; j <= cw.dv; ++j) {
-      cw.at(i, j, 0) = pc.c[static_cast<size_t>(d)].at(i, j);
-      cw.at(i, j, 1) = pc.w.at(i, j);
-    }
-  return cw;
-}
-
 /// Name of a patch and its parameter box, and of a patch-local parameter, for messages.
 std::string patch_name(const surface::BezierPatches& bp, int a, int b) {
   return "patch (" + std::to_string(a) + ", " + std::to_string(b) + ") over u in [" +
@@ -500,20 +389,6 @@ ComposeResult finish(const surface::BezierPatches& bp, const std::vector<Compose
   report.summary.message = report.brief();
   result.report = report;
   return result;
-}
-
-/// Per coordinate d, the factor for composing a patch with a cell whose local coordinate is
-/// (c_d − lo_d) / width_d in the coordinates of `pc`.
-std::array<Factor, 3> cell_factors(const PatchCoordinates& pc, std::array<double, 3> lo,
-                                   std::array<double, 3> width) {
-  const auto wd = weight_degrees(pc);
-  std::array<Factor, 3> f;
-  for (size_t d = 0; d < 3; ++d) {
-    Poly c = pc.c[d];
-    for (size_t k = 0; k < c.c.size(); ++k) c.c[k] = (c.c[k] - lo[d] * pc.w.c[k]) / width[d];
-    f[d] = make_factor(c, pc.w, pc.c_scale / width[d], wd);
-  }
-  return f;
 }
 
 double lattice_size(const Points3& points) {

@@ -25,44 +25,11 @@ using clay::ErrorCategory;
 using clay::surface::BSplineBasis;
 using clay::surface::BSplineSurface;
 using clay::test::error_of;
+using clay::test::random_surface_in;
+using clay::test::surface_in;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// A surface of degrees (p, q) with a clamped, non-uniform knot vector of `cu` x `cv` control
-/// points, control point (i, j) at frame.point(local(i, j)), weights in [0.5, 2] when rational.
-template <class Local>
-BSplineSurface surface_in(const Frame& frame, int p, int q, int cu, int cv, bool rational,
-                          std::mt19937& rng, const Local& local) {
-  std::uniform_real_distribution<double> jitter(-0.2, 0.2), weight(0.5, 2.0);
-  auto basis = [&](int d, int n) {
-    BSplineBasis b = clay::surface::clamped_uniform_basis(d, n);
-    const double h = 1.0 / (n - d);
-    for (int k = d + 1; k < n; ++k) b.knots[static_cast<size_t>(k)] += jitter(rng) * h;
-    return b;
-  };
-  BSplineSurface s;
-  s.u = basis(p, cu);
-  s.v = basis(q, cv);
-  s.points.resize(cu * cv, 3);
-  s.weights = Eigen::VectorXd::Ones(cu * cv);
-  for (int i = 0; i < cu; ++i)
-    for (int j = 0; j < cv; ++j) {
-      const Eigen::Vector3d l = local(i, j);
-      s.points.row(s.index(i, j)) = frame.point(l.x(), l.y(), l.z()).transpose();
-      if (rational) s.weights(s.index(i, j)) = weight(rng);
-    }
-  clay::surface::validate(s);
-  return s;
-}
-
-/// Random control points with local coordinates in [0.05, 0.95]: the surface lies in the lattice.
-BSplineSurface random_surface_in(const Frame& frame, int p, int q, int cu, int cv, bool rational,
-                                 std::mt19937& rng) {
-  std::uniform_real_distribution<double> c(0.05, 0.95);
-  return surface_in(frame, p, q, cu, cv, rational, rng,
-                    [&](int, int) { return Eigen::Vector3d(c(rng), c(rng), c(rng)); });
-}
 
 /// Largest distance between the composed surface and the pointwise deformation of the original
 /// at `n` random parameters.

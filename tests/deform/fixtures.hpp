@@ -1,6 +1,9 @@
 #pragma once
-// Random frames, displaced lattices and sample points for the deform tests (fixed seeds).
+// Random frames, displaced lattices, sample points and surfaces inside a frame for the deform
+// tests (fixed seeds).
 #include <clay/deform/lattice.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/bspline_surface.hpp>
 
 #include <Eigen/Core>
 
@@ -49,6 +52,41 @@ inline surface::Points3 sample_points(const deform::Frame& f, std::mt19937& rng,
   surface::Points3 p(n, 3);
   for (int r = 0; r < n; ++r) p.row(r) = f.point(c(rng), c(rng), c(rng)).transpose();
   return p;
+}
+
+/// A surface of degrees (p, q) with a clamped, non-uniform knot vector of `cu` x `cv` control
+/// points, control point (i, j) at frame.point(local(i, j)), weights in [0.5, 2] when rational.
+template <class Local>
+surface::BSplineSurface surface_in(const deform::Frame& frame, int p, int q, int cu, int cv,
+                                   bool rational, std::mt19937& rng, const Local& local) {
+  std::uniform_real_distribution<double> jitter(-0.2, 0.2), weight(0.5, 2.0);
+  auto basis = [&](int d, int n) {
+    surface::BSplineBasis b = surface::clamped_uniform_basis(d, n);
+    const double h = 1.0 / (n - d);
+    for (int k = d + 1; k < n; ++k) b.knots[static_cast<size_t>(k)] += jitter(rng) * h;
+    return b;
+  };
+  surface::BSplineSurface s;
+  s.u = basis(p, cu);
+  s.v = basis(q, cv);
+  s.points.resize(cu * cv, 3);
+  s.weights = Eigen::VectorXd::Ones(cu * cv);
+  for (int i = 0; i < cu; ++i)
+    for (int j = 0; j < cv; ++j) {
+      const Eigen::Vector3d l = local(i, j);
+      s.points.row(s.index(i, j)) = frame.point(l.x(), l.y(), l.z()).transpose();
+      if (rational) s.weights(s.index(i, j)) = weight(rng);
+    }
+  surface::validate(s);
+  return s;
+}
+
+/// Random control points with local coordinates in [0.05, 0.95]: the surface lies in the lattice.
+inline surface::BSplineSurface random_surface_in(const deform::Frame& frame, int p, int q, int cu,
+                                                 int cv, bool rational, std::mt19937& rng) {
+  std::uniform_real_distribution<double> c(0.05, 0.95);
+  return surface_in(frame, p, q, cu, cv, rational, rng,
+                    [&](int, int) { return Eigen::Vector3d(c(rng), c(rng), c(rng)); });
 }
 
 }  // namespace clay::test
