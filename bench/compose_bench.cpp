@@ -4,6 +4,7 @@
 // Target: under 20 ms each. "checked" includes the default deviation check (4 x 4 pointwise
 // samples per patch, ComposeOptions::check_samples = 4); "unchecked" sets it to 0. One thread.
 #include <clay/deform/compose.hpp>
+#include <clay/deform/derivatives.hpp>
 #include <clay/deform/surface_deformation.hpp>
 #include <clay/surface/basis.hpp>
 
@@ -69,6 +70,43 @@ void BM_ComposeExact(benchmark::State& state) {
 BENCHMARK(BM_ComposeExact)
     ->ArgsProduct({{0, 1}, {4, 0}})
     ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Issue #41: the composed surface's Jacobian (composition_jacobian: every patch composed once
+// with one channel per lattice point), against BM_ComposeExact of the same lattice and sheet in
+// the same run, and the adjoint product C^T g (g: a gradient with respect to the composed
+// control points). Arg: lattice (0 = (3, 3, 1), 1 = (2, 2, 2)).
+void BM_CompositionJacobian(benchmark::State& state) {
+  const BezierLattice l =
+      lattice(state.range(0) == 0 ? std::array<int, 3>{3, 3, 1} : std::array<int, 3>{2, 2, 2});
+  const auto s = bicubic_sheet(l.frame);
+  CompositionJacobian j;
+  for (auto _ : state) {
+    j = composition_jacobian(l, s);
+    benchmark::DoNotOptimize(j.matrix.valuePtr());
+  }
+  state.counters["control_points"] = static_cast<double>(j.matrix.rows());
+  state.counters["nonzeros"] = static_cast<double>(j.matrix.nonZeros());
+  state.SetLabel(state.range(0) == 0 ? "lattice (3,3,1)" : "lattice (2,2,2)");
+}
+BENCHMARK(BM_CompositionJacobian)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_CompositionJacobianTransposeProduct(benchmark::State& state) {
+  const BezierLattice l =
+      lattice(state.range(0) == 0 ? std::array<int, 3>{3, 3, 1} : std::array<int, 3>{2, 2, 2});
+  const CompositionJacobian j = composition_jacobian(l, bicubic_sheet(l.frame));
+  const Eigen::MatrixXd g = Eigen::MatrixXd::Random(j.matrix.rows(), 3);
+  Eigen::MatrixXd adjoint;
+  for (auto _ : state) {
+    adjoint = j.matrix.transpose() * g;
+    benchmark::DoNotOptimize(adjoint.data());
+  }
+  state.SetLabel(state.range(0) == 0 ? "C^T g, lattice (3,3,1)" : "C^T g, lattice (2,2,2)");
+}
+BENCHMARK(BM_CompositionJacobianTransposeProduct)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMicrosecond)
     ->UseRealTime();
 
 // Issue #38: the exact composition against the light form of the same (3, 3, 1) lattice step

@@ -266,6 +266,60 @@ void refit_twist(benchmark::State& state) {
 
 }  // namespace
 
+// Issue #41: the Jacobian of deformed points with respect to the lattice points (influence_matrix:
+// deformed = B x lattice points) for 10^6 points, and the adjoint user's product B^T g (g: a
+// gradient with respect to the deformed points, 10^6 x 3). Reference in the same run: deforming
+// the same points once (rows, 1 thread). Arg: 0 = Bézier 4x4x4, 1 = B-spline 8x8x8 cells.
+void jacobian_points(benchmark::State& state) {
+  const bool bspline = state.range(0) == 1;
+  const Points3 x = random_points(1000000);
+  Eigen::SparseMatrix<double, Eigen::RowMajor> b;
+  for (auto _ : state) {
+    b = bspline ? influence_matrix(
+                      displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8})), x)
+                : influence_matrix(displaced(make_bezier_lattice(skewed_frame(), {3, 3, 3})), x);
+    benchmark::DoNotOptimize(b.valuePtr());
+  }
+  state.counters["nonzeros"] = static_cast<double>(b.nonZeros());
+  state.SetLabel(bspline ? "assembly, B-spline 8x8x8 cells" : "assembly, Bézier 4x4x4");
+}
+void jacobian_transpose_product(benchmark::State& state) {
+  const bool bspline = state.range(0) == 1;
+  const Points3 x = random_points(1000000);
+  const auto b =
+      bspline ? influence_matrix(
+                    displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8})), x)
+              : influence_matrix(displaced(make_bezier_lattice(skewed_frame(), {3, 3, 3})), x);
+  const Eigen::MatrixXd g = Eigen::MatrixXd::Random(x.rows(), 3);
+  Eigen::MatrixXd adjoint;
+  for (auto _ : state) {
+    adjoint = b.transpose() * g;
+    benchmark::DoNotOptimize(adjoint.data());
+  }
+  state.SetLabel(bspline ? "B^T g, B-spline 8x8x8 cells" : "B^T g, Bézier 4x4x4");
+}
+// The same product without forming B (influence_transpose_product), from the points.
+void jacobian_transpose_product_matrix_free(benchmark::State& state) {
+  const bool bspline = state.range(0) == 1;
+  const Points3 x = random_points(1000000);
+  const Points3 g = Points3::Random(x.rows(), 3);
+  const auto bezier = displaced(make_bezier_lattice(skewed_frame(), {3, 3, 3}));
+  const auto cells = displaced(make_bspline_lattice(skewed_frame(), {3, 3, 3}, {8, 8, 8}));
+  Points3 adjoint;
+  for (auto _ : state) {
+    adjoint = bspline ? influence_transpose_product(cells, x, g)
+                      : influence_transpose_product(bezier, x, g);
+    benchmark::DoNotOptimize(adjoint.data());
+  }
+  state.SetLabel(bspline ? "B^T g unformed, B-spline 8x8x8 cells" : "B^T g unformed, Bézier 4x4x4");
+}
+BENCHMARK(jacobian_points)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(jacobian_transpose_product_matrix_free)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(jacobian_transpose_product)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(refit_twist)->Unit(benchmark::kMillisecond);
 BENCHMARK(rows)->Apply(arguments);
 BENCHMARK(columns)->Apply(arguments);

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -84,38 +85,71 @@ std::vector<Eigen::Vector3d> selected_locals(const Frame& frame, const Points3& 
   return locals;
 }
 
-/// Row-wise non-zeros of B (Hsu–Hughes–Kaufman eq. (2)): the tensor products of the three
-/// directions' basis values, columns in the lattice's s-major order.
-template <class Lattice>
-std::vector<Eigen::Triplet<double>> influence_triplets(const Lattice& lattice,
-                                                       const std::vector<Eigen::Vector3d>& locals) {
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (size_t i = 0; i < locals.size(); ++i) {
-    DirectionBasis b[3];
-    for (int d = 0; d < 3; ++d) b[d] = direction_basis(lattice, d, locals[i][d]);
-    for (size_t a = 0; a < b[0].values.size(); ++a)
-      for (size_t c = 0; c < b[1].values.size(); ++c)
-        for (size_t e = 0; e < b[2].values.size(); ++e) {
-          const double w = b[0].values[a] * b[1].values[c] * b[2].values[e];
-          if (w == 0.0) continue;
-          const Eigen::Index column =
-              lattice.index(b[0].first + static_cast<int>(a), b[1].first + static_cast<int>(c),
-                            b[2].first + static_cast<int>(e));
-          triplets.emplace_back(static_cast<int>(i), static_cast<int>(column), w);
-        }
-  }
-  return triplets;
-}
-
+/// B (Hsu–Hughes–Kaufman eq. (2)): row i holds the tensor products of the three directions' basis
+/// values at point i. Written row by row straight into the compressed arrays: a row's columns
+/// increase with the loops (the lattice's s-major index order), so nothing is sorted (10^6
+/// points through triplets took 10.5 s, most of it Eigen's sort and transpose; bench_deform
+/// jacobian_points).
 template <class Lattice>
 Eigen::SparseMatrix<double, Eigen::RowMajor> influence(const Lattice& lattice,
                                                        const Points3& points) {
   validate(lattice);
   const auto locals = selected_locals(lattice.frame, points);
-  Eigen::SparseMatrix<double, Eigen::RowMajor> b(points.rows(), lattice.points.rows());
-  const auto triplets = influence_triplets(lattice, locals);
-  b.setFromTriplets(triplets.begin(), triplets.end());
-  return b;
+  std::vector<int> outer(locals.size() + 1, 0), inner;
+  std::vector<double> values;
+  for (size_t i = 0; i < locals.size(); ++i) {
+    DirectionBasis b[3];
+    for (int d = 0; d < 3; ++d) b[d] = direction_basis(lattice, d, locals[i][d]);
+    if (i == 0) {  // every row has at most this many: reserve once
+      const size_t per_row = b[0].values.size() * b[1].values.size() * b[2].values.size();
+      inner.reserve(per_row * locals.size());
+      values.reserve(per_row * locals.size());
+    }
+    for (size_t a = 0; a < b[0].values.size(); ++a)
+      for (size_t c = 0; c < b[1].values.size(); ++c)
+        for (size_t e = 0; e < b[2].values.size(); ++e) {
+          const double w = b[0].values[a] * b[1].values[c] * b[2].values[e];
+          if (w == 0.0) continue;
+          inner.push_back(static_cast<int>(lattice.index(b[0].first + static_cast<int>(a),
+                                                         b[1].first + static_cast<int>(c),
+                                                         b[2].first + static_cast<int>(e))));
+          values.push_back(w);
+        }
+    if (inner.size() > static_cast<size_t>(std::numeric_limits<int>::max()))
+      throw Error(ErrorCategory::InvalidArgument,
+                  "influence_matrix: " + std::to_string(points.rows()) +
+                      " points give more non-zeros than one matrix indexes (2^31); give the "
+                      "points in parts");
+    outer[i + 1] = static_cast<int>(inner.size());
+  }
+  return Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>>(
+      points.rows(), lattice.points.rows(), static_cast<Eigen::Index>(values.size()), outer.data(),
+      inner.data(), values.data());
+}
+
+/// Σ_i B(x_i)ᵀ G_i, point by point (influence_transpose_product).
+template <class Lattice>
+Points3 transpose_product(const Lattice& lattice, const Points3& points, const Points3& g) {
+  validate(lattice);
+  if (g.rows() != points.rows())
+    throw Error(ErrorCategory::InvalidArgument,
+                "influence_transpose_product: G has " + std::to_string(g.rows()) + " rows for " +
+                    std::to_string(points.rows()) + " points; give one gradient row per point");
+  const auto locals = selected_locals(lattice.frame, points);
+  Points3 out = Points3::Zero(lattice.points.rows(), 3);
+  for (size_t i = 0; i < locals.size(); ++i) {
+    DirectionBasis b[3];
+    for (int d = 0; d < 3; ++d) b[d] = direction_basis(lattice, d, locals[i][d]);
+    const Eigen::RowVector3d gi = g.row(static_cast<Eigen::Index>(i));
+    for (size_t a = 0; a < b[0].values.size(); ++a)
+      for (size_t c = 0; c < b[1].values.size(); ++c) {
+        const double ac = b[0].values[a] * b[1].values[c];
+        for (size_t e = 0; e < b[2].values.size(); ++e)
+          out.row(lattice.index(b[0].first + static_cast<int>(a), b[1].first + static_cast<int>(c),
+                                b[2].first + static_cast<int>(e))) += (ac * b[2].values[e]) * gi;
+      }
+  }
+  return out;
 }
 
 double lattice_size(const Frame& f) {
@@ -177,6 +211,16 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(const BSplineLatti
 Eigen::SparseMatrix<double, Eigen::RowMajor> influence_matrix(const BezierLattice& lattice,
                                                               const Points3& points) {
   return influence(lattice, points);
+}
+
+Points3 influence_transpose_product(const BSplineLattice& lattice, const Points3& points,
+                                    const Points3& g) {
+  return transpose_product(lattice, points, g);
+}
+
+Points3 influence_transpose_product(const BezierLattice& lattice, const Points3& points,
+                                    const Points3& g) {
+  return transpose_product(lattice, points, g);
 }
 
 // ---- the solver -----------------------------------------------------------------------------

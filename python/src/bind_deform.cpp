@@ -3,6 +3,8 @@
 #include "common.hpp"
 
 #include <clay/deform/compose.hpp>
+#include <clay/deform/derivatives.hpp>
+#include <clay/deform/direct_manipulation.hpp>
 #include <clay/deform/frozen_lattice.hpp>
 #include <clay/deform/lattice.hpp>
 #include <clay/deform/style.hpp>
@@ -112,6 +114,18 @@ py::dict style_report(const deform::StyleReport& r) {
   return d;
 }
 
+/// A scipy.sparse CSR matrix copied from a row-major sparse matrix's own arrays (Debian's
+/// python3-scipy).
+py::object scipy_csr(Eigen::SparseMatrix<double, Eigen::RowMajor> m) {
+  m.makeCompressed();
+  py::array_t<double> data(m.nonZeros(), m.valuePtr());
+  py::array_t<int> indices(m.nonZeros(), m.innerIndexPtr());
+  py::array_t<int> indptr(m.outerSize() + 1, m.outerIndexPtr());
+  return py::module_::import("scipy.sparse")
+      .attr("csr_matrix")(py::make_tuple(data, indices, indptr),
+                          py::make_tuple(m.rows(), m.cols()));
+}
+
 template <class Lattice>
 void lattice_common(py::class_<Lattice>& c) {
   c.def_property(
@@ -193,6 +207,38 @@ void lattice_common(py::class_<Lattice>& c) {
           "The surface deformed by the lattice exactly (compose_exact): (surface, report). "
           "DegreeLimitError, before anything is composed, when the result would be above "
           "max_degree or max_control_points (> 0; the net predicted from the degrees).")
+      .def(
+          "influence_matrix",
+          [](const Lattice& l, const py::handle& points) {
+            const Points3 p = points_in(points, "points");
+            Eigen::SparseMatrix<double, Eigen::RowMajor> b;
+            {
+              py::gil_scoped_release free;
+              b = deform::influence_matrix(l, p);
+            }
+            return scipy_csr(std::move(b));
+          },
+          py::arg("points"),
+          "The Jacobian of the deformed points with respect to the lattice points, a "
+          "scipy.sparse CSR matrix B (points x lattice points): deform_points(points) == B @ "
+          "points of the lattice, exact and constant (eq. (2) is linear in them; a mesh's nodes, "
+          "or a surface's points at given (u, v)). OutOfDomainError for a point outside.")
+      .def(
+          "influence_transpose_product",
+          [](const Lattice& l, const py::handle& points, const py::handle& g) {
+            const Points3 p = points_in(points, "points");
+            const Points3 gradient = points_in(g, "g");
+            Points3 out;
+            {
+              py::gil_scoped_release free;
+              out = deform::influence_transpose_product(l, p, gradient);
+            }
+            return owned(std::move(out));
+          },
+          py::arg("points"), py::arg("g"),
+          "B.T @ g without forming B (influence_matrix): the gradient with respect to the "
+          "lattice points (lattice points x 3) of a function whose gradient with respect to the "
+          "deformed points is g (points x 3), for adjoint users.")
       .def("validate", [](const Lattice& l) { deform::validate(l); })
       .def("__copy__", [](const Lattice& l) { return l; })
       .def("__deepcopy__", [](const Lattice& l, py::dict) { return l; });
@@ -230,6 +276,21 @@ void bind_deform(py::module_& m) {
             deform::validate(l);
             return l;
           }));
+  bezier.def(
+      "composition_jacobian",
+      [](const BezierLattice& l, const BSplineSurface& s) {
+        deform::CompositionJacobian j;
+        {
+          py::gil_scoped_release free;
+          j = deform::composition_jacobian(l, s);
+        }
+        return py::make_tuple(std::move(j.surface), scipy_csr(j.matrix));
+      },
+      py::arg("surface"),
+      "(composed, C): the surface composed exactly in a fixed form (Bezier patches at their tensor "
+      "degrees, joined C0) and its control points' Jacobian, a scipy.sparse CSR matrix "
+      "(control points x lattice points): composed.points == C @ lattice.points, exact and "
+      "constant (docs/optimisation.md).");
   lattice_common(bezier);
 
   py::class_<BSplineLattice> bspline(

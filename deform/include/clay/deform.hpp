@@ -11,6 +11,7 @@
 #include <clay/deform/compose.hpp>
 #include <clay/deform/continuity.hpp>
 #include <clay/deform/deformation.hpp>
+#include <clay/deform/derivatives.hpp>
 #include <clay/deform/direct_manipulation.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/frozen_lattice.hpp>
