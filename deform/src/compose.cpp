@@ -267,11 +267,12 @@ std::pair<double, double> global_parameter(const surface::BezierPatches& bp, int
 }
 
 [[noreturn]] void throw_outside(const surface::BezierPatches& bp, int a, int b, int d,
-                                const Violation& v, std::string_view lattice_kind) {
+                                const Violation& v, std::string_view lattice_kind,
+                                std::string_view caller = "compose_exact") {
   const auto [u, w] = global_parameter(bp, a, b, v.x, v.y);
   throw Error(
       ErrorCategory::OutOfDomain,
-      "compose_exact: surface " + patch_name(bp, a, b) + " leaves the " +
+      std::string(caller) + ": surface " + patch_name(bp, a, b) + " leaves the " +
           std::string(lattice_kind) + ": local coordinate " + coordinate_name[d] + " = " +
           format(v.value) + (v.certain ? " at" : " (bound; not certified inside) near") +
           " parameter (" + format(u) + ", " + format(w) +
@@ -493,6 +494,88 @@ std::tuple<BSplineSurface, int, detail::PlaneCrossings> split_at_planes(
 
 // ---- public ---------------------------------------------------------------------------------
 
+namespace detail {
+
+LatticePatches locate_patches(const BSplineLattice& lattice, const BezierCells& cells,
+                              const BSplineSurface& surface, std::string_view caller) {
+  LatticePatches out;
+  std::tie(out.split, out.splits, out.planes) = split_at_planes(surface, lattice, cells.breaks);
+  out.bp = surface::extract_bezier(out.split);
+  const auto& bp = out.bp;
+  const auto dual = dual_vectors(lattice.frame);
+  const auto counts = cells.counts();
+  out.cells.resize(bp.patches.size());
+  out.factors.resize(bp.patches.size());
+  for (int a = 0; a < bp.count_u(); ++a)
+    for (int b = 0; b < bp.count_v(); ++b) {
+      const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
+      std::array<int, 3> index{};
+      std::array<double, 3> lo{}, width{};
+      for (int d = 0; d < 3; ++d) {
+        const Poly cw = ratio_poly(pc, d);
+        if (auto v = leaves(cw, 0, 1, face_tolerance))
+          throw_outside(bp, a, b, d, *v, "B-spline lattice", caller);
+        const auto& br = cells.breaks[static_cast<size_t>(d)];
+        const double centre = value_at(cw, 0.5, 0.5, 0) / value_at(cw, 0.5, 0.5, 1);
+        int cell =
+            static_cast<int>(std::upper_bound(br.begin(), br.end(), centre) - br.begin()) - 1;
+        cell = std::clamp(cell, 0, counts[static_cast<size_t>(d)] - 1);
+        // The cell holding the patch's centre, or a neighbour: a patch touching a knot plane at
+        // its centre lies in the cell on the other side.
+        // When none holds it, the message shows the smallest excursion out of its cell (a bump
+        // just over the plane rather than the far corner of the cell above).
+        auto excess = [&](const Violation& x, int c) {
+          return std::max(br[static_cast<size_t>(c)] - x.value,
+                          x.value - br[static_cast<size_t>(c + 1)]);
+        };
+        std::optional<Violation> v = leaves(cw, br[static_cast<size_t>(cell)],
+                                            br[static_cast<size_t>(cell + 1)], face_tolerance);
+        int shown = cell;
+        for (int next : {cell - 1, cell + 1}) {
+          if (!v || next < 0 || next >= counts[static_cast<size_t>(d)]) continue;
+          auto w = leaves(cw, br[static_cast<size_t>(next)], br[static_cast<size_t>(next + 1)],
+                          face_tolerance);
+          if (!w) {
+            cell = next;
+            v.reset();
+          } else if (w->certain && (!v->certain || excess(*w, next) < excess(*v, shown))) {
+            v = w;
+            shown = next;
+          }
+        }
+        const double c0 = br[static_cast<size_t>(v ? shown : cell)],
+                     c1 = br[static_cast<size_t>((v ? shown : cell) + 1)];
+        if (v) {
+          const double plane = v->value < c0 ? c0 : c1;
+          const auto [u, w] = global_parameter(bp, a, b, v->x, v->y);
+          throw Error(
+              ErrorCategory::InvalidArgument,
+              std::string(caller) + ": surface " + patch_name(bp, a, b) +
+                  " crosses the lattice knot plane " + coordinate_name[d] + " = " + format(plane) +
+                  " (" +
+                  (v->certain
+                       ? coordinate_name[d] + std::string(" = ") + format(v->value) +
+                             " at parameter ("
+                       : std::string("not decided: the convex hull's bound ") + coordinate_name[d] +
+                             " = " + format(v->value) + " near parameter (") +
+                  format(u) + ", " + format(w) +
+                  ")) other than along an iso-parameter line: no single polynomial patch is "
+                  "exact there; approximate the deformed surface with a refit tolerance "
+                  "(certified refit), or move the knot plane off the surface");
+        }
+        index[static_cast<size_t>(d)] = cell;
+        lo[static_cast<size_t>(d)] = c0;
+        width[static_cast<size_t>(d)] = c1 - c0;
+      }
+      const size_t k = static_cast<size_t>(a * bp.count_v() + b);
+      out.cells[k] = index;
+      out.factors[k] = cell_factors(pc, lo, width);
+    }
+  return out;
+}
+
+}  // namespace detail
+
 namespace {
 // The largest ComposeOptions::max_degree: the Bernstein products' binomials C(n, k) stay integers
 // exactly representable in a double (below 2^53) up to n = 56; 50 leaves room for the products.
@@ -584,12 +667,11 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
   validate(lattice, "compose_exact: B-spline lattice");
   surface::validate(surface, "compose_exact: surface");
   const BezierCells cells = bezier_cells(lattice);
-  const auto [split, splits, planes] = split_at_planes(surface, lattice, cells.breaks);
+  const detail::LatticePatches located = detail::locate_patches(lattice, cells, surface);
+  const BSplineSurface& split = located.split;
+  const auto& bp = located.bp;
+  const auto& factors = located.factors;
   const bool rational = split.is_rational();
-  const auto bp = surface::extract_bezier(split);
-  const auto dual = dual_vectors(lattice.frame);
-  const auto counts = cells.counts();
-  std::vector<std::array<Factor, 3>> factors(static_cast<size_t>(bp.patches.size()));
   std::vector<const BezierLattice*> cell_of(bp.patches.size());
   std::vector<std::pair<int, int>> degrees(bp.patches.size());
   std::string too_high;  // the first patch above max_degree
@@ -597,71 +679,12 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
   std::map<const BezierLattice*, LatticeMonomials> monomials_of;
   for (int a = 0; a < bp.count_u(); ++a)
     for (int b = 0; b < bp.count_v(); ++b) {
-      const PatchCoordinates pc = patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
-      std::array<int, 3> index{};
-      std::array<double, 3> lo{}, width{};
-      for (int d = 0; d < 3; ++d) {
-        const Poly cw = ratio_poly(pc, d);
-        if (auto v = leaves(cw, 0, 1, face_tolerance))
-          throw_outside(bp, a, b, d, *v, "B-spline lattice");
-        const auto& br = cells.breaks[static_cast<size_t>(d)];
-        const double centre = value_at(cw, 0.5, 0.5, 0) / value_at(cw, 0.5, 0.5, 1);
-        int cell =
-            static_cast<int>(std::upper_bound(br.begin(), br.end(), centre) - br.begin()) - 1;
-        cell = std::clamp(cell, 0, counts[static_cast<size_t>(d)] - 1);
-        // The cell holding the patch's centre, or a neighbour: a patch touching a knot plane at
-        // its centre lies in the cell on the other side.
-        // When none holds it, the message shows the smallest excursion out of its cell (a bump
-        // just over the plane rather than the far corner of the cell above).
-        auto excess = [&](const Violation& x, int c) {
-          return std::max(br[static_cast<size_t>(c)] - x.value,
-                          x.value - br[static_cast<size_t>(c + 1)]);
-        };
-        std::optional<Violation> v = leaves(cw, br[static_cast<size_t>(cell)],
-                                            br[static_cast<size_t>(cell + 1)], face_tolerance);
-        int shown = cell;
-        for (int next : {cell - 1, cell + 1}) {
-          if (!v || next < 0 || next >= counts[static_cast<size_t>(d)]) continue;
-          auto w = leaves(cw, br[static_cast<size_t>(next)], br[static_cast<size_t>(next + 1)],
-                          face_tolerance);
-          if (!w) {
-            cell = next;
-            v.reset();
-          } else if (w->certain && (!v->certain || excess(*w, next) < excess(*v, shown))) {
-            v = w;
-            shown = next;
-          }
-        }
-        const double c0 = br[static_cast<size_t>(v ? shown : cell)],
-                     c1 = br[static_cast<size_t>((v ? shown : cell) + 1)];
-        if (v) {
-          const double plane = v->value < c0 ? c0 : c1;
-          const auto [u, w] = global_parameter(bp, a, b, v->x, v->y);
-          throw Error(
-              ErrorCategory::InvalidArgument,
-              "compose_exact: surface " + patch_name(bp, a, b) +
-                  " crosses the lattice knot plane " + coordinate_name[d] + " = " + format(plane) +
-                  " (" +
-                  (v->certain
-                       ? coordinate_name[d] + std::string(" = ") + format(v->value) +
-                             " at parameter ("
-                       : std::string("not decided: the convex hull's bound ") + coordinate_name[d] +
-                             " = " + format(v->value) + " near parameter (") +
-                  format(u) + ", " + format(w) +
-                  ")) other than along an iso-parameter line: no single polynomial patch is "
-                  "exact there; approximate the deformed surface with a refit tolerance "
-                  "(certified refit), or move the knot plane off the surface");
-        }
-        index[static_cast<size_t>(d)] = cell;
-        lo[static_cast<size_t>(d)] = c0;
-        width[static_cast<size_t>(d)] = c1 - c0;
-      }
       const size_t k = static_cast<size_t>(a * bp.count_v() + b);
+      const auto& index = located.cells[k];
       cell_of[k] = &cells.cell(index[0], index[1], index[2]);
       auto known = monomials_of.find(cell_of[k]);
       if (known == monomials_of.end())
         known = monomials_of.emplace(cell_of[k], detail::lattice_monomials(*cell_of[k])).first;
-      factors[k] = cell_factors(pc, lo, width);
       const auto [du, dv] = composition_degrees(factors[k], *cell_of[k], known->second);
       degrees[k] = {du, dv};
       if (std::max(du, dv) > options.max_degree && too_high.empty())
@@ -705,9 +728,9 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
       }
     }
   }
-  detail::check_size(
-      detail::predicted_size(surface, bp, degrees, planes, detail::lattice_continuity(lattice)),
-      options, too_high);
+  detail::check_size(detail::predicted_size(surface, bp, degrees, located.planes,
+                                            detail::lattice_continuity(lattice)),
+                     options, too_high);
   std::vector<ComposedPatch> patches(bp.patches.size());
   for (size_t k = 0; k < patches.size(); ++k) {
     throw_if_cancelled("an exact composition");
@@ -718,7 +741,7 @@ ComposeResult compose_exact(const BSplineLattice& lattice, const BSplineSurface&
   return finish(
       bp, patches, rational, split,
       [&](const Eigen::Vector3d& x) { return deform_point(lattice, x); },
-      lattice_size(lattice.points), options, splits);
+      lattice_size(lattice.points), options, located.splits);
 }
 
 ComposeResult compose_exact(const Taper& taper, const BSplineSurface& surface,

@@ -5,14 +5,17 @@
 // Internal to clay_deform.
 #include <clay/deform/lattice.hpp>
 #include <clay/surface/bspline_surface.hpp>
+#include <clay/surface/knots.hpp>
 
 #include <Eigen/Core>
 
 #include <array>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "bernstein_poly.hpp"
+#include "compose_size.hpp"
 
 namespace clay::deform::detail {
 
@@ -64,5 +67,24 @@ Poly ratio_poly(const PatchCoordinates& pc, int d);
 /// (c_d − lo_d) / width_d in the coordinates of `pc`.
 std::array<Factor, 3> cell_factors(const PatchCoordinates& pc, std::array<double, 3> lo,
                                    std::array<double, 3> width);
+
+/// A surface in a B-spline lattice's Bézier cells: split where it meets a knot plane along an
+/// iso-parameter line, its Bézier patches, and per patch (a * bp.count_v() + b) the cell holding
+/// it and eq. (2)'s factors in that cell's coordinates.
+struct LatticePatches {
+  surface::BSplineSurface split;
+  int splits = 0;         ///< knots inserted by the split
+  PlaneCrossings planes;  ///< every crossing of a knot plane (compose_size.hpp)
+  surface::BezierPatches bp;
+  std::vector<std::array<int, 3>> cells;
+  std::vector<std::array<Factor, 3>> factors;
+};
+
+/// Locates the surface's patches in the lattice's cells (compose.cpp). Throws clay::Error, each
+/// message starting with `caller`: OutOfDomain when a patch leaves the lattice, InvalidArgument
+/// when one crosses a knot plane other than along an iso-parameter line.
+LatticePatches locate_patches(const BSplineLattice& lattice, const BezierCells& cells,
+                              const surface::BSplineSurface& surface,
+                              std::string_view caller = "compose_exact");
 
 }  // namespace clay::deform::detail

@@ -5,6 +5,8 @@
 #include <clay/error.hpp>
 #include <clay/surface/knots.hpp>
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <array>
 #include <cstddef>
@@ -56,18 +58,70 @@ std::vector<double> c0_knots(const std::vector<double>& breaks, int p) {
   return k;
 }
 
+/// One composed patch: channel c of `h` is the coefficient of lattice point columns[c].
+struct PatchColumns {
+  Poly h;
+  std::vector<int> columns;
+};
+
+/// The patches joined as join_bezier_patches joins them: each elevated to the largest degrees,
+/// the homogeneous points that neighbours share summed. A composed point's weight is the sum of
+/// its channels (the B_j sum to 1, so eq. (2) with every point's weight 1 gives W^(l+m+n)), and
+/// its control point is H_r / W_r: row r of C is the summed channels over the summed weights.
+CompositionJacobian join_columns(const surface::BezierPatches& bp,
+                                 const std::vector<PatchColumns>& patches, const Points3& points,
+                                 bool rational) {
+  int pu = 1, pv = 1;
+  for (const PatchColumns& p : patches) {
+    pu = std::max(pu, p.h.du);
+    pv = std::max(pv, p.h.dv);
+  }
+  const int cu = bp.count_u(), cv = bp.count_v();
+  const int nu = cu * pu + 1, nv = cv * pv + 1;
+  const Eigen::Index rows = static_cast<Eigen::Index>(nu) * nv;
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::VectorXd weight = Eigen::VectorXd::Zero(rows);
+  Eigen::VectorXi shared = Eigen::VectorXi::Zero(rows);
+  for (int a = 0; a < cu; ++a)
+    for (int b = 0; b < cv; ++b) {
+      const PatchColumns& p = patches[static_cast<std::size_t>(a * cv + b)];
+      const Poly h = detail::to_degree(detail::to_degree(p.h, pu, 0), pv, 1);
+      for (int i = 0; i <= pu; ++i)
+        for (int j = 0; j <= pv; ++j) {
+          const Eigen::Index r = static_cast<Eigen::Index>(a * pu + i) * nv + (b * pv + j);
+          ++shared(r);
+          for (int c = 0; c < h.dim; ++c) {
+            const double x = h.at(i, j, c);
+            weight(r) += x;
+            if (x != 0)
+              entries.emplace_back(static_cast<int>(r), p.columns[static_cast<std::size_t>(c)], x);
+          }
+        }
+    }
+  CompositionJacobian out;
+  out.matrix.resize(rows, points.rows());
+  out.matrix.setFromTriplets(entries.begin(), entries.end());
+  out.matrix = weight.cwiseInverse().asDiagonal() * out.matrix;
+  out.surface.u = {pu, c0_knots(bp.breaks_u, pu)};
+  out.surface.v = {pv, c0_knots(bp.breaks_v, pv)};
+  out.surface.points = out.matrix * points;
+  out.surface.weights = rational ? Eigen::VectorXd(weight.cwiseQuotient(shared.cast<double>()))
+                                 : Eigen::VectorXd::Ones(rows);
+  return out;
+}
+
 }  // namespace
 
 CompositionJacobian composition_jacobian(const BezierLattice& lattice,
                                          const surface::BSplineSurface& surface) {
   validate(lattice, "composition_jacobian: Bézier lattice");
   surface::validate(surface, "composition_jacobian: surface");
-  const bool rational = surface.is_rational();
   const auto bp = surface::extract_bezier(surface);
   const auto dual = detail::dual_vectors(lattice.frame);
   const int cu = bp.count_u(), cv = bp.count_v();
-  std::vector<Poly> patches(bp.patches.size());
-  int pu = 1, pv = 1;
+  std::vector<int> every(static_cast<std::size_t>(lattice.points.rows()));
+  for (std::size_t j = 0; j < every.size(); ++j) every[j] = static_cast<int>(j);
+  std::vector<PatchColumns> patches(bp.patches.size());
   for (int a = 0; a < cu; ++a)
     for (int b = 0; b < cv; ++b) {
       const auto pc = detail::patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
@@ -81,47 +135,54 @@ CompositionJacobian composition_jacobian(const BezierLattice& lattice,
                           " is outside [0, 1]; the FFD is the identity outside the lattice, so "
                           "the deformed surface is not one polynomial there: enlarge the "
                           "lattice frame to contain the whole surface");
-      Poly& h = patches[static_cast<std::size_t>(a * cv + b)];
-      h = compose_channels(lattice, detail::cell_factors(pc, {0, 0, 0}, {1, 1, 1}));
-      pu = std::max(pu, h.du);
-      pv = std::max(pv, h.dv);
+      patches[static_cast<std::size_t>(a * cv + b)] = {
+          compose_channels(lattice, detail::cell_factors(pc, {0, 0, 0}, {1, 1, 1})), every};
     }
-  // Joined as join_bezier_patches joins: each patch elevated to (pu, pv), the homogeneous points
-  // that neighbours share summed. A composed point's weight is the sum of its channels (the B_j
-  // sum to 1, so eq. (2) with every point's weight 1 gives W^(l+m+n)), and its control point is
-  // H_r / W_r: row r of C is the summed channels over the summed weights.
-  const int nu = cu * pu + 1, nv = cv * pv + 1;
-  const Eigen::Index rows = static_cast<Eigen::Index>(nu) * nv;
-  const auto n = lattice.counts();
-  const int channels = n[0] * n[1] * n[2];
-  std::vector<Eigen::Triplet<double>> entries;
-  Eigen::VectorXd weight = Eigen::VectorXd::Zero(rows);
-  Eigen::VectorXi shared = Eigen::VectorXi::Zero(rows);
-  for (int a = 0; a < cu; ++a)
-    for (int b = 0; b < cv; ++b) {
-      const Poly h = detail::to_degree(
-          detail::to_degree(patches[static_cast<std::size_t>(a * cv + b)], pu, 0), pv, 1);
-      for (int i = 0; i <= pu; ++i)
-        for (int j = 0; j <= pv; ++j) {
-          const Eigen::Index r = static_cast<Eigen::Index>(a * pu + i) * nv + (b * pv + j);
-          ++shared(r);
-          for (int c = 0; c < channels; ++c) {
-            const double x = h.at(i, j, c);
-            weight(r) += x;
-            if (x != 0) entries.emplace_back(static_cast<int>(r), c, x);
-          }
-        }
-    }
-  CompositionJacobian out;
-  out.matrix.resize(rows, channels);
-  out.matrix.setFromTriplets(entries.begin(), entries.end());
-  out.matrix = weight.cwiseInverse().asDiagonal() * out.matrix;
-  out.surface.u = {pu, c0_knots(bp.breaks_u, pu)};
-  out.surface.v = {pv, c0_knots(bp.breaks_v, pv)};
-  out.surface.points = out.matrix * lattice.points;
-  out.surface.weights = rational ? Eigen::VectorXd(weight.cwiseQuotient(shared.cast<double>()))
-                                 : Eigen::VectorXd::Ones(rows);
-  return out;
+  return join_columns(bp, patches, lattice.points, surface.is_rational());
+}
+
+CompositionJacobian composition_jacobian(const BSplineLattice& lattice,
+                                         const surface::BSplineSurface& surface) {
+  validate(lattice, "composition_jacobian: B-spline lattice");
+  surface::validate(surface, "composition_jacobian: surface");
+  const BezierCells cells = bezier_cells(lattice);
+  const detail::LatticePatches located =
+      detail::locate_patches(lattice, cells, surface, "composition_jacobian");
+  std::array<std::vector<surface::SpanExtraction>, 3> spans;
+  for (std::size_t d = 0; d < 3; ++d) spans[d] = surface::bezier_extraction(lattice.bases[d]);
+  std::vector<PatchColumns> patches(located.bp.patches.size());
+  for (std::size_t k = 0; k < patches.size(); ++k) {
+    const auto [ci, cj, ck] = located.cells[k];
+    const BezierLattice& cell = cells.cell(ci, cj, ck);
+    const Poly local = compose_channels(cell, located.factors[k]);
+    // The cell's Bézier points from the lattice's (bezier_cells): point (i, j, k) of the cell is
+    // Σ ea(i, ii) eb(j, jj) ec(k, kk) P(first + (ii, jj, kk)), so its channels map to the lattice
+    // points of the cell's support through E = ea ⊗ eb ⊗ ec.
+    const auto& ea = spans[0][static_cast<std::size_t>(ci)];
+    const auto& eb = spans[1][static_cast<std::size_t>(cj)];
+    const auto& ec = spans[2][static_cast<std::size_t>(ck)];
+    const auto n = cell.counts();
+    const int m = n[0] * n[1] * n[2];
+    Eigen::MatrixXd e(m, m);
+    PatchColumns out{Poly(local.du, local.dv, m), std::vector<int>(static_cast<std::size_t>(m))};
+    for (int i = 0; i < n[0]; ++i)
+      for (int j = 0; j < n[1]; ++j)
+        for (int kk = 0; kk < n[2]; ++kk)
+          for (int ii = 0; ii < n[0]; ++ii)
+            for (int jj = 0; jj < n[1]; ++jj)
+              for (int kz = 0; kz < n[2]; ++kz) {
+                e(cell.index(i, j, kk), cell.index(ii, jj, kz)) =
+                    ea.matrix(i, ii) * eb.matrix(j, jj) * ec.matrix(kk, kz);
+                out.columns[static_cast<std::size_t>(cell.index(ii, jj, kz))] =
+                    static_cast<int>(lattice.index(ea.first + ii, eb.first + jj, ec.first + kz));
+              }
+    using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+    const Eigen::Index coefficients = static_cast<Eigen::Index>(local.du + 1) * (local.dv + 1);
+    Eigen::Map<Rows>(out.h.c.data(), coefficients, m) =
+        Eigen::Map<const Rows>(local.c.data(), coefficients, m) * e;
+    patches[k] = std::move(out);
+  }
+  return join_columns(located.bp, patches, lattice.points, located.split.is_rational());
 }
 
 }  // namespace clay::deform

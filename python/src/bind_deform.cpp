@@ -208,6 +208,22 @@ void lattice_common(py::class_<Lattice>& c) {
           "DegreeLimitError, before anything is composed, when the result would be above "
           "max_degree or max_control_points (> 0; the net predicted from the degrees).")
       .def(
+          "composition_jacobian",
+          [](const Lattice& l, const BSplineSurface& s) {
+            deform::CompositionJacobian j;
+            {
+              py::gil_scoped_release free;
+              j = deform::composition_jacobian(l, s);
+            }
+            return py::make_tuple(std::move(j.surface), scipy_csr(j.matrix));
+          },
+          py::arg("surface"),
+          "(composed, C): the surface composed exactly in a fixed form (Bezier patches at their "
+          "tensor degrees, joined C0; split at a B-spline lattice's knot planes as compose "
+          "splits it) and its control points' Jacobian, a scipy.sparse CSR matrix (control "
+          "points x lattice points): composed.points == C @ lattice.points, exact and constant "
+          "(docs/optimisation.md).")
+      .def(
           "influence_matrix",
           [](const Lattice& l, const py::handle& points) {
             const Points3 p = points_in(points, "points");
@@ -276,21 +292,6 @@ void bind_deform(py::module_& m) {
             deform::validate(l);
             return l;
           }));
-  bezier.def(
-      "composition_jacobian",
-      [](const BezierLattice& l, const BSplineSurface& s) {
-        deform::CompositionJacobian j;
-        {
-          py::gil_scoped_release free;
-          j = deform::composition_jacobian(l, s);
-        }
-        return py::make_tuple(std::move(j.surface), scipy_csr(j.matrix));
-      },
-      py::arg("surface"),
-      "(composed, C): the surface composed exactly in a fixed form (Bezier patches at their tensor "
-      "degrees, joined C0) and its control points' Jacobian, a scipy.sparse CSR matrix "
-      "(control points x lattice points): composed.points == C @ lattice.points, exact and "
-      "constant (docs/optimisation.md).");
   lattice_common(bezier);
 
   py::class_<BSplineLattice> bspline(

@@ -259,3 +259,85 @@ TEST_CASE(
   check(bezier);
   check(cells);
 }
+
+TEST_CASE(
+    "composition_jacobian with a B-spline lattice: sparse, the pointwise FFD, central "
+    "differences, one structure",
+    "[derivatives]") {
+  // A sheet whose s depends on u only and t on v only meets the knot planes along iso-lines
+  // (split there, as compose_exact splits it). Each row of C holds one cell's support.
+  std::mt19937 rng(4106);
+  const Frame frame = clay::test::random_frame(rng);
+  const BSplineLattice lattice =
+      clay::test::displaced(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), rng);
+  const std::vector<double> x{0.05, 0.3, 0.6, 0.7, 0.95}, y{0.1, 0.4, 0.6, 0.9};
+  std::uniform_real_distribution<double> lift(0.2, 0.8);
+  BSplineSurface s = clay::test::surface_in(frame, 3, 2, 5, 4, false, rng, [&](int i, int j) {
+    return Eigen::Vector3d(x[size_t(i)], y[size_t(j)], lift(rng));
+  });
+  for (const bool rational : {false, true}) {
+    INFO((rational ? "rational" : "polynomial") << " sheet");
+    if (rational)  // product weights a_i b_j: s stays a function of u alone
+      for (int i = 0; i < 5; ++i)
+        for (int j = 0; j < 4; ++j)
+          s.weights(s.index(i, j)) = (1.0 + 0.3 * i) * (1.5 - 0.1 * j * j);
+    const CompositionJacobian j = composition_jacobian(lattice, s);
+    const double size = clay::test::size_of(lattice.points);
+    CHECK((j.matrix * lattice.points - j.surface.points).cwiseAbs().maxCoeff() <= 1e-12 * size);
+    // Sparse: a row inside a patch holds one cell's support, (3 + 1)(3 + 1)(2 + 1) = 48 of the
+    // 90 lattice points; one on a patch corner shared by 2 x 2 cells (in s and t; u has one
+    // cell) their union, (3 + 2)(3 + 2)(2 + 1) = 75.
+    int widest = 0, inside = 0;
+    for (Eigen::Index r = 0; r < j.matrix.outerSize(); ++r) {
+      const int n = static_cast<int>(j.matrix.row(r).nonZeros());
+      widest = std::max(widest, n);
+      inside += n <= 48 ? 1 : 0;
+    }
+    CHECK(widest <= 75);
+    CHECK(inside > j.matrix.rows() / 2);
+    std::uniform_real_distribution<double> at(0.0, 1.0);
+    double worst = 0;
+    for (int k = 0; k < 400; ++k) {
+      const double u = at(rng), v = at(rng);
+      worst = std::max(worst, (clay::surface::evaluate(j.surface, u, v) -
+                               deform_point(lattice, clay::surface::evaluate(s, u, v)))
+                                  .norm());
+    }
+    CHECK(worst <= 1e-12 * size);
+    // Central differences of compose_exact, point by point, for a few lattice points and axes.
+    const Eigen::MatrixXd dense = Eigen::MatrixXd(j.matrix);
+    std::uniform_int_distribution<int> which(0, static_cast<int>(lattice.points.rows()) - 1);
+    double miss = 0, largest = 0;
+    for (int trial = 0; trial < 6; ++trial) {
+      const int point = which(rng), axis = trial % 3;
+      BSplineLattice plus = lattice, minus = lattice;
+      plus.points(point, axis) += 0.5;
+      minus.points(point, axis) -= 0.5;
+      const BSplineSurface up = compose_exact(plus, s).surface;
+      const BSplineSurface down = compose_exact(minus, s).surface;
+      for (int k = 0; k < 30; ++k) {
+        const double u = at(rng), v = at(rng);
+        const double difference =
+            (clay::surface::evaluate(up, u, v) - clay::surface::evaluate(down, u, v))(axis);
+        const double exact = scalar_at(j.surface, dense.col(point), u, v);
+        miss = std::max(miss, std::abs(difference - exact));
+        largest = std::max(largest, std::abs(exact));
+      }
+    }
+    INFO("largest " << largest << ", miss " << miss);
+    CHECK(largest > 0.05);
+    CHECK(miss <= 1e-10 * largest);
+    // The undisplaced lattice gives the same C, bit for bit.
+    const CompositionJacobian rest =
+        composition_jacobian(make_bspline_lattice(frame, {3, 3, 2}, {3, 2, 1}), s);
+    REQUIRE(rest.matrix.nonZeros() == j.matrix.nonZeros());
+    CHECK(Eigen::MatrixXd(rest.matrix) == dense);
+  }
+  // A surface that crosses a knot plane obliquely has no exact composition: refused, named.
+  const BSplineSurface oblique = random_surface_in(frame, 2, 2, 4, 4, false, rng);
+  const auto [category, message] =
+      clay::test::error_of([&] { (void)composition_jacobian(lattice, oblique); });
+  CHECK(category == ErrorCategory::InvalidArgument);
+  CHECK_THAT(message, Catch::Matchers::Contains("composition_jacobian: surface") &&
+                          Catch::Matchers::Contains("crosses the lattice knot plane"));
+}

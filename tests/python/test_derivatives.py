@@ -68,3 +68,18 @@ def test_influence_matrix_is_the_jacobian_of_deformed_points() -> None:
         adjoint = lat.influence_transpose_product(x, g)
         assert adjoint.shape == lat.points.shape
         assert np.max(np.abs(adjoint - b.T @ g)) < 1e-12 * np.max(np.abs(adjoint))
+
+
+def test_bspline_lattice_jacobian_of_a_sheet_split_at_its_knot_planes() -> None:
+    # A sheet whose x follows u and y follows v meets the lattice's knot planes along iso-lines.
+    lat = cf.BSplineLattice([0, 0, 0], [100, 0, 0], [0, 80, 0], [0, 0, 40], (3, 2, 2), (3, 2, 1))
+    lat.points[:] += np.random.default_rng(5).uniform(-3, 3, size=lat.points.shape)
+    knots = [0.0] * 4 + [0.5] + [1.0] * 4
+    pts = np.array([[5 + 90 * i / 4, 6 + 68 * j / 4, 20 + 5 * np.sin(i + j)] for i in range(5) for j in range(5)])
+    sheet = cf.Surface((3, 3), knots, knots, pts)
+    composed, jacobian = lat.composition_jacobian(sheet)
+    assert np.max(np.abs(jacobian @ lat.points - composed.points)) < 1e-12 * 150
+    u, v = np.meshgrid(np.linspace(0, 1, 17), np.linspace(0, 1, 13))
+    pointwise = lat.deform_points(sheet.evaluate(u, v).reshape(-1, 3))
+    assert np.max(np.abs(composed.evaluate(u, v).reshape(-1, 3) - pointwise)) < 1e-12 * 150
+    assert jacobian.nnz < jacobian.shape[0] * jacobian.shape[1]

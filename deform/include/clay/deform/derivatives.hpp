@@ -38,5 +38,13 @@ struct CompositionJacobian {
 /// deformed surface is not one polynomial there; enlarge the lattice's frame).
 CLAY_DEFORM_API CompositionJacobian composition_jacobian(const BezierLattice& lattice,
                                                          const surface::BSplineSurface& surface);
+/// Same for a B-spline lattice: the surface split where it meets a knot plane along an
+/// iso-parameter line (as compose_exact splits it), each patch composed in its Bézier cell and
+/// the cell's points written as the lattice's (bezier_cells' extraction, a fixed linear map), so
+/// C is sparse: a row holds the lattice points of one cell's support. Throws as above, and
+/// InvalidArgument when a patch crosses a knot plane other than along an iso-parameter line
+/// (no single polynomial patch is exact there).
+CLAY_DEFORM_API CompositionJacobian composition_jacobian(const BSplineLattice& lattice,
+                                                         const surface::BSplineSurface& surface);
 
 }  // namespace clay::deform
