@@ -49,15 +49,6 @@ Poly compose_channels(const BezierLattice& lattice, const std::array<detail::Fac
   return h;
 }
 
-/// Knots of degree p over `breaks`: ends p + 1 times, interior breaks p times (C0).
-std::vector<double> c0_knots(const std::vector<double>& breaks, int p) {
-  std::vector<double> k;
-  for (std::size_t i = 0; i < breaks.size(); ++i)
-    k.insert(k.end(), static_cast<std::size_t>(i == 0 || i + 1 == breaks.size() ? p + 1 : p),
-             breaks[i]);
-  return k;
-}
-
 /// One composed patch: channel c of `h` is the coefficient of lattice point columns[c].
 struct PatchColumns {
   Poly h;
@@ -102,8 +93,8 @@ CompositionJacobian join_columns(const surface::BezierPatches& bp,
   out.matrix.resize(rows, points.rows());
   out.matrix.setFromTriplets(entries.begin(), entries.end());
   out.matrix = weight.cwiseInverse().asDiagonal() * out.matrix;
-  out.surface.u = {pu, c0_knots(bp.breaks_u, pu)};
-  out.surface.v = {pv, c0_knots(bp.breaks_v, pv)};
+  out.surface.u = {pu, surface::c0_knots(bp.breaks_u, pu)};
+  out.surface.v = {pv, surface::c0_knots(bp.breaks_v, pv)};
   out.surface.points = out.matrix * points;
   out.surface.weights = rational ? Eigen::VectorXd(weight.cwiseQuotient(shared.cast<double>()))
                                  : Eigen::VectorXd::Ones(rows);

@@ -26,7 +26,8 @@ bool single_span(const BSplineBasis& basis, double a, double b) {
   return true;
 }
 
-/// Knots of degree p over `breaks`: ends p + 1 times, interior breaks p times (C0).
+}  // namespace
+
 std::vector<double> c0_knots(const std::vector<double>& breaks, int p) {
   std::vector<double> k;
   for (std::size_t i = 0; i < breaks.size(); ++i)
@@ -34,8 +35,6 @@ std::vector<double> c0_knots(const std::vector<double>& breaks, int p) {
              breaks[i]);
   return k;
 }
-
-}  // namespace
 
 BSplineSurface join_bezier_patches(const BezierPatches& bp, double relative_gap) {
   const int cu = bp.count_u(), cv = bp.count_v();

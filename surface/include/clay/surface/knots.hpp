@@ -80,6 +80,11 @@ CLAY_SURFACE_API BezierPatches extract_bezier(const BSplineSurface& surface);
 CLAY_SURFACE_API BSplineSurface join_bezier_patches(const BezierPatches& patches,
                                                     double relative_gap = 1e-9);
 
+/// The knot vector of degree p joining Bézier spans over `breaks` (distinct, increasing, ends
+/// included) with C0 continuity: the ends p + 1 times, every interior break p times, as
+/// join_bezier_patches writes it.
+CLAY_SURFACE_API std::vector<double> c0_knots(const std::vector<double>& breaks, int p);
+
 /// The Bézier extraction operator of one non-empty span [a, b] of a basis: the span's Bézier
 /// control point r is sum_q matrix(r, q) P[first + q] (first = span index − degree).
 struct SpanExtraction {
