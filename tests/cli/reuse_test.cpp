@@ -239,10 +239,19 @@ TEST_CASE("studio session: a lattice drag previews in one product, the release c
 
 TEST_CASE("run_recipe: a style with net convergence previews on its first net, converges after",
           "[recipe][reuse]") {
-  // The tank's exact style refined until a halving changes it by under 5 % (what the studio
-  // gives a new style): a drag update styles on the first net alone, the release converges.
+  // The tank's exact style refined until a halving changes it by under 5 % (the studio's
+  // first convergence choice): a drag update styles on the first net alone, the release
+  // converges. The style alone: the tank's lattice after it (a certified light fit of the
+  // converged net, most of this test's time when sanitized) is not what is tested here.
   const std::string style_step = "surfaces.styled.steps[0]";
-  Json doc = tank();
+  auto style_alone = [] {
+    Json d = tank();
+    d["surfaces"].erase("tank");
+    d["deformations"].erase("knees");
+    d.erase("exports");
+    return d;
+  };
+  Json doc = style_alone();
   doc["deformations"]["spine"][0]["net_convergence"] = 0.05;
   const auto first = std::make_shared<const RunResult>(run(doc));
   const double converged = std::get<double>(*figure(step(*first, style_step), "net_change"));
@@ -259,7 +268,7 @@ TEST_CASE("run_recipe: a style with net convergence previews on its first net, c
   CHECK(std::find(preview.previewed.begin(), preview.previewed.end(), "styled") !=
         preview.previewed.end());
   // The preview is the style without convergence rounds, bit for bit.
-  Json coarse = tank();
+  Json coarse = style_alone();
   coarse["deformations"]["spine"][0]["net_convergence"] = 0;
   const RunResult plain = run(coarse);
   CHECK(preview.surface("styled").points == plain.surface("styled").points);
