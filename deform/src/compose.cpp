@@ -496,6 +496,11 @@ std::tuple<BSplineSurface, int, detail::PlaneCrossings> split_at_planes(
 
 namespace detail {
 
+void throw_leaves_lattice(const surface::BezierPatches& bp, int a, int b, int d, const Violation& v,
+                          std::string_view lattice_kind, std::string_view caller) {
+  throw_outside(bp, a, b, d, v, lattice_kind, caller);
+}
+
 LatticePatches locate_patches(const BSplineLattice& lattice, const BezierCells& cells,
                               const BSplineSurface& surface, std::string_view caller) {
   LatticePatches out;

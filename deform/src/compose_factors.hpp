@@ -16,6 +16,7 @@
 
 #include "bernstein_poly.hpp"
 #include "compose_size.hpp"
+#include "patch_containment.hpp"
 
 namespace clay::deform::detail {
 
@@ -79,6 +80,13 @@ struct LatticePatches {
   std::vector<std::array<int, 3>> cells;
   std::vector<std::array<Factor, 3>> factors;
 };
+
+/// Throws clay::Error(OutOfDomain): patch (a, b) of `bp` leaves the lattice along local
+/// coordinate d (`v` from leaves), naming the patch, the coordinate and the surface parameter,
+/// the message starting with `caller`.
+[[noreturn]] void throw_leaves_lattice(const surface::BezierPatches& bp, int a, int b, int d,
+                                       const Violation& v, std::string_view lattice_kind,
+                                       std::string_view caller);
 
 /// Locates the surface's patches in the lattice's cells (compose.cpp). Throws clay::Error, each
 /// message starting with `caller`: OutOfDomain when a patch leaves the lattice, InvalidArgument

@@ -15,7 +15,6 @@
 
 #include "bernstein_poly.hpp"
 #include "compose_factors.hpp"
-#include "messages.hpp"
 #include "patch_containment.hpp"
 
 namespace clay::deform {
@@ -118,14 +117,7 @@ CompositionJacobian composition_jacobian(const BezierLattice& lattice,
       const auto pc = detail::patch_coordinates(bp.patch(a, b), lattice.frame.origin, dual);
       for (int d = 0; d < 3; ++d)
         if (const auto v = detail::leaves(detail::ratio_poly(pc, d), 0, 1, face_tolerance))
-          throw Error(ErrorCategory::OutOfDomain,
-                      "composition_jacobian: patch (" + std::to_string(a) + ", " +
-                          std::to_string(b) +
-                          ") of the surface leaves the Bézier lattice: " + "local coordinate " +
-                          std::string(1, "stu"[d]) + " = " + detail::format(v->value) +
-                          " is outside [0, 1]; the FFD is the identity outside the lattice, so "
-                          "the deformed surface is not one polynomial there: enlarge the "
-                          "lattice frame to contain the whole surface");
+          detail::throw_leaves_lattice(bp, a, b, d, *v, "Bézier lattice", "composition_jacobian");
       patches[static_cast<std::size_t>(a * cv + b)] = {
           compose_channels(lattice, detail::cell_factors(pc, {0, 0, 0}, {1, 1, 1})), every};
     }

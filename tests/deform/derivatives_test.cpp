@@ -206,7 +206,7 @@ TEST_CASE("composition_jacobian: a surface that leaves the lattice is refused, n
     (void)composition_jacobian(make_bezier_lattice(frame, {1, 1, 1}), s);
   });
   CHECK(category == ErrorCategory::OutOfDomain);
-  CHECK_THAT(message, Catch::Matchers::Contains("composition_jacobian: patch (") &&
+  CHECK_THAT(message, Catch::Matchers::Contains("composition_jacobian: surface patch (") &&
                           Catch::Matchers::Contains("enlarge the lattice frame"));
 }
 
