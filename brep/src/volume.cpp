@@ -8,6 +8,8 @@
 #include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
 
+#include "integration.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -20,137 +22,14 @@
 namespace clay::brep {
 namespace {
 
-/// The n-point Gauss–Legendre rule, n in [1, 16], computed once.
-const internal::GaussRule& rule(int n) {
-  static const std::vector<internal::GaussRule> rules = [] {
-    std::vector<internal::GaussRule> all;
-    for (int k = 0; k <= 16; ++k) all.push_back(internal::gauss_legendre(std::max(k, 1)));
-    return all;
-  }();
-  return rules[static_cast<std::size_t>(n)];
-}
-
-/// The integral of f over [a, b] by n-point Gauss–Legendre (exact for degree 2n - 1).
-template <class F>
-double gauss(int n, double a, double b, F&& f) {
-  const auto& r = rule(n);
-  double sum = 0;
-  for (std::size_t g = 0; g < r.nodes.size(); ++g)
-    sum += r.weights[g] * f(0.5 * (a + b) + 0.5 * (b - a) * r.nodes[g]);
-  return 0.5 * (b - a) * sum;
-}
-
-/// What one face's adaptive integration may spend, and whether it converged. A 7 KB IGES file
-/// with one weight of 1e6 ran the unbounded recursion for ever: once the halved tolerance fell
-/// below rounding, every branch descended to the depth cap, 2^40 times (issue #36).
-struct Budget {
-  long intervals = 0;  // subdivisions still allowed on this face
-  bool converged = true;
-};
-
-/// Adaptive: accepts [a, b] when the 16- and 10-point rules agree to `tol` (absolute; both exact
-/// to degree 19, so agreement means the integrand is resolved), or to the rounding of the rule
-/// itself (32 ulps of ∫|f| over the interval: a tolerance below that can never be met), else
-/// halves the interval. Past the depth cap or the budget the interval is accepted unconverged.
-template <class F>
-double adaptive(double a, double b, F&& f, double tol, Budget& budget, int depth = 0) {
-  const auto& r = rule(16);
-  double fine = 0, magnitude = 0;
-  for (std::size_t g = 0; g < r.nodes.size(); ++g) {
-    const double y = r.weights[g] * f(0.5 * (a + b) + 0.5 * (b - a) * r.nodes[g]);
-    fine += y;
-    magnitude += std::abs(y);
-  }
-  fine *= 0.5 * (b - a);
-  magnitude *= 0.5 * std::abs(b - a);
-  const double gap = std::abs(fine - gauss(10, a, b, f));
-  if (!std::isfinite(fine)) {
-    budget.converged = false;
-    return fine;
-  }
-  if (gap <= tol || gap <= 32 * std::numeric_limits<double>::epsilon() * magnitude) return fine;
-  if (depth >= 40 || --budget.intervals < 0) {
-    budget.converged = false;
-    return fine;
-  }
-  const double m = 0.5 * (a + b);
-  return adaptive(a, m, f, 0.5 * tol, budget, depth + 1) +
-         adaptive(m, b, f, 0.5 * tol, budget, depth + 1);
-}
-
-/// The distinct knots of a basis strictly inside (a, b), with a and b around them.
-std::vector<double> breaks(const surface::BSplineBasis& basis, double a, double b) {
-  std::vector<double> out{a};
-  for (double k : basis.knots)
-    if (k > a && k < b && k != out.back()) out.push_back(k);
-  out.push_back(b);
-  return out;
-}
-
-/// `pieces` (a pcurve's parameters, increasing) with the parameters added where the pcurve
-/// crosses a knot of the surface's v basis. The loop integrand z (x_u y_v − x_v y_u) v'(t) is
-/// only as smooth as the surface in v: at a C0 knot line (Alias's fillets carry triple knots in a
-/// cubic v) it jumps, and an adaptive rule halving the tolerance with the interval can never meet
-/// it there (issue #39: Alias's k1 key was refused). Crossings are bracketed by 32 samples per
-/// piece and bisected to rounding; a pcurve that only touches a knot line keeps a kink, not a
-/// jump.
-std::vector<double> with_knot_crossings(const surface::BSplineCurve& pcurve,
-                                        const std::vector<double>& pieces,
-                                        const surface::BSplineBasis& v_basis, double t_lo,
-                                        double t_hi) {
-  const auto [v0, v1] = v_basis.domain();
-  const std::vector<double> knots = breaks(v_basis, v0, v1);
-  if (knots.size() <= 2) return pieces;
-  auto v_at = [&](double t) {
-    return surface::derivatives(pcurve, std::clamp(t, t_lo, t_hi), 0).point.y();
-  };
-  std::vector<double> out;
-  constexpr int samples = 32;
-  for (std::size_t k = 0; k + 1 < pieces.size(); ++k) {
-    out.push_back(pieces[k]);
-    const double a = pieces[k], b = pieces[k + 1];
-    double ta = a, va = v_at(a);
-    for (int i = 1; i <= samples; ++i) {
-      const double tb = i == samples ? b : a + (b - a) * i / samples;
-      const double vb = v_at(tb);
-      for (std::size_t j = 1; j + 1 < knots.size(); ++j) {
-        const double kappa = knots[j];
-        if (vb == kappa && i < samples) out.push_back(tb);  // a sample on the knot line
-        if ((va - kappa) * (vb - kappa) >= 0) continue;     // no strict crossing in [ta, tb]
-        double lo = ta, hi = tb, vlo = va;
-        for (int it = 0; it < 200 && hi - lo > 4 * std::numeric_limits<double>::epsilon() *
-                                                   std::max({1.0, std::abs(lo), std::abs(hi)});
-             ++it) {
-          const double mid = 0.5 * (lo + hi);
-          const double vm = v_at(mid);
-          if ((vlo - kappa) * (vm - kappa) <= 0) {
-            hi = mid;
-          } else {
-            lo = mid;
-            vlo = vm;
-          }
-        }
-        out.push_back(0.5 * (lo + hi));
-      }
-      ta = tb;
-      va = vb;
-    }
-  }
-  out.push_back(pieces.back());
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
-/// A face's budget: 200,000 subdivisions and 1,000 more per knot span (the real files of
-/// tests/data/cad need at most about 42,000 on a face; a weight of 1e6 takes all of them, about
-/// 3 s).
-long face_budget(const surface::BSplineSurface& s) {
-  const long spans =
-      static_cast<long>(breaks(s.u, s.u.domain().first, s.u.domain().second).size() - 1) *
-      static_cast<long>(breaks(s.v, s.v.domain().first, s.v.domain().second).size() - 1);
-  return 200000 + 1000 * std::min(spans, 1800L);
-}
+using detail::adaptive;
+using detail::body_centre;
+using detail::breaks;
+using detail::Budget;
+using detail::face_budget;
+using detail::gauss;
+using detail::size_cubed;
+using detail::with_knot_crossings;
 
 /// F(u, v) = ∫_a^u (S − c)·(S_u × S_v) / 3 ds, per knot span of u. On a polynomial surface of
 /// degree p in u the integrand has degree 3p - 1 there, so ceil(3p / 2) points are exact. A
@@ -266,54 +145,6 @@ FaceVolume face_volume(const Model& m, const Face& face, const Eigen::Vector3d& 
   return out;
 }
 
-/// The cube of the diagonal of the model's control points: the scale of volume tolerances.
-double size_cubed(const Model& m) {
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-  for (const Face& f : m.faces)
-    for (Eigen::Index r = 0; r < f.surface.points.rows(); ++r) {
-      lo = lo.cwiseMin(f.surface.points.row(r).transpose());
-      hi = hi.cwiseMax(f.surface.points.row(r).transpose());
-    }
-  const double d = m.faces.empty() ? 1.0 : (hi - lo).norm();
-  return d * d * d;
-}
-
-/// The centre of the field (x − c) / 3 for body `b`: the mean of the vertices its faces' edges
-/// end at (each once), else of its faces' control points (a body of untrimmed closed faces). Any
-/// c gives the same volume on a watertight shell; on a real file's shell with gaps (up to its
-/// edge tolerances) the figure is the flux through the faces only, and a c that moves with the
-/// model keeps it covariant: an affine map x -> A x + b maps the vertices' mean to A c + b, so it
-/// multiplies the figure by det A exactly. The field (0, 0, z) of the first version was not: NX
-/// 9's gappy bracket, stretched, was 6.5e-5 off det A x V (issue #39). Near the body, c also
-/// keeps the gaps' lever arm short.
-Eigen::Vector3d body_centre(const Model& m, const Body& body) {
-  std::vector<char> seen(m.vertices.size(), 0);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  long count = 0;
-  for (const Shell& shell : body.shells)
-    for (int f : shell.faces)
-      for (const Loop& loop : m.faces[static_cast<std::size_t>(f)].loops)
-        for (const Coedge& coedge : loop.coedges) {
-          const Edge& e = m.edges[static_cast<std::size_t>(coedge.edge)];
-          for (int v : {e.start, e.end})
-            if (!seen[static_cast<std::size_t>(v)]) {
-              seen[static_cast<std::size_t>(v)] = 1;
-              sum += m.vertices[static_cast<std::size_t>(v)].point;
-              ++count;
-            }
-        }
-  if (count > 0) return sum / static_cast<double>(count);
-  for (const Shell& shell : body.shells)
-    for (int f : shell.faces) {
-      const auto& points = m.faces[static_cast<std::size_t>(f)].surface.points;
-      for (Eigen::Index r = 0; r < points.rows(); ++r) {
-        sum += points.row(r).transpose();
-        ++count;
-      }
-    }
-  return count > 0 ? Eigen::Vector3d(sum / static_cast<double>(count)) : Eigen::Vector3d::Zero();
-}
-
 /// The signed volume of the bodies `wanted` says (0 for the others): the faces' contributions
 /// integrated on the hardware's threads (each face on its own), then summed per body in shell
 /// order, so the result does not depend on the threads. Only the wanted bodies' faces are
@@ -326,7 +157,7 @@ std::vector<double> body_volumes(const Model& m, const std::vector<bool>& wanted
   std::vector<Eigen::Vector3d> centre(m.faces.size(), Eigen::Vector3d::Zero());
   for (std::size_t b = 0; b < m.bodies.size(); ++b)
     if (wanted[b]) {
-      const Eigen::Vector3d c = body_centre(m, m.bodies[b]);
+      const Eigen::Vector3d c = body_centre(m, {static_cast<int>(b)});
       for (const Shell& shell : m.bodies[b].shells)
         for (int f : shell.faces) {
           integrate[static_cast<std::size_t>(f)] = true;

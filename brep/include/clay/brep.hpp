@@ -4,6 +4,7 @@
 /// along edges (clay/brep/continuity.hpp), the volume of their solids (clay/brep/volume.hpp) and
 /// the types of their triangle meshes (clay/brep/mesh.hpp).
 #include <clay/brep/continuity.hpp>
+#include <clay/brep/mass_properties.hpp>
 #include <clay/brep/mesh.hpp>
 #include <clay/brep/model.hpp>
 #include <clay/brep/volume.hpp>

@@ -1,0 +1,126 @@
+// Quadrature helpers of clay_brep (see integration.hpp).
+#include "integration.hpp"
+
+#include <clay/surface/evaluate.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace clay::brep::detail {
+
+const internal::GaussRule& rule(int n) {
+  static const std::vector<internal::GaussRule> rules = [] {
+    std::vector<internal::GaussRule> all;
+    for (int k = 0; k <= 64; ++k) all.push_back(internal::gauss_legendre(std::max(k, 1)));
+    return all;
+  }();
+  return rules[static_cast<std::size_t>(n)];
+}
+
+std::vector<double> breaks(const surface::BSplineBasis& basis, double a, double b) {
+  std::vector<double> out{a};
+  for (double k : basis.knots)
+    if (k > a && k < b && k != out.back()) out.push_back(k);
+  out.push_back(b);
+  return out;
+}
+
+std::vector<double> with_knot_crossings(const surface::BSplineCurve& pcurve,
+                                        const std::vector<double>& pieces,
+                                        const surface::BSplineBasis& v_basis, double t_lo,
+                                        double t_hi) {
+  const auto [v0, v1] = v_basis.domain();
+  const std::vector<double> knots = breaks(v_basis, v0, v1);
+  if (knots.size() <= 2) return pieces;
+  auto v_at = [&](double t) {
+    return surface::derivatives(pcurve, std::clamp(t, t_lo, t_hi), 0).point.y();
+  };
+  std::vector<double> out;
+  constexpr int samples = 32;
+  for (std::size_t k = 0; k + 1 < pieces.size(); ++k) {
+    out.push_back(pieces[k]);
+    const double a = pieces[k], b = pieces[k + 1];
+    double ta = a, va = v_at(a);
+    for (int i = 1; i <= samples; ++i) {
+      const double tb = i == samples ? b : a + (b - a) * i / samples;
+      const double vb = v_at(tb);
+      for (std::size_t j = 1; j + 1 < knots.size(); ++j) {
+        const double kappa = knots[j];
+        if (vb == kappa && i < samples) out.push_back(tb);  // a sample on the knot line
+        if ((va - kappa) * (vb - kappa) >= 0) continue;     // no strict crossing in [ta, tb]
+        double lo = ta, hi = tb, vlo = va;
+        for (int it = 0; it < 200 && hi - lo > 4 * std::numeric_limits<double>::epsilon() *
+                                                   std::max({1.0, std::abs(lo), std::abs(hi)});
+             ++it) {
+          const double mid = 0.5 * (lo + hi);
+          const double vm = v_at(mid);
+          if ((vlo - kappa) * (vm - kappa) <= 0) {
+            hi = mid;
+          } else {
+            lo = mid;
+            vlo = vm;
+          }
+        }
+        out.push_back(0.5 * (lo + hi));
+      }
+      ta = tb;
+      va = vb;
+    }
+  }
+  out.push_back(pieces.back());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+long face_budget(const surface::BSplineSurface& s) {
+  const long spans =
+      static_cast<long>(breaks(s.u, s.u.domain().first, s.u.domain().second).size() - 1) *
+      static_cast<long>(breaks(s.v, s.v.domain().first, s.v.domain().second).size() - 1);
+  return 200000 + 1000 * std::min(spans, 1800L);
+}
+
+double size_cubed(const Model& m) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const Face& f : m.faces)
+    for (Eigen::Index r = 0; r < f.surface.points.rows(); ++r) {
+      lo = lo.cwiseMin(f.surface.points.row(r).transpose());
+      hi = hi.cwiseMax(f.surface.points.row(r).transpose());
+    }
+  const double d = m.faces.empty() ? 1.0 : (hi - lo).norm();
+  return d * d * d;
+}
+
+Eigen::Vector3d body_centre(const Model& m, const std::vector<int>& bodies) {
+  std::vector<char> seen(m.vertices.size(), 0);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  long count = 0;
+  for (int b : bodies)
+    for (const Shell& shell : m.bodies[static_cast<std::size_t>(b)].shells)
+      for (int f : shell.faces)
+        for (const Loop& loop : m.faces[static_cast<std::size_t>(f)].loops)
+          for (const Coedge& coedge : loop.coedges) {
+            const Edge& e = m.edges[static_cast<std::size_t>(coedge.edge)];
+            for (int v : {e.start, e.end})
+              if (!seen[static_cast<std::size_t>(v)]) {
+                seen[static_cast<std::size_t>(v)] = 1;
+                sum += m.vertices[static_cast<std::size_t>(v)].point;
+                ++count;
+              }
+          }
+  if (count > 0) return sum / static_cast<double>(count);
+  for (int b : bodies)
+    for (const Shell& shell : m.bodies[static_cast<std::size_t>(b)].shells)
+      for (int f : shell.faces) {
+        const auto& points = m.faces[static_cast<std::size_t>(f)].surface.points;
+        for (Eigen::Index r = 0; r < points.rows(); ++r) {
+          sum += points.row(r).transpose();
+          ++count;
+        }
+      }
+  return count > 0 ? Eigen::Vector3d(sum / static_cast<double>(count)) : Eigen::Vector3d::Zero();
+}
+
+}  // namespace clay::brep::detail

@@ -1,0 +1,420 @@
+// Mass properties and their gradients by the divergence, Green and Hadamard theorems (see
+// clay/brep/mass_properties.hpp).
+#include <clay/brep/mass_properties.hpp>
+
+#include <clay/error.hpp>
+#include <clay/parallel.hpp>
+#include <clay/surface/basis.hpp>
+#include <clay/surface/evaluate.hpp>
+
+#include "integration.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace clay::brep {
+namespace {
+
+using detail::breaks;
+using detail::Budget;
+using detail::rule;
+
+/// The ten moments about c: ∭ 1, y_x, y_y, y_z, y_x², y_y², y_z², y_x y_y, y_x y_z, y_y y_z dV.
+using Moments = Eigen::Matrix<double, 10, 1>;
+
+/// φ of each moment at y = x − c.
+Moments densities(const Eigen::Vector3d& y) {
+  Moments phi;
+  phi << 1, y.x(), y.y(), y.z(), y.x() * y.x(), y.y() * y.y(), y.z() * y.z(), y.x() * y.y(),
+      y.x() * y.z(), y.y() * y.z();
+  return phi;
+}
+
+/// Φ·n of each moment's field (div Φ = φ) at y, n = X_u × X_v.
+Moments fluxes(const Eigen::Vector3d& y, const Eigen::Vector3d& n) {
+  Moments f;
+  f << y.dot(n) / 3,  //
+      y.x() * y.x() * n.x() / 2, y.y() * y.y() * n.y() / 2, y.z() * y.z() * n.z() / 2,
+      y.x() * y.x() * y.x() * n.x() / 3, y.y() * y.y() * y.y() * n.y() / 3,
+      y.z() * y.z() * y.z() * n.z() / 3, y.x() * y.x() * y.y() * n.x() / 2,
+      y.x() * y.x() * y.z() * n.x() / 2, y.y() * y.y() * y.z() * n.y() / 2;
+  return f;
+}
+
+/// A quadrature node of a face's trimmed domain: ∬_D f du dv ≈ Σ w f(u, v).
+struct Node {
+  double u, v, w;
+};
+
+/// The surface at (u, v): y = S − c, n = S_u × S_v, and the rational basis R_k of the control
+/// points rows (p + 1)(q + 1) starting at spans (su − p, sv − q) when `basis` is asked for.
+struct Sample {
+  Eigen::Vector3d y, n;
+  int su = 0, sv = 0;
+  std::array<double, 2 * (surface::max_kernel_degree + 1)> nu{}, nv{};
+  double weight = 1;  // W(u, v)
+};
+
+void sample(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double u, double v,
+            Sample& out) {
+  u = std::clamp(u, s.u.domain().first, s.u.domain().second);
+  v = std::clamp(v, s.v.domain().first, s.v.domain().second);
+  const int p = s.u.degree, q = s.v.degree;
+  out.su = surface::find_span(s.u, u);
+  out.sv = surface::find_span(s.v, v);
+  surface::basis_derivatives(s.u, out.su, u, 1, out.nu);
+  surface::basis_derivatives(s.v, out.sv, v, 1, out.nv);
+  Eigen::Vector4d h = Eigen::Vector4d::Zero(), hu = h, hv = h;
+  for (int i = 0; i <= p; ++i)
+    for (int j = 0; j <= q; ++j) {
+      const Eigen::Index r = s.index(out.su - p + i, out.sv - q + j);
+      const double w = s.weights[r];
+      const Eigen::Vector4d pw(s.points(r, 0) * w, s.points(r, 1) * w, s.points(r, 2) * w, w);
+      const double a = out.nu[static_cast<std::size_t>(i)], b = out.nv[static_cast<std::size_t>(j)];
+      h += a * b * pw;
+      hu += out.nu[static_cast<std::size_t>(p + 1 + i)] * b * pw;
+      hv += a * out.nv[static_cast<std::size_t>(q + 1 + j)] * pw;
+    }
+  // the rational quotient rule (The NURBS Book A4.4) at first order
+  const Eigen::Vector3d point = h.head<3>() / h[3];
+  const Eigen::Vector3d du = (hu.head<3>() - hu[3] * point) / h[3];
+  const Eigen::Vector3d dv = (hv.head<3>() - hv[3] * point) / h[3];
+  out.y = point - c;
+  out.n = du.cross(dv);
+  out.weight = h[3];
+}
+
+/// Adaptive on every moment at once, as detail::adaptive on one: [a, b] is accepted when the 16-
+/// and 10-point rules agree to tol (per moment) or to their own rounding, else halved. f(x, rec)
+/// gives the integrand at x and appends the nodes it used (weights per unit of x) to rec when rec
+/// is not null; the nodes of an accepted interval's 16-point rule are appended to `record`,
+/// weighted by the rule.
+template <class F>
+Moments adaptive_moments(double a, double b, F&& f, const Moments& tol, Budget& budget,
+                         std::vector<Node>& record, int depth = 0) {
+  const auto& r16 = rule(16);
+  const auto& r10 = rule(10);
+  const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
+  Moments fine = Moments::Zero(), magnitude = Moments::Zero(), coarse = Moments::Zero();
+  std::vector<Node> mine;
+  for (std::size_t g = 0; g < r16.nodes.size(); ++g) {
+    const std::size_t first = mine.size();
+    const Moments y = r16.weights[g] * f(mid + half * r16.nodes[g], &mine);
+    for (std::size_t k = first; k < mine.size(); ++k) mine[k].w *= r16.weights[g] * half;
+    fine += y;
+    magnitude += y.cwiseAbs();
+  }
+  for (std::size_t g = 0; g < r10.nodes.size(); ++g)
+    coarse += r10.weights[g] * f(mid + half * r10.nodes[g], nullptr);
+  fine *= half;
+  coarse *= half;
+  magnitude *= std::abs(half);
+  const Moments gap = (fine - coarse).cwiseAbs();
+  bool resolved = fine.allFinite();
+  for (int k = 0; k < Moments::RowsAtCompileTime && resolved; ++k)
+    resolved =
+        gap[k] <= tol[k] || gap[k] <= 32 * std::numeric_limits<double>::epsilon() * magnitude[k];
+  if (!fine.allFinite() || (!resolved && (depth >= 40 || --budget.intervals < 0))) {
+    budget.converged = false;
+    resolved = true;
+  }
+  if (resolved) {
+    record.insert(record.end(), mine.begin(), mine.end());
+    return fine;
+  }
+  return adaptive_moments(a, mid, f, tol / 2, budget, record, depth + 1) +
+         adaptive_moments(mid, b, f, tol / 2, budget, record, depth + 1);
+}
+
+/// ∫_a^u Φ·n ds at v (F of Green's theorem for every moment), appending its nodes to rec: Gauss
+/// with ceil(5p / 2) points per knot span of u on a polynomial surface (exact: the second
+/// moments' integrand has degree 5p − 1 in u), adaptive on a rational one.
+Moments inner(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double a, double u,
+              double v, const Moments& tol, Budget& budget, std::vector<Node>* rec) {
+  u = std::clamp(u, s.u.domain().first, s.u.domain().second);
+  v = std::clamp(v, s.v.domain().first, s.v.domain().second);
+  const double lo = std::min(a, u), hi = std::max(a, u);
+  if (hi == lo) return Moments::Zero();
+  const double sign = u >= a ? 1 : -1;
+  const auto spans = breaks(s.u, lo, hi);
+  Sample at;
+  auto integrand = [&](double x, std::vector<Node>* r) -> Moments {
+    if (r) r->push_back({x, v, 1});
+    sample(s, c, x, v, at);
+    return fluxes(at.y, at.n);
+  };
+  Moments sum = Moments::Zero();
+  std::vector<Node> nodes;
+  for (std::size_t k = 0; k + 1 < spans.size(); ++k) {
+    if (s.is_rational()) {
+      sum += adaptive_moments(spans[k], spans[k + 1], integrand, tol, budget, nodes);
+    } else {
+      const auto& g = rule(std::clamp((5 * s.u.degree + 1) / 2, 1, 64));
+      const double half = 0.5 * (spans[k + 1] - spans[k]), mid = 0.5 * (spans[k] + spans[k + 1]);
+      for (std::size_t i = 0; i < g.nodes.size(); ++i) {
+        const std::size_t first = nodes.size();
+        sum += g.weights[i] * half * integrand(mid + half * g.nodes[i], &nodes);
+        nodes[first].w = g.weights[i] * half;
+      }
+    }
+  }
+  if (rec)
+    for (Node n : nodes) rec->push_back({n.u, n.v, sign * n.w});
+  return sign * sum;
+}
+
+/// One face's quadrature nodes (their weights carry the loop's orientation and the face's), and
+/// whether its integration converged.
+struct FaceRule {
+  std::vector<Node> nodes;
+  Budget budget;
+};
+
+FaceRule face_rule(const Model& m, const Face& face, const Eigen::Vector3d& centre,
+                   const Moments& tol) {
+  FaceRule out;
+  out.budget.intervals = detail::face_budget(face.surface);
+  const surface::BSplineSurface& s = face.surface;
+  const double u0 = s.u.domain().first, u1 = s.u.domain().second;
+  const double v0 = s.v.domain().first, v1 = s.v.domain().second;
+  const Moments tol_inner = tol / std::max(v1 - v0, 1e-300);
+  if (face.loops.empty()) {
+    // The whole domain: along its right side (the left one has F = 0, the others dv = 0).
+    const auto spans = breaks(s.v, v0, v1);
+    for (std::size_t k = 0; k + 1 < spans.size(); ++k)
+      adaptive_moments(
+          spans[k], spans[k + 1],
+          [&](double v, std::vector<Node>* rec) {
+            return inner(s, centre, u0, u1, v, tol_inner, out.budget, rec);
+          },
+          tol, out.budget, out.nodes);
+  } else {
+    for (const Loop& loop : face.loops)
+      for (const Coedge& co : loop.coedges) {
+        const Edge& e = m.edges[static_cast<std::size_t>(co.edge)];
+        const double d0 = co.pcurve.basis.domain().first, d1 = co.pcurve.basis.domain().second;
+        auto integrand = [&](double t, std::vector<Node>* rec) -> Moments {
+          const surface::CurveDerivatives q =
+              surface::derivatives(co.pcurve, std::clamp(t, d0, d1), 1);
+          if (q.d1.y() == 0.0) return Moments::Zero();
+          const std::size_t first = rec ? rec->size() : 0;
+          const Moments f =
+              inner(s, centre, u0, q.point.x(), q.point.y(), tol_inner, out.budget, rec);
+          if (rec)
+            for (std::size_t k = first; k < rec->size(); ++k) (*rec)[k].w *= q.d1.y();
+          return f * q.d1.y();
+        };
+        const auto pieces = detail::with_knot_crossings(
+            co.pcurve, breaks(co.pcurve.basis, e.t0, e.t1), s.v, d0, d1);
+        const std::size_t first = out.nodes.size();
+        for (std::size_t k = 0; k + 1 < pieces.size(); ++k)
+          adaptive_moments(pieces[k], pieces[k + 1], integrand, tol, out.budget, out.nodes);
+        if (!co.same_sense)
+          for (std::size_t k = first; k < out.nodes.size(); ++k) out.nodes[k].w = -out.nodes[k].w;
+      }
+  }
+  if (face.reversed)
+    for (Node& n : out.nodes) n.w = -n.w;
+  return out;
+}
+
+/// A face's moments and, when asked, their gradients with respect to its control points (one
+/// n x 3 matrix per moment).
+struct FaceMoments {
+  Moments value = Moments::Zero();
+  std::array<Eigen::MatrixX3d, 10> gradient;
+  Budget budget;
+};
+
+FaceMoments face_moments(const Model& m, const Face& face, const Eigen::Vector3d& centre,
+                         const Moments& tol, bool gradients) {
+  const FaceRule r = face_rule(m, face, centre, tol);
+  const surface::BSplineSurface& s = face.surface;
+  FaceMoments out;
+  out.budget = r.budget;
+  if (gradients)
+    for (auto& g : out.gradient) g = Eigen::MatrixX3d::Zero(s.points.rows(), 3);
+  const int p = s.u.degree, q = s.v.degree;
+  Sample at;
+  for (const Node& node : r.nodes) {
+    sample(s, centre, node.u, node.v, at);
+    out.value += node.w * fluxes(at.y, at.n);
+    if (!gradients) continue;
+    // ∂/∂P_k ∭ φ dV = ∬ φ(X) R_k n du dv (Hadamard), R_k = N_i N_j w_k / W.
+    const Moments phi = node.w * densities(at.y);
+    for (int i = 0; i <= p; ++i)
+      for (int j = 0; j <= q; ++j) {
+        const Eigen::Index k = s.index(at.su - p + i, at.sv - q + j);
+        const double rk = at.nu[static_cast<std::size_t>(i)] * at.nv[static_cast<std::size_t>(j)] *
+                          s.weights[k] / at.weight;
+        if (rk == 0) continue;
+        const Eigen::RowVector3d dn = rk * at.n.transpose();
+        for (int m2 = 0; m2 < 10; ++m2)
+          out.gradient[static_cast<std::size_t>(m2)].row(k) += phi[m2] * dn;
+      }
+  }
+  return out;
+}
+
+/// The moments of the solids `bodies` about their common centre, and their face gradients.
+struct Totals {
+  Eigen::Vector3d centre;
+  Moments value = Moments::Zero();
+  std::array<FaceGradients, 10> gradient;
+};
+
+Totals totals(const Model& m, const std::vector<int>& bodies, bool gradients) {
+  Totals out;
+  out.centre = detail::body_centre(m, bodies);
+  const double d = std::cbrt(detail::size_cubed(m));
+  Moments tol;
+  tol << std::pow(d, 3), Eigen::Matrix<double, 3, 1>::Constant(std::pow(d, 4)),
+      Eigen::Matrix<double, 6, 1>::Constant(std::pow(d, 5));
+  tol *= 1e-14;
+  std::vector<bool> measured(m.faces.size(), false);
+  for (int b : bodies)
+    for (const Shell& shell : m.bodies[static_cast<std::size_t>(b)].shells)
+      for (int f : shell.faces) measured[static_cast<std::size_t>(f)] = true;
+  std::vector<FaceMoments> face(m.faces.size());
+  const std::size_t parts = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1,
+                                                    std::max<std::size_t>(1, m.faces.size()));
+  run_on_threads(parts, [&](std::size_t part) {
+    for (std::size_t f = part; f < m.faces.size(); f += parts)
+      if (measured[f]) face[f] = face_moments(m, m.faces[f], out.centre, tol, gradients);
+  });
+  std::string failed;
+  int count = 0;
+  for (std::size_t f = 0; f < face.size(); ++f) {
+    if (!face[f].budget.converged && ++count <= 5)
+      failed += (failed.empty() ? "" : ", ") + std::to_string(f);
+    out.value += face[f].value;
+  }
+  if (count > 0)
+    throw Error(
+        ErrorCategory::ToleranceNotMet,
+        "mass_properties: the integration did not converge on " + std::to_string(count) +
+            " face(s) (" + failed + (count > 5 ? ", ..." : "") +
+            ") within its budget of quadrature intervals: a surface with extreme weights "
+            "or a near-singular parametrization; rebuild those faces with moderate weights");
+  if (gradients)
+    for (std::size_t k = 0; k < 10; ++k) {
+      out.gradient[k].resize(m.faces.size());
+      for (std::size_t f = 0; f < m.faces.size(); ++f)
+        out.gradient[k][f] = measured[f] ? std::move(face[f].gradient[k]) : Eigen::MatrixX3d(0, 3);
+    }
+  return out;
+}
+
+/// The faces' sum a0 g0 + a1 g1 (+ a2 g2) of gradients with the same shapes.
+FaceGradients combine(std::initializer_list<std::pair<double, const FaceGradients*>> terms) {
+  FaceGradients out = *terms.begin()->second;
+  for (auto& g : out) g *= terms.begin()->first;
+  for (auto it = terms.begin() + 1; it != terms.end(); ++it)
+    for (std::size_t f = 0; f < out.size(); ++f) out[f] += it->first * (*it->second)[f];
+  return out;
+}
+
+/// Volume, centroid and inertia from the moments about c: centroid g = c + M1 / V, second
+/// moments about it S' = S − M1 M1ᵀ / V, inertia tr(S') 1 − S'; their gradients by the chain rule
+/// when the moments have them.
+MassPropertyGradients assemble(const Totals& t, bool gradients) {
+  MassPropertyGradients out;
+  const double volume = t.value[0];
+  const Eigen::Vector3d first = t.value.segment<3>(1);
+  Eigen::Matrix3d second;
+  second << t.value[4], t.value[7], t.value[8],  //
+      t.value[7], t.value[5], t.value[9],        //
+      t.value[8], t.value[9], t.value[6];
+  const Eigen::Matrix3d about = second - first * first.transpose() / volume;
+  out.value.volume_mm3 = volume;
+  out.value.centroid_mm = t.centre + first / volume;
+  out.value.inertia_mm5 = about.trace() * Eigen::Matrix3d::Identity() - about;
+  if (!gradients) return out;
+  out.volume = t.gradient[0];
+  for (int i = 0; i < 3; ++i)  // d(c_i + M1_i / V) = dM1_i / V − M1_i dV / V²
+    out.centroid[static_cast<std::size_t>(i)] =
+        combine({{1 / volume, &t.gradient[static_cast<std::size_t>(1 + i)]},
+                 {-first[i] / (volume * volume), &t.gradient[0]}});
+  // dS'_ij = dS_ij − (dM1_i M1_j + M1_i dM1_j) / V + M1_i M1_j dV / V²
+  const std::array<std::array<int, 3>, 3> slot{{{4, 7, 8}, {7, 5, 9}, {8, 9, 6}}};
+  auto d_about = [&](int i, int j) {
+    return combine({{1.0, &t.gradient[static_cast<std::size_t>(slot[i][j])]},
+                    {-first[j] / volume, &t.gradient[static_cast<std::size_t>(1 + i)]},
+                    {-first[i] / volume, &t.gradient[static_cast<std::size_t>(1 + j)]},
+                    {first[i] * first[j] / (volume * volume), &t.gradient[0]}});
+  };
+  const FaceGradients sxx = d_about(0, 0), syy = d_about(1, 1), szz = d_about(2, 2);
+  out.inertia[0] = combine({{1.0, &syy}, {1.0, &szz}});
+  out.inertia[1] = combine({{1.0, &sxx}, {1.0, &szz}});
+  out.inertia[2] = combine({{1.0, &sxx}, {1.0, &syy}});
+  const FaceGradients sxy = d_about(0, 1), sxz = d_about(0, 2), syz = d_about(1, 2);
+  out.inertia[3] = combine({{-1.0, &sxy}});
+  out.inertia[4] = combine({{-1.0, &sxz}});
+  out.inertia[5] = combine({{-1.0, &syz}});
+  return out;
+}
+
+/// The solids a call measures, checked: `body` alone, or every solid when body < 0.
+std::vector<int> measured_bodies(const Model& model, int body, const char* function) {
+  validate(model);
+  const std::string name = function;
+  if (model.is_assembly())
+    throw Error(ErrorCategory::InvalidArgument,
+                name +
+                    ": the model is an assembly; measure brep::flattened(model), whose bodies "
+                    "are its placed instances");
+  std::vector<int> out;
+  if (body >= 0) {
+    if (body >= static_cast<int>(model.bodies.size()))
+      throw Error(ErrorCategory::InvalidArgument,
+                  name + ": body " + std::to_string(body) + " does not exist; the model has " +
+                      std::to_string(model.bodies.size()) + " bodies");
+    if (model.bodies[static_cast<std::size_t>(body)].kind != BodyKind::Solid)
+      throw Error(ErrorCategory::InvalidArgument,
+                  name + ": body " + std::to_string(body) +
+                      " is not a solid (a sheet or wire body encloses no volume); choose a solid");
+    out.push_back(body);
+  } else {
+    for (std::size_t b = 0; b < model.bodies.size(); ++b)
+      if (model.bodies[b].kind == BodyKind::Solid) out.push_back(static_cast<int>(b));
+    if (out.empty())
+      throw Error(ErrorCategory::InvalidArgument,
+                  name + ": the model has no solid (" + std::to_string(model.bodies.size()) +
+                      " sheet or wire bodies): mass properties need a closed shell");
+  }
+  return out;
+}
+
+}  // namespace
+
+MassProperties mass_properties(const Model& model) {
+  return assemble(totals(model, measured_bodies(model, -1, "mass_properties"), false), false).value;
+}
+
+MassProperties mass_properties(const Model& model, int body) {
+  if (body < 0)
+    throw Error(ErrorCategory::InvalidArgument,
+                "mass_properties: body " + std::to_string(body) + " does not exist (negative)");
+  return assemble(totals(model, measured_bodies(model, body, "mass_properties"), false), false)
+      .value;
+}
+
+MassPropertyGradients mass_property_gradients(const Model& model) {
+  return assemble(totals(model, measured_bodies(model, -1, "mass_property_gradients"), true), true);
+}
+
+MassPropertyGradients mass_property_gradients(const Model& model, int body) {
+  if (body < 0)
+    throw Error(
+        ErrorCategory::InvalidArgument,
+        "mass_property_gradients: body " + std::to_string(body) + " does not exist (negative)");
+  return assemble(totals(model, measured_bodies(model, body, "mass_property_gradients"), true),
+                  true);
+}
+
+}  // namespace clay::brep
