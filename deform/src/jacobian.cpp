@@ -2,6 +2,7 @@
 
 #include <clay/internal/math.hpp>
 #include <clay/surface/basis.hpp>
+#include <clay/surface/knots.hpp>
 
 #include <Eigen/LU>
 
@@ -180,6 +181,115 @@ JacobianBounds jacobian_bounds(const BezierLattice& lattice) {
 
 JacobianBounds jacobian_bounds(const BSplineLattice& lattice) {
   return bounds_of(jacobian_bernstein(lattice));
+}
+
+namespace {
+
+/// The hodographs D[direction][coordinate] of a lattice's points.
+using Hodographs = std::array<std::array<BernsteinVolume, 3>, 3>;
+
+Hodographs hodographs(const BezierLattice& lattice) {
+  Hodographs D;
+  for (int d = 0; d < 3; ++d)
+    for (int c = 0; c < 3; ++c)
+      D[static_cast<size_t>(d)][static_cast<size_t>(c)] = derivative(lattice, d, c);
+  return D;
+}
+
+/// a × b per coordinate, for Bernstein vectors.
+std::array<BernsteinVolume, 3> cross(const std::array<BernsteinVolume, 3>& a,
+                                     const std::array<BernsteinVolume, 3>& b) {
+  return {difference(product(a[1], b[2]), product(a[2], b[1])),
+          difference(product(a[2], b[0]), product(a[0], b[2])),
+          difference(product(a[0], b[1]), product(a[1], b[0]))};
+}
+
+/// Values and the dense gradient (coefficients x 3 × points) of one Bézier lattice.
+std::pair<Eigen::VectorXd, Eigen::MatrixXd> constraints_dense(const BezierLattice& lattice) {
+  validate(lattice);
+  const Hodographs x = hodographs(lattice);
+  // e_s · (X_t × X_u) + e_t · (X_u × X_s) + e_u · (X_s × X_t)
+  const std::array<std::array<BernsteinVolume, 3>, 3> cofactors = {
+      cross(x[1], x[2]), cross(x[2], x[0]), cross(x[0], x[1])};
+  const double volume = lattice.frame.volume();
+  const Eigen::VectorXd values = jacobian_bernstein(lattice).coefficients;
+  Eigen::MatrixXd gradient = Eigen::MatrixXd::Zero(values.size(), 3 * lattice.points.rows());
+  BezierLattice unit = lattice;
+  unit.points.setZero();
+  for (Eigen::Index j = 0; j < lattice.points.rows(); ++j)
+    for (int c = 0; c < 3; ++c) {
+      unit.points(j, c) = 1;
+      for (int d = 0; d < 3; ++d)
+        gradient.col(3 * j + c) +=
+            product(derivative(unit, d, c),
+                    cofactors[static_cast<size_t>(d)][static_cast<size_t>(c)])
+                .coefficients;
+      unit.points(j, c) = 0;
+    }
+  gradient /= volume;
+  return {values, gradient};
+}
+
+}  // namespace
+
+JacobianConstraints jacobian_constraints(const BezierLattice& lattice) {
+  auto [values, dense] = constraints_dense(lattice);
+  JacobianConstraints out;
+  out.values = std::move(values);
+  out.gradient = dense.sparseView();
+  return out;
+}
+
+JacobianConstraints jacobian_constraints(const BSplineLattice& lattice) {
+  const BezierCells cells = bezier_cells(lattice);
+  std::array<std::vector<surface::SpanExtraction>, 3> spans;
+  for (std::size_t d = 0; d < 3; ++d) spans[d] = surface::bezier_extraction(lattice.bases[d]);
+  const auto n = cells.counts();
+  std::vector<double> values;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int ci = 0; ci < n[0]; ++ci)
+    for (int cj = 0; cj < n[1]; ++cj)
+      for (int ck = 0; ck < n[2]; ++ck) {
+        const BezierLattice& cell = cells.cell(ci, cj, ck);
+        const auto [v, g] = constraints_dense(cell);
+        // Cell point (i, j, k) = Σ ea(i, ii) eb(j, jj) ec(k, kk) P(first + (ii, jj, kk)).
+        const auto& ea = spans[0][static_cast<size_t>(ci)];
+        const auto& eb = spans[1][static_cast<size_t>(cj)];
+        const auto& ec = spans[2][static_cast<size_t>(ck)];
+        const auto m = cell.counts();
+        Eigen::MatrixXd e = Eigen::MatrixXd::Zero(cell.points.rows(), cell.points.rows());
+        std::vector<Eigen::Index> column(static_cast<size_t>(cell.points.rows()));
+        for (int i = 0; i < m[0]; ++i)
+          for (int j = 0; j < m[1]; ++j)
+            for (int k = 0; k < m[2]; ++k)
+              for (int ii = 0; ii < m[0]; ++ii)
+                for (int jj = 0; jj < m[1]; ++jj)
+                  for (int kk = 0; kk < m[2]; ++kk) {
+                    e(cell.index(i, j, k), cell.index(ii, jj, kk)) =
+                        ea.matrix(i, ii) * eb.matrix(j, jj) * ec.matrix(k, kk);
+                    column[static_cast<size_t>(cell.index(ii, jj, kk))] =
+                        lattice.index(ea.first + ii, eb.first + jj, ec.first + kk);
+                  }
+        const auto first_row = static_cast<int>(values.size());
+        values.insert(values.end(), v.data(), v.data() + v.size());
+        for (Eigen::Index q = 0; q < e.cols(); ++q)  // lattice point column[q] of the support
+          for (int c = 0; c < 3; ++c) {
+            Eigen::VectorXd d = Eigen::VectorXd::Zero(v.size());
+            for (Eigen::Index p = 0; p < e.rows(); ++p)
+              if (e(p, q) != 0) d += e(p, q) * g.col(3 * p + c);
+            for (Eigen::Index r = 0; r < d.size(); ++r)
+              if (d[r] != 0)
+                entries.emplace_back(first_row + static_cast<int>(r),
+                                     static_cast<int>(3 * column[static_cast<size_t>(q)] + c),
+                                     d[r]);
+          }
+      }
+  JacobianConstraints out;
+  out.values =
+      Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+  out.gradient.resize(out.values.size(), 3 * lattice.points.rows());
+  out.gradient.setFromTriplets(entries.begin(), entries.end());
+  return out;
 }
 
 Eigen::Matrix3d jacobian_matrix(const BezierLattice& lattice, const Eigen::Vector3d& x) {

@@ -6,6 +6,7 @@
 
 #include <Eigen/LU>
 
+#include <functional>
 #include <random>
 
 #include "fixtures.hpp"
@@ -106,4 +107,78 @@ TEST_CASE("a lattice folded through its neighbours is not fold-free", "[deform]"
   BSplineLattice gentle = make_bspline_lattice(f, {2, 2, 2}, {3, 3, 3});
   gentle.points.row(r) += 0.05 * f.t.transpose();
   CHECK(jacobian_bounds(gentle).fold_free);
+}
+
+namespace {
+
+/// The 5-point central difference of f at 0, exact for a cubic (to rounding).
+Eigen::VectorXd cubic_derivative(const std::function<Eigen::VectorXd(double)>& f, double h) {
+  return (8 * (f(h) - f(-h)) - (f(2 * h) - f(-2 * h))) / (12 * h);
+}
+
+/// Every Jacobian coefficient of a lattice (cells concatenated for a B-spline one).
+Eigen::VectorXd coefficients_of(const BezierLattice& l) {
+  return jacobian_bernstein(l).coefficients;
+}
+Eigen::VectorXd coefficients_of(const BSplineLattice& l) {
+  std::vector<double> all;
+  for (const auto& cell : jacobian_bernstein(l))
+    all.insert(all.end(), cell.coefficients.data(),
+               cell.coefficients.data() + cell.coefficients.size());
+  return Eigen::Map<Eigen::VectorXd>(all.data(), static_cast<Eigen::Index>(all.size()));
+}
+
+template <class Lattice>
+void check_constraints(Lattice lattice, std::mt19937& rng) {
+  std::normal_distribution<double> normal(0, 0.05 * lattice.frame.s.norm());
+  for (Eigen::Index r = 0; r < lattice.points.rows(); ++r)
+    for (int c = 0; c < 3; ++c) lattice.points(r, c) += normal(rng);
+  const JacobianConstraints k = jacobian_constraints(lattice);
+  const Eigen::VectorXd expected = coefficients_of(lattice);
+  REQUIRE(k.values.size() == expected.size());
+  CHECK((k.values - expected).cwiseAbs().maxCoeff() == 0);
+  REQUIRE(k.gradient.cols() == 3 * lattice.points.rows());
+  // Along a random direction of every point and along single coordinates: the coefficients are
+  // cubic in the points, so the 5-point difference is exact to rounding.
+  clay::surface::Points3 direction(lattice.points.rows(), 3);
+  for (Eigen::Index r = 0; r < direction.rows(); ++r)
+    for (int c = 0; c < 3; ++c) direction(r, c) = normal(rng);
+  auto along = [&](const clay::surface::Points3& d) {
+    return cubic_derivative(
+        [&](double h) {
+          Lattice moved = lattice;
+          moved.points += h * d;
+          return coefficients_of(moved);
+        },
+        1e-2);
+  };
+  const Eigen::Map<const Eigen::VectorXd> flat(direction.data(), direction.size());  // row-major
+  const Eigen::VectorXd d = along(direction);
+  CHECK((k.gradient * flat - d).cwiseAbs().maxCoeff() <= 1e-10 * d.cwiseAbs().maxCoeff());
+  for (const auto& [point, axis] : {std::pair{0, 2}, std::pair{5, 0}, std::pair{11, 1}}) {
+    clay::surface::Points3 unit = clay::surface::Points3::Zero(lattice.points.rows(), 3);
+    unit(point, axis) = 1;
+    const Eigen::VectorXd e = along(unit);
+    const Eigen::VectorXd column = Eigen::MatrixXd(k.gradient).col(3 * point + axis);
+    CHECK((column - e).cwiseAbs().maxCoeff() <= 1e-10 * std::max(1.0, e.cwiseAbs().maxCoeff()));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("jacobian_constraints: the coefficients and their exact gradient against differences",
+          "[deform]") {
+  std::mt19937 rng(41);
+  for (bool left : {false, true}) {
+    const Frame f = random_frame(rng, left);
+    check_constraints(make_bezier_lattice(f, {2, 2, 1}), rng);
+    check_constraints(make_bezier_lattice(f, {3, 2, 2}), rng);
+    check_constraints(make_bspline_lattice(f, {2, 2, 2}, {2, 1, 2}), rng);
+  }
+  // A B-spline lattice's rows hold one cell's support only.
+  const JacobianConstraints k =
+      jacobian_constraints(make_bspline_lattice(random_frame(rng, false), {2, 2, 2}, {3, 3, 3}));
+  const Eigen::Index per_row = k.gradient.row(0).nonZeros();
+  CHECK(per_row <= 3 * 27);
+  CHECK(k.gradient.cols() == 3 * 125);
 }

@@ -10,6 +10,7 @@
 #include <clay/deform/lattice.hpp>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include <array>
 #include <vector>
@@ -48,6 +49,26 @@ CLAY_DEFORM_API std::vector<BernsteinVolume> jacobian_bernstein(const BSplineLat
 CLAY_DEFORM_API JacobianBounds jacobian_bounds(const BezierLattice& lattice);
 /// Same over all cells of a B-spline lattice.
 CLAY_DEFORM_API JacobianBounds jacobian_bounds(const BSplineLattice& lattice);
+
+/// The Jacobian's Bernstein coefficients as an optimiser's constraints (issue #41): keeping every
+/// value above a floor > 0 keeps the lattice fold-free with a bounded volume ratio.
+struct JacobianConstraints {
+  /// Every coefficient of jacobian_bernstein (a B-spline lattice: cell after cell in
+  /// bezier_cells order), each a cubic polynomial in the lattice points.
+  Eigen::VectorXd values;
+  /// Their exact gradient: values x 3 × points, column 3 j + c the derivative with respect to
+  /// coordinate c of point j. det(X_s, X_t, X_u) is trilinear in its columns, so the derivative
+  /// along a unit move e of one coordinate is e_s · (X_t × X_u) + e_t · (X_u × X_s) +
+  /// e_u · (X_s × X_t) (e_s its s-hodograph), formed by the same exact Bernstein products.
+  Eigen::SparseMatrix<double, Eigen::RowMajor> gradient;
+};
+
+/// The constraints of a Bézier lattice. Throws clay::Error(InvalidGeometry) for an invalid
+/// lattice.
+CLAY_DEFORM_API JacobianConstraints jacobian_constraints(const BezierLattice& lattice);
+/// Same for a B-spline lattice: each cell's gradient taken through its Bézier extraction (a
+/// fixed linear map from the lattice's points), so a row holds the cell's support only.
+CLAY_DEFORM_API JacobianConstraints jacobian_constraints(const BSplineLattice& lattice);
 
 /// The 3 x 3 derivative dX_fd / dX at x (world coordinates) from the derivative of eq. (2) by
 /// de Casteljau; the identity outside the lattice. Precondition: a valid lattice.
