@@ -231,6 +231,11 @@ LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian) {
   return gradients_at(jacobian, jacobian.model);
 }
 
+LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian,
+                                             const Points3& points) {
+  return gradients_at(jacobian, deformed_model(jacobian, points));
+}
+
 KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
                          const KeptProperties& keep) {
   const std::string name = "keep_properties";

@@ -116,16 +116,6 @@ py::dict style_report(const deform::StyleReport& r) {
 
 /// A scipy.sparse CSR matrix copied from a row-major sparse matrix's own arrays (Debian's
 /// python3-scipy).
-py::object scipy_csr(Eigen::SparseMatrix<double, Eigen::RowMajor> m) {
-  m.makeCompressed();
-  py::array_t<double> data(m.nonZeros(), m.valuePtr());
-  py::array_t<int> indices(m.nonZeros(), m.innerIndexPtr());
-  py::array_t<int> indptr(m.outerSize() + 1, m.outerIndexPtr());
-  return py::module_::import("scipy.sparse")
-      .attr("csr_matrix")(py::make_tuple(data, indices, indptr),
-                          py::make_tuple(m.rows(), m.cols()));
-}
-
 template <class Lattice>
 void lattice_common(py::class_<Lattice>& c) {
   c.def_property(

@@ -8,6 +8,8 @@
 #include <clay/error.hpp>
 #include <clay/surface/bspline_curve.hpp>
 
+#include <Eigen/SparseCore>
+
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -144,6 +146,17 @@ py::tuple tuple_of(const std::array<T, N>& a) {
 }
 inline py::tuple tuple_of(const Eigen::Vector3d& p) { return py::make_tuple(p.x(), p.y(), p.z()); }
 
+/// A row-major Eigen sparse matrix as a scipy.sparse CSR matrix (copied).
+inline py::object scipy_csr(Eigen::SparseMatrix<double, Eigen::RowMajor> m) {
+  m.makeCompressed();
+  py::array_t<double> data(m.nonZeros(), m.valuePtr());
+  py::array_t<int> indices(m.nonZeros(), m.innerIndexPtr());
+  py::array_t<int> indptr(m.outerSize() + 1, m.outerIndexPtr());
+  return py::module_::import("scipy.sparse")
+      .attr("csr_matrix")(py::make_tuple(data, indices, indptr),
+                          py::make_tuple(m.rows(), m.cols()));
+}
+
 void register_errors(py::module_& m);
 void bind_geometry(py::module_& m);
 void bind_deform(py::module_& m);
@@ -151,5 +164,6 @@ void bind_sketch(py::module_& m);
 void bind_recipe(py::module_& m);
 void bind_model(py::module_& m);
 void bind_stack(py::module_& m);
+void bind_optimisation(py::module_& m);
 
 }  // namespace clay::python

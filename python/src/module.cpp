@@ -93,4 +93,5 @@ PYBIND11_MODULE(_clayform, m) {
   clay::python::bind_stack(m);
   clay::python::bind_model(m);
   clay::python::bind_recipe(m);
+  clay::python::bind_optimisation(m);
 }

@@ -1,4 +1,4 @@
-"""The three Python examples run (each in its own process, as a user runs them), and mypy
+"""The Python examples run (each in its own process, as a user runs them), and mypy
 --strict accepts them against the package's type stubs."""
 from __future__ import annotations
 
@@ -54,6 +54,24 @@ def test_sweep_sail(tmp_path: Path) -> None:
     assert (tmp_path / "contact_sheet.png").stat().st_size > 10_000
     again = run("sweep_sail.py", str(tmp_path))
     assert again.count(" done ") == 6  # the second run skips every finished variant
+
+
+def test_optimise_block(tmp_path: Path) -> None:
+    # SLSQP on a real STEP part with the kernel's exact derivatives, then with SciPy's finite
+    # differences, in one process (docs/optimisation.md): both meet the targets; the exact run
+    # takes fewer iterations and evaluations, and both land on the same design.
+    f = figures(run("optimise_block.py", str(tmp_path)))
+    assert f["exact_success"] == 1 and f["fd_success"] == 1
+    assert f["exact_volume_error"] < 1e-12 and f["exact_height_error_mm"] < 1e-9
+    assert f["exact_iterations"] < f["fd_iterations"]
+    assert f["exact_volume_evaluations"] < f["fd_volume_evaluations"]
+    assert f["solutions_apart_mm"] < 1e-3 * f["largest_move_mm"]
+    assert f["all_steps_valid"] == 1 and f["steps_written"] == f["exact_iterations"]
+    # The written part, read back by the STEP reader: 8 % more volume than the original.
+    model, report = cf.read_model(tmp_path / "optimised_block.step")
+    assert not report["problems"]
+    original, _ = cf.read_model(EXAMPLES.parent / "models" / "block.step")
+    assert model.volume_mm3() == pytest.approx(1.08 * original.volume_mm3(), rel=1e-9)
 
 
 def test_mypy_strict_accepts_the_examples() -> None:

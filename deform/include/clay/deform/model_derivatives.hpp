@@ -83,6 +83,10 @@ struct LatticeMassGradients {
 /// lattice points: C_fᵀ times each face's gradient (brep::mass_property_gradients), summed.
 /// Throws as brep::mass_property_gradients.
 CLAY_DEFORM_API LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian);
+/// Same at other lattice points (of deformed_model(jacobian, points)): an optimiser's evaluation.
+/// Throws as deformed_model and brep::mass_property_gradients.
+CLAY_DEFORM_API LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian,
+                                                             const Points3& points);
 
 /// What keep_properties holds while the lattice moves.
 struct KeptProperties {
