@@ -7,6 +7,7 @@
 #include <clay/brep/continuity.hpp>
 #include <clay/brep/volume.hpp>
 #include <clay/deform/model_deformation.hpp>
+#include <clay/deform/model_derivatives.hpp>
 #include <clay/deform/regular.hpp>
 #include <clay/occt/model_exchange.hpp>
 
@@ -15,6 +16,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "occt_test_models.hpp"
 
@@ -217,6 +219,100 @@ void BM_TwistBlockEdges(benchmark::State& state) {
 
 }  // namespace
 
+// Shape optimisation on the 200-face plate (issue #41): the model's Jacobian with respect to a
+// (2, 2, 1) lattice's 18 points, its transpose product (an adjoint's step), the model at other
+// points, the mass properties' gradients and a volume-keeping drag; the references in the same
+// run: deform_model with the same lattice (composing again) and brep::volume_mm3.
+deform::BezierLattice plate_lattice() {
+  auto lattice = deform::make_bezier_lattice(around_plate(), {2, 2, 1});
+  lattice.points.row(lattice.index(1, 1, 1)) += Eigen::RowVector3d(3, -2, 6);
+  lattice.points.row(lattice.index(2, 0, 1)) += Eigen::RowVector3d(0, 4, -2);
+  return lattice;
+}
+
+const deform::ModelJacobian& plate_jacobian() {
+  static const deform::ModelJacobian j = deform::model_jacobian(plate_lattice(), plate());
+  return j;
+}
+
+void jacobian_counters(benchmark::State& state) {
+  long rows = 0, entries = 0;
+  for (const auto& f : plate_jacobian().faces) {
+    rows += f.rows();
+    entries += f.nonZeros();
+  }
+  state.counters["control_points"] = static_cast<double>(rows);
+  state.counters["nonzeros"] = static_cast<double>(entries);
+  faces_counter(state);
+}
+
+void BM_ModelJacobian(benchmark::State& state) {
+  const auto lattice = plate_lattice();
+  for (auto _ : state) benchmark::DoNotOptimize(deform::model_jacobian(lattice, plate()));
+  jacobian_counters(state);
+}
+
+void BM_ModelJacobianReferenceDeform(benchmark::State& state) {
+  deform::DeformationStack stack;
+  stack.steps.push_back({plate_lattice(), "lattice", true});
+  plate();
+  for (auto _ : state) benchmark::DoNotOptimize(deform::deform_model(stack, plate()));
+  faces_counter(state);
+}
+
+void BM_ModelJacobianTransposeProduct(benchmark::State& state) {
+  const auto& j = plate_jacobian();
+  std::vector<surface::Points3> g;
+  for (const auto& f : j.faces) g.push_back(surface::Points3::Ones(f.rows(), 3));
+  for (auto _ : state) {
+    surface::Points3 out = surface::Points3::Zero(j.lattice_points, 3);
+    for (std::size_t f = 0; f < g.size(); ++f) out += j.faces[f].transpose() * g[f];
+    benchmark::DoNotOptimize(out);
+  }
+  jacobian_counters(state);
+}
+
+void BM_DeformedModel(benchmark::State& state) {
+  const auto& j = plate_jacobian();
+  surface::Points3 points = plate_lattice().points;
+  points(0, 2) += 1;
+  for (auto _ : state) benchmark::DoNotOptimize(deform::deformed_model(j, points));
+  jacobian_counters(state);
+}
+
+void BM_MassPropertyGradients(benchmark::State& state) {
+  const auto& j = plate_jacobian();
+  for (auto _ : state) benchmark::DoNotOptimize(deform::mass_property_gradients(j));
+  jacobian_counters(state);
+}
+
+void BM_MassPropertyReferenceVolume(benchmark::State& state) {
+  const auto& j = plate_jacobian();
+  for (auto _ : state) benchmark::DoNotOptimize(brep::volume_mm3(j.model));
+  jacobian_counters(state);
+}
+
+void BM_KeepVolumeDrag(benchmark::State& state) {
+  const auto& j = plate_jacobian();
+  deform::KeptProperties keep;
+  keep.volume_mm3 = brep::volume_mm3(j.model);
+  const int dragged = static_cast<int>(plate_lattice().index(1, 2, 1));
+  keep.held = {dragged};
+  surface::Points3 moved = plate_lattice().points;
+  moved.row(dragged) += Eigen::RowVector3d(2, 3, 4);
+  int iterations = 0;
+  for (auto _ : state) iterations = deform::keep_properties(j, moved, keep).iterations;
+  state.counters["newton_steps"] = iterations;
+  jacobian_counters(state);
+}
+
+BENCHMARK(BM_ModelJacobian)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ModelJacobianReferenceDeform)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_ModelJacobianTransposeProduct)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DeformedModel)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MassPropertyGradients)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MassPropertyReferenceVolume)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_KeepVolumeDrag)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TwistBlockEdges)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Read)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DeformExact)->Unit(benchmark::kMillisecond);

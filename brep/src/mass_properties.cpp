@@ -360,8 +360,9 @@ MassPropertyGradients assemble(const Totals& t, bool gradients) {
 }
 
 /// The solids a call measures, checked: `body` alone, or every solid when body < 0.
-std::vector<int> measured_bodies(const Model& model, int body, const char* function) {
-  validate(model);
+std::vector<int> measured_bodies(const Model& model, int body, const char* function,
+                                 bool check = true) {
+  if (check) validate(model);
   const std::string name = function;
   if (model.is_assembly())
     throw Error(ErrorCategory::InvalidArgument,
@@ -414,6 +415,19 @@ MassPropertyGradients mass_property_gradients(const Model& model, int body) {
         ErrorCategory::InvalidArgument,
         "mass_property_gradients: body " + std::to_string(body) + " does not exist (negative)");
   return assemble(totals(model, measured_bodies(model, body, "mass_property_gradients"), true),
+                  true);
+}
+
+MassPropertyGradients mass_property_gradients(const Model& model,
+                                              const MassPropertyOptions& options) {
+  if (options.body && *options.body < 0)
+    throw Error(ErrorCategory::InvalidArgument, "mass_property_gradients: body " +
+                                                    std::to_string(*options.body) +
+                                                    " does not exist (negative)");
+  return assemble(totals(model,
+                         measured_bodies(model, options.body.value_or(-1),
+                                         "mass_property_gradients", options.validate),
+                         true),
                   true);
 }
 

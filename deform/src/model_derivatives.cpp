@@ -134,15 +134,46 @@ Points3 to_lattice(const ModelJacobian& j, const brep::FaceGradients& g) {
   return out;
 }
 
-/// mass_property_gradients of `m`, jacobian.model at other lattice points (deformed_model).
-LatticeMassGradients gradients_at(const ModelJacobian& jacobian, const brep::Model& m) {
-  const brep::MassPropertyGradients g = brep::mass_property_gradients(m);
+/// mass_property_gradients of `m`, jacobian.model at other lattice points (deformed_model; or
+/// moved_geometry, unchecked).
+LatticeMassGradients gradients_at(const ModelJacobian& jacobian, const brep::Model& m,
+                                  bool check = true) {
+  brep::MassPropertyOptions options;
+  options.validate = check;
+  const brep::MassPropertyGradients g = brep::mass_property_gradients(m, options);
   LatticeMassGradients out;
   out.value = g.value;
   out.volume = to_lattice(jacobian, g.volume);
   for (std::size_t i = 0; i < 3; ++i) out.centroid[i] = to_lattice(jacobian, g.centroid[i]);
   for (std::size_t i = 0; i < 6; ++i) out.inertia[i] = to_lattice(jacobian, g.inertia[i]);
   return out;
+}
+
+/// Refuses lattice points of another shape than the Jacobian's, or not finite.
+void check_points(const ModelJacobian& jacobian, const Points3& points, const std::string& where) {
+  if (points.rows() != jacobian.lattice_points)
+    throw Error(ErrorCategory::InvalidArgument,
+                where + ": " + std::to_string(points.rows()) +
+                    " lattice points given, but the Jacobian was taken for " +
+                    std::to_string(jacobian.lattice_points) +
+                    "; give the points of a lattice of the same shape");
+  if (!points.allFinite())
+    throw Error(ErrorCategory::InvalidArgument,
+                where + ": a lattice point is not finite; give finite coordinates");
+}
+
+/// The model's faces and vertices at other lattice points, edges and tolerances as they are: what
+/// the mass properties read (the faces, and the vertices for their reference point). A Newton
+/// step's model: its topology is jacobian.model's, already checked.
+brep::Model moved_geometry(const ModelJacobian& jacobian, const Points3& points) {
+  brep::Model m = jacobian.model;
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    if (jacobian.faces[f].nonZeros() > 0) m.faces[f].surface.points = jacobian.faces[f] * points;
+  const Points3 at = jacobian.vertices * points;
+  for (std::size_t v = 0; v < m.vertices.size(); ++v)
+    if (jacobian.vertices.outerIndexPtr()[v + 1] > jacobian.vertices.outerIndexPtr()[v])
+      m.vertices[v].point = at.row(static_cast<Eigen::Index>(v)).transpose();
+  return m;
 }
 
 }  // namespace
@@ -156,27 +187,13 @@ ModelJacobian model_jacobian(const BSplineLattice& lattice, const brep::Model& m
 }
 
 brep::Model deformed_model(const ModelJacobian& jacobian, const Points3& points) {
-  if (points.rows() != jacobian.lattice_points)
-    throw Error(ErrorCategory::InvalidArgument,
-                "deformed_model: " + std::to_string(points.rows()) +
-                    " lattice points given, but the Jacobian was taken for " +
-                    std::to_string(jacobian.lattice_points) +
-                    "; give the points of a lattice of the same shape");
-  if (!points.allFinite())
-    throw Error(ErrorCategory::InvalidArgument,
-                "deformed_model: a lattice point is not finite; give finite coordinates");
-  brep::Model m = jacobian.model;
-  for (std::size_t f = 0; f < m.faces.size(); ++f)
-    if (jacobian.faces[f].nonZeros() > 0) m.faces[f].surface.points = jacobian.faces[f] * points;
+  check_points(jacobian, points, "deformed_model");
+  brep::Model m = moved_geometry(jacobian, points);
   for (std::size_t e = 0; e < m.edges.size(); ++e)
     if (jacobian.edges[e].nonZeros() > 0) m.edges[e].curve.points = jacobian.edges[e] * points;
-  const Points3 at = jacobian.vertices * points;
   std::vector<bool> moved(m.vertices.size(), false);
   for (std::size_t v = 0; v < m.vertices.size(); ++v)
-    if (jacobian.vertices.outerIndexPtr()[v + 1] > jacobian.vertices.outerIndexPtr()[v]) {
-      moved[v] = true;
-      m.vertices[v].point = at.row(static_cast<Eigen::Index>(v)).transpose();
-    }
+    moved[v] = jacobian.vertices.outerIndexPtr()[v + 1] > jacobian.vertices.outerIndexPtr()[v];
   widen_stretched_tolerances(m, moved, size_of(m));
   return m;
 }
@@ -231,8 +248,7 @@ LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian) {
   return gradients_at(jacobian, jacobian.model);
 }
 
-LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian,
-                                             const Points3& points) {
+LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian, const Points3& points) {
   return gradients_at(jacobian, deformed_model(jacobian, points));
 }
 
@@ -254,11 +270,12 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
                       std::to_string(jacobian.lattice_points) + " points");
     held[static_cast<std::size_t>(h)] = true;
   }
+  check_points(jacobian, moved, name);
   const double size = size_of(jacobian.model);
   // The constraints: residuals and gradients (free rows only) at lattice points L.
   auto constraints = [&](const Points3& l, brep::MassProperties& value,
                          std::vector<Points3>& gradients) {
-    const LatticeMassGradients g = gradients_at(jacobian, deformed_model(jacobian, l));
+    const LatticeMassGradients g = gradients_at(jacobian, moved_geometry(jacobian, l), false);
     value = g.value;
     std::vector<double> residual;
     gradients.clear();

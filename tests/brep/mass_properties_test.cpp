@@ -189,3 +189,27 @@ TEST_CASE("mass_properties: bad input is refused, named") {
       clay::test::error_of([&] { (void)clay::brep::mass_property_gradients(sheet, 0); });
   CHECK_THAT(message, Catch::Matchers::Contains("body 0 is not a solid"));
 }
+
+TEST_CASE("mass_property_gradients: options choose the body and whether to check the model") {
+  const Model cube = clay::test::cube(10);
+  clay::brep::MassPropertyOptions options;
+  options.body = 0;
+  const auto checked = clay::brep::mass_property_gradients(cube, options);
+  CHECK(checked.value.volume_mm3 == Approx(1000).epsilon(1e-14));
+  // Unchecked: the same figures on a valid model, and a torn one is measured, not refused.
+  options.validate = false;
+  CHECK(clay::brep::mass_property_gradients(cube, options).value.volume_mm3 ==
+        checked.value.volume_mm3);
+  Model torn = cube;
+  torn.faces[1].surface.points.col(2).array() += 1e-3;  // the top lifted off its edges
+  CHECK(clay::test::error_of([&] { (void)clay::brep::mass_property_gradients(torn); }).first ==
+        clay::ErrorCategory::InvalidGeometry);
+  CHECK(clay::brep::mass_property_gradients(torn, options).value.volume_mm3 ==
+        Approx(1000 + 100 * 1e-3 / 3).epsilon(1e-12));  // the flux of (x - c) / 3 through the
+                                                        // lifted top: 100 mm^2 x 1e-3 mm / 3
+  options.body = -1;
+  CHECK_THAT(clay::test::error_of([&] {
+               (void)clay::brep::mass_property_gradients(cube, options);
+             }).second,
+             Catch::Matchers::Contains("body -1 does not exist"));
+}

@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <optional>
 #include <vector>
 
 namespace clay::brep {
@@ -51,6 +52,17 @@ struct MassPropertyGradients {
   std::array<FaceGradients, 6> inertia;
 };
 
+/// What mass_property_gradients measures and checks.
+struct MassPropertyOptions {
+  /// The solid to measure (index into model.bodies); none: every solid together.
+  std::optional<int> body;
+  /// Check the model first (validate: its invariants, edge gaps within tolerance). false: the
+  /// caller vouches for it, as an optimiser re-evaluating one topology at moved points does
+  /// (the check costs as much as the integration on a 200-face plate); an invalid model then
+  /// gives a meaningless figure, never a crash of a valid-topology model.
+  bool validate = true;
+};
+
 /// Mass properties of every solid of the model together (its voids subtracted). Throws
 /// clay::Error: InvalidGeometry when the model breaks an invariant (validate), InvalidArgument
 /// for an assembly (flatten it first: brep::flattened) or a model without a solid,
@@ -65,5 +77,8 @@ CLAY_BREP_API MassProperties mass_properties(const Model& model, int body);
 CLAY_BREP_API MassPropertyGradients mass_property_gradients(const Model& model);
 /// Same for body `body`.
 CLAY_BREP_API MassPropertyGradients mass_property_gradients(const Model& model, int body);
+/// Same as options say.
+CLAY_BREP_API MassPropertyGradients mass_property_gradients(const Model& model,
+                                                            const MassPropertyOptions& options);
 
 }  // namespace clay::brep
