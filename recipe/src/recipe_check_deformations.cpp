@@ -79,7 +79,7 @@ std::optional<deform::Deformation> RecipeChecker::lattice(
     const Json& j, const std::string& path, bool bspline,
     std::initializer_list<std::string_view> extra_keys) {
   std::vector<std::string_view> keys{"kind",    "name",   "enabled", "frame",
-                                     "degrees", "points", "moves"};
+                                     "degrees", "points", "moves",   "keep"};
   if (bspline) keys.insert(keys.end(), {"bases", "cells", "knots"});
   keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
   for (const auto& [key, v] : j.items()) {
@@ -482,10 +482,34 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
     if (const Json* n = c_.member(s, p, "name", false, ""))
       step.name = c_.string(*n, key_path(p, "name")).value_or("");
     step.enabled = c_.boolean_or(s, p, "enabled", true);
+    // "keep" belongs to lattice steps (the other kinds' readers refuse it as an unknown key).
+    const bool lattice_kind = step.kind == "bezier_lattice" || step.kind == "bspline_lattice";
+    if (const Json* keep = lattice_kind && s.contains("keep") ? &s.at("keep") : nullptr)
+      step.keep = kept_properties(*keep, key_path(p, "keep"));
     const bool ok = readers[static_cast<std::size_t>(*kind)].second(s, p, step);
     if (ok) def.steps.push_back(std::move(step));
   }
   if (c_.problems.size() == before) data.stacks.push_back(std::move(def));
+}
+
+std::vector<std::string> RecipeChecker::kept_properties(const Json& j, const std::string& path) {
+  static const std::vector<std::string> known = {"volume", "centroid"};
+  std::vector<std::string> out;
+  if (!j.is_array() || j.empty()) {
+    c_.add(path, "expected a list of properties the move keeps, such as [\"volume\"], found " +
+                     found(j) + "; give some of " + join(known));
+    return out;
+  }
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    const auto k = c_.choice(j[i], index_path(path, i), known);
+    if (!k) continue;
+    const std::string& name = known[static_cast<std::size_t>(*k)];
+    if (std::find(out.begin(), out.end(), name) != out.end())
+      c_.add(index_path(path, i), "\"" + name + "\" is listed twice; list it once");
+    else
+      out.push_back(name);
+  }
+  return out;
 }
 
 std::optional<StyleDef> RecipeChecker::style(const Json& j, const std::string& p) {

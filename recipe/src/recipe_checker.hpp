@@ -585,6 +585,8 @@ class RecipeChecker {
   void stack(const std::string& name, const Json& j, const std::string& path);
 
   std::optional<StyleDef> style(const Json& j, const std::string& p);
+  /// A lattice step's "keep": distinct names among "volume", "centroid".
+  std::vector<std::string> kept_properties(const Json& j, const std::string& path);
 
   std::optional<DirectDef> direct(const Json& j, const std::string& p);
 

@@ -187,6 +187,9 @@ struct StepDef {
   std::string path, name, kind;
   bool enabled = true;
   std::variant<deform::Deformation, StyleDef, DirectDef> step;
+  /// A lattice step's "keep": the model properties its move must not change ("volume",
+  /// "centroid"); the step's points are corrected by deform::keep_properties (issue #41).
+  std::vector<std::string> keep = {};
 };
 
 struct StackDef {

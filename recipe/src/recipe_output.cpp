@@ -312,6 +312,18 @@ Json model_figures(const ModelRunResult& r) {
     model["volume_ratio_max"] = m.volume_ratio_max;
   }
   model["fold_free"] = r.fold_free;
+  if (!r.kept.empty()) {
+    Json kept = Json::array();
+    for (const ModelRunResult::Kept& k : r.kept)
+      kept.push_back({{"step", k.step},
+                      {"properties", k.properties},
+                      {"volume_before_mm3", k.volume_before_mm3},
+                      {"volume_after_mm3", k.volume_after_mm3},
+                      {"centroid_shift_mm", k.centroid_shift_mm},
+                      {"newton_steps", k.iterations},
+                      {"largest_correction_mm", k.largest_correction_mm}});
+    model["kept"] = kept;
+  }
   model["continuity"] = detail::continuity_json(m.continuity_before, m.continuity_after);
   model["message"] = m.brief();
   return model;

@@ -211,6 +211,13 @@ class Runner {
           rep.message += ": disabled, skipped";
           return;
         }
+        if (!step.keep.empty())
+          throw Error(ErrorCategory::InvalidArgument,
+                      "\"keep\" holds a solid's volume or centroid while its lattice moves, "
+                      "but this stack deforms the surface \"" +
+                          name +
+                          "\"; use it in a stack that deforms a model (\"models\"), or "
+                          "remove it");
         Stage stage{name, p, step.kind, s, {}, {}, {}, {}};
         if (const auto* style = std::get_if<StyleDef>(&step.step)) {
           if (!style->bound.empty()) stage.curves.push_back(style->bound);

@@ -4,10 +4,12 @@
 
 #include "recipe_model.hpp"
 
+#include <clay/brep/mass_properties.hpp>
 #include <clay/brep/volume.hpp>
 #include <clay/constraints/solve.hpp>
 #include <clay/deform/jacobian.hpp>
 #include <clay/deform/model_deformation.hpp>
+#include <clay/deform/model_derivatives.hpp>
 #include <clay/deform/refit.hpp>
 #include <clay/deform/surface_deformation.hpp>
 #include <clay/error.hpp>
@@ -246,6 +248,95 @@ std::vector<int> chosen_faces(const brep::Model& flat, const ModelDef& def) {
   return out;
 }
 
+/// One lattice corrected to keep `properties` of `model` (see keep_properties below).
+template <class Lattice>
+ModelRunResult::Kept keep_step(Lattice& lattice, const brep::Model& model,
+                               const std::vector<std::string>& properties,
+                               const std::string& where) {
+  ModelRunResult::Kept out;
+  out.properties = properties;
+  bool solid = false;
+  for (const brep::Body& b : model.bodies) solid = solid || b.kind == brep::BodyKind::Solid;
+  if (!solid)
+    throw Error(ErrorCategory::InvalidArgument,
+                where +
+                    ": \"keep\" holds a solid's volume or centroid, but the model has no "
+                    "solid (its bodies are sheets or wires); remove \"keep\"");
+  deform::ModelJacobian jacobian;
+  try {
+    jacobian = deform::model_jacobian(lattice, model);
+  } catch (const Error& e) {
+    throw Error(e.category(), where +
+                                  ": \"keep\" needs the model composed exactly with the "
+                                  "lattice: " +
+                                  e.message());
+  }
+  const brep::MassProperties before = brep::mass_properties(model);
+  deform::KeptProperties keep;
+  for (const std::string& p : properties) {
+    if (p == "volume") keep.volume_mm3 = before.volume_mm3;
+    if (p == "centroid") keep.centroid_mm = before.centroid_mm;
+  }
+  // The points the step moved stay where it put them (a drag stays under the cursor).
+  const surface::Points3 rest = deform::undisplaced_points(lattice);
+  for (Eigen::Index r = 0; r < rest.rows(); ++r)
+    if (lattice.points.row(r) != rest.row(r)) keep.held.push_back(static_cast<int>(r));
+  deform::KeptMove kept;
+  try {
+    kept = deform::keep_properties(jacobian, lattice.points, keep);
+  } catch (const Error& e) {
+    throw Error(e.category(), where + ": " + e.message());
+  }
+  out.volume_before_mm3 = before.volume_mm3;
+  out.volume_after_mm3 = kept.properties.volume_mm3;
+  out.centroid_shift_mm = (kept.properties.centroid_mm - before.centroid_mm).norm();
+  out.iterations = kept.iterations;
+  out.largest_correction_mm = (kept.points - lattice.points).rowwise().norm().maxCoeff();
+  lattice.points = kept.points;
+  return out;
+}
+
+/// The lattice steps with "keep" corrected so that the model's kept properties stay as they were
+/// before each such step (deform::keep_properties on the model's fixed form; the points the step
+/// moved from their rest positions stay, the others take the correction). The model before a
+/// step is the stack's earlier steps applied to `flat`. Refused with a face selection (the kept
+/// figures are the whole model's) and, naming the step, where the model has no solid or a face
+/// crosses the lattice's boundary.
+void keep_properties(const StackDef& def, deform::DeformationStack& stack, const brep::Model& flat,
+                     const deform::ModelDeformationOptions& options, ModelRunResult& out) {
+  for (std::size_t i = 0; i < def.steps.size(); ++i) {
+    const StepDef& step = def.steps[i];
+    if (step.keep.empty() || !step.enabled) continue;
+    const std::string where = def.path + ".steps[" + std::to_string(i) + "]" +
+                              (step.name.empty() ? "" : " '" + step.name + "'");
+    if (!options.faces.empty())
+      throw Error(ErrorCategory::InvalidArgument,
+                  where +
+                      ": \"keep\" holds the whole model's figures, but the model deforms "
+                      "chosen faces only (\"bodies\"/\"faces\"); deform the whole model, or "
+                      "remove \"keep\"");
+    deform::DeformationStack before_step;
+    before_step.steps.assign(stack.steps.begin(),
+                             stack.steps.begin() + static_cast<std::ptrdiff_t>(i));
+    bool any_before = false;
+    for (const auto& s : before_step.steps) any_before = any_before || s.enabled;
+    const brep::Model before =
+        any_before ? deform::deform_model(before_step, flat, options).model : flat;
+    ModelRunResult::Kept kept;
+    std::visit(
+        [&](auto& lattice) {
+          using T = std::decay_t<decltype(lattice)>;
+          if constexpr (std::is_same_v<T, deform::BezierLattice> ||
+                        std::is_same_v<T, deform::BSplineLattice>) {
+            kept = keep_step(lattice, before, step.keep, where);
+          }
+        },
+        stack.steps[i].deformation);
+    kept.step = where;
+    out.kept.push_back(std::move(kept));
+  }
+}
+
 ModelRunResult run_model(const RecipeData& d, const ModelDef& def, const std::string& profile) {
   const auto t0 = Clock::now();
   ModelRunResult out;
@@ -271,7 +362,7 @@ ModelRunResult run_model(const RecipeData& d, const ModelDef& def, const std::st
     out.report.volume_before_mm3 = out.report.volume_after_mm3 = brep::volume_mm3(flat);
   } else {
     const StackDef& stack_def = pick_stack(d, def.deformation);
-    const deform::DeformationStack stack = model_stack(stack_def, out.fold_free, def.allow_fold);
+    deform::DeformationStack stack = model_stack(stack_def, out.fold_free, def.allow_fold);
     deform::ModelDeformationOptions options;
     options.surface = deformation_options(d.composition);
     // Faces above the composition's budget are light, and every refitted or light face
@@ -281,6 +372,7 @@ ModelRunResult run_model(const RecipeData& d, const ModelDef& def, const std::st
     options.faces = chosen_faces(flat, def);
     const std::string& receiver = profile.empty() ? def.profile : profile;
     if (!receiver.empty()) options.profile = deform::receiver_profile(receiver);
+    keep_properties(stack_def, stack, flat, options, out);
     auto r = deform::deform_model(stack, flat, options);
     out.model = std::move(r.model);
     out.report = std::move(r.report);

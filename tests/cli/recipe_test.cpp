@@ -309,6 +309,62 @@ TEST_CASE("a model's faces above the composition's budget are light and keep the
         1e-5 * exact.report.volume_after_mm3);
 }
 
+TEST_CASE("a lattice step's \"keep\" holds the model's volume while its points move", "[recipe]") {
+  // block.step lifted 6 mm at the middle of its top by a (2, 1, 1) lattice: 7 % more volume
+  // without "keep"; with it the lattice's unmoved points take a correction and the volume stays,
+  // measured by deform_model's own composition of the corrected lattice.
+  const fs::path models = fs::path(CLAY_EXAMPLES_DIR) / "models";
+  auto text = [](const std::string& keep, const std::string& model_extra = "") {
+    return std::string(R"({"format": "clayform.recipe", "version": 1, "name": "kept",
+      "deformations": {"lift": [{"kind": "bezier_lattice", "name": "lift",
+        "frame": {"origin": [-5, -5, -5], "s": [70, 0, 0], "t": [0, 50, 0], "u": [0, 0, 30]},
+        "degrees": [2, 1, 1],
+        "moves": [{"index": [1, 0, 1], "to": [30, -5, 31]}, {"index": [1, 1, 1], "to": [30, 45, 31]}])") +
+           keep + R"(}]},
+      "models": {"block": {"import": "block.step", "deformation": "lift")" +
+           model_extra + "}}}";
+  };
+  const auto free = run_recipe(parse_recipe(text(""), models));
+  const auto kept = run_recipe(parse_recipe(text(R"(, "keep": ["volume"])"), models));
+  REQUIRE(free.models.size() == 1);
+  REQUIRE(kept.models.size() == 1);
+  const auto& f = free.models[0].report;
+  const auto& k = kept.models[0].report;
+  INFO(f.brief() << "\n" << k.brief());
+  CHECK(f.volume_after_mm3 / f.volume_before_mm3 - 1 > 0.05);
+  CHECK(std::abs(k.volume_after_mm3 / k.volume_before_mm3 - 1) <= 1e-12);
+  REQUIRE(kept.models[0].kept.size() == 1);
+  const auto& record = kept.models[0].kept[0];
+  CHECK(record.step == "deformations.lift.steps[0] 'lift'");
+  CHECK(record.properties == std::vector<std::string>{"volume"});
+  CHECK(record.iterations >= 1);
+  CHECK(record.largest_correction_mm > 0.1);
+  CHECK(std::abs(record.volume_after_mm3 - record.volume_before_mm3) <=
+        1e-12 * record.volume_before_mm3);
+  // The lifted points stay where the step put them: the top's middle is still 6 mm higher.
+  CHECK(k.faces_exact == 17);
+
+  // The checker and the run refuse what "keep" cannot do, naming the step and the fix.
+  CHECK(mentions(check_recipe(text(R"(, "keep": ["mass"])")), "deformations.lift[0].keep[0]",
+                 "expected one of volume, centroid"));
+  CHECK(mentions(check_recipe(text(R"(, "keep": "volume")")), "deformations.lift[0].keep",
+                 "[\"volume\"]"));
+  CHECK(mentions(check_recipe(text(R"(, "keep": ["volume", "volume"])")),
+                 "deformations.lift[0].keep[1]", "listed twice"));
+  // A surface's stack has no solid to keep.
+  std::string step = lattice_step;
+  step.insert(step.size() - 1, R"(, "keep": ["volume"])");
+  const std::string on_surface =
+      error_of([&] {
+        run_recipe(parse_recipe(
+            recipe_with(R"(, "bulged": {"deform": {"surface": "dome", "deformation": "shape"}})",
+                        R"("deformations": {"shape": [)" + step + "]}")));
+      }).second;
+  CHECK_THAT(on_surface,
+             Contains("surfaces.bulged.steps[0] (bezier_lattice): \"keep\" holds a solid's"));
+  CHECK_THAT(on_surface, Contains("deforms the surface \"bulged\""));
+}
+
 TEST_CASE("a model's \"profile\" writes its deformed faces for that receiver", "[recipe]") {
   // block_model's "lift" (a (2, 1, 1) Bézier lattice raising the top's middle 6 mm): exact, its
   // planes stay planes of degree 1 or 2. For a bicubic receiver every face is degree 3 x 3, and

@@ -213,7 +213,18 @@ struct ModelRunResult {
   std::vector<std::string> bodies, faces;
   brep::Model model;  ///< the deformed model (flattened when it was an assembly)
   deform::ModelDeformationReport report;
-  bool fold_free = true;             ///< every lattice step's Jacobian bounds are positive
+  bool fold_free = true;  ///< every lattice step's Jacobian bounds are positive
+  /// What each lattice step with "keep" corrected: the properties before the step and after it
+  /// (measured on the exact result), the Newton steps and the largest correction of a point.
+  struct Kept {
+    std::string step;  ///< "deformations.lift.steps[0] 'lift'"
+    std::vector<std::string> properties;
+    double volume_before_mm3 = 0, volume_after_mm3 = 0;
+    double centroid_shift_mm = 0;  ///< |centroid after − before|
+    int iterations = 0;
+    double largest_correction_mm = 0;
+  };
+  std::vector<Kept> kept;
   std::vector<std::string> formats;  ///< "step", "iges", "glb" (the model's, or for `clayform
                                      ///< deform` the recipe's first export's; all three when none)
   std::string schema = "AP214";      ///< STEP schema
