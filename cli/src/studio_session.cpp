@@ -565,6 +565,21 @@ struct StudioSession::Impl {
       }
     Json out = {{"op", op},       {"recipe", result.recipe},   {"seconds", result.seconds},
                 {"steps", steps}, {"history", history_json()}, {"revision", revision}};
+    // Each model's volume before and after its stack, and what a "keep" corrected: the lattice
+    // panel shows them (a drag that keeps the volume says so, with the correction's size).
+    Json figures = Json::object();
+    for (const ModelRunResult& m : result.models) {
+      Json corrected = Json::array();
+      for (const ModelRunResult::Kept& k : m.kept)
+        corrected.push_back({{"step", k.step},
+                             {"properties", k.properties},
+                             {"newton_steps", k.iterations},
+                             {"largest_correction_mm", k.largest_correction_mm}});
+      figures[m.name] = {{"volume_before_mm3", m.report.volume_before_mm3},
+                         {"volume_after_mm3", m.report.volume_after_mm3},
+                         {"kept", corrected}};
+    }
+    out["model_figures"] = figures;
     if (changes) {
       out["changes"] = *changes;
       out["from_revision"] = revision - 1;

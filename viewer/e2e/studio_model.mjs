@@ -1,6 +1,7 @@
 // Clayform Studio's end-to-end test, part "model" (docs/studio.md § Opening a STEP model): a STEP
 // model opened whole, a lattice placed around it and dragged (the nodes moved onto the faces' new
-// nets, checked against Sederberg–Parry's FFD here), saved and replayed by `clayform run`.
+// nets, checked against Sederberg–Parry's FFD here), saved and replayed by `clayform run`; the
+// drag keeping the model's volume (issue #41).
 import { spawnSync } from 'node:child_process';
 import { copyFileSync, mkdirSync, readdirSync } from 'node:fs';
 import { join } from 'node:path';
@@ -80,7 +81,33 @@ export default async function model({ clayform, work, check, withStudio }) {
       const height = Math.hypot(...lockedStep.frame.u);
       const rise = move.to[2] - top.p[2];
       assert(rise > 0 && rise < 0.5 * height, `a 30-pixel z-locked drag in the Top view moved the point by ${rise} mm (lattice ${height} mm high)`);
-      return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; after the drag the faces' nets only, the nodes ${worstNode.toExponential(1)} mm from the pointwise FFD; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}; a z-locked drag in the Top view rose ${rise.toFixed(2)} mm, x and y kept exactly`;
+      // Issue #41: the panel shows the model's volume change; with "keep the volume" ticked the
+      // kernel corrects the points not dragged, the volume stays to 1e-12, and a new drag keeps it.
+      const free = (await m.call(() => window.clayStudio.reply())).model_figures.block;
+      const freeChange = free.volume_after_mm3 / free.volume_before_mm3 - 1;
+      assert(Math.abs(freeChange) > 1e-4, `the drags did not change the volume: ${JSON.stringify(free)}`);
+      assert((await modelPage.locator('#lattice-volume').textContent()).includes('block: volume'), 'no volume in the lattice panel');
+      await modelPage.check('#lattice-keep-volume');
+      await m.idle();
+      assert(!(await m.lastError()), await m.lastError());
+      const ticked = await m.call(() => window.clayStudio.recipe());
+      assert(JSON.stringify(ticked.deformations[ticked.models.block.deformation][0].keep) === '["volume"]', 'the step has no keep');
+      const kept = (await m.call(() => window.clayStudio.reply())).model_figures.block;
+      assert(Math.abs(kept.volume_after_mm3 / kept.volume_before_mm3 - 1) < 1e-12, `kept volume ${kept.volume_before_mm3} -> ${kept.volume_after_mm3}`);
+      assert(kept.kept.length === 1 && kept.kept[0].largest_correction_mm > 0, `kept: ${JSON.stringify(kept.kept)}`);
+      assert((await modelPage.locator('#lattice-volume').textContent()).includes('kept'), 'the panel does not say the volume is kept');
+      const again = (await m.call(() => window.clayStudio.handles())).find((h) => h.kind === 'lattice' && h.index.join() === '2,2,1');
+      await modelPage.mouse.move(...again.screen);
+      await modelPage.mouse.down();
+      for (let k = 1; k <= 10; k++) await modelPage.mouse.move(again.screen[0] + 2 * k, again.screen[1] + 2 * k);
+      await modelPage.mouse.up();
+      await m.idle();
+      assert(!(await m.lastError()), await m.lastError());
+      const dragged = (await m.call(() => window.clayStudio.reply())).model_figures.block;
+      const draggedRecipe = await m.call(() => window.clayStudio.recipe());
+      assert(draggedRecipe.deformations[draggedRecipe.models.block.deformation][0].moves.some((mv) => mv.index.join() === '2,2,1'), 'the second drag moved nothing');
+      assert(Math.abs(dragged.volume_after_mm3 / dragged.volume_before_mm3 - 1) < 1e-12, `after a kept drag: ${dragged.volume_before_mm3} -> ${dragged.volume_after_mm3}`);
+      return `${models.block.triangles} triangles; the top rose ${(topAfter - topBefore).toFixed(2)} mm; after the drag the faces' nets only, the nodes ${worstNode.toExponential(1)} mm from the pointwise FFD; replay wrote ${files.filter((f) => f.startsWith('block')).join(', ')}; a z-locked drag in the Top view rose ${rise.toFixed(2)} mm, x and y kept exactly; volume ${(freeChange * 100).toFixed(2)} % free, kept to ${Math.abs(dragged.volume_after_mm3 / dragged.volume_before_mm3 - 1).toExponential(1)} after two drags (points corrected by up to ${kept.kept[0].largest_correction_mm.toFixed(2)} mm)`;
     });
   });
 }

@@ -51,6 +51,31 @@ function activeGlobal() {
   return null;
 }
 
+/** The models a lattice step deforms, with their step: the lattices "keep the volume" applies to. */
+function modelLattices() {
+  const out = [];
+  for (const [name, def] of Object.entries(doc.recipe.models || {})) {
+    const stack = def.deformation && (doc.recipe.deformations || {})[def.deformation];
+    const i = stack ? stack.findIndex((st) => st.kind === 'bezier_lattice' || st.kind === 'bspline_lattice') : -1;
+    if (i >= 0) out.push({ model: name, deformation: def.deformation, stepIndex: i, step: stack[i] });
+  }
+  return out;
+}
+
+/** Each model's volume before and after its stack, and whether a keep held it (the kernel's figures). */
+function showModelVolumes() {
+  const figures = (doc.reply && doc.reply.model_figures) || {};
+  const lines = [];
+  for (const l of modelLattices()) {
+    const f = figures[l.model];
+    if (!f) continue;
+    const kept = f.kept.find((k) => k.properties.includes('volume'));
+    const change = f.volume_before_mm3 ? (f.volume_after_mm3 / f.volume_before_mm3 - 1) * 100 : 0;
+    lines.push(`${l.model}: volume ${f.volume_before_mm3.toFixed(2)} → ${f.volume_after_mm3.toFixed(2)} mm³ (${change >= 0 ? '+' : ''}${change.toPrecision(3)} %)${kept ? `, kept: the other points corrected by up to ${kept.largest_correction_mm.toPrecision(3)} mm` : ''}`);
+  }
+  $('lattice-volume').textContent = lines.join('\n');
+}
+
 /** The Lattice and Taper/Twist/Bend panels, for the selection. */
 export function showLatticePanels() {
   const lattices = latticesShown();
@@ -59,6 +84,10 @@ export function showLatticePanels() {
     $('lattice-name').textContent = lattices.map((l) => l.deformation).join(', ');
     showLatticeFigures();
   }
+  const models = modelLattices();
+  $('lattice-keep').hidden = !models.length;
+  $('lattice-keep-volume').checked = models.length > 0 && models.every((l) => (l.step.keep || []).includes('volume'));
+  showModelVolumes();
   const global = activeGlobal();
   $('global-panel').hidden = !global;
   if (global) {
@@ -185,5 +214,11 @@ export function wireLattice() {
       const group = sliderGroup(id);
       dragEdit(() => ({ changes: { path: `deformations.${g.deformation}`, value: names.withGlobal(doc.recipe.deformations[g.deformation], ...values) }, label: `${g.deformation} ${id.slice(7)}`, group }), event.timeStamp);
     });
+  $('lattice-keep-volume').addEventListener('change', () => {
+    const keep = $('lattice-keep-volume').checked;
+    const changes = modelLattices().map((l) => (keep ? { path: `deformations.${l.deformation}[${l.stepIndex}].keep`, value: ['volume'], create: true } : { path: `deformations.${l.deformation}[${l.stepIndex}].keep`, remove: true }));
+    const unchanged = modelLattices().every((l) => (l.step.keep || []).includes('volume') === keep);
+    if (changes.length && !unchanged) edit(changes, keep ? 'keep the volume' : 'let the volume change');
+  });
   $('lattice-strength').addEventListener('input', () => ($('lattice-strength').parentElement.querySelector('output').textContent = $('lattice-strength').value));
 }
