@@ -93,10 +93,9 @@ double size_cubed(const Model& m) {
   return d * d * d;
 }
 
-Eigen::Vector3d body_centre(const Model& m, const std::vector<int>& bodies) {
+CentrePoints centre_points(const Model& m, const std::vector<int>& bodies) {
+  CentrePoints out;
   std::vector<char> seen(m.vertices.size(), 0);
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  long count = 0;
   for (int b : bodies)
     for (const Shell& shell : m.bodies[static_cast<std::size_t>(b)].shells)
       for (int f : shell.faces)
@@ -106,20 +105,31 @@ Eigen::Vector3d body_centre(const Model& m, const std::vector<int>& bodies) {
             for (int v : {e.start, e.end})
               if (!seen[static_cast<std::size_t>(v)]) {
                 seen[static_cast<std::size_t>(v)] = 1;
-                sum += m.vertices[static_cast<std::size_t>(v)].point;
-                ++count;
+                out.vertices.push_back(v);
               }
           }
-  if (count > 0) return sum / static_cast<double>(count);
-  for (int b : bodies)
-    for (const Shell& shell : m.bodies[static_cast<std::size_t>(b)].shells)
-      for (int f : shell.faces) {
-        const auto& points = m.faces[static_cast<std::size_t>(f)].surface.points;
-        for (Eigen::Index r = 0; r < points.rows(); ++r) {
-          sum += points.row(r).transpose();
-          ++count;
-        }
-      }
+  if (out.vertices.empty())
+    for (int b : bodies)
+      for (const Shell& shell : m.bodies[static_cast<std::size_t>(b)].shells)
+        for (int f : shell.faces) out.faces.push_back(f);
+  return out;
+}
+
+Eigen::Vector3d body_centre(const Model& m, const std::vector<int>& bodies) {
+  const CentrePoints c = centre_points(m, bodies);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  long count = 0;
+  for (int v : c.vertices) {
+    sum += m.vertices[static_cast<std::size_t>(v)].point;
+    ++count;
+  }
+  for (int f : c.faces) {
+    const auto& points = m.faces[static_cast<std::size_t>(f)].surface.points;
+    for (Eigen::Index r = 0; r < points.rows(); ++r) {
+      sum += points.row(r).transpose();
+      ++count;
+    }
+  }
   return count > 0 ? Eigen::Vector3d(sum / static_cast<double>(count)) : Eigen::Vector3d::Zero();
 }
 

@@ -90,6 +90,14 @@ long face_budget(const surface::BSplineSurface& s);
 /// The cube of the diagonal of the model's control points: the scale of volume tolerances.
 double size_cubed(const Model& m);
 
+/// The points whose mean is body_centre: the vertices the bodies' faces' edges end at (each
+/// once), or, when there are none, every control point of the bodies' faces (`faces`).
+struct CentrePoints {
+  std::vector<int> vertices;
+  std::vector<int> faces;
+};
+CentrePoints centre_points(const Model& m, const std::vector<int>& bodies);
+
 /// The centre of the field (x − c) / 3 for the bodies `bodies` (indices into m.bodies): the mean of
 /// the vertices its faces' edges end at (each once), else of its faces' control points (a body of
 /// untrimmed closed faces). Any c gives the same volume on a watertight shell; on a real file's

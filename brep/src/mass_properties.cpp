@@ -27,12 +27,32 @@ using detail::rule;
 /// The ten moments about c: ∭ 1, y_x, y_y, y_z, y_x², y_y², y_z², y_x y_y, y_x y_z, y_y y_z dV.
 using Moments = Eigen::Matrix<double, 10, 1>;
 
-/// φ of each moment at y = x − c.
-Moments densities(const Eigen::Vector3d& y) {
-  Moments phi;
-  phi << 1, y.x(), y.y(), y.z(), y.x() * y.x(), y.y() * y.y(), y.z() * y.z(), y.x() * y.y(),
-      y.x() * y.z(), y.y() * y.z();
-  return phi;
+/// Each moment's field Φ_m(y) (div Φ_m = φ_m) and (∇Φ_m)ᵀ n, the derivative of Φ_m·n along a
+/// move of the point: e·(∇Φ_mᵀ n) for a move e.
+struct Fields {
+  std::array<Eigen::Vector3d, 10> phi, a;
+};
+
+Fields fields(const Eigen::Vector3d& y, const Eigen::Vector3d& n) {
+  Fields f;
+  f.phi[0] = y / 3;
+  f.a[0] = n / 3;
+  for (int i = 0; i < 3; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const Eigen::Vector3d e = Eigen::Vector3d::Unit(i);
+    f.phi[1 + k] = e * y[i] * y[i] / 2;
+    f.a[1 + k] = e * y[i] * n[i];
+    f.phi[4 + k] = e * y[i] * y[i] * y[i] / 3;
+    f.a[4 + k] = e * y[i] * y[i] * n[i];
+  }
+  const double x = y.x(), yy = y.y(), z = y.z();
+  f.phi[7] = Eigen::Vector3d(x * x * yy / 2, 0, 0);
+  f.a[7] = n.x() * Eigen::Vector3d(x * yy, x * x / 2, 0);
+  f.phi[8] = Eigen::Vector3d(x * x * z / 2, 0, 0);
+  f.a[8] = n.x() * Eigen::Vector3d(x * z, 0, x * x / 2);
+  f.phi[9] = Eigen::Vector3d(0, yy * yy * z / 2, 0);
+  f.a[9] = n.y() * Eigen::Vector3d(0, yy * z, yy * yy / 2);
+  return f;
 }
 
 /// Φ·n of each moment's field (div Φ = φ) at y, n = X_u × X_v.
@@ -51,13 +71,14 @@ struct Node {
   double u, v, w;
 };
 
-/// The surface at (u, v): y = S − c, n = S_u × S_v, and the rational basis R_k of the control
-/// points rows (p + 1)(q + 1) starting at spans (su − p, sv − q) when `basis` is asked for.
+/// The surface at (u, v): y = S − c, its derivatives, n = S_u × S_v, the spans and the basis
+/// functions with their first derivatives (nu: N_i at 0..p, N_i' at p + 1..2p + 1), the weight
+/// function W and its derivatives.
 struct Sample {
-  Eigen::Vector3d y, n;
+  Eigen::Vector3d y, du, dv, n;
   int su = 0, sv = 0;
   std::array<double, 2 * (surface::max_kernel_degree + 1)> nu{}, nv{};
-  double weight = 1;  // W(u, v)
+  double weight = 1, weight_u = 0, weight_v = 0;
 };
 
 void sample(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double u, double v,
@@ -85,8 +106,12 @@ void sample(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double u
   const Eigen::Vector3d du = (hu.head<3>() - hu[3] * point) / h[3];
   const Eigen::Vector3d dv = (hv.head<3>() - hv[3] * point) / h[3];
   out.y = point - c;
+  out.du = du;
+  out.dv = dv;
   out.n = du.cross(dv);
   out.weight = h[3];
+  out.weight_u = hu[3];
+  out.weight_v = hv[3];
 }
 
 /// Adaptive on every moment at once, as detail::adaptive on one: [a, b] is accepted when the 16-
@@ -224,10 +249,11 @@ FaceRule face_rule(const Model& m, const Face& face, const Eigen::Vector3d& cent
 }
 
 /// A face's moments and, when asked, their gradients with respect to its control points (one
-/// n x 3 matrix per moment).
+/// n x 3 matrix per moment) and to the reference point c.
 struct FaceMoments {
   Moments value = Moments::Zero();
   std::array<Eigen::MatrixX3d, 10> gradient;
+  Eigen::Matrix<double, 10, 3> centre = Eigen::Matrix<double, 10, 3>::Zero();
   Budget budget;
 };
 
@@ -241,36 +267,72 @@ FaceMoments face_moments(const Model& m, const Face& face, const Eigen::Vector3d
     for (auto& g : out.gradient) g = Eigen::MatrixX3d::Zero(s.points.rows(), 3);
   const int p = s.u.degree, q = s.v.degree;
   Sample at;
+  std::array<Eigen::RowVector3d, 10> a, b, c;
   for (const Node& node : r.nodes) {
     sample(s, centre, node.u, node.v, at);
     out.value += node.w * fluxes(at.y, at.n);
     if (!gradients) continue;
-    // ∂/∂P_k ∭ φ dV = ∬ φ(X) R_k n du dv (Hadamard), R_k = N_i N_j w_k / W.
-    const Moments phi = node.w * densities(at.y);
+    // P_k -> P_k + e moves the flux ∬ Φ(y)·(X_u × X_v) by
+    // ∬ R_k e·(∇Φᵀ n) + R_k,u e·(X_v × Φ) + R_k,v e·(Φ × X_u), and c -> c + e by −∬ e·(∇Φᵀ n).
+    const Fields f = fields(at.y, at.n);
+    for (std::size_t k = 0; k < 10; ++k) {
+      a[k] = node.w * f.a[k].transpose();
+      b[k] = node.w * at.dv.cross(f.phi[k]).transpose();
+      c[k] = node.w * f.phi[k].cross(at.du).transpose();
+      out.centre.row(static_cast<Eigen::Index>(k)) -= a[k];
+    }
+    const double w = at.weight, w2 = w * w;
     for (int i = 0; i <= p; ++i)
       for (int j = 0; j <= q; ++j) {
         const Eigen::Index k = s.index(at.su - p + i, at.sv - q + j);
-        const double rk = at.nu[static_cast<std::size_t>(i)] * at.nv[static_cast<std::size_t>(j)] *
-                          s.weights[k] / at.weight;
-        if (rk == 0) continue;
-        const Eigen::RowVector3d dn = rk * at.n.transpose();
-        for (int m2 = 0; m2 < 10; ++m2)
-          out.gradient[static_cast<std::size_t>(m2)].row(k) += phi[m2] * dn;
+        const double ni = at.nu[static_cast<std::size_t>(i)],
+                     nj = at.nv[static_cast<std::size_t>(j)];
+        const double di = at.nu[static_cast<std::size_t>(p + 1 + i)];
+        const double dj = at.nv[static_cast<std::size_t>(q + 1 + j)];
+        const double wk = s.weights[k];
+        // R_k = N_i N_j w_k / W and its derivatives by the quotient rule
+        const double rk = ni * nj * wk / w;
+        const double ru = wk * (di * nj * w - ni * nj * at.weight_u) / w2;
+        const double rv = wk * (ni * dj * w - ni * nj * at.weight_v) / w2;
+        if (rk == 0 && ru == 0 && rv == 0) continue;
+        for (std::size_t m2 = 0; m2 < 10; ++m2)
+          out.gradient[m2].row(k) += rk * a[m2] + ru * b[m2] + rv * c[m2];
       }
   }
   return out;
 }
 
-/// The moments of the solids `bodies` about their common centre, and their face gradients.
+/// The moments of the solids `bodies` about their common centre c, their gradients, and the
+/// gradient of c itself (what its points' rows of `unit_centre` times a vector give).
 struct Totals {
   Eigen::Vector3d centre;
   Moments value = Moments::Zero();
-  std::array<FaceGradients, 10> gradient;
+  std::array<PointGradients, 10> gradient;
+  detail::CentrePoints centre_points;
+  long centre_count = 0;           // how many points c is the mean of
+  std::vector<Eigen::Index> rows;  // per face: its control points when measured, else 0
 };
+
+/// A gradient that is `d` at c, spread over the points c is the mean of (d / count each).
+PointGradients through_centre(const Model& m, const Totals& t, const Eigen::Vector3d& d) {
+  PointGradients out;
+  for (Eigen::Index n : t.rows) out.faces.push_back(Eigen::MatrixX3d::Zero(n, 3));
+  out.vertices = Eigen::MatrixX3d::Zero(static_cast<Eigen::Index>(m.vertices.size()), 3);
+  if (t.centre_count == 0) return out;
+  const Eigen::RowVector3d share = d.transpose() / static_cast<double>(t.centre_count);
+  for (int v : t.centre_points.vertices) out.vertices.row(v) += share;
+  for (int f : t.centre_points.faces) out.faces[static_cast<std::size_t>(f)].rowwise() += share;
+  return out;
+}
 
 Totals totals(const Model& m, const std::vector<int>& bodies, bool gradients) {
   Totals out;
   out.centre = detail::body_centre(m, bodies);
+  out.centre_points = detail::centre_points(m, bodies);
+  out.centre_count = static_cast<long>(out.centre_points.vertices.size());
+  for (int f : out.centre_points.faces)
+    out.centre_count +=
+        static_cast<long>(m.faces[static_cast<std::size_t>(f)].surface.points.rows());
   const double d = std::cbrt(detail::size_cubed(m));
   Moments tol;
   tol << std::pow(d, 3), Eigen::Matrix<double, 3, 1>::Constant(std::pow(d, 4)),
@@ -280,6 +342,8 @@ Totals totals(const Model& m, const std::vector<int>& bodies, bool gradients) {
   for (int b : bodies)
     for (const Shell& shell : m.bodies[static_cast<std::size_t>(b)].shells)
       for (int f : shell.faces) measured[static_cast<std::size_t>(f)] = true;
+  for (std::size_t f = 0; f < m.faces.size(); ++f)
+    out.rows.push_back(measured[f] ? m.faces[f].surface.points.rows() : 0);
   std::vector<FaceMoments> face(m.faces.size());
   const std::size_t parts = std::clamp<std::size_t>(std::thread::hardware_concurrency(), 1,
                                                     std::max<std::size_t>(1, m.faces.size()));
@@ -301,28 +365,38 @@ Totals totals(const Model& m, const std::vector<int>& bodies, bool gradients) {
             " face(s) (" + failed + (count > 5 ? ", ..." : "") +
             ") within its budget of quadrature intervals: a surface with extreme weights "
             "or a near-singular parametrization; rebuild those faces with moderate weights");
-  if (gradients)
+  if (gradients) {
+    Eigen::Matrix<double, 10, 3> centre = Eigen::Matrix<double, 10, 3>::Zero();
+    for (const FaceMoments& f : face) centre += f.centre;
     for (std::size_t k = 0; k < 10; ++k) {
-      out.gradient[k].resize(m.faces.size());
+      // c's own gradient, spread over its points, then the faces' control points' own
+      PointGradients g =
+          through_centre(m, out, centre.row(static_cast<Eigen::Index>(k)).transpose());
       for (std::size_t f = 0; f < m.faces.size(); ++f)
-        out.gradient[k][f] = measured[f] ? std::move(face[f].gradient[k]) : Eigen::MatrixX3d(0, 3);
+        if (measured[f]) g.faces[f] += face[f].gradient[k];
+      out.gradient[k] = std::move(g);
     }
+  }
   return out;
 }
 
-/// The faces' sum a0 g0 + a1 g1 (+ a2 g2) of gradients with the same shapes.
-FaceGradients combine(std::initializer_list<std::pair<double, const FaceGradients*>> terms) {
-  FaceGradients out = *terms.begin()->second;
-  for (auto& g : out) g *= terms.begin()->first;
-  for (auto it = terms.begin() + 1; it != terms.end(); ++it)
-    for (std::size_t f = 0; f < out.size(); ++f) out[f] += it->first * (*it->second)[f];
+/// The sum a0 g0 + a1 g1 + ... of gradients with the same shapes.
+PointGradients combine(std::initializer_list<std::pair<double, const PointGradients*>> terms) {
+  PointGradients out = *terms.begin()->second;
+  for (auto& g : out.faces) g *= terms.begin()->first;
+  out.vertices *= terms.begin()->first;
+  for (auto it = terms.begin() + 1; it != terms.end(); ++it) {
+    for (std::size_t f = 0; f < out.faces.size(); ++f)
+      out.faces[f] += it->first * it->second->faces[f];
+    out.vertices += it->first * it->second->vertices;
+  }
   return out;
 }
 
 /// Volume, centroid and inertia from the moments about c: centroid g = c + M1 / V, second
 /// moments about it S' = S − M1 M1ᵀ / V, inertia tr(S') 1 − S'; their gradients by the chain rule
 /// when the moments have them.
-MassPropertyGradients assemble(const Totals& t, bool gradients) {
+MassPropertyGradients assemble(const Model& m, const Totals& t, bool gradients) {
   MassPropertyGradients out;
   const double volume = t.value[0];
   const Eigen::Vector3d first = t.value.segment<3>(1);
@@ -336,10 +410,13 @@ MassPropertyGradients assemble(const Totals& t, bool gradients) {
   out.value.inertia_mm5 = about.trace() * Eigen::Matrix3d::Identity() - about;
   if (!gradients) return out;
   out.volume = t.gradient[0];
-  for (int i = 0; i < 3; ++i)  // d(c_i + M1_i / V) = dM1_i / V − M1_i dV / V²
+  for (int i = 0; i < 3; ++i) {  // d(c_i + M1_i / V) = dc_i + dM1_i / V − M1_i dV / V²
+    const PointGradients own = through_centre(m, t, Eigen::Vector3d::Unit(i));
     out.centroid[static_cast<std::size_t>(i)] =
-        combine({{1 / volume, &t.gradient[static_cast<std::size_t>(1 + i)]},
+        combine({{1.0, &own},
+                 {1 / volume, &t.gradient[static_cast<std::size_t>(1 + i)]},
                  {-first[i] / (volume * volume), &t.gradient[0]}});
+  }
   // dS'_ij = dS_ij − (dM1_i M1_j + M1_i dM1_j) / V + M1_i M1_j dV / V²
   const std::array<std::array<int, 3>, 3> slot{{{4, 7, 8}, {7, 5, 9}, {8, 9, 6}}};
   auto d_about = [&](int i, int j) {
@@ -348,11 +425,11 @@ MassPropertyGradients assemble(const Totals& t, bool gradients) {
                     {-first[i] / volume, &t.gradient[static_cast<std::size_t>(1 + j)]},
                     {first[i] * first[j] / (volume * volume), &t.gradient[0]}});
   };
-  const FaceGradients sxx = d_about(0, 0), syy = d_about(1, 1), szz = d_about(2, 2);
+  const PointGradients sxx = d_about(0, 0), syy = d_about(1, 1), szz = d_about(2, 2);
   out.inertia[0] = combine({{1.0, &syy}, {1.0, &szz}});
   out.inertia[1] = combine({{1.0, &sxx}, {1.0, &szz}});
   out.inertia[2] = combine({{1.0, &sxx}, {1.0, &syy}});
-  const FaceGradients sxy = d_about(0, 1), sxz = d_about(0, 2), syz = d_about(1, 2);
+  const PointGradients sxy = d_about(0, 1), sxz = d_about(0, 2), syz = d_about(1, 2);
   out.inertia[3] = combine({{-1.0, &sxy}});
   out.inertia[4] = combine({{-1.0, &sxz}});
   out.inertia[5] = combine({{-1.0, &syz}});
@@ -394,19 +471,22 @@ std::vector<int> measured_bodies(const Model& model, int body, const char* funct
 }  // namespace
 
 MassProperties mass_properties(const Model& model) {
-  return assemble(totals(model, measured_bodies(model, -1, "mass_properties"), false), false).value;
+  return assemble(model, totals(model, measured_bodies(model, -1, "mass_properties"), false), false)
+      .value;
 }
 
 MassProperties mass_properties(const Model& model, int body) {
   if (body < 0)
     throw Error(ErrorCategory::InvalidArgument,
                 "mass_properties: body " + std::to_string(body) + " does not exist (negative)");
-  return assemble(totals(model, measured_bodies(model, body, "mass_properties"), false), false)
+  return assemble(model, totals(model, measured_bodies(model, body, "mass_properties"), false),
+                  false)
       .value;
 }
 
 MassPropertyGradients mass_property_gradients(const Model& model) {
-  return assemble(totals(model, measured_bodies(model, -1, "mass_property_gradients"), true), true);
+  return assemble(model, totals(model, measured_bodies(model, -1, "mass_property_gradients"), true),
+                  true);
 }
 
 MassPropertyGradients mass_property_gradients(const Model& model, int body) {
@@ -414,8 +494,8 @@ MassPropertyGradients mass_property_gradients(const Model& model, int body) {
     throw Error(
         ErrorCategory::InvalidArgument,
         "mass_property_gradients: body " + std::to_string(body) + " does not exist (negative)");
-  return assemble(totals(model, measured_bodies(model, body, "mass_property_gradients"), true),
-                  true);
+  return assemble(
+      model, totals(model, measured_bodies(model, body, "mass_property_gradients"), true), true);
 }
 
 MassPropertyGradients mass_property_gradients(const Model& model,
@@ -424,7 +504,8 @@ MassPropertyGradients mass_property_gradients(const Model& model,
     throw Error(ErrorCategory::InvalidArgument, "mass_property_gradients: body " +
                                                     std::to_string(*options.body) +
                                                     " does not exist (negative)");
-  return assemble(totals(model,
+  return assemble(model,
+                  totals(model,
                          measured_bodies(model, options.body.value_or(-1),
                                          "mass_property_gradients", options.validate),
                          true),

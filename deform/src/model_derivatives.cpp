@@ -126,11 +126,13 @@ ModelJacobian jacobian_of(const Lattice& lattice, const brep::Model& input) {
   return out;
 }
 
-/// The lattice gradient Σ_f C_fᵀ G_f of a property whose face gradients are `g`.
-Points3 to_lattice(const ModelJacobian& j, const brep::FaceGradients& g) {
-  Points3 out = Points3::Zero(j.lattice_points, 3);
-  for (std::size_t f = 0; f < g.size(); ++f)
-    if (g[f].rows() > 0 && j.faces[f].nonZeros() > 0) out += Points3(j.faces[f].transpose() * g[f]);
+/// The lattice gradient Σ_f C_fᵀ G_f + Vᵀ G_v of a property whose gradients with respect to the
+/// faces' control points and the vertices are `g`.
+Points3 to_lattice(const ModelJacobian& j, const brep::PointGradients& g) {
+  Points3 out = Points3(j.vertices.transpose() * g.vertices);
+  for (std::size_t f = 0; f < g.faces.size(); ++f)
+    if (g.faces[f].rows() > 0 && j.faces[f].nonZeros() > 0)
+      out += Points3(j.faces[f].transpose() * g.faces[f]);
   return out;
 }
 

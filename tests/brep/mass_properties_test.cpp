@@ -49,13 +49,16 @@ Model mapped(Model m, const std::function<Vector3d(const Vector3d&)>& f, double 
   return m;
 }
 
-/// Σ_f Σ_k ∂q/∂P_k · d(P_k): a gradient's directional derivative along a move of the points.
-double along(const clay::brep::FaceGradients& g, const Model& m,
+/// Σ_f Σ_k ∂q/∂P_k · d(P_k) + Σ_v ∂q/∂V_v · d(V_v): a gradient's directional derivative along a
+/// move of the points (control points and vertices alike).
+double along(const clay::brep::PointGradients& g, const Model& m,
              const std::function<Vector3d(const Vector3d&)>& d) {
   double sum = 0;
-  for (size_t f = 0; f < g.size(); ++f)
-    for (Eigen::Index k = 0; k < g[f].rows(); ++k)
-      sum += g[f].row(k).dot(d(m.faces[f].surface.points.row(k).transpose()));
+  for (size_t f = 0; f < g.faces.size(); ++f)
+    for (Eigen::Index k = 0; k < g.faces[f].rows(); ++k)
+      sum += g.faces[f].row(k).dot(d(m.faces[f].surface.points.row(k).transpose()));
+  for (size_t v = 0; v < m.vertices.size(); ++v)
+    sum += g.vertices.row(static_cast<Eigen::Index>(v)).dot(d(m.vertices[v].point));
   return sum;
 }
 
