@@ -1,7 +1,10 @@
 // Quadrature helpers of clay_brep (see integration.hpp).
 #include "integration.hpp"
 
+#include <clay/surface/basis.hpp>
 #include <clay/surface/evaluate.hpp>
+
+#include <array>
 
 #include <algorithm>
 #include <cmath>
@@ -91,6 +94,60 @@ double size_cubed(const Model& m) {
     }
   const double d = m.faces.empty() ? 1.0 : (hi - lo).norm();
   return d * d * d;
+}
+
+Isocurve::Isocurve(const surface::BSplineSurface& s, double v, double lo, double hi) : s_(s) {
+  v = std::clamp(v, s.v.domain().first, s.v.domain().second);
+  const int p = s.u.degree, q = s.v.degree;
+  const int sv = surface::find_span(s.v, v);
+  std::array<double, 2 * (surface::max_kernel_degree + 1)> nv{};
+  surface::basis_derivatives(s.v, sv, v, 1, nv);
+  row0_ = surface::find_span(s.u, lo) - p;
+  const int row1 = surface::find_span(s.u, hi);
+  rows_.resize(static_cast<std::size_t>(2 * (row1 - row0_ + 1)));
+  for (int i = row0_; i <= row1; ++i) {
+    Eigen::Vector4d h = Eigen::Vector4d::Zero(), hv = Eigen::Vector4d::Zero();
+    for (int j = 0; j <= q; ++j) {
+      const Eigen::Index r = s.index(i, sv - q + j);
+      const double w = s.weights[r];
+      const Eigen::Vector4d pw(s.points(r, 0) * w, s.points(r, 1) * w, s.points(r, 2) * w, w);
+      h += nv[static_cast<std::size_t>(j)] * pw;
+      hv += nv[static_cast<std::size_t>(q + 1 + j)] * pw;
+    }
+    rows_[static_cast<std::size_t>(2 * (i - row0_))] = h;
+    rows_[static_cast<std::size_t>(2 * (i - row0_) + 1)] = hv;
+  }
+}
+
+void Isocurve::at(double u, Point& out) const {
+  u = std::clamp(u, s_.u.domain().first, s_.u.domain().second);
+  const int p = s_.u.degree;
+  out.span = surface::find_span(s_.u, u);
+  surface::basis_derivatives(s_.u, out.span, u, 1, out.basis);
+  Eigen::Vector4d h = Eigen::Vector4d::Zero(), hu = Eigen::Vector4d::Zero(),
+                  hv = Eigen::Vector4d::Zero();
+  for (int i = 0; i <= p; ++i) {
+    const auto k = static_cast<std::size_t>(2 * (out.span - p + i - row0_));
+    h += out.basis[static_cast<std::size_t>(i)] * rows_[k];
+    hv += out.basis[static_cast<std::size_t>(i)] * rows_[k + 1];
+    hu += out.basis[static_cast<std::size_t>(p + 1 + i)] * rows_[k];
+  }
+  // the rational quotient rule (The NURBS Book A4.4) at first order
+  out.point = h.head<3>() / h[3];
+  out.du = (hu.head<3>() - hu[3] * out.point) / h[3];
+  out.dv = (hv.head<3>() - hv[3] * out.point) / h[3];
+  out.weight = h[3];
+  out.weight_u = hu[3];
+  out.weight_v = hv[3];
+}
+
+void Isocurve::at(double u, Eigen::Vector3d& point, Eigen::Vector3d& du,
+                  Eigen::Vector3d& dv) const {
+  Point p;
+  at(u, p);
+  point = p.point;
+  du = p.du;
+  dv = p.dv;
 }
 
 CentrePoints centre_points(const Model& m, const std::vector<int>& bodies) {

@@ -71,49 +71,6 @@ struct Node {
   double u, v, w;
 };
 
-/// The surface at (u, v): y = S − c, its derivatives, n = S_u × S_v, the spans and the basis
-/// functions with their first derivatives (nu: N_i at 0..p, N_i' at p + 1..2p + 1), the weight
-/// function W and its derivatives.
-struct Sample {
-  Eigen::Vector3d y, du, dv, n;
-  int su = 0, sv = 0;
-  std::array<double, 2 * (surface::max_kernel_degree + 1)> nu{}, nv{};
-  double weight = 1, weight_u = 0, weight_v = 0;
-};
-
-void sample(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double u, double v,
-            Sample& out) {
-  u = std::clamp(u, s.u.domain().first, s.u.domain().second);
-  v = std::clamp(v, s.v.domain().first, s.v.domain().second);
-  const int p = s.u.degree, q = s.v.degree;
-  out.su = surface::find_span(s.u, u);
-  out.sv = surface::find_span(s.v, v);
-  surface::basis_derivatives(s.u, out.su, u, 1, out.nu);
-  surface::basis_derivatives(s.v, out.sv, v, 1, out.nv);
-  Eigen::Vector4d h = Eigen::Vector4d::Zero(), hu = h, hv = h;
-  for (int i = 0; i <= p; ++i)
-    for (int j = 0; j <= q; ++j) {
-      const Eigen::Index r = s.index(out.su - p + i, out.sv - q + j);
-      const double w = s.weights[r];
-      const Eigen::Vector4d pw(s.points(r, 0) * w, s.points(r, 1) * w, s.points(r, 2) * w, w);
-      const double a = out.nu[static_cast<std::size_t>(i)], b = out.nv[static_cast<std::size_t>(j)];
-      h += a * b * pw;
-      hu += out.nu[static_cast<std::size_t>(p + 1 + i)] * b * pw;
-      hv += a * out.nv[static_cast<std::size_t>(q + 1 + j)] * pw;
-    }
-  // the rational quotient rule (The NURBS Book A4.4) at first order
-  const Eigen::Vector3d point = h.head<3>() / h[3];
-  const Eigen::Vector3d du = (hu.head<3>() - hu[3] * point) / h[3];
-  const Eigen::Vector3d dv = (hv.head<3>() - hv[3] * point) / h[3];
-  out.y = point - c;
-  out.du = du;
-  out.dv = dv;
-  out.n = du.cross(dv);
-  out.weight = h[3];
-  out.weight_u = hu[3];
-  out.weight_v = hv[3];
-}
-
 /// Adaptive on every moment at once, as detail::adaptive on one: [a, b] is accepted when the 16-
 /// and 10-point rules agree to tol (per moment) or to their own rounding, else halved. f(x, rec)
 /// gives the integrand at x and appends the nodes it used (weights per unit of x) to rec when rec
@@ -167,11 +124,12 @@ Moments inner(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double
   if (hi == lo) return Moments::Zero();
   const double sign = u >= a ? 1 : -1;
   const auto spans = breaks(s.u, lo, hi);
-  Sample at;
+  const detail::Isocurve iso(s, v, lo, hi);  // v is fixed along the integral
   auto integrand = [&](double x, std::vector<Node>* r) -> Moments {
     if (r) r->push_back({x, v, 1});
-    sample(s, c, x, v, at);
-    return fluxes(at.y, at.n);
+    Eigen::Vector3d point, du, dv;
+    iso.at(x, point, du, dv);
+    return fluxes(point - c, du.cross(dv));
   };
   Moments sum = Moments::Zero();
   std::vector<Node> nodes;
@@ -197,6 +155,7 @@ Moments inner(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double
 /// whether its integration converged.
 struct FaceRule {
   std::vector<Node> nodes;
+  Moments value = Moments::Zero();  // the moments the nodes integrate (their accepted sums)
   Budget budget;
 };
 
@@ -212,7 +171,7 @@ FaceRule face_rule(const Model& m, const Face& face, const Eigen::Vector3d& cent
     // The whole domain: along its right side (the left one has F = 0, the others dv = 0).
     const auto spans = breaks(s.v, v0, v1);
     for (std::size_t k = 0; k + 1 < spans.size(); ++k)
-      adaptive_moments(
+      out.value += adaptive_moments(
           spans[k], spans[k + 1],
           [&](double v, std::vector<Node>* rec) {
             return inner(s, centre, u0, u1, v, tol_inner, out.budget, rec);
@@ -237,14 +196,19 @@ FaceRule face_rule(const Model& m, const Face& face, const Eigen::Vector3d& cent
         const auto pieces = detail::with_knot_crossings(
             co.pcurve, breaks(co.pcurve.basis, e.t0, e.t1), s.v, d0, d1);
         const std::size_t first = out.nodes.size();
+        Moments along = Moments::Zero();
         for (std::size_t k = 0; k + 1 < pieces.size(); ++k)
-          adaptive_moments(pieces[k], pieces[k + 1], integrand, tol, out.budget, out.nodes);
+          along +=
+              adaptive_moments(pieces[k], pieces[k + 1], integrand, tol, out.budget, out.nodes);
+        out.value += co.same_sense ? along : Moments(-along);
         if (!co.same_sense)
           for (std::size_t k = first; k < out.nodes.size(); ++k) out.nodes[k].w = -out.nodes[k].w;
       }
   }
-  if (face.reversed)
+  if (face.reversed) {
+    out.value = -out.value;
     for (Node& n : out.nodes) n.w = -n.w;
+  }
   return out;
 }
 
@@ -263,41 +227,75 @@ FaceMoments face_moments(const Model& m, const Face& face, const Eigen::Vector3d
   const surface::BSplineSurface& s = face.surface;
   FaceMoments out;
   out.budget = r.budget;
-  if (gradients)
-    for (auto& g : out.gradient) g = Eigen::MatrixX3d::Zero(s.points.rows(), 3);
+  out.value = r.value;
+  if (!gradients) return out;
+  for (auto& g : out.gradient) g = Eigen::MatrixX3d::Zero(s.points.rows(), 3);
   const int p = s.u.degree, q = s.v.degree;
-  Sample at;
-  std::array<Eigen::RowVector3d, 10> a, b, c;
-  for (const Node& node : r.nodes) {
-    sample(s, centre, node.u, node.v, at);
-    out.value += node.w * fluxes(at.y, at.n);
-    if (!gradients) continue;
-    // P_k -> P_k + e moves the flux ∬ Φ(y)·(X_u × X_v) by
-    // ∬ R_k e·(∇Φᵀ n) + R_k,u e·(X_v × Φ) + R_k,v e·(Φ × X_u), and c -> c + e by −∬ e·(∇Φᵀ n).
-    const Fields f = fields(at.y, at.n);
-    for (std::size_t k = 0; k < 10; ++k) {
-      a[k] = node.w * f.a[k].transpose();
-      b[k] = node.w * at.dv.cross(f.phi[k]).transpose();
-      c[k] = node.w * f.phi[k].cross(at.du).transpose();
-      out.centre.row(static_cast<Eigen::Index>(k)) -= a[k];
+  // P_k -> P_k + e moves the flux ∬ Φ(y)·(X_u × X_v) by
+  // ∬ R_k e·(∇Φᵀ n) + R_k,u e·(X_v × Φ) + R_k,v e·(Φ × X_u), and c -> c + e by −∬ e·(∇Φᵀ n).
+  // With R_k = w_k N_i N_j / W that is w_k [N_j (N_i A + N_i' B) + N_j' N_i C], A = (a − (W_u b +
+  // W_v c) / W) / W, B = b / W, C = c / W (a = ∇Φᵀ n, b = X_v × Φ, c = Φ × X_u, times the node's
+  // weight). The nodes of one inner integral share v, so N_j(v) too: the sums over i are made per
+  // control row along the line, then spread over j once per line ((p + 1) work per node, not
+  // (p + 1)(q + 1): NX 9's B-spline sphere under a (2, 2, 2) lattice, 117 -> 26 s; its values alone 17 s).
+  using Block = Eigen::Matrix<double, 10, 3>;
+  std::vector<Block> along(static_cast<std::size_t>(s.count_u()), Block::Zero());
+  std::vector<Block> across(static_cast<std::size_t>(s.count_u()), Block::Zero());
+  std::array<double, 2 * (surface::max_kernel_degree + 1)> nv{};
+  detail::Isocurve::Point at;
+  for (std::size_t first = 0; first < r.nodes.size();) {
+    const double v = r.nodes[first].v;
+    std::size_t last = first;
+    double lo = r.nodes[first].u, hi = lo;
+    for (; last < r.nodes.size() && r.nodes[last].v == v; ++last) {
+      lo = std::min(lo, r.nodes[last].u);
+      hi = std::max(hi, r.nodes[last].u);
     }
-    const double w = at.weight, w2 = w * w;
-    for (int i = 0; i <= p; ++i)
-      for (int j = 0; j <= q; ++j) {
-        const Eigen::Index k = s.index(at.su - p + i, at.sv - q + j);
-        const double ni = at.nu[static_cast<std::size_t>(i)],
-                     nj = at.nv[static_cast<std::size_t>(j)];
-        const double di = at.nu[static_cast<std::size_t>(p + 1 + i)];
-        const double dj = at.nv[static_cast<std::size_t>(q + 1 + j)];
-        const double wk = s.weights[k];
-        // R_k = N_i N_j w_k / W and its derivatives by the quotient rule
-        const double rk = ni * nj * wk / w;
-        const double ru = wk * (di * nj * w - ni * nj * at.weight_u) / w2;
-        const double rv = wk * (ni * dj * w - ni * nj * at.weight_v) / w2;
-        if (rk == 0 && ru == 0 && rv == 0) continue;
-        for (std::size_t m2 = 0; m2 < 10; ++m2)
-          out.gradient[m2].row(k) += rk * a[m2] + ru * b[m2] + rv * c[m2];
+    const double u0 = s.u.domain().first, u1 = s.u.domain().second;
+    const detail::Isocurve iso(s, v, std::clamp(lo, u0, u1), std::clamp(hi, u0, u1));
+    int row_lo = s.count_u(), row_hi = -1;
+    for (std::size_t k = first; k < last; ++k) {
+      iso.at(r.nodes[k].u, at);
+      const Eigen::Vector3d y = at.point - centre;
+      const Fields f = fields(y, at.du.cross(at.dv));
+      const double w = r.nodes[k].w, weight = at.weight;
+      Block a, b, c;
+      for (int m2 = 0; m2 < 10; ++m2) {
+        const auto i2 = static_cast<std::size_t>(m2);
+        a.row(m2) = w * f.a[i2].transpose();
+        b.row(m2) = w * at.dv.cross(f.phi[i2]).transpose();
+        c.row(m2) = w * f.phi[i2].cross(at.du).transpose();
       }
+      out.centre -= a;
+      const Block big_a = (a - (at.weight_u * b + at.weight_v * c) / weight) / weight;
+      const Block big_b = b / weight, big_c = c / weight;
+      for (int i = 0; i <= p; ++i) {
+        const int row = at.span - p + i;
+        const auto r2 = static_cast<std::size_t>(row);
+        const double ni = at.basis[static_cast<std::size_t>(i)];
+        const double di = at.basis[static_cast<std::size_t>(p + 1 + i)];
+        along[r2] += ni * big_a + di * big_b;
+        across[r2] += ni * big_c;
+        row_lo = std::min(row_lo, row);
+        row_hi = std::max(row_hi, row);
+      }
+    }
+    const double vc = std::clamp(v, s.v.domain().first, s.v.domain().second);
+    const int sv = surface::find_span(s.v, vc);
+    surface::basis_derivatives(s.v, sv, vc, 1, nv);
+    for (int row = row_lo; row <= row_hi; ++row) {
+      const auto r2 = static_cast<std::size_t>(row);
+      for (int j = 0; j <= q; ++j) {
+        const Eigen::Index k = s.index(row, sv - q + j);
+        const Block g = s.weights[k] * (nv[static_cast<std::size_t>(j)] * along[r2] +
+                                        nv[static_cast<std::size_t>(q + 1 + j)] * across[r2]);
+        for (int m2 = 0; m2 < 10; ++m2)
+          out.gradient[static_cast<std::size_t>(m2)].row(k) += g.row(m2);
+      }
+      along[r2].setZero();
+      across[r2].setZero();
+    }
+    first = last;
   }
   return out;
 }

@@ -45,43 +45,10 @@ double inner(const surface::BSplineSurface& s, const Eigen::Vector3d& c, double 
   const double lo = std::min(a, u), hi = std::max(a, u);
   if (hi == lo) return 0;
   const auto spans = breaks(s.u, lo, hi);
-  // v is fixed along the integral: the homogeneous isocurve at v and its v derivative are made
-  // once for the rows the spans use, and each point sums p + 1 of them instead of (p + 1)(q + 1)
-  // control points with both bases (surface::derivatives' own sums, in its order: the same
-  // numbers). The volume integration spent three quarters of reading a real file here.
-  const int p = s.u.degree, q = s.v.degree;
-  const int sv = surface::find_span(s.v, v);
-  std::array<double, 2 * (surface::max_kernel_degree + 1)> nv{}, nu{};
-  surface::basis_derivatives(s.v, sv, v, 1, nv);
-  const int row0 = surface::find_span(s.u, lo) - p, row1 = surface::find_span(s.u, hi);
-  std::vector<Eigen::Vector4d> iso(static_cast<std::size_t>(2 * (row1 - row0 + 1)));
-  for (int i = row0; i <= row1; ++i) {
-    Eigen::Vector4d h = Eigen::Vector4d::Zero(), hv = Eigen::Vector4d::Zero();
-    for (int j = 0; j <= q; ++j) {
-      const Eigen::Index r = s.index(i, sv - q + j);
-      const double w = s.weights[r];
-      const Eigen::Vector4d pw(s.points(r, 0) * w, s.points(r, 1) * w, s.points(r, 2) * w, w);
-      h += nv[static_cast<std::size_t>(j)] * pw;
-      hv += nv[static_cast<std::size_t>(q + 1 + j)] * pw;
-    }
-    iso[static_cast<std::size_t>(2 * (i - row0))] = h;
-    iso[static_cast<std::size_t>(2 * (i - row0) + 1)] = hv;
-  }
+  const detail::Isocurve iso(s, v, lo, hi);  // v is fixed along the integral
   auto integrand = [&](double x) {
-    const int su = surface::find_span(s.u, x);
-    surface::basis_derivatives(s.u, su, x, 1, nu);
-    Eigen::Vector4d h = Eigen::Vector4d::Zero(), hu = Eigen::Vector4d::Zero(),
-                    hv = Eigen::Vector4d::Zero();
-    for (int i = 0; i <= p; ++i) {
-      const std::size_t k = static_cast<std::size_t>(2 * (su - p + i - row0));
-      h += nu[static_cast<std::size_t>(i)] * iso[k];
-      hv += nu[static_cast<std::size_t>(i)] * iso[k + 1];
-      hu += nu[static_cast<std::size_t>(p + 1 + i)] * iso[k];
-    }
-    // the rational quotient rule (The NURBS Book A4.4) at first order
-    const Eigen::Vector3d point = h.head<3>() / h[3];
-    const Eigen::Vector3d du = (hu.head<3>() - hu[3] * point) / h[3];
-    const Eigen::Vector3d dv = (hv.head<3>() - hv[3] * point) / h[3];
+    Eigen::Vector3d point, du, dv;
+    iso.at(x, point, du, dv);
     return (point - c).dot(du.cross(dv)) / 3.0;
   };
   double sum = 0;
