@@ -237,7 +237,8 @@ FaceMoments face_moments(const Model& m, const Face& face, const Eigen::Vector3d
   // W_v c) / W) / W, B = b / W, C = c / W (a = ∇Φᵀ n, b = X_v × Φ, c = Φ × X_u, times the node's
   // weight). The nodes of one inner integral share v, so N_j(v) too: the sums over i are made per
   // control row along the line, then spread over j once per line ((p + 1) work per node, not
-  // (p + 1)(q + 1): NX 9's B-spline sphere under a (2, 2, 2) lattice, 117 -> 26 s; its values alone 17 s).
+  // (p + 1)(q + 1): NX 9's B-spline sphere under a (2, 2, 2) lattice, 117 -> 26 s; its values alone
+  // 17 s).
   using Block = Eigen::Matrix<double, 10, 3>;
   std::vector<Block> along(static_cast<std::size_t>(s.count_u()), Block::Zero());
   std::vector<Block> across(static_cast<std::size_t>(s.count_u()), Block::Zero());
