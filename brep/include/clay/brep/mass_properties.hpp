@@ -1,6 +1,6 @@
 #pragma once
 /// Mass properties of solids (volume, centroid, inertia) and their exact gradients with respect to
-/// the faces' control points (issue #41).
+/// the faces' control points and the vertices (issue #41).
 ///
 /// Every property is a volume integral ∭_Ω φ(x) dV, φ = 1, x_i or x_i x_j (about a reference point
 /// c near the solid), turned into ∯ Φ·n dA by the divergence theorem with div Φ = φ

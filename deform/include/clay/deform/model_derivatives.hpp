@@ -10,7 +10,8 @@
 /// move (deform_model's lightest form keeps an undisplaced face as it is). The pcurves do not
 /// change (composition keeps (u, v)). A model's mass properties are then polynomials (the volume
 /// is cubic) in L on polynomial faces, and their gradients are
-/// ∂q/∂L_J = Σ_faces Σ_k C_kJ ∂q/∂P_k (brep::mass_property_gradients).
+/// ∂q/∂L_J = Σ_faces Σ_k C_kJ ∂q/∂P_k + Σ_v V_vJ ∂q/∂V_v (brep::mass_property_gradients: with
+/// respect to the faces' control points and the vertices).
 #include <clay/brep/mass_properties.hpp>
 #include <clay/brep/model.hpp>
 #include <clay/deform/export.hpp>
@@ -80,7 +81,8 @@ struct LatticeMassGradients {
 };
 
 /// Mass properties of every solid of jacobian.model and their gradients with respect to the
-/// lattice points: C_fᵀ times each face's gradient (brep::mass_property_gradients), summed.
+/// lattice points: C_fᵀ times each face's gradient and Vᵀ times the vertices'
+/// (brep::mass_property_gradients), summed.
 /// Throws as brep::mass_property_gradients.
 CLAY_DEFORM_API LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian);
 /// Same at other lattice points (of deformed_model(jacobian, points)): an optimiser's evaluation.
