@@ -398,6 +398,11 @@ PointGradients combine(std::initializer_list<std::pair<double, const PointGradie
 MassPropertyGradients assemble(const Model& m, const Totals& t, bool gradients) {
   MassPropertyGradients out;
   const double volume = t.value[0];
+  if (!(std::isfinite(volume) && volume != 0))
+    throw Error(ErrorCategory::InvalidGeometry,
+                "mass_properties: the solids enclose a volume of " + std::to_string(volume) +
+                    " mm^3, so their centroid and inertia are undefined; measure closed solids "
+                    "with volume (brep::problems names open shells)");
   const Eigen::Vector3d first = t.value.segment<3>(1);
   Eigen::Matrix3d second;
   second << t.value[4], t.value[7], t.value[8],  //

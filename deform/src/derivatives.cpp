@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bernstein_poly.hpp"
+#include "cell_extraction.hpp"
 #include "compose_factors.hpp"
 #include "patch_containment.hpp"
 
@@ -138,31 +139,14 @@ CompositionJacobian composition_jacobian(const BSplineLattice& lattice,
     const auto [ci, cj, ck] = located.cells[k];
     const BezierLattice& cell = cells.cell(ci, cj, ck);
     const Poly local = compose_channels(cell, located.factors[k]);
-    // The cell's Bézier points from the lattice's (bezier_cells): point (i, j, k) of the cell is
-    // Σ ea(i, ii) eb(j, jj) ec(k, kk) P(first + (ii, jj, kk)), so its channels map to the lattice
-    // points of the cell's support through E = ea ⊗ eb ⊗ ec.
-    const auto& ea = spans[0][static_cast<std::size_t>(ci)];
-    const auto& eb = spans[1][static_cast<std::size_t>(cj)];
-    const auto& ec = spans[2][static_cast<std::size_t>(ck)];
-    const auto n = cell.counts();
-    const int m = n[0] * n[1] * n[2];
-    Eigen::MatrixXd e(m, m);
-    PatchColumns out{Poly(local.du, local.dv, m), std::vector<int>(static_cast<std::size_t>(m))};
-    for (int i = 0; i < n[0]; ++i)
-      for (int j = 0; j < n[1]; ++j)
-        for (int kk = 0; kk < n[2]; ++kk)
-          for (int ii = 0; ii < n[0]; ++ii)
-            for (int jj = 0; jj < n[1]; ++jj)
-              for (int kz = 0; kz < n[2]; ++kz) {
-                e(cell.index(i, j, kk), cell.index(ii, jj, kz)) =
-                    ea.matrix(i, ii) * eb.matrix(j, jj) * ec.matrix(kk, kz);
-                out.columns[static_cast<std::size_t>(cell.index(ii, jj, kz))] =
-                    static_cast<int>(lattice.index(ea.first + ii, eb.first + jj, ec.first + kz));
-              }
+    // The cell's channels map to the lattice points of its support through its extraction.
+    const detail::CellExtraction e = detail::cell_extraction(lattice, cell, spans, ci, cj, ck);
+    const auto m = static_cast<int>(cell.points.rows());
+    PatchColumns out{Poly(local.du, local.dv, m), e.points};
     using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
     const Eigen::Index coefficients = static_cast<Eigen::Index>(local.du + 1) * (local.dv + 1);
     Eigen::Map<Rows>(out.h.c.data(), coefficients, m) =
-        Eigen::Map<const Rows>(local.c.data(), coefficients, m) * e;
+        Eigen::Map<const Rows>(local.c.data(), coefficients, m) * e.matrix;
     patches[k] = std::move(out);
   }
   return join_columns(located.bp, patches, lattice.points, located.split.is_rational());

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bernstein.hpp"
+#include "cell_extraction.hpp"
 
 namespace clay::deform {
 
@@ -252,36 +253,18 @@ JacobianConstraints jacobian_constraints(const BSplineLattice& lattice) {
       for (int ck = 0; ck < n[2]; ++ck) {
         const BezierLattice& cell = cells.cell(ci, cj, ck);
         const auto [v, g] = constraints_dense(cell);
-        // Cell point (i, j, k) = Σ ea(i, ii) eb(j, jj) ec(k, kk) P(first + (ii, jj, kk)).
-        const auto& ea = spans[0][static_cast<size_t>(ci)];
-        const auto& eb = spans[1][static_cast<size_t>(cj)];
-        const auto& ec = spans[2][static_cast<size_t>(ck)];
-        const auto m = cell.counts();
-        Eigen::MatrixXd e = Eigen::MatrixXd::Zero(cell.points.rows(), cell.points.rows());
-        std::vector<Eigen::Index> column(static_cast<size_t>(cell.points.rows()));
-        for (int i = 0; i < m[0]; ++i)
-          for (int j = 0; j < m[1]; ++j)
-            for (int k = 0; k < m[2]; ++k)
-              for (int ii = 0; ii < m[0]; ++ii)
-                for (int jj = 0; jj < m[1]; ++jj)
-                  for (int kk = 0; kk < m[2]; ++kk) {
-                    e(cell.index(i, j, k), cell.index(ii, jj, kk)) =
-                        ea.matrix(i, ii) * eb.matrix(j, jj) * ec.matrix(k, kk);
-                    column[static_cast<size_t>(cell.index(ii, jj, kk))] =
-                        lattice.index(ea.first + ii, eb.first + jj, ec.first + kk);
-                  }
+        const detail::CellExtraction e = detail::cell_extraction(lattice, cell, spans, ci, cj, ck);
         const auto first_row = static_cast<int>(values.size());
         values.insert(values.end(), v.data(), v.data() + v.size());
-        for (Eigen::Index q = 0; q < e.cols(); ++q)  // lattice point column[q] of the support
+        for (Eigen::Index q = 0; q < e.matrix.cols(); ++q)  // lattice point e.points[q]
           for (int c = 0; c < 3; ++c) {
             Eigen::VectorXd d = Eigen::VectorXd::Zero(v.size());
-            for (Eigen::Index p = 0; p < e.rows(); ++p)
-              if (e(p, q) != 0) d += e(p, q) * g.col(3 * p + c);
+            for (Eigen::Index p = 0; p < e.matrix.rows(); ++p)
+              if (e.matrix(p, q) != 0) d += e.matrix(p, q) * g.col(3 * p + c);
             for (Eigen::Index r = 0; r < d.size(); ++r)
               if (d[r] != 0)
                 entries.emplace_back(first_row + static_cast<int>(r),
-                                     static_cast<int>(3 * column[static_cast<size_t>(q)] + c),
-                                     d[r]);
+                                     3 * e.points[static_cast<size_t>(q)] + c, d[r]);
           }
       }
   JacobianConstraints out;

@@ -272,9 +272,20 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
                       std::to_string(jacobian.lattice_points) + " points");
     held[static_cast<std::size_t>(h)] = true;
   }
+  if (keep.volume_mm3 && !(std::isfinite(*keep.volume_mm3) && *keep.volume_mm3 != 0))
+    throw Error(ErrorCategory::InvalidArgument,
+                name + ": the volume to keep is " + internal::shortest(*keep.volume_mm3) +
+                    " mm^3; give the solid's own volume (finite, not 0)");
+  if (keep.centroid_mm && !keep.centroid_mm->allFinite())
+    throw Error(ErrorCategory::InvalidArgument,
+                name + ": the centroid to keep is not finite; give the solid's own centroid");
   check_points(jacobian, moved, name);
   const double size = size_of(jacobian.model);
-  // The constraints: residuals and gradients (free rows only) at lattice points L.
+  // The constraints: residuals and gradients (free rows only) at lattice points L, each divided
+  // by its scale (the volume by the target's, the centroid by the model's size), so the Newton
+  // matrix mixes no units: a volume row ~ L^4 next to centroid rows ~ 1 fell below FullPivLU's
+  // rank threshold for a part of a few metres in mm.
+  const double volume_scale = keep.volume_mm3 ? std::abs(*keep.volume_mm3) : 1.0;
   auto constraints = [&](const Points3& l, brep::MassProperties& value,
                          std::vector<Points3>& gradients) {
     const LatticeMassGradients g = gradients_at(jacobian, moved_geometry(jacobian, l), false);
@@ -282,13 +293,13 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
     std::vector<double> residual;
     gradients.clear();
     if (keep.volume_mm3) {
-      residual.push_back(g.value.volume_mm3 - *keep.volume_mm3);
-      gradients.push_back(g.volume);
+      residual.push_back((g.value.volume_mm3 - *keep.volume_mm3) / volume_scale);
+      gradients.push_back(g.volume / volume_scale);
     }
     if (keep.centroid_mm)
       for (int i = 0; i < 3; ++i) {
-        residual.push_back(g.value.centroid_mm[i] - (*keep.centroid_mm)[i]);
-        gradients.push_back(g.centroid[static_cast<std::size_t>(i)]);
+        residual.push_back((g.value.centroid_mm[i] - (*keep.centroid_mm)[i]) / size);
+        gradients.push_back(g.centroid[static_cast<std::size_t>(i)] / size);
       }
     for (Points3& d : gradients)
       for (std::size_t r = 0; r < held.size(); ++r)
@@ -299,8 +310,8 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
   auto met = [&](const Eigen::VectorXd& r, KeptMove& out) {
     int k = 0;
     out.volume_error = out.centroid_error_mm = 0;
-    if (keep.volume_mm3) out.volume_error = std::abs(r[k++]) / std::abs(*keep.volume_mm3);
-    if (keep.centroid_mm) out.centroid_error_mm = r.segment(k, 3).norm();
+    if (keep.volume_mm3) out.volume_error = std::abs(r[k++]);
+    if (keep.centroid_mm) out.centroid_error_mm = r.segment(k, 3).norm() * size;
     return out.volume_error <= keep.tolerance && out.centroid_error_mm <= keep.tolerance * size;
   };
   KeptMove out;

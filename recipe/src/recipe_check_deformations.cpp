@@ -79,7 +79,7 @@ std::optional<deform::Deformation> RecipeChecker::lattice(
     const Json& j, const std::string& path, bool bspline,
     std::initializer_list<std::string_view> extra_keys) {
   std::vector<std::string_view> keys{"kind",    "name",   "enabled", "frame",
-                                     "degrees", "points", "moves",   "keep"};
+                                     "degrees", "points", "moves"};
   if (bspline) keys.insert(keys.end(), {"bases", "cells", "knots"});
   keys.insert(keys.end(), extra_keys.begin(), extra_keys.end());
   for (const auto& [key, v] : j.items()) {
@@ -450,9 +450,9 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
   using Reader = std::function<bool(const Json&, const std::string&, StepDef&)>;
   const std::vector<std::pair<std::string, Reader>> readers = {
       {"bezier_lattice", [&](const Json& s, const std::string& p,
-                             StepDef& st) { return set(st, lattice(s, p, false, {})); }},
+                             StepDef& st) { return set(st, lattice(s, p, false, {"keep"})); }},
       {"bspline_lattice", [&](const Json& s, const std::string& p,
-                              StepDef& st) { return set(st, lattice(s, p, true, {})); }},
+                              StepDef& st) { return set(st, lattice(s, p, true, {"keep"})); }},
       {"extended_lattice",  // from a generator (a primitive's lattice), or given point by point
        [&](const Json& s, const std::string& p, StepDef& st) {
          return s.contains("generator") ? set(st, extended_from_generator(s, p)) : schema(s, p, st);

@@ -271,16 +271,31 @@ ModelRunResult::Kept keep_step(Lattice& lattice, const brep::Model& model,
                                   "lattice: " +
                                   e.message());
   }
-  const brep::MassProperties before = brep::mass_properties(model);
+  brep::MassProperties before;
+  try {
+    before = brep::mass_properties(model);
+  } catch (const Error& e) {
+    throw Error(e.category(), where + ": \"keep\" measures the model first: " + e.message());
+  }
   deform::KeptProperties keep;
   for (const std::string& p : properties) {
     if (p == "volume") keep.volume_mm3 = before.volume_mm3;
     if (p == "centroid") keep.centroid_mm = before.centroid_mm;
   }
-  // The points the step moved stay where it put them (a drag stays under the cursor).
+  // The points the step moved stay where it put them (a drag stays under the cursor); a point
+  // within 1e-9 of the frame's size of its rest position (a recipe's "points" rounded on a round
+  // trip) is at rest.
   const surface::Points3 rest = deform::undisplaced_points(lattice);
+  const double size = lattice.frame.s.norm() + lattice.frame.t.norm() + lattice.frame.u.norm();
   for (Eigen::Index r = 0; r < rest.rows(); ++r)
-    if (lattice.points.row(r) != rest.row(r)) keep.held.push_back(static_cast<int>(r));
+    if ((lattice.points.row(r) - rest.row(r)).norm() > 1e-9 * size)
+      keep.held.push_back(static_cast<int>(r));
+  if (keep.held.size() == static_cast<std::size_t>(rest.rows()))
+    throw Error(ErrorCategory::InvalidArgument,
+                where +
+                    ": \"keep\" corrects the points the step leaves at rest, but it moves all " +
+                    std::to_string(rest.rows()) +
+                    " of them; move fewer points, or use a lattice with more points");
   deform::KeptMove kept;
   try {
     kept = deform::keep_properties(jacobian, lattice.points, keep);
@@ -303,7 +318,8 @@ ModelRunResult::Kept keep_step(Lattice& lattice, const brep::Model& model,
 /// figures are the whole model's) and, naming the step, where the model has no solid or a face
 /// crosses the lattice's boundary.
 void keep_properties(const StackDef& def, deform::DeformationStack& stack, const brep::Model& flat,
-                     const deform::ModelDeformationOptions& options, ModelRunResult& out) {
+                     const deform::ModelDeformationOptions& options, bool allow_fold,
+                     const std::string& allow, ModelRunResult& out) {
   for (std::size_t i = 0; i < def.steps.size(); ++i) {
     const StepDef& step = def.steps[i];
     if (step.keep.empty() || !step.enabled) continue;
@@ -320,8 +336,14 @@ void keep_properties(const StackDef& def, deform::DeformationStack& stack, const
                              stack.steps.begin() + static_cast<std::ptrdiff_t>(i));
     bool any_before = false;
     for (const auto& s : before_step.steps) any_before = any_before || s.enabled;
-    const brep::Model before =
-        any_before ? deform::deform_model(before_step, flat, options).model : flat;
+    brep::Model before;
+    try {
+      before = any_before ? deform::deform_model(before_step, flat, options).model : flat;
+    } catch (const Error& e) {
+      throw Error(
+          e.category(),
+          where + ": \"keep\" measures the model after the steps before it: " + e.message());
+    }
     ModelRunResult::Kept kept;
     std::visit(
         [&](auto& lattice) {
@@ -334,6 +356,9 @@ void keep_properties(const StackDef& def, deform::DeformationStack& stack, const
         stack.steps[i].deformation);
     kept.step = where;
     out.kept.push_back(std::move(kept));
+    // The correction moved points too: the corrected lattice is checked for folds again.
+    check_fold(stack.steps[i].deformation, where + " (corrected to keep its figures)", allow,
+               out.fold_free, allow_fold);
   }
 }
 
@@ -372,7 +397,8 @@ ModelRunResult run_model(const RecipeData& d, const ModelDef& def, const std::st
     options.faces = chosen_faces(flat, def);
     const std::string& receiver = profile.empty() ? def.profile : profile;
     if (!receiver.empty()) options.profile = deform::receiver_profile(receiver);
-    keep_properties(stack_def, stack, flat, options, out);
+    keep_properties(stack_def, stack, flat, options, def.allow_fold,
+                    "\"allow_fold\": true on the model (clayform deform --allow-fold)", out);
     auto r = deform::deform_model(stack, flat, options);
     out.model = std::move(r.model);
     out.report = std::move(r.report);
@@ -397,12 +423,14 @@ ModelRunResult deform_model(const Recipe& recipe, const brep::Model& model,
   ModelRunResult result;
   result.recipe = d.name;
   result.deformation = def.name;
-  const deform::DeformationStack stack = model_stack(def, result.fold_free, allow_fold);
+  deform::DeformationStack stack = model_stack(def, result.fold_free, allow_fold);
   deform::ModelDeformationOptions options;
   options.surface = deformation_options(d.composition);
   options.edge_gap_mm = d.composition.edge_gap_mm;
   options.edge_angle_deg = d.composition.edge_angle_deg;
   if (!profile.empty()) options.profile = deform::receiver_profile(profile);
+  keep_properties(def, stack, brep::flattened(model), options, allow_fold,
+                  "--allow-fold (clayform deform) or allow_fold=True (Python)", result);
   try {
     auto r = deform::deform_model(stack, model, options);
     result.model = std::move(r.model);

@@ -57,7 +57,7 @@ double dot(const Points3& a, const Points3& b) { return a.cwiseProduct(b).sum();
 
 TEST_CASE(
     "model_jacobian: a filleted block under a moved Bézier lattice, exact and fixed in form") {
-  const Model block = read(TestModel::FilletedBlock, "block.step");
+  const Model block = read(TestModel::FilletedBlock, "block-form.step");
   const BezierLattice lattice = make_bezier_lattice(frame_around(block, 0.1), {2, 2, 1});
   const BezierLattice moved = shaken(lattice, 1.5, 3);
   const ModelJacobian at_identity = model_jacobian(lattice, block);
@@ -106,7 +106,7 @@ TEST_CASE(
 }
 
 TEST_CASE("face_point_jacobian: central differences of the pointwise FFD, every lattice point") {
-  const Model block = read(TestModel::FilletedBlock, "block.step");
+  const Model block = read(TestModel::FilletedBlock, "block-points.step");
   const BezierLattice lattice =
       shaken(make_bezier_lattice(frame_around(block, 0.1), {2, 2, 1}), 1, 5);
   const ModelJacobian j = model_jacobian(lattice, block);
@@ -145,7 +145,7 @@ TEST_CASE("face_point_jacobian: central differences of the pointwise FFD, every 
 }
 
 TEST_CASE("mass_property_gradients: a real part's volume and centroid against differences") {
-  const Model block = read(TestModel::FilletedBlock, "block.step");
+  const Model block = read(TestModel::FilletedBlock, "block-mass.step");
   const BezierLattice lattice =
       shaken(make_bezier_lattice(frame_around(block, 0.1), {2, 2, 1}), 0.8, 11);
   const ModelJacobian j = model_jacobian(lattice, block);
@@ -211,7 +211,7 @@ TEST_CASE("mass_property_gradients: solids under an affine lattice against close
 }
 
 TEST_CASE("keep_properties: 100 random drags of a real solid keep its volume to 1e-12") {
-  const Model block = read(TestModel::FilletedBlock, "block.step");
+  const Model block = read(TestModel::FilletedBlock, "block-keep.step");
   const BezierLattice lattice = make_bezier_lattice(frame_around(block, 0.1), {2, 2, 1});
   const ModelJacobian j = model_jacobian(lattice, block);
   const double v0 = clay::brep::volume_mm3(j.model);
@@ -248,7 +248,7 @@ TEST_CASE("keep_properties: 100 random drags of a real solid keep its volume to 
 }
 
 TEST_CASE("keep_properties: the centroid with the volume, and bad requests refused") {
-  const Model sphere = read(TestModel::Sphere, "sphere.step");
+  const Model sphere = read(TestModel::Sphere, "sphere-keep.step");
   // The knot plane z = 0 through the centre: the sphere meets it along its equator, a knot line,
   // where a B-spline lattice composes exactly.
   Frame frame;
@@ -281,6 +281,10 @@ TEST_CASE("keep_properties: the centroid with the volume, and bad requests refus
       clay::test::error_of([&] { (void)keep_properties(j, moved, all); });
   CHECK(category == ErrorCategory::InvalidArgument);
   CHECK_THAT(message, Catch::Matchers::Contains("hold fewer points"));
+  KeptProperties nothing = keep;
+  nothing.volume_mm3 = 0;
+  CHECK_THAT(clay::test::error_of([&] { (void)keep_properties(j, moved, nothing); }).second,
+             Catch::Matchers::Contains("the volume to keep is 0 mm^3"));
   KeptProperties wrong = keep;
   wrong.held = {999};
   CHECK_THAT(clay::test::error_of([&] { (void)keep_properties(j, moved, wrong); }).second,
@@ -291,7 +295,7 @@ TEST_CASE("keep_properties: the centroid with the volume, and bad requests refus
 }
 
 TEST_CASE("model_jacobian: a face crossing the lattice's boundary is refused, named") {
-  const Model block = read(TestModel::FilletedBlock, "block.step");
+  const Model block = read(TestModel::FilletedBlock, "block-boundary.step");
   Frame frame = frame_around(block, 0.1);
   frame.s *= 0.5;  // half the block sticks out along x
   const auto [category, message] = clay::test::error_of([&] {

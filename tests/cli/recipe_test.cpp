@@ -351,6 +351,31 @@ TEST_CASE("a lattice step's \"keep\" holds the model's volume while its points m
                  "[\"volume\"]"));
   CHECK(mentions(check_recipe(text(R"(, "keep": ["volume", "volume"])")),
                  "deformations.lift[0].keep[1]", "listed twice"));
+  // `clayform deform` and Python's deform_model take the same path through the recipe's stack.
+  const clay::brep::Model block = clay::brep::read_model(models / "block.step").model;
+  const auto deformed = clay::recipe::deform_model(
+      parse_recipe(text(R"(, "keep": ["volume"])"), models), block, "lift");
+  REQUIRE(deformed.kept.size() == 1);
+  CHECK(std::abs(deformed.report.volume_after_mm3 / deformed.report.volume_before_mm3 - 1) <=
+        1e-12);
+  // A step that moves every point leaves nothing to correct.
+  const std::string every =
+      std::string(R"({"format": "clayform.recipe", "version": 1, "name": "all",
+      "deformations": {"grow": [{"kind": "bezier_lattice",
+        "frame": {"origin": [-5, -5, -5], "s": [70, 0, 0], "t": [0, 50, 0], "u": [0, 0, 30]},
+        "degrees": [1, 1, 1], "keep": ["volume"],
+        "points": [[-6, -6, -6], [-6, -6, 26], [-6, 46, -6], [-6, 46, 26], [66, -6, -6], [66, -6, 26], [66, 46, -6], [66, 46, 26]]}]},
+      "models": {"block": {"import": "block.step", "deformation": "grow"}}})");
+  CHECK_THAT(error_of([&] { run_recipe(parse_recipe(every, models)); }).second,
+             Contains("\"keep\" corrects the points the step leaves at rest, but it moves all 8"));
+  // "keep" belongs to a lattice step, not to a direct manipulation's lattice.
+  CHECK(mentions(
+      check_recipe(recipe_with("", R"("deformations": {"pull": [{"kind": "direct_manipulation",
+      "lattice": {"kind": "bezier_lattice", "frame": {"origin": [0, 0, 0], "s": [1, 0, 0], "t": [0, 1, 0], "u": [0, 0, 1]},
+        "degrees": [1, 1, 1], "keep": ["volume"]},
+      "moves": [{"point": [0.5, 0.5, 0.5], "to": [0.5, 0.5, 0.6]}]}]})")),
+      "deformations.pull[0].lattice.keep", "unknown key"));
+
   // A surface's stack has no solid to keep.
   std::string step = lattice_step;
   step.insert(step.size() - 1, R"(, "keep": ["volume"])");
