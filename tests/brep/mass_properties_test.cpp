@@ -120,6 +120,41 @@ TEST_CASE("mass_properties: a sphere and a cone frustum (rational faces) against
   CHECK(std::abs(c.inertia_mm5(0, 1)) <= 1e-10 * c.inertia_mm5(2, 2));
 }
 
+TEST_CASE("mass_properties: two solids apart, each about its own point, put together") {
+  // A box 20^3 at the origin and a ball r 5 at (50, 10, 10): the parallel-axis theorem.
+  const Model two = read(TestModel::Separated, "separated.step");
+  const double box = 8000, ball = 4.0 / 3.0 * std::numbers::pi * 125, v = box + ball;
+  const Vector3d gb(10, 10, 10), gs(50, 10, 10);
+  const Vector3d g = (box * gb + ball * gs) / v;
+  Matrix3d inertia = Matrix3d::Identity() * (box * 400 / 6) + ball_inertia(5);
+  for (const auto& [mass, at] : {std::pair{box, gb}, std::pair{ball, gs}}) {
+    const Vector3d d = at - g;
+    inertia += mass * (d.squaredNorm() * Matrix3d::Identity() - d * d.transpose());
+  }
+  const MassProperties p = clay::brep::mass_properties(two);
+  CHECK(p.volume_mm3 == Approx(v).epsilon(1e-12));
+  CHECK(p.volume_mm3 == Approx(clay::brep::volume_mm3(two)).epsilon(1e-14));
+  CHECK((p.centroid_mm - g).norm() <= 1e-11 * 60);
+  CHECK((p.inertia_mm5 - inertia).norm() <= 1e-11 * inertia.norm());
+  // The gradients put together as the values: an affine move's derivative in closed form.
+  Matrix3d a;
+  a << 0.3, -0.2, 0.5, 0.1, -0.4, 0.25, 0.2, 0.6, 0.15;
+  const auto d = [&](const Vector3d& x) { return Vector3d(a * x); };
+  const auto grad = clay::brep::mass_property_gradients(two);
+  CHECK(along(grad.volume, two, d) == Approx(a.trace() * v).epsilon(1e-11));
+  for (int i = 0; i < 3; ++i)
+    CHECK(along(grad.centroid[static_cast<size_t>(i)], two, d) ==
+          Approx((a * g)[i]).margin(1e-11 * 60));
+  const Matrix3d sp = 0.5 * inertia.trace() * Matrix3d::Identity() - inertia;
+  const Matrix3d ds = a.trace() * sp + a * sp + sp * a.transpose();
+  const Matrix3d di = ds.trace() * Matrix3d::Identity() - ds;
+  const std::array<std::pair<int, int>, 6> entries{
+      {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
+  for (size_t e = 0; e < 6; ++e)
+    CHECK(along(grad.inertia[e], two, d) ==
+          Approx(di(entries[e].first, entries[e].second)).margin(1e-11 * inertia.norm()));
+}
+
 TEST_CASE("mass_property_gradients: an affine move's derivative in closed form") {
   // A nonlinear move of the control points would open a trimmed model's edges (each carrier
   // moves its own way); an affine one keeps every model closed. Trimmed faces on planes,
