@@ -507,6 +507,45 @@ TEST_CASE("volume_mm3 ends on a face with an extreme weight, exact or refused, n
   }
 }
 
+TEST_CASE("mass_properties ends on a face with an extreme weight, exact or refused, never hung",
+          "[brep]") {
+  // The volume's case above (issue #36) through the mass properties' own adaptive rule, which
+  // resolves ten moments at once: a corner weight of 1e3 converges to the flux's closed form, one
+  // of 1e6 is refused within the face's budget, naming both faces, never hung. The plate and its
+  // mirror measured as a solid, unchecked (a solid of two loose sheets breaks the invariants).
+  for (double w : {1e3, 1e6}) {
+    INFO("corner weight " << w);
+    Builder b;
+    const int f = b.quad({0, 0, 4}, {10, 0, 0}, {0, 10, 0}, "plate");
+    Body solid;
+    solid.kind = BodyKind::Sheet;
+    solid.shells.push_back({{f}});
+    b.m.bodies.push_back(solid);
+    b.m.faces[static_cast<std::size_t>(f)].loops.clear();
+    b.m.edges.clear();
+    b.m.vertices.clear();
+    clay::surface::BSplineSurface& s = b.m.faces[static_cast<std::size_t>(f)].surface;
+    s.weights = Eigen::VectorXd::Ones(s.points.rows());
+    s.weights(0) = w;
+    add_mirror_below(b.m, 0);
+    b.m.bodies[0].kind = BodyKind::Solid;
+    clay::brep::MassPropertyOptions options;
+    options.body = 0;
+    options.validate = false;
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      const auto p = clay::brep::mass_property_gradients(b.m, options);
+      CHECK(p.value.volume_mm3 == Approx(2.0 / 3.0 * 4 * 100).epsilon(1e-12));
+      CHECK(w < 1e6);
+    } catch (const clay::Error& e) {
+      CHECK(e.category() == clay::ErrorCategory::ToleranceNotMet);
+      CHECK_THAT(e.message(), Contains("the integration did not converge on 2 face(s) (0, 1)"));
+      CHECK(w >= 1e6);
+    }
+    CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(60));
+  }
+}
+
 TEST_CASE("volume_mm3 integrates across a C0 knot line that a loop crosses", "[brep]") {
   // Issue #39 (Alias's k1 key): the loop integrand z (x_u y_v - x_v y_u) v'(t) jumps where a
   // pcurve crosses a C0 knot line in v, and an adaptive rule halving its tolerance with the
