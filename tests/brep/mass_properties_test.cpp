@@ -73,6 +73,22 @@ Matrix3d ball_inertia(double r) {
   return Matrix3d::Identity() * 0.4 * (4.0 / 3.0 * std::numbers::pi * r * r * r) * r * r;
 }
 
+/// The inertia's derivative along the affine move x -> x + ε A x: the second moments about the
+/// centroid S' (from I = tr(S') 1 − S') move by tr(A) S' + A S' + S' Aᵀ, and I with them; each
+/// entry of the gradients against it, within 1e-11 of the inertia.
+void check_inertia_derivative(const clay::brep::MassPropertyGradients& g, const Model& m,
+                              const Matrix3d& a, const Matrix3d& inertia) {
+  const Matrix3d s = 0.5 * inertia.trace() * Matrix3d::Identity() - inertia;
+  const Matrix3d ds = a.trace() * s + a * s + s * a.transpose();
+  const Matrix3d di = ds.trace() * Matrix3d::Identity() - ds;
+  const std::array<std::pair<int, int>, 6> entries{
+      {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
+  const auto d = [&](const Vector3d& x) { return Vector3d(a * x); };
+  for (size_t e = 0; e < 6; ++e)
+    CHECK(along(g.inertia[e], m, d) ==
+          Approx(di(entries[e].first, entries[e].second)).margin(1e-11 * inertia.norm()));
+}
+
 }  // namespace
 
 TEST_CASE("mass_properties: a cube, its affine image and their closed forms") {
@@ -145,14 +161,7 @@ TEST_CASE("mass_properties: two solids apart, each about its own point, put toge
   for (int i = 0; i < 3; ++i)
     CHECK(along(grad.centroid[static_cast<size_t>(i)], two, d) ==
           Approx((a * g)[i]).margin(1e-11 * 60));
-  const Matrix3d sp = 0.5 * inertia.trace() * Matrix3d::Identity() - inertia;
-  const Matrix3d ds = a.trace() * sp + a * sp + sp * a.transpose();
-  const Matrix3d di = ds.trace() * Matrix3d::Identity() - ds;
-  const std::array<std::pair<int, int>, 6> entries{
-      {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
-  for (size_t e = 0; e < 6; ++e)
-    CHECK(along(grad.inertia[e], two, d) ==
-          Approx(di(entries[e].first, entries[e].second)).margin(1e-11 * inertia.norm()));
+  check_inertia_derivative(grad, two, a, inertia);
 }
 
 TEST_CASE("mass_property_gradients: an affine move's derivative in closed form") {
@@ -187,14 +196,7 @@ TEST_CASE("mass_property_gradients: an affine move's derivative in closed form")
     CHECK(along(g.centroid[static_cast<size_t>(i)], moved, d) ==
           Approx((a * g.value.centroid_mm)[i]).margin(1e-11 * 100));  // 1e-11 of the size
   const Matrix3d i0 = g.value.inertia_mm5;
-  const Matrix3d s = 0.5 * i0.trace() * Matrix3d::Identity() - i0;  // S' from I = tr(S') 1 − S'
-  const Matrix3d ds = a.trace() * s + a * s + s * a.transpose();
-  const Matrix3d di = ds.trace() * Matrix3d::Identity() - ds;
-  const std::array<std::pair<int, int>, 6> entries{
-      {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
-  for (size_t e = 0; e < 6; ++e)
-    CHECK(along(g.inertia[e], moved, d) ==
-          Approx(di(entries[e].first, entries[e].second)).margin(1e-11 * i0.norm()));
+  check_inertia_derivative(g, moved, a, i0);
 }
 
 TEST_CASE("mass_property_gradients: central differences under a nonlinear move of the points") {

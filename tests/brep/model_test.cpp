@@ -86,6 +86,26 @@ void add_mirror_below(Model& m, int body) {
   }
 }
 
+/// A sheet body: the plate 10 x 10 at z = 4 (untrimmed: the whole domain, its edges would follow
+/// the old parametrization), one corner weight `w`, and its mirror below (add_mirror_below), so
+/// the flux of (x − c) / 3 through the pair is (2/3) 4 × 100 whatever the weight.
+Model heavy_corner_plates(double w) {
+  Builder b;
+  const int f = b.quad({0, 0, 4}, {10, 0, 0}, {0, 10, 0}, "plate");
+  Body sheet;
+  sheet.kind = BodyKind::Sheet;
+  sheet.shells.push_back({{f}});
+  b.m.bodies.push_back(sheet);
+  b.m.faces[static_cast<std::size_t>(f)].loops.clear();
+  b.m.edges.clear();
+  b.m.vertices.clear();
+  clay::surface::BSplineSurface& s = b.m.faces[static_cast<std::size_t>(f)].surface;
+  s.weights = Eigen::VectorXd::Ones(s.points.rows());
+  s.weights(0) = w;
+  add_mirror_below(b.m, 0);
+  return b.m;
+}
+
 std::string all(const std::vector<std::string>& list) {
   std::string s;
   for (const auto& p : list) s += p + "\n";
@@ -468,21 +488,7 @@ TEST_CASE("volume_mm3 ends on a face with an extreme weight, exact or refused, n
   // (2/3) z × area (add_mirror_below).
   for (double w : {1e3, 1e6, 1e9}) {
     INFO("corner weight " << w);
-    Builder b;
-    const int f = b.quad({0, 0, 4}, {10, 0, 0}, {0, 10, 0}, "plate");
-    Body sheet;
-    sheet.kind = BodyKind::Sheet;
-    sheet.shells.push_back({{f}});
-    b.m.bodies.push_back(sheet);
-    // Untrimmed: the whole domain (its edges would follow the old parametrization).
-    b.m.faces[static_cast<std::size_t>(f)].loops.clear();
-    b.m.edges.clear();
-    b.m.vertices.clear();
-    clay::surface::BSplineSurface& s = b.m.faces[static_cast<std::size_t>(f)].surface;
-    s.weights = Eigen::VectorXd::Ones(s.points.rows());
-    s.weights(0) = w;
-    add_mirror_below(b.m, 0);
-    const Model& m = b.m;
+    const Model m = heavy_corner_plates(w);
     INFO(all(clay::brep::problems(m)));
     REQUIRE(clay::brep::problems(m).empty());
     const auto start = std::chrono::steady_clock::now();
@@ -515,26 +521,14 @@ TEST_CASE("mass_properties ends on a face with an extreme weight, exact or refus
   // mirror measured as a solid, unchecked (a solid of two loose sheets breaks the invariants).
   for (double w : {1e3, 1e6}) {
     INFO("corner weight " << w);
-    Builder b;
-    const int f = b.quad({0, 0, 4}, {10, 0, 0}, {0, 10, 0}, "plate");
-    Body solid;
-    solid.kind = BodyKind::Sheet;
-    solid.shells.push_back({{f}});
-    b.m.bodies.push_back(solid);
-    b.m.faces[static_cast<std::size_t>(f)].loops.clear();
-    b.m.edges.clear();
-    b.m.vertices.clear();
-    clay::surface::BSplineSurface& s = b.m.faces[static_cast<std::size_t>(f)].surface;
-    s.weights = Eigen::VectorXd::Ones(s.points.rows());
-    s.weights(0) = w;
-    add_mirror_below(b.m, 0);
-    b.m.bodies[0].kind = BodyKind::Solid;
+    Model m = heavy_corner_plates(w);
+    m.bodies[0].kind = BodyKind::Solid;
     clay::brep::MassPropertyOptions options;
     options.body = 0;
     options.validate = false;
     const auto start = std::chrono::steady_clock::now();
     try {
-      const auto p = clay::brep::mass_property_gradients(b.m, options);
+      const auto p = clay::brep::mass_property_gradients(m, options);
       CHECK(p.value.volume_mm3 == Approx(2.0 / 3.0 * 4 * 100).epsilon(1e-12));
       CHECK(w < 1e6);
     } catch (const clay::Error& e) {
