@@ -66,51 +66,13 @@ Moments fluxes(const Eigen::Vector3d& y, const Eigen::Vector3d& n) {
   return f;
 }
 
-/// A quadrature node of a face's trimmed domain: ∬_D f du dv ≈ Σ w f(u, v).
-struct Node {
-  double u, v, w;
-};
+using detail::Node;
 
-/// Adaptive on every moment at once, as detail::adaptive on one: [a, b] is accepted when the 16-
-/// and 10-point rules agree to tol (per moment) or to their own rounding, else halved. f(x, rec)
-/// gives the integrand at x and appends the nodes it used (weights per unit of x) to rec when rec
-/// is not null; the nodes of an accepted interval's 16-point rule are appended to `record`,
-/// weighted by the rule.
+/// adaptive_vector on the ten moments.
 template <class F>
 Moments adaptive_moments(double a, double b, F&& f, const Moments& tol, Budget& budget,
-                         std::vector<Node>& record, int depth = 0) {
-  const auto& r16 = rule(16);
-  const auto& r10 = rule(10);
-  const double half = 0.5 * (b - a), mid = 0.5 * (a + b);
-  Moments fine = Moments::Zero(), magnitude = Moments::Zero(), coarse = Moments::Zero();
-  std::vector<Node> mine;
-  for (std::size_t g = 0; g < r16.nodes.size(); ++g) {
-    const std::size_t first = mine.size();
-    const Moments y = r16.weights[g] * f(mid + half * r16.nodes[g], &mine);
-    for (std::size_t k = first; k < mine.size(); ++k) mine[k].w *= r16.weights[g] * half;
-    fine += y;
-    magnitude += y.cwiseAbs();
-  }
-  for (std::size_t g = 0; g < r10.nodes.size(); ++g)
-    coarse += r10.weights[g] * f(mid + half * r10.nodes[g], nullptr);
-  fine *= half;
-  coarse *= half;
-  magnitude *= std::abs(half);
-  const Moments gap = (fine - coarse).cwiseAbs();
-  bool resolved = fine.allFinite();
-  for (int k = 0; k < Moments::RowsAtCompileTime && resolved; ++k)
-    resolved =
-        gap[k] <= tol[k] || gap[k] <= 32 * std::numeric_limits<double>::epsilon() * magnitude[k];
-  if (!fine.allFinite() || (!resolved && (depth >= 40 || --budget.intervals < 0))) {
-    budget.converged = false;
-    resolved = true;
-  }
-  if (resolved) {
-    record.insert(record.end(), mine.begin(), mine.end());
-    return fine;
-  }
-  return adaptive_moments(a, mid, f, tol / 2, budget, record, depth + 1) +
-         adaptive_moments(mid, b, f, tol / 2, budget, record, depth + 1);
+                         std::vector<Node>& record) {
+  return detail::adaptive_vector(a, b, std::forward<F>(f), tol, budget, record);
 }
 
 /// ∫_a^u Φ·n ds at v (F of Green's theorem for every moment), appending its nodes to rec: Gauss
@@ -229,75 +191,20 @@ FaceMoments face_moments(const Model& m, const Face& face, const Eigen::Vector3d
   out.budget = r.budget;
   out.value = r.value;
   if (!gradients) return out;
-  for (auto& g : out.gradient) g = Eigen::MatrixX3d::Zero(s.points.rows(), 3);
-  const int p = s.u.degree, q = s.v.degree;
   // P_k -> P_k + e moves the flux ∬ Φ(y)·(X_u × X_v) by
   // ∬ R_k e·(∇Φᵀ n) + R_k,u e·(X_v × Φ) + R_k,v e·(Φ × X_u), and c -> c + e by −∬ e·(∇Φᵀ n).
-  // With R_k = w_k N_i N_j / W that is w_k [N_j (N_i A + N_i' B) + N_j' N_i C], A = (a − (W_u b +
-  // W_v c) / W) / W, B = b / W, C = c / W (a = ∇Φᵀ n, b = X_v × Φ, c = Φ × X_u, times the node's
-  // weight). The nodes of one inner integral share v, so N_j(v) too: the sums over i are made per
-  // control row along the line, then spread over j once per line ((p + 1) work per node, not
-  // (p + 1)(q + 1): NX 9's B-spline sphere under a (2, 2, 2) lattice, 117 -> 26 s; its values alone
-  // 17 s).
   using Block = Eigen::Matrix<double, 10, 3>;
-  std::vector<Block> along(static_cast<std::size_t>(s.count_u()), Block::Zero());
-  std::vector<Block> across(static_cast<std::size_t>(s.count_u()), Block::Zero());
-  std::array<double, 2 * (surface::max_kernel_degree + 1)> nv{};
-  detail::Isocurve::Point at;
-  for (std::size_t first = 0; first < r.nodes.size();) {
-    const double v = r.nodes[first].v;
-    std::size_t last = first;
-    double lo = r.nodes[first].u, hi = lo;
-    for (; last < r.nodes.size() && r.nodes[last].v == v; ++last) {
-      lo = std::min(lo, r.nodes[last].u);
-      hi = std::max(hi, r.nodes[last].u);
-    }
-    const double u0 = s.u.domain().first, u1 = s.u.domain().second;
-    const detail::Isocurve iso(s, v, std::clamp(lo, u0, u1), std::clamp(hi, u0, u1));
-    int row_lo = s.count_u(), row_hi = -1;
-    for (std::size_t k = first; k < last; ++k) {
-      iso.at(r.nodes[k].u, at);
-      const Eigen::Vector3d y = at.point - centre;
-      const Fields f = fields(y, at.du.cross(at.dv));
-      const double w = r.nodes[k].w, weight = at.weight;
-      Block a, b, c;
-      for (int m2 = 0; m2 < 10; ++m2) {
-        const auto i2 = static_cast<std::size_t>(m2);
-        a.row(m2) = w * f.a[i2].transpose();
-        b.row(m2) = w * at.dv.cross(f.phi[i2]).transpose();
-        c.row(m2) = w * f.phi[i2].cross(at.du).transpose();
-      }
-      out.centre -= a;
-      const Block big_a = (a - (at.weight_u * b + at.weight_v * c) / weight) / weight;
-      const Block big_b = b / weight, big_c = c / weight;
-      for (int i = 0; i <= p; ++i) {
-        const int row = at.span - p + i;
-        const auto r2 = static_cast<std::size_t>(row);
-        const double ni = at.basis[static_cast<std::size_t>(i)];
-        const double di = at.basis[static_cast<std::size_t>(p + 1 + i)];
-        along[r2] += ni * big_a + di * big_b;
-        across[r2] += ni * big_c;
-        row_lo = std::min(row_lo, row);
-        row_hi = std::max(row_hi, row);
-      }
-    }
-    const double vc = std::clamp(v, s.v.domain().first, s.v.domain().second);
-    const int sv = surface::find_span(s.v, vc);
-    surface::basis_derivatives(s.v, sv, vc, 1, nv);
-    for (int row = row_lo; row <= row_hi; ++row) {
-      const auto r2 = static_cast<std::size_t>(row);
-      for (int j = 0; j <= q; ++j) {
-        const Eigen::Index k = s.index(row, sv - q + j);
-        const Block g = s.weights[k] * (nv[static_cast<std::size_t>(j)] * along[r2] +
-                                        nv[static_cast<std::size_t>(q + 1 + j)] * across[r2]);
-        for (int m2 = 0; m2 < 10; ++m2)
-          out.gradient[static_cast<std::size_t>(m2)].row(k) += g.row(m2);
-      }
-      along[r2].setZero();
-      across[r2].setZero();
-    }
-    first = last;
-  }
+  out.gradient = detail::control_point_gradients<10>(
+      s, r.nodes, [&](const detail::Isocurve::Point& at, double w, Block& a, Block& b, Block& c) {
+        const Fields f = fields(at.point - centre, at.du.cross(at.dv));
+        for (int m2 = 0; m2 < 10; ++m2) {
+          const auto i2 = static_cast<std::size_t>(m2);
+          a.row(m2) = w * f.a[i2].transpose();
+          b.row(m2) = w * at.dv.cross(f.phi[i2]).transpose();
+          c.row(m2) = w * f.phi[i2].cross(at.du).transpose();
+        }
+        out.centre -= a;
+      });
   return out;
 }
 

@@ -254,6 +254,16 @@ LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian, cons
   return gradients_at(jacobian, deformed_model(jacobian, points));
 }
 
+LatticeAreaGradient surface_area_gradient(const ModelJacobian& jacobian) {
+  const brep::SurfaceAreaGradient g = brep::surface_area_gradient(jacobian.model);
+  return {g.value, to_lattice(jacobian, g.area)};
+}
+
+LatticeAreaGradient surface_area_gradient(const ModelJacobian& jacobian, const Points3& points) {
+  const brep::SurfaceAreaGradient g = brep::surface_area_gradient(deformed_model(jacobian, points));
+  return {g.value, to_lattice(jacobian, g.area)};
+}
+
 KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
                          const KeptProperties& keep) {
   const std::string name = "keep_properties";

@@ -429,6 +429,11 @@ ShapeFacts facts_of_file(const fs::path& file) {
   TopTools_IndexedMapOfShape faces;
   TopExp::MapShapes(shape, TopAbs_FACE, faces);
   for (int i = 1; i <= faces.Extent(); ++i) {
+    GProp_GProps props;
+    BRepGProp::SurfaceProperties(faces(i), props, 1e-10);
+    facts.area += props.Mass();
+  }
+  for (int i = 1; i <= faces.Extent(); ++i) {
     switch (BRepAdaptor_Surface(TopoDS::Face(faces(i)), false).GetType()) {
       case GeomAbs_Plane:
         ++facts.planes;

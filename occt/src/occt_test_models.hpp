@@ -41,6 +41,7 @@ void write_test_model(TestModel model, const std::filesystem::path& file);
 struct ShapeFacts {
   int solids = 0, shells = 0, faces = 0, edges = 0, vertices = 0;
   double volume = 0;   ///< BRepGProp::VolumeProperties with Eps 1e-9 (0 without solids)
+  double area = 0;     ///< BRepGProp::SurfaceProperties of each distinct face, Eps 1e-10
   bool valid = false;  ///< BRepCheck_Analyzer
   /// Faces per surface type (BRepAdaptor_Surface::GetType), distinct faces.
   int planes = 0, cylinders = 0, cones = 0, spheres = 0, tori = 0, other_surfaces = 0;

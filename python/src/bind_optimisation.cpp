@@ -43,6 +43,15 @@ py::dict gradients_dict(deform::LatticeMassGradients&& g) {
   return d;
 }
 
+py::dict area_dict(const brep::SurfaceArea& a) {
+  py::dict d;
+  d["area_mm2"] = a.area_mm2;
+  d["bound_mm2"] = a.bound_mm2;
+  d["faces_mm2"] =
+      py::array_t<double>(static_cast<py::ssize_t>(a.faces_mm2.size()), a.faces_mm2.data());
+  return d;
+}
+
 /// Refuses a lattice its Jacobian's coefficients do not prove fold-free, unless allowed.
 template <class Lattice>
 void refuse_fold(const Lattice& lattice, bool allow_fold) {
@@ -184,6 +193,26 @@ void bind_optimisation(py::module_& m) {
           "volume_gradient (points, 3), centroid_gradient (3, points, 3), inertia_gradient "
           "(6, points, 3) of xx, yy, zz, xy, xz, yz.")
       .def(
+          "surface_area",
+          [](const ModelJacobian& j, const py::object& points) {
+            deform::LatticeAreaGradient g;
+            if (points.is_none()) {
+              py::gil_scoped_release free;
+              g = deform::surface_area_gradient(j);
+            } else {
+              const Points3 l = points_in(points, "points");
+              py::gil_scoped_release free;
+              g = deform::surface_area_gradient(j, l);
+            }
+            py::dict d = area_dict(g.value);
+            d["area_gradient"] = owned(std::move(g.area));
+            return d;
+          },
+          py::arg("points") = py::none(),
+          "{area_mm2, bound_mm2 (|error| <= it), faces_mm2 (per face), area_gradient (points, "
+          "3)}: the faces' area at the lattice points given (None: the Jacobian's own) and its "
+          "exact gradient with respect to the lattice points.")
+      .def(
           "keep_properties",
           [](const ModelJacobian& j, const py::handle& moved, const py::object& volume,
              const py::object& centroid, const std::vector<int>& held, double tolerance) {
@@ -231,7 +260,25 @@ void bind_optimisation(py::module_& m) {
           py::arg("body") = py::none(),
           "{volume_mm3, centroid_mm (3,), inertia_mm5 (3, 3)}: the solids' mass properties "
           "(unit density; inertia about the centroid), or body `body`'s. An assembly: "
-          "flattened() first.");
+          "flattened() first.")
+      .def(
+          "surface_area",
+          [](const brep::Model& x, const py::object& body) {
+            brep::SurfaceArea a;
+            if (body.is_none()) {
+              py::gil_scoped_release free;
+              a = brep::surface_area(x);
+            } else {
+              const int b = body.cast<int>();
+              py::gil_scoped_release free;
+              a = brep::surface_area(x, b);
+            }
+            return area_dict(a);
+          },
+          py::arg("body") = py::none(),
+          "{area_mm2, bound_mm2, faces_mm2}: the area of every body's faces (solids, shells, "
+          "sheets), or body `body`'s, with a bound on its error (|error| <= bound_mm2) and each "
+          "face's area. An assembly: flattened() first.");
 }
 
 }  // namespace clay::python

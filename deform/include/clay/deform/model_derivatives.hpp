@@ -90,6 +90,22 @@ CLAY_DEFORM_API LatticeMassGradients mass_property_gradients(const ModelJacobian
 CLAY_DEFORM_API LatticeMassGradients mass_property_gradients(const ModelJacobian& jacobian,
                                                              const Points3& points);
 
+/// The area of the model's faces at the jacobian's lattice points (with its error bound,
+/// brep::surface_area) and its gradient with respect to the lattice points.
+struct LatticeAreaGradient {
+  brep::SurfaceArea value;
+  Points3 area;  ///< ∂A/∂L_J (mm)
+};
+
+/// The area of every face of jacobian.model and its gradient with respect to the lattice points:
+/// C_fᵀ times each face's gradient (brep::surface_area_gradient), summed. Throws as
+/// brep::surface_area_gradient.
+CLAY_DEFORM_API LatticeAreaGradient surface_area_gradient(const ModelJacobian& jacobian);
+/// Same at other lattice points (of deformed_model(jacobian, points)). Throws as deformed_model
+/// and brep::surface_area_gradient.
+CLAY_DEFORM_API LatticeAreaGradient surface_area_gradient(const ModelJacobian& jacobian,
+                                                          const Points3& points);
+
 /// What keep_properties holds while the lattice moves.
 struct KeptProperties {
   std::optional<double> volume_mm3;            ///< the solids' total volume
