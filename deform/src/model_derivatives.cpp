@@ -67,6 +67,7 @@ ModelJacobian jacobian_of(const Lattice& lattice, const brep::Model& input) {
                 "and vertices (read a file with faces)");
   const Eigen::Index n = lattice.points.rows();
   out.lattice_points = n;
+  out.points = lattice.points;
   out.faces.resize(m.faces.size());
   for (std::size_t f = 0; f < m.faces.size(); ++f) {
     brep::Face& face = m.faces[f];
@@ -264,12 +265,171 @@ LatticeAreaGradient surface_area_gradient(const ModelJacobian& jacobian, const P
   return {g.value, to_lattice(jacobian, g.area)};
 }
 
+namespace {
+
+/// The free coordinates' feasible set of keep_properties' linear constraints, K y = 0 on the
+/// displacement y = L − jacobian.points (coordinate 3J + c), held coordinates fixed at moved's.
+struct LinearSet {
+  std::vector<Eigen::Index> free;  // the free coordinates
+  Eigen::MatrixXd null;            // orthonormal basis of K's null space on them (free × dim)
+  Points3 projected;               // moved, its free coordinates moved least onto the set
+  bool any = false;                // any linear constraint
+};
+
+Eigen::Vector3d row3(const Points3& p, Eigen::Index r) { return p.row(r).transpose(); }
+
+/// The rows of K: per fixed face, an orthonormal basis of C_f's row space (C_f y = 0 per
+/// coordinate), per symmetry plane y_m(J) − S y_J = 0.
+Eigen::MatrixXd linear_rows(const ModelJacobian& j, const KeptProperties& keep,
+                            const std::string& name) {
+  const Eigen::Index n = j.lattice_points;
+  std::vector<Eigen::RowVectorXd> rows;
+  for (int f : keep.fixed_faces) {
+    if (f < 0 || f >= static_cast<int>(j.faces.size()))
+      throw Error(ErrorCategory::InvalidArgument, name + ": fixed face " + std::to_string(f) +
+                                                      " does not exist; the model has " +
+                                                      std::to_string(j.faces.size()) + " faces");
+    const SparseRows& c = j.faces[static_cast<std::size_t>(f)];
+    if (c.nonZeros() == 0) continue;  // outside the lattice: it never moves
+    std::vector<Eigen::Index> touched;
+    std::vector<Eigen::Index> column(static_cast<std::size_t>(n), -1);
+    for (Eigen::Index r = 0; r < c.rows(); ++r)
+      for (SparseRows::InnerIterator it(c, r); it; ++it)
+        if (column[static_cast<std::size_t>(it.col())] < 0) {
+          column[static_cast<std::size_t>(it.col())] = static_cast<Eigen::Index>(touched.size());
+          touched.push_back(it.col());
+        }
+    Eigen::MatrixXd dt = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(touched.size()), c.rows());
+    for (Eigen::Index r = 0; r < c.rows(); ++r)
+      for (SparseRows::InnerIterator it(c, r); it; ++it)
+        dt(column[static_cast<std::size_t>(it.col())], r) = it.value();
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(dt);
+    qr.setThreshold(1e-10);
+    const Eigen::MatrixXd q = qr.householderQ();
+    for (Eigen::Index k = 0; k < qr.rank(); ++k)
+      for (int coord = 0; coord < 3; ++coord) {
+        Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(3 * n);
+        for (std::size_t t = 0; t < touched.size(); ++t)
+          row[3 * touched[t] + coord] = q(static_cast<Eigen::Index>(t), k);
+        rows.push_back(std::move(row));
+      }
+  }
+  const Eigen::Vector3d lo = j.points.colwise().minCoeff().transpose();
+  const Eigen::Vector3d hi = j.points.colwise().maxCoeff().transpose();
+  const double size = std::max((hi - lo).norm(), 1e-300);
+  for (std::size_t k = 0; k < keep.symmetry_planes.size(); ++k) {
+    const SymmetryPlane& plane = keep.symmetry_planes[k];
+    const std::string which = "symmetry plane " + std::to_string(k);
+    if (!plane.point.allFinite() || !plane.normal.allFinite() || plane.normal.norm() == 0)
+      throw Error(ErrorCategory::InvalidArgument,
+                  name + ": " + which +
+                      " has a zero or non-finite normal or point; give a point "
+                      "on the plane and its normal");
+    const Eigen::Vector3d u = plane.normal.normalized();
+    const Eigen::Matrix3d reflect = Eigen::Matrix3d::Identity() - 2 * u * u.transpose();
+    for (Eigen::Index a = 0; a < n; ++a) {
+      const Eigen::Vector3d x = row3(j.points, a);
+      const Eigen::Vector3d image = x - 2 * (x - plane.point).dot(u) * u;
+      Eigen::Index b = -1;
+      for (Eigen::Index c = 0; c < n && b < 0; ++c)
+        if ((row3(j.points, c) - image).norm() <= 1e-9 * size) b = c;
+      if (b < 0)
+        throw Error(ErrorCategory::InvalidArgument,
+                    name + ": lattice point " + std::to_string(a) + " has no mirror image across " +
+                        which +
+                        ", so the lattice's moves cannot mirror across it; make the "
+                        "lattice symmetric about the plane (a frame centred on it)");
+      if (b < a) continue;  // the pair's rows are already there
+      for (int coord = 0; coord < 3; ++coord) {
+        Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(3 * n);
+        row[3 * b + coord] += 1;
+        for (int d = 0; d < 3; ++d) row[3 * a + d] -= reflect(coord, d);
+        rows.push_back(std::move(row));
+      }
+    }
+  }
+  Eigen::MatrixXd k(static_cast<Eigen::Index>(rows.size()), 3 * n);
+  for (std::size_t r = 0; r < rows.size(); ++r) k.row(static_cast<Eigen::Index>(r)) = rows[r];
+  return k;
+}
+
+LinearSet linear_set(const ModelJacobian& j, const KeptProperties& keep,
+                     const std::vector<bool>& held, const Points3& moved, const std::string& name) {
+  LinearSet out;
+  out.projected = moved;
+  const Eigen::Index n = j.lattice_points;
+  for (Eigen::Index i = 0; i < 3 * n; ++i)
+    if (!held[static_cast<std::size_t>(i / 3)]) out.free.push_back(i);
+  const auto nf = static_cast<Eigen::Index>(out.free.size());
+  const Eigen::MatrixXd k = linear_rows(j, keep, name);
+  out.any = k.rows() > 0;
+  if (!out.any) {
+    out.null = Eigen::MatrixXd::Identity(nf, nf);
+    return out;
+  }
+  Eigen::VectorXd y(3 * n);  // the displacement asked for
+  for (Eigen::Index i = 0; i < 3 * n; ++i) y[i] = moved(i / 3, i % 3) - j.points(i / 3, i % 3);
+  Eigen::MatrixXd kf(k.rows(), nf);
+  Eigen::VectorXd yf(nf);
+  for (Eigen::Index i = 0; i < nf; ++i) {
+    kf.col(i) = k.col(out.free[static_cast<std::size_t>(i)]);
+    yf[i] = y[out.free[static_cast<std::size_t>(i)]];
+  }
+  const Eigen::VectorXd rhs = kf * yf - k * y;  // = −K_H y_H
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(kf.transpose());
+  qr.setThreshold(1e-10);
+  const Eigen::MatrixXd q = qr.householderQ();
+  const Eigen::Index rank = qr.rank();
+  out.null = q.rightCols(nf - rank);
+  const Eigen::MatrixXd range = q.leftCols(rank);
+  Eigen::VectorXd solution = out.null * (out.null.transpose() * yf);
+  if (rank > 0) solution += range * (kf * range).colPivHouseholderQr().solve(rhs);
+  const double lattice_size =
+      std::max((j.points.colwise().maxCoeff() - j.points.colwise().minCoeff()).norm(), 1e-300);
+  if ((kf * solution - rhs).cwiseAbs().maxCoeff() > 1e-9 * lattice_size)
+    throw Error(ErrorCategory::InvalidArgument,
+                name +
+                    ": the held lattice points move a fixed face or break a symmetry plane, "
+                    "and the free points cannot restore it; hold no point that moves a fixed face "
+                    "(or release the face), and drag points so their mirrors may follow");
+  for (Eigen::Index i = 0; i < nf; ++i) {
+    const Eigen::Index c = out.free[static_cast<std::size_t>(i)];
+    out.projected(c / 3, c % 3) = j.points(c / 3, c % 3) + solution[i];
+  }
+  return out;
+}
+
+/// The largest residual of the linear constraints at lattice points l, mm.
+double linear_residual(const ModelJacobian& j, const KeptProperties& keep, const Points3& l) {
+  double worst = 0;
+  for (int f : keep.fixed_faces) {
+    const SparseRows& c = j.faces[static_cast<std::size_t>(f)];
+    if (c.nonZeros() == 0) continue;
+    const Points3 at = c * l;
+    worst = std::max(
+        worst,
+        (at - j.model.faces[static_cast<std::size_t>(f)].surface.points).cwiseAbs().maxCoeff());
+  }
+  if (!keep.symmetry_planes.empty()) {
+    const Eigen::MatrixXd k = linear_rows(j, keep, "keep_properties");
+    Eigen::VectorXd y(3 * j.lattice_points);
+    for (Eigen::Index i = 0; i < y.size(); ++i) y[i] = l(i / 3, i % 3) - j.points(i / 3, i % 3);
+    if (k.rows() > 0) worst = std::max(worst, (k * y).cwiseAbs().maxCoeff());
+  }
+  return worst;
+}
+
+}  // namespace
+
 KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
                          const KeptProperties& keep) {
   const std::string name = "keep_properties";
-  if (!keep.volume_mm3 && !keep.centroid_mm)
+  const bool mass = keep.volume_mm3 || keep.centroid_mm;
+  if (!mass && !keep.area_mm2 && keep.fixed_faces.empty() && keep.symmetry_planes.empty())
     throw Error(ErrorCategory::InvalidArgument,
-                name + ": nothing to keep; give a volume, a centroid or both");
+                name +
+                    ": nothing to keep; give a volume, a centroid, an area, fixed faces or "
+                    "symmetry planes");
   if (!(keep.tolerance > 0 && keep.tolerance < 1e-3))
     throw Error(ErrorCategory::InvalidArgument,
                 name + ": tolerance " + internal::shortest(keep.tolerance) +
@@ -286,48 +446,82 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
     throw Error(ErrorCategory::InvalidArgument,
                 name + ": the volume to keep is " + internal::shortest(*keep.volume_mm3) +
                     " mm^3; give the solid's own volume (finite, not 0)");
+  if (keep.area_mm2 && !(std::isfinite(*keep.area_mm2) && *keep.area_mm2 > 0))
+    throw Error(ErrorCategory::InvalidArgument,
+                name + ": the area to keep is " + internal::shortest(*keep.area_mm2) +
+                    " mm^2; give the faces' own area (finite, positive)");
   if (keep.centroid_mm && !keep.centroid_mm->allFinite())
     throw Error(ErrorCategory::InvalidArgument,
                 name + ": the centroid to keep is not finite; give the solid's own centroid");
   check_points(jacobian, moved, name);
+  if (jacobian.points.rows() != jacobian.lattice_points)
+    throw Error(ErrorCategory::InvalidArgument,
+                name +
+                    ": the Jacobian has no rest points (ModelJacobian::points); take it with "
+                    "model_jacobian");
   const double size = size_of(jacobian.model);
-  // The constraints: residuals and gradients (free rows only) at lattice points L, each divided
-  // by its scale (the volume by the target's, the centroid by the model's size), so the Newton
-  // matrix mixes no units: a volume row ~ L^4 next to centroid rows ~ 1 fell below FullPivLU's
-  // rank threshold for a part of a few metres in mm.
+  const LinearSet linear = linear_set(jacobian, keep, held, moved, name);
+  // A gradient (lattice points × 3) restricted to the linear set's tangent space: its free
+  // coordinates projected onto K's null space (Z Zᵀ), the held ones zero.
+  auto tangent = [&](const Points3& g) {
+    Eigen::VectorXd gf(static_cast<Eigen::Index>(linear.free.size()));
+    for (std::size_t i = 0; i < linear.free.size(); ++i)
+      gf[static_cast<Eigen::Index>(i)] = g(linear.free[i] / 3, linear.free[i] % 3);
+    if (linear.any) gf = linear.null * (linear.null.transpose() * gf);
+    Points3 out = Points3::Zero(g.rows(), 3);
+    for (std::size_t i = 0; i < linear.free.size(); ++i)
+      out(linear.free[i] / 3, linear.free[i] % 3) = gf[static_cast<Eigen::Index>(i)];
+    return out;
+  };
+  // The constraints: residuals and gradients (tangent) at lattice points L, each divided by its
+  // scale (the volume by the target's, the centroid by the model's size), so the Newton matrix
+  // mixes no units: a volume row ~ L^4 next to centroid rows ~ 1 fell below FullPivLU's rank
+  // threshold for a part of a few metres in mm.
   const double volume_scale = keep.volume_mm3 ? std::abs(*keep.volume_mm3) : 1.0;
-  auto constraints = [&](const Points3& l, brep::MassProperties& value,
-                         std::vector<Points3>& gradients) {
-    const LatticeMassGradients g = gradients_at(jacobian, moved_geometry(jacobian, l), false);
-    value = g.value;
+  const double area_scale = keep.area_mm2 ? *keep.area_mm2 : 1.0;
+  auto constraints = [&](const Points3& l, KeptMove& report, std::vector<Points3>& gradients) {
+    const brep::Model m = moved_geometry(jacobian, l);
     std::vector<double> residual;
     gradients.clear();
-    if (keep.volume_mm3) {
-      residual.push_back((g.value.volume_mm3 - *keep.volume_mm3) / volume_scale);
-      gradients.push_back(g.volume / volume_scale);
-    }
-    if (keep.centroid_mm)
-      for (int i = 0; i < 3; ++i) {
-        residual.push_back((g.value.centroid_mm[i] - (*keep.centroid_mm)[i]) / size);
-        gradients.push_back(g.centroid[static_cast<std::size_t>(i)] / size);
+    if (mass) {
+      const LatticeMassGradients g = gradients_at(jacobian, m, false);
+      report.properties = g.value;
+      if (keep.volume_mm3) {
+        residual.push_back((g.value.volume_mm3 - *keep.volume_mm3) / volume_scale);
+        gradients.push_back(tangent(g.volume / volume_scale));
       }
-    for (Points3& d : gradients)
-      for (std::size_t r = 0; r < held.size(); ++r)
-        if (held[r]) d.row(static_cast<Eigen::Index>(r)).setZero();
+      if (keep.centroid_mm)
+        for (int i = 0; i < 3; ++i) {
+          residual.push_back((g.value.centroid_mm[i] - (*keep.centroid_mm)[i]) / size);
+          gradients.push_back(tangent(g.centroid[static_cast<std::size_t>(i)] / size));
+        }
+    }
+    if (keep.area_mm2) {
+      brep::MassPropertyOptions unchecked;
+      unchecked.validate = false;
+      const brep::SurfaceAreaGradient g = brep::surface_area_gradient(m, unchecked);
+      residual.push_back((g.value.area_mm2 - *keep.area_mm2) / area_scale);
+      gradients.push_back(tangent(to_lattice(jacobian, g.area) / area_scale));
+    }
     return Eigen::VectorXd(
         Eigen::Map<Eigen::VectorXd>(residual.data(), static_cast<Eigen::Index>(residual.size())));
   };
   auto met = [&](const Eigen::VectorXd& r, KeptMove& out) {
     int k = 0;
-    out.volume_error = out.centroid_error_mm = 0;
+    out.volume_error = out.centroid_error_mm = out.area_error = 0;
     if (keep.volume_mm3) out.volume_error = std::abs(r[k++]);
-    if (keep.centroid_mm) out.centroid_error_mm = r.segment(k, 3).norm() * size;
-    return out.volume_error <= keep.tolerance && out.centroid_error_mm <= keep.tolerance * size;
+    if (keep.centroid_mm) {
+      out.centroid_error_mm = r.segment(k, 3).norm() * size;
+      k += 3;
+    }
+    if (keep.area_mm2) out.area_error = std::abs(r[k++]);
+    return out.volume_error <= keep.tolerance && out.centroid_error_mm <= keep.tolerance * size &&
+           out.area_error <= keep.tolerance;
   };
   KeptMove out;
-  out.points = moved;
+  out.points = linear.projected;
   std::vector<Points3> directions, gradients;
-  Eigen::VectorXd r = constraints(moved, out.properties, directions);
+  Eigen::VectorXd r = constraints(out.points, out, directions);
   const auto m = static_cast<Eigen::Index>(directions.size());
   gradients = directions;
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
@@ -335,10 +529,11 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
     if (out.iterations == 20)
       throw Error(ErrorCategory::ToleranceNotMet,
                   name + ": 20 Newton steps left the volume " +
-                      internal::shortest(out.volume_error) + " (relative) and the centroid " +
-                      internal::shortest(out.centroid_error_mm) +
-                      " mm off their targets; the move folds the lattice or is too large to "
-                      "correct: move in smaller steps");
+                      internal::shortest(out.volume_error) + " (relative), the centroid " +
+                      internal::shortest(out.centroid_error_mm) + " mm and the area " +
+                      internal::shortest(out.area_error) +
+                      " (relative) off their targets; the move folds the lattice or is too large "
+                      "to correct: move in smaller steps");
     Eigen::MatrixXd j(m, m);  // ∂q_i/∂λ_k = ∇q_i · direction_k
     for (Eigen::Index i = 0; i < m; ++i)
       for (Eigen::Index k = 0; k < m; ++k)
@@ -350,13 +545,15 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
       throw Error(ErrorCategory::InvalidArgument,
                   name +
                       ": the free lattice points cannot change the kept properties "
-                      "independently (every point that moves them is held); hold fewer points");
+                      "independently (every point that moves them is held, fixed or mirrored); "
+                      "hold fewer points");
     lambda -= lu.solve(r);
-    out.points = moved;
+    out.points = linear.projected;
     for (Eigen::Index k = 0; k < m; ++k)
       out.points += lambda[k] * directions[static_cast<std::size_t>(k)];
-    r = constraints(out.points, out.properties, gradients);
+    r = constraints(out.points, out, gradients);
   }
+  if (linear.any) out.linear_error_mm = linear_residual(jacobian, keep, out.points);
   return out;
 }
 

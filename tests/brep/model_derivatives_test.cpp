@@ -273,7 +273,8 @@ TEST_CASE("keep_properties: the centroid with the volume, and bad requests refus
 
   using clay::ErrorCategory;
   CHECK(clay::test::error_of([&] { (void)keep_properties(j, moved, KeptProperties{}); }).second ==
-        "invalid argument: keep_properties: nothing to keep; give a volume, a centroid or both");
+        "invalid argument: keep_properties: nothing to keep; give a volume, a centroid, an area, "
+        "fixed faces or symmetry planes");
   KeptProperties all = keep;
   all.held.clear();
   for (int p = 0; p < static_cast<int>(lattice.points.rows()); ++p) all.held.push_back(p);
@@ -292,6 +293,117 @@ TEST_CASE("keep_properties: the centroid with the volume, and bad requests refus
   CHECK_THAT(
       clay::test::error_of([&] { (void)deformed_model(j, Points3::Zero(3, 3)); }).second,
       Catch::Matchers::Contains("3 lattice points given, but the Jacobian was taken for 36"));
+}
+
+TEST_CASE("keep_properties: a symmetry plane and the volume, checked by the pointwise FFD") {
+  // The sphere in a lattice symmetric about x = 0: a point dragged (held), its mirror follows,
+  // the volume is kept; the FFD of the corrected lattice commutes with the reflection at random
+  // points (F(R x) = R F(x), the pointwise deform_point, not the Jacobian), so the sphere's
+  // centroid stays on the plane.
+  const Model sphere = read(TestModel::Sphere, "sphere-symmetry.step");
+  Frame frame;
+  frame.origin = {-25, -25, -25};
+  frame.s = {50, 0, 0};
+  frame.t = {0, 50, 0};
+  frame.u = {0, 0, 50};
+  BezierLattice lattice = make_bezier_lattice(frame, {2, 2, 2});
+  const ModelJacobian j = model_jacobian(lattice, sphere);
+  const auto before = clay::brep::mass_properties(j.model);
+  const int dragged = static_cast<int>(lattice.index(2, 1, 2));
+  Points3 moved = lattice.points;
+  moved.row(dragged) += Eigen::RowVector3d(3, 2, -1.5);
+  KeptProperties keep;
+  keep.volume_mm3 = before.volume_mm3;
+  keep.symmetry_planes = {SymmetryPlane{Vector3d::Zero(), Vector3d(2, 0, 0)}};
+  keep.held = {dragged};
+  const KeptMove kept = keep_properties(j, moved, keep);
+  CHECK(kept.points.row(dragged) == moved.row(dragged));
+  CHECK(kept.linear_error_mm <= 1e-12);
+  const int mirror = static_cast<int>(lattice.index(0, 1, 2));
+  const auto after = clay::brep::mass_properties(deformed_model(j, kept.points));
+  CHECK(std::abs(after.volume_mm3 / before.volume_mm3 - 1) <= 1e-12);
+  CHECK(std::abs(after.centroid_mm.x()) <= 1e-10);
+  lattice.points = kept.points;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> in(-24, 24);
+  const Eigen::Matrix3d reflect = Eigen::Vector3d(-1, 1, 1).asDiagonal();
+  for (int k = 0; k < 50; ++k) {
+    const Vector3d x(in(rng), in(rng), in(rng));
+    CHECK((deform_point(lattice, reflect * x) - reflect * deform_point(lattice, x)).norm() <=
+          1e-12 * 50);
+  }
+  // the mirror point sits where the dragged one's reflection does
+  CHECK((kept.points.row(mirror) - kept.points.row(dragged) * reflect).norm() <= 1e-12 * 50);
+  // An unsymmetric lattice is refused, named.
+  KeptProperties off = keep;
+  off.symmetry_planes = {SymmetryPlane{Vector3d(1, 0, 0), Vector3d(1, 0, 0)}};
+  CHECK_THAT(clay::test::error_of([&] { (void)keep_properties(j, moved, off); }).second,
+             Catch::Matchers::Contains("has no mirror image across symmetry plane 0"));
+}
+
+TEST_CASE("keep_properties: a fixed face stays put exactly while the volume is kept") {
+  // The filleted block's bottom face fixed, a top lattice point dragged: the bottom face's
+  // control points (deformed_model, the Jacobian's own composition) where they were to 1e-12 of
+  // the size, the volume by volume_mm3 to 1e-12. Holding the points above and below the face at
+  // once (both dragged) cannot keep it: refused, named.
+  const Model block = read(TestModel::FilletedBlock, "block-fixed.step");
+  const BezierLattice lattice = make_bezier_lattice(frame_around(block, 0.1), {2, 2, 1});
+  const ModelJacobian j = model_jacobian(lattice, block);
+  int bottom = 0;
+  double lowest = 1e300;
+  for (std::size_t f = 0; f < j.model.faces.size(); ++f) {
+    const double z = j.model.faces[f].surface.points.col(2).maxCoeff();
+    if (z < lowest) {
+      lowest = z;
+      bottom = static_cast<int>(f);
+    }
+  }
+  const double v0 = clay::brep::volume_mm3(j.model);
+  const int top = static_cast<int>(lattice.index(1, 1, 1));
+  Points3 moved = lattice.points;
+  moved.row(top) += Eigen::RowVector3d(2, -1, 4);
+  KeptProperties keep;
+  keep.volume_mm3 = v0;
+  keep.fixed_faces = {bottom};
+  keep.held = {top};
+  const KeptMove kept = keep_properties(j, moved, keep);
+  const Model after = deformed_model(j, kept.points);
+  const double size = 80;
+  CHECK((after.faces[static_cast<std::size_t>(bottom)].surface.points -
+         j.model.faces[static_cast<std::size_t>(bottom)].surface.points)
+            .cwiseAbs()
+            .maxCoeff() <= 1e-12 * size);
+  CHECK(kept.linear_error_mm <= 1e-12 * size);
+  CHECK(std::abs(clay::brep::volume_mm3(after) / v0 - 1) <= 1e-12);
+  CHECK((kept.points - moved).norm() > 1e-3);  // the bottom layer and the volume corrected it
+  KeptProperties both = keep;
+  const int below = static_cast<int>(lattice.index(1, 1, 0));
+  moved.row(below) += Eigen::RowVector3d(0, 0, 1);
+  both.held = {top, below};
+  CHECK_THAT(clay::test::error_of([&] { (void)keep_properties(j, moved, both); }).second,
+             Catch::Matchers::Contains("move a fixed face or break a symmetry plane"));
+  KeptProperties missing = keep;
+  missing.fixed_faces = {999};
+  CHECK_THAT(clay::test::error_of([&] { (void)keep_properties(j, moved, missing); }).second,
+             Catch::Matchers::Contains("fixed face 999 does not exist"));
+}
+
+TEST_CASE("keep_properties: the area kept, measured by surface_area") {
+  const Model sphere = read(TestModel::Sphere, "sphere-area.step");
+  const BezierLattice lattice = make_bezier_lattice(frame_around(sphere, 0.2), {2, 2, 2});
+  const ModelJacobian j = model_jacobian(lattice, sphere);
+  const double a0 = clay::brep::surface_area(j.model).area_mm2;
+  const int dragged = static_cast<int>(lattice.index(2, 2, 1));
+  Points3 moved = lattice.points;
+  moved.row(dragged) += Eigen::RowVector3d(4, 3, 1);
+  KeptProperties keep;
+  keep.area_mm2 = a0;
+  keep.held = {dragged};
+  const KeptMove kept = keep_properties(j, moved, keep);
+  const auto after = clay::brep::surface_area(deformed_model(j, kept.points));
+  CHECK(std::abs(after.area_mm2 / a0 - 1) <= 1e-12);
+  CHECK(kept.area_error <= 1e-13);
+  CHECK(clay::brep::surface_area(deformed_model(j, moved)).area_mm2 > a0 * (1 + 1e-3));
 }
 
 TEST_CASE("model_jacobian: a face crossing the lattice's boundary is refused, named") {

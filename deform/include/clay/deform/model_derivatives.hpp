@@ -45,6 +45,8 @@ struct ModelJacobian {
   SparseRows vertices;
   /// The lattice's point count (the matrices' columns).
   Eigen::Index lattice_points = 0;
+  /// The lattice points `model` is composed at (lattice_points × 3).
+  Points3 points;
 };
 
 /// The Jacobian of `model` deformed by `lattice` (see above). Throws clay::Error: InvalidGeometry
@@ -106,10 +108,23 @@ CLAY_DEFORM_API LatticeAreaGradient surface_area_gradient(const ModelJacobian& j
 CLAY_DEFORM_API LatticeAreaGradient surface_area_gradient(const ModelJacobian& jacobian,
                                                           const Points3& points);
 
+/// A plane the lattice's displacement mirrors across: a part symmetric about it stays symmetric.
+struct SymmetryPlane {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitX();  ///< any length but 0
+};
+
 /// What keep_properties holds while the lattice moves.
 struct KeptProperties {
   std::optional<double> volume_mm3;            ///< the solids' total volume
   std::optional<Eigen::Vector3d> centroid_mm;  ///< their centroid
+  std::optional<double> area_mm2;              ///< the faces' total area (brep::surface_area)
+  /// Faces (indices into jacobian.model.faces) that stay exactly where jacobian.model has them:
+  /// C_f L = P_f, linear in the lattice points L (a mounting face, a flange).
+  std::vector<int> fixed_faces;
+  /// Planes the displacement L − jacobian.points mirrors across (L_m(J) − rest_m(J) =
+  /// S (L_J − rest_J), S the reflection; the lattice's rest points must be symmetric about each).
+  std::vector<SymmetryPlane> symmetry_planes;
   /// Lattice points (indices) the correction leaves where `moved` has them: the dragged point,
   /// or the points that hold a face fixed.
   std::vector<int> held;
@@ -124,16 +139,25 @@ struct KeptMove {
   int iterations = 0;               ///< Newton steps taken
   double volume_error = 0;          ///< |V − target| / target (0 when the volume is not kept)
   double centroid_error_mm = 0;     ///< |g − target| (0 when the centroid is not kept)
+  double area_error = 0;            ///< |A − target| / target (0 when the area is not kept)
+  /// The largest residual of the linear constraints (fixed faces' control points, mirrored
+  /// displacements), mm; 0 when there are none.
+  double linear_error_mm = 0;
 };
 
-/// `moved` corrected so that the kept properties hold: moved + G λ, G the kept properties'
-/// gradients with respect to the free points (rows of held points zeroed) at `moved`, λ by
-/// Newton (V is cubic along the correction: two or three steps reach 1e-13). The smallest
-/// correction in the span of the gradients (Sederberg–Parry §4's volume constraint, on exact
-/// geometry). Throws InvalidArgument when nothing is kept, a held index is out of range or the
-/// free points cannot change a kept property (every point held); ToleranceNotMet when 20 steps
-/// do not reach the tolerance (the move folds the lattice or is too large to correct: smaller
-/// steps).
+/// `moved` corrected so that the kept properties hold. The linear ones first (fixed faces,
+/// symmetry planes): the free points (not held) moved least, in the least-squares sense, onto
+/// the affine set K L = b they define (an orthonormal basis Z of K's null space on the free
+/// coordinates, by a column-pivoting QR). Then the nonlinear ones: + G λ, G the kept properties'
+/// gradients with respect to the free points projected onto that null space (Z Zᵀ), λ by Newton
+/// (V is cubic along the correction: two or three steps reach 1e-13), so every step keeps the
+/// linear ones. The smallest correction in the span of the gradients (Sederberg–Parry §4's
+/// volume constraint, on exact geometry). Throws InvalidArgument when nothing is kept, an index
+/// is out of range, a plane's normal is zero or the lattice's rest points are not symmetric about
+/// it, the held points break a linear constraint that the free ones cannot restore (a dragged
+/// point that moves a fixed face), or the free points cannot change a kept property (every
+/// point held); ToleranceNotMet when 20 steps do not reach the tolerance (the move folds the
+/// lattice or is too large to correct: smaller steps).
 CLAY_DEFORM_API KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
                                          const KeptProperties& keep);
 
