@@ -344,6 +344,10 @@ int deform_model_file(const fs::path& file, const fs::path& recipe_file,
         "steps, points corrected by up to %.3g mm)\n",
         k.step.c_str(), k.volume_before_mm3, k.volume_after_mm3, k.centroid_shift_mm, k.iterations,
         k.largest_correction_mm);
+  for (const auto& k : result.kept)
+    if (std::find(k.properties.begin(), k.properties.end(), "area") != k.properties.end())
+      std::printf("  %s kept the area %.10g -> %.10g mm^2\n", k.step.c_str(), k.area_before_mm2,
+                  k.area_after_mm2);
   if (!result.fold_free)
     std::printf(
         "  WARNING: a lattice may fold (a Jacobian bound <= 0, allowed by --allow-fold): "

@@ -500,6 +500,7 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
       brep::MassPropertyOptions unchecked;
       unchecked.validate = false;
       const brep::SurfaceAreaGradient g = brep::surface_area_gradient(m, unchecked);
+      report.area_mm2 = g.value.area_mm2;
       residual.push_back((g.value.area_mm2 - *keep.area_mm2) / area_scale);
       gradients.push_back(tangent(to_lattice(jacobian, g.area) / area_scale));
     }

@@ -493,7 +493,7 @@ void RecipeChecker::stack(const std::string& name, const Json& j, const std::str
 }
 
 std::vector<std::string> RecipeChecker::kept_properties(const Json& j, const std::string& path) {
-  static const std::vector<std::string> known = {"volume", "centroid"};
+  static const std::vector<std::string> known = {"volume", "centroid", "area"};
   std::vector<std::string> out;
   if (!j.is_array() || j.empty()) {
     c_.add(path, "expected a list of properties the move keeps, such as [\"volume\"], found " +

@@ -320,6 +320,8 @@ Json model_figures(const ModelRunResult& r) {
                       {"volume_before_mm3", k.volume_before_mm3},
                       {"volume_after_mm3", k.volume_after_mm3},
                       {"centroid_shift_mm", k.centroid_shift_mm},
+                      {"area_before_mm2", k.area_before_mm2},
+                      {"area_after_mm2", k.area_after_mm2},
                       {"newton_steps", k.iterations},
                       {"largest_correction_mm", k.largest_correction_mm}});
     model["kept"] = kept;

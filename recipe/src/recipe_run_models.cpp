@@ -257,7 +257,9 @@ ModelRunResult::Kept keep_step(Lattice& lattice, const brep::Model& model,
   out.properties = properties;
   bool solid = false;
   for (const brep::Body& b : model.bodies) solid = solid || b.kind == brep::BodyKind::Solid;
-  if (!solid)
+  const bool mass = std::find(properties.begin(), properties.end(), "area") == properties.end() ||
+                    properties.size() > 1;
+  if (!solid && mass)
     throw Error(ErrorCategory::InvalidArgument,
                 where +
                     ": \"keep\" holds a solid's volume or centroid, but the model has no "
@@ -272,15 +274,16 @@ ModelRunResult::Kept keep_step(Lattice& lattice, const brep::Model& model,
                                   e.message());
   }
   brep::MassProperties before;
+  deform::KeptProperties keep;
   try {
-    before = brep::mass_properties(model);
+    if (mass) before = brep::mass_properties(model);
+    for (const std::string& p : properties) {
+      if (p == "volume") keep.volume_mm3 = before.volume_mm3;
+      if (p == "centroid") keep.centroid_mm = before.centroid_mm;
+      if (p == "area") keep.area_mm2 = out.area_before_mm2 = brep::surface_area(model).area_mm2;
+    }
   } catch (const Error& e) {
     throw Error(e.category(), where + ": \"keep\" measures the model first: " + e.message());
-  }
-  deform::KeptProperties keep;
-  for (const std::string& p : properties) {
-    if (p == "volume") keep.volume_mm3 = before.volume_mm3;
-    if (p == "centroid") keep.centroid_mm = before.centroid_mm;
   }
   // The points the step moved stay where it put them (a drag stays under the cursor); a point
   // within 1e-9 of the frame's size of its rest position (a recipe's "points" rounded on a round
@@ -304,6 +307,7 @@ ModelRunResult::Kept keep_step(Lattice& lattice, const brep::Model& model,
   }
   out.volume_before_mm3 = before.volume_mm3;
   out.volume_after_mm3 = kept.properties.volume_mm3;
+  if (keep.area_mm2) out.area_after_mm2 = kept.area_mm2;
   out.centroid_shift_mm = (kept.properties.centroid_mm - before.centroid_mm).norm();
   out.iterations = kept.iterations;
   out.largest_correction_mm = (kept.points - lattice.points).rowwise().norm().maxCoeff();

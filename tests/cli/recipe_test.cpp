@@ -4,6 +4,8 @@
 // lattice built here from the same numbers), closed forms, the exchange read-back.
 #include <catch2/catch.hpp>
 
+#include <clay/brep/mass_properties.hpp>
+
 #include <clay/brep/volume.hpp>
 #include <clay/deform/extended_lattice.hpp>
 #include <clay/deform/lattice.hpp>
@@ -344,9 +346,21 @@ TEST_CASE("a lattice step's \"keep\" holds the model's volume while its points m
   // The lifted points stay where the step put them: the top's middle is still 6 mm higher.
   CHECK(k.faces_exact == 17);
 
+  // "area": the faces' area kept instead, measured by brep::surface_area on the result (its
+  // own integration of the written model), while the volume changes.
+  const auto area = run_recipe(parse_recipe(text(R"(, "keep": ["area"])"), models));
+  REQUIRE(area.models.size() == 1);
+  REQUIRE(area.models[0].kept.size() == 1);
+  const auto& by_area = area.models[0].kept[0];
+  const double a0 =
+      clay::brep::surface_area(clay::brep::read_model(models / "block.step").model).area_mm2;
+  CHECK(by_area.area_before_mm2 == Approx(a0).epsilon(1e-14));
+  CHECK(std::abs(clay::brep::surface_area(area.models[0].model).area_mm2 / a0 - 1) <= 1e-12);
+  CHECK(std::abs(by_area.area_after_mm2 / a0 - 1) <= 1e-12);
+  CHECK(clay::brep::surface_area(free.models[0].model).area_mm2 / a0 - 1 > 0.01);
   // The checker and the run refuse what "keep" cannot do, naming the step and the fix.
   CHECK(mentions(check_recipe(text(R"(, "keep": ["mass"])")), "deformations.lift[0].keep[0]",
-                 "expected one of volume, centroid"));
+                 "expected one of volume, centroid, area"));
   CHECK(mentions(check_recipe(text(R"(, "keep": "volume")")), "deformations.lift[0].keep",
                  "[\"volume\"]"));
   CHECK(mentions(check_recipe(text(R"(, "keep": ["volume", "volume"])")),

@@ -135,7 +135,8 @@ struct KeptProperties {
 /// A move corrected to keep properties, and how it went.
 struct KeptMove {
   Points3 points;                   ///< the corrected lattice points
-  brep::MassProperties properties;  ///< at them
+  brep::MassProperties properties;  ///< at them (when the volume or centroid is kept)
+  double area_mm2 = 0;              ///< the area at them (when the area is kept)
   int iterations = 0;               ///< Newton steps taken
   double volume_error = 0;          ///< |V − target| / target (0 when the volume is not kept)
   double centroid_error_mm = 0;     ///< |g − target| (0 when the centroid is not kept)
