@@ -215,11 +215,26 @@ void bind_optimisation(py::module_& m) {
       .def(
           "keep_properties",
           [](const ModelJacobian& j, const py::handle& moved, const py::object& volume,
-             const py::object& centroid, const std::vector<int>& held, double tolerance) {
+             const py::object& centroid, const py::object& area, const std::vector<int>& held,
+             const std::vector<int>& fixed_faces, const py::list& symmetry_planes,
+             double tolerance) {
             deform::KeptProperties keep;
             if (!volume.is_none()) keep.volume_mm3 = volume.cast<double>();
             if (!centroid.is_none()) keep.centroid_mm = vec3(centroid, "centroid_mm");
+            if (!area.is_none()) keep.area_mm2 = area.cast<double>();
             keep.held = held;
+            keep.fixed_faces = fixed_faces;
+            for (std::size_t i = 0; i < symmetry_planes.size(); ++i) {
+              const py::handle plane = symmetry_planes[i];
+              if (!py::isinstance<py::sequence>(plane) || py::isinstance<py::str>(plane) ||
+                  py::len(plane) != 2)
+                throw Error(ErrorCategory::InvalidArgument,
+                            "keep_properties: symmetry_planes[" + std::to_string(i) +
+                                "]: expected a (point, normal) pair of 3-vectors");
+              const auto pair = py::reinterpret_borrow<py::sequence>(plane);
+              keep.symmetry_planes.push_back(
+                  {vec3(pair[0], "symmetry plane point"), vec3(pair[1], "symmetry plane normal")});
+            }
             keep.tolerance = tolerance;
             const Points3 l = points_in(moved, "moved");
             deform::KeptMove k;
@@ -231,14 +246,21 @@ void bind_optimisation(py::module_& m) {
             d["iterations"] = k.iterations;
             d["volume_error"] = k.volume_error;
             d["centroid_error_mm"] = k.centroid_error_mm;
+            d["area_mm2"] = k.area_mm2;
+            d["area_error"] = k.area_error;
+            d["linear_error_mm"] = k.linear_error_mm;
             return py::make_tuple(owned(std::move(k.points)), d);
           },
           py::arg("moved"), py::kw_only(), py::arg("volume_mm3") = py::none(),
-          py::arg("centroid_mm") = py::none(), py::arg("held") = std::vector<int>{},
-          py::arg("tolerance") = 1e-13,
-          "(points, report): the moved lattice points corrected along the kept properties' "
-          "gradients (Newton) so that the volume and/or centroid equal the targets to "
-          "`tolerance` (relative); `held` points do not move (the dragged one).");
+          py::arg("centroid_mm") = py::none(), py::arg("area_mm2") = py::none(),
+          py::arg("held") = std::vector<int>{}, py::arg("fixed_faces") = std::vector<int>{},
+          py::arg("symmetry_planes") = py::list(), py::arg("tolerance") = 1e-13,
+          "(points, report): the moved lattice points corrected so that the fixed faces stay "
+          "exactly where they are and the displacement mirrors across the symmetry planes "
+          "((point, normal) pairs; least squares onto those linear constraints first), then "
+          "along the kept properties' projected gradients (Newton) so that the volume, centroid "
+          "and/or area equal the targets to `tolerance` (relative); `held` points do not move "
+          "(the dragged one).");
 
   lattice_methods(py::reinterpret_borrow<py::class_<BezierLattice>>(m.attr("BezierLattice")));
   lattice_methods(py::reinterpret_borrow<py::class_<BSplineLattice>>(m.attr("BSplineLattice")));

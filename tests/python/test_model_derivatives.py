@@ -99,6 +99,53 @@ def test_a_drag_keeps_the_volume(examples: Path) -> None:
         j.keep_properties(moved)
 
 
+def test_surface_area_its_bound_and_gradient(examples: Path) -> None:
+    model = block(examples)
+    a = model.surface_area()
+    assert a["bound_mm2"] < 1e-10 * a["area_mm2"]
+    assert np.sum(a["faces_mm2"]) == pytest.approx(a["area_mm2"], rel=1e-15)
+    lat = lattice_for(model, seed=4)
+    j = lat.model_jacobian(model)
+    g = j.surface_area()
+    assert g["area_gradient"].shape == (len(lat.points), 3)
+    direction = np.random.default_rng(2).normal(size=lat.points.shape)
+    da = five_point(lambda h: j.surface_area(lat.points + h * direction)["area_mm2"], 0.01)
+    assert np.sum(g["area_gradient"] * direction) == pytest.approx(da, rel=1e-9)
+    # Homogeneous of degree 2 in the points: a scaling about any point gives 2 A.
+    scaling = lat.points - lat.points.mean(axis=0)
+    assert np.sum(g["area_gradient"] * scaling) == pytest.approx(2 * g["area_mm2"], rel=1e-12)
+
+
+def test_a_drag_keeps_a_fixed_face_and_a_symmetry_plane(examples: Path) -> None:
+    model = block(examples)
+    lo, hi = (np.array(c) for c in model.bounding_box())
+    pad = 0.1 * (hi - lo)
+    size = hi - lo + 2 * pad
+    lat = cf.BezierLattice(lo - pad, [size[0], 0, 0], [0, size[1], 0], [0, 0, size[2]], (2, 2, 1))
+    j = lat.model_jacobian(model)
+    bottom = int(np.argmin([j.model.face_surface(f).points[:, 2].max() for f in range(len(j.faces))]))
+    middle = (lo + hi) / 2
+    v0 = j.mass_properties()["volume_mm3"]
+    moved = lat.points.copy()
+    dragged = lat.index(2, 1, 1)
+    moved[dragged] += [3.0, 0.0, 4.0]
+    points, report = j.keep_properties(
+        moved, volume_mm3=v0, held=[dragged], fixed_faces=[bottom],
+        symmetry_planes=[(middle, [0.0, 1.0, 0.0])])
+    assert report["linear_error_mm"] < 1e-12 * 80
+    after = j.deformed(points)
+    assert np.max(np.abs(after.face_surface(bottom).points - j.model.face_surface(bottom).points)) < 1e-12 * 80
+    assert abs(after.volume_mm3() / v0 - 1) < 1e-12
+    # y displacements mirror across the middle plane: point (i, k, l) and (i, 2 - k, l)
+    d = points - lat.points
+    for i in range(3):
+        for layer in range(2):
+            a, b = d[lat.index(i, 0, layer)], d[lat.index(i, 2, layer)]
+            assert np.allclose([a[0], -a[1], a[2]], b, atol=1e-12 * 80)
+    with pytest.raises(cf.InvalidArgumentError, match="symmetry_planes"):
+        j.keep_properties(moved, volume_mm3=v0, symmetry_planes=[(middle,)])
+
+
 def test_jacobian_constraints_and_a_folded_lattice(examples: Path) -> None:
     model = block(examples)
     lat = lattice_for(model, seed=2)
