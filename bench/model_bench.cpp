@@ -306,6 +306,50 @@ void BM_KeepVolumeDrag(benchmark::State& state) {
   jacobian_counters(state);
 }
 
+// The area with its bound and gradient (adaptive inner rule: |n| is not polynomial), against the
+// surface area alone and against the volume's fixed rule above.
+void BM_SurfaceAreaGradient(benchmark::State& state) {
+  const auto& j = plate_jacobian();
+  double bound = 0;
+  for (auto _ : state) bound = deform::surface_area_gradient(j).value.bound_mm2;
+  state.counters["bound_mm2"] = bound;
+  jacobian_counters(state);
+}
+
+void BM_SurfaceArea(benchmark::State& state) {
+  const auto& j = plate_jacobian();
+  for (auto _ : state) benchmark::DoNotOptimize(brep::surface_area(j.model));
+  jacobian_counters(state);
+}
+
+// A drag keeping the volume with the plate's bottom face fixed and the middle plane x = const a
+// symmetry plane: the linear constraints' QR and the projected Newton steps.
+void BM_KeepVolumeFixedSymmetricDrag(benchmark::State& state) {
+  // The lattice at rest (symmetric about its middle plane), not plate_lattice's moved one.
+  const deform::BezierLattice lattice = deform::make_bezier_lattice(around_plate(), {2, 2, 1});
+  static const deform::ModelJacobian j = deform::model_jacobian(lattice, plate());
+  deform::KeptProperties keep;
+  keep.volume_mm3 = brep::volume_mm3(j.model);
+  int bottom = 0;
+  double lowest = 1e300;
+  for (std::size_t f = 0; f < j.model.faces.size(); ++f)
+    if (j.faces[f].nonZeros() > 0 && j.model.faces[f].surface.points.col(2).maxCoeff() < lowest) {
+      lowest = j.model.faces[f].surface.points.col(2).maxCoeff();
+      bottom = static_cast<int>(f);
+    }
+  keep.fixed_faces = {bottom};
+  const Eigen::Vector3d middle = j.points.colwise().mean().transpose();
+  keep.symmetry_planes = {{middle, lattice.frame.s}};
+  const int dragged = static_cast<int>(lattice.index(1, 2, 1));
+  keep.held = {dragged};
+  surface::Points3 moved = lattice.points;
+  moved.row(dragged) += Eigen::RowVector3d(0, 3, 4);
+  int iterations = 0;
+  for (auto _ : state) iterations = deform::keep_properties(j, moved, keep).iterations;
+  state.counters["newton_steps"] = iterations;
+  jacobian_counters(state);
+}
+
 BENCHMARK(BM_ModelJacobian)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ModelJacobianReferenceDeform)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ModelJacobianTransposeProduct)->Unit(benchmark::kMillisecond);
@@ -313,6 +357,9 @@ BENCHMARK(BM_DeformedModel)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MassPropertyGradients)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MassPropertyReferenceVolume)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_KeepVolumeDrag)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SurfaceAreaGradient)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SurfaceArea)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_KeepVolumeFixedSymmetricDrag)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TwistBlockEdges)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Read)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DeformExact)->Unit(benchmark::kMillisecond);
