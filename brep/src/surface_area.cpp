@@ -52,9 +52,11 @@ std::pair<double, double> inner(const surface::BSplineSurface& s, double a, doub
 
 /// One face's area, its error bound and the nodes that integrate it (their weights carry the
 /// loops' orientation), and whether the integration converged. The bound: the sum over the
-/// accepted intervals along the loops of |16-point − 10-point| (the coarser rule's error; the
-/// area is the finer's) plus the outer rule applied to the inner integrals' own bounds (each the
-/// same sum along u), times |v'|: |Q[G̃] − ∫G| ≤ Q[|G̃ − G|] + |Q[G] − ∫G|.
+/// accepted intervals along the loops of |Q16 − Q10| (the coarser rule's error; the area is the
+/// finer's) plus three times the outer rule applied to the inner integrals' own bounds e (each
+/// the same sum along u) times |v'|: the gap is measured on the inexact G̃, so
+/// |Q16[G] − Q10[G]| ≤ gap + Q16[e] + Q10[e], and |Q16[G̃] − ∫G| ≤ Q16[e] + |Q16[G] − ∫G|
+/// (Q10[e] taken as Q16[e]: both rules integrate the same smooth bound).
 struct FaceArea {
   double area = 0, bound = 0;
   std::vector<Node> nodes;
@@ -83,7 +85,7 @@ FaceArea face_area(const Model& m, const Face& face, double tol) {
           },
           tols, out.budget, out.nodes, &gaps);
       out.area += along[0];
-      out.bound += gaps[0] + std::abs(along[1]);
+      out.bound += gaps[0] + 3 * std::abs(along[1]);
     }
     return out;
   }
@@ -109,7 +111,7 @@ FaceArea face_area(const Model& m, const Face& face, double tol) {
         along += detail::adaptive_vector(pieces[k], pieces[k + 1], integrand, tols, out.budget,
                                          out.nodes, &gaps);
       out.area += co.same_sense ? along[0] : -along[0];
-      out.bound += gaps[0] + std::abs(along[1]);
+      out.bound += gaps[0] + 3 * std::abs(along[1]);
       if (!co.same_sense)
         for (std::size_t k = first; k < out.nodes.size(); ++k) out.nodes[k].w = -out.nodes[k].w;
     }
@@ -139,7 +141,7 @@ std::vector<bool> measured_faces(const Model& model, int body, const char* funct
   if (!any)
     throw Error(ErrorCategory::InvalidArgument,
                 name + ": " +
-                    (body < 0 ? std::string("the model has no face")
+                    (body < 0 ? std::string("no body of the model has a face")
                               : "body " + std::to_string(body) + " has no face (a wire body)") +
                     ": the area is that of faces; measure a solid, shell or sheet");
   return out;

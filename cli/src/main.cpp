@@ -338,16 +338,19 @@ int deform_model_file(const fs::path& file, const fs::path& recipe_file,
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("%s: %s in %.2f s\n", file.string().c_str(), result.report.brief().c_str(), seconds);
-  for (const auto& k : result.kept)
-    std::printf(
-        "  %s kept the volume %.10g -> %.10g mm^3 (centroid moved %.2g mm; %d Newton "
-        "steps, points corrected by up to %.3g mm)\n",
-        k.step.c_str(), k.volume_before_mm3, k.volume_after_mm3, k.centroid_shift_mm, k.iterations,
-        k.largest_correction_mm);
-  for (const auto& k : result.kept)
-    if (std::find(k.properties.begin(), k.properties.end(), "area") != k.properties.end())
+  for (const auto& k : result.kept) {
+    auto has = [&](const char* p) {
+      return std::find(k.properties.begin(), k.properties.end(), p) != k.properties.end();
+    };
+    if (has("volume") || has("centroid"))
+      std::printf("  %s kept the volume %.10g -> %.10g mm^3 (centroid moved %.2g mm)\n",
+                  k.step.c_str(), k.volume_before_mm3, k.volume_after_mm3, k.centroid_shift_mm);
+    if (has("area"))
       std::printf("  %s kept the area %.10g -> %.10g mm^2\n", k.step.c_str(), k.area_before_mm2,
                   k.area_after_mm2);
+    std::printf("  %s: %d Newton steps, points corrected by up to %.3g mm\n", k.step.c_str(),
+                k.iterations, k.largest_correction_mm);
+  }
   if (!result.fold_free)
     std::printf(
         "  WARNING: a lattice may fold (a Jacobian bound <= 0, allowed by --allow-fold): "

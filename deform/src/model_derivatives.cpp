@@ -479,21 +479,27 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
   // threshold for a part of a few metres in mm.
   const double volume_scale = keep.volume_mm3 ? std::abs(*keep.volume_mm3) : 1.0;
   const double area_scale = keep.area_mm2 ? *keep.area_mm2 : 1.0;
+  std::vector<double> raw;  // each row's gradient norm before the projection
+  auto project = [&](const Points3& g) {
+    raw.push_back(g.norm());
+    return tangent(g);
+  };
   auto constraints = [&](const Points3& l, KeptMove& report, std::vector<Points3>& gradients) {
     const brep::Model m = moved_geometry(jacobian, l);
     std::vector<double> residual;
     gradients.clear();
+    raw.clear();
     if (mass) {
       const LatticeMassGradients g = gradients_at(jacobian, m, false);
       report.properties = g.value;
       if (keep.volume_mm3) {
         residual.push_back((g.value.volume_mm3 - *keep.volume_mm3) / volume_scale);
-        gradients.push_back(tangent(g.volume / volume_scale));
+        gradients.push_back(project(g.volume / volume_scale));
       }
       if (keep.centroid_mm)
         for (int i = 0; i < 3; ++i) {
           residual.push_back((g.value.centroid_mm[i] - (*keep.centroid_mm)[i]) / size);
-          gradients.push_back(tangent(g.centroid[static_cast<std::size_t>(i)] / size));
+          gradients.push_back(project(g.centroid[static_cast<std::size_t>(i)] / size));
         }
     }
     if (keep.area_mm2) {
@@ -502,7 +508,7 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
       const brep::SurfaceAreaGradient g = brep::surface_area_gradient(m, unchecked);
       report.area_mm2 = g.value.area_mm2;
       residual.push_back((g.value.area_mm2 - *keep.area_mm2) / area_scale);
-      gradients.push_back(tangent(to_lattice(jacobian, g.area) / area_scale));
+      gradients.push_back(project(to_lattice(jacobian, g.area) / area_scale));
     }
     return Eigen::VectorXd(
         Eigen::Map<Eigen::VectorXd>(residual.data(), static_cast<Eigen::Index>(residual.size())));
@@ -523,6 +529,44 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
   out.points = linear.projected;
   std::vector<Points3> directions, gradients;
   Eigen::VectorXd r = constraints(out.points, out, directions);
+  // A property the linear constraints freeze (the centroid's component across a symmetry plane
+  // of a symmetric part: its projected gradient vanishes) has no Newton direction: met already,
+  // it leaves the system (met() still checks it); not met, no allowed move reaches its target.
+  static const char* const row_names[] = {"volume", "centroid x", "centroid y", "centroid z",
+                                          "area"};
+  std::vector<std::string> names;
+  if (keep.volume_mm3) names.push_back(row_names[0]);
+  if (keep.centroid_mm)
+    for (int i = 1; i <= 3; ++i) names.push_back(row_names[i]);
+  if (keep.area_mm2) names.push_back(row_names[4]);
+  std::vector<std::size_t> active;
+  for (std::size_t i = 0; i < directions.size(); ++i) {
+    if (directions[i].norm() > 1e-8 * raw[i]) {
+      active.push_back(i);
+      continue;
+    }
+    // every residual is relative: the volume and area by their targets, the centroid by the size
+    const double tolerance = keep.tolerance;
+    if (std::abs(r[static_cast<Eigen::Index>(i)]) > tolerance)
+      throw Error(ErrorCategory::InvalidArgument,
+                  name + ": the held points, fixed faces and symmetry planes hold the " + names[i] +
+                      " where it is, so no allowed move reaches its target (" +
+                      internal::shortest(std::abs(r[static_cast<Eigen::Index>(i)])) +
+                      " off, relative); hold fewer points, give a target the constraints allow "
+                      "(a centroid on the symmetry plane), or drop a constraint");
+  }
+  auto pick = [&](std::vector<Points3>& all) {
+    std::vector<Points3> kept_rows;
+    for (std::size_t i : active) kept_rows.push_back(all[i]);
+    all = std::move(kept_rows);
+  };
+  auto picked = [&](const Eigen::VectorXd& all) {
+    Eigen::VectorXd out_rows(static_cast<Eigen::Index>(active.size()));
+    for (std::size_t k = 0; k < active.size(); ++k)
+      out_rows[static_cast<Eigen::Index>(k)] = all[static_cast<Eigen::Index>(active[k])];
+    return out_rows;
+  };
+  pick(directions);
   const auto m = static_cast<Eigen::Index>(directions.size());
   gradients = directions;
   Eigen::VectorXd lambda = Eigen::VectorXd::Zero(m);
@@ -548,11 +592,12 @@ KeptMove keep_properties(const ModelJacobian& jacobian, const Points3& moved,
                       ": the free lattice points cannot change the kept properties "
                       "independently (every point that moves them is held, fixed or mirrored); "
                       "hold fewer points");
-    lambda -= lu.solve(r);
+    lambda -= lu.solve(picked(r));
     out.points = linear.projected;
     for (Eigen::Index k = 0; k < m; ++k)
       out.points += lambda[k] * directions[static_cast<std::size_t>(k)];
     r = constraints(out.points, out, gradients);
+    pick(gradients);
   }
   if (linear.any) out.linear_error_mm = linear_residual(jacobian, keep, out.points);
   return out;

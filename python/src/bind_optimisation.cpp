@@ -242,12 +242,16 @@ void bind_optimisation(py::module_& m) {
               py::gil_scoped_release free;
               k = deform::keep_properties(j, l, keep);
             }
-            py::dict d = properties_dict(k.properties);
+            // The mass properties only when measured (the volume or centroid kept).
+            py::dict d =
+                keep.volume_mm3 || keep.centroid_mm ? properties_dict(k.properties) : py::dict();
             d["iterations"] = k.iterations;
             d["volume_error"] = k.volume_error;
             d["centroid_error_mm"] = k.centroid_error_mm;
-            d["area_mm2"] = k.area_mm2;
-            d["area_error"] = k.area_error;
+            if (keep.area_mm2) {
+              d["area_mm2"] = k.area_mm2;
+              d["area_error"] = k.area_error;
+            }
             d["linear_error_mm"] = k.linear_error_mm;
             return py::make_tuple(owned(std::move(k.points)), d);
           },

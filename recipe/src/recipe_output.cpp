@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 #include <unistd.h>
 #include <cerrno>
 #include <cstring>
@@ -314,16 +316,25 @@ Json model_figures(const ModelRunResult& r) {
   model["fold_free"] = r.fold_free;
   if (!r.kept.empty()) {
     Json kept = Json::array();
-    for (const ModelRunResult::Kept& k : r.kept)
-      kept.push_back({{"step", k.step},
-                      {"properties", k.properties},
-                      {"volume_before_mm3", k.volume_before_mm3},
-                      {"volume_after_mm3", k.volume_after_mm3},
-                      {"centroid_shift_mm", k.centroid_shift_mm},
-                      {"area_before_mm2", k.area_before_mm2},
-                      {"area_after_mm2", k.area_after_mm2},
-                      {"newton_steps", k.iterations},
-                      {"largest_correction_mm", k.largest_correction_mm}});
+    for (const ModelRunResult::Kept& k : r.kept) {
+      auto has = [&](const char* p) {
+        return std::find(k.properties.begin(), k.properties.end(), p) != k.properties.end();
+      };
+      Json entry = {{"step", k.step},
+                    {"properties", k.properties},
+                    {"newton_steps", k.iterations},
+                    {"largest_correction_mm", k.largest_correction_mm}};
+      if (has("volume") || has("centroid")) {  // measured only when kept
+        entry["volume_before_mm3"] = k.volume_before_mm3;
+        entry["volume_after_mm3"] = k.volume_after_mm3;
+        entry["centroid_shift_mm"] = k.centroid_shift_mm;
+      }
+      if (has("area")) {
+        entry["area_before_mm2"] = k.area_before_mm2;
+        entry["area_after_mm2"] = k.area_after_mm2;
+      }
+      kept.push_back(entry);
+    }
     model["kept"] = kept;
   }
   model["continuity"] = detail::continuity_json(m.continuity_before, m.continuity_after);

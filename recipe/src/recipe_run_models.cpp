@@ -260,10 +260,11 @@ ModelRunResult::Kept keep_step(Lattice& lattice, const brep::Model& model,
   const bool mass = std::find(properties.begin(), properties.end(), "area") == properties.end() ||
                     properties.size() > 1;
   if (!solid && mass)
-    throw Error(ErrorCategory::InvalidArgument,
-                where +
-                    ": \"keep\" holds a solid's volume or centroid, but the model has no "
-                    "solid (its bodies are sheets or wires); remove \"keep\"");
+    throw Error(
+        ErrorCategory::InvalidArgument,
+        where +
+            ": \"keep\" holds a solid's volume or centroid, but the model has no "
+            "solid (its bodies are sheets or wires); keep only \"area\", or remove \"keep\"");
   deform::ModelJacobian jacobian;
   try {
     jacobian = deform::model_jacobian(lattice, model);

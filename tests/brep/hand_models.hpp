@@ -1,12 +1,15 @@
 #pragma once
 // Models built by hand from planar quadrilateral faces, whose edges, pcurves, gaps and angles have
-// closed forms: the B-rep tests' fixtures (model_test.cpp, continuity_test.cpp).
+// closed forms: the B-rep tests' fixtures (model_test.cpp, continuity_test.cpp), and `mapped`, a
+// model's points moved by a function (the mass property and area tests).
 #include <clay/brep/model.hpp>
 #include <clay/surface/bspline_curve.hpp>
 #include <clay/surface/bspline_surface.hpp>
 
 #include <Eigen/Core>
 
+#include <algorithm>
+#include <functional>
 #include <map>
 #include <string>
 #include <tuple>
@@ -118,6 +121,28 @@ inline Model cube(double a = 10) {
   body.shells.push_back({{0, 1, 2, 3, 4, 5}});
   b.m.bodies.push_back(body);
   return b.m;
+}
+
+/// Every control point, edge point and vertex x moved to f(x), edge and vertex tolerances widened
+/// to `tolerance` (a nonlinear f opens the edges by its curvature).
+inline Model mapped(Model m, const std::function<Vector3d(const Vector3d&)>& f,
+                    double tolerance = 0) {
+  auto move = [&](clay::surface::Points3& p) {
+    for (Eigen::Index r = 0; r < p.rows(); ++r) p.row(r) = f(p.row(r).transpose()).transpose();
+  };
+  for (auto& face : m.faces) {
+    move(face.surface.points);
+    face.elementary.reset();  // no longer a plane, cylinder, ...
+  }
+  for (auto& edge : m.edges) {
+    move(edge.curve.points);
+    edge.tolerance_mm = std::max(edge.tolerance_mm, tolerance);
+  }
+  for (auto& v : m.vertices) {
+    v.point = f(v.point);
+    v.tolerance_mm = std::max(v.tolerance_mm, tolerance);
+  }
+  return m;
 }
 
 }  // namespace clay::test

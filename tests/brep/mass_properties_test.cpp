@@ -22,31 +22,12 @@ using clay::surface::occt_reference::TestModel;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
+using clay::test::mapped;
+
 namespace {
 
 Model read(TestModel model, const std::string& name) {
   return clay::test::read_test_model(model, clay::test::test_output("brep-mass", name));
-}
-
-/// Every control point, edge point and vertex x moved to f(x), edge and vertex tolerances widened
-/// to `tolerance` (a nonlinear f opens the edges by its curvature).
-Model mapped(Model m, const std::function<Vector3d(const Vector3d&)>& f, double tolerance = 0) {
-  auto move = [&](clay::surface::Points3& p) {
-    for (Eigen::Index r = 0; r < p.rows(); ++r) p.row(r) = f(p.row(r).transpose()).transpose();
-  };
-  for (auto& face : m.faces) {
-    move(face.surface.points);
-    face.elementary.reset();  // no longer a plane, cylinder, ...
-  }
-  for (auto& edge : m.edges) {
-    move(edge.curve.points);
-    edge.tolerance_mm = std::max(edge.tolerance_mm, tolerance);
-  }
-  for (auto& v : m.vertices) {
-    v.point = f(v.point);
-    v.tolerance_mm = std::max(v.tolerance_mm, tolerance);
-  }
-  return m;
 }
 
 /// Σ_f Σ_k ∂q/∂P_k · d(P_k) + Σ_v ∂q/∂V_v · d(V_v): a gradient's directional derivative along a

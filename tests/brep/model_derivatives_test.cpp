@@ -334,6 +334,19 @@ TEST_CASE("keep_properties: a symmetry plane and the volume, checked by the poin
   }
   // the mirror point sits where the dragged one's reflection does
   CHECK((kept.points.row(mirror) - kept.points.row(dragged) * reflect).norm() <= 1e-12 * 50);
+  // The centroid kept too: its x cannot move under mirrored moves of a symmetric part (its
+  // projected gradient vanishes), so it leaves the Newton system, still checked; y and z are
+  // corrected. A target off the plane cannot be reached: refused, naming the component.
+  KeptProperties centred = keep;
+  centred.centroid_mm = before.centroid_mm;
+  const KeptMove both = keep_properties(j, moved, centred);
+  const auto measured = clay::brep::mass_properties(deformed_model(j, both.points));
+  CHECK((measured.centroid_mm - before.centroid_mm).norm() <= 1e-11);
+  CHECK(std::abs(measured.volume_mm3 / before.volume_mm3 - 1) <= 1e-12);
+  KeptProperties aside = centred;
+  aside.centroid_mm = before.centroid_mm + Vector3d(1, 0, 0);
+  CHECK_THAT(clay::test::error_of([&] { (void)keep_properties(j, moved, aside); }).second,
+             Catch::Matchers::Contains("hold the centroid x where it is"));
   // An unsymmetric lattice is refused, named.
   KeptProperties off = keep;
   off.symmetry_planes = {SymmetryPlane{Vector3d(1, 0, 0), Vector3d(1, 0, 0)}};

@@ -219,9 +219,9 @@ struct ModelRunResult {
   struct Kept {
     std::string step;  ///< "deformations.lift.steps[0] 'lift'"
     std::vector<std::string> properties;
-    double volume_before_mm3 = 0, volume_after_mm3 = 0;
-    double centroid_shift_mm = 0;                    ///< |centroid after − before|
-    double area_before_mm2 = 0, area_after_mm2 = 0;  ///< when "area" is kept
+    double volume_before_mm3 = 0, volume_after_mm3 = 0;  ///< when "volume" or "centroid" is kept
+    double centroid_shift_mm = 0;                        ///< |centroid after − before|
+    double area_before_mm2 = 0, area_after_mm2 = 0;      ///< when "area" is kept
     int iterations = 0;
     double largest_correction_mm = 0;
   };
