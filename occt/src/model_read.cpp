@@ -54,6 +54,7 @@
 #include <StepData_StepModel.hxx>
 #include <StepData_UndefinedEntity.hxx>
 #include <TCollection_AsciiString.hxx>
+#include <TCollection_ExtendedString.hxx>
 #include <TDF_Label.hxx>
 #include <TDF_LabelSequence.hxx>
 #include <TDataStd_Name.hxx>
@@ -850,10 +851,75 @@ class ModelBuilder {
   int free_edges_given_vertices_ = 0;  // free edges the file gave no vertices (free_edge_of)
 };
 
+/// Reads OpenCASCADE's BRep `file` into `document` as one free shape, with `attributes`' names
+/// and colours on it and on its faces (TopExp::MapShapes order). Throws clay::Error(Exchange) when
+/// the file is not BRep or holds no shape, InvalidArgument when a face list does not match.
+bool read_brep_file(const fs::path& file, const BrepAttributes& attributes,
+                    const Handle(TDocStd_Document) & document) {
+  TopoDS_Shape shape;
+  BRep_Builder builder;
+  if (!BRepTools::Read(shape, file.string().c_str(), builder) || shape.IsNull())
+    throw Error(ErrorCategory::Exchange,
+                "read_model: " + quoted(file) +
+                    " could not be parsed as an OpenCASCADE BRep file (BRepTools::Write's text)");
+  // XCAF gives a located top shape's faces no sub-shape labels (AddSubShape returns none:
+  // FreeCAD writes every recomputed feature's shape with its Placement as a location). An
+  // identity location is dropped; any other is kept one level down, in a compound.
+  if (!shape.Location().IsIdentity()) {
+    if (shape.Location().Transformation().Form() == gp_Identity) {
+      shape.Location(TopLoc_Location());
+    } else {
+      TopoDS_Compound wrapper;
+      builder.MakeCompound(wrapper);
+      builder.Add(wrapper, shape);
+      shape = wrapper;
+    }
+  }
+  const Handle(XCAFDoc_ShapeTool) shapes = XCAFDoc_DocumentTool::ShapeTool(document->Main());
+  const Handle(XCAFDoc_ColorTool) colours = XCAFDoc_DocumentTool::ColorTool(document->Main());
+  // Not "prepared" (XCAF would move a located shape's location into a new one): the faces below
+  // are the text's own, numbered as TopExp::MapShapes numbers them.
+  const TDF_Label label = shapes->AddShape(shape, false, false);
+  TopTools_IndexedMapOfShape faces;
+  TopExp::MapShapes(shapes->GetShape(label), TopAbs_FACE, faces);
+  auto check_count = [&](std::size_t given, const char* field) {
+    if (given != 0 && given != static_cast<std::size_t>(faces.Extent()))
+      throw Error(ErrorCategory::InvalidArgument,
+                  "read_model: brep." + std::string(field) + " has " + std::to_string(given) +
+                      " entries but " + quoted(file) + " has " + std::to_string(faces.Extent()) +
+                      " faces; give one per face (Shape.Faces order) or none");
+  };
+  check_count(attributes.face_colours.size(), "face_colours");
+  check_count(attributes.face_names.size(), "face_names");
+  // (Pointers rather than optionals copied: GCC 12 takes a copied empty optional's fields for
+  // uninitialized.)
+  auto put = [&](const TDF_Label& l, const std::string& name, const Colour* c) {
+    // UTF-8 in, as name_of reads it back.
+    if (!name.empty()) TDataStd_Name::Set(l, TCollection_ExtendedString(name.c_str(), true));
+    if (c != nullptr)
+      colours->SetColor(l, Quantity_Color(c->r, c->g, c->b, Quantity_TOC_sRGB), XCAFDoc_ColorSurf);
+  };
+  put(label, attributes.name, attributes.colour ? &*attributes.colour : nullptr);
+  for (int i = 1; i <= faces.Extent(); ++i) {
+    const auto k = static_cast<std::size_t>(i - 1);
+    const std::string name = k < attributes.face_names.size() ? attributes.face_names[k] : "";
+    const Colour* colour = k < attributes.face_colours.size() && attributes.face_colours[k]
+                               ? &*attributes.face_colours[k]
+                               : nullptr;
+    if (name.empty() && colour == nullptr) continue;
+    const TDF_Label sub = shapes->AddSubShape(label, faces(i));
+    if (sub.IsNull())
+      throw Error(ErrorCategory::Exchange, "read_model: face " + std::to_string(k) + " of " +
+                                               quoted(file) + " could not be given its attributes");
+    put(sub, name, colour);
+  }
+  return true;
+}
+
 /// read_model's work; the caller holds the exchange session. `plain`: read_plain instead of
 /// the XCAF readers.
 ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options, bool step,
-                          bool plain = false) {
+                          bool plain = false, bool brep = false) {
   return surface::occt::guarded(ErrorCategory::Exchange, "read_model", [&] {
     Handle(TDocStd_Document) document;
     XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
@@ -861,7 +927,9 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
     UnknownEntities unknown;
     std::vector<std::string> failed;
     Handle(XSControl_WorkSession) session;  // for naming the entities of shapes left out
-    if (plain) {
+    if (brep) {
+      read = read_brep_file(file, options.brep, document);
+    } else if (plain) {
       read = read_plain(file, step, document, failed, session);
     } else if (step) {
       STEPCAFControl_Controller::Init();
@@ -921,11 +989,30 @@ ImportedModel read_model(const fs::path& file, const ModelReadOptions& options) 
   options.validate();
   const bool step = extension_is(file, {".step", ".stp"});
   const bool iges = extension_is(file, {".iges", ".igs"});
-  if (!step && !iges)
+  const bool brep = extension_is(file, {".brep", ".brp"});
+  if (!step && !iges && !brep)
     throw Error(ErrorCategory::InvalidArgument,
                 "read_model: " + quoted(file) +
-                    " has an unknown extension; name a .step, .stp, .iges or .igs file");
+                    " has an unknown extension; name a .step, .stp, .iges, .igs, .brep or .brp "
+                    "file");
+  const BrepAttributes& a = options.brep;
+  if (!brep && (!a.name.empty() || a.colour || !a.face_colours.empty() || !a.face_names.empty()))
+    throw Error(ErrorCategory::InvalidArgument,
+                "read_model: " + quoted(file) +
+                    " carries its own names and colours; give ModelReadOptions::brep only for a "
+                    ".brep file");
   surface::occt::check_readable(file, caller);
+  if (brep) {
+    // A BRep file has no pre-check (OpenCASCADE's own format, no entity graph to size up); an
+    // isolated read still bounds its time and memory.
+    surface::occt::ExchangeSession session;
+    if (!options.read.isolate) return read_locked(file, options, false, false, true);
+    ImportedModel out = deserialize(surface::occt::read_in_child(
+        file, options.read, caller,
+        [&](const fs::path& f) { return serialize(read_locked(f, options, false, false, true)); }));
+    complete_report(out);
+    return out;
+  }
   if (options.read.precheck) {
     if (step)
       surface::detail::precheck_step(file, caller, surface::max_exchange_degree);

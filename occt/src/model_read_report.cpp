@@ -11,8 +11,33 @@ namespace clay::brep {
 
 using internal::shortest;
 
+namespace {
+
+/// "brep.colour is (1.2, 0, 0): each component must be a finite number in [0, 1]", if so.
+void colour_problem(const std::optional<Colour>& c, const std::string& field,
+                    std::vector<std::string>& out) {
+  if (!c) return;
+  for (double x : {c->r, c->g, c->b})
+    if (!(x >= 0 && x <= 1)) {
+      out.push_back(field + " is (" + shortest(c->r) + ", " + shortest(c->g) + ", " +
+                    shortest(c->b) + "); each component must be a number in [0, 1]");
+      return;
+    }
+}
+
+}  // namespace
+
+std::vector<std::string> BrepAttributes::problems() const {
+  std::vector<std::string> out;
+  colour_problem(colour, "colour", out);
+  for (std::size_t k = 0; k < face_colours.size(); ++k)
+    colour_problem(face_colours[k], "face_colours[" + std::to_string(k) + "]", out);
+  return out;
+}
+
 std::vector<std::string> ModelReadOptions::problems() const {
   std::vector<std::string> out = read.problems();
+  for (const std::string& p : brep.problems()) out.push_back("brep." + p);
   if (!(sewing_tolerance_mm > 0 && sewing_tolerance_mm <= 1))
     out.push_back("sewing_tolerance_mm is " + shortest(sewing_tolerance_mm) +
                   "; it must be in (0, 1] mm");

@@ -15,6 +15,29 @@ namespace clay::python {
 
 namespace {
 
+/// A ModelCheck as the dict Model.write and Model.check return.
+py::dict check_dict(const brep::ModelCheck& c) {
+  py::dict d;
+  d["valid"] = c.valid;
+  d["problems"] = c.problems;
+  d["volume_mm3"] = c.volume_mm3;
+  d["occt_volume_mm3"] = c.occt_volume_mm3;
+  d["message"] = c.brief();
+  return d;
+}
+
+/// None, or (r, g, b) in [0, 1] (checked by BrepAttributes::problems).
+std::optional<brep::Colour> colour_in(const py::handle& obj, const std::string& what) {
+  if (obj.is_none()) return std::nullopt;
+  const Eigen::Vector3d c = vec3(obj, what);
+  return brep::Colour{c.x(), c.y(), c.z()};
+}
+
+py::object colour_out(const std::optional<brep::Colour>& c) {
+  if (!c) return py::none();
+  return py::make_tuple(c->r, c->g, c->b);
+}
+
 py::dict counts_dict(const brep::Counts& c) {
   py::dict d;
   d["bodies"] = c.bodies;
@@ -30,6 +53,24 @@ py::dict counts_dict(const brep::Counts& c) {
   d["instances"] = c.instances;
   d["wires"] = c.wires;
   d["wire_edges"] = c.wire_edges;
+  return d;
+}
+
+/// A read's report as the dict read_model and read_brep return.
+py::dict read_report(const brep::ModelReadReport& r) {
+  py::dict d;
+  d["counts"] = counts_dict(r.counts);
+  d["size_mm"] = r.size_mm;
+  d["faces_bspline"] = r.faces_bspline;
+  d["faces_affine"] = r.faces_affine;
+  d["faces_angular"] = r.faces_angular;
+  d["max_edge_gap_mm"] = r.max_edge_gap_mm;
+  d["healing"] = r.healing;
+  d["ignored"] = r.ignored;
+  d["skipped"] = r.skipped;
+  d["left_out"] = r.left_out;
+  d["problems"] = r.problems;
+  d["message"] = r.brief();
   return d;
 }
 
@@ -214,16 +255,25 @@ void bind_model(py::module_& m) {
               py::gil_scoped_release free;
               c = brep::write_model(x, path);
             }
-            py::dict d;
-            d["valid"] = c.valid;
-            d["problems"] = c.problems;
-            d["volume_mm3"] = c.volume_mm3;
-            d["message"] = c.brief();
-            return d;
+            return check_dict(c);
           },
           py::arg("path"),
           "Writes STEP (.step/.stp), IGES (.igs/.iges) or a glTF preview (.glb), atomically, read "
-          "back and checked (BRepCheck): the check as a dict.")
+          "back and checked (BRepCheck): the check as a dict (valid, problems, volume_mm3, "
+          "occt_volume_mm3: OpenCASCADE's BRepGProp at 1e-9, message).")
+      .def(
+          "check",
+          [](const brep::Model& x) {
+            brep::ModelCheck c;
+            {
+              py::gil_scoped_release free;
+              c = brep::check_model(x);
+            }
+            return check_dict(c);
+          },
+          "OpenCASCADE's view of the model, as write() checks it without writing: {valid "
+          "(BRepCheck), problems, volume_mm3 (ours, exact), occt_volume_mm3 (BRepGProp at 1e-9: "
+          "an independent integration), message}.")
       .def(
           "bounding_box",
           [](const brep::Model& x, const py::object& faces) {
@@ -259,6 +309,29 @@ void bind_model(py::module_& m) {
           "opencascade, catia, class_a, bicubic; '' none). tolerance_mm > 0: a face that cannot be "
           "exact (a B-spline lattice's knot plane across it, twist, bend) is refitted within it, "
           "certified; 0: refused, naming the face.")
+      .def(
+          "to_brep",
+          [](const brep::Model& x) {
+            brep::BrepText t;
+            {
+              py::gil_scoped_release free;
+              t = brep::write_brep(x);
+            }
+            py::dict d;
+            d["brep"] = py::str(t.text);
+            d["name"] = t.attributes.name;
+            d["colour"] = colour_out(t.attributes.colour);
+            py::list colours;
+            for (const auto& c : t.attributes.face_colours) colours.append(colour_out(c));
+            d["face_colours"] = colours;
+            d["face_names"] = t.attributes.face_names;
+            return d;
+          },
+          "The model as OpenCASCADE's BRep text (FreeCAD: Part.Shape().importBrepFromString), "
+          "exact to the last bit (an assembly flattened), with what the text cannot hold: "
+          "{brep, name, colour, face_colours, face_names}, the lists per face in the written "
+          "shape's Shape.Faces order (empty when no face has one; a face's colour is its own or "
+          "its body's). clayform.read_brep reads it back.")
       .def("__copy__", [](const brep::Model& x) { return x; })
       .def("__deepcopy__", [](const brep::Model& x, py::dict) { return x; })
       .def("__repr__", [](const brep::Model& x) {
@@ -280,20 +353,7 @@ void bind_model(py::module_& m) {
           py::gil_scoped_release free;
           imported = brep::read_model(path, o);
         }
-        const auto& r = imported.report;
-        py::dict d;
-        d["counts"] = counts_dict(r.counts);
-        d["size_mm"] = r.size_mm;
-        d["faces_bspline"] = r.faces_bspline;
-        d["faces_affine"] = r.faces_affine;
-        d["faces_angular"] = r.faces_angular;
-        d["max_edge_gap_mm"] = r.max_edge_gap_mm;
-        d["healing"] = r.healing;
-        d["ignored"] = r.ignored;
-        d["skipped"] = r.skipped;
-        d["left_out"] = r.left_out;
-        d["problems"] = r.problems;
-        d["message"] = r.brief();
+        py::dict d = read_report(imported.report);
         return py::make_tuple(std::move(imported.model), d);
       },
       py::arg("path"), py::arg("sew") = false, py::arg("isolate") = true, py::arg("strict") = false,
@@ -307,6 +367,38 @@ void bind_model(py::module_& m) {
       "curves become wire bodies; strict=True heals as before "
       "issue #39 (pcurves outside their domains, gaps wider than the file's tolerances and "
       "misordered loops are listed in report['problems'] instead).");
+
+  m.def(
+      "read_brep",
+      [](const std::string& text, const std::string& name, const py::object& colour,
+         const py::object& face_colours, const py::object& face_names, bool isolate) {
+        brep::ModelReadOptions o;
+        o.read.isolate = isolate;
+        o.brep.name = name;
+        o.brep.colour = colour_in(colour, "colour");
+        if (!face_colours.is_none()) {
+          std::size_t k = 0;
+          for (const py::handle c : face_colours)
+            o.brep.face_colours.push_back(
+                colour_in(c, "face_colours[" + std::to_string(k++) + "]"));
+        }
+        if (!face_names.is_none()) o.brep.face_names = face_names.cast<std::vector<std::string>>();
+        brep::ImportedModel imported;
+        {
+          py::gil_scoped_release free;
+          imported = brep::read_brep(text, o);
+        }
+        py::dict d = read_report(imported.report);
+        return py::make_tuple(std::move(imported.model), d);
+      },
+      py::arg("text"), py::kw_only(), py::arg("name") = "", py::arg("colour") = py::none(),
+      py::arg("face_colours") = py::none(), py::arg("face_names") = py::none(),
+      py::arg("isolate") = true,
+      "Reads a model from OpenCASCADE's BRep text (FreeCAD's Shape.exportBrepToString()): "
+      "(Model, report), as read_model reads a file. BRep holds no names or colours: name and "
+      "colour ((r, g, b) in [0, 1]) go to the shape's body, face_colours and face_names (None, "
+      "or one entry per face in Shape.Faces order; a None colour: the body's) to its faces. "
+      "Model.to_brep() is the way back.");
 
   m.def(
       "lattice_around",

@@ -25,9 +25,26 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace clay::brep {
+
+/// What OpenCASCADE's BRep format does not hold and an embedding CAD system keeps beside its
+/// shape (FreeCAD: a document object's label, its ShapeColor and its faces' DiffuseColor). Faces
+/// are numbered from 0 as TopExp::MapShapes numbers the shape's faces, which is the order of
+/// FreeCAD's Shape.Faces.
+struct CLAY_OCCT_API BrepAttributes {
+  std::string name;              ///< the shape's name: its body's, when it holds one body
+  std::optional<Colour> colour;  ///< the shape's colour: its body's, when it holds one body
+  /// Empty, or one entry per face (none: the face takes the body's colour).
+  std::vector<std::optional<Colour>> face_colours;
+  /// Empty, or one entry per face ("": unnamed).
+  std::vector<std::string> face_names;
+
+  /// Every bad field (a colour outside [0, 1] or not finite), naming it; empty when valid.
+  std::vector<std::string> problems() const;
+};
 
 /// Settings of read_model.
 struct CLAY_OCCT_API ModelReadOptions {
@@ -47,6 +64,10 @@ struct CLAY_OCCT_API ModelReadOptions {
   /// 1e-4 of the model's size), and a hole taken for the outer loop stays first: problems()
   /// names each, and the report lists them, as for a broken file.
   bool strict = false;
+  /// A .brep file only: the names and colours to put on what it holds (a STEP or IGES file
+  /// carries its own: giving any for one is refused). The face lists must be empty or hold one
+  /// entry per face of the file, else clay::Error(InvalidArgument) says how many it has.
+  BrepAttributes brep;
 
   /// Every bad field, each naming the field, its value and the rule broken; empty when valid.
   std::vector<std::string> problems() const;
@@ -107,7 +128,9 @@ struct ImportedModel {
   ModelReadReport report;
 };
 
-/// Reads a STEP (.step, .stp) or IGES (.iges, .igs) file, chosen by its extension, into a model:
+/// Reads a STEP (.step, .stp), IGES (.iges, .igs) or OpenCASCADE BRep (.brep, .brp) file, chosen
+/// by its extension, into a model (a BRep file holds no names or colours: ModelReadOptions::brep
+/// gives them):
 /// solids, shells and loose faces become bodies, and free curves wire bodies (a body per free
 /// wire, one for the loose edges; unbounded curves are left out, named in the report); an assembly
 /// becomes parts and instances with their placements; names and colours of parts, bodies and faces
@@ -171,5 +194,25 @@ CLAY_OCCT_API ModelCheck check_model(const Model& model);
 /// Exchange when OpenCASCADE refuses the model. Returns the check of the shapes written.
 CLAY_OCCT_API ModelCheck write_model(const Model& model, const std::filesystem::path& file,
                                      const ModelWriteOptions& options = {});
+
+/// Reads a model from OpenCASCADE's BRep text (BRepTools::Write, FreeCAD's
+/// Shape.exportBrepToString) with the names and colours of options.brep, as read_model reads a
+/// .brep file (through a private temporary file, so that options.read.isolate can read it in a
+/// child process). Throws as read_model; Exchange when the text is not BRep or holds no shape.
+CLAY_OCCT_API ImportedModel read_brep(std::string_view text, const ModelReadOptions& options = {});
+
+/// A model as OpenCASCADE's BRep text, with what the text cannot hold.
+struct BrepText {
+  std::string text;  ///< BRepTools::Write of the bodies (one body: itself; else a compound)
+  BrepAttributes attributes;  ///< per face in the written shape's TopExp::MapShapes order
+};
+
+/// Writes `model` (an assembly flattened(): each placed instance a body) as OpenCASCADE's BRep
+/// text, exactly as write_model builds its shapes, with its names and colours beside it (a face's
+/// colour is its own or else its body's). OpenCASCADE writes geometry with 17 significant digits,
+/// so read_brep gives the same surfaces, curves and pcurves bit for bit; it writes edge parameter
+/// ranges and vertex points with 15 (those come back within 1e-14, relative). Throws
+/// clay::Error as check_model.
+CLAY_OCCT_API BrepText write_brep(const Model& model);
 
 }  // namespace clay::brep

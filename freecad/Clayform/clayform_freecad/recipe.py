@@ -1,0 +1,104 @@
+"""The recipe of what the workbench did, written beside the document (issue #42).
+
+For a document ``/path/part.FCStd``, the folder ``/path/part.clayform/`` holds, per Deformed
+feature ``D``: ``D-source.step`` (its source, written by Clayform with the faces' names and
+colours) and ``D.json``, a recipe that ``clayform run D.json --out OUT`` replays into the same
+deformed model (docs/recipe.md § Models; docs/freecad.md). Written when the document is saved
+(``RecipeWriter``, a document observer the workbench's Init.py registers: ``register()``) or by ``write_recipes(doc)``.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import List
+
+import FreeCAD as App
+
+from . import features, transfer
+
+
+def recipe_folder(doc) -> Path:
+    """The folder beside a saved document where its recipes go."""
+    if not doc.FileName:
+        raise ValueError(f"the document '{doc.Label}' is not saved; save it, then its recipes "
+                         f"are written beside it")
+    path = Path(doc.FileName)
+    return path.with_name(path.stem + ".clayform")
+
+
+def _is_deformed(obj) -> bool:
+    return isinstance(getattr(obj, "Proxy", None), features.DeformedFeature)
+
+
+def recipe_of(obj, source_file: str, face_names: List[str]) -> dict:
+    """The recipe replaying Deformed feature `obj` on `source_file` (relative to the recipe)."""
+    shape, faces, _ = features._source(obj.Source)
+    step = features.deformation_step(obj, shape)
+    step.setdefault("name", obj.Kind.lower())
+    model = {"import": source_file, "deformation": "deformation", "formats": ["step"]}
+    if faces:
+        model["faces"] = [face_names[k] for k in faces]
+    if obj.Profile != "none":
+        model["profile"] = obj.Profile
+    if obj.AllowFold:
+        model["allow_fold"] = True
+    recipe = {
+        "format": "clayform.recipe",
+        "version": 1,
+        "name": obj.Name,
+        "description": f"FreeCAD document '{obj.Document.Label}', feature '{obj.Label}': "
+                       f"{obj.Kind} of '{obj.Source[0].Label}', written by the Clayform workbench",
+        "units": "mm",
+        "deformations": {"deformation": [step]},
+        "models": {obj.Name: model},
+    }
+    if obj.ToleranceMm > 0:
+        recipe["composition"] = {"mode": "refit", "tolerance_mm": obj.ToleranceMm}
+    return recipe
+
+
+def write_recipe(obj, folder: Path) -> Path:
+    """Writes Deformed feature `obj`'s source and recipe into `folder`; returns the recipe."""
+    folder.mkdir(parents=True, exist_ok=True)
+    shape, _, src = features._source(obj.Source)
+    # Faces are chosen by name in a recipe: a face the source leaves unnamed is named after its
+    # FreeCAD sub-element ("Face3").
+    names = features._face_names(src) or [""] * len(shape.Faces)
+    names = [n or f"Face{k + 1}" for k, n in enumerate(names)]
+    model, _ = transfer.model_from_shape(shape, transfer.Attributes(name=src.Label, face_names=names))
+    source = folder / f"{obj.Name}-source.step"
+    model.write(source)
+    path = folder / f"{obj.Name}.json"
+    path.write_text(json.dumps(recipe_of(obj, source.name, names), indent=2) + "\n")
+    return path
+
+
+def write_recipes(doc) -> List[Path]:
+    """Writes the recipe of every Deformed feature of a saved document; returns their paths."""
+    folder = recipe_folder(doc)
+    return [write_recipe(obj, folder) for obj in doc.Objects if _is_deformed(obj)]
+
+
+class RecipeWriter:
+    """A document observer: writes a saved document's recipes beside it."""
+
+    def slotFinishSaveDocument(self, doc, filename):  # noqa: N802 (FreeCAD's name)
+        try:
+            if any(_is_deformed(o) for o in doc.Objects):
+                written = write_recipes(doc)
+                App.Console.PrintMessage(
+                    f"Clayform: {len(written)} recipe(s) written to {recipe_folder(doc)}\n")
+        except Exception as e:  # a failed recipe must not fail the save: say it
+            App.Console.PrintError(f"Clayform: the recipes were not written: {e}\n")
+
+
+_writer = None
+
+
+def register() -> None:
+    """Registers the recipe writer with FreeCAD once (FreeCAD's Init.py of the workbench calls
+    it); a module-level reference keeps it alive."""
+    global _writer
+    if _writer is None:
+        _writer = RecipeWriter()
+        App.addDocumentObserver(_writer)
