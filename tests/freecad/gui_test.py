@@ -90,6 +90,10 @@ def run():
     result["dragged"] = {"point": n, "to": list(target), "volume_before": volume_before,
                          "volume_after": deformed.VolumeAfter}
     result["after"] = shoot("freecad_lattice_after.png")
+    view.viewFront()
+    view.fitAll()
+    result["after_front"] = shoot("freecad_lattice_after_front.png")  # the dome in profile
+    view.viewIsometric()
 
     # Axis lock: z stays, x moves.
     lat.LockZ = True

@@ -342,7 +342,25 @@ def case_style():
     # Outside the bound, the face is where it was.
     for p in (App.Vector(2, 2, 0), App.Vector(68, 68, 0), App.Vector(5, 60, 0)):
         check(Part.Vertex(p).distToShape(face)[0] < 1e-9, f"moved outside the bound at {p}")
-    return f"target met within {worst:.2e} mm, {style.MovedVertices} vertices moved"
+    # Saved: its recipe replays in `clayform run` to the same surface.
+    path = WORK / "style.FCStd"
+    doc.saveAs(str(path))
+    written = path.with_name("style.clayform") / f"{style.Name}.json"
+    check(written.is_file(), f"no recipe {written}")
+    out = WORK / "style-replay"
+    run = subprocess.run([os.environ["CLAY_CLAYFORM"], "run", str(written), "--out", str(out)],
+                         capture_output=True, text=True)
+    check(run.returncode == 0, f"clayform run: {run.returncode}\n{run.stdout}\n{run.stderr}")
+    replayed = Part.read(str(out / f"{style.Name}.step")).Faces[0]
+    u0, u1, v0, v1 = face.ParameterRange
+    gap = 0.0
+    for i in range(11):
+        for j in range(11):
+            p = face.Surface.value(u0 + (u1 - u0) * i / 10, v0 + (v1 - v0) * j / 10)
+            gap = max(gap, Part.Vertex(p).distToShape(replayed)[0])
+    check(gap < 1e-9, f"the replayed surface is {gap} mm from the feature's")
+    return (f"target met within {worst:.2e} mm, {style.MovedVertices} vertices moved; "
+            f"the recipe replays within {gap:.1e} mm")
 
 
 def case_errors():

@@ -3,7 +3,8 @@
 For a document ``/path/part.FCStd``, the folder ``/path/part.clayform/`` holds, per Deformed
 feature ``D``: ``D-source.step`` (its source, written by Clayform with the faces' names and
 colours) and ``D.json``, a recipe that ``clayform run D.json --out OUT`` replays into the same
-deformed model (docs/recipe.md § Models; docs/freecad.md). Written when the document is saved
+deformed model (docs/recipe.md § Models; docs/freecad.md); per Style feature ``S``: ``S.json``,
+its face's surface and curves given exactly and the style step, the styled surface exported. Written when the document is saved
 (``RecipeWriter``, a document observer the workbench's Init.py registers: ``register()``) or by ``write_recipes(doc)``.
 """
 from __future__ import annotations
@@ -73,10 +74,63 @@ def write_recipe(obj, folder: Path) -> Path:
     return path
 
 
+def _is_style(obj) -> bool:
+    return isinstance(getattr(obj, "Proxy", None), features.StyleFeature)
+
+
+def _curve_json(curve) -> dict:
+    c = {"degree": int(curve.degree), "knots": [float(k) for k in curve.knots],
+         "points": [[float(x) for x in p] for p in curve.points]}
+    if curve.rational:
+        c["weights"] = [float(w) for w in curve.weights]
+    return {"bspline": c}
+
+
+def style_recipe_of(obj) -> dict:
+    """The recipe replaying Style feature `obj`: its face's surface and the curves given exactly
+    (B-splines), the style step with the feature's mode and λ, the styled surface exported."""
+    src, subs = obj.Face
+    face = src.Shape.Faces[transfer.face_indices(src.Shape, [s for s in subs if s])[0]]
+    parent = features.surface_of_face(face)
+    surface = {"degrees": [int(d) for d in parent.degrees],
+               "knots_u": [float(k) for k in parent.knots_u],
+               "knots_v": [float(k) for k in parent.knots_v],
+               "points": [[float(x) for x in p] for p in parent.points]}
+    if parent.rational:
+        surface["weights"] = [float(w) for w in parent.weights.reshape(-1)]
+    step = {"kind": "style", "name": obj.Label, "target": "target", "mode": obj.Mode,
+            "lambda": obj.Lambda}
+    curves = {"target": _curve_json(features.curve_of(obj.Target))}
+    if obj.Bound is not None:
+        curves["bound"] = _curve_json(features.curve_of(obj.Bound))
+        step["bound"] = "bound"
+    return {
+        "format": "clayform.recipe",
+        "version": 1,
+        "name": obj.Name,
+        "description": f"FreeCAD document '{obj.Document.Label}', feature '{obj.Label}': "
+                       f"{src.Label}.{subs[0]} styled, written by the Clayform workbench",
+        "units": "mm",
+        "curves": curves,
+        "surfaces": {"parent": {"bspline": surface},
+                     "styled": {"deform": {"surface": "parent", "deformation": "style"}}},
+        "deformations": {"style": [step]},
+        "exports": {obj.Name: {"surfaces": ["styled"], "formats": ["step"]}},
+    }
+
+
 def write_recipes(doc) -> List[Path]:
-    """Writes the recipe of every Deformed feature of a saved document; returns their paths."""
+    """Writes the recipe of every Deformed and Style feature of a saved document; returns their
+    paths."""
     folder = recipe_folder(doc)
-    return [write_recipe(obj, folder) for obj in doc.Objects if _is_deformed(obj)]
+    out = [write_recipe(obj, folder) for obj in doc.Objects if _is_deformed(obj)]
+    for obj in doc.Objects:
+        if _is_style(obj):
+            folder.mkdir(parents=True, exist_ok=True)
+            path = folder / f"{obj.Name}.json"
+            path.write_text(json.dumps(style_recipe_of(obj), indent=2) + "\n")
+            out.append(path)
+    return out
 
 
 class RecipeWriter:
@@ -84,7 +138,7 @@ class RecipeWriter:
 
     def slotFinishSaveDocument(self, doc, filename):  # noqa: N802 (FreeCAD's name)
         try:
-            if any(_is_deformed(o) for o in doc.Objects):
+            if any(_is_deformed(o) or _is_style(o) for o in doc.Objects):
                 written = write_recipes(doc)
                 App.Console.PrintMessage(
                     f"Clayform: {len(written)} recipe(s) written to {recipe_folder(doc)}\n")
