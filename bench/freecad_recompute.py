@@ -1,6 +1,6 @@
 """Issue #42: the time from a lattice edit to the recomputed shape in FreeCAD, on a 50-face part.
 
-Run in freecadcmd (bench/README: scripts/freecad_bench.sh runs it after a build):
+Run in freecadcmd after a Release build (docs/freecad.md § Figures has the last run):
     CLAY_WORKBENCH=freecad/Clayform CLAY_PYTHONPATH=build/python freecadcmd bench/freecad_recompute.py
 
 The part: a 120 x 60 x 20 mm plate with 44 through holes (6 planes + 44 cylinders = 50 faces),

@@ -22,7 +22,13 @@ clay_ensure_packages() {
   if ((${#missing[@]} > 0)); then
     echo "==> installing missing Debian packages: ${missing[*]}"
     local sudo=""
-    if [[ $(id -u) -ne 0 ]]; then sudo="sudo"; fi
+    if [[ $(id -u) -ne 0 ]]; then
+      command -v sudo >/dev/null || {
+        echo "Missing Debian packages: ${missing[*]}. Install them as root (apt-get install ...), or install sudo, then run this again." >&2
+        exit 1
+      }
+      sudo="sudo"
+    fi
     $sudo apt-get update
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y "${missing[@]}"
   fi

@@ -25,8 +25,12 @@ python_dir=${CLAYFORM_PYTHON_DIR:-$CLAY_BUILD/python}
   echo "scripts/freecad.sh: no built clayform package in $python_dir; run it without --no-build" >&2
   exit 1
 }
+command -v freecadcmd >/dev/null || {
+  echo "scripts/freecad.sh: freecadcmd not found; install Debian's freecad-python3 (run this script without --no-build, as root or with sudo)" >&2
+  exit 1
+}
 data=$(freecadcmd -c "import FreeCAD; print('USERDATA=' + FreeCAD.getUserAppDataDir())" 2>/dev/null |
-  sed -n 's/^USERDATA=//p' | tail -n 1)
+  sed -n 's/^USERDATA=//p' | tail -n 1 || true)
 [[ -n "$data" ]] || { echo "scripts/freecad.sh: freecadcmd did not say where its user data is" >&2; exit 1; }
 mod=${data%/}/Mod/Clayform
 rm -rf "$mod"

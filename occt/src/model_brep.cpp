@@ -7,8 +7,10 @@
 #include <clay/occt/model_exchange.hpp>
 
 #include <unistd.h>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <sstream>
 #include <string>
 
@@ -31,11 +33,16 @@ ImportedModel read_brep(std::string_view text, const ModelReadOptions& options) 
   options.validate();
   // read_model reads files (an isolated read hands the child a path): the text goes to a file of
   // this process's own, created exclusively (mkstemps), removed whatever happens.
-  std::string name = (fs::temp_directory_path() / "clayform-brep-XXXXXX.brep").string();
+  std::error_code ec;
+  const fs::path folder = fs::temp_directory_path(ec);
+  if (ec)
+    throw Error(ErrorCategory::Io, "read_brep: no temporary folder (" + ec.message() +
+                                       "); set TMPDIR to a writable folder");
+  std::string name = (folder / "clayform-brep-XXXXXX.brep").string();
   const int fd = ::mkstemps(name.data(), 5);
   if (fd < 0)
     throw Error(ErrorCategory::Io, "read_brep: could not create a temporary file in " +
-                                       surface::occt::quoted(fs::temp_directory_path()) +
+                                       surface::occt::quoted(folder) +
                                        "; set TMPDIR to a writable folder");
   struct Removed {
     std::string file;
@@ -44,14 +51,26 @@ ImportedModel read_brep(std::string_view text, const ModelReadOptions& options) 
   std::size_t written = 0;
   while (written < text.size()) {
     const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+    if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;
     written += static_cast<std::size_t>(n);
   }
-  ::close(fd);
-  if (written != text.size())
+  const bool closed = ::close(fd) == 0;
+  if (written != text.size() || !closed)
     throw Error(ErrorCategory::Io, "read_brep: could not write the BRep text to " +
-                                       surface::occt::quoted(name) + " (disk full?)");
-  return read_model(name, options);
+                                       surface::occt::quoted(name) + " (" + std::strerror(errno) +
+                                       "); set TMPDIR to a folder with room");
+  try {
+    return read_model(name, options);
+  } catch (const Error& e) {
+    // The temporary file is gone when the caller reads the message: name what it held.
+    std::string message = e.message();
+    const std::string quoted_name = surface::occt::quoted(name);
+    for (std::size_t at = message.find(quoted_name); at != std::string::npos;
+         at = message.find(quoted_name, at))
+      message.replace(at, quoted_name.size(), "the BRep text");
+    throw Error(e.category(), message);
+  }
 }
 
 BrepText write_brep(const Model& model) {
@@ -91,7 +110,10 @@ BrepText write_brep(const Model& model) {
     for (int i = 1; i <= faces.Extent(); ++i) {
       std::optional<Colour> colour;
       std::string name;
-      if (index.IsBound(faces(i))) {
+      if (!index.IsBound(faces(i)))
+        throw Error(ErrorCategory::Internal, "write_brep: face " + std::to_string(i - 1) +
+                                                 " of the written shape is none of the model's");
+      {
         const auto k = static_cast<std::size_t>(index.Find(faces(i)));
         const Face& face = m.faces[k];
         colour = face.colour;

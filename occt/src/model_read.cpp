@@ -851,6 +851,26 @@ class ModelBuilder {
   int free_edges_given_vertices_ = 0;  // free edges the file gave no vertices (free_edge_of)
 };
 
+/// The prefix read_brep_file gives face k's name: "\x1f" k "\x1f", a control character no name
+/// read from a file holds; untag_brep_faces takes it off.
+std::string brep_face_tag(int k) { return "\x1f" + std::to_string(k) + "\x1f"; }
+
+/// Takes the tags off the faces' names, recording each face's place in the text in
+/// report.brep_faces. Throws clay::Error(Internal) for a face that lost its tag.
+void untag_brep_faces(ImportedModel& imported) {
+  imported.report.brep_faces.assign(imported.model.faces.size(), -1);
+  for (std::size_t j = 0; j < imported.model.faces.size(); ++j) {
+    std::string& name = imported.model.faces[j].name;
+    const std::size_t end =
+        name.size() > 1 && name[0] == '\x1f' ? name.find('\x1f', 1) : std::string::npos;
+    if (end == std::string::npos)
+      throw Error(ErrorCategory::Internal,
+                  "read_model: face " + std::to_string(j) + " of the BRep text lost its place");
+    imported.report.brep_faces[j] = std::stoi(name.substr(1, end - 1));
+    name.erase(0, end + 1);
+  }
+}
+
 /// Reads OpenCASCADE's BRep `file` into `document` as one free shape, with `attributes`' names
 /// and colours on it and on its faces (TopExp::MapShapes order). Throws clay::Error(Exchange) when
 /// the file is not BRep or holds no shape, InvalidArgument when a face list does not match.
@@ -902,11 +922,13 @@ bool read_brep_file(const fs::path& file, const BrepAttributes& attributes,
   put(label, attributes.name, attributes.colour ? &*attributes.colour : nullptr);
   for (int i = 1; i <= faces.Extent(); ++i) {
     const auto k = static_cast<std::size_t>(i - 1);
-    const std::string name = k < attributes.face_names.size() ? attributes.face_names[k] : "";
+    // Every face's name carries its place in the text (brep_face_tag), so that the model's faces,
+    // numbered solids first and a face of two solids twice, are traced back to the text's.
+    const std::string name = brep_face_tag(static_cast<int>(k)) +
+                             (k < attributes.face_names.size() ? attributes.face_names[k] : "");
     const Colour* colour = k < attributes.face_colours.size() && attributes.face_colours[k]
                                ? &*attributes.face_colours[k]
                                : nullptr;
-    if (name.empty() && colour == nullptr) continue;
     const TDF_Label sub = shapes->AddSubShape(label, faces(i));
     if (sub.IsNull())
       throw Error(ErrorCategory::Exchange, "read_model: face " + std::to_string(k) + " of " +
@@ -982,6 +1004,16 @@ ImportedModel read_locked(const fs::path& file, const ModelReadOptions& options,
   });
 }
 
+/// What came through the pipe from an isolated read is checked again here, as the surface
+/// reader does.
+void check_piped_surfaces(const ImportedModel& out, const fs::path& file, std::string_view caller) {
+  for (std::size_t k = 0; k < out.model.faces.size(); ++k)
+    if (const auto list = surface::problems(out.model.faces[k].surface,
+                                            quoted(file) + " face #" + std::to_string(k));
+        !list.empty())
+      throw Error(ErrorCategory::Exchange, std::string(caller) + ": " + list.front());
+}
+
 }  // namespace
 
 ImportedModel read_model(const fs::path& file, const ModelReadOptions& options) {
@@ -1006,10 +1038,17 @@ ImportedModel read_model(const fs::path& file, const ModelReadOptions& options) 
     // A BRep file has no pre-check (OpenCASCADE's own format, no entity graph to size up); an
     // isolated read still bounds its time and memory.
     surface::occt::ExchangeSession session;
-    if (!options.read.isolate) return read_locked(file, options, false, false, true);
-    ImportedModel out = deserialize(surface::occt::read_in_child(
-        file, options.read, caller,
-        [&](const fs::path& f) { return serialize(read_locked(f, options, false, false, true)); }));
+    ImportedModel out;
+    if (!options.read.isolate) {
+      out = read_locked(file, options, false, false, true);
+    } else {
+      out = deserialize(
+          surface::occt::read_in_child(file, options.read, caller, [&](const fs::path& f) {
+            return serialize(read_locked(f, options, false, false, true));
+          }));
+      check_piped_surfaces(out, file, caller);
+    }
+    untag_brep_faces(out);
     complete_report(out);
     return out;
   }
@@ -1038,12 +1077,7 @@ ImportedModel read_model(const fs::path& file, const ModelReadOptions& options) 
         "OpenCASCADE's XCAF reader crashed on this file, so its plain reader read it: the "
         "shapes are whole, but names, colours and the assembly tree are not read");
   }
-  // What came through the pipe is checked again here, as the surface reader does.
-  for (std::size_t k = 0; k < out.model.faces.size(); ++k)
-    if (const auto list = surface::problems(out.model.faces[k].surface,
-                                            quoted(file) + " face #" + std::to_string(k));
-        !list.empty())
-      throw Error(ErrorCategory::Exchange, std::string(caller) + ": " + list.front());
+  check_piped_surfaces(out, file, caller);
   complete_report(out);
   return out;
 }

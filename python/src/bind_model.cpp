@@ -70,6 +70,7 @@ py::dict read_report(const brep::ModelReadReport& r) {
   d["skipped"] = r.skipped;
   d["left_out"] = r.left_out;
   d["problems"] = r.problems;
+  d["shape_faces"] = r.brep_faces;
   d["message"] = r.brief();
   return d;
 }
@@ -186,6 +187,7 @@ void bind_model(py::module_& m) {
             for (const auto& b : x.bodies) {
               py::dict d;
               d["name"] = b.name;
+              d["colour"] = colour_out(b.colour);
               d["kind"] = kind_name(b.kind);
               std::vector<int> faces;
               for (const auto& s : b.shells)
@@ -204,6 +206,9 @@ void bind_model(py::module_& m) {
           py::arg("face"), "The face's NURBS surface (a copy; the loops trim it).")
       .def(
           "face_name", [](brep::Model& x, int k) { return face_at(x, k).name; }, py::arg("face"))
+      .def(
+          "face_colour", [](brep::Model& x, int k) { return colour_out(face_at(x, k).colour); },
+          py::arg("face"), "The face's own colour (r, g, b), or None (it takes its body's).")
       .def(
           "volume_mm3",
           [](const brep::Model& x) {
@@ -398,7 +403,8 @@ void bind_model(py::module_& m) {
       "(Model, report), as read_model reads a file. BRep holds no names or colours: name and "
       "colour ((r, g, b) in [0, 1]) go to the shape's body, face_colours and face_names (None, "
       "or one entry per face in Shape.Faces order; a None colour: the body's) to its faces. "
-      "Model.to_brep() is the way back.");
+      "report['shape_faces'][j]: model face j's index in Shape.Faces (the model numbers faces "
+      "solids first and holds a face two solids share twice). Model.to_brep() is the way back.");
 
   m.def(
       "lattice_around",

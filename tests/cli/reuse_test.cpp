@@ -73,7 +73,7 @@ const std::string lattice_step = "surfaces.tank.steps[0]";
 }  // namespace
 
 TEST_CASE("run_recipe: an edit of deformations alone reruns what they touch, bit for bit",
-          "[recipe][reuse]") {
+          "[recipe][reuse][release-only]") {
   const auto first = std::make_shared<const RunResult>(run(tank()));
   const Json edited = tank_moved(5);
   const RunResult whole = run(edited);
@@ -104,7 +104,7 @@ TEST_CASE("run_recipe: an edit of deformations alone reruns what they touch, bit
 }
 
 TEST_CASE("run_recipe: a drag preview is the light form on its last knots, certified when let go",
-          "[recipe][reuse]") {
+          "[recipe][reuse][release-only]") {
   const auto first = std::make_shared<const RunResult>(run(tank()));
   const surface::BSplineSurface& light = first->surface("tank");
   const double tolerance = std::get<double>(*figure(step(*first, lattice_step), "tolerance_mm"));
@@ -199,7 +199,7 @@ TEST_CASE("run_recipe: a refitted lattice step is previewed on its knots too", "
 }
 
 TEST_CASE("studio session: a lattice drag previews in one product, the release certifies",
-          "[studio][reuse]") {
+          "[studio][reuse][release-only]") {
   std::ifstream in(tank_file, std::ios::binary);
   std::ostringstream text;
   text << in.rdbuf();
@@ -238,7 +238,7 @@ TEST_CASE("studio session: a lattice drag previews in one product, the release c
 }
 
 TEST_CASE("run_recipe: a style with net convergence previews on its first net, converges after",
-          "[recipe][reuse]") {
+          "[recipe][reuse][release-only]") {
   // The tank's exact style refined until a halving changes it by under 5 % (the studio's
   // first convergence choice): a drag update styles on the first net alone, the release
   // converges. The style alone: the tank's lattice after it (a certified light fit of the
@@ -280,7 +280,7 @@ TEST_CASE("run_recipe: a style with net convergence previews on its first net, c
 }
 
 TEST_CASE("run_recipe: a style target drag previews from a kept StyleEditor, the release restyles",
-          "[recipe][reuse]") {
+          "[recipe][reuse][release-only]") {
   // The tank with its target a B-spline curve whose middle control point is dragged, run as the
   // studio session runs a drag update (a preview with the last run and the session's cache).
   Json doc = tank();

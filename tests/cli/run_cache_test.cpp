@@ -104,7 +104,7 @@ const std::set<std::string> tank_steps{
 }  // namespace
 
 TEST_CASE("run_recipe with a cache: the second run takes every step, bit for bit",
-          "[recipe][cache]") {
+          "[recipe][cache][release-only]") {
   const RunResult whole = run(tank());
   const auto cache = std::make_shared<RunCache>();
   const RunResult first = run(tank(), cache);
@@ -132,7 +132,7 @@ TEST_CASE("run_recipe with a cache: the second run takes every step, bit for bit
 }
 
 TEST_CASE("run_recipe with a cache: an edit re-runs only the steps downstream of it",
-          "[recipe][cache]") {
+          "[recipe][cache][release-only]") {
   const auto cache = std::make_shared<RunCache>();
   (void)run(tank(), cache);
 
@@ -373,7 +373,7 @@ TEST_CASE(
 TEST_CASE(
     "studio session: dragging a style's target previews the lattice after it, the release "
     "certifies",
-    "[recipe][cache][studio]") {
+    "[recipe][cache][studio][release-only]") {
   // Issue #40: a drag of the tank's target curve re-ran the lattice's certified light fit on
   // every update (740 ms); now the update previews it on its last knots, as a lattice drag does,
   // and the release fits and certifies it: what a whole run of the saved recipe gives.
@@ -419,7 +419,7 @@ TEST_CASE(
 }
 
 TEST_CASE("parse_recipe_document: a document held parsed runs as its text does",
-          "[recipe][cache]") {
+          "[recipe][cache][release-only]") {
   // The studio checks its edited document without printing and parsing it (issue #40): the
   // same recipe, the same cache keys, bit for bit what the text gives.
   const std::string text = tank().dump();
@@ -479,7 +479,7 @@ TEST_CASE("parse_recipe_document: a document held parsed runs as its text does",
 }
 
 TEST_CASE("studio session: an edit's reply carries its changes and revisions, not the text",
-          "[recipe][studio]") {
+          "[recipe][studio][release-only]") {
   // Issue #40: the reply of every edit held the recipe's whole text, which grew with the design.
   // Now it holds the edit's changes and the revision they apply to; the text held at that
   // revision, changed by them (here by JSON pointers, independently of the session), is the

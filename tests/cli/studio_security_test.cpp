@@ -649,7 +649,7 @@ TEST_CASE("studio session: example bottle opens, edits, saves in order and repla
   edit_and_save_example("bottle", true);
 }
 TEST_CASE("studio session: example superellipsoid_bend opens, edits, saves in order and replays",
-          "[studio][examples]") {
+          "[studio][examples][release-only]") {
   edit_and_save_example("superellipsoid_bend", true);
 }
 TEST_CASE(

@@ -73,6 +73,25 @@ def part_from(path, doc, name="Part"):
     return obj
 
 
+def max_surface_gap(a, b):
+    """Largest distance from points of a's face surfaces to b's face k's surface, face by face
+    (OpenCASCADE's projection onto b's surfaces)."""
+    worst = 0.0
+    for fa, fb in zip(a.Faces, b.Faces):
+        u0, u1, v0, v1 = fa.ParameterRange
+        for su, sv in ((0.3, 0.4), (0.5, 0.5), (0.7, 0.2)):
+            p = fa.Surface.value(u0 + su * (u1 - u0), v0 + sv * (v1 - v0))
+            q = fb.Surface.value(*fb.Surface.parameter(p))
+            worst = max(worst, (p - q).Length)
+    return worst
+
+
+def _closest_uv(surface, p):
+    """(u, v) of a Clayform surface's point nearest p, by FreeCAD's projection onto the same
+    surface rebuilt as a Part.BSplineSurface (exact copy of the control net)."""
+    return features.part_surface(surface).parameter(p)
+
+
 # ---- cases ---------------------------------------------------------------------------------------
 
 
@@ -99,13 +118,7 @@ def case_transfer_round_trip():
         for a in shape.Vertexes:
             d = min((a.Point - b.Point).Length for b in back.Vertexes)
             check(d <= 1e-14 * size, f"{path.name}: vertex {a.Point} is {d} mm from any back")
-        worst = 0.0
-        for fa, fb in zip(shape.Faces, back.Faces):
-            u0, u1, v0, v1 = fa.ParameterRange
-            for su, sv in ((0.3, 0.4), (0.5, 0.5), (0.7, 0.2)):
-                p = fa.Surface.value(u0 + su * (u1 - u0), v0 + sv * (v1 - v0))
-                q = fb.Surface.value(*fb.Surface.parameter(p))
-                worst = max(worst, (p - q).Length)
+        worst = max_surface_gap(shape, back)
         check(worst <= 1e-9, f"{path.name}: a face is {worst} mm off its original surface")
         # A second trip gives the same text: nothing drifts.
         again, _ = transfer.model_from_shape(back)
@@ -117,6 +130,15 @@ def case_transfer_round_trip():
     check(any(names), "block.step has named faces")
     check(attributes.face_names == names, "face names in Shape.Faces order")
     colours = attributes.face_colours
+    # Each face's colour is its own in the STEP file, else its body's (block.step: one face of
+    # its own colour, 16 in the body's).
+    body = model.bodies[0]["colour"]
+    want = [model.face_colour(k) or body for k in range(model.face_count)]
+    check(body is not None and len(colours) == model.face_count and all(
+        c is not None and max(abs(x - y) for x, y in zip(c, w)) < 1e-12
+        for c, w in zip(colours, want)), f"face colours {colours}, want {want}")
+    own = sum(model.face_colour(k) is not None for k in range(model.face_count))
+    check(own >= 1, "block.step has a face of its own colour")
     back, _ = transfer.model_from_shape(shape, attributes)
     text = back.to_brep()
     check(text["face_names"] == names, "names back")
@@ -137,8 +159,26 @@ def case_transfer_round_trip():
         d = min((a.Point - b.Point).Length for b in back.Vertexes)
         check(d <= 1e-12, f"placed vertex {a.Point} is {d} mm from any back")
     close(model.volume_mm3(), placed.Volume, 1e-6, "placed volume")
+    check(max_surface_gap(placed, back) <= 1e-9, "placed faces on their surfaces")
+    # Faces the model numbers differently: a loose face before a solid (the model puts solids
+    # first), and two solids sharing a face (the model holds it twice, Shape.Faces once).
+    loose = Part.makePlane(5, 5, App.Vector(50, 0, 0))
+    mixed = Part.makeCompound([loose, Part.makeBox(10, 10, 10)])
+    shared = Part.makeBox(10, 10, 10).generalFuse([Part.makeBox(10, 10, 10, App.Vector(10, 0, 0))])[0]
+    for what, s, faces in (("a face before a solid", mixed, 6 + 1), ("two solids", shared, 12)):
+        m, r = transfer.model_from_shape(s)
+        check(m.face_count == faces, f"{what}: {m.face_count} model faces")
+        check(sorted(set(r["shape_faces"])) == list(range(len(s.Faces))), f"{what}: every face")
+        for j, k in enumerate(r["shape_faces"]):
+            f = s.Faces[k]
+            u0, u1, v0, v1 = f.ParameterRange
+            p = f.Surface.value((u0 + u1) / 2, (v0 + v1) / 2)
+            q = m.face_surface(j).evaluate(*_closest_uv(m.face_surface(j), p))
+            check((App.Vector(*map(float, q)) - p).Length < 1e-9, f"{what}: model face {j} is not Face{k + 1}")
+    check(len(shared.Faces) == 11, "the shared face once in Shape.Faces")
     return (f"5 shapes (one placed) round trip: surfaces within 1e-9 mm, vertices 1e-14; "
-            f"{sum(bool(n) for n in names)} face names and {len(colours)} face colours kept")
+            f"{sum(bool(n) for n in names)} face names and {len(colours)} face colours "
+            f"({own} of the face's own) kept; faces traced through a compound and a shared face")
 
 
 def _lattice_block(doc, path=MODELS / "block.step"):
@@ -182,9 +222,24 @@ def case_lattice_and_deformed():
     again, _ = transfer.model_from_shape(deformed.Shape)
     check(not again.problems(), f"problems: {again.problems()}")
     close(again.volume_mm3(), deformed.VolumeAfter, 1e-12, "volume of the shape read back")
+    bumped = deformed.VolumeAfter
+    # A new degree would refit the frame and lose the moved points: refused until Refit is set.
+    lat.DegreeS = 3
+    doc.recompute()
+    check("Invalid" in lat.State and len(lat.Points) == 18, f"degree change with moves: {lat.State}")
+    try:
+        lat.Proxy.execute(lat)
+        raise AssertionError("moved points were dropped")
+    except cf.InvalidArgumentError as e:
+        check("set Refit to True" in str(e), str(e))
+    lat.Refit = True
+    doc.recompute()
+    check(lat.isValid() and not lat.Refit and lat.MovedPoints == 0 and len(lat.Points) == 24,
+          f"refit: {lat.State}, {lat.MovedPoints} moved, {len(lat.Points)} points")
+    close(deformed.VolumeAfter, deformed.VolumeBefore, 1e-12, "a lattice at rest is the identity")
     return (f"block: affine lift volume {deformed.VolumeBefore:.1f} -> "
             f"{deformed.VolumeBefore * (1 + h / height):.1f} mm^3 (1e-12), bump "
-            f"{deformed.VolumeAfter:.1f}; {deformed.ExactFaces} exact faces")
+            f"{bumped:.1f}; {deformed.ExactFaces} exact faces; refit on request only")
 
 
 def _k(lat, n):
@@ -292,18 +347,27 @@ def case_faces_and_continuity():
     src.Shape = Part.makeBox(60, 40, 20)
     top = max(range(6), key=lambda k: src.Shape.Faces[k].CenterOfMass.z)
     name = f"Face{top + 1}"
-    lat = features.make_lattice(src, [name], degrees=(3, 3, 3), cells=(4, 4, 4))
-    check(lat.Continuity == "C2" and lat.Margin == 1e-6, "faces: C2, margin 1e-6 by default")
+    lat = features.make_lattice(src, [name])
+    check(lat.Continuity == "C2" and lat.Margin == 1e-6 and (lat.DegreeS, lat.CellsS) == (3, 4),
+          "faces: C2, margin 1e-6, degrees 3 and 4 cells by default")
     deformed = features.make_deformed(src, lat, [name])
     lattice = features.lattice_of(lat)
     held = lattice.index(2, 3, 3)  # the third layer from the lattice's x = 0 face
     try:
         features.move_point(lat, held, lat.Points[held] + App.Vector(0, 0, 1))
+        raise AssertionError("move_point moved a held point")
+    except cf.InvalidArgumentError as e:
+        check("held by Continuity C2" in str(e), str(e))
+    points = list(lat.Points)  # the property editor's way: the feature refuses it on recompute
+    points[held] = points[held] + App.Vector(0, 0, 1)
+    lat.Points = points
+    try:
         lat.Proxy.execute(lat)
         raise AssertionError("a held point was moved")
     except cf.InvalidArgumentError as e:
         check("held by Continuity C2" in str(e), str(e))
-    features.move_point(lat, held, features.rest_points(lat)[held])
+    points[held] = App.Vector(*features.rest_points(lat)[held])
+    lat.Points = points
     inner = lattice.index(3, 3, 3)  # the one point C2 leaves free in a 7 x 7 x 7 lattice
     check(not features.held_points(lat)[inner], "inner point is free")
     features.move_point(lat, inner, lat.Points[inner] + App.Vector(0, 0, 1.5))

@@ -388,3 +388,33 @@ def test_free_curves_written_by_freecad_read_as_wire_bodies_and_deform_exactly(
             off = float(np.abs(np.array([tuple(b.valueAt(t)) for t in ts]) - mapped).max())
         worst = max(worst, off)
     assert worst <= 1e-9 * size, worst
+
+
+def test_brep_text_round_trip(examples: Path) -> None:
+    """Model.to_brep / read_brep (issue #42, FreeCAD's way in): the same surfaces bit for bit,
+    the volume, every face's name and colour (its own, else its body's) in Shape.Faces order,
+    shape_faces tracing each face; Model.check's two volumes; bad input refused, named."""
+    model, _ = cf.read_model(examples / "models" / "block.step")
+    text = model.to_brep()
+    assert text["brep"].find("CASCADE Topology V") >= 0
+    body = model.bodies[0]["colour"]
+    assert text["face_colours"] == [model.face_colour(k) or body for k in range(model.face_count)]
+    assert text["face_names"] == [model.face_name(k) for k in range(model.face_count)]
+    again, report = cf.read_brep(text["brep"], name=text["name"], colour=text["colour"],
+                                 face_colours=text["face_colours"], face_names=text["face_names"])
+    assert report["shape_faces"] == list(range(model.face_count))
+    assert again.bodies[0]["name"] == model.bodies[0]["name"]
+    for k in range(model.face_count):
+        a, b = model.face_surface(k), again.face_surface(k)
+        assert a.identical(b)
+        assert again.face_name(k) == model.face_name(k)
+    assert again.volume_mm3() == pytest.approx(model.volume_mm3(), rel=1e-13)
+    check = again.check()
+    assert check["valid"] and check["volume_mm3"] == pytest.approx(model.volume_mm3(), rel=1e-13)
+    assert check["occt_volume_mm3"] == pytest.approx(model.volume_mm3(), rel=1e-6)
+    with pytest.raises(cf.ExchangeError, match="the BRep text could not be parsed"):
+        cf.read_brep("not a shape")
+    with pytest.raises(cf.InvalidArgumentError, match="face_colours has 2 entries"):
+        cf.read_brep(text["brep"], face_colours=[None, None])
+    with pytest.raises(cf.InvalidArgumentError, match=r"brep.colour is \(2, 0, 0\)"):
+        cf.read_brep(text["brep"], colour=(2, 0, 0))

@@ -62,21 +62,22 @@ def _add(obj, kind: str, name: str, group: str, doc: str, value=None, read_only:
 
 
 class _ModelCache:
-    """The Clayform model of a source shape, read again only when the shape's BRep text changes
-    (a lattice edit recomputes the deformation, not the transfer)."""
+    """The Clayform model of a source shape and its read's report, read again only when the
+    shape's BRep text or its attributes change (a lattice edit recomputes the deformation, not
+    the transfer)."""
 
     def __init__(self):
         self.key = None
         self.model = None
+        self.report = None
 
-    def model_of(self, shape, names: Sequence[str] = ()):
+    def model_of(self, shape, attributes: "transfer.Attributes"):
         text = shape.exportBrepToString()
-        key = (hash(text), len(text), tuple(names))
+        key = (hash(text), len(text), repr(attributes))
         if key != self.key:
-            a = transfer.Attributes(face_names=list(names)) if names else None
-            self.model, _ = transfer.model_from_shape(shape, a)
+            self.model, self.report = transfer.model_from_shape(shape, attributes)
             self.key = key
-        return self.model
+        return self.model, self.report
 
 
 def _source(link) -> Tuple[object, List[int], object]:
@@ -99,6 +100,20 @@ def _face_names(obj) -> List[str]:
     return names if shape is not None and len(names) == len(shape.Faces) else []
 
 
+def source_attributes(obj) -> "transfer.Attributes":
+    """What a source object says beside its shape: its label, its faces' names (FaceNames) and,
+    with the GUI, its colour and its faces' colours (ShapeColor, DiffuseColor when it has one
+    entry per face). freecadcmd has no colours: none are sent."""
+    a = transfer.Attributes(name=obj.Label, face_names=_face_names(obj))
+    view = getattr(obj, "ViewObject", None) if App.GuiUp else None
+    if view is not None and hasattr(view, "ShapeColor"):
+        a.colour = tuple(view.ShapeColor[:3])
+        diffuse = list(getattr(view, "DiffuseColor", []) or [])
+        if len(diffuse) == len(obj.Shape.Faces) and len(diffuse) > 1:
+            a.face_colours = [tuple(c[:3]) for c in diffuse]
+    return a
+
+
 # ---- Lattice -----------------------------------------------------------------------------------
 
 
@@ -111,15 +126,18 @@ def lattice_of(obj):
         lattice = cf.BezierLattice(o, s, t, u, degrees)
     else:
         lattice = cf.BSplineLattice(o, s, t, u, degrees, cells)
-    if len(obj.Points) == len(lattice.points):
-        lattice.points = np.array([[p.x, p.y, p.z] for p in obj.Points], dtype=np.float64)
+    if len(obj.Points) != len(lattice.points):
+        raise cf.InvalidArgumentError(
+            f"{obj.Label}: Points holds {len(obj.Points)} points but degrees {degrees} and cells "
+            f"{cells} make {len(lattice.points)}; recompute the lattice (or set Refit)")
+    lattice.points = np.array([[p.x, p.y, p.z] for p in obj.Points], dtype=np.float64)
     return lattice
 
 
 def held_points(obj) -> List[bool]:
     """Per point: held where it is by Continuity (the layers next to the lattice's faces)."""
     layers = CONTINUITIES.index(obj.Continuity)  # Free 0, C0 1, C1 2, C2 3
-    lattice = lattice_of(obj)
+    lattice = _rest_lattice(obj)
     n = lattice.counts
     held = [False] * (n[0] * n[1] * n[2])
     for i in range(n[0]):
@@ -130,16 +148,18 @@ def held_points(obj) -> List[bool]:
     return held
 
 
-def rest_points(obj) -> List[Tuple[float, float, float]]:
-    """The lattice's undisplaced points (its frame's regular grid)."""
+def _rest_lattice(obj):
     o, s, t, u = (_vec(getattr(obj, n)) for n in ("Origin", "AxisS", "AxisT", "AxisU"))
     cells = (obj.CellsS, obj.CellsT, obj.CellsU)
     degrees = (obj.DegreeS, obj.DegreeT, obj.DegreeU)
     if cells == (1, 1, 1):
-        rest = cf.BezierLattice(o, s, t, u, degrees)
-    else:
-        rest = cf.BSplineLattice(o, s, t, u, degrees, cells)
-    return [tuple(p) for p in rest.points]
+        return cf.BezierLattice(o, s, t, u, degrees)
+    return cf.BSplineLattice(o, s, t, u, degrees, cells)
+
+
+def rest_points(obj) -> List[Tuple[float, float, float]]:
+    """The lattice's undisplaced points (its frame's regular grid)."""
+    return [tuple(p) for p in _rest_lattice(obj).points]
 
 
 class LatticeFeature:
@@ -190,8 +210,12 @@ class LatticeFeature:
              "Largest Jacobian bound (local volume ratio)", read_only=True)
         _add(obj, "App::PropertyInteger", "MovedPoints", "Report",
              "Points away from their rest positions", read_only=True)
+        _add(obj, "App::PropertyBool", "Refit", "Lattice",
+             "Set to refit the frame around the source and put every point back at rest", False)
+        _add(obj, "App::PropertyString", "FrameKey", "Frame",
+             "The degrees, cells, margin, faces and source box the frame was fitted for",
+             hidden=True)
         self.cache = _ModelCache()
-        self.frame_key = None
 
     def onDocumentRestored(self, obj):
         self.setup(obj)
@@ -215,11 +239,11 @@ class LatticeFeature:
             raise cf.InvalidArgumentError(
                 f"{obj.Label}: Margin {obj.Margin} must be > 0 (the shape's points must lie "
                 f"strictly inside the lattice); 1e-6 keeps faces' edges on their box")
-        model = self.cache.model_of(shape, _face_names(src))
+        model, report = self.cache.model_of(shape, source_attributes(src))
         degrees = (obj.DegreeS, obj.DegreeT, obj.DegreeU)
         cells = (obj.CellsS, obj.CellsT, obj.CellsU)
         lattice = cf.lattice_around(model, degrees, None if cells == (1, 1, 1) else cells,
-                                    obj.Margin, faces or None)
+                                    obj.Margin, transfer.model_faces(report, faces) if faces else None)
         o, s, t, u = (App.Vector(*x) for x in lattice.frame)
         # Faces that are flat (a top face) give an axis as thin as the margin: a lattice a
         # quarter as thick as it is long, centred on them, so that its points can be moved.
@@ -237,16 +261,33 @@ class LatticeFeature:
     def execute(self, obj):
         if not hasattr(self, "cache"):
             self.setup(obj)
-        key = (obj.DegreeS, obj.DegreeT, obj.DegreeU, obj.CellsS, obj.CellsT, obj.CellsU,
-               obj.Margin)
-        rest = None
-        if obj.AxisS.Length == 0 or self.frame_key not in (None, key):
+        shape, faces, _ = _source(obj.Source)
+        box = shape.BoundBox
+        key = repr(((obj.DegreeS, obj.DegreeT, obj.DegreeU), (obj.CellsS, obj.CellsT, obj.CellsU),
+                    obj.Margin, faces))
+        source_box = repr(tuple(round(x, 9) for x in (box.XMin, box.YMin, box.ZMin, box.XMax,
+                                                      box.YMax, box.ZMax)))
+        fitted, fitted_box = (obj.FrameKey.split("@", 1) + [""])[:2] if obj.FrameKey else ("", "")
+        if obj.Refit or not fitted or obj.AxisS.Length == 0:
             self.fit_frame(obj)
-        else:
-            rest = rest_points(obj)
-            if len(obj.Points) != len(rest):
-                self.fit_frame(obj)
-        self.frame_key = key
+        elif fitted != key:
+            # New degrees, cells, margin or faces make a new frame and put every point at rest:
+            # moved points would be lost, so that waits for Refit.
+            if obj.MovedPoints > 0:
+                raise cf.InvalidArgumentError(
+                    f"{obj.Label}: {obj.MovedPoints} points are moved, and new degrees, cells, "
+                    f"margin or faces refit the frame with every point at rest; set Refit to "
+                    f"True to do that, or undo the change")
+            self.fit_frame(obj)
+        elif fitted_box != source_box and obj.MovedPoints == 0:
+            self.fit_frame(obj)  # the source changed and nothing was moved: follow it
+        elif len(obj.Points) != len(rest_points(obj)):
+            raise cf.InvalidArgumentError(
+                f"{obj.Label}: Points holds {len(obj.Points)} points but the lattice has "
+                f"{len(rest_points(obj))}; give every point, or set Refit to True")
+        obj.FrameKey = key + "@" + source_box
+        if obj.Refit:
+            obj.Refit = False
         rest = rest_points(obj)
         lattice = lattice_of(obj)
         held = held_points(obj)
@@ -296,10 +337,16 @@ def net_shape(lattice):
     return Part.Compound(shapes)
 
 
-def make_lattice(source, faces: Sequence[str] = (), degrees=(2, 2, 2), cells=(1, 1, 1),
+def make_lattice(source, faces: Sequence[str] = (), degrees=None, cells=None,
                  name: str = "Lattice"):
     """A Lattice feature around `source` (a document object with a shape), or around its
-    `faces` ("Face3", ...), recomputed."""
+    `faces` ("Face3", ...), recomputed. Defaults: a Bézier lattice of degrees (2, 2, 2) around a
+    shape; around faces (C2 held: three layers at each side) a B-spline lattice of degrees
+    (3, 3, 3) and (4, 4, 4) cells, whose centre point is free."""
+    if degrees is None:
+        degrees = (3, 3, 3) if faces else (2, 2, 2)
+    if cells is None:
+        cells = (4, 4, 4) if faces else (1, 1, 1)
     doc = source.Document
     obj = doc.addObject("Part::FeaturePython", name)
     LatticeFeature(obj, source, faces)
@@ -316,6 +363,12 @@ def move_point(obj, n: int, to) -> None:
     if not 0 <= n < len(points):
         raise cf.InvalidArgumentError(
             f"{obj.Label} has no point {n}; its points are 0..{len(points) - 1}")
+    if held_points(obj)[n]:
+        i, j, k = _ijk(_rest_lattice(obj), n)
+        raise cf.InvalidArgumentError(
+            f"{obj.Label}: point {n} (i, j, k) = ({i}, {j}, {k}) is held by Continuity "
+            f"{obj.Continuity} (a layer next to the lattice's faces); move an inner point, or "
+            f"set Continuity to a lower order")
     p = points[n]
     x, y, z = _vec(to)
     points[n] = App.Vector(p.x if obj.LockX else x, p.y if obj.LockY else y, p.z if obj.LockZ else z)
@@ -467,9 +520,9 @@ class DeformedFeature:
             self.setup(obj)
         t0 = time.perf_counter()
         shape, faces, src = _source(obj.Source)
-        model = self.cache.model_of(shape, _face_names(src))
+        model, read = self.cache.model_of(shape, source_attributes(src))
         result, report = model.deform(
-            deformation_of(obj, shape), faces=faces or None, allow_fold=obj.AllowFold,
+            deformation_of(obj, shape), faces=transfer.model_faces(read, faces) if faces else None, allow_fold=obj.AllowFold,
             profile="" if obj.Profile == "none" else obj.Profile, tolerance_mm=obj.ToleranceMm)
         out, attributes = transfer.shape_from_model(result)
         obj.Shape = out
@@ -483,7 +536,6 @@ class DeformedFeature:
         obj.VolumeAfter = float(report["volume_after_mm3"])
         obj.FoldFree = bool(report["fold_free"])
         obj.Message = str(report.get("message", ""))
-        self.face_colours = attributes.face_colours
         obj.Seconds = time.perf_counter() - t0
         _apply_colours(obj, attributes)
 
@@ -548,6 +600,12 @@ def surface_of_face(face):
 
 def bspline_face(surface, face):
     """A Clayform Surface as a FreeCAD face over the parameter range of `face`."""
+    u0, u1, v0, v1 = face.ParameterRange
+    return part_surface(surface).toShape(u0, u1, v0, v1)
+
+
+def part_surface(surface):
+    """A Clayform Surface as a Part.BSplineSurface (the same knots, poles and weights)."""
     knots_u, knots_v = list(surface.knots_u), list(surface.knots_v)
 
     def compress(knots):
@@ -573,8 +631,7 @@ def bspline_face(surface, face):
         bs.buildFromPolesMultsKnots(poles, mu, mv, ku, kv, False, False, du, dv, weights)
     else:
         bs.buildFromPolesMultsKnots(poles, mu, mv, ku, kv, False, False, du, dv)
-    u0, u1, v0, v1 = face.ParameterRange
-    return bs.toShape(u0, u1, v0, v1)
+    return bs
 
 
 def curve_of(obj):

@@ -8,6 +8,8 @@ import FreeCAD as App
 import FreeCADGui as Gui
 from pivy import coin
 
+import clayform as cf
+
 from . import features, recipe
 
 try:
@@ -128,8 +130,9 @@ class DragSession:
         self.view = view or Gui.ActiveDocument.ActiveView
         held = features.held_points(obj)
         if held[n]:
-            raise ValueError(f"{obj.Label}: point {n} is held by Continuity {obj.Continuity}; "
-                             f"drag an inner point")
+            raise cf.InvalidArgumentError(
+                f"{obj.Label}: point {n} is held by Continuity {obj.Continuity}; drag an inner "
+                f"point, or set Continuity to a lower order")
         size = max(obj.AxisS.Length, obj.AxisT.Length, obj.AxisU.Length)
         self.scale = size / 12.0  # the dragger is about one unit wide: a twelfth of the lattice
         self.root = coin.SoSeparator()
@@ -198,11 +201,16 @@ def selected_lattice_point():
     """(Lattice feature, point index) of the selected lattice vertex, or None."""
     for sel in Gui.Selection.getSelectionEx():
         if isinstance(getattr(sel.Object, "Proxy", None), features.LatticeFeature):
+            points = sel.Object.Points
             for name in sel.SubElementNames:
-                if name.startswith("Vertex"):
+                if name.startswith("Vertex") and name[6:].isdigit():
                     n = int(name[6:]) - 1
-                    if n < len(sel.Object.Points):
+                    if n < len(points):
                         return sel.Object, n
+                    # A click may pick a net line's end vertex, which sits on a point: the
+                    # point nearest it.
+                    p = sel.Object.Shape.Vertexes[n].Point
+                    return sel.Object, min(range(len(points)), key=lambda m: (points[m] - p).Length)
     return None
 
 

@@ -15,13 +15,15 @@ from typing import List
 
 import FreeCAD as App
 
+import clayform as cf
+
 from . import features, transfer
 
 
 def recipe_folder(doc) -> Path:
     """The folder beside a saved document where its recipes go."""
     if not doc.FileName:
-        raise ValueError(f"the document '{doc.Label}' is not saved; save it, then its recipes "
+        raise cf.InvalidArgumentError(f"the document '{doc.Label}' is not saved; save it, then its recipes "
                          f"are written beside it")
     path = Path(doc.FileName)
     return path.with_name(path.stem + ".clayform")
@@ -58,15 +60,30 @@ def recipe_of(obj, source_file: str, face_names: List[str]) -> dict:
     return recipe
 
 
+def recipe_face_names(names: List[str]) -> List[str]:
+    """Faces are chosen by name in a recipe, so each needs one of its own: an unnamed face is
+    named after its FreeCAD sub-element ("Face3"), and a name already taken (STEP files repeat
+    names; a real face may be called "Face3") gets " #2", " #3", ... until it is unique."""
+    out, taken = [], set()
+    for k, name in enumerate(names):
+        base = name or f"Face{k + 1}"
+        unique, n = base, 1
+        while unique in taken:
+            n += 1
+            unique = f"{base} #{n}"
+        taken.add(unique)
+        out.append(unique)
+    return out
+
+
 def write_recipe(obj, folder: Path) -> Path:
     """Writes Deformed feature `obj`'s source and recipe into `folder`; returns the recipe."""
     folder.mkdir(parents=True, exist_ok=True)
     shape, _, src = features._source(obj.Source)
-    # Faces are chosen by name in a recipe: a face the source leaves unnamed is named after its
-    # FreeCAD sub-element ("Face3").
-    names = features._face_names(src) or [""] * len(shape.Faces)
-    names = [n or f"Face{k + 1}" for k, n in enumerate(names)]
-    model, _ = transfer.model_from_shape(shape, transfer.Attributes(name=src.Label, face_names=names))
+    names = recipe_face_names(features._face_names(src) or [""] * len(shape.Faces))
+    attributes = features.source_attributes(src)
+    attributes.face_names = names
+    model, _ = transfer.model_from_shape(shape, attributes)
     source = folder / f"{obj.Name}-source.step"
     model.write(source)
     path = folder / f"{obj.Name}.json"
@@ -123,13 +140,22 @@ def write_recipes(doc) -> List[Path]:
     """Writes the recipe of every Deformed and Style feature of a saved document; returns their
     paths."""
     folder = recipe_folder(doc)
-    out = [write_recipe(obj, folder) for obj in doc.Objects if _is_deformed(obj)]
+    out, failed = [], []
     for obj in doc.Objects:
-        if _is_style(obj):
-            folder.mkdir(parents=True, exist_ok=True)
-            path = folder / f"{obj.Name}.json"
-            path.write_text(json.dumps(style_recipe_of(obj), indent=2) + "\n")
-            out.append(path)
+        try:
+            if _is_deformed(obj):
+                out.append(write_recipe(obj, folder))
+            elif _is_style(obj):
+                folder.mkdir(parents=True, exist_ok=True)
+                path = folder / f"{obj.Name}.json"
+                path.write_text(json.dumps(style_recipe_of(obj), indent=2) + "\n")
+                out.append(path)
+        except Exception as e:  # one feature's failure leaves the others' recipes written
+            failed.append(f"{obj.Label}: {e}")
+    if failed:
+        raise cf.InvalidArgumentError(
+            f"the recipes of {len(failed)} feature(s) were not written (the others were): "
+            + "; ".join(failed) + "; recompute them without errors, then save again")
     return out
 
 

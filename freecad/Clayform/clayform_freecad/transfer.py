@@ -39,8 +39,10 @@ def _rgb(c) -> Optional[Colour]:
 def model_from_shape(shape, attributes: Optional[Attributes] = None, isolate: bool = True):
     """A Clayform ``Model`` (and the read's report) from a FreeCAD ``Part.Shape``, exactly.
 
-    ``attributes``' face lists, when given, must have one entry per face of ``shape``. Raises
-    ``clayform.ClayError`` (``ExchangeError`` for a null or unreadable shape)."""
+    ``attributes``' face lists, when given, must have one entry per face of ``shape``.
+    ``report["shape_faces"][j]`` is model face j's index in ``Shape.Faces`` (``model_faces``
+    maps a selection). Raises ``clayform.ClayError`` (``ExchangeError`` for an unreadable
+    shape)."""
     if shape is None or shape.isNull():
         raise cf.InvalidArgumentError(
             "model_from_shape: the shape is empty; select an object that has a shape")
@@ -53,6 +55,14 @@ def model_from_shape(shape, attributes: Optional[Attributes] = None, isolate: bo
         face_names=list(a.face_names) or None,
         isolate=isolate,
     )
+
+
+def model_faces(report, shape_faces: Sequence[int]) -> List[int]:
+    """The model's faces (indices) that came from the given faces of the shape (0-based indices
+    into ``Shape.Faces``), by the read's ``report["shape_faces"]``: the model numbers its faces
+    solids first and holds a face two solids share twice."""
+    wanted = set(shape_faces)
+    return [j for j, k in enumerate(report["shape_faces"]) if k in wanted]
 
 
 def shape_from_model(model) -> Tuple[object, Attributes]:

@@ -116,6 +116,11 @@ struct CLAY_OCCT_API ModelReadReport {
   /// brep::problems(model): invariants the model breaks (empty for a clean file). The model is
   /// still returned, so that it can be inspected; deforming it refuses it.
   std::vector<std::string> problems;
+  /// A .brep read only: for each face of the model, its index (from 0) among the text's faces as
+  /// TopExp::MapShapes numbers them (FreeCAD's Shape.Faces). The model numbers its faces solids
+  /// first and holds a face two solids share twice, so the two orders can differ. Empty for STEP
+  /// and IGES.
+  std::vector<int> brep_faces;
 
   /// One line: "1 solid, 1 shell, 42 faces (18 trimmed, 6 holes), 104 edges, 66 vertices;
   /// 30 faces converted; pcurves 160 kept, 40 exact, 8 fitted (<= 3e-12 mm); edge gap 1e-7 mm".
