@@ -838,19 +838,8 @@ void write_gltf(const std::vector<BSplineSurface>& surfaces, const fs::path& fil
       builder.UpdateFace(face, triangulation);
       builder.Add(compound, face);
     }
-    Handle(XCAFApp_Application) application = XCAFApp_Application::GetApplication();
-    Handle(TDocStd_Document) document;
-    application->NewDocument("MDTV-XCAF", document);
-    struct Closer {
-      Handle(XCAFApp_Application) application;
-      Handle(TDocStd_Document) document;
-      ~Closer() {
-        try {
-          application->Close(document);
-        } catch (const Standard_Failure&) {
-        }
-      }
-    } closer{application, document};
+    occt::XcafDocument held;  // closed on every way out
+    Handle(TDocStd_Document)& document = held.get();
     XCAFDoc_DocumentTool::ShapeTool(document->Main())->AddShape(compound, false);
     write_atomically(file, caller, [&](const fs::path& temp) {
       RWGltf_CafWriter writer(TCollection_AsciiString(temp.string().c_str()), true);

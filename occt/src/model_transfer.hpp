@@ -1,7 +1,9 @@
 #pragma once
 // What OpenCASCADE's transfer of a STEP or IGES file left out or did not know, for the report of
-// read_model (model_read.cpp), and its plain reader (no XCAF), which reads files its XCAF readers
-// crash on. Internal to the OCCT library.
+// read_model (model_read.cpp), its plain reader (no XCAF), which reads files its XCAF readers
+// crash on, and its reader of BRep files (model_brep.cpp). Internal to the OCCT library.
+#include <clay/occt/model_exchange.hpp>
+
 #include <Standard_Handle.hxx>
 #include <TDocStd_Document.hxx>
 #include <XSControl_WorkSession.hxx>
@@ -34,5 +36,20 @@ std::vector<std::string> failed_entities(const Handle(XSControl_WorkSession) & s
 bool read_plain(const std::filesystem::path& file, bool step,
                 const Handle(TDocStd_Document) & document, std::vector<std::string>& failed,
                 Handle(XSControl_WorkSession) & session);
+
+/// The prefix read_brep_file gives face k's name ("\x1f" k "\x1f": a control character no name
+/// read from a file holds), so that the model's faces are traced back to the text's.
+std::string brep_face_tag(int k);
+
+/// Takes the tags off the faces' names, recording each face's place in the text in
+/// report.brep_faces. Throws clay::Error(Internal) for a face that lost its tag.
+void untag_brep_faces(ImportedModel& imported);
+
+/// Reads OpenCASCADE's BRep `file` into `document` as one free shape, with `attributes`' names
+/// and colours on it and on its faces (TopExp::MapShapes order), every face's name tagged
+/// (brep_face_tag). Throws clay::Error(Exchange) when the file is not BRep or holds no shape,
+/// InvalidArgument when a face list does not match (model_brep.cpp).
+bool read_brep_file(const std::filesystem::path& file, const BrepAttributes& attributes,
+                    const Handle(TDocStd_Document) & document);
 
 }  // namespace clay::brep::detail

@@ -462,8 +462,8 @@ ModelCheck write_model(const Model& model, const fs::path& file, const ModelWrit
       check = check_shapes(m, shapes);
     else
       check.checked = false;
-    Handle(TDocStd_Document) document;
-    XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
+    surface::occt::XcafDocument held;  // closed on every way out
+    Handle(TDocStd_Document)& document = held.get();
     fill_document(m, shapes, document);
     if (glb) {
       write_glb(m, shapes, file, options.mesh, document);
@@ -528,7 +528,6 @@ ModelCheck write_model(const Model& model, const fs::path& file, const ModelWrit
         });
       });
     }
-    XCAFApp_Application::GetApplication()->Close(document);
     return check;
   });
 }

@@ -13,7 +13,9 @@
 #include <BRepCheck_ListOfStatus.hxx>
 #include <BRepCheck_Result.hxx>
 #include <Interface_Static.hxx>
+#include <Standard_Failure.hxx>
 #include <TopExp_Explorer.hxx>
+#include <XCAFApp_Application.hxx>
 
 namespace clay::surface::occt {
 
@@ -22,6 +24,18 @@ namespace fs = std::filesystem;
 std::mutex& exchange_mutex() {
   static std::mutex mutex;
   return mutex;
+}
+
+XcafDocument::XcafDocument() {
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document_);
+}
+
+XcafDocument::~XcafDocument() {
+  try {
+    XCAFApp_Application::GetApplication()->Close(document_);
+  } catch (const Standard_Failure&) {
+    // nothing to do in a destructor: the document was not open
+  }
 }
 
 std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }

@@ -22,6 +22,7 @@
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_Printer.hxx>
+#include <TDocStd_Document.hxx>
 #include <TopoDS_Face.hxx>
 
 namespace clay::surface::occt {
@@ -87,6 +88,22 @@ struct ExchangeSession {
   QuietMessages quiet;
   internal::FpTrapsHeld floating_point;
   KeptSettings settings;
+};
+
+/// A new XCAF document, closed when this goes out of scope, also when an exception leaves it:
+/// an open document stays registered with the XCAF application, its shapes and all (sanitized,
+/// a leak; in a host application such as FreeCAD, memory kept for the process's life).
+class XcafDocument {
+ public:
+  XcafDocument();
+  ~XcafDocument();
+  XcafDocument(const XcafDocument&) = delete;
+  XcafDocument& operator=(const XcafDocument&) = delete;
+  /// The document (OpenCASCADE's transfers take it by non-const reference).
+  Handle(TDocStd_Document) & get() { return document_; }
+
+ private:
+  Handle(TDocStd_Document) document_;
 };
 
 /// 'path', for messages.

@@ -58,6 +58,27 @@ def _add(obj, kind: str, name: str, group: str, doc: str, value=None, read_only:
         obj.setEditorMode(name, 2)
 
 
+class _Proxy:
+    """What every feature's proxy shares: its properties set up again when a document is
+    reopened (FreeCAD does not call __init__ then), and nothing of its own saved (the state is in
+    the properties; FreeCAD 0.20 saves __getstate__, 0.21 and later dumps)."""
+
+    def onDocumentRestored(self, obj):  # noqa: N802 (FreeCAD's name)
+        self.setup(obj)
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+
 # ---- the source shape, cached per feature ------------------------------------------------------
 
 
@@ -162,7 +183,7 @@ def rest_points(obj) -> List[Tuple[float, float, float]]:
     return [tuple(p) for p in _rest_lattice(obj).points]
 
 
-class LatticeFeature:
+class LatticeFeature(_Proxy):
     """Proxy of a Lattice feature."""
 
     def __init__(self, obj, source=None, faces: Sequence[str] = ()):
@@ -217,20 +238,6 @@ class LatticeFeature:
              hidden=True)
         self.cache = _ModelCache()
 
-    def onDocumentRestored(self, obj):
-        self.setup(obj)
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-    def dumps(self):  # FreeCAD 0.21 and later
-        return None
-
-    def loads(self, state):
-        return None
 
     def fit_frame(self, obj):
         """Sets the frame around the source (Margin) and the Points to rest."""
@@ -455,7 +462,7 @@ def deformation_of(obj, shape):
         _json({"format": "clayform.deformation-stack", "version": 1, "steps": [step]}))
 
 
-class DeformedFeature:
+class DeformedFeature(_Proxy):
     """Proxy of a Deformed feature."""
 
     def __init__(self, obj, source=None, faces: Sequence[str] = (), lattice=None):
@@ -500,20 +507,6 @@ class DeformedFeature:
             _add(obj, kind, name, "Report", doc, read_only=True)
         self.cache = _ModelCache()
 
-    def onDocumentRestored(self, obj):
-        self.setup(obj)
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
 
     def execute(self, obj):
         if not hasattr(self, "cache"):
@@ -657,7 +650,7 @@ def curve_of(obj):
     return cf.Curve(curve.Degree, knots, points, weights if rational else None)
 
 
-class StyleFeature:
+class StyleFeature(_Proxy):
     """Proxy of a Style feature."""
 
     def __init__(self, obj, face=None, target=None, bound=None):
@@ -689,20 +682,6 @@ class StyleFeature:
                 ("Seconds", "App::PropertyFloat", "Time of the last recompute (s)")):
             _add(obj, kind, name, "Report", doc, read_only=True)
 
-    def onDocumentRestored(self, obj):
-        self.setup(obj)
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
 
     def execute(self, obj):
         t0 = time.perf_counter()
