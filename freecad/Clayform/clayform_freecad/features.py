@@ -140,17 +140,11 @@ def source_attributes(obj) -> "transfer.Attributes":
 
 def lattice_of(obj):
     """The Clayform lattice a Lattice feature describes (its frame, degrees, cells and Points)."""
-    o, s, t, u = (_vec(getattr(obj, n)) for n in ("Origin", "AxisS", "AxisT", "AxisU"))
-    degrees = (obj.DegreeS, obj.DegreeT, obj.DegreeU)
-    cells = (obj.CellsS, obj.CellsT, obj.CellsU)
-    if cells == (1, 1, 1):
-        lattice = cf.BezierLattice(o, s, t, u, degrees)
-    else:
-        lattice = cf.BSplineLattice(o, s, t, u, degrees, cells)
+    lattice = _rest_lattice(obj)
     if len(obj.Points) != len(lattice.points):
         raise cf.InvalidArgumentError(
-            f"{obj.Label}: Points holds {len(obj.Points)} points but degrees {degrees} and cells "
-            f"{cells} make {len(lattice.points)}; recompute the lattice (or set Refit)")
+            f"{obj.Label}: Points holds {len(obj.Points)} points but its degrees and cells make "
+            f"{len(lattice.points)}; recompute the lattice (or set Refit)")
     lattice.points = np.array([[p.x, p.y, p.z] for p in obj.Points], dtype=np.float64)
     return lattice
 
@@ -170,6 +164,8 @@ def held_points(obj) -> List[bool]:
 
 
 def _rest_lattice(obj):
+    """The undisplaced lattice of the feature's frame, degrees and cells (Bézier when every axis
+    has one cell)."""
     o, s, t, u = (_vec(getattr(obj, n)) for n in ("Origin", "AxisS", "AxisT", "AxisU"))
     cells = (obj.CellsS, obj.CellsT, obj.CellsU)
     degrees = (obj.DegreeS, obj.DegreeT, obj.DegreeU)
